@@ -1,0 +1,230 @@
+//! An XY bounding-volume hierarchy over a mesh's triangles, with the highest
+//! z of each subtree, for branch-and-bound drop-cutter queries: a subtree is
+//! skipped when it lies outside the cutter's disk or when nothing in it is
+//! higher than the best cutter location found so far.
+
+use scallop_geom::{Aabb2, Point2, Point3, Vec3};
+
+use crate::TriMesh;
+
+const LEAF_SIZE: usize = 4;
+
+#[derive(Clone, Copy, Debug)]
+struct Node {
+    min: [f64; 2],
+    max: [f64; 2],
+    zmax: f64,
+    /// Leaf: first slot. Inner: index of the second child (the first is `self + 1`).
+    first_or_right: u32,
+    /// Leaf: number of slots (> 0). Inner: 0.
+    count: u32,
+}
+
+/// Triangles of a [`TriMesh`] in an XY hierarchy, stored in leaf order
+/// ("slots") with the data drop-cutter needs next to each other.
+#[derive(Debug, Clone)]
+pub struct MeshIndex {
+    nodes: Vec<Node>,
+    corners: Vec<[Point3; 3]>,
+    normals: Vec<Vec3>,
+    zmax: Vec<f64>,
+    original: Vec<u32>,
+    bounds: scallop_geom::Aabb3,
+}
+
+impl MeshIndex {
+    /// Builds the hierarchy (median splits along the longer XY side).
+    ///
+    /// ```
+    /// use scallop_geom::Point3;
+    /// use scallop_mesh::{MeshIndex, TriMesh};
+    /// let p = |x, y, z| Point3::new(x, y, z);
+    /// let (mesh, _) = TriMesh::from_soup(&[[p(0., 0., 1.), p(1., 0., 1.), p(0., 1., 1.)]]).unwrap();
+    /// let index = MeshIndex::build(&mesh);
+    /// assert_eq!(index.len(), 1);
+    /// ```
+    #[must_use]
+    pub fn build(mesh: &TriMesh) -> MeshIndex {
+        let n = mesh.triangles().len();
+        let tris: Vec<[Point3; 3]> = (0..n).map(|i| mesh.triangle(i)).collect();
+        let centroid: Vec<[f64; 2]> = tris
+            .iter()
+            .map(|t| {
+                [
+                    (t[0].x + t[1].x + t[2].x) / 3.0,
+                    (t[0].y + t[1].y + t[2].y) / 3.0,
+                ]
+            })
+            .collect();
+        let mut order: Vec<u32> = (0..u32::try_from(n).unwrap_or(u32::MAX)).collect();
+        let mut nodes = Vec::with_capacity(2 * n / LEAF_SIZE + 1);
+        build_node(&mut nodes, &tris, &centroid, &mut order, 0);
+        let corners: Vec<[Point3; 3]> = order.iter().map(|&i| tris[i as usize]).collect();
+        let normals = corners
+            .iter()
+            .map(|t| {
+                let n = (t[1] - t[0]).cross(&(t[2] - t[0]));
+                let n = if n.z < 0.0 { -n } else { n };
+                let len = n.norm();
+                if len > 0.0 { n / len } else { Vec3::zeros() }
+            })
+            .collect();
+        let zmax = corners
+            .iter()
+            .map(|t| t[0].z.max(t[1].z).max(t[2].z))
+            .collect();
+        MeshIndex {
+            nodes,
+            corners,
+            normals,
+            zmax,
+            original: order,
+            bounds: mesh.bounds(),
+        }
+    }
+
+    /// Number of triangles.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.corners.len()
+    }
+
+    /// Whether there is no triangle (never true for an index of a valid mesh).
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.corners.is_empty()
+    }
+
+    /// Bounding box of the indexed mesh.
+    #[must_use]
+    pub fn bounds(&self) -> scallop_geom::Aabb3 {
+        self.bounds
+    }
+
+    /// Corners of the triangle in `slot`.
+    #[must_use]
+    pub fn corners(&self, slot: usize) -> &[Point3; 3] {
+        &self.corners[slot]
+    }
+
+    /// Unit normal of the triangle in `slot`, oriented with `z >= 0`.
+    #[must_use]
+    pub fn normal(&self, slot: usize) -> &Vec3 {
+        &self.normals[slot]
+    }
+
+    /// Highest z of the triangle in `slot`.
+    #[must_use]
+    pub fn zmax(&self, slot: usize) -> f64 {
+        self.zmax[slot]
+    }
+
+    /// The triangle number in the source mesh of `slot`.
+    #[must_use]
+    pub fn original_index(&self, slot: usize) -> usize {
+        self.original[slot] as usize
+    }
+
+    /// Calls `visit(slot, bound)` for every triangle whose XY box meets the
+    /// disk of `radius` around `center` and whose highest z exceeds `*bound`
+    /// at the time the subtree is reached. `visit` may raise `*bound`, which
+    /// prunes the rest of the search. Higher subtrees are visited first.
+    pub fn visit_disk(
+        &self,
+        center: Point2,
+        radius: f64,
+        bound: &mut f64,
+        mut visit: impl FnMut(usize, &mut f64),
+    ) {
+        let r2 = radius * radius;
+        let mut stack: [u32; 64] = [0; 64];
+        let mut top = 1usize;
+        while top > 0 {
+            top -= 1;
+            let node = &self.nodes[stack[top] as usize];
+            if node.zmax <= *bound {
+                continue;
+            }
+            let b = Aabb2 {
+                min: Point2::new(node.min[0], node.min[1]),
+                max: Point2::new(node.max[0], node.max[1]),
+            };
+            if b.distance_squared(&center) > r2 {
+                continue;
+            }
+            if node.count > 0 {
+                let first = node.first_or_right as usize;
+                for slot in first..first + node.count as usize {
+                    if self.zmax[slot] > *bound {
+                        visit(slot, bound);
+                    }
+                }
+            } else {
+                let left = stack[top] + 1;
+                let right = node.first_or_right;
+                let (lo, hi) = if self.nodes[left as usize].zmax >= self.nodes[right as usize].zmax
+                {
+                    (right, left)
+                } else {
+                    (left, right)
+                };
+                // Depth is at most log2(n / LEAF_SIZE) + 1 < 64 for any n that fits in memory.
+                stack[top] = lo;
+                stack[top + 1] = hi;
+                top += 2;
+            }
+        }
+    }
+}
+
+fn build_node(
+    nodes: &mut Vec<Node>,
+    tris: &[[Point3; 3]],
+    centroid: &[[f64; 2]],
+    order: &mut [u32],
+    offset: usize,
+) -> usize {
+    let mut min = [f64::INFINITY; 2];
+    let mut max = [f64::NEG_INFINITY; 2];
+    let mut zmax = f64::NEG_INFINITY;
+    for &i in order.iter() {
+        for p in &tris[i as usize] {
+            min[0] = min[0].min(p.x);
+            min[1] = min[1].min(p.y);
+            max[0] = max[0].max(p.x);
+            max[1] = max[1].max(p.y);
+            zmax = zmax.max(p.z);
+        }
+    }
+    let me = nodes.len();
+    let to_u32 = |v: usize| u32::try_from(v).unwrap_or(u32::MAX);
+    if order.len() <= LEAF_SIZE {
+        nodes.push(Node {
+            min,
+            max,
+            zmax,
+            first_or_right: to_u32(offset),
+            count: to_u32(order.len()),
+        });
+        return me;
+    }
+    nodes.push(Node {
+        min,
+        max,
+        zmax,
+        first_or_right: 0,
+        count: 0,
+    });
+    let axis = usize::from(max[1] - min[1] > max[0] - min[0]);
+    let mid = order.len() / 2;
+    order.select_nth_unstable_by(mid, |&a, &b| {
+        centroid[a as usize][axis]
+            .total_cmp(&centroid[b as usize][axis])
+            .then(a.cmp(&b))
+    });
+    let (left, right) = order.split_at_mut(mid);
+    build_node(nodes, tris, centroid, left, offset);
+    let r = build_node(nodes, tris, centroid, right, offset + mid);
+    nodes[me].first_or_right = to_u32(r);
+    me
+}

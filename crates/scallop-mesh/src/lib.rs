@@ -1,0 +1,28 @@
+//! Triangle meshes for scallop: one validated f64 indexed mesh ([`TriMesh`]),
+//! vertex welding scaled to the model, degenerate-triangle removal with
+//! diagnostics, and an XY bounding-volume hierarchy ([`MeshIndex`]) for
+//! drop-cutter queries.
+//!
+//! ```
+//! use scallop_geom::Point3;
+//! use scallop_mesh::TriMesh;
+//! let p = |x, y, z| Point3::new(x, y, z);
+//! let soup = [[p(0., 0., 0.), p(1., 0., 0.), p(0., 1., 0.)],
+//!             [p(1., 0., 0.), p(1., 1., 0.), p(0., 1., 0.)],
+//!             [p(0., 0., 0.), p(1., 0., 0.), p(2., 0., 0.)]]; // collinear: dropped
+//! let (mesh, diag) = TriMesh::from_soup(&soup).unwrap();
+//! assert_eq!(mesh.triangles().len(), 2);
+//! assert_eq!(mesh.vertices().len(), 4);
+//! assert_eq!(diag.degenerate_dropped, 1);
+//! ```
+//!
+//! # Invariants
+//! - A [`TriMesh`] is never empty, has only finite coordinates, in-range
+//!   indices and no degenerate (exactly collinear) triangle. Nothing re-validates it.
+//! - Never performs I/O.
+
+mod index;
+mod trimesh;
+
+pub use index::MeshIndex;
+pub use trimesh::{MeshDiagnostics, MeshError, TriMesh};
