@@ -46,10 +46,7 @@ impl Aabb3 {
     pub fn from_points(points: impl IntoIterator<Item = Point3>) -> Option<Self> {
         let mut it = points.into_iter();
         let first = it.next()?;
-        let mut b = Aabb3 {
-            min: first,
-            max: first,
-        };
+        let mut b = Aabb3 { min: first, max: first };
         for p in it {
             b.grow(&p);
         }
@@ -106,19 +103,13 @@ impl Aabb2 {
     /// ```
     #[must_use]
     pub fn around(c: Point2, r: f64) -> Self {
-        Aabb2 {
-            min: Point2::new(c.x - r, c.y - r),
-            max: Point2::new(c.x + r, c.y + r),
-        }
+        Aabb2 { min: Point2::new(c.x - r, c.y - r), max: Point2::new(c.x + r, c.y + r) }
     }
 
     /// Closed overlap test.
     #[must_use]
     pub fn overlaps(&self, o: &Aabb2) -> bool {
-        self.min.x <= o.max.x
-            && o.min.x <= self.max.x
-            && self.min.y <= o.max.y
-            && o.min.y <= self.max.y
+        self.min.x <= o.max.x && o.min.x <= self.max.x && self.min.y <= o.max.y && o.min.y <= self.max.y
     }
 
     /// Squared distance from `p` to the box (0 inside).
@@ -139,10 +130,6 @@ impl Aabb2 {
 macro_rules! assert_near {
     ($a:expr, $b:expr, $eps:expr) => {{
         let (a, b, eps): (f64, f64, f64) = ($a, $b, $eps);
-        assert!(
-            (a - b).abs() <= eps,
-            "assert_near failed: {a} vs {b} (|diff| = {} > {eps})",
-            (a - b).abs()
-        );
+        assert!((a - b).abs() <= eps, "assert_near failed: {a} vs {b} (|diff| = {} > {eps})", (a - b).abs());
     }};
 }

@@ -47,15 +47,8 @@ impl MeshIndex {
     pub fn build(mesh: &TriMesh) -> MeshIndex {
         let n = mesh.triangles().len();
         let tris: Vec<[Point3; 3]> = (0..n).map(|i| mesh.triangle(i)).collect();
-        let centroid: Vec<[f64; 2]> = tris
-            .iter()
-            .map(|t| {
-                [
-                    (t[0].x + t[1].x + t[2].x) / 3.0,
-                    (t[0].y + t[1].y + t[2].y) / 3.0,
-                ]
-            })
-            .collect();
+        let centroid: Vec<[f64; 2]> =
+            tris.iter().map(|t| [(t[0].x + t[1].x + t[2].x) / 3.0, (t[0].y + t[1].y + t[2].y) / 3.0]).collect();
         let mut order: Vec<u32> = (0..u32::try_from(n).unwrap_or(u32::MAX)).collect();
         let mut nodes = Vec::with_capacity(2 * n / LEAF_SIZE + 1);
         build_node(&mut nodes, &tris, &centroid, &mut order, 0);
@@ -69,18 +62,8 @@ impl MeshIndex {
                 if len > 0.0 { n / len } else { Vec3::zeros() }
             })
             .collect();
-        let zmax = corners
-            .iter()
-            .map(|t| t[0].z.max(t[1].z).max(t[2].z))
-            .collect();
-        MeshIndex {
-            nodes,
-            corners,
-            normals,
-            zmax,
-            original: order,
-            bounds: mesh.bounds(),
-        }
+        let zmax = corners.iter().map(|t| t[0].z.max(t[1].z).max(t[2].z)).collect();
+        MeshIndex { nodes, corners, normals, zmax, original: order, bounds: mesh.bounds() }
     }
 
     /// Number of triangles.
@@ -129,13 +112,7 @@ impl MeshIndex {
     /// disk of `radius` around `center` and whose highest z exceeds `*bound`
     /// at the time the subtree is reached. `visit` may raise `*bound`, which
     /// prunes the rest of the search. Higher subtrees are visited first.
-    pub fn visit_disk(
-        &self,
-        center: Point2,
-        radius: f64,
-        bound: &mut f64,
-        mut visit: impl FnMut(usize, &mut f64),
-    ) {
+    pub fn visit_disk(&self, center: Point2, radius: f64, bound: &mut f64, mut visit: impl FnMut(usize, &mut f64)) {
         let r2 = radius * radius;
         let mut stack: [u32; 64] = [0; 64];
         let mut top = 1usize;
@@ -145,10 +122,7 @@ impl MeshIndex {
             if node.zmax <= *bound {
                 continue;
             }
-            let b = Aabb2 {
-                min: Point2::new(node.min[0], node.min[1]),
-                max: Point2::new(node.max[0], node.max[1]),
-            };
+            let b = Aabb2 { min: Point2::new(node.min[0], node.min[1]), max: Point2::new(node.max[0], node.max[1]) };
             if b.distance_squared(&center) > r2 {
                 continue;
             }
@@ -162,8 +136,7 @@ impl MeshIndex {
             } else {
                 let left = stack[top] + 1;
                 let right = node.first_or_right;
-                let (lo, hi) = if self.nodes[left as usize].zmax >= self.nodes[right as usize].zmax
-                {
+                let (lo, hi) = if self.nodes[left as usize].zmax >= self.nodes[right as usize].zmax {
                     (right, left)
                 } else {
                     (left, right)
@@ -199,28 +172,14 @@ fn build_node(
     let me = nodes.len();
     let to_u32 = |v: usize| u32::try_from(v).unwrap_or(u32::MAX);
     if order.len() <= LEAF_SIZE {
-        nodes.push(Node {
-            min,
-            max,
-            zmax,
-            first_or_right: to_u32(offset),
-            count: to_u32(order.len()),
-        });
+        nodes.push(Node { min, max, zmax, first_or_right: to_u32(offset), count: to_u32(order.len()) });
         return me;
     }
-    nodes.push(Node {
-        min,
-        max,
-        zmax,
-        first_or_right: 0,
-        count: 0,
-    });
+    nodes.push(Node { min, max, zmax, first_or_right: 0, count: 0 });
     let axis = usize::from(max[1] - min[1] > max[0] - min[0]);
     let mid = order.len() / 2;
     order.select_nth_unstable_by(mid, |&a, &b| {
-        centroid[a as usize][axis]
-            .total_cmp(&centroid[b as usize][axis])
-            .then(a.cmp(&b))
+        centroid[a as usize][axis].total_cmp(&centroid[b as usize][axis]).then(a.cmp(&b))
     });
     let (left, right) = order.split_at_mut(mid);
     build_node(nodes, tris, centroid, left, offset);

@@ -27,9 +27,7 @@ pub enum MeshError {
         value: [f64; 3],
     },
     /// An indexed triangle names a vertex that does not exist.
-    #[error(
-        "triangle {triangle} refers to vertex {index}, but there are only {vertex_count} vertices"
-    )]
+    #[error("triangle {triangle} refers to vertex {index}, but there are only {vertex_count} vertices")]
     IndexOutOfRange {
         /// Triangle number in input order.
         triangle: usize,
@@ -78,9 +76,7 @@ impl TriMesh {
     /// [`MeshError::Empty`], [`MeshError::NonFinite`] or [`MeshError::AllDegenerate`].
     pub fn from_soup(soup: &[[Point3; 3]]) -> Result<(TriMesh, MeshDiagnostics), MeshError> {
         let vertices: Vec<Point3> = soup.iter().flatten().copied().collect();
-        let triangles: Vec<[usize; 3]> = (0..soup.len())
-            .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
-            .collect();
+        let triangles: Vec<[usize; 3]> = (0..soup.len()).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
         Self::from_indexed(&vertices, &triangles)
     }
 
@@ -99,24 +95,15 @@ impl TriMesh {
         for (t, tri) in triangles.iter().enumerate() {
             for (k, &i) in tri.iter().enumerate() {
                 let Some(p) = vertices.get(i) else {
-                    return Err(MeshError::IndexOutOfRange {
-                        triangle: t,
-                        index: i,
-                        vertex_count: vertices.len(),
-                    });
+                    return Err(MeshError::IndexOutOfRange { triangle: t, index: i, vertex_count: vertices.len() });
                 };
                 if !(p.x.is_finite() && p.y.is_finite() && p.z.is_finite()) {
-                    return Err(MeshError::NonFinite {
-                        triangle: t,
-                        vertex: k,
-                        value: [p.x, p.y, p.z],
-                    });
+                    return Err(MeshError::NonFinite { triangle: t, vertex: k, value: [p.x, p.y, p.z] });
                 }
             }
         }
         // INVARIANT: triangles is non-empty and every index was checked above.
-        let bounds = Aabb3::from_points(triangles.iter().flatten().map(|&i| vertices[i]))
-            .ok_or(MeshError::Empty)?;
+        let bounds = Aabb3::from_points(triangles.iter().flatten().map(|&i| vertices[i])).ok_or(MeshError::Empty)?;
         let weld_distance = tol::REL_WELD * bounds.diagonal();
         let (welded, remap) = weld(vertices, weld_distance);
 
@@ -132,9 +119,7 @@ impl TriMesh {
             }
         }
         if kept.is_empty() {
-            return Err(MeshError::AllDegenerate {
-                count: triangles.len(),
-            });
+            return Err(MeshError::AllDegenerate { count: triangles.len() });
         }
         // Drop vertices no kept triangle uses, keeping first-use order (deterministic).
         let mut new_index = vec![u32::MAX; welded.len()];
@@ -160,14 +145,7 @@ impl TriMesh {
             boundary_edges,
             non_manifold_edges,
         };
-        Ok((
-            TriMesh {
-                vertices: used,
-                triangles: kept,
-                bounds,
-            },
-            diag,
-        ))
+        Ok((TriMesh { vertices: used, triangles: kept, bounds }, diag))
     }
 
     /// The vertices (mm).
@@ -206,9 +184,7 @@ impl TriMesh {
     /// The triangle soup (corners of every triangle).
     #[must_use]
     pub fn soup(&self) -> Vec<[Point3; 3]> {
-        (0..self.triangles.len())
-            .map(|i| self.triangle(i))
-            .collect()
+        (0..self.triangles.len()).map(|i| self.triangle(i)).collect()
     }
 
     /// A copy scaled by `factor` about the origin (unit conversion).
@@ -231,11 +207,7 @@ impl TriMesh {
     fn mapped(&self, f: impl Fn(&Point3) -> Point3) -> TriMesh {
         let vertices: Vec<Point3> = self.vertices.iter().map(f).collect();
         let bounds = Aabb3::from_points(vertices.iter().copied()).unwrap_or(self.bounds);
-        TriMesh {
-            vertices,
-            triangles: self.triangles.clone(),
-            bounds,
-        }
+        TriMesh { vertices, triangles: self.triangles.clone(), bounds }
     }
 
     /// Total surface area (mm²).
@@ -268,11 +240,7 @@ fn weld(points: &[Point3], dist: f64) -> (Vec<Point3>, Vec<u32>) {
     let key = |p: &Point3| {
         // Saturating float-to-int casts: huge coordinates share a cell, which is still correct.
         #[allow(clippy::cast_possible_truncation)]
-        let k = [
-            (p.x / cell).floor() as i64,
-            (p.y / cell).floor() as i64,
-            (p.z / cell).floor() as i64,
-        ];
+        let k = [(p.x / cell).floor() as i64, (p.y / cell).floor() as i64, (p.z / cell).floor() as i64];
         k
     };
     let mut grid: HashMap<[i64; 3], Vec<u32>> = HashMap::with_capacity(points.len());
@@ -333,10 +301,8 @@ mod tests {
     #[test]
     fn welds_near_duplicates_and_counts_edges() {
         let e = 1e-12;
-        let soup = [
-            [p(0., 0., 0.), p(1., 0., 0.), p(0., 1., 0.)],
-            [p(1. + e, 0., 0.), p(1., 1., 0.), p(0., 1. - e, 0.)],
-        ];
+        let soup =
+            [[p(0., 0., 0.), p(1., 0., 0.), p(0., 1., 0.)], [p(1. + e, 0., 0.), p(1., 1., 0.), p(0., 1. - e, 0.)]];
         let (m, d) = TriMesh::from_soup(&soup).unwrap();
         assert_eq!(m.vertices().len(), 4);
         assert_eq!(d.boundary_edges, 4);
@@ -345,46 +311,23 @@ mod tests {
 
     #[test]
     fn rejects_nan_with_place() {
-        let soup = [
-            [p(0., 0., 0.), p(1., 0., 0.), p(0., 1., 0.)],
-            [p(0., 0., 0.), p(f64::NAN, 0., 0.), p(0., 1., 0.)],
-        ];
+        let soup = [[p(0., 0., 0.), p(1., 0., 0.), p(0., 1., 0.)], [p(0., 0., 0.), p(f64::NAN, 0., 0.), p(0., 1., 0.)]];
         let err = TriMesh::from_soup(&soup).unwrap_err();
-        assert!(
-            matches!(
-                err,
-                MeshError::NonFinite {
-                    triangle: 1,
-                    vertex: 1,
-                    ..
-                }
-            ),
-            "{err:?}"
-        );
+        assert!(matches!(err, MeshError::NonFinite { triangle: 1, vertex: 1, .. }), "{err:?}");
     }
 
     #[test]
     fn rejects_empty_and_all_degenerate() {
         assert_eq!(TriMesh::from_soup(&[]).unwrap_err(), MeshError::Empty);
         let soup = [[p(0., 0., 0.), p(1., 1., 1.), p(2., 2., 2.)]];
-        assert_eq!(
-            TriMesh::from_soup(&soup).unwrap_err(),
-            MeshError::AllDegenerate { count: 1 }
-        );
+        assert_eq!(TriMesh::from_soup(&soup).unwrap_err(), MeshError::AllDegenerate { count: 1 });
     }
 
     #[test]
     fn index_out_of_range_is_an_error() {
         let v = [p(0., 0., 0.), p(1., 0., 0.), p(0., 1., 0.)];
         let err = TriMesh::from_indexed(&v, &[[0, 1, 3]]).unwrap_err();
-        assert_eq!(
-            err,
-            MeshError::IndexOutOfRange {
-                triangle: 0,
-                index: 3,
-                vertex_count: 3
-            }
-        );
+        assert_eq!(err, MeshError::IndexOutOfRange { triangle: 0, index: 3, vertex_count: 3 });
     }
 
     #[test]
