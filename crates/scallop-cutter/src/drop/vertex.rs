@@ -1,0 +1,32 @@
+//! Vertex contact: a corner at horizontal distance rho <= R from the axis
+//! touches the profile at height h(rho), so the tip is at `z - h(rho)`.
+
+use scallop_geom::{Point2, Point3};
+
+use super::{ClPoint, Contact};
+use crate::CutterShape;
+
+pub(super) fn drop_vertices(
+    shape: &CutterShape,
+    radius: f64,
+    corners: &[Point3; 3],
+    triangle: usize,
+    c: Point2,
+    best: &mut ClPoint,
+) {
+    let r2 = radius * radius;
+    for p in corners {
+        if p.z <= best.tip.z {
+            continue;
+        }
+        let (dx, dy) = (p.x - c.x, p.y - c.y);
+        let d2 = dx * dx + dy * dy;
+        if d2 <= r2 {
+            let z = p.z - shape.height_at(d2.sqrt());
+            if z > best.tip.z {
+                best.tip.z = z;
+                best.contact = Contact::Vertex { triangle, point: *p };
+            }
+        }
+    }
+}

@@ -1,0 +1,230 @@
+//! Property tests of the drop-cutter: no gouge, touches, index = brute force,
+//! translation invariance, monotone under adding triangles, and analytic cases.
+
+use proptest::prelude::*;
+use scallop_cutter::{ClPoint, Contact, Cutter, CutterShape, drop_cutter, drop_cutter_brute_force, drop_grid};
+use scallop_geom::{Point2, Point3, Vec3, assert_near};
+use scallop_mesh::{MeshIndex, TriMesh};
+
+const FLOOR: f64 = -100.0;
+/// Measurement tolerance of these tests (mm): models are ~10 mm, rounding ~1e-14.
+const EPS: f64 = 1e-9;
+
+fn shape_strategy() -> impl Strategy<Value = CutterShape> {
+    (0usize..4, 0.3f64..3.0, 0.05f64..1.0, 0.15f64..1.45).prop_map(|(kind, radius, frac, angle)| match kind {
+        0 => CutterShape::Flat { radius },
+        1 => CutterShape::Ball { radius },
+        2 => CutterShape::Bull { radius, corner: radius * frac },
+        _ => CutterShape::Cone { radius, half_angle: angle },
+    })
+}
+
+fn cutter(shape: CutterShape) -> Cutter {
+    Cutter::new(shape, 100.0).expect("valid cutter")
+}
+
+fn triangle_strategy() -> impl Strategy<Value = [Point3; 3]> {
+    prop::array::uniform3((0.0f64..10.0, 0.0f64..10.0, 0.0f64..3.0))
+        .prop_map(|v| v.map(|(x, y, z)| Point3::new(x, y, z)))
+}
+
+fn soup_strategy(max: usize) -> impl Strategy<Value = Vec<[Point3; 3]>> {
+    prop::collection::vec(triangle_strategy(), 1..max)
+}
+
+fn build(soup: &[[Point3; 3]]) -> Option<(TriMesh, MeshIndex)> {
+    let (mesh, _) = TriMesh::from_soup(soup).ok()?;
+    let index = MeshIndex::build(&mesh);
+    Some((mesh, index))
+}
+
+/// Lowest clearance between the cutter at `cl` and triangle `t`, by dense
+/// barycentric sampling (independent of the contact solvers): the surface z
+/// minus the cutter's lower surface z, over samples within the disk.
+fn min_clearance(shape: &CutterShape, cl: &ClPoint, t: &[Point3; 3]) -> f64 {
+    let n = 40;
+    let r = shape.radius();
+    let mut worst = f64::INFINITY;
+    for i in 0..=n {
+        for j in 0..=(n - i) {
+            let (u, v) = (f64::from(i) / f64::from(n), f64::from(j) / f64::from(n));
+            let p = t[0] + (t[1] - t[0]) * u + (t[2] - t[0]) * v;
+            let rho = (p.x - cl.tip.x).hypot(p.y - cl.tip.y);
+            if rho <= r {
+                worst = worst.min(cl.tip.z + shape.height_at(rho) - p.z);
+            }
+        }
+    }
+    worst
+}
+
+fn contact_point(c: &Contact) -> Option<(usize, Point3)> {
+    match *c {
+        Contact::Floor => None,
+        Contact::Vertex { triangle, point }
+        | Contact::Edge { triangle, point }
+        | Contact::Facet { triangle, point } => Some((triangle, point)),
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 200, ..ProptestConfig::default() })]
+
+    #[test]
+    fn index_equals_brute_force(soup in soup_strategy(60), shape in shape_strategy(),
+                                pts in prop::collection::vec((-2.0f64..12.0, -2.0f64..12.0), 1..20)) {
+        let Some((_, index)) = build(&soup) else { return Ok(()) };
+        let c = cutter(shape);
+        for (x, y) in pts {
+            let xy = Point2::new(x, y);
+            let fast = drop_cutter(&c, &index, xy, FLOOR);
+            let slow = drop_cutter_brute_force(&c, &index, xy, FLOOR);
+            prop_assert_eq!(fast.tip.z.to_bits(), slow.tip.z.to_bits(), "at {:?}: {:?} vs {:?}", xy, fast, slow);
+            prop_assert_eq!(matches!(fast.contact, Contact::Floor), matches!(slow.contact, Contact::Floor));
+        }
+    }
+
+    #[test]
+    fn no_gouge_and_touches(soup in soup_strategy(12), shape in shape_strategy(),
+                            pts in prop::collection::vec((-1.0f64..11.0, -1.0f64..11.0), 1..6)) {
+        let Some((mesh, index)) = build(&soup) else { return Ok(()) };
+        let c = cutter(shape);
+        for (x, y) in pts {
+            let cl = drop_cutter(&c, &index, Point2::new(x, y), FLOOR);
+            for t in mesh.soup() {
+                let clearance = min_clearance(&shape, &cl, &t);
+                prop_assert!(clearance >= -EPS, "gouge {clearance} at {cl:?}");
+            }
+            if let Some((tri, p)) = contact_point(&cl.contact) {
+                let rho = (p.x - cl.tip.x).hypot(p.y - cl.tip.y);
+                prop_assert!(rho <= shape.radius() + EPS);
+                prop_assert!((cl.tip.z + shape.height_at(rho.min(shape.radius())) - p.z).abs() <= 1e-7,
+                    "contact point not on the cutter: {cl:?}");
+                // the contact point lies on the named triangle (distance to its plane)
+                let t = mesh.triangle(tri);
+                let n = (t[1] - t[0]).cross(&(t[2] - t[0])).normalize();
+                prop_assert!(n.dot(&(p - t[0])).abs() <= 1e-7, "contact off triangle {tri}: {cl:?}");
+            } else {
+                prop_assert_eq!(cl.tip.z, FLOOR);
+            }
+        }
+    }
+
+    #[test]
+    fn translation_moves_the_result(soup in soup_strategy(30), shape in shape_strategy(),
+                                    t in (-50.0f64..50.0, -50.0f64..50.0, -50.0f64..50.0),
+                                    pts in prop::collection::vec((-1.0f64..11.0, -1.0f64..11.0), 1..10)) {
+        let Some((mesh, index)) = build(&soup) else { return Ok(()) };
+        let offset = Vec3::new(t.0, t.1, t.2);
+        let moved = MeshIndex::build(&mesh.translated(&offset));
+        let c = cutter(shape);
+        for (x, y) in pts {
+            let a = drop_cutter(&c, &index, Point2::new(x, y), FLOOR);
+            let b = drop_cutter(&c, &moved, Point2::new(x + t.0, y + t.1), FLOOR + t.2);
+            prop_assert!((b.tip.z - (a.tip.z + t.2)).abs() <= 1e-8, "{a:?} vs {b:?}");
+        }
+    }
+
+    #[test]
+    fn adding_triangles_never_lowers(soup in soup_strategy(30), extra in soup_strategy(10), shape in shape_strategy(),
+                                     pts in prop::collection::vec((-1.0f64..11.0, -1.0f64..11.0), 1..10)) {
+        let Some((_, index)) = build(&soup) else { return Ok(()) };
+        let mut all = soup.clone();
+        all.extend(extra);
+        let Some((_, bigger)) = build(&all) else { return Ok(()) };
+        let c = cutter(shape);
+        for (x, y) in pts {
+            let a = drop_cutter(&c, &index, Point2::new(x, y), FLOOR);
+            let b = drop_cutter(&c, &bigger, Point2::new(x, y), FLOOR);
+            prop_assert!(b.tip.z >= a.tip.z, "{a:?} vs {b:?}");
+        }
+    }
+}
+
+/// A big triangle through the origin, tilted by `theta` about the y axis.
+fn inclined_plane(theta: f64) -> MeshIndex {
+    let z = |x: f64| x * theta.tan();
+    let p = |x: f64, y: f64| Point3::new(x, y, z(x));
+    let (m, _) = TriMesh::from_soup(&[[p(-50.0, -50.0), p(50.0, -50.0), p(0.0, 80.0)]]).expect("mesh");
+    MeshIndex::build(&m)
+}
+
+#[test]
+fn analytic_inclined_plane_every_shape() {
+    let (big_r, small_r, alpha) = (3.0, 1.0, 0.5f64);
+    for &theta in &[0.0, 0.2, 0.7, 1.2] {
+        let index = inclined_plane(theta);
+        let (s, c) = (theta.sin(), theta.cos());
+        let cases = [
+            (CutterShape::Flat { radius: big_r }, big_r * s / c),
+            (CutterShape::Ball { radius: big_r }, big_r * (1.0 / c - 1.0)),
+            (
+                CutterShape::Bull { radius: big_r, corner: small_r },
+                (big_r - small_r) * s / c + small_r * (1.0 / c - 1.0),
+            ),
+            (
+                CutterShape::Cone { radius: big_r, half_angle: alpha },
+                if theta < std::f64::consts::FRAC_PI_2 - alpha { 0.0 } else { big_r * s / c - big_r / alpha.tan() },
+            ),
+        ];
+        for (shape, lift) in cases {
+            let cl = drop_cutter(&cutter(shape), &index, Point2::new(1.5, 0.5), FLOOR);
+            assert_near!(cl.tip.z, 1.5 * theta.tan() + lift, 1e-12);
+        }
+    }
+}
+
+#[test]
+fn analytic_ridge_edge_every_shape() {
+    // A vertical wall in the plane y = 0 whose top edge is at z = 0: vertical facets
+    // never hold a contact, so only the top edge touches.
+    let p = |x: f64, y: f64, z: f64| Point3::new(x, y, z);
+    let (m, _) = TriMesh::from_soup(&[
+        [p(-30., 0., 0.), p(30., 0., 0.), p(-30., 0., -50.)],
+        [p(30., 0., 0.), p(30., 0., -50.), p(-30., 0., -50.)],
+    ])
+    .expect("mesh");
+    let index = MeshIndex::build(&m);
+    let (big_r, small_r, alpha) = (2.0, 0.5, 0.6f64);
+    for &d in &[0.0, 0.4, 1.0, 1.7, 1.99] {
+        let shapes = [
+            CutterShape::Flat { radius: big_r },
+            CutterShape::Ball { radius: big_r },
+            CutterShape::Bull { radius: big_r, corner: small_r },
+            CutterShape::Cone { radius: big_r, half_angle: alpha },
+        ];
+        for shape in shapes {
+            let cl = drop_cutter(&cutter(shape), &index, Point2::new(3.0, d), FLOOR);
+            assert_near!(cl.tip.z, -shape.height_at(d), 1e-12);
+        }
+    }
+}
+
+#[test]
+fn grid_is_row_major_and_thread_independent() {
+    let p = |x: f64, y: f64, z: f64| Point3::new(x, y, z);
+    let mut soup = Vec::new();
+    for i in 0..20 {
+        for j in 0..20 {
+            let (x, y) = (f64::from(i), f64::from(j));
+            let h = |x: f64, y: f64| (x * 0.7).sin() + (y * 0.4).cos();
+            soup.push([p(x, y, h(x, y)), p(x + 1., y, h(x + 1., y)), p(x, y + 1., h(x, y + 1.))]);
+            soup.push([p(x + 1., y, h(x + 1., y)), p(x + 1., y + 1., h(x + 1., y + 1.)), p(x, y + 1., h(x, y + 1.))]);
+        }
+    }
+    let (mesh, _) = TriMesh::from_soup(&soup).expect("mesh");
+    let index = MeshIndex::build(&mesh);
+    let c = cutter(CutterShape::Bull { radius: 1.5, corner: 0.4 });
+    let xs: Vec<f64> = (0..50).map(|i| f64::from(i) * 0.4).collect();
+    let ys: Vec<f64> = (0..40).map(|i| f64::from(i) * 0.5).collect();
+    let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().expect("pool");
+    let two = rayon::ThreadPoolBuilder::new().num_threads(2).build().expect("pool");
+    let a = one.install(|| drop_grid(&c, &index, &xs, &ys, FLOOR, &|_| {}));
+    let b = two.install(|| drop_grid(&c, &index, &xs, &ys, FLOOR, &|_| {}));
+    assert_eq!(a.len(), xs.len() * ys.len());
+    for (k, (pa, pb)) in a.iter().zip(&b).enumerate() {
+        assert_eq!(pa.tip.z.to_bits(), pb.tip.z.to_bits());
+        assert_eq!(pa.tip.x, xs[k % xs.len()]);
+        assert_eq!(pa.tip.y, ys[k / xs.len()]);
+    }
+}
