@@ -168,6 +168,49 @@ impl CutterShape {
     }
 }
 
+/// The profile with its constants computed once (no trigonometry in the hot loop).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Profile {
+    pub(crate) shape: CutterShape,
+    pub(crate) radius: f64,
+    /// R - r for the bull-nose.
+    pub(crate) flat_radius: f64,
+    /// r for the bull-nose and R for the ball.
+    pub(crate) corner: f64,
+    /// tan(half angle) for the cone.
+    pub(crate) tan: f64,
+    /// 1 / tan(half angle) for the cone.
+    pub(crate) cot: f64,
+}
+
+impl Profile {
+    pub(crate) fn new(shape: &CutterShape) -> Profile {
+        let radius = shape.radius();
+        let (flat_radius, corner, tan) = match *shape {
+            CutterShape::Flat { .. } => (radius, 0.0, 0.0),
+            CutterShape::Ball { radius } => (0.0, radius, 0.0),
+            CutterShape::Bull { radius, corner } => (radius - corner, corner, 0.0),
+            CutterShape::Cone { half_angle, .. } => (0.0, 0.0, half_angle.tan()),
+        };
+        let cot = if tan > 0.0 { 1.0 / tan } else { 0.0 };
+        Profile { shape: *shape, radius, flat_radius, corner, tan, cot }
+    }
+
+    /// Same as [`CutterShape::height_at`], without trigonometry.
+    #[inline]
+    pub(crate) fn height(&self, rho: f64) -> f64 {
+        match self.shape {
+            CutterShape::Flat { .. } => 0.0,
+            CutterShape::Ball { .. } => self.corner - (self.corner * self.corner - rho * rho).max(0.0).sqrt(),
+            CutterShape::Bull { .. } => {
+                let s = rho - self.flat_radius;
+                if s <= 0.0 { 0.0 } else { self.corner - (self.corner * self.corner - s * s).max(0.0).sqrt() }
+            }
+            CutterShape::Cone { .. } => rho * self.cot,
+        }
+    }
+}
+
 fn positive(what: &'static str, value: f64) -> Result<(), CutterError> {
     if value.is_finite() && value > 0.0 { Ok(()) } else { Err(CutterError::NotPositive { what, value }) }
 }

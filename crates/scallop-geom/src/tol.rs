@@ -32,6 +32,17 @@ pub const REL_WELD: f64 = 1e-9;
 /// mesh in tests and verification (times the model scale).
 pub const REL_CONTACT: f64 = 1e-9;
 
+/// Relative slack added to upper bounds in branch-and-bound searches (times the
+/// model's largest |coordinate|), far above rounding error and far below any
+/// geometric feature: pruning stays conservative.
+pub const REL_PRUNE_SLACK: f64 = 1e-9;
+
+/// Relative convergence of parameter iterations (times the parameter's range).
+/// Used where the result is the maximum of a smooth concave function, whose
+/// value errs by O(parameter error^2): 1e-10 of a 10 mm range moves a height by
+/// far less than 1e-12 mm.
+pub const PARAMETER_CONVERGENCE: f64 = 1e-10;
+
 /// Numeric epsilon derived from the largest |coordinate| of a model: rounding
 /// error grows with coordinate magnitude, not with part size. Never user-facing.
 #[derive(Clone, Copy, Debug, PartialEq, PartialOrd)]

@@ -30,6 +30,9 @@ pub struct MeshIndex {
     zmax: Vec<f64>,
     original: Vec<u32>,
     bounds: scallop_geom::Aabb3,
+    /// Added to every upper bound so that rounding in a contact computation can
+    /// never make pruning skip a triangle that would win by a few ulps.
+    slack: f64,
 }
 
 impl MeshIndex {
@@ -63,7 +66,8 @@ impl MeshIndex {
             })
             .collect();
         let zmax = corners.iter().map(|t| t[0].z.max(t[1].z).max(t[2].z)).collect();
-        MeshIndex { nodes, corners, normals, zmax, original: order, bounds: mesh.bounds() }
+        let slack = scallop_geom::tol::REL_PRUNE_SLACK * mesh.bounds().max_abs_coord().max(1.0);
+        MeshIndex { nodes, corners, normals, zmax, original: order, bounds: mesh.bounds(), slack }
     }
 
     /// Number of triangles.
@@ -108,43 +112,74 @@ impl MeshIndex {
         self.original[slot] as usize
     }
 
-    /// Calls `visit(slot, bound)` for every triangle whose XY box meets the
-    /// disk of `radius` around `center` and whose highest z exceeds `*bound`
-    /// at the time the subtree is reached. `visit` may raise `*bound`, which
-    /// prunes the rest of the search. Higher subtrees are visited first.
-    pub fn visit_disk(&self, center: Point2, radius: f64, bound: &mut f64, mut visit: impl FnMut(usize, &mut f64)) {
+    /// Branch-and-bound search for the highest cutter location over the disk of
+    /// `radius` around `center`. `lift(d2)` must be a lower bound of how far the
+    /// cutter's profile rises above its tip at squared horizontal distance
+    /// `>= d2` (non-decreasing; `|_| 0.0` is always valid). A subtree or triangle
+    /// is visited only if its highest z minus `lift` of its squared distance to
+    /// `center` exceeds `*bound`, i.e. only if it could raise the result; the
+    /// more promising child is visited first. `visit(slot, bound)` may raise
+    /// `*bound`, which prunes the rest of the search.
+    pub fn visit_disk(
+        &self,
+        center: Point2,
+        radius: f64,
+        lift: impl Fn(f64) -> f64,
+        bound: &mut f64,
+        mut visit: impl FnMut(usize, &mut f64),
+    ) {
         let r2 = radius * radius;
-        let mut stack: [u32; 64] = [0; 64];
-        let mut top = 1usize;
+        let node_box = |n: &Node| Aabb2 { min: Point2::new(n.min[0], n.min[1]), max: Point2::new(n.max[0], n.max[1]) };
+        // Upper bound of what a node can give, or None when it is out of reach.
+        let reach = |n: &Node| {
+            let d2 = node_box(n).distance_squared(&center);
+            (d2 <= r2).then(|| n.zmax - lift(d2) + self.slack)
+        };
+        let mut stack: [(u32, f64); 64] = [(0, 0.0); 64];
+        let mut top = 0usize;
+        if let Some(ub) = reach(&self.nodes[0]) {
+            stack[0] = (0, ub);
+            top = 1;
+        }
         while top > 0 {
             top -= 1;
-            let node = &self.nodes[stack[top] as usize];
-            if node.zmax <= *bound {
+            let (id, ub) = stack[top];
+            if ub <= *bound {
                 continue;
             }
-            let b = Aabb2 { min: Point2::new(node.min[0], node.min[1]), max: Point2::new(node.max[0], node.max[1]) };
-            if b.distance_squared(&center) > r2 {
-                continue;
-            }
+            let node = &self.nodes[id as usize];
             if node.count > 0 {
                 let first = node.first_or_right as usize;
                 for slot in first..first + node.count as usize {
-                    if self.zmax[slot] > *bound {
+                    if self.zmax[slot] + self.slack <= *bound {
+                        continue;
+                    }
+                    let t = &self.corners[slot];
+                    let tb = Aabb2 {
+                        min: Point2::new(t[0].x.min(t[1].x).min(t[2].x), t[0].y.min(t[1].y).min(t[2].y)),
+                        max: Point2::new(t[0].x.max(t[1].x).max(t[2].x), t[0].y.max(t[1].y).max(t[2].y)),
+                    };
+                    let d2 = tb.distance_squared(&center);
+                    if d2 <= r2 && self.zmax[slot] - lift(d2) + self.slack > *bound {
                         visit(slot, bound);
                     }
                 }
             } else {
-                let left = stack[top] + 1;
-                let right = node.first_or_right;
-                let (lo, hi) = if self.nodes[left as usize].zmax >= self.nodes[right as usize].zmax {
-                    (right, left)
-                } else {
-                    (left, right)
+                let (left, right) = (id + 1, node.first_or_right);
+                let a = reach(&self.nodes[left as usize]).map(|ub| (left, ub));
+                let b = reach(&self.nodes[right as usize]).map(|ub| (right, ub));
+                let (first, second) = match (a, b) {
+                    (Some(a), Some(b)) if a.1 >= b.1 => (Some(b), Some(a)),
+                    (a, b) => (a, b),
                 };
-                // Depth is at most log2(n / LEAF_SIZE) + 1 < 64 for any n that fits in memory.
-                stack[top] = lo;
-                stack[top + 1] = hi;
-                top += 2;
+                // Pushed so that the higher bound pops first. Depth is at most
+                // log2(n / LEAF_SIZE) + 1 < 64 for any n that fits in memory.
+                for entry in [first, second].into_iter().flatten() {
+                    if entry.1 > *bound {
+                        stack[top] = entry;
+                        top += 1;
+                    }
+                }
             }
         }
     }

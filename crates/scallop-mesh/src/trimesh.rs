@@ -1,4 +1,5 @@
 use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
 
 use scallop_geom::{Aabb3, Eps, Point2, Point3, Vec3, predicates::orient2d, tol};
 
@@ -236,32 +237,37 @@ fn is_collinear(p: &[Point3; 3]) -> bool {
 /// representative, so the result is deterministic). Returns the kept points
 /// and, per input point, its representative's index.
 fn weld(points: &[Point3], dist: f64) -> (Vec<Point3>, Vec<u32>) {
-    let cell = if dist > 0.0 { dist } else { f64::MIN_POSITIVE };
-    let key = |p: &Point3| {
-        // Saturating float-to-int casts: huge coordinates share a cell, which is still correct.
-        #[allow(clippy::cast_possible_truncation)]
-        let k = [(p.x / cell).floor() as i64, (p.y / cell).floor() as i64, (p.z / cell).floor() as i64];
-        k
-    };
-    let mut grid: HashMap<[i64; 3], Vec<u32>> = HashMap::with_capacity(points.len());
+    // Cells much larger than the weld distance: a point looks into a
+    // neighbouring cell only along the axes where it lies within `dist` of a face.
+    let cell = if dist > 0.0 { dist * WELD_CELL_FACTOR } else { f64::MIN_POSITIVE };
+    let mut grid: FastMap<[i64; 3], Vec<u32>> = FastMap::with_capacity_and_hasher(points.len(), Default::default());
     let mut kept: Vec<Point3> = Vec::new();
     let mut remap = Vec::with_capacity(points.len());
     let d2 = dist * dist;
     for p in points {
-        let k = key(p);
-        let mut found = None;
-        'search: for dx in -1..=1 {
-            for dy in -1..=1 {
-                for dz in -1..=1 {
+        let mut k = [0i64; 3];
+        let mut span = [(0i64, 0i64); 3];
+        for axis in 0..3 {
+            let q = p[axis] / cell;
+            let f = q.floor();
+            // Saturating float-to-int cast: huge coordinates share a cell, which is still correct.
+            #[allow(clippy::cast_possible_truncation)]
+            let ki = f as i64;
+            k[axis] = ki;
+            let lo = i64::from((q - f) * cell < dist);
+            let hi = i64::from((f + 1.0 - q) * cell <= dist);
+            span[axis] = (-lo, hi);
+        }
+        let mut found: Option<u32> = None;
+        for dx in span[0].0..=span[0].1 {
+            for dy in span[1].0..=span[1].1 {
+                for dz in span[2].0..=span[2].1 {
                     if let Some(list) = grid.get(&[k[0] + dx, k[1] + dy, k[2] + dz]) {
                         for &i in list {
                             if (kept[i as usize] - p).norm_squared() <= d2 {
-                                found = Some(found.map_or(i, |f: u32| f.min(i)));
+                                found = Some(found.map_or(i, |f| f.min(i)));
                             }
                         }
-                    }
-                    if found.is_some() && dist == 0.0 {
-                        break 'search;
                     }
                 }
             }
@@ -277,8 +283,43 @@ fn weld(points: &[Point3], dist: f64) -> (Vec<Point3>, Vec<u32>) {
     (kept, remap)
 }
 
+/// Weld grid cell size in weld distances.
+const WELD_CELL_FACTOR: f64 = 64.0;
+
+/// A multiply-rotate hasher (the Fx hash of rustc) for integer keys: the
+/// keys are our own cell numbers and indices, so no hash flooding can occur,
+/// and iteration order never reaches an output.
+#[derive(Default)]
+struct FxHasher(u64);
+
+impl Hasher for FxHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.write_u64(u64::from(b));
+        }
+    }
+    fn write_u64(&mut self, v: u64) {
+        self.0 = (self.0.rotate_left(5) ^ v).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+    fn write_u32(&mut self, v: u32) {
+        self.write_u64(u64::from(v));
+    }
+    fn write_i64(&mut self, v: i64) {
+        self.write_u64(v.cast_unsigned());
+    }
+    fn write_usize(&mut self, v: usize) {
+        self.write_u64(v as u64);
+    }
+}
+
+type FastMap<K, V> = HashMap<K, V, BuildHasherDefault<FxHasher>>;
+
 fn edge_counts(triangles: &[[u32; 3]]) -> (usize, usize) {
-    let mut edges: HashMap<(u32, u32), u32> = HashMap::with_capacity(triangles.len() * 3 / 2);
+    let mut edges: FastMap<(u32, u32), u32> =
+        FastMap::with_capacity_and_hasher(triangles.len() * 3 / 2, Default::default());
     for t in triangles {
         for k in 0..3 {
             let (a, b) = (t[k], t[(k + 1) % 3]);

@@ -17,35 +17,26 @@
 //! flat:  x = x_R if m > 0 (else any; 0)
 //! ball:  x = m x_R / sqrt(1 + m^2)
 //! cone:  k = m tan(a); x = x_R if k >= 1, else d k / sqrt(1 - k^2)
-//! bull:  rho = (R - r) + r sin(phi), h' = tan(phi):
-//!        G(phi) = sin(phi) x(phi) - m cos(phi) rho(phi) = 0, increasing in phi on
-//!        [phi_0, pi/2], solved by Newton steps kept inside a shrinking bracket.
+//! bull:  a polynomial in s = rho - (R - r) with one sign change on the corner,
+//!        solved by Newton steps kept inside a shrinking bracket (see below).
 //! ```
 //!
 //! f is flat at its maximum, so a parameter error e moves the height by O(e^2).
 
-use std::f64::consts::FRAC_PI_2;
-
-use scallop_geom::{Point2, Point3};
+use scallop_geom::{Point2, Point3, tol};
 
 use super::{ClPoint, Contact};
 use crate::CutterShape;
+use crate::shape::Profile;
 
 /// Iteration cap of the bull-nose root finder; the bracket halves at least
 /// every other step, so 200 is far beyond what f64 resolution needs.
 const MAX_ITERATIONS: usize = 200;
 
-pub(super) fn drop_edge(
-    shape: &CutterShape,
-    radius: f64,
-    a: &Point3,
-    b: &Point3,
-    triangle: usize,
-    c: Point2,
-    best: &mut ClPoint,
-) {
+pub(super) fn drop_edge(profile: &Profile, a: &Point3, b: &Point3, triangle: usize, c: Point2, best: &mut ClPoint) {
     let (ex, ey) = (b.x - a.x, b.y - a.y);
-    let len = ex.hypot(ey);
+    let radius = profile.radius;
+    let len = (ex * ex + ey * ey).sqrt();
     if len == 0.0 {
         return; // vertical edge: its upper corner is the highest contact
     }
@@ -64,13 +55,15 @@ pub(super) fn drop_edge(
     }
     let m = (b.z - a.z) / len;
     let z_at = |x: f64| a.z + m * (x - xa);
-    if z_at(lo).max(z_at(hi)) <= best.tip.z {
+    // Upper bound: the highest point of the chord, lifted by the profile at the
+    // smallest distance d (h is non-decreasing).
+    if z_at(lo).max(z_at(hi)) - profile.height(d) <= best.tip.z {
         return;
     }
-    let x_c = maximiser(shape, m.abs(), d, x_r);
+    let x_c = maximiser(profile, m.abs(), d, x_r);
     let x = (if m < 0.0 { -x_c } else { x_c }).clamp(lo, hi);
     let zc = z_at(x);
-    let tip = zc - shape.height_at((x * x + d * d).sqrt());
+    let tip = zc - profile.height((x * x + d * d).sqrt());
     if tip > best.tip.z {
         let t = (x - xa) / len;
         best.tip.z = tip;
@@ -79,8 +72,8 @@ pub(super) fn drop_edge(
 }
 
 /// The x >= 0 that maximises `m x - h(sqrt(x^2 + d^2))` on [0, x_r], for m >= 0.
-fn maximiser(shape: &CutterShape, m: f64, d: f64, x_r: f64) -> f64 {
-    match *shape {
+fn maximiser(profile: &Profile, m: f64, d: f64, x_r: f64) -> f64 {
+    match profile.shape {
         CutterShape::Flat { .. } => {
             if m > 0.0 {
                 x_r
@@ -89,56 +82,61 @@ fn maximiser(shape: &CutterShape, m: f64, d: f64, x_r: f64) -> f64 {
             }
         }
         CutterShape::Ball { .. } => m * x_r / (1.0 + m * m).sqrt(),
-        CutterShape::Cone { half_angle, .. } => {
-            let k = m * half_angle.tan();
+        CutterShape::Cone { .. } => {
+            let k = m * profile.tan;
             if k >= 1.0 { x_r } else { (d * k / (1.0 - k * k).sqrt()).min(x_r) }
         }
-        CutterShape::Bull { radius, corner } => {
+        CutterShape::Bull { .. } => {
             if m == 0.0 {
                 0.0
             } else {
-                bull_maximiser(radius - corner, corner, m, d, x_r)
+                bull_maximiser(profile.flat_radius, profile.corner, m, d, x_r)
             }
         }
     }
 }
 
-/// Solves G(phi) = sin(phi) x - m cos(phi) rho = 0 with rho = a + r sin(phi),
-/// x = sqrt(rho^2 - d^2), on [phi_0, pi/2] where G(phi_0) <= 0 <= G(pi/2) = x_r.
+/// Solves h'(rho) x / rho = m on the corner of the bull-nose, without
+/// trigonometry. With s = rho - a (a = R - r, 0 <= s <= r),
+/// h' = s / sqrt(r^2 - s^2) and x = sqrt(rho^2 - d^2); squaring gives
+///
+/// ```text
+/// P(s) = s^2 ((a + s)^2 - d^2) - m^2 (a + s)^2 (r^2 - s^2)
+///      = rho^2 (r^2 - s^2) (g(s)^2 - m^2),   g = h' x / rho increasing,
+/// ```
+///
+/// so P changes sign exactly once on [s_0, r] (P(s_0) <= 0 <= P(r)), where
+/// s_0 = max(0, d - a). Newton steps kept inside a shrinking bracket.
 fn bull_maximiser(a: f64, r: f64, m: f64, d: f64, x_r: f64) -> f64 {
-    let x_of = |phi: f64| {
-        let rho = a + r * phi.sin();
-        (rho * rho - d * d).max(0.0).sqrt()
-    };
-    let phi0 = if d <= a { 0.0 } else { ((d - a) / r).min(1.0).asin() };
-    let (mut lo, mut hi) = (phi0, FRAC_PI_2);
+    let m2 = m * m;
+    let (r2, d2) = (r * r, d * d);
+    let (mut lo, mut hi) = ((d - a).max(0.0), r);
     if hi <= lo {
         return x_r;
     }
-    let mut phi = 0.5 * (lo + hi);
+    let tol = tol::PARAMETER_CONVERGENCE * r;
+    let mut s = 0.5 * (lo + hi);
     for _ in 0..MAX_ITERATIONS {
-        let (s, co) = phi.sin_cos();
-        let rho = a + r * s;
-        let x = (rho * rho - d * d).max(0.0).sqrt();
-        let g = s * x - m * co * rho;
-        if g < 0.0 {
-            lo = phi;
+        let rho = a + s;
+        let (rho2, s2) = (rho * rho, s * s);
+        let p = s2 * (rho2 - d2) - m2 * rho2 * (r2 - s2);
+        if p < 0.0 {
+            lo = s;
         } else {
-            hi = phi;
+            hi = s;
         }
-        // G' = cos x + sin x' + m sin rho - m cos rho', rho' = r cos, x' = rho rho' / x
-        let drho = r * co;
-        let dx = if x > 0.0 { rho * drho / x } else { f64::INFINITY };
-        let dg = co * x + s * dx + m * s * rho - m * co * drho;
-        let newton = phi - g / dg;
-        let next = if dg.is_finite() && dg > 0.0 && newton > lo && newton < hi { newton } else { 0.5 * (lo + hi) };
-        if next == phi || hi - lo <= f64::EPSILON * hi {
-            phi = next;
+        // P' = 2s (rho^2 - d^2) + 2 s^2 rho - m^2 (2 rho (r^2 - s^2) - 2 s rho^2)
+        let dp = 2.0 * s * (rho2 - d2) + 2.0 * s2 * rho - m2 * (2.0 * rho * (r2 - s2) - 2.0 * s * rho2);
+        let newton = s - p / dp;
+        let next = if dp > 0.0 && newton > lo && newton < hi { newton } else { 0.5 * (lo + hi) };
+        let step = (next - s).abs();
+        s = next;
+        if step <= tol || hi - lo <= tol {
             break;
         }
-        phi = next;
     }
-    x_of(phi).min(x_r)
+    let rho = a + s;
+    (rho * rho - d2).max(0.0).sqrt().min(x_r)
 }
 
 #[cfg(test)]
@@ -170,7 +168,7 @@ mod tests {
             for &d in &[0.0, 0.3, 1.2, 1.6, 1.99] {
                 for &m in &[0.0, 0.01, 0.3, 1.0, 4.0, 100.0] {
                     let x_r = (4.0_f64 - d * d).sqrt();
-                    let x = maximiser(&shape, m, d, x_r);
+                    let x = maximiser(&Profile::new(&shape), m, d, x_r);
                     assert!((0.0..=x_r).contains(&x), "{shape:?} d={d} m={m}: x={x}");
                     let ours = m * x - shape.height_at((x * x + d * d).sqrt());
                     let sampled = sampled_max(&shape, m, d, x_r);

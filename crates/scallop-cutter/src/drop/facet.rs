@@ -17,9 +17,10 @@ use scallop_geom::{Point2, Point3, Vec3, predicates::in_triangle};
 
 use super::{ClPoint, Contact};
 use crate::CutterShape;
+use crate::shape::Profile;
 
 pub(super) fn drop_facet(
-    shape: &CutterShape,
+    profile: &Profile,
     corners: &[Point3; 3],
     n: &Vec3,
     triangle: usize,
@@ -29,20 +30,20 @@ pub(super) fn drop_facet(
     if n.z <= 0.0 {
         return; // vertical facet: its edges and corners hold every contact
     }
-    let nxy = n.x.hypot(n.y);
+    let nxy = (n.x * n.x + n.y * n.y).sqrt();
     let (ux, uy) = if nxy > 0.0 { (n.x / nxy, n.y / nxy) } else { (0.0, 0.0) };
-    let (dx, dy, dz) = match *shape {
+    let (dx, dy, dz) = match profile.shape {
         CutterShape::Ball { radius } => (-radius * n.x, -radius * n.y, radius - radius * n.z),
         CutterShape::Flat { radius } => (-radius * ux, -radius * uy, 0.0),
         CutterShape::Bull { radius, corner } => {
             let a = radius - corner;
             (-a * ux - corner * n.x, -a * uy - corner * n.y, corner - corner * n.z)
         }
-        CutterShape::Cone { radius, half_angle } => {
-            if nxy * half_angle.tan() < n.z {
+        CutterShape::Cone { radius, .. } => {
+            if nxy * profile.tan < n.z {
                 (0.0, 0.0, 0.0)
             } else {
-                (-radius * ux, -radius * uy, radius / half_angle.tan())
+                (-radius * ux, -radius * uy, radius * profile.cot)
             }
         }
     };

@@ -27,6 +27,7 @@ use scallop_geom::{Point2, Point3, Vec3};
 use scallop_mesh::MeshIndex;
 
 use crate::Cutter;
+use crate::shape::Profile;
 
 /// Which feature of the mesh the cutter rests on.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -77,15 +78,18 @@ impl ClPoint {
 /// triangle (`corners`, unit `normal` with z >= 0, number `triangle` for the
 /// report). Only strictly higher candidates replace `best`.
 pub fn drop_triangle(cutter: &Cutter, corners: &[Point3; 3], normal: &Vec3, triangle: usize, best: &mut ClPoint) {
-    let shape = cutter.shape();
-    let radius = shape.radius();
+    drop_triangle_profile(&Profile::new(cutter.shape()), corners, normal, triangle, best);
+}
+
+#[inline]
+fn drop_triangle_profile(profile: &Profile, corners: &[Point3; 3], normal: &Vec3, triangle: usize, best: &mut ClPoint) {
     let c = Point2::new(best.tip.x, best.tip.y);
-    vertex::drop_vertices(shape, radius, corners, triangle, c, best);
-    facet::drop_facet(shape, corners, normal, triangle, c, best);
+    vertex::drop_vertices(profile, corners, triangle, c, best);
+    facet::drop_facet(profile, corners, normal, triangle, c, best);
     for k in 0..3 {
         let (a, b) = (&corners[k], &corners[(k + 1) % 3]);
         if a.z.max(b.z) > best.tip.z {
-            edge::drop_edge(shape, radius, a, b, triangle, c, best);
+            edge::drop_edge(profile, a, b, triangle, c, best);
         }
     }
 }
@@ -94,21 +98,59 @@ pub fn drop_triangle(cutter: &Cutter, corners: &[Point3; 3], normal: &Vec3, tria
 /// height returned (where nothing is under the cutter).
 #[must_use]
 pub fn drop_cutter(cutter: &Cutter, index: &MeshIndex, xy: Point2, floor: f64) -> ClPoint {
+    drop_seeded(cutter, index, xy, floor, None).0
+}
+
+/// Drop-cutter that first tries the triangle in `seed` (typically the contact
+/// of the neighbouring grid point): its contact is a valid lower bound that
+/// lets the search prune from the start. Returns the slot of the contact.
+fn drop_seeded(
+    cutter: &Cutter,
+    index: &MeshIndex,
+    xy: Point2,
+    floor: f64,
+    seed: Option<usize>,
+) -> (ClPoint, Option<usize>) {
+    let profile = Profile::new(cutter.shape());
     let mut best = ClPoint::floor(xy, floor);
-    let mut bound = floor;
-    index.visit_disk(xy, cutter.radius(), &mut bound, |slot, bound| {
-        drop_triangle(cutter, index.corners(slot), index.normal(slot), index.original_index(slot), &mut best);
-        *bound = best.tip.z;
-    });
-    best
+    let mut best_slot = None;
+    if let Some(slot) = seed {
+        drop_triangle_profile(&profile, index.corners(slot), index.normal(slot), index.original_index(slot), &mut best);
+        if !matches!(best.contact, Contact::Floor) {
+            best_slot = Some(slot);
+        }
+    }
+    let mut bound = best.tip.z;
+    index.visit_disk(
+        xy,
+        cutter.radius(),
+        |d2| profile.height(d2.sqrt()),
+        &mut bound,
+        |slot, bound| {
+            let before = best.tip.z;
+            drop_triangle_profile(
+                &profile,
+                index.corners(slot),
+                index.normal(slot),
+                index.original_index(slot),
+                &mut best,
+            );
+            if best.tip.z > before {
+                best_slot = Some(slot);
+            }
+            *bound = best.tip.z;
+        },
+    );
+    (best, best_slot)
 }
 
 /// The test oracle: every triangle, no index, no pruning.
 #[must_use]
 pub fn drop_cutter_brute_force(cutter: &Cutter, index: &MeshIndex, xy: Point2, floor: f64) -> ClPoint {
+    let profile = Profile::new(cutter.shape());
     let mut best = ClPoint::floor(xy, floor);
     for slot in 0..index.len() {
-        drop_triangle(cutter, index.corners(slot), index.normal(slot), index.original_index(slot), &mut best);
+        drop_triangle_profile(&profile, index.corners(slot), index.normal(slot), index.original_index(slot), &mut best);
     }
     best
 }
@@ -135,7 +177,15 @@ pub fn drop_grid(
     let rows: Vec<Vec<ClPoint>> = ys
         .par_iter()
         .map(|&y| {
-            let row: Vec<ClPoint> = xs.iter().map(|&x| drop_cutter(cutter, index, Point2::new(x, y), floor)).collect();
+            let mut seed = None;
+            let row: Vec<ClPoint> = xs
+                .iter()
+                .map(|&x| {
+                    let (cl, slot) = drop_seeded(cutter, index, Point2::new(x, y), floor, seed);
+                    seed = slot;
+                    cl
+                })
+                .collect();
             progress(done.fetch_add(1, Ordering::Relaxed) + 1);
             row
         })

@@ -4,17 +4,10 @@
 use scallop_geom::{Point2, Point3};
 
 use super::{ClPoint, Contact};
-use crate::CutterShape;
+use crate::shape::Profile;
 
-pub(super) fn drop_vertices(
-    shape: &CutterShape,
-    radius: f64,
-    corners: &[Point3; 3],
-    triangle: usize,
-    c: Point2,
-    best: &mut ClPoint,
-) {
-    let r2 = radius * radius;
+pub(super) fn drop_vertices(profile: &Profile, corners: &[Point3; 3], triangle: usize, c: Point2, best: &mut ClPoint) {
+    let r2 = profile.radius * profile.radius;
     for p in corners {
         if p.z <= best.tip.z {
             continue;
@@ -22,7 +15,7 @@ pub(super) fn drop_vertices(
         let (dx, dy) = (p.x - c.x, p.y - c.y);
         let d2 = dx * dx + dy * dy;
         if d2 <= r2 {
-            let z = p.z - shape.height_at(d2.sqrt());
+            let z = p.z - profile.height(d2.sqrt());
             if z > best.tip.z {
                 best.tip.z = z;
                 best.contact = Contact::Vertex { triangle, point: *p };
