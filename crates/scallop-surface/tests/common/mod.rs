@@ -1,0 +1,147 @@
+//! Shared fixtures and oracles of the integration tests.
+#![allow(dead_code)]
+
+use scallop_geom::{Point3, Vec3};
+use scallop_surface::{Patch, SurfaceSet, builtin};
+
+pub fn p(x: f64, y: f64, z: f64) -> Point3 {
+    Point3::new(x, y, z)
+}
+
+/// The single patch of a built-in set.
+pub fn builtin_patch(name: &str) -> Patch {
+    builtin(name).expect("built-in exists").into_patches().remove(0)
+}
+
+/// Quarter cylinder of radius `r` and height `h` around the z axis, from +x (u = 0)
+/// to +y (u = 1): rational quadratic in u (weights 1, sqrt(2)/2, 1), linear in v.
+pub fn quarter_cylinder(r: f64, h: f64) -> Patch {
+    let w = std::f64::consts::FRAC_1_SQRT_2;
+    Patch::bezier(
+        "cylinder",
+        [2, 1],
+        &[vec![p(r, 0., 0.), p(r, 0., h)], vec![p(r, r, 0.), p(r, r, h)], vec![p(0., r, 0.), p(0., r, h)]],
+        Some(&[vec![1.0, 1.0], vec![w, w], vec![1.0, 1.0]]),
+    )
+    .expect("valid cylinder")
+}
+
+/// Rubio written as a NURBS patch: each u-column split at u = 1/2 by de Casteljau,
+/// knots [0, 0, 0, 1/2, 1/2, 1, 1, 1] (a double interior knot). Same surface.
+pub fn rubio_split_as_nurbs() -> Patch {
+    let rubio = builtin_patch("rubio");
+    let mut rows: Vec<Vec<Point3>> = vec![Vec::new(); 5];
+    for j in 0..3 {
+        let [a, b, c] = [0, 1, 2].map(|i| rubio.control_point(i, j).coords);
+        let ab = (a + b) * 0.5;
+        let bc = (b + c) * 0.5;
+        let mid = (ab + bc) * 0.5;
+        for (row, q) in rows.iter_mut().zip([a, ab, mid, bc, c]) {
+            row.push(Point3::from(q));
+        }
+    }
+    Patch::nurbs(
+        "rubio-split",
+        [2, 2],
+        [vec![0., 0., 0., 0.5, 0.5, 1., 1., 1.], vec![0., 0., 0., 1., 1., 1.]],
+        &rows,
+        None,
+    )
+    .expect("valid split")
+}
+
+/// A rational bicubic NURBS patch with interior knots, unclamped in v, on the domain
+/// [1, 3] x [knot range]; wavy and not too curved.
+pub fn rational_nurbs() -> Patch {
+    let (rows, columns) = (6, 5);
+    let control: Vec<Vec<Point3>> = (0..rows)
+        .map(|i| {
+            (0..columns)
+                .map(|j| {
+                    let (x, y) = (10.0 * i as f64, 8.0 * j as f64);
+                    p(x, y, 3.0 * ((i * 7 + j * 3) % 5) as f64)
+                })
+                .collect()
+        })
+        .collect();
+    let weights: Vec<Vec<f64>> =
+        (0..rows).map(|i| (0..columns).map(|j| 0.6 + 0.2 * ((i + 2 * j) % 4) as f64).collect()).collect();
+    let knots_u = vec![1., 1., 1., 1., 1.5, 2.25, 3., 3., 3., 3.];
+    let knots_v = vec![0., 0.5, 1., 2., 3., 4., 5., 5.5, 6.]; // unclamped, degree 3: domain [2, 4]
+    Patch::nurbs("wavy", [3, 3], [knots_u, knots_v], &control, Some(&weights)).expect("valid NURBS")
+}
+
+pub fn set_of(patches: Vec<Patch>) -> SurfaceSet {
+    SurfaceSet::new(patches).expect("valid set")
+}
+
+/// Deterministic pseudo-random numbers in [0, 1) (SplitMix64).
+pub struct Rng(u64);
+
+impl Rng {
+    pub fn new(seed: u64) -> Self {
+        Rng(seed)
+    }
+
+    pub fn next_f64(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^= z >> 31;
+        (z >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    pub fn range(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * self.next_f64()
+    }
+}
+
+/// Distance from `q` to triangle `abc` (Ericson, Real-Time Collision Detection 5.1.5).
+pub fn point_triangle_distance(q: &Point3, [a, b, c]: [Point3; 3]) -> f64 {
+    let ab = b - a;
+    let ac = c - a;
+    let ap = q - a;
+    let d1 = ab.dot(&ap);
+    let d2 = ac.dot(&ap);
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return (q - a).norm();
+    }
+    let bp = q - b;
+    let d3 = ab.dot(&bp);
+    let d4 = ac.dot(&bp);
+    if d3 >= 0.0 && d4 <= d3 {
+        return (q - b).norm();
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        let v = d1 / (d1 - d3);
+        return (q - (a + ab * v)).norm();
+    }
+    let cp = q - c;
+    let d5 = ab.dot(&cp);
+    let d6 = ac.dot(&cp);
+    if d6 >= 0.0 && d5 <= d6 {
+        return (q - c).norm();
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        let w = d2 / (d2 - d6);
+        return (q - (a + ac * w)).norm();
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return (q - (b + (c - b) * w)).norm();
+    }
+    let denom = 1.0 / (va + vb + vc);
+    let v = vb * denom;
+    let w = vc * denom;
+    (q - (a + ab * v + ac * w)).norm()
+}
+
+/// `|a - b| <= tol * max(1, |b|)`, with a message naming `what`.
+pub fn assert_vec_near(a: &Vec3, b: &Vec3, tol: f64, what: &str) {
+    let scale = b.norm().max(1.0);
+    assert!((a - b).norm() <= tol * scale, "{what}: {a:?} vs {b:?} (|diff| = {:e}, scale {scale})", (a - b).norm());
+}
