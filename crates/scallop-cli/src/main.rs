@@ -1,0 +1,67 @@
+//! `scallop`: the command-line program. Parses arguments, reads and writes
+//! files, shows progress, maps failures to exit codes (0 ok, 1 job rejected,
+//! 2 I/O or internal error). All the work is done by the libraries.
+
+mod drop;
+mod output;
+mod part;
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+/// How a command failed: the user's input was rejected, or the machine failed us.
+#[derive(Debug)]
+pub enum Failure {
+    /// Bad input or an unsafe result: exit code 1.
+    Rejected(anyhow::Error),
+    /// I/O or internal error: exit code 2.
+    Io(anyhow::Error),
+}
+
+impl Failure {
+    /// A rejection with a message.
+    pub fn rejected(msg: impl std::fmt::Display) -> Failure {
+        Failure::Rejected(anyhow::anyhow!("{msg}"))
+    }
+}
+
+/// Result of a command.
+pub type CliResult<T> = Result<T, Failure>;
+
+#[derive(Parser, Debug)]
+#[command(name = "scallop", version, about = "scallop: verified, time-efficient toolpaths for free-form surfaces")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Run the built-in demo: Choi surface, ball cutter, zigzag drop-cutter raster, plain G-code.
+    Demo(output::DemoArgs),
+    /// Drop a cutter onto a part on an XY grid and write the cutter locations as CSV.
+    Drop(drop::DropArgs),
+    /// Load a part and report what was read (size, welding, open and non-manifold edges).
+    Inspect(part::InspectArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Demo(args) => output::demo(&args),
+        Command::Drop(args) => drop::run(&args),
+        Command::Inspect(args) => part::inspect(&args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(Failure::Rejected(e)) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(1)
+        }
+        Err(Failure::Io(e)) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(2)
+        }
+    }
+}

@@ -1,0 +1,128 @@
+//! Writing results: atomic files, JSON and text on stdout, progress bars.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use clap::Args;
+use indicatif::{ProgressBar, ProgressStyle};
+use scallop_engine::{DemoSettings, run_demo};
+use serde::Serialize;
+
+use crate::{CliResult, Failure};
+
+/// Writes `bytes` to `path` atomically: a temporary file beside it, then a
+/// rename, so a failure never leaves a half-written output.
+pub fn write_atomic(
+    path: &Path,
+    write: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> std::io::Result<()>,
+) -> CliResult<()> {
+    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    std::fs::create_dir_all(dir)
+        .map_err(|e| Failure::Io(anyhow::anyhow!("{}: cannot create the folder: {e}", dir.display())))?;
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "output".into());
+    let tmp: PathBuf = dir.join(format!(".{name}.tmp-{}", std::process::id()));
+    let result = (|| -> std::io::Result<()> {
+        let file = std::fs::File::create(&tmp)?;
+        let mut w = std::io::BufWriter::new(file);
+        write(&mut w)?;
+        w.flush()?;
+        w.get_ref().sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    result.map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        Failure::Io(anyhow::anyhow!("{}: cannot write: {e}", path.display()))
+    })
+}
+
+/// Prints one JSON object on stdout.
+pub fn print_json(value: &impl Serialize) -> CliResult<()> {
+    let text = serde_json::to_string_pretty(value).map_err(|e| Failure::Io(e.into()))?;
+    print_text(&format!("{text}\n"))
+}
+
+/// Prints text on stdout; a closed pipe is not an error.
+pub fn print_text(text: &str) -> CliResult<()> {
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(Failure::Io(e.into())),
+        _ => Ok(()),
+    }
+}
+
+/// A progress bar on stderr when it is a terminal and not under CI; hidden otherwise.
+pub fn progress_bar(total: u64, what: &str) -> ProgressBar {
+    use std::io::IsTerminal;
+    let visible = std::io::stderr().is_terminal() && std::env::var_os("CI").is_none();
+    if !visible {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::new(total);
+    let style = ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} {per_sec} eta {eta}")
+        .unwrap_or_else(|_| ProgressStyle::default_bar())
+        .progress_chars("=> ");
+    bar.set_style(style);
+    bar.set_message(what.to_string());
+    bar
+}
+
+/// Arguments of `scallop demo`.
+#[derive(Args, Debug)]
+pub struct DemoArgs {
+    /// Folder for the program (`demo.nc`) and the summary (`summary.json`).
+    #[arg(short, long, default_value = "out/demo")]
+    output: PathBuf,
+    /// Print the summary as JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+/// `scallop demo`.
+pub fn demo(args: &DemoArgs) -> CliResult<()> {
+    let settings = DemoSettings::standard();
+    let bar = progress_bar(0, "drop-cutter raster");
+    let start = std::time::Instant::now();
+    let out = run_demo(&settings, &|done, total| {
+        bar.set_length(total as u64);
+        bar.set_position(done as u64);
+    })
+    .map_err(|e| Failure::Io(anyhow::anyhow!("the built-in demo failed: {e}")))?;
+    bar.finish_and_clear();
+    let seconds = start.elapsed().as_secs_f64();
+    let nc = args.output.join("demo.nc");
+    write_atomic(&nc, |w| w.write_all(out.gcode.as_bytes()))?;
+    let json = serde_json::to_string_pretty(&out.summary).map_err(|e| Failure::Io(e.into()))?;
+    write_atomic(&args.output.join("summary.json"), |w| w.write_all(json.as_bytes()))?;
+    if args.json {
+        return print_json(&out.summary);
+    }
+    let s = &out.summary;
+    let text = format!(
+        "scallop demo: finishing the built-in {part} surface\n\
+         \x20 part       {tris} triangles, within {chord:.4} mm of the surface\n\
+         \x20 cutter     {cutter}, stepover {so} mm (scallop {sc:.4} mm on a flat)\n\
+         \x20 toolpath   {passes} passes, {moves} moves, {cl} drop-cutter queries in {seconds:.2} s\n\
+         \x20 lengths    feed {feed:.0} mm, links {link:.0} mm, plunge {plunge:.0} mm, rapid {rapid:.0} mm\n\
+         \x20 tip z      {z0:.3} .. {z1:.3} mm\n\
+         \x20 time       {t:.0} s at the programmed feeds (no acceleration limits yet)\n\
+         \x20 program    {nc}\n",
+        part = s.part,
+        tris = s.triangles,
+        chord = s.chordal_error_mm,
+        cutter = s.cutter,
+        so = s.stepover_mm,
+        sc = s.flat_scallop_mm,
+        passes = s.passes,
+        moves = s.moves,
+        cl = s.cl_points_dropped,
+        feed = s.feed_length_mm,
+        link = s.link_length_mm,
+        plunge = s.plunge_length_mm,
+        rapid = s.rapid_length_mm,
+        z0 = s.tip_z_range_mm[0],
+        z1 = s.tip_z_range_mm[1],
+        t = s.naive_time_s,
+        nc = nc.display(),
+    );
+    print_text(&text)
+}

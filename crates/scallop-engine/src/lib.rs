@@ -1,0 +1,95 @@
+//! The API boundary of scallop: a part (mesh or parametric surfaces) and the
+//! machining settings in, cutter locations, toolpaths, G-code text and
+//! reports out. Orchestration only: the geometry lives in the crates below.
+//!
+//! ```
+//! use scallop_engine::{Part, prepare_part};
+//! use scallop_geom::Tolerances;
+//! let part = Part::builtin("choi").unwrap();
+//! let prepared = prepare_part(&part, &Tolerances { path: 0.01, gouge: 0.0 }).unwrap();
+//! assert!(prepared.chordal_error <= 0.0025 + 1e-12);
+//! ```
+//!
+//! # Invariants
+//! - Never performs I/O and never prints; progress goes through callbacks.
+//! - Deterministic: the same inputs give the same outputs on any thread count.
+
+mod demo;
+mod grid;
+
+use scallop_geom::Tolerances;
+use scallop_mesh::{MeshIndex, TriMesh};
+use scallop_surface::SurfaceSet;
+
+pub use demo::{DemoOutput, DemoSettings, DemoSummary, run_demo};
+pub use grid::{GridAxis, GridError, MAX_GRID_POINTS};
+
+/// Why the engine rejected a request. Each variant says the cause and the fix.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum EngineError {
+    /// Surfaces could not be tessellated within the tolerance.
+    #[error("tessellating the surfaces failed: {0}")]
+    Surface(#[from] scallop_surface::SurfaceError),
+    /// A tolerance that is not a finite positive number.
+    #[error("the path tolerance {0} mm must be a finite number > 0")]
+    BadTolerance(f64),
+    /// A cutter that is not a real tool.
+    #[error("cutter: {0}")]
+    Cutter(#[from] scallop_cutter::CutterError),
+    /// A grid that makes no sense.
+    #[error("{0}")]
+    Grid(#[from] GridError),
+}
+
+/// A part to machine.
+#[derive(Debug, Clone)]
+pub enum Part {
+    /// A triangle mesh (mm).
+    Mesh(TriMesh),
+    /// Parametric patches (mm).
+    Surfaces(SurfaceSet),
+}
+
+impl Part {
+    /// A built-in part by name (`choi`, `rubio`: the Bezier test surfaces of the finishing spec).
+    #[must_use]
+    pub fn builtin(name: &str) -> Option<Part> {
+        scallop_surface::builtin(name).map(Part::Surfaces)
+    }
+}
+
+/// A part ready for drop-cutter queries.
+#[derive(Debug, Clone)]
+pub struct PreparedPart {
+    /// The mesh the queries run on (the part itself, or its tessellation).
+    pub mesh: TriMesh,
+    /// The XY index of `mesh`.
+    pub index: MeshIndex,
+    /// Largest distance between the true part and `mesh` (mm): 0 for a mesh part,
+    /// the tessellation's chordal bound for surfaces. Drop-cutter heights on the
+    /// mesh are within this of the heights on the true surface.
+    pub chordal_error: f64,
+    /// Whether `chordal_error` is proven (polynomial patches) or estimated.
+    pub chordal_error_guaranteed: bool,
+}
+
+/// Prepares a part: surfaces are tessellated within `tol.tessellation()` (the
+/// share of the path tolerance budgeted for it), then indexed.
+///
+/// # Errors
+/// A bad tolerance or a surface that cannot be tessellated that finely.
+pub fn prepare_part(part: &Part, tol: &Tolerances) -> Result<PreparedPart, EngineError> {
+    if !(tol.path.is_finite() && tol.path > 0.0) {
+        return Err(EngineError::BadTolerance(tol.path));
+    }
+    let (mesh, chordal_error, guaranteed) = match part {
+        Part::Mesh(mesh) => (mesh.clone(), 0.0, true),
+        Part::Surfaces(set) => {
+            let t = set.tessellate(tol.tessellation())?;
+            (t.mesh, t.chordal_bound, t.guaranteed)
+        }
+    };
+    let index = MeshIndex::build(&mesh);
+    Ok(PreparedPart { mesh, index, chordal_error, chordal_error_guaranteed: guaranteed })
+}

@@ -1,0 +1,162 @@
+//! The toolpath intermediate representation: moves of the tool tip in the
+//! part frame (mm, mm/min), with their kind, and simple measures.
+//!
+//! ```
+//! use scallop_geom::Point3;
+//! use scallop_toolpath::{Move, MoveKind, Toolpath};
+//! let mut path = Toolpath::new(1000.0);
+//! path.push(Move::new(MoveKind::Rapid, Point3::new(0.0, 0.0, 10.0)));
+//! path.push(Move::new(MoveKind::Plunge, Point3::new(0.0, 0.0, 0.0)));
+//! path.push(Move::new(MoveKind::Feed, Point3::new(3.0, 4.0, 0.0)));
+//! assert_eq!(path.length(MoveKind::Feed), 5.0);
+//! ```
+//!
+//! # Invariants
+//! - Never performs I/O. Coordinates are finite (checked by [`Toolpath::push`] in debug builds).
+//! - The tool axis is +Z (3-axis); multi-axis poses come with the machine layer.
+
+use scallop_geom::Point3;
+
+/// What a move is for; decides how it is emitted and coloured.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum MoveKind {
+    /// Positioning at rapid rate, out of the material.
+    Rapid,
+    /// Descent into the material at the plunge feed.
+    Plunge,
+    /// Cutting move at the cutting feed.
+    Feed,
+    /// Connection between passes at cutting feed, on the CL surface.
+    Link,
+    /// Retract to the clearance height (emitted at rapid rate).
+    Retract,
+}
+
+/// One straight move of the tool tip to `to`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Move {
+    /// Kind of move.
+    pub kind: MoveKind,
+    /// End point of the tool tip (mm, part frame).
+    pub to: Point3,
+}
+
+impl Move {
+    /// A move of `kind` to `to`.
+    #[must_use]
+    pub fn new(kind: MoveKind, to: Point3) -> Move {
+        Move { kind, to }
+    }
+}
+
+/// A sequence of moves from an unspecified start (the first move is a rapid in practice).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Toolpath {
+    /// Cutting feed (mm/min).
+    pub feed: f64,
+    /// Plunge feed (mm/min).
+    pub plunge_feed: f64,
+    moves: Vec<Move>,
+}
+
+impl Toolpath {
+    /// An empty toolpath with the cutting feed; the plunge feed is half of it.
+    #[must_use]
+    pub fn new(feed: f64) -> Toolpath {
+        Toolpath { feed, plunge_feed: 0.5 * feed, moves: Vec::new() }
+    }
+
+    /// Appends a move.
+    pub fn push(&mut self, m: Move) {
+        debug_assert!(m.to.coords.iter().all(|c| c.is_finite()), "non-finite move {m:?}");
+        self.moves.push(m);
+    }
+
+    /// The moves.
+    #[must_use]
+    pub fn moves(&self) -> &[Move] {
+        &self.moves
+    }
+
+    /// Total length of the moves of `kind` (mm); the first move has no length.
+    #[must_use]
+    pub fn length(&self, kind: MoveKind) -> f64 {
+        self.moves.windows(2).filter(|w| w[1].kind == kind).map(|w| (w[1].to - w[0].to).norm()).sum()
+    }
+
+    /// Number of moves of `kind`.
+    #[must_use]
+    pub fn count(&self, kind: MoveKind) -> usize {
+        self.moves.iter().filter(|m| m.kind == kind).count()
+    }
+}
+
+/// Removes interior points of a polyline whose removal keeps every removed
+/// point within `max_deviation` of the kept chord (Douglas-Peucker, iterative,
+/// endpoints kept). Returns the indices kept, in order.
+///
+/// ```
+/// use scallop_geom::Point3;
+/// let line: Vec<Point3> = (0..10).map(|i| Point3::new(f64::from(i), 0.0, 0.0)).collect();
+/// assert_eq!(scallop_toolpath::simplify(&line, 1e-9), vec![0, 9]);
+/// ```
+#[must_use]
+pub fn simplify(points: &[Point3], max_deviation: f64) -> Vec<usize> {
+    let n = points.len();
+    if n <= 2 {
+        return (0..n).collect();
+    }
+    let mut keep = vec![false; n];
+    keep[0] = true;
+    keep[n - 1] = true;
+    let mut stack = vec![(0usize, n - 1)];
+    while let Some((a, b)) = stack.pop() {
+        let (pa, pb) = (points[a], points[b]);
+        let ab = pb - pa;
+        let len2 = ab.norm_squared();
+        let mut worst = (0.0f64, a);
+        for (k, p) in points.iter().enumerate().take(b).skip(a + 1) {
+            let ap = p - pa;
+            let d = if len2 > 0.0 {
+                let t = (ap.dot(&ab) / len2).clamp(0.0, 1.0);
+                (ap - ab * t).norm()
+            } else {
+                ap.norm()
+            };
+            if d > worst.0 {
+                worst = (d, k);
+            }
+        }
+        if worst.0 > max_deviation {
+            keep[worst.1] = true;
+            stack.push((a, worst.1));
+            stack.push((worst.1, b));
+        }
+    }
+    (0..n).filter(|&i| keep[i]).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn simplify_keeps_deviation_within_budget() {
+        let pts: Vec<Point3> =
+            (0..200).map(|i| f64::from(i) * 0.05).map(|x| Point3::new(x, 0.0, (x * 1.3).sin())).collect();
+        let tol = 0.01;
+        let kept = simplify(&pts, tol);
+        assert!(kept.len() < pts.len() / 2);
+        for w in kept.windows(2) {
+            let (a, b) = (pts[w[0]], pts[w[1]]);
+            for p in &pts[w[0]..=w[1]] {
+                let ab = b - a;
+                let t = ((p - a).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0);
+                assert!((p - a - ab * t).norm() <= tol + 1e-12);
+            }
+        }
+        // idempotent
+        let again: Vec<Point3> = kept.iter().map(|&i| pts[i]).collect();
+        assert_eq!(simplify(&again, tol).len(), again.len());
+    }
+}
