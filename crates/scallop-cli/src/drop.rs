@@ -39,16 +39,16 @@ pub struct DropArgs {
     #[arg(long, value_enum)]
     cutter: CutterArg,
     /// Cutter diameter D (mm).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     diameter: f64,
     /// Corner radius r of a bull-nose cutter (mm), 0 < r <= D/2.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     corner_radius: Option<f64>,
     /// Included tip angle of a cone cutter (degrees), 0 < angle < 180.
-    #[arg(long, default_value_t = 90.0)]
+    #[arg(long, default_value_t = 90.0, allow_hyphen_values = true)]
     angle: f64,
     /// Flute length (mm); default 4 D or the cone's height if longer.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     flute_length: Option<f64>,
     /// X samples MIN:MAX:STEP (mm).
     #[arg(long, allow_hyphen_values = true)]
@@ -66,7 +66,7 @@ pub struct DropArgs {
     #[arg(long, value_enum, default_value = "mm")]
     units: UnitsArg,
     /// Path tolerance (mm); a quarter of it is the tessellation budget for surfaces.
-    #[arg(long, default_value_t = 0.01)]
+    #[arg(long, default_value_t = 0.01, allow_hyphen_values = true)]
     tolerance: f64,
     /// Output CSV (`x,y,z` rows, x fastest).
     #[arg(short, long)]

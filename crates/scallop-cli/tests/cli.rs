@@ -1,0 +1,204 @@
+//! Smoke tests of the `scallop` binary: outputs, exit codes, bad input.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn scallop() -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_scallop"));
+    c.env("CI", "true");
+    c
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("scallop-cli-test-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("scratch dir");
+    dir
+}
+
+/// A binary STL of a 10 x 10 pyramid of height 5 (4 faces).
+fn pyramid_stl() -> Vec<u8> {
+    let apex = [5.0f32, 5.0, 5.0];
+    let base = [[0.0f32, 0.0, 0.0], [10.0, 0.0, 0.0], [10.0, 10.0, 0.0], [0.0, 10.0, 0.0]];
+    let mut out = vec![0u8; 80];
+    out.extend_from_slice(&4u32.to_le_bytes());
+    for k in 0..4 {
+        out.extend_from_slice(&[0u8; 12]);
+        for p in [base[k], base[(k + 1) % 4], apex] {
+            for c in p {
+                out.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+        out.extend_from_slice(&[0u8; 2]);
+    }
+    out
+}
+
+#[test]
+fn demo_writes_a_program() {
+    let dir = scratch("demo");
+    let out = scallop().args(["demo", "-o"]).arg(&dir).output().expect("run");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let nc = std::fs::read_to_string(dir.join("demo.nc")).expect("demo.nc");
+    assert!(nc.lines().filter(|l| l.starts_with("G1")).count() > 1000);
+    assert!(String::from_utf8_lossy(&out.stdout).contains("passes"));
+}
+
+#[test]
+fn drop_writes_the_grid_x_fastest_and_is_thread_independent() {
+    let dir = scratch("drop");
+    std::fs::write(dir.join("p.stl"), pyramid_stl()).expect("write");
+    let run = |threads: &str, name: &str| {
+        let out = scallop()
+            .current_dir(&dir)
+            .args(["drop", "--mesh", "p.stl", "--cutter", "bull", "--diameter", "2", "--corner-radius", "0.5"])
+            .args(["--x=-1:11:0.5", "--y=0:10:1", "--floor=-1", "--threads", threads, "-o", name, "--json"])
+            .output()
+            .expect("run");
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let report: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
+        assert_eq!(report["points"], 25 * 11);
+        std::fs::read_to_string(dir.join(name)).expect("csv")
+    };
+    let one = run("1", "a.csv");
+    let two = run("2", "b.csv");
+    assert_eq!(one, two);
+    let rows: Vec<&str> = one.lines().collect();
+    assert_eq!(rows[0], "x,y,z");
+    assert_eq!(rows.len(), 1 + 25 * 11);
+    assert!(rows[1].starts_with("-1,0,"), "{}", rows[1]);
+    assert!(rows[2].starts_with("-0.5,0,"), "{}", rows[2]);
+    // At the apex the bull-nose's flat bottom rests on the apex: z = 5.
+    let apex = rows.iter().find(|r| r.starts_with("5,5,")).expect("apex row");
+    assert_eq!(*apex, "5,5,5");
+}
+
+fn assert_rejected(args: &[&str], dir: &PathBuf, needle: &str) {
+    let out = scallop().current_dir(dir).args(args).output().expect("run");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+    assert!(err.contains(needle), "{args:?}: '{err}' lacks '{needle}'");
+    assert!(!err.contains("panicked"), "{err}");
+}
+
+#[test]
+fn bad_input_is_rejected_with_the_place_and_no_output() {
+    let dir = scratch("bad");
+    let stl = pyramid_stl();
+    std::fs::write(dir.join("short.stl"), &stl[..stl.len() - 7]).expect("write");
+    std::fs::write(dir.join("nan.stl"), b"solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex nan 0 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid x\n").expect("write");
+    std::fs::write(dir.join("ok.stl"), &stl).expect("write");
+    std::fs::write(dir.join("knots.toml"), "units = \"mm\"\n[[patch]]\nname = \"p\"\nkind = \"nurbs\"\ndegree = [1, 1]\ncontrol = [[[0,0,0],[0,1,0]],[[1,0,0],[1,1,0]]]\nknots_u = [0, 1, 0, 1]\nknots_v = [0, 0, 1, 1]\n").expect("write");
+    let grid = ["--x", "0:1:0.5", "--y", "0:1:0.5", "-o", "out.csv"];
+    let with = |extra: &[&'static str]| -> Vec<&'static str> {
+        let mut v: Vec<&'static str> = vec!["drop", "--cutter", "ball", "--diameter", "1"];
+        v.extend_from_slice(extra);
+        v.extend_from_slice(&grid);
+        v
+    };
+    assert_rejected(&with(&["--mesh", "short.stl"]), &dir, "short.stl");
+    assert_rejected(&with(&["--mesh", "nan.stl"]), &dir, "line 5");
+    assert_rejected(&with(&["--mesh", "missing.stl"]), &dir, "missing.stl");
+    assert_rejected(&with(&["--mesh", "notes.txt"]), &dir, "unknown part format");
+    assert_rejected(&with(&["--surface", "knots.toml"]), &dir, "knots.toml");
+    assert_rejected(
+        &[
+            "drop",
+            "--mesh",
+            "ok.stl",
+            "--cutter",
+            "bull",
+            "--diameter",
+            "1",
+            "--x",
+            "0:1:0.5",
+            "--y",
+            "0:1:0.5",
+            "-o",
+            "out.csv",
+        ],
+        &dir,
+        "--corner-radius",
+    );
+    assert_rejected(
+        &[
+            "drop",
+            "--mesh",
+            "ok.stl",
+            "--cutter",
+            "ball",
+            "--diameter",
+            "-1",
+            "--x",
+            "0:1:0.5",
+            "--y",
+            "0:1:0.5",
+            "-o",
+            "out.csv",
+        ],
+        &dir,
+        "--diameter",
+    );
+    assert_rejected(
+        &[
+            "drop",
+            "--mesh",
+            "ok.stl",
+            "--cutter",
+            "ball",
+            "--diameter",
+            "1",
+            "--x",
+            "0:1:0",
+            "--y",
+            "0:1:0.5",
+            "-o",
+            "out.csv",
+        ],
+        &dir,
+        "--x",
+    );
+    assert_rejected(
+        &[
+            "drop",
+            "--mesh",
+            "ok.stl",
+            "--cutter",
+            "ball",
+            "--diameter",
+            "1",
+            "--x",
+            "0:1e12:1e-6",
+            "--y",
+            "0:1:0.5",
+            "-o",
+            "out.csv",
+        ],
+        &dir,
+        "larger STEP",
+    );
+    assert!(!dir.join("out.csv").exists(), "a rejected job must not leave an output file");
+    assert!(
+        std::fs::read_dir(&dir).expect("dir").all(|e| !e
+            .expect("entry")
+            .file_name()
+            .to_string_lossy()
+            .contains(".tmp-"))
+    );
+}
+
+#[test]
+fn inspect_reports_mesh_diagnostics() {
+    let dir = scratch("inspect");
+    std::fs::write(dir.join("p.stl"), pyramid_stl()).expect("write");
+    let out = scallop().current_dir(&dir).args(["inspect", "p.stl", "--json"]).output().expect("run");
+    assert!(out.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
+    assert_eq!(v["triangles"], 4);
+    assert_eq!(v["vertices"], 5);
+    assert_eq!(v["boundary_edges"], 4);
+    let inches =
+        scallop().current_dir(&dir).args(["inspect", "p.stl", "--units", "in", "--json"]).output().expect("run");
+    let v: serde_json::Value = serde_json::from_slice(&inches.stdout).expect("json");
+    assert_eq!(v["bounds_max"][0], 254.0);
+}
