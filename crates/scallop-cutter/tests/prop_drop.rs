@@ -85,6 +85,21 @@ proptest! {
     }
 
     #[test]
+    fn grid_equals_brute_force(soup in soup_strategy(80), shape in shape_strategy(),
+                               x0 in -3.0f64..3.0, step in 0.05f64..1.5, y0 in -3.0f64..3.0) {
+        let Some((_, index)) = build(&soup) else { return Ok(()) };
+        let c = cutter(shape);
+        let xs: Vec<f64> = (0..40).map(|i| x0 + step * f64::from(i)).collect();
+        let ys: Vec<f64> = (0..8).map(|j| y0 + 1.7 * f64::from(j)).collect();
+        let grid = drop_grid(&c, &index, &xs, &ys, FLOOR, &|_| {});
+        for (k, cl) in grid.iter().enumerate() {
+            let xy = Point2::new(xs[k % xs.len()], ys[k / xs.len()]);
+            let slow = drop_cutter_brute_force(&c, &index, xy, FLOOR);
+            prop_assert_eq!(cl.tip.z.to_bits(), slow.tip.z.to_bits(), "at {:?}: {:?} vs {:?}", xy, cl, slow);
+        }
+    }
+
+    #[test]
     fn no_gouge_and_touches(soup in soup_strategy(12), shape in shape_strategy(),
                             pts in prop::collection::vec((-1.0f64..11.0, -1.0f64..11.0), 1..6)) {
         let Some((mesh, index)) = build(&soup) else { return Ok(()) };

@@ -29,6 +29,7 @@ pub struct MeshIndex {
     normals: Vec<Vec3>,
     zmax: Vec<f64>,
     original: Vec<u32>,
+    owned: Vec<u8>,
     bounds: scallop_geom::Aabb3,
     /// Added to every upper bound so that rounding in a contact computation can
     /// never make pruning skip a triangle that would win by a few ulps.
@@ -67,7 +68,8 @@ impl MeshIndex {
             .collect();
         let zmax = corners.iter().map(|t| t[0].z.max(t[1].z).max(t[2].z)).collect();
         let slack = scallop_geom::tol::REL_PRUNE_SLACK * mesh.bounds().max_abs_coord().max(1.0);
-        MeshIndex { nodes, corners, normals, zmax, original: order, bounds: mesh.bounds(), slack }
+        let owned = ownership(mesh, &order);
+        MeshIndex { nodes, corners, normals, zmax, original: order, owned, bounds: mesh.bounds(), slack }
     }
 
     /// Number of triangles.
@@ -112,6 +114,62 @@ impl MeshIndex {
         self.original[slot] as usize
     }
 
+    /// Which corners and edges of the triangle in `slot` it owns: bit k
+    /// (k = 0, 1, 2) for corner k, bit 3 + k for the edge from corner k to
+    /// corner k + 1 (mod 3). Every vertex and edge of the mesh is owned by
+    /// exactly one triangle that contains it (the first in slot order), so a
+    /// search that tests only owned features tests each once; it stays exact
+    /// because the owner's bounds cover the feature.
+    #[must_use]
+    pub fn owned_features(&self, slot: usize) -> u8 {
+        self.owned[slot]
+    }
+
+    /// Appends to `out` every slot whose triangle's XY box meets `query`
+    /// (closed test), in leaf order.
+    pub fn collect_box(&self, query: &Aabb2, out: &mut Vec<u32>) {
+        let mut stack: [u32; 64] = [0; 64];
+        let mut top = 1usize;
+        while top > 0 {
+            top -= 1;
+            let id = stack[top];
+            let node = &self.nodes[id as usize];
+            let b = Aabb2 { min: Point2::new(node.min[0], node.min[1]), max: Point2::new(node.max[0], node.max[1]) };
+            if !b.overlaps(query) {
+                continue;
+            }
+            if node.count > 0 {
+                let first = node.first_or_right as usize;
+                for slot in first..first + node.count as usize {
+                    if self.xy_box(slot).overlaps(query) {
+                        out.push(u32::try_from(slot).unwrap_or(u32::MAX));
+                    }
+                }
+            } else {
+                stack[top] = node.first_or_right;
+                stack[top + 1] = id + 1;
+                top += 2;
+            }
+        }
+    }
+
+    /// XY bounding box of the triangle in `slot`.
+    #[must_use]
+    pub fn xy_box(&self, slot: usize) -> Aabb2 {
+        let t = &self.corners[slot];
+        Aabb2 {
+            min: Point2::new(t[0].x.min(t[1].x).min(t[2].x), t[0].y.min(t[1].y).min(t[2].y)),
+            max: Point2::new(t[0].x.max(t[1].x).max(t[2].x), t[0].y.max(t[1].y).max(t[2].y)),
+        }
+    }
+
+    /// The slack added to every upper bound by the searches (mm); callers that
+    /// prune on their own use the same.
+    #[must_use]
+    pub fn slack(&self) -> f64 {
+        self.slack
+    }
+
     /// Branch-and-bound search for the highest cutter location over the disk of
     /// `radius` around `center`. `lift(d2)` must be a lower bound of how far the
     /// cutter's profile rises above its tip at squared horizontal distance
@@ -154,12 +212,7 @@ impl MeshIndex {
                     if self.zmax[slot] + self.slack <= *bound {
                         continue;
                     }
-                    let t = &self.corners[slot];
-                    let tb = Aabb2 {
-                        min: Point2::new(t[0].x.min(t[1].x).min(t[2].x), t[0].y.min(t[1].y).min(t[2].y)),
-                        max: Point2::new(t[0].x.max(t[1].x).max(t[2].x), t[0].y.max(t[1].y).max(t[2].y)),
-                    };
-                    let d2 = tb.distance_squared(&center);
+                    let d2 = self.xy_box(slot).distance_squared(&center);
                     if d2 <= r2 && self.zmax[slot] - lift(d2) + self.slack > *bound {
                         visit(slot, bound);
                     }
@@ -183,6 +236,31 @@ impl MeshIndex {
             }
         }
     }
+}
+
+/// Ownership masks, see [`MeshIndex::owned_features`].
+fn ownership(mesh: &TriMesh, order: &[u32]) -> Vec<u8> {
+    let mut vertex_owned = vec![false; mesh.vertices().len()];
+    let mut edges: std::collections::BTreeSet<(u32, u32)> = std::collections::BTreeSet::new();
+    order
+        .iter()
+        .map(|&t| {
+            let tri = mesh.triangles()[t as usize];
+            let mut mask = 0u8;
+            for k in 0..3 {
+                let v = tri[k] as usize;
+                if !vertex_owned[v] {
+                    vertex_owned[v] = true;
+                    mask |= 1 << k;
+                }
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                if edges.insert((a.min(b), a.max(b))) {
+                    mask |= 1 << (3 + k);
+                }
+            }
+            mask
+        })
+        .collect()
 }
 
 fn build_node(

@@ -60,8 +60,23 @@ pub(super) fn drop_edge(profile: &Profile, a: &Point3, b: &Point3, triangle: usi
     if z_at(lo).max(z_at(hi)) - profile.height(d) <= best.tip.z {
         return;
     }
-    let x_c = maximiser(profile, m.abs(), d, x_r);
-    let x = (if m < 0.0 { -x_c } else { x_c }).clamp(lo, hi);
+    let x = if matches!(profile.shape, CutterShape::Bull { .. }) && m != 0.0 {
+        // Mirror so that the edge rises with x, solve, mirror back.
+        let (l, h) = if m > 0.0 { (lo, hi) } else { (-hi, -lo) };
+        match bull_edge(profile, m.abs(), d, l, h, z_at(0.0), best.tip.z) {
+            Some(x) => {
+                if m > 0.0 {
+                    x
+                } else {
+                    -x
+                }
+            }
+            None => return,
+        }
+    } else {
+        let x_c = maximiser(profile, m.abs(), d, x_r);
+        (if m < 0.0 { -x_c } else { x_c }).clamp(lo, hi)
+    };
     let zc = z_at(x);
     let tip = zc - profile.height((x * x + d * d).sqrt());
     if tip > best.tip.z {
@@ -90,10 +105,64 @@ fn maximiser(profile: &Profile, m: f64, d: f64, x_r: f64) -> f64 {
             if m == 0.0 {
                 0.0
             } else {
-                bull_maximiser(profile.flat_radius, profile.corner, m, d, x_r)
+                let (a, r) = (profile.flat_radius, profile.corner);
+                bull_maximiser(a, r, m, d, (d - a).max(0.0), r, 0.5 * ((d - a).max(0.0) + r)).min(x_r)
             }
         }
     }
+}
+
+/// Slope of g(x) = m x - h(rho(x)) for the bull-nose: m - h'(rho) x / rho
+/// (+inf or -inf where h' is infinite, at rho = R).
+fn bull_slope(a: f64, r: f64, m: f64, d: f64, x: f64) -> f64 {
+    let rho = (x * x + d * d).sqrt();
+    let s = rho - a;
+    if s <= 0.0 || rho == 0.0 {
+        return m;
+    }
+    let q = r * r - s * s;
+    if q <= 0.0 {
+        return if x > 0.0 { f64::NEG_INFINITY } else { f64::INFINITY };
+    }
+    m - s / q.sqrt() * x / rho
+}
+
+/// The maximiser of g(x) = m x - h(rho(x)) on [l, h] for a bull-nose and
+/// m > 0, or `None` when even an upper bound of the contact height
+/// `z0 + max g` cannot beat `best`. Concavity gives both shortcuts:
+/// g' >= 0 at h or g' <= 0 at l puts the maximum at that end; otherwise the two
+/// end tangents lie above g and meet above its maximum (the bound), and their
+/// crossing is a good first guess for the root finder.
+fn bull_edge(profile: &Profile, m: f64, d: f64, l: f64, h: f64, z0: f64, best: f64) -> Option<f64> {
+    let (a, r) = (profile.flat_radius, profile.corner);
+    let slope_h = bull_slope(a, r, m, d, h);
+    if slope_h >= 0.0 {
+        return Some(h);
+    }
+    let slope_l = bull_slope(a, r, m, d, l);
+    if slope_l <= 0.0 {
+        return Some(l);
+    }
+    let g = |x: f64| m * x - profile.height((x * x + d * d).sqrt());
+    let (g_l, g_h) = (g(l), g(h));
+    let (bound, guess) = match (slope_l.is_finite(), slope_h.is_finite()) {
+        (true, true) => {
+            let x = ((g_h - g_l + slope_l * l - slope_h * h) / (slope_l - slope_h)).clamp(l, h);
+            (g_l + slope_l * (x - l), x)
+        }
+        (true, false) => (g_l + slope_l * (h - l), h),
+        (false, true) => (g_h + slope_h * (l - h), l),
+        (false, false) => (f64::INFINITY, 0.5 * (l + h)),
+    };
+    let slack = tol::REL_PRUNE_SLACK * (z0.abs() + best.abs() + profile.radius + 1.0);
+    if z0 + bound + slack <= best {
+        return None;
+    }
+    let s_of = |x: f64| ((x * x + d * d).sqrt() - a).clamp(0.0, r);
+    // The root has x > 0 (g' > 0 for x <= 0) and lies in (l, h).
+    let (s_lo, s_hi) = (s_of(l.max(0.0)), s_of(h));
+    let x = bull_maximiser(a, r, m, d, s_lo, s_hi, s_of(guess.max(0.0)));
+    Some(x.clamp(l, h))
 }
 
 /// Solves h'(rho) x / rho = m on the corner of the bull-nose, without
@@ -106,16 +175,18 @@ fn maximiser(profile: &Profile, m: f64, d: f64, x_r: f64) -> f64 {
 /// ```
 ///
 /// so P changes sign exactly once on [s_0, r] (P(s_0) <= 0 <= P(r)), where
-/// s_0 = max(0, d - a). Newton steps kept inside a shrinking bracket.
-fn bull_maximiser(a: f64, r: f64, m: f64, d: f64, x_r: f64) -> f64 {
+/// s_0 = max(0, d - a). Newton steps kept inside a shrinking bracket
+/// [`s_lo`, `s_hi`] (narrowed by the caller where it knows more), from `s_start`.
+/// Returns x >= 0.
+fn bull_maximiser(a: f64, r: f64, m: f64, d: f64, s_lo: f64, s_hi: f64, s_start: f64) -> f64 {
     let m2 = m * m;
     let (r2, d2) = (r * r, d * d);
-    let (mut lo, mut hi) = ((d - a).max(0.0), r);
-    if hi <= lo {
-        return x_r;
-    }
+    let (mut lo, mut hi) = (s_lo, s_hi);
     let tol = tol::PARAMETER_CONVERGENCE * r;
-    let mut s = 0.5 * (lo + hi);
+    let mut s = if s_start > lo && s_start < hi { s_start } else { 0.5 * (lo + hi) };
+    if hi <= lo {
+        s = hi;
+    }
     for _ in 0..MAX_ITERATIONS {
         let rho = a + s;
         let (rho2, s2) = (rho * rho, s * s);
@@ -136,7 +207,7 @@ fn bull_maximiser(a: f64, r: f64, m: f64, d: f64, x_r: f64) -> f64 {
         }
     }
     let rho = a + s;
-    (rho * rho - d2).max(0.0).sqrt().min(x_r)
+    (rho * rho - d2).max(0.0).sqrt()
 }
 
 #[cfg(test)]

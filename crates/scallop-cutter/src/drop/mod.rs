@@ -23,7 +23,7 @@ mod vertex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use rayon::prelude::*;
-use scallop_geom::{Point2, Point3, Vec3};
+use scallop_geom::{Aabb2, Point2, Point3, Vec3};
 use scallop_mesh::MeshIndex;
 
 use crate::Cutter;
@@ -83,12 +83,28 @@ pub fn drop_triangle(cutter: &Cutter, corners: &[Point3; 3], normal: &Vec3, tria
 
 #[inline]
 fn drop_triangle_profile(profile: &Profile, corners: &[Point3; 3], normal: &Vec3, triangle: usize, best: &mut ClPoint) {
+    drop_features(profile, corners, normal, triangle, ALL_FEATURES, best);
+}
+
+/// All corners and edges: see [`MeshIndex::owned_features`] for the bits.
+const ALL_FEATURES: u8 = 0b11_1111;
+
+/// The contacts of one triangle, its corners and edges restricted to `features`.
+#[inline]
+fn drop_features(
+    profile: &Profile,
+    corners: &[Point3; 3],
+    normal: &Vec3,
+    triangle: usize,
+    features: u8,
+    best: &mut ClPoint,
+) {
     let c = Point2::new(best.tip.x, best.tip.y);
-    vertex::drop_vertices(profile, corners, triangle, c, best);
+    vertex::drop_vertices(profile, corners, features, triangle, c, best);
     facet::drop_facet(profile, corners, normal, triangle, c, best);
     for k in 0..3 {
         let (a, b) = (&corners[k], &corners[(k + 1) % 3]);
-        if a.z.max(b.z) > best.tip.z {
+        if features & (1 << (3 + k)) != 0 && a.z.max(b.z) > best.tip.z {
             edge::drop_edge(profile, a, b, triangle, c, best);
         }
     }
@@ -164,6 +180,12 @@ pub fn drop_points(cutter: &Cutter, index: &MeshIndex, points: &[Point2], floor:
 
 /// Drop-cutter on the grid `xs` x `ys`, row-major with x fastest, in parallel
 /// over rows. `progress(rows_done)` is called after each row (from any thread).
+///
+/// Each row is cut into blocks of neighbouring points that share one candidate
+/// list (the triangles whose XY box meets the block's reach), sorted by an
+/// upper bound of what each can give anywhere in the block: a point scans it until no remaining triangle can rise above its
+/// current best, seeded with the previous point's contact triangle. The
+/// result equals [`drop_cutter`] at every point, bit for bit.
 #[must_use]
 pub fn drop_grid(
     cutter: &Cutter,
@@ -174,21 +196,112 @@ pub fn drop_grid(
     progress: &(dyn Fn(usize) + Sync),
 ) -> Vec<ClPoint> {
     let done = AtomicUsize::new(0);
+    let profile = Profile::new(cutter.shape());
+    let radius = profile.radius;
     let rows: Vec<Vec<ClPoint>> = ys
         .par_iter()
-        .map(|&y| {
+        .map_init(Vec::new, |scratch: &mut Vec<Candidate>, &y| {
+            let mut row = Vec::with_capacity(xs.len());
             let mut seed = None;
-            let row: Vec<ClPoint> = xs
-                .iter()
-                .map(|&x| {
-                    let (cl, slot) = drop_seeded(cutter, index, Point2::new(x, y), floor, seed);
+            let mut slots = Vec::new();
+            let mut start = 0;
+            while start < xs.len() {
+                // A block spans about one cutter diameter (at most BLOCK_POINTS points).
+                let mut end = start + 1;
+                while end < xs.len() && end - start < BLOCK_POINTS && (xs[end] - xs[start]).abs() <= 2.0 * radius {
+                    end += 1;
+                }
+                let (x0, x1) = (xs[start].min(xs[end - 1]), xs[start].max(xs[end - 1]));
+                let reach =
+                    Aabb2 { min: Point2::new(x0 - radius, y - radius), max: Point2::new(x1 + radius, y + radius) };
+                slots.clear();
+                index.collect_box(&reach, &mut slots);
+                scratch.clear();
+                // Bound valid for every point of the block: the triangle's top lifted by
+                // the profile at its distance to the block's segment [x0, x1] x {y}.
+                let segment = Aabb2 { min: Point2::new(x0, y), max: Point2::new(x1, y) };
+                scratch.extend(slots.iter().map(|&slot| {
+                    let slot = slot as usize;
+                    let b = index.xy_box(slot);
+                    let zmax = index.zmax(slot);
+                    let dx = (b.min.x - segment.max.x).max(0.0).max(segment.min.x - b.max.x);
+                    let dy = (b.min.y - y).max(0.0).max(y - b.max.y);
+                    let d2 = (dx * dx + dy * dy).min(radius * radius);
+                    let ub = zmax - profile.height(d2.sqrt());
+                    Candidate { ub, zmax, min: [b.min.x, b.min.y], max: [b.max.x, b.max.y], slot }
+                }));
+                scratch.sort_unstable_by(|a, b| b.ub.total_cmp(&a.ub).then(a.slot.cmp(&b.slot)));
+                for &x in &xs[start..end] {
+                    let (cl, slot) = drop_candidates(&profile, index, scratch, Point2::new(x, y), floor, seed);
                     seed = slot;
-                    cl
-                })
-                .collect();
+                    row.push(cl);
+                }
+                start = end;
+            }
             progress(done.fetch_add(1, Ordering::Relaxed) + 1);
             row
         })
         .collect();
     rows.into_iter().flatten().collect()
+}
+
+/// Most points sharing one candidate list.
+const BLOCK_POINTS: usize = 64;
+
+/// A triangle near a block of grid points.
+#[derive(Debug, Clone, Copy)]
+struct Candidate {
+    /// Upper bound of the tip height this triangle can give anywhere in the block.
+    ub: f64,
+    zmax: f64,
+    min: [f64; 2],
+    max: [f64; 2],
+    slot: usize,
+}
+
+/// Drop-cutter at `xy` over `candidates` sorted by decreasing bound `ub`,
+/// which must hold every triangle within the cutter's reach of `xy`.
+fn drop_candidates(
+    profile: &Profile,
+    index: &MeshIndex,
+    candidates: &[Candidate],
+    xy: Point2,
+    floor: f64,
+    seed: Option<usize>,
+) -> (ClPoint, Option<usize>) {
+    let mut best = ClPoint::floor(xy, floor);
+    let mut best_slot = None;
+    if let Some(slot) = seed {
+        drop_triangle_profile(profile, index.corners(slot), index.normal(slot), index.original_index(slot), &mut best);
+        if !matches!(best.contact, Contact::Floor) {
+            best_slot = Some(slot);
+        }
+    }
+    let slack = index.slack();
+    let r2 = profile.radius * profile.radius;
+    for c in candidates {
+        if c.ub + slack <= best.tip.z {
+            break; // sorted: nothing after this can rise above the best
+        }
+        let dx = (c.min[0] - xy.x).max(0.0).max(xy.x - c.max[0]);
+        let dy = (c.min[1] - xy.y).max(0.0).max(xy.y - c.max[1]);
+        let d2 = dx * dx + dy * dy;
+        if d2 > r2 || c.zmax - profile.height(d2.sqrt()) + slack <= best.tip.z {
+            continue;
+        }
+        let before = best.tip.z;
+        let (slot, features) = (c.slot, index.owned_features(c.slot));
+        drop_features(
+            profile,
+            index.corners(slot),
+            index.normal(slot),
+            index.original_index(slot),
+            features,
+            &mut best,
+        );
+        if best.tip.z > before {
+            best_slot = Some(c.slot);
+        }
+    }
+    (best, best_slot)
 }

@@ -6,10 +6,17 @@ use scallop_geom::{Point2, Point3};
 use super::{ClPoint, Contact};
 use crate::shape::Profile;
 
-pub(super) fn drop_vertices(profile: &Profile, corners: &[Point3; 3], triangle: usize, c: Point2, best: &mut ClPoint) {
+pub(super) fn drop_vertices(
+    profile: &Profile,
+    corners: &[Point3; 3],
+    features: u8,
+    triangle: usize,
+    c: Point2,
+    best: &mut ClPoint,
+) {
     let r2 = profile.radius * profile.radius;
-    for p in corners {
-        if p.z <= best.tip.z {
+    for (k, p) in corners.iter().enumerate() {
+        if features & (1 << k) == 0 || p.z <= best.tip.z {
             continue;
         }
         let (dx, dy) = (p.x - c.x, p.y - c.y);
