@@ -30,10 +30,44 @@ pub fn orient2d(a: &Point2, b: &Point2, c: &Point2) -> f64 {
 /// ```
 #[must_use]
 pub fn in_triangle(p: &Point2, a: &Point2, b: &Point2, c: &Point2) -> bool {
-    let area = orient2d(a, b, c);
-    if area == 0.0 {
+    // Inside (closed) iff the three sides see p on the same side or on the line;
+    // all three zero means the triangle is degenerate and p on its line: not inside.
+    let o1 = orient2d(a, b, p);
+    let o2 = orient2d(b, c, p);
+    if (o1 > 0.0 && o2 < 0.0) || (o1 < 0.0 && o2 > 0.0) {
         return false;
     }
-    let s = area.signum();
-    orient2d(a, b, p) * s >= 0.0 && orient2d(b, c, p) * s >= 0.0 && orient2d(c, a, p) * s >= 0.0
+    let o3 = orient2d(c, a, p);
+    let (pos, neg) = (o1 > 0.0 || o2 > 0.0 || o3 > 0.0, o1 < 0.0 || o2 < 0.0 || o3 < 0.0);
+    pos != neg || (!pos && !neg && orient2d(a, b, c) != 0.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The three-orientation shortcut agrees with the definition by the area sign.
+    #[test]
+    fn in_triangle_matches_area_sign_definition() {
+        let reference = |p: &Point2, a: &Point2, b: &Point2, c: &Point2| {
+            let area = orient2d(a, b, c);
+            if area == 0.0 {
+                return false;
+            }
+            let s = area.signum();
+            orient2d(a, b, p) * s >= 0.0 && orient2d(b, c, p) * s >= 0.0 && orient2d(c, a, p) * s >= 0.0
+        };
+        // A small integer lattice hits every boundary, vertex and degenerate case.
+        let pts: Vec<Point2> =
+            (0..4).flat_map(|i| (0..4).map(move |j| Point2::new(f64::from(i), f64::from(j)))).collect();
+        for a in &pts {
+            for b in &pts {
+                for c in &pts {
+                    for p in &pts {
+                        assert_eq!(in_triangle(p, a, b, c), reference(p, a, b, c), "{p} in {a} {b} {c}");
+                    }
+                }
+            }
+        }
+    }
 }

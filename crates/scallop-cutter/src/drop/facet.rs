@@ -55,6 +55,14 @@ pub(super) fn drop_facet(
     if tip <= best.tip.z {
         return;
     }
+    // Cheap rejection by the XY box before the exact test.
+    if q.x < a.x.min(b.x).min(cc.x)
+        || q.x > a.x.max(b.x).max(cc.x)
+        || q.y < a.y.min(b.y).min(cc.y)
+        || q.y > a.y.max(b.y).max(cc.y)
+    {
+        return;
+    }
     if in_triangle(&q, &Point2::new(a.x, a.y), &Point2::new(b.x, b.y), &Point2::new(cc.x, cc.y)) {
         best.tip.z = tip;
         best.contact = Contact::Facet { triangle, point: Point3::new(q.x, q.y, zq) };
