@@ -89,94 +89,33 @@ fn bad_input_is_rejected_with_the_place_and_no_output() {
     std::fs::write(dir.join("nan.stl"), b"solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex nan 0 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid x\n").expect("write");
     std::fs::write(dir.join("ok.stl"), &stl).expect("write");
     std::fs::write(dir.join("knots.toml"), "units = \"mm\"\n[[patch]]\nname = \"p\"\nkind = \"nurbs\"\ndegree = [1, 1]\ncontrol = [[[0,0,0],[0,1,0]],[[1,0,0],[1,1,0]]]\nknots_u = [0, 1, 0, 1]\nknots_v = [0, 0, 1, 1]\n").expect("write");
-    let grid = ["--x", "0:1:0.5", "--y", "0:1:0.5", "-o", "out.csv"];
-    let with = |extra: &[&'static str]| -> Vec<&'static str> {
-        let mut v: Vec<&'static str> = vec!["drop", "--cutter", "ball", "--diameter", "1"];
-        v.extend_from_slice(extra);
-        v.extend_from_slice(&grid);
+    // A drop command on `part` with a ball D1 over a small grid, with `change` replacing defaults.
+    let drop_cmd = |part: &[&'static str], change: &[(&'static str, &'static str)]| -> Vec<&'static str> {
+        let mut opts = vec![("--cutter", "ball"), ("--diameter", "1"), ("--x", "0:1:0.5"), ("--y", "0:1:0.5")];
+        for (key, value) in change {
+            match opts.iter_mut().find(|(k, _)| k == key) {
+                Some(slot) => slot.1 = value,
+                None => opts.push((key, value)),
+            }
+        }
+        let mut v = vec!["drop"];
+        v.extend_from_slice(part);
+        v.extend(opts.iter().flat_map(|(k, val)| [*k, *val]));
+        v.extend_from_slice(&["-o", "out.csv"]);
         v
     };
-    assert_rejected(&with(&["--mesh", "short.stl"]), &dir, "short.stl");
-    assert_rejected(&with(&["--mesh", "nan.stl"]), &dir, "line 5");
-    assert_rejected(&with(&["--mesh", "missing.stl"]), &dir, "missing.stl");
-    assert_rejected(&with(&["--mesh", "notes.txt"]), &dir, "unknown part format");
-    assert_rejected(&with(&["--surface", "knots.toml"]), &dir, "knots.toml");
-    assert_rejected(
-        &[
-            "drop",
-            "--mesh",
-            "ok.stl",
-            "--cutter",
-            "bull",
-            "--diameter",
-            "1",
-            "--x",
-            "0:1:0.5",
-            "--y",
-            "0:1:0.5",
-            "-o",
-            "out.csv",
-        ],
-        &dir,
-        "--corner-radius",
-    );
-    assert_rejected(
-        &[
-            "drop",
-            "--mesh",
-            "ok.stl",
-            "--cutter",
-            "ball",
-            "--diameter",
-            "-1",
-            "--x",
-            "0:1:0.5",
-            "--y",
-            "0:1:0.5",
-            "-o",
-            "out.csv",
-        ],
-        &dir,
-        "--diameter",
-    );
-    assert_rejected(
-        &[
-            "drop",
-            "--mesh",
-            "ok.stl",
-            "--cutter",
-            "ball",
-            "--diameter",
-            "1",
-            "--x",
-            "0:1:0",
-            "--y",
-            "0:1:0.5",
-            "-o",
-            "out.csv",
-        ],
-        &dir,
-        "--x",
-    );
-    assert_rejected(
-        &[
-            "drop",
-            "--mesh",
-            "ok.stl",
-            "--cutter",
-            "ball",
-            "--diameter",
-            "1",
-            "--x",
-            "0:1e12:1e-6",
-            "--y",
-            "0:1:0.5",
-            "-o",
-            "out.csv",
-        ],
-        &dir,
-        "larger STEP",
-    );
+    let ok = ["--mesh", "ok.stl"];
+    assert_rejected(&drop_cmd(&["--mesh", "short.stl"], &[]), &dir, "short.stl");
+    assert_rejected(&drop_cmd(&["--mesh", "nan.stl"], &[]), &dir, "line 5");
+    assert_rejected(&drop_cmd(&["--mesh", "missing.stl"], &[]), &dir, "missing.stl");
+    assert_rejected(&drop_cmd(&["--mesh", "notes.txt"], &[]), &dir, "unknown part format");
+    assert_rejected(&drop_cmd(&["--surface", "knots.toml"], &[]), &dir, "knots.toml");
+    assert_rejected(&drop_cmd(&ok, &[("--cutter", "bull")]), &dir, "--corner-radius");
+    assert_rejected(&drop_cmd(&ok, &[("--diameter", "-1")]), &dir, "--diameter");
+    assert_rejected(&drop_cmd(&ok, &[("--x", "0:1:0")]), &dir, "--x");
+    assert_rejected(&drop_cmd(&ok, &[("--x", "0:1e12:1e-6")]), &dir, "larger STEP");
+    assert_rejected(&drop_cmd(&ok, &[("--cutter", "cone"), ("--angle", "180")]), &dir, "--angle");
+    assert_rejected(&drop_cmd(&ok, &[("--threads", "0")]), &dir, "--threads");
     assert!(!dir.join("out.csv").exists(), "a rejected job must not leave an output file");
     assert!(
         std::fs::read_dir(&dir).expect("dir").all(|e| !e
