@@ -40,10 +40,10 @@ pub struct LoadedPart {
 /// Loads `spec`: a mesh file (.stl .obj .ply .3mf), a surface file (.toml) or a built-in name.
 pub fn load(spec: &str, units: UnitsArg) -> CliResult<LoadedPart> {
     let path = Path::new(spec);
-    if !path.exists() {
-        if let Some(part) = Part::builtin(spec) {
-            return Ok(LoadedPart { part, description: format!("built-in surface '{spec}'"), diagnostics: None });
-        }
+    if !path.exists()
+        && let Some(part) = Part::builtin(spec)
+    {
+        return Ok(LoadedPart { part, description: format!("built-in surface '{spec}'"), diagnostics: None });
     }
     let is_toml = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml"));
     let format = MeshFormat::from_extension(spec);

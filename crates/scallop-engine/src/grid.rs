@@ -60,7 +60,7 @@ impl GridAxis {
         }
         let count = ((max - min) / step).round() + 1.0;
         #[allow(clippy::cast_precision_loss)]
-        if !(count <= MAX_AXIS_SAMPLES as f64) {
+        if count.is_nan() || count > MAX_AXIS_SAMPLES as f64 {
             return Err(GridError::TooMany { spec: spec.to_string(), count });
         }
         Ok(GridAxis { min, max, step })

@@ -19,16 +19,20 @@ use super::{ClPoint, Contact};
 use crate::CutterShape;
 use crate::shape::Profile;
 
-pub(super) fn drop_facet(
-    profile: &Profile,
-    corners: &[Point3; 3],
-    n: &Vec3,
-    triangle: usize,
-    c: Point2,
-    best: &mut ClPoint,
-) {
+/// The cutter resting on the triangle's whole plane: the support point `q`
+/// (XY), the plane's height there and the tip height. `None` for a vertical
+/// plane. No point of the plane within the cutter's reach can hold the tip
+/// higher, so `tip` bounds every contact of the triangle.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct PlaneContact {
+    q: Point2,
+    zq: f64,
+    pub(super) tip: f64,
+}
+
+pub(super) fn plane_contact(profile: &Profile, corners: &[Point3; 3], n: &Vec3, c: Point2) -> Option<PlaneContact> {
     if n.z <= 0.0 {
-        return; // vertical facet: its edges and corners hold every contact
+        return None; // vertical facet: its edges and corners hold every contact
     }
     let nxy = (n.x * n.x + n.y * n.y).sqrt();
     let (ux, uy) = if nxy > 0.0 { (n.x / nxy, n.y / nxy) } else { (0.0, 0.0) };
@@ -48,13 +52,19 @@ pub(super) fn drop_facet(
         }
     };
     let q = Point2::new(c.x + dx, c.y + dy);
-    let [a, b, cc] = corners;
+    let a = &corners[0];
     // z of the plane at q: n . (p - a) = 0
     let zq = a.z - (n.x * (q.x - a.x) + n.y * (q.y - a.y)) / n.z;
-    let tip = zq - dz;
+    Some(PlaneContact { q, zq, tip: zq - dz })
+}
+
+/// Facet contact: the plane contact, when its support point lies in the triangle.
+pub(super) fn drop_facet(plane: &PlaneContact, corners: &[Point3; 3], triangle: usize, best: &mut ClPoint) {
+    let PlaneContact { q, zq, tip } = *plane;
     if tip <= best.tip.z {
         return;
     }
+    let [a, b, cc] = corners;
     // Cheap rejection by the XY box before the exact test.
     if q.x < a.x.min(b.x).min(cc.x)
         || q.x > a.x.max(b.x).max(cc.x)

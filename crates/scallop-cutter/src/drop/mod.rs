@@ -23,7 +23,7 @@ mod vertex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use rayon::prelude::*;
-use scallop_geom::{Aabb2, Point2, Point3, Vec3};
+use scallop_geom::{Aabb2, Point2, Point3, Vec3, tol};
 use scallop_mesh::MeshIndex;
 
 use crate::Cutter;
@@ -100,8 +100,19 @@ fn drop_features(
     best: &mut ClPoint,
 ) {
     let c = Point2::new(best.tip.x, best.tip.y);
+    let plane = facet::plane_contact(profile, corners, normal, c);
+    if let Some(plane) = &plane {
+        // Nothing on the triangle's plane can hold the tip above the plane contact
+        // (the slack keeps this conservative under rounding).
+        let slack = tol::REL_PRUNE_SLACK * (plane.tip.abs() + profile.radius + 1.0);
+        if plane.tip + slack <= best.tip.z {
+            return;
+        }
+    }
     vertex::drop_vertices(profile, corners, features, triangle, c, best);
-    facet::drop_facet(profile, corners, normal, triangle, c, best);
+    if let Some(plane) = &plane {
+        facet::drop_facet(plane, corners, triangle, best);
+    }
     for k in 0..3 {
         let (a, b) = (&corners[k], &corners[(k + 1) % 3]);
         if features & (1 << (3 + k)) != 0 && a.z.max(b.z) > best.tip.z {
@@ -200,10 +211,9 @@ pub fn drop_grid(
     let radius = profile.radius;
     let rows: Vec<Vec<ClPoint>> = ys
         .par_iter()
-        .map_init(Vec::new, |scratch: &mut Vec<Candidate>, &y| {
+        .map_init(BlockScratch::default, |scratch, &y| {
             let mut row = Vec::with_capacity(xs.len());
             let mut seed = None;
-            let mut slots = Vec::new();
             let mut start = 0;
             while start < xs.len() {
                 // A block spans about one cutter diameter (at most BLOCK_POINTS points).
@@ -212,27 +222,9 @@ pub fn drop_grid(
                     end += 1;
                 }
                 let (x0, x1) = (xs[start].min(xs[end - 1]), xs[start].max(xs[end - 1]));
-                let reach =
-                    Aabb2 { min: Point2::new(x0 - radius, y - radius), max: Point2::new(x1 + radius, y + radius) };
-                slots.clear();
-                index.collect_box(&reach, &mut slots);
-                scratch.clear();
-                // Bound valid for every point of the block: the triangle's top lifted by
-                // the profile at its distance to the block's segment [x0, x1] x {y}.
-                let segment = Aabb2 { min: Point2::new(x0, y), max: Point2::new(x1, y) };
-                scratch.extend(slots.iter().map(|&slot| {
-                    let slot = slot as usize;
-                    let b = index.xy_box(slot);
-                    let zmax = index.zmax(slot);
-                    let dx = (b.min.x - segment.max.x).max(0.0).max(segment.min.x - b.max.x);
-                    let dy = (b.min.y - y).max(0.0).max(y - b.max.y);
-                    let d2 = (dx * dx + dy * dy).min(radius * radius);
-                    let ub = zmax - profile.height(d2.sqrt());
-                    Candidate { ub, zmax, min: [b.min.x, b.min.y], max: [b.max.x, b.max.y], slot }
-                }));
-                scratch.sort_unstable_by(|a, b| b.ub.total_cmp(&a.ub).then(a.slot.cmp(&b.slot)));
+                scratch.fill(index, &profile, x0, x1, y);
                 for &x in &xs[start..end] {
-                    let (cl, slot) = drop_candidates(&profile, index, scratch, Point2::new(x, y), floor, seed);
+                    let (cl, slot) = drop_candidates(&profile, index, &scratch.sorted, Point2::new(x, y), floor, seed);
                     seed = slot;
                     row.push(cl);
                 }
@@ -243,6 +235,56 @@ pub fn drop_grid(
         })
         .collect();
     rows.into_iter().flatten().collect()
+}
+
+/// Reusable buffers of one worker: the candidates of the current block.
+#[derive(Default)]
+struct BlockScratch {
+    slots: Vec<u32>,
+    unsorted: Vec<Candidate>,
+    keys: Vec<(u64, u32)>,
+    sorted: Vec<Candidate>,
+}
+
+impl BlockScratch {
+    /// The triangles within reach of the block `[x0, x1] x {y}`, sorted by
+    /// decreasing bound (ties by slot, so the order is deterministic).
+    fn fill(&mut self, index: &MeshIndex, profile: &Profile, x0: f64, x1: f64, y: f64) {
+        let radius = profile.radius;
+        let reach = Aabb2 { min: Point2::new(x0 - radius, y - radius), max: Point2::new(x1 + radius, y + radius) };
+        self.slots.clear();
+        index.collect_box(&reach, &mut self.slots);
+        // Bound valid for every point of the block: the triangle's top lifted by
+        // the profile at its distance to the block's segment [x0, x1] x {y}.
+        self.unsorted.clear();
+        self.unsorted.extend(self.slots.iter().map(|&slot| {
+            let slot = slot as usize;
+            let b = index.xy_box(slot);
+            let zmax = index.zmax(slot);
+            let dx = (b.min.x - x1).max(0.0).max(x0 - b.max.x);
+            let dy = (b.min.y - y).max(0.0).max(y - b.max.y);
+            let d2 = (dx * dx + dy * dy).min(radius * radius);
+            let ub = zmax - profile.height(d2.sqrt());
+            Candidate { ub, zmax, min: [b.min.x, b.min.y], max: [b.max.x, b.max.y], slot }
+        }));
+        // Sort small keys, not the candidates: descending bound, then slot.
+        self.keys.clear();
+        self.keys.extend(
+            self.unsorted
+                .iter()
+                .enumerate()
+                .map(|(i, c)| (!total_order_key(c.ub), u32::try_from(i).unwrap_or(u32::MAX))),
+        );
+        self.keys.sort_unstable();
+        self.sorted.clear();
+        self.sorted.extend(self.keys.iter().map(|&(_, i)| self.unsorted[i as usize]));
+    }
+}
+
+/// A u64 whose unsigned order is the total order of f64 (`f64::total_cmp`).
+fn total_order_key(v: f64) -> u64 {
+    let bits = v.to_bits();
+    if bits >> 63 == 1 { !bits } else { bits | (1 << 63) }
 }
 
 /// Most points sharing one candidate list.
