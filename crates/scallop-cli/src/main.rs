@@ -2,6 +2,7 @@
 //! files, shows progress, maps failures to exit codes (0 ok, 1 job rejected,
 //! 2 I/O or internal error). All the work is done by the libraries.
 
+mod analyze;
 mod drop;
 mod output;
 mod part;
@@ -42,6 +43,8 @@ enum Command {
     Demo(output::DemoArgs),
     /// Drop a cutter onto a part on an XY grid and write the cutter locations as CSV.
     Drop(drop::DropArgs),
+    /// Analyse a part's shape (PCA) and recommend a cutter and a feed direction before any toolpath.
+    Analyze(analyze::AnalyzeArgs),
     /// Load a part and report what was read (size, welding, open and non-manifold edges).
     Inspect(part::InspectArgs),
 }
@@ -60,6 +63,7 @@ fn main() -> ExitCode {
         Command::Demo(args) => output::demo(&args),
         Command::Drop(args) => drop::run(&args),
         Command::Inspect(args) => part::inspect(&args),
+        Command::Analyze(args) => analyze::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

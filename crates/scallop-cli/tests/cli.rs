@@ -141,3 +141,22 @@ fn inspect_reports_mesh_diagnostics() {
     let v: serde_json::Value = serde_json::from_slice(&inches.stdout).expect("json");
     assert_eq!(v["bounds_max"][0], 254.0);
 }
+
+#[test]
+fn analyze_recommends_the_spec_tool_for_choi_and_rubio() {
+    let dir = scratch("analyze");
+    for (part, expected) in [("choi", "toroidal_along_slope"), ("rubio", "ball_along_principal")] {
+        let out = scallop()
+            .current_dir(&dir)
+            .args(["analyze", part, "--json", "--plot", &format!("{part}.svg")])
+            .output()
+            .expect("run");
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
+        assert_eq!(v["recommendation"], expected, "{part}");
+        let svg = std::fs::read_to_string(dir.join(format!("{part}.svg"))).expect("svg");
+        assert!(svg.starts_with("<svg") || svg.starts_with("<?xml"), "{part}: not an SVG");
+    }
+    let bad = scallop().current_dir(&dir).args(["analyze", "choi", "--scallop", "-1"]).output().expect("run");
+    assert_eq!(bad.status.code(), Some(1));
+}
