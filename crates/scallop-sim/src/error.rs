@@ -1,0 +1,108 @@
+//! The crate's one error type. Safety problems (gouges, rapids into stock,
+//! shank or holder collisions) are errors, never warnings.
+
+use scallop_geom::Point2;
+
+use crate::{Collision, GougeCell, MoveId, RapidHit};
+
+/// Why a stock cannot be built or a program is not safe. Each variant names
+/// the place and the fix.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum SimError {
+    /// The grid resolution is not a finite positive number of mm.
+    #[error("z-map resolution must be a finite number > 0 mm, got {resolution}; use e.g. 0.05")]
+    BadResolution {
+        /// The value given.
+        resolution: f64,
+    },
+    /// The stock box is empty, inverted or not finite.
+    #[error("stock box {min:?} .. {max:?} is empty or not finite; give min < max on every axis (mm) in finite numbers")]
+    BadStock {
+        /// Lowest corner given.
+        min: [f64; 3],
+        /// Highest corner given.
+        max: [f64; 3],
+    },
+    /// The grid would have more cells than the limit.
+    #[error(
+        "z-map of {nx} x {ny} cells exceeds the limit of {limit} cells; use a coarser resolution or a smaller stock"
+    )]
+    TooManyCells {
+        /// Cells along x.
+        nx: usize,
+        /// Cells along y.
+        ny: usize,
+        /// The limit ([`crate::MAX_CELLS`]).
+        limit: usize,
+    },
+    /// A toolpath has more moves than a move id can name.
+    #[error("toolpath of {moves} moves exceeds the simulator's limit of u32::MAX moves; split the program")]
+    TooManyMoves {
+        /// Number of moves.
+        moves: usize,
+    },
+    /// The stock was cut below the part by more than the gouge tolerance.
+    #[error(
+        "gouge: {count} cells lie below the part by more than {tolerance} mm; the worst is {depth:.4} mm deep at \
+         ({x:.3}, {y:.3}), cut by {cut_by}; fix the toolpath there (drop-cutter contact, stepdown or linking)",
+        depth = worst.first().map_or(0.0, |g| g.depth),
+        x = worst.first().map_or(0.0, |g| g.at.x),
+        y = worst.first().map_or(0.0, |g| g.at.y),
+        cut_by = worst.first().and_then(|g| g.cut_by).map_or_else(|| "no move".to_string(), |m| m.to_string())
+    )]
+    Gouge {
+        /// Number of gouged cells.
+        count: usize,
+        /// The gouge tolerance used (mm).
+        tolerance: f64,
+        /// The deepest cells, deepest first.
+        worst: Vec<GougeCell>,
+    },
+    /// Rapid (or retract) moves went through stock.
+    #[error(
+        "{count} rapid moves hit the stock; the first is {first} at ({x:.3}, {y:.3}), {depth:.4} mm deep; \
+         raise the clearance height or turn the move into a feed move",
+        first = hits.first().map_or(MoveId { operation: 0, index: 0 }, |h| h.id),
+        x = hits.first().map_or(0.0, |h| h.at.x),
+        y = hits.first().map_or(0.0, |h| h.at.y),
+        depth = hits.first().map_or(0.0, |h| h.depth)
+    )]
+    RapidIntoStock {
+        /// Number of rapid moves that removed material.
+        count: usize,
+        /// The first ones, in program order.
+        hits: Vec<RapidHit>,
+    },
+    /// The shank or holder touched the in-process stock.
+    #[error(
+        "{count} moves drive the {what} into the stock; the first is {first} at ({x:.3}, {y:.3}), {depth:.4} mm deep; \
+         use longer flutes or a longer shank, or cut in more stepdowns",
+        what = collisions.first().map_or("shank", |c| c.part.name()),
+        first = collisions.first().map_or(MoveId { operation: 0, index: 0 }, |c| c.id),
+        x = collisions.first().map_or(0.0, |c| c.at.x),
+        y = collisions.first().map_or(0.0, |c| c.at.y),
+        depth = collisions.first().map_or(0.0, |c| c.depth)
+    )]
+    HolderCollision {
+        /// Number of colliding moves.
+        count: usize,
+        /// The first ones, in program order.
+        collisions: Vec<Collision>,
+    },
+    /// An uncut cell lies below the part: the stock box does not contain the part.
+    #[error(
+        "the part rises above the stock at ({x:.3}, {y:.3}): part z {part_z} > stock z {stock_z} where nothing was cut; \
+         enlarge the stock box or move the part into it",
+        x = at.x,
+        y = at.y
+    )]
+    PartOutsideStock {
+        /// Cell centre.
+        at: Point2,
+        /// Stock height there (uncut).
+        stock_z: f64,
+        /// Part top there.
+        part_z: f64,
+    },
+}

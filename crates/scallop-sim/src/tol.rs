@@ -1,0 +1,15 @@
+//! The simulator's named numeric thresholds (the workspace-wide ones are in
+//! `scallop_geom::tol`).
+
+/// A stock width within this relative distance of a whole number of cells is
+/// that number of cells (not one more): `60 / 0.05` is 1200 cells even when the
+/// division rounds to 1200.0000000000002.
+pub const GRID_SNAP: f64 = 1e-9;
+
+/// Default number of gouge cells listed in a [`crate::SimError::Gouge`].
+pub const WORST_REPORTED: usize = 20;
+
+/// Slopes `|dz / L|` of a move above this are treated as vertical: the
+/// horizontal travel is then below 1e-100 of the vertical one, far below
+/// rounding, and the slope's square stays finite in the closed forms.
+pub const VERTICAL_SLOPE: f64 = 1e100;

@@ -1,0 +1,268 @@
+//! Verification of a cut stock against the design part.
+
+use rayon::prelude::*;
+use scallop_geom::predicates::{in_triangle, orient2d};
+use scallop_geom::{Aabb2, Point2, Tolerances};
+use scallop_mesh::MeshIndex;
+
+use crate::tol::WORST_REPORTED;
+use crate::zmap::index_range;
+use crate::{MoveId, SimError, ZMap};
+
+/// Rows per band of the part rasterisation (fixed: results do not depend on threads).
+const PART_BAND_ROWS: usize = 16;
+
+/// Algorithm knobs of [`verify`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VerifyOptions {
+    /// Largest allowed penetration of the stock below the part (mm); the
+    /// stock's rounding epsilon is added. Normally `Tolerances::gouge` plus the
+    /// chordal error the program is allowed to have.
+    pub gouge_tolerance: f64,
+    /// How many of the deepest gouge cells a [`SimError::Gouge`] lists.
+    pub worst_reported: usize,
+}
+
+impl Default for VerifyOptions {
+    /// No gouge allowed beyond rounding; the 20 deepest cells reported.
+    fn default() -> Self {
+        VerifyOptions { gouge_tolerance: 0.0, worst_reported: WORST_REPORTED }
+    }
+}
+
+impl VerifyOptions {
+    /// Options taking the gouge tolerance from the job's tolerances.
+    ///
+    /// ```
+    /// use scallop_geom::Tolerances;
+    /// let o = scallop_sim::VerifyOptions::from_tolerances(&Tolerances { path: 0.01, gouge: 0.002 });
+    /// assert_eq!(o.gouge_tolerance, 0.002);
+    /// ```
+    #[must_use]
+    pub fn from_tolerances(tolerances: &Tolerances) -> Self {
+        VerifyOptions { gouge_tolerance: tolerances.gouge, ..Self::default() }
+    }
+}
+
+/// One stock cell below the part.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GougeCell {
+    /// Cell (column, row).
+    pub cell: (usize, usize),
+    /// Cell centre.
+    pub at: Point2,
+    /// Stock height there.
+    pub stock_z: f64,
+    /// Part top there.
+    pub part_z: f64,
+    /// `part_z - stock_z` (mm, > 0).
+    pub depth: f64,
+    /// The last move that lowered the cell (the one that cut it this deep).
+    pub cut_by: Option<MoveId>,
+}
+
+/// The verdict of [`verify`] when the stock is safe.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Verification {
+    /// Cells with part under them.
+    pub part_cells: usize,
+    /// Largest `stock - part` over part cells (mm): the material left, the
+    /// scallop where the surface was finished (0 when no cell has part).
+    pub max_scallop: f64,
+    /// Where `max_scallop` is (the first such cell in row order).
+    pub max_scallop_at: Option<Point2>,
+    /// Smallest `stock - part` over part cells (mm; >= minus the gouge tolerance).
+    pub min_deviation: f64,
+    /// Volume of stock left (mm^3), see [`ZMap::volume`].
+    pub remaining_volume: f64,
+    /// Volume removed from the full stock box (mm^3).
+    pub removed_volume: f64,
+    /// Volume of stock above the part over part cells (mm^3): what finishing would still remove.
+    pub excess_volume: f64,
+}
+
+/// The part's top z under each cell centre (vertical ray: the highest
+/// triangle containing the centre, exact inside test), row-major with x
+/// fastest; `f64::NEG_INFINITY` where no triangle lies under the centre.
+/// Rasterised per triangle over fixed bands of rows, in parallel; a maximum
+/// is exact, so the result does not depend on the thread count.
+///
+/// ```
+/// use scallop_geom::{Aabb3, Point3};
+/// use scallop_mesh::{MeshIndex, TriMesh};
+/// use scallop_sim::{ZMap, part_heights};
+/// let p = |x, y, z| Point3::new(x, y, z);
+/// let (mesh, _) = TriMesh::from_soup(&[[p(0., 0., 1.), p(4., 0., 1.), p(0., 4., 3.)]]).unwrap();
+/// let zmap = ZMap::new(Aabb3 { min: p(0., 0., 0.), max: p(4., 4., 5.) }, 1.0).unwrap();
+/// let top = part_heights(&zmap, &MeshIndex::build(&mesh));
+/// assert_eq!(top[0], 1.25); // centre (0.5, 0.5): z = 1 + 0.5 * 0.5
+/// assert_eq!(top[15], f64::NEG_INFINITY); // centre (3.5, 3.5) is outside
+/// ```
+#[must_use]
+pub fn part_heights(zmap: &ZMap, part: &MeshIndex) -> Vec<f64> {
+    let (nx, ny) = (zmap.nx(), zmap.ny());
+    let (cell_x, cell_y) = zmap.cell_size();
+    let stock = zmap.stock();
+    let mut top = vec![f64::NEG_INFINITY; nx * ny];
+    top.par_chunks_mut(PART_BAND_ROWS * nx).enumerate().for_each_init(Vec::new, |slots, (band, out)| {
+        let rows = out.len() / nx;
+        let j0 = band * PART_BAND_ROWS;
+        let y_lo = zmap.cell_center(0, j0).y;
+        let y_hi = zmap.cell_center(0, j0 + rows - 1).y;
+        let strip = Aabb2 {
+            min: Point2::new(stock.min.x, y_lo - 0.5 * cell_y),
+            max: Point2::new(stock.max.x, y_hi + 0.5 * cell_y),
+        };
+        slots.clear();
+        part.collect_box(&strip, slots);
+        for &slot in slots.iter() {
+            let [a, b, c] = *part.corners(slot as usize);
+            let (a2, b2, c2) = (a.xy(), b.xy(), c.xy());
+            let bx = part.xy_box(slot as usize);
+            let Some((i0, i1)) = index_range(bx.min.x, bx.max.x, stock.min.x, cell_x, nx) else { continue };
+            let Some((r0, r1)) = index_range(bx.min.y, bx.max.y, stock.min.y, cell_y, ny) else { continue };
+            for j in r0.max(j0)..=r1.min(j0 + rows - 1) {
+                for i in i0..=i1 {
+                    let p = zmap.cell_center(i, j);
+                    if !in_triangle(&p, &a2, &b2, &c2) {
+                        continue;
+                    }
+                    // Barycentric weights of one sign inside: z is a convex combination.
+                    let (wa, wb, wc) = (orient2d(&b2, &c2, &p), orient2d(&c2, &a2, &p), orient2d(&a2, &b2, &p));
+                    let total = wa + wb + wc;
+                    let z = if total == 0.0 { a.z.max(b.z).max(c.z) } else { (wa * a.z + wb * b.z + wc * c.z) / total };
+                    let cell = &mut out[(j - j0) * nx + i];
+                    *cell = cell.max(z);
+                }
+            }
+        }
+    });
+    top
+}
+
+#[derive(Default)]
+struct RowStats {
+    part_cells: usize,
+    max: Option<(f64, usize)>,
+    min: Option<f64>,
+    excess: f64,
+    gouges: usize,
+    worst: Vec<GougeCell>,
+    outside: Option<(usize, f64, f64)>,
+}
+
+fn deepest_first(a: &GougeCell, b: &GougeCell) -> std::cmp::Ordering {
+    b.depth.total_cmp(&a.depth).then((a.cell.1, a.cell.0).cmp(&(b.cell.1, b.cell.0)))
+}
+
+/// Compares the stock with the part cell by cell (signed deviation
+/// `stock - part` at every cell centre with part under it) and returns the
+/// scallop and volume figures, or the gouges.
+///
+/// # Errors
+/// [`SimError::Gouge`] when some cell lies below the part by more than
+/// `options.gouge_tolerance` plus the stock's epsilon (deepest cells first,
+/// each with the move that cut it); [`SimError::PartOutsideStock`] when an
+/// uncut cell is below the part (the stock box does not contain the part).
+///
+/// ```
+/// use scallop_geom::{Aabb3, Point3};
+/// use scallop_mesh::{MeshIndex, TriMesh};
+/// use scallop_sim::{VerifyOptions, ZMap, verify};
+/// let p = |x, y, z| Point3::new(x, y, z);
+/// let (plane, _) = TriMesh::from_soup(&[[p(-1., -1., 1.), p(9., -1., 1.), p(-1., 9., 1.)]]).unwrap();
+/// let zmap = ZMap::new(Aabb3 { min: p(0., 0., 0.), max: p(4., 4., 3.) }, 0.5).unwrap();
+/// let v = verify(&zmap, &MeshIndex::build(&plane), &VerifyOptions::default()).unwrap();
+/// assert_eq!(v.max_scallop, 2.0); // nothing cut yet: 2 mm of stock above the part
+/// assert_eq!(v.removed_volume, 0.0);
+/// ```
+pub fn verify(zmap: &ZMap, part: &MeshIndex, options: &VerifyOptions) -> Result<Verification, SimError> {
+    let top = part_heights(zmap, part);
+    let nx = zmap.nx();
+    let (cell_x, cell_y) = zmap.cell_size();
+    let area = cell_x * cell_y;
+    let limit = options.gouge_tolerance + zmap.eps();
+    let keep = options.worst_reported;
+    let rows: Vec<RowStats> = zmap
+        .heights()
+        .par_chunks(nx)
+        .zip(top.par_chunks(nx))
+        .enumerate()
+        .map(|(j, (stock_row, part_row))| {
+            let mut s = RowStats::default();
+            for (i, (&stock_z, &part_z)) in stock_row.iter().zip(part_row).enumerate() {
+                if part_z == f64::NEG_INFINITY {
+                    continue;
+                }
+                s.part_cells += 1;
+                let dev = stock_z - part_z;
+                if s.max.is_none_or(|(m, _)| dev > m) {
+                    s.max = Some((dev, i));
+                }
+                s.min = Some(s.min.map_or(dev, |m| m.min(dev)));
+                s.excess += dev.max(0.0);
+                if -dev > limit {
+                    let cut_by = zmap.last_cut(i, j);
+                    if cut_by.is_none() {
+                        if s.outside.is_none() {
+                            s.outside = Some((i, stock_z, part_z));
+                        }
+                        continue;
+                    }
+                    s.gouges += 1;
+                    s.worst.push(GougeCell {
+                        cell: (i, j),
+                        at: zmap.cell_center(i, j),
+                        stock_z,
+                        part_z,
+                        depth: -dev,
+                        cut_by,
+                    });
+                }
+            }
+            s.worst.sort_by(deepest_first);
+            s.worst.truncate(keep);
+            s.excess *= area;
+            s
+        })
+        .collect();
+
+    let mut part_cells = 0;
+    let mut max: Option<(f64, (usize, usize))> = None;
+    let mut min_deviation: Option<f64> = None;
+    let mut excess_volume = 0.0;
+    let mut gouges = 0;
+    let mut worst = Vec::new();
+    for (j, s) in rows.into_iter().enumerate() {
+        if let Some((i, stock_z, part_z)) = s.outside {
+            return Err(SimError::PartOutsideStock { at: zmap.cell_center(i, j), stock_z, part_z });
+        }
+        part_cells += s.part_cells;
+        if let Some((m, i)) = s.max
+            && max.is_none_or(|(best, _)| m > best)
+        {
+            max = Some((m, (i, j)));
+        }
+        if let Some(m) = s.min {
+            min_deviation = Some(min_deviation.map_or(m, |b: f64| b.min(m)));
+        }
+        excess_volume += s.excess;
+        gouges += s.gouges;
+        worst.extend(s.worst);
+    }
+    if gouges > 0 {
+        worst.sort_by(deepest_first);
+        worst.truncate(keep);
+        return Err(SimError::Gouge { count: gouges, tolerance: options.gouge_tolerance, worst });
+    }
+    let remaining_volume = zmap.volume();
+    Ok(Verification {
+        part_cells,
+        max_scallop: max.map_or(0.0, |(m, _)| m),
+        max_scallop_at: max.map(|(_, (i, j))| zmap.cell_center(i, j)),
+        min_deviation: min_deviation.unwrap_or(0.0),
+        remaining_volume,
+        removed_volume: zmap.initial_volume() - remaining_volume,
+        excess_volume,
+    })
+}

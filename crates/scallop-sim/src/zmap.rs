@@ -1,0 +1,756 @@
+//! The z-map stock: a height field on a regular XY grid, cut by swept cutters.
+
+use std::fmt;
+
+use rayon::prelude::*;
+use scallop_cutter::Cutter;
+use scallop_geom::{Aabb3, Eps, Point2};
+use scallop_toolpath::{MoveKind, Toolpath};
+
+use crate::SimError;
+use crate::envelope::SweptMove;
+use crate::tol::GRID_SNAP;
+
+/// The largest number of cells a [`ZMap`] may have (16 bytes each).
+pub const MAX_CELLS: usize = 64_000_000;
+
+/// Rows per band: the unit of parallel work. Fixed, so the partition (and so
+/// the order of every floating-point sum) does not depend on the thread count.
+const BAND_ROWS: usize = 8;
+
+/// Cells per tile: a run of cells of one row sharing an upper bound of their
+/// heights, so that a move skips whole tiles it provably cannot lower.
+const TILE: usize = 16;
+
+/// One move of one [`ZMap::cut`] call: `operation` counts the calls on the
+/// stock (0 for the first), `index` is the move's position in its toolpath.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct MoveId {
+    /// Which [`ZMap::cut`] call (0-based).
+    pub operation: u32,
+    /// Index of the move in that call's toolpath.
+    pub index: u32,
+}
+
+impl fmt::Display for MoveId {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "move {} of operation {}", self.index, self.operation)
+    }
+}
+
+impl MoveId {
+    fn pack(self) -> u64 {
+        ((u64::from(self.operation) << 32) | u64::from(self.index)) + 1
+    }
+
+    fn unpack(v: u64) -> Option<MoveId> {
+        let v = v.checked_sub(1)?;
+        // INVARIANT: both halves of a packed id came from u32 values.
+        Some(MoveId { operation: (v >> 32) as u32, index: (v & 0xffff_ffff) as u32 })
+    }
+}
+
+/// A rapid (or retract) move that removed stock.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RapidHit {
+    /// The move.
+    pub id: MoveId,
+    /// Centre of the cell it cut deepest.
+    pub at: Point2,
+    /// How much it lowered that cell (mm).
+    pub depth: f64,
+}
+
+/// Which non-cutting part of the tool touched the stock.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ToolPart {
+    /// The shank (or stock above the flutes within the cutter radius).
+    Shank,
+    /// Holder segment number (bottom first).
+    Holder(usize),
+}
+
+impl ToolPart {
+    /// A word for messages.
+    #[must_use]
+    pub fn name(&self) -> &'static str {
+        match self {
+            ToolPart::Shank => "shank",
+            ToolPart::Holder(_) => "holder",
+        }
+    }
+}
+
+/// A move that drove the shank or holder into the in-process stock.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Collision {
+    /// The move.
+    pub id: MoveId,
+    /// The part of the tool.
+    pub part: ToolPart,
+    /// Centre of the cell where the penetration is deepest.
+    pub at: Point2,
+    /// Stock height above the part's lower face there (mm).
+    pub depth: f64,
+}
+
+/// What one [`ZMap::cut`] did, move by move.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CutReport {
+    /// The operation number given to this call's [`MoveId`]s.
+    pub operation: u32,
+    /// Volume removed by each move (mm^3), in program order.
+    pub removed_by_move: Vec<f64>,
+    /// Total removed volume (mm^3): the sum of `removed_by_move`.
+    pub removed_volume: f64,
+    /// Number of [`MoveKind::Feed`] moves.
+    pub feed_moves: usize,
+    /// Feed moves that lowered no cell by more than the stock's rounding epsilon.
+    pub air_feed_moves: usize,
+    /// Rapid and retract moves that removed stock, in program order (errors).
+    pub rapid_hits: Vec<RapidHit>,
+    /// Shank and holder collisions with the in-process stock, in program order (errors).
+    pub collisions: Vec<Collision>,
+}
+
+impl CutReport {
+    /// Share of feed moves that cut air, in [0, 1] (0 when there are none).
+    ///
+    /// ```
+    /// use scallop_cutter::{Cutter, CutterShape};
+    /// use scallop_geom::{Aabb3, Point3};
+    /// use scallop_sim::ZMap;
+    /// use scallop_toolpath::{Move, MoveKind, Toolpath};
+    /// let stock = Aabb3 { min: Point3::new(0.0, 0.0, -2.0), max: Point3::new(10.0, 10.0, 0.0) };
+    /// let mut zmap = ZMap::new(stock, 0.5).unwrap();
+    /// let flat = Cutter::new(CutterShape::Flat { radius: 1.0 }, 5.0).unwrap();
+    /// let mut path = Toolpath::new(500.0);
+    /// path.push(Move::new(MoveKind::Rapid, Point3::new(-2.0, 5.0, -1.0)));
+    /// path.push(Move::new(MoveKind::Feed, Point3::new(12.0, 5.0, -1.0))); // cuts a slot
+    /// path.push(Move::new(MoveKind::Feed, Point3::new(-2.0, 5.0, -1.0))); // back through it: air
+    /// let report = zmap.cut(&flat, &path).unwrap();
+    /// assert_eq!((report.feed_moves, report.air_feed_moves), (2, 1));
+    /// assert_eq!(report.air_cut_share(), 0.5);
+    /// assert!(report.check().is_ok());
+    /// ```
+    #[must_use]
+    pub fn air_cut_share(&self) -> f64 {
+        if self.feed_moves == 0 {
+            0.0
+        } else {
+            // Counts far below 2^52: exact conversions.
+            self.air_feed_moves as f64 / self.feed_moves as f64
+        }
+    }
+
+    /// The safety verdict of the cut: rapid hits first, then collisions.
+    ///
+    /// # Errors
+    /// [`SimError::RapidIntoStock`] when a rapid or retract removed stock,
+    /// [`SimError::HolderCollision`] when the shank or holder touched it.
+    pub fn check(&self) -> Result<(), SimError> {
+        if !self.rapid_hits.is_empty() {
+            return Err(SimError::RapidIntoStock { count: self.rapid_hits.len(), hits: self.rapid_hits.clone() });
+        }
+        if !self.collisions.is_empty() {
+            return Err(SimError::HolderCollision {
+                count: self.collisions.len(),
+                collisions: self.collisions.clone(),
+            });
+        }
+        Ok(())
+    }
+}
+
+/// A height-field stock: one z per cell of a regular XY grid over a stock box,
+/// sampled at cell centres, never below the box bottom.
+///
+/// ```
+/// use scallop_geom::{Aabb3, Point3};
+/// use scallop_sim::ZMap;
+/// let stock = Aabb3 { min: Point3::new(0.0, 0.0, -5.0), max: Point3::new(10.0, 4.0, 0.0) };
+/// let zmap = ZMap::new(stock, 0.5).unwrap();
+/// assert_eq!((zmap.nx(), zmap.ny()), (20, 8));
+/// assert_eq!(zmap.volume(), 200.0);
+/// assert!(ZMap::new(stock, 0.0).is_err());
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+pub struct ZMap {
+    stock: Aabb3,
+    nx: usize,
+    ny: usize,
+    cell_x: f64,
+    cell_y: f64,
+    heights: Vec<f64>,
+    last_cut: Vec<u64>,
+    operations: u32,
+    eps: f64,
+}
+
+/// A move prepared for the per-cell solve.
+struct Plan {
+    cutter: SweptMove,
+    /// First and one-past-last disc in `discs`.
+    discs: (usize, usize),
+    /// Lowest z any part of the tool reaches during the move.
+    z_low: f64,
+    /// Lowest z of the shank and holder discs.
+    disc_low: f64,
+    reach: f64,
+    from: Point2,
+    to: Point2,
+    rapid: bool,
+}
+
+/// What a band found, sparse per move.
+#[derive(Default)]
+struct BandOutput {
+    /// (move, removed volume, largest lowering).
+    removed: Vec<(u32, f64, f64)>,
+    /// (move, depth, cell).
+    rapid: Vec<(u32, f64, usize)>,
+    /// (move, part, depth, cell).
+    collisions: Vec<(u32, ToolPart, f64, usize)>,
+}
+
+impl ZMap {
+    /// A full stock box sampled at `resolution` (mm): `ceil(width / resolution)`
+    /// cells along x (the same along y), each of width `width / nx <= resolution`,
+    /// so the cells tile the box exactly. Every cell starts at the box top.
+    ///
+    /// # Errors
+    /// [`SimError::BadResolution`], [`SimError::BadStock`] (empty or not finite),
+    /// [`SimError::TooManyCells`] beyond [`MAX_CELLS`].
+    pub fn new(stock: Aabb3, resolution: f64) -> Result<ZMap, SimError> {
+        if !(resolution.is_finite() && resolution > 0.0) {
+            return Err(SimError::BadResolution { resolution });
+        }
+        let size = stock.size();
+        let finite = stock.min.coords.iter().chain(stock.max.coords.iter()).all(|c| c.is_finite());
+        if !(finite && size.x > 0.0 && size.y > 0.0 && size.z > 0.0) {
+            return Err(SimError::BadStock { min: stock.min.coords.into(), max: stock.max.coords.into() });
+        }
+        let count = |w: f64| {
+            let n = w / resolution;
+            // A width that is a whole number of cells up to rounding is not rounded up.
+            let n = if (n - n.round()).abs() <= GRID_SNAP * n { n.round() } else { n.ceil() };
+            n.max(1.0)
+        };
+        let (fx, fy) = (count(size.x), count(size.y));
+        let limit = MAX_CELLS as f64;
+        if fx * fy > limit {
+            // Saturating float-to-int conversions: only used in the message.
+            return Err(SimError::TooManyCells { nx: fx as usize, ny: fy as usize, limit: MAX_CELLS });
+        }
+        // Below MAX_CELLS: exact conversions.
+        let (nx, ny) = (fx as usize, fy as usize);
+        Ok(ZMap {
+            stock,
+            nx,
+            ny,
+            cell_x: size.x / fx,
+            cell_y: size.y / fy,
+            heights: vec![stock.max.z; nx * ny],
+            last_cut: vec![0; nx * ny],
+            operations: 0,
+            eps: Eps::for_bounds(&stock).0,
+        })
+    }
+
+    /// Cells along x.
+    #[must_use]
+    pub fn nx(&self) -> usize {
+        self.nx
+    }
+
+    /// Cells along y.
+    #[must_use]
+    pub fn ny(&self) -> usize {
+        self.ny
+    }
+
+    /// Cell size along x and y (mm), each at most the resolution asked for.
+    #[must_use]
+    pub fn cell_size(&self) -> (f64, f64) {
+        (self.cell_x, self.cell_y)
+    }
+
+    /// The stock box.
+    #[must_use]
+    pub fn stock(&self) -> Aabb3 {
+        self.stock
+    }
+
+    /// The rounding epsilon of the stock (mm): lowerings below it do not count as cuts.
+    #[must_use]
+    pub fn eps(&self) -> f64 {
+        self.eps
+    }
+
+    /// Centre of cell `(i, j)` (column, row).
+    #[must_use]
+    pub fn cell_center(&self, i: usize, j: usize) -> Point2 {
+        Point2::new(self.x_of(i), self.y_of(j))
+    }
+
+    fn x_of(&self, i: usize) -> f64 {
+        // Cell indices are far below 2^52: exact.
+        self.stock.min.x + (i as f64 + 0.5) * self.cell_x
+    }
+
+    fn y_of(&self, j: usize) -> f64 {
+        self.stock.min.y + (j as f64 + 0.5) * self.cell_y
+    }
+
+    /// Height of cell `(i, j)`, or `None` outside the grid.
+    #[must_use]
+    pub fn height(&self, i: usize, j: usize) -> Option<f64> {
+        (i < self.nx && j < self.ny).then(|| self.heights[j * self.nx + i])
+    }
+
+    /// All heights, row-major with x fastest.
+    #[must_use]
+    pub fn heights(&self) -> &[f64] {
+        &self.heights
+    }
+
+    /// The last move that lowered cell `(i, j)` (the one that left its height),
+    /// `None` when uncut or outside the grid.
+    ///
+    /// ```
+    /// use scallop_cutter::{Cutter, CutterShape};
+    /// use scallop_geom::{Aabb3, Point3};
+    /// use scallop_sim::{MoveId, ZMap};
+    /// use scallop_toolpath::{Move, MoveKind, Toolpath};
+    /// let stock = Aabb3 { min: Point3::new(0.0, 0.0, -2.0), max: Point3::new(4.0, 4.0, 0.0) };
+    /// let mut zmap = ZMap::new(stock, 1.0).unwrap();
+    /// let ball = Cutter::new(CutterShape::Ball { radius: 1.0 }, 5.0).unwrap();
+    /// let mut path = Toolpath::new(500.0);
+    /// path.push(Move::new(MoveKind::Rapid, Point3::new(0.5, 0.5, 3.0)));
+    /// path.push(Move::new(MoveKind::Plunge, Point3::new(0.5, 0.5, -1.0)));
+    /// zmap.cut(&ball, &path).unwrap();
+    /// assert_eq!(zmap.cell_center(0, 0), scallop_geom::Point2::new(0.5, 0.5));
+    /// assert_eq!(zmap.height(0, 0), Some(-1.0));
+    /// assert_eq!(zmap.last_cut(0, 0), Some(MoveId { operation: 0, index: 1 }));
+    /// assert_eq!(zmap.last_cut(3, 3), None);
+    /// assert_eq!(zmap.last_cut(0, 0).unwrap().to_string(), "move 1 of operation 0");
+    /// ```
+    #[must_use]
+    pub fn last_cut(&self, i: usize, j: usize) -> Option<MoveId> {
+        if i < self.nx && j < self.ny { MoveId::unpack(self.last_cut[j * self.nx + i]) } else { None }
+    }
+
+    /// Volume of stock left (mm^3): the sum over cells of height above the box bottom
+    /// times the cell area (summed row by row, in order).
+    #[must_use]
+    pub fn volume(&self) -> f64 {
+        let bottom = self.stock.min.z;
+        let area = self.cell_x * self.cell_y;
+        self.heights.chunks(self.nx).map(|row| row.iter().map(|h| h - bottom).sum::<f64>() * area).sum()
+    }
+
+    /// Volume of the full stock box (mm^3), in the same cell sum as [`ZMap::volume`].
+    #[must_use]
+    pub fn initial_volume(&self) -> f64 {
+        let area = self.cell_x * self.cell_y;
+        let column = self.stock.max.z - self.stock.min.z;
+        (0..self.ny).map(|_| (0..self.nx).map(|_| column).sum::<f64>() * area).sum()
+    }
+
+    /// Removes the material swept by `cutter` along `toolpath` (straight moves,
+    /// tool axis +Z). The first move has no known start: the tool is placed at
+    /// its end point (a zero-length move). Each cell centre is lowered to the
+    /// lowest point of the cutter's swept lower envelope above it (exact, see
+    /// [`crate::swept_floor`]), never below the stock bottom; a z-map removes the
+    /// whole column above that point.
+    ///
+    /// Before each move cuts, the shank (a disc of radius max(R, shank radius) at
+    /// the flute length above the tip, so that stock above the flutes, which a
+    /// z-map could not keep, is reported too) and each holder segment (a disc of
+    /// its larger radius at its bottom: conservative for frusta) are checked
+    /// against the in-process stock; penetrations beyond the stock's epsilon go
+    /// into [`CutReport::collisions`]. Rapid and retract moves that remove stock
+    /// go into [`CutReport::rapid_hits`]. Neither stops the cut; use
+    /// [`CutReport::check`].
+    ///
+    /// Only cells within a move's reach are visited: the rows of its XY box, on
+    /// each row the chord of the stadium around the segment, and on the chord
+    /// only runs of cells ("tiles") whose height bound lies above a lower bound
+    /// of the move's floor there (`z_low + k d^2`, see the envelope module), so
+    /// skipping never changes a result.
+    ///
+    /// Work is parallel over fixed bands of grid rows; each band applies the
+    /// moves in program order, so the result is identical on any thread count.
+    ///
+    /// # Errors
+    /// [`SimError::TooManyMoves`] when a move index or the operation count
+    /// would not fit in `u32`.
+    ///
+    /// ```
+    /// use scallop_cutter::{Cutter, CutterShape};
+    /// use scallop_geom::{Aabb3, Point3};
+    /// use scallop_sim::ZMap;
+    /// use scallop_toolpath::{Move, MoveKind, Toolpath};
+    /// let stock = Aabb3 { min: Point3::new(0.0, 0.0, -5.0), max: Point3::new(20.0, 10.0, 0.0) };
+    /// let mut zmap = ZMap::new(stock, 0.1).unwrap();
+    /// let flat = Cutter::new(CutterShape::Flat { radius: 2.0 }, 10.0).unwrap();
+    /// let mut path = Toolpath::new(1000.0);
+    /// path.push(Move::new(MoveKind::Rapid, Point3::new(-3.0, 5.0, 5.0)));
+    /// path.push(Move::new(MoveKind::Plunge, Point3::new(-3.0, 5.0, -1.0)));
+    /// path.push(Move::new(MoveKind::Feed, Point3::new(23.0, 5.0, -1.0)));
+    /// path.push(Move::new(MoveKind::Retract, Point3::new(23.0, 5.0, 5.0)));
+    /// let report = zmap.cut(&flat, &path).unwrap();
+    /// report.check().unwrap();
+    /// // A slot 4 mm wide and 1 mm deep through the 20 mm stock.
+    /// assert!((report.removed_volume - 80.0).abs() < 1e-9);
+    /// assert_eq!(zmap.height(100, 50), Some(-1.0));
+    /// ```
+    pub fn cut(&mut self, cutter: &Cutter, toolpath: &Toolpath) -> Result<CutReport, SimError> {
+        let moves = toolpath.moves();
+        let n = u32::try_from(moves.len()).map_err(|_| SimError::TooManyMoves { moves: moves.len() })?;
+        let operation = self.operations;
+        self.operations = self.operations.checked_add(1).ok_or(SimError::TooManyMoves { moves: moves.len() })?;
+
+        // Non-cutting parts as flat discs: (radius, lift above the tip, part).
+        let mut parts = vec![(cutter.radius().max(cutter.shank_radius()), cutter.flute_length(), ToolPart::Shank)];
+        let mut lift = cutter.flute_length() + cutter.shank_length();
+        for (k, s) in cutter.holder().iter().enumerate() {
+            parts.push((s.bottom_radius.max(s.top_radius), lift, ToolPart::Holder(k)));
+            lift += s.length;
+        }
+        let mut discs = Vec::with_capacity(moves.len() * parts.len());
+        let plans: Vec<Plan> = moves
+            .iter()
+            .enumerate()
+            .map(|(k, m)| {
+                let from = if k == 0 { m.to } else { moves[k - 1].to };
+                let cut = SweptMove::new(cutter.shape(), &from, &m.to);
+                let first = discs.len();
+                let mut reach = cut.radius();
+                let mut disc_low = f64::INFINITY;
+                for &(radius, lift, _) in &parts {
+                    let d = SweptMove::disc(radius, lift, &from, &m.to);
+                    reach = reach.max(radius);
+                    disc_low = disc_low.min(d.z_low);
+                    discs.push(d);
+                }
+                let z_low = cut.z_low.min(disc_low);
+                Plan {
+                    cutter: cut,
+                    discs: (first, discs.len()),
+                    z_low,
+                    disc_low,
+                    reach,
+                    from: from.xy(),
+                    to: m.to.xy(),
+                    rapid: matches!(m.kind, MoveKind::Rapid | MoveKind::Retract),
+                }
+            })
+            .collect();
+
+        // Moves per band (compressed rows), in program order.
+        let bands = self.ny.div_ceil(BAND_ROWS);
+        let band_range = |p: &Plan| {
+            let (lo, hi) = (p.from.y.min(p.to.y) - p.reach, p.from.y.max(p.to.y) + p.reach);
+            self.row_range(lo, hi).map(|(a, b)| (a / BAND_ROWS, b / BAND_ROWS))
+        };
+        let mut start = vec![0usize; bands + 1];
+        for p in &plans {
+            if let Some((a, b)) = band_range(p) {
+                for s in &mut start[a + 1..=b + 1] {
+                    *s += 1;
+                }
+            }
+        }
+        for b in 0..bands {
+            start[b + 1] += start[b];
+        }
+        let mut fill = start.clone();
+        let mut members = vec![0u32; start[bands]];
+        for (k, p) in plans.iter().enumerate() {
+            if let Some((a, b)) = band_range(p) {
+                for f in &mut fill[a..=b] {
+                    // k < n <= u32::MAX (checked above).
+                    members[*f] = k as u32;
+                    *f += 1;
+                }
+            }
+        }
+
+        let grid = Grid {
+            nx: self.nx,
+            ny: self.ny,
+            min_x: self.stock.min.x,
+            min_y: self.stock.min.y,
+            cell_x: self.cell_x,
+            cell_y: self.cell_y,
+            bottom: self.stock.min.z,
+            eps: self.eps,
+        };
+        let nx = self.nx;
+        let outputs: Vec<BandOutput> = self
+            .heights
+            .par_chunks_mut(BAND_ROWS * nx)
+            .zip(self.last_cut.par_chunks_mut(BAND_ROWS * nx))
+            .enumerate()
+            .map(|(band, (heights, last))| {
+                let ids = &members[start[band]..start[band + 1]];
+                grid.cut_band(band, heights, last, ids, &plans, &discs, &parts, operation)
+            })
+            .collect();
+
+        // Merge in band order: deterministic sums and tie-breaks.
+        let count = moves.len();
+        let mut removed_by_move = vec![0.0; count];
+        let mut lowered = vec![0.0f64; count];
+        let mut rapid: Vec<Option<(f64, usize)>> = vec![None; count];
+        let mut collided: Vec<Vec<(ToolPart, f64, usize)>> = vec![Vec::new(); count];
+        for out in &outputs {
+            for &(k, volume, lower) in &out.removed {
+                removed_by_move[k as usize] += volume;
+                lowered[k as usize] = lowered[k as usize].max(lower);
+            }
+            for &(k, depth, cell) in &out.rapid {
+                let slot = &mut rapid[k as usize];
+                if slot.is_none_or(|(d, _)| depth > d) {
+                    *slot = Some((depth, cell));
+                }
+            }
+            for &(k, part, depth, cell) in &out.collisions {
+                let list = &mut collided[k as usize];
+                match list.iter_mut().find(|(p, _, _)| *p == part) {
+                    Some(entry) if depth > entry.1 => *entry = (part, depth, cell),
+                    Some(_) => {}
+                    None => list.push((part, depth, cell)),
+                }
+            }
+        }
+        let cell_point = |cell: usize| self.cell_center(cell % nx, cell / nx);
+        let id = |k: usize| MoveId { operation, index: k as u32 };
+        let feed_moves = moves.iter().filter(|m| m.kind == MoveKind::Feed).count();
+        let air_feed_moves =
+            moves.iter().zip(&lowered).filter(|(m, l)| m.kind == MoveKind::Feed && **l <= self.eps).count();
+        let rapid_hits = rapid
+            .iter()
+            .enumerate()
+            .filter_map(|(k, r)| r.map(|(depth, cell)| RapidHit { id: id(k), at: cell_point(cell), depth }))
+            .collect();
+        let collisions = collided
+            .iter()
+            .enumerate()
+            .flat_map(|(k, list)| list.iter().map(move |&(part, depth, cell)| (k, part, depth, cell)))
+            .map(|(k, part, depth, cell)| Collision { id: id(k), part, at: cell_point(cell), depth })
+            .collect();
+        let removed_volume = removed_by_move.iter().sum();
+        debug_assert_eq!(n as usize, count);
+        Ok(CutReport { operation, removed_by_move, removed_volume, feed_moves, air_feed_moves, rapid_hits, collisions })
+    }
+
+    /// Rows whose centres may lie in [lo, hi] (one row of margin each side), or None.
+    fn row_range(&self, lo: f64, hi: f64) -> Option<(usize, usize)> {
+        index_range(lo, hi, self.stock.min.y, self.cell_y, self.ny)
+    }
+}
+
+/// Cell indices whose centres `min + (i + 0.5) cell` may lie in [lo, hi], with
+/// one cell of margin each side (the per-cell solve decides exactly).
+pub(crate) fn index_range(lo: f64, hi: f64, min: f64, cell: f64, n: usize) -> Option<(usize, usize)> {
+    let a = ((lo - min) / cell - 0.5).floor() - 1.0;
+    let b = ((hi - min) / cell - 0.5).ceil() + 1.0;
+    let last = n as f64 - 1.0;
+    if !(b >= 0.0 && a <= last) {
+        return None;
+    }
+    // Clamped to [0, n - 1]: exact conversions.
+    Some((a.max(0.0) as usize, b.min(last) as usize))
+}
+
+/// The grid geometry, shared by the bands.
+#[derive(Clone, Copy)]
+struct Grid {
+    nx: usize,
+    ny: usize,
+    min_x: f64,
+    min_y: f64,
+    cell_x: f64,
+    cell_y: f64,
+    bottom: f64,
+    eps: f64,
+}
+
+impl Grid {
+    fn x_of(&self, i: usize) -> f64 {
+        // Cell indices are far below 2^52: exact.
+        self.min_x + (i as f64 + 0.5) * self.cell_x
+    }
+
+    #[allow(clippy::too_many_arguments)] // one private call site; the pieces are unrelated borrows.
+    fn cut_band(
+        &self,
+        band: usize,
+        heights: &mut [f64],
+        last: &mut [u64],
+        ids: &[u32],
+        plans: &[Plan],
+        discs: &[SweptMove],
+        parts: &[(f64, f64, ToolPart)],
+        operation: u32,
+    ) -> BandOutput {
+        let nx = self.nx;
+        let row0 = band * BAND_ROWS;
+        let rows = heights.len() / nx;
+        let area = self.cell_x * self.cell_y;
+        // Upper bounds of each tile's heights; heights only go down, so a stale
+        // bound stays valid. `dirty` tiles get a fresh one when it matters.
+        let tiles_per_row = nx.div_ceil(TILE);
+        let tile_cells = |tile: usize| {
+            let (local, t) = (tile / tiles_per_row, tile % tiles_per_row);
+            local * nx + t * TILE..local * nx + ((t + 1) * TILE).min(nx)
+        };
+        let tile_max =
+            |heights: &[f64], tile: usize| heights[tile_cells(tile)].iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let mut tile_top: Vec<f64> = (0..rows * tiles_per_row).map(|t| tile_max(heights, t)).collect();
+        let mut dirty = vec![false; tile_top.len()];
+        let mut out = BandOutput::default();
+        for &k in ids {
+            let plan = &plans[k as usize];
+            let packed = MoveId { operation, index: k }.pack();
+            let (dy_lo, dy_hi) = (plan.from.y.min(plan.to.y) - plan.reach, plan.from.y.max(plan.to.y) + plan.reach);
+            let Some((j0, j1)) = index_range(dy_lo, dy_hi, self.min_y, self.cell_y, self.ny) else { continue };
+            let (j0, j1) = (j0.max(row0), j1.min(row0 + rows - 1));
+            let (box_x0, box_x1) = (plan.from.x.min(plan.to.x), plan.from.x.max(plan.to.x));
+            let (box_y0, box_y1) = (plan.from.y.min(plan.to.y), plan.from.y.max(plan.to.y));
+            let quadratic = plan.cutter.quadratic();
+            // Nothing at or below this can touch a disc (collisions need > eps).
+            let disc_bound = plan.disc_low + self.eps;
+            let mut removed = 0.0;
+            let mut max_lower = 0.0f64;
+            let mut rapid_worst: Option<(f64, usize)> = None;
+            let mut collision_worst: Vec<Option<(f64, usize)>> = vec![None; plan.discs.1 - plan.discs.0];
+            for j in j0..=j1 {
+                let local = j - row0;
+                let y = self.min_y + (j as f64 + 0.5) * self.cell_y;
+                let Some((i0, i1)) = self.columns(plan, y) else { continue };
+                let dy = (box_y0 - y).max(0.0).max(y - box_y1);
+                for t in i0 / TILE..=i1 / TILE {
+                    let tile = local * tiles_per_row + t;
+                    let (c0, c1) = (i0.max(t * TILE), i1.min(t * TILE + TILE - 1));
+                    // Lower bound of the cutter's floor on the tile's centres:
+                    // z_low + k d^2 with d the distance to the move's box.
+                    let (xa, xb) = (self.x_of(c0), self.x_of(c1));
+                    let dx = (box_x0 - xb).max(0.0).max(xa - box_x1);
+                    let bound = (plan.cutter.z_low + quadratic * (dx * dx + dy * dy)).min(disc_bound);
+                    if tile_top[tile] <= bound {
+                        continue;
+                    }
+                    if dirty[tile] {
+                        tile_top[tile] = tile_max(heights, tile);
+                        dirty[tile] = false;
+                        if tile_top[tile] <= bound {
+                            continue;
+                        }
+                    }
+                    let row = &mut heights[local * nx..(local + 1) * nx];
+                    let row_last = &mut last[local * nx..(local + 1) * nx];
+                    let mut lowered = false;
+                    for i in c0..=c1 {
+                        let old = row[i];
+                        if old <= plan.z_low {
+                            continue;
+                        }
+                        let x = self.x_of(i);
+                        if old > disc_bound {
+                            for (slot, disc) in discs[plan.discs.0..plan.discs.1].iter().enumerate() {
+                                if old - disc.z_low > self.eps {
+                                    let depth = old - disc.floor_below(x, y, old);
+                                    if depth > self.eps && collision_worst[slot].is_none_or(|(d, _)| depth > d) {
+                                        collision_worst[slot] = Some((depth, local * nx + i));
+                                    }
+                                }
+                            }
+                        }
+                        if old <= plan.cutter.z_low {
+                            continue;
+                        }
+                        let new = plan.cutter.floor_below(x, y, old).max(self.bottom);
+                        if new < old {
+                            row[i] = new;
+                            row_last[i] = packed;
+                            lowered = true;
+                            let lower = old - new;
+                            removed += lower;
+                            max_lower = max_lower.max(lower);
+                            if plan.rapid && lower > self.eps && rapid_worst.is_none_or(|(d, _)| lower > d) {
+                                rapid_worst = Some((lower, local * nx + i));
+                            }
+                        }
+                    }
+                    if lowered {
+                        dirty[tile] = true;
+                    }
+                }
+            }
+            let to_global = |cell: usize| row0 * nx + cell;
+            if removed > 0.0 {
+                out.removed.push((k, removed * area, max_lower));
+            }
+            if let Some((depth, cell)) = rapid_worst {
+                out.rapid.push((k, depth, to_global(cell)));
+            }
+            for (slot, worst) in collision_worst.iter().enumerate() {
+                if let Some((depth, cell)) = *worst {
+                    out.collisions.push((k, parts[slot].2, depth, to_global(cell)));
+                }
+            }
+        }
+        out
+    }
+
+    /// Columns the move may reach on the row at `y`: the row's chord of the
+    /// stadium (points within `reach` of the segment), the hull of the chords
+    /// of the two end discs and of the band between them; the index range has
+    /// one cell of margin each side (the per-cell solve decides exactly).
+    fn columns(&self, plan: &Plan, y: f64) -> Option<(usize, usize)> {
+        let (a, b, r) = (plan.from, plan.to, plan.reach);
+        let mut lo = f64::INFINITY;
+        let mut hi = f64::NEG_INFINITY;
+        for end in [a, b] {
+            let dy = y - end.y;
+            let h2 = r * r - dy * dy;
+            if h2 >= 0.0 {
+                let h = h2.sqrt();
+                lo = lo.min(end.x - h);
+                hi = hi.max(end.x + h);
+            }
+        }
+        let (dx, dy) = (b.x - a.x, b.y - a.y);
+        let len = dx.hypot(dy);
+        if len > 0.0 {
+            let (ex, ey) = (dx / len, dy / len);
+            // Band: 0 <= (x - ax) ex + (y - ay) ey <= L and |(x - ax) ey - (y - ay) ex| <= r,
+            // each a condition coef * x in [low, high].
+            let mut band = (f64::NEG_INFINITY, f64::INFINITY);
+            let q = y - a.y;
+            for (coef, low, high) in
+                [(ex, a.x * ex - q * ey, a.x * ex - q * ey + len), (ey, a.x * ey + q * ex - r, a.x * ey + q * ex + r)]
+            {
+                if coef == 0.0 {
+                    if low > 0.0 || high < 0.0 {
+                        band = (f64::INFINITY, f64::NEG_INFINITY);
+                    }
+                } else {
+                    let (p, q) = (low / coef, high / coef);
+                    band = (band.0.max(p.min(q)), band.1.min(p.max(q)));
+                }
+            }
+            if band.0 <= band.1 {
+                lo = lo.min(band.0);
+                hi = hi.max(band.1);
+            }
+        }
+        if lo > hi {
+            return None;
+        }
+        index_range(lo, hi, self.min_x, self.cell_x, self.nx)
+    }
+}
