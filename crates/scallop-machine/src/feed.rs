@@ -1,0 +1,196 @@
+//! Joint-space blocks: tip and tool-axis deviation of joint-linear interpolation,
+//! subdivision until the tip stays within its tolerance (spec 3.10), and inverse-time
+//! (G93) feeds bounded by every axis's velocity limit (spec 3.9).
+
+use scallop_geom::nalgebra::UnitQuaternion;
+use scallop_geom::{Point3, Vec3};
+
+use crate::chain::{Joints, Kinematics, Pose};
+use crate::error::MachineError;
+use crate::plan::select;
+use crate::tol;
+
+/// Distance from `p` to the segment `[a, b]`.
+fn distance_to_segment(p: &Point3, a: &Point3, b: &Point3) -> f64 {
+    let ab = b - a;
+    let len2 = ab.norm_squared();
+    let t = if len2 > 0.0 { ((p - a).dot(&ab) / len2).clamp(0.0, 1.0) } else { 0.0 };
+    (p - (a + ab * t)).norm()
+}
+
+/// Spherical interpolation of unit vectors (`a` when they are parallel or opposite).
+fn slerp(a: &Vec3, b: &Vec3, s: f64) -> Vec3 {
+    UnitQuaternion::rotation_between(a, b).map_or(*a, |r| UnitQuaternion::identity().slerp(&r, s) * a)
+}
+
+/// Deviation of the joint-linear motion `qa -> qb` from the part-frame block
+/// `pose_a -> pose_b`: the largest tip distance to the segment `[P_a, P_b]` and the
+/// largest angle (rad) between the tool axis and `slerp(O_a, O_b, s)`, over 16 uniform
+/// samples refined by golden section around the worst (spec 3.10).
+///
+/// ```
+/// use scallop_machine::{Kinematics, Machine, Joints, feed::deviation};
+/// let k = Kinematics::new(&Machine::builtin("ucp710").unwrap(), 0.0);
+/// let qa = Joints::new(0.0, 0.0, 50.0, 0.0, 0.0);
+/// let qb = Joints::new(10.0, 0.0, 50.0, 0.0, 0.0);
+/// let (pos, ang) = deviation(&k, &k.fk(&qa), &k.fk(&qb), &qa, &qb);
+/// assert!(pos < 1e-12 && ang < 1e-12); // pure translation
+/// ```
+#[must_use]
+pub fn deviation(kin: &Kinematics, pose_a: &Pose, pose_b: &Pose, qa: &Joints, qb: &Joints) -> (f64, f64) {
+    let pos_at = |s: f64| {
+        let p = kin.fk(&(qa + (qb - qa) * s)).tip;
+        distance_to_segment(&p, &pose_a.tip, &pose_b.tip)
+    };
+    let ang_at = |s: f64| {
+        let o = kin.fk(&(qa + (qb - qa) * s)).axis;
+        let ideal = slerp(&pose_a.axis, &pose_b.axis, s);
+        o.cross(&ideal).norm().atan2(o.dot(&ideal))
+    };
+    (maximise(pos_at), maximise(ang_at))
+}
+
+/// Max of `f` on [0, 1]: uniform samples, then golden section around the best.
+fn maximise(f: impl Fn(f64) -> f64) -> f64 {
+    let n = tol::DEVIATION_SAMPLES;
+    let step = 1.0 / n as f64;
+    let (mut best_s, mut best) = (0.0, f(0.0));
+    for k in 1..=n {
+        let s = k as f64 * step;
+        let v = f(s);
+        if v > best {
+            best = v;
+            best_s = s;
+        }
+    }
+    let (mut lo, mut hi) = ((best_s - step).max(0.0), (best_s + step).min(1.0));
+    let g = (5f64.sqrt() - 1.0) / 2.0;
+    let (mut x1, mut x2) = (hi - g * (hi - lo), lo + g * (hi - lo));
+    let (mut f1, mut f2) = (f(x1), f(x2));
+    for _ in 0..tol::DEVIATION_REFINE_ITERATIONS {
+        if f1 > f2 {
+            hi = x2;
+            x2 = x1;
+            f2 = f1;
+            x1 = hi - g * (hi - lo);
+            f1 = f(x1);
+        } else {
+            lo = x1;
+            x1 = x2;
+            f1 = f2;
+            x2 = lo + g * (hi - lo);
+            f2 = f(x2);
+        }
+    }
+    best.max(f1).max(f2)
+}
+
+/// One sub-block end: the part-frame pose and its joints.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BlockEnd {
+    /// Pose in the part frame.
+    pub pose: Pose,
+    /// Joint values.
+    pub joints: Joints,
+}
+
+/// Subdivides the joint-space block `qa -> qb` (poses `pose_a -> pose_b`) by bisection
+/// until joint-linear motion keeps the tip within `tol_pos` (mm) of the segment and the
+/// tool axis within `tol_ang` (rad) of the great circle (spec 3.10): the midpoint is
+/// `P_m = (P_a + P_b)/2`, `O_m = slerp(O_a, O_b, 1/2)`, solved continuing the branch and
+/// windings of `qa`. Returns the block ends after `qa` (the last one is `qb`).
+///
+/// ```
+/// use scallop_geom::{Point3, Vec3};
+/// use scallop_machine::{Kinematics, Machine, Joints, feed::subdivide};
+/// let k = Kinematics::new(&Machine::builtin("ucp710").unwrap(), 0.0);
+/// let qa = Joints::new(0.0, 0.0, 50.0, 0.5, 0.0);
+/// let qb = Joints::new(0.0, 0.0, 50.0, 0.5, 0.3);
+/// let ends = subdivide(&k, &k.fk(&qa), &k.fk(&qb), &qa, &qb, 0.01, 1.0, 0).unwrap();
+/// assert!(ends.len() > 1 && ends.last().unwrap().joints == qb);
+/// ```
+///
+/// # Errors
+/// [`MachineError::SubdivisionFailed`] after 16 levels; the inverse's errors for a
+/// midpoint, with `block`.
+#[allow(clippy::too_many_arguments, reason = "a block is two poses, two joint vectors and two tolerances")]
+pub fn subdivide(
+    kin: &Kinematics,
+    pose_a: &Pose,
+    pose_b: &Pose,
+    qa: &Joints,
+    qb: &Joints,
+    tol_pos: f64,
+    tol_ang: f64,
+    block: usize,
+) -> Result<Vec<BlockEnd>, MachineError> {
+    let mut out = Vec::new();
+    split(kin, (pose_a, qa), (pose_b, qb), (tol_pos, tol_ang), block, 0, &mut out)?;
+    Ok(out)
+}
+
+fn split(
+    kin: &Kinematics,
+    a: (&Pose, &Joints),
+    b: (&Pose, &Joints),
+    tolerance: (f64, f64),
+    block: usize,
+    depth: usize,
+    out: &mut Vec<BlockEnd>,
+) -> Result<(), MachineError> {
+    let (pos, ang) = deviation(kin, a.0, b.0, a.1, b.1);
+    if pos <= tolerance.0 && ang <= tolerance.1 {
+        out.push(BlockEnd { pose: *b.0, joints: *b.1 });
+        return Ok(());
+    }
+    if depth >= tol::SUBDIVISION_MAX_DEPTH {
+        return Err(MachineError::SubdivisionFailed { block, deviation: pos, depth });
+    }
+    let mid = Pose::new(Point3::from((a.0.tip.coords + b.0.tip.coords) / 2.0), slerp(&a.0.axis, &b.0.axis, 0.5));
+    // At the pole (C free, e.g. a pole flip) the midpoint takes the mean pole-axis value
+    // and the other axes are solved for it (spec 3.10): that is the hold of the inverse.
+    let pole = kin.pole_axis();
+    let mut hold = *a.1;
+    hold[pole] = (a.1[pole] + b.1[pole]) / 2.0;
+    let sols = kin.ik(&mid, &hold).map_err(|e| e.at_block(block))?;
+    let mut q_mid = select(kin, sols.as_slice(), Some(a.1), Some(block))?.joints;
+    if (q_mid - a.1).amax() > (b.1 - a.1).amax() + tol::BRANCH_JUMP {
+        // The midpoint jumped branch (a flip inside the block): interpolate the pole
+        // axis and solve the rest for it.
+        q_mid = hold;
+        kin.solve_linear(&mid.tip, &mut q_mid);
+    }
+    split(kin, a, (&mid, &q_mid), tolerance, block, depth + 1, out)?;
+    split(kin, (&mid, &q_mid), b, tolerance, block, depth + 1, out)
+}
+
+/// Inverse-time feed word of the block `qa -> qb` (spec 3.9):
+/// `T = max(L/F, r_ref·Δφ/F, max_j |Δq_j|/vmax_j, T_min)` and `F_inv = 1/T` in 1/min,
+/// rounded down to `nc.decimals.feed` so that no axis exceeds its velocity limit.
+/// `feed` is the programmed tip feed in mm/min.
+///
+/// ```
+/// use scallop_machine::{Kinematics, Machine, Joints, feed::inverse_time_feed};
+/// let k = Kinematics::new(&Machine::builtin("ucp710").unwrap(), 0.0);
+/// let qa = Joints::new(0.0, 0.0, 50.0, 0.0, 0.0);
+/// let qb = Joints::new(10.0, 0.0, 50.0, 0.0, 0.0);
+/// assert_eq!(inverse_time_feed(&k, &k.fk(&qa), &k.fk(&qb), &qa, &qb, 1000.0), 100.0);
+/// ```
+#[must_use]
+pub fn inverse_time_feed(kin: &Kinematics, pose_a: &Pose, pose_b: &Pose, qa: &Joints, qb: &Joints, feed: f64) -> f64 {
+    let machine = kin.machine();
+    let f = feed / 60.0; // mm/s
+    let length = (pose_b.tip - pose_a.tip).norm();
+    let dphi = pose_a.axis.cross(&pose_b.axis).norm().atan2(pose_a.axis.dot(&pose_b.axis));
+    let rate = crate::plan::move_time(machine, qa, qb);
+    let t = (length / f).max(machine.nc().r_ref * dphi / f).max(rate).max(machine.nc().min_block_time);
+    let scale = 10f64.powi(i32::from(machine.nc().decimals.feed));
+    let exact = 60.0 / t;
+    // Round down, but keep an exact value when it is already representable.
+    let rounded = (exact * scale).floor() / scale;
+    if (exact - (exact * scale).round() / scale).abs() <= tol::FEED_ROUNDING * exact {
+        (exact * scale).round() / scale
+    } else {
+        rounded
+    }
+}

@@ -1,0 +1,587 @@
+//! From inverse solutions to one joint vector per pose: rotary unwrapping to the shortest
+//! path within the strokes (spec 3.7), axis-limit checks, and the branch selection
+//! policy (spec 3.5, greedy streaming form): continuity with the previous joints first,
+//! then the strokes, then the user preference.
+
+use std::f64::consts::PI;
+
+use crate::chain::{Joints, Kinematics, Pose};
+use crate::desc::{AxisKind, Machine};
+use crate::error::MachineError;
+use crate::ik::{Branch, IkSolution};
+use crate::tol;
+
+/// The winding `raw + 2 pi n` of a rotary value for the move from `previous`: the one
+/// nearest `previous` (shortest path) if it is inside `limits` (joint units, rad), else
+/// the admissible winding nearest to it. Returns the value and whether it is an unwind
+/// (not the shortest path), or `None` when no winding fits the stroke.
+///
+/// ```
+/// use scallop_machine::plan::unwrap_angle;
+/// let d = std::f64::consts::PI / 180.0;
+/// let (c, unwound) = unwrap_angle(-170.0 * d, 170.0 * d, None).unwrap();
+/// assert!((c - 190.0 * d).abs() < 1e-12 && !unwound);
+/// let (c, unwound) = unwrap_angle(-170.0 * d, 170.0 * d, Some((-PI, PI))).unwrap();
+/// # use std::f64::consts::PI;
+/// assert!((c + 170.0 * d).abs() < 1e-12 && unwound);
+/// ```
+#[must_use]
+pub fn unwrap_angle(raw: f64, previous: f64, limits: Option<(f64, f64)>) -> Option<(f64, bool)> {
+    let turn = 2.0 * PI;
+    let nearest = (previous - raw) / turn;
+    let n_near = nearest.round();
+    let value = raw + n_near * turn;
+    let Some((lo, hi)) = limits else {
+        return Some((value, false));
+    };
+    let (lo, hi) = (lo - tol::LIMIT_SLACK, hi + tol::LIMIT_SLACK);
+    if value >= lo && value <= hi {
+        return Some((value, false));
+    }
+    let n_min = ((lo - raw) / turn).ceil();
+    let n_max = ((hi - raw) / turn).floor();
+    if n_min > n_max {
+        return None;
+    }
+    // The admissible winding nearest to `previous`.
+    let n = nearest.clamp(n_min, n_max).round().clamp(n_min, n_max);
+    Some((raw + n * turn, true))
+}
+
+/// Checks every axis of `q` against its stroke; the error names the block, the axis
+/// and the NC word.
+///
+/// ```
+/// use scallop_machine::{Machine, Joints, plan::check_limits};
+/// let m = Machine::builtin("mx330").unwrap();
+/// assert!(check_limits(&m, &Joints::new(0.0, 0.0, 100.0, -0.5, 9.0), Some(3)).is_ok());
+/// let err = check_limits(&m, &Joints::new(0.0, 0.0, 100.0, 0.5, 0.0), Some(3)).unwrap_err();
+/// assert!(err.to_string().contains("block 3: axis A"));
+/// ```
+///
+/// # Errors
+/// [`MachineError::LimitViolation`] for the first axis (joint order) outside its stroke.
+pub fn check_limits(machine: &Machine, q: &Joints, block: Option<usize>) -> Result<(), MachineError> {
+    for (i, axis) in machine.axes().iter().enumerate() {
+        if let Some((lo, hi)) = axis.joint_limits()
+            && (q[i] < lo - tol::LIMIT_SLACK || q[i] > hi + tol::LIMIT_SLACK)
+        {
+            let (min, max) = axis.limits.map_or((lo, hi), |l| l);
+            let to_word = |v: f64| if axis.kind == AxisKind::Rotary { v.to_degrees() } else { v };
+            return Err(MachineError::LimitViolation {
+                block,
+                axis: axis.name.clone(),
+                value: axis.to_nc_word(q[i]),
+                min: to_word(min),
+                max: to_word(max),
+                unit: axis.unit(),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Something the planner did that the post-processor or the user should know.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Event {
+    /// The branch changed at this block with a jump of the pole axis above 90 deg (a
+    /// flip; a continuous pole crossing is not reported).
+    BranchChange {
+        /// Block index.
+        block: usize,
+        /// The new branch.
+        to: Branch,
+    },
+    /// A rotary took a winding other than the shortest path because of its stroke
+    /// (a long move: needs a retract if cutting).
+    Unwind {
+        /// Block index.
+        block: usize,
+        /// Axis name.
+        axis: String,
+        /// Rotation of this block (deg).
+        delta_deg: f64,
+    },
+    /// The tool axis was on the pole: the pole axis was held at its previous value.
+    PoleHold {
+        /// Block index.
+        block: usize,
+    },
+    /// The pole axis turns in place at the pole (tool axis and tip fixed) to continue on
+    /// the other branch (spec 3.6 rule 3): allowed while cutting, leaves a dwell mark.
+    PoleFlip {
+        /// Block index (the move into this pose crosses or touches the pole).
+        block: usize,
+        /// The pole axis.
+        axis: String,
+        /// Its rotation (deg).
+        delta_deg: f64,
+        /// Time of the rotation at the axis's maximum velocity (s).
+        seconds: f64,
+    },
+    /// A rotary jump above the flip threshold on a non-cutting move (retract, reorient,
+    /// approach).
+    Reorient {
+        /// Block index.
+        block: usize,
+        /// The axis with the largest jump.
+        axis: String,
+        /// Its rotation (deg).
+        delta_deg: f64,
+    },
+}
+
+/// The chosen joints of one pose.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Selected {
+    /// Joint values with rotaries unwrapped.
+    pub joints: Joints,
+    /// The branch.
+    pub branch: Branch,
+    /// For each joint (joint order), whether it took an unwinding move (rotaries only).
+    pub unwound: [bool; 5],
+    /// The pose was on the pole.
+    pub at_pole: bool,
+}
+
+/// Unwraps `sol` against `previous` (rotaries) and checks all strokes.
+fn admissible(machine: &Machine, sol: &IkSolution, previous: Option<&Joints>) -> Result<Selected, MachineError> {
+    let mut q = sol.joints;
+    let mut unwound = [false; 5];
+    for i in 3..5 {
+        let axis = &machine.axes()[i];
+        let prev = previous.map_or(0.0, |p| p[i]);
+        match unwrap_angle(q[i], prev, axis.joint_limits()) {
+            Some((v, u)) => {
+                q[i] = v;
+                if u && previous.is_some() {
+                    unwound[i] = true;
+                }
+            }
+            None => {
+                // No winding fits: report the shortest-path value.
+                q[i] = unwrap_angle(q[i], prev, None).map_or(q[i], |(v, _)| v);
+            }
+        }
+    }
+    check_limits(machine, &q, None)?;
+    Ok(Selected { joints: q, branch: sol.branch, unwound, at_pole: sol.at_pole })
+}
+
+/// Velocity-limited time of the move `a -> b`: `max_j |dq_j| / vmax_j` (spec 3.5).
+///
+/// ```
+/// use scallop_machine::{Machine, Joints, plan::move_time};
+/// let m = Machine::builtin("mx330").unwrap();
+/// let t = move_time(&m, &Joints::zeros(), &Joints::new(0.0, 0.0, 0.0, 0.0, 198f64.to_radians()));
+/// assert!((t - 1.0).abs() < 1e-12);
+/// ```
+#[must_use]
+pub fn move_time(machine: &Machine, a: &Joints, b: &Joints) -> f64 {
+    machine.axes().iter().enumerate().map(|(i, ax)| (b[i] - a[i]).abs() / ax.dynamics.vmax).fold(0.0, f64::max)
+}
+
+/// Chooses one of the inverse solutions: candidates outside the strokes (after
+/// unwrapping) are dropped; with a previous joint vector the candidate with the
+/// smallest velocity-limited move time wins (continuity); ties and the first point go
+/// to the machine's `preferred_branch`, then the smaller |tilt|, then the smaller
+/// |pole axis| value.
+///
+/// ```
+/// use scallop_geom::{Point3, Vec3};
+/// use scallop_machine::{Kinematics, Machine, Joints, Pose, Branch, plan::select};
+/// let k = Kinematics::new(&Machine::builtin("mx330").unwrap(), 100.0);
+/// let pose = Pose::new(Point3::new(0.0, 0.0, 0.0), Vec3::new(0.0, 0.5, 1.0));
+/// let sols = k.ik(&pose, &Joints::zeros()).unwrap();
+/// let s = select(&k, sols.as_slice(), None, Some(0)).unwrap();
+/// assert_eq!(s.branch, Branch::Negative); // A in [-125, 10]: only branch (-) fits
+/// ```
+///
+/// # Errors
+/// [`MachineError::LimitViolation`] (naming the axis of the preferred candidate) when no
+/// candidate fits the strokes.
+pub fn select(
+    kin: &Kinematics,
+    solutions: &[IkSolution],
+    previous: Option<&Joints>,
+    block: Option<usize>,
+) -> Result<Selected, MachineError> {
+    let machine = kin.machine();
+    let mut best: Option<(Selected, f64)> = None;
+    let mut first_error = None;
+    let preference = |s: &Selected| -> (u8, f64, f64) {
+        let preferred = machine.preferred_branch().is_some_and(|p| {
+            let word = machine.axes()[p.axis].to_nc_word(s.joints[p.axis]);
+            word * p.sign > 0.0
+        });
+        (u8::from(!preferred), s.joints[kin.tilt_axis()].abs(), s.joints[kin.pole_axis()].abs())
+    };
+    for sol in solutions {
+        match admissible(machine, sol, previous) {
+            Ok(s) => {
+                let cost = previous.map_or(0.0, |p| move_time(machine, p, &s.joints));
+                let better = match &best {
+                    None => true,
+                    Some((b, bc)) => {
+                        if (cost - bc).abs() > tol::COST_TIE * (1.0 + bc.abs()) {
+                            cost < *bc
+                        } else {
+                            preference(&s) < preference(b)
+                        }
+                    }
+                };
+                if better {
+                    best = Some((s, cost));
+                }
+            }
+            Err(e) => {
+                if first_error.is_none() {
+                    first_error = Some(e);
+                }
+            }
+        }
+    }
+    match (best, first_error) {
+        (Some((s, _)), _) => Ok(s),
+        (None, Some(e)) => Err(block.map_or(e.clone(), |b| e.at_block(b))),
+        (None, None) => Err(MachineError::BadInput {
+            place: "plan::select".into(),
+            problem: "no inverse solution given".into(),
+            fix: "pass the solutions of Kinematics::ik".into(),
+        }),
+    }
+}
+
+/// A path in joint space with the planner's events.
+#[derive(Clone, Debug, PartialEq)]
+pub struct JointPath {
+    /// Joint vectors: one per input pose, plus the in-place rotations of pole flips.
+    pub joints: Vec<Joints>,
+    /// For each joint vector, the index of its pose.
+    pub pose_index: Vec<usize>,
+    /// What happened on the way.
+    pub events: Vec<Event>,
+}
+
+/// Inverse kinematics of a whole path, greedy streaming form of spec 3.5: each pose is
+/// solved with the previous joints held at the pole and [`select`]ed for continuity.
+/// No look-ahead: a path that must flip at the pole to stay within the strokes later
+/// needs [`plan_path`].
+/// `start` is the machine state before the first pose (`None`: no previous state, the
+/// preference decides).
+///
+/// ```
+/// use scallop_geom::{Point3, Vec3};
+/// use scallop_machine::{Kinematics, Machine, Pose, plan::solve_path};
+/// let k = Kinematics::new(&Machine::builtin("ucp710").unwrap(), 0.0);
+/// let poses: Vec<Pose> = (0..10)
+///     .map(|i| Pose::new(Point3::new(i as f64, 0.0, 50.0), Vec3::new(0.0, 0.1 * i as f64, 1.0)))
+///     .collect();
+/// let path = solve_path(&k, &poses, None).unwrap();
+/// assert_eq!(path.joints.len(), 10);
+/// ```
+///
+/// # Errors
+/// The first error, with its block index: [`MachineError::Unreachable`],
+/// [`MachineError::LimitViolation`] (axis named) or [`MachineError::NoConvergence`].
+pub fn solve_path(kin: &Kinematics, poses: &[Pose], start: Option<Joints>) -> Result<JointPath, MachineError> {
+    let mut joints: Vec<Joints> = Vec::with_capacity(poses.len());
+    let mut events = Vec::new();
+    let mut previous = start;
+    let mut previous_branch: Option<Branch> = None;
+    for (block, pose) in poses.iter().enumerate() {
+        let hold = previous.unwrap_or_else(Joints::zeros);
+        let sols = kin.ik(pose, &hold).map_err(|e| e.at_block(block))?;
+        let s = select(kin, sols.as_slice(), previous.as_ref(), Some(block))?;
+        if s.at_pole {
+            events.push(Event::PoleHold { block });
+        } else {
+            // A flip is a branch change with a pole-axis jump; crossing the pole along a
+            // great circle changes the tilt sign with the pole axis still (spec 3.6 rule 2).
+            let pole = kin.pole_axis();
+            let jump = (s.joints[pole] - hold[pole]).abs() > tol::BRANCH_JUMP;
+            if previous_branch.is_some_and(|b| b != s.branch) && jump {
+                events.push(Event::BranchChange { block, to: s.branch });
+            }
+            previous_branch = Some(s.branch);
+        }
+        for i in (0..5).filter(|i| s.unwound[*i]) {
+            let delta = s.joints[i] - hold[i];
+            events.push(Event::Unwind {
+                block,
+                axis: kin.machine().axes()[i].name.clone(),
+                delta_deg: delta.to_degrees(),
+            });
+        }
+        previous = Some(s.joints);
+        joints.push(s.joints);
+    }
+    let pose_index = (0..joints.len()).collect();
+    Ok(JointPath { joints, pose_index, events })
+}
+
+/// Options of [`plan_path`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlanOptions {
+    /// A rotary move above this in one block (rad) is a jump: a flip or an unwind.
+    pub flip_threshold: f64,
+    /// Time charged for a jump on a non-cutting move (retract, reorient, approach; s).
+    pub reorient_penalty: f64,
+}
+
+impl Default for PlanOptions {
+    fn default() -> Self {
+        PlanOptions { flip_threshold: tol::FLIP_THRESHOLD_DEFAULT, reorient_penalty: tol::REORIENT_PENALTY_DEFAULT }
+    }
+}
+
+#[derive(Clone, Debug)]
+struct State {
+    q: Joints,
+    at_pole: bool,
+    cost: f64,
+    /// Preference key of the first pose of this chain (spec 3.5 ties).
+    first: (u8, f64, f64),
+    back: usize,
+    edge: Edge,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Edge {
+    Plain,
+    PoleFlip,
+    Reorient(usize),
+}
+
+fn preference_key(kin: &Kinematics, q: &Joints) -> (u8, f64, f64) {
+    let machine = kin.machine();
+    let preferred =
+        machine.preferred_branch().is_some_and(|p| machine.axes()[p.axis].to_nc_word(q[p.axis]) * p.sign > 0.0);
+    (u8::from(!preferred), q[kin.tilt_axis()].abs(), q[kin.pole_axis()].abs())
+}
+
+fn better(a: &State, b: &State) -> bool {
+    if (a.cost - b.cost).abs() > tol::COST_TIE * (1.0 + b.cost.abs()) { a.cost < b.cost } else { a.first < b.first }
+}
+
+/// The pole direction in the part frame (tool axis at tilt 0).
+fn pole_direction(kin: &Kinematics) -> scallop_geom::Vec3 {
+    let u = kin.machine().axes()[kin.pole_axis()].direction;
+    let a0 = kin.machine().tool_axis();
+    let signed = if u.dot(&a0) < 0.0 { -u } else { u };
+    kin.part_frame().inverse_transform_vector(&signed)
+}
+
+/// Whether the great-circle arc from `a` to `b` passes within `eps` of the unit vector `c`.
+fn arc_passes(a: &scallop_geom::Vec3, b: &scallop_geom::Vec3, c: &scallop_geom::Vec3, eps: f64) -> bool {
+    let n = a.cross(b);
+    let len = n.norm();
+    if len <= eps {
+        return (a - c).norm() <= eps || (b - c).norm() <= eps;
+    }
+    let n = n / len;
+    if c.dot(&n).abs() > eps {
+        return false;
+    }
+    let p = c - n * c.dot(&n);
+    a.cross(&p).dot(&n) >= 0.0 && p.cross(b).dot(&n) >= 0.0 && p.dot(c) > 0.0
+}
+
+/// Inverse kinematics of a whole path by dynamic programming over the inverse branches
+/// and rotary windings (spec 3.5, Viterbi with at most [`tol::PLAN_BEAM`] candidates per
+/// pose). Edge cost: the velocity-limited time `max_j |dq_j| / vmax_j`. A rotary jump
+/// above `flip_threshold` is allowed while cutting only as a pole flip (only the pole
+/// axis jumps, and the tool axis is on the pole at one end of the block or crosses it
+/// within the block; spec 3.6 rule 3); on a non-cutting move it costs
+/// `reorient_penalty` more. Ties go to the machine's preferred branch at the first pose,
+/// then the smaller |tilt|, then the smaller |pole axis|. A pole flip at a pose on the
+/// pole is emitted as an extra joint vector at that pose (an in-place rotation).
+///
+/// `cutting[i]` says whether the move into pose `i` is in the material.
+///
+/// ```
+/// use scallop_geom::{Point3, Vec3};
+/// use scallop_machine::{Kinematics, Machine, Pose, plan::{plan_path, Event, PlanOptions}};
+/// let k = Kinematics::new(&Machine::builtin("mx330").unwrap(), 100.0);
+/// // Tool axis swept through the pole in the YZ plane, tip fixed: A <= 10 deg forces a flip.
+/// let poses: Vec<Pose> = (-30..=30)
+///     .map(|i| { let p = (i as f64).to_radians(); Pose::new(Point3::new(0.0, 0.0, 20.0), Vec3::new(0.0, p.sin(), p.cos())) })
+///     .collect();
+/// let path = plan_path(&k, &poses, &vec![true; poses.len()], None, &PlanOptions::default()).unwrap();
+/// assert_eq!(path.events.iter().filter(|e| matches!(e, Event::PoleFlip { .. })).count(), 1);
+/// ```
+///
+/// # Errors
+/// [`MachineError::BadInput`] when `cutting` and `poses` differ in length; the first
+/// pose with no admissible solution gives its [`MachineError::LimitViolation`] or
+/// [`MachineError::Unreachable`] with the block; [`MachineError::FlipWhileCutting`] when
+/// every way on needs a jump inside the material.
+pub fn plan_path(
+    kin: &Kinematics,
+    poses: &[Pose],
+    cutting: &[bool],
+    start: Option<Joints>,
+    options: &PlanOptions,
+) -> Result<JointPath, MachineError> {
+    if cutting.len() != poses.len() {
+        return Err(MachineError::BadInput {
+            place: "plan::plan_path".into(),
+            problem: format!("{} poses but {} cutting flags", poses.len(), cutting.len()),
+            fix: "give one cutting flag per pose".into(),
+        });
+    }
+    let machine = kin.machine();
+    let pole = kin.pole_axis();
+    let pole_dir = pole_direction(kin);
+    let eps = machine.pole_eps();
+    let root = State {
+        q: start.unwrap_or_else(Joints::zeros),
+        at_pole: false,
+        cost: 0.0,
+        first: (0, 0.0, 0.0),
+        back: 0,
+        edge: Edge::Plain,
+    };
+    let mut layers: Vec<Vec<State>> = Vec::with_capacity(poses.len());
+    for (i, pose) in poses.iter().enumerate() {
+        let preds: &[State] = if i == 0 { std::slice::from_ref(&root) } else { &layers[i - 1] };
+        let mut next: Vec<State> = Vec::new();
+        let mut first_error: Option<MachineError> = None;
+        let mut smallest_jump: Option<(usize, f64)> = None;
+        // Off the pole the inverse does not depend on the held joints: solve once.
+        let shared = kin.ik(pose, &preds[0].q).map_err(|e| e.at_block(i))?;
+        let polar = shared.as_slice().iter().any(|s| s.at_pole) || kin.solver() == crate::chain::Solver::Numeric;
+        for (pi, p) in preds.iter().enumerate() {
+            let sols = if polar && pi > 0 { kin.ik(pose, &p.q).map_err(|e| e.at_block(i))? } else { shared };
+            for sol in sols.as_slice() {
+                let has_previous = i > 0 || start.is_some();
+                let cand = match admissible(machine, sol, has_previous.then_some(&p.q)) {
+                    Ok(c) => c,
+                    Err(e) => {
+                        first_error.get_or_insert(e.at_block(i));
+                        continue;
+                    }
+                };
+                let (cost, edge) = if has_previous {
+                    let dq = cand.joints - p.q;
+                    let t = move_time(machine, &p.q, &cand.joints);
+                    let jump = [3, 4].map(|j| dq[j].abs() > options.flip_threshold);
+                    if jump == [false, false] {
+                        (t, Edge::Plain)
+                    } else {
+                        let only_pole = (0..2).all(|r| jump[r] == (r + 3 == pole));
+                        let crosses = p.at_pole
+                            || cand.at_pole
+                            || (i > 0 && arc_passes(&poses[i - 1].axis, &pose.axis, &pole_dir, eps));
+                        if only_pole && crosses {
+                            (t, Edge::PoleFlip)
+                        } else if cutting[i] {
+                            let j = if dq[3].abs() >= dq[4].abs() { 3 } else { 4 };
+                            if smallest_jump.is_none_or(|(_, d)| dq[j].abs() < d) {
+                                smallest_jump = Some((j, dq[j].abs()));
+                            }
+                            continue;
+                        } else {
+                            let j = if dq[3].abs() >= dq[4].abs() { 3 } else { 4 };
+                            (t + options.reorient_penalty, Edge::Reorient(j))
+                        }
+                    }
+                } else {
+                    (0.0, Edge::Plain)
+                };
+                let first = if i == 0 { preference_key(kin, &cand.joints) } else { p.first };
+                let state = State { q: cand.joints, at_pole: cand.at_pole, cost: p.cost + cost, first, back: pi, edge };
+                match next.iter_mut().find(|s| (s.q - state.q).amax() < tol::SAME_JOINTS) {
+                    Some(existing) => {
+                        if better(&state, existing) {
+                            *existing = state;
+                        }
+                    }
+                    None => next.push(state),
+                }
+            }
+        }
+        if next.is_empty() {
+            if let Some((j, d)) = smallest_jump {
+                return Err(MachineError::FlipWhileCutting {
+                    block: i,
+                    axis: machine.axes()[j].name.clone(),
+                    delta_deg: d.to_degrees(),
+                });
+            }
+            return Err(first_error.unwrap_or(MachineError::Unreachable {
+                block: Some(i),
+                axis: [pose.axis.x, pose.axis.y, pose.axis.z],
+            }));
+        }
+        // Deterministic order, then the beam.
+        next.sort_by(|a, b| {
+            if better(a, b) {
+                std::cmp::Ordering::Less
+            } else if better(b, a) {
+                std::cmp::Ordering::Greater
+            } else {
+                std::cmp::Ordering::Equal
+            }
+        });
+        next.truncate(tol::PLAN_BEAM);
+        layers.push(next);
+    }
+    // Backtrack from the best final state.
+    let mut chain: Vec<&State> = Vec::with_capacity(poses.len());
+    if let Some(last) = layers.last() {
+        let mut idx = 0; // layers are sorted: the best is first
+        for layer in layers.iter().rev() {
+            let s = &layer[idx];
+            chain.push(s);
+            idx = s.back;
+        }
+        debug_assert_eq!(chain.len(), poses.len());
+        debug_assert!(!last.is_empty());
+    }
+    chain.reverse();
+    let mut joints = Vec::with_capacity(poses.len() + 2);
+    let mut pose_index = Vec::with_capacity(poses.len() + 2);
+    let mut events = Vec::new();
+    for (i, s) in chain.iter().enumerate() {
+        let prev = if i == 0 { start } else { Some(chain[i - 1].q) };
+        match (s.edge, prev) {
+            (Edge::PoleFlip, Some(pq)) => {
+                let delta = s.q[pole] - pq[pole];
+                let axis = &machine.axes()[pole];
+                events.push(Event::PoleFlip {
+                    block: i,
+                    axis: axis.name.clone(),
+                    delta_deg: delta.to_degrees(),
+                    seconds: delta.abs() / axis.dynamics.vmax,
+                });
+                if i > 0 && chain[i - 1].at_pole {
+                    // Turn in place at the previous (polar) pose.
+                    let mut q = pq;
+                    q[pole] = s.q[pole];
+                    kin.solve_linear(&poses[i - 1].tip, &mut q);
+                    joints.push(q);
+                    pose_index.push(i - 1);
+                } else if s.at_pole {
+                    let mut q = s.q;
+                    q[pole] = pq[pole];
+                    kin.solve_linear(&poses[i].tip, &mut q);
+                    joints.push(q);
+                    pose_index.push(i);
+                }
+            }
+            (Edge::Reorient(j), Some(pq)) => events.push(Event::Reorient {
+                block: i,
+                axis: machine.axes()[j].name.clone(),
+                delta_deg: (s.q[j] - pq[j]).to_degrees(),
+            }),
+            _ => {}
+        }
+        if s.at_pole {
+            events.push(Event::PoleHold { block: i });
+        }
+        joints.push(s.q);
+        pose_index.push(i);
+    }
+    Ok(JointPath { joints, pose_index, events })
+}

@@ -1,0 +1,105 @@
+//! Machine descriptions: every shipped file loads; validation errors name the field and the fix.
+
+use scallop_machine::{Machine, MachineError};
+
+fn ucp_text() -> String {
+    std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../machines/mikron-ucp710.toml")).expect("file")
+}
+
+fn invalid_place(text: &str) -> String {
+    match Machine::from_toml_str(text) {
+        Err(MachineError::Invalid { place, fix, .. }) => {
+            assert!(!fix.is_empty());
+            place
+        }
+        other => panic!("expected Invalid, got {other:?}"),
+    }
+}
+
+#[test]
+fn every_shipped_machine_loads_and_validates() {
+    for name in Machine::builtin_names() {
+        let m = Machine::builtin(name).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(m.axes().len(), 5);
+        for a in m.axes() {
+            assert!((a.direction.norm() - 1.0).abs() < 1e-15);
+            if let Some((lo, hi)) = a.limits {
+                assert!(lo < hi);
+            }
+            assert!(a.dynamics.vmax > 0.0 && a.dynamics.amax > 0.0 && a.dynamics.jmax > 0.0);
+        }
+    }
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../machines");
+    let files = std::fs::read_dir(dir).expect("machines/").count();
+    assert_eq!(files, Machine::builtin_names().len(), "every file in machines/ is shipped as a builtin");
+}
+
+#[test]
+fn stroke_min_not_below_max() {
+    let t = ucp_text().replace("limits = [-30, 120]", "limits = [120, -30]");
+    assert_eq!(invalid_place(&t), "axes.A.limits");
+}
+
+#[test]
+fn direction_must_be_unit() {
+    let t = ucp_text().replace("direction = [-1, 0, 0]", "direction = [-1, 0.1, 0]");
+    assert_eq!(invalid_place(&t), "axes.A.direction");
+}
+
+#[test]
+fn dynamics_must_exist_and_be_positive() {
+    let t = ucp_text().replace("A = [90.0, 298.8, 1800]", "A = [90.0, -298.8, 1800]");
+    assert_eq!(invalid_place(&t), "dynamics.A");
+    let t = ucp_text().replace("A = [90.0, 298.8, 1800]\n", "");
+    assert_eq!(invalid_place(&t), "dynamics.A");
+}
+
+#[test]
+fn chains_must_cover_every_axis_once() {
+    let t = ucp_text().replace("part = [\"A\", \"C\"]", "part = [\"A\"]");
+    assert_eq!(invalid_place(&t), "chains");
+    let t = ucp_text().replace("part = [\"A\", \"C\"]", "part = [\"A\", \"C\", \"Q\"]");
+    assert_eq!(invalid_place(&t), "chains.part");
+}
+
+#[test]
+fn rotary_axes_need_a_pivot_and_must_not_be_parallel() {
+    let t = ucp_text().replace(", point = [0, 0, -100]", "");
+    assert_eq!(invalid_place(&t), "axes.A.point");
+    let t = ucp_text().replace("direction = [-1, 0, 0], point", "direction = [0, 0, 1], point");
+    assert_eq!(invalid_place(&t), "axes.C.direction");
+}
+
+#[test]
+fn schema_and_unknown_fields() {
+    let t = ucp_text().replace("scallop.machine/1", "scallop.machine/9");
+    assert_eq!(invalid_place(&t), "schema");
+    let t = ucp_text().replace("controlled_point = \"tip\"", "controlled_point = \"tip\"\nspeed = 3");
+    match Machine::from_toml_str(&t) {
+        Err(MachineError::Parse { line, message, .. }) => {
+            let expected = t.lines().position(|l| l.starts_with("speed")).expect("inserted") + 1;
+            assert_eq!(line, expected, "{message}");
+            assert!(message.contains("speed"), "{message}");
+        }
+        other => panic!("{other:?}"),
+    }
+    let t = ucp_text().replace("nc_sign = 1, limits = [-30, 120]", "nc_sign = 1, limts = [-30, 120]");
+    match Machine::from_toml_str(&t) {
+        Err(e @ MachineError::Parse { .. }) => {
+            let s = e.to_string();
+            let line = t.lines().position(|l| l.contains("limts")).expect("typo") + 1;
+            assert!(s.contains("limts") && s.contains(&format!("line {line} ")), "{s}");
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn four_axis_machines_are_unsupported_for_now() {
+    let t = ucp_text().replace("part = [\"A\", \"C\"]", "part = [\"C\"]").replace(
+        "A = { kind = \"rotary\", direction = [-1, 0, 0], point = [0, 0, -100], nc_sign = 1, limits = [-30, 120] }\n",
+        "",
+    );
+    let t = t.replace("A = [90.0, 298.8, 1800]\n", "").replace("preferred_branch = { axis = \"A\", sign = 1 }\n", "");
+    assert!(matches!(Machine::from_toml_str(&t), Err(MachineError::Unsupported { .. })));
+}
