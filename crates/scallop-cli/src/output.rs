@@ -104,6 +104,8 @@ pub fn demo(args: &DemoArgs) -> CliResult<()> {
          \x20 toolpath   {passes} passes, {moves} moves, {cl} drop-cutter queries in {seconds:.2} s\n\
          \x20 lengths    feed {feed:.0} mm, links {link:.0} mm, plunge {plunge:.0} mm, rapid {rapid:.0} mm\n\
          \x20 tip z      {z0:.3} .. {z1:.3} mm\n\
+         \x20 verified   no gouge on a {res} mm stock simulation; max material left {ms:.4} mm, \
+         deepest {md:+.4} mm; {air:.1} % of feed moves cut air\n\
          \x20 time       {t:.0} s at the programmed feeds (no acceleration limits yet)\n\
          \x20 program    {nc}\n",
         part = s.part,
@@ -122,6 +124,10 @@ pub fn demo(args: &DemoArgs) -> CliResult<()> {
         z0 = s.tip_z_range_mm[0],
         z1 = s.tip_z_range_mm[1],
         t = s.naive_time_s,
+        res = s.sim_resolution_mm,
+        ms = s.verified_max_scallop_mm,
+        md = s.verified_min_deviation_mm,
+        air = 100.0 * s.air_cut_share,
         nc = nc.display(),
     );
     print_text(&text)

@@ -4,10 +4,11 @@
 //! fixed stepover by the scallop-driven one and the naive time by the
 //! jerk-limited model.
 
+use rayon::prelude::*;
 use scallop_cutter::{ClPoint, Contact, Cutter, CutterShape, drop_grid, drop_points};
 use scallop_geom::{Point2, Point3, Tolerances};
 use scallop_post::{Dialect, write_gcode};
-use scallop_toolpath::{Move, MoveKind, Toolpath, simplify};
+use scallop_toolpath::{Move, MoveKind, Toolpath, simplify_above};
 use serde::Serialize;
 
 use crate::{EngineError, Part, prepare_part};
@@ -16,6 +17,11 @@ use crate::{EngineError, Part, prepare_part};
 /// (the tessellation takes `Tolerances::TESSELLATION_SHARE`; the rest is left
 /// for the sampling along the passes).
 pub const SIMPLIFY_SHARE: f64 = 0.5;
+
+/// Share of the path tolerance given to sampling along a pass: a straight
+/// move between two CL points may deviate this far from the CL surface at its
+/// middle (checked by refinement).
+pub const SAMPLING_SHARE: f64 = 0.25;
 
 /// Settings of the demo job (all in mm, mm/min).
 #[derive(Debug, Clone, PartialEq)]
@@ -34,6 +40,8 @@ pub struct DemoSettings {
     pub rapid_rate: f64,
     /// Clearance height above the part's top (mm).
     pub clearance: f64,
+    /// Cell size of the verifying stock simulation (mm).
+    pub sim_resolution: f64,
     /// Path and gouge tolerances.
     pub tolerances: Tolerances,
 }
@@ -50,6 +58,7 @@ impl DemoSettings {
             feed: 2000.0,
             rapid_rate: 10_000.0,
             clearance: 5.0,
+            sim_resolution: 0.1,
             tolerances: Tolerances { path: 0.01, gouge: 0.0 },
         }
     }
@@ -90,6 +99,16 @@ pub struct DemoSummary {
     pub tip_z_range_mm: [f64; 2],
     /// Tolerance of collinear-point merging (mm).
     pub simplify_tolerance_mm: f64,
+    /// Cell size of the stock simulation that verified the program (mm).
+    pub sim_resolution_mm: f64,
+    /// Largest material left above the part, measured on the simulated stock (mm).
+    pub verified_max_scallop_mm: f64,
+    /// Where the most material is left (XY, mm).
+    pub verified_max_scallop_at: Option<[f64; 2]>,
+    /// Smallest stock-minus-part deviation (mm); a gouge would make the run fail.
+    pub verified_min_deviation_mm: f64,
+    /// Share of feed moves that removed nothing.
+    pub air_cut_share: f64,
 }
 
 /// The demo's results.
@@ -118,7 +137,9 @@ pub fn run_demo(settings: &DemoSettings, progress: &(dyn Fn(usize, usize) + Sync
         .ok_or_else(|| crate::GridError::Syntax(format!("unknown built-in part '{}' (choi, rubio)", s.part)))?;
     let prepared = prepare_part(&part, &s.tolerances)?;
     let radius = 0.5 * s.cutter_diameter;
-    let cutter = Cutter::new(CutterShape::Ball { radius }, 4.0 * s.cutter_diameter)?;
+    // Long flutes: the Choi surface is 24 mm deep and the verifying stock reaches
+    // 1 mm above its top (the shank check of the simulation would refuse shorter ones).
+    let cutter = Cutter::new(CutterShape::Ball { radius }, 5.0 * s.cutter_diameter)?;
     let bounds = prepared.mesh.bounds();
     let floor = bounds.min.z - s.cutter_diameter;
     let axis = |lo: f64, hi: f64, step: f64| -> Vec<f64> {
@@ -128,8 +149,12 @@ pub fn run_demo(settings: &DemoSettings, progress: &(dyn Fn(usize, usize) + Sync
         #[allow(clippy::cast_precision_loss)]
         (0..=n).map(|i| lo + (hi - lo) * i as f64 / n as f64).collect()
     };
-    let xs = axis(bounds.min.x, bounds.max.x, s.sample_step);
-    let ys = axis(bounds.min.y, bounds.max.y, s.stepover);
+    // The raster overruns the part by the cutter radius so that the cutter
+    // finishes the edges (on a slope, a ball centred over a downhill edge rests
+    // uphill and leaves the edge uncut); points where it touches nothing split
+    // the passes.
+    let xs = axis(bounds.min.x - radius, bounds.max.x + radius, s.sample_step);
+    let ys = axis(bounds.min.y - radius, bounds.max.y + radius, s.stepover);
     let total = ys.len();
     let grid = drop_grid(&cutter, &prepared.index, &xs, &ys, floor, &|done| progress(done, total));
     let mut dropped = grid.len();
@@ -155,19 +180,28 @@ pub fn run_demo(settings: &DemoSettings, progress: &(dyn Fn(usize, usize) + Sync
         }
     }
 
+    // Refine every run where the straight move between two samples would leave
+    // the CL surface: below it at all (a gouge) or above it by more than the
+    // sampling share of the path tolerance.
+    let sampling_tol = SAMPLING_SHARE * s.tolerances.path;
+    let runs: Vec<Vec<Point3>> =
+        runs.par_iter().map(|run| refine(&cutter, &prepared.index, run, floor, sampling_tol, &mut 0)).collect();
+    dropped += runs.iter().map(Vec::len).sum::<usize>();
+
     let clearance = bounds.max.z + s.clearance;
     let mut path = Toolpath::new(s.feed);
     let mut last: Option<Point3> = None;
     for run in &runs {
         let start = run[0];
         let link = last.and_then(|p| {
-            let cl = link_on_surface(&cutter, &prepared.index, p, start, s.sample_step, floor);
+            let cl = link_on_surface(&cutter, &prepared.index, p, start, s.sample_step, floor)
+                .map(|points| refine(&cutter, &prepared.index, &points, floor, sampling_tol, &mut 0));
             dropped += cl.as_ref().map_or(0, Vec::len);
             cl
         });
         match link {
             Some(points) => {
-                for i in simplify(&points, simplify_tol).into_iter().skip(1) {
+                for i in simplify_above(&points, simplify_tol).into_iter().skip(1) {
                     path.push(Move::new(MoveKind::Link, points[i]));
                 }
             }
@@ -179,7 +213,7 @@ pub fn run_demo(settings: &DemoSettings, progress: &(dyn Fn(usize, usize) + Sync
                 path.push(Move::new(MoveKind::Plunge, start));
             }
         }
-        for i in simplify(run, simplify_tol).into_iter().skip(1) {
+        for i in simplify_above(run, simplify_tol).into_iter().skip(1) {
             path.push(Move::new(MoveKind::Feed, run[i]));
         }
         last = run.last().copied();
@@ -187,6 +221,21 @@ pub fn run_demo(settings: &DemoSettings, progress: &(dyn Fn(usize, usize) + Sync
     if let Some(p) = last {
         path.push(Move::new(MoveKind::Retract, Point3::new(p.x, p.y, clearance)));
     }
+
+    // Verify the program on a simulated stock: the part's box from 1 mm below to
+    // 1 mm above. A gouge beyond the gouge tolerance plus the tessellation's
+    // chordal error (the program follows the mesh, which lies that close to the
+    // surface) plus the sampling share (what remains between refined samples is
+    // of second order, bounded here by the share) is an error.
+    let stock = scallop_geom::Aabb3 {
+        min: Point3::new(bounds.min.x, bounds.min.y, bounds.min.z - 1.0),
+        max: Point3::new(bounds.max.x, bounds.max.y, bounds.max.z + 1.0),
+    };
+    let options = scallop_sim::VerifyOptions {
+        gouge_tolerance: s.tolerances.gouge + prepared.chordal_error + sampling_tol,
+        ..scallop_sim::VerifyOptions::default()
+    };
+    let sim = scallop_sim::simulate(stock, s.sim_resolution, &cutter, &path, &prepared.index, &options)?;
 
     let cutter_text = format!("ball D{} mm", s.cutter_diameter);
     let mut gcode = Vec::new();
@@ -229,9 +278,65 @@ pub fn run_demo(settings: &DemoSettings, progress: &(dyn Fn(usize, usize) + Sync
             * ((feed_len + link_len) / s.feed + plunge_len / path.plunge_feed + rapid_len / s.rapid_rate),
         tip_z_range_mm: [zmin, zmax],
         simplify_tolerance_mm: simplify_tol,
+        sim_resolution_mm: s.sim_resolution,
+        verified_max_scallop_mm: sim.verification.max_scallop,
+        verified_max_scallop_at: sim.verification.max_scallop_at.map(|p| [p.x, p.y]),
+        verified_min_deviation_mm: sim.verification.min_deviation,
+        air_cut_share: sim.cut.air_cut_share(),
     };
     Ok(DemoOutput { toolpath: path, gcode, summary })
 }
+
+/// Inserts drop-cutter points between consecutive CL points `run` until the
+/// straight move between neighbours lies within `tol` of the CL point at its
+/// middle (above or below: a dip below is a gouge of at most `tol`, which the
+/// verification budgets); segments shorter than `MIN_REFINE_STEP` are left as
+/// they are.
+fn refine(
+    cutter: &Cutter,
+    index: &scallop_mesh::MeshIndex,
+    run: &[Point3],
+    floor: f64,
+    tol: f64,
+    count: &mut usize,
+) -> Vec<Point3> {
+    let mut out = Vec::with_capacity(run.len());
+    for w in run.windows(2) {
+        out.push(w[0]);
+        let mut stack = vec![(w[0], w[1])];
+        let mut inserted: Vec<Point3> = Vec::new();
+        while let Some((p, q)) = stack.pop() {
+            if (q.xy() - p.xy()).norm() < MIN_REFINE_STEP {
+                continue;
+            }
+            let mid = Point2::from((p.xy().coords + q.xy().coords) * 0.5);
+            let cl = scallop_cutter::drop_cutter(cutter, index, mid, floor);
+            if matches!(cl.contact, Contact::Floor) {
+                continue;
+            }
+            let chord = 0.5 * (p.z + q.z);
+            if (cl.tip.z - chord).abs() > tol {
+                *count += 1;
+                inserted.push(cl.tip);
+                // Depth first, left half last pushed so it is refined first.
+                stack.push((cl.tip, q));
+                stack.push((p, cl.tip));
+            }
+        }
+        // Points come out in no particular order: sort them along the segment.
+        let (a, b) = (w[0].xy(), w[1].xy());
+        let dir = b - a;
+        inserted.sort_by(|m, n| (m.xy() - a).dot(&dir).total_cmp(&(n.xy() - a).dot(&dir)));
+        out.extend(inserted);
+    }
+    if let Some(last) = run.last() {
+        out.push(*last);
+    }
+    out
+}
+
+/// Shortest segment that [`refine`] still splits (mm).
+const MIN_REFINE_STEP: f64 = 1e-3;
 
 /// CL points of a straight XY link from `a` to `b`, dropped on the part, or
 /// `None` when the cutter would leave the part on the way (then retract).
@@ -268,7 +373,7 @@ mod tests {
         // Every feed and link vertex is a drop-cutter point of the part: re-drop it.
         let part = Part::builtin("choi").unwrap();
         let prepared = prepare_part(&part, &DemoSettings::standard().tolerances).unwrap();
-        let cutter = Cutter::new(CutterShape::Ball { radius: 3.0 }, 24.0).unwrap();
+        let cutter = Cutter::new(CutterShape::Ball { radius: 3.0 }, 30.0).unwrap();
         for m in out.toolpath.moves().iter().filter(|m| matches!(m.kind, MoveKind::Feed | MoveKind::Link)) {
             let cl = scallop_cutter::drop_cutter(&cutter, &prepared.index, m.to.xy(), -1e3);
             assert!((cl.tip.z - m.to.z).abs() < 1e-9, "{m:?} vs {cl:?}");

@@ -40,6 +40,10 @@ pub enum EngineError {
     /// A grid that makes no sense.
     #[error("{0}")]
     Grid(#[from] GridError),
+    /// The stock simulation found a safety problem (gouge, rapid into stock,
+    /// collision) or could not run.
+    #[error("verification: {0}")]
+    Verification(#[from] scallop_sim::SimError),
 }
 
 /// A part to machine.

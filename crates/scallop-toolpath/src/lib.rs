@@ -136,6 +136,59 @@ pub fn simplify(points: &[Point3], max_deviation: f64) -> Vec<usize> {
     (0..n).filter(|&i| keep[i]).collect()
 }
 
+/// Like [`simplify`], but one-sided for a 3-axis CL polyline: a point is
+/// removed only when the kept chord passes through or above it (never below: a
+/// chord below a CL point would drive the cutter into the part) and within
+/// `max_deviation` of it. Vertical offsets are measured at the point's
+/// position along the chord in XY. Returns the indices kept, in order.
+///
+/// ```
+/// use scallop_geom::Point3;
+/// // A hill: straight chords would pass below the crest, so the crest is kept.
+/// let hill: Vec<Point3> = (0..11).map(|i| f64::from(i)).map(|x| Point3::new(x, 0.0, -0.001 * (x - 5.0).powi(2))).collect();
+/// assert!(scallop_toolpath::simplify_above(&hill, 1.0).len() > 2);
+/// // A valley: the chord lies above every point, so it goes.
+/// let valley: Vec<Point3> = hill.iter().map(|p| Point3::new(p.x, 0.0, -p.z)).collect();
+/// assert_eq!(scallop_toolpath::simplify_above(&valley, 1.0), vec![0, 10]);
+/// ```
+#[must_use]
+pub fn simplify_above(points: &[Point3], max_deviation: f64) -> Vec<usize> {
+    let n = points.len();
+    if n <= 2 {
+        return (0..n).collect();
+    }
+    let mut keep = vec![false; n];
+    keep[0] = true;
+    keep[n - 1] = true;
+    let mut stack = vec![(0usize, n - 1)];
+    while let Some((a, b)) = stack.pop() {
+        let (pa, pb) = (points[a], points[b]);
+        let ab = pb - pa;
+        let len2 = ab.xy().norm_squared();
+        // The worst offender: any point above the chord, else the largest deviation.
+        let mut worst: Option<(bool, f64, usize)> = None;
+        for (k, p) in points.iter().enumerate().take(b).skip(a + 1) {
+            let t = if len2 > 0.0 { ((p - pa).xy().dot(&ab.xy()) / len2).clamp(0.0, 1.0) } else { 0.0 };
+            let chord = pa + ab * t;
+            let above = p.z > chord.z;
+            let dev = (p - chord).norm();
+            if above || dev > max_deviation {
+                let candidate = (above, dev, k);
+                worst = Some(match worst {
+                    Some(w) if (w.0, w.1) >= (candidate.0, candidate.1) => w,
+                    _ => candidate,
+                });
+            }
+        }
+        if let Some((_, _, k)) = worst {
+            keep[k] = true;
+            stack.push((a, k));
+            stack.push((k, b));
+        }
+    }
+    (0..n).filter(|&i| keep[i]).collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -158,5 +211,26 @@ mod tests {
         // idempotent
         let again: Vec<Point3> = kept.iter().map(|&i| pts[i]).collect();
         assert_eq!(simplify(&again, tol).len(), again.len());
+    }
+
+    #[test]
+    fn simplify_above_never_passes_below_a_removed_point() {
+        let pts: Vec<Point3> = (0..400)
+            .map(|i| f64::from(i) * 0.05)
+            .map(|x| Point3::new(x, 0.3 * x, (x * 1.3).sin() + 0.2 * (x * 5.1).cos()))
+            .collect();
+        let tol = 0.01;
+        let kept = simplify_above(&pts, tol);
+        assert!(kept.len() < pts.len());
+        for w in kept.windows(2) {
+            let (a, b) = (pts[w[0]], pts[w[1]]);
+            let ab = b - a;
+            for p in &pts[w[0]..=w[1]] {
+                let t = ((p - a).xy().dot(&ab.xy()) / ab.xy().norm_squared()).clamp(0.0, 1.0);
+                let chord = a + ab * t;
+                assert!(p.z <= chord.z + 1e-12, "chord below a CL point at {p}");
+                assert!((p - chord).norm() <= tol + 1e-12);
+            }
+        }
     }
 }
