@@ -37,6 +37,8 @@ use std::hash::{BuildHasherDefault, Hasher};
 use scallop_geom::Point3;
 pub use scallop_mesh::{MeshDiagnostics, MeshError, TriMesh};
 
+pub mod gcode;
+
 pub use error::{MeshReadError, Place};
 
 /// A mesh file format.

@@ -1,0 +1,409 @@
+//! A reader of plain 3-axis G-code (RS-274 subset) into a [`Toolpath`], so
+//! that programs from other systems can be simulated and verified.
+//!
+//! Understood: `G0 G1 G2 G3` (arcs in the XY plane, `G17`, with `I J` centre
+//! offsets or `R`), `G20 G21` (inches, millimetres), `G90 G91` (absolute,
+//! incremental), `F`, `X Y Z`, line numbers `N`, comments `( ... )` and `;`,
+//! block delete `/`, and `%`. Spindle, coolant, tool and program words (`S T M
+//! O`) and `G17 G40 G49 G54..G59 G80 G94 G64 G61` are accepted and have no
+//! effect on the path. Anything else that moves the tool (`G18 G19`, canned
+//! cycles, `G28`, `G53`, `G92`, rotary words `A B C`, ...) is an error naming
+//! the line: a simulation must never silently skip motion.
+//!
+//! Arcs are replaced by chords within `arc_tolerance` (sagitta), so every move
+//! of the result is straight.
+
+use scallop_geom::Point3;
+use scallop_toolpath::{Move, MoveKind, Toolpath};
+
+/// Why a G-code program cannot be read. Lines count from 1.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum GcodeError {
+    /// A word that is not a letter followed by a number.
+    #[error("G-code line {line}: '{word}' is not a word (a letter and a number)")]
+    Syntax {
+        /// Line number.
+        line: usize,
+        /// The text.
+        word: String,
+    },
+    /// A code that moves the tool in a way this reader does not follow.
+    #[error(
+        "G-code line {line}: {code} is not supported ({why}); the simulation would be wrong, so the program is refused"
+    )]
+    Unsupported {
+        /// Line number.
+        line: usize,
+        /// The code.
+        code: String,
+        /// Why it matters.
+        why: &'static str,
+    },
+    /// An arc whose end is not on its circle, or with no centre.
+    #[error("G-code line {line}: arc is inconsistent ({why})")]
+    BadArc {
+        /// Line number.
+        line: usize,
+        /// What is wrong.
+        why: String,
+    },
+    /// A feed move before any position is known, or without a feed rate.
+    #[error("G-code line {line}: {why}")]
+    State {
+        /// Line number.
+        line: usize,
+        /// What is missing.
+        why: &'static str,
+    },
+    /// The program has no motion at all.
+    #[error("the program has no motion (no G0/G1/G2/G3 move with coordinates)")]
+    Empty,
+}
+
+/// Options of [`read_gcode`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GcodeOptions {
+    /// Largest distance between an arc and its chords (mm).
+    pub arc_tolerance: f64,
+    /// Where the tool is before the first move; `None` = unknown (the first
+    /// move then only places the tool).
+    pub start: Option<Point3>,
+}
+
+impl Default for GcodeOptions {
+    fn default() -> Self {
+        GcodeOptions { arc_tolerance: 0.001, start: None }
+    }
+}
+
+/// Largest number of chords one arc is cut into.
+const MAX_ARC_CHORDS: usize = 100_000;
+/// Millimetres per inch.
+const MM_PER_INCH: f64 = 25.4;
+
+/// Reads a program.
+///
+/// # Errors
+/// [`GcodeError`] naming the line of the first problem.
+///
+/// ```
+/// use scallop_io::gcode::{read_gcode, GcodeOptions};
+/// let path = read_gcode("G21 G90\nG0 X0 Y0 Z5\nG1 Z0 F300\nG1 X10\nG2 X20 Y0 I5 J0\n", &GcodeOptions::default()).unwrap();
+/// assert!(path.moves().len() > 4);
+/// let last = path.moves().last().unwrap().to;
+/// assert!((last.x - 20.0).abs() < 1e-12 && last.y.abs() < 1e-12);
+/// assert!(read_gcode("G0 X0\nG18\n", &GcodeOptions::default()).unwrap_err().to_string().contains("line 2"));
+/// ```
+pub fn read_gcode(text: &str, options: &GcodeOptions) -> Result<Toolpath, GcodeError> {
+    let mut state = State { pos: options.start, scale: 1.0, absolute: true, motion: None, feed: None };
+    let mut path = Toolpath::new(0.0);
+    let mut feeds: Vec<f64> = Vec::new();
+    for (k, raw) in text.lines().enumerate() {
+        let line = k + 1;
+        let words = words(raw, line)?;
+        let mut target = [None::<f64>; 3];
+        let (mut i, mut j, mut r) = (None, None, None);
+        for (letter, value) in words {
+            match letter {
+                'G' => state.g_code(value, line)?,
+                'X' => target[0] = Some(value),
+                'Y' => target[1] = Some(value),
+                'Z' => target[2] = Some(value),
+                'I' => i = Some(value),
+                'J' => j = Some(value),
+                'K' => {}
+                'R' => r = Some(value),
+                'F' => {
+                    if !(value.is_finite() && value > 0.0) {
+                        return Err(GcodeError::Syntax { line, word: format!("F{value}") });
+                    }
+                    state.feed = Some(value);
+                }
+                'N' | 'S' | 'T' | 'M' | 'O' | 'P' | 'H' | 'D' => {}
+                'A' | 'B' | 'C' | 'U' | 'V' | 'W' => {
+                    return Err(GcodeError::Unsupported {
+                        line,
+                        code: letter.to_string(),
+                        why: "rotary or extra axes: this reader is 3-axis",
+                    });
+                }
+                other => return Err(GcodeError::Syntax { line, word: other.to_string() }),
+            }
+        }
+        if target.iter().all(Option::is_none) {
+            continue;
+        }
+        let Some(motion) = state.motion else {
+            return Err(GcodeError::State { line, why: "coordinates without a motion mode (G0/G1/G2/G3)" });
+        };
+        let to = state.resolve(target, line)?;
+        let Some(from) = state.pos else {
+            // Unknown start: place the tool.
+            path.push(Move::new(MoveKind::Rapid, to));
+            state.pos = Some(to);
+            continue;
+        };
+        match motion {
+            0 => path.push(Move::new(MoveKind::Rapid, to)),
+            1 | 2 | 3 => {
+                let feed = state.feed.ok_or(GcodeError::State { line, why: "a feed move before any F word" })?;
+                feeds.push(feed * state.scale);
+                let kind = if (to.x - from.x).abs() + (to.y - from.y).abs() == 0.0 && to.z < from.z {
+                    MoveKind::Plunge
+                } else {
+                    MoveKind::Feed
+                };
+                if motion == 1 {
+                    path.push(Move::new(kind, to));
+                } else {
+                    let centre = arc_centre(
+                        from,
+                        to,
+                        i.map(|v| v * state.scale),
+                        j.map(|v| v * state.scale),
+                        r.map(|v| v * state.scale),
+                        motion == 2,
+                        line,
+                    )?;
+                    for p in arc_points(from, to, centre, motion == 2, options.arc_tolerance) {
+                        path.push(Move::new(MoveKind::Feed, p));
+                    }
+                }
+            }
+            _ => unreachable!("motion modes are 0..=3"),
+        }
+        state.pos = Some(to);
+    }
+    if path.moves().is_empty() {
+        return Err(GcodeError::Empty);
+    }
+    // One feed for the path: the most common programmed feed (mm/min), for time estimates.
+    feeds.sort_by(f64::total_cmp);
+    path.feed = feeds.get(feeds.len() / 2).copied().unwrap_or(0.0);
+    path.plunge_feed = path.feed;
+    Ok(path)
+}
+
+struct State {
+    pos: Option<Point3>,
+    scale: f64,
+    absolute: bool,
+    motion: Option<u8>,
+    feed: Option<f64>,
+}
+
+impl State {
+    fn g_code(&mut self, value: f64, line: usize) -> Result<(), GcodeError> {
+        // G codes are integers or one decimal (G64.1 and the like).
+        let tenth = (value * 10.0).round();
+        #[allow(clippy::cast_possible_truncation)]
+        let code = tenth as i64;
+        match code {
+            0 | 10 | 20 | 30 => self.motion = Some(u8::try_from(code / 10).unwrap_or(0)),
+            170 | 400 | 490 | 800 | 940 | 610 | 640 | 641 | 540 | 550 | 560 | 570 | 580 | 590 => {}
+            200 => self.scale = MM_PER_INCH,
+            210 => self.scale = 1.0,
+            900 => self.absolute = true,
+            910 => self.absolute = false,
+            180 | 190 => {
+                return Err(GcodeError::Unsupported {
+                    line,
+                    code: format!("G{value}"),
+                    why: "arcs outside the XY plane",
+                });
+            }
+            _ => {
+                return Err(GcodeError::Unsupported {
+                    line,
+                    code: format!("G{value}"),
+                    why: "a code that may move the tool or change the frame",
+                });
+            }
+        }
+        Ok(())
+    }
+
+    fn resolve(&self, target: [Option<f64>; 3], line: usize) -> Result<Point3, GcodeError> {
+        let mut p = [0.0; 3];
+        for axis in 0..3 {
+            let current = self.pos.map(|q| q[axis]);
+            p[axis] = match (target[axis], current) {
+                (Some(v), Some(c)) if !self.absolute => c + v * self.scale,
+                (Some(v), _) => v * self.scale,
+                (None, Some(c)) => c,
+                (None, None) => {
+                    return Err(GcodeError::State {
+                        line,
+                        why: "the first move must give X, Y and Z (the start is unknown)",
+                    });
+                }
+            };
+        }
+        Ok(Point3::new(p[0], p[1], p[2]))
+    }
+}
+
+fn words(raw: &str, line: usize) -> Result<Vec<(char, f64)>, GcodeError> {
+    let mut text = String::with_capacity(raw.len());
+    let mut depth = 0usize;
+    for ch in raw.chars() {
+        match ch {
+            '(' => depth += 1,
+            ')' => depth = depth.saturating_sub(1),
+            ';' if depth == 0 => break,
+            c if depth == 0 => text.push(c),
+            _ => {}
+        }
+    }
+    let text = text.trim();
+    if text.starts_with('/') || text.starts_with('%') || text.is_empty() {
+        return Ok(Vec::new());
+    }
+    let mut out = Vec::new();
+    let bytes: Vec<char> = text.chars().filter(|c| !c.is_whitespace()).collect();
+    let mut k = 0;
+    while k < bytes.len() {
+        let letter = bytes[k].to_ascii_uppercase();
+        if !letter.is_ascii_alphabetic() {
+            return Err(GcodeError::Syntax { line, word: bytes[k..].iter().collect() });
+        }
+        let start = k + 1;
+        let mut end = start;
+        while end < bytes.len() && (bytes[end].is_ascii_digit() || matches!(bytes[end], '.' | '-' | '+')) {
+            end += 1;
+        }
+        let number: String = bytes[start..end].iter().collect();
+        let value: f64 = number
+            .parse()
+            .ok()
+            .filter(|v: &f64| v.is_finite())
+            .ok_or_else(|| GcodeError::Syntax { line, word: format!("{letter}{number}") })?;
+        out.push((letter, value));
+        k = end;
+    }
+    Ok(out)
+}
+
+fn arc_centre(
+    from: Point3,
+    to: Point3,
+    i: Option<f64>,
+    j: Option<f64>,
+    r: Option<f64>,
+    clockwise: bool,
+    line: usize,
+) -> Result<(f64, f64), GcodeError> {
+    if i.is_some() || j.is_some() {
+        let c = (from.x + i.unwrap_or(0.0), from.y + j.unwrap_or(0.0));
+        let (r0, r1) = ((from.x - c.0).hypot(from.y - c.1), (to.x - c.0).hypot(to.y - c.1));
+        if (r0 - r1).abs() > ARC_RADIUS_MISMATCH * r0.max(1.0) {
+            return Err(GcodeError::BadArc { line, why: format!("start radius {r0:.4} mm, end radius {r1:.4} mm") });
+        }
+        return Ok(c);
+    }
+    let Some(r) = r else { return Err(GcodeError::BadArc { line, why: "neither I/J nor R given".into() }) };
+    let (dx, dy) = (to.x - from.x, to.y - from.y);
+    let d = dx.hypot(dy);
+    if d == 0.0 || d > 2.0 * r.abs() * (1.0 + ARC_RADIUS_MISMATCH) {
+        return Err(GcodeError::BadArc { line, why: format!("R {r} cannot join points {d:.4} mm apart") });
+    }
+    let h = (r * r - d * d / 4.0).max(0.0).sqrt();
+    // Centre to the left of the chord for CCW with R > 0 (the short arc), mirrored otherwise.
+    let side = if clockwise == (r > 0.0) { -1.0 } else { 1.0 };
+    let (mx, my) = (from.x + dx / 2.0, from.y + dy / 2.0);
+    Ok((mx - side * h * dy / d, my + side * h * dx / d))
+}
+
+/// Relative mismatch of start and end radii accepted in an arc.
+const ARC_RADIUS_MISMATCH: f64 = 1e-3;
+
+fn arc_points(from: Point3, to: Point3, c: (f64, f64), clockwise: bool, tolerance: f64) -> Vec<Point3> {
+    let radius = (from.x - c.0).hypot(from.y - c.1);
+    let a0 = (from.y - c.1).atan2(from.x - c.0);
+    let a1 = (to.y - c.1).atan2(to.x - c.0);
+    let mut sweep = a1 - a0;
+    if clockwise {
+        while sweep >= 0.0 {
+            sweep -= std::f64::consts::TAU;
+        }
+    } else {
+        while sweep <= 0.0 {
+            sweep += std::f64::consts::TAU;
+        }
+    }
+    // Chord sagitta r (1 - cos(theta / 2)) <= tolerance.
+    let max_step = if radius > tolerance { 2.0 * (1.0 - tolerance / radius).acos() } else { std::f64::consts::PI };
+    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+    let n = ((sweep.abs() / max_step.max(f64::EPSILON)).ceil() as usize).clamp(1, MAX_ARC_CHORDS);
+    #[allow(clippy::cast_precision_loss)]
+    let mut pts: Vec<Point3> = (1..n)
+        .map(|k| {
+            let t = k as f64 / n as f64;
+            let a = a0 + sweep * t;
+            Point3::new(c.0 + radius * a.cos(), c.1 + radius * a.sin(), from.z + (to.z - from.z) * t)
+        })
+        .collect();
+    pts.push(to);
+    pts
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn read(text: &str) -> Result<Toolpath, GcodeError> {
+        read_gcode(text, &GcodeOptions::default())
+    }
+
+    #[test]
+    fn modal_incremental_and_inches() {
+        let p = read("G20 G91\nG0 X1 Y1 Z1\nG1 X1 F10\nX1\n").unwrap();
+        let m = p.moves();
+        assert_eq!(m.len(), 3);
+        assert_eq!(m[0].to, Point3::new(25.4, 25.4, 25.4));
+        assert!((m[2].to - Point3::new(76.2, 25.4, 25.4)).norm() < 1e-12);
+        assert_eq!(p.feed, 254.0);
+    }
+
+    #[test]
+    fn arcs_stay_on_their_circle_within_tolerance() {
+        for (code, centre) in
+            [("G2 X10 Y0 I5 J0", (5.0, 0.0)), ("G3 X10 Y0 R5", (5.0, 0.0)), ("G2 X10 Y0 R5", (5.0, 0.0))]
+        {
+            let p = read(&format!("G0 X0 Y0 Z0\nG1 F100\n{code}\n")).unwrap();
+            let pts: Vec<Point3> = p.moves().iter().map(|m| m.to).collect();
+            assert!(pts.len() > 10, "{code}");
+            for w in pts.windows(2) {
+                let mid = ((w[0].x + w[1].x) / 2.0, (w[0].y + w[1].y) / 2.0);
+                let r_mid = (mid.0 - centre.0).hypot(mid.1 - centre.1);
+                assert!(5.0 - r_mid <= 0.001 + 1e-9, "{code}: sagitta {}", 5.0 - r_mid);
+            }
+            // CW from (0,0) to (10,0) around (5,0) goes through y > 0; CCW through y < 0.
+            let y_mid = pts[pts.len() / 2].y;
+            assert!(if code.starts_with("G2") { y_mid > 0.0 } else { y_mid < 0.0 }, "{code}: {y_mid}");
+        }
+    }
+
+    #[test]
+    fn refuses_what_it_cannot_follow() {
+        let e = read("G0 X0 Y0 Z0\nG1 X1 F100\nG18 G2 X2 Z1 I1\n").unwrap_err();
+        assert!(matches!(e, GcodeError::Unsupported { line: 3, .. }), "{e}");
+        assert!(matches!(read("G0 X0 Y0 Z0\nG1 X1 A90 F100\n").unwrap_err(), GcodeError::Unsupported { line: 2, .. }));
+        assert!(matches!(read("G0 X0 Y0 Z0\nG1 X1\n").unwrap_err(), GcodeError::State { line: 2, .. }));
+        assert!(matches!(read("G0 X0 Y0 Z0\nG1 X1Q F100\n").unwrap_err(), GcodeError::Syntax { line: 2, .. }));
+        assert!(matches!(read("G0 X0 Y0 Z0\nG2 X1 Y1 I3 F100\n").unwrap_err(), GcodeError::BadArc { line: 2, .. }));
+        assert!(matches!(read("G0 X1\n").unwrap_err(), GcodeError::State { line: 1, .. }));
+        assert_eq!(read("(only a comment)\nM30\n").unwrap_err(), GcodeError::Empty);
+        assert!(matches!(read("G0 X0 Y0 Z0\nG28\n").unwrap_err(), GcodeError::Unsupported { line: 2, .. }));
+    }
+
+    #[test]
+    fn reads_scallops_own_output_back() {
+        let text = "(scallop)\nG21 G90 G17 G94\nG40 G49 G80\nG0 X1.000 Y2.000 Z9.000\nG1 X1.000 Y2.000 Z0.500 F1000\nG1 X3.000 Y2.000 Z0.250 F2000\nG1 X4.000 Y2.500 Z0.250\nG0 X4.000 Y2.500 Z9.000\nM5\nM30\n";
+        let p = read(text).unwrap();
+        let kinds: Vec<MoveKind> = p.moves().iter().map(|m| m.kind).collect();
+        assert_eq!(kinds, vec![MoveKind::Rapid, MoveKind::Plunge, MoveKind::Feed, MoveKind::Feed, MoveKind::Rapid]);
+        assert_eq!(p.moves()[3].to, Point3::new(4.0, 2.5, 0.25));
+    }
+}
