@@ -26,15 +26,9 @@ pub enum CutterArg {
     Cone,
 }
 
-/// Arguments of `scallop drop`.
+/// The cutter on the command line.
 #[derive(Args, Debug)]
-pub struct DropArgs {
-    /// Mesh file (.stl .obj .ply .3mf).
-    #[arg(long, conflicts_with = "surface", required_unless_present = "surface")]
-    mesh: Option<String>,
-    /// Surface file (.toml) or built-in surface (choi, rubio), dropped on through its tessellation.
-    #[arg(long)]
-    surface: Option<String>,
+pub struct CutterArgs {
     /// Cutter shape.
     #[arg(long, value_enum)]
     cutter: CutterArg,
@@ -50,6 +44,19 @@ pub struct DropArgs {
     /// Flute length (mm); default 4 D or the cone's height if longer.
     #[arg(long, allow_hyphen_values = true)]
     flute_length: Option<f64>,
+}
+
+/// Arguments of `scallop drop`.
+#[derive(Args, Debug)]
+pub struct DropArgs {
+    /// Mesh file (.stl .obj .ply .3mf).
+    #[arg(long, conflicts_with = "surface", required_unless_present = "surface")]
+    mesh: Option<String>,
+    /// Surface file (.toml) or built-in surface (choi, rubio), dropped on through its tessellation.
+    #[arg(long)]
+    surface: Option<String>,
+    #[command(flatten)]
+    tool: CutterArgs,
     /// X samples MIN:MAX:STEP (mm).
     #[arg(long, allow_hyphen_values = true)]
     x: String,
@@ -94,7 +101,14 @@ struct DropReport {
     output: String,
 }
 
-fn cutter_from(args: &DropArgs) -> CliResult<(Cutter, String)> {
+impl CutterArgs {
+    /// The validated cutter and a short description.
+    pub fn build(&self) -> CliResult<(Cutter, String)> {
+        cutter_from(self)
+    }
+}
+
+fn cutter_from(args: &CutterArgs) -> CliResult<(Cutter, String)> {
     let d = args.diameter;
     if !(d.is_finite() && d > 0.0) {
         return Err(Failure::rejected(format!("--diameter {d}: must be a finite number > 0 mm")));
@@ -124,7 +138,7 @@ fn cutter_from(args: &DropArgs) -> CliResult<(Cutter, String)> {
 
 /// `scallop drop`.
 pub fn run(args: &DropArgs) -> CliResult<()> {
-    let (cutter, cutter_text) = cutter_from(args)?;
+    let (cutter, cutter_text) = args.tool.build()?;
     let xs = GridAxis::parse(&args.x).map_err(|e| Failure::rejected(format!("--x {e}")))?;
     let ys = GridAxis::parse(&args.y).map_err(|e| Failure::rejected(format!("--y {e}")))?;
     let total = xs.len().saturating_mul(ys.len());

@@ -6,6 +6,8 @@ mod analyze;
 mod drop;
 mod output;
 mod part;
+mod picture;
+mod simulate;
 
 use std::process::ExitCode;
 
@@ -45,6 +47,8 @@ enum Command {
     Drop(drop::DropArgs),
     /// Analyse a part's shape (PCA) and recommend a cutter and a feed direction before any toolpath.
     Analyze(analyze::AnalyzeArgs),
+    /// Cut a stock with a 3-axis G-code program and verify it against the part (gouges are errors).
+    Simulate(simulate::SimulateArgs),
     /// Load a part and report what was read (size, welding, open and non-manifold edges).
     Inspect(part::InspectArgs),
 }
@@ -64,6 +68,7 @@ fn main() -> ExitCode {
         Command::Drop(args) => drop::run(&args),
         Command::Inspect(args) => part::inspect(&args),
         Command::Analyze(args) => analyze::run(&args),
+        Command::Simulate(args) => simulate::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

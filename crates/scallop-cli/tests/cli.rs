@@ -160,3 +160,50 @@ fn analyze_recommends_the_spec_tool_for_choi_and_rubio() {
     let bad = scallop().current_dir(&dir).args(["analyze", "choi", "--scallop", "-1"]).output().expect("run");
     assert_eq!(bad.status.code(), Some(1));
 }
+
+#[test]
+fn simulate_passes_the_demo_and_catches_a_lowered_copy() {
+    let dir = scratch("simulate");
+    let out = scallop().args(["demo", "-o"]).arg(&dir).output().expect("run");
+    assert!(out.status.success());
+    let nc = std::fs::read_to_string(dir.join("demo.nc")).expect("demo.nc");
+    // The same program 0.05 mm lower on every feed move.
+    let lowered: String = nc
+        .lines()
+        .map(|l| {
+            if !l.starts_with("G1") {
+                return format!("{l}\n");
+            }
+            let words: Vec<String> = l
+                .split(' ')
+                .map(|w| match w.strip_prefix('Z') {
+                    Some(z) => format!("Z{:.3}", z.parse::<f64>().expect("z") - 0.05),
+                    None => w.to_string(),
+                })
+                .collect();
+            format!("{}\n", words.join(" "))
+        })
+        .collect();
+    std::fs::write(dir.join("low.nc"), lowered).expect("write");
+    let sim = |program: &str, out: &str| {
+        scallop()
+            .current_dir(&dir)
+            .args(["simulate", "--part", "choi", "--program", program, "--cutter", "ball", "--diameter", "6"])
+            .args(["--flute-length", "30", "--gouge-tolerance", "0.003", "-o", out, "--json"])
+            .output()
+            .expect("run")
+    };
+    let good = sim("demo.nc", "good");
+    assert!(good.status.success(), "{}", String::from_utf8_lossy(&good.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&good.stdout).expect("json");
+    assert_eq!(v["verdict"][0], "ok");
+    assert!(v["max_scallop_mm"].as_f64().expect("number") < 0.03);
+    assert!(std::fs::read(dir.join("good/deviation.png")).expect("png").starts_with(b"\x89PNG"));
+    let bad = sim("low.nc", "bad");
+    assert_eq!(bad.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("gouge"));
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("bad/sim.json")).expect("sim.json")).expect("json");
+    assert!(v["verdict"][0].as_str().expect("text").contains("gouge"));
+    assert!(v["min_deviation_mm"].as_f64().expect("number") < -0.04);
+}

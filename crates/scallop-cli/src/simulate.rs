@@ -1,0 +1,216 @@
+//! `scallop simulate`: cut a stock with a G-code program and verify it against the part.
+
+use std::path::PathBuf;
+
+use clap::Args;
+use scallop_engine::prepare_part;
+use scallop_geom::{Aabb3, Point3, Tolerances};
+use scallop_io::gcode::{GcodeOptions, read_gcode};
+use scallop_sim::{VerifyOptions, ZMap, part_heights, verify};
+use serde::Serialize;
+
+use crate::drop::CutterArgs;
+use crate::output::{print_json, print_text, write_atomic};
+use crate::part::{UnitsArg, load};
+use crate::picture::{Image, ramp};
+use crate::{CliResult, Failure};
+
+/// Arguments of `scallop simulate`.
+#[derive(Args, Debug)]
+pub struct SimulateArgs {
+    /// The design part: mesh file, surface file (.toml) or built-in name (choi, rubio).
+    #[arg(long)]
+    part: String,
+    /// The program: plain 3-axis G-code (G0/G1/G2/G3, G20/G21, G90/G91).
+    #[arg(long)]
+    program: PathBuf,
+    #[command(flatten)]
+    tool: CutterArgs,
+    /// Stock cell size (mm).
+    #[arg(long, default_value_t = 0.1, allow_hyphen_values = true)]
+    resolution: f64,
+    /// Stock box XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX (mm); default: the part's box grown by
+    /// the cutter radius in X and Y, from 1 mm below to 1 mm above the part.
+    #[arg(long, allow_hyphen_values = true)]
+    stock: Option<String>,
+    /// Allowed penetration below the part (mm); for surfaces the tessellation's
+    /// chordal error is added.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    gouge_tolerance: f64,
+    /// Unit of mesh coordinates.
+    #[arg(long, value_enum, default_value = "mm")]
+    units: UnitsArg,
+    /// Output folder for `sim.json` and `deviation.png`.
+    #[arg(short, long, default_value = "out/simulate")]
+    output: PathBuf,
+    /// Print the report as JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Serialize)]
+struct SimReport {
+    part: String,
+    program: String,
+    cutter: String,
+    resolution_mm: f64,
+    cells: [usize; 2],
+    moves: usize,
+    feed_moves: usize,
+    air_cut_share: f64,
+    removed_volume_mm3: f64,
+    remaining_volume_mm3: f64,
+    max_scallop_mm: f64,
+    max_scallop_at: Option<[f64; 2]>,
+    min_deviation_mm: f64,
+    gouge_tolerance_mm: f64,
+    /// "ok", or the safety problems found (each an error).
+    verdict: Vec<String>,
+}
+
+fn parse_stock(text: &str) -> CliResult<Aabb3> {
+    let v: Vec<f64> =
+        text.split(',').map(|t| t.trim().parse::<f64>()).collect::<Result<_, _>>().map_err(|_| {
+            Failure::rejected(format!("--stock '{text}': give six numbers XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX"))
+        })?;
+    let [x0, y0, z0, x1, y1, z1] = v.as_slice() else {
+        return Err(Failure::rejected(format!("--stock '{text}': give six numbers XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX")));
+    };
+    Ok(Aabb3 { min: Point3::new(*x0, *y0, *z0), max: Point3::new(*x1, *y1, *z1) })
+}
+
+/// `scallop simulate`.
+pub fn run(args: &SimulateArgs) -> CliResult<()> {
+    let (cutter, cutter_text) = args.tool.build()?;
+    if !(args.gouge_tolerance.is_finite() && args.gouge_tolerance >= 0.0) {
+        return Err(Failure::rejected(format!("--gouge-tolerance {}: must be >= 0", args.gouge_tolerance)));
+    }
+    let loaded = load(&args.part, args.units)?;
+    let prepared = prepare_part(&loaded.part, &Tolerances { path: 0.01, gouge: args.gouge_tolerance })
+        .map_err(|e| Failure::rejected(format!("{}: {e}", args.part)))?;
+    let name = args.program.display().to_string();
+    let bytes = std::fs::read(&args.program).map_err(|e| {
+        let err = anyhow::anyhow!("{name}: cannot read the program: {e}");
+        if e.kind() == std::io::ErrorKind::NotFound { Failure::Rejected(err) } else { Failure::Io(err) }
+    })?;
+    let text = std::str::from_utf8(&bytes)
+        .map_err(|e| Failure::rejected(format!("{name}: byte {}: the program is not UTF-8 text", e.valid_up_to())))?;
+    let program = read_gcode(text, &GcodeOptions::default()).map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
+
+    let b = prepared.mesh.bounds();
+    let r = cutter.radius();
+    let stock = match &args.stock {
+        Some(s) => parse_stock(s)?,
+        None => Aabb3 {
+            min: Point3::new(b.min.x - r, b.min.y - r, b.min.z - 1.0),
+            max: Point3::new(b.max.x + r, b.max.y + r, b.max.z + 1.0),
+        },
+    };
+    let mut zmap = ZMap::new(stock, args.resolution).map_err(|e| Failure::rejected(format!("stock: {e}")))?;
+    let cut = zmap.cut(&cutter, &program).map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
+    let options =
+        VerifyOptions { gouge_tolerance: args.gouge_tolerance + prepared.chordal_error, ..VerifyOptions::default() };
+    let mut verdict = Vec::new();
+    if let Err(e) = cut.check() {
+        verdict.push(e.to_string());
+    }
+    let verification = match verify(&zmap, &prepared.index, &options) {
+        Ok(v) => Some(v),
+        Err(e) => {
+            verdict.push(e.to_string());
+            None
+        }
+    };
+
+    // Deviation per cell, for the picture and the figures when verify refused.
+    let top = part_heights(&zmap, &prepared.index);
+    let dev: Vec<f64> =
+        zmap.heights().iter().zip(&top).map(|(s, p)| if p.is_finite() { s - p } else { f64::NAN }).collect();
+    let finite = || dev.iter().copied().filter(|d| d.is_finite());
+    let max_dev = finite().fold(0.0f64, f64::max);
+    let min_dev = finite().fold(f64::INFINITY, f64::min);
+    let report = SimReport {
+        part: loaded.description.clone(),
+        program: name.clone(),
+        cutter: cutter_text,
+        resolution_mm: args.resolution,
+        cells: [zmap.nx(), zmap.ny()],
+        moves: program.moves().len(),
+        feed_moves: cut.feed_moves,
+        air_cut_share: cut.air_cut_share(),
+        removed_volume_mm3: cut.removed_volume,
+        remaining_volume_mm3: zmap.volume(),
+        max_scallop_mm: verification.as_ref().map_or(max_dev, |v| v.max_scallop),
+        max_scallop_at: verification.as_ref().and_then(|v| v.max_scallop_at).map(|p| [p.x, p.y]),
+        min_deviation_mm: verification.as_ref().map_or(min_dev, |v| v.min_deviation),
+        gouge_tolerance_mm: options.gouge_tolerance,
+        verdict: if verdict.is_empty() { vec!["ok".into()] } else { verdict.clone() },
+    };
+    let json = serde_json::to_string_pretty(&report).map_err(|e| Failure::Io(e.into()))?;
+    write_atomic(&args.output.join("sim.json"), |w| std::io::Write::write_all(w, json.as_bytes()))?;
+    let png = deviation_picture(&zmap, &dev, max_dev, options.gouge_tolerance).to_png();
+    write_atomic(&args.output.join("deviation.png"), |w| std::io::Write::write_all(w, &png))?;
+
+    if args.json {
+        print_json(&report)?;
+    } else {
+        print_text(&format!(
+            "{} on {}: {} x {} cells of {} mm, {} moves ({:.1} % of feed moves in air)\n\
+             \x20 material left up to {:.4} mm, deepest {:+.4} mm (gouge tolerance {:.4} mm)\n\
+             \x20 removed {:.0} mm³, remaining {:.0} mm³\n  wrote {}\n",
+            report.program,
+            report.part,
+            report.cells[0],
+            report.cells[1],
+            report.resolution_mm,
+            report.moves,
+            100.0 * report.air_cut_share,
+            report.max_scallop_mm,
+            report.min_deviation_mm,
+            report.gouge_tolerance_mm,
+            report.removed_volume_mm3,
+            report.remaining_volume_mm3,
+            args.output.display()
+        ))?;
+    }
+    if verdict.is_empty() { Ok(()) } else { Err(Failure::rejected(format!("{name}: {}", verdict.join("; ")))) }
+}
+
+/// Top view of the stock: material left from 0 (blue) to `max_dev` (red),
+/// gouges magenta, cells without part dark grey; a colour bar on the right.
+fn deviation_picture(zmap: &ZMap, dev: &[f64], max_dev: f64, gouge_tol: f64) -> Image {
+    let (nx, ny) = (zmap.nx(), zmap.ny());
+    // At most MAX_PICTURE pixels across: nearest-cell sampling.
+    let step = nx.max(ny).div_ceil(MAX_PICTURE).max(1);
+    let (w, h) = (nx.div_ceil(step), ny.div_ceil(step));
+    let bar = 120;
+    let mut img = Image::new(w + bar, h.max(160), [255, 255, 255]);
+    let scale = if max_dev > 0.0 { max_dev } else { 1.0 };
+    for py in 0..h {
+        for px in 0..w {
+            let (i, j) = (px * step, py * step);
+            let d = dev[j * nx + i];
+            let rgb = if d.is_nan() {
+                [70, 70, 70]
+            } else if d < -gouge_tol {
+                [230, 0, 230]
+            } else {
+                ramp(d.max(0.0) / scale)
+            };
+            // Image rows go down, y goes up.
+            img.set(px, h - 1 - py, rgb);
+        }
+    }
+    let (x0, top, height) = (w + 12, 20, h.max(160) - 40);
+    for k in 0..height {
+        #[allow(clippy::cast_precision_loss)]
+        img.fill(x0, top + k, 16, 1, ramp(1.0 - k as f64 / height.max(1) as f64));
+    }
+    img.text(x0 + 20, top, &format!("{max_dev:.4}"), 2, [0, 0, 0]);
+    img.text(x0 + 20, top + height - 14, "0", 2, [0, 0, 0]);
+    img.text(x0 + 20, top + height / 2, "mm", 2, [0, 0, 0]);
+    img
+}
+
+/// Largest picture side in pixels.
+const MAX_PICTURE: usize = 1600;
