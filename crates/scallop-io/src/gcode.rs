@@ -146,7 +146,7 @@ pub fn read_gcode(text: &str, options: &GcodeOptions) -> Result<Toolpath, GcodeE
         };
         match motion {
             0 => path.push(Move::new(MoveKind::Rapid, to)),
-            1 | 2 | 3 => {
+            1..=3 => {
                 let feed = state.feed.ok_or(GcodeError::State { line, why: "a feed move before any F word" })?;
                 feeds.push(feed * state.scale);
                 let kind = if (to.x - from.x).abs() + (to.y - from.y).abs() == 0.0 && to.z < from.z {
