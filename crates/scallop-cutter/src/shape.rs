@@ -325,6 +325,11 @@ impl Cutter {
 }
 
 #[cfg(test)]
+#[allow(
+    clippy::unwrap_used,
+    clippy::float_cmp,
+    reason = "tests: a panic is the failure report; exact values are intended"
+)]
 mod tests {
     use super::*;
 

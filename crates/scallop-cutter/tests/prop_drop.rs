@@ -1,3 +1,7 @@
+#![allow(
+    clippy::float_cmp,
+    reason = "exact equalities (bit-identical heights, floor values) are the property under test"
+)]
 //! Property tests of the drop-cutter: no gouge, touches, index = brute force,
 //! translation invariance, monotone under adding triangles, and analytic cases.
 

@@ -360,6 +360,11 @@ fn link_on_surface(
 }
 
 #[cfg(test)]
+#[allow(
+    clippy::unwrap_used,
+    clippy::float_cmp,
+    reason = "tests: a panic is the failure report; exact values are intended"
+)]
 mod tests {
     use super::*;
 

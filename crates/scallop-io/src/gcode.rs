@@ -349,6 +349,11 @@ fn arc_points(from: Point3, to: Point3, c: (f64, f64), clockwise: bool, toleranc
 }
 
 #[cfg(test)]
+#[allow(
+    clippy::unwrap_used,
+    clippy::float_cmp,
+    reason = "tests: a panic is the failure report; exact values are intended"
+)]
 mod tests {
     use super::*;
 

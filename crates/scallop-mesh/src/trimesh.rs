@@ -332,6 +332,11 @@ fn edge_counts(triangles: &[[u32; 3]]) -> (usize, usize) {
 }
 
 #[cfg(test)]
+#[allow(
+    clippy::unwrap_used,
+    clippy::float_cmp,
+    reason = "tests: a panic is the failure report; exact values are intended"
+)]
 mod tests {
     use super::*;
 
