@@ -1,0 +1,82 @@
+//! Why planning failed. Every variant names the parameter or place and the fix.
+
+/// Errors of [`crate::plan_finishing`] and [`crate::verify_scallop`].
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum StrategyError {
+    /// A parameter that must be a finite number in a range.
+    #[error("parameter `{name}` = {value} is invalid: {fix}")]
+    BadParameter {
+        /// Parameter name (as in [`crate::FinishingParams`] or [`scallop_geom::Tolerances`]).
+        name: &'static str,
+        /// The value given.
+        value: f64,
+        /// What to do instead.
+        fix: &'static str,
+    },
+    /// The scallop height is not smaller than the cutter's radius (or corner radius).
+    #[error(
+        "parameter `scallop_height` = {scallop_height} mm is not smaller than the cutter's {what} {radius} mm; \
+         use a scallop height well below it (typically 0.001 to 0.1 mm)"
+    )]
+    ScallopTooLarge {
+        /// The scallop height asked for (mm).
+        scallop_height: f64,
+        /// Which radius bounds it.
+        what: &'static str,
+        /// That radius (mm).
+        radius: f64,
+    },
+    /// The cutter shape has no finishing model.
+    #[error(
+        "cutter shape `{shape}` is not supported by parallel-planes finishing; use a ball, flat or bull-nose cutter"
+    )]
+    Unsupported {
+        /// The shape name.
+        shape: &'static str,
+    },
+    /// No plane crosses the region: nothing to machine.
+    #[error(
+        "the region to machine is empty for feed direction {direction_deg} deg (no cutter location over the part); \
+         check the part, the `boundary` rule and `max_step` (smaller than the part)"
+    )]
+    EmptyRegion {
+        /// Feed direction (degrees).
+        direction_deg: f64,
+    },
+    /// The scallop height cannot be met: the plane spacing would fall below the minimum.
+    #[error(
+        "the cutter cannot reach the surface within scallop height {scallop_height} mm near ({x:.3}, {y:.3}) mm: \
+         the plane spacing would be {spacing} mm; use a ball or bull-nose cutter, another `direction`, \
+         or a larger `scallop_height`"
+    )]
+    Unreachable {
+        /// Place (mm).
+        x: f64,
+        /// Place (mm).
+        y: f64,
+        /// The spacing that would be needed (mm).
+        spacing: f64,
+        /// The scallop height asked for (mm).
+        scallop_height: f64,
+    },
+    /// Verification found a pass pair whose scallop exceeds the limit.
+    #[error(
+        "scallop {height} mm between planes {plane} and {next} near ({x:.3}, {y:.3}) mm exceeds {limit} mm; \
+         this is a planner bug or a toolpath edited after planning"
+    )]
+    ScallopExceeded {
+        /// Index of the first plane of the pair.
+        plane: usize,
+        /// Index of the second plane.
+        next: usize,
+        /// Place of the worst cusp (mm).
+        x: f64,
+        /// Place of the worst cusp (mm).
+        y: f64,
+        /// Measured height (mm).
+        height: f64,
+        /// The limit `sh` (mm).
+        limit: f64,
+    },
+}

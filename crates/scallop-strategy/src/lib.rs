@@ -1,0 +1,262 @@
+//! Finishing strategies for scallop (finishing.md chapters 5 to 7): parallel
+//! planes over a part with a **guaranteed scallop height**, links, an
+//! independent scallop measurement, and the machining time from jerk-limited
+//! kinematics.
+//!
+//! [`plan_finishing`] takes the part as a [`MeshIndex`] (a mesh, or the
+//! tessellation of parametric surfaces made by `scallop_engine::prepare_part`),
+//! a ball, flat or bull-nose [`Cutter`], the machining decisions
+//! ([`FinishingParams`]) and the [`Tolerances`], and returns a [`Planned`]: the
+//! [`Toolpath`], the planes and their passes, the verified scallop
+//! ([`ScallopReport`]) and a serialisable [`Report`].
+//!
+//! ```
+//! use scallop_analysis::MachineLimits;
+//! use scallop_cutter::{Cutter, CutterShape};
+//! use scallop_geom::{Point3, Tolerances};
+//! use scallop_mesh::{MeshIndex, TriMesh};
+//! use scallop_strategy::{plan_finishing, Boundary, FinishingParams, Pattern};
+//!
+//! // A 20 x 10 mm plane tilted 30 degrees about Y.
+//! let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
+//! let p = |x: f64, y: f64| Point3::new(x * c, y, x * s);
+//! let (mesh, _) = TriMesh::from_soup(&[[p(0., 0.), p(10., 0.), p(0., 20.)], [p(10., 0.), p(10., 20.), p(0., 20.)]]).unwrap();
+//! let index = MeshIndex::build(&mesh);
+//! let cutter = Cutter::new(CutterShape::Bull { radius: 5.0, corner: 2.0 }, 20.0).unwrap();
+//! let params = FinishingParams {
+//!     direction: 0.0,                      // passes along X: the steepest slope
+//!     pattern: Pattern::Zigzag,
+//!     scallop_height: 0.01,
+//!     boundary: Boundary::ContactInside,
+//!     max_step: 1.0,
+//!     clearance: 5.0,
+//!     machine: MachineLimits::default(),   // V = 5 m/min, A = 6 m/s^2, J = 40 m/s^3
+//!     plunge_feed: 20.0,
+//!     rapid_rate: 500.0,
+//!     sharp_corner: 30f64.to_radians(),
+//!     blend_tolerance: 0.01,
+//! };
+//! let planned = plan_finishing(&index, &cutter, &params, &Tolerances { path: 0.01, gouge: 0.0 }).unwrap();
+//! assert!(planned.report.max_scallop_mm <= 0.01);
+//! assert!(planned.report.passes > 10);
+//! assert!(planned.report.machining_time_lookahead_s < planned.report.machining_time_s);
+//! ```
+//!
+//! # Strategy
+//! - **Region.** A cutter location belongs to the region when its contact lies on
+//!   the part away from the part's open boundary ([`Boundary::ContactInside`]): a
+//!   cutter riding on the part's edge, or touching nothing, has left it. The
+//!   contact points then sweep the surface up to its edges, so pass lengths are
+//!   the surface's (the analytic models of finishing.md 8).
+//! - **Passes.** Plane `k` is the vertical plane `m . p = d_k`, `m` normal to the
+//!   feed direction `f`. Along it the cutter is dropped (exact drop-cutter) on a
+//!   uniform grid of step `max_step` (in parallel), then a step is bisected while
+//!   the CL midpoint deviates from the chord by more than `SAMPLING_SHARE * path`.
+//!   Samples outside the region split the plane into passes (non-convex parts
+//!   give several); each pass end is located by bisection to
+//!   `BOUNDARY_SHARE * path`. Collinear points are merged by
+//!   `scallop_toolpath::simplify` within `SIMPLIFY_SHARE * path` (budget in [`tol`]).
+//! - **Spacing rule (finishing.md 6.4, worst point).** At every CL sample of the
+//!   plane: the part normal `n` at the contact, tilt `s = acos |n_z|`, horizontal
+//!   feed angle `alpha` between `f` and `(n_x, n_y)`, effective radius
+//!   `R_eff(s, alpha)` (Eq. 1.5 via `scallop_analysis`; ball `R`; a flat end as
+//!   the torus with `r = 0`), step-over `sod = min(2 sqrt(2 sh R_eff - sh^2), sod_max)`
+//!   (5.2, 5.3; for a flat end at least `sh / sin s`, its saw tooth), and the
+//!   horizontal spacing `sod |c . m|`, `c = n x (m x n)` normalised (the on-surface
+//!   cross-feed direction). The candidate gap is the minimum over the plane. The
+//!   normal at a contact is the cutter's own normal there where that is smooth
+//!   (ball; torus of a bull-nose), which equals the part normal at tangent
+//!   contacts and is the normal of the envelope actually cut at edge and vertex
+//!   contacts; elsewhere the contact triangle's normal.
+//! - **Guarantee: the rule, then a measurement.** The circle model ignores the
+//!   part's curvature across the feed and its change between planes, so the
+//!   candidate next plane is planned and the real scallop between the two is
+//!   *measured* ([`verify_scallop`]'s method, at every feed sample); while it
+//!   exceeds `sh` the gap shrinks (`sqrt(sh / h)`, then at least 10 % per retry).
+//!   On a plane the model is exact and nothing shrinks. After planning, every
+//!   pair of adjacent planes is measured again ([`Planned::scallop`]); a pair over
+//!   `sh` is an `Err`. The measurement shares no model with the rule, but it is
+//!   the same code the planner used to accept the plane.
+//! - **Rest material.** Where the cutter cannot follow the part (a hollow
+//!   tighter than the cutter, the flat bottom of a bull-nose over a concave
+//!   region), the residual under a cusp does not vanish at any spacing. A cusp
+//!   over `sh` is therefore re-measured against a dense family of virtual passes
+//!   between the two planes; what even they leave is rest material, reported in
+//!   [`ScallopReport::rest_material_mm`], not counted as scallop.
+//! - **Margins.** Ranges of plane offsets with passes are found by scanning at
+//!   `max_step` and bisecting their edges; the first plane of a range lies half
+//!   its spacing inside the edge, and the last within half its spacing of the far
+//!   edge: the strips along the boundary get half a step-over, as between passes,
+//!   and the pass count is `ceil(width / sod)`, the analytic count rounded up
+//!   (on the spec's 56 x 28 plane: 85 passes for 84.7, 45 for 44.3).
+//! - **Links.** Zigzag: the next pass starts where the previous one ended, on the
+//!   adjacent plane; if the cutter rests on the part all along the straight XY
+//!   segment between them, the link follows its drop-cutter points (sampled and
+//!   refined like a pass: on the CL surface, hence safe) as `Link` moves.
+//!   Otherwise, and always for one-way: retract to the clearance height above the
+//!   part's top, rapid, plunge at the plunge feed.
+//! - **Time.** [`stop_to_stop_time`] (model (a), finishing.md 7, the chains between
+//!   sharp corners) and [`lookahead_time`] (model (b)); see their docs. Model (b)
+//!   may exceed model (a): (a) takes corners below the sharp angle at full feed,
+//!   (b) slows down for every corner beyond the blending tolerance.
+//!
+//! # Limits
+//! - Features narrower than `max_step` (along a pass or across planes) may be missed.
+//! - The scallop is measured in the vertical section normal to the feed, as the
+//!   vertical residual times `n_z` (the distance to the local tangent plane), at
+//!   the cusp of the two envelopes (for a flat end: the largest of 33 lateral
+//!   samples); sections where an envelope comes from a pass end (the end strips,
+//!   an edge effect) and the strips between the boundary and the first or last
+//!   plane are not measured.
+//! - Heights are relative to the part's mesh (the tessellation for surfaces,
+//!   within `Tolerances::TESSELLATION_SHARE * path` of the true surface).
+//!
+//! # Invariants
+//! - Never performs I/O, never prints, never reads clocks or the environment:
+//!   [`Report::planning_time_s`] is 0 and the caller fills it in.
+//! - Deterministic: the output does not depend on the number of rayon threads
+//!   (parallel drops and measurements are collected in order; reductions run in
+//!   a fixed order).
+//! - Every CL point is a drop-cutter point on the part's mesh (no gouge of the mesh).
+//! - Every pair of adjacent passes is measured with scallop `<= sh` (up to a
+//!   relative measurement slack of [`tol::SCALLOP_REL_SLACK`]); otherwise the
+//!   result is an `Err`, never a warning.
+//! - Every numeric threshold lives in [`tol`].
+
+mod error;
+mod geometry;
+mod params;
+mod plan;
+mod scallop;
+mod time;
+pub mod tol;
+
+pub use error::StrategyError;
+pub use params::{Boundary, FinishingParams, Pattern};
+pub use scallop::{PairScallop, ScallopReport, verify_scallop};
+pub use time::{ClassTimes, lookahead_time, stop_to_stop_time};
+
+use scallop_cutter::Cutter;
+use scallop_geom::{Point3, Tolerances};
+use scallop_mesh::MeshIndex;
+use scallop_toolpath::{MoveKind, Toolpath};
+use serde::{Deserialize, Serialize};
+
+/// One vertical plane of the sweep and its passes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Plane {
+    /// Offset `d = m . p` of the plane (mm), `m = (-sin theta, cos theta)`.
+    pub offset: f64,
+    /// Passes: CL polylines of the tool tip in increasing feed coordinate
+    /// (the toolpath may run them backwards).
+    pub passes: Vec<Vec<Point3>>,
+}
+
+/// The numbers of a plan (mm, s), serialisable for `report.json`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Report {
+    /// Stop-to-stop jerk-limited time of the cutting moves (passes and links), model (a) (s).
+    pub machining_time_s: f64,
+    /// Look-ahead time of the cutting moves, model (b) (s).
+    pub machining_time_lookahead_s: f64,
+    /// Stop-to-stop time of rapids and retracts at the rapid rate (s).
+    pub rapid_time_s: f64,
+    /// Stop-to-stop time of plunges at the plunge feed (s).
+    pub plunge_time_s: f64,
+    /// `machining_time_s + rapid_time_s + plunge_time_s` (s).
+    pub total_time_s: f64,
+    /// Passes plus links (mm), the thesis's path length.
+    pub path_length_mm: f64,
+    /// Passes only (mm).
+    pub feed_length_mm: f64,
+    /// Links only (mm).
+    pub link_length_mm: f64,
+    /// Rapids and retracts (mm).
+    pub rapid_length_mm: f64,
+    /// Plunges (mm).
+    pub plunge_length_mm: f64,
+    /// Number of passes.
+    pub passes: usize,
+    /// Number of planes (including planes without a pass).
+    pub planes: usize,
+    /// Links on the CL surface.
+    pub links: usize,
+    /// Retract-rapid-plunge connections.
+    pub retracts: usize,
+    /// Largest verified scallop (mm).
+    pub max_scallop_mm: f64,
+    /// Mean verified scallop (mm).
+    pub mean_scallop_mm: f64,
+    /// Moves of the toolpath.
+    pub points: usize,
+    /// Drop-cutter queries made.
+    pub cl_points_dropped: usize,
+    /// Planning time (s): 0 from the library (no clocks); the caller measures it.
+    pub planning_time_s: f64,
+}
+
+/// The result of [`plan_finishing`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Planned {
+    /// The moves.
+    pub toolpath: Toolpath,
+    /// The planes in sweep order with their passes.
+    pub planes: Vec<Plane>,
+    /// Feed coordinates `t` at which the scallop was measured.
+    pub feed_samples: Vec<f64>,
+    /// The verified scallop.
+    pub scallop: ScallopReport,
+    /// Times, lengths and counts.
+    pub report: Report,
+}
+
+/// Plans parallel-planes finishing of the part indexed by `index` (see the crate
+/// docs for the method) and verifies its scallop.
+///
+/// # Errors
+/// - [`StrategyError::BadParameter`]: a parameter or `tol.path` out of range;
+/// - [`StrategyError::ScallopTooLarge`]: `sh` not below the cutter (corner) radius;
+/// - [`StrategyError::Unsupported`]: a cone cutter;
+/// - [`StrategyError::EmptyRegion`]: no pass anywhere;
+/// - [`StrategyError::Unreachable`]: the spacing needed for `sh` falls below
+///   [`tol::MIN_SPACING`] (e.g. a flat end across a slope);
+/// - [`StrategyError::ScallopExceeded`]: the verification failed (a bug).
+pub fn plan_finishing(
+    index: &MeshIndex,
+    cutter: &Cutter,
+    params: &FinishingParams,
+    tol: &Tolerances,
+) -> Result<Planned, StrategyError> {
+    let mut planner = plan::Planner::new(index, cutter, params, tol)?;
+    let planes = planner.sweep()?;
+    let (toolpath, links, retracts) = planner.toolpath(&planes);
+    let planes: Vec<Plane> = planes.into_iter().map(|p| p.plane).collect();
+    let feed_samples = planner.feed_samples.clone();
+    let scallop = verify_scallop(index, cutter, &planes, params.direction, &feed_samples, params.scallop_height)?;
+    let a = stop_to_stop_time(&toolpath, params);
+    let b = lookahead_time(&toolpath, params);
+    let feed = toolpath.length(MoveKind::Feed);
+    let link = toolpath.length(MoveKind::Link);
+    let report = Report {
+        machining_time_s: a.cutting,
+        machining_time_lookahead_s: b.cutting,
+        rapid_time_s: a.rapid,
+        plunge_time_s: a.plunge,
+        total_time_s: a.total(),
+        path_length_mm: feed + link,
+        feed_length_mm: feed,
+        link_length_mm: link,
+        rapid_length_mm: toolpath.length(MoveKind::Rapid) + toolpath.length(MoveKind::Retract),
+        plunge_length_mm: toolpath.length(MoveKind::Plunge),
+        passes: planes.iter().map(|p| p.passes.len()).sum(),
+        planes: planes.len(),
+        links,
+        retracts,
+        max_scallop_mm: scallop.max_mm,
+        mean_scallop_mm: scallop.mean_mm,
+        points: toolpath.moves().len(),
+        cl_points_dropped: planner.drops,
+        planning_time_s: 0.0,
+    };
+    Ok(Planned { toolpath, planes, feed_samples, scallop, report })
+}

@@ -1,0 +1,552 @@
+//! Parallel-planes finishing: passes by drop-cutter in vertical planes, plane
+//! spacing from the local effective radius and the measured scallop, links.
+
+use rayon::prelude::*;
+use scallop_analysis::fold_direction_angle;
+use scallop_cutter::{ClPoint, Contact, Cutter, CutterShape, drop_cutter, drop_points};
+use scallop_geom::{Point2, Point3, Tolerances, Vec2, Vec3};
+use scallop_mesh::MeshIndex;
+use scallop_toolpath::{Move, MoveKind, Toolpath, simplify};
+
+use crate::geometry::{Frame, PartBoundary, contact_normal, slots_by_original};
+use crate::scallop::{Curve, Measure, pair_heights};
+use crate::{Boundary, FinishingParams, Pattern, Plane, StrategyError, tol};
+
+/// A straight XY line `origin + t dir` along which the cutter is dropped.
+#[derive(Debug, Clone, Copy)]
+struct Line {
+    origin: Point2,
+    dir: Vec2,
+}
+
+impl Line {
+    fn at(&self, t: f64) -> Point2 {
+        self.origin + self.dir * t
+    }
+}
+
+#[derive(Debug, Clone, Copy)]
+struct Sample {
+    t: f64,
+    cl: ClPoint,
+}
+
+/// Everything the planner needs, computed once.
+pub(crate) struct Planner<'a> {
+    index: &'a MeshIndex,
+    cutter: &'a Cutter,
+    shape: CutterShape,
+    model: scallop_analysis::Cutter,
+    params: &'a FinishingParams,
+    pub(crate) frame: Frame,
+    slots: Vec<u32>,
+    part_boundary: PartBoundary,
+    measure: Measure<'a>,
+    raw_measure: Measure<'a>,
+    floor: f64,
+    sample_tol: f64,
+    simplify_tol: f64,
+    boundary_tol: f64,
+    min_step: f64,
+    pub(crate) d_range: [f64; 2],
+    pub(crate) feed_samples: Vec<f64>,
+    pub(crate) drops: usize,
+}
+
+/// One plane with its passes and the samples the spacing rule reads.
+pub(crate) struct PlanePasses {
+    pub(crate) plane: Plane,
+    samples: Vec<ClPoint>,
+    curves: Vec<Curve>,
+}
+
+impl<'a> Planner<'a> {
+    pub(crate) fn new(
+        index: &'a MeshIndex,
+        cutter: &'a Cutter,
+        params: &'a FinishingParams,
+        tol_: &Tolerances,
+    ) -> Result<Planner<'a>, StrategyError> {
+        params.validate()?;
+        if !(tol_.path.is_finite() && tol_.path > 0.0) {
+            return Err(StrategyError::BadParameter {
+                name: "tolerances.path",
+                value: tol_.path,
+                fix: "give a positive chordal tolerance in mm (e.g. 0.01)",
+            });
+        }
+        let shape = *cutter.shape();
+        let sh = params.scallop_height;
+        let (model, bound, what) = match shape {
+            CutterShape::Ball { radius } => (scallop_analysis::Cutter::Ball { radius }, radius, "radius"),
+            CutterShape::Bull { radius, corner } => {
+                (scallop_analysis::Cutter::Toroidal { radius, corner }, corner, "corner radius")
+            }
+            // A flat end is the torus with r = 0 in Eq. 1.5 (R / sin s along the slope).
+            CutterShape::Flat { radius } => {
+                (scallop_analysis::Cutter::Toroidal { radius, corner: 0.0 }, radius, "radius")
+            }
+            CutterShape::Cone { .. } => return Err(StrategyError::Unsupported { shape: "cone" }),
+        };
+        if sh >= bound {
+            return Err(StrategyError::ScallopTooLarge { scallop_height: sh, what, radius: bound });
+        }
+        let frame = Frame::new(params.direction);
+        // Cutter locations with a contact lie within R of the part.
+        let reach = match params.boundary {
+            Boundary::ContactInside => cutter.radius(),
+        };
+        let (mut t_range, mut d_range) = ([f64::INFINITY, f64::NEG_INFINITY], [f64::INFINITY, f64::NEG_INFINITY]);
+        for slot in 0..index.len() {
+            for p in index.corners(slot) {
+                let (t, d) = (frame.t(p), frame.d(p));
+                t_range = [t_range[0].min(t), t_range[1].max(t)];
+                d_range = [d_range[0].min(d), d_range[1].max(d)];
+            }
+        }
+        if t_range[0] > t_range[1] {
+            return Err(StrategyError::EmptyRegion { direction_deg: params.direction.to_degrees() });
+        }
+        t_range = [t_range[0] - reach, t_range[1] + reach];
+        d_range = [d_range[0] - reach, d_range[1] + reach];
+        let span = t_range[1] - t_range[0];
+        let steps = (span / params.max_step).ceil().max(1.0);
+        // INVARIANT: span / max_step is finite and positive, so steps fits a usize.
+        let n = steps as usize;
+        let feed_samples = (0..=n).map(|k| t_range[0] + span * (k as f64 / steps)).collect();
+        let bounds = index.bounds();
+        Ok(Planner {
+            index,
+            cutter,
+            shape,
+            model,
+            params,
+            frame,
+            slots: slots_by_original(index),
+            part_boundary: PartBoundary::new(index),
+            measure: Measure::new(index, cutter, params.direction, sh),
+            raw_measure: Measure { refine: false, ..Measure::new(index, cutter, params.direction, sh) },
+            floor: bounds.min.z - bounds.diagonal() - 1.0,
+            sample_tol: tol::SAMPLING_SHARE * tol_.path,
+            simplify_tol: tol::SIMPLIFY_SHARE * tol_.path,
+            boundary_tol: tol::BOUNDARY_SHARE * tol_.path,
+            min_step: params.max_step * tol::MIN_STEP_FRACTION,
+            d_range,
+            feed_samples,
+            drops: 0,
+        })
+    }
+
+    fn drop_at(&mut self, xy: Point2) -> ClPoint {
+        self.drops += 1;
+        drop_cutter(self.cutter, self.index, xy, self.floor)
+    }
+
+    fn is_inside(&self, cl: &ClPoint, _scratch: &mut Vec<u32>) -> bool {
+        match self.params.boundary {
+            Boundary::ContactInside => self.part_boundary.is_interior_contact(self.index, &self.slots, cl),
+        }
+    }
+
+    /// The last inside sample between an inside sample and an outside abscissa.
+    fn bisect(&mut self, line: &Line, mut inside: Sample, mut outside: f64, scratch: &mut Vec<u32>) -> Sample {
+        while (outside - inside.t).abs() > self.boundary_tol {
+            let t = 0.5 * (inside.t + outside);
+            let cl = self.drop_at(line.at(t));
+            if self.is_inside(&cl, scratch) {
+                inside = Sample { t, cl };
+            } else {
+                outside = t;
+            }
+        }
+        inside
+    }
+
+    /// Appends the samples after `a` up to `b` (both inside), bisecting a step
+    /// while the CL midpoint is farther than the sampling tolerance from the
+    /// chord; `None` marks a gap where the midpoint left the region.
+    fn refine(&mut self, line: &Line, a: Sample, b: Sample, out: &mut Vec<Option<Sample>>, scratch: &mut Vec<u32>) {
+        if b.t - a.t <= self.min_step {
+            out.push(Some(b));
+            return;
+        }
+        let t = 0.5 * (a.t + b.t);
+        let mid = Sample { t, cl: self.drop_at(line.at(t)) };
+        if !self.is_inside(&mid.cl, scratch) {
+            let end = self.bisect(line, a, t, scratch);
+            if end.t > a.t {
+                self.refine(line, a, end, out, scratch);
+            }
+            out.push(None);
+            let start = self.bisect(line, b, t, scratch);
+            out.push(Some(start));
+            if b.t > start.t {
+                self.refine(line, start, b, out, scratch);
+            }
+            return;
+        }
+        if distance_to_segment(&mid.cl.tip, &a.cl.tip, &b.cl.tip) > self.sample_tol {
+            self.refine(line, a, mid, out, scratch);
+            self.refine(line, mid, b, out, scratch);
+        } else {
+            out.push(Some(b));
+        }
+    }
+
+    /// Like [`Planner::refine`] for links: every point must have a contact
+    /// (on the CL surface); `None` when one has not.
+    fn refine_link(&mut self, line: &Line, a: Sample, b: Sample, out: &mut Vec<Point3>) -> Option<()> {
+        if b.t - a.t > self.min_step {
+            let t = 0.5 * (a.t + b.t);
+            let mid = Sample { t, cl: self.drop_at(line.at(t)) };
+            if matches!(mid.cl.contact, Contact::Floor) {
+                return None;
+            }
+            if distance_to_segment(&mid.cl.tip, &a.cl.tip, &b.cl.tip) > self.sample_tol {
+                self.refine_link(line, a, mid, out)?;
+                return self.refine_link(line, mid, b, out);
+            }
+        }
+        out.push(b.cl.tip);
+        Some(())
+    }
+
+    /// Samples the line on `ts` (in parallel), then refines: runs of inside samples.
+    fn runs(&mut self, line: &Line, ts: &[f64]) -> Vec<Vec<Sample>> {
+        let xys: Vec<Point2> = ts.iter().map(|&t| line.at(t)).collect();
+        let cls = drop_points(self.cutter, self.index, &xys, self.floor);
+        self.drops += cls.len();
+        let mut scratch = Vec::new();
+        let inside: Vec<bool> = cls.iter().map(|cl| self.is_inside(cl, &mut scratch)).collect();
+        let mut marks: Vec<Option<Sample>> = Vec::new();
+        let mut last: Option<Sample> = None;
+        for (k, (&t, cl)) in ts.iter().zip(&cls).enumerate() {
+            let s = Sample { t, cl: *cl };
+            match (inside[k], last) {
+                (true, None) => {
+                    let start = if k > 0 { self.bisect(line, s, ts[k - 1], &mut scratch) } else { s };
+                    marks.push(Some(start));
+                    if s.t > start.t {
+                        self.refine(line, start, s, &mut marks, &mut scratch);
+                    }
+                    last = Some(s);
+                }
+                (true, Some(prev)) => {
+                    self.refine(line, prev, s, &mut marks, &mut scratch);
+                    last = Some(s);
+                }
+                (false, Some(prev)) => {
+                    let end = self.bisect(line, prev, t, &mut scratch);
+                    if end.t > prev.t {
+                        self.refine(line, prev, end, &mut marks, &mut scratch);
+                    }
+                    marks.push(None);
+                    last = None;
+                }
+                (false, None) => {}
+            }
+        }
+        let mut runs = Vec::new();
+        let mut current = Vec::new();
+        for m in marks {
+            match m {
+                Some(s) => current.push(s),
+                None => {
+                    if current.len() >= 2 {
+                        runs.push(std::mem::take(&mut current));
+                    }
+                    current.clear();
+                }
+            }
+        }
+        if current.len() >= 2 {
+            runs.push(current);
+        }
+        runs
+    }
+
+    /// The passes of the plane at offset `d`.
+    pub(crate) fn plane(&mut self, d: f64) -> PlanePasses {
+        let line = Line { origin: self.frame.xy(0.0, d), dir: self.frame.f };
+        let ts = self.feed_samples.clone();
+        let runs = self.runs(&line, &ts);
+        let mut passes = Vec::with_capacity(runs.len());
+        let mut samples = Vec::new();
+        for run in runs {
+            let points: Vec<Point3> = run.iter().map(|s| s.cl.tip).collect();
+            let kept = simplify(&points, self.simplify_tol);
+            passes.push(kept.iter().map(|&i| points[i]).collect::<Vec<_>>());
+            samples.extend(run.iter().map(|s| s.cl));
+        }
+        let curves = passes.iter().map(|p: &Vec<Point3>| Curve::new(&self.frame, p)).collect();
+        PlanePasses { plane: Plane { offset: d, passes }, samples, curves }
+    }
+
+    /// NEXT_SPACING (finishing.md 6.4): the smallest horizontal plane spacing
+    /// over the samples of the plane, `sod_i |c_i . m|`, with the place.
+    fn spacing(&self, plane: &PlanePasses) -> Option<(f64, Point2)> {
+        let sh = self.params.scallop_height;
+        let m = Vec3::new(self.frame.m.x, self.frame.m.y, 0.0);
+        let mut best: Option<(f64, Point2)> = None;
+        for cl in &plane.samples {
+            let n = contact_normal(&self.shape, self.index, &self.slots, cl);
+            let slope = n.z.abs().min(1.0).acos();
+            let horizontal = n.x.hypot(n.y);
+            let alpha = if horizontal < tol::HORIZONTAL_XY {
+                0.0
+            } else {
+                fold_direction_angle(n.y.atan2(n.x) - self.params.direction)
+            };
+            let mut sod = self.model.step_over(sh, slope, alpha);
+            if let CutterShape::Flat { radius } = self.shape {
+                // A sharp rim leaves a saw tooth, not a circle: start from sh / sin s
+                // (the measured scallop corrects it); never more than the diameter.
+                let sin_s = slope.sin();
+                if sin_s > 0.0 {
+                    sod = sod.max(sh / sin_s);
+                }
+                sod = sod.min(2.0 * radius);
+            }
+            let tau = m.cross(&n);
+            let cross = if tau.norm() > 0.0 { n.cross(&(tau / tau.norm())) } else { Vec3::zeros() };
+            let factor = if cross.norm() > 0.0 { (cross / cross.norm()).dot(&m).abs() } else { 0.0 };
+            let delta = sod * factor;
+            if best.is_none_or(|(b, _)| delta < b) {
+                best = Some((delta, Point2::new(cl.tip.x, cl.tip.y)));
+            }
+        }
+        best
+    }
+
+    /// Largest measured scallop between two planes at the feed samples.
+    fn measured(&self, a: &PlanePasses, b: &PlanePasses, refine: bool) -> (f64, Point2) {
+        let measure = if refine { &self.measure } else { &self.raw_measure };
+        let chunks: Vec<(f64, Point2)> = self
+            .feed_samples
+            .par_chunks(16)
+            .map(|ts| {
+                let hs = pair_heights(measure, &a.curves, &b.curves, ts);
+                hs.into_iter()
+                    .fold((0.0, Point2::origin()), |acc, c| if c.height > acc.0 { (c.height, c.at) } else { acc })
+            })
+            .collect();
+        chunks.into_iter().fold((0.0, Point2::origin()), |acc, h| if h.0 > acc.0 { h } else { acc })
+    }
+
+    fn unreachable(&self, spacing: f64, at: Point2) -> StrategyError {
+        StrategyError::Unreachable { x: at.x, y: at.y, spacing, scallop_height: self.params.scallop_height }
+    }
+
+    /// The offset between `empty` (a plane without passes) and `full` (with
+    /// passes) where passes begin, to the boundary tolerance; returns the plane
+    /// on the `full` side.
+    fn edge(&mut self, mut empty: f64, full: PlanePasses) -> PlanePasses {
+        let mut full = full;
+        while (full.plane.offset - empty).abs() > self.boundary_tol {
+            let mid = self.plane(0.5 * (empty + full.plane.offset));
+            if mid.plane.passes.is_empty() {
+                empty = mid.plane.offset;
+            } else {
+                full = mid;
+            }
+        }
+        full
+    }
+
+    /// The plane sweep (finishing.md 6.5 with half-spacing margins, see the crate
+    /// docs): ranges of offsets with passes are found by scanning at `max_step`;
+    /// in each, the first plane lies half its spacing inside the first edge, each
+    /// next plane one spacing further (shrunk until the measured scallop holds),
+    /// and the last within half its spacing of the far edge.
+    pub(crate) fn sweep(&mut self) -> Result<Vec<PlanePasses>, StrategyError> {
+        let sh = self.params.scallop_height;
+        let [d_lo, d_hi] = self.d_range;
+        let cap = self.model.max_step_over(sh).min(2.0 * self.cutter.radius());
+        let mut planes: Vec<PlanePasses> = Vec::new();
+        let mut empty = d_lo;
+        'ranges: loop {
+            // Scan for the next plane with passes.
+            let mut probe = empty;
+            let found = loop {
+                probe += self.params.max_step;
+                if probe > d_hi {
+                    break None;
+                }
+                let p = self.plane(probe);
+                if !p.plane.passes.is_empty() {
+                    break Some(p);
+                }
+                empty = probe;
+            };
+            let Some(found) = found else { break 'ranges };
+            let edge = self.edge(empty, found);
+            let edge_offset = edge.plane.offset;
+            // First plane: half its own spacing inside the edge (fixed point).
+            let mut delta = cap;
+            let mut first = edge;
+            for _ in 0..tol::FIRST_PLANE_ITERATIONS {
+                let candidate = self.plane(edge_offset + 0.5 * delta);
+                if candidate.plane.passes.is_empty() {
+                    break;
+                }
+                let spacing = self.spacing(&candidate).map_or(delta, |(s, _)| s);
+                first = candidate;
+                if spacing >= delta {
+                    break;
+                }
+                delta = spacing.max(tol::MIN_SPACING);
+            }
+            planes.push(first);
+            loop {
+                // INVARIANT: a plane was pushed above.
+                let current = planes.last().expect("a plane of this range");
+                let d = current.plane.offset;
+                let (spacing, at) = self.spacing(current).unwrap_or((delta, self.frame.xy(0.0, d)));
+                if spacing < tol::MIN_SPACING {
+                    return Err(self.unreachable(spacing, at));
+                }
+                delta = spacing;
+                let mut gap = spacing;
+                let mut next = self.plane(d + gap);
+                if next.plane.passes.is_empty() {
+                    let here = self.plane(d);
+                    let far = self.edge(d + gap, here);
+                    let end = far.plane.offset;
+                    if end - d <= 0.5 * spacing + self.boundary_tol {
+                        empty = d + gap;
+                        continue 'ranges;
+                    }
+                    gap = end - 0.5 * spacing - d;
+                    next = self.plane(d + gap);
+                    if next.plane.passes.is_empty() {
+                        empty = d + gap;
+                        continue 'ranges;
+                    }
+                }
+                let mut accepted = false;
+                for retry in 0..tol::MAX_SPACING_RETRIES {
+                    // INVARIANT: as above.
+                    let current = planes.last().expect("a plane of this range");
+                    let (h, place) = self.measured(current, &next, retry >= tol::RAW_RETRIES);
+                    if h <= sh {
+                        accepted = true;
+                        break;
+                    }
+                    // Scallop ~ gap^2; after a first exact-ratio try, shrink by at
+                    // least SPACING_MIN_SHRINK per retry (curvature, rest material).
+                    let ratio = if h.is_finite() { (sh / h).sqrt() * tol::SPACING_SAFETY } else { 0.5 };
+                    gap *= if retry == 0 { ratio } else { ratio.min(tol::SPACING_MIN_SHRINK) };
+                    if gap < tol::MIN_SPACING {
+                        return Err(self.unreachable(gap, place));
+                    }
+                    next = self.plane(d + gap);
+                }
+                if !accepted {
+                    return Err(self.unreachable(gap, at));
+                }
+                planes.push(next);
+            }
+        }
+        if planes.is_empty() {
+            return Err(StrategyError::EmptyRegion { direction_deg: self.params.direction.to_degrees() });
+        }
+        Ok(planes)
+    }
+
+    /// CL points of a straight link from `a` to `b` on the CL surface (every
+    /// drop-cutter point has a contact), or `None` when the cutter would touch
+    /// nothing somewhere along it.
+    fn link(&mut self, a: &Point3, b: &Point3) -> Option<Vec<Point3>> {
+        let v = Vec2::new(b.x - a.x, b.y - a.y);
+        let len = v.norm();
+        if len <= self.min_step {
+            return Some(vec![*b]);
+        }
+        let line = Line { origin: Point2::new(a.x, a.y), dir: v / len };
+        let steps = (len / self.params.max_step).ceil().max(1.0);
+        // INVARIANT: finite positive.
+        let n = steps as usize;
+        let ts: Vec<f64> = (0..=n).map(|k| len * (k as f64 / steps)).collect();
+        let xys: Vec<Point2> = ts.iter().map(|&t| line.at(t)).collect();
+        let cls = drop_points(self.cutter, self.index, &xys, self.floor);
+        self.drops += cls.len();
+        if cls.iter().any(|cl| matches!(cl.contact, Contact::Floor)) {
+            return None;
+        }
+        let mut points = vec![cls[0].tip];
+        for k in 1..=n {
+            let (p, q) = (Sample { t: ts[k - 1], cl: cls[k - 1] }, Sample { t: ts[k], cl: cls[k] });
+            self.refine_link(&line, p, q, &mut points)?;
+        }
+        // The ends are the pass ends (same drop, same point); keep them exact.
+        if let Some(first) = points.first_mut() {
+            *first = *a;
+        }
+        if let Some(last) = points.last_mut() {
+            *last = *b;
+        }
+        let kept = simplify(&points, self.simplify_tol);
+        Some(kept.iter().skip(1).map(|&i| points[i]).collect())
+    }
+
+    /// Orders the passes (zigzag or one-way) and joins them into a toolpath.
+    pub(crate) fn toolpath(&mut self, planes: &[PlanePasses]) -> (Toolpath, usize, usize) {
+        let params = self.params;
+        let mut path = Toolpath::new(params.machine.feed * 60.0);
+        path.plunge_feed = params.plunge_feed * 60.0;
+        let clear = self.index.bounds().max.z + params.clearance;
+        let mut ordered: Vec<Vec<Point3>> = Vec::new();
+        let mut parity = false;
+        for plane in planes.iter().filter(|p| !p.plane.passes.is_empty()) {
+            let mut passes = plane.plane.passes.clone();
+            if parity && params.pattern == Pattern::Zigzag {
+                passes.reverse();
+                for p in &mut passes {
+                    p.reverse();
+                }
+            }
+            ordered.extend(passes);
+            parity = !parity;
+        }
+        let (mut links, mut retracts) = (0, 0);
+        for (i, pass) in ordered.iter().enumerate() {
+            let (Some(start), Some(end)) = (pass.first(), pass.last()) else { continue };
+            if i == 0 {
+                path.push(Move::new(MoveKind::Rapid, Point3::new(start.x, start.y, clear)));
+                path.push(Move::new(MoveKind::Plunge, *start));
+            }
+            for p in &pass[1..] {
+                path.push(Move::new(MoveKind::Feed, *p));
+            }
+            let Some(next) = ordered.get(i + 1).and_then(|p| p.first()) else {
+                path.push(Move::new(MoveKind::Retract, Point3::new(end.x, end.y, clear)));
+                continue;
+            };
+            let link = if params.pattern == Pattern::Zigzag { self.link(end, next) } else { None };
+            if let Some(points) = link {
+                links += 1;
+                for p in points {
+                    path.push(Move::new(MoveKind::Link, p));
+                }
+            } else {
+                retracts += 1;
+                path.push(Move::new(MoveKind::Retract, Point3::new(end.x, end.y, clear)));
+                path.push(Move::new(MoveKind::Rapid, Point3::new(next.x, next.y, clear)));
+                path.push(Move::new(MoveKind::Plunge, *next));
+            }
+        }
+        (path, links, retracts)
+    }
+}
+
+fn distance_to_segment(p: &Point3, a: &Point3, b: &Point3) -> f64 {
+    let ab = b - a;
+    let len2 = ab.norm_squared();
+    let ap = p - a;
+    if len2 > 0.0 {
+        let t = (ap.dot(&ab) / len2).clamp(0.0, 1.0);
+        (ap - ab * t).norm()
+    } else {
+        ap.norm()
+    }
+}

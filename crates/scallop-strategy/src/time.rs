@@ -1,0 +1,275 @@
+//! Machining time of a toolpath: the specification's stop-to-stop model and a
+//! look-ahead feed profile.
+//!
+//! Moves fall in three classes, each with its own speed limit and the machine's
+//! `A` and `J`: **cutting** (`Feed` and `Link` moves, at the feed `V`),
+//! **plunge** (`Plunge`, at the plunge feed) and **rapid** (`Rapid` and
+//! `Retract`, at the rapid rate). The tool stops wherever the class changes.
+//!
+//! # (a) Stop-to-stop model (finishing.md 7.1, 7.2)
+//! Consecutive moves of one class form a chain until a **sharp corner**, a
+//! direction change larger than [`crate::FinishingParams::sharp_corner`]; every
+//! chain is one stop-to-stop move of its total length `L`, timed by
+//! [`scallop_analysis::MachineLimits::segment_time`] (the 3-case jerk-limited
+//! model, full S-curve by default). Direction changes below the angle are
+//! taken at full speed (the model of the thesis: a pass is a portion without
+//! sharp angles).
+//!
+//! # (b) Look-ahead model
+//! Every move is a segment with a speed limit; junction speeds are bounded by
+//! - 0 at the start, the end and wherever the class changes;
+//! - corner blending with tolerance `delta` (the "junction deviation" of grbl
+//!   and LinuxCNC's blending): a corner of deflection `phi` is rounded by a
+//!   circular arc whose distance to the corner is `delta`; the arc of radius
+//!   `rho = delta cos(phi/2) / (1 - cos(phi/2))` is taken at the speed of
+//!   centripetal acceleration `A`: `v^2 = A rho`;
+//! - the speed limits of both segments.
+//!
+//! A forward pass then a backward pass lower each junction speed to what the
+//! segment before (after) it can reach with a **jerk-limited transition**:
+//! changing speed by `dv` from rest acceleration to rest acceleration takes
+//! `T = 2 sqrt(dv/J)` when `dv <= A^2/J`, else `T = dv/A + A/J`, and covers
+//! `(v0 + v1) T / 2` (the profile is symmetric). Each segment is then timed as
+//! transition up to a peak speed, cruise, transition down, with the highest
+//! peak that fits. Acceleration returns to 0 at every junction (conservative:
+//! real controllers blend transitions across junctions). With every junction
+//! speed 0 this reproduces model (a) exactly: the four cases of finishing.md 7.2.
+
+use scallop_analysis::MachineLimits;
+use scallop_geom::Vec3;
+use scallop_toolpath::{MoveKind, Toolpath};
+use serde::{Deserialize, Serialize};
+
+use crate::{FinishingParams, tol};
+
+/// Time (s) per class of move.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct ClassTimes {
+    /// `Feed` and `Link` moves.
+    pub cutting: f64,
+    /// `Plunge` moves.
+    pub plunge: f64,
+    /// `Rapid` and `Retract` moves.
+    pub rapid: f64,
+}
+
+impl ClassTimes {
+    /// Sum of the classes.
+    #[must_use]
+    pub fn total(&self) -> f64 {
+        self.cutting + self.plunge + self.rapid
+    }
+
+    fn add(&mut self, class: Class, t: f64) {
+        match class {
+            Class::Cutting => self.cutting += t,
+            Class::Plunge => self.plunge += t,
+            Class::Rapid => self.rapid += t,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Class {
+    Cutting,
+    Plunge,
+    Rapid,
+}
+
+fn class(kind: MoveKind) -> Class {
+    match kind {
+        MoveKind::Feed | MoveKind::Link => Class::Cutting,
+        MoveKind::Plunge => Class::Plunge,
+        MoveKind::Rapid | MoveKind::Retract => Class::Rapid,
+    }
+}
+
+fn limits(params: &FinishingParams, class: Class) -> MachineLimits {
+    let feed = match class {
+        Class::Cutting => params.machine.feed,
+        Class::Plunge => params.plunge_feed,
+        Class::Rapid => params.rapid_rate,
+    };
+    MachineLimits { feed, ..params.machine }
+}
+
+struct Segment {
+    class: Class,
+    length: f64,
+    dir: Vec3,
+}
+
+fn segments(path: &Toolpath) -> Vec<Segment> {
+    path.moves()
+        .windows(2)
+        .filter_map(|w| {
+            let v = w[1].to - w[0].to;
+            let length = v.norm();
+            (length > tol::ZERO_LENGTH).then(|| Segment { class: class(w[1].kind), length, dir: v / length })
+        })
+        .collect()
+}
+
+/// Model (a): stop-to-stop jerk-limited time of every chain between sharp
+/// corners (see the module docs).
+///
+/// ```
+/// # use scallop_strategy::{stop_to_stop_time, FinishingParams, Pattern, Boundary};
+/// # use scallop_toolpath::{Move, MoveKind, Toolpath};
+/// # use scallop_geom::Point3;
+/// # use scallop_analysis::MachineLimits;
+/// # let params = FinishingParams { direction: 0.0, pattern: Pattern::Zigzag, scallop_height: 0.01,
+/// #     boundary: Boundary::ContactInside, max_step: 0.5, clearance: 5.0, machine: MachineLimits::default(),
+/// #     plunge_feed: 20.0, rapid_rate: 500.0, sharp_corner: 0.5, blend_tolerance: 0.01 };
+/// let mut path = Toolpath::new(5000.0);
+/// path.push(Move::new(MoveKind::Feed, Point3::new(0.0, 0.0, 0.0)));
+/// path.push(Move::new(MoveKind::Feed, Point3::new(28.0, 0.0, 0.0)));
+/// let t = stop_to_stop_time(&path, &params);
+/// assert!((t.cutting - params.machine.segment_time(28.0)).abs() < 1e-12);
+/// ```
+#[must_use]
+pub fn stop_to_stop_time(path: &Toolpath, params: &FinishingParams) -> ClassTimes {
+    let cos_sharp = params.sharp_corner.cos();
+    let mut times = ClassTimes::default();
+    let mut chain: Option<(Class, f64, Vec3)> = None;
+    for s in segments(path) {
+        chain = match chain {
+            Some((c, len, dir)) if c == s.class && dir.dot(&s.dir) >= cos_sharp => Some((c, len + s.length, s.dir)),
+            Some((c, len, _)) => {
+                times.add(c, limits(params, c).segment_time(len));
+                Some((s.class, s.length, s.dir))
+            }
+            None => Some((s.class, s.length, s.dir)),
+        };
+    }
+    if let Some((c, len, _)) = chain {
+        times.add(c, limits(params, c).segment_time(len));
+    }
+    times
+}
+
+/// Duration and distance of a jerk-limited speed change between `v0` and `v1`.
+fn transition(v0: f64, v1: f64, m: &MachineLimits) -> (f64, f64) {
+    let dv = (v1 - v0).abs();
+    let t = if dv * m.jerk <= m.acceleration * m.acceleration {
+        2.0 * (dv / m.jerk).sqrt()
+    } else {
+        dv / m.acceleration + m.acceleration / m.jerk
+    };
+    (t, 0.5 * (v0 + v1) * t)
+}
+
+/// The highest speed `<= vmax` reachable from `v0` within `length`.
+fn reach(v0: f64, length: f64, vmax: f64, m: &MachineLimits) -> f64 {
+    if v0 >= vmax || transition(v0, vmax, m).1 <= length {
+        return vmax.max(v0).min(vmax);
+    }
+    let (mut lo, mut hi) = (v0, vmax);
+    for _ in 0..tol::VELOCITY_ITERATIONS {
+        let mid = 0.5 * (lo + hi);
+        if transition(v0, mid, m).1 <= length {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    lo
+}
+
+/// Time of one segment entered at `v0`, left at `v1`, with speed limit `vmax`.
+fn segment_time(v0: f64, v1: f64, length: f64, vmax: f64, m: &MachineLimits) -> f64 {
+    let used = |vp: f64| transition(v0, vp, m).1 + transition(vp, v1, m).1;
+    let base = v0.max(v1);
+    let peak = if used(vmax) <= length {
+        vmax
+    } else {
+        let (mut lo, mut hi) = (base, vmax);
+        for _ in 0..tol::VELOCITY_ITERATIONS {
+            let mid = 0.5 * (lo + hi);
+            if used(mid) <= length {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        lo
+    };
+    if peak <= 0.0 {
+        return 0.0;
+    }
+    let cruise = (length - used(peak)).max(0.0) / peak;
+    transition(v0, peak, m).0 + transition(peak, v1, m).0 + cruise
+}
+
+/// Model (b): look-ahead jerk-limited feed profile with corner blending
+/// tolerance [`FinishingParams::blend_tolerance`] (see the module docs).
+///
+/// ```
+/// # use scallop_strategy::{lookahead_time, stop_to_stop_time, FinishingParams, Pattern, Boundary};
+/// # use scallop_toolpath::{Move, MoveKind, Toolpath};
+/// # use scallop_geom::Point3;
+/// # use scallop_analysis::MachineLimits;
+/// # let params = FinishingParams { direction: 0.0, pattern: Pattern::Zigzag, scallop_height: 0.01,
+/// #     boundary: Boundary::ContactInside, max_step: 0.5, clearance: 5.0, machine: MachineLimits::default(),
+/// #     plunge_feed: 20.0, rapid_rate: 500.0, sharp_corner: 0.5, blend_tolerance: 0.01 };
+/// let mut path = Toolpath::new(5000.0);
+/// for (x, y) in [(0.0, 0.0), (20.0, 0.0), (20.0, 1.0), (0.0, 1.0)] {
+///     path.push(Move::new(MoveKind::Feed, Point3::new(x, y, 0.0)));
+/// }
+/// let (a, b) = (stop_to_stop_time(&path, &params), lookahead_time(&path, &params));
+/// assert!(b.cutting < a.cutting); // blended corners need no full stop
+/// ```
+#[must_use]
+pub fn lookahead_time(path: &Toolpath, params: &FinishingParams) -> ClassTimes {
+    let segs = segments(path);
+    let n = segs.len();
+    let mut times = ClassTimes::default();
+    if n == 0 {
+        return times;
+    }
+    let lims: Vec<MachineLimits> = segs.iter().map(|s| limits(params, s.class)).collect();
+    let a_max = params.machine.acceleration;
+    let mut v = vec![0.0f64; n + 1];
+    for i in 1..n {
+        let (p, q) = (&segs[i - 1], &segs[i]);
+        if p.class != q.class {
+            continue;
+        }
+        let cos_phi = p.dir.dot(&q.dir).clamp(-1.0, 1.0);
+        let cos_half = (0.5 * (1.0 + cos_phi)).sqrt(); // cos(phi / 2)
+        let cap = lims[i - 1].feed.min(lims[i].feed);
+        v[i] = if 1.0 - cos_half <= 0.0 {
+            cap
+        } else {
+            (a_max * params.blend_tolerance * cos_half / (1.0 - cos_half)).sqrt().min(cap)
+        };
+    }
+    for i in 0..n {
+        v[i + 1] = v[i + 1].min(reach(v[i], segs[i].length, lims[i].feed, &lims[i]));
+    }
+    for i in (0..n).rev() {
+        v[i] = v[i].min(reach(v[i + 1], segs[i].length, lims[i].feed, &lims[i]));
+    }
+    for (i, s) in segs.iter().enumerate() {
+        times.add(s.class, segment_time(v[i], v[i + 1], s.length, lims[i].feed, &lims[i]));
+    }
+    times
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// With zero entry and exit speeds the look-ahead segment time equals the
+    /// spec's stop-to-stop S-curve in all four cases.
+    #[test]
+    fn stopped_segment_matches_s_curve() {
+        for m in [MachineLimits::default(), MachineLimits::from_thesis_units(30.0, 2.0, 40.0)] {
+            for length in [0.01, 0.5, 3.0, 7.0, 7.7, 20.0, 200.0, 2000.0] {
+                let a = m.segment_time(length);
+                let b = segment_time(0.0, 0.0, length, m.feed, &m);
+                assert!((a - b).abs() <= 1e-9 * a, "{length}: {a} vs {b}");
+            }
+        }
+    }
+}

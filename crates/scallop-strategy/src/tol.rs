@@ -1,0 +1,96 @@
+//! Every numeric threshold and algorithm constant of this crate.
+//!
+//! Path-tolerance budget (style guide 2.6): the tessellation of parametric
+//! surfaces takes [`scallop_geom::Tolerances::TESSELLATION_SHARE`] (0.25), the
+//! forward sampling along a pass [`SAMPLING_SHARE`] (0.5) and the merging of
+//! collinear points [`SIMPLIFY_SHARE`] (0.25): the total is `Tolerances::path`.
+
+/// Share of the path tolerance for the chordal deviation of the sampled CL
+/// polyline (a step is bisected while the CL midpoint is farther than this
+/// share of `path` from the chord).
+pub const SAMPLING_SHARE: f64 = 0.5;
+
+/// Share of the path tolerance for merging nearly collinear CL points
+/// (`scallop_toolpath::simplify`).
+pub const SIMPLIFY_SHARE: f64 = 0.25;
+
+/// Pass ends are located by bisection of the region boundary until the bracket
+/// is shorter than this share of the path tolerance (mm along the pass).
+pub const BOUNDARY_SHARE: f64 = 0.5;
+
+/// Forward steps are never bisected below this fraction of `max_step`.
+pub const MIN_STEP_FRACTION: f64 = 1.0 / 4096.0;
+
+/// The smallest horizontal plane spacing (mm) the planner accepts (finishing.md
+/// 6.4 uses `Delta_min = 1e-6 m`); below it the scallop height cannot be met
+/// with this cutter and direction and planning fails.
+pub const MIN_SPACING: f64 = 1e-3;
+
+/// When the measured scallop between a plane and its tentative successor
+/// exceeds `sh`, the gap is multiplied by `sqrt(sh / h) * SPACING_SAFETY` (the
+/// scallop grows about as the square of the gap) and measured again.
+pub const SPACING_SAFETY: f64 = 1.0 - 1e-6;
+
+/// Retries of the tentative next plane before giving up.
+pub const MAX_SPACING_RETRIES: usize = 24;
+
+/// Iterations of the first-plane fixed point (its offset is half its own spacing).
+pub const FIRST_PLANE_ITERATIONS: usize = 4;
+
+/// Relative measurement slack of the scallop check: a measured height up to
+/// `sh * (1 + SCALLOP_REL_SLACK)` passes (rounding of the envelope search).
+pub const SCALLOP_REL_SLACK: f64 = 1e-6;
+
+/// Golden-section iterations of the envelope minimisation along one segment.
+pub const GOLDEN_ITERATIONS: usize = 64;
+
+/// Iterations of the cusp search (Illinois false position, then bisection).
+pub const CUSP_ITERATIONS: usize = 80;
+
+/// Relative convergence of the cusp search (times the plane gap).
+pub const CUSP_REL_TOL: f64 = 1e-9;
+
+/// Bins of the scallop histogram over `[0, sh]` (one more bin counts heights above `sh`).
+pub const HISTOGRAM_BINS: usize = 10;
+
+/// A normal whose XY projection is shorter than this is horizontal (slope 0).
+pub const HORIZONTAL_XY: f64 = 1e-12;
+
+/// A contact this far (relative to the cutter radius) outside the flat bottom
+/// of a bull-nose lies on its torus, whose normal is then used.
+pub const TORUS_CONTACT_REL: f64 = 1e-9;
+
+/// Bisection iterations of the look-ahead velocity solver.
+pub const VELOCITY_ITERATIONS: usize = 60;
+
+/// Moves shorter than this (mm) are ignored by the time models (no direction).
+pub const ZERO_LENGTH: f64 = 1e-12;
+
+/// An envelope minimum within this fraction of the cutter radius of a pass end
+/// comes from the end position (scallop samples there are skipped).
+pub const PASS_END_REL: f64 = 1e-9;
+
+/// A contact within this fraction of its triangle's longest edge from a vertex
+/// or an edge lies on it (for the region's boundary test).
+pub const ON_FEATURE_REL: f64 = 1e-9;
+
+/// Virtual planes (plus one) of the dense-pass reference of a cusp over the limit.
+pub const REFERENCE_PLANES: usize = 8;
+
+/// Forward step of the dense-pass reference, as a fraction of the cutter radius.
+pub const REFERENCE_STEP_FRACTION: f64 = 1.0 / 32.0;
+
+/// From the second retry on, the gap shrinks at least by this factor.
+pub const SPACING_MIN_SHRINK: f64 = 0.9;
+
+/// Lateral samples of the residual between two passes when the envelopes do
+/// not cross or the cutter is flat (its saw tooth need not peak at the crossing).
+pub const CUSP_SPAN_SAMPLES: usize = 32;
+
+/// The first retries of a plane measure the scallop against the part only;
+/// later ones also subtract rest material (dense virtual passes, costly).
+pub const RAW_RETRIES: usize = 3;
+
+/// Relative convergence of the golden-section envelope search (times the cutter
+/// radius): the envelope's value errs by the square of it (times the curvature).
+pub const GOLDEN_REL_TOL: f64 = 1e-6;

@@ -1,0 +1,79 @@
+//! Rejected plans name the parameter and the fix.
+#![allow(clippy::unwrap_used)]
+
+mod common;
+
+use common::{ball, bull, inclined_plane, params};
+use scallop_cutter::{Cutter, CutterShape};
+use scallop_geom::Tolerances;
+use scallop_strategy::{Pattern, StrategyError, plan_finishing};
+
+const TOL: Tolerances = Tolerances { path: 0.01, gouge: 0.0 };
+
+/// Breaks one parameter.
+type Edit = fn(&mut scallop_strategy::FinishingParams);
+
+#[test]
+fn bad_parameters_are_named() {
+    let index = inclined_plane(20.0, 10.0, 30.0);
+    let cases: [(&str, Edit); 5] = [
+        ("scallop_height", |p| p.scallop_height = -0.01),
+        ("max_step", |p| p.max_step = 0.0),
+        ("clearance", |p| p.clearance = f64::NAN),
+        ("machine.jerk", |p| p.machine.jerk = -1.0),
+        ("sharp_corner", |p| p.sharp_corner = 4.0),
+    ];
+    for (name, edit) in cases {
+        let mut p = params(0.0, Pattern::Zigzag, 0.01, 0.5);
+        edit(&mut p);
+        match plan_finishing(&index, &ball(3.0), &p, &TOL) {
+            Err(e @ StrategyError::BadParameter { name: n, .. }) => {
+                assert_eq!(n, name);
+                assert!(e.to_string().contains(name));
+            }
+            other => panic!("{name}: {other:?}"),
+        }
+    }
+    let bad_tol = Tolerances { path: 0.0, gouge: 0.0 };
+    assert!(matches!(
+        plan_finishing(&index, &ball(3.0), &params(0.0, Pattern::Zigzag, 0.01, 0.5), &bad_tol),
+        Err(StrategyError::BadParameter { name: "tolerances.path", .. })
+    ));
+}
+
+#[test]
+fn scallop_height_must_be_below_the_radius() {
+    let index = inclined_plane(20.0, 10.0, 30.0);
+    let e = plan_finishing(&index, &ball(3.0), &params(0.0, Pattern::Zigzag, 3.0, 0.5), &TOL).unwrap_err();
+    assert!(matches!(e, StrategyError::ScallopTooLarge { .. }), "{e}");
+    let e = plan_finishing(&index, &bull(5.0, 0.5), &params(0.0, Pattern::Zigzag, 0.6, 0.5), &TOL).unwrap_err();
+    assert!(e.to_string().contains("corner radius"), "{e}");
+}
+
+#[test]
+fn cone_cutters_are_unsupported() {
+    let index = inclined_plane(20.0, 10.0, 30.0);
+    let cone = Cutter::new(CutterShape::Cone { radius: 3.0, half_angle: 0.5 }, 20.0).unwrap();
+    let e = plan_finishing(&index, &cone, &params(0.0, Pattern::Zigzag, 0.01, 0.5), &TOL).unwrap_err();
+    assert!(matches!(e, StrategyError::Unsupported { shape: "cone" }));
+}
+
+#[test]
+fn a_part_smaller_than_the_step_is_an_empty_region() {
+    let index = inclined_plane(0.2, 0.2, 10.0);
+    let e = plan_finishing(&index, &ball(3.0), &params(0.0, Pattern::Zigzag, 0.01, 5.0), &TOL).unwrap_err();
+    assert!(matches!(e, StrategyError::EmptyRegion { .. }), "{e}");
+}
+
+/// finishing.md A19: at 45 degrees to the slope the toroidal cutter's spacing
+/// follows the horizontal-angle Eq. 1.5 (4.77 mm), and the scallop holds.
+#[test]
+fn oblique_feed_keeps_the_scallop() {
+    let index = inclined_plane(56.0, 28.0, 60.0);
+    let planned =
+        plan_finishing(&index, &bull(5.0, 2.0), &params(45f64.to_radians(), Pattern::OneWay, 0.01, 0.5), &TOL).unwrap();
+    let s = &planned.scallop;
+    assert!(s.max_mm <= 0.01 && s.mean_mm > 0.009, "{s:?}");
+    assert_eq!(s.histogram.last(), Some(&0));
+    assert!(planned.report.retracts + 1 == planned.report.passes);
+}
