@@ -39,9 +39,29 @@ fn demo_writes_a_program() {
     let dir = scratch("demo");
     let out = scallop().args(["demo", "-o"]).arg(&dir).output().expect("run");
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let nc = std::fs::read_to_string(dir.join("demo.nc")).expect("demo.nc");
+    let nc = std::fs::read_to_string(dir.join("program.nc")).expect("program.nc");
     assert!(nc.lines().filter(|l| l.starts_with("G1")).count() > 1000);
     assert!(String::from_utf8_lossy(&out.stdout).contains("passes"));
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).expect("report")).expect("json");
+    for key in [
+        "machining_time_s",
+        "machining_time_lookahead_s",
+        "rapid_time_s",
+        "path_length_mm",
+        "feed_length_mm",
+        "rapid_length_mm",
+        "passes",
+        "max_scallop_mm",
+        "mean_scallop_mm",
+        "points",
+        "planning_time_s",
+    ] {
+        assert!(report["plan"][key].is_number(), "report.json lacks plan.{key}");
+    }
+    assert!(report["plan"]["max_scallop_mm"].as_f64().expect("number") <= 0.01);
+    let csv = std::fs::read_to_string(dir.join("toolpath.csv")).expect("toolpath.csv");
+    assert!(csv.starts_with("kind,x,y,z\n"));
 }
 
 #[test]
@@ -164,7 +184,7 @@ fn analyze_recommends_the_spec_tool_for_choi_and_rubio() {
 #[test]
 fn simulate_passes_the_demo_and_catches_a_lowered_copy() {
     let dir = scratch("simulate");
-    let out = scallop().args(["demo", "-o"]).arg(&dir).output().expect("run");
+    let out = scallop().args(["demo", "--raster", "-o"]).arg(&dir).output().expect("run");
     assert!(out.status.success());
     let nc = std::fs::read_to_string(dir.join("demo.nc")).expect("demo.nc");
     // The same program 0.05 mm lower on every feed move.

@@ -15,6 +15,7 @@
 //! - Deterministic: the same inputs give the same outputs on any thread count.
 
 mod demo;
+mod finish;
 mod grid;
 
 use scallop_geom::Tolerances;
@@ -22,6 +23,7 @@ use scallop_mesh::{MeshIndex, TriMesh};
 use scallop_surface::SurfaceSet;
 
 pub use demo::{DemoOutput, DemoSettings, DemoSummary, run_demo};
+pub use finish::{FinishOutput, FinishReport, FinishSettings, run_finishing, toolpath_csv};
 pub use grid::{GridAxis, GridError, MAX_GRID_POINTS};
 
 /// Why the engine rejected a request. Each variant says the cause and the fix.
@@ -40,6 +42,13 @@ pub enum EngineError {
     /// A grid that makes no sense.
     #[error("{0}")]
     Grid(#[from] GridError),
+    /// The finishing planner refused (a parameter, an unreachable surface, a
+    /// scallop over the height asked).
+    #[error("finishing: {0}")]
+    Strategy(#[from] scallop_strategy::StrategyError),
+    /// The surface analysis failed (degenerate samples).
+    #[error("analysis: {0}")]
+    Analysis(scallop_analysis::AnalysisError),
     /// The stock simulation found a safety problem (gouge, rapid into stock,
     /// collision) or could not run.
     #[error("verification: {0}")]

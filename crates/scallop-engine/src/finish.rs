@@ -1,0 +1,226 @@
+//! The main job (`scallop demo`): the Choi surface finished with a bull-nose
+//! cutter R = 5, r = 2 mm at a guaranteed scallop height of 0.01 mm, along the
+//! steepest-slope direction of the surface's PCA plane (what the tool-choice
+//! rule of the finishing spec picks for this surface), with the machining time
+//! of the spec's machine (V = 5 m/min, A = 6 m/s², J = 40 m/s³), plain
+//! G-code, and a stock simulation that proves the program before it is
+//! written.
+
+use scallop_analysis::{GridOptions, MachineLimits, Recommendation, ToolOptions, analyze, sample_surface_set};
+use scallop_cutter::{Cutter, CutterShape};
+use scallop_geom::{Aabb3, Point3, Tolerances};
+use scallop_post::{Dialect, write_gcode};
+use scallop_strategy::{Boundary, FinishingParams, Pattern, plan_finishing};
+use scallop_toolpath::{MoveKind, Toolpath};
+use serde::Serialize;
+
+use crate::{EngineError, Part, prepare_part};
+
+/// Settings of the finishing job (mm, seconds; machine limits in the spec's units).
+#[derive(Debug, Clone, PartialEq)]
+pub struct FinishSettings {
+    /// Built-in part name.
+    pub part: String,
+    /// Bull-nose radius R (mm).
+    pub radius: f64,
+    /// Corner radius r (mm).
+    pub corner: f64,
+    /// Flute length (mm).
+    pub flute_length: f64,
+    /// Scallop height sh (mm).
+    pub scallop_height: f64,
+    /// Feed V (m/min), acceleration A (m/s²), jerk J (m/s³).
+    pub machine: [f64; 3],
+    /// Path and gouge tolerances (mm).
+    pub tolerances: Tolerances,
+    /// Longest forward step between drop-cutter samples (mm).
+    pub max_step: f64,
+    /// Cell size of the verifying stock simulation (mm).
+    pub sim_resolution: f64,
+}
+
+impl FinishSettings {
+    /// The spec's main job on the Choi surface.
+    #[must_use]
+    pub fn standard() -> FinishSettings {
+        FinishSettings {
+            part: "choi".into(),
+            radius: 5.0,
+            corner: 2.0,
+            flute_length: 30.0,
+            scallop_height: 0.01,
+            machine: [5.0, 6.0, 40.0],
+            tolerances: Tolerances { path: 0.01, gouge: 0.0 },
+            max_step: 0.5,
+            sim_resolution: 0.1,
+        }
+    }
+}
+
+/// What the job produced (serialisable as `report.json`).
+#[derive(Debug, Clone, Serialize)]
+pub struct FinishReport {
+    /// Part name.
+    pub part: String,
+    /// Cutter.
+    pub cutter: String,
+    /// Scallop height asked (mm).
+    pub scallop_height_mm: f64,
+    /// Feed direction from +X (degrees): the PCA steepest-slope direction.
+    pub direction_deg: f64,
+    /// What the tool-choice analysis recommends for this part.
+    pub recommendation: Recommendation,
+    /// PCA slope of the part (degrees) and its critical slope (degrees).
+    pub slope_deg: f64,
+    /// Critical slope s_c(mu) (degrees).
+    pub critical_slope_deg: f64,
+    /// Distance between the surface and the mesh the cutter was dropped on (mm).
+    pub chordal_error_mm: f64,
+    /// The planner's figures (times, lengths, passes, verified scallop).
+    pub plan: scallop_strategy::Report,
+    /// Cell size of the stock simulation (mm).
+    pub sim_resolution_mm: f64,
+    /// Largest material left on the simulated stock (mm; includes the simulation's resolution effects).
+    pub sim_max_material_mm: f64,
+    /// Deepest stock-minus-part deviation on the simulated stock (mm).
+    pub sim_min_deviation_mm: f64,
+    /// Gouge tolerance the simulation enforced (mm).
+    pub sim_gouge_tolerance_mm: f64,
+}
+
+/// The job's outputs.
+#[derive(Debug, Clone)]
+pub struct FinishOutput {
+    /// The toolpath.
+    pub toolpath: Toolpath,
+    /// The G-code text.
+    pub gcode: String,
+    /// The report.
+    pub report: FinishReport,
+}
+
+/// Runs the finishing job. `planning_seconds` is measured by the caller and
+/// written into the report (the library reads no clock).
+///
+/// # Errors
+/// Bad settings, an unknown part, a plan that cannot hold the scallop height,
+/// or a safety problem found by the stock simulation.
+pub fn run_finishing(settings: &FinishSettings) -> Result<FinishOutput, EngineError> {
+    let s = settings;
+    let part = Part::builtin(&s.part)
+        .ok_or_else(|| crate::GridError::Syntax(format!("unknown built-in part '{}' (choi, rubio)", s.part)))?;
+    let Part::Surfaces(set) = &part else {
+        return Err(crate::GridError::Syntax("the finishing demo needs a surface part".into()).into());
+    };
+    let prepared = prepare_part(&part, &s.tolerances)?;
+    let machine = MachineLimits::from_thesis_units(s.machine[0], s.machine[1], s.machine[2]);
+    let samples = sample_surface_set(set, &GridOptions::default()).map_err(EngineError::Analysis)?;
+    let tools = ToolOptions { ball_radius: s.radius, toroidal_radius: s.radius, corner_radius: s.corner };
+    let analysis = analyze(&samples, &tools, &machine, s.scallop_height).map_err(EngineError::Analysis)?;
+    let direction = analysis.slope_direction_deg.to_radians();
+    let cutter = Cutter::new(CutterShape::Bull { radius: s.radius, corner: s.corner }, s.flute_length)?;
+    let params = FinishingParams {
+        direction,
+        pattern: Pattern::Zigzag,
+        scallop_height: s.scallop_height,
+        boundary: Boundary::ContactInside,
+        max_step: s.max_step,
+        clearance: 5.0,
+        machine,
+        plunge_feed: machine.feed / 4.0,
+        rapid_rate: RAPID_RATE,
+        sharp_corner: SHARP_CORNER_DEG.to_radians(),
+        blend_tolerance: s.tolerances.path,
+    };
+    let planned = plan_finishing(&prepared.index, &cutter, &params, &s.tolerances)?;
+
+    // Prove the program on a simulated stock before anyone runs it: the part's
+    // box grown by the cutter radius, from 1 mm below to 1 mm above the part.
+    let b = prepared.mesh.bounds();
+    let stock = Aabb3 {
+        min: Point3::new(b.min.x - s.radius, b.min.y - s.radius, b.min.z - 1.0),
+        max: Point3::new(b.max.x + s.radius, b.max.y + s.radius, b.max.z + 1.0),
+    };
+    // The program follows the tessellation (within the chordal error of the
+    // surface); between samples the planner keeps moves within the path
+    // tolerance of the CL surface.
+    let gouge_tolerance = s.tolerances.gouge + prepared.chordal_error + s.tolerances.path;
+    let options = scallop_sim::VerifyOptions { gouge_tolerance, ..scallop_sim::VerifyOptions::default() };
+    let sim = scallop_sim::simulate(stock, s.sim_resolution, &cutter, &planned.toolpath, &prepared.index, &options)?;
+
+    let cutter_text = format!("bull-nose R{} r{} mm", s.radius, s.corner);
+    let r = &planned.report;
+    let comments = [
+        format!("part: built-in {} surface, tessellated within {:.5} mm", s.part, prepared.chordal_error),
+        format!("tool: {cutter_text}; scallop height {} mm", s.scallop_height),
+        format!(
+            "path tolerance {} mm; gouge tolerance {} mm; feed direction {:.2} deg",
+            s.tolerances.path, s.tolerances.gouge, analysis.slope_direction_deg
+        ),
+        format!(
+            "predicted machining time {:.1} s (stop-to-stop), {:.1} s (look-ahead), rapids {:.1} s",
+            r.machining_time_s, r.machining_time_lookahead_s, r.rapid_time_s
+        ),
+    ];
+    let refs: Vec<&str> = comments.iter().map(String::as_str).collect();
+    let mut text = Vec::new();
+    write_gcode(&planned.toolpath, &Dialect::plain(), &refs, &mut text)
+        .map_err(|_| EngineError::BadTolerance(f64::NAN))?;
+    let report = FinishReport {
+        part: s.part.clone(),
+        cutter: cutter_text,
+        scallop_height_mm: s.scallop_height,
+        direction_deg: analysis.slope_direction_deg,
+        recommendation: analysis.recommendation,
+        slope_deg: analysis.slope_deg,
+        critical_slope_deg: analysis.critical_slope_deg,
+        chordal_error_mm: prepared.chordal_error,
+        plan: planned.report.clone(),
+        sim_resolution_mm: s.sim_resolution,
+        sim_max_material_mm: sim.verification.max_scallop,
+        sim_min_deviation_mm: sim.verification.min_deviation,
+        sim_gouge_tolerance_mm: gouge_tolerance,
+    };
+    Ok(FinishOutput { toolpath: planned.toolpath, gcode: String::from_utf8_lossy(&text).into_owned(), report })
+}
+
+/// Rapid rate of the demo machine (mm/s).
+const RAPID_RATE: f64 = 500.0;
+/// Direction change above which the stop-to-stop model stops (degrees).
+const SHARP_CORNER_DEG: f64 = 30.0;
+
+/// The toolpath as CSV: `kind,x,y,z` per move.
+#[must_use]
+pub fn toolpath_csv(path: &Toolpath) -> String {
+    let mut out = String::from("kind,x,y,z\n");
+    for m in path.moves() {
+        let kind = match m.kind {
+            MoveKind::Rapid => "rapid",
+            MoveKind::Plunge => "plunge",
+            MoveKind::Feed => "feed",
+            MoveKind::Link => "link",
+            MoveKind::Retract => "retract",
+        };
+        out.push_str(&format!("{kind},{},{},{}\n", m.to.x, m.to.y, m.to.z));
+    }
+    out
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used, reason = "tests: a panic is the failure report")]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn choi_finishing_holds_the_scallop_and_proves_itself() {
+        let out = run_finishing(&FinishSettings::standard()).unwrap();
+        let r = &out.report;
+        assert_eq!(r.recommendation, Recommendation::ToroidalAlongSlope);
+        assert!(r.plan.max_scallop_mm <= 0.01, "{r:?}");
+        assert!(r.plan.machining_time_s > 0.0 && r.plan.machining_time_lookahead_s > 0.0);
+        assert!(r.sim_min_deviation_mm >= -r.sim_gouge_tolerance_mm);
+        assert!(out.gcode.contains("predicted machining time"));
+        let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
+        assert_eq!(one.install(|| run_finishing(&FinishSettings::standard()).unwrap()).gcode, out.gcode);
+    }
+}
