@@ -7,6 +7,7 @@ mod drop;
 mod output;
 mod part;
 mod picture;
+mod run;
 mod simulate;
 
 use std::process::ExitCode;
@@ -43,6 +44,8 @@ struct Cli {
 enum Command {
     /// Run the built-in demo: Choi surface, ball cutter, zigzag drop-cutter raster, plain G-code.
     Demo(output::DemoArgs),
+    /// Run a finishing job from a job file (TOML; see docs/job.md): program, report, toolpath.
+    Run(run::RunArgs),
     /// Drop a cutter onto a part on an XY grid and write the cutter locations as CSV.
     Drop(drop::DropArgs),
     /// Analyse a part's shape (PCA) and recommend a cutter and a feed direction before any toolpath.
@@ -66,6 +69,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Demo(args) => output::demo(&args),
         Command::Drop(args) => drop::run(&args),
+        Command::Run(args) => run::run(&args),
         Command::Inspect(args) => part::inspect(&args),
         Command::Analyze(args) => analyze::run(&args),
         Command::Simulate(args) => simulate::run(&args),

@@ -86,33 +86,39 @@ pub fn demo(args: &DemoArgs) -> CliResult<()> {
     if args.raster {
         return raster_demo(args);
     }
-    let settings = scallop_engine::FinishSettings::standard();
+    let job = scallop_engine::FinishJob::choi_demo();
     let spinner = progress_bar(0, "planning and verifying the finishing of the Choi surface");
     spinner.enable_steady_tick(std::time::Duration::from_millis(120));
     let start = std::time::Instant::now();
-    let out = scallop_engine::run_finishing(&settings)
+    let out = scallop_engine::run_finishing(&job)
         .map_err(|e| Failure::Io(anyhow::anyhow!("the built-in demo failed: {e}")))?;
     let seconds = start.elapsed().as_secs_f64();
     spinner.finish_and_clear();
+    write_finishing(&out, seconds, &args.output, args.json)
+}
+
+/// Writes `program.nc`, `report.json` and `toolpath.csv` of a finishing job into
+/// `folder` and prints the summary (or the report as JSON).
+pub fn write_finishing(out: &scallop_engine::FinishOutput, seconds: f64, folder: &Path, json: bool) -> CliResult<()> {
     let mut report = out.report.clone();
     report.plan.planning_time_s = seconds;
-    let nc = args.output.join("program.nc");
+    let nc = folder.join("program.nc");
     write_atomic(&nc, |w| w.write_all(out.gcode.as_bytes()))?;
-    let json = serde_json::to_string_pretty(&report).map_err(|e| Failure::Io(e.into()))?;
-    write_atomic(&args.output.join("report.json"), |w| w.write_all(json.as_bytes()))?;
+    let text = serde_json::to_string_pretty(&report).map_err(|e| Failure::Io(e.into()))?;
+    write_atomic(&folder.join("report.json"), |w| w.write_all(text.as_bytes()))?;
     let csv = scallop_engine::toolpath_csv(&out.toolpath);
-    write_atomic(&args.output.join("toolpath.csv"), |w| w.write_all(csv.as_bytes()))?;
-    if args.json {
+    write_atomic(&folder.join("toolpath.csv"), |w| w.write_all(csv.as_bytes()))?;
+    if json {
         return print_json(&report);
     }
     let (r, p) = (&report, &report.plan);
     print_text(&format!(
-        "scallop demo: finishing the built-in {part} surface\n\
-         \x20 analysis   PCA slope {slope:.2}° < critical {crit:.2}°: bull-nose along the steepest slope ({dir:.2}° from X)\n\
+        "finishing the {part}\n\
+         \x20 analysis   PCA slope {slope:.2}°, critical slope {crit:.2}°: {rec}; feed at {dir:.2}° from X\n\
          \x20 cutter     {cutter}, scallop height {sh} mm, surface tessellated within {chord:.4} mm\n\
          \x20 toolpath   {passes} passes on {planes} planes, {points} points, {links} links, {retracts} retracts\n\
          \x20 scallop    verified max {smax:.5} mm, mean {smean:.5} mm (<= {sh} mm)\n\
-         \x20 time       {t1:.1} s stop-to-stop, {t2:.1} s look-ahead, + {tr:.1} s rapids (V 5 m/min, A 6 m/s², J 40 m/s³)\n\
+         \x20 time       {t1:.1} s stop-to-stop, {t2:.1} s look-ahead, + {tr:.1} s rapids\n\
          \x20 lengths    feed {feed:.0} mm, links {link:.0} mm, rapid {rapid:.0} mm\n\
          \x20 simulated  no gouge on a {res} mm stock; deepest {dev:+.4} mm (tolerance {gt:.4} mm), most material left {mat:.4} mm\n\
          \x20 planned    in {secs:.2} s\n\
@@ -121,6 +127,10 @@ pub fn demo(args: &DemoArgs) -> CliResult<()> {
         slope = r.slope_deg,
         crit = r.critical_slope_deg,
         dir = r.direction_deg + 0.0,
+        rec = match r.recommendation {
+            scallop_analysis::Recommendation::BallAlongPrincipal => "a ball along the principal direction is faster",
+            scallop_analysis::Recommendation::ToroidalAlongSlope => "a bull-nose along the steepest slope is faster",
+        },
         cutter = r.cutter,
         sh = r.scallop_height_mm,
         chord = r.chordal_error_mm,

@@ -227,3 +227,20 @@ fn simulate_passes_the_demo_and_catches_a_lowered_copy() {
     assert!(v["verdict"][0].as_str().expect("text").contains("gouge"));
     assert!(v["min_deviation_mm"].as_f64().expect("number") < -0.04);
 }
+
+#[test]
+fn run_plans_a_job_file_and_rejects_bad_keys() {
+    let dir = scratch("run");
+    let job = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/jobs/choi.toml");
+    let out = scallop().current_dir(&dir).args(["run", job, "-o", "out", "--json"]).output().expect("run");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
+    assert!(v["plan"]["max_scallop_mm"].as_f64().expect("number") <= 0.01);
+    assert!(dir.join("out/program.nc").exists());
+    std::fs::write(dir.join("bad.toml"), "[part]\nbuiltin = \"choi\"\n[cutter]\nshape = \"ball\"\ndiameter = 6\n[finishing]\nscallop_height = 0.01\nscallop = 2\n").expect("write");
+    let bad = scallop().current_dir(&dir).args(["run", "bad.toml", "-o", "bad"]).output().expect("run");
+    assert_eq!(bad.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&bad.stderr);
+    assert!(err.contains("bad.toml") && err.contains("scallop"), "{err}");
+    assert!(!dir.join("bad").exists(), "a rejected job writes nothing");
+}

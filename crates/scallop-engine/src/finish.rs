@@ -6,7 +6,9 @@
 //! G-code, and a stock simulation that proves the program before it is
 //! written.
 
-use scallop_analysis::{GridOptions, MachineLimits, Recommendation, ToolOptions, analyze, sample_surface_set};
+use scallop_analysis::{
+    GridOptions, MachineLimits, Recommendation, ToolOptions, analyze, sample_mesh, sample_surface_set,
+};
 use scallop_cutter::{Cutter, CutterShape};
 use scallop_geom::{Aabb3, Point3, Tolerances};
 use scallop_post::{Dialect, write_gcode};
@@ -16,21 +18,29 @@ use serde::Serialize;
 
 use crate::{EngineError, Part, prepare_part};
 
-/// Settings of the finishing job (mm, seconds; machine limits in the spec's units).
-#[derive(Debug, Clone, PartialEq)]
-pub struct FinishSettings {
-    /// Built-in part name.
-    pub part: String,
-    /// Bull-nose radius R (mm).
-    pub radius: f64,
-    /// Corner radius r (mm).
-    pub corner: f64,
-    /// Flute length (mm).
-    pub flute_length: f64,
+/// A finishing job (mm, seconds; machine limits in the spec's units).
+#[derive(Debug, Clone)]
+pub struct FinishJob {
+    /// The part.
+    pub part: Part,
+    /// How to call it in reports.
+    pub part_name: String,
+    /// The cutter (ball, flat or bull-nose).
+    pub cutter: Cutter,
     /// Scallop height sh (mm).
     pub scallop_height: f64,
+    /// Feed direction from +X (degrees); `None`: from the PCA of the part (the
+    /// steepest slope for bull-nose and flat cutters, the principal direction
+    /// for a ball).
+    pub direction_deg: Option<f64>,
+    /// Zigzag or one-way.
+    pub pattern: Pattern,
     /// Feed V (m/min), acceleration A (m/s²), jerk J (m/s³).
     pub machine: [f64; 3],
+    /// Rapid rate (mm/s).
+    pub rapid_rate: f64,
+    /// Clearance above the part's top (mm).
+    pub clearance: f64,
     /// Path and gouge tolerances (mm).
     pub tolerances: Tolerances,
     /// Longest forward step between drop-cutter samples (mm).
@@ -39,17 +49,30 @@ pub struct FinishSettings {
     pub sim_resolution: f64,
 }
 
-impl FinishSettings {
-    /// The spec's main job on the Choi surface.
+impl FinishJob {
+    /// The spec's main job: the Choi surface, bull-nose R 5 r 2, sh 0.01 mm,
+    /// V 5 m/min, A 6 m/s², J 40 m/s³, along the PCA steepest slope.
+    ///
+    /// # Panics
+    /// Never: the built-in part and cutter are valid (checked by tests).
     #[must_use]
-    pub fn standard() -> FinishSettings {
-        FinishSettings {
-            part: "choi".into(),
-            radius: 5.0,
-            corner: 2.0,
-            flute_length: 30.0,
+    pub fn choi_demo() -> FinishJob {
+        // INVARIANT: the built-in surface exists and the cutter sizes are valid.
+        #[allow(clippy::unwrap_used, clippy::missing_panics_doc)]
+        let (part, cutter) = (
+            Part::builtin("choi").unwrap(),
+            Cutter::new(CutterShape::Bull { radius: 5.0, corner: 2.0 }, 30.0).unwrap(),
+        );
+        FinishJob {
+            part,
+            part_name: "built-in choi surface".into(),
+            cutter,
             scallop_height: 0.01,
+            direction_deg: None,
+            pattern: Pattern::Zigzag,
             machine: [5.0, 6.0, 40.0],
+            rapid_rate: RAPID_RATE,
+            clearance: 5.0,
             tolerances: Tolerances { path: 0.01, gouge: 0.0 },
             max_step: 0.5,
             sim_resolution: 0.1,
@@ -60,13 +83,13 @@ impl FinishSettings {
 /// What the job produced (serialisable as `report.json`).
 #[derive(Debug, Clone, Serialize)]
 pub struct FinishReport {
-    /// Part name.
+    /// Part.
     pub part: String,
     /// Cutter.
     pub cutter: String,
     /// Scallop height asked (mm).
     pub scallop_height_mm: f64,
-    /// Feed direction from +X (degrees): the PCA steepest-slope direction.
+    /// Feed direction from +X (degrees).
     pub direction_deg: f64,
     /// What the tool-choice analysis recommends for this part.
     pub recommendation: Recommendation,
@@ -105,57 +128,69 @@ pub struct FinishOutput {
 /// # Errors
 /// Bad settings, an unknown part, a plan that cannot hold the scallop height,
 /// or a safety problem found by the stock simulation.
-pub fn run_finishing(settings: &FinishSettings) -> Result<FinishOutput, EngineError> {
-    let s = settings;
-    let part = Part::builtin(&s.part)
-        .ok_or_else(|| crate::GridError::Syntax(format!("unknown built-in part '{}' (choi, rubio)", s.part)))?;
-    let Part::Surfaces(set) = &part else {
-        return Err(crate::GridError::Syntax("the finishing demo needs a surface part".into()).into());
+pub fn run_finishing(job: &FinishJob) -> Result<FinishOutput, EngineError> {
+    let prepared = prepare_part(&job.part, &job.tolerances)?;
+    let machine = MachineLimits::from_thesis_units(job.machine[0], job.machine[1], job.machine[2]);
+    let samples = match &job.part {
+        Part::Surfaces(set) => sample_surface_set(set, &GridOptions::default()).map_err(EngineError::Analysis)?,
+        Part::Mesh(mesh) => sample_mesh(mesh),
     };
-    let prepared = prepare_part(&part, &s.tolerances)?;
-    let machine = MachineLimits::from_thesis_units(s.machine[0], s.machine[1], s.machine[2]);
-    let samples = sample_surface_set(set, &GridOptions::default()).map_err(EngineError::Analysis)?;
-    let tools = ToolOptions { ball_radius: s.radius, toroidal_radius: s.radius, corner_radius: s.corner };
-    let analysis = analyze(&samples, &tools, &machine, s.scallop_height).map_err(EngineError::Analysis)?;
-    let direction = analysis.slope_direction_deg.to_radians();
-    let cutter = Cutter::new(CutterShape::Bull { radius: s.radius, corner: s.corner }, s.flute_length)?;
+    let radius = job.cutter.radius();
+    let (corner, is_ball) = match *job.cutter.shape() {
+        CutterShape::Bull { corner, .. } => (corner, false),
+        CutterShape::Ball { .. } => (radius / 2.0, true),
+        _ => (radius / 2.0, false),
+    };
+    let tools = ToolOptions { ball_radius: radius, toroidal_radius: radius, corner_radius: corner };
+    let analysis = analyze(&samples, &tools, &machine, job.scallop_height).map_err(EngineError::Analysis)?;
+    let direction_deg = job.direction_deg.unwrap_or(if is_ball {
+        analysis.principal_direction_deg
+    } else {
+        analysis.slope_direction_deg
+    });
     let params = FinishingParams {
-        direction,
-        pattern: Pattern::Zigzag,
-        scallop_height: s.scallop_height,
+        direction: direction_deg.to_radians(),
+        pattern: job.pattern,
+        scallop_height: job.scallop_height,
         boundary: Boundary::ContactInside,
-        max_step: s.max_step,
-        clearance: 5.0,
+        max_step: job.max_step,
+        clearance: job.clearance,
         machine,
         plunge_feed: machine.feed / 4.0,
-        rapid_rate: RAPID_RATE,
+        rapid_rate: job.rapid_rate,
         sharp_corner: SHARP_CORNER_DEG.to_radians(),
-        blend_tolerance: s.tolerances.path,
+        blend_tolerance: job.tolerances.path,
     };
-    let planned = plan_finishing(&prepared.index, &cutter, &params, &s.tolerances)?;
+    let planned = plan_finishing(&prepared.index, &job.cutter, &params, &job.tolerances)?;
 
     // Prove the program on a simulated stock before anyone runs it: the part's
     // box grown by the cutter radius, from 1 mm below to 1 mm above the part.
     let b = prepared.mesh.bounds();
     let stock = Aabb3 {
-        min: Point3::new(b.min.x - s.radius, b.min.y - s.radius, b.min.z - 1.0),
-        max: Point3::new(b.max.x + s.radius, b.max.y + s.radius, b.max.z + 1.0),
+        min: Point3::new(b.min.x - radius, b.min.y - radius, b.min.z - 1.0),
+        max: Point3::new(b.max.x + radius, b.max.y + radius, b.max.z + 1.0),
     };
     // The program follows the tessellation (within the chordal error of the
     // surface); between samples the planner keeps moves within the path
     // tolerance of the CL surface.
-    let gouge_tolerance = s.tolerances.gouge + prepared.chordal_error + s.tolerances.path;
+    let gouge_tolerance = job.tolerances.gouge + prepared.chordal_error + job.tolerances.path;
     let options = scallop_sim::VerifyOptions { gouge_tolerance, ..scallop_sim::VerifyOptions::default() };
-    let sim = scallop_sim::simulate(stock, s.sim_resolution, &cutter, &planned.toolpath, &prepared.index, &options)?;
+    let sim =
+        scallop_sim::simulate(stock, job.sim_resolution, &job.cutter, &planned.toolpath, &prepared.index, &options)?;
 
-    let cutter_text = format!("bull-nose R{} r{} mm", s.radius, s.corner);
+    let cutter_text = match *job.cutter.shape() {
+        CutterShape::Bull { radius, corner } => format!("bull-nose R{radius} r{corner} mm"),
+        CutterShape::Ball { radius } => format!("ball R{radius} mm"),
+        CutterShape::Flat { radius } => format!("flat R{radius} mm"),
+        CutterShape::Cone { radius, .. } => format!("cone R{radius} mm"),
+    };
     let r = &planned.report;
     let comments = [
-        format!("part: built-in {} surface, tessellated within {:.5} mm", s.part, prepared.chordal_error),
-        format!("tool: {cutter_text}; scallop height {} mm", s.scallop_height),
+        format!("part: {}, tessellated within {:.5} mm", job.part_name, prepared.chordal_error),
+        format!("tool: {cutter_text}; scallop height {} mm", job.scallop_height),
         format!(
             "path tolerance {} mm; gouge tolerance {} mm; feed direction {:.2} deg",
-            s.tolerances.path, s.tolerances.gouge, analysis.slope_direction_deg
+            job.tolerances.path, job.tolerances.gouge, direction_deg
         ),
         format!(
             "predicted machining time {:.1} s (stop-to-stop), {:.1} s (look-ahead), rapids {:.1} s",
@@ -167,16 +202,16 @@ pub fn run_finishing(settings: &FinishSettings) -> Result<FinishOutput, EngineEr
     write_gcode(&planned.toolpath, &Dialect::plain(), &refs, &mut text)
         .map_err(|_| EngineError::BadTolerance(f64::NAN))?;
     let report = FinishReport {
-        part: s.part.clone(),
+        part: job.part_name.clone(),
         cutter: cutter_text,
-        scallop_height_mm: s.scallop_height,
-        direction_deg: analysis.slope_direction_deg,
+        scallop_height_mm: job.scallop_height,
+        direction_deg,
         recommendation: analysis.recommendation,
         slope_deg: analysis.slope_deg,
         critical_slope_deg: analysis.critical_slope_deg,
         chordal_error_mm: prepared.chordal_error,
         plan: planned.report.clone(),
-        sim_resolution_mm: s.sim_resolution,
+        sim_resolution_mm: job.sim_resolution,
         sim_max_material_mm: sim.verification.max_scallop,
         sim_min_deviation_mm: sim.verification.min_deviation,
         sim_gouge_tolerance_mm: gouge_tolerance,
@@ -213,7 +248,7 @@ mod tests {
 
     #[test]
     fn choi_finishing_holds_the_scallop_and_proves_itself() {
-        let out = run_finishing(&FinishSettings::standard()).unwrap();
+        let out = run_finishing(&FinishJob::choi_demo()).unwrap();
         let r = &out.report;
         assert_eq!(r.recommendation, Recommendation::ToroidalAlongSlope);
         assert!(r.plan.max_scallop_mm <= 0.01, "{r:?}");
@@ -221,6 +256,6 @@ mod tests {
         assert!(r.sim_min_deviation_mm >= -r.sim_gouge_tolerance_mm);
         assert!(out.gcode.contains("predicted machining time"));
         let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
-        assert_eq!(one.install(|| run_finishing(&FinishSettings::standard()).unwrap()).gcode, out.gcode);
+        assert_eq!(one.install(|| run_finishing(&FinishJob::choi_demo()).unwrap()).gcode, out.gcode);
     }
 }

@@ -38,6 +38,7 @@ use scallop_geom::Point3;
 pub use scallop_mesh::{MeshDiagnostics, MeshError, TriMesh};
 
 pub mod gcode;
+pub mod job;
 
 pub use error::{MeshReadError, Place};
 

@@ -1,0 +1,92 @@
+//! `scallop run JOB.toml`: a finishing job from a job file (`docs/job.md`).
+
+use std::path::{Path, PathBuf};
+
+use clap::Args;
+use scallop_cutter::{Cutter, CutterShape};
+use scallop_engine::{FinishJob, run_finishing};
+use scallop_geom::Tolerances;
+use scallop_io::job::{DirectionSpec, JobFile, parse_job};
+use scallop_strategy::Pattern;
+
+use crate::output::{progress_bar, write_finishing};
+use crate::part::{UnitsArg, load};
+use crate::{CliResult, Failure};
+
+/// Arguments of `scallop run`.
+#[derive(Args, Debug)]
+pub struct RunArgs {
+    /// The job file (TOML, see docs/job.md).
+    job: PathBuf,
+    /// Output folder for `program.nc`, `report.json` and `toolpath.csv`.
+    #[arg(short, long, default_value = "out/run")]
+    output: PathBuf,
+    /// Print the report as JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+/// `scallop run`.
+pub fn run(args: &RunArgs) -> CliResult<()> {
+    let name = args.job.display().to_string();
+    let bytes = std::fs::read(&args.job).map_err(|e| {
+        let err = anyhow::anyhow!("{name}: cannot read the job file: {e}");
+        if e.kind() == std::io::ErrorKind::NotFound { Failure::Rejected(err) } else { Failure::Io(err) }
+    })?;
+    let text = std::str::from_utf8(&bytes)
+        .map_err(|e| Failure::rejected(format!("{name}: byte {}: the job file is not UTF-8 text", e.valid_up_to())))?;
+    let spec = parse_job(text).map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
+    let job = finish_job(&spec, args.job.parent().unwrap_or(Path::new("."))).map_err(|e| match e {
+        Failure::Rejected(e) => Failure::Rejected(anyhow::anyhow!("{name}: {e:#}")),
+        other => other,
+    })?;
+    let spinner = progress_bar(0, "planning and verifying");
+    spinner.enable_steady_tick(std::time::Duration::from_millis(120));
+    let start = std::time::Instant::now();
+    let out = run_finishing(&job).map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
+    spinner.finish_and_clear();
+    write_finishing(&out, start.elapsed().as_secs_f64(), &args.output, args.json)
+}
+
+fn finish_job(spec: &JobFile, folder: &Path) -> CliResult<FinishJob> {
+    let units = if spec.part.units == "in" { UnitsArg::In } else { UnitsArg::Mm };
+    let (part, part_name) = match (&spec.part.file, &spec.part.builtin) {
+        (Some(file), _) => {
+            let path = folder.join(file);
+            let loaded = load(&path.to_string_lossy(), units)?;
+            (loaded.part, loaded.description)
+        }
+        (None, Some(name)) => {
+            let part = scallop_engine::Part::builtin(name).ok_or_else(|| {
+                Failure::rejected(format!("part.builtin = \"{name}\": no such built-in part (choi, rubio)"))
+            })?;
+            (part, format!("built-in {name} surface"))
+        }
+        (None, None) => return Err(Failure::rejected("part: give `file` or `builtin`")),
+    };
+    let radius = spec.cutter.diameter / 2.0;
+    let shape = match spec.cutter.shape.as_str() {
+        "ball" => CutterShape::Ball { radius },
+        "flat" => CutterShape::Flat { radius },
+        _ => CutterShape::Bull { radius, corner: spec.cutter.corner_radius.unwrap_or(radius) },
+    };
+    let flute = spec.cutter.flute_length.unwrap_or(4.0 * spec.cutter.diameter);
+    let cutter = Cutter::new(shape, flute).map_err(|e| Failure::rejected(format!("cutter: {e}")))?;
+    Ok(FinishJob {
+        part,
+        part_name,
+        cutter,
+        scallop_height: spec.finishing.scallop_height,
+        direction_deg: match spec.finishing.direction {
+            DirectionSpec::Degrees(d) => Some(d),
+            DirectionSpec::Named(_) | DirectionSpec::Auto => None,
+        },
+        pattern: if spec.finishing.pattern == "one-way" { Pattern::OneWay } else { Pattern::Zigzag },
+        machine: [spec.machine.feed, spec.machine.acceleration, spec.machine.jerk],
+        rapid_rate: spec.machine.rapid * 1000.0 / 60.0,
+        clearance: spec.machine.clearance,
+        tolerances: Tolerances { path: spec.tolerances.path, gouge: spec.tolerances.gouge },
+        max_step: spec.finishing.max_step,
+        sim_resolution: spec.verify.resolution,
+    })
+}

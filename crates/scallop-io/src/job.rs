@@ -1,0 +1,349 @@
+//! The job file (`scallop run JOB.toml`): what to machine, with what, how
+//! finely. The schema is documented in `docs/job.md`; unknown keys are errors,
+//! so a misspelt key is never silently ignored.
+//!
+//! ```
+//! use scallop_io::job::parse_job;
+//! let job = parse_job(r#"
+//! [part]
+//! builtin = "choi"
+//! [cutter]
+//! shape = "bull"
+//! diameter = 10
+//! corner_radius = 2
+//! [finishing]
+//! scallop_height = 0.01
+//! "#).unwrap();
+//! assert_eq!(job.cutter.diameter, 10.0);
+//! assert!(parse_job("[part]\nbuiltin = \"choi\"\ncolour = 3\n").unwrap_err().to_string().contains("colour"));
+//! ```
+
+use serde::Deserialize;
+
+/// A job file.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JobFile {
+    /// The part.
+    pub part: PartSpec,
+    /// The cutter.
+    pub cutter: CutterSpec,
+    /// The finishing operation.
+    pub finishing: FinishingSpec,
+    /// Tolerances (mm).
+    #[serde(default)]
+    pub tolerances: TolerancesSpec,
+    /// Machine limits.
+    #[serde(default)]
+    pub machine: MachineSpec,
+    /// Stock simulation that proves the program.
+    #[serde(default)]
+    pub verify: VerifySpec,
+}
+
+/// `[part]`: one of `file` (mesh or surface file, relative to the job file) or `builtin`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PartSpec {
+    /// Mesh (.stl .obj .ply .3mf) or surface (.toml) file.
+    pub file: Option<String>,
+    /// Built-in surface name (`choi`, `rubio`).
+    pub builtin: Option<String>,
+    /// Unit of mesh coordinates: `mm` (default) or `in`.
+    #[serde(default = "default_units")]
+    pub units: String,
+}
+
+fn default_units() -> String {
+    "mm".into()
+}
+
+/// `[cutter]`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CutterSpec {
+    /// `ball`, `flat` or `bull`.
+    pub shape: String,
+    /// Diameter D (mm).
+    pub diameter: f64,
+    /// Corner radius r of a bull-nose (mm).
+    pub corner_radius: Option<f64>,
+    /// Flute length (mm); default 4 D.
+    pub flute_length: Option<f64>,
+}
+
+/// `[finishing]`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FinishingSpec {
+    /// Largest scallop height sh (mm).
+    pub scallop_height: f64,
+    /// Feed direction: `"auto"` (the PCA steepest slope for a bull-nose or flat
+    /// cutter, the principal direction for a ball) or an angle from +X in degrees.
+    #[serde(default)]
+    pub direction: DirectionSpec,
+    /// `zigzag` (default) or `one-way`.
+    #[serde(default = "default_pattern")]
+    pub pattern: String,
+    /// Longest forward step between drop-cutter samples (mm).
+    #[serde(default = "default_max_step")]
+    pub max_step: f64,
+}
+
+fn default_pattern() -> String {
+    "zigzag".into()
+}
+
+fn default_max_step() -> f64 {
+    0.5
+}
+
+/// A feed direction.
+#[derive(Debug, Clone, PartialEq, Deserialize, Default)]
+#[serde(untagged)]
+pub enum DirectionSpec {
+    /// `"auto"`.
+    Named(String),
+    /// Degrees from +X.
+    Degrees(f64),
+    /// Not given: auto.
+    #[default]
+    #[serde(skip)]
+    Auto,
+}
+
+/// `[tolerances]` (mm).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TolerancesSpec {
+    /// Largest deviation of the motion from the ideal CL surface.
+    #[serde(default = "default_path")]
+    pub path: f64,
+    /// Largest allowed penetration into the part.
+    #[serde(default)]
+    pub gouge: f64,
+}
+
+fn default_path() -> f64 {
+    0.01
+}
+
+impl Default for TolerancesSpec {
+    fn default() -> Self {
+        TolerancesSpec { path: default_path(), gouge: 0.0 }
+    }
+}
+
+/// `[machine]`: the spec's units (m/min, m/s², m/s³) and mm.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MachineSpec {
+    /// Feed V (m/min).
+    #[serde(default = "default_feed")]
+    pub feed: f64,
+    /// Acceleration A (m/s²).
+    #[serde(default = "default_acceleration")]
+    pub acceleration: f64,
+    /// Jerk J (m/s³).
+    #[serde(default = "default_jerk")]
+    pub jerk: f64,
+    /// Rapid rate (m/min).
+    #[serde(default = "default_rapid")]
+    pub rapid: f64,
+    /// Clearance above the part's top (mm).
+    #[serde(default = "default_clearance")]
+    pub clearance: f64,
+}
+
+fn default_feed() -> f64 {
+    5.0
+}
+fn default_acceleration() -> f64 {
+    6.0
+}
+fn default_jerk() -> f64 {
+    40.0
+}
+fn default_rapid() -> f64 {
+    30.0
+}
+fn default_clearance() -> f64 {
+    5.0
+}
+
+impl Default for MachineSpec {
+    fn default() -> Self {
+        MachineSpec {
+            feed: default_feed(),
+            acceleration: default_acceleration(),
+            jerk: default_jerk(),
+            rapid: default_rapid(),
+            clearance: default_clearance(),
+        }
+    }
+}
+
+/// `[verify]`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct VerifySpec {
+    /// Stock cell size (mm).
+    #[serde(default = "default_resolution")]
+    pub resolution: f64,
+}
+
+fn default_resolution() -> f64 {
+    0.1
+}
+
+impl Default for VerifySpec {
+    fn default() -> Self {
+        VerifySpec { resolution: default_resolution() }
+    }
+}
+
+/// Why a job file is unusable: the TOML parser's message with line and column,
+/// or the key and the fix.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum JobError {
+    /// Syntax, unknown key, missing key or wrong type (line and column included).
+    #[error("{0}")]
+    Toml(String),
+    /// A value that makes no sense.
+    #[error("`{key}` = {value}: {fix}")]
+    Value {
+        /// The key, e.g. `cutter.diameter`.
+        key: &'static str,
+        /// The value given.
+        value: String,
+        /// What to do.
+        fix: &'static str,
+    },
+}
+
+/// Parses and checks a job file.
+///
+/// # Errors
+/// [`JobError`] naming the line or the key.
+pub fn parse_job(text: &str) -> Result<JobFile, JobError> {
+    let job: JobFile = toml::from_str(text).map_err(|e| JobError::Toml(e.to_string().trim_end().to_string()))?;
+    let bad = |key, value: f64, fix| Err(JobError::Value { key, value: value.to_string(), fix });
+    match (&job.part.file, &job.part.builtin) {
+        (Some(_), Some(_)) | (None, None) => {
+            return Err(JobError::Value {
+                key: "part",
+                value: "file and builtin".into(),
+                fix: "give exactly one of `file` and `builtin`",
+            });
+        }
+        _ => {}
+    }
+    if !matches!(job.part.units.as_str(), "mm" | "in") {
+        return Err(JobError::Value { key: "part.units", value: job.part.units.clone(), fix: "use \"mm\" or \"in\"" });
+    }
+    if !matches!(job.cutter.shape.as_str(), "ball" | "flat" | "bull") {
+        return Err(JobError::Value {
+            key: "cutter.shape",
+            value: job.cutter.shape.clone(),
+            fix: "use \"ball\", \"flat\" or \"bull\" (finishing)",
+        });
+    }
+    let positive = |v: f64| v.is_finite() && v > 0.0;
+    if !positive(job.cutter.diameter) {
+        return bad("cutter.diameter", job.cutter.diameter, "give the diameter in mm, > 0");
+    }
+    if job.cutter.shape == "bull" {
+        match job.cutter.corner_radius {
+            Some(r) if positive(r) && r <= job.cutter.diameter / 2.0 => {}
+            Some(r) => return bad("cutter.corner_radius", r, "need 0 < r <= diameter / 2"),
+            None => {
+                return Err(JobError::Value {
+                    key: "cutter.corner_radius",
+                    value: "missing".into(),
+                    fix: "a bull-nose cutter needs its corner radius",
+                });
+            }
+        }
+    }
+    let sh = job.finishing.scallop_height;
+    if !positive(sh) || sh >= job.cutter.diameter / 2.0 {
+        return bad("finishing.scallop_height", sh, "need 0 < sh < the cutter radius");
+    }
+    match &job.finishing.direction {
+        DirectionSpec::Named(n) if n != "auto" => {
+            return Err(JobError::Value {
+                key: "finishing.direction",
+                value: n.clone(),
+                fix: "use \"auto\" or an angle in degrees",
+            });
+        }
+        DirectionSpec::Degrees(d) if !d.is_finite() => return bad("finishing.direction", *d, "give a finite angle"),
+        _ => {}
+    }
+    if !matches!(job.finishing.pattern.as_str(), "zigzag" | "one-way") {
+        return Err(JobError::Value {
+            key: "finishing.pattern",
+            value: job.finishing.pattern.clone(),
+            fix: "use \"zigzag\" or \"one-way\"",
+        });
+    }
+    for (key, v) in [
+        ("finishing.max_step", job.finishing.max_step),
+        ("tolerances.path", job.tolerances.path),
+        ("machine.feed", job.machine.feed),
+        ("machine.acceleration", job.machine.acceleration),
+        ("machine.jerk", job.machine.jerk),
+        ("machine.rapid", job.machine.rapid),
+        ("machine.clearance", job.machine.clearance),
+        ("verify.resolution", job.verify.resolution),
+    ] {
+        if !positive(v) {
+            return bad(key, v, "must be a finite number > 0");
+        }
+    }
+    if !(job.tolerances.gouge.is_finite() && job.tolerances.gouge >= 0.0) {
+        return bad("tolerances.gouge", job.tolerances.gouge, "must be >= 0");
+    }
+    Ok(job)
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used, reason = "tests: a panic is the failure report")]
+mod tests {
+    use super::*;
+
+    const BASE: &str = "[part]\nbuiltin = \"choi\"\n[cutter]\nshape = \"bull\"\ndiameter = 10\ncorner_radius = 2\n[finishing]\nscallop_height = 0.01\n";
+
+    #[test]
+    fn defaults_and_example_files_parse() {
+        let job = parse_job(BASE).unwrap();
+        assert_eq!(job.finishing.direction, DirectionSpec::Auto);
+        assert_eq!(job.machine.feed, 5.0);
+        for example in
+            [include_str!("../../../examples/jobs/choi.toml"), include_str!("../../../examples/jobs/rubio.toml")]
+        {
+            parse_job(example).unwrap();
+        }
+    }
+
+    #[test]
+    fn bad_jobs_name_the_key() {
+        let cases = [
+            (BASE.replace("diameter = 10", "diameter = -10"), "cutter.diameter"),
+            (BASE.replace("scallop_height = 0.01", "scallop_height = 7"), "finishing.scallop_height"),
+            (BASE.replace("corner_radius = 2", "corner_radius = 9"), "cutter.corner_radius"),
+            (BASE.replace("corner_radius = 2\n", ""), "cutter.corner_radius"),
+            (BASE.replace("\"bull\"", "\"lollipop\""), "cutter.shape"),
+            (format!("{BASE}[machine]\njerk = 0\n"), "machine.jerk"),
+            (format!("{BASE}[machine]\njerks = 40\n"), "jerks"),
+            (format!("{BASE}direction = \"north\"\n"), "finishing.direction"),
+            (BASE.replace("builtin = \"choi\"", "builtin = \"choi\"\nfile = \"a.stl\""), "part"),
+            (BASE.replace("scallop_height = 0.01", "scallop_height = \"fine\""), "scallop_height"),
+        ];
+        for (text, key) in cases {
+            let err = parse_job(&text).unwrap_err().to_string();
+            assert!(err.contains(key), "{key}: {err}");
+        }
+    }
+}
