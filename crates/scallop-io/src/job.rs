@@ -309,7 +309,7 @@ pub fn parse_job(text: &str) -> Result<JobFile, JobError> {
 }
 
 #[cfg(test)]
-#[allow(clippy::unwrap_used, reason = "tests: a panic is the failure report")]
+#[allow(clippy::unwrap_used, clippy::float_cmp, reason = "tests: a panic is the failure report; defaults are exact")]
 mod tests {
     use super::*;
 
