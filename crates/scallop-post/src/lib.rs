@@ -1,5 +1,15 @@
-//! G-code output. A [`Dialect`] is data (decimals, header and footer lines);
-//! [`write_gcode`] turns a 3-axis [`Toolpath`] into text through `io::Write`.
+//! G-code output. A [`Dialect`] is data (decimals, axis words, feed conventions, header
+//! and footer templates, line numbering, modal suppression, TCP and tilted-plane codes),
+//! loadable from TOML, with built-ins for LinuxCNC, Fanuc, Siemens 840D, Heidenhain
+//! (plain language and ISO) and grbl. Two writers:
+//! - [`write_gcode`]: a 3-axis [`Toolpath`] (the demo path);
+//! - [`write_program`]: a joint-space [`MachineProgram`](scallop_machine::program::MachineProgram)
+//!   in joint space with inverse-time feeds, in TCP form, or in tilted work planes
+//!   ([`OutputMode`]).
+//!
+//! [`replay`] reads our own output back into joint motion through the machine's forward
+//! kinematics and [`check_replay`] checks it against the input CL path (spec K16).
+//! Specification: `kinematics.md` 3.9-3.13; user documentation: `docs/post.md`.
 //!
 //! ```
 //! use scallop_geom::Point3;
@@ -15,42 +25,27 @@
 //! ```
 //!
 //! # Invariants
+//! - Never performs file I/O and never prints: text goes through `io::Write`.
 //! - Output is deterministic: fixed decimals, `-0` written as `0`, modal words
 //!   suppressed only by rule.
-//! - Units in: mm and mm/min; the only place where numbers become text.
+//! - Units in: mm, rad and mm/min; out: mm, deg, mm/min (1/min for G93, s for `FT`).
+//!   G93 words are rounded down and `FT` times up, so no axis exceeds its velocity.
+//! - Every numeric threshold lives in [`tol`].
 
 use std::io::{self, Write};
 
 use scallop_toolpath::{MoveKind, Toolpath};
 
-/// A controller dialect as data.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Dialect {
-    /// Name, printed in the header.
-    pub name: String,
-    /// Decimals of coordinates.
-    pub decimals: usize,
-    /// Lines before the first move.
-    pub header: Vec<String>,
-    /// Lines after the last move.
-    pub footer: Vec<String>,
-    /// Comment delimiters.
-    pub comment: (String, String),
-}
+pub mod dialect;
+pub mod error;
+pub mod reader;
+pub mod tol;
+pub mod writer;
 
-impl Dialect {
-    /// Plain RS-274 (LinuxCNC / Fanuc-compatible subset) in millimetres.
-    #[must_use]
-    pub fn plain() -> Dialect {
-        Dialect {
-            name: "plain RS-274, mm".into(),
-            decimals: 3,
-            header: vec!["G21 G90 G17 G94".into(), "G40 G49 G80".into()],
-            footer: vec!["M5".into(), "M30".into()],
-            comment: ("(".into(), ")".into()),
-        }
-    }
-}
+pub use dialect::{Dialect, FeedByTime, LineNumbers, ModuloWords, Syntax, TcpCodes, TiltedPlane};
+pub use error::PostError;
+pub use reader::{ReplayedBlock, RoundTrip, check_replay, replay};
+pub use writer::{OutputMode, PostParams, cycle800_angles, program_text, write_program};
 
 /// Formats `v` with `decimals` digits, writing negative zero as zero.
 ///

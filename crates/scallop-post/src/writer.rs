@@ -1,0 +1,616 @@
+//! Writers from a joint-space [`MachineProgram`] (spec 3.9, 3.11-3.13): simultaneous
+//! 5-axis joint-space output with inverse-time feeds, TCP output (tip and rotary
+//! positions, the controller does the kinematics) and 3+2 output through tilted work
+//! planes.
+
+use std::fmt::Write as _;
+use std::io::Write;
+
+use scallop_geom::nalgebra::Rotation3;
+use scallop_geom::{Point3, Vec3};
+use scallop_machine::program::{MachineProgram, Motion, ProgramBlock};
+use scallop_machine::{AxisKind, Kinematics, ToolLengthMode, Wrap};
+
+use crate::dialect::{Dialect, FeedByTime, Syntax, TiltedPlane};
+use crate::error::PostError;
+use crate::{fmt_number, tol};
+
+/// Output mode (spec 3.11, 3.13).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum OutputMode {
+    /// Joint-space words (the machine's NC words), inverse-time feeds where the dialect has them.
+    Joint,
+    /// TCP, rotary form: X/Y/Z are the tool tip in the part frame, A/B/C the rotary words;
+    /// the controller computes the linear joints. Tip feed in G94.
+    Tcp,
+    /// 3+2: every run of blocks with one tool axis is written in a tilted work plane
+    /// (`z_f` = tool axis, [`scallop_machine::frame::tilted_plane`], origin at the part
+    /// origin) with X/Y/Z in that plane; the axis may change only on a rapid (the plane is
+    /// switched before it). Dialects without tilted-plane codes get joint-space output with
+    /// the rotaries held (spec 3.13 (a)).
+    TiltedPlane,
+}
+
+impl OutputMode {
+    /// Name printed in the header.
+    ///
+    /// ```
+    /// assert_eq!(scallop_post::OutputMode::Tcp.name(), "tcp");
+    /// ```
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            OutputMode::Joint => "joint",
+            OutputMode::Tcp => "tcp",
+            OutputMode::TiltedPlane => "tilted_plane",
+        }
+    }
+}
+
+/// The job decisions a program is written with (no `Default`: they are user decisions).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PostParams {
+    /// Program name or number (`O{program}`, `BEGIN PGM {program} MM`).
+    pub program: String,
+    /// Output mode.
+    pub mode: OutputMode,
+    /// Tool number.
+    pub tool: u32,
+    /// Tool length used by the kinematics (mm; 0 when the controller applies it).
+    pub tool_length: f64,
+    /// Spindle speed (1/min).
+    pub spindle: f64,
+    /// Path tolerance of joint-space interpolation (mm), printed in the header.
+    pub tol_pos: f64,
+    /// Tool-axis tolerance (rad), printed in the header; also the tolerance that groups
+    /// blocks of one tool axis in [`OutputMode::TiltedPlane`].
+    pub tol_ang: f64,
+    /// Predicted machining time (s), printed in the header.
+    pub predicted_time: Option<f64>,
+}
+
+/// Rounds `v` down to `decimals` (an exactly representable value is kept).
+pub(crate) fn round_down(v: f64, decimals: usize) -> f64 {
+    let s = 10f64.powi(i32::try_from(decimals).unwrap_or(9));
+    let r = (v * s).round();
+    if ((v * s) - r).abs() <= tol::ROUNDING_SLACK * r.abs().max(1.0) { r / s } else { (v * s).floor() / s }
+}
+
+/// Rounds `v` up to `decimals` (an exactly representable value is kept).
+pub(crate) fn round_up(v: f64, decimals: usize) -> f64 {
+    -round_down(-v, decimals)
+}
+
+/// Writes `program` in `dialect` and `params.mode` through `out`.
+///
+/// ```
+/// use scallop_geom::{Point3, Vec3};
+/// use scallop_machine::{Kinematics, Machine, Pose};
+/// use scallop_machine::program::{to_program, ClRecord, Motion, ProgramOptions};
+/// use scallop_post::{Dialect, OutputMode, PostParams, write_program};
+/// let k = Kinematics::new(&Machine::builtin("linuxcnc-xyzac-trt").unwrap(), 0.0);
+/// let rec = |x: f64, m| ClRecord { pose: Pose::new(Point3::new(x, 0.0, 20.0), Vec3::new(0.0, -0.3, 1.0)), motion: m, feed: 1000.0 };
+/// let prog = to_program(&k, &[rec(0.0, Motion::Rapid), rec(10.0, Motion::Feed)], None, &ProgramOptions::default()).unwrap();
+/// let params = PostParams { program: "1".into(), mode: OutputMode::Joint, tool: 1, tool_length: 0.0, spindle: 10000.0,
+///                           tol_pos: 0.005, tol_ang: 0.001, predicted_time: None };
+/// let mut out = Vec::new();
+/// write_program(&prog, &k, &Dialect::builtin("linuxcnc").unwrap(), &params, &mut out).unwrap();
+/// assert!(String::from_utf8(out).unwrap().contains("G93 G1"));
+/// ```
+///
+/// # Errors
+/// [`PostError::Unsupported`] when the dialect or the machine cannot express the mode
+/// (no TCP, more axes than the controller drives); [`PostError::Io`] from `out`.
+pub fn write_program(
+    program: &MachineProgram,
+    kin: &Kinematics,
+    dialect: &Dialect,
+    params: &PostParams,
+    out: &mut impl Write,
+) -> Result<(), PostError> {
+    let text = program_text(program, kin, dialect, params)?;
+    out.write_all(text.as_bytes())?;
+    Ok(())
+}
+
+/// [`write_program`] into a `String`.
+///
+/// # Errors
+/// As [`write_program`].
+pub fn program_text(
+    program: &MachineProgram,
+    kin: &Kinematics,
+    dialect: &Dialect,
+    params: &PostParams,
+) -> Result<String, PostError> {
+    let machine = kin.machine();
+    let unsupported =
+        |what: String, fix: &str| PostError::Unsupported { dialect: dialect.name.clone(), what, fix: fix.to_string() };
+    let rotary: Vec<usize> =
+        (0..machine.axes().len()).filter(|&i| machine.axes()[i].kind == AxisKind::Rotary).collect();
+    if machine.axes().len() > dialect.max_axes {
+        let half = 0.5 * 10f64.powi(-i32::try_from(dialect.rotary_decimals).unwrap_or(4));
+        if let Some(b) = program.blocks.iter().find(|b| rotary.iter().any(|&i| b.words[i].abs() >= half)) {
+            return Err(unsupported(
+                format!("a rotary move (block of CL {}) on a {}-axis controller", b.cl_index, dialect.max_axes),
+                "use a 5-axis dialect, or a 3-axis toolpath with the tool along the machine Z",
+            ));
+        }
+    }
+    let mode = params.mode;
+    let tcp = if mode == OutputMode::Tcp {
+        let codes = dialect.tcp.as_ref().ok_or_else(|| unsupported("TCP output".into(), "use joint output"))?;
+        if !machine.tcp().supported {
+            return Err(unsupported(
+                format!("TCP on machine `{}` (its [tcp] says unsupported)", machine.name()),
+                "use joint output",
+            ));
+        }
+        Some(codes)
+    } else {
+        None
+    };
+    let planes = mode == OutputMode::TiltedPlane && dialect.tilted_plane != TiltedPlane::None;
+    let mode_name = match mode {
+        OutputMode::TiltedPlane if !planes => "tilted_plane (joint space, rotaries held)",
+        m => m.name(),
+    };
+    let tool_length = if mode == OutputMode::Tcp || machine.tool_length_mode() == ToolLengthMode::Controller {
+        format!("length applied by the controller, kinematics length {} mm", fmt_number(params.tool_length, 4))
+    } else {
+        format!("baked length {} mm: this program runs only with this tool length", fmt_number(params.tool_length, 4))
+    };
+    let vars = Vars {
+        pairs: vec![
+            ("program", params.program.clone()),
+            ("dialect", dialect.name.clone()),
+            ("machine", machine.name().to_string()),
+            ("mode", mode_name.to_string()),
+            ("tool", params.tool.to_string()),
+            ("tool_length", tool_length),
+            ("tol_pos", fmt_number(params.tol_pos, 4)),
+            ("tol_ang", fmt_number(params.tol_ang.to_degrees(), 4)),
+            ("time", params.predicted_time.map_or_else(|| "not computed".to_string(), |t| format!("{t:.1} s"))),
+            ("spindle", fmt_number(params.spindle, 0)),
+            ("version", env!("CARGO_PKG_VERSION").to_string()),
+            ("machine_tcp_on", machine.tcp().on.clone().unwrap_or_default()),
+            ("machine_tcp_off", machine.tcp().off.clone().unwrap_or_default()),
+        ],
+    };
+    let mut e = Emitter::new(dialect);
+    for c in &dialect.header_comments {
+        e.comment(&vars.render(c));
+    }
+    for h in &dialect.header {
+        e.line(&vars.render(h));
+    }
+    for t in &dialect.tool_change {
+        e.line(&vars.render(t));
+    }
+    if let Some(codes) = tcp {
+        for l in &codes.on {
+            let text = vars.render(l);
+            if text.trim().is_empty() {
+                return Err(unsupported(
+                    format!("TCP on machine `{}` without `tcp.on`/`tcp.off` codes", machine.name()),
+                    "declare the configuration's TCP codes in the machine description's [tcp]",
+                ));
+            }
+            e.line(&text);
+        }
+    } else if machine.tool_length_mode() == ToolLengthMode::Controller {
+        for l in &dialect.length_offset {
+            e.line(&vars.render(l));
+        }
+    }
+    let letters: Vec<String> = machine.axes().iter().map(|a| dialect.axis_word(&a.name).to_string()).collect();
+    let write_axis: Vec<bool> =
+        machine.axes().iter().map(|a| a.kind == AxisKind::Linear || machine.axes().len() <= dialect.max_axes).collect();
+    let linear_component = |i: usize| -> Result<usize, PostError> {
+        match machine.axes()[i].name.as_str() {
+            "X" => Ok(0),
+            "Y" => Ok(1),
+            "Z" => Ok(2),
+            other => Err(PostError::Unsupported {
+                dialect: dialect.name.clone(),
+                what: format!("TCP or tilted-plane output with a linear axis named `{other}`"),
+                fix: "name the linear axes X, Y, Z, or use joint output".into(),
+            }),
+        }
+    };
+    let mut previous: Option<&ProgramBlock> = None;
+    let mut plane: Option<(Vec3, Rotation3<f64>)> = None;
+    for b in &program.blocks {
+        if planes {
+            let needs_new = plane.as_ref().is_none_or(|(axis, _)| angle(axis, &b.pose.axis) > params.tol_ang);
+            if needs_new {
+                if previous.is_some() && b.motion != Motion::Rapid {
+                    return Err(unsupported(
+                        format!("a tool-axis change on a cutting move (CL {}) in tilted-plane output", b.cl_index),
+                        "reorient on rapids only (3+2 work), or use joint or TCP output for simultaneous 5-axis moves",
+                    ));
+                }
+                if plane.is_some() {
+                    e.plane_off();
+                }
+                let r = scallop_machine::frame::tilted_plane(&b.pose.axis);
+                let dir = if b.words[kin.tilt_axis()] >= 0.0 { 1 } else { -1 };
+                e.plane_on(&r, dir);
+                plane = Some((b.pose.axis, r));
+            }
+            let r = &plane.as_ref().map_or_else(Rotation3::identity, |p| p.1);
+            let local = r.inverse() * b.pose.tip;
+            let mut words = Vec::new();
+            for i in 0..machine.axes().len() {
+                if machine.axes()[i].kind == AxisKind::Linear {
+                    words.push((letters[i].clone(), e.num(local[linear_component(i)?], dialect.decimals)));
+                }
+            }
+            let feed = if b.motion == Motion::Rapid { FeedWord::Rapid } else { FeedWord::PerMinute(b.feed) };
+            e.motion(&words, feed);
+            previous = Some(b);
+            continue;
+        }
+        let pieces = previous.map_or(1, |p| pieces(machine, p, b));
+        for piece in 1..=pieces {
+            let s = f64::from(piece) / f64::from(pieces);
+            let (words_a, tip_a) = previous.map_or((b.words, b.pose.tip), |p| (p.words, p.pose.tip));
+            let word_at = |i: usize| words_a[i] + (b.words[i] - words_a[i]) * s;
+            let tip: Point3 = tip_a + (b.pose.tip - tip_a) * s;
+            let mut words = Vec::new();
+            for i in 0..machine.axes().len() {
+                if !write_axis[i] {
+                    continue;
+                }
+                let axis = &machine.axes()[i];
+                let w = word_at(i);
+                let token = match axis.kind {
+                    AxisKind::Linear if mode == OutputMode::Tcp => {
+                        format!("{}{}", letters[i], e.num(tip[linear_component(i)?], dialect.decimals))
+                    }
+                    AxisKind::Linear => format!("{}{}", letters[i], e.num(w, dialect.decimals)),
+                    AxisKind::Rotary => {
+                        let before = word_at_prev(&words_a, &b.words, i, piece, pieces);
+                        e.rotary(&letters[i], w, w - before, axis.wrap)
+                    }
+                };
+                words.push((letters[i].clone(), token));
+            }
+            let feed = match (b.motion, previous) {
+                (Motion::Rapid, _) => FeedWord::Rapid,
+                (_, None) => FeedWord::PerMinute(b.feed),
+                (_, Some(_)) if mode == OutputMode::Tcp => FeedWord::PerMinute(b.feed),
+                (_, Some(p)) => {
+                    let f_inv = b.inverse_time.unwrap_or_else(|| {
+                        scallop_machine::feed::inverse_time_feed(kin, &p.pose, &b.pose, &p.joints, &b.joints, b.feed)
+                    }) * f64::from(pieces);
+                    let f_inv = rounding_cap(machine, dialect, &p.words, &b.words, pieces, f_inv);
+                    match dialect.feed_by_time {
+                        FeedByTime::G93 => FeedWord::InverseTime(f_inv),
+                        FeedByTime::BlockSeconds => FeedWord::Seconds(60.0 / f_inv),
+                        FeedByTime::None => {
+                            let delta: Vec<f64> =
+                                (0..5).map(|i| (b.words[i] - p.words[i]) / f64::from(pieces)).collect();
+                            FeedWord::PerMinute(controller_length(machine, &delta) * f_inv)
+                        }
+                    }
+                }
+            };
+            e.motion_tokens(&words, feed);
+        }
+        previous = Some(b);
+    }
+    if plane.is_some() {
+        e.plane_off();
+    }
+    if let Some(codes) = tcp {
+        for l in &codes.off {
+            e.line(&vars.render(l));
+        }
+    }
+    for f in &dialect.footer {
+        e.line(&vars.render(f));
+    }
+    Ok(e.text)
+}
+
+/// Caps an inverse-time word so that no axis exceeds its velocity even when its rounded
+/// words move it by one rounding unit more than the exact delta.
+fn rounding_cap(
+    machine: &scallop_machine::Machine,
+    dialect: &Dialect,
+    a: &[f64; 5],
+    b: &[f64; 5],
+    pieces: u32,
+    f_inv: f64,
+) -> f64 {
+    let mut cap = f_inv;
+    for (i, axis) in machine.axes().iter().enumerate() {
+        let delta = (b[i] - a[i]).abs() / f64::from(pieces);
+        if delta == 0.0 {
+            continue;
+        }
+        let (decimals, vmax) = match axis.kind {
+            AxisKind::Linear => (dialect.decimals, axis.dynamics.vmax),
+            AxisKind::Rotary => (dialect.rotary_decimals, axis.dynamics.vmax.to_degrees()),
+        };
+        let unit = 10f64.powi(-i32::try_from(decimals).unwrap_or(4));
+        cap = cap.min(60.0 * vmax / (delta + unit));
+    }
+    cap
+}
+
+fn word_at_prev(a: &[f64; 5], b: &[f64; 5], i: usize, piece: u32, pieces: u32) -> f64 {
+    a[i] + (b[i] - a[i]) * f64::from(piece - 1) / f64::from(pieces)
+}
+
+/// Angle between two unit vectors (rad).
+pub(crate) fn angle(a: &Vec3, b: &Vec3) -> f64 {
+    a.cross(b).norm().atan2(a.dot(b))
+}
+
+/// Number of equal pieces so that no modulo-360 rotary turns 180 deg or more in one
+/// block (spec 3.7: the control takes the shortest path).
+fn pieces(machine: &scallop_machine::Machine, a: &ProgramBlock, b: &ProgramBlock) -> u32 {
+    let mut n = 1.0f64;
+    for (i, axis) in machine.axes().iter().enumerate() {
+        if axis.kind == AxisKind::Rotary && axis.wrap != Wrap::Absolute {
+            n = n.max(((b.words[i] - a.words[i]).abs() / tol::MODULO_HALF_TURN).floor() + 1.0);
+        }
+    }
+    // INVARIANT: n is a small positive integer (a block turns a few revolutions at most).
+    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "small positive integer")]
+    let n = n as u32;
+    n
+}
+
+/// The controller's length of a block from its word deltas (spec 3.9, `nc.g94_feed_norm`).
+fn controller_length(machine: &scallop_machine::Machine, delta: &[f64]) -> f64 {
+    let (mut lin, mut rot) = (0.0, 0.0);
+    for (axis, d) in machine.axes().iter().zip(delta) {
+        match axis.kind {
+            AxisKind::Linear => lin += d * d,
+            AxisKind::Rotary => rot += d * d,
+        }
+    }
+    match machine.nc().g94_feed_norm {
+        scallop_machine::FeedNorm::XyzThenAbc if lin > 0.0 => lin.sqrt(),
+        scallop_machine::FeedNorm::XyzThenAbc => rot.sqrt(),
+        _ => (lin + rot).sqrt(),
+    }
+}
+
+struct Vars {
+    pairs: Vec<(&'static str, String)>,
+}
+
+impl Vars {
+    fn render(&self, template: &str) -> String {
+        let mut s = template.to_string();
+        for (k, v) in &self.pairs {
+            s = s.replace(&format!("{{{k}}}"), v);
+        }
+        s
+    }
+}
+
+#[derive(Clone, Copy)]
+enum FeedWord {
+    Rapid,
+    PerMinute(f64),
+    InverseTime(f64),
+    Seconds(f64),
+}
+
+/// Line writer with numbering and modal state.
+struct Emitter<'a> {
+    d: &'a Dialect,
+    text: String,
+    number: u64,
+    last_words: std::collections::BTreeMap<String, String>,
+    last_motion: Option<&'static str>,
+    last_feed: Option<String>,
+    g93: bool,
+}
+
+impl<'a> Emitter<'a> {
+    fn new(d: &'a Dialect) -> Emitter<'a> {
+        Emitter {
+            d,
+            text: String::new(),
+            number: d.line_numbers.as_ref().map_or(0, |n| n.start),
+            last_words: std::collections::BTreeMap::new(),
+            last_motion: None,
+            last_feed: None,
+            g93: false,
+        }
+    }
+
+    fn line(&mut self, s: &str) {
+        if let Some(n) = &self.d.line_numbers
+            && s != "%"
+        {
+            let _ = write!(self.text, "{}{} ", n.prefix, self.number);
+            self.number += n.step;
+        }
+        self.text.push_str(s);
+        self.text.push('\n');
+    }
+
+    fn comment(&mut self, s: &str) {
+        let (open, close) = (&self.d.comment.0, &self.d.comment.1);
+        let clean: String = if close.is_empty() {
+            s.chars().map(|c| if c == '\n' { ' ' } else { c }).collect()
+        } else {
+            s.chars().map(|c| if c == '(' || c == ')' || c == '\n' { '_' } else { c }).collect()
+        };
+        let line = format!("{open}{clean}{close}");
+        self.line(&line);
+    }
+
+    fn num(&self, v: f64, decimals: usize) -> String {
+        let s = fmt_number(v, decimals);
+        if self.d.explicit_plus && !s.starts_with('-') { format!("+{s}") } else { s }
+    }
+
+    /// A rotary word: absolute, or modulo 360 with the dialect's templates.
+    fn rotary(&self, letter: &str, word: f64, delta: f64, wrap: Wrap) -> String {
+        let dec = self.d.rotary_decimals;
+        let token = |value: String, template: Option<&String>| match template {
+            Some(t) => t.replace("{axis}", letter).replace("{value}", &value),
+            None => format!("{letter}{value}"),
+        };
+        match wrap {
+            Wrap::Absolute => format!("{letter}{}", self.num(word, dec)),
+            _ => {
+                let mut m = word.rem_euclid(360.0);
+                if fmt_number(m, dec) == fmt_number(360.0, dec) {
+                    m = 0.0;
+                }
+                let value = self.num(m, dec);
+                let t = self.d.modulo_words.as_ref().map(|w| match wrap {
+                    Wrap::Modulo360Signed if delta >= 0.0 => &w.positive,
+                    Wrap::Modulo360Signed => &w.negative,
+                    _ => &w.shortest,
+                });
+                token(value, t)
+            }
+        }
+    }
+
+    /// A motion block from `(letter, number)` pairs.
+    fn motion(&mut self, words: &[(String, String)], feed: FeedWord) {
+        let tokens: Vec<(String, String)> = words.iter().map(|(l, v)| (l.clone(), format!("{l}{v}"))).collect();
+        self.motion_tokens(&tokens, feed);
+    }
+
+    /// A motion block from `(letter, full token)` pairs.
+    fn motion_tokens(&mut self, words: &[(String, String)], feed: FeedWord) {
+        let mut changed = Vec::new();
+        for (letter, token) in words {
+            if !self.d.modal || self.last_words.get(letter) != Some(token) {
+                changed.push(token.clone());
+            }
+        }
+        if changed.is_empty() {
+            return;
+        }
+        for (letter, token) in words {
+            self.last_words.insert(letter.clone(), token.clone());
+        }
+        let mut parts: Vec<String> = Vec::new();
+        match self.d.syntax {
+            Syntax::Iso => {
+                let want_g93 = matches!(feed, FeedWord::InverseTime(_));
+                if want_g93 != self.g93 {
+                    parts.push(if want_g93 { "G93".into() } else { "G94".into() });
+                    self.g93 = want_g93;
+                    self.last_feed = None;
+                }
+                let code = if matches!(feed, FeedWord::Rapid) { "G0" } else { "G1" };
+                if !self.d.modal || self.last_motion != Some(code) {
+                    parts.push(code.into());
+                    self.last_motion = Some(code);
+                }
+                parts.extend(changed);
+                let f = match feed {
+                    FeedWord::Rapid | FeedWord::Seconds(_) => None,
+                    FeedWord::PerMinute(f) => {
+                        Some(fmt_number(round_down(f, self.d.feed_decimals), self.d.feed_decimals))
+                    }
+                    FeedWord::InverseTime(f) => {
+                        self.last_feed = None; // G93 needs F on every block
+                        Some(fmt_number(round_down(f, self.d.inverse_time_decimals), self.d.inverse_time_decimals))
+                    }
+                };
+                if let Some(f) = f
+                    && (!self.d.modal || self.last_feed.as_ref() != Some(&f))
+                {
+                    parts.push(format!("F{f}"));
+                    self.last_feed = Some(f);
+                }
+            }
+            Syntax::Heidenhain => {
+                parts.push("L".into());
+                parts.extend(changed);
+                match feed {
+                    FeedWord::Rapid => {
+                        parts.push("FMAX".into());
+                        self.last_feed = None;
+                    }
+                    FeedWord::Seconds(t) => {
+                        let dec = self.d.inverse_time_decimals;
+                        parts.push(format!("FT{}", fmt_number(round_up(t, dec), dec)));
+                        self.last_feed = None;
+                    }
+                    FeedWord::PerMinute(f) | FeedWord::InverseTime(f) => {
+                        let f = fmt_number(round_down(f, self.d.feed_decimals), self.d.feed_decimals);
+                        if !self.d.modal || self.last_feed.as_ref() != Some(&f) {
+                            parts.push(format!("F{f}"));
+                            self.last_feed = Some(f);
+                        }
+                    }
+                }
+            }
+        }
+        let line = parts.join(" ");
+        self.line(&line);
+    }
+
+    /// Activates a tilted plane `r` (columns x_f, y_f, z_f in the part frame) at the
+    /// part origin; `dir` selects the rotary solution (sign of the tilt word).
+    fn plane_on(&mut self, r: &Rotation3<f64>, dir: i32) {
+        let dec = self.d.rotary_decimals;
+        let deg = |v: f64| self.num(v.to_degrees(), dec);
+        let lines: Vec<String> = match self.d.tilted_plane {
+            TiltedPlane::None => Vec::new(),
+            TiltedPlane::G68_2 => {
+                let (i, j, k) = scallop_machine::frame::fanuc_g68_2(r);
+                vec![format!("G68.2 X0 Y0 Z0 I{} J{} K{}", deg(i), deg(j), deg(k)), "G53.1".into()]
+            }
+            TiltedPlane::Cycle800 => {
+                let (a, b, c) = cycle800_angles(r);
+                vec![format!("CYCLE800(0,\"TC1\",200000,57,0,0,0,{},{},{},0,0,0,{dir},100,1)", deg(a), deg(b), deg(c))]
+            }
+            TiltedPlane::PlaneSpatial => {
+                let (a, b, c) = scallop_machine::frame::plane_spatial(r);
+                let seq = if dir >= 0 { "SEQ+" } else { "SEQ-" };
+                vec![format!("PLANE SPATIAL SPA{} SPB{} SPC{} TURN FMAX {seq}", deg(a), deg(b), deg(c))]
+            }
+        };
+        for l in lines {
+            self.line(&l);
+        }
+        self.last_words.clear();
+        self.last_motion = None;
+    }
+
+    fn plane_off(&mut self) {
+        let l = match self.d.tilted_plane {
+            TiltedPlane::None => return,
+            TiltedPlane::G68_2 => "G69",
+            TiltedPlane::Cycle800 => "CYCLE800()",
+            TiltedPlane::PlaneSpatial => "PLANE RESET STAY",
+        };
+        self.line(l);
+        self.last_words.clear();
+        self.last_motion = None;
+    }
+}
+
+/// `CYCLE800` axis-by-axis angles (X, then the rotated Y, then the rotated Z):
+/// `R_f = Rx(a) Ry(b) Rz(c)`, so `b = atan2(R13, sqrt(R11^2 + R12^2))`,
+/// `a = atan2(-R23, R33)`, `c = atan2(-R12, R11)`.
+///
+/// ```
+/// use scallop_geom::Vec3;
+/// let r = scallop_machine::frame::tilted_plane(&Vec3::new(1.0, 0.0, 1.0));
+/// let (a, b, c) = scallop_post::cycle800_angles(&r);
+/// assert!(a.abs() < 1e-12 && (b - std::f64::consts::FRAC_PI_4).abs() < 1e-12 && c.abs() < 1e-12);
+/// ```
+#[must_use]
+pub fn cycle800_angles(r: &Rotation3<f64>) -> (f64, f64, f64) {
+    let m = r.matrix();
+    let b = m[(0, 2)].atan2(m[(0, 0)].hypot(m[(0, 1)]));
+    ((-m[(1, 2)]).atan2(m[(2, 2)]), b, (-m[(0, 1)]).atan2(m[(0, 0)]))
+}
