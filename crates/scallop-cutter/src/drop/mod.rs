@@ -209,32 +209,33 @@ pub fn drop_grid(
     let done = AtomicUsize::new(0);
     let profile = Profile::new(cutter.shape());
     let radius = profile.radius;
-    let rows: Vec<Vec<ClPoint>> = ys
-        .par_iter()
-        .map_init(BlockScratch::default, |scratch, &y| {
-            let mut row = Vec::with_capacity(xs.len());
-            let mut seed = None;
-            let mut start = 0;
-            while start < xs.len() {
-                // A block spans about one cutter diameter (at most BLOCK_POINTS points).
-                let mut end = start + 1;
-                while end < xs.len() && end - start < BLOCK_POINTS && (xs[end] - xs[start]).abs() <= 2.0 * radius {
-                    end += 1;
-                }
-                let (x0, x1) = (xs[start].min(xs[end - 1]), xs[start].max(xs[end - 1]));
-                scratch.fill(index, &profile, x0, x1, y);
-                for &x in &xs[start..end] {
-                    let (cl, slot) = drop_candidates(&profile, index, &scratch.sorted, Point2::new(x, y), floor, seed);
-                    seed = slot;
-                    row.push(cl);
-                }
-                start = end;
+    // Each row writes its own slice of the output: no per-row vectors, no
+    // serial concatenation at the end.
+    let mut out = vec![ClPoint::floor(Point2::origin(), floor); xs.len() * ys.len()];
+    if xs.is_empty() {
+        return out;
+    }
+    out.par_chunks_mut(xs.len()).zip(ys.par_iter()).for_each_init(BlockScratch::default, |scratch, (row, &y)| {
+        let mut seed = None;
+        let mut start = 0;
+        while start < xs.len() {
+            // A block spans about one cutter diameter (at most BLOCK_POINTS points).
+            let mut end = start + 1;
+            while end < xs.len() && end - start < BLOCK_POINTS && (xs[end] - xs[start]).abs() <= 2.0 * radius {
+                end += 1;
             }
-            progress(done.fetch_add(1, Ordering::Relaxed) + 1);
-            row
-        })
-        .collect();
-    rows.into_iter().flatten().collect()
+            let (x0, x1) = (xs[start].min(xs[end - 1]), xs[start].max(xs[end - 1]));
+            scratch.fill(index, &profile, x0, x1, y);
+            for (slot_out, &x) in row[start..end].iter_mut().zip(&xs[start..end]) {
+                let (cl, slot) = drop_candidates(&profile, index, &scratch.sorted, Point2::new(x, y), floor, seed);
+                seed = slot;
+                *slot_out = cl;
+            }
+            start = end;
+        }
+        progress(done.fetch_add(1, Ordering::Relaxed) + 1);
+    });
+    out
 }
 
 /// Reusable buffers of one worker: the candidates of the current block.
