@@ -56,5 +56,34 @@ fn bench(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, bench);
+/// The same kernel on 1 and 2 threads over a finer grid (250,000 points on the
+/// terrain): the ratio of the two medians is the thread scaling.
+fn scaling(c: &mut Criterion) {
+    let terrain = grid_mesh(150, |u, v| {
+        let (x, y) = (100.0 * u, 100.0 * v);
+        Point3::new(x, y, 5.0 * (x * 0.13).sin() * (y * 0.09).cos() + 2.0 * (0.31 * x + 0.17 * y).sin())
+    });
+    let xs: Vec<f64> = (0..500).map(|i| 100.0 * f64::from(i) / 499.0).collect();
+    let ys = xs.clone();
+    let mut group = c.benchmark_group("drop_grid_threads/dense_freeform");
+    group.throughput(Throughput::Elements((xs.len() * ys.len()) as u64));
+    group.sample_size(10);
+    for (name, shape) in [
+        ("ball", CutterShape::Ball { radius: 2.5 }),
+        ("flat", CutterShape::Flat { radius: 2.5 }),
+        ("bull", CutterShape::Bull { radius: 2.5, corner: 0.625 }),
+        ("cone", CutterShape::Cone { radius: 2.5, half_angle: PI / 4.0 }),
+    ] {
+        let cutter = Cutter::new(shape, 20.0).expect("valid cutter");
+        for threads in [1, 2] {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("pool");
+            group.bench_function(format!("{name}/{threads}"), |b| {
+                b.iter(|| pool.install(|| drop_grid(&cutter, &terrain, &xs, &ys, -100.0, &|_| {})))
+            });
+        }
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench, scaling);
 criterion_main!(benches);

@@ -211,7 +211,10 @@ pub fn drop_grid(
     let radius = profile.radius;
     // Each row writes its own slice of the output: no per-row vectors, no
     // serial concatenation at the end.
-    let mut out = vec![ClPoint::floor(Point2::origin(), floor); xs.len() * ys.len()];
+    // Initialised in parallel too: a serial fill of a large grid (64 bytes a
+    // point) would be the serial fraction that limits the second thread.
+    let mut out: Vec<ClPoint> =
+        (0..xs.len() * ys.len()).into_par_iter().map(|_| ClPoint::floor(Point2::origin(), floor)).collect();
     if xs.is_empty() {
         return out;
     }
