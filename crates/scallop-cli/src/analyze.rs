@@ -4,8 +4,8 @@ use std::path::PathBuf;
 
 use clap::Args;
 use scallop_analysis::{
-    AnalysisReport, GridOptions, MachineLimits, Recommendation, ToolOptions, analyze, plot_svg, sample_mesh,
-    sample_surface_set,
+    AnalysisReport, GridOptions, MachineLimits, Recommendation, ToolOptions, analyze, critical_slope, plot_svg,
+    sample_mesh, sample_surface_set,
 };
 use scallop_engine::Part;
 
@@ -45,7 +45,7 @@ pub struct AnalyzeArgs {
     /// Sample cells per parameter direction on surfaces.
     #[arg(long, default_value_t = 80)]
     cells: usize,
-    /// Write the (mu, s) decision plot as SVG.
+    /// Write the (mu, s) decision plot: SVG, or PNG when the name ends in .png.
     #[arg(long)]
     plot: Option<PathBuf>,
     /// Print the report as JSON.
@@ -86,13 +86,65 @@ pub fn run(args: &AnalyzeArgs) -> CliResult<()> {
     let report = analyze(&samples, &tools, &machine, args.scallop)
         .map_err(|e| Failure::rejected(format!("{}: {e}", args.part)))?;
     if let Some(path) = &args.plot {
-        let svg = plot_svg(&report);
-        write_atomic(path, |w| std::io::Write::write_all(w, svg.as_bytes()))?;
+        let is_png = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"));
+        let bytes = if is_png { plot_png(&report) } else { plot_svg(&report).into_bytes() };
+        write_atomic(path, |w| std::io::Write::write_all(w, &bytes))?;
     }
     if args.json {
         return print_json(&report);
     }
     print_text(&human(&loaded.description, &report))
+}
+
+/// The (mu, s) decision plane as a PNG: the ball region (s > s_c) blue, the
+/// bull-nose region orange, the critical curve black, the part a red dot;
+/// ticks every 15 degrees and every unit of mu, labelled.
+fn plot_png(r: &AnalysisReport) -> Vec<u8> {
+    use crate::picture::Image;
+    let (w, h, left, top, pw, ph) = (720usize, 480usize, 60usize, 20usize, 620usize, 400usize);
+    let mu_max = (1.15 * r.shape_factor).ceil().max(5.0);
+    let mut img = Image::new(w, h, [255, 255, 255]);
+    #[allow(clippy::cast_precision_loss)]
+    let mu_of = |px: usize| 1.0 + (mu_max - 1.0) * px as f64 / (pw - 1) as f64;
+    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+    let row_of = |deg: f64| ((1.0 - deg.clamp(0.0, 90.0) / 90.0) * (ph - 1) as f64).round() as usize;
+    for px in 0..pw {
+        let s_c = critical_slope(mu_of(px), r.size_mm2, &r.tools, r.scallop_height_mm, &r.machine).to_degrees();
+        let curve = row_of(s_c);
+        for py in 0..ph {
+            let rgb = if py < curve { [214, 229, 245] } else { [253, 228, 204] };
+            img.set(left + px, top + py, rgb);
+        }
+        img.fill(left + px, top + curve.saturating_sub(1), 1, 3, [0, 0, 0]);
+    }
+    // Axes, ticks and labels (degrees on the left, mu below).
+    img.fill(left, top, 2, ph, [0, 0, 0]);
+    img.fill(left, top + ph - 1, pw, 2, [0, 0, 0]);
+    for deg in (0..=90).step_by(15) {
+        let y = top + row_of(f64::from(deg));
+        img.fill(left - 6, y, 6, 1, [0, 0, 0]);
+        img.text(8, y.saturating_sub(7), &format!("{deg:>2}"), 2, [0, 0, 0]);
+    }
+    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+    for mu in 1..=(mu_max as usize) {
+        #[allow(clippy::cast_precision_loss)]
+        let x = left + ((mu as f64 - 1.0) / (mu_max - 1.0) * (pw - 1) as f64).round() as usize;
+        img.fill(x, top + ph, 1, 6, [0, 0, 0]);
+        img.text(x.saturating_sub(5), top + ph + 10, &mu.to_string(), 2, [0, 0, 0]);
+    }
+    // The part.
+    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, clippy::cast_precision_loss)]
+    let px = left + (((r.shape_factor.clamp(1.0, mu_max) - 1.0) / (mu_max - 1.0)) * (pw - 1) as f64).round() as usize;
+    let py = top + row_of(r.slope_deg);
+    for dy in 0..11usize {
+        for dx in 0..11usize {
+            let (ex, ey) = (dx.abs_diff(5), dy.abs_diff(5));
+            if ex * ex + ey * ey <= 25 {
+                img.set((px + dx).saturating_sub(5), (py + dy).saturating_sub(5), [200, 0, 0]);
+            }
+        }
+    }
+    img.to_png()
 }
 
 /// An XY direction (mod 180 degrees) shown in (-90, 90] without "-0.00" or "-90.00".

@@ -177,6 +177,9 @@ fn analyze_recommends_the_spec_tool_for_choi_and_rubio() {
         let svg = std::fs::read_to_string(dir.join(format!("{part}.svg"))).expect("svg");
         assert!(svg.starts_with("<svg") || svg.starts_with("<?xml"), "{part}: not an SVG");
     }
+    let png = scallop().current_dir(&dir).args(["analyze", "rubio", "--plot", "rubio.png"]).output().expect("run");
+    assert!(png.status.success());
+    assert!(std::fs::read(dir.join("rubio.png")).expect("png").starts_with(b"\x89PNG"));
     let bad = scallop().current_dir(&dir).args(["analyze", "choi", "--scallop", "-1"]).output().expect("run");
     assert_eq!(bad.status.code(), Some(1));
 }
