@@ -423,7 +423,7 @@ def main():
     ap.add_argument("--ocl-only", action="store_true", help="run and time OCL alone")
     ap.add_argument("--scallop", default=os.path.join("target", "release", "scallop"), help="scallop binary")
     ap.add_argument("--cutters", default=",".join(CUTTERS), help="comma-separated subset of " + ",".join(CUTTERS))
-    ap.add_argument("--workdir", default=os.path.join("bench", "ocl", "work"), help="where CL CSV files go")
+    ap.add_argument("--workdir", default=os.path.join("bench", "ocl", "results"), help="where CL CSV files go")
     ap.add_argument("--markdown", help="also write the table as Markdown to this file")
     ap.add_argument("--keep-csv", action="store_true", help="keep scallop's CL CSV files in --workdir")
     ap.add_argument("--adjudicate", type=int, default=3, help="worst points checked per failing case")
