@@ -102,6 +102,28 @@ impl Toolpath {
 /// ```
 #[must_use]
 pub fn simplify(points: &[Point3], max_deviation: f64) -> Vec<usize> {
+    douglas_peucker(points, |pa, pb, interior| {
+        let ab = pb - pa;
+        let len2 = ab.norm_squared();
+        let mut worst = (0.0f64, None);
+        for (k, p) in interior {
+            let ap = p - pa;
+            let d = if len2 > 0.0 { (ap - ab * (ap.dot(&ab) / len2).clamp(0.0, 1.0)).norm() } else { ap.norm() };
+            if d > worst.0 {
+                worst = (d, Some(k));
+            }
+        }
+        if worst.0 > max_deviation { worst.1 } else { None }
+    })
+}
+
+/// Iterative Douglas-Peucker: `split(a, b, interior)` returns the interior point
+/// (index, from `interior`: the points strictly between `a` and `b`) that must be
+/// kept, if any; the endpoints are always kept. Returns the kept indices in order.
+fn douglas_peucker<'p>(
+    points: &'p [Point3],
+    split: impl Fn(Point3, Point3, &mut dyn Iterator<Item = (usize, &'p Point3)>) -> Option<usize>,
+) -> Vec<usize> {
     let n = points.len();
     if n <= 2 {
         return (0..n).collect();
@@ -111,26 +133,11 @@ pub fn simplify(points: &[Point3], max_deviation: f64) -> Vec<usize> {
     keep[n - 1] = true;
     let mut stack = vec![(0usize, n - 1)];
     while let Some((a, b)) = stack.pop() {
-        let (pa, pb) = (points[a], points[b]);
-        let ab = pb - pa;
-        let len2 = ab.norm_squared();
-        let mut worst = (0.0f64, a);
-        for (k, p) in points.iter().enumerate().take(b).skip(a + 1) {
-            let ap = p - pa;
-            let d = if len2 > 0.0 {
-                let t = (ap.dot(&ab) / len2).clamp(0.0, 1.0);
-                (ap - ab * t).norm()
-            } else {
-                ap.norm()
-            };
-            if d > worst.0 {
-                worst = (d, k);
-            }
-        }
-        if worst.0 > max_deviation {
-            keep[worst.1] = true;
-            stack.push((a, worst.1));
-            stack.push((worst.1, b));
+        let mut interior = points.iter().enumerate().take(b).skip(a + 1);
+        if let Some(k) = split(points[a], points[b], &mut interior) {
+            keep[k] = true;
+            stack.push((a, k));
+            stack.push((k, b));
         }
     }
     (0..n).filter(|&i| keep[i]).collect()
@@ -153,25 +160,15 @@ pub fn simplify(points: &[Point3], max_deviation: f64) -> Vec<usize> {
 /// ```
 #[must_use]
 pub fn simplify_above(points: &[Point3], max_deviation: f64) -> Vec<usize> {
-    let n = points.len();
-    if n <= 2 {
-        return (0..n).collect();
-    }
-    let mut keep = vec![false; n];
-    keep[0] = true;
-    keep[n - 1] = true;
-    let mut stack = vec![(0usize, n - 1)];
-    while let Some((a, b)) = stack.pop() {
-        let (pa, pb) = (points[a], points[b]);
+    douglas_peucker(points, |pa, pb, interior| {
         let ab = pb - pa;
         let len2 = ab.xy().norm_squared();
         // The worst offender: any point above the chord, else the largest deviation.
         let mut worst: Option<(bool, f64, usize)> = None;
-        for (k, p) in points.iter().enumerate().take(b).skip(a + 1) {
+        for (k, p) in interior {
             let t = if len2 > 0.0 { ((p - pa).xy().dot(&ab.xy()) / len2).clamp(0.0, 1.0) } else { 0.0 };
             let chord = pa + ab * t;
-            let above = p.z > chord.z;
-            let dev = (p - chord).norm();
+            let (above, dev) = (p.z > chord.z, (p - chord).norm());
             if above || dev > max_deviation {
                 let candidate = (above, dev, k);
                 worst = Some(match worst {
@@ -180,13 +177,8 @@ pub fn simplify_above(points: &[Point3], max_deviation: f64) -> Vec<usize> {
                 });
             }
         }
-        if let Some((_, _, k)) = worst {
-            keep[k] = true;
-            stack.push((a, k));
-            stack.push((k, b));
-        }
-    }
-    (0..n).filter(|&i| keep[i]).collect()
+        worst.map(|w| w.2)
+    })
 }
 
 #[cfg(test)]
