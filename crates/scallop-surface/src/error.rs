@@ -285,11 +285,11 @@ pub enum SurfaceError {
     },
 }
 
-impl SurfaceError {
-    /// The patch the error is about, if it is about one.
-    #[must_use]
-    pub fn patch(&self) -> Option<&PatchLabel> {
-        match self {
+/// The one list of the variants that carry a patch label, shared by
+/// [`SurfaceError::patch`] and `patch_mut` (`&` and `&mut` need two matches).
+macro_rules! patch_of {
+    ($error:expr) => {
+        match $error {
             SurfaceError::DegreeTooLow { patch, .. }
             | SurfaceError::ControlRows { patch, .. }
             | SurfaceError::ControlColumns { patch, .. }
@@ -306,6 +306,14 @@ impl SurfaceError {
             | SurfaceError::Mesh { patch, .. } => Some(patch),
             SurfaceError::EmptySet | SurfaceError::BadTolerance { .. } => None,
         }
+    };
+}
+
+impl SurfaceError {
+    /// The patch the error is about, if it is about one.
+    #[must_use]
+    pub fn patch(&self) -> Option<&PatchLabel> {
+        patch_of!(self)
     }
 
     /// The same error with the patch's position set to `index` (for builders of
@@ -327,22 +335,6 @@ impl SurfaceError {
     }
 
     fn patch_mut(&mut self) -> Option<&mut PatchLabel> {
-        match self {
-            SurfaceError::DegreeTooLow { patch, .. }
-            | SurfaceError::ControlRows { patch, .. }
-            | SurfaceError::ControlColumns { patch, .. }
-            | SurfaceError::KnotCount { patch, .. }
-            | SurfaceError::NonFiniteKnot { patch, .. }
-            | SurfaceError::KnotsDecreasing { patch, .. }
-            | SurfaceError::KnotMultiplicity { patch, .. }
-            | SurfaceError::EmptyDomain { patch, .. }
-            | SurfaceError::NonFiniteControlPoint { patch, .. }
-            | SurfaceError::WeightsShape { patch, .. }
-            | SurfaceError::BadWeight { patch, .. }
-            | SurfaceError::DuplicateName { patch, .. }
-            | SurfaceError::TooFine { patch, .. }
-            | SurfaceError::Mesh { patch, .. } => Some(patch),
-            SurfaceError::EmptySet | SurfaceError::BadTolerance { .. } => None,
-        }
+        patch_of!(self)
     }
 }
