@@ -7,6 +7,7 @@ mod drop;
 mod output;
 mod part;
 mod picture;
+mod post;
 mod run;
 mod simulate;
 
@@ -52,6 +53,8 @@ enum Command {
     Analyze(analyze::AnalyzeArgs),
     /// Cut a stock with a 3-axis G-code program and verify it against the part (gouges are errors).
     Simulate(simulate::SimulateArgs),
+    /// Post-process a cutter-location file for a machine and a dialect, with a machine-aware time report.
+    Post(post::PostArgs),
     /// Load a part and report what was read (size, welding, open and non-manifold edges).
     Inspect(part::InspectArgs),
 }
@@ -73,6 +76,7 @@ fn main() -> ExitCode {
         Command::Inspect(args) => part::inspect(&args),
         Command::Analyze(args) => analyze::run(&args),
         Command::Simulate(args) => simulate::run(&args),
+        Command::Post(args) => post::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

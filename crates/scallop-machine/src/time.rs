@@ -217,7 +217,12 @@ pub fn path_time(kin: &Kinematics, joints: &[Joints], feeds: &[f64]) -> Result<T
 
 /// The look-ahead profile of [`path_time`]; `relax` lifts one axis's dynamic limits
 /// (velocity, acceleration, jerk) to measure the time that axis costs.
-fn profile(kin: &Kinematics, joints: &[Joints], feeds: &[f64], relax: Option<usize>) -> Result<TimeReport, MachineError> {
+fn profile(
+    kin: &Kinematics,
+    joints: &[Joints],
+    feeds: &[f64],
+    relax: Option<usize>,
+) -> Result<TimeReport, MachineError> {
     let n = joints.len().saturating_sub(1);
     if feeds.len() != n || feeds.iter().any(|f| !(f.is_finite() && *f > 0.0)) {
         return Err(MachineError::BadInput {

@@ -124,3 +124,7 @@ pub const BRANCH_JUMP: f64 = std::f64::consts::FRAC_PI_2;
 /// time that axis costs (`TimeReport::axis_time_lost`): large enough that the axis never
 /// binds, finite so the jerk-limited formulas stay defined.
 pub const RELAXED_AXIS_FACTOR: f64 = 1e9;
+
+/// Largest total rotation of one block (rad) for which `feed::deviation_bound` holds
+/// (its distance bound needs `3 Omega < 1`); larger blocks are sampled.
+pub const BOUND_MAX_ROTATION: f64 = 0.3;

@@ -130,6 +130,7 @@ mod plan;
 mod scallop;
 mod time;
 pub mod tol;
+pub mod trochoid;
 
 pub use error::StrategyError;
 pub use params::{Boundary, FinishingParams, Pattern};
