@@ -37,6 +37,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let text = program_text(&program, &kin, &Dialect::builtin("linuxcnc")?, &params)?;
     let t2 = t0.elapsed();
+    let hash = text.bytes().fold(0xcbf2_9ce4_8422_2325_u64, |h, b| (h ^ u64::from(b)).wrapping_mul(0x100_0000_01b3));
+    println!("output FNV-1a {hash:016x}");
     println!(
         "{n} poses, {} blocks, {} bytes: IK+plan {:.3} s, post {:.3} s",
         program.blocks.len(),
