@@ -55,9 +55,19 @@ pub use writer::{OutputMode, PostParams, cycle800_angles, program_text, write_pr
 /// ```
 #[must_use]
 pub fn fmt_number(v: f64, decimals: usize) -> String {
-    if let Some(s) = fmt_number_fast(v, decimals) {
-        return s;
+    let mut s = String::with_capacity(16);
+    push_number(&mut s, v, decimals);
+    s
+}
+
+/// Appends `v` with `decimals` digits to `out`, exactly as [`fmt_number`] formats it.
+pub fn push_number(out: &mut String, v: f64, decimals: usize) {
+    if !push_number_fast(out, v, decimals) {
+        out.push_str(&fmt_number_exact(v, decimals));
     }
+}
+
+fn fmt_number_exact(v: f64, decimals: usize) -> String {
     let s = format!("{v:.decimals$}");
     if s.starts_with('-') && s[1..].chars().all(|c| c == '0' || c == '.') { s[1..].to_string() } else { s }
 }
@@ -65,41 +75,40 @@ pub fn fmt_number(v: f64, decimals: usize) -> String {
 /// `fmt_number` by integer arithmetic, byte for byte equal to the exact formatting
 /// (`format!("{v:.decimals$}")` with `-0` cleaned) where it answers: away from rounding
 /// ties by more than the product's rounding error, and for magnitudes where the scaled
-/// value is an exact integer range. `None` sends the caller to the exact formatter.
-fn fmt_number_fast(v: f64, decimals: usize) -> Option<String> {
+/// value is an exact integer range. `false` (nothing written) sends the caller to the
+/// exact formatter.
+fn push_number_fast(out: &mut String, v: f64, decimals: usize) -> bool {
     const POW10: [f64; 10] = [1.0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9];
-    let scale = *POW10.get(decimals)?;
+    let Some(&scale) = POW10.get(decimals) else { return false };
     let x = v.abs() * scale;
     // |x| < 1e9: the product's error is below 2.3e-7, far from the 1e-6 tie margin.
     if x.is_nan() || x >= 1e9 {
-        return None;
+        return false;
     }
     let floor = x.floor();
     let frac = x - floor;
     if (frac - 0.5).abs() < tol::FAST_FORMAT_TIE_MARGIN {
-        return None;
+        return false;
     }
-    let n = if frac > 0.5 { floor + 1.0 } else { floor } as u64;
-    let digits = n.to_string();
-    let mut out = String::with_capacity(digits.len() + decimals + 3);
-    if v < 0.0 && n != 0 {
+    let mut n = if frac > 0.5 { floor + 1.0 } else { floor } as u64;
+    // Digits, least significant first, at least decimals + 1 of them (leading zeros).
+    let mut digits = [b'0'; 24];
+    let mut len = 0;
+    while n > 0 || len <= decimals {
+        digits[len] = b'0' + (n % 10) as u8;
+        n /= 10;
+        len += 1;
+    }
+    if v < 0.0 && digits[..len].iter().any(|&d| d != b'0') {
         out.push('-');
     }
-    if decimals == 0 {
-        out.push_str(&digits);
-        return Some(out);
+    for k in (0..len).rev() {
+        out.push(char::from(digits[k]));
+        if k == decimals && decimals > 0 {
+            out.push('.');
+        }
     }
-    if digits.len() <= decimals {
-        out.push_str("0.");
-        out.extend(std::iter::repeat_n('0', decimals - digits.len()));
-        out.push_str(&digits);
-    } else {
-        let (int, frac) = digits.split_at(digits.len() - decimals);
-        out.push_str(int);
-        out.push('.');
-        out.push_str(frac);
-    }
-    Some(out)
+    true
 }
 
 /// Writes `path` as G-code. `comments` go into the header (one line each).

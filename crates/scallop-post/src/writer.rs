@@ -220,6 +220,7 @@ pub fn program_text(
     };
     let mut previous: Option<&ProgramBlock> = None;
     let mut plane: Option<(Vec3, Rotation3<f64>)> = None;
+    let mut words: Vec<(&str, String)> = Vec::with_capacity(machine.axes().len());
     for b in &program.blocks {
         if planes {
             let needs_new = plane.as_ref().is_none_or(|(axis, _)| angle(axis, &b.pose.axis) > params.tol_ang);
@@ -257,7 +258,7 @@ pub fn program_text(
             let (words_a, tip_a) = previous.map_or((b.words, b.pose.tip), |p| (p.words, p.pose.tip));
             let word_at = |i: usize| words_a[i] + (b.words[i] - words_a[i]) * s;
             let tip: Point3 = tip_a + (b.pose.tip - tip_a) * s;
-            let mut words = Vec::new();
+            words.clear();
             for i in 0..machine.axes().len() {
                 if !write_axis[i] {
                     continue;
@@ -266,9 +267,9 @@ pub fn program_text(
                 let w = word_at(i);
                 let token = match axis.kind {
                     AxisKind::Linear if mode == OutputMode::Tcp => {
-                        format!("{}{}", letters[i], e.num(tip[linear_component(i)?], dialect.decimals))
+                        e.token(&letters[i], tip[linear_component(i)?], dialect.decimals)
                     }
-                    AxisKind::Linear => format!("{}{}", letters[i], e.num(w, dialect.decimals)),
+                    AxisKind::Linear => e.token(&letters[i], w, dialect.decimals),
                     AxisKind::Rotary => {
                         let before = word_at_prev(&words_a, &b.words, i, piece, pieces);
                         e.rotary(&letters[i], w, w - before, axis.wrap)
@@ -451,6 +452,17 @@ impl<'a> Emitter<'a> {
         self.line(&line);
     }
 
+    /// `letter` followed by `v` as [`Emitter::num`] writes it, in one allocation.
+    fn token(&self, letter: &str, v: f64, decimals: usize) -> String {
+        let mut s = String::with_capacity(letter.len() + 16);
+        s.push_str(letter);
+        crate::push_number(&mut s, v, decimals);
+        if self.d.explicit_plus && !s[letter.len()..].starts_with('-') {
+            s.insert(letter.len(), '+');
+        }
+        s
+    }
+
     fn num(&self, v: f64, decimals: usize) -> String {
         let s = fmt_number(v, decimals);
         if self.d.explicit_plus && !s.starts_with('-') { format!("+{s}") } else { s }
@@ -464,7 +476,7 @@ impl<'a> Emitter<'a> {
             None => format!("{letter}{value}"),
         };
         match wrap {
-            Wrap::Absolute => format!("{letter}{}", self.num(word, dec)),
+            Wrap::Absolute => self.token(letter, word, dec),
             _ => {
                 let mut m = word.rem_euclid(360.0);
                 if fmt_number(m, dec) == fmt_number(360.0, dec) {
