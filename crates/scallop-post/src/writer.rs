@@ -513,7 +513,7 @@ impl<'a> Emitter<'a> {
         }
         let mut buf = std::mem::take(&mut self.buf);
         buf.clear();
-        let mut push = |buf: &mut String, t: &str| {
+        let push = |buf: &mut String, t: &str| {
             if !buf.is_empty() {
                 buf.push(' ');
             }
