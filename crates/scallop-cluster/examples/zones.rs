@@ -1,8 +1,8 @@
 //! Prints ASCII maps of the clusters and zones of a built-in surface.
 //!
-//! `cargo run --release -p scallop-cluster --example zones -- [choi|rubio] [K] [N] [STEP]`
-//! (defaults: choi, K = 3, an N x N = 80 x 80 grid, every STEP = 2nd cell printed).
-//! K-means, Euclidean metric, omega = 1, wrapped theta. Rows go from v = 1 (top) to
+//! `cargo run --release -p scallop-cluster --example zones -- [choi|rubio] [K] [N] [STEP] [OMEGA]`
+//! (defaults: choi, K = 3, an N x N = 80 x 80 grid, every STEP = 2nd cell printed,
+//! OMEGA = `1,1,1,1`). K-means, (weighted) Euclidean metric, wrapped theta. Rows go from v = 1 (top) to
 //! v = 0, columns from u = 0 (left) to u = 1. Cluster map: digits; zone map:
 //! letters (zone 0 = 'A').
 
@@ -15,6 +15,12 @@ fn main() {
     let k: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(3);
     let n: usize = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(80);
     let step: usize = args.get(4).and_then(|s| s.parse().ok()).unwrap_or(2).max(1);
+    let mut omega = [1.0; 4];
+    if let Some(list) = args.get(5) {
+        for (w, text) in omega.iter_mut().zip(list.split(',')) {
+            *w = text.trim().parse().unwrap_or(f64::NAN);
+        }
+    }
     let Some(set) = scallop_surface::builtin(name) else {
         eprintln!("unknown surface {name}: use choi or rubio");
         std::process::exit(2);
@@ -27,7 +33,7 @@ fn main() {
         }
     };
     let result =
-        Features::from_samples(&samples).and_then(|f| partition(&f, &ClusterParams { k, ..Default::default() }));
+        Features::from_samples(&samples).and_then(|f| partition(&f, &ClusterParams { k, omega, ..Default::default() }));
     let p = match result {
         Ok(p) => p,
         Err(e) => {
@@ -36,7 +42,7 @@ fn main() {
         }
     };
     println!(
-        "{name}: {n} x {n} cells, K-means Euclidean, K = {k}, omega = 1: {} clusters, {} zones, {} iterations (converged: {})",
+        "{name}: {n} x {n} cells, K-means Euclidean, K = {k}, omega = {omega:?}: {} clusters, {} zones, {} iterations (converged: {})",
         p.clusters,
         p.zone_count(),
         p.iterations,
