@@ -229,18 +229,24 @@ impl Frozen {
         z.factor * term
     }
 
+    /// The full `d^2(x_i, c_c)` (base part plus the PCA term when active).
+    #[inline]
+    pub(crate) fn distance2(&self, setup: &Setup, i: usize, c: usize, previous: Option<&[u32]>) -> f64 {
+        let mut d = self.base(&setup.features.x[i], c, setup.wrapped());
+        if self.pca.is_some() {
+            let member = previous.is_some_and(|p| p[i] as usize == c);
+            d += self.pca_term(setup, i, c, member);
+        }
+        d
+    }
+
     /// The nearest centre of point `i` (lowest index on ties).
     #[inline]
-    fn nearest(&self, setup: &Setup, i: usize, previous: Option<&[u32]>, wrapped: bool) -> u32 {
-        let x = &setup.features.x[i];
+    fn nearest(&self, setup: &Setup, i: usize, previous: Option<&[u32]>) -> u32 {
         let mut best = (f64::INFINITY, 0u32);
         #[allow(clippy::cast_possible_truncation)] // k <= cells < u32::MAX
         for c in 0..self.centres.len() {
-            let mut d = self.base(x, c, wrapped);
-            if self.pca.is_some() {
-                let member = previous.is_some_and(|p| p[i] as usize == c);
-                d += self.pca_term(setup, i, c, member);
-            }
+            let d = self.distance2(setup, i, c, previous);
             if d < best.0 {
                 best = (d, c as u32);
             }
@@ -259,7 +265,7 @@ impl Frozen {
             out.par_chunks_mut(tol::PARALLEL_CHUNK).enumerate().for_each(|(chunk, part)| {
                 let start = chunk * tol::PARALLEL_CHUNK;
                 for (j, label) in part.iter_mut().enumerate() {
-                    *label = self.nearest(setup, start + j, previous, wrapped);
+                    *label = self.nearest(setup, start + j, previous);
                 }
             });
         } else if self.diagonal && self.pca.is_none() {
@@ -278,7 +284,7 @@ impl Frozen {
             }
         } else {
             for (i, label) in out.iter_mut().enumerate() {
-                *label = self.nearest(setup, i, previous, wrapped);
+                *label = self.nearest(setup, i, previous);
             }
         }
     }
@@ -311,4 +317,92 @@ pub(crate) fn compact(labels: &mut [u32], k: usize) -> (usize, Vec<usize>) {
         *l = map[*l as usize];
     }
     (kept.len(), kept)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::metric::PcaFactor;
+    use scallop_analysis::{GridOptions, Pca, sample_patch};
+
+    /// The PCA metric (Eq. 3.2) against a direct evaluation with the analysis
+    /// crate's PCA, for members and non-members, both factors.
+    #[test]
+    fn pca_metric_matches_direct_formula() {
+        let set = scallop_surface::builtin("rubio").unwrap();
+        let samples = sample_patch(&set.patches()[0], &GridOptions { cells_u: 12, cells_v: 9 }).unwrap();
+        let f = Features::from_samples(&samples).unwrap();
+        let (points, _) = f.geometry().unwrap();
+        let labels: Vec<u32> = f.x.iter().map(|x| u32::from(x[0] > 0.5) + u32::from(x[1] > 0.6)).collect();
+        for factor in [PcaFactor::OneMinusRhoSquared, PcaFactor::RhoSquared] {
+            let setup = Setup::new(&f, [1.0; 4], Metric::Pca { factor }, ThetaMode::Wrapped);
+            let stats = Stats::batch(&setup, &labels, 3);
+            let centres = means(&stats, &[[0.0; 4]; 3], ThetaMode::Wrapped);
+            let frozen = Frozen::new(&setup, centres.clone(), Some((&stats, &labels)), false);
+            let angle = |v: scallop_geom::Vec3| v.y.atan2(v.x);
+            for i in (0..f.len()).step_by(7) {
+                for c in 0..3 {
+                    let members: Vec<Point3> =
+                        (0..f.len()).filter(|&j| labels[j] as usize == c).map(|j| points[j]).collect();
+                    let pca = Pca::from_moments(&Moments::of_points(&members));
+                    let rho = pca.eigenvalues[1] / pca.eigenvalues[0];
+                    let weight = factor.apply(rho);
+                    let theta_i = angle(pca.axes[0]);
+                    let centre = points[nearest_point(&f, centres[c][0], centres[c][1])];
+                    let beta = angle(points[i] - centre);
+                    let theta_prime = if labels[i] as usize == c {
+                        theta_i
+                    } else {
+                        let mut with = members.clone();
+                        with.push(points[i]);
+                        angle(Pca::from_moments(&Moments::of_points(&with)).axes[0])
+                    };
+                    let d = delta(&f.x[i], &centres[c], true);
+                    let base: f64 = d.iter().map(|v| v * v).sum();
+                    let expected =
+                        base + weight * ((theta_i - beta).sin().powi(2) + (centres[c][3] - theta_prime).sin().powi(2));
+                    let got = frozen.distance2(&setup, i, c, Some(&labels));
+                    assert!((got - expected).abs() < 1e-9, "cell {i} cluster {c}: {got} vs {expected}");
+                }
+            }
+        }
+    }
+
+    /// Incremental sums (add/remove in any order) give the batch means (A12 for the
+    /// feature statistics; the 3D moments are tested in scallop-analysis).
+    #[test]
+    fn incremental_sums_equal_batch() {
+        let features: Vec<scallop_analysis::FeatureVector> = (0..50)
+            .map(|i| {
+                let t = i as f64;
+                scallop_analysis::FeatureVector {
+                    u: (t * 0.37).fract(),
+                    v: (t * 0.61).fract(),
+                    slope: (t * 0.13).fract(),
+                    slope_direction: (t * 0.77).fract() * 3.0 - 1.5,
+                }
+            })
+            .collect();
+        let f = Features::from_grid([5, 10], &features).unwrap();
+        let setup = Setup::new(&f, [1.0; 4], Metric::Euclidean, ThetaMode::Wrapped);
+        let mut labels: Vec<u32> = (0..50).map(|i| (i % 3) as u32).collect();
+        let mut stats = Stats::batch(&setup, &labels, 3);
+        for step in 0..200usize {
+            let i = (step * 17) % 50;
+            let to = ((step * 7) % 3) as u32;
+            if labels[i] != to {
+                stats.move_point(&setup, i, labels[i], to);
+                labels[i] = to;
+            }
+        }
+        let batch = Stats::batch(&setup, &labels, 3);
+        for mode in [ThetaMode::Wrapped, ThetaMode::Plain] {
+            for c in 0..3 {
+                let (a, b) = (stats.sums[c].mean(mode).unwrap(), batch.sums[c].mean(mode).unwrap());
+                for k in 0..4 {
+                    assert!((a[k] - b[k]).abs() < 1e-12, "{mode:?} cluster {c} component {k}");
+                }
+            }
+        }
+    }
 }

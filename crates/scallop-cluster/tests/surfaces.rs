@@ -58,11 +58,13 @@ fn check_zones(p: &Partition) {
             assert_eq!(p.cluster_of_cell[c], zone.cluster);
         }
     }
-    assert!(seen.iter().all(|&s| s));
+    for (c, &s) in seen.iter().enumerate() {
+        assert_eq!(s, p.cluster_of_cell[c] != NO_LABEL, "cell {c}: in a zone exactly when not masked");
+    }
     for c in 0..nu * nv {
         let (a, b) = (c / nv, c % nv);
         for m in [(a + 1 < nu).then(|| c + nv), (b + 1 < nv).then(|| c + 1)].into_iter().flatten() {
-            if p.cluster_of_cell[m] == p.cluster_of_cell[c] {
+            if p.cluster_of_cell[c] != NO_LABEL && p.cluster_of_cell[m] == p.cluster_of_cell[c] {
                 assert_eq!(p.zone_of_cell[m], p.zone_of_cell[c], "adjacent cells of one cluster share a zone");
             }
         }
@@ -130,4 +132,33 @@ fn choi_partition_is_mirror_symmetric() {
         agree += votes.iter().filter(|((x, _), _)| *x == c).map(|(_, &v)| v).max().unwrap_or(0);
     }
     assert!(n * n - agree <= n * n / 200, "{} of {} cells break the mirror symmetry", n * n - agree, n * n);
+}
+
+/// A masked stripe `35 <= a < 45` across the Choi grid: masked cells get no
+/// label, and no zone crosses the stripe (a cluster on both sides is two zones).
+#[test]
+fn masked_stripe_splits_zones() {
+    let set = scallop_surface::builtin("choi").unwrap();
+    let grid = GridOptions { cells_u: 80, cells_v: 80 };
+    let samples =
+        scallop_analysis::sample_patch_masked(&set.patches()[0], &grid, |a, _| !(35..45).contains(&a)).unwrap();
+    let f = Features::from_samples(&samples).unwrap();
+    assert_eq!((f.len(), f.cell_count()), (5600, 6400));
+    let p = partition(&f, &ClusterParams { k: 2, ..Default::default() }).unwrap();
+    for a in 0..80 {
+        for b in 0..80 {
+            let masked = (35..45).contains(&a);
+            assert_eq!(p.cluster_of_cell[a * 80 + b] == NO_LABEL, masked);
+            assert_eq!(p.zone_of_cell[a * 80 + b] == NO_LABEL, masked);
+        }
+    }
+    for zone in &p.zones {
+        let left = zone.cells.iter().filter(|&&c| (c as usize / 80) < 35).count();
+        assert!(left == 0 || left == zone.len(), "a zone crosses the masked stripe");
+    }
+    assert_eq!(p.zones.iter().map(|z| z.len()).sum::<usize>(), 5600);
+    check_zones(&p);
+    let pairs: std::collections::HashSet<(u32, bool)> =
+        p.zones.iter().map(|z| (z.cluster, (z.cells[0] as usize / 80) < 35)).collect();
+    assert!(p.zone_count() >= pairs.len() && p.zone_count() >= 2, "{} zones", p.zone_count());
 }
