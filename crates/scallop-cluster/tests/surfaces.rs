@@ -12,9 +12,9 @@ use scallop_analysis::{GridOptions, Moments, sample_patch};
 use scallop_cluster::{ClusterParams, Features, Metric, NO_LABEL, Partition, ThetaMode, partition};
 
 fn features(name: &str, n: usize) -> Features {
-    let set = scallop_surface::builtin(name).unwrap();
-    let samples = sample_patch(&set.patches()[0], &GridOptions { cells_u: n, cells_v: n }).unwrap();
-    Features::from_samples(&samples).unwrap()
+    let set = scallop_surface::builtin(name).expect("built-in surface");
+    let samples = sample_patch(&set.patches()[0], &GridOptions { cells_u: n, cells_v: n }).expect("grid");
+    Features::from_samples(&samples).expect("grid samples")
 }
 
 /// Zones are connected, cover the grid once, and two zones of one cluster never touch.
