@@ -39,7 +39,7 @@ fn bench(c: &mut Criterion) {
     group.bench_function("kmeans_pca_metric_k3_partition", |b| {
         b.iter(|| single.install(|| partition(&f80, &pca).expect("valid")))
     });
-    let hac = ClusterParams { method: Method::Hac(HacCut::default()), ..Default::default() };
+    let hac = ClusterParams { method: Method::Hac { cut: HacCut::default() }, ..Default::default() };
     group.bench_function("hac_ward_partition", |b| b.iter(|| single.install(|| partition(&f80, &hac).expect("valid"))));
     group.bench_function("hac_ward_40x40_partition", |b| {
         b.iter(|| single.install(|| partition(&f40, &hac).expect("valid")))

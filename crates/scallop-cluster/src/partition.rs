@@ -28,15 +28,15 @@ pub enum HacCut {
     LargestGap {
         /// Fewest clusters (>= 1).
         min: usize,
-        /// Most clusters.
-        max: usize,
+        /// Most clusters (`None`: no limit).
+        max: Option<usize>,
     },
 }
 
 impl Default for HacCut {
-    /// `LargestGap { min: 2, max: usize::MAX }`.
+    /// `LargestGap { min: 2, max: None }`.
     fn default() -> Self {
-        HacCut::LargestGap { min: 2, max: usize::MAX }
+        HacCut::LargestGap { min: 2, max: None }
     }
 }
 
@@ -57,7 +57,10 @@ pub enum Method {
     /// scaling. In [`ThetaMode::Wrapped`] theta is embedded as
     /// `(cos 2 theta, sin 2 theta) / 2` (chord length `|sin d theta|`, equal to the
     /// wrapped difference to first order) so that Ward stays exact and reducible.
-    Hac(HacCut),
+    Hac {
+        /// Where the dendrogram is cut.
+        cut: HacCut,
+    },
 }
 
 impl Method {
@@ -65,7 +68,7 @@ impl Method {
         match self {
             Method::KMeans => "k-means",
             Method::Rpcl => "RPCL",
-            Method::Hac(_) => "hierarchical clustering (Ward)",
+            Method::Hac { .. } => "hierarchical clustering (Ward)",
         }
     }
 }
@@ -186,7 +189,7 @@ impl Partition {
 /// See [`cluster`].
 pub fn validate(features: &Features, params: &ClusterParams) -> Result<(), ClusterError> {
     let cells = features.len();
-    let k_used = !matches!(params.method, Method::Hac(HacCut::LargestGap { .. }));
+    let k_used = !matches!(params.method, Method::Hac { cut: HacCut::LargestGap { .. } });
     if k_used && (params.k == 0 || params.k > cells) {
         return Err(ClusterError::BadClusterCount { k: params.k, cells });
     }
@@ -234,7 +237,7 @@ pub fn validate(features: &Features, params: &ClusterParams) -> Result<(), Clust
     if matches!(params.metric, Metric::Pca { .. }) && features.geometry().is_none() {
         return Err(ClusterError::NeedsGeometry);
     }
-    if let Method::Hac(cut) = params.method {
+    if let Method::Hac { cut } = params.method {
         let diagonal = matches!(params.metric, Metric::Euclidean | Metric::StdDev { scope: Scope::Global, .. });
         if !diagonal {
             return Err(ClusterError::Unsupported {
@@ -251,7 +254,7 @@ pub fn validate(features: &Features, params: &ClusterParams) -> Result<(), Clust
             });
         }
         if let HacCut::LargestGap { min, max } = cut
-            && (min == 0 || max < min)
+            && (min == 0 || max.is_some_and(|m| m < min))
         {
             return Err(ClusterError::BadSetting {
                 name: "hac cut min clusters",
@@ -288,7 +291,7 @@ pub fn cluster(features: &Features, params: &ClusterParams) -> Result<Clustering
     Ok(match params.method {
         Method::KMeans => kmeans(&setup, params.k, params.max_iterations),
         Method::Rpcl => rpcl(&setup, params.k, params.max_iterations, &params.rpcl, params.seed),
-        Method::Hac(cut) => hac(features, params, cut),
+        Method::Hac { cut } => hac(features, params, cut),
     })
 }
 
@@ -310,7 +313,7 @@ fn hac(features: &Features, params: &ClusterParams, cut: HacCut) -> Clustering {
     let merges = ward_linkage(&points, dim);
     let clusters = match cut {
         HacCut::Clusters => params.k,
-        HacCut::LargestGap { min, max } => largest_gap_clusters(n, &merges, min, max),
+        HacCut::LargestGap { min, max } => largest_gap_clusters(n, &merges, min, max.unwrap_or(usize::MAX)),
     };
     let labels = cut_dendrogram(n, &merges, clusters);
     let clusters = labels.iter().map(|&l| l as usize + 1).max().unwrap_or(0);

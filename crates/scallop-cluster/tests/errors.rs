@@ -57,7 +57,7 @@ fn unsupported_combinations_and_settings() {
     let pca = ClusterParams { metric: Metric::Pca { factor: Default::default() }, ..Default::default() };
     assert_eq!(cluster(&features, &pca).unwrap_err(), ClusterError::NeedsGeometry);
     let hac = ClusterParams {
-        method: Method::Hac(HacCut::Clusters),
+        method: Method::Hac { cut: HacCut::Clusters },
         metric: Metric::Mahalanobis { scope: Scope::Global },
         ..Default::default()
     };
@@ -65,7 +65,10 @@ fn unsupported_combinations_and_settings() {
     assert!(matches!(err, ClusterError::Unsupported { .. }) && err.to_string().contains("euclidean"), "{err}");
     let capped = ClusterParams { max_iterations: 0, ..Default::default() };
     assert!(cluster(&features, &capped).unwrap_err().to_string().contains("max_iterations"));
-    let bad_cut = ClusterParams { method: Method::Hac(HacCut::LargestGap { min: 3, max: 2 }), ..Default::default() };
+    let bad_cut = ClusterParams {
+        method: Method::Hac { cut: HacCut::LargestGap { min: 3, max: Some(2) } },
+        ..Default::default()
+    };
     assert!(matches!(cluster(&features, &bad_cut).unwrap_err(), ClusterError::BadSetting { .. }));
     let bad_rate = ClusterParams {
         method: Method::Rpcl,
@@ -73,4 +76,37 @@ fn unsupported_combinations_and_settings() {
         ..Default::default()
     };
     assert!(cluster(&features, &bad_rate).unwrap_err().to_string().contains("rpcl.alpha_winner"));
+}
+
+/// Parameters round-trip through serde (job files), every method and metric.
+#[test]
+fn params_round_trip() {
+    use scallop_cluster::{PcaFactor, StdScaling, ThetaMode};
+    let cases = [
+        ClusterParams::default(),
+        ClusterParams {
+            k: 7,
+            omega: [0.5, 1.0, 0.0, 0.25],
+            metric: Metric::StdDev { scaling: StdScaling::Variance, scope: Scope::PerCluster },
+            method: Method::Rpcl,
+            theta: ThetaMode::Plain,
+            seed: 42,
+            ..Default::default()
+        },
+        ClusterParams { metric: Metric::Pca { factor: PcaFactor::RhoSquared }, ..Default::default() },
+        ClusterParams {
+            method: Method::Hac { cut: HacCut::LargestGap { min: 3, max: Some(8) } },
+            ..Default::default()
+        },
+        ClusterParams { method: Method::Hac { cut: HacCut::default() }, ..Default::default() },
+    ];
+    for params in cases {
+        let text = serde_json::to_string(&params).unwrap();
+        let back: ClusterParams = serde_json::from_str(&text).unwrap();
+        assert_eq!(back, params, "{text}");
+    }
+    let partial: ClusterParams =
+        serde_json::from_str(r#"{"k": 5, "method": {"kind": "hac", "cut": {"kind": "clusters"}}}"#).unwrap();
+    assert_eq!(partial, ClusterParams { k: 5, method: Method::Hac { cut: HacCut::Clusters }, ..Default::default() });
+    assert!(serde_json::from_str::<ClusterParams>(r#"{"kk": 5}"#).is_err());
 }

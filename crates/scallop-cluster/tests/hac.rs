@@ -109,12 +109,15 @@ fn largest_gap_finds_separated_groups() {
 #[test]
 fn hac_method_on_features() {
     let features = common::grid([12, 12], |u, _| if u < 0.5 { (0.1, 0.2) } else { (1.4, -1.2) });
-    let exact =
-        cluster(&features, &ClusterParams { k: 4, method: Method::Hac(HacCut::Clusters), ..Default::default() })
-            .unwrap();
+    let exact = cluster(
+        &features,
+        &ClusterParams { k: 4, method: Method::Hac { cut: HacCut::Clusters }, ..Default::default() },
+    )
+    .unwrap();
     assert_eq!(exact.clusters, 4);
     let gap =
-        cluster(&features, &ClusterParams { method: Method::Hac(HacCut::default()), ..Default::default() }).unwrap();
+        cluster(&features, &ClusterParams { method: Method::Hac { cut: HacCut::default() }, ..Default::default() })
+            .unwrap();
     assert_eq!(gap.clusters, 2);
     for (i, &l) in gap.labels.iter().enumerate() {
         assert_eq!(l, u32::from(i / 12 >= 6));

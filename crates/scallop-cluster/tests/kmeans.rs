@@ -65,7 +65,7 @@ fn two_blobs_two_clusters() {
         let noise = 0.01 * ((17.0 * u + 29.0 * v).sin());
         if u < 0.5 { (0.2 + noise, 0.3 + noise) } else { (1.3 + noise, -1.0 + noise) }
     });
-    for method in [Method::KMeans, Method::Rpcl, Method::Hac(Default::default())] {
+    for method in [Method::KMeans, Method::Rpcl, Method::Hac { cut: Default::default() }] {
         let p = partition(&features, &ClusterParams { k: 2, method, ..Default::default() }).unwrap();
         assert_eq!(p.clusters, 2, "{method:?}");
         assert_eq!(p.zone_count(), 2, "{method:?}");
@@ -130,7 +130,7 @@ fn deterministic_across_runs_and_threads() {
             &features,
         ),
         (ClusterParams { k: 3, metric: Metric::Pca { factor: Default::default() }, ..Default::default() }, &features),
-        (ClusterParams { k: 4, method: Method::Hac(Default::default()), ..Default::default() }, &features),
+        (ClusterParams { k: 4, method: Method::Hac { cut: Default::default() }, ..Default::default() }, &features),
         (ClusterParams { k: 6, max_iterations: 20, ..Default::default() }, &big),
     ];
     for (params, features) in cases {
