@@ -28,6 +28,20 @@
 //! }
 //! ```
 //!
+//! # Decisions (where finishing.md leaves room)
+//! - Circle initialisation (11.4) takes `s` and `theta` from the cell that contains
+//!   `(u_k, v_k)` (the nearest kept cell on a masked grid) instead of evaluating the
+//!   surface there: the crate sees samples, not patches (at 80 x 80 the two differ by
+//!   half a cell). Likewise the PCA metric's `S(u_k, v_k)` is that cell's point.
+//! - `omega` weighs every metric as `W^(1/2) M W^(1/2)` (see [`Metric`]); for
+//!   Mahalanobis, scaling the features instead would cancel out.
+//! - K-means on the global diagonal metrics uses Hamerly's bounds, with the same
+//!   labels and sweeps as the plain algorithm (tested bit for bit).
+//! - HAC in [`ThetaMode::Wrapped`] embeds theta as `(cos 2 theta, sin 2 theta) / 2`;
+//!   its gap cut may return 2 clusters (see [`HacCut`]).
+//! - A global Mahalanobis covariance that is singular (a constant component) uses
+//!   the pseudo-inverse; a singular per-cluster one falls back to the global one.
+//!
 //! # Units
 //! `u, v` in `[0, 1]` (fractions of the parameter domain), `s` and `theta` in rad,
 //! 3D statistics in mm and mm^2.

@@ -1,12 +1,13 @@
 //! Parameters and entry points: [`cluster`] (labels only) and [`partition`]
 //! (clusters, connected zones and zone records).
 
+use scallop_analysis::FeatureVector;
 use serde::{Deserialize, Serialize};
 
 use crate::ccl::connected_components;
 use crate::engine::Setup;
 use crate::error::ClusterError;
-use crate::features::{Features, NO_LABEL, ThetaMode};
+use crate::features::{Features, NO_LABEL, Sums, ThetaMode};
 use crate::hac::{cut_dendrogram, largest_gap_clusters, ward_linkage};
 use crate::kmeans::kmeans;
 use crate::metric::{Metric, Scope, metric_matrix};
@@ -169,6 +170,11 @@ pub struct Partition {
     pub zones: Vec<Zone>,
     /// Number of non-empty clusters.
     pub clusters: usize,
+    /// Mean feature vector of every cluster (theta per [`ClusterParams::theta`]: the
+    /// circular mean when wrapped): K-means' final centres, and the mean
+    /// steepest-slope direction that starts the optimiser's `Theta_k`
+    /// (finishing.md 12.8; theta is in `(-pi/2, pi/2]`, Theta in `[0, pi]`).
+    pub cluster_means: Vec<FeatureVector>,
     /// Assignment sweeps run (0 for HAC).
     pub iterations: usize,
     /// See [`Clustering::converged`].
@@ -345,6 +351,17 @@ pub fn partition(features: &Features, params: &ClusterParams) -> Result<Partitio
     let (zone_of_cell, count) = connected_components(features.grid(), &cluster_of_cell)?;
     let zones = zone_records(features, &zone_of_cell, &cluster_of_cell, count, params.theta);
     let zone_cluster = zones.iter().map(|z| z.cluster).collect();
+    let mut sums = vec![Sums::default(); clustering.clusters];
+    for (i, &label) in clustering.labels.iter().enumerate() {
+        sums[label as usize].add(&features.x[i], &features.doubled[i]);
+    }
+    let cluster_means = sums
+        .iter()
+        .map(|s| {
+            let [u, v, slope, slope_direction] = s.mean(params.theta).unwrap_or([0.0; 4]);
+            FeatureVector { u, v, slope, slope_direction }
+        })
+        .collect();
     Ok(Partition {
         grid: features.grid(),
         cluster_of_cell,
@@ -352,6 +369,7 @@ pub fn partition(features: &Features, params: &ClusterParams) -> Result<Partitio
         zone_cluster,
         zones,
         clusters: clustering.clusters,
+        cluster_means,
         iterations: clustering.iterations,
         converged: clustering.converged,
     })

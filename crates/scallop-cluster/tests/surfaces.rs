@@ -86,6 +86,13 @@ fn choi_and_rubio_zones() {
             (0..4).for_each(|k| m[k][k] = 1.0);
             m
         });
+        // Cluster means (the optimiser's initial Theta_k) against an independent computation.
+        let independent = common::means(&f, &p.cluster_of_cell, p.clusters, ThetaMode::Wrapped);
+        for (m, e) in p.cluster_means.iter().zip(&independent) {
+            for (a, b) in [m.u, m.v, m.slope, m.slope_direction].iter().zip(e) {
+                assert!((a - b).abs() < 1e-12, "{name}: cluster mean {a} vs {b}");
+            }
+        }
         // Zone records against an independent computation.
         let (points, normals) = f.geometry().unwrap();
         for zone in &p.zones {
