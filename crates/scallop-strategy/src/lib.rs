@@ -125,6 +125,7 @@
 
 mod error;
 mod geometry;
+pub mod network;
 mod params;
 mod plan;
 mod scallop;
