@@ -125,3 +125,10 @@ pub const PLANE_NUDGE_REL: f64 = 1e-9;
 /// A far strip wider than half a spacing by less than this fraction of the
 /// spacing gets no further plane (rounding; ends the network sweep).
 pub const END_STRIP_REL: f64 = 1e-6;
+
+/// Look-ahead moves of the network sweep that go exactly to the spacing found;
+/// later ones shrink by an extra `LOOKAHEAD_SHRINK * 2^k` (at most 1/2).
+pub const LOOKAHEAD_PLAIN_RETRIES: usize = 4;
+
+/// See [`LOOKAHEAD_PLAIN_RETRIES`].
+pub const LOOKAHEAD_SHRINK: f64 = 1e-3;

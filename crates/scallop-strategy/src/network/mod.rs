@@ -87,6 +87,7 @@
 //! - Adjacent planes `d_k < d_{k+1}` satisfy `d_{k+1} - d_k <= Delta_i` for the
 //!   NEXT_SPACING term `Delta_i` of every vertex of both planes.
 
+mod normals;
 mod passes;
 mod spacing;
 mod time;
@@ -101,7 +102,7 @@ use serde::{Deserialize, Serialize};
 use crate::{StrategyError, tol};
 
 pub use time::{SurfaceTime, TransitionModel, Transitions, surface_time};
-pub use zone::{plan_zone, plan_zones};
+pub use zone::{plan_zone, plan_zones, plane_passes};
 
 /// The isoparametric machining network of a patch (finishing.md 6.3): `(N_u + 1)
 /// x (N_v + 1)` nodes `Q_ab = S(a / N_u, b / N_v)` with exact unit normals,
@@ -116,6 +117,11 @@ pub struct Network {
     points: Vec<Point3>,
     normals: Vec<Vec3>,
     orientation: Option<Orientation>,
+    /// The surface, for exact normals at pass vertices.
+    patch: Patch,
+    edge_normals: Option<normals::EdgeNormals>,
+    /// The global orientation sign of the normals (4.2).
+    normal_sign: f64,
 }
 
 impl Network {
@@ -141,18 +147,26 @@ impl Network {
                 fix: "give the machining-mesh step in mm, e.g. 0.5",
             });
         }
-        let domain = patch.domain();
-        let isoline = |along_u: bool, t: f64| -> f64 {
-            let n = tol::NETWORK_ISOLINE_SEGMENTS;
-            let at = |k: usize| {
-                let s = k as f64 / n as f64;
-                let (u, v) = if along_u { domain.lerp(s, t) } else { domain.lerp(t, s) };
-                patch.point(u, v)
-            };
-            (1..=n).map(|k| (at(k) - at(k - 1)).norm()).sum()
-        };
-        let count = |along_u: bool| -> Result<usize, StrategyError> {
-            let length = tol::NETWORK_ISOLINE_PARAMETERS.iter().map(|&t| isoline(along_u, t)).fold(0.0, f64::max);
+        let params = |n: usize| (0..=n).map(|k| k as f64 / n as f64).collect::<Vec<f64>>();
+        let samples = params(tol::NETWORK_ISOLINE_SEGMENTS);
+        let isolines = &tol::NETWORK_ISOLINE_PARAMETERS;
+        let polyline = |points: &[Point3]| points.windows(2).map(|w| (w[1] - w[0]).norm()).sum::<f64>();
+        // u-isolines: fixed v, row-major nodes a * 5 + b with a along u.
+        let (along_u, _) = grid(patch, &samples, isolines, false);
+        let (along_v, _) = grid(patch, isolines, &samples, false);
+        let count = |along_u_direction: bool| -> Result<usize, StrategyError> {
+            let lines = isolines.len();
+            let samples_len = samples.len();
+            let length = (0..lines)
+                .map(|k| {
+                    let line: Vec<Point3> = if along_u_direction {
+                        (0..samples_len).map(|a| along_u[a * lines + k]).collect()
+                    } else {
+                        along_v[k * samples_len..(k + 1) * samples_len].to_vec()
+                    };
+                    polyline(&line)
+                })
+                .fold(0.0, f64::max);
             let n = (length / step_mm).ceil().max(2.0);
             if n > tol::MAX_NETWORK_QUADS as f64 {
                 return Err(StrategyError::BadParameter {
@@ -173,24 +187,24 @@ impl Network {
     #[must_use]
     pub fn with_resolution(patch: &Patch, quads_u: usize, quads_v: usize) -> Network {
         let (nu, nv) = (quads_u.max(1), quads_v.max(1));
-        let domain = patch.domain();
-        let mut points = Vec::with_capacity((nu + 1) * (nv + 1));
-        let mut normals = Vec::with_capacity((nu + 1) * (nv + 1));
-        for a in 0..=nu {
-            for b in 0..=nv {
-                let (u, v) = domain.lerp(a as f64 / nu as f64, b as f64 / nv as f64);
-                points.push(patch.point(u, v));
-                normals.push(patch.normal(u, v));
-            }
-        }
+        let fractions = |n: usize| (0..=n).map(|k| k as f64 / n as f64).collect::<Vec<f64>>();
+        let (points, mut normals) = grid(patch, &fractions(nu), &fractions(nv), true);
         // Global orientation (4.2): the mean n_z is made non-negative.
         let mean_z: f64 = normals.iter().map(|n| n.z).sum();
-        if mean_z < 0.0 {
-            for n in &mut normals {
-                *n = -*n;
-            }
+        let normal_sign = if mean_z < 0.0 { -1.0 } else { 1.0 };
+        for n in &mut normals {
+            *n *= normal_sign;
         }
-        Network { quads_u: nu, quads_v: nv, points, normals, orientation: None }
+        Network {
+            quads_u: nu,
+            quads_v: nv,
+            points,
+            normals,
+            orientation: None,
+            patch: patch.clone(),
+            edge_normals: normals::EdgeNormals::new(patch, [nu, nv]),
+            normal_sign,
+        }
     }
 
     /// `(N_u, N_v)`: quads along u and v.
@@ -231,6 +245,9 @@ impl Network {
             points: self.points.iter().map(|p| orientation.to_machine(&back(p))).collect(),
             normals: self.normals.iter().map(|n| orientation.matrix * back_n(n)).collect(),
             orientation: Some(*orientation),
+            patch: self.patch.clone(),
+            edge_normals: self.edge_normals.clone(),
+            normal_sign: self.normal_sign,
         }
     }
 
@@ -246,10 +263,151 @@ impl Network {
         a * (self.quads_v + 1) + b
     }
 
+    /// The exact unit normal (oriented, in this frame) from `(S_u, S_v)` known up
+    /// to a common positive factor at domain fractions `(u, v)`.
+    fn finish_normal(&self, (su, sv): (Vec3, Vec3), u: f64, v: f64) -> Vec3 {
+        let n = su.cross(&sv);
+        let norm = n.norm();
+        let n = if norm > scallop_surface::tol::NORMAL_DEGENERATE_REL * (su.norm_squared() + sv.norm_squared()) {
+            n / norm
+        } else {
+            let (pu, pv) = self.patch.domain().lerp(u, v);
+            self.patch.normal(pu, pv)
+        } * self.normal_sign;
+        self.orientation.as_ref().map_or(n, |o| o.matrix * n)
+    }
+
+    /// Exact normal at domain fractions `(u, v)`.
+    pub(crate) fn normal_at(&self, u: f64, v: f64) -> Vec3 {
+        match &self.edge_normals {
+            Some(e) => self.finish_normal(e.at(u, v), u, v),
+            None => {
+                let (pu, pv) = self.patch.domain().lerp(u, v);
+                let d = self.patch.derivatives(pu, pv);
+                self.finish_normal((d.du, d.dv), u, v)
+            }
+        }
+    }
+
+    /// Exact normal on the u-edge row `b` (`v = b / N_v`) at `u`.
+    pub(crate) fn normal_on_row(&self, b: usize, u: f64) -> Vec3 {
+        let v = b as f64 / self.quads_v as f64;
+        match &self.edge_normals {
+            Some(e) => self.finish_normal(e.on_row(b, u), u, v),
+            None => self.normal_at(u, v),
+        }
+    }
+
+    /// Exact normal on the v-edge column `a` (`u = a / N_u`) at `v`.
+    pub(crate) fn normal_on_column(&self, a: usize, v: f64) -> Vec3 {
+        let u = a as f64 / self.quads_u as f64;
+        match &self.edge_normals {
+            Some(e) => self.finish_normal(e.on_column(a, v), u, v),
+            None => self.normal_at(u, v),
+        }
+    }
+
     /// A point of this frame back in the part frame.
     pub(crate) fn to_part(&self, p: &Point3) -> Point3 {
         self.orientation.as_ref().map_or(*p, |o| o.to_part(p))
     }
+}
+
+/// Points (and unit normals when asked) of `patch` on the tensor grid of domain
+/// fractions `us x vs`, index `a * vs.len() + b`. Bezier patches are evaluated
+/// from per-row Bernstein tables (no allocation per point); NURBS patches point
+/// by point. Normals are `Su x Sv` normalised, or `Patch::normal`'s fallback at
+/// degenerate points.
+fn grid(patch: &Patch, us: &[f64], vs: &[f64], with_normals: bool) -> (Vec<Point3>, Vec<Vec3>) {
+    let domain = patch.domain();
+    let size = us.len() * vs.len();
+    let mut points = Vec::with_capacity(size);
+    let mut normals = Vec::with_capacity(if with_normals { size } else { 0 });
+    let normal_of = |du: &Vec3, dv: &Vec3, u: f64, v: f64| {
+        let n = du.cross(dv);
+        let norm = n.norm();
+        if norm > scallop_surface::tol::NORMAL_DEGENERATE_REL * (du.norm_squared() + dv.norm_squared()) {
+            n / norm
+        } else {
+            patch.normal(u, v)
+        }
+    };
+    if !patch.is_bezier() {
+        for &s in us {
+            for &t in vs {
+                let (u, v) = domain.lerp(s, t);
+                let d = patch.derivatives(u, v);
+                points.push(d.point);
+                if with_normals {
+                    normals.push(normal_of(&d.du, &d.dv, u, v));
+                }
+            }
+        }
+        return (points, normals);
+    }
+    let [p, q] = patch.degree();
+    let weight = |i: usize, j: usize| patch.weights().map_or(1.0, |w| w[i * (q + 1) + j]);
+    let table_v: Vec<[Vec<f64>; 2]> = vs.iter().map(|&t| bernstein(q, t)).collect();
+    // Per u: the homogeneous row curves H_j = sum_i B_i(u) w_ij [P_ij, 1] and H'_j.
+    let mut rows = vec![[0.0; 4]; q + 1];
+    let mut rows_du = vec![[0.0; 4]; q + 1];
+    for &s in us {
+        let [bu, dbu] = bernstein(p, s);
+        for j in 0..=q {
+            rows[j] = [0.0; 4];
+            rows_du[j] = [0.0; 4];
+            for i in 0..=p {
+                let w = weight(i, j);
+                let c = patch.control_point(i, j);
+                let h = [c.x * w, c.y * w, c.z * w, w];
+                for k in 0..4 {
+                    rows[j][k] += bu[i] * h[k];
+                    rows_du[j][k] += dbu[i] * h[k];
+                }
+            }
+        }
+        for (&t, [bv, dbv]) in vs.iter().zip(&table_v) {
+            let (mut a, mut a_u, mut a_v) = ([0.0; 4], [0.0; 4], [0.0; 4]);
+            for j in 0..=q {
+                for k in 0..4 {
+                    a[k] += bv[j] * rows[j][k];
+                    a_u[k] += bv[j] * rows_du[j][k];
+                    a_v[k] += dbv[j] * rows[j][k];
+                }
+            }
+            let point = Point3::new(a[0] / a[3], a[1] / a[3], a[2] / a[3]);
+            points.push(point);
+            if with_normals {
+                let du = (Vec3::new(a_u[0], a_u[1], a_u[2]) - point.coords * a_u[3]) / a[3];
+                let dv = (Vec3::new(a_v[0], a_v[1], a_v[2]) - point.coords * a_v[3]) / a[3];
+                let (u, v) = domain.lerp(s, t);
+                normals.push(normal_of(&du, &dv, u, v));
+            }
+        }
+    }
+    (points, normals)
+}
+
+/// Bernstein polynomials of degree `n` at `t` and their first derivatives:
+/// `B_i = C(n, i) t^i (1 - t)^(n - i)`, `B_i' = n (B_{i-1}^{n-1} - B_i^{n-1})`.
+fn bernstein(n: usize, t: f64) -> [Vec<f64>; 2] {
+    let of_degree = |d: usize| -> Vec<f64> {
+        let mut b = vec![0.0; d + 1];
+        b[0] = 1.0;
+        for k in 1..=d {
+            // de Casteljau's triangle: B^k from B^(k-1).
+            for i in (0..=k).rev() {
+                let left = if i > 0 { b[i - 1] } else { 0.0 };
+                b[i] = (1.0 - t) * b[i] + t * left;
+            }
+        }
+        b
+    };
+    let values = of_degree(n);
+    let lower = if n > 0 { of_degree(n - 1) } else { Vec::new() };
+    let at = |i: usize| lower.get(i).copied().unwrap_or(0.0);
+    let derivative = (0..=n).map(|i| n as f64 * ((if i > 0 { at(i - 1) } else { 0.0 }) - at(i))).collect();
+    [values, derivative]
 }
 
 /// A 3+2 orientation (finishing.md 4.5): tool axis `a = (sin tilt cos azimuth,
@@ -566,5 +724,38 @@ impl ZonePlan {
                 if backwards { Box::new(plane.passes.iter().rev()) } else { Box::new(plane.passes.iter()) };
             passes.map(move |p| (p, backwards))
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The tabulated grid equals point-by-point evaluation, rational patches included.
+    #[test]
+    fn grid_matches_the_patch() {
+        let p = |x, y, z| Point3::new(x, y, z);
+        let control = [
+            vec![p(0., 0., 0.), p(0., 5., 2.), p(0., 10., 0.)],
+            vec![p(5., 0., 1.), p(5., 5., 6.), p(5., 10., 1.)],
+            vec![p(10., 0., 0.), p(10., 5., -2.), p(10., 10., 3.)],
+        ];
+        let weights = [vec![1.0, 2.0, 1.0], vec![0.5, 1.0, 3.0], vec![1.0, 1.5, 1.0]];
+        let choi = scallop_surface::builtin("choi").unwrap_or_else(|| unreachable!()).patches()[0].clone();
+        for patch in [
+            choi,
+            Patch::bezier("rational", [2, 2], &control, Some(&weights)).unwrap_or_else(|e| panic!("{e}")),
+        ] {
+            let us = [0.0, 0.13, 0.5, 0.77, 1.0];
+            let vs = [0.0, 0.31, 0.9, 1.0];
+            let (points, normals) = grid(&patch, &us, &vs, true);
+            for (a, &u) in us.iter().enumerate() {
+                for (b, &v) in vs.iter().enumerate() {
+                    let k = a * vs.len() + b;
+                    assert!((points[k] - patch.point(u, v)).norm() < 1e-12, "{u} {v}");
+                    assert!((normals[k] - patch.normal(u, v)).norm() < 1e-12, "{u} {v}");
+                }
+            }
+        }
     }
 }

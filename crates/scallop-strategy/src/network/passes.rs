@@ -208,9 +208,18 @@ impl<'a> PlaneCutter<'a> {
             let w = self.net.quads_v + 1;
             [(node / w) as f64 / nu, (node % w) as f64 / nv]
         };
-        let a = Vertex { p: self.net.points[i], n: self.net.normals[i], uv: uv(i) };
-        let b = Vertex { p: self.net.points[j], n: self.net.normals[j], uv: uv(j) };
-        a.lerp(&b, t)
+        let a = Vertex { p: self.net.points[i], n: Vec3::zeros(), uv: uv(i) };
+        let b = Vertex { p: self.net.points[j], n: Vec3::zeros(), uv: uv(j) };
+        let mut x = a.lerp(&b, t);
+        // The exact normal at the crossing's (u, v) (6.4), along the edge's isoline.
+        let (qa, qb) = (q / self.net.quads_v, q % self.net.quads_v);
+        x.n = match k {
+            0 => self.net.normal_on_row(qb, x.uv[0]),
+            2 => self.net.normal_on_row(qb + 1, x.uv[0]),
+            1 => self.net.normal_on_column(qa + 1, x.uv[1]),
+            _ => self.net.normal_on_column(qa, x.uv[1]),
+        };
+        x
     }
 
     /// The exit edge of a curve entering quad `q` by local edge `k` (marching
@@ -332,7 +341,10 @@ impl<'a> PlaneCutter<'a> {
             None => self.finish(line, tool, cut),
             Some((zoning, zone)) => {
                 let mut piece = std::mem::take(&mut self.ws.piece);
-                clip(line, &zoning.labels, zone, &mut piece, |p| self.finish(p, tool, cut));
+                let net = self.net;
+                clip(line, &zoning.labels, zone, &mut piece, |uv| net.normal_at(uv[0], uv[1]), |p| {
+                    self.finish(p, tool, cut);
+                });
                 self.ws.piece = piece;
             }
         }
@@ -361,8 +373,16 @@ impl<'a> PlaneCutter<'a> {
 
 /// Splits `line` where the clustering-cell label changes (exact crossing of the
 /// axis-aligned cell boundaries, the boundary point inserted) and hands each
-/// maximal piece of label `zone` to `out`.
-fn clip(line: &[Vertex], labels: &CellLabels, zone: u32, piece: &mut Vec<Vertex>, mut out: impl FnMut(&[Vertex])) {
+/// maximal piece of label `zone` to `out`; inserted points get the exact
+/// `normal` at their `(u, v)`.
+fn clip(
+    line: &[Vertex],
+    labels: &CellLabels,
+    zone: u32,
+    piece: &mut Vec<Vertex>,
+    normal: impl Fn([f64; 2]) -> Vec3,
+    mut out: impl FnMut(&[Vertex]),
+) {
     let (cu, cv) = (labels.cells_u, labels.cells_v);
     let cell = |v: &Vertex| (CellLabels::cell_index(v.uv[0], cu), CellLabels::cell_index(v.uv[1], cv));
     let label = |(i, j): (usize, usize)| labels.labels[i * cv + j];
@@ -387,7 +407,8 @@ fn clip(line: &[Vertex], labels: &CellLabels, zone: u32, piece: &mut Vec<Vertex>
                 j = (j + dj).clamp(0, cv.cast_signed() - 1);
                 let now = label((i.cast_unsigned(), j.cast_unsigned())) == zone;
                 if now != inside {
-                    let x = a.lerp(b, t);
+                    let mut x = a.lerp(b, t);
+                    x.n = normal(x.uv);
                     if inside {
                         piece.push(x);
                         out(piece);

@@ -30,6 +30,34 @@ pub fn plan_zone(
     plan_in(network, zoning, zone, params, &mut ws)
 }
 
+/// PLANE_PASSES and NEXT_SPACING (finishing.md 6.3, 6.4) of one plane `m . P =
+/// offset` (`m = (-sin t, cos t, 0)`, `t = params.direction`): the passes of
+/// `zone` (the whole surface without a zoning), oriented along the feed and
+/// sorted by feed coordinate, and the plane's spacing. Passes shorter than
+/// [`tol::MIN_PASS_LENGTH`] are left out but count for the spacing.
+///
+/// # Errors
+/// As [`plan_zone`]; a zone without cells is [`StrategyError::EmptyZone`].
+pub fn plane_passes(
+    network: &Network,
+    zoning: Option<&Zoning>,
+    zone: u32,
+    params: &ZoneParams,
+    offset: f64,
+) -> Result<NetworkPlane, StrategyError> {
+    validate(network, zoning, params)?;
+    let tool = ToolModel::new(&params.tool, params.scallop_height)?;
+    let cos_sharp = params.sharp_corner.min(std::f64::consts::PI).cos();
+    let mut ws = Workspace::default();
+    let Some(mut cutter) =
+        PlaneCutter::new(network, zoning.map(|z| (z, zone)), params.direction, cos_sharp, params.machine, &mut ws)
+    else {
+        return Err(StrategyError::EmptyZone { zone });
+    };
+    let cut = cutter.plane(offset, &tool);
+    Ok(NetworkPlane { offset, spacing: cut.spacing, passes: cut.passes })
+}
+
 /// Plans every zone of `zoning` (3-axis), zone `zoning.zones()[i]` along
 /// `directions[i]`, the other settings shared; the plans come in increasing
 /// label, the order of [`super::surface_time`]. Buffers are shared between zones.
@@ -225,11 +253,21 @@ fn lookahead(
 ) -> Result<(f64, PlaneCut), StrategyError> {
     let mut gap = gap;
     let mut cut = cutter.plane(d + gap, tool);
-    for _ in 0..tol::MAX_LOOKAHEAD_RETRIES {
+    for retry in 0..tol::MAX_LOOKAHEAD_RETRIES {
         if cut.spacing >= gap * (1.0 - tol::LOOKAHEAD_REL) {
-            return Ok((d + gap, cut));
+            // Within rounding of the spacing: record the plane at the spacing
+            // (its passes, cut `LOOKAHEAD_REL * gap` away, are kept), so that no
+            // recorded gap exceeds a spacing.
+            return Ok((d + gap.min(cut.spacing), cut));
         }
-        gap = cut.spacing;
+        // The fixed point of gap = spacing(d + gap), approached from above; after
+        // a few plain steps each retry shrinks more (slow convergence).
+        let extra = if retry < tol::LOOKAHEAD_PLAIN_RETRIES {
+            0.0
+        } else {
+            (tol::LOOKAHEAD_SHRINK * f64::from(1u32 << (retry - tol::LOOKAHEAD_PLAIN_RETRIES).min(20))).min(0.5)
+        };
+        gap = cut.spacing * (1.0 - extra);
         if gap < tol::MIN_SPACING {
             return Err(unreachable(&cut, gap, params));
         }

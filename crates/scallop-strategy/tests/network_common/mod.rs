@@ -37,6 +37,13 @@ pub fn rel(a: f64, b: f64) -> f64 {
 /// A flat end (`Toroidal { corner: 0 }`) is at least its saw tooth `sh / sin s`,
 /// at most its diameter.
 pub fn spacing_at(n: &Vec3, theta: f64, tool: &Cutter, sh: f64) -> f64 {
+    let (sod, factor) = step_over_and_factor(n, theta, tool, sh);
+    sod * factor
+}
+
+/// The step-over `sod` at a point of unit normal `n` and the factor `|c . m|`
+/// turning it into a horizontal plane spacing (see [`spacing_at`]).
+pub fn step_over_and_factor(n: &Vec3, theta: f64, tool: &Cutter, sh: f64) -> (f64, f64) {
     let slope = n.z.abs().min(1.0).acos();
     let alpha = if n.x.hypot(n.y) < 1e-12 { 0.0 } else { n.y.atan2(n.x) - theta };
     let mut sod = tool.step_over(sh, slope, alpha);
@@ -48,10 +55,10 @@ pub fn spacing_at(n: &Vec3, theta: f64, tool: &Cutter, sh: f64) -> f64 {
     let m = Vec3::new(-theta.sin(), theta.cos(), 0.0);
     let tau = m.cross(n);
     if tau.norm() == 0.0 {
-        return 0.0;
+        return (sod, 0.0);
     }
     let c = n.cross(&(tau / tau.norm()));
-    sod * (c / c.norm()).dot(&m).abs()
+    (sod, (c / c.norm()).dot(&m).abs())
 }
 
 /// Every point of every pass, with its plane index.
