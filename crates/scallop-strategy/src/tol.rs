@@ -132,3 +132,9 @@ pub const LOOKAHEAD_PLAIN_RETRIES: usize = 4;
 
 /// See [`LOOKAHEAD_PLAIN_RETRIES`].
 pub const LOOKAHEAD_SHRINK: f64 = 1e-3;
+
+/// Where the spacing shrinks from plane to plane, the network sweep steps by
+/// `Delta_k - LOOKAHEAD_TREND (Delta_{k-1} - Delta_k)` instead of `Delta_k`, so
+/// that the next plane's own spacing usually accepts the gap at once (a
+/// slightly conservative step instead of a second plane).
+pub const LOOKAHEAD_TREND: f64 = 1.25;

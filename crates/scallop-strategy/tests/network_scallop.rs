@@ -58,7 +58,7 @@ proptest! {
             for (_, p, uv) in points.iter().filter(|(i, _, _)| *i == k || *i == k + 1) {
                 let n = surface.normal(uv[0], uv[1]);
                 let (sod, factor) = step_over_and_factor(&n, theta, &cutter, sh);
-                if factor == 0.0 {
+                if factor <= 0.0 {
                     continue; // a vertical tangent across the feed: no cusp in this section
                 }
                 let across = gap / factor;

@@ -55,8 +55,10 @@
 //!   `sod_i |c_i . m| = sod_i sqrt(1 - (n_i . m)^2)` with `sod_i` the step-over of
 //!   5.2 and 5.3 at the vertex's tilt and horizontal feed angle
 //!   ([`scallop_analysis::Cutter`]'s Eq. 1.5, evaluated from the normal's
-//!   components without trigonometry). Normals at crossing points are the
-//!   normalised interpolation of the exact node normals.
+//!   components without trigonometry) and `n_i` the **exact** normal at the
+//!   vertex's `(u, v)`: on a network edge one parameter is fixed, so the patch
+//!   restricted to that isoline is tabulated once per network row and column and
+//!   a crossing costs one degree-`p` Bernstein evaluation (`normals.rs`).
 //! - **Look-ahead** \[DECISION\]: the next plane at `d + Delta` is accepted only if its
 //!   own spacing is at least `Delta`; otherwise it moves to `d + Delta'` and is
 //!   checked again. Every vertex of both planes of a gap then sees the gap within
@@ -83,7 +85,7 @@
 //! - Never performs I/O, never reads clocks; deterministic (no threads, no hashing).
 //! - Every pass vertex lies on the network (a node, an edge point or a point of a
 //!   segment inside a quad), with `(u, v)` in `[0, 1]^2` (fractions of the patch
-//!   domain).
+//!   domain); its normal for the spacing is the surface's exact normal there.
 //! - Adjacent planes `d_k < d_{k+1}` satisfy `d_{k+1} - d_k <= Delta_i` for the
 //!   NEXT_SPACING term `Delta_i` of every vertex of both planes.
 
@@ -332,7 +334,8 @@ fn grid(patch: &Patch, us: &[f64], vs: &[f64], with_normals: bool) -> (Vec<Point
             patch.normal(u, v)
         }
     };
-    if !patch.is_bezier() {
+    let [p, q] = patch.degree();
+    if !patch.is_bezier() || p > normals::MAX_DEGREE || q > normals::MAX_DEGREE {
         for &s in us {
             for &t in vs {
                 let (u, v) = domain.lerp(s, t);
@@ -345,14 +348,18 @@ fn grid(patch: &Patch, us: &[f64], vs: &[f64], with_normals: bool) -> (Vec<Point
         }
         return (points, normals);
     }
-    let [p, q] = patch.degree();
     let weight = |i: usize, j: usize| patch.weights().map_or(1.0, |w| w[i * (q + 1) + j]);
-    let table_v: Vec<[Vec<f64>; 2]> = vs.iter().map(|&t| bernstein(q, t)).collect();
+    let table = |n: usize, t: f64| {
+        let (mut values, mut derivatives) = ([0.0; normals::MAX_DEGREE + 1], [0.0; normals::MAX_DEGREE + 1]);
+        normals::bernstein(n, t, &mut values, &mut derivatives);
+        [values, derivatives]
+    };
+    let table_v: Vec<[[f64; normals::MAX_DEGREE + 1]; 2]> = vs.iter().map(|&t| table(q, t)).collect();
     // Per u: the homogeneous row curves H_j = sum_i B_i(u) w_ij [P_ij, 1] and H'_j.
     let mut rows = vec![[0.0; 4]; q + 1];
     let mut rows_du = vec![[0.0; 4]; q + 1];
     for &s in us {
-        let [bu, dbu] = bernstein(p, s);
+        let [bu, dbu] = table(p, s);
         for j in 0..=q {
             rows[j] = [0.0; 4];
             rows_du[j] = [0.0; 4];
@@ -386,28 +393,6 @@ fn grid(patch: &Patch, us: &[f64], vs: &[f64], with_normals: bool) -> (Vec<Point
         }
     }
     (points, normals)
-}
-
-/// Bernstein polynomials of degree `n` at `t` and their first derivatives:
-/// `B_i = C(n, i) t^i (1 - t)^(n - i)`, `B_i' = n (B_{i-1}^{n-1} - B_i^{n-1})`.
-fn bernstein(n: usize, t: f64) -> [Vec<f64>; 2] {
-    let of_degree = |d: usize| -> Vec<f64> {
-        let mut b = vec![0.0; d + 1];
-        b[0] = 1.0;
-        for k in 1..=d {
-            // de Casteljau's triangle: B^k from B^(k-1).
-            for i in (0..=k).rev() {
-                let left = if i > 0 { b[i - 1] } else { 0.0 };
-                b[i] = (1.0 - t) * b[i] + t * left;
-            }
-        }
-        b
-    };
-    let values = of_degree(n);
-    let lower = if n > 0 { of_degree(n - 1) } else { Vec::new() };
-    let at = |i: usize| lower.get(i).copied().unwrap_or(0.0);
-    let derivative = (0..=n).map(|i| n as f64 * ((if i > 0 { at(i - 1) } else { 0.0 }) - at(i))).collect();
-    [values, derivative]
 }
 
 /// A 3+2 orientation (finishing.md 4.5): tool axis `a = (sin tilt cos azimuth,

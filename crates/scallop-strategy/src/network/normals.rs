@@ -20,7 +20,7 @@ use scallop_geom::Vec3;
 use scallop_surface::Patch;
 
 /// Largest Bezier degree tabulated (higher degrees use `Patch::normal`).
-const MAX_DEGREE: usize = 15;
+pub(crate) const MAX_DEGREE: usize = 15;
 
 type Homogeneous = [f64; 4];
 
@@ -38,7 +38,28 @@ pub(crate) struct EdgeNormals {
 }
 
 /// Bernstein values and first derivatives of degree `n` at `t` into `values`, `derivatives`.
-fn bernstein(n: usize, t: f64, values: &mut [f64; MAX_DEGREE + 1], derivatives: &mut [f64; MAX_DEGREE + 1]) {
+pub(crate) fn bernstein(n: usize, t: f64, values: &mut [f64; MAX_DEGREE + 1], derivatives: &mut [f64; MAX_DEGREE + 1]) {
+    let s = 1.0 - t;
+    // Closed forms of the common degrees (the general loop below is the same).
+    match n {
+        1 => {
+            values[..2].copy_from_slice(&[s, t]);
+            derivatives[..2].copy_from_slice(&[-1.0, 1.0]);
+            return;
+        }
+        2 => {
+            values[..3].copy_from_slice(&[s * s, 2.0 * s * t, t * t]);
+            derivatives[..3].copy_from_slice(&[-2.0 * s, 2.0 * (s - t), 2.0 * t]);
+            return;
+        }
+        3 => {
+            let (s2, t2) = (s * s, t * t);
+            values[..4].copy_from_slice(&[s2 * s, 3.0 * s2 * t, 3.0 * s * t2, t2 * t]);
+            derivatives[..4].copy_from_slice(&[-3.0 * s2, 3.0 * s * (s - 2.0 * t), 3.0 * t * (2.0 * s - t), 3.0 * t2]);
+            return;
+        }
+        _ => {}
+    }
     *values = [0.0; MAX_DEGREE + 1];
     values[0] = 1.0;
     let step = |values: &mut [f64; MAX_DEGREE + 1], k: usize| {
@@ -65,6 +86,21 @@ fn axpy(acc: &mut Homogeneous, a: f64, x: &Homogeneous) {
     for k in 0..4 {
         acc[k] += a * x[k];
     }
+}
+
+/// Along an isoline with tables `curve` (degree `n`) and `cross` (its
+/// derivative across): the homogeneous point, its derivative along `t` and
+/// across.
+fn along(n: usize, t: f64, curve: &[Homogeneous], cross: &[Homogeneous]) -> (Homogeneous, Homogeneous, Homogeneous) {
+    let (mut values, mut derivatives) = ([0.0; MAX_DEGREE + 1], [0.0; MAX_DEGREE + 1]);
+    bernstein(n, t, &mut values, &mut derivatives);
+    let (mut a, mut a_along, mut a_across) = ([0.0; 4], [0.0; 4], [0.0; 4]);
+    for i in 0..=n {
+        axpy(&mut a, values[i], &curve[i]);
+        axpy(&mut a_along, derivatives[i], &curve[i]);
+        axpy(&mut a_across, values[i], &cross[i]);
+    }
+    (a, a_along, a_across)
 }
 
 /// `W X_u - W_u X` as a vector from homogeneous `A` and its derivative.
@@ -123,30 +159,16 @@ impl EdgeNormals {
     /// `(S_u, S_v)` up to a common positive factor on the u-edge row `b` at `u`.
     pub(crate) fn on_row(&self, b: usize, u: f64) -> (Vec3, Vec3) {
         let p = self.degree[0];
-        let (mut values, mut derivatives) = ([0.0; MAX_DEGREE + 1], [0.0; MAX_DEGREE + 1]);
-        bernstein(p, u, &mut values, &mut derivatives);
-        let (mut a, mut a_u, mut a_v) = ([0.0; 4], [0.0; 4], [0.0; 4]);
-        for i in 0..=p {
-            let (r, r_dv) = (&self.rows[b * (p + 1) + i], &self.rows_dv[b * (p + 1) + i]);
-            axpy(&mut a, values[i], r);
-            axpy(&mut a_u, derivatives[i], r);
-            axpy(&mut a_v, values[i], r_dv);
-        }
+        let range = b * (p + 1)..(b + 1) * (p + 1);
+        let (a, a_u, a_v) = along(p, u, &self.rows[range.clone()], &self.rows_dv[range]);
         (tangent(&a, &a_u), tangent(&a, &a_v))
     }
 
     /// `(S_u, S_v)` up to a common positive factor on the v-edge column `a` at `v`.
     pub(crate) fn on_column(&self, column: usize, v: f64) -> (Vec3, Vec3) {
         let q = self.degree[1];
-        let (mut values, mut derivatives) = ([0.0; MAX_DEGREE + 1], [0.0; MAX_DEGREE + 1]);
-        bernstein(q, v, &mut values, &mut derivatives);
-        let (mut a, mut a_u, mut a_v) = ([0.0; 4], [0.0; 4], [0.0; 4]);
-        for j in 0..=q {
-            let (c, c_du) = (&self.columns[column * (q + 1) + j], &self.columns_du[column * (q + 1) + j]);
-            axpy(&mut a, values[j], c);
-            axpy(&mut a_v, derivatives[j], c);
-            axpy(&mut a_u, values[j], c_du);
-        }
+        let range = column * (q + 1)..(column + 1) * (q + 1);
+        let (a, a_v, a_u) = along(q, v, &self.columns[range.clone()], &self.columns_du[range]);
         (tangent(&a, &a_u), tangent(&a, &a_v))
     }
 
@@ -167,5 +189,30 @@ impl EdgeNormals {
             }
         }
         (tangent(&a, &a_u), tangent(&a, &a_v))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Closed forms and the general recursion give `C(n, i) t^i (1 - t)^(n - i)`
+    /// and its derivative.
+    #[test]
+    fn bernstein_values_and_derivatives() {
+        for n in 1..=6usize {
+            for &t in &[0.0, 0.2, 0.5, 0.93, 1.0] {
+                let (mut values, mut derivatives) = ([0.0; MAX_DEGREE + 1], [0.0; MAX_DEGREE + 1]);
+                bernstein(n, t, &mut values, &mut derivatives);
+                let binomial = |n: usize, i: usize| (1..=i).fold(1.0, |c, k| c * (n + 1 - k) as f64 / k as f64);
+                let b = |n: usize, i: usize| binomial(n, i) * t.powi(i as i32) * (1.0 - t).powi((n - i) as i32);
+                for i in 0..=n {
+                    assert!((values[i] - b(n, i)).abs() < 1e-14, "n {n} i {i} t {t}");
+                    let left = if i > 0 { b(n - 1, i - 1) } else { 0.0 };
+                    let right = if i < n { b(n - 1, i) } else { 0.0 };
+                    assert!((derivatives[i] - n as f64 * (left - right)).abs() < 1e-13, "n {n} i {i} t {t}");
+                }
+            }
+        }
     }
 }

@@ -46,6 +46,13 @@ pub(crate) struct Workspace {
     piece: Vec<Vertex>,
 }
 
+/// A network quad by its indices along u and v.
+#[derive(Debug, Clone, Copy)]
+struct Quad {
+    a: usize,
+    b: usize,
+}
+
 #[derive(Debug, Clone, Copy, Default)]
 struct Span {
     lo: f64,
@@ -179,10 +186,16 @@ impl<'a> PlaneCutter<'a> {
         self.zoning.is_none_or(|(z, zone)| z.quad_in_zone(q, zone))
     }
 
-    /// `(node0, node1, edge id)` of local edge `k` of quad `q`.
-    fn edge(&self, q: usize, k: usize) -> (usize, usize, usize) {
+    /// The quad `(a, b)` of index `q`.
+    fn quad(&self, q: usize) -> Quad {
+        let nv = self.net.quads_v;
+        Quad { a: q / nv, b: q % nv }
+    }
+
+    /// `(node0, node1, edge id)` of local edge `k` of quad `(a, b)`.
+    fn edge(&self, quad: Quad, k: usize) -> (usize, usize, usize) {
         let (nu, nv) = (self.net.quads_u, self.net.quads_v);
-        let (a, b) = (q / nv, q % nv);
+        let Quad { a, b } = quad;
         let u_edges = nu * (nv + 1);
         let n = |a, b| self.net.node(a, b);
         match k {
@@ -193,95 +206,102 @@ impl<'a> PlaneCutter<'a> {
         }
     }
 
-    fn crosses(&self, q: usize, k: usize, d: f64) -> bool {
-        let (i, j, _) = self.edge(q, k);
-        (self.ws.g[i] >= d) != (self.ws.g[j] >= d)
+    /// `g` at the corners `(a, b), (a + 1, b), (a + 1, b + 1), (a, b + 1)`.
+    fn corners(&self, quad: Quad) -> [f64; 4] {
+        let Quad { a, b } = quad;
+        let g = &self.ws.g;
+        let (n00, n10) = (self.net.node(a, b), self.net.node(a + 1, b));
+        [g[n00], g[n10], g[n10 + 1], g[n00 + 1]]
     }
 
-    /// The crossing point of local edge `k` of `q` (the same from both quads).
-    fn point(&self, q: usize, k: usize, d: f64) -> Vertex {
-        let (i, j, _) = self.edge(q, k);
+    /// Which local edges cross the plane, from the corner values.
+    fn crossings(c: &[f64; 4], d: f64) -> [bool; 4] {
+        let s = c.map(|x| x >= d);
+        [s[0] != s[1], s[1] != s[2], s[3] != s[2], s[0] != s[3]]
+    }
+
+    /// The crossing point of local edge `k` of a quad (the same from both quads).
+    fn point(&self, quad: Quad, k: usize, d: f64) -> Vertex {
+        let (i, j, _) = self.edge(quad, k);
         let (gi, gj) = (self.ws.g[i], self.ws.g[j]);
         let t = ((d - gi) / (gj - gi)).clamp(0.0, 1.0);
         let (nu, nv) = (self.net.quads_u as f64, self.net.quads_v as f64);
-        let uv = |node: usize| {
-            let w = self.net.quads_v + 1;
-            [(node / w) as f64 / nu, (node % w) as f64 / nv]
-        };
-        let a = Vertex { p: self.net.points[i], n: Vec3::zeros(), uv: uv(i) };
-        let b = Vertex { p: self.net.points[j], n: Vec3::zeros(), uv: uv(j) };
-        let mut x = a.lerp(&b, t);
+        let (pi, pj) = (self.net.points[i], self.net.points[j]);
+        let p = pi + (pj - pi) * t;
+        let Quad { a, b } = quad;
         // The exact normal at the crossing's (u, v) (6.4), along the edge's isoline.
-        let (qa, qb) = (q / self.net.quads_v, q % self.net.quads_v);
-        x.n = match k {
-            0 => self.net.normal_on_row(qb, x.uv[0]),
-            2 => self.net.normal_on_row(qb + 1, x.uv[0]),
-            1 => self.net.normal_on_column(qa + 1, x.uv[1]),
-            _ => self.net.normal_on_column(qa, x.uv[1]),
+        let (uv, n) = match k {
+            0 | 2 => {
+                let row = if k == 0 { b } else { b + 1 };
+                let u = (a as f64 + t) / nu;
+                ([u, row as f64 / nv], self.net.normal_on_row(row, u))
+            }
+            _ => {
+                let column = if k == 1 { a + 1 } else { a };
+                let v = (b as f64 + t) / nv;
+                ([column as f64 / nu, v], self.net.normal_on_column(column, v))
+            }
         };
-        x
+        Vertex { p, n, uv }
     }
 
-    /// The exit edge of a curve entering quad `q` by local edge `k` (marching
-    /// squares; a saddle is resolved by the sign at the quad centre).
-    fn partner(&self, q: usize, k: usize, d: f64) -> usize {
-        let crossing: [bool; 4] = std::array::from_fn(|e| self.crosses(q, e, d));
-        if crossing.iter().filter(|&&c| c).count() == 4 {
-            let (c0, _, _) = self.edge(q, 0);
-            let (c1, c2, _) = self.edge(q, 1);
-            let (c3, _, _) = self.edge(q, 2);
-            let g = &self.ws.g;
-            let centre = 0.25 * (g[c0] + g[c1] + g[c2] + g[c3]);
+    /// The exit edge of a curve entering a quad of corner values `c` by local
+    /// edge `k` (marching squares; a saddle is resolved by the sign at the
+    /// quad centre).
+    fn partner(c: &[f64; 4], k: usize, d: f64) -> usize {
+        let crossing = Self::crossings(c, d);
+        if crossing.iter().all(|&x| x) {
+            let centre = 0.25 * (c[0] + c[1] + c[2] + c[3]);
             // Same side as corner 0 at the centre: corners 1 and 3 are cut off.
-            let pairs = if (centre >= d) == (g[c0] >= d) { [1, 0, 3, 2] } else { [3, 2, 1, 0] };
+            let pairs = if (centre >= d) == (c[0] >= d) { [1, 0, 3, 2] } else { [3, 2, 1, 0] };
             return pairs[k];
         }
         (0..4).find(|&e| e != k && crossing[e]).unwrap_or(k)
     }
 
-    /// The quad across local edge `k` of `q`, and that edge's local index there.
-    fn neighbour(&self, q: usize, k: usize) -> Option<(usize, usize)> {
+    /// The quad across local edge `k`, and that edge's local index there.
+    fn neighbour(&self, quad: Quad, k: usize) -> Option<(Quad, usize)> {
         let (nu, nv) = (self.net.quads_u, self.net.quads_v);
-        let (a, b) = (q / nv, q % nv);
+        let Quad { a, b } = quad;
         let next = match k {
-            0 => (b > 0).then(|| (q - 1, 2)),
-            1 => (a + 1 < nu).then(|| (q + nv, 3)),
-            2 => (b + 1 < nv).then(|| (q + 1, 0)),
-            _ => (a > 0).then(|| (q - nv, 1)),
+            0 => (b > 0).then(|| (Quad { a, b: b - 1 }, 2)),
+            1 => (a + 1 < nu).then(|| (Quad { a: a + 1, b }, 3)),
+            2 => (b + 1 < nv).then(|| (Quad { a, b: b + 1 }, 0)),
+            _ => (a > 0).then(|| (Quad { a: a - 1, b }, 1)),
         };
-        next.filter(|&(n, _)| self.in_zone(n))
+        next.filter(|(n, _)| self.in_zone(n.a * nv + n.b))
     }
 
-    /// Walks from quad `q` entered by edge `k`, appending crossing points; true
+    /// Walks from a quad entered by edge `k`, appending crossing points; true
     /// when it came back to a marked edge (a closed curve).
-    fn walk(&mut self, mut q: usize, mut k: usize, d: f64, into: &mut Vec<Vertex>) -> bool {
+    fn walk(&mut self, mut quad: Quad, mut k: usize, d: f64, into: &mut Vec<Vertex>) -> bool {
         loop {
-            let exit = self.partner(q, k, d);
-            let (_, _, id) = self.edge(q, exit);
+            let exit = Self::partner(&self.corners(quad), k, d);
+            let (_, _, id) = self.edge(quad, exit);
             if self.ws.marks[id] == self.ws.stamp {
                 return true;
             }
             self.ws.marks[id] = self.ws.stamp;
-            into.push(self.point(q, exit, d));
-            match self.neighbour(q, exit) {
-                Some((n, e)) => (q, k) = (n, e),
+            into.push(self.point(quad, exit, d));
+            match self.neighbour(quad, exit) {
+                Some((n, e)) => (quad, k) = (n, e),
                 None => return false,
             }
         }
     }
 
-    /// The whole curve through local edge `k` of quad `q`, into `forward`.
-    fn trace(&mut self, q: usize, k: usize, d: f64) -> Vec<Vertex> {
+    /// The whole curve through local edge `k` of a quad.
+    fn trace(&mut self, quad: Quad, k: usize, d: f64) -> Vec<Vertex> {
         let mut forward = std::mem::take(&mut self.ws.forward);
         let mut backward = std::mem::take(&mut self.ws.backward);
         forward.clear();
         backward.clear();
-        let (_, _, id) = self.edge(q, k);
+        let (_, _, id) = self.edge(quad, k);
         self.ws.marks[id] = self.ws.stamp;
-        forward.push(self.point(q, k, d));
-        if self.walk(q, k, d, &mut forward) {
+        forward.push(self.point(quad, k, d));
+        if self.walk(quad, k, d, &mut forward) {
             forward.push(forward[0]);
-        } else if let Some((n, e)) = self.neighbour(q, k) {
+        } else if let Some((n, e)) = self.neighbour(quad, k) {
             self.walk(n, e, d, &mut backward);
             backward.reverse();
             backward.append(&mut forward);
@@ -309,11 +329,12 @@ impl<'a> PlaneCutter<'a> {
             if !(span.lo < d && span.hi >= d) {
                 continue;
             }
-            let q = span.quad as usize;
+            let quad = self.quad(span.quad as usize);
+            let crossing = Self::crossings(&self.corners(quad), d);
             for k in 0..4 {
-                let (_, _, id) = self.edge(q, k);
-                if self.ws.marks[id] != self.ws.stamp && self.crosses(q, k, d) {
-                    let mut line = self.trace(q, k, d);
+                let (_, _, id) = self.edge(quad, k);
+                if crossing[k] && self.ws.marks[id] != self.ws.stamp {
+                    let mut line = self.trace(quad, k, d);
                     self.emit(&mut line, tool, &mut cut);
                     self.ws.forward = line;
                 }

@@ -214,23 +214,36 @@ fn sweep(cutter: &mut PlaneCutter<'_>, tool: &ToolModel, params: &ZoneParams) ->
             (d_min + start, cutter.plane(d_min + start, tool))
         }
     };
+    // The spacing of the previous plane, for the trend of the look-ahead.
+    let mut previous = f64::INFINITY;
+    let mut first = true;
     loop {
         if cut.spacing.is_finite() {
+            previous = if first { f64::INFINITY } else { delta };
             delta = cut.spacing;
         }
+        first = false;
         if delta < tol::MIN_SPACING {
             return Err(unreachable(&cut, delta, params));
         }
         if !cut.passes.is_empty() {
             planes.push(NetworkPlane { offset: d, spacing: cut.spacing, passes: cut.passes });
         }
+        // Where the spacing shrinks from plane to plane, the next plane's own
+        // spacing is likely below `delta`: step by the extrapolated spacing
+        // (at least half of `delta`) to spare the look-ahead a second plane.
+        let step = if previous.is_finite() && previous > delta * (1.0 + tol::LOOKAHEAD_REL) {
+            (delta - tol::LOOKAHEAD_TREND * (previous - delta)).max(0.5 * delta)
+        } else {
+            delta
+        };
         let target = match params.margins {
             Margins::HalfStep => (d + 0.5 * delta < d_max - tol::END_STRIP_REL * delta)
-                .then(|| (d + delta).min(d_max - 0.5 * delta)),
+                .then(|| (d + step).min(d_max - 0.5 * delta)),
             Margins::Fixed { end, .. } => {
                 let stop = d_max - end;
                 if d + delta <= stop {
-                    Some(d + delta)
+                    Some(d + step)
                 } else {
                     (stop - d > (0.5 + tol::END_STRIP_REL) * delta).then_some(stop)
                 }

@@ -48,13 +48,13 @@ pub fn step_over_and_factor(n: &Vec3, theta: f64, tool: &Cutter, sh: f64) -> (f6
     let alpha = if n.x.hypot(n.y) < 1e-12 { 0.0 } else { n.y.atan2(n.x) - theta };
     let mut sod = tool.step_over(sh, slope, alpha);
     if let Cutter::Toroidal { radius, corner } = *tool
-        && corner == 0.0
+        && corner <= 0.0
     {
         sod = sod.max(sh / slope.sin()).min(2.0 * radius);
     }
     let m = Vec3::new(-theta.sin(), theta.cos(), 0.0);
     let tau = m.cross(n);
-    if tau.norm() == 0.0 {
+    if tau.norm() <= 0.0 {
         return (sod, 0.0);
     }
     let c = n.cross(&(tau / tau.norm()));
