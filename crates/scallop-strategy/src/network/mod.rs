@@ -486,7 +486,8 @@ impl CellLabels {
     pub(crate) fn cell_index(t: f64, cells: usize) -> usize {
         // INVARIANT: t is clamped into [0, 1] and the product into [0, cells - 1].
         #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
-        let i = (t.clamp(0.0, 1.0) * cells as f64).floor() as usize;
+        // Truncation is the floor of a non-negative value (and avoids a libm call).
+        let i = (t.clamp(0.0, 1.0) * cells as f64) as usize;
         i.min(cells - 1)
     }
 
@@ -519,6 +520,9 @@ pub struct Zoning {
     quads: Vec<Vec<u32>>,
     /// Per quad: the label of its cells when they all agree, else `MIXED`.
     quad_label: Vec<u32>,
+    /// Cells `[first, last]` overlapped by each network column `a` and row `b`.
+    ranges_u: Vec<(usize, usize)>,
+    ranges_v: Vec<(usize, usize)>,
 }
 
 /// Marks a quad whose cells carry several labels.
@@ -545,30 +549,37 @@ impl Zoning {
         zones.dedup();
         let mut quads = vec![Vec::new(); zones.len()];
         let mut quad_label = Vec::with_capacity(nu * nv);
+        let ranges_u: Vec<(usize, usize)> = (0..nu).map(|a| cell_range(a, nu, labels.cells_u)).collect();
+        let ranges_v: Vec<(usize, usize)> = (0..nv).map(|b| cell_range(b, nv, labels.cells_v)).collect();
         let mut seen: Vec<u32> = Vec::new();
-        for a in 0..nu {
-            let (i0, i1) = cell_range(a, nu, labels.cells_u);
-            for b in 0..nv {
-                let (j0, j1) = cell_range(b, nv, labels.cells_v);
+        for (a, &(i0, i1)) in ranges_u.iter().enumerate() {
+            for (b, &(j0, j1)) in ranges_v.iter().enumerate() {
+                let q = u32::try_from(a * nv + b).unwrap_or(u32::MAX);
+                let first = labels.labels[i0 * labels.cells_v + j0];
+                let uniform =
+                    (i0..=i1).all(|i| labels.labels[i * labels.cells_v + j0..=i * labels.cells_v + j1].iter().all(|&l| l == first));
+                if uniform {
+                    // INVARIANT: every label is in `zones`.
+                    quads[zones.binary_search(&first).unwrap_or(0)].push(q);
+                    quad_label.push(first);
+                    continue;
+                }
                 seen.clear();
                 for i in i0..=i1 {
-                    for j in j0..=j1 {
-                        let l = labels.labels[i * labels.cells_v + j];
+                    for &l in &labels.labels[i * labels.cells_v + j0..=i * labels.cells_v + j1] {
                         if !seen.contains(&l) {
                             seen.push(l);
                         }
                     }
                 }
-                let q = u32::try_from(a * nv + b).unwrap_or(u32::MAX);
                 for l in &seen {
                     // INVARIANT: every label is in `zones`.
-                    let k = zones.binary_search(l).unwrap_or(0);
-                    quads[k].push(q);
+                    quads[zones.binary_search(l).unwrap_or(0)].push(q);
                 }
-                quad_label.push(if seen.len() == 1 { seen[0] } else { MIXED });
+                quad_label.push(MIXED);
             }
         }
-        Ok(Zoning { labels: labels.clone(), quads_u: nu, quads_v: nv, zones, quads, quad_label })
+        Ok(Zoning { labels: labels.clone(), quads_u: nu, quads_v: nv, zones, quads, quad_label, ranges_u, ranges_v })
     }
 
     /// The zones (distinct labels), increasing.
@@ -590,8 +601,7 @@ impl Zoning {
             return l == zone;
         }
         let (a, b) = (q / self.quads_v, q % self.quads_v);
-        let (i0, i1) = cell_range(a, self.quads_u, self.labels.cells_u);
-        let (j0, j1) = cell_range(b, self.quads_v, self.labels.cells_v);
+        let ((i0, i1), (j0, j1)) = (self.ranges_u[a], self.ranges_v[b]);
         (i0..=i1).any(|i| (j0..=j1).any(|j| self.labels.labels[i * self.labels.cells_v + j] == zone))
     }
 }

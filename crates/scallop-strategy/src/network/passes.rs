@@ -98,8 +98,27 @@ impl<'a> PlaneCutter<'a> {
         let (sin, cos) = theta.sin_cos();
         let f = [cos, sin];
         let m = [-sin, cos];
-        ws.g.clear();
-        ws.g.extend(net.points.iter().map(|p| m[0] * p.x + m[1] * p.y));
+        // g = m . Q at the nodes the zone's quads use (all nodes without a zoning);
+        // the others are never read.
+        let dot = |p: &Point3| m[0] * p.x + m[1] * p.y;
+        ws.g.resize(net.points.len(), 0.0);
+        match zoning {
+            None => {
+                for (g, p) in ws.g.iter_mut().zip(&net.points) {
+                    *g = dot(p);
+                }
+            }
+            Some((zoning, zone)) => {
+                let k = zoning.zones.binary_search(&zone).ok()?;
+                let nv = net.quads_v;
+                for &q in &zoning.quads[k] {
+                    let (a, b) = (q as usize / nv, q as usize % nv);
+                    for node in [net.node(a, b), net.node(a, b) + 1, net.node(a + 1, b), net.node(a + 1, b) + 1] {
+                        ws.g[node] = dot(&net.points[node]);
+                    }
+                }
+            }
+        }
         let edges = net.quads_u * (net.quads_v + 1) + (net.quads_u + 1) * net.quads_v;
         if ws.marks.len() != edges {
             ws.marks = vec![0; edges];
@@ -122,8 +141,8 @@ impl<'a> PlaneCutter<'a> {
         match zoning {
             None => {
                 ws.spans.extend((0..nu * nv).map(span));
-                for &x in g {
-                    range = (range.0.min(x), range.1.max(x));
+                for s in &ws.spans {
+                    range = (range.0.min(s.lo), range.1.max(s.hi));
                 }
             }
             Some((zoning, zone)) => {
@@ -488,8 +507,7 @@ fn zone_extent(net: &Network, zoning: &Zoning, zone: u32, g: &[f64], q: usize, s
     let (a, b) = (q / nv, q % nv);
     let gc = [g[net.node(a, b)], g[net.node(a + 1, b)], g[net.node(a, b + 1)], g[net.node(a + 1, b + 1)]];
     let labels = &zoning.labels;
-    let (i0, i1) = super::cell_range(a, nu, labels.cells_u);
-    let (j0, j1) = super::cell_range(b, nv, labels.cells_v);
+    let ((i0, i1), (j0, j1)) = (zoning.ranges_u[a], zoning.ranges_v[b]);
     let local = |cell: usize, cells: usize, k: usize, n: usize| {
         let lo = (cell as f64 / cells as f64 * n as f64 - k as f64).clamp(0.0, 1.0);
         let hi = ((cell + 1) as f64 / cells as f64 * n as f64 - k as f64).clamp(0.0, 1.0);
