@@ -75,8 +75,7 @@ fn bench(c: &mut Criterion) {
             group.bench_function(format!("{id}/{name}"), |b| {
                 b.iter(|| {
                     let zoning = Zoning::new(&network, &labels).expect("zoning");
-                    let directions: Vec<f64> =
-                        (0..zoning.zones().len()).map(|i| theta + spread * i as f64).collect();
+                    let directions: Vec<f64> = (0..zoning.zones().len()).map(|i| theta + spread * i as f64).collect();
                     let plans = plan_zones(&network, &zoning, &directions, &params(theta)).expect("plans");
                     surface_time(&plans, &transitions, &machine).total_s
                 });

@@ -22,7 +22,9 @@ const ROUNDING_SLACK: f64 = 1e-8;
 
 fn patch(z: &[f64], size: [f64; 2]) -> Patch {
     let rows: Vec<Vec<Point3>> = (0..4)
-        .map(|i| (0..4).map(|j| Point3::new(size[0] * i as f64 / 3.0, size[1] * j as f64 / 3.0, z[i * 4 + j])).collect())
+        .map(|i| {
+            (0..4).map(|j| Point3::new(size[0] * i as f64 / 3.0, size[1] * j as f64 / 3.0, z[i * 4 + j])).collect()
+        })
         .collect();
     Patch::bezier("random", [3, 3], &rows, None).unwrap()
 }

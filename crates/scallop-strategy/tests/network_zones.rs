@@ -12,8 +12,7 @@ use proptest::prelude::*;
 use scallop_analysis::{Cutter, MachineLimits};
 use scallop_strategy::StrategyError;
 use scallop_strategy::network::{
-    CellLabels, Network, Pass, TransitionModel, Transitions, Zoning, plan_zone, plan_zones, plane_passes,
-    surface_time,
+    CellLabels, Network, Pass, TransitionModel, Transitions, Zoning, plan_zone, plan_zones, plane_passes, surface_time,
 };
 
 const TORUS: Cutter = Cutter::Toroidal { radius: 5.0, corner: 2.0 };

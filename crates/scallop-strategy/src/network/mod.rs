@@ -556,8 +556,9 @@ impl Zoning {
             for (b, &(j0, j1)) in ranges_v.iter().enumerate() {
                 let q = u32::try_from(a * nv + b).unwrap_or(u32::MAX);
                 let first = labels.labels[i0 * labels.cells_v + j0];
-                let uniform =
-                    (i0..=i1).all(|i| labels.labels[i * labels.cells_v + j0..=i * labels.cells_v + j1].iter().all(|&l| l == first));
+                let uniform = (i0..=i1).all(|i| {
+                    labels.labels[i * labels.cells_v + j0..=i * labels.cells_v + j1].iter().all(|&l| l == first)
+                });
                 if uniform {
                     // INVARIANT: every label is in `zones`.
                     quads[zones.binary_search(&first).unwrap_or(0)].push(q);
@@ -737,10 +738,9 @@ mod tests {
         ];
         let weights = [vec![1.0, 2.0, 1.0], vec![0.5, 1.0, 3.0], vec![1.0, 1.5, 1.0]];
         let choi = scallop_surface::builtin("choi").unwrap_or_else(|| unreachable!()).patches()[0].clone();
-        for patch in [
-            choi,
-            Patch::bezier("rational", [2, 2], &control, Some(&weights)).unwrap_or_else(|e| panic!("{e}")),
-        ] {
+        for patch in
+            [choi, Patch::bezier("rational", [2, 2], &control, Some(&weights)).unwrap_or_else(|e| panic!("{e}"))]
+        {
             let us = [0.0, 0.13, 0.5, 0.77, 1.0];
             let vs = [0.0, 0.31, 0.9, 1.0];
             let (points, normals) = grid(&patch, &us, &vs, true);

@@ -158,7 +158,8 @@ impl<'a> PlaneCutter<'a> {
             return None;
         }
         // Bucket the quads by their minimum (counting sort, one bucket per quad).
-        let (g0, g1) = ws.spans.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |acc, s| (acc.0.min(s.lo), acc.1.max(s.lo)));
+        let (g0, g1) =
+            ws.spans.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |acc, s| (acc.0.min(s.lo), acc.1.max(s.lo)));
         let extent = ws.spans.iter().fold(0.0f64, |acc, s| acc.max(s.hi - s.lo));
         let buckets = ws.spans.len();
         let width = (g1 - g0) / buckets as f64;
@@ -350,9 +351,9 @@ impl<'a> PlaneCutter<'a> {
             }
             let quad = self.quad(span.quad as usize);
             let crossing = Self::crossings(&self.corners(quad), d);
-            for k in 0..4 {
+            for (k, &crosses) in crossing.iter().enumerate() {
                 let (_, _, id) = self.edge(quad, k);
-                if crossing[k] && self.ws.marks[id] != self.ws.stamp {
+                if crosses && self.ws.marks[id] != self.ws.stamp {
                     let mut line = self.trace(quad, k, d);
                     self.emit(&mut line, tool, &mut cut);
                     self.ws.forward = line;
@@ -382,9 +383,16 @@ impl<'a> PlaneCutter<'a> {
             Some((zoning, zone)) => {
                 let mut piece = std::mem::take(&mut self.ws.piece);
                 let net = self.net;
-                clip(line, &zoning.labels, zone, &mut piece, |uv| net.normal_at(uv[0], uv[1]), |p| {
-                    self.finish(p, tool, cut);
-                });
+                clip(
+                    line,
+                    &zoning.labels,
+                    zone,
+                    &mut piece,
+                    |uv| net.normal_at(uv[0], uv[1]),
+                    |p| {
+                        self.finish(p, tool, cut);
+                    },
+                );
                 self.ws.piece = piece;
             }
         }
@@ -499,7 +507,15 @@ fn boundary_crossings(a: f64, b: f64, from: usize, to: usize, cells: usize, mut 
 /// Widens `range` by the extent along `m` of quad `q`'s part in `zone`: its
 /// corners when all its cells are the zone's, else the corners of its
 /// intersection with each cell of the zone, on the bilinear quad.
-fn zone_extent(net: &Network, zoning: &Zoning, zone: u32, g: &[f64], q: usize, span: &Span, range: (f64, f64)) -> (f64, f64) {
+fn zone_extent(
+    net: &Network,
+    zoning: &Zoning,
+    zone: u32,
+    g: &[f64],
+    q: usize,
+    span: &Span,
+    range: (f64, f64),
+) -> (f64, f64) {
     if zoning.quad_label[q] == zone {
         return (range.0.min(span.lo), range.1.max(span.hi));
     }

@@ -103,13 +103,17 @@ fn validate(network: &Network, zoning: Option<&Zoning>, params: &ZoneParams) -> 
         }
     }
     if let Err(e) = params.machine.validate() {
-        return bad("machine", f64::NAN, match e {
-            scallop_analysis::AnalysisError::BadMachine { what: "feed", .. } => "give a positive feed V (mm/s)",
-            scallop_analysis::AnalysisError::BadMachine { what: "acceleration", .. } => {
-                "give a positive acceleration A (mm/s^2)"
-            }
-            _ => "give a positive jerk J (mm/s^3)",
-        });
+        return bad(
+            "machine",
+            f64::NAN,
+            match e {
+                scallop_analysis::AnalysisError::BadMachine { what: "feed", .. } => "give a positive feed V (mm/s)",
+                scallop_analysis::AnalysisError::BadMachine { what: "acceleration", .. } => {
+                    "give a positive acceleration A (mm/s^2)"
+                }
+                _ => "give a positive jerk J (mm/s^3)",
+            },
+        );
     }
     if let Some(z) = zoning
         && network.resolution() != (z.quads_u, z.quads_v)
@@ -188,7 +192,11 @@ fn plan_in(
 
 /// The planes of the sweep in increasing offset (planes without a pass of the
 /// zone are left out).
-fn sweep(cutter: &mut PlaneCutter<'_>, tool: &ToolModel, params: &ZoneParams) -> Result<Vec<NetworkPlane>, StrategyError> {
+fn sweep(
+    cutter: &mut PlaneCutter<'_>,
+    tool: &ToolModel,
+    params: &ZoneParams,
+) -> Result<Vec<NetworkPlane>, StrategyError> {
     let (d_min, d_max) = cutter.range();
     let mut planes = Vec::new();
     // The last finite spacing (the spec's fallback for a plane without vertices).
@@ -238,8 +246,9 @@ fn sweep(cutter: &mut PlaneCutter<'_>, tool: &ToolModel, params: &ZoneParams) ->
             delta
         };
         let target = match params.margins {
-            Margins::HalfStep => (d + 0.5 * delta < d_max - tol::END_STRIP_REL * delta)
-                .then(|| (d + step).min(d_max - 0.5 * delta)),
+            Margins::HalfStep => {
+                (d + 0.5 * delta < d_max - tol::END_STRIP_REL * delta).then(|| (d + step).min(d_max - 0.5 * delta))
+            }
             Margins::Fixed { end, .. } => {
                 let stop = d_max - end;
                 if d + delta <= stop {
@@ -290,10 +299,5 @@ fn lookahead(
 }
 
 fn unreachable(cut: &PlaneCut, spacing: f64, params: &ZoneParams) -> StrategyError {
-    StrategyError::Unreachable {
-        x: cut.worst.x,
-        y: cut.worst.y,
-        spacing,
-        scallop_height: params.scallop_height,
-    }
+    StrategyError::Unreachable { x: cut.worst.x, y: cut.worst.y, spacing, scallop_height: params.scallop_height }
 }
