@@ -3,8 +3,9 @@
 //! **isoparametric network** of a parametric patch, spaced by the worst-point
 //! rule, joined in zigzag by straight connections and timed by the jerk-limited
 //! stop-to-stop model. This is the black box of the optimisation (issue 8): one
-//! evaluation of an 80 x 80 labelling of the Choi or Rubio surface at the 0.5 mm
-//! machining mesh takes about a millisecond (see `docs/benchmarks.md`).
+//! evaluation of an 80 x 80 labelling of the Choi surface at the 0.5 mm machining
+//! mesh is about 15 to 35 million instructions, a few milliseconds (figures in
+//! `docs/benchmarks.md`).
 //!
 //! Unlike [`crate::plan_finishing`] it drops no cutter and writes no toolpath:
 //! the passes are **contact** polylines on the network, lengths are measured
