@@ -4,8 +4,9 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use scallop_cutter::{Cutter, CutterShape};
-use scallop_engine::{FinishJob, run_finishing};
+use scallop_engine::{FinishJob, OutputOptions, Setup, run_finishing};
 use scallop_geom::Tolerances;
+use scallop_geom::nalgebra::Rotation3;
 use scallop_io::job::{DirectionSpec, JobFile, parse_job};
 use scallop_strategy::Pattern;
 
@@ -72,6 +73,30 @@ fn finish_job(spec: &JobFile, folder: &Path) -> CliResult<FinishJob> {
     };
     let flute = spec.cutter.flute_length.unwrap_or(4.0 * spec.cutter.diameter);
     let cutter = Cutter::new(shape, flute).map_err(|e| Failure::rejected(format!("cutter: {e}")))?;
+    let o = &spec.output;
+    let dialect = scallop_post::Dialect::builtin(&o.dialect).map_err(|_| {
+        Failure::rejected(format!(
+            "`output.dialect` = \"{}\": no such dialect; use one of {:?}",
+            o.dialect,
+            scallop_post::Dialect::builtin_names()
+        ))
+    })?;
+    let output = OutputOptions {
+        dialect,
+        arc_fitting: o.arc_fitting,
+        program: o.program.clone(),
+        tool: o.tool,
+        spindle: o.spindle,
+    };
+    let setup = match &spec.setup {
+        None => None,
+        Some(s) => {
+            let machine = scallop_machine::Machine::builtin(&s.machine)
+                .map_err(|e| Failure::rejected(format!("`setup.machine` = \"{}\": {e}", s.machine)))?;
+            let [rx, ry, rz] = s.rotation_deg.map(f64::to_radians);
+            Some(Setup { rotation: Rotation3::from_euler_angles(rx, ry, rz), machine, tool_length: s.tool_length })
+        }
+    };
     Ok(FinishJob {
         part,
         part_name,
@@ -88,5 +113,7 @@ fn finish_job(spec: &JobFile, folder: &Path) -> CliResult<FinishJob> {
         tolerances: Tolerances { path: spec.tolerances.path, gouge: spec.tolerances.gouge },
         max_step: spec.finishing.max_step,
         sim_resolution: spec.verify.resolution,
+        output,
+        setup,
     })
 }

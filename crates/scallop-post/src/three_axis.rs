@@ -108,7 +108,8 @@ pub fn write_fitted(
         writeln!(out, "G0 {}", words.join(" "))?;
     }
     let d = dialect.decimals;
-    let xyz = |p: &scallop_geom::Point3| format!("X{} Y{} Z{}", fmt_number(p.x, d), fmt_number(p.y, d), fmt_number(p.z, d));
+    let xyz =
+        |p: &scallop_geom::Point3| format!("X{} Y{} Z{}", fmt_number(p.x, d), fmt_number(p.y, d), fmt_number(p.z, d));
     let mut last_feed: Option<f64> = None;
     let mut plane = ArcPlane::Xy; // every ISO header selects G17
     let mut from: Option<scallop_geom::Point3> = None;
