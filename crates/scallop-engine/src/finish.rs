@@ -43,10 +43,17 @@ pub struct OutputOptions {
 }
 
 impl OutputOptions {
-    /// Plain RS-274, no arcs, no tool change.
+    /// LinuxCNC (4 decimals: the program replays within 1e-4 mm), no arcs, no tool
+    /// change.
+    ///
+    /// # Panics
+    /// Never: the shipped dialect parses (tested in `scallop-post`).
     #[must_use]
-    pub fn plain() -> OutputOptions {
-        OutputOptions { dialect: Dialect::plain(), arc_fitting: false, program: "1".into(), tool: 0, spindle: 0.0 }
+    pub fn linuxcnc() -> OutputOptions {
+        // INVARIANT: the shipped dialect files parse.
+        #[allow(clippy::unwrap_used, clippy::missing_panics_doc)]
+        let dialect = Dialect::builtin("linuxcnc").unwrap();
+        OutputOptions { dialect, arc_fitting: false, program: "1".into(), tool: 0, spindle: 0.0 }
     }
 }
 
@@ -127,7 +134,7 @@ impl FinishJob {
             tolerances: Tolerances { path: 0.01, gouge: 0.0 },
             max_step: 0.5,
             sim_resolution: 0.1,
-            output: OutputOptions::plain(),
+            output: OutputOptions::linuxcnc(),
             setup: None,
         }
     }

@@ -50,7 +50,7 @@ pub struct JobFile {
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct OutputSpec {
-    /// Controller dialect: `plain` (default), `linuxcnc`, `fanuc`, `grbl`, `siemens840d`,
+    /// Controller dialect: `linuxcnc` (default), `plain`, `fanuc`, `grbl`, `siemens840d`,
     /// `heidenhain-iso` (checked by the caller against the shipped dialects).
     #[serde(default = "default_dialect")]
     pub dialect: String,
@@ -69,7 +69,7 @@ pub struct OutputSpec {
 }
 
 fn default_dialect() -> String {
-    "plain".into()
+    "linuxcnc".into()
 }
 fn default_program() -> String {
     "1".into()
