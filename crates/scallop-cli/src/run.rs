@@ -44,7 +44,7 @@ pub fn run(args: &RunArgs) -> CliResult<()> {
     let spinner = progress_bar(0, "planning and verifying");
     spinner.enable_steady_tick(std::time::Duration::from_millis(120));
     let start = std::time::Instant::now();
-    let out = run_finishing(&job).map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
+    let out = run_finishing(&job).map_err(|e| Failure::rejected(format!("{name}: {e}{}", job_keys(&e))))?;
     spinner.finish_and_clear();
     write_finishing(&out, start.elapsed().as_secs_f64(), &args.output, args.json)
 }
@@ -72,7 +72,9 @@ fn finish_job(spec: &JobFile, folder: &Path) -> CliResult<FinishJob> {
         _ => CutterShape::Bull { radius, corner: spec.cutter.corner_radius.unwrap_or(radius) },
     };
     let flute = spec.cutter.flute_length.unwrap_or(4.0 * spec.cutter.diameter);
-    let cutter = Cutter::new(shape, flute).map_err(|e| Failure::rejected(format!("cutter: {e}")))?;
+    let cutter = Cutter::new(shape, flute).map_err(|e| {
+        Failure::rejected(format!("[cutter] (diameter, corner_radius, flute_length): {e}"))
+    })?;
     let o = &spec.output;
     let dialect = scallop_post::Dialect::builtin(&o.dialect).map_err(|_| {
         Failure::rejected(format!(
@@ -116,4 +118,20 @@ fn finish_job(spec: &JobFile, folder: &Path) -> CliResult<FinishJob> {
         output,
         setup,
     })
+}
+
+/// The job keys behind a planning failure, so the message names what to change.
+fn job_keys(e: &scallop_engine::EngineError) -> &'static str {
+    use scallop_engine::EngineError as E;
+    use scallop_strategy::StrategyError as S;
+    match e {
+        E::Strategy(S::Unreachable { .. }) => {
+            " (job keys: cutter.shape, finishing.direction, finishing.scallop_height)"
+        }
+        E::Strategy(S::EmptyRegion { .. }) => " (job keys: part, finishing.max_step, cutter.diameter)",
+        E::Strategy(S::ScallopTooLarge { .. }) => " (job keys: finishing.scallop_height, cutter.corner_radius)",
+        E::Verification(_) => " (job keys: cutter.flute_length, machine.clearance, tolerances.gouge)",
+        E::Output { .. } => " (job keys: [output], [setup])",
+        _ => "",
+    }
 }
