@@ -8,7 +8,7 @@ use scallop_engine::{FinishJob, OutputOptions, Setup, run_finishing};
 use scallop_geom::Tolerances;
 use scallop_geom::nalgebra::Rotation3;
 use scallop_io::job::{DirectionSpec, JobFile, parse_job};
-use scallop_strategy::Pattern;
+use scallop_strategy::{LeadKind, Pattern};
 
 use crate::output::{progress_bar, write_finishing};
 use crate::part::{UnitsArg, load};
@@ -72,9 +72,8 @@ fn finish_job(spec: &JobFile, folder: &Path) -> CliResult<FinishJob> {
         _ => CutterShape::Bull { radius, corner: spec.cutter.corner_radius.unwrap_or(radius) },
     };
     let flute = spec.cutter.flute_length.unwrap_or(4.0 * spec.cutter.diameter);
-    let cutter = Cutter::new(shape, flute).map_err(|e| {
-        Failure::rejected(format!("[cutter] (diameter, corner_radius, flute_length): {e}"))
-    })?;
+    let cutter = Cutter::new(shape, flute)
+        .map_err(|e| Failure::rejected(format!("[cutter] (diameter, corner_radius, flute_length): {e}")))?;
     let o = &spec.output;
     let dialect = scallop_post::Dialect::builtin(&o.dialect).map_err(|_| {
         Failure::rejected(format!(
@@ -117,6 +116,13 @@ fn finish_job(spec: &JobFile, folder: &Path) -> CliResult<FinishJob> {
         sim_resolution: spec.verify.resolution,
         output,
         setup,
+        leads: match spec.finishing.lead.as_str() {
+            "arc" => LeadKind::Arc { radius: spec.finishing.lead_radius },
+            "ramp" => {
+                LeadKind::Ramp { length: spec.finishing.lead_length, angle: spec.finishing.lead_angle_deg.to_radians() }
+            }
+            _ => LeadKind::None,
+        },
     })
 }
 

@@ -257,26 +257,42 @@ fn bad_jobs_name_the_key_and_the_fix_and_write_nothing() {
     let cases: [(&str, String, &[&str]); 10] = [
         ("unknown key", format!("{base}colour = \"red\"\n"), &["colour"]),
         ("negative size", base.replace("diameter = 6", "diameter = -6"), &["cutter.diameter", "> 0"]),
-        ("sh over the radius", base.replace("scallop_height = 0.01", "scallop_height = 4"), &["finishing.scallop_height", "radius"]),
+        (
+            "sh over the radius",
+            base.replace("scallop_height = 0.01", "scallop_height = 4"),
+            &["finishing.scallop_height", "radius"],
+        ),
         (
             "unreachable",
-            base.replace("\"ball\"", "\"flat\"").replace("scallop_height = 0.01", "scallop_height = 0.0001\ndirection = 90"),
+            base.replace("\"ball\"", "\"flat\"")
+                .replace("scallop_height = 0.01", "scallop_height = 0.0001\ndirection = 90"),
             &["cannot reach", "finishing.scallop_height", "ball or bull-nose"],
         ),
         (
             "empty region",
-            base.replace("builtin = \"choi\"", "file = \"tiny.stl\"").replace("scallop_height = 0.01", "scallop_height = 0.01\ndirection = 0"),
+            base.replace("builtin = \"choi\"", "file = \"tiny.stl\"")
+                .replace("scallop_height = 0.01", "scallop_height = 0.01\ndirection = 0"),
             &["region to machine is empty", "finishing.max_step"],
         ),
         ("short flutes", base.replace("flute_length = 60", "flute_length = 8"), &["shank", "cutter.flute_length"]),
-        ("flutes under the profile", base.replace("flute_length = 60", "flute_length = 2"), &["flute_length", "profile"]),
+        (
+            "flutes under the profile",
+            base.replace("flute_length = 60", "flute_length = 2"),
+            &["flute_length", "profile"],
+        ),
         ("unknown dialect", format!("{base}[output]\ndialect = \"haas\"\n"), &["output.dialect", "linuxcnc"]),
         (
             "arcs in 3+2",
-            format!("{base}[setup]\nrotation_deg = [10, 0, 0]\nmachine = \"linuxcnc-xyzac-trt\"\n[output]\narc_fitting = true\n"),
+            format!(
+                "{base}[setup]\nrotation_deg = [10, 0, 0]\nmachine = \"linuxcnc-xyzac-trt\"\n[output]\narc_fitting = true\n"
+            ),
             &["output.arc_fitting", "false"],
         ),
-        ("unknown machine", format!("{base}[setup]\nrotation_deg = [10, 0, 0]\nmachine = \"mill\"\n"), &["setup.machine", "mill"]),
+        (
+            "unknown machine",
+            format!("{base}[setup]\nrotation_deg = [10, 0, 0]\nmachine = \"mill\"\n"),
+            &["setup.machine", "mill"],
+        ),
     ];
     for (what, text, needles) in cases {
         std::fs::write(dir.join("job.toml"), &text).expect("write");

@@ -16,7 +16,10 @@ use scallop_machine::program::{ProgramOptions, records_from_toolpath, to_program
 use scallop_machine::{Kinematics, Machine};
 use scallop_mesh::{MeshIndex, TriMesh};
 use scallop_post::{Dialect, OutputMode, PostParams, ProgramInfo, program_text, write_fitted};
-use scallop_strategy::{Boundary, FinishingParams, Pattern, plan_finishing};
+use scallop_strategy::{
+    Boundary, FinishingParams, LeadKind, LeadReport, Pattern, apply_leads, lookahead_time, plan_finishing,
+    stop_to_stop_time,
+};
 use scallop_toolpath::{FittedPath, Move, MoveKind, Toolpath, fit_arcs};
 use serde::Serialize;
 
@@ -105,6 +108,8 @@ pub struct FinishJob {
     pub output: OutputOptions,
     /// 3+2 setup; `None` for 3-axis work in the part frame.
     pub setup: Option<Setup>,
+    /// Lead-in/lead-out at plunges and retracts.
+    pub leads: LeadKind,
 }
 
 impl FinishJob {
@@ -136,6 +141,7 @@ impl FinishJob {
             sim_resolution: 0.1,
             output: OutputOptions::linuxcnc(),
             setup: None,
+            leads: LeadKind::None,
         }
     }
 }
@@ -169,6 +175,8 @@ pub struct FinishReport {
     pub sim_min_deviation_mm: f64,
     /// Gouge tolerance the simulation enforced (mm).
     pub sim_gouge_tolerance_mm: f64,
+    /// Leads applied, and those replaced by straight plunges (with where and why).
+    pub leads: LeadReport,
 }
 
 /// The job's outputs.
@@ -244,7 +252,23 @@ pub fn run_finishing(job: &FinishJob) -> Result<FinishOutput, EngineError> {
         sharp_corner: SHARP_CORNER_DEG.to_radians(),
         blend_tolerance: job.tolerances.path,
     };
-    let planned = plan_finishing(&prepared.index, &job.cutter, &params, &tolerances)?;
+    let mut planned = plan_finishing(&prepared.index, &job.cutter, &params, &tolerances)?;
+    let (led, leads) =
+        apply_leads(&planned.toolpath, &prepared.index, &job.cutter, job.leads, tolerances.path, job.tolerances.gouge)?;
+    if leads.applied > 0 {
+        // The leads change the plunges and retracts: times and lengths again.
+        let (a, b) = (stop_to_stop_time(&led, &params), lookahead_time(&led, &params));
+        let r = &mut planned.report;
+        r.machining_time_s = a.cutting;
+        r.machining_time_lookahead_s = b.cutting;
+        r.rapid_time_s = a.rapid;
+        r.plunge_time_s = a.plunge;
+        r.total_time_s = a.total();
+        r.rapid_length_mm = led.length(MoveKind::Rapid) + led.length(MoveKind::Retract);
+        r.plunge_length_mm = led.length(MoveKind::Plunge);
+        r.points = led.moves().len();
+        planned.toolpath = led;
+    }
 
     // Prove the program on a simulated stock before anyone runs it: the part's
     // box grown by the cutter radius, from 1 mm below to 1 mm above the part.
@@ -323,6 +347,7 @@ pub fn run_finishing(job: &FinishJob) -> Result<FinishOutput, EngineError> {
         sim_max_material_mm: sim.verification.max_scallop,
         sim_min_deviation_mm: sim.verification.min_deviation,
         sim_gouge_tolerance_mm: gouge_tolerance,
+        leads,
     };
     Ok(FinishOutput { toolpath: planned.toolpath, gcode: text, report, fitted })
 }
@@ -411,5 +436,21 @@ mod tests {
         assert!(out.gcode.contains("predicted machining time"));
         let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
         assert_eq!(one.install(|| run_finishing(&FinishJob::choi_demo()).unwrap()).gcode, out.gcode);
+    }
+
+    #[test]
+    fn one_way_finishing_with_leads_enters_tangentially_and_proves_itself() {
+        for leads in [LeadKind::Arc { radius: 2.0 }, LeadKind::Ramp { length: 3.0, angle: 15f64.to_radians() }] {
+            let mut job = FinishJob::choi_demo();
+            job.pattern = Pattern::OneWay;
+            job.scallop_height = 0.03;
+            job.leads = leads;
+            // run_finishing fails if the stock simulation finds a gouge or a rapid into stock.
+            let out = run_finishing(&job).unwrap();
+            let r = &out.report;
+            assert!(r.plan.retracts > 10);
+            assert_eq!(r.leads.applied + r.leads.fallbacks.len(), 2 * (r.plan.retracts + 1), "{:?}", r.leads);
+            assert!(r.leads.applied > r.plan.retracts, "{:?}", r.leads);
+        }
     }
 }

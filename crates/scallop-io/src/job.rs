@@ -142,6 +142,28 @@ pub struct FinishingSpec {
     /// Longest forward step between drop-cutter samples (mm).
     #[serde(default = "default_max_step")]
     pub max_step: f64,
+    /// Lead-in/lead-out at plunges and retracts: `none` (default), `arc` or `ramp`.
+    #[serde(default = "default_lead")]
+    pub lead: String,
+    /// Radius of arc leads (mm).
+    #[serde(default = "default_lead_size")]
+    pub lead_radius: f64,
+    /// Length of ramp leads (mm).
+    #[serde(default = "default_lead_size")]
+    pub lead_length: f64,
+    /// Angle of ramp leads above the pass's tangent (degrees).
+    #[serde(default = "default_lead_angle")]
+    pub lead_angle_deg: f64,
+}
+
+fn default_lead() -> String {
+    "none".into()
+}
+fn default_lead_size() -> f64 {
+    2.0
+}
+fn default_lead_angle() -> f64 {
+    15.0
 }
 
 fn default_pattern() -> String {
@@ -350,7 +372,20 @@ pub fn parse_job(text: &str) -> Result<JobFile, JobError> {
             fix: "use \"zigzag\" or \"one-way\"",
         });
     }
+    if !matches!(job.finishing.lead.as_str(), "none" | "arc" | "ramp") {
+        return Err(JobError::Value {
+            key: "finishing.lead",
+            value: job.finishing.lead.clone(),
+            fix: "use \"none\", \"arc\" or \"ramp\"",
+        });
+    }
+    let angle = job.finishing.lead_angle_deg;
+    if !(angle.is_finite() && angle > 0.0 && angle < 90.0) {
+        return bad("finishing.lead_angle_deg", angle, "need 0 < angle < 90 degrees");
+    }
     for (key, v) in [
+        ("finishing.lead_radius", job.finishing.lead_radius),
+        ("finishing.lead_length", job.finishing.lead_length),
         ("finishing.max_step", job.finishing.max_step),
         ("tolerances.path", job.tolerances.path),
         ("machine.feed", job.machine.feed),
@@ -426,6 +461,9 @@ mod tests {
             (BASE.replace("scallop_height = 0.01", "scallop_height = 3"), "corner radius"),
             (BASE.replace("diameter = 10", "diameter = 10\nflute_length = -3"), "cutter.flute_length"),
             (format!("{BASE}[output]\nspindle = -1\n"), "output.spindle"),
+            (format!("{BASE}lead = \"loop\"\n"), "finishing.lead"),
+            (format!("{BASE}lead = \"arc\"\nlead_radius = -2\n"), "finishing.lead_radius"),
+            (format!("{BASE}lead = \"ramp\"\nlead_angle_deg = 90\n"), "finishing.lead_angle_deg"),
             (format!("{BASE}[output]\narcs = true\n"), "arcs"),
             (format!("{BASE}[setup]\nrotation_deg = [0, 30]\nmachine = \"m\"\n"), "rotation_deg"),
             (

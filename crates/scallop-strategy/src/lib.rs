@@ -125,6 +125,7 @@
 
 mod error;
 mod geometry;
+mod leads;
 mod params;
 mod plan;
 mod scallop;
@@ -132,6 +133,7 @@ mod time;
 pub mod tol;
 
 pub use error::StrategyError;
+pub use leads::{LeadFallback, LeadKind, LeadReport, apply_leads};
 pub use params::{Boundary, FinishingParams, Pattern};
 pub use scallop::{PairScallop, ScallopReport, verify_scallop};
 pub use time::{ClassTimes, lookahead_time, stop_to_stop_time};
