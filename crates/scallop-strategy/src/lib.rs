@@ -125,6 +125,7 @@
 
 mod error;
 mod geometry;
+mod iso;
 mod leads;
 mod params;
 mod plan;
@@ -133,6 +134,7 @@ mod time;
 pub mod tol;
 
 pub use error::StrategyError;
+pub use iso::{IsoDirection, IsoPass, IsoPlanned, iso_scallop, plan_isoparametric};
 pub use leads::{LeadFallback, LeadKind, LeadReport, apply_leads};
 pub use params::{Boundary, FinishingParams, Pattern};
 pub use scallop::{PairScallop, ScallopReport, verify_scallop};

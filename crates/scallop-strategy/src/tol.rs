@@ -94,3 +94,18 @@ pub const RAW_RETRIES: usize = 3;
 /// Relative convergence of the golden-section envelope search (times the cutter
 /// radius): the envelope's value errs by the square of it (times the curvature).
 pub const GOLDEN_REL_TOL: f64 = 1e-6;
+
+/// Measurements of the scallop per isoparametric pass pair while fitting the
+/// spacing (each scales the step by `sqrt(sh / h)`).
+pub const ISO_FIT_ITERATIONS: usize = 8;
+
+/// Points across the gap between two isoparametric passes, plus one, at which the
+/// scallop is measured (at every running sample).
+pub const ISO_LATERAL_SAMPLES: usize = 6;
+
+/// Most samples of one isoparametric pass.
+pub const ISO_MAX_SAMPLES: usize = 20_000;
+
+/// Largest isoparametric step-over, as a multiple of the cutter radius (where the
+/// effective radius is infinite: a horizontal flat bottom).
+pub const ISO_MAX_STEP_OVER: f64 = 1.8;
