@@ -4,11 +4,11 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use scallop_cutter::{Cutter, CutterShape};
-use scallop_engine::{FinishJob, OutputOptions, Setup, run_finishing};
+use scallop_engine::{FinishJob, OutputOptions, Setup, Strategy, run_finishing};
 use scallop_geom::Tolerances;
 use scallop_geom::nalgebra::Rotation3;
 use scallop_io::job::{DirectionSpec, JobFile, parse_job};
-use scallop_strategy::{LeadKind, Pattern};
+use scallop_strategy::{IsoDirection, LeadKind, Pattern};
 
 use crate::output::{progress_bar, write_finishing};
 use crate::part::{UnitsArg, load};
@@ -116,6 +116,11 @@ fn finish_job(spec: &JobFile, folder: &Path) -> CliResult<FinishJob> {
         sim_resolution: spec.verify.resolution,
         output,
         setup,
+        strategy: match (spec.finishing.strategy.as_str(), spec.finishing.iso_direction.as_str()) {
+            ("isoparametric", "v") => Strategy::Isoparametric(IsoDirection::V),
+            ("isoparametric", _) => Strategy::Isoparametric(IsoDirection::U),
+            _ => Strategy::ParallelPlanes,
+        },
         leads: match spec.finishing.lead.as_str() {
             "arc" => LeadKind::Arc { radius: spec.finishing.lead_radius },
             "ramp" => {

@@ -17,8 +17,8 @@ use scallop_machine::{Kinematics, Machine};
 use scallop_mesh::{MeshIndex, TriMesh};
 use scallop_post::{Dialect, OutputMode, PostParams, ProgramInfo, program_text, write_fitted};
 use scallop_strategy::{
-    Boundary, FinishingParams, LeadKind, LeadReport, Pattern, apply_leads, lookahead_time, plan_finishing,
-    stop_to_stop_time,
+    Boundary, FinishingParams, IsoDirection, LeadKind, LeadReport, Pattern, apply_leads, lookahead_time,
+    plan_finishing, plan_isoparametric, stop_to_stop_time,
 };
 use scallop_toolpath::{FittedPath, Move, MoveKind, Toolpath, fit_arcs};
 use serde::Serialize;
@@ -110,6 +110,8 @@ pub struct FinishJob {
     pub setup: Option<Setup>,
     /// Lead-in/lead-out at plunges and retracts.
     pub leads: LeadKind,
+    /// Parallel planes or isoparametric passes.
+    pub strategy: Strategy,
 }
 
 impl FinishJob {
@@ -142,6 +144,7 @@ impl FinishJob {
             output: OutputOptions::linuxcnc(),
             setup: None,
             leads: LeadKind::None,
+            strategy: Strategy::ParallelPlanes,
         }
     }
 }
@@ -252,7 +255,28 @@ pub fn run_finishing(job: &FinishJob) -> Result<FinishOutput, EngineError> {
         sharp_corner: SHARP_CORNER_DEG.to_radians(),
         blend_tolerance: job.tolerances.path,
     };
-    let mut planned = plan_finishing(&prepared.index, &job.cutter, &params, &tolerances)?;
+    let mut planned = match job.strategy {
+        Strategy::ParallelPlanes => {
+            let p = plan_finishing(&prepared.index, &job.cutter, &params, &tolerances)?;
+            Plan { toolpath: p.toolpath, report: p.report }
+        }
+        Strategy::Isoparametric(direction) => {
+            let Part::Surfaces(set) = &job.part else {
+                return Err(EngineError::Output {
+                    what: "isoparametric passes on a mesh part".into(),
+                    fix: "use a parametric part (builtin or a surface file) or finishing.strategy = \"parallel\""
+                        .into(),
+                });
+            };
+            if job.setup.is_some() {
+                return Err(EngineError::Output {
+                    what: "isoparametric passes in a 3+2 setup".into(),
+                    fix: "remove [setup] or use finishing.strategy = \"parallel\"".into(),
+                });
+            }
+            isoparametric(set, &prepared, job, &params, &tolerances, direction)?
+        }
+    };
     let (led, leads) =
         apply_leads(&planned.toolpath, &prepared.index, &job.cutter, job.leads, tolerances.path, job.tolerances.gouge)?;
     if leads.applied > 0 {
@@ -350,6 +374,80 @@ pub fn run_finishing(job: &FinishJob) -> Result<FinishOutput, EngineError> {
         leads,
     };
     Ok(FinishOutput { toolpath: planned.toolpath, gcode: text, report, fitted })
+}
+
+/// Which finishing strategy.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Strategy {
+    /// Parallel vertical planes (`scallop_strategy::plan_finishing`).
+    ParallelPlanes,
+    /// Isoparametric passes on every patch of a parametric part.
+    Isoparametric(IsoDirection),
+}
+
+/// A toolpath and its figures, whatever the strategy.
+struct Plan {
+    toolpath: Toolpath,
+    report: scallop_strategy::Report,
+}
+
+/// Isoparametric passes patch after patch; the report's times and lengths are those
+/// of the joined toolpath, its scallop the largest measured over all patches.
+fn isoparametric(
+    set: &scallop_surface::SurfaceSet,
+    prepared: &PreparedPart,
+    job: &FinishJob,
+    params: &FinishingParams,
+    tolerances: &Tolerances,
+    direction: IsoDirection,
+) -> Result<Plan, EngineError> {
+    let mut toolpath = Toolpath::new(params.machine.feed * 60.0);
+    toolpath.plunge_feed = params.plunge_feed * 60.0;
+    let (mut passes, mut max_h, mut mean_sum) = (0, 0.0f64, 0.0);
+    for patch in set.patches() {
+        let p = plan_isoparametric(
+            patch,
+            &prepared.index,
+            &job.cutter,
+            params,
+            direction,
+            tolerances,
+            prepared.chordal_error,
+        )?;
+        passes += p.passes.len();
+        max_h = max_h.max(p.max_scallop_mm);
+        mean_sum += p.mean_scallop_mm;
+        toolpath.plunge_feed = p.toolpath.plunge_feed;
+        for m in p.toolpath.moves() {
+            toolpath.push(*m);
+        }
+    }
+    let (a, b) = (stop_to_stop_time(&toolpath, params), lookahead_time(&toolpath, params));
+    let feed = toolpath.length(MoveKind::Feed);
+    #[allow(clippy::cast_precision_loss, reason = "patch counts")]
+    let mean = mean_sum / set.patches().len().max(1) as f64;
+    let report = scallop_strategy::Report {
+        machining_time_s: a.cutting,
+        machining_time_lookahead_s: b.cutting,
+        rapid_time_s: a.rapid,
+        plunge_time_s: a.plunge,
+        total_time_s: a.total(),
+        path_length_mm: feed,
+        feed_length_mm: feed,
+        link_length_mm: 0.0,
+        rapid_length_mm: toolpath.length(MoveKind::Rapid) + toolpath.length(MoveKind::Retract),
+        plunge_length_mm: toolpath.length(MoveKind::Plunge),
+        passes,
+        planes: passes,
+        links: 0,
+        retracts: toolpath.count(MoveKind::Retract),
+        max_scallop_mm: max_h,
+        mean_scallop_mm: mean,
+        points: toolpath.moves().len(),
+        cl_points_dropped: 0,
+        planning_time_s: 0.0,
+    };
+    Ok(Plan { toolpath, report })
 }
 
 /// The prepared part turned into the planning frame of a 3+2 setup.

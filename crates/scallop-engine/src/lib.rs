@@ -23,7 +23,9 @@ use scallop_mesh::{MeshIndex, TriMesh};
 use scallop_surface::SurfaceSet;
 
 pub use demo::{DemoOutput, DemoSettings, DemoSummary, run_demo};
-pub use finish::{ARC_SHARE, FinishJob, FinishOutput, FinishReport, OutputOptions, Setup, run_finishing, toolpath_csv};
+pub use finish::{
+    ARC_SHARE, FinishJob, FinishOutput, FinishReport, OutputOptions, Setup, Strategy, run_finishing, toolpath_csv,
+};
 pub use grid::{GridAxis, GridError, MAX_GRID_POINTS};
 
 /// Why the engine rejected a request. Each variant says the cause and the fix.

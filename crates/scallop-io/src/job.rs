@@ -142,6 +142,12 @@ pub struct FinishingSpec {
     /// Longest forward step between drop-cutter samples (mm).
     #[serde(default = "default_max_step")]
     pub max_step: f64,
+    /// `parallel` (default: parallel vertical planes) or `isoparametric` (parametric parts).
+    #[serde(default = "default_strategy")]
+    pub strategy: String,
+    /// Isoparametric passes along `u` (default) or `v`.
+    #[serde(default = "default_iso")]
+    pub iso_direction: String,
     /// Lead-in/lead-out at plunges and retracts: `none` (default), `arc` or `ramp`.
     #[serde(default = "default_lead")]
     pub lead: String,
@@ -156,6 +162,12 @@ pub struct FinishingSpec {
     pub lead_angle_deg: f64,
 }
 
+fn default_strategy() -> String {
+    "parallel".into()
+}
+fn default_iso() -> String {
+    "u".into()
+}
 fn default_lead() -> String {
     "none".into()
 }
@@ -372,6 +384,20 @@ pub fn parse_job(text: &str) -> Result<JobFile, JobError> {
             fix: "use \"zigzag\" or \"one-way\"",
         });
     }
+    if !matches!(job.finishing.strategy.as_str(), "parallel" | "isoparametric") {
+        return Err(JobError::Value {
+            key: "finishing.strategy",
+            value: job.finishing.strategy.clone(),
+            fix: "use \"parallel\" or \"isoparametric\"",
+        });
+    }
+    if !matches!(job.finishing.iso_direction.as_str(), "u" | "v") {
+        return Err(JobError::Value {
+            key: "finishing.iso_direction",
+            value: job.finishing.iso_direction.clone(),
+            fix: "use \"u\" or \"v\"",
+        });
+    }
     if !matches!(job.finishing.lead.as_str(), "none" | "arc" | "ramp") {
         return Err(JobError::Value {
             key: "finishing.lead",
@@ -440,6 +466,7 @@ mod tests {
             include_str!("../../../examples/jobs/rubio.toml"),
             include_str!("../../../examples/jobs/choi-arcs.toml"),
             include_str!("../../../examples/jobs/choi-3plus2.toml"),
+            include_str!("../../../examples/jobs/rubio-iso.toml"),
         ] {
             parse_job(example).unwrap();
         }
@@ -462,6 +489,8 @@ mod tests {
             (BASE.replace("diameter = 10", "diameter = 10\nflute_length = -3"), "cutter.flute_length"),
             (format!("{BASE}[output]\nspindle = -1\n"), "output.spindle"),
             (format!("{BASE}lead = \"loop\"\n"), "finishing.lead"),
+            (format!("{BASE}strategy = \"spiral\"\n"), "finishing.strategy"),
+            (format!("{BASE}iso_direction = \"w\"\n"), "finishing.iso_direction"),
             (format!("{BASE}lead = \"arc\"\nlead_radius = -2\n"), "finishing.lead_radius"),
             (format!("{BASE}lead = \"ramp\"\nlead_angle_deg = 90\n"), "finishing.lead_angle_deg"),
             (format!("{BASE}[output]\narcs = true\n"), "arcs"),

@@ -67,7 +67,9 @@ pub struct IsoPass {
     pub iso: f64,
     /// Cutter locations (tool tip, mm) in increasing running parameter.
     pub cl: Vec<Point3>,
-    /// Running parameters of the surface points under `cl` (before merging: see `samples`).
+    /// Running parameter of each point of `cl`.
+    pub cl_params: Vec<f64>,
+    /// Running parameters of all samples before merging (where the scallop is measured).
     pub samples: Vec<f64>,
 }
 
@@ -254,6 +256,7 @@ impl Ctx<'_> {
         IsoPass {
             iso: c,
             cl: kept.iter().map(|&i| points[i]).collect(),
+            cl_params: kept.iter().map(|&i| samples[i].0).collect(),
             samples: samples.iter().map(|s| s.0).collect(),
         }
     }
@@ -346,22 +349,30 @@ fn body_distance(p: &Point3, tip: &Point3, radius: f64, corner: f64) -> f64 {
     ((h - (radius - corner)).max(0.0).hypot(dz) - corner).max(0.0)
 }
 
-/// Smallest distance from `p` to the cutter moving along the CL polyline `cl`
-/// (golden section per segment: the distance is convex along a straight move).
-fn swept_distance(p: &Point3, cl: &[Point3], radius: f64, corner: f64) -> f64 {
-    let reach = radius + 1.0;
+/// Smallest distance from `p` to the cutter moving along the pass (golden section
+/// per segment: the distance is convex along a straight move). Segments are visited
+/// outwards from the one at running parameter `s` and the walk stops on each side
+/// after [`tol::ISO_WINDOW_MISSES`] segments in a row that cannot come closer; a
+/// segment left out can only make the result larger (the check stays conservative).
+fn swept_distance(p: &Point3, pass: &IsoPass, s: f64, radius: f64, corner: f64) -> f64 {
+    let cl = &pass.cl;
+    if cl.len() < 2 {
+        return cl.first().map_or(f64::INFINITY, |t| body_distance(p, t, radius, corner));
+    }
+    let start = pass.cl_params.partition_point(|&x| x < s).clamp(1, cl.len() - 1) - 1;
     let mut best = f64::INFINITY;
-    for w in cl.windows(2) {
-        let (a, b) = (w[0], w[1]);
-        // Skip segments whose cutters are far from p in XY.
+    let visit = |k: usize, best: &mut f64| -> bool {
+        let (a, b) = (cl[k], cl[k + 1]);
         let ab = b.xy() - a.xy();
         let t = if ab.norm_squared() > 0.0 {
             ((p.xy() - a.xy()).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0)
         } else {
             0.0
         };
-        if (a.xy() + ab * t - p.xy()).norm() > reach + best.min(reach) {
-            continue;
+        // The body reaches at most `radius` sideways from its axis.
+        let lower = (a.xy() + ab * t - p.xy()).norm() - radius;
+        if lower > *best {
+            return false;
         }
         let f = |s: f64| body_distance(p, &(a + (b - a) * s), radius, corner);
         let (mut lo, mut hi) = (0.0f64, 1.0f64);
@@ -383,7 +394,23 @@ fn swept_distance(p: &Point3, cl: &[Point3], radius: f64, corner: f64) -> f64 {
                 f2 = f(x2);
             }
         }
-        best = best.min(f1.min(f2)).min(f(0.0)).min(f(1.0));
+        *best = best.min(f1.min(f2)).min(f(0.0)).min(f(1.0));
+        true
+    };
+    visit(start, &mut best);
+    let mut misses = 0;
+    for k in (0..start).rev() {
+        misses = if visit(k, &mut best) { 0 } else { misses + 1 };
+        if misses >= tol::ISO_WINDOW_MISSES {
+            break;
+        }
+    }
+    misses = 0;
+    for k in start + 1..cl.len() - 1 {
+        misses = if visit(k, &mut best) { 0 } else { misses + 1 };
+        if misses >= tol::ISO_WINDOW_MISSES {
+            break;
+        }
     }
     best
 }
@@ -426,7 +453,7 @@ pub fn iso_scallop(
             if near_end {
                 continue;
             }
-            let d = swept_distance(&p, &a.cl, radius, corner).min(swept_distance(&p, &b.cl, radius, corner));
+            let d = swept_distance(&p, a, s, radius, corner).min(swept_distance(&p, b, s, radius, corner));
             if d <= worst {
                 continue;
             }

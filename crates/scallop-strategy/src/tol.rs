@@ -109,3 +109,8 @@ pub const ISO_MAX_SAMPLES: usize = 20_000;
 /// Largest isoparametric step-over, as a multiple of the cutter radius (where the
 /// effective radius is infinite: a horizontal flat bottom).
 pub const ISO_MAX_STEP_OVER: f64 = 1.8;
+
+/// The isoparametric scallop check walks a pass's segments outwards from the
+/// measured point's running parameter and stops after this many in a row that
+/// cannot come closer (a segment left out only enlarges the measured scallop).
+pub const ISO_WINDOW_MISSES: usize = 8;
