@@ -551,4 +551,21 @@ mod tests {
             assert!(r.leads.applied > r.plan.retracts, "{:?}", r.leads);
         }
     }
+
+    #[test]
+    fn isoparametric_finishing_of_choi_holds_the_scallop_and_proves_itself() {
+        let mut job = FinishJob::choi_demo();
+        job.cutter = Cutter::new(CutterShape::Ball { radius: 3.0 }, 40.0).unwrap();
+        job.scallop_height = 0.05;
+        job.strategy = Strategy::Isoparametric(IsoDirection::U);
+        // run_finishing fails if the stock simulation finds a gouge or a rapid into stock.
+        let out = run_finishing(&job).unwrap();
+        let r = &out.report.plan;
+        assert!(r.passes > 10 && r.max_scallop_mm <= 0.05, "{r:?}");
+        // A mesh part has no isolines.
+        let mut mesh_job = job.clone();
+        let mesh = prepare_part(&job.part, &job.tolerances).unwrap().mesh;
+        mesh_job.part = Part::Mesh(mesh);
+        assert!(matches!(run_finishing(&mesh_job), Err(EngineError::Output { .. })));
+    }
 }
