@@ -92,7 +92,7 @@ const MM_PER_INCH: f64 = 25.4;
 /// assert!(path.moves().len() > 4);
 /// let last = path.moves().last().unwrap().to;
 /// assert!((last.x - 20.0).abs() < 1e-12 && last.y.abs() < 1e-12);
-/// assert!(read_gcode("G0 X0 Y0 Z0\nG18\n", &GcodeOptions::default()).unwrap_err().to_string().contains("line 2"));
+/// assert!(read_gcode("G0 X0 Y0 Z0\nG28\n", &GcodeOptions::default()).unwrap_err().to_string().contains("line 2"));
 /// ```
 pub fn read_gcode(text: &str, options: &GcodeOptions) -> Result<Toolpath, GcodeError> {
     let mut state =
