@@ -22,7 +22,8 @@
 //! - **Guarantee: measured.** The candidate next pass is planned and the scallop
 //!   between the two is measured by [`iso_scallop`] (below); the step is scaled by
 //!   `sqrt(sh / h)` (the scallop grows as the square of the spacing) up to
-//!   [`tol::ISO_FIT_ITERATIONS`] times, keeping the largest step measured `<= sh`.
+//!   [`tol::ISO_FIT_ITERATIONS`] times, keeping the largest step measured `<= sh`
+//!   (a step measured within [`tol::ISO_FIT_ACCEPT`] of `sh` is taken at once).
 //!   A pair over `sh` after that is an `Err`.
 //! - **Independent check.** [`iso_scallop`] uses no effective radius: the cutter
 //!   body (ball, flat or bull-nose) is convex, the Minkowski sum of a horizontal
@@ -146,7 +147,7 @@ pub fn plan_isoparametric(
                 if better {
                     best = Some((next, h, worst));
                 }
-                if reached_end {
+                if reached_end || worst >= tol::ISO_FIT_ACCEPT * target {
                     break;
                 }
             }

@@ -114,3 +114,7 @@ pub const ISO_MAX_STEP_OVER: f64 = 1.8;
 /// measured point's running parameter and stops after this many in a row that
 /// cannot come closer (a segment left out only enlarges the measured scallop).
 pub const ISO_WINDOW_MISSES: usize = 8;
+
+/// An isoparametric step whose measured scallop lies between this fraction of
+/// `sh` and `sh` is accepted without trying a larger one.
+pub const ISO_FIT_ACCEPT: f64 = 0.8;
