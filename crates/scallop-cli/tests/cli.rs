@@ -254,7 +254,7 @@ fn bad_jobs_name_the_key_and_the_fix_and_write_nothing() {
     let tiny = "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 0.05 0 0\nvertex 0 0.05 0\nendloop\nendfacet\nendsolid t\n";
     std::fs::write(dir.join("tiny.stl"), tiny).expect("write");
     let base = "[part]\nbuiltin = \"choi\"\n[cutter]\nshape = \"ball\"\ndiameter = 6\nflute_length = 60\n[finishing]\nscallop_height = 0.01\n";
-    let cases: [(&str, String, &[&str]); 10] = [
+    let cases: [(&str, String, &[&str]); 11] = [
         ("unknown key", format!("{base}colour = \"red\"\n"), &["colour"]),
         ("negative size", base.replace("diameter = 6", "diameter = -6"), &["cutter.diameter", "> 0"]),
         (
@@ -281,6 +281,7 @@ fn bad_jobs_name_the_key_and_the_fix_and_write_nothing() {
             &["flute_length", "profile"],
         ),
         ("unknown dialect", format!("{base}[output]\ndialect = \"haas\"\n"), &["output.dialect", "linuxcnc"]),
+        ("plain-language 3-axis", format!("{base}[output]\ndialect = \"heidenhain\"\n"), &["ISO dialect", "[output]"]),
         (
             "arcs in 3+2",
             format!(

@@ -209,6 +209,12 @@ pub fn run_finishing(job: &FinishJob) -> Result<FinishOutput, EngineError> {
     } else {
         job.tolerances
     };
+    if job.setup.is_none() && job.output.dialect.syntax != scallop_post::Syntax::Iso {
+        return Err(EngineError::Output {
+            what: format!("3-axis output in the plain-language dialect `{}`", job.output.dialect.name),
+            fix: "use an ISO dialect (linuxcnc, fanuc, grbl, siemens840d, heidenhain-iso)".into(),
+        });
+    }
     if job.output.arc_fitting && job.setup.is_some() {
         return Err(EngineError::Output {
             what: "arc fitting in 3+2 output".into(),
