@@ -302,3 +302,62 @@ fn post_writes_a_proven_program_with_a_time_report() {
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("nosuch"));
 }
+
+#[test]
+fn bad_jobs_name_the_key_and_the_fix_and_write_nothing() {
+    let dir = scratch("badjobs");
+    let tiny = "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 0.05 0 0\nvertex 0 0.05 0\nendloop\nendfacet\nendsolid t\n";
+    std::fs::write(dir.join("tiny.stl"), tiny).expect("write");
+    let base = "[part]\nbuiltin = \"choi\"\n[cutter]\nshape = \"ball\"\ndiameter = 6\nflute_length = 60\n[finishing]\nscallop_height = 0.01\n";
+    let cases: [(&str, String, &[&str]); 11] = [
+        ("unknown key", format!("{base}colour = \"red\"\n"), &["colour"]),
+        ("negative size", base.replace("diameter = 6", "diameter = -6"), &["cutter.diameter", "> 0"]),
+        (
+            "sh over the radius",
+            base.replace("scallop_height = 0.01", "scallop_height = 4"),
+            &["finishing.scallop_height", "radius"],
+        ),
+        (
+            "unreachable",
+            base.replace("\"ball\"", "\"flat\"")
+                .replace("scallop_height = 0.01", "scallop_height = 0.0001\ndirection = 90"),
+            &["cannot reach", "finishing.scallop_height", "ball or bull-nose"],
+        ),
+        (
+            "empty region",
+            base.replace("builtin = \"choi\"", "file = \"tiny.stl\"")
+                .replace("scallop_height = 0.01", "scallop_height = 0.01\ndirection = 0"),
+            &["region to machine is empty", "finishing.max_step"],
+        ),
+        ("short flutes", base.replace("flute_length = 60", "flute_length = 8"), &["shank", "cutter.flute_length"]),
+        (
+            "flutes under the profile",
+            base.replace("flute_length = 60", "flute_length = 2"),
+            &["flute_length", "profile"],
+        ),
+        ("unknown dialect", format!("{base}[output]\ndialect = \"haas\"\n"), &["output.dialect", "linuxcnc"]),
+        ("plain-language 3-axis", format!("{base}[output]\ndialect = \"heidenhain\"\n"), &["ISO dialect", "[output]"]),
+        (
+            "arcs in 3+2",
+            format!(
+                "{base}[setup]\nrotation_deg = [10, 0, 0]\nmachine = \"linuxcnc-xyzac-trt\"\n[output]\narc_fitting = true\n"
+            ),
+            &["output.arc_fitting", "false"],
+        ),
+        (
+            "unknown machine",
+            format!("{base}[setup]\nrotation_deg = [10, 0, 0]\nmachine = \"mill\"\n"),
+            &["setup.machine", "mill"],
+        ),
+    ];
+    for (what, text, needles) in cases {
+        std::fs::write(dir.join("job.toml"), &text).expect("write");
+        let out = scallop().current_dir(&dir).args(["run", "job.toml", "-o", "out"]).output().expect("run");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{what}: {err}");
+        for n in needles {
+            assert!(err.contains(n), "{what}: '{err}' lacks '{n}'");
+        }
+        assert!(!dir.join("out").exists(), "{what}: a rejected job writes nothing");
+    }
+}

@@ -131,6 +131,8 @@
 mod error;
 mod geometry;
 pub mod network;
+mod iso;
+mod leads;
 mod params;
 mod plan;
 mod scallop;
@@ -139,6 +141,8 @@ pub mod tol;
 pub mod trochoid;
 
 pub use error::StrategyError;
+pub use iso::{IsoDirection, IsoPass, IsoPlanned, iso_scallop, plan_isoparametric};
+pub use leads::{LeadFallback, LeadKind, LeadReport, apply_leads};
 pub use params::{Boundary, FinishingParams, Pattern};
 pub use scallop::{PairScallop, ScallopReport, verify_scallop};
 pub use time::{ClassTimes, lookahead_time, stop_to_stop_time};
