@@ -6,7 +6,7 @@ mod analyze;
 mod drop;
 mod output;
 mod part;
-mod picture;
+mod render;
 mod run;
 mod simulate;
 
@@ -52,6 +52,8 @@ enum Command {
     Analyze(analyze::AnalyzeArgs),
     /// Cut a stock with a 3-axis G-code program and verify it against the part (gouges are errors).
     Simulate(simulate::SimulateArgs),
+    /// Render a part (and a toolpath) to a PNG picture, without a browser.
+    Render(render::RenderArgs),
     /// Load a part and report what was read (size, welding, open and non-manifold edges).
     Inspect(part::InspectArgs),
 }
@@ -73,6 +75,7 @@ fn main() -> ExitCode {
         Command::Inspect(args) => part::inspect(&args),
         Command::Analyze(args) => analyze::run(&args),
         Command::Simulate(args) => simulate::run(&args),
+        Command::Render(args) => render::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

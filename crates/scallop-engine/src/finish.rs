@@ -16,7 +16,7 @@ use scallop_strategy::{Boundary, FinishingParams, Pattern, plan_finishing};
 use scallop_toolpath::{MoveKind, Toolpath};
 use serde::Serialize;
 
-use crate::{EngineError, Part, prepare_part};
+use crate::{EngineError, Part, PreparedPart, prepare_part};
 
 /// A finishing job (mm, seconds; machine limits in the spec's units).
 #[derive(Debug, Clone)]
@@ -120,6 +120,25 @@ pub struct FinishOutput {
     pub gcode: String,
     /// The report.
     pub report: FinishReport,
+    /// What the pictures and the HTML report show (`scallop-report`).
+    pub details: FinishDetails,
+}
+
+/// The intermediate results behind a [`FinishReport`], kept for reports and
+/// pictures: the part as cut, the stock, the planner's settings, the measured
+/// scallop and the simulated stock.
+#[derive(Debug, Clone)]
+pub struct FinishDetails {
+    /// The mesh the cutter was dropped on, and its index.
+    pub prepared: PreparedPart,
+    /// The stock box of the simulation.
+    pub stock: Aabb3,
+    /// The settings the planner ran with (for the look-ahead feed profile).
+    pub params: FinishingParams,
+    /// The verified scallop (histogram, pairs).
+    pub scallop: scallop_strategy::ScallopReport,
+    /// The simulated stock and its verification.
+    pub simulation: scallop_sim::Simulation,
 }
 
 /// Runs the finishing job. `planning_seconds` is measured by the caller and
@@ -216,7 +235,13 @@ pub fn run_finishing(job: &FinishJob) -> Result<FinishOutput, EngineError> {
         sim_min_deviation_mm: sim.verification.min_deviation,
         sim_gouge_tolerance_mm: gouge_tolerance,
     };
-    Ok(FinishOutput { toolpath: planned.toolpath, gcode: String::from_utf8_lossy(&text).into_owned(), report })
+    let details = FinishDetails { prepared, stock, params, scallop: planned.scallop, simulation: sim };
+    Ok(FinishOutput {
+        toolpath: planned.toolpath,
+        gcode: String::from_utf8_lossy(&text).into_owned(),
+        report,
+        details,
+    })
 }
 
 /// Rapid rate of the demo machine (mm/s).

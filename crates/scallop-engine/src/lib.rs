@@ -23,7 +23,7 @@ use scallop_mesh::{MeshIndex, TriMesh};
 use scallop_surface::SurfaceSet;
 
 pub use demo::{DemoOutput, DemoSettings, DemoSummary, run_demo};
-pub use finish::{FinishJob, FinishOutput, FinishReport, run_finishing, toolpath_csv};
+pub use finish::{FinishDetails, FinishJob, FinishOutput, FinishReport, run_finishing, toolpath_csv};
 pub use grid::{GridAxis, GridError, MAX_GRID_POINTS};
 
 /// Why the engine rejected a request. Each variant says the cause and the fix.

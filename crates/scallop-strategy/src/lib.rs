@@ -134,7 +134,7 @@ pub mod tol;
 pub use error::StrategyError;
 pub use params::{Boundary, FinishingParams, Pattern};
 pub use scallop::{PairScallop, ScallopReport, verify_scallop};
-pub use time::{ClassTimes, lookahead_time, stop_to_stop_time};
+pub use time::{ClassTimes, MoveFeed, lookahead_profile, lookahead_time, stop_to_stop_time};
 
 use scallop_cutter::Cutter;
 use scallop_geom::{Point3, Tolerances};

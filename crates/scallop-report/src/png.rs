@@ -1,6 +1,7 @@
 //! Pictures without dependencies: an RGB raster, a 5x7 digit font for labels,
 //! and a PNG encoder (stored deflate blocks: larger files, but byte-for-byte
-//! deterministic and tiny code).
+//! deterministic and tiny code). The one PNG encoder of the workspace: the
+//! renderer and the CLI's plots use it.
 
 /// An RGB image.
 pub struct Image {
@@ -14,6 +15,7 @@ pub struct Image {
 
 impl Image {
     /// A blank image of one colour.
+    #[must_use]
     pub fn new(width: usize, height: usize, rgb: [u8; 3]) -> Image {
         Image { width, height, pixels: rgb.repeat(width * height) }
     }
@@ -49,7 +51,17 @@ impl Image {
         }
     }
 
+    /// The colour of a pixel (`None` outside).
+    #[must_use]
+    pub fn get(&self, x: usize, y: usize) -> Option<[u8; 3]> {
+        (x < self.width && y < self.height).then(|| {
+            let k = 3 * (y * self.width + x);
+            [self.pixels[k], self.pixels[k + 1], self.pixels[k + 2]]
+        })
+    }
+
     /// The PNG file.
+    #[must_use]
     pub fn to_png(&self) -> Vec<u8> {
         let mut raw = Vec::with_capacity((3 * self.width + 1) * self.height);
         for row in self.pixels.chunks(3 * self.width) {
@@ -132,6 +144,7 @@ fn glyph(ch: char) -> [u8; 7] {
 }
 
 /// A perceptually ordered colour ramp (blue, cyan, green, yellow, red) for t in [0, 1].
+#[must_use]
 pub fn ramp(t: f64) -> [u8; 3] {
     let stops: [[f64; 3]; 5] =
         [[40.0, 60.0, 200.0], [0.0, 190.0, 220.0], [40.0, 190.0, 60.0], [240.0, 220.0, 30.0], [220.0, 50.0, 40.0]];
