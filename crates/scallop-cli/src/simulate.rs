@@ -12,9 +12,9 @@ use serde::Serialize;
 use crate::drop::CutterArgs;
 use crate::output::{print_json, print_text, write_atomic};
 use crate::part::{UnitsArg, load};
+use crate::{CliResult, Failure};
 use scallop_report::png::{Image, ramp};
 use scallop_report::{DeviationMap, Figure, ReportData};
-use crate::{CliResult, Failure};
 
 /// Arguments of `scallop simulate`.
 #[derive(Args, Debug)]

@@ -236,12 +236,7 @@ pub fn run_finishing(job: &FinishJob) -> Result<FinishOutput, EngineError> {
         sim_gouge_tolerance_mm: gouge_tolerance,
     };
     let details = FinishDetails { prepared, stock, params, scallop: planned.scallop, simulation: sim };
-    Ok(FinishOutput {
-        toolpath: planned.toolpath,
-        gcode: String::from_utf8_lossy(&text).into_owned(),
-        report,
-        details,
-    })
+    Ok(FinishOutput { toolpath: planned.toolpath, gcode: String::from_utf8_lossy(&text).into_owned(), report, details })
 }
 
 /// Rapid rate of the demo machine (mm/s).

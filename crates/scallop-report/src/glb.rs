@@ -70,7 +70,7 @@ impl Builder {
     fn view(&mut self, bytes: Vec<u8>, target: u32) -> usize {
         let offset = self.bin.len();
         self.bin.extend_from_slice(&bytes);
-        while self.bin.len() % 4 != 0 {
+        while !self.bin.len().is_multiple_of(4) {
             self.bin.push(0);
         }
         self.views.push(json!({"buffer": 0, "byteOffset": offset, "byteLength": bytes.len(), "target": target}));
@@ -192,7 +192,7 @@ pub fn scene_glb(data: &ReportData) -> Result<Vec<u8>, ReportError> {
         }
     }
     let mut text = gltf.to_string().into_bytes();
-    while text.len() % 4 != 0 {
+    while !text.len().is_multiple_of(4) {
         text.push(b' ');
     }
     let total = 12 + 8 + text.len() + if bin_len > 0 { 8 + b.bin.len() } else { 0 };

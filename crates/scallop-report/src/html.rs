@@ -123,9 +123,11 @@ fn scene_json(data: &ReportData) -> Value {
                 .map(|(v, _)| *v)
                 .fold(path.feed, f64::max)
         });
-        let zones = data.zones.as_ref().filter(|z| z.of_move.len() == moves.len()).map(|z| {
-            base64(&keep.iter().flat_map(|&i| z.of_move[i].to_le_bytes()).collect::<Vec<u8>>())
-        });
+        let zones = data
+            .zones
+            .as_ref()
+            .filter(|z| z.of_move.len() == moves.len())
+            .map(|z| base64(&keep.iter().flat_map(|&i| z.of_move[i].to_le_bytes()).collect::<Vec<u8>>()));
         json!({
             "positions": b64_f32(keep.iter().flat_map(|&i| rel(&moves[i].to))),
             "kinds": base64(&keep.iter().map(|&i| kind_index(kinds[i])).collect::<Vec<u8>>()),

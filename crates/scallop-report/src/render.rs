@@ -43,7 +43,8 @@ impl Camera {
         let forward = Vec3::new(-1.0, 1.0, -1.0).normalize();
         let right = forward.cross(&Vec3::z()).normalize();
         let up = right.cross(&forward);
-        let mut cam = Camera { right, up, forward, centre: [0.0, 0.0], scale: 1.0, size: [width as f64, height as f64] };
+        let mut cam =
+            Camera { right, up, forward, centre: [0.0, 0.0], scale: 1.0, size: [width as f64, height as f64] };
         let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
         for k in 0..8 {
             let p = Point3::new(
@@ -117,14 +118,13 @@ pub fn render(data: &ReportData, width: usize, height: usize) -> Image {
         }
     }
     if let Some(stock) = &data.stock {
-        let corner =
-            |k: usize| {
-                Point3::new(
-                    if k & 1 == 0 { stock.min.x } else { stock.max.x },
-                    if k & 2 == 0 { stock.min.y } else { stock.max.y },
-                    if k & 4 == 0 { stock.min.z } else { stock.max.z },
-                )
-            };
+        let corner = |k: usize| {
+            Point3::new(
+                if k & 1 == 0 { stock.min.x } else { stock.max.x },
+                if k & 2 == 0 { stock.min.y } else { stock.max.y },
+                if k & 4 == 0 { stock.min.z } else { stock.max.z },
+            )
+        };
         for a in 0..8usize {
             for bit in [1usize, 2, 4] {
                 if a & bit == 0 {

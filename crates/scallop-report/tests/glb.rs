@@ -13,15 +13,18 @@ fn u32_at(b: &[u8], at: usize) -> usize {
 
 fn scene() -> ReportData {
     let p = |x, y, z| Point3::new(x, y, z);
-    let (mesh, _) =
-        TriMesh::from_soup(&[[p(0., 0., 0.), p(10., 0., 1.), p(0., 8., 2.)], [p(10., 0., 1.), p(10., 8., 3.), p(0., 8., 2.)]])
-            .unwrap();
+    let (mesh, _) = TriMesh::from_soup(&[
+        [p(0., 0., 0.), p(10., 0., 1.), p(0., 8., 2.)],
+        [p(10., 0., 1.), p(10., 8., 3.), p(0., 8., 2.)],
+    ])
+    .unwrap();
     let mut path = Toolpath::new(1000.0);
     for (k, (x, y, z)) in [(0., 0., 10.), (0., 0., 3.), (10., 0., 3.), (10., 1., 3.5), (0., 1., 3.), (0., 1., 10.)]
         .into_iter()
         .enumerate()
     {
-        let kind = [MoveKind::Rapid, MoveKind::Plunge, MoveKind::Feed, MoveKind::Link, MoveKind::Feed, MoveKind::Retract][k];
+        let kind =
+            [MoveKind::Rapid, MoveKind::Plunge, MoveKind::Feed, MoveKind::Link, MoveKind::Feed, MoveKind::Retract][k];
         path.push(Move::new(kind, p(x, y, z)));
     }
     let mut data = ReportData::new("glb test");
@@ -92,8 +95,8 @@ fn structure_accessors_and_bounds_are_valid() {
         for c in 0..3 {
             let lo = floats.iter().skip(c).step_by(3).copied().fold(f32::INFINITY, f32::min);
             let hi = floats.iter().skip(c).step_by(3).copied().fold(f32::NEG_INFINITY, f32::max);
-            assert_eq!(a["min"][c].as_f64().unwrap() as f32, lo);
-            assert_eq!(a["max"][c].as_f64().unwrap() as f32, hi);
+            assert_eq!((a["min"][c].as_f64().unwrap() as f32).to_bits(), lo.to_bits());
+            assert_eq!((a["max"][c].as_f64().unwrap() as f32).to_bits(), hi.to_bits());
         }
         // Indices in range of the vertices.
         if let Some(ix) = prim["indices"].as_u64() {

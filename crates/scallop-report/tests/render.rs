@@ -94,7 +94,8 @@ fn a_box_covers_its_projected_hexagon() {
         assert_eq!(img.get(x, y).unwrap(), BACKGROUND);
     }
     // Shaded: the three visible faces have three different colours.
-    let mut colours: Vec<[u8; 3]> = img.pixels.chunks(3).map(|p| [p[0], p[1], p[2]]).filter(|p| *p != BACKGROUND).collect();
+    let mut colours: Vec<[u8; 3]> =
+        img.pixels.chunks(3).map(|p| [p[0], p[1], p[2]]).filter(|p| *p != BACKGROUND).collect();
     colours.sort_unstable();
     colours.dedup();
     assert_eq!(colours.len(), 3, "{colours:?}");
@@ -139,12 +140,14 @@ fn renders_are_byte_identical_and_show_the_toolpath_on_top() {
         path.push(Move::new(MoveKind::Feed, Point3::new(if k % 2 == 0 { 20.0 } else { 0.0 }, y, 5.0)));
         path.push(Move::new(MoveKind::Link, Point3::new(if k % 2 == 0 { 20.0 } else { 0.0 }, y + 1.0, 5.0)));
     }
+    path.push(Move::new(MoveKind::Retract, Point3::new(0.0, 10.0, 10.0)));
+    path.push(Move::new(MoveKind::Rapid, Point3::new(0.0, 0.0, 10.0)));
     data.toolpath = Some(path);
     data.stock = Some(scallop_geom::Aabb3 { min: Point3::new(-1.0, -1.0, -1.0), max: Point3::new(21.0, 11.0, 6.0) });
     let a = render(&data, 300, 200).to_png();
     assert_eq!(a, render(&data, 300, 200).to_png());
     let img = render(&data, 300, 200);
-    for kind in [0usize, 1, 2, 3] {
-        assert!(img.pixels.chunks(3).any(|p| p == KIND_COLOURS[kind]), "kind {kind} not drawn");
+    for (kind, colour) in KIND_COLOURS.iter().enumerate() {
+        assert!(img.pixels.chunks(3).any(|p| p == colour), "kind {kind} not drawn");
     }
 }
