@@ -6,8 +6,8 @@ mod analyze;
 mod drop;
 mod output;
 mod part;
-mod picture;
 mod post;
+mod render;
 mod run;
 mod simulate;
 
@@ -55,6 +55,8 @@ enum Command {
     Simulate(simulate::SimulateArgs),
     /// Post-process a cutter-location file for a machine and a dialect, with a machine-aware time report.
     Post(post::PostArgs),
+    /// Render a part (and a toolpath) to a PNG picture, without a browser.
+    Render(render::RenderArgs),
     /// Load a part and report what was read (size, welding, open and non-manifold edges).
     Inspect(part::InspectArgs),
 }
@@ -77,6 +79,7 @@ fn main() -> ExitCode {
         Command::Analyze(args) => analyze::run(&args),
         Command::Simulate(args) => simulate::run(&args),
         Command::Post(args) => post::run(&args),
+        Command::Render(args) => render::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

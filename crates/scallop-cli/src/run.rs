@@ -19,7 +19,7 @@ use crate::{CliResult, Failure};
 pub struct RunArgs {
     /// The job file (TOML, see docs/job.md).
     job: PathBuf,
-    /// Output folder for `program.nc`, `report.json` and `toolpath.csv`.
+    /// Output folder for `program.nc`, `report.json`, `toolpath.csv`, `report.html` and `scene.glb`.
     #[arg(short, long, default_value = "out/run")]
     output: PathBuf,
     /// Print the report as JSON.
@@ -46,7 +46,8 @@ pub fn run(args: &RunArgs) -> CliResult<()> {
     let start = std::time::Instant::now();
     let out = run_finishing(&job).map_err(|e| Failure::rejected(format!("{name}: {e}{}", job_keys(&e))))?;
     spinner.finish_and_clear();
-    write_finishing(&out, start.elapsed().as_secs_f64(), &args.output, args.json)
+    let command = format!("scallop run {name}");
+    write_finishing(&job, &out, start.elapsed().as_secs_f64(), &args.output, args.json, &command)
 }
 
 fn finish_job(spec: &JobFile, folder: &Path) -> CliResult<FinishJob> {

@@ -62,6 +62,36 @@ fn demo_writes_a_program() {
     assert!(report["plan"]["max_scallop_mm"].as_f64().expect("number") <= 0.01);
     let csv = std::fs::read_to_string(dir.join("toolpath.csv")).expect("toolpath.csv");
     assert!(csv.starts_with("kind,x,y,z\n"));
+    let html = std::fs::read_to_string(dir.join("report.html")).expect("report.html");
+    assert!(html.starts_with("<!DOCTYPE html>") && html.contains("id=\"scene-data\""));
+    let glb = std::fs::read(dir.join("scene.glb")).expect("scene.glb");
+    assert_eq!(&glb[..4], b"glTF");
+    assert_eq!(u32::from_le_bytes(glb[8..12].try_into().expect("4 bytes")) as usize, glb.len());
+}
+
+#[test]
+fn render_writes_the_same_png_twice_and_rejects_a_bad_size() {
+    let dir = scratch("render");
+    std::fs::write(dir.join("p.stl"), pyramid_stl()).expect("write");
+    std::fs::write(dir.join("t.csv"), "kind,x,y,z\nrapid,0,0,10\nplunge,0,0,1\nfeed,10,0,1\nlink,10,2,1\nfeed,0,2,1\n")
+        .expect("write");
+    let render = |name: &str| {
+        let out = scallop()
+            .current_dir(&dir)
+            .args(["render", "p.stl", "--toolpath", "t.csv", "--size", "160x120", "-o", name])
+            .output()
+            .expect("run");
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        std::fs::read(dir.join(name)).expect("png")
+    };
+    let a = render("a.png");
+    assert_eq!(&a[..8], b"\x89PNG\r\n\x1a\n");
+    assert_eq!(a, render("b.png"));
+    assert_rejected(&["render", "p.stl", "--size", "0x10", "-o", "c.png"], &dir, "--size");
+    assert!(!dir.join("c.png").exists());
+    std::fs::write(dir.join("bad.csv"), "kind,x,y,z\nwobble,0,0,0\n").expect("write");
+    assert_rejected(&["render", "p.stl", "--toolpath", "bad.csv", "-o", "d.png"], &dir, "bad.csv: line 2");
+    assert!(!dir.join("d.png").exists());
 }
 
 #[test]

@@ -194,6 +194,26 @@ pub struct FinishOutput {
     /// What the 3-axis program was written from (lines and arcs, planning frame);
     /// lines only for 3+2 output.
     pub fitted: FittedPath,
+    /// What the pictures and the HTML report show (`scallop-report`).
+    pub details: FinishDetails,
+}
+
+/// The intermediate results behind a [`FinishReport`], kept for reports and
+/// pictures: the part as cut, the stock, the planner's settings, the measured
+/// scallop and the simulated stock.
+#[derive(Debug, Clone)]
+pub struct FinishDetails {
+    /// The mesh the cutter was dropped on, and its index.
+    pub prepared: PreparedPart,
+    /// The stock box of the simulation.
+    pub stock: Aabb3,
+    /// The settings the planner ran with (for the look-ahead feed profile).
+    pub params: FinishingParams,
+    /// The verified scallop of parallel planes (histogram, pairs); isoparametric
+    /// passes are checked by `iso_scallop`, which keeps no histogram.
+    pub scallop: Option<scallop_strategy::ScallopReport>,
+    /// The simulated stock and its verification.
+    pub simulation: scallop_sim::Simulation,
 }
 
 /// Runs the finishing job. `planning_seconds` is measured by the caller and
@@ -264,7 +284,7 @@ pub fn run_finishing(job: &FinishJob) -> Result<FinishOutput, EngineError> {
     let mut planned = match job.strategy {
         Strategy::ParallelPlanes => {
             let p = plan_finishing(&prepared.index, &job.cutter, &params, &tolerances)?;
-            Plan { toolpath: p.toolpath, report: p.report }
+            Plan { toolpath: p.toolpath, report: p.report, scallop: Some(p.scallop) }
         }
         Strategy::Isoparametric(direction) => {
             let Part::Surfaces(set) = &job.part else {
@@ -379,7 +399,8 @@ pub fn run_finishing(job: &FinishJob) -> Result<FinishOutput, EngineError> {
         sim_gouge_tolerance_mm: gouge_tolerance,
         leads,
     };
-    Ok(FinishOutput { toolpath: planned.toolpath, gcode: text, report, fitted })
+    let details = FinishDetails { prepared, stock, params, scallop: planned.scallop, simulation: sim };
+    Ok(FinishOutput { toolpath: planned.toolpath, gcode: text, report, fitted, details })
 }
 
 /// Which finishing strategy.
@@ -395,6 +416,7 @@ pub enum Strategy {
 struct Plan {
     toolpath: Toolpath,
     report: scallop_strategy::Report,
+    scallop: Option<scallop_strategy::ScallopReport>,
 }
 
 /// Isoparametric passes patch after patch; the report's times and lengths are those
@@ -453,7 +475,7 @@ fn isoparametric(
         cl_points_dropped: 0,
         planning_time_s: 0.0,
     };
-    Ok(Plan { toolpath, report })
+    Ok(Plan { toolpath, report, scallop: None })
 }
 
 /// The prepared part turned into the planning frame of a 3+2 setup.
