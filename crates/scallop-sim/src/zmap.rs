@@ -3,7 +3,7 @@
 use std::fmt;
 
 use rayon::prelude::*;
-use scallop_cutter::Cutter;
+use scallop_cutter::{Cutter, CutterShape};
 use scallop_geom::{Aabb3, Eps, Point2};
 use scallop_toolpath::{MoveKind, Toolpath};
 
@@ -279,6 +279,51 @@ impl ZMap {
     #[must_use]
     pub fn stock(&self) -> Aabb3 {
         self.stock
+    }
+
+    /// The simulator's resolution bound for `shape` on this grid (mm): how far
+    /// the stock's true swept floor can lie below what its cell centres show.
+    ///
+    /// Every point of the grid lies within `rho = sqrt(cell_x^2 + cell_y^2) / 2`
+    /// (half a cell diagonal) of a cell centre, and the height at a centre is
+    /// exact. Where the floor has a minimum between centres (the bottom of a
+    /// pass, of a gouge), its gradient vanishes there and its curvature is at
+    /// most the profile's largest curvature `kappa` (a swept surface is no more
+    /// curved across the move than the profile, and along a straight move it is
+    /// straight), so the nearest centre lies at most `kappa rho^2 / 2` above it:
+    /// ball `kappa = 1 / R`, bull-nose `1 / r` (its corner), flat `0` (a flat
+    /// bottom sweeps planes). A cone's tip has no curvature bound; its floor
+    /// rises at most `cot(a)` per mm from a minimum, so its bound is `cot(a) rho`.
+    /// A deviation measured at the centres (gouge depth, material left) is
+    /// therefore within this bound of the true extreme on the floor; at a
+    /// ridge between passes (a cusp) the centres can only under-state the
+    /// height, by at most the profile's slope there times `rho`.
+    ///
+    /// ```
+    /// use scallop_cutter::CutterShape;
+    /// use scallop_geom::{Aabb3, Point3};
+    /// use scallop_sim::ZMap;
+    /// let stock = Aabb3 { min: Point3::new(0.0, 0.0, -1.0), max: Point3::new(10.0, 10.0, 0.0) };
+    /// let zmap = ZMap::new(stock, 0.05).unwrap();
+    /// let b = zmap.resolution_bound(&CutterShape::Bull { radius: 5.0, corner: 2.0 });
+    /// assert!((b - 0.05f64.powi(2) * 2.0 / 8.0 / 2.0).abs() < 1e-15); // rho^2 / (2 r)
+    /// assert_eq!(zmap.resolution_bound(&CutterShape::Flat { radius: 1.0 }), 0.0);
+    /// ```
+    #[must_use]
+    pub fn resolution_bound(&self, shape: &CutterShape) -> f64 {
+        let rho2 = 0.25 * (self.cell_x * self.cell_x + self.cell_y * self.cell_y);
+        match *shape {
+            CutterShape::Flat { .. } => 0.0,
+            CutterShape::Ball { radius } => 0.5 * rho2 / radius,
+            CutterShape::Bull { corner, .. } => {
+                if corner > 0.0 {
+                    0.5 * rho2 / corner
+                } else {
+                    0.0
+                }
+            }
+            CutterShape::Cone { half_angle, .. } => rho2.sqrt() / half_angle.tan(),
+        }
     }
 
     /// The rounding epsilon of the stock (mm): lowerings below it do not count as cuts.
