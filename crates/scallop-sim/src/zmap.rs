@@ -5,6 +5,7 @@ use std::fmt;
 use rayon::prelude::*;
 use scallop_cutter::{Cutter, CutterShape};
 use scallop_geom::{Aabb3, Eps, Point2};
+use scallop_mesh::MeshIndex;
 use scallop_toolpath::{MoveKind, Toolpath};
 
 use crate::SimError;
@@ -452,9 +453,71 @@ impl ZMap {
     /// ```
     pub fn cut(&mut self, cutter: &Cutter, toolpath: &Toolpath) -> Result<CutReport, SimError> {
         let moves = toolpath.moves();
-        let n = u32::try_from(moves.len()).map_err(|_| SimError::TooManyMoves { moves: moves.len() })?;
         let operation = self.operations;
         self.operations = self.operations.checked_add(1).ok_or(SimError::TooManyMoves { moves: moves.len() })?;
+        self.sweep(cutter, toolpath, operation, true)
+    }
+
+    /// Checks the shank and holder of `cutter` along `toolpath` against the
+    /// design part itself (not the in-process stock): the part's top under
+    /// each cell centre (see [`crate::part_heights`]) is tested against the
+    /// same discs as in [`ZMap::cut`] (the shank of radius max(R, shank radius)
+    /// from the flute length up, each holder segment), so a part wall higher
+    /// than the flutes within R of a pass is found even where the stock was
+    /// already cleared. The stock is not changed; `operation` names the moves
+    /// (the [`CutReport::operation`] of the cut of the same toolpath).
+    /// Penetrations beyond the stock's epsilon, deepest cell per move and part
+    /// of the tool, in program order.
+    ///
+    /// # Errors
+    /// [`SimError::TooManyMoves`] when a move index would not fit in `u32`.
+    ///
+    /// ```
+    /// use scallop_cutter::{Cutter, CutterShape};
+    /// use scallop_geom::{Aabb3, Point3};
+    /// use scallop_mesh::{MeshIndex, TriMesh};
+    /// use scallop_sim::{ToolPart, ZMap};
+    /// use scallop_toolpath::{Move, MoveKind, Toolpath};
+    /// let p = |x, y, z| Point3::new(x, y, z);
+    /// // A block 10 mm tall at y >= 6; a pass along y = 5 with a 2 mm ball,
+    /// // 3 mm of flutes, 5 mm below the block's top.
+    /// let (block, _) = TriMesh::from_soup(&[[p(-5., 6., 10.), p(30., 6., 10.), p(-5., 20., 10.)]]).unwrap();
+    /// let zmap = ZMap::new(Aabb3 { min: p(0., 0., -1.), max: p(20., 10., 11.) }, 0.1).unwrap();
+    /// let ball = Cutter::new(CutterShape::Ball { radius: 2.0 }, 3.0).unwrap();
+    /// let mut path = Toolpath::new(1000.0);
+    /// path.push(Move::new(MoveKind::Rapid, p(2., 5., 5.)));
+    /// path.push(Move::new(MoveKind::Feed, p(18., 5., 5.)));
+    /// let hits = zmap.part_collisions(&MeshIndex::build(&block), &ball, &path, 0).unwrap();
+    /// assert_eq!(hits.len(), 2);
+    /// assert_eq!((hits[1].id.index, hits[1].part), (1, ToolPart::Shank));
+    /// assert!((hits[1].depth - 2.0).abs() < 1e-9); // the wall top 2 mm above the flutes' end
+    /// ```
+    pub fn part_collisions(
+        &self,
+        part: &MeshIndex,
+        cutter: &Cutter,
+        toolpath: &Toolpath,
+        operation: u32,
+    ) -> Result<Vec<Collision>, SimError> {
+        let bottom = self.stock.min.z;
+        let mut field = self.clone();
+        field.heights = crate::part_heights(self, part)
+            .into_iter()
+            .map(|z| if z == f64::NEG_INFINITY { bottom } else { z.max(bottom) })
+            .collect();
+        Ok(field.sweep(cutter, toolpath, operation, false)?.collisions)
+    }
+
+    /// The body of [`ZMap::cut`]; `remove == false` only checks the discs.
+    fn sweep(
+        &mut self,
+        cutter: &Cutter,
+        toolpath: &Toolpath,
+        operation: u32,
+        remove: bool,
+    ) -> Result<CutReport, SimError> {
+        let moves = toolpath.moves();
+        let n = u32::try_from(moves.len()).map_err(|_| SimError::TooManyMoves { moves: moves.len() })?;
 
         // Non-cutting parts as flat discs: (radius, lift above the tip, part).
         let mut parts = vec![(cutter.radius().max(cutter.shank_radius()), cutter.flute_length(), ToolPart::Shank)];
@@ -540,7 +603,7 @@ impl ZMap {
             .enumerate()
             .map(|(band, (heights, last))| {
                 let ids = &members[start[band]..start[band + 1]];
-                grid.cut_band(band, heights, last, ids, &plans, &discs, &parts, operation)
+                grid.cut_band(band, heights, last, ids, &plans, &discs, &parts, operation, remove)
             })
             .collect();
 
@@ -640,6 +703,7 @@ impl Grid {
         discs: &[SweptMove],
         parts: &[(f64, f64, ToolPart)],
         operation: u32,
+        remove: bool,
     ) -> BandOutput {
         let nx = self.nx;
         let row0 = band * BAND_ROWS;
@@ -684,7 +748,11 @@ impl Grid {
                     // z_low + k d^2 with d the distance to the move's box.
                     let (xa, xb) = (self.x_of(c0), self.x_of(c1));
                     let dx = (box_x0 - xb).max(0.0).max(xa - box_x1);
-                    let bound = (plan.cutter.z_low + quadratic * (dx * dx + dy * dy)).min(disc_bound);
+                    let bound = if remove {
+                        (plan.cutter.z_low + quadratic * (dx * dx + dy * dy)).min(disc_bound)
+                    } else {
+                        disc_bound
+                    };
                     if tile_top[tile] <= bound {
                         continue;
                     }
@@ -714,7 +782,7 @@ impl Grid {
                                 }
                             }
                         }
-                        if old <= plan.cutter.z_low {
+                        if !remove || old <= plan.cutter.z_low {
                             continue;
                         }
                         let new = plan.cutter.floor_below(x, y, old).max(self.bottom);
