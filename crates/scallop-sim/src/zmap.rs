@@ -4,7 +4,7 @@ use std::fmt;
 
 use rayon::prelude::*;
 use scallop_cutter::{Cutter, CutterShape};
-use scallop_geom::{Aabb3, Eps, Point2};
+use scallop_geom::{Aabb3, Eps, Point2, Point3};
 use scallop_mesh::MeshIndex;
 use scallop_toolpath::{MoveKind, Toolpath};
 
@@ -188,8 +188,23 @@ pub struct ZMap {
     eps: f64,
 }
 
-/// A move prepared for the per-cell solve.
+/// Largest distance between a helical arc and the chords it is simulated by
+/// (mm): helices are the one case not solved in closed form (their floor
+/// `z(theta) + h(rho(theta))` has no convexity to exploit); planar arcs are exact.
+const HELIX_SAGITTA: f64 = 1e-4;
+
+/// Largest number of chords of one helical move.
+const MAX_HELIX_CHORDS: f64 = 1e6;
+
+/// A move (or a chord of a helical move) prepared for the per-cell solve.
 struct Plan {
+    /// The move's index in the toolpath.
+    id: u32,
+    /// XY box of the tip's path.
+    box_lo: Point2,
+    box_hi: Point2,
+    /// Whether the tip's path is an arc (columns from the box, not the stadium).
+    arc: bool,
     cutter: SweptMove,
     /// First and one-past-last disc in `discs`.
     discs: (usize, usize),
@@ -201,6 +216,38 @@ struct Plan {
     from: Point2,
     to: Point2,
     rapid: bool,
+}
+
+impl Plan {
+    #[allow(clippy::too_many_arguments)] // private; the pieces of one move.
+    fn new(
+        id: u32,
+        cutter: SweptMove,
+        discs: &[SweptMove],
+        first: usize,
+        parts: &[(f64, f64, ToolPart)],
+        from: &Point3,
+        to: &Point3,
+        rapid: bool,
+    ) -> Plan {
+        let reach = parts.iter().fold(cutter.radius(), |r, &(radius, _, _)| r.max(radius));
+        let disc_low = discs[first..].iter().fold(f64::INFINITY, |low, d| low.min(d.z_low));
+        let (box_lo, box_hi) = cutter.tip_box(from, to);
+        Plan {
+            id,
+            box_lo,
+            box_hi,
+            arc: cutter.is_arc(),
+            z_low: cutter.z_low.min(disc_low),
+            cutter,
+            discs: (first, discs.len()),
+            disc_low,
+            reach,
+            from: from.xy(),
+            to: to.xy(),
+            rapid,
+        }
+    }
 }
 
 /// What a band found, sparse per move.
@@ -527,39 +574,65 @@ impl ZMap {
             lift += s.length;
         }
         let mut discs = Vec::with_capacity(moves.len() * parts.len());
-        let plans: Vec<Plan> = moves
-            .iter()
-            .enumerate()
-            .map(|(k, m)| {
-                let from = if k == 0 { m.to } else { moves[k - 1].to };
-                let cut = SweptMove::new(cutter.shape(), &from, &m.to);
-                let first = discs.len();
-                let mut reach = cut.radius();
-                let mut disc_low = f64::INFINITY;
-                for &(radius, lift, _) in &parts {
-                    let d = SweptMove::disc(radius, lift, &from, &m.to);
-                    reach = reach.max(radius);
-                    disc_low = disc_low.min(d.z_low);
-                    discs.push(d);
+        let mut plans: Vec<Plan> = Vec::with_capacity(moves.len());
+        for (k, m) in moves.iter().enumerate() {
+            let from = if k == 0 { m.to } else { moves[k - 1].to };
+            // k < n <= u32::MAX (checked above).
+            let id = k as u32;
+            let rapid = matches!(m.kind, MoveKind::Rapid | MoveKind::Retract);
+            let arc = if k == 0 { None } else { toolpath.arc(k) };
+            match arc {
+                // A planar arc (z constant within the stock's epsilon): exact (SweptMove::arc).
+                Some(arc) if (from.z - m.to.z).abs() <= self.eps => {
+                    let first = discs.len();
+                    for &(radius, lift, _) in &parts {
+                        discs.push(SweptMove::arc(None, (radius, lift), &from, &m.to, arc.center, arc.sweep));
+                    }
+                    let cut = SweptMove::arc(Some(cutter.shape()), (0.0, 0.0), &from, &m.to, arc.center, arc.sweep);
+                    plans.push(Plan::new(id, cut, &discs, first, &parts, &from, &m.to, rapid));
                 }
-                let z_low = cut.z_low.min(disc_low);
-                Plan {
-                    cutter: cut,
-                    discs: (first, discs.len()),
-                    z_low,
-                    disc_low,
-                    reach,
-                    from: from.xy(),
-                    to: m.to.xy(),
-                    rapid: matches!(m.kind, MoveKind::Rapid | MoveKind::Retract),
+                // A helix: straight chords within `HELIX_SAGITTA` of it.
+                Some(arc) => {
+                    let c = arc.center;
+                    let r = (from.x - c.x).hypot(from.y - c.y);
+                    let start = (from.y - c.y).atan2(from.x - c.x);
+                    let step =
+                        if r > HELIX_SAGITTA { 2.0 * (1.0 - HELIX_SAGITTA / r).acos() } else { std::f64::consts::PI };
+                    // Bounded by MAX_HELIX_CHORDS: exact conversions.
+                    let chords = (arc.sweep.abs() / step).ceil().clamp(1.0, MAX_HELIX_CHORDS);
+                    let mut a = from;
+                    for q in 1..=chords as u32 {
+                        let t = f64::from(q) / chords;
+                        let b = if q == chords as u32 {
+                            m.to
+                        } else {
+                            let theta = start + arc.sweep * t;
+                            Point3::new(c.x + r * theta.cos(), c.y + r * theta.sin(), from.z + (m.to.z - from.z) * t)
+                        };
+                        let first = discs.len();
+                        for &(radius, lift, _) in &parts {
+                            discs.push(SweptMove::disc(radius, lift, &a, &b));
+                        }
+                        let cut = SweptMove::new(cutter.shape(), &a, &b);
+                        plans.push(Plan::new(id, cut, &discs, first, &parts, &a, &b, rapid));
+                        a = b;
+                    }
                 }
-            })
-            .collect();
+                None => {
+                    let first = discs.len();
+                    for &(radius, lift, _) in &parts {
+                        discs.push(SweptMove::disc(radius, lift, &from, &m.to));
+                    }
+                    let cut = SweptMove::new(cutter.shape(), &from, &m.to);
+                    plans.push(Plan::new(id, cut, &discs, first, &parts, &from, &m.to, rapid));
+                }
+            }
+        }
 
         // Moves per band (compressed rows), in program order.
         let bands = self.ny.div_ceil(BAND_ROWS);
         let band_range = |p: &Plan| {
-            let (lo, hi) = (p.from.y.min(p.to.y) - p.reach, p.from.y.max(p.to.y) + p.reach);
+            let (lo, hi) = (p.box_lo.y - p.reach, p.box_hi.y + p.reach);
             self.row_range(lo, hi).map(|(a, b)| (a / BAND_ROWS, b / BAND_ROWS))
         };
         let mut start = vec![0usize; bands + 1];
@@ -723,12 +796,12 @@ impl Grid {
         let mut out = BandOutput::default();
         for &k in ids {
             let plan = &plans[k as usize];
-            let packed = MoveId { operation, index: k }.pack();
-            let (dy_lo, dy_hi) = (plan.from.y.min(plan.to.y) - plan.reach, plan.from.y.max(plan.to.y) + plan.reach);
+            let packed = MoveId { operation, index: plan.id }.pack();
+            let (dy_lo, dy_hi) = (plan.box_lo.y - plan.reach, plan.box_hi.y + plan.reach);
             let Some((j0, j1)) = index_range(dy_lo, dy_hi, self.min_y, self.cell_y, self.ny) else { continue };
             let (j0, j1) = (j0.max(row0), j1.min(row0 + rows - 1));
-            let (box_x0, box_x1) = (plan.from.x.min(plan.to.x), plan.from.x.max(plan.to.x));
-            let (box_y0, box_y1) = (plan.from.y.min(plan.to.y), plan.from.y.max(plan.to.y));
+            let (box_x0, box_x1) = (plan.box_lo.x, plan.box_hi.x);
+            let (box_y0, box_y1) = (plan.box_lo.y, plan.box_hi.y);
             let quadratic = plan.cutter.quadratic();
             // Nothing at or below this can touch a disc (collisions need > eps).
             let disc_bound = plan.disc_low + self.eps;
@@ -805,14 +878,14 @@ impl Grid {
             }
             let to_global = |cell: usize| row0 * nx + cell;
             if removed > 0.0 {
-                out.removed.push((k, removed * area, max_lower));
+                out.removed.push((plan.id, removed * area, max_lower));
             }
             if let Some((depth, cell)) = rapid_worst {
-                out.rapid.push((k, depth, to_global(cell)));
+                out.rapid.push((plan.id, depth, to_global(cell)));
             }
             for (slot, worst) in collision_worst.iter().enumerate() {
                 if let Some((depth, cell)) = *worst {
-                    out.collisions.push((k, parts[slot].2, depth, to_global(cell)));
+                    out.collisions.push((plan.id, parts[slot].2, depth, to_global(cell)));
                 }
             }
         }
@@ -824,6 +897,15 @@ impl Grid {
     /// of the two end discs and of the band between them; the index range has
     /// one cell of margin each side (the per-cell solve decides exactly).
     fn columns(&self, plan: &Plan, y: f64) -> Option<(usize, usize)> {
+        if plan.arc {
+            return index_range(
+                plan.box_lo.x - plan.reach,
+                plan.box_hi.x + plan.reach,
+                self.min_x,
+                self.cell_x,
+                self.nx,
+            );
+        }
         let (a, b, r) = (plan.from, plan.to, plan.reach);
         let mut lo = f64::INFINITY;
         let mut hi = f64::NEG_INFINITY;
