@@ -131,3 +131,29 @@ fn arcs_agree_with_fine_chords_and_helices_with_their_chords() {
         assert!(exact.heights().iter().any(|&h| h < -0.4));
     }
 }
+
+#[test]
+fn gcode_arcs_are_read_as_arcs_and_cut_exactly() {
+    use scallop_io::gcode::{GcodeOptions, read_gcode, read_gcode_arcs};
+    // A flat 3 mm cutter, 1 mm deep, a full clockwise circle of radius 6 about
+    // (10, 10) in incremental I J, then a counter-clockwise half circle by R.
+    let text = "G21 G90 G17\nG0 X16 Y10 Z5\nG1 Z-1 F300\nG2 X16 Y10 I-6 J0\nG3 X4 Y10 R6\nG0 Z5\n";
+    let arcs = read_gcode_arcs(text, &GcodeOptions::default()).unwrap();
+    assert_eq!(arcs.arc_count(), 2);
+    let chords = read_gcode(text, &GcodeOptions::default()).unwrap();
+    assert_eq!(chords.arc_count(), 0);
+    assert!(chords.moves().len() > 100);
+    let flat = Cutter::new(CutterShape::Flat { radius: 1.5 }, 10.0).unwrap();
+    let mut exact = ZMap::new(stock(), 0.05).unwrap();
+    let report = exact.cut(&flat, &arcs).unwrap();
+    report.check().unwrap();
+    // The half circle retraces half of the annulus: the annulus alone.
+    let annulus = 4.0 * PI * 6.0 * 1.5 * 1.0;
+    assert!((report.removed_volume - annulus).abs() <= 0.01 * annulus, "{} vs {annulus}", report.removed_volume);
+    let mut linear = ZMap::new(stock(), 0.05).unwrap();
+    linear.cut(&flat, &chords).unwrap().check().unwrap();
+    // The chords (0.001 mm sagitta) move the walls by at most 0.001 mm: only
+    // cells whose centres lie that close to a wall can differ.
+    let differ = exact.heights().iter().zip(linear.heights()).filter(|(a, b)| a != b).count();
+    assert!(differ <= exact.heights().len() / 100, "{differ}");
+}
