@@ -132,7 +132,8 @@ pub fn write_finishing(
          \x20 scallop    verified max {smax:.5} mm, mean {smean:.5} mm (<= {sh} mm)\n\
          \x20 time       {t1:.1} s stop-to-stop, {t2:.1} s look-ahead, + {tr:.1} s rapids\n\
          \x20 lengths    feed {feed:.0} mm, links {link:.0} mm, rapid {rapid:.0} mm\n\
-         \x20 simulated  no gouge on a {res} mm stock; deepest {dev:+.4} mm (tolerance {gt:.4} mm), most material left {mat:.4} mm\n\
+         \x20 simulated  no gouge on a {res} mm stock; deepest {dev:+.4} mm (tolerance {gt:.4} mm), most material left {mat:.4} mm;\n\
+         \x20            scallop {ssim:.4} mm along the normal beyond R from the edge (<= sh + {bound:.5} mm), {sedge:.4} mm within it\n\
          \x20 planned    in {secs:.2} s\n\
          \x20 wrote      {nc}, report.json, toolpath.csv, report.html, scene.glb\n",
         part = r.part,
@@ -163,6 +164,9 @@ pub fn write_finishing(
         dev = r.sim_min_deviation_mm,
         gt = r.sim_gouge_tolerance_mm,
         mat = r.sim_max_material_mm,
+        ssim = r.sim_max_scallop_mm,
+        bound = r.sim_resolution_bound_mm,
+        sedge = r.sim_edge_max_scallop_mm,
         secs = seconds,
         nc = nc.display(),
     ))

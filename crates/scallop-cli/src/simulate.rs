@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use clap::Args;
 use scallop_engine::prepare_part;
 use scallop_geom::{Aabb3, Point3, Tolerances};
-use scallop_io::gcode::{GcodeOptions, read_gcode};
+use scallop_io::gcode::{GcodeOptions, read_gcode_arcs};
 use scallop_sim::{VerifyOptions, ZMap, part_heights, verify};
 use serde::Serialize;
 
@@ -96,7 +96,9 @@ pub fn run(args: &SimulateArgs) -> CliResult<()> {
     })?;
     let text = std::str::from_utf8(&bytes)
         .map_err(|e| Failure::rejected(format!("{name}: byte {}: the program is not UTF-8 text", e.valid_up_to())))?;
-    let program = read_gcode(text, &GcodeOptions::default()).map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
+    // Arcs stay arcs: the simulator cuts them exactly.
+    let program =
+        read_gcode_arcs(text, &GcodeOptions::default()).map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
 
     let b = prepared.mesh.bounds();
     let r = cutter.radius();
@@ -114,6 +116,12 @@ pub fn run(args: &SimulateArgs) -> CliResult<()> {
     let mut verdict = Vec::new();
     if let Err(e) = cut.check() {
         verdict.push(e.to_string());
+    }
+    let collisions = zmap
+        .part_collisions(&prepared.index, &cutter, &program, cut.operation)
+        .map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
+    if !collisions.is_empty() {
+        verdict.push(scallop_sim::SimError::PartCollision { count: collisions.len(), collisions }.to_string());
     }
     let verification = match verify(&zmap, &prepared.index, &options) {
         Ok(v) => Some(v),

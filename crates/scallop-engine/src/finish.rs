@@ -174,6 +174,16 @@ pub struct FinishReport {
     pub sim_resolution_mm: f64,
     /// Largest material left on the simulated stock (mm; includes the simulation's resolution effects).
     pub sim_max_material_mm: f64,
+    /// Largest material thickness along the part normal on the simulated stock
+    /// farther than the cutter radius from the part's edge (mm): the scallop
+    /// height the plan guarantees, as the simulation measures it.
+    pub sim_max_scallop_mm: f64,
+    /// The same within the cutter radius of the part's edge (mm; shaped by pass
+    /// ends and the outer planes, not held to the scallop height).
+    pub sim_edge_max_scallop_mm: f64,
+    /// The simulation's resolution bound for this cutter and cell size (mm),
+    /// see `scallop_sim::ZMap::resolution_bound`.
+    pub sim_resolution_bound_mm: f64,
     /// Deepest stock-minus-part deviation on the simulated stock (mm).
     pub sim_min_deviation_mm: f64,
     /// Gouge tolerance the simulation enforced (mm).
@@ -331,7 +341,11 @@ pub fn run_finishing(job: &FinishJob) -> Result<FinishOutput, EngineError> {
     // surface); between samples the planner keeps moves within the path
     // tolerance of the CL surface.
     let gouge_tolerance = job.tolerances.gouge + prepared.chordal_error + job.tolerances.path;
-    let options = scallop_sim::VerifyOptions { gouge_tolerance, ..scallop_sim::VerifyOptions::default() };
+    // The scallop is held where neighbouring passes shape the surface: beyond
+    // the cutter radius from the part's edge (see `VerifyOptions::scallop_margin`);
+    // the edge strip's figure is reported too.
+    let options =
+        scallop_sim::VerifyOptions { gouge_tolerance, scallop_margin: radius, ..scallop_sim::VerifyOptions::default() };
     let sim =
         scallop_sim::simulate(stock, job.sim_resolution, &job.cutter, &planned.toolpath, &prepared.index, &options)?;
 
@@ -395,6 +409,9 @@ pub fn run_finishing(job: &FinishJob) -> Result<FinishOutput, EngineError> {
         plan: planned.report.clone(),
         sim_resolution_mm: job.sim_resolution,
         sim_max_material_mm: sim.verification.max_scallop,
+        sim_max_scallop_mm: sim.verification.max_thickness,
+        sim_edge_max_scallop_mm: sim.verification.margin_max_thickness,
+        sim_resolution_bound_mm: sim.zmap.resolution_bound(job.cutter.shape()),
         sim_min_deviation_mm: sim.verification.min_deviation,
         sim_gouge_tolerance_mm: gouge_tolerance,
         leads,
@@ -559,6 +576,7 @@ mod tests {
         assert!(r.plan.max_scallop_mm <= 0.01, "{r:?}");
         assert!(r.plan.machining_time_s > 0.0 && r.plan.machining_time_lookahead_s > 0.0);
         assert!(r.sim_min_deviation_mm >= -r.sim_gouge_tolerance_mm);
+        assert!(r.sim_max_scallop_mm <= r.scallop_height_mm + r.sim_resolution_bound_mm, "{r:?}");
         assert!(out.gcode.contains("predicted machining time"));
         let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
         assert_eq!(one.install(|| run_finishing(&FinishJob::choi_demo()).unwrap()).gcode, out.gcode);

@@ -12,8 +12,8 @@
 //! Arcs are replaced by chords within `arc_tolerance` (sagitta), so every move
 //! of the result is straight.
 
-use scallop_geom::Point3;
-use scallop_toolpath::{Move, MoveKind, Toolpath};
+use scallop_geom::{Point2, Point3};
+use scallop_toolpath::{ArcXY, Move, MoveKind, Toolpath};
 
 /// Why a G-code program cannot be read. Lines count from 1.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -95,6 +95,32 @@ const MM_PER_INCH: f64 = 25.4;
 /// assert!(read_gcode("G0 X0 Y0 Z0\nG28\n", &GcodeOptions::default()).unwrap_err().to_string().contains("line 2"));
 /// ```
 pub fn read_gcode(text: &str, options: &GcodeOptions) -> Result<Toolpath, GcodeError> {
+    read(text, options, false)
+}
+
+/// Reads a program like [`read_gcode`], but keeps every `G2`/`G3` in the XY plane (G17) as one move
+/// to its end point carrying its circle and signed sweep
+/// ([`Toolpath::arc`]); `arc_tolerance` is unused.
+///
+/// # Errors
+/// As [`read_gcode`].
+///
+/// ```
+/// use scallop_io::gcode::{read_gcode_arcs, GcodeOptions};
+/// // A full clockwise circle of radius 5 about (5, 0), then a half circle.
+/// let text = "G21 G90\nG0 X0 Y0 Z5\nG1 Z0 F300\nG2 X0 Y0 I5 J0\nG3 X10 Y0 R5\n";
+/// let path = read_gcode_arcs(text, &GcodeOptions::default()).unwrap();
+/// assert_eq!(path.moves().len(), 4);
+/// let full = path.arc(2).unwrap();
+/// assert_eq!((full.center.x, full.center.y), (5.0, 0.0));
+/// assert!((full.sweep + std::f64::consts::TAU).abs() < 1e-12);
+/// assert!((path.arc(3).unwrap().sweep - std::f64::consts::PI).abs() < 1e-12);
+/// ```
+pub fn read_gcode_arcs(text: &str, options: &GcodeOptions) -> Result<Toolpath, GcodeError> {
+    read(text, options, true)
+}
+
+fn read(text: &str, options: &GcodeOptions, keep_arcs: bool) -> Result<Toolpath, GcodeError> {
     let mut state =
         State { pos: options.start, scale: 1.0, absolute: true, motion: None, feed: None, plane: (0, 1, 2) };
     let mut path = Toolpath::new(0.0);
@@ -167,8 +193,14 @@ pub fn read_gcode(text: &str, options: &GcodeOptions) -> Result<Toolpath, GcodeE
                         motion == 2,
                         line,
                     )?;
-                    for p in arc_points(from, to, centre, state.plane, motion == 2, options.arc_tolerance) {
-                        path.push(Move::new(MoveKind::Feed, p));
+                    if keep_arcs && state.plane == (0, 1, 2) {
+                        let sweep = arc_sweep(from, to, centre, motion == 2);
+                        let arc = ArcXY { center: Point2::new(centre.0, centre.1), sweep };
+                        path.push_arc(Move::new(MoveKind::Feed, to), arc);
+                    } else {
+                        for p in arc_points(from, to, centre, state.plane, motion == 2, options.arc_tolerance) {
+                            path.push(Move::new(MoveKind::Feed, p));
+                        }
                     }
                 }
             }
@@ -316,6 +348,24 @@ fn arc_centre(
 
 /// Relative mismatch of start and end radii accepted in an arc.
 const ARC_RADIUS_MISMATCH: f64 = 1e-3;
+
+/// Signed sweep of an arc (rad; negative clockwise), a full turn when the
+/// ends coincide.
+fn arc_sweep(from: Point3, to: Point3, c: (f64, f64), clockwise: bool) -> f64 {
+    let a0 = (from.y - c.1).atan2(from.x - c.0);
+    let a1 = (to.y - c.1).atan2(to.x - c.0);
+    let mut sweep = a1 - a0;
+    if clockwise {
+        while sweep >= 0.0 {
+            sweep -= std::f64::consts::TAU;
+        }
+    } else {
+        while sweep <= 0.0 {
+            sweep += std::f64::consts::TAU;
+        }
+    }
+    sweep
+}
 
 fn arc_points(
     from: Point3,

@@ -97,6 +97,20 @@ pub(crate) struct SweptMove {
     quadratic: f64,
     /// Lowest tip z plus lift: a lower bound of the floor everywhere.
     pub(crate) z_low: f64,
+    /// A planar circular arc instead of a straight move (see [`SweptMove::arc`]).
+    arc: Option<PlanarArc>,
+}
+
+/// A planar arc of the tip: centre, radius, start angle, signed sweep, and
+/// its two end points.
+#[derive(Debug, Clone, Copy)]
+struct PlanarArc {
+    cx: f64,
+    cy: f64,
+    r: f64,
+    start: f64,
+    sweep: f64,
+    ends: [(f64, f64); 2],
 }
 
 impl SweptMove {
@@ -159,7 +173,92 @@ impl SweptMove {
             secant: (1.0 + slope * slope).sqrt(),
             quadratic,
             z_low: from.z.min(to.z) + lift,
+            arc: None,
         }
+    }
+
+    /// The profile `shape` (or, with `disc`, a flat disc of that radius at
+    /// `lift` above the tip) moving at constant z along a circular arc of the XY
+    /// plane from `from` around `center` by `sweep` radians (positive
+    /// counter-clockwise) to `to`.
+    ///
+    /// # Derivation
+    /// At constant z the cutter's lower surface above a point `p` is at
+    /// `z + h(rho)`, `rho` the horizontal distance from the axis to `p`, and `h`
+    /// is non-decreasing on [0, R]: the swept floor is `z + h(d)` with `d` the
+    /// distance from `p` to the tip's arc (none when `d > R`). With `a = |p - c|`
+    /// and `phi` the angle of `p` about `c`: `d = |a - r|` when `phi` lies in the
+    /// swept range (the nearest point of the circle is on the arc), else the
+    /// distance to the nearer end point (the distance to the circle point at
+    /// angle `theta` grows with the angle between `theta` and `phi`). At the
+    /// centre (`a = 0`) every point of the arc is at `r`. Exact: no sampling.
+    pub(crate) fn arc(
+        shape: Option<&CutterShape>,
+        disc: (f64, f64),
+        from: &Point3,
+        to: &Point3,
+        center: Point2,
+        sweep: f64,
+    ) -> SweptMove {
+        let mut m = match shape {
+            Some(shape) => SweptMove::new(shape, from, from),
+            None => SweptMove::disc(disc.0, disc.1, from, from),
+        };
+        let start = (from.y - center.y).atan2(from.x - center.x);
+        let r = (from.x - center.x).hypot(from.y - center.y);
+        m.arc = Some(PlanarArc { cx: center.x, cy: center.y, r, start, sweep, ends: [(from.x, from.y), (to.x, to.y)] });
+        m
+    }
+
+    /// The floor of an arc move (see [`SweptMove::arc`]).
+    #[inline(never)]
+    fn arc_floor(&self, arc: &PlanarArc, x: f64, y: f64) -> f64 {
+        let (qx, qy) = (x - arc.cx, y - arc.cy);
+        let a = qx.hypot(qy);
+        let along = if arc.sweep.abs() >= std::f64::consts::TAU || a == 0.0 {
+            true
+        } else {
+            let phi = qy.atan2(qx);
+            let delta = if arc.sweep > 0.0 { phi - arc.start } else { arc.start - phi };
+            delta.rem_euclid(std::f64::consts::TAU) <= arc.sweep.abs()
+        };
+        let d = if along {
+            (a - arc.r).abs()
+        } else {
+            let [(x0, y0), (x1, y1)] = arc.ends;
+            (x - x0).hypot(y - y0).min((x - x1).hypot(y - y1))
+        };
+        let d2 = d * d;
+        if d2 > self.radius2 {
+            return f64::INFINITY;
+        }
+        self.z_low + self.profile_height(0.0, d2, self.radius2 - d2)
+    }
+
+    /// The XY box of the tip's path: the two ends and the circle's extreme
+    /// points within the sweep (for an arc).
+    pub(crate) fn tip_box(&self, from: &Point3, to: &Point3) -> (Point2, Point2) {
+        let mut lo = Point2::new(from.x.min(to.x), from.y.min(to.y));
+        let mut hi = Point2::new(from.x.max(to.x), from.y.max(to.y));
+        if let Some(arc) = &self.arc {
+            for k in 0..4 {
+                let theta = f64::from(k) * std::f64::consts::FRAC_PI_2;
+                let delta = if arc.sweep > 0.0 { theta - arc.start } else { arc.start - theta };
+                if arc.sweep.abs() >= std::f64::consts::TAU
+                    || delta.rem_euclid(std::f64::consts::TAU) <= arc.sweep.abs()
+                {
+                    let (px, py) = (arc.cx + arc.r * theta.cos(), arc.cy + arc.r * theta.sin());
+                    lo = Point2::new(lo.x.min(px), lo.y.min(py));
+                    hi = Point2::new(hi.x.max(px), hi.y.max(py));
+                }
+            }
+        }
+        (lo, hi)
+    }
+
+    /// Whether this is an arc move.
+    pub(crate) fn is_arc(&self) -> bool {
+        self.arc.is_some()
     }
 
     /// Height of the profile above the tip at `w` along the move from the foot
@@ -192,6 +291,9 @@ impl SweptMove {
     /// a parabola whose minimum over the move is in closed form.
     #[inline(always)] // hot: called per cell and move; inlining lets the row loop keep state in registers
     pub(crate) fn floor_below(&self, x: f64, y: f64, limit: f64) -> f64 {
+        if let Some(arc) = &self.arc {
+            return self.arc_floor(arc, x, y);
+        }
         let (qx, qy) = (x - self.ax, y - self.ay);
         if self.vertical {
             let rho2 = qx * qx + qy * qy;

@@ -90,6 +90,23 @@ pub enum SimError {
         /// The first ones, in program order.
         collisions: Vec<Collision>,
     },
+    /// The shank or holder touched the design part itself.
+    #[error(
+        "{count} moves drive the {what} into the part; the first is {first} at ({x:.3}, {y:.3}), {depth:.4} mm deep \
+         (part surface above the {what}'s lower face); use a tool with longer flutes or a longer reach, \
+         or keep the passes farther from that wall",
+        what = collisions.first().map_or("shank", |c| c.part.name()),
+        first = collisions.first().map_or(MoveId { operation: 0, index: 0 }, |c| c.id),
+        x = collisions.first().map_or(0.0, |c| c.at.x),
+        y = collisions.first().map_or(0.0, |c| c.at.y),
+        depth = collisions.first().map_or(0.0, |c| c.depth)
+    )]
+    PartCollision {
+        /// Number of colliding moves (per part of the tool).
+        count: usize,
+        /// The first ones, in program order.
+        collisions: Vec<Collision>,
+    },
     /// An uncut cell lies below the part: the stock box does not contain the part.
     #[error(
         "the part rises above the stock at ({x:.3}, {y:.3}): part z {part_z} > stock z {stock_z} where nothing was cut; \

@@ -6,7 +6,8 @@
 //!   lowers every cell centre to the lowest point of the cutter's lower envelope
 //!   swept along each straight move, solved exactly per shape (flat, ball,
 //!   bull-nose, cone; see [`swept_floor`]), and checks rapids and the shank and
-//!   holder against the in-process stock ([`CutReport`]).
+//!   holder against the in-process stock ([`CutReport`]);
+//!   [`ZMap::part_collisions`] checks them against the design part.
 //! - [`verify`]: the signed deviation `stock - part` per cell against a design
 //!   part (a [`scallop_mesh::MeshIndex`]): max scallop, volumes, and gouges as errors.
 //! - [`simulate`]: both, with every safety problem as an `Err`.
@@ -90,8 +91,10 @@ pub struct Simulation {
 ///
 /// # Errors
 /// Stock errors of [`ZMap::new`]; then, in this order, the safety errors of
-/// [`CutReport::check`] (rapids into stock, shank or holder collisions) and of
-/// [`verify`] (part outside the stock, gouges).
+/// rapids into stock ([`SimError::RapidIntoStock`]), shank or holder against
+/// the part ([`SimError::PartCollision`], see [`ZMap::part_collisions`]),
+/// against the stock ([`SimError::HolderCollision`], [`CutReport::check`]),
+/// then the errors of [`verify`] (part outside the stock, gouges).
 ///
 /// ```
 /// use scallop_cutter::{Cutter, CutterShape};
@@ -119,6 +122,15 @@ pub fn simulate(
 ) -> Result<Simulation, SimError> {
     let mut zmap = ZMap::new(stock, resolution)?;
     let cut = zmap.cut(cutter, toolpath)?;
+    if !cut.rapid_hits.is_empty() {
+        cut.check()?;
+    }
+    // The part under the stock means a collision with the part is one with
+    // the stock too: the part's comes first, as no roughing can fix it.
+    let collisions = zmap.part_collisions(part, cutter, toolpath, cut.operation)?;
+    if !collisions.is_empty() {
+        return Err(SimError::PartCollision { count: collisions.len(), collisions });
+    }
     cut.check()?;
     let verification = verify(&zmap, part, options)?;
     Ok(Simulation { zmap, cut, verification })

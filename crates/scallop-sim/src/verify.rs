@@ -21,12 +21,24 @@ pub struct VerifyOptions {
     pub gouge_tolerance: f64,
     /// How many of the deepest gouge cells a [`SimError::Gouge`] lists.
     pub worst_reported: usize,
+    /// Width (mm) of the strip along the edge of the part's footprint that
+    /// the scallop figures [`Verification::max_thickness`] leave out (its
+    /// largest thickness is reported apart, in
+    /// [`Verification::margin_max_thickness`]; gouges are checked everywhere).
+    /// A finishing plan guarantees its scallop height where neighbouring passes
+    /// both shape the surface; near the part's open edge the surface is shaped by
+    /// pass ends and by the first and last planes (half a spacing inside the
+    /// edge) instead. With scallop's `Boundary::ContactInside` rule every cutter
+    /// location that shapes a point farther than the cutter radius R from the
+    /// edge has its contact inside the part, so R is the margin that matches it.
+    /// 0 (the default): the whole footprint.
+    pub scallop_margin: f64,
 }
 
 impl Default for VerifyOptions {
     /// No gouge allowed beyond rounding; the 20 deepest cells reported.
     fn default() -> Self {
-        VerifyOptions { gouge_tolerance: 0.0, worst_reported: WORST_REPORTED }
+        VerifyOptions { gouge_tolerance: 0.0, worst_reported: WORST_REPORTED, scallop_margin: 0.0 }
     }
 }
 
@@ -73,6 +85,20 @@ pub struct Verification {
     pub max_scallop_at: Option<Point2>,
     /// Smallest `stock - part` over part cells (mm; >= minus the gouge tolerance).
     pub min_deviation: f64,
+    /// Largest material thickness along the part normal, `(stock - part) |n_z|`
+    /// with `n` the normal of the part triangle under the cell centre (the
+    /// distance from the stock point to that triangle's plane), over the part
+    /// cells at least [`VerifyOptions::scallop_margin`] inside the footprint's
+    /// edge (mm; 0 when there are none). This is the scallop height as a
+    /// finishing plan defines it (along the normal, not vertically).
+    pub max_thickness: f64,
+    /// Where `max_thickness` is (the first such cell in row order).
+    pub max_thickness_at: Option<Point2>,
+    /// Largest normal thickness in the edge strip left out of
+    /// `max_thickness` (mm; 0 without a margin): reported, never hidden.
+    pub margin_max_thickness: f64,
+    /// Part cells inside the margin, where `max_thickness` is measured.
+    pub scallop_cells: usize,
     /// Volume of stock left (mm^3), see [`ZMap::volume`].
     pub remaining_volume: f64,
     /// Volume removed from the full stock box (mm^3).
@@ -100,10 +126,17 @@ pub struct Verification {
 /// ```
 #[must_use]
 pub fn part_heights(zmap: &ZMap, part: &MeshIndex) -> Vec<f64> {
+    part_surface(zmap, part).into_iter().map(|(z, _)| z).collect()
+}
+
+/// [`part_heights`] with the `|n_z|` of the triangle that gives each height
+/// (the highest one; of equal heights the least steep), `(NEG_INFINITY, 0)`
+/// where no triangle lies under the centre.
+pub(crate) fn part_surface(zmap: &ZMap, part: &MeshIndex) -> Vec<(f64, f64)> {
     let (nx, ny) = (zmap.nx(), zmap.ny());
     let (cell_x, cell_y) = zmap.cell_size();
     let stock = zmap.stock();
-    let mut top = vec![f64::NEG_INFINITY; nx * ny];
+    let mut top = vec![(f64::NEG_INFINITY, 0.0); nx * ny];
     top.par_chunks_mut(PART_BAND_ROWS * nx).enumerate().for_each_init(Vec::new, |slots, (band, out)| {
         let rows = out.len() / nx;
         let j0 = band * PART_BAND_ROWS;
@@ -118,6 +151,9 @@ pub fn part_heights(zmap: &ZMap, part: &MeshIndex) -> Vec<f64> {
         for &slot in slots.iter() {
             let [a, b, c] = *part.corners(slot as usize);
             let (a2, b2, c2) = (a.xy(), b.xy(), c.xy());
+            let normal = (b - a).cross(&(c - a));
+            let length = normal.norm();
+            let nz = if length > 0.0 { (normal.z / length).abs() } else { 0.0 };
             let bx = part.xy_box(slot as usize);
             let Some((i0, i1)) = index_range(bx.min.x, bx.max.x, stock.min.x, cell_x, nx) else { continue };
             let Some((r0, r1)) = index_range(bx.min.y, bx.max.y, stock.min.y, cell_y, ny) else { continue };
@@ -132,12 +168,95 @@ pub fn part_heights(zmap: &ZMap, part: &MeshIndex) -> Vec<f64> {
                     let total = wa + wb + wc;
                     let z = if total == 0.0 { a.z.max(b.z).max(c.z) } else { (wa * a.z + wb * b.z + wc * c.z) / total };
                     let cell = &mut out[(j - j0) * nx + i];
-                    *cell = cell.max(z);
+                    // A lexicographic maximum: independent of the triangle order.
+                    if z.total_cmp(&cell.0).then(nz.total_cmp(&cell.1)).is_gt() {
+                        *cell = (z, nz);
+                    }
                 }
             }
         }
     });
     top
+}
+
+/// Squared distance (mm^2) from each cell centre to the nearest centre of a
+/// cell with `inside == false`, the cells just outside the grid counting as
+/// outside: an exact Euclidean distance transform (lower envelope of
+/// parabolas, one pass along rows, one along columns; Felzenszwalb and
+/// Huttenlocher 2012). Rows and columns are independent and each is computed
+/// the same way on any thread count.
+pub(crate) fn edge_distance2(inside: &[bool], nx: usize, ny: usize, cell_x: f64, cell_y: f64) -> Vec<f64> {
+    // Along rows: the sites are the outside cells and the two virtual ones.
+    let mut rows = vec![0.0; nx * ny];
+    rows.par_chunks_mut(nx).enumerate().for_each_init(
+        || (Vec::new(), Vec::new()),
+        |(sites, env), (j, out)| {
+            sites.clear();
+            sites.push((-1.0, 0.0));
+            for i in 0..nx {
+                if !inside[j * nx + i] {
+                    // Cell indices far below 2^52: exact.
+                    sites.push((i as f64, 0.0));
+                }
+            }
+            sites.push((nx as f64, 0.0));
+            lower_envelope(sites, cell_x, env, out);
+        },
+    );
+    // Along columns: the sites are every cell with its row distance, plus the
+    // two virtual outside cells.
+    let mut columns = vec![0.0; nx * ny];
+    columns.par_chunks_mut(ny).enumerate().for_each_init(
+        || (Vec::new(), Vec::new()),
+        |(sites, env), (i, out)| {
+            sites.clear();
+            sites.push((-1.0, 0.0));
+            for j in 0..ny {
+                sites.push((j as f64, rows[j * nx + i]));
+            }
+            sites.push((ny as f64, 0.0));
+            lower_envelope(sites, cell_y, env, out);
+        },
+    );
+    let mut d2 = vec![0.0; nx * ny];
+    for (i, column) in columns.chunks(ny).enumerate() {
+        for (j, &v) in column.iter().enumerate() {
+            d2[j * nx + i] = v;
+        }
+    }
+    d2
+}
+
+/// `out[q] = min over sites (s, f) of ((q - s) step)^2 + f` for q in 0..out.len();
+/// `sites` sorted by position.
+fn lower_envelope(sites: &[(f64, f64)], step: f64, env: &mut Vec<((f64, f64), f64)>, out: &mut [f64]) {
+    // Each parabola in world units: (x - s step)^2 + f, with the abscissa from
+    // which it is the lowest.
+    env.clear();
+    for &(s, f) in sites {
+        let x = s * step;
+        let mut from = f64::NEG_INFINITY;
+        while let Some(&((px, pf), pfrom)) = env.last() {
+            // Intersection of the new parabola with the last one on the envelope.
+            let meet = ((f + x * x) - (pf + px * px)) / (2.0 * (x - px));
+            if meet <= pfrom {
+                env.pop();
+            } else {
+                from = meet;
+                break;
+            }
+        }
+        env.push(((x, f), from));
+    }
+    let mut k = 0;
+    for (q, slot) in out.iter_mut().enumerate() {
+        let x = q as f64 * step;
+        while k + 1 < env.len() && env[k + 1].1 <= x {
+            k += 1;
+        }
+        let ((px, pf), _) = env[k];
+        *slot = (x - px) * (x - px) + pf;
+    }
 }
 
 #[derive(Default)]
@@ -149,6 +268,9 @@ struct RowStats {
     gouges: usize,
     worst: Vec<GougeCell>,
     outside: Option<(usize, f64, f64)>,
+    thickness: Option<(f64, usize)>,
+    margin_thickness: f64,
+    scallop_cells: usize,
 }
 
 fn deepest_first(a: &GougeCell, b: &GougeCell) -> std::cmp::Ordering {
@@ -175,11 +297,23 @@ fn deepest_first(a: &GougeCell, b: &GougeCell) -> std::cmp::Ordering {
 /// let v = verify(&zmap, &MeshIndex::build(&plane), &VerifyOptions::default()).unwrap();
 /// assert_eq!(v.max_scallop, 2.0); // nothing cut yet: 2 mm of stock above the part
 /// assert_eq!(v.removed_volume, 0.0);
+/// assert_eq!((v.max_thickness, v.scallop_cells), (2.0, 64)); // a level part: along the normal too
+/// // A 1 mm margin leaves out the footprint's outer ring of cells (the part
+/// // covers the stock; the grid's edge is the footprint's edge).
+/// let o = VerifyOptions { scallop_margin: 1.0, ..VerifyOptions::default() };
+/// let v = verify(&zmap, &MeshIndex::build(&plane), &o).unwrap();
+/// assert_eq!((v.scallop_cells, v.margin_max_thickness), (16, 2.0));
 /// ```
 pub fn verify(zmap: &ZMap, part: &MeshIndex, options: &VerifyOptions) -> Result<Verification, SimError> {
-    let top = part_heights(zmap, part);
-    let nx = zmap.nx();
+    let top = part_surface(zmap, part);
+    let (nx, ny) = (zmap.nx(), zmap.ny());
     let (cell_x, cell_y) = zmap.cell_size();
+    let margin = options.scallop_margin.max(0.0);
+    let edge2 = (margin > 0.0).then(|| {
+        let inside: Vec<bool> = top.iter().map(|&(z, _)| z != f64::NEG_INFINITY).collect();
+        edge_distance2(&inside, nx, ny, cell_x, cell_y)
+    });
+    let margin2 = margin * margin;
     let area = cell_x * cell_y;
     let limit = options.gouge_tolerance + zmap.eps();
     let keep = options.worst_reported;
@@ -190,12 +324,21 @@ pub fn verify(zmap: &ZMap, part: &MeshIndex, options: &VerifyOptions) -> Result<
         .enumerate()
         .map(|(j, (stock_row, part_row))| {
             let mut s = RowStats::default();
-            for (i, (&stock_z, &part_z)) in stock_row.iter().zip(part_row).enumerate() {
+            for (i, (&stock_z, &(part_z, nz))) in stock_row.iter().zip(part_row).enumerate() {
                 if part_z == f64::NEG_INFINITY {
                     continue;
                 }
                 s.part_cells += 1;
                 let dev = stock_z - part_z;
+                let thickness = dev * nz;
+                if edge2.as_ref().is_none_or(|d| d[j * nx + i] > margin2) {
+                    s.scallop_cells += 1;
+                    if s.thickness.is_none_or(|(m, _)| thickness > m) {
+                        s.thickness = Some((thickness, i));
+                    }
+                } else {
+                    s.margin_thickness = s.margin_thickness.max(thickness);
+                }
                 if s.max.is_none_or(|(m, _)| dev > m) {
                     s.max = Some((dev, i));
                 }
@@ -233,7 +376,17 @@ pub fn verify(zmap: &ZMap, part: &MeshIndex, options: &VerifyOptions) -> Result<
     let mut excess_volume = 0.0;
     let mut gouges = 0;
     let mut worst = Vec::new();
+    let mut thickness: Option<(f64, (usize, usize))> = None;
+    let mut margin_max_thickness = 0.0f64;
+    let mut scallop_cells = 0;
     for (j, s) in rows.into_iter().enumerate() {
+        if let Some((m, i)) = s.thickness
+            && thickness.is_none_or(|(best, _)| m > best)
+        {
+            thickness = Some((m, (i, j)));
+        }
+        margin_max_thickness = margin_max_thickness.max(s.margin_thickness);
+        scallop_cells += s.scallop_cells;
         if let Some((i, stock_z, part_z)) = s.outside {
             return Err(SimError::PartOutsideStock { at: zmap.cell_center(i, j), stock_z, part_z });
         }
@@ -261,8 +414,51 @@ pub fn verify(zmap: &ZMap, part: &MeshIndex, options: &VerifyOptions) -> Result<
         max_scallop: max.map_or(0.0, |(m, _)| m),
         max_scallop_at: max.map(|(_, (i, j))| zmap.cell_center(i, j)),
         min_deviation: min_deviation.unwrap_or(0.0),
+        max_thickness: thickness.map_or(0.0, |(m, _)| m),
+        max_thickness_at: thickness.map(|(_, (i, j))| zmap.cell_center(i, j)),
+        margin_max_thickness,
+        scallop_cells,
         remaining_volume,
         removed_volume: zmap.initial_volume() - remaining_volume,
         excess_volume,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The distance transform equals the brute-force minimum over outside
+    /// centres (and the virtual ring just outside the grid) on scattered masks.
+    #[test]
+    fn edge_distance_matches_brute_force() {
+        let (nx, ny, cx, cy) = (23usize, 17usize, 0.3, 0.5);
+        for seed in 1..6u64 {
+            let mut state = seed;
+            let inside: Vec<bool> = (0..nx * ny)
+                .map(|_| {
+                    state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+                    (state >> 33) % 7 != 0
+                })
+                .collect();
+            let d2 = edge_distance2(&inside, nx, ny, cx, cy);
+            let (nxi, nyi) = (nx as i64, ny as i64);
+            for j in 0..nyi {
+                for i in 0..nxi {
+                    let mut best = f64::INFINITY;
+                    for b in -1..=nyi {
+                        for a in -1..=nxi {
+                            let outside = a < 0 || b < 0 || a == nxi || b == nyi || !inside[(b * nxi + a) as usize];
+                            if outside {
+                                let (dx, dy) = ((a - i) as f64 * cx, (b - j) as f64 * cy);
+                                best = best.min(dx * dx + dy * dy);
+                            }
+                        }
+                    }
+                    let got = d2[(j * nxi + i) as usize];
+                    assert!((got - best).abs() <= 1e-9 * best.max(1.0), "({i}, {j}): {got} vs {best}");
+                }
+            }
+        }
+    }
 }

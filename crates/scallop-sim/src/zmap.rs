@@ -3,8 +3,9 @@
 use std::fmt;
 
 use rayon::prelude::*;
-use scallop_cutter::Cutter;
-use scallop_geom::{Aabb3, Eps, Point2};
+use scallop_cutter::{Cutter, CutterShape};
+use scallop_geom::{Aabb3, Eps, Point2, Point3};
+use scallop_mesh::MeshIndex;
 use scallop_toolpath::{MoveKind, Toolpath};
 
 use crate::SimError;
@@ -187,8 +188,23 @@ pub struct ZMap {
     eps: f64,
 }
 
-/// A move prepared for the per-cell solve.
+/// Largest distance between a helical arc and the chords it is simulated by
+/// (mm): helices are the one case not solved in closed form (their floor
+/// `z(theta) + h(rho(theta))` has no convexity to exploit); planar arcs are exact.
+const HELIX_SAGITTA: f64 = 1e-4;
+
+/// Largest number of chords of one helical move.
+const MAX_HELIX_CHORDS: f64 = 1e6;
+
+/// A move (or a chord of a helical move) prepared for the per-cell solve.
 struct Plan {
+    /// The move's index in the toolpath.
+    id: u32,
+    /// XY box of the tip's path.
+    box_lo: Point2,
+    box_hi: Point2,
+    /// Whether the tip's path is an arc (columns from the box, not the stadium).
+    arc: bool,
     cutter: SweptMove,
     /// First and one-past-last disc in `discs`.
     discs: (usize, usize),
@@ -200,6 +216,38 @@ struct Plan {
     from: Point2,
     to: Point2,
     rapid: bool,
+}
+
+impl Plan {
+    #[allow(clippy::too_many_arguments)] // private; the pieces of one move.
+    fn new(
+        id: u32,
+        cutter: SweptMove,
+        discs: &[SweptMove],
+        first: usize,
+        parts: &[(f64, f64, ToolPart)],
+        from: &Point3,
+        to: &Point3,
+        rapid: bool,
+    ) -> Plan {
+        let reach = parts.iter().fold(cutter.radius(), |r, &(radius, _, _)| r.max(radius));
+        let disc_low = discs[first..].iter().fold(f64::INFINITY, |low, d| low.min(d.z_low));
+        let (box_lo, box_hi) = cutter.tip_box(from, to);
+        Plan {
+            id,
+            box_lo,
+            box_hi,
+            arc: cutter.is_arc(),
+            z_low: cutter.z_low.min(disc_low),
+            cutter,
+            discs: (first, discs.len()),
+            disc_low,
+            reach,
+            from: from.xy(),
+            to: to.xy(),
+            rapid,
+        }
+    }
 }
 
 /// What a band found, sparse per move.
@@ -279,6 +327,51 @@ impl ZMap {
     #[must_use]
     pub fn stock(&self) -> Aabb3 {
         self.stock
+    }
+
+    /// The simulator's resolution bound for `shape` on this grid (mm): how far
+    /// the stock's true swept floor can lie below what its cell centres show.
+    ///
+    /// Every point of the grid lies within `rho = sqrt(cell_x^2 + cell_y^2) / 2`
+    /// (half a cell diagonal) of a cell centre, and the height at a centre is
+    /// exact. Where the floor has a minimum between centres (the bottom of a
+    /// pass, of a gouge), its gradient vanishes there and its curvature is at
+    /// most the profile's largest curvature `kappa` (a swept surface is no more
+    /// curved across the move than the profile, and along a straight move it is
+    /// straight), so the nearest centre lies at most `kappa rho^2 / 2` above it:
+    /// ball `kappa = 1 / R`, bull-nose `1 / r` (its corner), flat `0` (a flat
+    /// bottom sweeps planes). A cone's tip has no curvature bound; its floor
+    /// rises at most `cot(a)` per mm from a minimum, so its bound is `cot(a) rho`.
+    /// A deviation measured at the centres (gouge depth, material left) is
+    /// therefore within this bound of the true extreme on the floor; at a
+    /// ridge between passes (a cusp) the centres can only under-state the
+    /// height, by at most the profile's slope there times `rho`.
+    ///
+    /// ```
+    /// use scallop_cutter::CutterShape;
+    /// use scallop_geom::{Aabb3, Point3};
+    /// use scallop_sim::ZMap;
+    /// let stock = Aabb3 { min: Point3::new(0.0, 0.0, -1.0), max: Point3::new(10.0, 10.0, 0.0) };
+    /// let zmap = ZMap::new(stock, 0.05).unwrap();
+    /// let b = zmap.resolution_bound(&CutterShape::Bull { radius: 5.0, corner: 2.0 });
+    /// assert!((b - 0.05f64.powi(2) * 2.0 / 8.0 / 2.0).abs() < 1e-15); // rho^2 / (2 r)
+    /// assert_eq!(zmap.resolution_bound(&CutterShape::Flat { radius: 1.0 }), 0.0);
+    /// ```
+    #[must_use]
+    pub fn resolution_bound(&self, shape: &CutterShape) -> f64 {
+        let rho2 = 0.25 * (self.cell_x * self.cell_x + self.cell_y * self.cell_y);
+        match *shape {
+            CutterShape::Flat { .. } => 0.0,
+            CutterShape::Ball { radius } => 0.5 * rho2 / radius,
+            CutterShape::Bull { corner, .. } => {
+                if corner > 0.0 {
+                    0.5 * rho2 / corner
+                } else {
+                    0.0
+                }
+            }
+            CutterShape::Cone { half_angle, .. } => rho2.sqrt() / half_angle.tan(),
+        }
     }
 
     /// The rounding epsilon of the stock (mm): lowerings below it do not count as cuts.
@@ -407,9 +500,71 @@ impl ZMap {
     /// ```
     pub fn cut(&mut self, cutter: &Cutter, toolpath: &Toolpath) -> Result<CutReport, SimError> {
         let moves = toolpath.moves();
-        let n = u32::try_from(moves.len()).map_err(|_| SimError::TooManyMoves { moves: moves.len() })?;
         let operation = self.operations;
         self.operations = self.operations.checked_add(1).ok_or(SimError::TooManyMoves { moves: moves.len() })?;
+        self.sweep(cutter, toolpath, operation, true)
+    }
+
+    /// Checks the shank and holder of `cutter` along `toolpath` against the
+    /// design part itself (not the in-process stock): the part's top under
+    /// each cell centre (see [`crate::part_heights`]) is tested against the
+    /// same discs as in [`ZMap::cut`] (the shank of radius max(R, shank radius)
+    /// from the flute length up, each holder segment), so a part wall higher
+    /// than the flutes within R of a pass is found even where the stock was
+    /// already cleared. The stock is not changed; `operation` names the moves
+    /// (the [`CutReport::operation`] of the cut of the same toolpath).
+    /// Penetrations beyond the stock's epsilon, deepest cell per move and part
+    /// of the tool, in program order.
+    ///
+    /// # Errors
+    /// [`SimError::TooManyMoves`] when a move index would not fit in `u32`.
+    ///
+    /// ```
+    /// use scallop_cutter::{Cutter, CutterShape};
+    /// use scallop_geom::{Aabb3, Point3};
+    /// use scallop_mesh::{MeshIndex, TriMesh};
+    /// use scallop_sim::{ToolPart, ZMap};
+    /// use scallop_toolpath::{Move, MoveKind, Toolpath};
+    /// let p = |x, y, z| Point3::new(x, y, z);
+    /// // A block 10 mm tall at y >= 6; a pass along y = 5 with a 2 mm ball,
+    /// // 3 mm of flutes, 5 mm below the block's top.
+    /// let (block, _) = TriMesh::from_soup(&[[p(-5., 6., 10.), p(30., 6., 10.), p(-5., 20., 10.)]]).unwrap();
+    /// let zmap = ZMap::new(Aabb3 { min: p(0., 0., -1.), max: p(20., 10., 11.) }, 0.1).unwrap();
+    /// let ball = Cutter::new(CutterShape::Ball { radius: 2.0 }, 3.0).unwrap();
+    /// let mut path = Toolpath::new(1000.0);
+    /// path.push(Move::new(MoveKind::Rapid, p(2., 5., 5.)));
+    /// path.push(Move::new(MoveKind::Feed, p(18., 5., 5.)));
+    /// let hits = zmap.part_collisions(&MeshIndex::build(&block), &ball, &path, 0).unwrap();
+    /// assert_eq!(hits.len(), 2);
+    /// assert_eq!((hits[1].id.index, hits[1].part), (1, ToolPart::Shank));
+    /// assert!((hits[1].depth - 2.0).abs() < 1e-9); // the wall top 2 mm above the flutes' end
+    /// ```
+    pub fn part_collisions(
+        &self,
+        part: &MeshIndex,
+        cutter: &Cutter,
+        toolpath: &Toolpath,
+        operation: u32,
+    ) -> Result<Vec<Collision>, SimError> {
+        let bottom = self.stock.min.z;
+        let mut field = self.clone();
+        field.heights = crate::part_heights(self, part)
+            .into_iter()
+            .map(|z| if z == f64::NEG_INFINITY { bottom } else { z.max(bottom) })
+            .collect();
+        Ok(field.sweep(cutter, toolpath, operation, false)?.collisions)
+    }
+
+    /// The body of [`ZMap::cut`]; `remove == false` only checks the discs.
+    fn sweep(
+        &mut self,
+        cutter: &Cutter,
+        toolpath: &Toolpath,
+        operation: u32,
+        remove: bool,
+    ) -> Result<CutReport, SimError> {
+        let moves = toolpath.moves();
+        let n = u32::try_from(moves.len()).map_err(|_| SimError::TooManyMoves { moves: moves.len() })?;
 
         // Non-cutting parts as flat discs: (radius, lift above the tip, part).
         let mut parts = vec![(cutter.radius().max(cutter.shank_radius()), cutter.flute_length(), ToolPart::Shank)];
@@ -419,39 +574,65 @@ impl ZMap {
             lift += s.length;
         }
         let mut discs = Vec::with_capacity(moves.len() * parts.len());
-        let plans: Vec<Plan> = moves
-            .iter()
-            .enumerate()
-            .map(|(k, m)| {
-                let from = if k == 0 { m.to } else { moves[k - 1].to };
-                let cut = SweptMove::new(cutter.shape(), &from, &m.to);
-                let first = discs.len();
-                let mut reach = cut.radius();
-                let mut disc_low = f64::INFINITY;
-                for &(radius, lift, _) in &parts {
-                    let d = SweptMove::disc(radius, lift, &from, &m.to);
-                    reach = reach.max(radius);
-                    disc_low = disc_low.min(d.z_low);
-                    discs.push(d);
+        let mut plans: Vec<Plan> = Vec::with_capacity(moves.len());
+        for (k, m) in moves.iter().enumerate() {
+            let from = if k == 0 { m.to } else { moves[k - 1].to };
+            // k < n <= u32::MAX (checked above).
+            let id = k as u32;
+            let rapid = matches!(m.kind, MoveKind::Rapid | MoveKind::Retract);
+            let arc = if k == 0 { None } else { toolpath.arc(k) };
+            match arc {
+                // A planar arc (z constant within the stock's epsilon): exact (SweptMove::arc).
+                Some(arc) if (from.z - m.to.z).abs() <= self.eps => {
+                    let first = discs.len();
+                    for &(radius, lift, _) in &parts {
+                        discs.push(SweptMove::arc(None, (radius, lift), &from, &m.to, arc.center, arc.sweep));
+                    }
+                    let cut = SweptMove::arc(Some(cutter.shape()), (0.0, 0.0), &from, &m.to, arc.center, arc.sweep);
+                    plans.push(Plan::new(id, cut, &discs, first, &parts, &from, &m.to, rapid));
                 }
-                let z_low = cut.z_low.min(disc_low);
-                Plan {
-                    cutter: cut,
-                    discs: (first, discs.len()),
-                    z_low,
-                    disc_low,
-                    reach,
-                    from: from.xy(),
-                    to: m.to.xy(),
-                    rapid: matches!(m.kind, MoveKind::Rapid | MoveKind::Retract),
+                // A helix: straight chords within `HELIX_SAGITTA` of it.
+                Some(arc) => {
+                    let c = arc.center;
+                    let r = (from.x - c.x).hypot(from.y - c.y);
+                    let start = (from.y - c.y).atan2(from.x - c.x);
+                    let step =
+                        if r > HELIX_SAGITTA { 2.0 * (1.0 - HELIX_SAGITTA / r).acos() } else { std::f64::consts::PI };
+                    // Bounded by MAX_HELIX_CHORDS: exact conversions.
+                    let chords = (arc.sweep.abs() / step).ceil().clamp(1.0, MAX_HELIX_CHORDS);
+                    let mut a = from;
+                    for q in 1..=chords as u32 {
+                        let t = f64::from(q) / chords;
+                        let b = if q == chords as u32 {
+                            m.to
+                        } else {
+                            let theta = start + arc.sweep * t;
+                            Point3::new(c.x + r * theta.cos(), c.y + r * theta.sin(), from.z + (m.to.z - from.z) * t)
+                        };
+                        let first = discs.len();
+                        for &(radius, lift, _) in &parts {
+                            discs.push(SweptMove::disc(radius, lift, &a, &b));
+                        }
+                        let cut = SweptMove::new(cutter.shape(), &a, &b);
+                        plans.push(Plan::new(id, cut, &discs, first, &parts, &a, &b, rapid));
+                        a = b;
+                    }
                 }
-            })
-            .collect();
+                None => {
+                    let first = discs.len();
+                    for &(radius, lift, _) in &parts {
+                        discs.push(SweptMove::disc(radius, lift, &from, &m.to));
+                    }
+                    let cut = SweptMove::new(cutter.shape(), &from, &m.to);
+                    plans.push(Plan::new(id, cut, &discs, first, &parts, &from, &m.to, rapid));
+                }
+            }
+        }
 
         // Moves per band (compressed rows), in program order.
         let bands = self.ny.div_ceil(BAND_ROWS);
         let band_range = |p: &Plan| {
-            let (lo, hi) = (p.from.y.min(p.to.y) - p.reach, p.from.y.max(p.to.y) + p.reach);
+            let (lo, hi) = (p.box_lo.y - p.reach, p.box_hi.y + p.reach);
             self.row_range(lo, hi).map(|(a, b)| (a / BAND_ROWS, b / BAND_ROWS))
         };
         let mut start = vec![0usize; bands + 1];
@@ -495,7 +676,7 @@ impl ZMap {
             .enumerate()
             .map(|(band, (heights, last))| {
                 let ids = &members[start[band]..start[band + 1]];
-                grid.cut_band(band, heights, last, ids, &plans, &discs, &parts, operation)
+                grid.cut_band(band, heights, last, ids, &plans, &discs, &parts, operation, remove)
             })
             .collect();
 
@@ -595,6 +776,7 @@ impl Grid {
         discs: &[SweptMove],
         parts: &[(f64, f64, ToolPart)],
         operation: u32,
+        remove: bool,
     ) -> BandOutput {
         let nx = self.nx;
         let row0 = band * BAND_ROWS;
@@ -614,12 +796,12 @@ impl Grid {
         let mut out = BandOutput::default();
         for &k in ids {
             let plan = &plans[k as usize];
-            let packed = MoveId { operation, index: k }.pack();
-            let (dy_lo, dy_hi) = (plan.from.y.min(plan.to.y) - plan.reach, plan.from.y.max(plan.to.y) + plan.reach);
+            let packed = MoveId { operation, index: plan.id }.pack();
+            let (dy_lo, dy_hi) = (plan.box_lo.y - plan.reach, plan.box_hi.y + plan.reach);
             let Some((j0, j1)) = index_range(dy_lo, dy_hi, self.min_y, self.cell_y, self.ny) else { continue };
             let (j0, j1) = (j0.max(row0), j1.min(row0 + rows - 1));
-            let (box_x0, box_x1) = (plan.from.x.min(plan.to.x), plan.from.x.max(plan.to.x));
-            let (box_y0, box_y1) = (plan.from.y.min(plan.to.y), plan.from.y.max(plan.to.y));
+            let (box_x0, box_x1) = (plan.box_lo.x, plan.box_hi.x);
+            let (box_y0, box_y1) = (plan.box_lo.y, plan.box_hi.y);
             let quadratic = plan.cutter.quadratic();
             // Nothing at or below this can touch a disc (collisions need > eps).
             let disc_bound = plan.disc_low + self.eps;
@@ -639,7 +821,11 @@ impl Grid {
                     // z_low + k d^2 with d the distance to the move's box.
                     let (xa, xb) = (self.x_of(c0), self.x_of(c1));
                     let dx = (box_x0 - xb).max(0.0).max(xa - box_x1);
-                    let bound = (plan.cutter.z_low + quadratic * (dx * dx + dy * dy)).min(disc_bound);
+                    let bound = if remove {
+                        (plan.cutter.z_low + quadratic * (dx * dx + dy * dy)).min(disc_bound)
+                    } else {
+                        disc_bound
+                    };
                     if tile_top[tile] <= bound {
                         continue;
                     }
@@ -669,7 +855,7 @@ impl Grid {
                                 }
                             }
                         }
-                        if old <= plan.cutter.z_low {
+                        if !remove || old <= plan.cutter.z_low {
                             continue;
                         }
                         let new = plan.cutter.floor_below(x, y, old).max(self.bottom);
@@ -692,14 +878,14 @@ impl Grid {
             }
             let to_global = |cell: usize| row0 * nx + cell;
             if removed > 0.0 {
-                out.removed.push((k, removed * area, max_lower));
+                out.removed.push((plan.id, removed * area, max_lower));
             }
             if let Some((depth, cell)) = rapid_worst {
-                out.rapid.push((k, depth, to_global(cell)));
+                out.rapid.push((plan.id, depth, to_global(cell)));
             }
             for (slot, worst) in collision_worst.iter().enumerate() {
                 if let Some((depth, cell)) = *worst {
-                    out.collisions.push((k, parts[slot].2, depth, to_global(cell)));
+                    out.collisions.push((plan.id, parts[slot].2, depth, to_global(cell)));
                 }
             }
         }
@@ -711,6 +897,15 @@ impl Grid {
     /// of the two end discs and of the band between them; the index range has
     /// one cell of margin each side (the per-cell solve decides exactly).
     fn columns(&self, plan: &Plan, y: f64) -> Option<(usize, usize)> {
+        if plan.arc {
+            return index_range(
+                plan.box_lo.x - plan.reach,
+                plan.box_hi.x + plan.reach,
+                self.min_x,
+                self.cell_x,
+                self.nx,
+            );
+        }
         let (a, b, r) = (plan.from, plan.to, plan.reach);
         let mut lo = f64::INFINITY;
         let mut hi = f64::NEG_INFINITY;

@@ -272,3 +272,52 @@ fn holder_collides_with_a_pocket_wall_cut_by_an_earlier_operation() {
         other => panic!("expected a holder collision, got {other:?}"),
     }
 }
+
+/// A floor at z = 0 with a wall 10 mm tall at y >= 6 (top and side faces).
+fn floor_and_wall() -> MeshIndex {
+    let soup = [
+        [p(-5.0, -5.0, 0.0), p(25.0, -5.0, 0.0), p(25.0, 6.0, 0.0)],
+        [p(-5.0, -5.0, 0.0), p(25.0, 6.0, 0.0), p(-5.0, 6.0, 0.0)],
+        [p(-5.0, 6.0, 0.0), p(25.0, 6.0, 0.0), p(25.0, 6.0, 10.0)],
+        [p(-5.0, 6.0, 0.0), p(25.0, 6.0, 10.0), p(-5.0, 6.0, 10.0)],
+        [p(-5.0, 6.0, 10.0), p(25.0, 6.0, 10.0), p(25.0, 15.0, 10.0)],
+        [p(-5.0, 6.0, 10.0), p(25.0, 15.0, 10.0), p(-5.0, 15.0, 10.0)],
+    ];
+    MeshIndex::build(&TriMesh::from_soup(&soup).unwrap().0)
+}
+
+#[test]
+fn shank_hitting_a_wall_of_the_part_names_the_move_and_the_place() {
+    let part = floor_and_wall();
+    let s = stock(20.0, 10.0, -1.0, 10.0);
+    // A 1 mm ball on a 3 mm shank: the pass at y = 4.5 keeps the ball 0.5 mm
+    // from the wall, but the shank (from the flute length up) reaches y = 7.5.
+    let pass = path(&[p(-2.0, 4.5, 0.0), p(22.0, 4.5, 0.0)], 25.0);
+    let short = Cutter::new(CutterShape::Ball { radius: 1.0 }, 3.0).unwrap().with_shank(3.0, 20.0).unwrap();
+    match simulate(s, 0.1, &short, &pass, &part, &VerifyOptions::default()) {
+        Err(e @ SimError::PartCollision { .. }) => {
+            let message = e.to_string();
+            assert!(message.contains("shank into the part") && message.contains("move 1 of operation 0"), "{message}");
+            let SimError::PartCollision { collisions, .. } = e else { unreachable!() };
+            // The plunge, the feed move and the retract (each starts or ends
+            // at z = 0 beside the stock's ends), each deepest on the wall's top
+            // within the shank's 3 mm of the path: 10 mm of wall above z = 3.
+            let moves: Vec<u32> = collisions.iter().map(|c| c.id.index).collect();
+            assert_eq!(moves, vec![1, 2, 3]);
+            for c in &collisions {
+                assert_eq!(c.part, ToolPart::Shank);
+                assert!(c.at.y > 6.0 && c.at.y <= 7.5, "{c:?}");
+                assert_near!(c.depth, 7.0, 1e-9);
+            }
+        }
+        other => panic!("expected a shank collision with the part, got {other:?}"),
+    }
+    // The same check alone, on a stock already cut: the part is what it sees.
+    let zmap = ZMap::new(s, 0.1).unwrap();
+    assert_eq!(zmap.part_collisions(&part, &short, &pass, 0).unwrap().len(), 3);
+    // Flutes longer than the wall: no collision with the part or the stock.
+    let long = Cutter::new(CutterShape::Ball { radius: 1.0 }, 12.0).unwrap().with_shank(3.0, 20.0).unwrap();
+    let sim = simulate(s, 0.1, &long, &pass, &part, &VerifyOptions::default()).unwrap();
+    assert!(sim.verification.min_deviation >= -1e-9);
+    assert!(zmap.part_collisions(&part, &long, &pass, 0).unwrap().is_empty());
+}

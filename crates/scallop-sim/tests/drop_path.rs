@@ -79,7 +79,7 @@ const CHORDAL: f64 = 0.004;
 #[test]
 fn drop_cutter_raster_has_no_gouge_and_a_lowered_pass_gouges_under_it() {
     let (ball, part, stock) = setup();
-    let options = VerifyOptions { gouge_tolerance: CHORDAL, worst_reported: 1_000_000 };
+    let options = VerifyOptions { gouge_tolerance: CHORDAL, worst_reported: 1_000_000, ..VerifyOptions::default() };
     let (path, _) = raster(&ball, &part, None);
     let sim = simulate(stock, 0.1, &ball, &path, &part, &options).unwrap();
     let v = sim.verification;

@@ -15,7 +15,7 @@
 //! - Never performs I/O. Coordinates are finite (checked by [`Toolpath::push`] in debug builds).
 //! - The tool axis is +Z (3-axis); multi-axis poses come with the machine layer.
 
-use scallop_geom::Point3;
+use scallop_geom::{Point2, Point3};
 
 mod arcs;
 
@@ -53,6 +53,20 @@ impl Move {
     }
 }
 
+/// The circle of a move that is a circular arc in the XY plane (G17), from
+/// the previous move's end to the move's own `to`; z changes linearly with the
+/// angle (a helix when the ends differ in z). Attached to a move by
+/// [`Toolpath::push_arc`]; the move itself keeps its end point, so a consumer
+/// that ignores arcs sees the chord.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ArcXY {
+    /// Centre of the circle (mm).
+    pub center: Point2,
+    /// Signed swept angle (rad): positive counter-clockwise (G3), negative
+    /// clockwise (G2); a full circle is +-2 pi.
+    pub sweep: f64,
+}
+
 /// A sequence of moves from an unspecified start (the first move is a rapid in practice).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Toolpath {
@@ -61,13 +75,47 @@ pub struct Toolpath {
     /// Plunge feed (mm/min).
     pub plunge_feed: f64,
     moves: Vec<Move>,
+    /// (move index, arc), increasing indices; empty for straight-line paths.
+    arcs: Vec<(usize, ArcXY)>,
 }
 
 impl Toolpath {
     /// An empty toolpath with the cutting feed; the plunge feed is half of it.
     #[must_use]
     pub fn new(feed: f64) -> Toolpath {
-        Toolpath { feed, plunge_feed: 0.5 * feed, moves: Vec::new() }
+        Toolpath { feed, plunge_feed: 0.5 * feed, moves: Vec::new(), arcs: Vec::new() }
+    }
+
+    /// Appends a move along a circular arc in the XY plane ending at `m.to`
+    /// (see [`ArcXY`]).
+    ///
+    /// ```
+    /// use scallop_geom::{Point2, Point3};
+    /// use scallop_toolpath::{ArcXY, Move, MoveKind, Toolpath};
+    /// let mut path = Toolpath::new(1000.0);
+    /// path.push(Move::new(MoveKind::Feed, Point3::new(10.0, 0.0, 0.0)));
+    /// let half = ArcXY { center: Point2::new(5.0, 0.0), sweep: std::f64::consts::PI };
+    /// path.push_arc(Move::new(MoveKind::Feed, Point3::new(0.0, 0.0, 0.0)), half);
+    /// assert_eq!(path.arc(1), Some(half));
+    /// assert_eq!(path.arc(0), None);
+    /// assert_eq!(path.arc_count(), 1);
+    /// ```
+    pub fn push_arc(&mut self, m: Move, arc: ArcXY) {
+        debug_assert!(arc.center.coords.iter().all(|c| c.is_finite()) && arc.sweep.is_finite(), "bad arc {arc:?}");
+        self.arcs.push((self.moves.len(), arc));
+        self.push(m);
+    }
+
+    /// The arc of move `index`, `None` for a straight move.
+    #[must_use]
+    pub fn arc(&self, index: usize) -> Option<ArcXY> {
+        self.arcs.binary_search_by_key(&index, |&(k, _)| k).ok().map(|slot| self.arcs[slot].1)
+    }
+
+    /// Number of arc moves.
+    #[must_use]
+    pub fn arc_count(&self) -> usize {
+        self.arcs.len()
     }
 
     /// Appends a move.
