@@ -78,6 +78,13 @@ fn fmt_number_exact(v: f64, decimals: usize) -> String {
 /// value is an exact integer range. `false` (nothing written) sends the caller to the
 /// exact formatter.
 fn push_number_fast(out: &mut String, v: f64, decimals: usize) -> bool {
+    const POW10_U64: [u64; 10] =
+        [1, 10, 100, 1_000, 10_000, 100_000, 1_000_000, 10_000_000, 100_000_000, 1_000_000_000];
+    const DIGIT_PAIRS: &[u8; 200] = b"0001020304050607080910111213141516171819\
+        2021222324252627282930313233343536373839\
+        4041424344454647484950515253545556575859\
+        6061626364656667686970717273747576777879\
+        8081828384858687888990919293949596979899";
     const POW10: [f64; 10] = [1.0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9];
     let Some(&scale) = POW10.get(decimals) else { return false };
     let x = v.abs() * scale;
@@ -91,23 +98,45 @@ fn push_number_fast(out: &mut String, v: f64, decimals: usize) -> bool {
         return false;
     }
     let mut n = if frac > 0.5 { floor + 1.0 } else { floor } as u64;
-    // Digits, least significant first, at least decimals + 1 of them (leading zeros).
-    let mut digits = [b'0'; 24];
-    let mut len = 0;
-    while n > 0 || len <= decimals {
-        digits[len] = b'0' + (n % 10) as u8;
+    // Written right to left into a stack buffer: at least decimals + 1 digits (leading
+    // zeros), the point, the sign; then appended in one copy.
+    let mut bytes = [b'0'; 32];
+    let mut at = bytes.len();
+    let nonzero = n != 0;
+    let mut k = 0;
+    if decimals > 0 {
+        // The fraction digits, two at a time, then the point.
+        let mut f = n % POW10_U64[decimals];
+        n /= POW10_U64[decimals];
+        while k + 2 <= decimals {
+            let pair = (f % 100) as usize;
+            f /= 100;
+            at -= 2;
+            bytes[at..at + 2].copy_from_slice(&DIGIT_PAIRS[2 * pair..2 * pair + 2]);
+            k += 2;
+        }
+        if k < decimals {
+            at -= 1;
+            bytes[at] = b'0' + (f % 10) as u8;
+        }
+        at -= 1;
+        bytes[at] = b'.';
+    }
+    // The integer digits (at least one).
+    loop {
+        at -= 1;
+        bytes[at] = b'0' + (n % 10) as u8;
         n /= 10;
-        len += 1;
-    }
-    if v < 0.0 && digits[..len].iter().any(|&d| d != b'0') {
-        out.push('-');
-    }
-    for k in (0..len).rev() {
-        out.push(char::from(digits[k]));
-        if k == decimals && decimals > 0 {
-            out.push('.');
+        if n == 0 {
+            break;
         }
     }
+    if v < 0.0 && nonzero {
+        at -= 1;
+        bytes[at] = b'-';
+    }
+    // Only ASCII digits, '.' and '-' were written: one char per byte.
+    out.extend(bytes[at..].iter().map(|&c| char::from(c)));
     true
 }
 

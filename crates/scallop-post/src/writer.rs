@@ -220,7 +220,11 @@ pub fn program_text(
     };
     let mut previous: Option<&ProgramBlock> = None;
     let mut plane: Option<(Vec3, Rotation3<f64>)> = None;
-    let mut words: Vec<(&str, String)> = Vec::with_capacity(machine.axes().len());
+    // One token string per written axis, reused block after block (no allocation per token).
+    let mut words: Vec<(&str, String)> = (0..machine.axes().len())
+        .filter(|&i| write_axis[i])
+        .map(|i| (letters[i].as_str(), String::with_capacity(24)))
+        .collect();
     for b in &program.blocks {
         if planes {
             let needs_new = plane.as_ref().is_none_or(|(axis, _)| angle(axis, &b.pose.axis) > params.tol_ang);
@@ -258,24 +262,25 @@ pub fn program_text(
             let (words_a, tip_a) = previous.map_or((b.words, b.pose.tip), |p| (p.words, p.pose.tip));
             let word_at = |i: usize| words_a[i] + (b.words[i] - words_a[i]) * s;
             let tip: Point3 = tip_a + (b.pose.tip - tip_a) * s;
-            words.clear();
+            let mut slot = 0;
             for i in 0..machine.axes().len() {
                 if !write_axis[i] {
                     continue;
                 }
                 let axis = &machine.axes()[i];
                 let w = word_at(i);
-                let token = match axis.kind {
+                let token = &mut words[slot].1;
+                slot += 1;
+                match axis.kind {
                     AxisKind::Linear if mode == OutputMode::Tcp => {
-                        e.token(&letters[i], tip[linear_component(i)?], dialect.decimals)
+                        e.token_into(token, &letters[i], tip[linear_component(i)?], dialect.decimals);
                     }
-                    AxisKind::Linear => e.token(&letters[i], w, dialect.decimals),
+                    AxisKind::Linear => e.token_into(token, &letters[i], w, dialect.decimals),
                     AxisKind::Rotary => {
                         let before = word_at_prev(&words_a, &b.words, i, piece, pieces);
-                        e.rotary(&letters[i], w, w - before, axis.wrap)
+                        e.rotary_into(token, &letters[i], w, w - before, axis.wrap);
                     }
-                };
-                words.push((letters[i].as_str(), token));
+                }
             }
             let feed = match (b.motion, previous) {
                 (Motion::Rapid, _) => FeedWord::Rapid,
@@ -408,12 +413,18 @@ struct Emitter<'a> {
     d: &'a Dialect,
     text: String,
     number: u64,
-    last_words: std::collections::BTreeMap<String, String>,
+    /// Last written token per word letter, `(letter, token)`, in first-use order: a few
+    /// entries searched linearly (cheaper than a map for five axes), strings reused.
+    last_words: Vec<(String, String)>,
     last_motion: Option<&'static str>,
     last_feed: Option<String>,
     g93: bool,
     /// Reused line buffer of `motion_tokens`.
     buf: String,
+    /// Reused feed-word buffer of `motion_tokens`.
+    feed: String,
+    /// Reused per-word "differs from the modal word" flags of `motion_tokens`.
+    changed: Vec<bool>,
 }
 
 impl<'a> Emitter<'a> {
@@ -422,12 +433,19 @@ impl<'a> Emitter<'a> {
             d,
             text: String::new(),
             number: d.line_numbers.as_ref().map_or(0, |n| n.start),
-            last_words: std::collections::BTreeMap::new(),
+            last_words: Vec::new(),
             last_motion: None,
             last_feed: None,
             g93: false,
             buf: String::new(),
+            feed: String::new(),
+            changed: Vec::new(),
         }
+    }
+
+    /// The last token written for `letter`.
+    fn last_word(&self, letter: &str) -> Option<&String> {
+        self.last_words.iter().find(|(l, _)| l == letter).map(|(_, t)| t)
     }
 
     fn line(&mut self, s: &str) {
@@ -455,12 +473,29 @@ impl<'a> Emitter<'a> {
     /// `letter` followed by `v` as [`Emitter::num`] writes it, in one allocation.
     fn token(&self, letter: &str, v: f64, decimals: usize) -> String {
         let mut s = String::with_capacity(letter.len() + 16);
+        self.token_into(&mut s, letter, v, decimals);
+        s
+    }
+
+    /// [`Emitter::token`] into `s` (cleared first; its allocation is reused).
+    fn token_into(&self, s: &mut String, letter: &str, v: f64, decimals: usize) {
+        s.clear();
         s.push_str(letter);
-        crate::push_number(&mut s, v, decimals);
+        crate::push_number(s, v, decimals);
         if self.d.explicit_plus && !s[letter.len()..].starts_with('-') {
             s.insert(letter.len(), '+');
         }
-        s
+    }
+
+    /// [`Emitter::rotary`] into `s` (cleared first; its allocation is reused).
+    fn rotary_into(&self, s: &mut String, letter: &str, word: f64, delta: f64, wrap: Wrap) {
+        if wrap == Wrap::Absolute {
+            self.token_into(s, letter, word, self.d.rotary_decimals);
+        } else {
+            let t = self.rotary(letter, word, delta, wrap);
+            s.clear();
+            s.push_str(&t);
+        }
     }
 
     fn num(&self, v: f64, decimals: usize) -> String {
@@ -503,12 +538,13 @@ impl<'a> Emitter<'a> {
     /// one line buffer reused, modal words compared in place, no per-token allocation
     /// beyond the tokens themselves.
     fn motion_tokens(&mut self, words: &[(&str, String)], feed: FeedWord) {
-        let mut any = false;
+        let mut changed = std::mem::take(&mut self.changed);
+        changed.clear();
         for (letter, token) in words {
-            let same = self.d.modal && self.last_words.get(*letter).is_some_and(|t| t == token);
-            any |= !same;
+            changed.push(!self.d.modal || self.last_word(letter).is_none_or(|t| t != token));
         }
-        if !any {
+        if !changed.contains(&true) {
+            self.changed = changed;
             return;
         }
         let mut buf = std::mem::take(&mut self.buf);
@@ -518,9 +554,6 @@ impl<'a> Emitter<'a> {
                 buf.push(' ');
             }
             buf.push_str(t);
-        };
-        let changed = |me: &Self, letter: &str, token: &String| {
-            !me.d.modal || me.last_words.get(letter).is_none_or(|t| t != token)
         };
         match self.d.syntax {
             Syntax::Iso => {
@@ -535,33 +568,34 @@ impl<'a> Emitter<'a> {
                     push(&mut buf, code);
                     self.last_motion = Some(code);
                 }
-                for (letter, token) in words {
-                    if changed(self, letter, token) {
+                for ((_, token), &c) in words.iter().zip(&changed) {
+                    if c {
                         push(&mut buf, token);
                     }
                 }
-                let f = match feed {
-                    FeedWord::Rapid | FeedWord::Seconds(_) => None,
-                    FeedWord::PerMinute(f) => {
-                        Some(fmt_number(round_down(f, self.d.feed_decimals), self.d.feed_decimals))
-                    }
-                    FeedWord::InverseTime(f) => {
-                        self.last_feed = None; // G93 needs F on every block
-                        Some(fmt_number(round_down(f, self.d.inverse_time_decimals), self.d.inverse_time_decimals))
-                    }
+                // G93 needs F on every block (`always`).
+                let (dec, always) = match feed {
+                    FeedWord::Rapid | FeedWord::Seconds(_) => (None, false),
+                    FeedWord::PerMinute(_) => (Some(self.d.feed_decimals), false),
+                    FeedWord::InverseTime(_) => (Some(self.d.inverse_time_decimals), true),
                 };
-                if let Some(f) = f
-                    && (!self.d.modal || self.last_feed.as_ref() != Some(&f))
-                {
-                    push(&mut buf, "F");
-                    buf.push_str(&f);
-                    self.last_feed = Some(f);
+                if let (Some(dec), FeedWord::PerMinute(f) | FeedWord::InverseTime(f)) = (dec, feed) {
+                    self.feed.clear();
+                    crate::push_number(&mut self.feed, round_down(f, dec), dec);
+                    if always || !self.d.modal || self.last_feed.as_ref() != Some(&self.feed) {
+                        push(&mut buf, "F");
+                        buf.push_str(&self.feed);
+                        match &mut self.last_feed {
+                            Some(l) => l.clone_from(&self.feed),
+                            None => self.last_feed = Some(self.feed.clone()),
+                        }
+                    }
                 }
             }
             Syntax::Heidenhain => {
                 push(&mut buf, "L");
-                for (letter, token) in words {
-                    if changed(self, letter, token) {
+                for ((_, token), &c) in words.iter().zip(&changed) {
+                    if c {
                         push(&mut buf, token);
                     }
                 }
@@ -586,15 +620,14 @@ impl<'a> Emitter<'a> {
             }
         }
         for (letter, token) in words {
-            match self.last_words.get_mut(*letter) {
-                Some(t) => t.clone_from(token),
-                None => {
-                    self.last_words.insert((*letter).to_string(), token.clone());
-                }
+            match self.last_words.iter_mut().find(|(l, _)| l == letter) {
+                Some((_, t)) => t.clone_from(token),
+                None => self.last_words.push(((*letter).to_string(), token.clone())),
             }
         }
         self.line(&buf);
         self.buf = buf;
+        self.changed = changed;
     }
 
     /// Activates a tilted plane `r` (columns x_f, y_f, z_f in the part frame) at the
