@@ -101,8 +101,12 @@ pub fn deviation_bound(kin: &Kinematics, qa: &Joints, qb: &Joints) -> Option<(f6
     let tip_m = kin.chain_transform(&machine.tool_chain, qa) * kin.t0;
     let mut d0 = 0.0f64;
     for chain in [&machine.part_chain, &machine.tool_chain] {
+        // The transform is needed only up to the chain's last rotary axis.
+        let Some(last) = chain.iter().rposition(|&i| machine.axes[i].kind == crate::AxisKind::Rotary) else {
+            continue;
+        };
         let mut t = scallop_geom::nalgebra::Isometry3::identity();
-        for &i in chain.iter() {
+        for &i in &chain[..=last] {
             let a = &machine.axes[i];
             if a.kind == crate::AxisKind::Rotary {
                 let point = t * a.point;
@@ -110,7 +114,9 @@ pub fn deviation_bound(kin: &Kinematics, qa: &Joints, qb: &Joints) -> Option<(f6
                 let off = tip_m - point;
                 d0 = d0.max((off - dir * off.dot(&dir)).norm());
             }
-            t *= crate::chain::joint_isometry(&a.direction, &a.point, a.kind, qa[i]);
+            if i != chain[last] {
+                t *= crate::chain::joint_isometry(&a.direction, &a.point, a.kind, qa[i]);
+            }
         }
     }
     let d = (d0 + 2.0 * b) / (1.0 - 3.0 * omega);
