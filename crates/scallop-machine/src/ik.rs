@@ -19,10 +19,10 @@
 
 use std::f64::consts::PI;
 
-use scallop_geom::nalgebra::{Isometry3, Matrix3, SMatrix, Unit, UnitQuaternion};
+use scallop_geom::nalgebra::{Matrix3, SMatrix, Unit, UnitQuaternion};
 use scallop_geom::{Point3, Vec3};
 
-use crate::chain::{Class, Family, Joints, Kinematics, Pose, Solver, joint_isometry};
+use crate::chain::{Class, Family, Joints, Kinematics, Pose, Solver};
 use crate::desc::AxisKind;
 use crate::error::MachineError;
 use crate::tol;
@@ -155,17 +155,22 @@ impl Kinematics {
     pub(crate) fn solve_linear(&self, tip: &Point3, q: &mut Joints) {
         if self.linear_first {
             let x = self.w0 * tip;
-            let rotary_only = |chain: &[usize]| {
-                let mut t = Isometry3::identity();
-                for &i in chain {
+            // The chain's rotaries applied to a point, innermost first, each by Rodrigues'
+            // formula from one sin_cos (no quaternion or isometry composition).
+            let rotary_only = |chain: &[usize], p: Point3| {
+                let mut p = p;
+                for &i in chain.iter().rev() {
                     let a = &self.machine.axes[i];
                     if a.kind == AxisKind::Rotary {
-                        t *= joint_isometry(&a.direction, &a.point, a.kind, q[i]);
+                        let (s, c) = q[i].sin_cos();
+                        let u = &a.direction;
+                        let v = p - a.point;
+                        p = a.point + v * c + u.cross(&v) * s + u * (u.dot(&v) * (1.0 - c));
                     }
                 }
-                t
+                p
             };
-            let d = rotary_only(&self.machine.part_chain) * x - rotary_only(&self.machine.tool_chain) * self.t0;
+            let d = rotary_only(&self.machine.part_chain, x) - rotary_only(&self.machine.tool_chain, self.t0);
             let lin = self.linear_inverse * d;
             q[0] = lin[0];
             q[1] = lin[1];
