@@ -3,7 +3,6 @@
 //! positions, the controller does the kinematics) and 3+2 output through tilted work
 //! planes.
 
-use std::fmt::Write as _;
 use std::io::Write;
 
 use scallop_geom::nalgebra::Rotation3;
@@ -221,9 +220,9 @@ pub fn program_text(
     let mut previous: Option<&ProgramBlock> = None;
     let mut plane: Option<(Vec3, Rotation3<f64>)> = None;
     // One token string per written axis, reused block after block (no allocation per token).
-    let mut words: Vec<(&str, String)> = (0..machine.axes().len())
+    let mut words: Vec<(&str, Vec<u8>)> = (0..machine.axes().len())
         .filter(|&i| write_axis[i])
-        .map(|i| (letters[i].as_str(), String::with_capacity(24)))
+        .map(|i| (letters[i].as_str(), Vec::with_capacity(24)))
         .collect();
     for b in &program.blocks {
         if planes {
@@ -317,7 +316,8 @@ pub fn program_text(
     for f in &dialect.footer {
         e.line(&vars.render(f));
     }
-    Ok(e.text)
+    // INVARIANT: the text is built from `str` pieces and ASCII numbers only.
+    Ok(String::from_utf8(e.text).unwrap_or_else(|err| String::from_utf8_lossy(err.as_bytes()).into_owned()))
 }
 
 /// Caps an inverse-time word so that no axis exceeds its velocity even when its rounded
@@ -411,18 +411,19 @@ enum FeedWord {
 /// Line writer with numbering and modal state.
 struct Emitter<'a> {
     d: &'a Dialect,
-    text: String,
+    /// The program text, UTF-8 built as bytes (numbers are written as ASCII bytes).
+    text: Vec<u8>,
     number: u64,
     /// Last written token per word letter, `(letter, token)`, in first-use order: a few
     /// entries searched linearly (cheaper than a map for five axes), strings reused.
-    last_words: Vec<(String, String)>,
+    last_words: Vec<(String, Vec<u8>)>,
     last_motion: Option<&'static str>,
-    last_feed: Option<String>,
+    last_feed: Option<Vec<u8>>,
     g93: bool,
     /// Reused line buffer of `motion_tokens`.
-    buf: String,
+    buf: Vec<u8>,
     /// Reused feed-word buffer of `motion_tokens`.
-    feed: String,
+    feed: Vec<u8>,
     /// Reused per-word "differs from the modal word" flags of `motion_tokens`.
     changed: Vec<bool>,
 }
@@ -431,32 +432,38 @@ impl<'a> Emitter<'a> {
     fn new(d: &'a Dialect) -> Emitter<'a> {
         Emitter {
             d,
-            text: String::new(),
+            text: Vec::new(),
             number: d.line_numbers.as_ref().map_or(0, |n| n.start),
             last_words: Vec::new(),
             last_motion: None,
             last_feed: None,
             g93: false,
-            buf: String::new(),
-            feed: String::new(),
+            buf: Vec::new(),
+            feed: Vec::new(),
             changed: Vec::new(),
         }
     }
 
     /// The last token written for `letter`.
-    fn last_word(&self, letter: &str) -> Option<&String> {
+    fn last_word(&self, letter: &str) -> Option<&Vec<u8>> {
         self.last_words.iter().find(|(l, _)| l == letter).map(|(_, t)| t)
     }
 
     fn line(&mut self, s: &str) {
+        self.line_bytes(s.as_bytes());
+    }
+
+    fn line_bytes(&mut self, s: &[u8]) {
         if let Some(n) = &self.d.line_numbers
-            && s != "%"
+            && s != b"%"
         {
-            let _ = write!(self.text, "{}{} ", n.prefix, self.number);
+            self.text.extend_from_slice(n.prefix.as_bytes());
+            self.text.extend_from_slice(self.number.to_string().as_bytes());
+            self.text.push(b' ');
             self.number += n.step;
         }
-        self.text.push_str(s);
-        self.text.push('\n');
+        self.text.extend_from_slice(s);
+        self.text.push(b'\n');
     }
 
     fn comment(&mut self, s: &str) {
@@ -473,28 +480,36 @@ impl<'a> Emitter<'a> {
     /// `letter` followed by `v` as [`Emitter::num`] writes it, in one allocation.
     fn token(&self, letter: &str, v: f64, decimals: usize) -> String {
         let mut s = String::with_capacity(letter.len() + 16);
-        self.token_into(&mut s, letter, v, decimals);
-        s
-    }
-
-    /// [`Emitter::token`] into `s` (cleared first; its allocation is reused).
-    fn token_into(&self, s: &mut String, letter: &str, v: f64, decimals: usize) {
-        s.clear();
         s.push_str(letter);
-        crate::push_number(s, v, decimals);
+        crate::push_number(&mut s, v, decimals);
         if self.d.explicit_plus && !s[letter.len()..].starts_with('-') {
             s.insert(letter.len(), '+');
         }
+        s
     }
 
-    /// [`Emitter::rotary`] into `s` (cleared first; its allocation is reused).
-    fn rotary_into(&self, s: &mut String, letter: &str, word: f64, delta: f64, wrap: Wrap) {
+    /// [`Emitter::token`] as bytes into `s` (cleared first; its allocation is reused).
+    fn token_into(&self, s: &mut Vec<u8>, letter: &str, v: f64, decimals: usize) {
+        s.clear();
+        s.extend_from_slice(letter.as_bytes());
+        if self.d.explicit_plus {
+            s.push(b'+');
+        }
+        let at = s.len();
+        crate::push_number_bytes(s, v, decimals);
+        if self.d.explicit_plus && s.get(at) == Some(&b'-') {
+            s.remove(at - 1);
+        }
+    }
+
+    /// [`Emitter::rotary`] as bytes into `s` (cleared first; its allocation is reused).
+    fn rotary_into(&self, s: &mut Vec<u8>, letter: &str, word: f64, delta: f64, wrap: Wrap) {
         if wrap == Wrap::Absolute {
             self.token_into(s, letter, word, self.d.rotary_decimals);
         } else {
             let t = self.rotary(letter, word, delta, wrap);
             s.clear();
-            s.push_str(&t);
+            s.extend_from_slice(t.as_bytes());
         }
     }
 
@@ -530,14 +545,14 @@ impl<'a> Emitter<'a> {
 
     /// A motion block from `(letter, number)` pairs.
     fn motion(&mut self, words: &[(&str, String)], feed: FeedWord) {
-        let tokens: Vec<(&str, String)> = words.iter().map(|(l, v)| (*l, format!("{l}{v}"))).collect();
+        let tokens: Vec<(&str, Vec<u8>)> = words.iter().map(|(l, v)| (*l, format!("{l}{v}").into_bytes())).collect();
         self.motion_tokens(&tokens, feed);
     }
 
     /// A motion block from `(letter, full token)` pairs. Hot path of every program:
     /// one line buffer reused, modal words compared in place, no per-token allocation
     /// beyond the tokens themselves.
-    fn motion_tokens(&mut self, words: &[(&str, String)], feed: FeedWord) {
+    fn motion_tokens(&mut self, words: &[(&str, Vec<u8>)], feed: FeedWord) {
         let mut changed = std::mem::take(&mut self.changed);
         changed.clear();
         for (letter, token) in words {
@@ -549,23 +564,23 @@ impl<'a> Emitter<'a> {
         }
         let mut buf = std::mem::take(&mut self.buf);
         buf.clear();
-        let push = |buf: &mut String, t: &str| {
+        let push = |buf: &mut Vec<u8>, t: &[u8]| {
             if !buf.is_empty() {
-                buf.push(' ');
+                buf.push(b' ');
             }
-            buf.push_str(t);
+            buf.extend_from_slice(t);
         };
         match self.d.syntax {
             Syntax::Iso => {
                 let want_g93 = matches!(feed, FeedWord::InverseTime(_));
                 if want_g93 != self.g93 {
-                    push(&mut buf, if want_g93 { "G93" } else { "G94" });
+                    push(&mut buf, if want_g93 { b"G93" } else { b"G94" });
                     self.g93 = want_g93;
                     self.last_feed = None;
                 }
                 let code = if matches!(feed, FeedWord::Rapid) { "G0" } else { "G1" };
                 if !self.d.modal || self.last_motion != Some(code) {
-                    push(&mut buf, code);
+                    push(&mut buf, code.as_bytes());
                     self.last_motion = Some(code);
                 }
                 for ((_, token), &c) in words.iter().zip(&changed) {
@@ -581,10 +596,10 @@ impl<'a> Emitter<'a> {
                 };
                 if let (Some(dec), FeedWord::PerMinute(f) | FeedWord::InverseTime(f)) = (dec, feed) {
                     self.feed.clear();
-                    crate::push_number(&mut self.feed, round_down(f, dec), dec);
+                    crate::push_number_bytes(&mut self.feed, round_down(f, dec), dec);
                     if always || !self.d.modal || self.last_feed.as_ref() != Some(&self.feed) {
-                        push(&mut buf, "F");
-                        buf.push_str(&self.feed);
+                        push(&mut buf, b"F");
+                        buf.extend_from_slice(&self.feed);
                         match &mut self.last_feed {
                             Some(l) => l.clone_from(&self.feed),
                             None => self.last_feed = Some(self.feed.clone()),
@@ -593,7 +608,7 @@ impl<'a> Emitter<'a> {
                 }
             }
             Syntax::Heidenhain => {
-                push(&mut buf, "L");
+                push(&mut buf, b"L");
                 for ((_, token), &c) in words.iter().zip(&changed) {
                     if c {
                         push(&mut buf, token);
@@ -601,18 +616,18 @@ impl<'a> Emitter<'a> {
                 }
                 match feed {
                     FeedWord::Rapid => {
-                        push(&mut buf, "FMAX");
+                        push(&mut buf, b"FMAX");
                         self.last_feed = None;
                     }
                     FeedWord::Seconds(t) => {
                         let dec = self.d.inverse_time_decimals;
-                        push(&mut buf, &format!("FT{}", fmt_number(round_up(t, dec), dec)));
+                        push(&mut buf, format!("FT{}", fmt_number(round_up(t, dec), dec)).as_bytes());
                         self.last_feed = None;
                     }
                     FeedWord::PerMinute(f) | FeedWord::InverseTime(f) => {
-                        let f = fmt_number(round_down(f, self.d.feed_decimals), self.d.feed_decimals);
+                        let f = fmt_number(round_down(f, self.d.feed_decimals), self.d.feed_decimals).into_bytes();
                         if !self.d.modal || self.last_feed.as_ref() != Some(&f) {
-                            push(&mut buf, &format!("F{f}"));
+                            push(&mut buf, format!("F{}", String::from_utf8_lossy(&f)).as_bytes());
                             self.last_feed = Some(f);
                         }
                     }
@@ -625,7 +640,7 @@ impl<'a> Emitter<'a> {
                 None => self.last_words.push(((*letter).to_string(), token.clone())),
             }
         }
-        self.line(&buf);
+        self.line_bytes(&buf);
         self.buf = buf;
         self.changed = changed;
     }
