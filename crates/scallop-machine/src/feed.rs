@@ -97,25 +97,30 @@ pub fn deviation_bound(kin: &Kinematics, qa: &Joints, qb: &Joints) -> Option<(f6
     if omega.is_nan() || omega >= tol::BOUND_MAX_ROTATION {
         return None;
     }
-    // D0: distance from the tip to each rotary line at the start, both in M.
-    let tip_m = kin.chain_transform(&machine.tool_chain, qa) * kin.t0;
+    // D0: distance from the tip to each rotary line at the start, both in M. A joint's
+    // line is carried by the joints before it in its chain; the distance is invariant
+    // under rigid motion, so the tip is carried back instead: walking down the chain,
+    // the tip in the frame of joint k is the previous one moved by the inverse of joint
+    // k - 1 (one sin_cos per rotary, no transform composition).
+    let mut tip_m = kin.t0;
+    for &i in machine.tool_chain.iter().rev() {
+        let a = &machine.axes[i];
+        tip_m = crate::chain::joint_apply(&a.direction, &a.point, a.kind, qa[i], &tip_m);
+    }
     let mut d0 = 0.0f64;
     for chain in [&machine.part_chain, &machine.tool_chain] {
-        // The transform is needed only up to the chain's last rotary axis.
         let Some(last) = chain.iter().rposition(|&i| machine.axes[i].kind == crate::AxisKind::Rotary) else {
             continue;
         };
-        let mut t = scallop_geom::nalgebra::Isometry3::identity();
+        let mut p = tip_m;
         for &i in &chain[..=last] {
             let a = &machine.axes[i];
             if a.kind == crate::AxisKind::Rotary {
-                let point = t * a.point;
-                let dir = t.rotation * a.direction;
-                let off = tip_m - point;
-                d0 = d0.max((off - dir * off.dot(&dir)).norm());
+                let off = p - a.point;
+                d0 = d0.max((off - a.direction * off.dot(&a.direction)).norm());
             }
             if i != chain[last] {
-                t *= crate::chain::joint_isometry(&a.direction, &a.point, a.kind, qa[i]);
+                p = crate::chain::joint_apply(&a.direction, &a.point, a.kind, -qa[i], &p);
             }
         }
     }
