@@ -426,6 +426,8 @@ struct Emitter<'a> {
     feed: Vec<u8>,
     /// Reused per-word "differs from the modal word" flags of `motion_tokens`.
     changed: Vec<bool>,
+    /// Reused per-word indices into `last_words` of `motion_tokens`.
+    slots: Vec<Option<usize>>,
 }
 
 impl<'a> Emitter<'a> {
@@ -441,12 +443,18 @@ impl<'a> Emitter<'a> {
             buf: Vec::new(),
             feed: Vec::new(),
             changed: Vec::new(),
+            slots: Vec::new(),
         }
     }
 
     /// The last token written for `letter`.
-    fn last_word(&self, letter: &str) -> Option<&Vec<u8>> {
-        self.last_words.iter().find(|(l, _)| l == letter).map(|(_, t)| t)
+    /// The index in `last_words` of `letter`, tried first at `hint` (blocks list their
+    /// words in one order, so the hint is almost always right).
+    fn last_index(&self, hint: usize, letter: &str) -> Option<usize> {
+        if self.last_words.get(hint).is_some_and(|(l, _)| short_eq(l.as_bytes(), letter.as_bytes())) {
+            return Some(hint);
+        }
+        self.last_words.iter().position(|(l, _)| short_eq(l.as_bytes(), letter.as_bytes()))
     }
 
     fn line(&mut self, s: &str) {
@@ -555,11 +563,16 @@ impl<'a> Emitter<'a> {
     fn motion_tokens(&mut self, words: &[(&str, Vec<u8>)], feed: FeedWord) {
         let mut changed = std::mem::take(&mut self.changed);
         changed.clear();
-        for (letter, token) in words {
-            changed.push(!self.d.modal || self.last_word(letter).is_none_or(|t| t != token));
+        let mut slots = std::mem::take(&mut self.slots);
+        slots.clear();
+        for (k, (letter, token)) in words.iter().enumerate() {
+            let slot = self.last_index(k, letter);
+            slots.push(slot);
+            changed.push(!self.d.modal || slot.is_none_or(|j| !short_eq(&self.last_words[j].1, token)));
         }
         if !changed.contains(&true) {
             self.changed = changed;
+            self.slots = slots;
             return;
         }
         let mut buf = std::mem::take(&mut self.buf);
@@ -634,12 +647,17 @@ impl<'a> Emitter<'a> {
                 }
             }
         }
-        for (letter, token) in words {
-            match self.last_words.iter_mut().find(|(l, _)| l == letter) {
-                Some((_, t)) => t.clone_from(token),
-                None => self.last_words.push(((*letter).to_string(), token.clone())),
+        for ((letter, token), slot) in words.iter().zip(&slots) {
+            match slot {
+                Some(j) => self.last_words[*j].1.clone_from(token),
+                // A letter twice in one block: the later token is the modal one.
+                None => match self.last_words.iter_mut().find(|(l, _)| l == letter) {
+                    Some((_, t)) => t.clone_from(token),
+                    None => self.last_words.push(((*letter).to_string(), token.clone())),
+                },
             }
         }
+        self.slots = slots;
         self.line_bytes(&buf);
         self.buf = buf;
         self.changed = changed;
@@ -684,6 +702,11 @@ impl<'a> Emitter<'a> {
         self.last_words.clear();
         self.last_motion = None;
     }
+}
+
+/// Byte equality of short strings (word letters, tokens) without a `memcmp` call.
+fn short_eq(a: &[u8], b: &[u8]) -> bool {
+    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x == y)
 }
 
 /// `CYCLE800` axis-by-axis angles (X, then the rotated Y, then the rotated Z):
