@@ -251,6 +251,17 @@ fn split(
     split(kin, (&mid, &q_mid), b, tolerance, block, depth + 1, out)
 }
 
+/// `10f64.powi(e)` by table for `|e| <= 9`, bit for bit: the exponentiation by squaring
+/// is exact for these powers and a negative power is the reciprocal of the positive one.
+pub(crate) fn pow10i(e: i32) -> f64 {
+    const POW10: [f64; 10] = [1.0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9];
+    match usize::try_from(e.unsigned_abs()).ok().and_then(|k| POW10.get(k)) {
+        Some(&p) if e >= 0 => p,
+        Some(&p) => 1.0 / p,
+        None => 10f64.powi(e),
+    }
+}
+
 /// Inverse-time feed word of the block `qa -> qb` (spec 3.9):
 /// `T = max(L/F, r_ref·Δφ/F, max_j |Δq_j|/vmax_j, T_min)` and `F_inv = 1/T` in 1/min,
 /// rounded down to `nc.decimals.feed` so that no axis exceeds its velocity limit.
@@ -271,7 +282,7 @@ pub fn inverse_time_feed(kin: &Kinematics, pose_a: &Pose, pose_b: &Pose, qa: &Jo
     let dphi = pose_a.axis.cross(&pose_b.axis).norm().atan2(pose_a.axis.dot(&pose_b.axis));
     let rate = crate::plan::move_time(machine, qa, qb);
     let t = (length / f).max(machine.nc().r_ref * dphi / f).max(rate).max(machine.nc().min_block_time);
-    let scale = 10f64.powi(i32::from(machine.nc().decimals.feed));
+    let scale = pow10i(i32::from(machine.nc().decimals.feed));
     let exact = 60.0 / t;
     // Round down, but keep an exact value when it is already representable.
     let rounded = (exact * scale).floor() / scale;

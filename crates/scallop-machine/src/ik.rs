@@ -234,8 +234,10 @@ impl Kinematics {
         let (s_tilt, s_pole) = (sign(self.tilt), sign(self.pole));
         let mut items = [IkSolution { joints: Joints::zeros(), branch: Branch::Positive, at_pole: false }; 2];
         let r = rho.hypot(v.z);
+        // atan2 is odd in its first argument (exactly: the sign is applied last).
+        let tilt_positive = rho.atan2(v.z);
         for (slot, k) in items.iter_mut().zip([1.0, -1.0]) {
-            let tilt = (k * rho).atan2(v.z);
+            let tilt = if k > 0.0 { tilt_positive } else { -tilt_positive };
             // gamma = atan2(y, x) with (y, x) of length rho.
             let (y, x) = match family {
                 Family::TtAc => (k * v.x, k * v.y),

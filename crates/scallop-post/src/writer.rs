@@ -68,9 +68,20 @@ pub struct PostParams {
     pub predicted_time: Option<f64>,
 }
 
+/// `10f64.powi(e)` by table for `|e| <= 9`, bit for bit: the exponentiation by squaring
+/// is exact for these powers and a negative power is the reciprocal of the positive one.
+pub(crate) fn pow10i(e: i32) -> f64 {
+    const POW10: [f64; 10] = [1.0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9];
+    match usize::try_from(e.unsigned_abs()).ok().and_then(|k| POW10.get(k)) {
+        Some(&p) if e >= 0 => p,
+        Some(&p) => 1.0 / p,
+        None => 10f64.powi(e),
+    }
+}
+
 /// Rounds `v` down to `decimals` (an exactly representable value is kept).
 pub(crate) fn round_down(v: f64, decimals: usize) -> f64 {
-    let s = 10f64.powi(i32::try_from(decimals).unwrap_or(9));
+    let s = pow10i(i32::try_from(decimals).unwrap_or(9));
     let r = (v * s).round();
     if ((v * s) - r).abs() <= tol::ROUNDING_SLACK * r.abs().max(1.0) { r / s } else { (v * s).floor() / s }
 }
@@ -340,7 +351,7 @@ fn rounding_cap(
             AxisKind::Linear => (dialect.decimals, axis.dynamics.vmax),
             AxisKind::Rotary => (dialect.rotary_decimals, axis.dynamics.vmax.to_degrees()),
         };
-        let unit = 10f64.powi(-i32::try_from(decimals).unwrap_or(4));
+        let unit = pow10i(-i32::try_from(decimals).unwrap_or(4));
         cap = cap.min(60.0 * vmax / (delta + unit));
     }
     cap
