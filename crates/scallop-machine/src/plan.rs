@@ -449,8 +449,7 @@ pub fn plan_path(
     offsets.push(0);
     let mut next: Vec<State> = Vec::new();
     for (i, pose) in poses.iter().enumerate() {
-        let preds: &[State] =
-            if i == 0 { std::slice::from_ref(&root) } else { &arena[offsets[i - 1]..offsets[i]] };
+        let preds: &[State] = if i == 0 { std::slice::from_ref(&root) } else { &arena[offsets[i - 1]..offsets[i]] };
         next.clear();
         let mut first_error: Option<MachineError> = None;
         let mut smallest_jump: Option<(usize, f64)> = None;

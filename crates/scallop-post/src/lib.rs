@@ -98,7 +98,7 @@ fn number_fast(bytes: &mut [u8; 32], v: f64, decimals: usize) -> Option<usize> {
         6061626364656667686970717273747576777879\
         8081828384858687888990919293949596979899";
     const POW10: [f64; 10] = [1.0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9];
-    let Some(&scale) = POW10.get(decimals) else { return None };
+    let &scale = POW10.get(decimals)?;
     let x = v.abs() * scale;
     // |x| < 1e9: the product's error is below 2.3e-7, far from the 1e-6 tie margin.
     if x.is_nan() || x >= 1e9 {
