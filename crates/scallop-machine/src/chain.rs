@@ -129,6 +129,23 @@ pub(crate) fn joint_isometry(direction: &Vec3, point: &Point3, kind: AxisKind, q
     }
 }
 
+/// `joint_isometry(direction, point, kind, q) * p` without building the isometry: a
+/// translation, or a rotation about the line by Rodrigues' formula from one `sin_cos`
+/// (`direction` is a unit vector). `q -> -q` applies the inverse.
+pub(crate) fn joint_apply(direction: &Vec3, point: &Point3, kind: AxisKind, q: f64, p: &Point3) -> Point3 {
+    match kind {
+        AxisKind::Linear => p + direction * q,
+        AxisKind::Rotary => rotate_about(direction, point, q.sin_cos(), p),
+    }
+}
+
+/// `p` rotated about the line through `point` along the unit `direction` by the angle
+/// whose `(sin, cos)` is given (Rodrigues' formula).
+pub(crate) fn rotate_about(direction: &Vec3, point: &Point3, (s, c): (f64, f64), p: &Point3) -> Point3 {
+    let v = p - point;
+    point + v * c + direction.cross(&v) * s + direction * (direction.dot(&v) * (1.0 - c))
+}
+
 fn along(v: &Vec3, e: &Vec3) -> Option<f64> {
     if (v - e).norm() < tol::PARALLEL {
         Some(1.0)

@@ -97,20 +97,31 @@ pub fn deviation_bound(kin: &Kinematics, qa: &Joints, qb: &Joints) -> Option<(f6
     if omega.is_nan() || omega >= tol::BOUND_MAX_ROTATION {
         return None;
     }
-    // D0: distance from the tip to each rotary line at the start, both in M.
-    let tip_m = kin.chain_transform(&machine.tool_chain, qa) * kin.t0;
+    // D0: distance from the tip to each rotary line at the start, both in M. A joint's
+    // line is carried by the joints before it in its chain; the distance is invariant
+    // under rigid motion, so the tip is carried back instead: walking down the chain,
+    // the tip in the frame of joint k is the previous one moved by the inverse of joint
+    // k - 1 (one sin_cos per rotary, no transform composition).
+    let mut tip_m = kin.t0;
+    for &i in machine.tool_chain.iter().rev() {
+        let a = &machine.axes[i];
+        tip_m = crate::chain::joint_apply(&a.direction, &a.point, a.kind, qa[i], &tip_m);
+    }
     let mut d0 = 0.0f64;
     for chain in [&machine.part_chain, &machine.tool_chain] {
-        let mut t = scallop_geom::nalgebra::Isometry3::identity();
-        for &i in chain.iter() {
+        let Some(last) = chain.iter().rposition(|&i| machine.axes[i].kind == crate::AxisKind::Rotary) else {
+            continue;
+        };
+        let mut p = tip_m;
+        for &i in &chain[..=last] {
             let a = &machine.axes[i];
             if a.kind == crate::AxisKind::Rotary {
-                let point = t * a.point;
-                let dir = t.rotation * a.direction;
-                let off = tip_m - point;
-                d0 = d0.max((off - dir * off.dot(&dir)).norm());
+                let off = p - a.point;
+                d0 = d0.max((off - a.direction * off.dot(&a.direction)).norm());
             }
-            t *= crate::chain::joint_isometry(&a.direction, &a.point, a.kind, qa[i]);
+            if i != chain[last] {
+                p = crate::chain::joint_apply(&a.direction, &a.point, a.kind, -qa[i], &p);
+            }
         }
     }
     let d = (d0 + 2.0 * b) / (1.0 - 3.0 * omega);
@@ -240,6 +251,17 @@ fn split(
     split(kin, (&mid, &q_mid), b, tolerance, block, depth + 1, out)
 }
 
+/// `10f64.powi(e)` by table for `|e| <= 9`, bit for bit: the exponentiation by squaring
+/// is exact for these powers and a negative power is the reciprocal of the positive one.
+pub(crate) fn pow10i(e: i32) -> f64 {
+    const POW10: [f64; 10] = [1.0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9];
+    match usize::try_from(e.unsigned_abs()).ok().and_then(|k| POW10.get(k)) {
+        Some(&p) if e >= 0 => p,
+        Some(&p) => 1.0 / p,
+        None => 10f64.powi(e),
+    }
+}
+
 /// Inverse-time feed word of the block `qa -> qb` (spec 3.9):
 /// `T = max(L/F, r_ref·Δφ/F, max_j |Δq_j|/vmax_j, T_min)` and `F_inv = 1/T` in 1/min,
 /// rounded down to `nc.decimals.feed` so that no axis exceeds its velocity limit.
@@ -260,7 +282,7 @@ pub fn inverse_time_feed(kin: &Kinematics, pose_a: &Pose, pose_b: &Pose, qa: &Jo
     let dphi = pose_a.axis.cross(&pose_b.axis).norm().atan2(pose_a.axis.dot(&pose_b.axis));
     let rate = crate::plan::move_time(machine, qa, qb);
     let t = (length / f).max(machine.nc().r_ref * dphi / f).max(rate).max(machine.nc().min_block_time);
-    let scale = 10f64.powi(i32::from(machine.nc().decimals.feed));
+    let scale = pow10i(i32::from(machine.nc().decimals.feed));
     let exact = 60.0 / t;
     // Round down, but keep an exact value when it is already representable.
     let rounded = (exact * scale).floor() / scale;

@@ -19,10 +19,10 @@
 
 use std::f64::consts::PI;
 
-use scallop_geom::nalgebra::{Isometry3, Matrix3, SMatrix, Unit, UnitQuaternion};
+use scallop_geom::nalgebra::{Matrix3, SMatrix, Unit, UnitQuaternion};
 use scallop_geom::{Point3, Vec3};
 
-use crate::chain::{Class, Family, Joints, Kinematics, Pose, Solver, joint_isometry};
+use crate::chain::{Class, Family, Joints, Kinematics, Pose, Solver, rotate_about};
 use crate::desc::AxisKind;
 use crate::error::MachineError;
 use crate::tol;
@@ -148,24 +148,55 @@ impl Kinematics {
         IkSolution { joints: q, branch: Branch::of_tilt(q[self.tilt]), at_pole }
     }
 
+    /// [`Kinematics::solution`] with the rotaries' `(sin, cos)` known (the closed forms get
+    /// them from the tool axis's components without evaluating `sin_cos`).
+    fn solution_trig(
+        &self,
+        tip: &Point3,
+        (theta_primary, trig_primary): (f64, (f64, f64)),
+        (theta_secondary, trig_secondary): (f64, (f64, f64)),
+    ) -> IkSolution {
+        let mut q = Joints::zeros();
+        q[self.primary] = normalize_angle(theta_primary);
+        q[self.secondary] = normalize_angle(theta_secondary);
+        let mut trig = [(0.0, 1.0); 5];
+        trig[self.primary] = trig_primary;
+        trig[self.secondary] = trig_secondary;
+        self.solve_linear_trig(tip, &mut q, &trig);
+        IkSolution { joints: q, branch: Branch::of_tilt(q[self.tilt]), at_pole: false }
+    }
+
     /// Fills the linear joints of `q` (rotaries given) so that the controlled point is at
     /// `tip` (part frame). Linear axes nearer the bed: `D = F_part(x) - F_tool(t0)`,
     /// `q_lin = M^-1 D` (spec 3.2). Otherwise the tip is affine in the linear joints for
     /// fixed rotaries: `P(q_lin) = P(0) + A q_lin`, with A from three forward evaluations.
     pub(crate) fn solve_linear(&self, tip: &Point3, q: &mut Joints) {
+        let mut trig = [(0.0, 1.0); 5];
+        for (i, t) in trig.iter_mut().enumerate() {
+            if self.machine.axes[i].kind == AxisKind::Rotary {
+                *t = q[i].sin_cos();
+            }
+        }
+        self.solve_linear_trig(tip, q, &trig);
+    }
+
+    /// [`Kinematics::solve_linear`] with `trig[i] = (sin q_i, cos q_i)` given for the rotaries.
+    fn solve_linear_trig(&self, tip: &Point3, q: &mut Joints, trig: &[(f64, f64); 5]) {
         if self.linear_first {
             let x = self.w0 * tip;
-            let rotary_only = |chain: &[usize]| {
-                let mut t = Isometry3::identity();
-                for &i in chain {
+            // The chain's rotaries applied to a point, innermost first, each by Rodrigues'
+            // formula from one sin_cos (no quaternion or isometry composition).
+            let rotary_only = |chain: &[usize], p: Point3| {
+                let mut p = p;
+                for &i in chain.iter().rev() {
                     let a = &self.machine.axes[i];
                     if a.kind == AxisKind::Rotary {
-                        t *= joint_isometry(&a.direction, &a.point, a.kind, q[i]);
+                        p = rotate_about(&a.direction, &a.point, trig[i], &p);
                     }
                 }
-                t
+                p
             };
-            let d = rotary_only(&self.machine.part_chain) * x - rotary_only(&self.machine.tool_chain) * self.t0;
+            let d = rotary_only(&self.machine.part_chain, x) - rotary_only(&self.machine.tool_chain, self.t0);
             let lin = self.linear_inverse * d;
             q[0] = lin[0];
             q[1] = lin[1];
@@ -202,20 +233,27 @@ impl Kinematics {
         };
         let (s_tilt, s_pole) = (sign(self.tilt), sign(self.pole));
         let mut items = [IkSolution { joints: Joints::zeros(), branch: Branch::Positive, at_pole: false }; 2];
+        let r = rho.hypot(v.z);
+        // atan2 is odd in its first argument (exactly: the sign is applied last).
+        let tilt_positive = rho.atan2(v.z);
         for (slot, k) in items.iter_mut().zip([1.0, -1.0]) {
-            let tilt = (k * rho).atan2(v.z);
-            let gamma = match family {
-                Family::TtAc => (k * v.x).atan2(k * v.y),
-                Family::TtBc => (k * v.y).atan2(-k * v.x),
-                Family::HhCa => (k * v.x).atan2(-k * v.y),
-                Family::HhCb => (k * v.y).atan2(k * v.x),
-                Family::HtBc => (-k * v.y).atan2(k * v.x),
-                Family::HtAc => (-k * v.x).atan2(-k * v.y),
+            let tilt = if k > 0.0 { tilt_positive } else { -tilt_positive };
+            // gamma = atan2(y, x) with (y, x) of length rho.
+            let (y, x) = match family {
+                Family::TtAc => (k * v.x, k * v.y),
+                Family::TtBc => (k * v.y, -k * v.x),
+                Family::HhCa => (k * v.x, -k * v.y),
+                Family::HhCb => (k * v.y, k * v.x),
+                Family::HtBc => (-k * v.y, k * v.x),
+                Family::HtAc => (-k * v.x, -k * v.y),
             };
-            let (q_tilt, q_pole) = (s_tilt * tilt, s_pole * gamma);
-            let (theta_primary, theta_secondary) =
-                if self.tilt == self.primary { (q_tilt, q_pole) } else { (q_pole, q_tilt) };
-            *slot = self.solution(&pose.tip, theta_primary, theta_secondary, false);
+            let gamma = y.atan2(x);
+            // The sines and cosines from the same components (no sin_cos of the angles).
+            let tilt_trig = (s_tilt * k * rho / r, v.z / r);
+            let pole_trig = (s_pole * y / rho, x / rho);
+            let (q_tilt, q_pole) = ((s_tilt * tilt, tilt_trig), (s_pole * gamma, pole_trig));
+            let (primary, secondary) = if self.tilt == self.primary { (q_tilt, q_pole) } else { (q_pole, q_tilt) };
+            *slot = self.solution_trig(&pose.tip, primary, secondary);
         }
         Ok(IkSolutions { items, len: 2 })
     }

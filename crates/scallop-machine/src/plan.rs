@@ -442,10 +442,15 @@ pub fn plan_path(
         back: 0,
         edge: Edge::Plain,
     };
-    let mut layers: Vec<Vec<State>> = Vec::with_capacity(poses.len());
+    // The layers in one arena: layer i is `arena[offsets[i]..offsets[i + 1]]` (no
+    // allocation per pose); `next` is reused.
+    let mut arena: Vec<State> = Vec::with_capacity(poses.len() * 2);
+    let mut offsets: Vec<usize> = Vec::with_capacity(poses.len() + 1);
+    offsets.push(0);
+    let mut next: Vec<State> = Vec::new();
     for (i, pose) in poses.iter().enumerate() {
-        let preds: &[State] = if i == 0 { std::slice::from_ref(&root) } else { &layers[i - 1] };
-        let mut next: Vec<State> = Vec::new();
+        let preds: &[State] = if i == 0 { std::slice::from_ref(&root) } else { &arena[offsets[i - 1]..offsets[i]] };
+        next.clear();
         let mut first_error: Option<MachineError> = None;
         let mut smallest_jump: Option<(usize, f64)> = None;
         // Off the pole the inverse does not depend on the held joints: solve once.
@@ -525,13 +530,15 @@ pub fn plan_path(
             }
         });
         next.truncate(tol::PLAN_BEAM);
-        layers.push(next);
+        arena.extend_from_slice(&next);
+        offsets.push(arena.len());
     }
+    let layers = offsets.windows(2).map(|w| &arena[w[0]..w[1]]);
     // Backtrack from the best final state.
     let mut chain: Vec<&State> = Vec::with_capacity(poses.len());
-    if let Some(last) = layers.last() {
+    if let Some(last) = layers.clone().next_back() {
         let mut idx = 0; // layers are sorted: the best is first
-        for layer in layers.iter().rev() {
+        for layer in layers.rev() {
             let s = &layer[idx];
             chain.push(s);
             idx = s.back;

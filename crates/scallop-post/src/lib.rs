@@ -66,8 +66,20 @@ pub fn fmt_number(v: f64, decimals: usize) -> String {
 
 /// Appends `v` with `decimals` digits to `out`, exactly as [`fmt_number`] formats it.
 pub fn push_number(out: &mut String, v: f64, decimals: usize) {
-    if !push_number_fast(out, v, decimals) {
-        out.push_str(&fmt_number_exact(v, decimals));
+    let mut bytes = [0u8; 32];
+    match number_fast(&mut bytes, v, decimals) {
+        // Only ASCII digits, '.' and '-' were written.
+        Some(at) => out.push_str(std::str::from_utf8(&bytes[at..]).unwrap_or_default()),
+        None => out.push_str(&fmt_number_exact(v, decimals)),
+    }
+}
+
+/// [`push_number`] into a byte buffer (ASCII), for writers that build their text as bytes.
+pub(crate) fn push_number_bytes(out: &mut Vec<u8>, v: f64, decimals: usize) {
+    let mut bytes = [0u8; 32];
+    match number_fast(&mut bytes, v, decimals) {
+        Some(at) => out.extend_from_slice(&bytes[at..]),
+        None => out.extend_from_slice(fmt_number_exact(v, decimals).as_bytes()),
     }
 }
 
@@ -79,40 +91,66 @@ fn fmt_number_exact(v: f64, decimals: usize) -> String {
 /// `fmt_number` by integer arithmetic, byte for byte equal to the exact formatting
 /// (`format!("{v:.decimals$}")` with `-0` cleaned) where it answers: away from rounding
 /// ties by more than the product's rounding error, and for magnitudes where the scaled
-/// value is an exact integer range. `false` (nothing written) sends the caller to the
-/// exact formatter.
-fn push_number_fast(out: &mut String, v: f64, decimals: usize) -> bool {
+/// value is an exact integer range. `None` sends the caller to the
+/// exact formatter. The text is written at the end of `bytes`, from the returned index.
+fn number_fast(bytes: &mut [u8; 32], v: f64, decimals: usize) -> Option<usize> {
+    const POW10_U64: [u64; 10] =
+        [1, 10, 100, 1_000, 10_000, 100_000, 1_000_000, 10_000_000, 100_000_000, 1_000_000_000];
+    const DIGIT_PAIRS: &[u8; 200] = b"0001020304050607080910111213141516171819\
+        2021222324252627282930313233343536373839\
+        4041424344454647484950515253545556575859\
+        6061626364656667686970717273747576777879\
+        8081828384858687888990919293949596979899";
     const POW10: [f64; 10] = [1.0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9];
-    let Some(&scale) = POW10.get(decimals) else { return false };
+    let &scale = POW10.get(decimals)?;
     let x = v.abs() * scale;
     // |x| < 1e9: the product's error is below 2.3e-7, far from the 1e-6 tie margin.
     if x.is_nan() || x >= 1e9 {
-        return false;
+        return None;
     }
     let floor = x.floor();
     let frac = x - floor;
     if (frac - 0.5).abs() < tol::FAST_FORMAT_TIE_MARGIN {
-        return false;
+        return None;
     }
     let mut n = if frac > 0.5 { floor + 1.0 } else { floor } as u64;
-    // Digits, least significant first, at least decimals + 1 of them (leading zeros).
-    let mut digits = [b'0'; 24];
-    let mut len = 0;
-    while n > 0 || len <= decimals {
-        digits[len] = b'0' + (n % 10) as u8;
+    // Written right to left into a stack buffer: at least decimals + 1 digits (leading
+    // zeros), the point, the sign; then appended in one copy.
+    let mut at = bytes.len();
+    let nonzero = n != 0;
+    let mut k = 0;
+    if decimals > 0 {
+        // The fraction digits, two at a time, then the point.
+        let mut f = n % POW10_U64[decimals];
+        n /= POW10_U64[decimals];
+        while k + 2 <= decimals {
+            let pair = (f % 100) as usize;
+            f /= 100;
+            at -= 2;
+            bytes[at..at + 2].copy_from_slice(&DIGIT_PAIRS[2 * pair..2 * pair + 2]);
+            k += 2;
+        }
+        if k < decimals {
+            at -= 1;
+            bytes[at] = b'0' + (f % 10) as u8;
+        }
+        at -= 1;
+        bytes[at] = b'.';
+    }
+    // The integer digits (at least one).
+    loop {
+        at -= 1;
+        bytes[at] = b'0' + (n % 10) as u8;
         n /= 10;
-        len += 1;
-    }
-    if v < 0.0 && digits[..len].iter().any(|&d| d != b'0') {
-        out.push('-');
-    }
-    for k in (0..len).rev() {
-        out.push(char::from(digits[k]));
-        if k == decimals && decimals > 0 {
-            out.push('.');
+        if n == 0 {
+            break;
         }
     }
-    true
+    if v < 0.0 && nonzero {
+        at -= 1;
+        bytes[at] = b'-';
+    }
+    Some(at)
 }
 
 /// Writes `path` as G-code. `comments` go into the header (one line each).

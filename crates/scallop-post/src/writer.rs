@@ -3,7 +3,6 @@
 //! positions, the controller does the kinematics) and 3+2 output through tilted work
 //! planes.
 
-use std::fmt::Write as _;
 use std::io::Write;
 
 use scallop_geom::nalgebra::Rotation3;
@@ -69,9 +68,20 @@ pub struct PostParams {
     pub predicted_time: Option<f64>,
 }
 
+/// `10f64.powi(e)` by table for `|e| <= 9`, bit for bit: the exponentiation by squaring
+/// is exact for these powers and a negative power is the reciprocal of the positive one.
+pub(crate) fn pow10i(e: i32) -> f64 {
+    const POW10: [f64; 10] = [1.0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9];
+    match usize::try_from(e.unsigned_abs()).ok().and_then(|k| POW10.get(k)) {
+        Some(&p) if e >= 0 => p,
+        Some(&p) => 1.0 / p,
+        None => 10f64.powi(e),
+    }
+}
+
 /// Rounds `v` down to `decimals` (an exactly representable value is kept).
 pub(crate) fn round_down(v: f64, decimals: usize) -> f64 {
-    let s = 10f64.powi(i32::try_from(decimals).unwrap_or(9));
+    let s = pow10i(i32::try_from(decimals).unwrap_or(9));
     let r = (v * s).round();
     if ((v * s) - r).abs() <= tol::ROUNDING_SLACK * r.abs().max(1.0) { r / s } else { (v * s).floor() / s }
 }
@@ -220,7 +230,11 @@ pub fn program_text(
     };
     let mut previous: Option<&ProgramBlock> = None;
     let mut plane: Option<(Vec3, Rotation3<f64>)> = None;
-    let mut words: Vec<(&str, String)> = Vec::with_capacity(machine.axes().len());
+    // One token string per written axis, reused block after block (no allocation per token).
+    let mut words: Vec<(&str, Vec<u8>)> = (0..machine.axes().len())
+        .filter(|&i| write_axis[i])
+        .map(|i| (letters[i].as_str(), Vec::with_capacity(24)))
+        .collect();
     for b in &program.blocks {
         if planes {
             let needs_new = plane.as_ref().is_none_or(|(axis, _)| angle(axis, &b.pose.axis) > params.tol_ang);
@@ -258,24 +272,25 @@ pub fn program_text(
             let (words_a, tip_a) = previous.map_or((b.words, b.pose.tip), |p| (p.words, p.pose.tip));
             let word_at = |i: usize| words_a[i] + (b.words[i] - words_a[i]) * s;
             let tip: Point3 = tip_a + (b.pose.tip - tip_a) * s;
-            words.clear();
+            let mut slot = 0;
             for i in 0..machine.axes().len() {
                 if !write_axis[i] {
                     continue;
                 }
                 let axis = &machine.axes()[i];
                 let w = word_at(i);
-                let token = match axis.kind {
+                let token = &mut words[slot].1;
+                slot += 1;
+                match axis.kind {
                     AxisKind::Linear if mode == OutputMode::Tcp => {
-                        e.token(&letters[i], tip[linear_component(i)?], dialect.decimals)
+                        e.token_into(token, &letters[i], tip[linear_component(i)?], dialect.decimals);
                     }
-                    AxisKind::Linear => e.token(&letters[i], w, dialect.decimals),
+                    AxisKind::Linear => e.token_into(token, &letters[i], w, dialect.decimals),
                     AxisKind::Rotary => {
                         let before = word_at_prev(&words_a, &b.words, i, piece, pieces);
-                        e.rotary(&letters[i], w, w - before, axis.wrap)
+                        e.rotary_into(token, &letters[i], w, w - before, axis.wrap);
                     }
-                };
-                words.push((letters[i].as_str(), token));
+                }
             }
             let feed = match (b.motion, previous) {
                 (Motion::Rapid, _) => FeedWord::Rapid,
@@ -312,7 +327,8 @@ pub fn program_text(
     for f in &dialect.footer {
         e.line(&vars.render(f));
     }
-    Ok(e.text)
+    // INVARIANT: the text is built from `str` pieces and ASCII numbers only.
+    Ok(String::from_utf8(e.text).unwrap_or_else(|err| String::from_utf8_lossy(err.as_bytes()).into_owned()))
 }
 
 /// Caps an inverse-time word so that no axis exceeds its velocity even when its rounded
@@ -335,7 +351,7 @@ fn rounding_cap(
             AxisKind::Linear => (dialect.decimals, axis.dynamics.vmax),
             AxisKind::Rotary => (dialect.rotary_decimals, axis.dynamics.vmax.to_degrees()),
         };
-        let unit = 10f64.powi(-i32::try_from(decimals).unwrap_or(4));
+        let unit = pow10i(-i32::try_from(decimals).unwrap_or(4));
         cap = cap.min(60.0 * vmax / (delta + unit));
     }
     cap
@@ -406,39 +422,67 @@ enum FeedWord {
 /// Line writer with numbering and modal state.
 struct Emitter<'a> {
     d: &'a Dialect,
-    text: String,
+    /// The program text, UTF-8 built as bytes (numbers are written as ASCII bytes).
+    text: Vec<u8>,
     number: u64,
-    last_words: std::collections::BTreeMap<String, String>,
+    /// Last written token per word letter, `(letter, token)`, in first-use order: a few
+    /// entries searched linearly (cheaper than a map for five axes), strings reused.
+    last_words: Vec<(String, Vec<u8>)>,
     last_motion: Option<&'static str>,
-    last_feed: Option<String>,
+    last_feed: Option<Vec<u8>>,
     g93: bool,
     /// Reused line buffer of `motion_tokens`.
-    buf: String,
+    buf: Vec<u8>,
+    /// Reused feed-word buffer of `motion_tokens`.
+    feed: Vec<u8>,
+    /// Reused per-word "differs from the modal word" flags of `motion_tokens`.
+    changed: Vec<bool>,
+    /// Reused per-word indices into `last_words` of `motion_tokens`.
+    slots: Vec<Option<usize>>,
 }
 
 impl<'a> Emitter<'a> {
     fn new(d: &'a Dialect) -> Emitter<'a> {
         Emitter {
             d,
-            text: String::new(),
+            text: Vec::new(),
             number: d.line_numbers.as_ref().map_or(0, |n| n.start),
-            last_words: std::collections::BTreeMap::new(),
+            last_words: Vec::new(),
             last_motion: None,
             last_feed: None,
             g93: false,
-            buf: String::new(),
+            buf: Vec::new(),
+            feed: Vec::new(),
+            changed: Vec::new(),
+            slots: Vec::new(),
         }
     }
 
+    /// The last token written for `letter`.
+    /// The index in `last_words` of `letter`, tried first at `hint` (blocks list their
+    /// words in one order, so the hint is almost always right).
+    fn last_index(&self, hint: usize, letter: &str) -> Option<usize> {
+        if self.last_words.get(hint).is_some_and(|(l, _)| short_eq(l.as_bytes(), letter.as_bytes())) {
+            return Some(hint);
+        }
+        self.last_words.iter().position(|(l, _)| short_eq(l.as_bytes(), letter.as_bytes()))
+    }
+
     fn line(&mut self, s: &str) {
+        self.line_bytes(s.as_bytes());
+    }
+
+    fn line_bytes(&mut self, s: &[u8]) {
         if let Some(n) = &self.d.line_numbers
-            && s != "%"
+            && s != b"%"
         {
-            let _ = write!(self.text, "{}{} ", n.prefix, self.number);
+            self.text.extend_from_slice(n.prefix.as_bytes());
+            self.text.extend_from_slice(self.number.to_string().as_bytes());
+            self.text.push(b' ');
             self.number += n.step;
         }
-        self.text.push_str(s);
-        self.text.push('\n');
+        self.text.extend_from_slice(s);
+        self.text.push(b'\n');
     }
 
     fn comment(&mut self, s: &str) {
@@ -461,6 +505,31 @@ impl<'a> Emitter<'a> {
             s.insert(letter.len(), '+');
         }
         s
+    }
+
+    /// [`Emitter::token`] as bytes into `s` (cleared first; its allocation is reused).
+    fn token_into(&self, s: &mut Vec<u8>, letter: &str, v: f64, decimals: usize) {
+        s.clear();
+        s.extend_from_slice(letter.as_bytes());
+        if self.d.explicit_plus {
+            s.push(b'+');
+        }
+        let at = s.len();
+        crate::push_number_bytes(s, v, decimals);
+        if self.d.explicit_plus && s.get(at) == Some(&b'-') {
+            s.remove(at - 1);
+        }
+    }
+
+    /// [`Emitter::rotary`] as bytes into `s` (cleared first; its allocation is reused).
+    fn rotary_into(&self, s: &mut Vec<u8>, letter: &str, word: f64, delta: f64, wrap: Wrap) {
+        if wrap == Wrap::Absolute {
+            self.token_into(s, letter, word, self.d.rotary_decimals);
+        } else {
+            let t = self.rotary(letter, word, delta, wrap);
+            s.clear();
+            s.extend_from_slice(t.as_bytes());
+        }
     }
 
     fn num(&self, v: f64, decimals: usize) -> String {
@@ -495,106 +564,114 @@ impl<'a> Emitter<'a> {
 
     /// A motion block from `(letter, number)` pairs.
     fn motion(&mut self, words: &[(&str, String)], feed: FeedWord) {
-        let tokens: Vec<(&str, String)> = words.iter().map(|(l, v)| (*l, format!("{l}{v}"))).collect();
+        let tokens: Vec<(&str, Vec<u8>)> = words.iter().map(|(l, v)| (*l, format!("{l}{v}").into_bytes())).collect();
         self.motion_tokens(&tokens, feed);
     }
 
     /// A motion block from `(letter, full token)` pairs. Hot path of every program:
     /// one line buffer reused, modal words compared in place, no per-token allocation
     /// beyond the tokens themselves.
-    fn motion_tokens(&mut self, words: &[(&str, String)], feed: FeedWord) {
-        let mut any = false;
-        for (letter, token) in words {
-            let same = self.d.modal && self.last_words.get(*letter).is_some_and(|t| t == token);
-            any |= !same;
+    fn motion_tokens(&mut self, words: &[(&str, Vec<u8>)], feed: FeedWord) {
+        let mut changed = std::mem::take(&mut self.changed);
+        changed.clear();
+        let mut slots = std::mem::take(&mut self.slots);
+        slots.clear();
+        for (k, (letter, token)) in words.iter().enumerate() {
+            let slot = self.last_index(k, letter);
+            slots.push(slot);
+            changed.push(!self.d.modal || slot.is_none_or(|j| !short_eq(&self.last_words[j].1, token)));
         }
-        if !any {
+        if !changed.contains(&true) {
+            self.changed = changed;
+            self.slots = slots;
             return;
         }
         let mut buf = std::mem::take(&mut self.buf);
         buf.clear();
-        let push = |buf: &mut String, t: &str| {
+        let push = |buf: &mut Vec<u8>, t: &[u8]| {
             if !buf.is_empty() {
-                buf.push(' ');
+                buf.push(b' ');
             }
-            buf.push_str(t);
-        };
-        let changed = |me: &Self, letter: &str, token: &String| {
-            !me.d.modal || me.last_words.get(letter).is_none_or(|t| t != token)
+            buf.extend_from_slice(t);
         };
         match self.d.syntax {
             Syntax::Iso => {
                 let want_g93 = matches!(feed, FeedWord::InverseTime(_));
                 if want_g93 != self.g93 {
-                    push(&mut buf, if want_g93 { "G93" } else { "G94" });
+                    push(&mut buf, if want_g93 { b"G93" } else { b"G94" });
                     self.g93 = want_g93;
                     self.last_feed = None;
                 }
                 let code = if matches!(feed, FeedWord::Rapid) { "G0" } else { "G1" };
                 if !self.d.modal || self.last_motion != Some(code) {
-                    push(&mut buf, code);
+                    push(&mut buf, code.as_bytes());
                     self.last_motion = Some(code);
                 }
-                for (letter, token) in words {
-                    if changed(self, letter, token) {
+                for ((_, token), &c) in words.iter().zip(&changed) {
+                    if c {
                         push(&mut buf, token);
                     }
                 }
-                let f = match feed {
-                    FeedWord::Rapid | FeedWord::Seconds(_) => None,
-                    FeedWord::PerMinute(f) => {
-                        Some(fmt_number(round_down(f, self.d.feed_decimals), self.d.feed_decimals))
-                    }
-                    FeedWord::InverseTime(f) => {
-                        self.last_feed = None; // G93 needs F on every block
-                        Some(fmt_number(round_down(f, self.d.inverse_time_decimals), self.d.inverse_time_decimals))
-                    }
+                // G93 needs F on every block (`always`).
+                let (dec, always) = match feed {
+                    FeedWord::Rapid | FeedWord::Seconds(_) => (None, false),
+                    FeedWord::PerMinute(_) => (Some(self.d.feed_decimals), false),
+                    FeedWord::InverseTime(_) => (Some(self.d.inverse_time_decimals), true),
                 };
-                if let Some(f) = f
-                    && (!self.d.modal || self.last_feed.as_ref() != Some(&f))
-                {
-                    push(&mut buf, "F");
-                    buf.push_str(&f);
-                    self.last_feed = Some(f);
+                if let (Some(dec), FeedWord::PerMinute(f) | FeedWord::InverseTime(f)) = (dec, feed) {
+                    self.feed.clear();
+                    crate::push_number_bytes(&mut self.feed, round_down(f, dec), dec);
+                    if always || !self.d.modal || self.last_feed.as_ref() != Some(&self.feed) {
+                        push(&mut buf, b"F");
+                        buf.extend_from_slice(&self.feed);
+                        match &mut self.last_feed {
+                            Some(l) => l.clone_from(&self.feed),
+                            None => self.last_feed = Some(self.feed.clone()),
+                        }
+                    }
                 }
             }
             Syntax::Heidenhain => {
-                push(&mut buf, "L");
-                for (letter, token) in words {
-                    if changed(self, letter, token) {
+                push(&mut buf, b"L");
+                for ((_, token), &c) in words.iter().zip(&changed) {
+                    if c {
                         push(&mut buf, token);
                     }
                 }
                 match feed {
                     FeedWord::Rapid => {
-                        push(&mut buf, "FMAX");
+                        push(&mut buf, b"FMAX");
                         self.last_feed = None;
                     }
                     FeedWord::Seconds(t) => {
                         let dec = self.d.inverse_time_decimals;
-                        push(&mut buf, &format!("FT{}", fmt_number(round_up(t, dec), dec)));
+                        push(&mut buf, format!("FT{}", fmt_number(round_up(t, dec), dec)).as_bytes());
                         self.last_feed = None;
                     }
                     FeedWord::PerMinute(f) | FeedWord::InverseTime(f) => {
-                        let f = fmt_number(round_down(f, self.d.feed_decimals), self.d.feed_decimals);
+                        let f = fmt_number(round_down(f, self.d.feed_decimals), self.d.feed_decimals).into_bytes();
                         if !self.d.modal || self.last_feed.as_ref() != Some(&f) {
-                            push(&mut buf, &format!("F{f}"));
+                            push(&mut buf, format!("F{}", String::from_utf8_lossy(&f)).as_bytes());
                             self.last_feed = Some(f);
                         }
                     }
                 }
             }
         }
-        for (letter, token) in words {
-            match self.last_words.get_mut(*letter) {
-                Some(t) => t.clone_from(token),
-                None => {
-                    self.last_words.insert((*letter).to_string(), token.clone());
-                }
+        for ((letter, token), slot) in words.iter().zip(&slots) {
+            match slot {
+                Some(j) => self.last_words[*j].1.clone_from(token),
+                // A letter twice in one block: the later token is the modal one.
+                None => match self.last_words.iter_mut().find(|(l, _)| l == letter) {
+                    Some((_, t)) => t.clone_from(token),
+                    None => self.last_words.push(((*letter).to_string(), token.clone())),
+                },
             }
         }
-        self.line(&buf);
+        self.slots = slots;
+        self.line_bytes(&buf);
         self.buf = buf;
+        self.changed = changed;
     }
 
     /// Activates a tilted plane `r` (columns x_f, y_f, z_f in the part frame) at the
@@ -636,6 +713,11 @@ impl<'a> Emitter<'a> {
         self.last_words.clear();
         self.last_motion = None;
     }
+}
+
+/// Byte equality of short strings (word letters, tokens) without a `memcmp` call.
+fn short_eq(a: &[u8], b: &[u8]) -> bool {
+    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x == y)
 }
 
 /// `CYCLE800` axis-by-axis angles (X, then the rotated Y, then the rotated Z):
