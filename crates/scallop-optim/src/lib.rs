@@ -25,6 +25,7 @@
 mod error;
 mod mads;
 mod problem;
+pub mod study;
 pub mod tol;
 
 pub use error::OptimError;

@@ -194,11 +194,7 @@ impl<'a> Run<'a> {
     }
 
     fn frame_steps(&self) -> i64 {
-        if self.level >= 0 {
-            tol::INITIAL_FRAME_STEPS >> self.level
-        } else {
-            tol::INITIAL_FRAME_STEPS << (-self.level)
-        }
+        if self.level >= 0 { tol::INITIAL_FRAME_STEPS >> self.level } else { tol::INITIAL_FRAME_STEPS << (-self.level) }
     }
 
     fn mesh_steps(&self) -> i64 {
@@ -458,7 +454,8 @@ impl<'a> Run<'a> {
                     continue;
                 }
                 #[allow(clippy::cast_possible_truncation)] // |ratio d / inf| <= 2^16
-                let mut m: Lattice = x.iter().zip(&d).map(|(&xi, &di)| xi + mesh * (ratio * di / inf).round() as i64).collect();
+                let mut m: Lattice =
+                    x.iter().zip(&d).map(|(&xi, &di)| xi + mesh * (ratio * di / inf).round() as i64).collect();
                 self.project(&mut m);
                 if m != *x && !out.iter().any(|(p, _)| *p == m) {
                     out.push((m, d));
@@ -479,7 +476,12 @@ impl<'a> Run<'a> {
                 continue;
             }
             match self.surrogate(m) {
-                Some(e) => keys[k] = Some((e.violation > 0.0 || !e.is_valid(), if e.value.is_nan() { f64::INFINITY } else { e.value })),
+                Some(e) => {
+                    keys[k] = Some((
+                        e.violation > 0.0 || !e.is_valid(),
+                        if e.value.is_nan() { f64::INFINITY } else { e.value },
+                    ))
+                }
                 None => {
                     have_surrogate = false;
                     break;
@@ -500,7 +502,9 @@ impl<'a> Run<'a> {
                 let norm = d.iter().map(|a| a * a).sum::<f64>().sqrt() * last.iter().map(|a| a * a).sum::<f64>().sqrt();
                 if norm > 0.0 { dot / norm } else { -1.0 }
             };
-            if let Some(best) = (0..polls.len()).max_by(|&a, &b| cosine(&polls[a].1).total_cmp(&cosine(&polls[b].1)).then(b.cmp(&a))) {
+            if let Some(best) =
+                (0..polls.len()).max_by(|&a, &b| cosine(&polls[a].1).total_cmp(&cosine(&polls[b].1)).then(b.cmp(&a)))
+            {
                 order.retain(|&k| k != best);
                 order.insert(0, best);
             }
@@ -590,7 +594,15 @@ impl<'a> Run<'a> {
         let mut s = DVector::<f64>::zeros(n);
         let gv = DVector::from_vec(g);
         if lipschitz <= f64::EPSILON {
-            s = gv.map(|v| if v > 0.0 { -1.0 } else if v < 0.0 { 1.0 } else { 0.0 });
+            s = gv.map(|v| {
+                if v > 0.0 {
+                    -1.0
+                } else if v < 0.0 {
+                    1.0
+                } else {
+                    0.0
+                }
+            });
         } else {
             for _ in 0..tol::MODEL_DESCENT_STEPS {
                 let grad = &gv + &h * &s;
@@ -613,7 +625,7 @@ fn prime(j: usize) -> u64 {
     let mut p = 1u64;
     while count <= j {
         p += 1;
-        if (2..p).take_while(|d| d * d <= p).all(|d| p % d != 0) {
+        if (2..p).take_while(|d| d * d <= p).all(|d| !p.is_multiple_of(d)) {
             count += 1;
         }
     }

@@ -3,15 +3,19 @@
 //! variables; and its bookkeeping (budget, cache, determinism, never worse than
 //! the start).
 
-#![allow(clippy::unwrap_used, reason = "tests: a panic is the failure report")]
+#![allow(
+    clippy::unwrap_used,
+    clippy::float_cmp,
+    reason = "tests: a panic is the failure report; exact zeros and counts"
+)]
 
 use std::collections::HashSet;
 use std::f64::consts::{FRAC_PI_2, PI};
 
 use proptest::prelude::*;
 use scallop_optim::{
-    Barrier, BlackBoxOptimizer, Boundary, CostModel, Evaluation, MadsSettings, Objective, OrthoMads, Outcome,
-    Problem, StopReason, Variable,
+    Barrier, BlackBoxOptimizer, Boundary, CostModel, Evaluation, MadsSettings, Objective, OrthoMads, Outcome, Problem,
+    StopReason, Variable,
 };
 
 /// A closure objective that records every point it is asked for.
@@ -91,7 +95,8 @@ fn disk_constraint_with_both_barriers() {
         violation: (x[0] * x[0] + x[1] * x[1] - 1.0).max(0.0),
     };
     let optimum = 2.0 * (2.0 - 0.5f64.sqrt()).powi(2);
-    let cases = [(Barrier::Progressive, [-0.5, 0.0]), (Barrier::Extreme, [-0.5, 0.0]), (Barrier::Progressive, [-1.5, 1.8])];
+    let cases =
+        [(Barrier::Progressive, [-0.5, 0.0]), (Barrier::Extreme, [-0.5, 0.0]), (Barrier::Progressive, [-1.5, 1.8])];
     for (barrier, start) in cases {
         let problem = boxed(2, -2.0, 2.0, &start);
         let out = run(&problem, MadsSettings { budget: 2000.0, barrier, ..MadsSettings::default() }, f);
