@@ -4,6 +4,7 @@
 
 mod analyze;
 mod drop;
+mod optimize;
 mod output;
 mod part;
 mod picture;
@@ -52,6 +53,8 @@ enum Command {
     Analyze(analyze::AnalyzeArgs),
     /// Cut a stock with a 3-axis G-code program and verify it against the part (gouges are errors).
     Simulate(simulate::SimulateArgs),
+    /// Partition a surface into zones and optimise their directions or orientations (see docs/job.md).
+    Optimize(optimize::OptimizeArgs),
     /// Load a part and report what was read (size, welding, open and non-manifold edges).
     Inspect(part::InspectArgs),
 }
@@ -73,6 +76,7 @@ fn main() -> ExitCode {
         Command::Inspect(args) => part::inspect(&args),
         Command::Analyze(args) => analyze::run(&args),
         Command::Simulate(args) => simulate::run(&args),
+        Command::Optimize(args) => optimize::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -24,12 +24,14 @@
 
 mod error;
 mod mads;
+mod plot;
 mod problem;
 pub mod study;
 pub mod tol;
 
 pub use error::OptimError;
 pub use mads::OrthoMads;
+pub use plot::{convergence_svg, zones_svg};
 pub use problem::{
     Barrier, BlackBoxOptimizer, Boundary, CostModel, Evaluation, HistoryPoint, MadsSettings, Objective, Outcome,
     Problem, StopReason, Variable,

@@ -165,8 +165,14 @@ pub struct PlanReport {
     pub violation: f64,
     /// Clustering grid `[N_u, N_v]`.
     pub grid: [usize; 2],
-    /// Zone label of each clustering cell, index `a * N_v + b` (`u` index `a`).
+    /// Zone label of each clustering cell, index `a * N_v + b` (`u` index `a`)
+    /// (not serialised: large).
+    #[serde(skip)]
     pub labels: Vec<u32>,
+    /// XY position (mm) of each clustering cell's sample, same order (not
+    /// serialised).
+    #[serde(skip)]
+    pub cell_xy: Vec<[f64; 2]>,
     /// The zones.
     pub zones: Vec<ZoneReport>,
 }

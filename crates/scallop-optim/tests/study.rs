@@ -99,7 +99,9 @@ impl MachiningModel for Fake {
                 passes: 1,
             })
             .collect();
-        Ok(PlanReport { time_s: a.time_s, transition_time_s: 0.0, violation: a.violation, grid: [8, 8], labels, zones })
+        #[allow(clippy::cast_precision_loss)]
+        let cell_xy = (0..64).map(|i| [(i / 8) as f64, (i % 8) as f64]).collect();
+        Ok(PlanReport { time_s: a.time_s, transition_time_s: 0.0, violation: a.violation, grid: [8, 8], labels, cell_xy, zones })
     }
 }
 
@@ -150,6 +152,11 @@ fn parallel_equals_sequential_and_is_deterministic() {
     let b = two.install(|| run_study(&Fake { unreachable: false }, &s, &Silent, None).unwrap());
     assert_eq!(a, b);
     assert_eq!(serde_json::to_string(&a).unwrap(), serde_json::to_string(&b).unwrap());
+    let svg = scallop_optim::convergence_svg(&a);
+    assert_eq!(svg.matches("K = ").count(), a.results.len());
+    let zones = scallop_optim::zones_svg(&a.results[0].plan, "fake");
+    assert_eq!(zones.matches("<rect").count(), 65);
+    assert_eq!(zones.matches("<line").count(), a.results[0].plan.zones.len());
 }
 
 #[test]
