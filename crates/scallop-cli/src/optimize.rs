@@ -160,15 +160,19 @@ pub fn run(args: &OptimizeArgs) -> CliResult<()> {
     write_atomic(&out.join("study.json"), |w| w.write_all(to_json(&file)?.as_bytes()))?;
     write_atomic(&out.join("report.json"), |w| w.write_all(to_json(&report)?.as_bytes()))?;
     write_atomic(&out.join("convergence.svg"), |w| w.write_all(convergence_svg(&study).as_bytes()))?;
-    let title = format!("{part_name}, {:?}, K = {}", settings.formulation, best.k);
+    let title = format!("{part_name}, {}, K = {}", formulation_name(settings.formulation), best.k);
     write_atomic(&out.join("zones.svg"), |w| w.write_all(zones_svg(&best.plan, &title).as_bytes()))?;
     if args.json {
         return print_json(&file);
     }
     let mut text = format!(
-        "zone optimisation of the {part_name}: {:?}, K = {}..{}, budget {} per K, surrogate {:?}\n\
+        "zone optimisation of the {part_name}: {}, K = {}..{}, budget {} per K, surrogate {:?}\n\
          \x20  K  zones   start (s)    best (s)   gain   evals  surr.  wall (s)\n",
-        settings.formulation, settings.k_min, settings.k_max, settings.budget, settings.surrogate
+        formulation_name(settings.formulation),
+        settings.k_min,
+        settings.k_max,
+        settings.budget,
+        settings.surrogate
     );
     for r in &study.results {
         text.push_str(&format!(
@@ -195,6 +199,14 @@ pub fn run(args: &OptimizeArgs) -> CliResult<()> {
         out.display()
     ));
     print_text(&text)
+}
+
+fn formulation_name(f: Formulation) -> &'static str {
+    match f {
+        Formulation::ThreeAxis => "3-axis",
+        Formulation::ThreePlusTwo => "3+2",
+        Formulation::Heuristic => "PCA heuristic",
+    }
 }
 
 /// JSON text of a serialisable value, with the error as an I/O error.

@@ -27,6 +27,7 @@ mod mads;
 mod plot;
 mod problem;
 pub mod study;
+pub mod surface;
 pub mod tol;
 
 pub use error::OptimError;

@@ -145,7 +145,8 @@ pub fn zones_svg(plan: &PlanReport, title: &str) -> String {
         svg,
         "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{WIDTH}\" height=\"{HEIGHT}\" viewBox=\"0 0 {WIDTH} {HEIGHT}\" font-family=\"sans-serif\" font-size=\"12\">\n\
          <rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n\
-         <text x=\"{MARGIN}\" y=\"24\" font-size=\"14\">{title}: {} zones, {:.1} s (top view, X right, Y up; arrows: feed directions)</text>",
+         <text x=\"{MARGIN}\" y=\"22\" font-size=\"14\">{title}: {} zones, {:.1} s</text>\n\
+         <text x=\"{MARGIN}\" y=\"40\" font-size=\"11\">top view (X right, Y up); arrows: feed direction of each zone</text>",
         plan.zones.len(),
         plan.time_s
     );

@@ -474,9 +474,18 @@ struct KObjective<'a, M: MachiningModel> {
     black_box_seconds: f64,
     black_box_count: usize,
     last_surrogate_seconds: f64,
+    /// The first model error met (reported if the start point fails).
+    first_error: Option<String>,
 }
 
 impl<M: MachiningModel> KObjective<'_, M> {
+    fn failed(&mut self, e: &OptimError) -> Evaluation {
+        if self.first_error.is_none() {
+            self.first_error = Some(e.to_string());
+        }
+        Evaluation { value: f64::INFINITY, violation: 0.0 }
+    }
+
     fn run(&mut self, x: &[f64], fidelity: Fidelity) -> Evaluation {
         let design = self.layout.design(x);
         let omega = if self.layout.formulation == Formulation::Heuristic { [1.0; 4] } else { design.omega };
@@ -490,12 +499,12 @@ impl<M: MachiningModel> KObjective<'_, M> {
                     self.partitions.push((fidelity, key, p));
                     self.partitions.len() - 1
                 }
-                Err(_) => return Evaluation { value: f64::INFINITY, violation: 0.0 },
+                Err(e) => return self.failed(&e),
             },
         };
         match self.model.assess(&self.partitions[slot].2, self.layout.formulation, &design, fidelity) {
             Ok(a) => Evaluation { value: a.time_s, violation: a.violation },
-            Err(_) => Evaluation { value: f64::INFINITY, violation: 0.0 },
+            Err(e) => self.failed(&e),
         }
     }
 
@@ -600,12 +609,18 @@ pub fn run_k<M: MachiningModel>(
         black_box_seconds: 0.0,
         black_box_count: 0,
         last_surrogate_seconds: 0.0,
+        first_error: None,
     };
-    let outcome = mads.minimize(&problem, &mut objective).map_err(|e| match e {
+    let outcome = mads.minimize(&problem, &mut objective);
+    let outcome = outcome.map_err(|e| match e {
         OptimError::StartFailed { value, violation } => OptimError::Model(format!(
             "K = {k}: the start point of the {:?} study cannot be planned (time {value} s, \
-             accessibility violation {violation}): a zone no orientation can reach, or a planning failure",
-            settings.formulation
+             accessibility violation {violation}){}",
+            settings.formulation,
+            objective.first_error.as_ref().map_or_else(
+                || ": a zone no orientation can reach (use the progressive barrier) or a planning failure".to_string(),
+                |e| format!(": {e}")
+            )
         )),
         other => other,
     })?;

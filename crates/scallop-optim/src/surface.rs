@@ -16,7 +16,7 @@ use scallop_geom::nalgebra::Matrix3;
 use scallop_geom::{Point3, Vec3};
 use scallop_strategy::StrategyError;
 use scallop_strategy::network::{
-    CellLabels, Margins, Network, Orientation, Transitions, ZoneParams, ZonePlan, Zoning, plan_zone, surface_time,
+    CellLabels, Margins, Network, Orientation, Transitions, ZoneParams, ZonePlan, Zoning, plan_zone, plan_zones, surface_time,
 };
 use scallop_surface::Patch;
 
@@ -119,6 +119,14 @@ struct Oriented {
     violation: f64,
 }
 
+impl ZonePartition {
+    /// Number of zones.
+    #[must_use]
+    pub fn partition_zone_count(&self) -> usize {
+        self.partition.zones.len()
+    }
+}
+
 impl SurfaceModel {
     /// Samples, features and networks for the three fidelities.
     ///
@@ -216,6 +224,15 @@ impl SurfaceModel {
             return Err(OptimError::Model("internal: no machining network at this fidelity".into()));
         };
         let oriented = self.orient(zp, formulation, design);
+        if formulation == Formulation::ThreeAxis {
+            // Fast path: all zones with shared buffers; a zone without passes makes it
+            // fail, and the loop below then skips that zone.
+            let directions: Vec<f64> =
+                zp.partition.zones.iter().map(|z| design.theta[z.cluster as usize]).collect();
+            if let Ok(plans) = plan_zones(network, zoning, &directions, &self.params(zp.fidelity, 0.0)) {
+                return Ok((plans, oriented.violation));
+            }
+        }
         let mut plans = Vec::with_capacity(zp.partition.zones.len());
         // One oriented network per distinct orientation (3+2: per cluster).
         let mut cache: Vec<(Orientation, Network)> = Vec::new();
