@@ -8,6 +8,7 @@ mod optimize;
 mod output;
 mod part;
 mod picture;
+mod post;
 mod run;
 mod simulate;
 
@@ -55,6 +56,8 @@ enum Command {
     Simulate(simulate::SimulateArgs),
     /// Partition a surface into zones and optimise their directions or orientations (see docs/job.md).
     Optimize(optimize::OptimizeArgs),
+    /// Post-process a cutter-location file for a machine and a dialect, with a machine-aware time report.
+    Post(post::PostArgs),
     /// Load a part and report what was read (size, welding, open and non-manifold edges).
     Inspect(part::InspectArgs),
 }
@@ -77,6 +80,7 @@ fn main() -> ExitCode {
         Command::Analyze(args) => analyze::run(&args),
         Command::Simulate(args) => simulate::run(&args),
         Command::Optimize(args) => optimize::run(&args),
+        Command::Post(args) => post::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

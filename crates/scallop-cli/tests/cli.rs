@@ -278,3 +278,58 @@ fn optimize_writes_the_study_and_rejects_bad_settings() {
         assert!(!dir.join("bad").exists(), "a rejected job writes nothing");
     }
 }
+
+#[test]
+fn post_writes_a_proven_program_with_a_time_report() {
+    let dir = scratch("post");
+    // A 5-axis circle with a swinging tool axis, in the CL format with axes and feeds.
+    let mut cl = String::from("kind,x,y,z,i,j,k,feed\nrapid,20,0,80,0,0,1,\n");
+    for i in 0..=360 {
+        let t = f64::from(i).to_radians();
+        let a = 0.3 * (2.0 * t).sin();
+        cl.push_str(&format!("feed,{},{},40,{},0,{},1500\n", 20.0 * t.cos(), 20.0 * t.sin(), a.sin(), a.cos()));
+    }
+    std::fs::write(dir.join("circle.csv"), cl).expect("write");
+    let out = scallop()
+        .args(["post", "--machine", "ucp710", "--dialect", "linuxcnc", "--json", "-o"])
+        .arg(dir.join("circle.nc"))
+        .arg(dir.join("circle.csv"))
+        .output()
+        .expect("run");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
+    let total = report["total_time_s"].as_f64().expect("time");
+    let floor = report["feed_floor_s"].as_f64().expect("floor");
+    // 125.7 mm of circle at 1500 mm/min is 5.03 s: the machine can only be slower.
+    assert!(floor > 5.0 && total >= floor, "{report}");
+    assert!(report["replay_tip_deviation_mm"].as_f64().expect("dev") <= 0.01);
+    let axes = report["axes"].as_array().expect("axes");
+    assert_eq!(axes.len(), 5);
+    assert!(axes.iter().all(|a| a["time_lost_s"].as_f64().expect("lost") >= 0.0));
+    let nc = std::fs::read_to_string(dir.join("circle.nc")).expect("program");
+    assert!(nc.contains("G93") && nc.lines().filter(|l| l.contains('A')).count() > 100);
+    let written: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("post.json")).expect("post.json")).expect("json");
+    assert_eq!(written["blocks"], report["blocks"]);
+
+    // A bad row names the line and the column, exit 1, nothing written.
+    std::fs::write(dir.join("bad.csv"), "kind,x,y,z\nrapid,0,0,10\nfeed,1,oops,0\n").expect("write");
+    let out = scallop()
+        .args(["post", "--machine", "ucp710", "--dialect", "fanuc", "-o"])
+        .arg(dir.join("bad.nc"))
+        .arg(dir.join("bad.csv"))
+        .output()
+        .expect("run");
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("line 3, column `y`"), "{err}");
+    assert!(!dir.join("bad.nc").exists());
+    // An unknown machine is rejected with the fix.
+    let out = scallop()
+        .args(["post", "--machine", "nosuch", "--dialect", "fanuc"])
+        .arg(dir.join("circle.csv"))
+        .output()
+        .expect("run");
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("nosuch"));
+}

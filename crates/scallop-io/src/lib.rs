@@ -37,6 +37,7 @@ use std::hash::{BuildHasherDefault, Hasher};
 use scallop_geom::Point3;
 pub use scallop_mesh::{MeshDiagnostics, MeshError, TriMesh};
 
+pub mod cl;
 pub mod gcode;
 pub mod job;
 

@@ -41,6 +41,8 @@
 //! - Deterministic: same input, same bits; no hashing, no threads.
 //! - Every numeric threshold lives in [`tol`].
 
+#[cfg(feature = "ann-baseline")]
+pub mod ann;
 pub mod chain;
 pub mod desc;
 pub mod error;

@@ -181,6 +181,13 @@ pub struct TimeReport {
     pub axis_peak_speed: Joints,
     /// Junction velocity caps (mm/s) between consecutive blocks (spec 8.3).
     pub junction_caps: Vec<f64>,
+    /// Time lost to each axis's limits (s), joint order: `total` minus the total with that
+    /// axis's velocity, acceleration and jerk limits lifted (all other limits kept). A
+    /// marginal attribution: the sum can differ from the total loss when two axes bind
+    /// on the same block.
+    pub axis_time_lost: [f64; 5],
+    /// Time at the commanded feed alone (s): `sum s_k / F_k`, the floor no machine beats.
+    pub feed_time: f64,
 }
 
 /// Time of a joint-space polyline `joints` fed at `feeds[k]` (mm/min, block `k` from
@@ -200,6 +207,22 @@ pub struct TimeReport {
 /// [`MachineError::BadInput`] when `feeds` does not have one entry per block or a feed
 /// is not positive.
 pub fn path_time(kin: &Kinematics, joints: &[Joints], feeds: &[f64]) -> Result<TimeReport, MachineError> {
+    let mut report = profile(kin, joints, feeds, None)?;
+    for i in 0..kin.machine().axes().len().min(5) {
+        let relaxed = profile(kin, joints, feeds, Some(i))?;
+        report.axis_time_lost[i] = (report.total - relaxed.total).max(0.0);
+    }
+    Ok(report)
+}
+
+/// The look-ahead profile of [`path_time`]; `relax` lifts one axis's dynamic limits
+/// (velocity, acceleration, jerk) to measure the time that axis costs.
+fn profile(
+    kin: &Kinematics,
+    joints: &[Joints],
+    feeds: &[f64],
+    relax: Option<usize>,
+) -> Result<TimeReport, MachineError> {
     let n = joints.len().saturating_sub(1);
     if feeds.len() != n || feeds.iter().any(|f| !(f.is_finite() && *f > 0.0)) {
         return Err(MachineError::BadInput {
@@ -218,18 +241,18 @@ pub fn path_time(kin: &Kinematics, joints: &[Joints], feeds: &[f64]) -> Result<T
         let length = (poses[k + 1].tip - poses[k].tip).norm();
         let (oa, ob) = (poses[k].axis, poses[k + 1].axis);
         let dphi = oa.cross(&ob).norm().atan2(oa.dot(&ob));
-        let t_vel = (length / f).max(machine.nc().r_ref * dphi / f).max(crate::plan::move_time(
-            machine,
-            &joints[k],
-            &joints[k + 1],
-        ));
+        let axis_time = (0..machine.axes().len().min(5))
+            .map(|i| (joints[k + 1][i] - joints[k][i]).abs() / dynamics(machine, i, relax).0)
+            .fold(0.0, f64::max);
+        let t_vel = (length / f).max(machine.nc().r_ref * dphi / f).max(axis_time);
         let sk = f * t_vel;
         let ek = if sk > 0.0 { (joints[k + 1] - joints[k]) / sk } else { Joints::zeros() };
         let (mut a, mut j) = (f64::INFINITY, f64::INFINITY);
-        for (i, axis) in machine.axes().iter().enumerate() {
+        for i in 0..machine.axes().len().min(5) {
             if ek[i].abs() > tol::AXIS_DIRECTION_ZERO {
-                a = a.min(axis.dynamics.amax / ek[i].abs());
-                j = j.min(axis.dynamics.jmax / ek[i].abs());
+                let (_, amax, jmax) = dynamics(machine, i, relax);
+                a = a.min(amax / ek[i].abs());
+                j = j.min(jmax / ek[i].abs());
             }
         }
         s.push(sk);
@@ -239,7 +262,7 @@ pub fn path_time(kin: &Kinematics, joints: &[Joints], feeds: &[f64]) -> Result<T
     // Junction caps between block k-1 and k (index k = 1..n-1).
     let mut caps = vec![0.0; n + 1];
     for (k, cap) in caps.iter_mut().enumerate().take(n).skip(1) {
-        *cap = junction_cap(kin, &poses, &e, &s, feeds, k);
+        *cap = junction_cap(kin, &poses, &e, &s, feeds, k, relax);
     }
     // Look-ahead.
     let mut v = caps.clone();
@@ -263,7 +286,24 @@ pub fn path_time(kin: &Kinematics, joints: &[Joints], feeds: &[f64]) -> Result<T
         }
         blocks.push(BlockProfile { length: s[k], entry: v[k], peak, exit: v[k + 1], time: t });
     }
-    Ok(TimeReport { total, blocks, axis_peak_speed, junction_caps: caps[1..n.max(1)].to_vec() })
+    let feed_time = (0..n).map(|k| s[k] / (feeds[k] / 60.0)).sum();
+    Ok(TimeReport {
+        total,
+        blocks,
+        axis_peak_speed,
+        junction_caps: caps[1..n.max(1)].to_vec(),
+        axis_time_lost: [0.0; 5],
+        feed_time,
+    })
+}
+
+/// Velocity, acceleration and jerk limits of axis `i`, scaled by
+/// [`tol::RELAXED_AXIS_FACTOR`] when `relax` names it (finite, so the S-curve formulas
+/// never see `inf / inf`).
+fn dynamics(machine: &crate::Machine, i: usize, relax: Option<usize>) -> (f64, f64, f64) {
+    let d = &machine.axes()[i].dynamics;
+    let f = if relax == Some(i) { tol::RELAXED_AXIS_FACTOR } else { 1.0 };
+    (d.vmax * f, d.amax * f, d.jmax * f)
 }
 
 /// Junction velocity cap between blocks `k - 1` and `k` (spec 8.3).
@@ -274,6 +314,7 @@ fn junction_cap(
     s: &[f64],
     feeds: &[f64],
     k: usize,
+    relax: Option<usize>,
 ) -> f64 {
     let machine = kin.machine();
     let feed_cap = feeds[k - 1].min(feeds[k]) / 60.0;
@@ -300,12 +341,13 @@ fn junction_cap(
             de
         };
         let mut cap = feed_cap;
-        for (i, axis) in machine.axes().iter().enumerate() {
+        for i in 0..machine.axes().len().min(5) {
+            let (_, amax, jmax) = dynamics(machine, i, relax);
             if de[i].abs() > tol::AXIS_DIRECTION_ZERO {
-                cap = cap.min((axis.dynamics.amax * mean / de[i].abs()).sqrt());
+                cap = cap.min((amax * mean / de[i].abs()).sqrt());
             }
             if d2e[i].abs() > tol::AXIS_DIRECTION_ZERO {
-                cap = cap.min((axis.dynamics.jmax * mean * mean / d2e[i].abs()).cbrt());
+                cap = cap.min((jmax * mean * mean / d2e[i].abs()).cbrt());
             }
         }
         cap
@@ -317,9 +359,10 @@ fn junction_cap(
             s[k - 1].min(s[k]) / 2.0
         };
         let fits = |v: f64| {
-            machine.axes().iter().enumerate().all(|(i, axis)| {
+            (0..machine.axes().len().min(5)).all(|i| {
+                let (_, amax, jmax) = dynamics(machine, i, relax);
                 let dv = v * de[i].abs();
-                v * t_acc(dv, axis.dynamics.amax, axis.dynamics.jmax) <= blend
+                v * t_acc(dv, amax, jmax) <= blend
             })
         };
         if fits(feed_cap) {

@@ -119,3 +119,12 @@ pub const VERIFY_SLACK: f64 = 1e-9;
 /// the standard families differ by 180 deg on the pole axis, a continuous pole crossing
 /// keeps it (used by the greedy planner's events and the subdivision's midpoint check).
 pub const BRANCH_JUMP: f64 = std::f64::consts::FRAC_PI_2;
+
+/// Factor applied to one axis's velocity, acceleration and jerk limits to measure the
+/// time that axis costs (`TimeReport::axis_time_lost`): large enough that the axis never
+/// binds, finite so the jerk-limited formulas stay defined.
+pub const RELAXED_AXIS_FACTOR: f64 = 1e9;
+
+/// Largest total rotation of one block (rad) for which `feed::deviation_bound` holds
+/// (its distance bound needs `3 Omega < 1`); larger blocks are sampled.
+pub const BOUND_MAX_ROTATION: f64 = 0.3;

@@ -91,3 +91,29 @@ fn t7_circle_jerk_cap() {
     let cap = r.junction_caps.iter().copied().fold(f64::INFINITY, f64::min) * 60.0;
     assert!((cap - 2585.0).abs() <= 0.01 * 2585.0, "cap {cap}");
 }
+
+#[test]
+fn time_lost_is_charged_to_the_axes_that_move() {
+    // A straight X move: only X can cost time; Y, Z, A, C are never charged.
+    let k = ucp(0.1);
+    let r = path_time(&k, &[xy(0.0, 0.0), xy(100.0, 0.0)], &[2400.0]).expect("valid");
+    assert!(r.axis_time_lost[0] > 0.0, "{r:?}");
+    for lost in &r.axis_time_lost[1..] {
+        assert_near!(*lost, 0.0, 1e-12);
+    }
+    // Lifting X's limits leaves the feed-only floor: the loss is total - floor, up to the
+    // S-curve of the lifted (1e9 times larger, not infinite) limits, 2 sqrt(40 / 5e12) s.
+    assert_near!(r.feed_time, 100.0 / 40.0, 1e-12);
+    assert_near!(r.axis_time_lost[0], r.total - r.feed_time, 1e-5);
+    // A small circle at a high feed is acceleration-limited on X and Y alike: both pay.
+    let circle: Vec<Joints> = (0..=72)
+        .map(|i| {
+            let t = f64::from(i) * 5f64.to_radians();
+            xy(4.0 * t.cos(), 4.0 * t.sin())
+        })
+        .collect();
+    let r = path_time(&k, &circle, &vec![6000.0; 72]).expect("valid");
+    assert!(r.axis_time_lost[0] > 0.0 && r.axis_time_lost[1] > 0.0, "{r:?}");
+    assert!(r.total >= r.feed_time);
+    assert_near!(r.axis_time_lost[2], 0.0, 1e-12);
+}

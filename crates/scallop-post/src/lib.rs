@@ -55,8 +55,60 @@ pub use writer::{OutputMode, PostParams, cycle800_angles, program_text, write_pr
 /// ```
 #[must_use]
 pub fn fmt_number(v: f64, decimals: usize) -> String {
+    let mut s = String::with_capacity(16);
+    push_number(&mut s, v, decimals);
+    s
+}
+
+/// Appends `v` with `decimals` digits to `out`, exactly as [`fmt_number`] formats it.
+pub fn push_number(out: &mut String, v: f64, decimals: usize) {
+    if !push_number_fast(out, v, decimals) {
+        out.push_str(&fmt_number_exact(v, decimals));
+    }
+}
+
+fn fmt_number_exact(v: f64, decimals: usize) -> String {
     let s = format!("{v:.decimals$}");
     if s.starts_with('-') && s[1..].chars().all(|c| c == '0' || c == '.') { s[1..].to_string() } else { s }
+}
+
+/// `fmt_number` by integer arithmetic, byte for byte equal to the exact formatting
+/// (`format!("{v:.decimals$}")` with `-0` cleaned) where it answers: away from rounding
+/// ties by more than the product's rounding error, and for magnitudes where the scaled
+/// value is an exact integer range. `false` (nothing written) sends the caller to the
+/// exact formatter.
+fn push_number_fast(out: &mut String, v: f64, decimals: usize) -> bool {
+    const POW10: [f64; 10] = [1.0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9];
+    let Some(&scale) = POW10.get(decimals) else { return false };
+    let x = v.abs() * scale;
+    // |x| < 1e9: the product's error is below 2.3e-7, far from the 1e-6 tie margin.
+    if x.is_nan() || x >= 1e9 {
+        return false;
+    }
+    let floor = x.floor();
+    let frac = x - floor;
+    if (frac - 0.5).abs() < tol::FAST_FORMAT_TIE_MARGIN {
+        return false;
+    }
+    let mut n = if frac > 0.5 { floor + 1.0 } else { floor } as u64;
+    // Digits, least significant first, at least decimals + 1 of them (leading zeros).
+    let mut digits = [b'0'; 24];
+    let mut len = 0;
+    while n > 0 || len <= decimals {
+        digits[len] = b'0' + (n % 10) as u8;
+        n /= 10;
+        len += 1;
+    }
+    if v < 0.0 && digits[..len].iter().any(|&d| d != b'0') {
+        out.push('-');
+    }
+    for k in (0..len).rev() {
+        out.push(char::from(digits[k]));
+        if k == decimals && decimals > 0 {
+            out.push('.');
+        }
+    }
+    true
 }
 
 /// Writes `path` as G-code. `comments` go into the header (one line each).
@@ -98,4 +150,39 @@ pub fn write_gcode(path: &Toolpath, dialect: &Dialect, comments: &[&str], out: &
         writeln!(out, "{f}")?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::fmt_number;
+
+    fn exact(v: f64, decimals: usize) -> String {
+        let s = format!("{v:.decimals$}");
+        if s.starts_with('-') && s[1..].chars().all(|c| c == '0' || c == '.') { s[1..].to_string() } else { s }
+    }
+
+    #[test]
+    fn the_fast_path_equals_the_exact_formatter() {
+        // A deterministic sweep of magnitudes, signs, ties and near-ties.
+        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        for _ in 0..200_000 {
+            let bits = next();
+            let magnitude = 10f64.powi(i32::try_from(bits % 14).unwrap_or(0) - 6);
+            let v = ((next() >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 2.0 * magnitude;
+            for d in [0, 1, 3, 4, 6] {
+                assert_eq!(fmt_number(v, d), exact(v, d), "{v:e} at {d}");
+            }
+        }
+        for v in [0.5, 1.5, 2.5, -2.5, 0.125, -0.125, 1.0005, 123.45, -0.0, 0.0, 1e12, -7.00005, 999_999.999_95] {
+            for d in [0, 1, 2, 3, 4] {
+                assert_eq!(fmt_number(v, d), exact(v, d), "{v} at {d}");
+            }
+        }
+    }
 }

@@ -27,3 +27,7 @@ pub const CHECK_SLACK: f64 = 1e-6;
 
 /// Samples of each joint-space block in [`crate::check_replay`].
 pub const CHECK_SAMPLES: u32 = 16;
+
+/// Distance from a rounding tie (in units of the last digit) below which `fmt_number`
+/// leaves its integer fast path for the exact formatter.
+pub const FAST_FORMAT_TIE_MARGIN: f64 = 1e-6;

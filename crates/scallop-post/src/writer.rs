@@ -220,6 +220,7 @@ pub fn program_text(
     };
     let mut previous: Option<&ProgramBlock> = None;
     let mut plane: Option<(Vec3, Rotation3<f64>)> = None;
+    let mut words: Vec<(&str, String)> = Vec::with_capacity(machine.axes().len());
     for b in &program.blocks {
         if planes {
             let needs_new = plane.as_ref().is_none_or(|(axis, _)| angle(axis, &b.pose.axis) > params.tol_ang);
@@ -243,7 +244,7 @@ pub fn program_text(
             let mut words = Vec::new();
             for i in 0..machine.axes().len() {
                 if machine.axes()[i].kind == AxisKind::Linear {
-                    words.push((letters[i].clone(), e.num(local[linear_component(i)?], dialect.decimals)));
+                    words.push((letters[i].as_str(), e.num(local[linear_component(i)?], dialect.decimals)));
                 }
             }
             let feed = if b.motion == Motion::Rapid { FeedWord::Rapid } else { FeedWord::PerMinute(b.feed) };
@@ -257,7 +258,7 @@ pub fn program_text(
             let (words_a, tip_a) = previous.map_or((b.words, b.pose.tip), |p| (p.words, p.pose.tip));
             let word_at = |i: usize| words_a[i] + (b.words[i] - words_a[i]) * s;
             let tip: Point3 = tip_a + (b.pose.tip - tip_a) * s;
-            let mut words = Vec::new();
+            words.clear();
             for i in 0..machine.axes().len() {
                 if !write_axis[i] {
                     continue;
@@ -266,15 +267,15 @@ pub fn program_text(
                 let w = word_at(i);
                 let token = match axis.kind {
                     AxisKind::Linear if mode == OutputMode::Tcp => {
-                        format!("{}{}", letters[i], e.num(tip[linear_component(i)?], dialect.decimals))
+                        e.token(&letters[i], tip[linear_component(i)?], dialect.decimals)
                     }
-                    AxisKind::Linear => format!("{}{}", letters[i], e.num(w, dialect.decimals)),
+                    AxisKind::Linear => e.token(&letters[i], w, dialect.decimals),
                     AxisKind::Rotary => {
                         let before = word_at_prev(&words_a, &b.words, i, piece, pieces);
                         e.rotary(&letters[i], w, w - before, axis.wrap)
                     }
                 };
-                words.push((letters[i].clone(), token));
+                words.push((letters[i].as_str(), token));
             }
             let feed = match (b.motion, previous) {
                 (Motion::Rapid, _) => FeedWord::Rapid,
@@ -411,6 +412,8 @@ struct Emitter<'a> {
     last_motion: Option<&'static str>,
     last_feed: Option<String>,
     g93: bool,
+    /// Reused line buffer of `motion_tokens`.
+    buf: String,
 }
 
 impl<'a> Emitter<'a> {
@@ -423,6 +426,7 @@ impl<'a> Emitter<'a> {
             last_motion: None,
             last_feed: None,
             g93: false,
+            buf: String::new(),
         }
     }
 
@@ -448,6 +452,17 @@ impl<'a> Emitter<'a> {
         self.line(&line);
     }
 
+    /// `letter` followed by `v` as [`Emitter::num`] writes it, in one allocation.
+    fn token(&self, letter: &str, v: f64, decimals: usize) -> String {
+        let mut s = String::with_capacity(letter.len() + 16);
+        s.push_str(letter);
+        crate::push_number(&mut s, v, decimals);
+        if self.d.explicit_plus && !s[letter.len()..].starts_with('-') {
+            s.insert(letter.len(), '+');
+        }
+        s
+    }
+
     fn num(&self, v: f64, decimals: usize) -> String {
         let s = fmt_number(v, decimals);
         if self.d.explicit_plus && !s.starts_with('-') { format!("+{s}") } else { s }
@@ -461,7 +476,7 @@ impl<'a> Emitter<'a> {
             None => format!("{letter}{value}"),
         };
         match wrap {
-            Wrap::Absolute => format!("{letter}{}", self.num(word, dec)),
+            Wrap::Absolute => self.token(letter, word, dec),
             _ => {
                 let mut m = word.rem_euclid(360.0);
                 if fmt_number(m, dec) == fmt_number(360.0, dec) {
@@ -479,40 +494,52 @@ impl<'a> Emitter<'a> {
     }
 
     /// A motion block from `(letter, number)` pairs.
-    fn motion(&mut self, words: &[(String, String)], feed: FeedWord) {
-        let tokens: Vec<(String, String)> = words.iter().map(|(l, v)| (l.clone(), format!("{l}{v}"))).collect();
+    fn motion(&mut self, words: &[(&str, String)], feed: FeedWord) {
+        let tokens: Vec<(&str, String)> = words.iter().map(|(l, v)| (*l, format!("{l}{v}"))).collect();
         self.motion_tokens(&tokens, feed);
     }
 
-    /// A motion block from `(letter, full token)` pairs.
-    fn motion_tokens(&mut self, words: &[(String, String)], feed: FeedWord) {
-        let mut changed = Vec::new();
+    /// A motion block from `(letter, full token)` pairs. Hot path of every program:
+    /// one line buffer reused, modal words compared in place, no per-token allocation
+    /// beyond the tokens themselves.
+    fn motion_tokens(&mut self, words: &[(&str, String)], feed: FeedWord) {
+        let mut any = false;
         for (letter, token) in words {
-            if !self.d.modal || self.last_words.get(letter) != Some(token) {
-                changed.push(token.clone());
-            }
+            let same = self.d.modal && self.last_words.get(*letter).is_some_and(|t| t == token);
+            any |= !same;
         }
-        if changed.is_empty() {
+        if !any {
             return;
         }
-        for (letter, token) in words {
-            self.last_words.insert(letter.clone(), token.clone());
-        }
-        let mut parts: Vec<String> = Vec::new();
+        let mut buf = std::mem::take(&mut self.buf);
+        buf.clear();
+        let push = |buf: &mut String, t: &str| {
+            if !buf.is_empty() {
+                buf.push(' ');
+            }
+            buf.push_str(t);
+        };
+        let changed = |me: &Self, letter: &str, token: &String| {
+            !me.d.modal || me.last_words.get(letter).is_none_or(|t| t != token)
+        };
         match self.d.syntax {
             Syntax::Iso => {
                 let want_g93 = matches!(feed, FeedWord::InverseTime(_));
                 if want_g93 != self.g93 {
-                    parts.push(if want_g93 { "G93".into() } else { "G94".into() });
+                    push(&mut buf, if want_g93 { "G93" } else { "G94" });
                     self.g93 = want_g93;
                     self.last_feed = None;
                 }
                 let code = if matches!(feed, FeedWord::Rapid) { "G0" } else { "G1" };
                 if !self.d.modal || self.last_motion != Some(code) {
-                    parts.push(code.into());
+                    push(&mut buf, code);
                     self.last_motion = Some(code);
                 }
-                parts.extend(changed);
+                for (letter, token) in words {
+                    if changed(self, letter, token) {
+                        push(&mut buf, token);
+                    }
+                }
                 let f = match feed {
                     FeedWord::Rapid | FeedWord::Seconds(_) => None,
                     FeedWord::PerMinute(f) => {
@@ -526,35 +553,48 @@ impl<'a> Emitter<'a> {
                 if let Some(f) = f
                     && (!self.d.modal || self.last_feed.as_ref() != Some(&f))
                 {
-                    parts.push(format!("F{f}"));
+                    push(&mut buf, "F");
+                    buf.push_str(&f);
                     self.last_feed = Some(f);
                 }
             }
             Syntax::Heidenhain => {
-                parts.push("L".into());
-                parts.extend(changed);
+                push(&mut buf, "L");
+                for (letter, token) in words {
+                    if changed(self, letter, token) {
+                        push(&mut buf, token);
+                    }
+                }
                 match feed {
                     FeedWord::Rapid => {
-                        parts.push("FMAX".into());
+                        push(&mut buf, "FMAX");
                         self.last_feed = None;
                     }
                     FeedWord::Seconds(t) => {
                         let dec = self.d.inverse_time_decimals;
-                        parts.push(format!("FT{}", fmt_number(round_up(t, dec), dec)));
+                        push(&mut buf, &format!("FT{}", fmt_number(round_up(t, dec), dec)));
                         self.last_feed = None;
                     }
                     FeedWord::PerMinute(f) | FeedWord::InverseTime(f) => {
                         let f = fmt_number(round_down(f, self.d.feed_decimals), self.d.feed_decimals);
                         if !self.d.modal || self.last_feed.as_ref() != Some(&f) {
-                            parts.push(format!("F{f}"));
+                            push(&mut buf, &format!("F{f}"));
                             self.last_feed = Some(f);
                         }
                     }
                 }
             }
         }
-        let line = parts.join(" ");
-        self.line(&line);
+        for (letter, token) in words {
+            match self.last_words.get_mut(*letter) {
+                Some(t) => t.clone_from(token),
+                None => {
+                    self.last_words.insert((*letter).to_string(), token.clone());
+                }
+            }
+        }
+        self.line(&buf);
+        self.buf = buf;
     }
 
     /// Activates a tilted plane `r` (columns x_f, y_f, z_f in the part frame) at the

@@ -79,4 +79,26 @@ pub enum StrategyError {
         /// The limit `sh` (mm).
         limit: f64,
     },
+    /// Cell labels that do not fill their grid, or a zoning prepared for another network.
+    #[error(
+        "the cell labels ({cells_u} x {cells_v} cells, {found} labels) do not fit: give one label per cell \
+         (index a * cells_v + b, labels below u32::MAX) and build the Zoning from the network it is used with"
+    )]
+    BadLabels {
+        /// Cells along u.
+        cells_u: usize,
+        /// Cells along v.
+        cells_v: usize,
+        /// Labels given.
+        found: usize,
+    },
+    /// A zone with no cell in the labelling, or no pass.
+    #[error(
+        "zone {zone} has no pass: no cell carries this label, or the zone is too small for the network; \
+         check the zone number against Zoning::zones or use a finer machining mesh"
+    )]
+    EmptyZone {
+        /// The zone's label.
+        zone: u32,
+    },
 }

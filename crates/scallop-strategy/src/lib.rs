@@ -10,6 +10,11 @@
 //! [`Toolpath`], the planes and their passes, the verified scallop
 //! ([`ScallopReport`]) and a serialisable [`Report`].
 //!
+//! [`network`] is the specification's fast method on one parametric patch
+//! (finishing.md 6.3 to 6.5, 7.4): contact passes on the isoparametric network,
+//! zones from clustering labels, 3+2 orientations, zone and surface times; the
+//! optimiser's black box. It drops no cutter and writes no toolpath.
+//!
 //! ```
 //! use scallop_analysis::MachineLimits;
 //! use scallop_cutter::{Cutter, CutterShape};
@@ -125,11 +130,13 @@
 
 mod error;
 mod geometry;
+pub mod network;
 mod params;
 mod plan;
 mod scallop;
 mod time;
 pub mod tol;
+pub mod trochoid;
 
 pub use error::StrategyError;
 pub use params::{Boundary, FinishingParams, Pattern};

@@ -94,3 +94,47 @@ pub const RAW_RETRIES: usize = 3;
 /// Relative convergence of the golden-section envelope search (times the cutter
 /// radius): the envelope's value errs by the square of it (times the curvature).
 pub const GOLDEN_REL_TOL: f64 = 1e-6;
+
+/// Passes of the network planner shorter than this (mm) are dropped; their
+/// vertices still count for the spacing (finishing.md 6.3: `eps_pass = 1e-6 m`).
+pub const MIN_PASS_LENGTH: f64 = 1e-3;
+
+/// Segments of the polylines that estimate isoline lengths for the network
+/// resolution (finishing.md 6.3 \[DECISION\]).
+pub const NETWORK_ISOLINE_SEGMENTS: usize = 200;
+
+/// Parameters of the isolines whose longest length sets the network resolution
+/// (finishing.md 6.3: `v in {0, 1/4, 1/2, 3/4, 1}`, likewise for u).
+pub const NETWORK_ISOLINE_PARAMETERS: [f64; 5] = [0.0, 0.25, 0.5, 0.75, 1.0];
+
+/// Largest number of network quads per direction (a 0.5 mm mesh of a 1 m part).
+pub const MAX_NETWORK_QUADS: usize = 2048;
+
+/// Relative slack of the spacing comparisons of the network sweep: a plane's
+/// spacing within this fraction below the gap accepts the gap (rounding).
+pub const LOOKAHEAD_REL: f64 = 1e-9;
+
+/// Moves of a tentative next plane (look-ahead) before the sweep gives up.
+pub const MAX_LOOKAHEAD_RETRIES: usize = 32;
+
+/// A network plane closer than this fraction of the zone's extent (at least
+/// 1 mm) to the lowest node is moved that far inside, so that a plane at
+/// `d_min` yields the boundary (nodes on a plane count as above it).
+pub const PLANE_NUDGE_REL: f64 = 1e-9;
+
+/// A far strip wider than half a spacing by less than this fraction of the
+/// spacing gets no further plane (rounding; ends the network sweep).
+pub const END_STRIP_REL: f64 = 1e-6;
+
+/// Look-ahead moves of the network sweep that go exactly to the spacing found;
+/// later ones shrink by an extra `LOOKAHEAD_SHRINK * 2^k` (at most 1/2).
+pub const LOOKAHEAD_PLAIN_RETRIES: usize = 4;
+
+/// See [`LOOKAHEAD_PLAIN_RETRIES`].
+pub const LOOKAHEAD_SHRINK: f64 = 1e-3;
+
+/// Where the spacing shrinks from plane to plane, the network sweep steps by
+/// `Delta_k - LOOKAHEAD_TREND (Delta_{k-1} - Delta_k)` instead of `Delta_k`, so
+/// that the next plane's own spacing usually accepts the gap at once (a
+/// slightly conservative step instead of a second plane).
+pub const LOOKAHEAD_TREND: f64 = 1.25;

@@ -1,0 +1,204 @@
+//! Cutter-location files: the CSV that `scallop run` writes as `toolpath.csv`, with an
+//! optional tool axis and feed per row, read back for `scallop post`.
+//!
+//! Format: a header line naming the columns, then one move per line. Required columns:
+//! `kind` (`rapid`, `plunge`, `feed`, `link`, `retract`), `x`, `y`, `z` (mm, part frame,
+//! tool tip). Optional: `i`, `j`, `k` (tool axis from the tip towards the spindle, any
+//! length > 0, normalised on reading; all three or none; default +Z) and `feed` (mm/min).
+//! Columns may come in any order; blank lines and lines starting with `#` are skipped.
+//!
+//! ```
+//! use scallop_io::cl::read_cl_csv;
+//! let rows = read_cl_csv("kind,x,y,z,i,j,k\nrapid,0,0,10,0,0,1\nfeed,5,0,0,0,0.6,0.8\n").unwrap();
+//! assert_eq!(rows.len(), 2);
+//! assert!((rows[1].axis.y - 0.6).abs() < 1e-15);
+//! ```
+
+use scallop_geom::{Point3, Vec3};
+use scallop_toolpath::MoveKind;
+
+/// One cutter-location row.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ClRow {
+    /// Kind of move into this location.
+    pub kind: MoveKind,
+    /// Tool tip (mm).
+    pub tip: Point3,
+    /// Unit tool axis.
+    pub axis: Vec3,
+    /// Programmed feed (mm/min), when the file gives one.
+    pub feed: Option<f64>,
+}
+
+/// What is wrong with a CL file, and where.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum ClError {
+    /// The header misses a column or repeats one.
+    #[error("line 1: {problem}; the header must name kind,x,y,z and optionally i,j,k and feed")]
+    Header {
+        /// What is wrong.
+        problem: String,
+    },
+    /// A value cannot be read.
+    #[error("line {line}, column `{column}`: {problem}")]
+    Value {
+        /// 1-based line.
+        line: usize,
+        /// Column name.
+        column: String,
+        /// What is wrong and the fix.
+        problem: String,
+    },
+    /// No move at all.
+    #[error("the file holds no move; give at least one line after the header")]
+    Empty,
+}
+
+/// Reads a CL CSV (see the module documentation).
+///
+/// # Errors
+/// [`ClError`] naming the line and column of the first problem.
+pub fn read_cl_csv(text: &str) -> Result<Vec<ClRow>, ClError> {
+    let mut lines = text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
+    let Some((_, header)) = lines.next() else { return Err(ClError::Empty) };
+    let names: Vec<String> = header.split(',').map(|c| c.trim().to_ascii_lowercase()).collect();
+    let find = |name: &str| -> Result<Option<usize>, ClError> {
+        let hits: Vec<usize> = names.iter().enumerate().filter(|(_, n)| *n == name).map(|(i, _)| i).collect();
+        match hits.len() {
+            0 => Ok(None),
+            1 => Ok(Some(hits[0])),
+            _ => Err(ClError::Header { problem: format!("column `{name}` appears {} times", hits.len()) }),
+        }
+    };
+    let required = |name: &str| -> Result<usize, ClError> {
+        find(name)?.ok_or_else(|| ClError::Header { problem: format!("no `{name}` column") })
+    };
+    let (ck, cx, cy, cz) = (required("kind")?, required("x")?, required("y")?, required("z")?);
+    let axis_cols = [find("i")?, find("j")?, find("k")?];
+    let axis_cols = match axis_cols {
+        [Some(i), Some(j), Some(k)] => Some([i, j, k]),
+        [None, None, None] => None,
+        _ => return Err(ClError::Header { problem: "the tool axis needs all of i, j, k (or none)".into() }),
+    };
+    let cf = find("feed")?;
+    let mut rows = Vec::new();
+    for (index, line) in lines {
+        let line_no = index + 1;
+        let fields: Vec<&str> = line.split(',').map(str::trim).collect();
+        if fields.len() != names.len() {
+            return Err(ClError::Value {
+                line: line_no,
+                column: "*".into(),
+                problem: format!(
+                    "{} fields where the header names {}; give one value per column",
+                    fields.len(),
+                    names.len()
+                ),
+            });
+        }
+        let number = |c: usize| -> Result<f64, ClError> {
+            let v: f64 = fields[c].parse().map_err(|_| ClError::Value {
+                line: line_no,
+                column: names[c].clone(),
+                problem: format!("`{}` is not a number", fields[c]),
+            })?;
+            if v.is_finite() {
+                Ok(v)
+            } else {
+                Err(ClError::Value { line: line_no, column: names[c].clone(), problem: "not a finite number".into() })
+            }
+        };
+        let kind = match fields[ck].to_ascii_lowercase().as_str() {
+            "rapid" => MoveKind::Rapid,
+            "plunge" => MoveKind::Plunge,
+            "feed" => MoveKind::Feed,
+            "link" => MoveKind::Link,
+            "retract" => MoveKind::Retract,
+            other => {
+                return Err(ClError::Value {
+                    line: line_no,
+                    column: "kind".into(),
+                    problem: format!("`{other}` is not a move kind; use rapid, plunge, feed, link or retract"),
+                });
+            }
+        };
+        let tip = Point3::new(number(cx)?, number(cy)?, number(cz)?);
+        let axis = match axis_cols {
+            None => Vec3::z(),
+            Some([i, j, k]) => {
+                let a = Vec3::new(number(i)?, number(j)?, number(k)?);
+                let n = a.norm();
+                if !(n > 0.0 && n.is_finite()) {
+                    return Err(ClError::Value {
+                        line: line_no,
+                        column: "i,j,k".into(),
+                        problem: "the tool axis is zero; give a non-zero vector".into(),
+                    });
+                }
+                a / n
+            }
+        };
+        let feed = match cf {
+            None => None,
+            Some(c) if fields[c].is_empty() => None,
+            Some(c) => {
+                let f = number(c)?;
+                if f <= 0.0 {
+                    return Err(ClError::Value {
+                        line: line_no,
+                        column: "feed".into(),
+                        problem: format!("{f} mm/min; a feed must be > 0 (leave it empty to use the default)"),
+                    });
+                }
+                Some(f)
+            }
+        };
+        rows.push(ClRow { kind, tip, axis, feed });
+    }
+    if rows.is_empty() {
+        return Err(ClError::Empty);
+    }
+    Ok(rows)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reads_the_finishing_csv_and_defaults_the_axis() {
+        let rows = read_cl_csv("kind,x,y,z\nrapid,0,0,10\nplunge,0,0,0\nfeed,1.5,-2,0.25\n").unwrap();
+        assert_eq!(rows.len(), 3);
+        assert_eq!(rows[2].kind, MoveKind::Feed);
+        assert_eq!(rows[2].tip, Point3::new(1.5, -2.0, 0.25));
+        assert_eq!(rows[2].axis, Vec3::z());
+        assert_eq!(rows[2].feed, None);
+    }
+
+    #[test]
+    fn columns_in_any_order_with_feed_and_a_normalised_axis() {
+        let rows = read_cl_csv("feed,k,j,i,z,y,x,kind\n1200,2,0,0,3,2,1,feed\n").unwrap();
+        assert_eq!(rows[0].tip, Point3::new(1.0, 2.0, 3.0));
+        assert_eq!(rows[0].axis, Vec3::z());
+        assert_eq!(rows[0].feed, Some(1200.0));
+    }
+
+    #[test]
+    fn errors_name_the_line_and_column() {
+        let e = read_cl_csv("kind,x,y,z\nfeed,1,2,3\nfeed,1,nan,3\n").unwrap_err();
+        assert!(e.to_string().starts_with("line 3, column `y`"), "{e}");
+        let e = read_cl_csv("kind,x,y,z\ndrill,1,2,3\n").unwrap_err();
+        assert!(e.to_string().contains("not a move kind"), "{e}");
+        let e = read_cl_csv("kind,x,y\n").unwrap_err();
+        assert!(e.to_string().contains("no `z` column"), "{e}");
+        let e = read_cl_csv("kind,x,y,z,i,j\n").unwrap_err();
+        assert!(e.to_string().contains("i, j, k"), "{e}");
+        let e = read_cl_csv("kind,x,y,z,i,j,k\nfeed,0,0,0,0,0,0\n").unwrap_err();
+        assert!(e.to_string().contains("zero"), "{e}");
+        let e = read_cl_csv("kind,x,y,z\nfeed,1,2\n").unwrap_err();
+        assert!(e.to_string().contains("2 fields"), "{e}");
+        assert_eq!(read_cl_csv("kind,x,y,z\n"), Err(ClError::Empty));
+        assert_eq!(read_cl_csv(""), Err(ClError::Empty));
+    }
+}

@@ -1,0 +1,218 @@
+//! Exact unit normals at pass vertices (finishing.md 6.4: "n_i <- exact normal at
+//! (u_i, v_i)"), cheap on network edges.
+//!
+//! A vertex on a u-edge has `v = b / N_v` fixed, so for a (rational) Bezier patch
+//! with homogeneous control points `H_ij = w_ij [P_ij, 1]` the surface along the
+//! edge is `A(u) = sum_i B_i(u) R_i(b)` with the row table `R_i(b) = sum_j
+//! B_j(v_b) H_ij`, and `A_v(u) = sum_i B_i(u) R'_i(b)`, `R'_i(b) = sum_j B_j'(v_b)
+//! H_ij`: a curve of degree `p` per derivative, precomputed per network row
+//! (likewise per column for v-edges). With `A = [X, W]`:
+//!
+//! ```text
+//! S_u ~ W X_u - W_u X,   S_v ~ W X_v - W_v X,   n = S_u x S_v / |S_u x S_v|
+//! ```
+//!
+//! (the common factor `1 / W^2` drops out of the direction). Other points and
+//! NURBS patches use the full evaluation; degenerate points `Patch::normal`'s
+//! fallback.
+
+use scallop_geom::Vec3;
+use scallop_surface::Patch;
+
+/// Largest Bezier degree tabulated (higher degrees use `Patch::normal`).
+pub(crate) const MAX_DEGREE: usize = 15;
+
+type Homogeneous = [f64; 4];
+
+/// Per-row and per-column tables of a Bezier patch on a network.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct EdgeNormals {
+    degree: [usize; 2],
+    control: Vec<Homogeneous>,
+    /// `rows[b * (p + 1) + i] = R_i(b)`, `rows_dv` the same with `B_j'`.
+    rows: Vec<Homogeneous>,
+    rows_dv: Vec<Homogeneous>,
+    /// `columns[a * (q + 1) + j] = C_j(a)`, `columns_du` with `B_i'`.
+    columns: Vec<Homogeneous>,
+    columns_du: Vec<Homogeneous>,
+}
+
+/// Bernstein values and first derivatives of degree `n` at `t` into `values`, `derivatives`.
+pub(crate) fn bernstein(n: usize, t: f64, values: &mut [f64; MAX_DEGREE + 1], derivatives: &mut [f64; MAX_DEGREE + 1]) {
+    let s = 1.0 - t;
+    // Closed forms of the common degrees (the general loop below is the same).
+    match n {
+        1 => {
+            values[..2].copy_from_slice(&[s, t]);
+            derivatives[..2].copy_from_slice(&[-1.0, 1.0]);
+            return;
+        }
+        2 => {
+            values[..3].copy_from_slice(&[s * s, 2.0 * s * t, t * t]);
+            derivatives[..3].copy_from_slice(&[-2.0 * s, 2.0 * (s - t), 2.0 * t]);
+            return;
+        }
+        3 => {
+            let (s2, t2) = (s * s, t * t);
+            values[..4].copy_from_slice(&[s2 * s, 3.0 * s2 * t, 3.0 * s * t2, t2 * t]);
+            derivatives[..4].copy_from_slice(&[-3.0 * s2, 3.0 * s * (s - 2.0 * t), 3.0 * t * (2.0 * s - t), 3.0 * t2]);
+            return;
+        }
+        _ => {}
+    }
+    *values = [0.0; MAX_DEGREE + 1];
+    values[0] = 1.0;
+    let step = |values: &mut [f64; MAX_DEGREE + 1], k: usize| {
+        for i in (0..=k).rev() {
+            let left = if i > 0 { values[i - 1] } else { 0.0 };
+            values[i] = (1.0 - t) * values[i] + t * left;
+        }
+    };
+    for k in 1..n {
+        step(values, k);
+    }
+    // values holds degree n - 1: B_i^n' = n (B_{i-1}^{n-1} - B_i^{n-1}).
+    for i in 0..=n {
+        let left = if i > 0 { values[i - 1] } else { 0.0 };
+        let right = if i < n { values[i] } else { 0.0 };
+        derivatives[i] = n as f64 * (left - right);
+    }
+    if n > 0 {
+        step(values, n);
+    }
+}
+
+fn axpy(acc: &mut Homogeneous, a: f64, x: &Homogeneous) {
+    for k in 0..4 {
+        acc[k] += a * x[k];
+    }
+}
+
+/// Along an isoline with tables `curve` (degree `n`) and `cross` (its
+/// derivative across): the homogeneous point, its derivative along `t` and
+/// across.
+fn along(n: usize, t: f64, curve: &[Homogeneous], cross: &[Homogeneous]) -> (Homogeneous, Homogeneous, Homogeneous) {
+    let (mut values, mut derivatives) = ([0.0; MAX_DEGREE + 1], [0.0; MAX_DEGREE + 1]);
+    bernstein(n, t, &mut values, &mut derivatives);
+    let (mut a, mut a_along, mut a_across) = ([0.0; 4], [0.0; 4], [0.0; 4]);
+    for i in 0..=n {
+        axpy(&mut a, values[i], &curve[i]);
+        axpy(&mut a_along, derivatives[i], &curve[i]);
+        axpy(&mut a_across, values[i], &cross[i]);
+    }
+    (a, a_along, a_across)
+}
+
+/// `W X_u - W_u X` as a vector from homogeneous `A` and its derivative.
+fn tangent(a: &Homogeneous, da: &Homogeneous) -> Vec3 {
+    Vec3::new(a[3] * da[0] - da[3] * a[0], a[3] * da[1] - da[3] * a[1], a[3] * da[2] - da[3] * a[2])
+}
+
+impl EdgeNormals {
+    /// Tables for `patch` on a network of `quads` quads, `None` for NURBS or
+    /// degrees above the tabulated limit.
+    pub(crate) fn new(patch: &Patch, quads: [usize; 2]) -> Option<EdgeNormals> {
+        let [p, q] = patch.degree();
+        if !patch.is_bezier() || p > MAX_DEGREE || q > MAX_DEGREE {
+            return None;
+        }
+        let mut control = Vec::with_capacity((p + 1) * (q + 1));
+        for i in 0..=p {
+            for j in 0..=q {
+                let w = patch.weights().map_or(1.0, |w| w[i * (q + 1) + j]);
+                let c = patch.control_point(i, j);
+                control.push([c.x * w, c.y * w, c.z * w, w]);
+            }
+        }
+        let (mut values, mut derivatives) = ([0.0; MAX_DEGREE + 1], [0.0; MAX_DEGREE + 1]);
+        let mut rows = Vec::with_capacity((quads[1] + 1) * (p + 1));
+        let mut rows_dv = Vec::with_capacity(rows.capacity());
+        for b in 0..=quads[1] {
+            bernstein(q, b as f64 / quads[1] as f64, &mut values, &mut derivatives);
+            for i in 0..=p {
+                let (mut r, mut r_dv) = ([0.0; 4], [0.0; 4]);
+                for j in 0..=q {
+                    axpy(&mut r, values[j], &control[i * (q + 1) + j]);
+                    axpy(&mut r_dv, derivatives[j], &control[i * (q + 1) + j]);
+                }
+                rows.push(r);
+                rows_dv.push(r_dv);
+            }
+        }
+        let mut columns = Vec::with_capacity((quads[0] + 1) * (q + 1));
+        let mut columns_du = Vec::with_capacity(columns.capacity());
+        for a in 0..=quads[0] {
+            bernstein(p, a as f64 / quads[0] as f64, &mut values, &mut derivatives);
+            for j in 0..=q {
+                let (mut c, mut c_du) = ([0.0; 4], [0.0; 4]);
+                for i in 0..=p {
+                    axpy(&mut c, values[i], &control[i * (q + 1) + j]);
+                    axpy(&mut c_du, derivatives[i], &control[i * (q + 1) + j]);
+                }
+                columns.push(c);
+                columns_du.push(c_du);
+            }
+        }
+        Some(EdgeNormals { degree: [p, q], control, rows, rows_dv, columns, columns_du })
+    }
+
+    /// `(S_u, S_v)` up to a common positive factor on the u-edge row `b` at `u`.
+    pub(crate) fn on_row(&self, b: usize, u: f64) -> (Vec3, Vec3) {
+        let p = self.degree[0];
+        let range = b * (p + 1)..(b + 1) * (p + 1);
+        let (a, a_u, a_v) = along(p, u, &self.rows[range.clone()], &self.rows_dv[range]);
+        (tangent(&a, &a_u), tangent(&a, &a_v))
+    }
+
+    /// `(S_u, S_v)` up to a common positive factor on the v-edge column `a` at `v`.
+    pub(crate) fn on_column(&self, column: usize, v: f64) -> (Vec3, Vec3) {
+        let q = self.degree[1];
+        let range = column * (q + 1)..(column + 1) * (q + 1);
+        let (a, a_v, a_u) = along(q, v, &self.columns[range.clone()], &self.columns_du[range]);
+        (tangent(&a, &a_u), tangent(&a, &a_v))
+    }
+
+    /// `(S_u, S_v)` up to a common positive factor anywhere.
+    pub(crate) fn at(&self, u: f64, v: f64) -> (Vec3, Vec3) {
+        let [p, q] = self.degree;
+        let (mut bu, mut dbu) = ([0.0; MAX_DEGREE + 1], [0.0; MAX_DEGREE + 1]);
+        let (mut bv, mut dbv) = ([0.0; MAX_DEGREE + 1], [0.0; MAX_DEGREE + 1]);
+        bernstein(p, u, &mut bu, &mut dbu);
+        bernstein(q, v, &mut bv, &mut dbv);
+        let (mut a, mut a_u, mut a_v) = ([0.0; 4], [0.0; 4], [0.0; 4]);
+        for i in 0..=p {
+            for j in 0..=q {
+                let h = &self.control[i * (q + 1) + j];
+                axpy(&mut a, bu[i] * bv[j], h);
+                axpy(&mut a_u, dbu[i] * bv[j], h);
+                axpy(&mut a_v, bu[i] * dbv[j], h);
+            }
+        }
+        (tangent(&a, &a_u), tangent(&a, &a_v))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Closed forms and the general recursion give `C(n, i) t^i (1 - t)^(n - i)`
+    /// and its derivative.
+    #[test]
+    fn bernstein_values_and_derivatives() {
+        for n in 1..=6usize {
+            for &t in &[0.0, 0.2, 0.5, 0.93, 1.0] {
+                let (mut values, mut derivatives) = ([0.0; MAX_DEGREE + 1], [0.0; MAX_DEGREE + 1]);
+                bernstein(n, t, &mut values, &mut derivatives);
+                let binomial = |n: usize, i: usize| (1..=i).fold(1.0, |c, k| c * (n + 1 - k) as f64 / k as f64);
+                let b = |n: usize, i: usize| binomial(n, i) * t.powi(i as i32) * (1.0 - t).powi((n - i) as i32);
+                for i in 0..=n {
+                    assert!((values[i] - b(n, i)).abs() < 1e-14, "n {n} i {i} t {t}");
+                    let left = if i > 0 { b(n - 1, i - 1) } else { 0.0 };
+                    let right = if i < n { b(n - 1, i) } else { 0.0 };
+                    assert!((derivatives[i] - n as f64 * (left - right)).abs() < 1e-13, "n {n} i {i} t {t}");
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,547 @@
+//! PLANE_PASSES (finishing.md 6.3): plane-network intersection by marching
+//! squares, traced quad to quad, clipped to a zone.
+//!
+//! Edges: the u-edge `(a, b)` joins nodes `(a, b)` and `(a + 1, b)` (id
+//! `a (N_v + 1) + b`); the v-edge `(a, b)` joins `(a, b)` and `(a, b + 1)` (id
+//! `N_u (N_v + 1) + a N_v + b`). Local edges of quad `(a, b)`: 0 = u-edge
+//! `(a, b)`, 1 = v-edge `(a + 1, b)`, 2 = u-edge `(a, b + 1)`, 3 = v-edge `(a, b)`.
+//! A node is "above" when `m . Q >= d`; an edge crosses when its nodes differ.
+
+use scallop_geom::{Point3, Vec3};
+
+use super::spacing::ToolModel;
+use super::time::pass_length_time;
+use super::{CellLabels, Network, Pass, Zoning};
+use crate::tol;
+
+/// A point of a pass under construction.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Vertex {
+    pub(crate) p: Point3,
+    pub(crate) n: Vec3,
+    pub(crate) uv: [f64; 2],
+}
+
+impl Vertex {
+    fn lerp(&self, other: &Vertex, t: f64) -> Vertex {
+        Vertex {
+            p: self.p + (other.p - self.p) * t,
+            n: self.n + (other.n - self.n) * t,
+            uv: [self.uv[0] + (other.uv[0] - self.uv[0]) * t, self.uv[1] + (other.uv[1] - self.uv[1]) * t],
+        }
+    }
+}
+
+/// Reusable buffers of a sweep (one per thread).
+#[derive(Debug, Default)]
+pub(crate) struct Workspace {
+    g: Vec<f64>,
+    marks: Vec<u32>,
+    stamp: u32,
+    spans: Vec<Span>,
+    sorted: Vec<Span>,
+    starts: Vec<usize>,
+    forward: Vec<Vertex>,
+    backward: Vec<Vertex>,
+    piece: Vec<Vertex>,
+}
+
+/// A network quad by its indices along u and v.
+#[derive(Debug, Clone, Copy)]
+struct Quad {
+    a: usize,
+    b: usize,
+}
+
+#[derive(Debug, Clone, Copy, Default)]
+struct Span {
+    lo: f64,
+    hi: f64,
+    quad: u32,
+}
+
+/// The passes of one plane and its NEXT_SPACING.
+pub(crate) struct PlaneCut {
+    pub(crate) passes: Vec<Pass>,
+    pub(crate) spacing: f64,
+    /// The vertex that set the spacing.
+    pub(crate) worst: Point3,
+}
+
+/// A network, a direction and (optionally) a zone, ready to cut planes.
+pub(crate) struct PlaneCutter<'a> {
+    net: &'a Network,
+    zoning: Option<(&'a Zoning, u32)>,
+    f: [f64; 2],
+    m: [f64; 2],
+    ws: &'a mut Workspace,
+    g0: f64,
+    inv_width: f64,
+    buckets: usize,
+    extent: f64,
+    range: (f64, f64),
+    cos_sharp: f64,
+    machine: scallop_analysis::MachineLimits,
+}
+
+impl<'a> PlaneCutter<'a> {
+    /// Prepares planes of direction `theta` over the zone's quads (all quads
+    /// without a zoning). `None` when the zone has no quad.
+    pub(crate) fn new(
+        net: &'a Network,
+        zoning: Option<(&'a Zoning, u32)>,
+        theta: f64,
+        cos_sharp: f64,
+        machine: scallop_analysis::MachineLimits,
+        ws: &'a mut Workspace,
+    ) -> Option<PlaneCutter<'a>> {
+        let (sin, cos) = theta.sin_cos();
+        let f = [cos, sin];
+        let m = [-sin, cos];
+        // g = m . Q at the nodes the zone's quads use (all nodes without a zoning);
+        // the others are never read.
+        let dot = |p: &Point3| m[0] * p.x + m[1] * p.y;
+        ws.g.resize(net.points.len(), 0.0);
+        match zoning {
+            None => {
+                for (g, p) in ws.g.iter_mut().zip(&net.points) {
+                    *g = dot(p);
+                }
+            }
+            Some((zoning, zone)) => {
+                let k = zoning.zones.binary_search(&zone).ok()?;
+                let nv = net.quads_v;
+                for &q in &zoning.quads[k] {
+                    let (a, b) = (q as usize / nv, q as usize % nv);
+                    for node in [net.node(a, b), net.node(a, b) + 1, net.node(a + 1, b), net.node(a + 1, b) + 1] {
+                        ws.g[node] = dot(&net.points[node]);
+                    }
+                }
+            }
+        }
+        let edges = net.quads_u * (net.quads_v + 1) + (net.quads_u + 1) * net.quads_v;
+        if ws.marks.len() != edges {
+            ws.marks = vec![0; edges];
+            ws.stamp = 0;
+        }
+        let (nu, nv) = (net.quads_u, net.quads_v);
+        ws.spans.clear();
+        let g = &ws.g;
+        let span = |q: usize| {
+            let (a, b) = (q / nv, q % nv);
+            let c = [net.node(a, b), net.node(a + 1, b), net.node(a + 1, b + 1), net.node(a, b + 1)];
+            let (mut lo, mut hi) = (g[c[0]], g[c[0]]);
+            for &k in &c[1..] {
+                lo = lo.min(g[k]);
+                hi = hi.max(g[k]);
+            }
+            Span { lo, hi, quad: u32::try_from(q).unwrap_or(u32::MAX) }
+        };
+        let mut range = (f64::INFINITY, f64::NEG_INFINITY);
+        match zoning {
+            None => {
+                ws.spans.extend((0..nu * nv).map(span));
+                for s in &ws.spans {
+                    range = (range.0.min(s.lo), range.1.max(s.hi));
+                }
+            }
+            Some((zoning, zone)) => {
+                let k = zoning.zones.binary_search(&zone).ok()?;
+                for &q in &zoning.quads[k] {
+                    let s = span(q as usize);
+                    ws.spans.push(s);
+                    range = zone_extent(net, zoning, zone, g, q as usize, &s, range);
+                }
+            }
+        }
+        if ws.spans.is_empty() || range.0 > range.1 {
+            return None;
+        }
+        // Bucket the quads by their minimum (counting sort, one bucket per quad).
+        let (g0, g1) =
+            ws.spans.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |acc, s| (acc.0.min(s.lo), acc.1.max(s.lo)));
+        let extent = ws.spans.iter().fold(0.0f64, |acc, s| acc.max(s.hi - s.lo));
+        let buckets = ws.spans.len();
+        let width = (g1 - g0) / buckets as f64;
+        let inv_width = if width > 0.0 { width.recip() } else { 0.0 };
+        let bucket = |x: f64| -> usize {
+            // INVARIANT: clamped into [0, buckets - 1].
+            #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+            let b = ((x - g0) * inv_width).max(0.0) as usize;
+            b.min(buckets - 1)
+        };
+        ws.starts.clear();
+        ws.starts.resize(buckets + 1, 0);
+        for s in &ws.spans {
+            ws.starts[bucket(s.lo) + 1] += 1;
+        }
+        for i in 0..buckets {
+            ws.starts[i + 1] += ws.starts[i];
+        }
+        ws.sorted.clear();
+        ws.sorted.resize(ws.spans.len(), Span::default());
+        let mut fill = ws.starts.clone();
+        for s in &ws.spans {
+            let b = bucket(s.lo);
+            ws.sorted[fill[b]] = *s;
+            fill[b] += 1;
+        }
+        Some(PlaneCutter { net, zoning, f, m, ws, g0, inv_width, buckets, extent, range, cos_sharp, machine })
+    }
+
+    /// `(d_min, d_max)`: the extent of the zone along `m` (its cells clipped to
+    /// the bilinear network quads).
+    pub(crate) fn range(&self) -> (f64, f64) {
+        self.range
+    }
+
+    fn bucket(&self, x: f64) -> usize {
+        // INVARIANT: clamped into [0, buckets - 1].
+        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+        let b = ((x - self.g0) * self.inv_width).max(0.0) as usize;
+        b.min(self.buckets - 1)
+    }
+
+    fn in_zone(&self, q: usize) -> bool {
+        self.zoning.is_none_or(|(z, zone)| z.quad_in_zone(q, zone))
+    }
+
+    /// The quad `(a, b)` of index `q`.
+    fn quad(&self, q: usize) -> Quad {
+        let nv = self.net.quads_v;
+        Quad { a: q / nv, b: q % nv }
+    }
+
+    /// `(node0, node1, edge id)` of local edge `k` of quad `(a, b)`.
+    fn edge(&self, quad: Quad, k: usize) -> (usize, usize, usize) {
+        let (nu, nv) = (self.net.quads_u, self.net.quads_v);
+        let Quad { a, b } = quad;
+        let u_edges = nu * (nv + 1);
+        let n = |a, b| self.net.node(a, b);
+        match k {
+            0 => (n(a, b), n(a + 1, b), a * (nv + 1) + b),
+            1 => (n(a + 1, b), n(a + 1, b + 1), u_edges + (a + 1) * nv + b),
+            2 => (n(a, b + 1), n(a + 1, b + 1), a * (nv + 1) + b + 1),
+            _ => (n(a, b), n(a, b + 1), u_edges + a * nv + b),
+        }
+    }
+
+    /// `g` at the corners `(a, b), (a + 1, b), (a + 1, b + 1), (a, b + 1)`.
+    fn corners(&self, quad: Quad) -> [f64; 4] {
+        let Quad { a, b } = quad;
+        let g = &self.ws.g;
+        let (n00, n10) = (self.net.node(a, b), self.net.node(a + 1, b));
+        [g[n00], g[n10], g[n10 + 1], g[n00 + 1]]
+    }
+
+    /// Which local edges cross the plane, from the corner values.
+    fn crossings(c: &[f64; 4], d: f64) -> [bool; 4] {
+        let s = c.map(|x| x >= d);
+        [s[0] != s[1], s[1] != s[2], s[3] != s[2], s[0] != s[3]]
+    }
+
+    /// The crossing point of local edge `k` of a quad (the same from both quads).
+    fn point(&self, quad: Quad, k: usize, d: f64) -> Vertex {
+        let (i, j, _) = self.edge(quad, k);
+        let (gi, gj) = (self.ws.g[i], self.ws.g[j]);
+        let t = ((d - gi) / (gj - gi)).clamp(0.0, 1.0);
+        let (nu, nv) = (self.net.quads_u as f64, self.net.quads_v as f64);
+        let (pi, pj) = (self.net.points[i], self.net.points[j]);
+        let p = pi + (pj - pi) * t;
+        let Quad { a, b } = quad;
+        // The exact normal at the crossing's (u, v) (6.4), along the edge's isoline.
+        let (uv, n) = match k {
+            0 | 2 => {
+                let row = if k == 0 { b } else { b + 1 };
+                let u = (a as f64 + t) / nu;
+                ([u, row as f64 / nv], self.net.normal_on_row(row, u))
+            }
+            _ => {
+                let column = if k == 1 { a + 1 } else { a };
+                let v = (b as f64 + t) / nv;
+                ([column as f64 / nu, v], self.net.normal_on_column(column, v))
+            }
+        };
+        Vertex { p, n, uv }
+    }
+
+    /// The exit edge of a curve entering a quad of corner values `c` by local
+    /// edge `k` (marching squares; a saddle is resolved by the sign at the
+    /// quad centre).
+    fn partner(c: &[f64; 4], k: usize, d: f64) -> usize {
+        let crossing = Self::crossings(c, d);
+        if crossing.iter().all(|&x| x) {
+            let centre = 0.25 * (c[0] + c[1] + c[2] + c[3]);
+            // Same side as corner 0 at the centre: corners 1 and 3 are cut off.
+            let pairs = if (centre >= d) == (c[0] >= d) { [1, 0, 3, 2] } else { [3, 2, 1, 0] };
+            return pairs[k];
+        }
+        (0..4).find(|&e| e != k && crossing[e]).unwrap_or(k)
+    }
+
+    /// The quad across local edge `k`, and that edge's local index there.
+    fn neighbour(&self, quad: Quad, k: usize) -> Option<(Quad, usize)> {
+        let (nu, nv) = (self.net.quads_u, self.net.quads_v);
+        let Quad { a, b } = quad;
+        let next = match k {
+            0 => (b > 0).then(|| (Quad { a, b: b - 1 }, 2)),
+            1 => (a + 1 < nu).then(|| (Quad { a: a + 1, b }, 3)),
+            2 => (b + 1 < nv).then(|| (Quad { a, b: b + 1 }, 0)),
+            _ => (a > 0).then(|| (Quad { a: a - 1, b }, 1)),
+        };
+        next.filter(|(n, _)| self.in_zone(n.a * nv + n.b))
+    }
+
+    /// Walks from a quad entered by edge `k`, appending crossing points; true
+    /// when it came back to a marked edge (a closed curve).
+    fn walk(&mut self, mut quad: Quad, mut k: usize, d: f64, into: &mut Vec<Vertex>) -> bool {
+        loop {
+            let exit = Self::partner(&self.corners(quad), k, d);
+            let (_, _, id) = self.edge(quad, exit);
+            if self.ws.marks[id] == self.ws.stamp {
+                return true;
+            }
+            self.ws.marks[id] = self.ws.stamp;
+            into.push(self.point(quad, exit, d));
+            match self.neighbour(quad, exit) {
+                Some((n, e)) => (quad, k) = (n, e),
+                None => return false,
+            }
+        }
+    }
+
+    /// The whole curve through local edge `k` of a quad.
+    fn trace(&mut self, quad: Quad, k: usize, d: f64) -> Vec<Vertex> {
+        let mut forward = std::mem::take(&mut self.ws.forward);
+        let mut backward = std::mem::take(&mut self.ws.backward);
+        forward.clear();
+        backward.clear();
+        let (_, _, id) = self.edge(quad, k);
+        self.ws.marks[id] = self.ws.stamp;
+        forward.push(self.point(quad, k, d));
+        if self.walk(quad, k, d, &mut forward) {
+            forward.push(forward[0]);
+        } else if let Some((n, e)) = self.neighbour(quad, k) {
+            self.walk(n, e, d, &mut backward);
+            backward.reverse();
+            backward.append(&mut forward);
+            std::mem::swap(&mut forward, &mut backward);
+        }
+        self.ws.backward = backward;
+        forward
+    }
+
+    /// PLANE_PASSES at offset `d` with its NEXT_SPACING.
+    pub(crate) fn plane(&mut self, d: f64, tool: &ToolModel) -> PlaneCut {
+        // A plane through the lowest node would cut nothing (nodes on it are
+        // "above"): move it a rounding step inside, so that it yields the
+        // boundary as the top plane does.
+        let d = d.max(self.g0 + tol::PLANE_NUDGE_REL * (self.extent + (self.range.1 - self.range.0)).max(1.0));
+        self.ws.stamp = self.ws.stamp.wrapping_add(1);
+        if self.ws.stamp == 0 {
+            self.ws.marks.fill(0);
+            self.ws.stamp = 1;
+        }
+        let mut cut = PlaneCut { passes: Vec::new(), spacing: f64::INFINITY, worst: Point3::origin() };
+        let (first, last) = (self.bucket(d - self.extent), self.bucket(d));
+        for i in self.ws.starts[first]..self.ws.starts[last + 1] {
+            let span = self.ws.sorted[i];
+            if !(span.lo < d && span.hi >= d) {
+                continue;
+            }
+            let quad = self.quad(span.quad as usize);
+            let crossing = Self::crossings(&self.corners(quad), d);
+            for (k, &crosses) in crossing.iter().enumerate() {
+                let (_, _, id) = self.edge(quad, k);
+                if crosses && self.ws.marks[id] != self.ws.stamp {
+                    let mut line = self.trace(quad, k, d);
+                    self.emit(&mut line, tool, &mut cut);
+                    self.ws.forward = line;
+                }
+            }
+        }
+        cut.passes.sort_by(|a, b| self.mid(a).total_cmp(&self.mid(b)));
+        cut
+    }
+
+    fn mid(&self, pass: &Pass) -> f64 {
+        let (a, b) = (pass.points[0], pass.points[pass.points.len() - 1]);
+        0.5 * (self.f[0] * (a.x + b.x) + self.f[1] * (a.y + b.y))
+    }
+
+    /// Orients a traced curve along +f, clips it to the zone and adds its passes.
+    fn emit(&mut self, line: &mut [Vertex], tool: &ToolModel, cut: &mut PlaneCut) {
+        if line.len() < 2 {
+            return;
+        }
+        let along = |v: &Vertex| self.f[0] * v.p.x + self.f[1] * v.p.y;
+        if along(&line[line.len() - 1]) < along(&line[0]) {
+            line.reverse();
+        }
+        match self.zoning {
+            None => self.finish(line, tool, cut),
+            Some((zoning, zone)) => {
+                let mut piece = std::mem::take(&mut self.ws.piece);
+                let net = self.net;
+                clip(
+                    line,
+                    &zoning.labels,
+                    zone,
+                    &mut piece,
+                    |uv| net.normal_at(uv[0], uv[1]),
+                    |p| {
+                        self.finish(p, tool, cut);
+                    },
+                );
+                self.ws.piece = piece;
+            }
+        }
+    }
+
+    /// Counts a piece's vertices for the spacing and keeps it as a pass unless short.
+    fn finish(&self, piece: &[Vertex], tool: &ToolModel, cut: &mut PlaneCut) {
+        for v in piece {
+            let spacing = tool.spacing(&v.n, self.f, self.m);
+            if spacing < cut.spacing {
+                cut.spacing = spacing;
+                cut.worst = v.p;
+            }
+        }
+        if piece.len() < 2 {
+            return;
+        }
+        let points: Vec<Point3> = piece.iter().map(|v| v.p).collect();
+        let (length, time) = pass_length_time(&points, self.cos_sharp, &self.machine);
+        if length < tol::MIN_PASS_LENGTH {
+            return;
+        }
+        cut.passes.push(Pass { points, params: piece.iter().map(|v| v.uv).collect(), length, time });
+    }
+}
+
+/// Splits `line` where the clustering-cell label changes (exact crossing of the
+/// axis-aligned cell boundaries, the boundary point inserted) and hands each
+/// maximal piece of label `zone` to `out`; inserted points get the exact
+/// `normal` at their `(u, v)`.
+fn clip(
+    line: &[Vertex],
+    labels: &CellLabels,
+    zone: u32,
+    piece: &mut Vec<Vertex>,
+    normal: impl Fn([f64; 2]) -> Vec3,
+    mut out: impl FnMut(&[Vertex]),
+) {
+    let (cu, cv) = (labels.cells_u, labels.cells_v);
+    let cell = |v: &Vertex| (CellLabels::cell_index(v.uv[0], cu), CellLabels::cell_index(v.uv[1], cv));
+    let label = |(i, j): (usize, usize)| labels.labels[i * cv + j];
+    let mut current = cell(&line[0]);
+    let mut inside = label(current) == zone;
+    piece.clear();
+    if inside {
+        piece.push(line[0]);
+    }
+    let mut crossings: Vec<(f64, isize, isize)> = Vec::new();
+    for w in line.windows(2) {
+        let (a, b) = (&w[0], &w[1]);
+        let target = cell(b);
+        if target != current {
+            crossings.clear();
+            boundary_crossings(a.uv[0], b.uv[0], current.0, target.0, cu, |t, step| crossings.push((t, step, 0)));
+            boundary_crossings(a.uv[1], b.uv[1], current.1, target.1, cv, |t, step| crossings.push((t, 0, step)));
+            crossings.sort_by(|x, y| x.0.total_cmp(&y.0));
+            let (mut i, mut j) = (current.0.cast_signed(), current.1.cast_signed());
+            for &(t, di, dj) in &crossings {
+                i = (i + di).clamp(0, cu.cast_signed() - 1);
+                j = (j + dj).clamp(0, cv.cast_signed() - 1);
+                let now = label((i.cast_unsigned(), j.cast_unsigned())) == zone;
+                if now != inside {
+                    let mut x = a.lerp(b, t);
+                    x.n = normal(x.uv);
+                    if inside {
+                        piece.push(x);
+                        out(piece);
+                        piece.clear();
+                    } else {
+                        piece.push(x);
+                    }
+                    inside = now;
+                }
+            }
+            let final_inside = label(target) == zone;
+            if final_inside != inside {
+                // Rounding left the walk in another cell than b's: follow b.
+                if inside {
+                    out(piece);
+                    piece.clear();
+                } else {
+                    piece.push(*a);
+                }
+                inside = final_inside;
+            }
+            current = target;
+        }
+        if inside {
+            piece.push(*b);
+        }
+    }
+    if inside && !piece.is_empty() {
+        out(piece);
+    }
+}
+
+/// Calls `push(t, step)` for each cell boundary `k / cells` crossed between
+/// parameters `a` (cell `from`) and `b` (cell `to`), `t` the fraction along.
+fn boundary_crossings(a: f64, b: f64, from: usize, to: usize, cells: usize, mut push: impl FnMut(f64, isize)) {
+    let at = |k: usize| (((k as f64 / cells as f64) - a) / (b - a)).clamp(0.0, 1.0);
+    if to > from {
+        for k in from + 1..=to {
+            push(at(k), 1);
+        }
+    } else {
+        for k in (to + 1..=from).rev() {
+            push(at(k), -1);
+        }
+    }
+}
+
+/// Widens `range` by the extent along `m` of quad `q`'s part in `zone`: its
+/// corners when all its cells are the zone's, else the corners of its
+/// intersection with each cell of the zone, on the bilinear quad.
+fn zone_extent(
+    net: &Network,
+    zoning: &Zoning,
+    zone: u32,
+    g: &[f64],
+    q: usize,
+    span: &Span,
+    range: (f64, f64),
+) -> (f64, f64) {
+    if zoning.quad_label[q] == zone {
+        return (range.0.min(span.lo), range.1.max(span.hi));
+    }
+    let (nu, nv) = (net.quads_u, net.quads_v);
+    let (a, b) = (q / nv, q % nv);
+    let gc = [g[net.node(a, b)], g[net.node(a + 1, b)], g[net.node(a, b + 1)], g[net.node(a + 1, b + 1)]];
+    let labels = &zoning.labels;
+    let ((i0, i1), (j0, j1)) = (zoning.ranges_u[a], zoning.ranges_v[b]);
+    let local = |cell: usize, cells: usize, k: usize, n: usize| {
+        let lo = (cell as f64 / cells as f64 * n as f64 - k as f64).clamp(0.0, 1.0);
+        let hi = ((cell + 1) as f64 / cells as f64 * n as f64 - k as f64).clamp(0.0, 1.0);
+        [lo, hi]
+    };
+    let mut range = range;
+    for i in i0..=i1 {
+        for j in j0..=j1 {
+            if labels.labels[i * labels.cells_v + j] != zone {
+                continue;
+            }
+            for s in local(i, labels.cells_u, a, nu) {
+                for t in local(j, labels.cells_v, b, nv) {
+                    let x = (1.0 - s) * ((1.0 - t) * gc[0] + t * gc[2]) + s * ((1.0 - t) * gc[1] + t * gc[3]);
+                    range = (range.0.min(x), range.1.max(x));
+                }
+            }
+        }
+    }
+    range
+}
