@@ -123,7 +123,9 @@ pub fn run(args: &OptimizeArgs) -> CliResult<()> {
     let total = settings.budget.ceil() as u64;
     let bars = Bars {
         k_min: settings.k_min,
-        bars: (settings.k_min..=settings.k_max).map(|k| multi.add(progress_bar(total, &format!("K = {k:2}")))).collect(),
+        bars: (settings.k_min..=settings.k_max)
+            .map(|k| multi.add(progress_bar(total, &format!("K = {k:2}"))))
+            .collect(),
     };
     let clock = Clock(Instant::now());
     let study = run_study(&model, &settings, &bars, Some(&clock)).map_err(|e| rejected(&name, &e))?;

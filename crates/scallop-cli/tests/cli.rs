@@ -255,7 +255,8 @@ fn optimize_writes_the_study_and_rejects_bad_settings() {
                [finishing]\nscallop_height = 0.01\n[optimize]\nformulation = \"3axis\"\nk_min = 2\nk_max = 3\n\
                budget = 8\ngrid = [20, 20]\nsurrogate_grid = [10, 10]\nstep = 1.5\n";
     std::fs::write(dir.join("small.toml"), job).expect("write");
-    let out = scallop().current_dir(&dir).args(["optimize", "small.toml", "-o", "out", "--json"]).output().expect("run");
+    let out =
+        scallop().current_dir(&dir).args(["optimize", "small.toml", "-o", "out", "--json"]).output().expect("run");
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
     let results = v["study"]["results"].as_array().expect("results");

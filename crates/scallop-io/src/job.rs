@@ -440,7 +440,11 @@ fn check_optimize(o: &OptimizeSpec, sh: f64) -> Result<(), JobError> {
         return bad("optimize.k_min", o.k_min.to_string(), "give 1 <= k_min <= k_max");
     }
     if !(o.budget.is_finite() && o.budget >= 1.0) {
-        return bad("optimize.budget", o.budget.to_string(), "give at least 1 black-box evaluation per K (the spec uses 1000)");
+        return bad(
+            "optimize.budget",
+            o.budget.to_string(),
+            "give at least 1 black-box evaluation per K (the spec uses 1000)",
+        );
     }
     if !matches!(o.surrogate.as_str(), "none" | "s3" | "s4") {
         return bad("optimize.surrogate", o.surrogate.clone(), "use \"none\", \"s3\" or \"s4\"");
@@ -540,7 +544,10 @@ mod tests {
             (format!("{BASE}[optimize]\nformulation = \"3axis\"\nbudget = 0\n"), "optimize.budget"),
             (format!("{BASE}[optimize]\nformulation = \"3+2\"\nomega = [1, 1, 1.5, 1]\n"), "optimize.omega"),
             (format!("{BASE}[optimize]\nformulation = \"3+2\"\nsurrogate = \"s9\"\n"), "optimize.surrogate"),
-            (format!("{BASE}[optimize]\nformulation = \"3+2\"\nsurrogate_cost = \"free\"\n"), "optimize.surrogate_cost"),
+            (
+                format!("{BASE}[optimize]\nformulation = \"3+2\"\nsurrogate_cost = \"free\"\n"),
+                "optimize.surrogate_cost",
+            ),
             (format!("{BASE}[optimize]\nformulation = \"3+2\"\ngrid = [80, 1]\n"), "optimize.grid"),
             (format!("{BASE}[optimize]\nformulation = \"3+2\"\nstep = 0\n"), "optimize.step"),
             (format!("{BASE}[optimize]\nformulation = \"3+2\"\ntransition = \"teleport\"\n"), "optimize.transition"),

@@ -23,10 +23,14 @@ fn bench(c: &mut Criterion) {
             b.iter(|| single.install(|| model.partition(k, &omega, Fidelity::BlackBox).expect("clusters")))
         });
         group.bench_function(format!("k{k}_plan_3axis"), |b| {
-            b.iter(|| single.install(|| model.assess(&p, Formulation::ThreeAxis, &d, Fidelity::BlackBox).expect("plan")))
+            b.iter(|| {
+                single.install(|| model.assess(&p, Formulation::ThreeAxis, &d, Fidelity::BlackBox).expect("plan"))
+            })
         });
         group.bench_function(format!("k{k}_plan_3plus2"), |b| {
-            b.iter(|| single.install(|| model.assess(&p, Formulation::ThreePlusTwo, &d, Fidelity::BlackBox).expect("plan")))
+            b.iter(|| {
+                single.install(|| model.assess(&p, Formulation::ThreePlusTwo, &d, Fidelity::BlackBox).expect("plan"))
+            })
         });
         let p3 = model.partition(k, &omega, Fidelity::S3).expect("clusters");
         group.bench_function(format!("k{k}_s3_with_clustering"), |b| {

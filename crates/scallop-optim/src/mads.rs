@@ -518,7 +518,7 @@ impl<'a> Run<'a> {
         let x = &self.archive[centre].0;
         let frame = self.frame_steps();
         #[allow(clippy::cast_precision_loss)]
-        let (frame_f, lattice_f) = (frame as f64, tol::LATTICE as f64);
+        let frame_f = frame as f64;
         let radius = tol::MODEL_RADIUS_FRAMES * frame_f;
         let diff = |m: &Lattice| -> Vec<f64> {
             m.iter()
@@ -613,7 +613,6 @@ impl<'a> Run<'a> {
         #[allow(clippy::cast_precision_loss, clippy::cast_possible_truncation)]
         let mut m: Lattice =
             x.iter().zip(s.iter()).map(|(&xi, &si)| xi + mesh * (si * frame_f / mesh as f64).round() as i64).collect();
-        let _ = lattice_f;
         self.project(&mut m);
         (m != *x).then_some(m)
     }

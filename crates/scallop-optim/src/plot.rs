@@ -13,7 +13,7 @@ const MARGIN: f64 = 60.0;
 fn colour(i: usize) -> String {
     #[allow(clippy::cast_precision_loss)]
     let hue = (i as f64 * 137.507_764).rem_euclid(360.0);
-    format!("hsl({hue:.1},65%,{}%)", if i % 2 == 0 { 50 } else { 38 })
+    format!("hsl({hue:.1},65%,{}%)", if i.is_multiple_of(2) { 50 } else { 38 })
 }
 
 /// The best time against the budget spent, one step line per `K`

@@ -6,8 +6,6 @@
 //! rectangles) and S4 (the planner on a 5 mm network at `sh = 0.1 mm`), both
 //! on a coarser clustering grid (finishing.md 12.2, 12.6).
 
-use std::f64::consts::FRAC_PI_2;
-
 use scallop_analysis::{
     Cutter, GridOptions, MachineLimits, Moments, Pca, annex_e_time, direction_angle_xy, sample_patch,
 };
@@ -16,7 +14,8 @@ use scallop_geom::nalgebra::Matrix3;
 use scallop_geom::{Point3, Vec3};
 use scallop_strategy::StrategyError;
 use scallop_strategy::network::{
-    CellLabels, Margins, Network, Orientation, Transitions, ZoneParams, ZonePlan, Zoning, plan_zone, plan_zones, surface_time,
+    CellLabels, Margins, Network, Orientation, Transitions, ZoneParams, ZonePlan, Zoning, plan_zone, plan_zones,
+    surface_time,
 };
 use scallop_surface::Patch;
 
@@ -147,10 +146,13 @@ impl SurfaceModel {
         positive("optimize.surrogate_scallop_height", settings.surrogate_scallop_height)?;
         let black_box = Level::new(patch, settings.grid, Some(settings.step))?;
         let s3 = Level::new(patch, settings.surrogate_grid, None)?;
-        let s4 = Level { network: Some(
-            Network::new(patch, settings.surrogate_step)
-                .map_err(|e| OptimError::Model(format!("machining network at {} mm: {e}", settings.surrogate_step)))?,
-        ), ..s3.clone() };
+        let s4 =
+            Level {
+                network: Some(Network::new(patch, settings.surrogate_step).map_err(|e| {
+                    OptimError::Model(format!("machining network at {} mm: {e}", settings.surrogate_step))
+                })?),
+                ..s3.clone()
+            };
         Ok(SurfaceModel { settings, black_box, s3, s4 })
     }
 
@@ -167,7 +169,11 @@ impl SurfaceModel {
     }
 
     /// Points and normals of a zone's cells.
-    fn zone_samples<'a>(&'a self, level: &'a Level, cells: &'a [u32]) -> impl Iterator<Item = (&'a Point3, &'a Vec3)> + 'a {
+    fn zone_samples<'a>(
+        &'a self,
+        level: &'a Level,
+        cells: &'a [u32],
+    ) -> impl Iterator<Item = (&'a Point3, &'a Vec3)> + 'a {
         cells.iter().filter_map(move |&c| {
             let i = level.features.point_of_cell(c as usize)?;
             Some((&level.points[i], &level.normals[i]))
@@ -194,7 +200,12 @@ impl SurfaceModel {
                 }
                 Formulation::Heuristic => heuristic_axis(zone.geometry.as_ref().map(|g| &g.pca), design.zeta[c]),
             };
-            let mean = zone.geometry.as_ref().map_or_else(Point3::origin, |g| g.moments.mean());
+            // Rotation centre: the zone's mean in the heuristic, the origin in 3+2 so that the
+            // zones of a cluster share one oriented network (times do not depend on it, 4.5).
+            let mean = match formulation {
+                Formulation::Heuristic => zone.geometry.as_ref().map_or_else(Point3::origin, |g| g.moments.mean()),
+                _ => Point3::origin(),
+            };
             for (_, n) in self.zone_samples(level, &zone.cells) {
                 violation += (-n.dot(&axis)).max(0.0).powi(2);
             }
@@ -218,7 +229,12 @@ impl SurfaceModel {
 
     /// Plans every zone (zones without any pass are skipped: they are smaller
     /// than a plane spacing and cost nothing to this model).
-    fn plan(&self, zp: &ZonePartition, formulation: Formulation, design: &Design) -> Result<(Vec<ZonePlan>, f64), OptimError> {
+    fn plan(
+        &self,
+        zp: &ZonePartition,
+        formulation: Formulation,
+        design: &Design,
+    ) -> Result<(Vec<ZonePlan>, f64), OptimError> {
         let level = self.level(zp.fidelity);
         let (Some(network), Some(zoning)) = (&level.network, &zp.zoning) else {
             return Err(OptimError::Model("internal: no machining network at this fidelity".into()));
@@ -227,15 +243,14 @@ impl SurfaceModel {
         if formulation == Formulation::ThreeAxis {
             // Fast path: all zones with shared buffers; a zone without passes makes it
             // fail, and the loop below then skips that zone.
-            let directions: Vec<f64> =
-                zp.partition.zones.iter().map(|z| design.theta[z.cluster as usize]).collect();
+            let directions: Vec<f64> = zp.partition.zones.iter().map(|z| design.theta[z.cluster as usize]).collect();
             if let Ok(plans) = plan_zones(network, zoning, &directions, &self.params(zp.fidelity, 0.0)) {
                 return Ok((plans, oriented.violation));
             }
         }
         let mut plans = Vec::with_capacity(zp.partition.zones.len());
         // One oriented network per distinct orientation (3+2: per cluster).
-        let mut cache: Vec<(Orientation, Network)> = Vec::new();
+        let mut cache: Vec<(usize, Network)> = Vec::new();
         for (z, zone) in zp.partition.zones.iter().enumerate() {
             let c = zone.cluster as usize;
             let params = self.params(zp.fidelity, design.theta[c]);
@@ -244,11 +259,13 @@ impl SurfaceModel {
             let result = match oriented.orientations[z] {
                 None => plan_zone(network, Some(zoning), label, &params),
                 Some(o) => {
-                    let key = |x: &Orientation| x.tilt == o.tilt && x.azimuth == o.azimuth && x.centre == o.centre;
-                    let i = match cache.iter().position(|(x, _)| key(x)) {
+                    // 3+2: one orientation per cluster (times do not depend on the
+                    // rotation centre, 4.5); heuristic: one per zone.
+                    let tag = if formulation == Formulation::ThreePlusTwo { c } else { z };
+                    let i = match cache.iter().position(|(t, _)| *t == tag) {
                         Some(i) => i,
                         None => {
-                            cache.push((o, network.oriented(&o)));
+                            cache.push((tag, network.oriented(&o)));
                             cache.len() - 1
                         }
                     };
@@ -277,7 +294,13 @@ impl SurfaceModel {
                 None => g.pca,
                 Some(o) => rotated_pca(&g.moments, o),
             };
-            total += annex_e_time(&pca, design.theta[c], &self.settings.tool, self.settings.scallop_height, &self.settings.machine);
+            total += annex_e_time(
+                &pca,
+                design.theta[c],
+                &self.settings.tool,
+                self.settings.scallop_height,
+                &self.settings.machine,
+            );
             let mean = g.moments.mean();
             if let Some(p) = previous {
                 total += self.settings.transitions.time(&p, &mean, &self.settings.machine).0;
@@ -321,7 +344,13 @@ impl MachiningModel for SurfaceModel {
 
     fn partition(&self, k: usize, omega: &[f64; 4], fidelity: Fidelity) -> Result<ZonePartition, OptimError> {
         let level = self.level(fidelity);
-        let params = ClusterParams { k, omega: *omega, metric: Metric::Euclidean, method: Method::KMeans, ..ClusterParams::default() };
+        let params = ClusterParams {
+            k,
+            omega: *omega,
+            metric: Metric::Euclidean,
+            method: Method::KMeans,
+            ..ClusterParams::default()
+        };
         let partition =
             partition(&level.features, &params).map_err(|e| OptimError::Model(format!("clustering K = {k}: {e}")))?;
         let zoning = match &level.network {
@@ -385,7 +414,8 @@ impl MachiningModel for SurfaceModel {
                     let zone = p.zones.iter().filter(|z| z.cluster as usize == c).max_by_key(|z| z.len());
                     zone.map_or(0.0, |zone| {
                         let axis = heuristic_axis(zone.geometry.as_ref().map(|g| &g.pca), 0.0);
-                        let o = Orientation::new(axis.z.clamp(-1.0, 1.0).acos(), axis.y.atan2(axis.x), Point3::origin());
+                        let o =
+                            Orientation::new(axis.z.clamp(-1.0, 1.0).acos(), axis.y.atan2(axis.x), Point3::origin());
                         let (mut dx, mut dy) = (0.0, 0.0);
                         for (_, n) in self.zone_samples(level, &zone.cells) {
                             let r = o.rotate(n);
@@ -397,11 +427,15 @@ impl MachiningModel for SurfaceModel {
                 }
             };
         }
-        let _ = FRAC_PI_2;
         Ok(design)
     }
 
-    fn describe(&self, zp: &ZonePartition, formulation: Formulation, design: &Design) -> Result<PlanReport, OptimError> {
+    fn describe(
+        &self,
+        zp: &ZonePartition,
+        formulation: Formulation,
+        design: &Design,
+    ) -> Result<PlanReport, OptimError> {
         let (plans, violation) = self.plan(zp, formulation, design)?;
         let time = surface_time(&plans, &self.settings.transitions, &self.settings.machine);
         let oriented = self.orient(zp, formulation, design);
@@ -430,7 +464,9 @@ impl MachiningModel for SurfaceModel {
             .collect();
         let level = self.level(zp.fidelity);
         let cell_xy = (0..p.zone_of_cell.len())
-            .map(|cell| level.features.point_of_cell(cell).map_or([f64::NAN; 2], |i| [level.points[i].x, level.points[i].y]))
+            .map(|cell| {
+                level.features.point_of_cell(cell).map_or([f64::NAN; 2], |i| [level.points[i].x, level.points[i].y])
+            })
             .collect();
         Ok(PlanReport {
             time_s: time.total_s,

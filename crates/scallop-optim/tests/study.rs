@@ -101,7 +101,15 @@ impl MachiningModel for Fake {
             .collect();
         #[allow(clippy::cast_precision_loss)]
         let cell_xy = (0..64).map(|i| [(i / 8) as f64, (i % 8) as f64]).collect();
-        Ok(PlanReport { time_s: a.time_s, transition_time_s: 0.0, violation: a.violation, grid: [8, 8], labels, cell_xy, zones })
+        Ok(PlanReport {
+            time_s: a.time_s,
+            transition_time_s: 0.0,
+            violation: a.violation,
+            grid: [8, 8],
+            labels,
+            cell_xy,
+            zones,
+        })
     }
 }
 

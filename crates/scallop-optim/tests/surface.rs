@@ -10,7 +10,13 @@ use scallop_optim::study::{Design, Fidelity, Formulation, MachiningModel, Silent
 use scallop_optim::surface::{SurfaceModel, SurfaceSettings};
 
 fn coarse() -> SurfaceSettings {
-    SurfaceSettings { grid: [32, 32], surrogate_grid: [16, 16], step: 1.0, surrogate_step: 5.0, ..SurfaceSettings::default() }
+    SurfaceSettings {
+        grid: [32, 32],
+        surrogate_grid: [16, 16],
+        step: 1.0,
+        surrogate_step: 5.0,
+        ..SurfaceSettings::default()
+    }
 }
 
 fn model(name: &str) -> SurfaceModel {
@@ -26,7 +32,13 @@ fn every_formulation_improves_on_its_start_and_reaches_every_zone() {
             let s = StudySettings { k_min: 2, k_max: 3, budget: 25.0, ..StudySettings::thesis(formulation) };
             let study = run_study(&m, &s, &Silent, None).unwrap();
             for r in &study.results {
-                assert!(r.f_best <= r.f0 && r.f_best > 0.0, "{name} {formulation:?} K = {}: {} > {}", r.k, r.f_best, r.f0);
+                assert!(
+                    r.f_best <= r.f0 && r.f_best > 0.0,
+                    "{name} {formulation:?} K = {}: {} > {}",
+                    r.k,
+                    r.f_best,
+                    r.f0
+                );
                 assert!(r.spent <= s.budget);
                 assert_eq!(r.plan.violation, 0.0, "{name} {formulation:?} K = {}", r.k);
                 assert!(r.plan.zones.len() >= r.k, "{name}: {} zones for K = {}", r.plan.zones.len(), r.k);
