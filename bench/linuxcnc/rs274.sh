@@ -8,6 +8,10 @@
 # and fails on a non-zero status, on an error message, or when the canonical
 # STRAIGHT_FEED/STRAIGHT_TRAVERSE coordinates differ from our words by more than 1e-4, or
 # when a G93 SET_FEED_RATE differs from L_ctrl * F_inv (block time 1/F_inv).
+# It also runs two finishing jobs through `scallop run` with the LinuxCNC dialect: an
+# arc-fitted 3-axis program (examples/jobs/choi-arcs.toml: G18 arcs, checked against the
+# canonical ARC_FEED end point, centre and turning direction) and a 3+2 program
+# (examples/jobs/choi-3plus2.toml: indexed A/C on the XYZAC trunnion, then joint moves).
 # Usage: bench/linuxcnc/rs274.sh [MACHINE ...]   (default: both LinuxCNC trunnions)
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -51,9 +55,18 @@ printf 'T1 P1 Z0 D10\n' >"$work/check.tbl"
 machines=("$@")
 [ ${#machines[@]} -eq 0 ] && machines=(linuxcnc-xyzac-trt linuxcnc-xyzbc-trt)
 status=0
+programs=()
 for m in "${machines[@]}"; do
+    cargo run -q -p scallop-post --example post_demo -- "$m" linuxcnc joint >"$work/$m.ngc"
+    programs+=("$m")
+done
+for job in choi-arcs choi-3plus2; do
+    cargo run -q -p scallop-cli -- run "examples/jobs/$job.toml" -o "$work/$job" >/dev/null
+    cp "$work/$job/program.nc" "$work/$job.ngc"
+    programs+=("$job")
+done
+for m in "${programs[@]}"; do
     prog="$work/$m.ngc"
-    cargo run -q -p scallop-post --example post_demo -- "$m" linuxcnc joint >"$prog"
     # Remapped M-codes of a configuration (M428/M429, any M > 199) are unknown to the bare
     # interpreter: strip them (joint output has none; kept for hand-made programs).
     sed -i -E '/^(N[0-9]+ )?M(2[0-9][0-9]|[3-9][0-9][0-9])$/d' "$prog"
@@ -70,51 +83,75 @@ for m in "${machines[@]}"; do
         status=1
         continue
     fi
-    # Compare the canonical moves with our words (modal X Y Z A B C, 1e-4).
+    # Compare the canonical moves with our words (modal X Y Z A B C, 1e-4), arcs included.
     if ! python3 - "$prog" "$out" <<'PY'
 import math, re, sys
 prog, out = open(sys.argv[1]).read(), open(sys.argv[2]).read()
 axes = "XYZABC"
+# Plane (first, second, normal) axis indices as rs274's ARC_FEED orders them.
+PLANES = {"XY": (0, 1, 2), "XZ": (2, 0, 1), "YZ": (1, 2, 0)}
+G_PLANE = {"G17": "XY", "G18": "XZ", "G19": "YZ"}
 cur = dict.fromkeys(axes, 0.0)
-ours = []  # (words, rapid, expected SET_FEED_RATE in G93 or None)
-g93, rapid = False, True
+ours = []  # (words, expected SET_FEED_RATE in G93 or None, arc (centre first, second, rotation) or None)
+g93, motion, plane = False, 0, "XY"
 for line in prog.splitlines():
     line = re.sub(r"\(.*?\)", "", line).strip()
     tokens = line.split()
     for t in tokens:
-        if t in ("G93",): g93 = True
-        if t in ("G94",): g93 = False
-        if t in ("G0", "G00"): rapid = True
-        if t in ("G1", "G01"): rapid = False
-    words = dict((t[0], float(t[1:])) for t in tokens if t and t[0] in axes + "F")
+        if t == "G93": g93 = True
+        if t == "G94": g93 = False
+        if t in ("G0", "G00"): motion = 0
+        if t in ("G1", "G01"): motion = 1
+        if t in ("G2", "G02"): motion = 2
+        if t in ("G3", "G03"): motion = 3
+        if t in G_PLANE: plane = G_PLANE[t]
+    words = dict((t[0], float(t[1:])) for t in tokens if t and t[0] in axes + "FIJK")
     if not any(a in words for a in axes):
         continue
     before = dict(cur)
     for a in axes:
         if a in words: cur[a] = words[a]
     expected = None
-    if g93 and not rapid:
+    if g93 and motion == 1:
         lin = math.sqrt(sum((cur[a] - before[a]) ** 2 for a in "XYZ"))
         rot = math.sqrt(sum((cur[a] - before[a]) ** 2 for a in "ABC"))
         expected = (lin if lin > 0 else rot) * words["F"]
-    ours.append(([cur[a] for a in axes], expected))
-canon, rate = [], None
-for m in re.finditer(r"(SET_FEED_RATE|STRAIGHT_FEED|STRAIGHT_TRAVERSE)\(([^)]*)\)", out):
-    if m.group(1) == "SET_FEED_RATE":
-        rate = float(m.group(2))
+    arc = None
+    if motion in (2, 3):
+        centre = [before[a] + words.get(o, 0.0) for a, o in zip("XYZ", "IJK")]
+        f, s_, _ = PLANES[plane]
+        arc = (centre[f], centre[s_], 1 if motion == 3 else -1)
+    ours.append(([cur[a] for a in axes], expected, arc))
+canon, rate, cplane = [], None, "XY"
+for m in re.finditer(r"(SET_FEED_RATE|STRAIGHT_FEED|STRAIGHT_TRAVERSE|ARC_FEED|SELECT_PLANE)\(([^)]*)\)", out):
+    kind, args = m.group(1), m.group(2)
+    if kind == "SET_FEED_RATE":
+        rate = float(args)
+    elif kind == "SELECT_PLANE":
+        cplane = args.replace("CANON_PLANE_", "")
+    elif kind == "ARC_FEED":
+        v = [float(x) for x in args.split(",")]
+        f, s_, n = PLANES[cplane]
+        end = [0.0] * 3
+        end[f], end[s_], end[n] = v[0], v[1], v[5]
+        canon.append((end + v[6:9], None, (v[2], v[3], int(v[4]))))
     else:
-        canon.append(([float(v) for v in m.group(2).split(",")[:6]], rate if m.group(1) == "STRAIGHT_FEED" else None))
+        canon.append(([float(x) for x in args.split(",")[:6]], rate if kind == "STRAIGHT_FEED" else None, None))
 if len(canon) != len(ours):
     print(f"rs274.sh: {len(canon)} canonical moves for {len(ours)} motion blocks"); sys.exit(1)
-worst = max((abs(a - b) for (o, _), (c, _) in zip(ours, canon) for a, b in zip(o, c)), default=0.0)
+worst = max((abs(a - b) for (o, _, _), (c, _, _) in zip(ours, canon) for a, b in zip(o, c)), default=0.0)
 if worst > 1.0001e-4:
     print(f"rs274.sh: canonical coordinates differ from our words by {worst:.6f}"); sys.exit(1)
+arcs = [(o, c) for (_, _, o), (_, _, c) in zip(ours, canon) if o is not None or c is not None]
+for o, c in arcs:
+    if o is None or c is None or o[2] != c[2] or max(abs(o[0] - c[0]), abs(o[1] - c[1])) > 2.0001e-4:
+        print(f"rs274.sh: arc differs: ours {o}, rs274 {c}"); sys.exit(1)
 # G93: SET_FEED_RATE(r) with r = L_ctrl * F_inv, so the block time L_ctrl / r is 1 / F_inv (spec K15).
-rates = [(e, r) for (_, e), (_, r) in zip(ours, canon) if e is not None]
+rates = [(e, r) for (_, e, _), (_, r, _) in zip(ours, canon) if e is not None]
 bad = [(e, r) for e, r in rates if r is None or abs(e - r) > 1e-4 + 1e-9 * e]
 if bad:
     print(f"rs274.sh: {len(bad)} inverse-time feed rates differ, first: ours {bad[0][0]:.4f}, rs274 {bad[0][1]}"); sys.exit(1)
-print(f"rs274.sh: {len(ours)} moves match the canonical calls (max difference {worst:.1e}); {len(rates)} G93 feed rates match L_ctrl*F")
+print(f"rs274.sh: {len(ours)} moves match the canonical calls (max difference {worst:.1e}); {len(arcs)} arcs (end, centre, direction); {len(rates)} G93 feed rates match L_ctrl*F")
 PY
     then
         status=1

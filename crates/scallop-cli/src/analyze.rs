@@ -100,7 +100,7 @@ pub fn run(args: &AnalyzeArgs) -> CliResult<()> {
 /// bull-nose region orange, the critical curve black, the part a red dot;
 /// ticks every 15 degrees and every unit of mu, labelled.
 fn plot_png(r: &AnalysisReport) -> Vec<u8> {
-    use crate::picture::Image;
+    use scallop_report::png::Image;
     let (w, h, left, top, pw, ph) = (720usize, 480usize, 60usize, 20usize, 620usize, 400usize);
     let mu_max = (1.15 * r.shape_factor).ceil().max(5.0);
     let mut img = Image::new(w, h, [255, 255, 255]);

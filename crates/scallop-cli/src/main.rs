@@ -7,8 +7,8 @@ mod drop;
 mod optimize;
 mod output;
 mod part;
-mod picture;
 mod post;
+mod render;
 mod run;
 mod simulate;
 
@@ -58,6 +58,8 @@ enum Command {
     Optimize(optimize::OptimizeArgs),
     /// Post-process a cutter-location file for a machine and a dialect, with a machine-aware time report.
     Post(post::PostArgs),
+    /// Render a part (and a toolpath) to a PNG picture, without a browser.
+    Render(render::RenderArgs),
     /// Load a part and report what was read (size, welding, open and non-manifold edges).
     Inspect(part::InspectArgs),
 }
@@ -81,6 +83,7 @@ fn main() -> ExitCode {
         Command::Simulate(args) => simulate::run(&args),
         Command::Optimize(args) => optimize::run(&args),
         Command::Post(args) => post::run(&args),
+        Command::Render(args) => render::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -69,7 +69,7 @@ pub fn progress_bar(total: u64, what: &str) -> ProgressBar {
 /// Arguments of `scallop demo`.
 #[derive(Args, Debug)]
 pub struct DemoArgs {
-    /// Output folder: `program.nc`, `report.json`, `toolpath.csv` (with --raster:
+    /// Output folder: `program.nc`, `report.json`, `toolpath.csv`, `report.html`, `scene.glb` (with --raster:
     /// `demo.nc` and `summary.json`).
     #[arg(short, long, default_value = "out/demo")]
     output: PathBuf,
@@ -94,12 +94,20 @@ pub fn demo(args: &DemoArgs) -> CliResult<()> {
         .map_err(|e| Failure::Io(anyhow::anyhow!("the built-in demo failed: {e}")))?;
     let seconds = start.elapsed().as_secs_f64();
     spinner.finish_and_clear();
-    write_finishing(&out, seconds, &args.output, args.json)
+    write_finishing(&job, &out, seconds, &args.output, args.json, "scallop demo")
 }
 
-/// Writes `program.nc`, `report.json` and `toolpath.csv` of a finishing job into
-/// `folder` and prints the summary (or the report as JSON).
-pub fn write_finishing(out: &scallop_engine::FinishOutput, seconds: f64, folder: &Path, json: bool) -> CliResult<()> {
+/// Writes `program.nc`, `report.json`, `toolpath.csv`, `report.html` and
+/// `scene.glb` of a finishing job into `folder` and prints the summary (or the
+/// report as JSON).
+pub fn write_finishing(
+    job: &scallop_engine::FinishJob,
+    out: &scallop_engine::FinishOutput,
+    seconds: f64,
+    folder: &Path,
+    json: bool,
+    command: &str,
+) -> CliResult<()> {
     let mut report = out.report.clone();
     report.plan.planning_time_s = seconds;
     let nc = folder.join("program.nc");
@@ -108,6 +116,10 @@ pub fn write_finishing(out: &scallop_engine::FinishOutput, seconds: f64, folder:
     write_atomic(&folder.join("report.json"), |w| w.write_all(text.as_bytes()))?;
     let csv = scallop_engine::toolpath_csv(&out.toolpath);
     write_atomic(&folder.join("toolpath.csv"), |w| w.write_all(csv.as_bytes()))?;
+    let data = scallop_report::ReportData::from_finishing(job, out, seconds, command);
+    write_atomic(&folder.join("report.html"), |w| w.write_all(scallop_report::html::report_html(&data).as_bytes()))?;
+    let glb = scallop_report::glb::scene_glb(&data).map_err(|e| Failure::Io(anyhow::anyhow!("scene.glb: {e}")))?;
+    write_atomic(&folder.join("scene.glb"), |w| w.write_all(&glb))?;
     if json {
         return print_json(&report);
     }
@@ -122,7 +134,7 @@ pub fn write_finishing(out: &scallop_engine::FinishOutput, seconds: f64, folder:
          \x20 lengths    feed {feed:.0} mm, links {link:.0} mm, rapid {rapid:.0} mm\n\
          \x20 simulated  no gouge on a {res} mm stock; deepest {dev:+.4} mm (tolerance {gt:.4} mm), most material left {mat:.4} mm\n\
          \x20 planned    in {secs:.2} s\n\
-         \x20 wrote      {nc}, report.json, toolpath.csv\n",
+         \x20 wrote      {nc}, report.json, toolpath.csv, report.html, scene.glb\n",
         part = r.part,
         slope = r.slope_deg,
         crit = r.critical_slope_deg,

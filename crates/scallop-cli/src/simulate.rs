@@ -12,8 +12,9 @@ use serde::Serialize;
 use crate::drop::CutterArgs;
 use crate::output::{print_json, print_text, write_atomic};
 use crate::part::{UnitsArg, load};
-use crate::picture::{Image, ramp};
 use crate::{CliResult, Failure};
+use scallop_report::png::{Image, ramp};
+use scallop_report::{DeviationMap, Figure, ReportData};
 
 /// Arguments of `scallop simulate`.
 #[derive(Args, Debug)]
@@ -40,7 +41,7 @@ pub struct SimulateArgs {
     /// Unit of mesh coordinates.
     #[arg(long, value_enum, default_value = "mm")]
     units: UnitsArg,
-    /// Output folder for `sim.json` and `deviation.png`.
+    /// Output folder for `sim.json`, `deviation.png` and `report.html`.
     #[arg(short, long, default_value = "out/simulate")]
     output: PathBuf,
     /// Print the report as JSON.
@@ -150,6 +151,8 @@ pub fn run(args: &SimulateArgs) -> CliResult<()> {
     write_atomic(&args.output.join("sim.json"), |w| std::io::Write::write_all(w, json.as_bytes()))?;
     let png = deviation_picture(&zmap, &dev, max_dev, options.gouge_tolerance).to_png();
     write_atomic(&args.output.join("deviation.png"), |w| std::io::Write::write_all(w, &png))?;
+    let page = scallop_report::html::report_html(&report_data(&report, &prepared.mesh, &zmap, dev, &program));
+    write_atomic(&args.output.join("report.html"), |w| std::io::Write::write_all(w, page.as_bytes()))?;
 
     if args.json {
         print_json(&report)?;
@@ -174,6 +177,51 @@ pub fn run(args: &SimulateArgs) -> CliResult<()> {
         ))?;
     }
     if verdict.is_empty() { Ok(()) } else { Err(Failure::rejected(format!("{name}: {}", verdict.join("; ")))) }
+}
+
+/// The HTML report of a simulation: part, stock, program, deviation and figures.
+fn report_data(
+    r: &SimReport,
+    mesh: &scallop_mesh::TriMesh,
+    zmap: &ZMap,
+    dev: Vec<f64>,
+    program: &scallop_toolpath::Toolpath,
+) -> ReportData {
+    let c0 = zmap.cell_center(0, 0);
+    let (cx, cy) = zmap.cell_size();
+    let mut data = ReportData::new(&format!("Simulation of {} on {}", r.program, r.part));
+    data.command = format!("scallop simulate --program {}", r.program);
+    data.part = Some(mesh.clone());
+    data.stock = Some(zmap.stock());
+    data.toolpath = Some(program.clone());
+    data.deviation = Some(DeviationMap {
+        origin: [c0.x, c0.y],
+        cell: [cx, cy],
+        nx: zmap.nx(),
+        ny: zmap.ny(),
+        values: dev,
+        gouge_tolerance: r.gouge_tolerance_mm,
+    });
+    data.figures = vec![
+        Figure::text("verdict", r.verdict.join("; ")),
+        Figure::count("moves", r.moves),
+        Figure::count("feed moves", r.feed_moves),
+        Figure::number("feed moves in air", 100.0 * r.air_cut_share, 1, "%"),
+        Figure::number("material left, max", r.max_scallop_mm, 4, "mm"),
+        Figure::number("deepest deviation", r.min_deviation_mm, 4, "mm"),
+        Figure::number("gouge tolerance", r.gouge_tolerance_mm, 4, "mm"),
+        Figure::number("removed volume", r.removed_volume_mm3, 0, "mm³"),
+        Figure::number("remaining volume", r.remaining_volume_mm3, 0, "mm³"),
+        Figure::number("nominal time at the programmed feeds", data.move_durations().iter().sum(), 1, "s"),
+    ];
+    data.settings = vec![
+        Figure::text("part", r.part.clone()),
+        Figure::text("program", r.program.clone()),
+        Figure::text("cutter", r.cutter.clone()),
+        Figure::number("cell size", r.resolution_mm, 3, "mm"),
+        Figure::text("cells", format!("{} x {}", r.cells[0], r.cells[1])),
+    ];
+    data
 }
 
 /// Top view of the stock: material left from 0 (blue) to `max_dev` (red),

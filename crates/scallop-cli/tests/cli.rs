@@ -62,6 +62,36 @@ fn demo_writes_a_program() {
     assert!(report["plan"]["max_scallop_mm"].as_f64().expect("number") <= 0.01);
     let csv = std::fs::read_to_string(dir.join("toolpath.csv")).expect("toolpath.csv");
     assert!(csv.starts_with("kind,x,y,z\n"));
+    let html = std::fs::read_to_string(dir.join("report.html")).expect("report.html");
+    assert!(html.starts_with("<!DOCTYPE html>") && html.contains("id=\"scene-data\""));
+    let glb = std::fs::read(dir.join("scene.glb")).expect("scene.glb");
+    assert_eq!(&glb[..4], b"glTF");
+    assert_eq!(u32::from_le_bytes(glb[8..12].try_into().expect("4 bytes")) as usize, glb.len());
+}
+
+#[test]
+fn render_writes_the_same_png_twice_and_rejects_a_bad_size() {
+    let dir = scratch("render");
+    std::fs::write(dir.join("p.stl"), pyramid_stl()).expect("write");
+    std::fs::write(dir.join("t.csv"), "kind,x,y,z\nrapid,0,0,10\nplunge,0,0,1\nfeed,10,0,1\nlink,10,2,1\nfeed,0,2,1\n")
+        .expect("write");
+    let render = |name: &str| {
+        let out = scallop()
+            .current_dir(&dir)
+            .args(["render", "p.stl", "--toolpath", "t.csv", "--size", "160x120", "-o", name])
+            .output()
+            .expect("run");
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        std::fs::read(dir.join(name)).expect("png")
+    };
+    let a = render("a.png");
+    assert_eq!(&a[..8], b"\x89PNG\r\n\x1a\n");
+    assert_eq!(a, render("b.png"));
+    assert_rejected(&["render", "p.stl", "--size", "0x10", "-o", "c.png"], &dir, "--size");
+    assert!(!dir.join("c.png").exists());
+    std::fs::write(dir.join("bad.csv"), "kind,x,y,z\nwobble,0,0,0\n").expect("write");
+    assert_rejected(&["render", "p.stl", "--toolpath", "bad.csv", "-o", "d.png"], &dir, "bad.csv: line 2");
+    assert!(!dir.join("d.png").exists());
 }
 
 #[test]
@@ -333,4 +363,63 @@ fn post_writes_a_proven_program_with_a_time_report() {
         .expect("run");
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("nosuch"));
+}
+
+#[test]
+fn bad_jobs_name_the_key_and_the_fix_and_write_nothing() {
+    let dir = scratch("badjobs");
+    let tiny = "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 0.05 0 0\nvertex 0 0.05 0\nendloop\nendfacet\nendsolid t\n";
+    std::fs::write(dir.join("tiny.stl"), tiny).expect("write");
+    let base = "[part]\nbuiltin = \"choi\"\n[cutter]\nshape = \"ball\"\ndiameter = 6\nflute_length = 60\n[finishing]\nscallop_height = 0.01\n";
+    let cases: [(&str, String, &[&str]); 11] = [
+        ("unknown key", format!("{base}colour = \"red\"\n"), &["colour"]),
+        ("negative size", base.replace("diameter = 6", "diameter = -6"), &["cutter.diameter", "> 0"]),
+        (
+            "sh over the radius",
+            base.replace("scallop_height = 0.01", "scallop_height = 4"),
+            &["finishing.scallop_height", "radius"],
+        ),
+        (
+            "unreachable",
+            base.replace("\"ball\"", "\"flat\"")
+                .replace("scallop_height = 0.01", "scallop_height = 0.0001\ndirection = 90"),
+            &["cannot reach", "finishing.scallop_height", "ball or bull-nose"],
+        ),
+        (
+            "empty region",
+            base.replace("builtin = \"choi\"", "file = \"tiny.stl\"")
+                .replace("scallop_height = 0.01", "scallop_height = 0.01\ndirection = 0"),
+            &["region to machine is empty", "finishing.max_step"],
+        ),
+        ("short flutes", base.replace("flute_length = 60", "flute_length = 8"), &["shank", "cutter.flute_length"]),
+        (
+            "flutes under the profile",
+            base.replace("flute_length = 60", "flute_length = 2"),
+            &["flute_length", "profile"],
+        ),
+        ("unknown dialect", format!("{base}[output]\ndialect = \"haas\"\n"), &["output.dialect", "linuxcnc"]),
+        ("plain-language 3-axis", format!("{base}[output]\ndialect = \"heidenhain\"\n"), &["ISO dialect", "[output]"]),
+        (
+            "arcs in 3+2",
+            format!(
+                "{base}[setup]\nrotation_deg = [10, 0, 0]\nmachine = \"linuxcnc-xyzac-trt\"\n[output]\narc_fitting = true\n"
+            ),
+            &["output.arc_fitting", "false"],
+        ),
+        (
+            "unknown machine",
+            format!("{base}[setup]\nrotation_deg = [10, 0, 0]\nmachine = \"mill\"\n"),
+            &["setup.machine", "mill"],
+        ),
+    ];
+    for (what, text, needles) in cases {
+        std::fs::write(dir.join("job.toml"), &text).expect("write");
+        let out = scallop().current_dir(&dir).args(["run", "job.toml", "-o", "out"]).output().expect("run");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{what}: {err}");
+        for n in needles {
+            assert!(err.contains(n), "{what}: '{err}' lacks '{n}'");
+        }
+        assert!(!dir.join("out").exists(), "{what}: a rejected job writes nothing");
+    }
 }

@@ -10,13 +10,70 @@ use scallop_analysis::{
     GridOptions, MachineLimits, Recommendation, ToolOptions, analyze, sample_mesh, sample_surface_set,
 };
 use scallop_cutter::{Cutter, CutterShape};
-use scallop_geom::{Aabb3, Point3, Tolerances};
-use scallop_post::{Dialect, write_gcode};
-use scallop_strategy::{Boundary, FinishingParams, Pattern, plan_finishing};
-use scallop_toolpath::{MoveKind, Toolpath};
+use scallop_geom::nalgebra::Rotation3;
+use scallop_geom::{Aabb3, Point3, Tolerances, Vec3};
+use scallop_machine::program::{ProgramOptions, records_from_toolpath, to_program};
+use scallop_machine::{Kinematics, Machine};
+use scallop_mesh::{MeshIndex, TriMesh};
+use scallop_post::{Dialect, OutputMode, PostParams, ProgramInfo, program_text, write_fitted};
+use scallop_strategy::{
+    Boundary, FinishingParams, IsoDirection, LeadKind, LeadReport, Pattern, apply_leads, lookahead_time,
+    plan_finishing, plan_isoparametric, stop_to_stop_time,
+};
+use scallop_toolpath::{FittedPath, Move, MoveKind, Toolpath, fit_arcs};
 use serde::Serialize;
 
-use crate::{EngineError, Part, prepare_part};
+use crate::{EngineError, Part, PreparedPart, prepare_part};
+
+/// Share of the path tolerance given to arc fitting when it is on: the planning
+/// (tessellation, sampling, merging) then runs with `1 - ARC_SHARE` of it, and every
+/// toolpath vertex and chord midpoint lies within `ARC_SHARE * path` of its arc.
+pub const ARC_SHARE: f64 = 0.25;
+
+/// How the program is written.
+#[derive(Debug, Clone)]
+pub struct OutputOptions {
+    /// Controller dialect (3-axis ISO: `plain`, `linuxcnc`, `fanuc`, `grbl`, ...).
+    pub dialect: Dialect,
+    /// Replace runs of cutting moves by `G2`/`G3` arcs within `ARC_SHARE * path`.
+    pub arc_fitting: bool,
+    /// Program name or number.
+    pub program: String,
+    /// Tool number (0: no tool change).
+    pub tool: u32,
+    /// Spindle speed (1/min; 0: no spindle word).
+    pub spindle: f64,
+}
+
+impl OutputOptions {
+    /// LinuxCNC (4 decimals: the program replays within 1e-4 mm), no arcs, no tool
+    /// change.
+    ///
+    /// # Panics
+    /// Never: the shipped dialect parses (tested in `scallop-post`).
+    #[must_use]
+    pub fn linuxcnc() -> OutputOptions {
+        // INVARIANT: the shipped dialect files parse.
+        #[allow(clippy::unwrap_used, clippy::missing_panics_doc)]
+        let dialect = Dialect::builtin("linuxcnc").unwrap();
+        OutputOptions { dialect, arc_fitting: false, program: "1".into(), tool: 0, spindle: 0.0 }
+    }
+}
+
+/// 3+2 setup: the part is turned by `rotation` (part frame -> planning frame, where the
+/// tool is vertical), planned there as a 3-axis job, and written as indexed 5-axis
+/// output for `machine` (the tool axis `rotation^-1 z` held constant, rotaries moved on
+/// the first rapid only).
+#[derive(Debug, Clone)]
+pub struct Setup {
+    /// Part frame -> planning frame.
+    pub rotation: Rotation3<f64>,
+    /// The machine description (`scallop_machine::Machine::builtin` name) whose
+    /// kinematics turn the indexed tool axis into rotary words.
+    pub machine: Machine,
+    /// Tool length the kinematics use (mm; 0 when the controller applies it).
+    pub tool_length: f64,
+}
 
 /// A finishing job (mm, seconds; machine limits in the spec's units).
 #[derive(Debug, Clone)]
@@ -47,6 +104,14 @@ pub struct FinishJob {
     pub max_step: f64,
     /// Cell size of the verifying stock simulation (mm).
     pub sim_resolution: f64,
+    /// How the program is written.
+    pub output: OutputOptions,
+    /// 3+2 setup; `None` for 3-axis work in the part frame.
+    pub setup: Option<Setup>,
+    /// Lead-in/lead-out at plunges and retracts.
+    pub leads: LeadKind,
+    /// Parallel planes or isoparametric passes.
+    pub strategy: Strategy,
 }
 
 impl FinishJob {
@@ -76,6 +141,10 @@ impl FinishJob {
             tolerances: Tolerances { path: 0.01, gouge: 0.0 },
             max_step: 0.5,
             sim_resolution: 0.1,
+            output: OutputOptions::linuxcnc(),
+            setup: None,
+            leads: LeadKind::None,
+            strategy: Strategy::ParallelPlanes,
         }
     }
 }
@@ -109,6 +178,8 @@ pub struct FinishReport {
     pub sim_min_deviation_mm: f64,
     /// Gouge tolerance the simulation enforced (mm).
     pub sim_gouge_tolerance_mm: f64,
+    /// Leads applied, and those replaced by straight plunges (with where and why).
+    pub leads: LeadReport,
 }
 
 /// The job's outputs.
@@ -120,6 +191,29 @@ pub struct FinishOutput {
     pub gcode: String,
     /// The report.
     pub report: FinishReport,
+    /// What the 3-axis program was written from (lines and arcs, planning frame);
+    /// lines only for 3+2 output.
+    pub fitted: FittedPath,
+    /// What the pictures and the HTML report show (`scallop-report`).
+    pub details: FinishDetails,
+}
+
+/// The intermediate results behind a [`FinishReport`], kept for reports and
+/// pictures: the part as cut, the stock, the planner's settings, the measured
+/// scallop and the simulated stock.
+#[derive(Debug, Clone)]
+pub struct FinishDetails {
+    /// The mesh the cutter was dropped on, and its index.
+    pub prepared: PreparedPart,
+    /// The stock box of the simulation.
+    pub stock: Aabb3,
+    /// The settings the planner ran with (for the look-ahead feed profile).
+    pub params: FinishingParams,
+    /// The verified scallop of parallel planes (histogram, pairs); isoparametric
+    /// passes are checked by `iso_scallop`, which keeps no histogram.
+    pub scallop: Option<scallop_strategy::ScallopReport>,
+    /// The simulated stock and its verification.
+    pub simulation: scallop_sim::Simulation,
 }
 
 /// Runs the finishing job. `planning_seconds` is measured by the caller and
@@ -129,11 +223,37 @@ pub struct FinishOutput {
 /// Bad settings, an unknown part, a plan that cannot hold the scallop height,
 /// or a safety problem found by the stock simulation.
 pub fn run_finishing(job: &FinishJob) -> Result<FinishOutput, EngineError> {
-    let prepared = prepare_part(&job.part, &job.tolerances)?;
+    // With arcs on, planning gets `1 - ARC_SHARE` of the path tolerance.
+    let tolerances = if job.output.arc_fitting {
+        Tolerances { path: job.tolerances.path * (1.0 - ARC_SHARE), ..job.tolerances }
+    } else {
+        job.tolerances
+    };
+    if job.setup.is_none() && job.output.dialect.syntax != scallop_post::Syntax::Iso {
+        return Err(EngineError::Output {
+            what: format!("3-axis output in the plain-language dialect `{}`", job.output.dialect.name),
+            fix: "use an ISO dialect (linuxcnc, fanuc, grbl, siemens840d, heidenhain-iso)".into(),
+        });
+    }
+    if job.output.arc_fitting && job.setup.is_some() {
+        return Err(EngineError::Output {
+            what: "arc fitting in 3+2 output".into(),
+            fix: "set output.arc_fitting = false for a job with a [setup]".into(),
+        });
+    }
+    let prepared = prepare_part(&job.part, &tolerances)?;
+    let prepared = match &job.setup {
+        Some(setup) => rotate_prepared(&prepared, &setup.rotation)?,
+        None => prepared,
+    };
     let machine = MachineLimits::from_thesis_units(job.machine[0], job.machine[1], job.machine[2]);
-    let samples = match &job.part {
-        Part::Surfaces(set) => sample_surface_set(set, &GridOptions::default()).map_err(EngineError::Analysis)?,
-        Part::Mesh(mesh) => sample_mesh(mesh),
+    let samples = match (&job.part, &job.setup) {
+        (Part::Surfaces(set), None) => {
+            sample_surface_set(set, &GridOptions::default()).map_err(EngineError::Analysis)?
+        }
+        (Part::Mesh(mesh), None) => sample_mesh(mesh),
+        // 3+2: analyse the part as the cutter sees it, in the planning frame.
+        (_, Some(_)) => sample_mesh(&prepared.mesh),
     };
     let radius = job.cutter.radius();
     let (corner, is_ball) = match *job.cutter.shape() {
@@ -161,7 +281,44 @@ pub fn run_finishing(job: &FinishJob) -> Result<FinishOutput, EngineError> {
         sharp_corner: SHARP_CORNER_DEG.to_radians(),
         blend_tolerance: job.tolerances.path,
     };
-    let planned = plan_finishing(&prepared.index, &job.cutter, &params, &job.tolerances)?;
+    let mut planned = match job.strategy {
+        Strategy::ParallelPlanes => {
+            let p = plan_finishing(&prepared.index, &job.cutter, &params, &tolerances)?;
+            Plan { toolpath: p.toolpath, report: p.report, scallop: Some(p.scallop) }
+        }
+        Strategy::Isoparametric(direction) => {
+            let Part::Surfaces(set) = &job.part else {
+                return Err(EngineError::Output {
+                    what: "isoparametric passes on a mesh part".into(),
+                    fix: "use a parametric part (builtin or a surface file) or finishing.strategy = \"parallel\""
+                        .into(),
+                });
+            };
+            if job.setup.is_some() {
+                return Err(EngineError::Output {
+                    what: "isoparametric passes in a 3+2 setup".into(),
+                    fix: "remove [setup] or use finishing.strategy = \"parallel\"".into(),
+                });
+            }
+            isoparametric(set, &prepared, job, &params, &tolerances, direction)?
+        }
+    };
+    let (led, leads) =
+        apply_leads(&planned.toolpath, &prepared.index, &job.cutter, job.leads, tolerances.path, job.tolerances.gouge)?;
+    if leads.applied > 0 {
+        // The leads change the plunges and retracts: times and lengths again.
+        let (a, b) = (stop_to_stop_time(&led, &params), lookahead_time(&led, &params));
+        let r = &mut planned.report;
+        r.machining_time_s = a.cutting;
+        r.machining_time_lookahead_s = b.cutting;
+        r.rapid_time_s = a.rapid;
+        r.plunge_time_s = a.plunge;
+        r.total_time_s = a.total();
+        r.rapid_length_mm = led.length(MoveKind::Rapid) + led.length(MoveKind::Retract);
+        r.plunge_length_mm = led.length(MoveKind::Plunge);
+        r.points = led.moves().len();
+        planned.toolpath = led;
+    }
 
     // Prove the program on a simulated stock before anyone runs it: the part's
     // box grown by the cutter radius, from 1 mm below to 1 mm above the part.
@@ -197,10 +354,35 @@ pub fn run_finishing(job: &FinishJob) -> Result<FinishOutput, EngineError> {
             r.machining_time_s, r.machining_time_lookahead_s, r.rapid_time_s
         ),
     ];
-    let refs: Vec<&str> = comments.iter().map(String::as_str).collect();
-    let mut text = Vec::new();
-    write_gcode(&planned.toolpath, &Dialect::plain(), &refs, &mut text)
-        .map_err(|_| EngineError::BadTolerance(f64::NAN))?;
+    let mut comments = comments.to_vec();
+    let fitted = if job.output.arc_fitting {
+        let f = fit_arcs(&planned.toolpath, ARC_SHARE * job.tolerances.path);
+        comments.push(format!(
+            "arcs: {} G2/G3 within {} mm of the planned path; planning within {} mm",
+            f.arcs(),
+            ARC_SHARE * job.tolerances.path,
+            tolerances.path
+        ));
+        f
+    } else {
+        FittedPath::lines(&planned.toolpath)
+    };
+    let text = match &job.setup {
+        None => {
+            let refs: Vec<&str> = comments.iter().map(String::as_str).collect();
+            let info = ProgramInfo {
+                program: job.output.program.clone(),
+                tool: job.output.tool,
+                spindle: job.output.spindle,
+                indexed_rotaries: Vec::new(),
+            };
+            let mut text = Vec::new();
+            write_fitted(&fitted, &job.output.dialect, &info, &refs, &mut text)
+                .map_err(|e| EngineError::Output { what: format!("writing the program: {e}"), fix: String::new() })?;
+            String::from_utf8_lossy(&text).into_owned()
+        }
+        Some(setup) => indexed_program(job, setup, &planned.toolpath, r.machining_time_s)?,
+    };
     let report = FinishReport {
         part: job.part_name.clone(),
         cutter: cutter_text,
@@ -215,8 +397,131 @@ pub fn run_finishing(job: &FinishJob) -> Result<FinishOutput, EngineError> {
         sim_max_material_mm: sim.verification.max_scallop,
         sim_min_deviation_mm: sim.verification.min_deviation,
         sim_gouge_tolerance_mm: gouge_tolerance,
+        leads,
     };
-    Ok(FinishOutput { toolpath: planned.toolpath, gcode: String::from_utf8_lossy(&text).into_owned(), report })
+    let details = FinishDetails { prepared, stock, params, scallop: planned.scallop, simulation: sim };
+    Ok(FinishOutput { toolpath: planned.toolpath, gcode: text, report, fitted, details })
+}
+
+/// Which finishing strategy.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Strategy {
+    /// Parallel vertical planes (`scallop_strategy::plan_finishing`).
+    ParallelPlanes,
+    /// Isoparametric passes on every patch of a parametric part.
+    Isoparametric(IsoDirection),
+}
+
+/// A toolpath and its figures, whatever the strategy.
+struct Plan {
+    toolpath: Toolpath,
+    report: scallop_strategy::Report,
+    scallop: Option<scallop_strategy::ScallopReport>,
+}
+
+/// Isoparametric passes patch after patch; the report's times and lengths are those
+/// of the joined toolpath, its scallop the largest measured over all patches.
+fn isoparametric(
+    set: &scallop_surface::SurfaceSet,
+    prepared: &PreparedPart,
+    job: &FinishJob,
+    params: &FinishingParams,
+    tolerances: &Tolerances,
+    direction: IsoDirection,
+) -> Result<Plan, EngineError> {
+    let mut toolpath = Toolpath::new(params.machine.feed * 60.0);
+    toolpath.plunge_feed = params.plunge_feed * 60.0;
+    let (mut passes, mut max_h, mut mean_sum) = (0, 0.0f64, 0.0);
+    for patch in set.patches() {
+        let p = plan_isoparametric(
+            patch,
+            &prepared.index,
+            &job.cutter,
+            params,
+            direction,
+            tolerances,
+            prepared.chordal_error,
+        )?;
+        passes += p.passes.len();
+        max_h = max_h.max(p.max_scallop_mm);
+        mean_sum += p.mean_scallop_mm;
+        toolpath.plunge_feed = p.toolpath.plunge_feed;
+        for m in p.toolpath.moves() {
+            toolpath.push(*m);
+        }
+    }
+    let (a, b) = (stop_to_stop_time(&toolpath, params), lookahead_time(&toolpath, params));
+    let feed = toolpath.length(MoveKind::Feed);
+    #[allow(clippy::cast_precision_loss, reason = "patch counts")]
+    let mean = mean_sum / set.patches().len().max(1) as f64;
+    let report = scallop_strategy::Report {
+        machining_time_s: a.cutting,
+        machining_time_lookahead_s: b.cutting,
+        rapid_time_s: a.rapid,
+        plunge_time_s: a.plunge,
+        total_time_s: a.total(),
+        path_length_mm: feed,
+        feed_length_mm: feed,
+        link_length_mm: 0.0,
+        rapid_length_mm: toolpath.length(MoveKind::Rapid) + toolpath.length(MoveKind::Retract),
+        plunge_length_mm: toolpath.length(MoveKind::Plunge),
+        passes,
+        planes: passes,
+        links: 0,
+        retracts: toolpath.count(MoveKind::Retract),
+        max_scallop_mm: max_h,
+        mean_scallop_mm: mean,
+        points: toolpath.moves().len(),
+        cl_points_dropped: 0,
+        planning_time_s: 0.0,
+    };
+    Ok(Plan { toolpath, report, scallop: None })
+}
+
+/// The prepared part turned into the planning frame of a 3+2 setup.
+fn rotate_prepared(prepared: &PreparedPart, rotation: &Rotation3<f64>) -> Result<PreparedPart, EngineError> {
+    let vertices: Vec<Point3> = prepared.mesh.vertices().iter().map(|v| rotation * v).collect();
+    let triangles: Vec<[usize; 3]> = prepared.mesh.triangles().iter().map(|t| t.map(|i| i as usize)).collect();
+    let (mesh, _) = TriMesh::from_indexed(&vertices, &triangles).map_err(|e| EngineError::Output {
+        what: format!("the turned part: {e}"),
+        fix: "check the setup rotation".into(),
+    })?;
+    let index = MeshIndex::build(&mesh);
+    Ok(PreparedPart { mesh, index, ..prepared.clone() })
+}
+
+/// 3+2 output: the planning-frame toolpath back in the part frame with the tool axis
+/// `rotation^-1 z`, through the machine's inverse kinematics, written in tilted work
+/// planes (joint space with the rotaries held where the dialect has no plane code).
+fn indexed_program(job: &FinishJob, setup: &Setup, path: &Toolpath, time: f64) -> Result<String, EngineError> {
+    let back = setup.rotation.inverse();
+    let mut part_frame = Toolpath::new(path.feed);
+    part_frame.plunge_feed = path.plunge_feed;
+    for m in path.moves() {
+        part_frame.push(Move::new(m.kind, back * m.to));
+    }
+    let axis: Vec3 = back * Vec3::z();
+    let kin = Kinematics::new(&setup.machine, setup.tool_length);
+    let options = ProgramOptions::default();
+    let records = records_from_toolpath(&part_frame, &axis);
+    let program = to_program(&kin, &records, None, &options).map_err(|e| EngineError::Output {
+        what: format!("the indexed tool axis on machine `{}`: {e}", setup.machine.name()),
+        fix: "choose a setup rotation the machine can reach, or another machine".into(),
+    })?;
+    let params = PostParams {
+        program: job.output.program.clone(),
+        mode: OutputMode::TiltedPlane,
+        tool: job.output.tool.max(1),
+        tool_length: setup.tool_length,
+        spindle: job.output.spindle,
+        tol_pos: options.tol_pos,
+        tol_ang: options.tol_ang,
+        predicted_time: Some(time),
+    };
+    program_text(&program, &kin, &job.output.dialect, &params).map_err(|e| EngineError::Output {
+        what: e.to_string(),
+        fix: "use a 5-axis dialect (linuxcnc, fanuc, siemens840d, heidenhain)".into(),
+    })
 }
 
 /// Rapid rate of the demo machine (mm/s).
@@ -257,5 +562,38 @@ mod tests {
         assert!(out.gcode.contains("predicted machining time"));
         let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
         assert_eq!(one.install(|| run_finishing(&FinishJob::choi_demo()).unwrap()).gcode, out.gcode);
+    }
+
+    #[test]
+    fn one_way_finishing_with_leads_enters_tangentially_and_proves_itself() {
+        for leads in [LeadKind::Arc { radius: 2.0 }, LeadKind::Ramp { length: 3.0, angle: 15f64.to_radians() }] {
+            let mut job = FinishJob::choi_demo();
+            job.pattern = Pattern::OneWay;
+            job.scallop_height = 0.03;
+            job.leads = leads;
+            // run_finishing fails if the stock simulation finds a gouge or a rapid into stock.
+            let out = run_finishing(&job).unwrap();
+            let r = &out.report;
+            assert!(r.plan.retracts > 10);
+            assert_eq!(r.leads.applied + r.leads.fallbacks.len(), 2 * (r.plan.retracts + 1), "{:?}", r.leads);
+            assert!(r.leads.applied > r.plan.retracts, "{:?}", r.leads);
+        }
+    }
+
+    #[test]
+    fn isoparametric_finishing_of_choi_holds_the_scallop_and_proves_itself() {
+        let mut job = FinishJob::choi_demo();
+        job.cutter = Cutter::new(CutterShape::Ball { radius: 3.0 }, 40.0).unwrap();
+        job.scallop_height = 0.05;
+        job.strategy = Strategy::Isoparametric(IsoDirection::U);
+        // run_finishing fails if the stock simulation finds a gouge or a rapid into stock.
+        let out = run_finishing(&job).unwrap();
+        let r = &out.report.plan;
+        assert!(r.passes > 10 && r.max_scallop_mm <= 0.05, "{r:?}");
+        // A mesh part has no isolines.
+        let mut mesh_job = job.clone();
+        let mesh = prepare_part(&job.part, &job.tolerances).unwrap().mesh;
+        mesh_job.part = Part::Mesh(mesh);
+        assert!(matches!(run_finishing(&mesh_job), Err(EngineError::Output { .. })));
     }
 }

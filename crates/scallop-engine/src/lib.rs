@@ -23,7 +23,10 @@ use scallop_mesh::{MeshIndex, TriMesh};
 use scallop_surface::SurfaceSet;
 
 pub use demo::{DemoOutput, DemoSettings, DemoSummary, run_demo};
-pub use finish::{FinishJob, FinishOutput, FinishReport, run_finishing, toolpath_csv};
+pub use finish::{
+    ARC_SHARE, FinishDetails, FinishJob, FinishOutput, FinishReport, OutputOptions, Setup, Strategy, run_finishing,
+    toolpath_csv,
+};
 pub use grid::{GridAxis, GridError, MAX_GRID_POINTS};
 
 /// Why the engine rejected a request. Each variant says the cause and the fix.
@@ -53,6 +56,14 @@ pub enum EngineError {
     /// collision) or could not run.
     #[error("verification: {0}")]
     Verification(#[from] scallop_sim::SimError),
+    /// The program cannot be written as asked (dialect, machine, 3+2 setup).
+    #[error("output: {what}; fix: {fix}")]
+    Output {
+        /// What cannot be written.
+        what: String,
+        /// What to do.
+        fix: String,
+    },
 }
 
 /// A part to machine.

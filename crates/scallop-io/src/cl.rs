@@ -197,7 +197,7 @@ mod tests {
         let e = read_cl_csv("kind,x,y,z,i,j,k\nfeed,0,0,0,0,0,0\n").unwrap_err();
         assert!(e.to_string().contains("zero"), "{e}");
         let e = read_cl_csv("kind,x,y,z\nfeed,1,2\n").unwrap_err();
-        assert!(e.to_string().contains("2 fields"), "{e}");
+        assert!(e.to_string().contains("3 fields where the header names 4"), "{e}");
         assert_eq!(read_cl_csv("kind,x,y,z\n"), Err(ClError::Empty));
         assert_eq!(read_cl_csv(""), Err(ClError::Empty));
     }

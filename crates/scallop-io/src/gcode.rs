@@ -1,13 +1,12 @@
 //! A reader of plain 3-axis G-code (RS-274 subset) into a [`Toolpath`], so
 //! that programs from other systems can be simulated and verified.
 //!
-//! Understood: `G0 G1 G2 G3` (arcs in the XY plane, `G17`, with `I J` centre
-//! offsets or `R`), `G20 G21` (inches, millimetres), `G90 G91` (absolute,
+//! Understood: `G0 G1 G2 G3` (circular or helical arcs in the plane `G17` XY,
+//! `G18` ZX or `G19` YZ, with `I J K` centre offsets or `R`), `G20 G21` (inches, millimetres), `G90 G91` (absolute,
 //! incremental), `F`, `X Y Z`, line numbers `N`, comments `( ... )` and `;`,
 //! block delete `/`, and `%`. Spindle, coolant, tool and program words (`S T M
-//! O`) and `G17 G40 G49 G54..G59 G80 G94 G64 G61` are accepted and have no
-//! effect on the path. Anything else that moves the tool (`G18 G19`, canned
-//! cycles, `G28`, `G53`, `G92`, rotary words `A B C`, ...) is an error naming
+//! O`) and `G40 G43 G49 G54..G59 G80 G94 G64 G61` are accepted and have no
+//! effect on the path. Anything else that moves the tool (canned cycles, `G28`, `G53`, `G92`, rotary words `A B C`, ...) is an error naming
 //! the line: a simulation must never silently skip motion.
 //!
 //! Arcs are replaced by chords within `arc_tolerance` (sagitta), so every move
@@ -93,17 +92,18 @@ const MM_PER_INCH: f64 = 25.4;
 /// assert!(path.moves().len() > 4);
 /// let last = path.moves().last().unwrap().to;
 /// assert!((last.x - 20.0).abs() < 1e-12 && last.y.abs() < 1e-12);
-/// assert!(read_gcode("G0 X0 Y0 Z0\nG18\n", &GcodeOptions::default()).unwrap_err().to_string().contains("line 2"));
+/// assert!(read_gcode("G0 X0 Y0 Z0\nG28\n", &GcodeOptions::default()).unwrap_err().to_string().contains("line 2"));
 /// ```
 pub fn read_gcode(text: &str, options: &GcodeOptions) -> Result<Toolpath, GcodeError> {
-    let mut state = State { pos: options.start, scale: 1.0, absolute: true, motion: None, feed: None };
+    let mut state =
+        State { pos: options.start, scale: 1.0, absolute: true, motion: None, feed: None, plane: (0, 1, 2) };
     let mut path = Toolpath::new(0.0);
     let mut feeds: Vec<f64> = Vec::new();
     for (k, raw) in text.lines().enumerate() {
         let line = k + 1;
         let words = words(raw, line)?;
         let mut target = [None::<f64>; 3];
-        let (mut i, mut j, mut r) = (None, None, None);
+        let (mut i, mut j, mut kk, mut r) = (None, None, None, None);
         for (letter, value) in words {
             match letter {
                 'G' => state.g_code(value, line)?,
@@ -112,7 +112,7 @@ pub fn read_gcode(text: &str, options: &GcodeOptions) -> Result<Toolpath, GcodeE
                 'Z' => target[2] = Some(value),
                 'I' => i = Some(value),
                 'J' => j = Some(value),
-                'K' => {}
+                'K' => kk = Some(value),
                 'R' => r = Some(value),
                 'F' => {
                     if !(value.is_finite() && value > 0.0) {
@@ -157,16 +157,17 @@ pub fn read_gcode(text: &str, options: &GcodeOptions) -> Result<Toolpath, GcodeE
                 if motion == 1 {
                     path.push(Move::new(kind, to));
                 } else {
+                    let (u, v, _) = state.plane;
+                    let offsets = [i, j, kk].map(|o| o.map(|x| x * state.scale));
                     let centre = arc_centre(
-                        from,
-                        to,
-                        i.map(|v| v * state.scale),
-                        j.map(|v| v * state.scale),
-                        r.map(|v| v * state.scale),
+                        (from[u], from[v]),
+                        (to[u], to[v]),
+                        (offsets[u], offsets[v]),
+                        r.map(|x| x * state.scale),
                         motion == 2,
                         line,
                     )?;
-                    for p in arc_points(from, to, centre, motion == 2, options.arc_tolerance) {
+                    for p in arc_points(from, to, centre, state.plane, motion == 2, options.arc_tolerance) {
                         path.push(Move::new(MoveKind::Feed, p));
                     }
                 }
@@ -191,6 +192,8 @@ struct State {
     absolute: bool,
     motion: Option<u8>,
     feed: Option<f64>,
+    /// Arc plane `(u, v, n)`, right-handed: G17 (X, Y, Z), G18 (Z, X, Y), G19 (Y, Z, X).
+    plane: (usize, usize, usize),
 }
 
 impl State {
@@ -201,18 +204,14 @@ impl State {
         let code = tenth as i64;
         match code {
             0 | 10 | 20 | 30 => self.motion = Some(u8::try_from(code / 10).unwrap_or(0)),
-            170 | 400 | 490 | 800 | 940 | 610 | 640 | 641 | 540 | 550 | 560 | 570 | 580 | 590 => {}
+            400 | 430 | 490 | 800 | 940 | 610 | 640 | 641 | 540 | 550 | 560 | 570 | 580 | 590 => {}
+            170 => self.plane = (0, 1, 2),
+            180 => self.plane = (2, 0, 1),
+            190 => self.plane = (1, 2, 0),
             200 => self.scale = MM_PER_INCH,
             210 => self.scale = 1.0,
             900 => self.absolute = true,
             910 => self.absolute = false,
-            180 | 190 => {
-                return Err(GcodeError::Unsupported {
-                    line,
-                    code: format!("G{value}"),
-                    why: "arcs outside the XY plane",
-                });
-            }
             _ => {
                 return Err(GcodeError::Unsupported {
                     line,
@@ -285,25 +284,25 @@ fn words(raw: &str, line: usize) -> Result<Vec<(char, f64)>, GcodeError> {
     Ok(out)
 }
 
+/// Centre `(u, v)` of an arc in its plane from `(u, v)` start and end.
 fn arc_centre(
-    from: Point3,
-    to: Point3,
-    i: Option<f64>,
-    j: Option<f64>,
+    from: (f64, f64),
+    to: (f64, f64),
+    offsets: (Option<f64>, Option<f64>),
     r: Option<f64>,
     clockwise: bool,
     line: usize,
 ) -> Result<(f64, f64), GcodeError> {
-    if i.is_some() || j.is_some() {
-        let c = (from.x + i.unwrap_or(0.0), from.y + j.unwrap_or(0.0));
-        let (r0, r1) = ((from.x - c.0).hypot(from.y - c.1), (to.x - c.0).hypot(to.y - c.1));
+    if offsets.0.is_some() || offsets.1.is_some() {
+        let c = (from.0 + offsets.0.unwrap_or(0.0), from.1 + offsets.1.unwrap_or(0.0));
+        let (r0, r1) = ((from.0 - c.0).hypot(from.1 - c.1), (to.0 - c.0).hypot(to.1 - c.1));
         if (r0 - r1).abs() > ARC_RADIUS_MISMATCH * r0.max(1.0) {
             return Err(GcodeError::BadArc { line, why: format!("start radius {r0:.4} mm, end radius {r1:.4} mm") });
         }
         return Ok(c);
     }
-    let Some(r) = r else { return Err(GcodeError::BadArc { line, why: "neither I/J nor R given".into() }) };
-    let (dx, dy) = (to.x - from.x, to.y - from.y);
+    let Some(r) = r else { return Err(GcodeError::BadArc { line, why: "neither I/J/K nor R given".into() }) };
+    let (dx, dy) = (to.0 - from.0, to.1 - from.1);
     let d = dx.hypot(dy);
     if d == 0.0 || d > 2.0 * r.abs() * (1.0 + ARC_RADIUS_MISMATCH) {
         return Err(GcodeError::BadArc { line, why: format!("R {r} cannot join points {d:.4} mm apart") });
@@ -311,17 +310,24 @@ fn arc_centre(
     let h = (r * r - d * d / 4.0).max(0.0).sqrt();
     // Centre to the left of the chord for CCW with R > 0 (the short arc), mirrored otherwise.
     let side = if clockwise == (r > 0.0) { -1.0 } else { 1.0 };
-    let (mx, my) = (from.x + dx / 2.0, from.y + dy / 2.0);
+    let (mx, my) = (from.0 + dx / 2.0, from.1 + dy / 2.0);
     Ok((mx - side * h * dy / d, my + side * h * dx / d))
 }
 
 /// Relative mismatch of start and end radii accepted in an arc.
 const ARC_RADIUS_MISMATCH: f64 = 1e-3;
 
-fn arc_points(from: Point3, to: Point3, c: (f64, f64), clockwise: bool, tolerance: f64) -> Vec<Point3> {
-    let radius = (from.x - c.0).hypot(from.y - c.1);
-    let a0 = (from.y - c.1).atan2(from.x - c.0);
-    let a1 = (to.y - c.1).atan2(to.x - c.0);
+fn arc_points(
+    from: Point3,
+    to: Point3,
+    c: (f64, f64),
+    (u, v, n): (usize, usize, usize),
+    clockwise: bool,
+    tolerance: f64,
+) -> Vec<Point3> {
+    let radius = (from[u] - c.0).hypot(from[v] - c.1);
+    let a0 = (from[v] - c.1).atan2(from[u] - c.0);
+    let a1 = (to[v] - c.1).atan2(to[u] - c.0);
     let mut sweep = a1 - a0;
     if clockwise {
         while sweep >= 0.0 {
@@ -335,13 +341,17 @@ fn arc_points(from: Point3, to: Point3, c: (f64, f64), clockwise: bool, toleranc
     // Chord sagitta r (1 - cos(theta / 2)) <= tolerance.
     let max_step = if radius > tolerance { 2.0 * (1.0 - tolerance / radius).acos() } else { std::f64::consts::PI };
     #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
-    let n = ((sweep.abs() / max_step.max(f64::EPSILON)).ceil() as usize).clamp(1, MAX_ARC_CHORDS);
+    let steps = ((sweep.abs() / max_step.max(f64::EPSILON)).ceil() as usize).clamp(1, MAX_ARC_CHORDS);
     #[allow(clippy::cast_precision_loss)]
-    let mut pts: Vec<Point3> = (1..n)
+    let mut pts: Vec<Point3> = (1..steps)
         .map(|k| {
-            let t = k as f64 / n as f64;
+            let t = k as f64 / steps as f64;
             let a = a0 + sweep * t;
-            Point3::new(c.0 + radius * a.cos(), c.1 + radius * a.sin(), from.z + (to.z - from.z) * t)
+            let mut p = from;
+            p[u] = c.0 + radius * a.cos();
+            p[v] = c.1 + radius * a.sin();
+            p[n] = from[n] + (to[n] - from[n]) * t;
+            p
         })
         .collect();
     pts.push(to);
@@ -391,9 +401,24 @@ mod tests {
     }
 
     #[test]
+    fn arcs_in_the_zx_and_yz_planes_follow_the_g18_g19_conventions() {
+        // G18: clockwise seen from +Y. From (10, 0, 0) to (0, 0, 10) about the origin,
+        // the short way through x, z > 0 is clockwise (G2).
+        let p = read("G0 X10 Y3 Z0\nG1 F100\nG18 G2 X0 Z10 I-10 K0\n").unwrap();
+        for m in p.moves() {
+            assert!((m.to.x.hypot(m.to.z) - 10.0).abs() <= 0.001 + 1e-9 && m.to.y == 3.0, "{}", m.to);
+            assert!(m.to.x >= -1e-9 && m.to.z >= -1e-9, "{}", m.to);
+        }
+        // G19: counter-clockwise seen from +X, from (0, 10, 0) to (0, 0, 10), helical in X.
+        let p = read("G0 X0 Y10 Z0\nG1 F100\nG19 G3 X4 Y0 Z10 R10\n").unwrap();
+        let mid = p.moves()[p.moves().len() / 2].to;
+        assert!(mid.y > 0.0 && mid.z > 0.0 && (mid.x - 2.0).abs() < 0.3, "{mid}");
+    }
+
+    #[test]
     fn refuses_what_it_cannot_follow() {
-        let e = read("G0 X0 Y0 Z0\nG1 X1 F100\nG18 G2 X2 Z1 I1\n").unwrap_err();
-        assert!(matches!(e, GcodeError::Unsupported { line: 3, .. }), "{e}");
+        let e = read("G0 X0 Y0 Z0\nG1 X1 F100\nG18 G2 X2 Z1 I5\n").unwrap_err();
+        assert!(matches!(e, GcodeError::BadArc { line: 3, .. }), "{e}");
         assert!(matches!(read("G0 X0 Y0 Z0\nG1 X1 A90 F100\n").unwrap_err(), GcodeError::Unsupported { line: 2, .. }));
         assert!(matches!(read("G0 X0 Y0 Z0\nG1 X1\n").unwrap_err(), GcodeError::State { line: 2, .. }));
         assert!(matches!(read("G0 X0 Y0 Z0\nG1 X1Q F100\n").unwrap_err(), GcodeError::Syntax { line: 2, .. }));

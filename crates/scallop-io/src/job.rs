@@ -42,6 +42,60 @@ pub struct JobFile {
     /// Zone-optimisation study (`scallop optimize`).
     #[serde(default)]
     pub optimize: Option<OptimizeSpec>,
+    /// How the program is written.
+    #[serde(default)]
+    pub output: OutputSpec,
+    /// 3+2 setup (indexed rotaries); absent for 3-axis work.
+    pub setup: Option<SetupSpec>,
+}
+
+/// `[output]`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSpec {
+    /// Controller dialect: `linuxcnc` (default), `plain`, `fanuc`, `grbl`, `siemens840d`,
+    /// `heidenhain-iso` (checked by the caller against the shipped dialects).
+    #[serde(default = "default_dialect")]
+    pub dialect: String,
+    /// `G2`/`G3` arcs within a quarter of the path tolerance (default false).
+    #[serde(default)]
+    pub arc_fitting: bool,
+    /// Program name or number.
+    #[serde(default = "default_program")]
+    pub program: String,
+    /// Tool number (0: no tool change).
+    #[serde(default)]
+    pub tool: u32,
+    /// Spindle speed (1/min; 0: no spindle word).
+    #[serde(default)]
+    pub spindle: f64,
+}
+
+fn default_dialect() -> String {
+    "linuxcnc".into()
+}
+fn default_program() -> String {
+    "1".into()
+}
+
+impl Default for OutputSpec {
+    fn default() -> Self {
+        OutputSpec { dialect: default_dialect(), arc_fitting: false, program: default_program(), tool: 0, spindle: 0.0 }
+    }
+}
+
+/// `[setup]`: 3+2 work.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SetupSpec {
+    /// Rotation of the part into the frame where the tool is vertical, degrees about the
+    /// fixed X, then Y, then Z axes (`R = Rz Ry Rx`).
+    pub rotation_deg: [f64; 3],
+    /// Machine description whose kinematics give the rotary words (e.g. `linuxcnc-xyzac-trt`).
+    pub machine: String,
+    /// Tool length the kinematics use (mm; 0 when the controller applies it).
+    #[serde(default)]
+    pub tool_length: f64,
 }
 
 /// `[part]`: one of `file` (mesh or surface file, relative to the job file) or `builtin`.
@@ -91,6 +145,40 @@ pub struct FinishingSpec {
     /// Longest forward step between drop-cutter samples (mm).
     #[serde(default = "default_max_step")]
     pub max_step: f64,
+    /// `parallel` (default: parallel vertical planes) or `isoparametric` (parametric parts).
+    #[serde(default = "default_strategy")]
+    pub strategy: String,
+    /// Isoparametric passes along `u` (default) or `v`.
+    #[serde(default = "default_iso")]
+    pub iso_direction: String,
+    /// Lead-in/lead-out at plunges and retracts: `none` (default), `arc` or `ramp`.
+    #[serde(default = "default_lead")]
+    pub lead: String,
+    /// Radius of arc leads (mm).
+    #[serde(default = "default_lead_size")]
+    pub lead_radius: f64,
+    /// Length of ramp leads (mm).
+    #[serde(default = "default_lead_size")]
+    pub lead_length: f64,
+    /// Angle of ramp leads above the pass's tangent (degrees).
+    #[serde(default = "default_lead_angle")]
+    pub lead_angle_deg: f64,
+}
+
+fn default_strategy() -> String {
+    "parallel".into()
+}
+fn default_iso() -> String {
+    "u".into()
+}
+fn default_lead() -> String {
+    "none".into()
+}
+fn default_lead_size() -> f64 {
+    2.0
+}
+fn default_lead_angle() -> f64 {
+    15.0
 }
 
 fn default_pattern() -> String {
@@ -382,7 +470,15 @@ pub fn parse_job(text: &str) -> Result<JobFile, JobError> {
     }
     let sh = job.finishing.scallop_height;
     if !positive(sh) || sh >= job.cutter.diameter / 2.0 {
-        return bad("finishing.scallop_height", sh, "need 0 < sh < the cutter radius");
+        return bad("finishing.scallop_height", sh, "need 0 < sh < the cutter radius (diameter / 2)");
+    }
+    if job.cutter.shape == "bull" && job.cutter.corner_radius.is_some_and(|r| sh >= r) {
+        return bad("finishing.scallop_height", sh, "need 0 < sh < the bull-nose corner radius");
+    }
+    if let Some(f) = job.cutter.flute_length
+        && !positive(f)
+    {
+        return bad("cutter.flute_length", f, "give the flute length in mm, > 0");
     }
     match &job.finishing.direction {
         DirectionSpec::Named(n) if n != "auto" => {
@@ -402,7 +498,34 @@ pub fn parse_job(text: &str) -> Result<JobFile, JobError> {
             fix: "use \"zigzag\" or \"one-way\"",
         });
     }
+    if !matches!(job.finishing.strategy.as_str(), "parallel" | "isoparametric") {
+        return Err(JobError::Value {
+            key: "finishing.strategy",
+            value: job.finishing.strategy.clone(),
+            fix: "use \"parallel\" or \"isoparametric\"",
+        });
+    }
+    if !matches!(job.finishing.iso_direction.as_str(), "u" | "v") {
+        return Err(JobError::Value {
+            key: "finishing.iso_direction",
+            value: job.finishing.iso_direction.clone(),
+            fix: "use \"u\" or \"v\"",
+        });
+    }
+    if !matches!(job.finishing.lead.as_str(), "none" | "arc" | "ramp") {
+        return Err(JobError::Value {
+            key: "finishing.lead",
+            value: job.finishing.lead.clone(),
+            fix: "use \"none\", \"arc\" or \"ramp\"",
+        });
+    }
+    let angle = job.finishing.lead_angle_deg;
+    if !(angle.is_finite() && angle > 0.0 && angle < 90.0) {
+        return bad("finishing.lead_angle_deg", angle, "need 0 < angle < 90 degrees");
+    }
     for (key, v) in [
+        ("finishing.lead_radius", job.finishing.lead_radius),
+        ("finishing.lead_length", job.finishing.lead_length),
         ("finishing.max_step", job.finishing.max_step),
         ("tolerances.path", job.tolerances.path),
         ("machine.feed", job.machine.feed),
@@ -418,6 +541,24 @@ pub fn parse_job(text: &str) -> Result<JobFile, JobError> {
     }
     if !(job.tolerances.gouge.is_finite() && job.tolerances.gouge >= 0.0) {
         return bad("tolerances.gouge", job.tolerances.gouge, "must be >= 0");
+    }
+    if !(job.output.spindle.is_finite() && job.output.spindle >= 0.0) {
+        return bad("output.spindle", job.output.spindle, "give the spindle speed in 1/min, >= 0");
+    }
+    if let Some(setup) = &job.setup {
+        if let Some(a) = setup.rotation_deg.iter().find(|a| !a.is_finite()) {
+            return bad("setup.rotation_deg", *a, "give three finite angles in degrees");
+        }
+        if !(setup.tool_length.is_finite() && setup.tool_length >= 0.0) {
+            return bad("setup.tool_length", setup.tool_length, "give the tool length in mm, >= 0");
+        }
+        if job.output.arc_fitting {
+            return Err(JobError::Value {
+                key: "output.arc_fitting",
+                value: "true".into(),
+                fix: "3+2 output has no arcs: set it to false or remove [setup]",
+            });
+        }
     }
     if let Some(o) = &job.optimize {
         check_optimize(o, sh)?;
@@ -504,9 +645,13 @@ mod tests {
         let job = parse_job(BASE).unwrap();
         assert_eq!(job.finishing.direction, DirectionSpec::Auto);
         assert_eq!(job.machine.feed, 5.0);
-        for example in
-            [include_str!("../../../examples/jobs/choi.toml"), include_str!("../../../examples/jobs/rubio.toml")]
-        {
+        for example in [
+            include_str!("../../../examples/jobs/choi.toml"),
+            include_str!("../../../examples/jobs/rubio.toml"),
+            include_str!("../../../examples/jobs/choi-arcs.toml"),
+            include_str!("../../../examples/jobs/choi-3plus2.toml"),
+            include_str!("../../../examples/jobs/rubio-iso.toml"),
+        ] {
             parse_job(example).unwrap();
         }
         let job = parse_job(&format!("{BASE}[optimize]\nformulation = \"3axis\"\n")).unwrap();
@@ -553,6 +698,20 @@ mod tests {
             (format!("{BASE}[optimize]\nformulation = \"3+2\"\ntransition = \"teleport\"\n"), "optimize.transition"),
             (format!("{BASE}[optimize]\nformulation = \"3+2\"\nbarier = \"extreme\"\n"), "barier"),
             (format!("{BASE}[optimize]\nk_max = 4\n"), "formulation"),
+            (BASE.replace("scallop_height = 0.01", "scallop_height = 3"), "corner radius"),
+            (BASE.replace("diameter = 10", "diameter = 10\nflute_length = -3"), "cutter.flute_length"),
+            (format!("{BASE}[output]\nspindle = -1\n"), "output.spindle"),
+            (format!("{BASE}lead = \"loop\"\n"), "finishing.lead"),
+            (format!("{BASE}strategy = \"spiral\"\n"), "finishing.strategy"),
+            (format!("{BASE}iso_direction = \"w\"\n"), "finishing.iso_direction"),
+            (format!("{BASE}lead = \"arc\"\nlead_radius = -2\n"), "finishing.lead_radius"),
+            (format!("{BASE}lead = \"ramp\"\nlead_angle_deg = 90\n"), "finishing.lead_angle_deg"),
+            (format!("{BASE}[output]\narcs = true\n"), "arcs"),
+            (format!("{BASE}[setup]\nrotation_deg = [0, 30]\nmachine = \"m\"\n"), "rotation_deg"),
+            (
+                format!("{BASE}[setup]\nrotation_deg = [0, 30, 0]\nmachine = \"m\"\n[output]\narc_fitting = true\n"),
+                "output.arc_fitting",
+            ),
         ];
         for (text, key) in cases {
             let err = parse_job(&text).unwrap_err().to_string();

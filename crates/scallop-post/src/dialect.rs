@@ -46,6 +46,18 @@ pub enum TiltedPlane {
     PlaneSpatial,
 }
 
+/// How `G2`/`G3` arcs give their centre.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ArcWords {
+    /// `I J K`: the centre as an offset from the start (incremental, the ISO default of
+    /// LinuxCNC, Fanuc and grbl), two of them per plane (`G17` I J, `G18` I K, `G19` J K).
+    #[default]
+    Ijk,
+    /// `R`: the radius (arcs under a half turn only, as written by scallop).
+    Radius,
+}
+
 /// Line numbering (`N10`, `N20`, ... or Heidenhain's `0`, `1`, ...).
 #[derive(Debug, Clone, PartialEq, Eq, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -183,6 +195,9 @@ pub struct Dialect {
     /// Tilted-work-plane codes.
     #[serde(default)]
     pub tilted_plane: TiltedPlane,
+    /// Centre words of `G2`/`G3` arcs ([`crate::write_fitted`]).
+    #[serde(default)]
+    pub arc_words: ArcWords,
 }
 
 const BUILTIN: &[(&str, &str)] = &[
@@ -225,6 +240,7 @@ impl Dialect {
             modulo_words: None,
             tcp: None,
             tilted_plane: TiltedPlane::None,
+            arc_words: ArcWords::Ijk,
         }
     }
 

@@ -2,7 +2,9 @@
 //! and footer templates, line numbering, modal suppression, TCP and tilted-plane codes),
 //! loadable from TOML, with built-ins for LinuxCNC, Fanuc, Siemens 840D, Heidenhain
 //! (plain language and ISO) and grbl. Two writers:
-//! - [`write_gcode`]: a 3-axis [`Toolpath`] (the demo path);
+//! - [`write_gcode`]: a 3-axis [`Toolpath`] (the demo path); [`write_fitted`]: a 3-axis
+//!   path with `G2`/`G3` arcs ([`scallop_toolpath::fit_arcs`]) and the job's program,
+//!   tool, spindle and 3+2 rotary positioning;
 //! - [`write_program`]: a joint-space [`MachineProgram`](scallop_machine::program::MachineProgram)
 //!   in joint space with inverse-time feeds, in TCP form, or in tilted work planes
 //!   ([`OutputMode`]).
@@ -39,12 +41,14 @@ use scallop_toolpath::{MoveKind, Toolpath};
 pub mod dialect;
 pub mod error;
 pub mod reader;
+pub mod three_axis;
 pub mod tol;
 pub mod writer;
 
-pub use dialect::{Dialect, FeedByTime, LineNumbers, ModuloWords, Syntax, TcpCodes, TiltedPlane};
+pub use dialect::{ArcWords, Dialect, FeedByTime, LineNumbers, ModuloWords, Syntax, TcpCodes, TiltedPlane};
 pub use error::PostError;
 pub use reader::{ReplayedBlock, RoundTrip, check_replay, replay};
+pub use three_axis::{ProgramInfo, write_fitted, write_toolpath};
 pub use writer::{OutputMode, PostParams, cycle800_angles, program_text, write_program};
 
 /// Formats `v` with `decimals` digits, writing negative zero as zero.

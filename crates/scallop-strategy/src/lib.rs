@@ -130,6 +130,8 @@
 
 mod error;
 mod geometry;
+mod iso;
+mod leads;
 pub mod network;
 mod params;
 mod plan;
@@ -139,9 +141,11 @@ pub mod tol;
 pub mod trochoid;
 
 pub use error::StrategyError;
+pub use iso::{IsoDirection, IsoPass, IsoPlanned, iso_scallop, plan_isoparametric};
+pub use leads::{LeadFallback, LeadKind, LeadReport, apply_leads};
 pub use params::{Boundary, FinishingParams, Pattern};
 pub use scallop::{PairScallop, ScallopReport, verify_scallop};
-pub use time::{ClassTimes, lookahead_time, stop_to_stop_time};
+pub use time::{ClassTimes, MoveFeed, lookahead_profile, lookahead_time, stop_to_stop_time};
 
 use scallop_cutter::Cutter;
 use scallop_geom::{Point3, Tolerances};

@@ -177,7 +177,13 @@ fn reach(v0: f64, length: f64, vmax: f64, m: &MachineLimits) -> f64 {
 }
 
 /// Time of one segment entered at `v0`, left at `v1`, with speed limit `vmax`.
+#[cfg(test)]
 fn segment_time(v0: f64, v1: f64, length: f64, vmax: f64, m: &MachineLimits) -> f64 {
+    segment_profile(v0, v1, length, vmax, m).0
+}
+
+/// Time and peak speed of one segment entered at `v0`, left at `v1`, with speed limit `vmax`.
+fn segment_profile(v0: f64, v1: f64, length: f64, vmax: f64, m: &MachineLimits) -> (f64, f64) {
     let used = |vp: f64| transition(v0, vp, m).1 + transition(vp, v1, m).1;
     let base = v0.max(v1);
     let peak = if used(vmax) <= length {
@@ -195,10 +201,10 @@ fn segment_time(v0: f64, v1: f64, length: f64, vmax: f64, m: &MachineLimits) -> 
         lo
     };
     if peak <= 0.0 {
-        return 0.0;
+        return (0.0, 0.0);
     }
     let cruise = (length - used(peak)).max(0.0) / peak;
-    transition(v0, peak, m).0 + transition(peak, v1, m).0 + cruise
+    (transition(v0, peak, m).0 + transition(peak, v1, m).0 + cruise, peak)
 }
 
 /// Model (b): look-ahead jerk-limited feed profile with corner blending
@@ -221,17 +227,53 @@ fn segment_time(v0: f64, v1: f64, length: f64, vmax: f64, m: &MachineLimits) -> 
 /// ```
 #[must_use]
 pub fn lookahead_time(path: &Toolpath, params: &FinishingParams) -> ClassTimes {
-    let segs = segments(path);
-    let n = segs.len();
     let mut times = ClassTimes::default();
-    if n == 0 {
-        return times;
+    for (m, p) in path.moves().iter().zip(lookahead_profile(path, params)) {
+        times.add(class(m.kind), p.duration);
     }
-    let lims: Vec<MachineLimits> = segs.iter().map(|s| limits(params, s.class)).collect();
+    times
+}
+
+/// The feed of one move in the look-ahead model (b): entry, exit and peak
+/// speed and the move's duration (mm/s, s).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct MoveFeed {
+    /// Speed entering the move (mm/s).
+    pub entry: f64,
+    /// Speed leaving the move (mm/s).
+    pub exit: f64,
+    /// Highest speed reached on the move (mm/s).
+    pub peak: f64,
+    /// Duration of the move (s); 0 for the first move and for moves without length.
+    pub duration: f64,
+}
+
+/// Model (b) move by move: one [`MoveFeed`] per move of `path` (the first move,
+/// which has no start, and moves without length get zeros). The durations sum,
+/// per class, to [`lookahead_time`]; a report plots the achieved feed from it.
+#[must_use]
+pub fn lookahead_profile(path: &Toolpath, params: &FinishingParams) -> Vec<MoveFeed> {
+    let moves = path.moves();
+    let mut out = vec![MoveFeed::default(); moves.len()];
+    // (move index, segment) for the moves with a length.
+    let segs: Vec<(usize, Segment)> = moves
+        .windows(2)
+        .enumerate()
+        .filter_map(|(k, w)| {
+            let v = w[1].to - w[0].to;
+            let length = v.norm();
+            (length > tol::ZERO_LENGTH).then(|| (k + 1, Segment { class: class(w[1].kind), length, dir: v / length }))
+        })
+        .collect();
+    let n = segs.len();
+    if n == 0 {
+        return out;
+    }
+    let lims: Vec<MachineLimits> = segs.iter().map(|(_, s)| limits(params, s.class)).collect();
     let a_max = params.machine.acceleration;
     let mut v = vec![0.0f64; n + 1];
     for i in 1..n {
-        let (p, q) = (&segs[i - 1], &segs[i]);
+        let (p, q) = (&segs[i - 1].1, &segs[i].1);
         if p.class != q.class {
             continue;
         }
@@ -245,15 +287,16 @@ pub fn lookahead_time(path: &Toolpath, params: &FinishingParams) -> ClassTimes {
         };
     }
     for i in 0..n {
-        v[i + 1] = v[i + 1].min(reach(v[i], segs[i].length, lims[i].feed, &lims[i]));
+        v[i + 1] = v[i + 1].min(reach(v[i], segs[i].1.length, lims[i].feed, &lims[i]));
     }
     for i in (0..n).rev() {
-        v[i] = v[i].min(reach(v[i + 1], segs[i].length, lims[i].feed, &lims[i]));
+        v[i] = v[i].min(reach(v[i + 1], segs[i].1.length, lims[i].feed, &lims[i]));
     }
-    for (i, s) in segs.iter().enumerate() {
-        times.add(s.class, segment_time(v[i], v[i + 1], s.length, lims[i].feed, &lims[i]));
+    for (i, (k, s)) in segs.iter().enumerate() {
+        let (duration, peak) = segment_profile(v[i], v[i + 1], s.length, lims[i].feed, &lims[i]);
+        out[*k] = MoveFeed { entry: v[i], exit: v[i + 1], peak, duration };
     }
-    times
+    out
 }
 
 #[cfg(test)]

@@ -138,3 +138,26 @@ pub const LOOKAHEAD_SHRINK: f64 = 1e-3;
 /// that the next plane's own spacing usually accepts the gap at once (a
 /// slightly conservative step instead of a second plane).
 pub const LOOKAHEAD_TREND: f64 = 1.25;
+/// Measurements of the scallop per isoparametric pass pair while fitting the
+/// spacing (each scales the step by `sqrt(sh / h)`).
+pub const ISO_FIT_ITERATIONS: usize = 8;
+
+/// Points across the gap between two isoparametric passes, plus one, at which the
+/// scallop is measured (at every running sample).
+pub const ISO_LATERAL_SAMPLES: usize = 6;
+
+/// Most samples of one isoparametric pass.
+pub const ISO_MAX_SAMPLES: usize = 20_000;
+
+/// Largest isoparametric step-over, as a multiple of the cutter radius (where the
+/// effective radius is infinite: a horizontal flat bottom).
+pub const ISO_MAX_STEP_OVER: f64 = 1.8;
+
+/// The isoparametric scallop check walks a pass's segments outwards from the
+/// measured point's running parameter and stops after this many in a row that
+/// cannot come closer (a segment left out only enlarges the measured scallop).
+pub const ISO_WINDOW_MISSES: usize = 8;
+
+/// An isoparametric step whose measured scallop lies between this fraction of
+/// `sh` and `sh` is accepted without trying a larger one.
+pub const ISO_FIT_ACCEPT: f64 = 0.8;

@@ -17,6 +17,10 @@
 
 use scallop_geom::Point3;
 
+mod arcs;
+
+pub use arcs::{ArcMove, ArcPlane, FittedPath, MAX_ARC_POINTS, MAX_RADIUS, MAX_SWEEP, MIN_RADIUS, Segment, fit_arcs};
+
 /// What a move is for; decides how it is emitted and coloured.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum MoveKind {

@@ -1,0 +1,71 @@
+#!/usr/bin/env bash
+# Issue 7: open the HTML reports in headless Chromium and check that they work.
+# Builds the demo's finishing report (`scallop demo`) and the simulation report
+# of its program (`scallop simulate`), then for each:
+#   chromium --headless ... --screenshot   (1200 x 800)
+#   chromium --headless ... --dump-dom
+# and checks with bench/report/page_check.py that the viewer set its drawn
+# marker, that the page's error element is empty (window.onerror, console.error
+# and the draw try/catch write there), and that the canvas is not blank (pixel
+# statistics of the screenshot).
+# Installs Debian's `chromium` when missing; if apt cannot, says so and exits 0.
+# Usage: bench/report/check.sh [OUTDIR]   (default target/report-check)
+# Env: SCALLOP (binary, default target/release/scallop, built when missing).
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+OUT="${1:-target/report-check}"
+SCALLOP="${SCALLOP:-target/release/scallop}"
+
+find_chromium() {
+    for c in chromium chromium-browser; do
+        command -v "$c" 2>/dev/null && return 0
+    done
+    return 1
+}
+CHROMIUM="$(find_chromium || true)"
+if [ -z "$CHROMIUM" ]; then
+    SUDO=""
+    [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+    $SUDO apt-get update -qq >/dev/null 2>&1 || true
+    $SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null 2>&1 || true
+    CHROMIUM="$(find_chromium || true)"
+    if [ -z "$CHROMIUM" ]; then
+        echo "check.sh: apt could not install the Debian package chromium; the browser check of the reports is skipped."
+        exit 0
+    fi
+fi
+[ -x "$SCALLOP" ] || cargo build --release -q -p scallop-cli
+
+mkdir -p "$OUT"
+"$SCALLOP" demo -o "$OUT/demo" >/dev/null
+"$SCALLOP" simulate --part choi --program "$OUT/demo/program.nc" --cutter bull --diameter 10 --corner-radius 2 \
+    --flute-length 30 --resolution 0.2 --gouge-tolerance 0.0125 -o "$OUT/sim" >/dev/null
+
+# Chromium stalls on connection attempts without these flags (no network here).
+# WebGL runs on SwiftShader (software): --disable-gpu plus --enable-unsafe-swiftshader.
+browse() {
+    local profile
+    profile="$(mktemp -d)"
+    "$CHROMIUM" --headless --no-sandbox --disable-gpu --enable-unsafe-swiftshader \
+        --disable-background-networking --disable-component-update --disable-sync --no-first-run \
+        --disable-quic --user-data-dir="$profile" --window-size=1200,800 --virtual-time-budget=15000 \
+        "$@" 2>/dev/null
+    rm -rf "$profile"
+}
+
+status=0
+for page in "$OUT/demo/report.html" "$OUT/sim/report.html"; do
+    url="file://$(cd "$(dirname "$page")" && pwd)/$(basename "$page")"
+    shot="${page%.html}.png"
+    dom="${page%.html}.dom.html"
+    rm -f "$shot"
+    (cd "$(dirname "$page")" && browse --screenshot="$(basename "$shot")" "$url") >/dev/null
+    browse --dump-dom "$url" > "$dom"
+    if python3 bench/report/page_check.py "$dom" "$shot"; then
+        echo "ok: $page"
+    else
+        echo "FAILED: $page" >&2
+        status=1
+    fi
+done
+exit $status

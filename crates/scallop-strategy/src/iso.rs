@@ -1,0 +1,470 @@
+//! Isoparametric finishing of one parametric patch (issue 3): passes along the
+//! isolines of `u` (or `v`), the iso spacing adapted pass by pass so that the
+//! scallop between adjacent passes stays `<= sh`.
+//!
+//! - **Passes.** Pass `k` follows the isoline `cross = c_k` (`cross = v` for
+//!   passes along `u`). Its cutter locations are drop-cutter points (exact, on the
+//!   part's mesh) at the XY of the tip that touches each isoline point along the
+//!   surface normal (so the contact stays on the isoline where the cutter can
+//!   reach it), sampled every `max_step` mm and
+//!   bisected while the CL midpoint deviates from the chord by more than
+//!   `SAMPLING_SHARE * path`, then merged by `simplify_above` within
+//!   `SIMPLIFY_SHARE * path`. Passes run in zigzag order, joined by retract, rapid
+//!   and plunge (always safe).
+//! - **Spacing rule.** At every sample of pass `k`: the surface normal `n`, the
+//!   feed direction `f = S_along` and the cross direction `S_cross`; tilt
+//!   `s = acos |n_z|`, horizontal angle `alpha` between `f` and the steepest
+//!   slope, `R_eff(s, alpha)` of the cutter ([`scallop_analysis::Cutter`]: ball
+//!   `R`, bull-nose Eq. 1.5, flat as a torus with `r = 0`), step-over
+//!   `sod = min(2 sqrt(2 sh R_eff - sh^2), 1.8 R)` on the surface, and the
+//!   parameter step `sod / |S_cross x n-free part|` (`sod` over the length of
+//!   `S_cross` across the feed). The candidate is the minimum over the pass.
+//! - **Guarantee: measured.** The candidate next pass is planned and the scallop
+//!   between the two is measured by [`iso_scallop`] (below); the step is scaled by
+//!   `sqrt(sh / h)` (the scallop grows as the square of the spacing) up to
+//!   [`tol::ISO_FIT_ITERATIONS`] times, keeping the largest step measured `<= sh`
+//!   (a step measured within [`tol::ISO_FIT_ACCEPT`] of `sh` is taken at once).
+//!   A pair over `sh` after that is an `Err`.
+//! - **Independent check.** [`iso_scallop`] uses no effective radius: the cutter
+//!   body (ball, flat or bull-nose) is convex, the Minkowski sum of a horizontal
+//!   disc of radius `R - r` and a ball of radius `r`, so the distance from a point
+//!   to the cutter moving along a straight CL segment is convex in the segment
+//!   parameter and found exactly by golden section. The scallop at a surface point
+//!   between two passes is its distance to the nearest cutter position of either
+//!   pass (0 where a cutter touches it), evaluated at [`tol::ISO_LATERAL_SAMPLES`]
+//!   points across the gap at every sample of the pass, on the true surface, less
+//!   the rest material there (what the cutter placed to touch the point along its
+//!   normal, then dropped, still leaves: hollows tighter than the cutter, edges).
+//!   The end strips (within the cutter radius of a pass end, where the envelope
+//!   comes from the end position: the cutter never goes beyond the patch) are not
+//!   measured, as for parallel planes.
+//!   Heights include the tessellation's chordal error of the mesh the cutter was
+//!   dropped on, so the planner aims at `sh - chordal_error`.
+
+use scallop_analysis::Cutter as Model;
+use scallop_cutter::{Cutter, CutterShape, drop_cutter};
+use scallop_geom::{Point2, Point3, Tolerances, Vec3};
+use scallop_mesh::MeshIndex;
+use scallop_surface::Patch;
+use scallop_toolpath::{Move, MoveKind, Toolpath, simplify_above};
+use serde::{Deserialize, Serialize};
+
+use crate::{FinishingParams, StrategyError, tol};
+
+/// Which parameter runs along the passes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum IsoDirection {
+    /// Passes along `u` (isolines `v = const`).
+    U,
+    /// Passes along `v` (isolines `u = const`).
+    V,
+}
+
+/// One isoparametric pass.
+#[derive(Debug, Clone, PartialEq)]
+pub struct IsoPass {
+    /// The constant parameter of the isoline.
+    pub iso: f64,
+    /// Cutter locations (tool tip, mm) in increasing running parameter.
+    pub cl: Vec<Point3>,
+    /// Running parameter of each point of `cl`.
+    pub cl_params: Vec<f64>,
+    /// Running parameters of all samples before merging (where the scallop is measured).
+    pub samples: Vec<f64>,
+}
+
+/// The result of [`plan_isoparametric`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct IsoPlanned {
+    /// The moves (zigzag; retract, rapid and plunge between passes).
+    pub toolpath: Toolpath,
+    /// The passes in order.
+    pub passes: Vec<IsoPass>,
+    /// Largest measured scallop between adjacent passes (mm).
+    pub max_scallop_mm: f64,
+    /// Mean of the per-sample measured scallops (mm).
+    pub mean_scallop_mm: f64,
+}
+
+/// Plans isoparametric passes over `patch` (its tessellation indexed by `index`,
+/// within `chordal_error` of it) with `cutter`. From `params` it uses
+/// `scallop_height`, `max_step` and `clearance`; the feed is `params.machine.feed`.
+///
+/// # Errors
+/// A bad parameter, a cone cutter, `sh` not below the cutter (corner) radius, a
+/// spacing below [`tol::MIN_SPACING`] (in mm on the surface), or a measured scallop
+/// over `sh` (a bug).
+pub fn plan_isoparametric(
+    patch: &Patch,
+    index: &MeshIndex,
+    cutter: &Cutter,
+    params: &FinishingParams,
+    direction: IsoDirection,
+    tolerances: &Tolerances,
+    chordal_error: f64,
+) -> Result<IsoPlanned, StrategyError> {
+    params.validate()?;
+    let model = model(cutter)?;
+    let sh = params.scallop_height;
+    let limit = match *cutter.shape() {
+        CutterShape::Bull { corner, .. } => corner,
+        _ => cutter.radius(),
+    };
+    if sh >= limit {
+        return Err(StrategyError::ScallopTooLarge { scallop_height: sh, what: "radius", radius: limit });
+    }
+    let target = sh - chordal_error.max(0.0);
+    if target <= 0.0 {
+        return Err(StrategyError::BadParameter {
+            name: "tolerances.path",
+            value: tolerances.path,
+            fix: "the tessellation error exceeds the scallop height: use a smaller path tolerance",
+        });
+    }
+    let domain = patch.domain();
+    let (along, across) = match direction {
+        IsoDirection::U => (domain.u, domain.v),
+        IsoDirection::V => (domain.v, domain.u),
+    };
+    let ctx = Ctx { patch, index, cutter, direction, along, floor: index.bounds().min.z - 1.0, tolerances, params };
+    let mut passes = vec![ctx.pass(across[0])];
+    let mut heights: Vec<f64> = Vec::new();
+    let mut max_h = 0.0f64;
+    while passes.last().is_some_and(|p| p.iso < across[1]) {
+        let last = passes.last().map_or(across[0], |p| p.iso);
+        let current = &passes[passes.len() - 1];
+        let mut step = ctx.rule_step(current, &model, target);
+        let mut best: Option<(IsoPass, Vec<f64>, f64)> = None;
+        for _ in 0..tol::ISO_FIT_ITERATIONS {
+            let iso = (last + step).min(across[1]);
+            let next = ctx.pass(iso);
+            let h = iso_scallop(patch, index, cutter, direction, current, &next);
+            let worst = h.iter().copied().fold(0.0, f64::max);
+            let reached_end = iso >= across[1];
+            if worst <= target {
+                let better = best.as_ref().is_none_or(|b| iso > b.0.iso);
+                if better {
+                    best = Some((next, h, worst));
+                }
+                if reached_end || worst >= tol::ISO_FIT_ACCEPT * target {
+                    break;
+                }
+            }
+            let factor = if worst > 0.0 { (target / worst).sqrt() * tol::SPACING_SAFETY } else { 2.0 };
+            let grown = step * factor.clamp(0.25, 2.0);
+            if worst <= target && grown <= step {
+                break;
+            }
+            step = if worst > target { step * factor.clamp(0.25, 0.95) } else { grown };
+            if step * ctx.cross_speed(current) < tol::MIN_SPACING {
+                break;
+            }
+        }
+        let Some((next, h, worst)) = best else {
+            let p = current.cl.first().copied().unwrap_or_else(Point3::origin);
+            return Err(StrategyError::Unreachable { x: p.x, y: p.y, spacing: step, scallop_height: sh });
+        };
+        max_h = max_h.max(worst);
+        heights.extend(h);
+        passes.push(next);
+    }
+    #[allow(clippy::cast_precision_loss, reason = "sample counts")]
+    let mean = if heights.is_empty() { 0.0 } else { heights.iter().sum::<f64>() / heights.len() as f64 };
+    let toolpath = ctx.toolpath(&passes);
+    Ok(IsoPlanned { toolpath, passes, max_scallop_mm: max_h + chordal_error.max(0.0), mean_scallop_mm: mean })
+}
+
+fn model(cutter: &Cutter) -> Result<Model, StrategyError> {
+    match *cutter.shape() {
+        CutterShape::Ball { radius } => Ok(Model::Ball { radius }),
+        CutterShape::Bull { radius, corner } => Ok(Model::Toroidal { radius, corner }),
+        CutterShape::Flat { radius } => Ok(Model::Toroidal { radius, corner: 0.0 }),
+        CutterShape::Cone { .. } => Err(StrategyError::Unsupported { shape: "cone" }),
+    }
+}
+
+struct Ctx<'a> {
+    patch: &'a Patch,
+    index: &'a MeshIndex,
+    cutter: &'a Cutter,
+    direction: IsoDirection,
+    along: [f64; 2],
+    floor: f64,
+    tolerances: &'a Tolerances,
+    params: &'a FinishingParams,
+}
+
+fn uv(direction: IsoDirection, a: f64, c: f64) -> (f64, f64) {
+    match direction {
+        IsoDirection::U => (a, c),
+        IsoDirection::V => (c, a),
+    }
+}
+
+impl Ctx<'_> {
+    fn surface(&self, a: f64, c: f64) -> Point3 {
+        let (u, v) = uv(self.direction, a, c);
+        self.patch.point(u, v)
+    }
+
+    /// The cutter location whose contact is `S(a, c)` (the tip offset along the
+    /// normal), dropped onto the part: the contact stays on the isoline wherever the
+    /// cutter can reach it.
+    fn drop(&self, a: f64, c: f64) -> Point3 {
+        let (u, v) = uv(self.direction, a, c);
+        let ideal = touching_tip(self.patch, self.cutter, u, v);
+        drop_cutter(self.cutter, self.index, Point2::new(ideal.x, ideal.y), self.floor).tip
+    }
+
+    /// The pass on isoline `c`: uniform samples at about `max_step`, bisected to the
+    /// sampling share of the path tolerance, merged within the simplify share.
+    fn pass(&self, c: f64) -> IsoPass {
+        let [a0, a1] = self.along;
+        let coarse = 64;
+        #[allow(clippy::cast_precision_loss, reason = "small counts")]
+        let length: f64 = (0..coarse)
+            .map(|i| {
+                let (s, t) = (i as f64 / coarse as f64, (i + 1) as f64 / coarse as f64);
+                (self.surface(a0 + (a1 - a0) * t, c) - self.surface(a0 + (a1 - a0) * s, c)).norm()
+            })
+            .sum();
+        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a small positive count")]
+        let n = ((length / self.params.max_step).ceil() as usize).clamp(2, tol::ISO_MAX_SAMPLES);
+        #[allow(clippy::cast_precision_loss, reason = "small counts")]
+        let mut samples: Vec<(f64, Point3)> = (0..=n)
+            .map(|i| {
+                let a = a0 + (a1 - a0) * i as f64 / n as f64;
+                (a, self.drop(a, c))
+            })
+            .collect();
+        let sample_tol = tol::SAMPLING_SHARE * self.tolerances.path;
+        let min_da = (a1 - a0) * tol::MIN_STEP_FRACTION / n as f64;
+        let mut k = 0;
+        while k + 1 < samples.len() && samples.len() < tol::ISO_MAX_SAMPLES {
+            let ((sa, pa), (sb, pb)) = (samples[k], samples[k + 1]);
+            let m = 0.5 * (sa + sb);
+            let pm = self.drop(m, c);
+            let chord = Point3::from((pa.coords + pb.coords) * 0.5);
+            if (pm - chord).norm() > sample_tol && sb - sa > min_da {
+                samples.insert(k + 1, (m, pm));
+            } else {
+                k += 1;
+            }
+        }
+        let points: Vec<Point3> = samples.iter().map(|s| s.1).collect();
+        let kept = simplify_above(&points, tol::SIMPLIFY_SHARE * self.tolerances.path);
+        IsoPass {
+            iso: c,
+            cl: kept.iter().map(|&i| points[i]).collect(),
+            cl_params: kept.iter().map(|&i| samples[i].0).collect(),
+            samples: samples.iter().map(|s| s.0).collect(),
+        }
+    }
+
+    /// Length (mm) of the cross derivative, the smallest over the pass's samples.
+    fn cross_speed(&self, pass: &IsoPass) -> f64 {
+        pass.samples.iter().map(|&a| self.derivs(a, pass.iso).1.norm()).fold(f64::INFINITY, f64::min)
+    }
+
+    /// `(S_along, S_cross, normal)` at `(a, c)`.
+    fn derivs(&self, a: f64, c: f64) -> (Vec3, Vec3, Vec3) {
+        let (u, v) = uv(self.direction, a, c);
+        let d = self.patch.derivatives(u, v);
+        let n = self.patch.normal(u, v);
+        match self.direction {
+            IsoDirection::U => (d.du, d.dv, n),
+            IsoDirection::V => (d.dv, d.du, n),
+        }
+    }
+
+    /// The spacing rule: the smallest parameter step over the pass.
+    fn rule_step(&self, pass: &IsoPass, model: &Model, target: f64) -> f64 {
+        let mut step = f64::INFINITY;
+        for &a in &pass.samples {
+            let (f, x, n) = self.derivs(a, pass.iso);
+            let n = if n.z < 0.0 { -n } else { n };
+            let slope = n.z.clamp(-1.0, 1.0).acos();
+            let (nx, ny) = (n.x, n.y);
+            let alpha = if nx.hypot(ny) > tol::HORIZONTAL_XY && f.xy().norm() > tol::HORIZONTAL_XY {
+                (f.x * ny - f.y * nx).atan2(f.x * nx + f.y * ny)
+            } else {
+                0.0
+            };
+            let r_eff = model.effective_radius(slope, alpha);
+            let sod = scallop_analysis::step_over(target, r_eff).min(tol::ISO_MAX_STEP_OVER * model.radius());
+            // The part of S_cross across the feed direction on the surface.
+            let fu = f.try_normalize(1e-300).unwrap_or_else(Vec3::x);
+            let across = (x - fu * fu.dot(&x)).norm();
+            if across > 0.0 {
+                step = step.min(sod / across);
+            }
+        }
+        step
+    }
+
+    fn toolpath(&self, passes: &[IsoPass]) -> Toolpath {
+        let top = self.index.bounds().max.z + self.params.clearance;
+        let feed = self.params.machine.feed * 60.0;
+        let mut path = Toolpath::new(feed);
+        path.plunge_feed = self.params.plunge_feed * 60.0;
+        for (k, pass) in passes.iter().enumerate() {
+            let pts: Vec<Point3> = if k % 2 == 0 { pass.cl.clone() } else { pass.cl.iter().rev().copied().collect() };
+            let (Some(first), Some(last)) = (pts.first(), pts.last()) else { continue };
+            path.push(Move::new(MoveKind::Rapid, Point3::new(first.x, first.y, top)));
+            path.push(Move::new(MoveKind::Plunge, *first));
+            for p in &pts[1..] {
+                path.push(Move::new(MoveKind::Feed, *p));
+            }
+            path.push(Move::new(MoveKind::Retract, Point3::new(last.x, last.y, top)));
+        }
+        path
+    }
+}
+
+/// `(R, r)` of the cutter body: ball `r = R`, flat `r = 0`.
+fn radii(cutter: &Cutter) -> (f64, f64) {
+    match *cutter.shape() {
+        CutterShape::Ball { radius } => (radius, radius),
+        CutterShape::Bull { radius, corner } => (radius, corner),
+        CutterShape::Flat { radius } | CutterShape::Cone { radius, .. } => (radius, 0.0),
+    }
+}
+
+/// The tip of the cutter touching `S(u, v)` with the surface normal there (upward):
+/// the corner circle's centre is `S + r n`, the axis `(R - r)` inward of it.
+fn touching_tip(patch: &Patch, cutter: &Cutter, u: f64, v: f64) -> Point3 {
+    let (radius, corner) = radii(cutter);
+    let n = patch.normal(u, v);
+    let n = if n.z < 0.0 { -n } else { n };
+    let side = n.xy().try_normalize(tol::HORIZONTAL_XY).map_or(Vec3::zeros(), |h| Vec3::new(h.x, h.y, 0.0));
+    patch.point(u, v) + n * corner - side * (radius - corner) - Vec3::z() * corner
+}
+
+/// Distance (mm) from `p` to the cutter body with its tip at `tip` (0 inside):
+/// the body is a horizontal disc of radius `R - r` at height `r` above the tip,
+/// grown by a ball of radius `r` (ball: `r = R`; flat: `r = 0`).
+fn body_distance(p: &Point3, tip: &Point3, radius: f64, corner: f64) -> f64 {
+    let h = (p.xy() - tip.xy()).norm();
+    let dz = p.z - (tip.z + corner);
+    ((h - (radius - corner)).max(0.0).hypot(dz) - corner).max(0.0)
+}
+
+/// Smallest distance from `p` to the cutter moving along the pass (golden section
+/// per segment: the distance is convex along a straight move). Segments are visited
+/// outwards from the one at running parameter `s` and the walk stops on each side
+/// after [`tol::ISO_WINDOW_MISSES`] segments in a row that cannot come closer; a
+/// segment left out can only make the result larger (the check stays conservative).
+fn swept_distance(p: &Point3, pass: &IsoPass, s: f64, radius: f64, corner: f64) -> f64 {
+    let cl = &pass.cl;
+    if cl.len() < 2 {
+        return cl.first().map_or(f64::INFINITY, |t| body_distance(p, t, radius, corner));
+    }
+    let start = pass.cl_params.partition_point(|&x| x < s).clamp(1, cl.len() - 1) - 1;
+    let mut best = f64::INFINITY;
+    let visit = |k: usize, best: &mut f64| -> bool {
+        let (a, b) = (cl[k], cl[k + 1]);
+        let ab = b.xy() - a.xy();
+        let t = if ab.norm_squared() > 0.0 {
+            ((p.xy() - a.xy()).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        // The body reaches at most `radius` sideways from its axis.
+        let lower = (a.xy() + ab * t - p.xy()).norm() - radius;
+        if lower > *best {
+            return false;
+        }
+        let f = |s: f64| body_distance(p, &(a + (b - a) * s), radius, corner);
+        let (mut lo, mut hi) = (0.0f64, 1.0f64);
+        let g = 0.5 * (5f64.sqrt() - 1.0);
+        let (mut x1, mut x2) = (hi - g * (hi - lo), lo + g * (hi - lo));
+        let (mut f1, mut f2) = (f(x1), f(x2));
+        for _ in 0..tol::GOLDEN_ITERATIONS {
+            if f1 <= f2 {
+                hi = x2;
+                x2 = x1;
+                f2 = f1;
+                x1 = hi - g * (hi - lo);
+                f1 = f(x1);
+            } else {
+                lo = x1;
+                x1 = x2;
+                f1 = f2;
+                x2 = lo + g * (hi - lo);
+                f2 = f(x2);
+            }
+        }
+        *best = best.min(f1.min(f2)).min(f(0.0)).min(f(1.0));
+        true
+    };
+    visit(start, &mut best);
+    let mut misses = 0;
+    for k in (0..start).rev() {
+        misses = if visit(k, &mut best) { 0 } else { misses + 1 };
+        if misses >= tol::ISO_WINDOW_MISSES {
+            break;
+        }
+    }
+    misses = 0;
+    for k in start + 1..cl.len() - 1 {
+        misses = if visit(k, &mut best) { 0 } else { misses + 1 };
+        if misses >= tol::ISO_WINDOW_MISSES {
+            break;
+        }
+    }
+    best
+}
+
+/// Measured scallop (mm) between two adjacent isoparametric passes `a` and `b`, at
+/// every running sample of `a` (and `b`), the largest of
+/// [`tol::ISO_LATERAL_SAMPLES`] surface points across the gap: each point's distance to
+/// the nearest cutter position of either pass, less what the cutter leaves there
+/// anyway (rest material: the cutter placed to touch the point with its own normal,
+/// then dropped, is held up elsewhere). Independent of the spacing rule.
+#[must_use]
+pub fn iso_scallop(
+    patch: &Patch,
+    index: &MeshIndex,
+    cutter: &Cutter,
+    direction: IsoDirection,
+    a: &IsoPass,
+    b: &IsoPass,
+) -> Vec<f64> {
+    let (radius, corner) = radii(cutter);
+    let floor = index.bounds().min.z - 1.0;
+    let ends = [a.samples.first().copied(), a.samples.last().copied()];
+    let mut out = Vec::new();
+    let mut running: Vec<f64> = a.samples.iter().chain(&b.samples).copied().collect();
+    running.sort_by(f64::total_cmp);
+    running.dedup();
+    for &s in &running {
+        let mut worst = 0.0f64;
+        for k in 1..tol::ISO_LATERAL_SAMPLES {
+            #[allow(clippy::cast_precision_loss, reason = "small counts")]
+            let c = a.iso + (b.iso - a.iso) * k as f64 / tol::ISO_LATERAL_SAMPLES as f64;
+            let (u, v) = uv(direction, s, c);
+            let p = patch.point(u, v);
+            // End strips: within the cutter radius of a pass end the envelope comes from
+            // the end position (the cutter never goes beyond the patch): not a scallop.
+            let near_end = ends.iter().flatten().any(|&e| {
+                let (eu, ev) = uv(direction, e, c);
+                (patch.point(eu, ev) - p).norm() < radius
+            });
+            if near_end {
+                continue;
+            }
+            let d = swept_distance(&p, a, s, radius, corner).min(swept_distance(&p, b, s, radius, corner));
+            if d <= worst {
+                continue;
+            }
+            // The tip that touches p with the surface normal there, dropped.
+            let ideal = touching_tip(patch, cutter, u, v);
+            let held = drop_cutter(cutter, index, Point2::new(ideal.x, ideal.y), floor).tip;
+            let rest = if held.z > ideal.z { body_distance(&p, &held, radius, corner) } else { 0.0 };
+            worst = worst.max(d - rest);
+        }
+        out.push(worst);
+    }
+    out
+}

@@ -1,0 +1,86 @@
+//! Isoparametric finishing on random bicubic Bezier patches: the scallop measured
+//! independently between every pair of adjacent passes stays <= sh, no cutter
+//! location lies below the drop-cutter height (no gouge of the mesh), and the
+//! passes cover the patch from one iso edge to the other.
+
+mod common;
+
+use common::{ball, bull, params};
+use proptest::prelude::*;
+use scallop_cutter::{Cutter, drop_cutter};
+use scallop_geom::{Point2, Point3, Tolerances};
+use scallop_mesh::MeshIndex;
+use scallop_strategy::{IsoDirection, Pattern, iso_scallop, plan_isoparametric};
+use scallop_surface::Patch;
+use scallop_toolpath::MoveKind;
+
+fn patch(heights: &[f64]) -> Patch {
+    let control: Vec<Vec<Point3>> = (0..4)
+        .map(|i| {
+            (0..4)
+                .map(|j| Point3::new(10.0 * f64::from(i), 10.0 * f64::from(j), heights[4 * i as usize + j as usize]))
+                .collect()
+        })
+        .collect();
+    Patch::bezier("random", [3, 3], &control, None).expect("valid")
+}
+
+fn check(patch: &Patch, cutter: &Cutter, direction: IsoDirection, sh: f64) {
+    let tol = Tolerances { path: 0.01, gouge: 0.0 };
+    let t = patch.tessellate(tol.tessellation()).expect("tessellates");
+    let index = MeshIndex::build(&t.mesh);
+    let p = params(0.0, Pattern::Zigzag, sh, 1.0);
+    let planned = plan_isoparametric(patch, &index, cutter, &p, direction, &tol, t.chordal_bound).expect("plans");
+    assert!(planned.max_scallop_mm <= sh * (1.0 + 1e-6), "{} > {sh}", planned.max_scallop_mm);
+    // Independent re-measurement of every adjacent pair.
+    for w in planned.passes.windows(2) {
+        let h = iso_scallop(patch, &index, cutter, direction, &w[0], &w[1]);
+        let worst = h.iter().copied().fold(0.0, f64::max);
+        assert!(worst + t.chordal_bound <= sh * (1.0 + 1e-6), "pair at {}: {worst}", w[0].iso);
+    }
+    // Coverage: from one iso edge to the other.
+    let d = patch.domain();
+    let across = if direction == IsoDirection::U { d.v } else { d.u };
+    assert_eq!(planned.passes.first().map(|p| p.iso), Some(across[0]));
+    assert_eq!(planned.passes.last().map(|p| p.iso), Some(across[1]));
+    // No gouge: every cutting vertex is at or above the drop-cutter height.
+    for m in planned.toolpath.moves().iter().filter(|m| m.kind == MoveKind::Feed) {
+        let cl = drop_cutter(cutter, &index, Point2::new(m.to.x, m.to.y), -100.0);
+        assert!(m.to.z >= cl.tip.z - 1e-9, "{} below {}", m.to, cl.tip);
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(6))]
+    #[test]
+    fn random_bezier_patches_keep_the_scallop(
+        heights in prop::collection::vec(-3.0..3.0f64, 16),
+        along_u in any::<bool>(),
+        use_ball in any::<bool>(),
+    ) {
+        let cutter = if use_ball { ball(3.0) } else { bull(4.0, 1.5) };
+        let direction = if along_u { IsoDirection::U } else { IsoDirection::V };
+        check(&patch(&heights), &cutter, direction, 0.01);
+    }
+}
+
+#[test]
+fn a_plane_patch_gets_the_analytic_step_over() {
+    // A flat 30 x 30 patch with a ball R3 at sh 0.01: sod = 2 sqrt(2 sh R - sh^2) = 0.4894 mm,
+    // so ceil(30 / 0.4894) + 1 = 63 passes at most (the measured fit may only shrink it).
+    let flat = patch(&[0.0; 16]);
+    let tol = Tolerances { path: 0.01, gouge: 0.0 };
+    let t = flat.tessellate(tol.tessellation()).expect("tessellates");
+    let index = MeshIndex::build(&t.mesh);
+    let p = params(0.0, Pattern::Zigzag, 0.01, 1.0);
+    let planned =
+        plan_isoparametric(&flat, &index, &ball(3.0), &p, IsoDirection::U, &tol, t.chordal_bound).expect("plans");
+    let sod = 2.0 * (2.0f64 * 0.01 * 3.0 - 0.0001).sqrt();
+    let analytic = (30.0 / sod).ceil() as usize + 1;
+    assert!(
+        planned.passes.len() >= analytic - 1 && planned.passes.len() <= analytic + 2,
+        "{} passes for {analytic}",
+        planned.passes.len()
+    );
+    check(&flat, &ball(3.0), IsoDirection::U, 0.01);
+}
