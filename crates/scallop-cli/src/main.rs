@@ -4,6 +4,7 @@
 
 mod analyze;
 mod drop;
+mod optimize;
 mod output;
 mod part;
 mod post;
@@ -53,6 +54,8 @@ enum Command {
     Analyze(analyze::AnalyzeArgs),
     /// Cut a stock with a 3-axis G-code program and verify it against the part (gouges are errors).
     Simulate(simulate::SimulateArgs),
+    /// Partition a surface into zones and optimise their directions or orientations (see docs/job.md).
+    Optimize(optimize::OptimizeArgs),
     /// Post-process a cutter-location file for a machine and a dialect, with a machine-aware time report.
     Post(post::PostArgs),
     /// Render a part (and a toolpath) to a PNG picture, without a browser.
@@ -78,6 +81,7 @@ fn main() -> ExitCode {
         Command::Inspect(args) => part::inspect(&args),
         Command::Analyze(args) => analyze::run(&args),
         Command::Simulate(args) => simulate::run(&args),
+        Command::Optimize(args) => optimize::run(&args),
         Command::Post(args) => post::run(&args),
         Command::Render(args) => render::run(&args),
     };

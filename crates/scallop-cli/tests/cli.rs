@@ -279,6 +279,38 @@ fn run_plans_a_job_file_and_rejects_bad_keys() {
 }
 
 #[test]
+fn optimize_writes_the_study_and_rejects_bad_settings() {
+    let dir = scratch("optimize");
+    let job = "[part]\nbuiltin = \"rubio\"\n[cutter]\nshape = \"bull\"\ndiameter = 10\ncorner_radius = 2\n\
+               [finishing]\nscallop_height = 0.01\n[optimize]\nformulation = \"3axis\"\nk_min = 2\nk_max = 3\n\
+               budget = 8\ngrid = [20, 20]\nsurrogate_grid = [10, 10]\nstep = 1.5\n";
+    std::fs::write(dir.join("small.toml"), job).expect("write");
+    let out =
+        scallop().current_dir(&dir).args(["optimize", "small.toml", "-o", "out", "--json"]).output().expect("run");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
+    let results = v["study"]["results"].as_array().expect("results");
+    assert_eq!(results.len(), 2);
+    for r in results {
+        assert!(r["f_best"].as_f64().expect("f_best") <= r["f0"].as_f64().expect("f0"));
+        assert!(r["evaluations"].as_u64().expect("evaluations") <= 8);
+    }
+    for file in ["study.json", "report.json", "convergence.svg", "zones.svg"] {
+        assert!(dir.join("out").join(file).exists(), "{file}");
+    }
+    for (bad, key) in [
+        (job.replace("k_max = 3", "k_max = 1").replace("k_min = 2", "k_min = 1"), "optimize.k_max"),
+        (job.replace("budget = 8", "budget = 0"), "optimize.budget"),
+        (format!("{job}omega = [1, 2, 1, 1]\n"), "optimize.omega"),
+        (job.replace("[optimize]\nformulation = \"3axis\"\nk_min = 2\nk_max = 3\nbudget = 8\ngrid = [20, 20]\nsurrogate_grid = [10, 10]\nstep = 1.5\n", ""), "[optimize]"),
+    ] {
+        std::fs::write(dir.join("bad.toml"), &bad).expect("write");
+        assert_rejected(&["optimize", "bad.toml", "-o", "bad"], &dir, key);
+        assert!(!dir.join("bad").exists(), "a rejected job writes nothing");
+    }
+}
+
+#[test]
 fn post_writes_a_proven_program_with_a_time_report() {
     let dir = scratch("post");
     // A 5-axis circle with a swinging tool axis, in the CL format with axes and feeds.

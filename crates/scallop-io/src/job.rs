@@ -39,6 +39,9 @@ pub struct JobFile {
     /// Stock simulation that proves the program.
     #[serde(default)]
     pub verify: VerifySpec,
+    /// Zone-optimisation study (`scallop optimize`).
+    #[serde(default)]
+    pub optimize: Option<OptimizeSpec>,
     /// How the program is written.
     #[serde(default)]
     pub output: OutputSpec,
@@ -290,6 +293,117 @@ impl Default for VerifySpec {
     }
 }
 
+/// `[optimize]`: a zone-optimisation study (`scallop optimize`, finishing.md 12).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OptimizeSpec {
+    /// `"3axis"`, `"3+2"` or `"heuristic"`.
+    pub formulation: String,
+    /// Smallest number of clusters K (default 2).
+    #[serde(default = "default_k_min")]
+    pub k_min: i64,
+    /// Largest number of clusters K (default 10; at least 2).
+    #[serde(default = "default_k_max")]
+    pub k_max: i64,
+    /// Black-box-equivalent evaluations per K (default 1000).
+    #[serde(default = "default_budget")]
+    pub budget: f64,
+    /// Static surrogate ordering the poll: `"none"`, `"s3"` (default) or `"s4"`.
+    #[serde(default = "default_surrogate")]
+    pub surrogate: String,
+    /// Cost of one surrogate evaluation in black-box evaluations: a ratio
+    /// (deterministic; default 0.05) or `"measured"` (timed; not reproducible).
+    #[serde(default)]
+    pub surrogate_cost: SurrogateCostSpec,
+    /// Seed of the poll directions (default 0).
+    #[serde(default)]
+    pub seed: u64,
+    /// Start weights of the clustering pseudo-metric, each in [0, 1] (default all 1).
+    #[serde(default = "default_omega")]
+    pub omega: [f64; 4],
+    /// Clustering grid `[N_u, N_v]` of the black box (default `[80, 80]`).
+    #[serde(default = "default_grid")]
+    pub grid: [i64; 2],
+    /// Clustering grid of the surrogates (default `[40, 40]`).
+    #[serde(default = "default_surrogate_grid")]
+    pub surrogate_grid: [i64; 2],
+    /// Machining-mesh step of the black box (mm, default 0.5).
+    #[serde(default = "default_step")]
+    pub step: f64,
+    /// Machining-mesh step of surrogate S4 (mm, default 5).
+    #[serde(default = "default_surrogate_step")]
+    pub surrogate_step: f64,
+    /// Scallop height of surrogate S4 (mm, default 0.1).
+    #[serde(default = "default_surrogate_sh")]
+    pub surrogate_scallop_height: f64,
+    /// Inter-zone transition: `"retract"` (default: retract, traverse, plunge)
+    /// or `"linear"` (one straight move).
+    #[serde(default = "default_transition")]
+    pub transition: String,
+    /// Retract height above the higher end of a transition (mm, default 5).
+    #[serde(default = "default_clearance")]
+    pub transition_clearance: f64,
+    /// Quadratic-model search step (default: on for 3-axis only, as in the thesis).
+    #[serde(default)]
+    pub model_search: Option<bool>,
+    /// Constraint handling: `"progressive"` (default) or `"extreme"`.
+    #[serde(default = "default_barrier")]
+    pub barrier: String,
+}
+
+/// `optimize.surrogate_cost`: a number or `"measured"`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(untagged)]
+pub enum SurrogateCostSpec {
+    /// A fixed ratio.
+    Ratio(f64),
+    /// `"measured"`.
+    Named(String),
+}
+
+impl Default for SurrogateCostSpec {
+    fn default() -> Self {
+        SurrogateCostSpec::Ratio(0.05)
+    }
+}
+
+fn default_k_min() -> i64 {
+    2
+}
+fn default_k_max() -> i64 {
+    10
+}
+fn default_budget() -> f64 {
+    1000.0
+}
+fn default_surrogate() -> String {
+    "s3".into()
+}
+fn default_omega() -> [f64; 4] {
+    [1.0; 4]
+}
+fn default_grid() -> [i64; 2] {
+    [80, 80]
+}
+fn default_surrogate_grid() -> [i64; 2] {
+    [40, 40]
+}
+fn default_step() -> f64 {
+    0.5
+}
+fn default_surrogate_step() -> f64 {
+    5.0
+}
+fn default_surrogate_sh() -> f64 {
+    0.1
+}
+fn default_transition() -> String {
+    "retract".into()
+}
+fn default_barrier() -> String {
+    "progressive".into()
+}
+
 /// Why a job file is unusable: the TOML parser's message with line and column,
 /// or the key and the fix.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -446,7 +560,77 @@ pub fn parse_job(text: &str) -> Result<JobFile, JobError> {
             });
         }
     }
+    if let Some(o) = &job.optimize {
+        check_optimize(o, sh)?;
+    }
     Ok(job)
+}
+
+fn check_optimize(o: &OptimizeSpec, sh: f64) -> Result<(), JobError> {
+    let bad = |key, value: String, fix| Err(JobError::Value { key, value, fix });
+    if !matches!(o.formulation.as_str(), "3axis" | "3+2" | "heuristic") {
+        return bad("optimize.formulation", o.formulation.clone(), "use \"3axis\", \"3+2\" or \"heuristic\"");
+    }
+    if o.k_max < 2 {
+        return bad("optimize.k_max", o.k_max.to_string(), "give K_max >= 2 (the spec studies K = 2..10)");
+    }
+    if o.k_max > 64 {
+        return bad("optimize.k_max", o.k_max.to_string(), "give K_max <= 64");
+    }
+    if o.k_min < 1 || o.k_min > o.k_max {
+        return bad("optimize.k_min", o.k_min.to_string(), "give 1 <= k_min <= k_max");
+    }
+    if !(o.budget.is_finite() && o.budget >= 1.0) {
+        return bad(
+            "optimize.budget",
+            o.budget.to_string(),
+            "give at least 1 black-box evaluation per K (the spec uses 1000)",
+        );
+    }
+    if !matches!(o.surrogate.as_str(), "none" | "s3" | "s4") {
+        return bad("optimize.surrogate", o.surrogate.clone(), "use \"none\", \"s3\" or \"s4\"");
+    }
+    match &o.surrogate_cost {
+        SurrogateCostSpec::Ratio(r) if !(r.is_finite() && *r >= 0.0) => {
+            return bad("optimize.surrogate_cost", r.to_string(), "give a ratio >= 0 or \"measured\"");
+        }
+        SurrogateCostSpec::Named(n) if n != "measured" => {
+            return bad("optimize.surrogate_cost", n.clone(), "give a ratio >= 0 or \"measured\"");
+        }
+        _ => {}
+    }
+    if let Some(w) = o.omega.iter().find(|w| !(0.0..=1.0).contains(*w)) {
+        return bad("optimize.omega", w.to_string(), "clustering weights must lie in [0, 1]");
+    }
+    for (key, g) in [("optimize.grid", o.grid), ("optimize.surrogate_grid", o.surrogate_grid)] {
+        if g.iter().any(|&n| !(2..=2000).contains(&n)) {
+            return bad(key, format!("{g:?}"), "give [N_u, N_v] with 2 to 2000 cells each");
+        }
+    }
+    for (key, v) in [
+        ("optimize.step", o.step),
+        ("optimize.surrogate_step", o.surrogate_step),
+        ("optimize.transition_clearance", o.transition_clearance),
+    ] {
+        if !(v.is_finite() && v > 0.0) {
+            return bad(key, v.to_string(), "must be a finite number > 0 (mm)");
+        }
+    }
+    let ssh = o.surrogate_scallop_height;
+    if !(ssh.is_finite() && ssh >= sh) {
+        return bad(
+            "optimize.surrogate_scallop_height",
+            ssh.to_string(),
+            "give a scallop height >= finishing.scallop_height (S4 uses 0.1 mm)",
+        );
+    }
+    if !matches!(o.transition.as_str(), "retract" | "linear") {
+        return bad("optimize.transition", o.transition.clone(), "use \"retract\" or \"linear\"");
+    }
+    if !matches!(o.barrier.as_str(), "progressive" | "extreme") {
+        return bad("optimize.barrier", o.barrier.clone(), "use \"progressive\" or \"extreme\"");
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -470,6 +654,20 @@ mod tests {
         ] {
             parse_job(example).unwrap();
         }
+        let job = parse_job(&format!("{BASE}[optimize]\nformulation = \"3axis\"\n")).unwrap();
+        let o = job.optimize.unwrap();
+        assert_eq!((o.k_min, o.k_max, o.budget, o.grid, o.step), (2, 10, 1000.0, [80, 80], 0.5));
+        assert_eq!(o.surrogate_cost, SurrogateCostSpec::Ratio(0.05));
+        for example in [
+            include_str!("../../../examples/jobs/optimize-choi-3axis.toml"),
+            include_str!("../../../examples/jobs/optimize-choi-3plus2.toml"),
+            include_str!("../../../examples/jobs/optimize-choi-heuristic.toml"),
+            include_str!("../../../examples/jobs/optimize-rubio-3axis.toml"),
+            include_str!("../../../examples/jobs/optimize-rubio-3plus2.toml"),
+            include_str!("../../../examples/jobs/optimize-rubio-heuristic.toml"),
+        ] {
+            assert!(parse_job(example).unwrap().optimize.is_some());
+        }
     }
 
     #[test]
@@ -485,6 +683,21 @@ mod tests {
             (format!("{BASE}direction = \"north\"\n"), "finishing.direction"),
             (BASE.replace("builtin = \"choi\"", "builtin = \"choi\"\nfile = \"a.stl\""), "part"),
             (BASE.replace("scallop_height = 0.01", "scallop_height = \"fine\""), "scallop_height"),
+            (format!("{BASE}[optimize]\nformulation = \"5axis\"\n"), "optimize.formulation"),
+            (format!("{BASE}[optimize]\nformulation = \"3axis\"\nk_max = 1\n"), "optimize.k_max"),
+            (format!("{BASE}[optimize]\nformulation = \"3axis\"\nk_min = 0\n"), "optimize.k_min"),
+            (format!("{BASE}[optimize]\nformulation = \"3axis\"\nbudget = 0\n"), "optimize.budget"),
+            (format!("{BASE}[optimize]\nformulation = \"3+2\"\nomega = [1, 1, 1.5, 1]\n"), "optimize.omega"),
+            (format!("{BASE}[optimize]\nformulation = \"3+2\"\nsurrogate = \"s9\"\n"), "optimize.surrogate"),
+            (
+                format!("{BASE}[optimize]\nformulation = \"3+2\"\nsurrogate_cost = \"free\"\n"),
+                "optimize.surrogate_cost",
+            ),
+            (format!("{BASE}[optimize]\nformulation = \"3+2\"\ngrid = [80, 1]\n"), "optimize.grid"),
+            (format!("{BASE}[optimize]\nformulation = \"3+2\"\nstep = 0\n"), "optimize.step"),
+            (format!("{BASE}[optimize]\nformulation = \"3+2\"\ntransition = \"teleport\"\n"), "optimize.transition"),
+            (format!("{BASE}[optimize]\nformulation = \"3+2\"\nbarier = \"extreme\"\n"), "barier"),
+            (format!("{BASE}[optimize]\nk_max = 4\n"), "formulation"),
             (BASE.replace("scallop_height = 0.01", "scallop_height = 3"), "corner radius"),
             (BASE.replace("diameter = 10", "diameter = 10\nflute_length = -3"), "cutter.flute_length"),
             (format!("{BASE}[output]\nspindle = -1\n"), "output.spindle"),

@@ -130,9 +130,9 @@
 
 mod error;
 mod geometry;
-pub mod network;
 mod iso;
 mod leads;
+pub mod network;
 mod params;
 mod plan;
 mod scallop;

@@ -1,0 +1,324 @@
+//! `scallop optimize JOB.toml -o OUTDIR`: the zone-optimisation study of
+//! finishing.md chapter 4 (`docs/job.md`, table `[optimize]`).
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use clap::Args;
+use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget};
+use scallop_analysis::{Cutter, MachineLimits};
+use scallop_io::job::{JobFile, OptimizeSpec, SurrogateCostSpec, parse_job};
+use scallop_optim::study::{
+    Formulation, KResult, Stopwatch, Study, StudyObserver, StudySettings, Surrogate, run_study,
+};
+use scallop_optim::surface::{SurfaceModel, SurfaceSettings};
+use scallop_optim::{Barrier, CostModel, OptimError, convergence_svg, zones_svg};
+use scallop_strategy::network::{TransitionModel, Transitions};
+use serde::Serialize;
+
+use crate::output::{print_json, print_text, progress_bar, write_atomic};
+use crate::{CliResult, Failure};
+
+/// Arguments of `scallop optimize`.
+#[derive(Args, Debug)]
+pub struct OptimizeArgs {
+    /// The job file (TOML with an `[optimize]` table, see docs/job.md).
+    job: PathBuf,
+    /// Output folder for `study.json`, `report.json`, `convergence.svg` and `zones.svg`.
+    #[arg(short, long, default_value = "out/optimize")]
+    output: PathBuf,
+    /// Print the study as JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+struct Clock(Instant);
+
+impl Stopwatch for Clock {
+    fn seconds(&self) -> f64 {
+        self.0.elapsed().as_secs_f64()
+    }
+}
+
+/// One progress bar per K.
+struct Bars {
+    k_min: usize,
+    bars: Vec<ProgressBar>,
+}
+
+impl StudyObserver for Bars {
+    fn progress(&self, k: usize, spent: f64) {
+        if let Some(bar) = self.bars.get(k - self.k_min) {
+            #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)] // 0 <= spent <= budget
+            bar.set_position(spent as u64);
+        }
+    }
+    fn finished(&self, k: usize) {
+        if let Some(bar) = self.bars.get(k - self.k_min) {
+            bar.finish();
+        }
+    }
+}
+
+/// What `study.json` holds.
+#[derive(Serialize)]
+struct StudyFile<'a> {
+    job: String,
+    part: String,
+    cutter: String,
+    scallop_height_mm: f64,
+    threads: usize,
+    wall_time_s: f64,
+    gcode: &'static str,
+    study: &'a Study,
+}
+
+/// What `report.json` holds: the best plan over all K.
+#[derive(Serialize)]
+struct BestReport<'a> {
+    part: String,
+    formulation: Formulation,
+    k: usize,
+    time_s: f64,
+    start_time_s: f64,
+    eta: f64,
+    gcode: &'static str,
+    result: &'a KResult,
+}
+
+const NO_GCODE: &str = "not written: the engine's finishing path plans one direction over the whole part; \
+     per-zone G-code needs zone-clipped drop-cutter passes (not built yet). Times are the network planner's.";
+
+/// `scallop optimize`.
+pub fn run(args: &OptimizeArgs) -> CliResult<()> {
+    let name = args.job.display().to_string();
+    let bytes = std::fs::read(&args.job).map_err(|e| {
+        let err = anyhow::anyhow!("{name}: cannot read the job file: {e}");
+        if e.kind() == std::io::ErrorKind::NotFound { Failure::Rejected(err) } else { Failure::Io(err) }
+    })?;
+    let text = std::str::from_utf8(&bytes)
+        .map_err(|e| Failure::rejected(format!("{name}: byte {}: the job file is not UTF-8 text", e.valid_up_to())))?;
+    let spec = parse_job(text).map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
+    let Some(opt) = &spec.optimize else {
+        return Err(Failure::rejected(format!(
+            "{name}: the job has no [optimize] table; add one with at least `formulation` (docs/job.md)"
+        )));
+    };
+    let folder = args.job.parent().unwrap_or(Path::new("."));
+    let (patch, part_name) = load_patch(&spec, folder).map_err(|e| prefix(&name, e))?;
+    let (settings, model_settings) = settings(&spec, opt).map_err(|e| prefix(&name, e))?;
+    let model = SurfaceModel::new(&patch, model_settings).map_err(|e| rejected(&name, &e))?;
+
+    let visible = {
+        use std::io::IsTerminal;
+        std::io::stderr().is_terminal() && std::env::var_os("CI").is_none()
+    };
+    let multi = MultiProgress::with_draw_target(if visible {
+        ProgressDrawTarget::stderr()
+    } else {
+        ProgressDrawTarget::hidden()
+    });
+    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)] // budget >= 1, finite (validated)
+    let total = settings.budget.ceil() as u64;
+    let bars = Bars {
+        k_min: settings.k_min,
+        bars: (settings.k_min..=settings.k_max)
+            .map(|k| multi.add(progress_bar(total, &format!("K = {k:2}"))))
+            .collect(),
+    };
+    let clock = Clock(Instant::now());
+    let study = run_study(&model, &settings, &bars, Some(&clock)).map_err(|e| rejected(&name, &e))?;
+    let wall = clock.seconds();
+    let _ = multi.clear();
+
+    let best = &study.results[study.best];
+    let cutter = match model_settings.tool {
+        Cutter::Ball { radius } => format!("ball R{radius} mm"),
+        Cutter::Toroidal { radius, corner } => format!("bull-nose R{radius} r{corner} mm"),
+        Cutter::Flat { radius, .. } => format!("flat R{radius} mm"),
+    };
+    let file = StudyFile {
+        job: name.clone(),
+        part: part_name.clone(),
+        cutter,
+        scallop_height_mm: model_settings.scallop_height,
+        threads: rayon::current_num_threads(),
+        wall_time_s: wall,
+        gcode: NO_GCODE,
+        study: &study,
+    };
+    let report = BestReport {
+        part: part_name.clone(),
+        formulation: settings.formulation,
+        k: best.k,
+        time_s: best.f_best,
+        start_time_s: best.f0,
+        eta: best.eta,
+        gcode: NO_GCODE,
+        result: best,
+    };
+    let out = &args.output;
+    write_atomic(&out.join("study.json"), |w| w.write_all(to_json(&file)?.as_bytes()))?;
+    write_atomic(&out.join("report.json"), |w| w.write_all(to_json(&report)?.as_bytes()))?;
+    write_atomic(&out.join("convergence.svg"), |w| w.write_all(convergence_svg(&study).as_bytes()))?;
+    let title = format!("{part_name}, {}, K = {}", formulation_name(settings.formulation), best.k);
+    write_atomic(&out.join("zones.svg"), |w| w.write_all(zones_svg(&best.plan, &title).as_bytes()))?;
+    if args.json {
+        return print_json(&file);
+    }
+    let mut text = format!(
+        "zone optimisation of the {part_name}: {}, K = {}..{}, budget {} per K, surrogate {:?}\n\
+         \x20  K  zones   start (s)    best (s)   gain   evals  surr.  wall (s)\n",
+        formulation_name(settings.formulation),
+        settings.k_min,
+        settings.k_max,
+        settings.budget,
+        settings.surrogate
+    );
+    for r in &study.results {
+        text.push_str(&format!(
+            "  {:2}  {:5}  {:10.2}  {:10.2}  {:5.1}%  {:6}  {:5}  {:8.2}\n",
+            r.k,
+            r.plan.zones.len(),
+            r.f0,
+            r.f_best,
+            100.0 * r.eta,
+            r.evaluations,
+            r.surrogate_evaluations,
+            r.wall_time_s.unwrap_or(f64::NAN)
+        ));
+    }
+    text.push_str(&format!(
+        "  best: K = {} in {:.2} s ({:.1}% below its start); mean gain {:.1}%; study {:.1} s on {} threads\n\
+         \x20 wrote {}: study.json, report.json, convergence.svg, zones.svg (no G-code: see report.json)\n",
+        best.k,
+        best.f_best,
+        100.0 * best.eta,
+        100.0 * study.mean_eta,
+        wall,
+        rayon::current_num_threads(),
+        out.display()
+    ));
+    print_text(&text)
+}
+
+fn formulation_name(f: Formulation) -> &'static str {
+    match f {
+        Formulation::ThreeAxis => "3-axis",
+        Formulation::ThreePlusTwo => "3+2",
+        Formulation::Heuristic => "PCA heuristic",
+    }
+}
+
+/// JSON text of a serialisable value, with the error as an I/O error.
+fn to_json(value: &impl Serialize) -> std::io::Result<String> {
+    serde_json::to_string_pretty(value).map_err(std::io::Error::other)
+}
+
+fn prefix(name: &str, e: Failure) -> Failure {
+    match e {
+        Failure::Rejected(e) => Failure::Rejected(anyhow::anyhow!("{name}: {e:#}")),
+        other => other,
+    }
+}
+
+fn rejected(name: &str, e: &OptimError) -> Failure {
+    Failure::rejected(format!("{name}: {e}"))
+}
+
+/// The one patch of the job's part.
+fn load_patch(spec: &JobFile, folder: &Path) -> CliResult<(scallop_surface::Patch, String)> {
+    let (set, part_name) = match (&spec.part.file, &spec.part.builtin) {
+        (_, Some(name)) => {
+            let set = scallop_surface::builtin(name).ok_or_else(|| {
+                Failure::rejected(format!("part.builtin = \"{name}\": no such built-in surface (choi, rubio)"))
+            })?;
+            (set, format!("built-in {name} surface"))
+        }
+        (Some(file), None) => {
+            let path = folder.join(file);
+            let loaded = crate::part::load(&path.to_string_lossy(), crate::part::UnitsArg::Mm)?;
+            match loaded.part {
+                scallop_engine::Part::Surfaces(set) => (set, loaded.description),
+                scallop_engine::Part::Mesh(_) => {
+                    return Err(Failure::rejected(format!(
+                        "part.file = \"{file}\": zone optimisation needs a parametric surface (.toml), not a mesh"
+                    )));
+                }
+            }
+        }
+        (None, None) => return Err(Failure::rejected("part: give `file` or `builtin`")),
+    };
+    if set.patches().len() != 1 {
+        return Err(Failure::rejected(format!(
+            "part: {} patches; zone optimisation works on one parametric patch",
+            set.patches().len()
+        )));
+    }
+    Ok((set.patches()[0].clone(), part_name))
+}
+
+/// Study and model settings from the job.
+fn settings(spec: &JobFile, o: &OptimizeSpec) -> CliResult<(StudySettings, SurfaceSettings)> {
+    let formulation = match o.formulation.as_str() {
+        "3axis" => Formulation::ThreeAxis,
+        "3+2" => Formulation::ThreePlusTwo,
+        _ => Formulation::Heuristic,
+    };
+    let radius = spec.cutter.diameter / 2.0;
+    let tool = match spec.cutter.shape.as_str() {
+        "ball" => Cutter::Ball { radius },
+        "bull" => Cutter::Toroidal { radius, corner: spec.cutter.corner_radius.unwrap_or(radius) },
+        other => {
+            return Err(Failure::rejected(format!(
+                "cutter.shape = \"{other}\": zone optimisation plans ball or bull-nose cutters"
+            )));
+        }
+    };
+    let machine = MachineLimits::from_thesis_units(spec.machine.feed, spec.machine.acceleration, spec.machine.jerk);
+    let transitions = Transitions {
+        model: if o.transition == "linear" {
+            TransitionModel::Linear
+        } else {
+            TransitionModel::RetractTraverse { clearance: o.transition_clearance, rapid_feed: None }
+        },
+        reorientation_s: 0.0,
+    };
+    #[allow(clippy::cast_sign_loss, clippy::cast_possible_truncation)] // validated: 2..=2000
+    let grid = |g: [i64; 2]| [g[0] as usize, g[1] as usize];
+    #[allow(clippy::cast_sign_loss, clippy::cast_possible_truncation)] // validated: 1 <= k_min <= k_max <= 64
+    let (k_min, k_max) = (o.k_min as usize, o.k_max as usize);
+    let study = StudySettings {
+        formulation,
+        k_min,
+        k_max,
+        budget: o.budget,
+        surrogate: match o.surrogate.as_str() {
+            "none" => Surrogate::None,
+            "s4" => Surrogate::S4,
+            _ => Surrogate::S3,
+        },
+        seed: o.seed,
+        cost: match o.surrogate_cost {
+            SurrogateCostSpec::Ratio(r) => CostModel::Fixed(r),
+            SurrogateCostSpec::Named(_) => CostModel::Measured,
+        },
+        model_search: o.model_search,
+        barrier: if o.barrier == "extreme" { Barrier::Extreme } else { Barrier::Progressive },
+        start_omega: o.omega,
+    };
+    let model = SurfaceSettings {
+        tool,
+        scallop_height: spec.finishing.scallop_height,
+        surrogate_scallop_height: o.surrogate_scallop_height,
+        machine,
+        transitions,
+        grid: grid(o.grid),
+        surrogate_grid: grid(o.surrogate_grid),
+        step: o.step,
+        surrogate_step: o.surrogate_step,
+        ..SurfaceSettings::default()
+    };
+    Ok((study, model))
+}

@@ -1,0 +1,481 @@
+//! The real black box of chapter 4 on one parametric patch: K-means with the
+//! weighted pseudo-metric (`scallop-cluster`), connected components, per-zone
+//! orientation, the fast parallel-planes planner on the isoparametric network
+//! (`scallop_strategy::network`) and the jerk-limited time with inter-zone
+//! transitions; and its static surrogates S3 (Annex E on the zones' PCA
+//! rectangles) and S4 (the planner on a 5 mm network at `sh = 0.1 mm`), both
+//! on a coarser clustering grid (finishing.md 12.2, 12.6).
+
+use scallop_analysis::{
+    Cutter, GridOptions, MachineLimits, Moments, Pca, annex_e_time, direction_angle_xy, sample_patch,
+};
+use scallop_cluster::{ClusterParams, Features, Method, Metric, Partition, partition};
+use scallop_geom::nalgebra::Matrix3;
+use scallop_geom::{Point3, Vec3};
+use scallop_strategy::StrategyError;
+use scallop_strategy::network::{
+    CellLabels, Margins, Network, Orientation, Transitions, ZoneParams, ZonePlan, Zoning, plan_zone, plan_zones,
+    surface_time,
+};
+use scallop_surface::Patch;
+
+use crate::error::OptimError;
+use crate::study::{Assessment, Design, Fidelity, Formulation, MachiningModel, PlanReport, ZoneReport};
+
+/// Settings of the real model (mm, s; the job's `[optimize]` table).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfaceSettings {
+    /// Cutter (ball or toroidal).
+    pub tool: Cutter,
+    /// Scallop height `sh` of the black box (mm).
+    pub scallop_height: f64,
+    /// Scallop height of S4 (mm; 0.1).
+    pub surrogate_scallop_height: f64,
+    /// Machine kinematics.
+    pub machine: MachineLimits,
+    /// Inter-zone transitions.
+    pub transitions: Transitions,
+    /// Clustering grid of the black box (80 x 80).
+    pub grid: [usize; 2],
+    /// Clustering grid of the surrogates (40 x 40).
+    pub surrogate_grid: [usize; 2],
+    /// Machining-mesh step of the black box (mm; 0.5).
+    pub step: f64,
+    /// Machining-mesh step of S4 (mm; 5).
+    pub surrogate_step: f64,
+    /// Direction change that splits a pass into two stop-to-stop moves (rad).
+    pub sharp_corner: f64,
+}
+
+impl Default for SurfaceSettings {
+    /// The spec's defaults (13): toroidal R 5 r 2, sh 0.01 mm (S4: 0.1 mm),
+    /// V 5 m/min, A 6 m/s^2, J 40 m/s^3, RetractTraverse c = 5 mm, 80 x 80 /
+    /// 40 x 40 clustering, 0.5 mm / 5 mm machining mesh, sharp corner 30°.
+    fn default() -> Self {
+        SurfaceSettings {
+            tool: Cutter::Toroidal { radius: 5.0, corner: 2.0 },
+            scallop_height: 0.01,
+            surrogate_scallop_height: 0.1,
+            machine: MachineLimits::default(),
+            transitions: Transitions::default(),
+            grid: [80, 80],
+            surrogate_grid: [40, 40],
+            step: 0.5,
+            surrogate_step: 5.0,
+            sharp_corner: 30f64.to_radians(),
+        }
+    }
+}
+
+/// One clustering grid with its machining network.
+#[derive(Clone, Debug)]
+struct Level {
+    features: Features,
+    points: Vec<Point3>,
+    normals: Vec<Vec3>,
+    network: Option<Network>,
+}
+
+impl Level {
+    fn new(patch: &Patch, grid: [usize; 2], step: Option<f64>) -> Result<Level, OptimError> {
+        let samples = sample_patch(patch, &GridOptions { cells_u: grid[0], cells_v: grid[1] })
+            .map_err(|e| OptimError::Model(format!("sampling the surface on {grid:?} cells: {e}")))?;
+        let features = Features::from_samples(&samples)
+            .map_err(|e| OptimError::Model(format!("features of the {grid:?} grid: {e}")))?;
+        let points = samples.samples().iter().map(|s| s.point).collect();
+        let normals = samples.samples().iter().map(|s| s.normal).collect();
+        let network = match step {
+            Some(step) => Some(
+                Network::new(patch, step)
+                    .map_err(|e| OptimError::Model(format!("machining network at {step} mm: {e}")))?,
+            ),
+            None => None,
+        };
+        Ok(Level { features, points, normals, network })
+    }
+}
+
+/// The real machining model of one patch.
+#[derive(Clone, Debug)]
+pub struct SurfaceModel {
+    settings: SurfaceSettings,
+    black_box: Level,
+    s3: Level,
+    s4: Level,
+}
+
+/// A partition at one fidelity, with its network zoning.
+#[derive(Clone, Debug)]
+pub struct ZonePartition {
+    fidelity: Fidelity,
+    partition: Partition,
+    zoning: Option<Zoning>,
+}
+
+/// The orientation of each zone and its accessibility violation.
+struct Oriented {
+    orientations: Vec<Option<Orientation>>,
+    violation: f64,
+}
+
+impl ZonePartition {
+    /// Number of zones.
+    #[must_use]
+    pub fn partition_zone_count(&self) -> usize {
+        self.partition.zones.len()
+    }
+}
+
+impl SurfaceModel {
+    /// Samples, features and networks for the three fidelities.
+    ///
+    /// # Errors
+    /// [`OptimError::Model`] when the surface cannot be sampled or meshed, or a
+    /// setting is out of range.
+    pub fn new(patch: &Patch, settings: SurfaceSettings) -> Result<SurfaceModel, OptimError> {
+        let positive = |key: &'static str, v: f64| {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(OptimError::BadSetting { key, value: v.to_string(), fix: "must be a finite number > 0" })
+            }
+        };
+        positive("optimize.step", settings.step)?;
+        positive("optimize.surrogate_step", settings.surrogate_step)?;
+        positive("finishing.scallop_height", settings.scallop_height)?;
+        positive("optimize.surrogate_scallop_height", settings.surrogate_scallop_height)?;
+        let black_box = Level::new(patch, settings.grid, Some(settings.step))?;
+        let s3 = Level::new(patch, settings.surrogate_grid, None)?;
+        let s4 =
+            Level {
+                network: Some(Network::new(patch, settings.surrogate_step).map_err(|e| {
+                    OptimError::Model(format!("machining network at {} mm: {e}", settings.surrogate_step))
+                })?),
+                ..s3.clone()
+            };
+        Ok(SurfaceModel { settings, black_box, s3, s4 })
+    }
+
+    fn level(&self, fidelity: Fidelity) -> &Level {
+        match fidelity {
+            Fidelity::BlackBox => &self.black_box,
+            Fidelity::S3 => &self.s3,
+            Fidelity::S4 => &self.s4,
+        }
+    }
+
+    fn scallop_height(&self, fidelity: Fidelity) -> f64 {
+        if fidelity == Fidelity::S4 { self.settings.surrogate_scallop_height } else { self.settings.scallop_height }
+    }
+
+    /// Points and normals of a zone's cells.
+    fn zone_samples<'a>(
+        &'a self,
+        level: &'a Level,
+        cells: &'a [u32],
+    ) -> impl Iterator<Item = (&'a Point3, &'a Vec3)> + 'a {
+        cells.iter().filter_map(move |&c| {
+            let i = level.features.point_of_cell(c as usize)?;
+            Some((&level.points[i], &level.normals[i]))
+        })
+    }
+
+    /// The orientation of every zone under `design` and the violation
+    /// `h = sum_k sum_i max(0, -n_i . a_k)^2` (12.9); `None` orientations in 3-axis.
+    fn orient(&self, zp: &ZonePartition, formulation: Formulation, design: &Design) -> Oriented {
+        let level = self.level(zp.fidelity);
+        let p = &zp.partition;
+        let mut orientations = Vec::with_capacity(p.zones.len());
+        let mut violation = 0.0;
+        for zone in &p.zones {
+            let c = zone.cluster as usize;
+            let axis = match formulation {
+                Formulation::ThreeAxis => {
+                    orientations.push(None);
+                    continue;
+                }
+                Formulation::ThreePlusTwo => {
+                    let a = design.axis(c);
+                    Vec3::new(a[0], a[1], a[2])
+                }
+                Formulation::Heuristic => heuristic_axis(zone.geometry.as_ref().map(|g| &g.pca), design.zeta[c]),
+            };
+            // Rotation centre: the zone's mean in the heuristic, the origin in 3+2 so that the
+            // zones of a cluster share one oriented network (times do not depend on it, 4.5).
+            let mean = match formulation {
+                Formulation::Heuristic => zone.geometry.as_ref().map_or_else(Point3::origin, |g| g.moments.mean()),
+                _ => Point3::origin(),
+            };
+            for (_, n) in self.zone_samples(level, &zone.cells) {
+                violation += (-n.dot(&axis)).max(0.0).powi(2);
+            }
+            let tilt = axis.z.clamp(-1.0, 1.0).acos();
+            let azimuth = axis.y.atan2(axis.x);
+            orientations.push(Some(Orientation::new(tilt, azimuth, mean)));
+        }
+        Oriented { orientations, violation }
+    }
+
+    fn params(&self, fidelity: Fidelity, direction: f64) -> ZoneParams {
+        ZoneParams {
+            direction,
+            tool: self.settings.tool,
+            scallop_height: self.scallop_height(fidelity),
+            margins: Margins::HalfStep,
+            sharp_corner: self.settings.sharp_corner,
+            machine: self.settings.machine,
+        }
+    }
+
+    /// Plans every zone (zones without any pass are skipped: they are smaller
+    /// than a plane spacing and cost nothing to this model).
+    fn plan(
+        &self,
+        zp: &ZonePartition,
+        formulation: Formulation,
+        design: &Design,
+    ) -> Result<(Vec<ZonePlan>, f64), OptimError> {
+        let level = self.level(zp.fidelity);
+        let (Some(network), Some(zoning)) = (&level.network, &zp.zoning) else {
+            return Err(OptimError::Model("internal: no machining network at this fidelity".into()));
+        };
+        let oriented = self.orient(zp, formulation, design);
+        if formulation == Formulation::ThreeAxis {
+            // Fast path: all zones with shared buffers; a zone without passes makes it
+            // fail, and the loop below then skips that zone.
+            let directions: Vec<f64> = zp.partition.zones.iter().map(|z| design.theta[z.cluster as usize]).collect();
+            if let Ok(plans) = plan_zones(network, zoning, &directions, &self.params(zp.fidelity, 0.0)) {
+                return Ok((plans, oriented.violation));
+            }
+        }
+        let mut plans = Vec::with_capacity(zp.partition.zones.len());
+        // One oriented network per distinct orientation (3+2: per cluster).
+        let mut cache: Vec<(usize, Network)> = Vec::new();
+        for (z, zone) in zp.partition.zones.iter().enumerate() {
+            let c = zone.cluster as usize;
+            let params = self.params(zp.fidelity, design.theta[c]);
+            #[allow(clippy::cast_possible_truncation)]
+            let label = z as u32;
+            let result = match oriented.orientations[z] {
+                None => plan_zone(network, Some(zoning), label, &params),
+                Some(o) => {
+                    // 3+2: one orientation per cluster (times do not depend on the
+                    // rotation centre, 4.5); heuristic: one per zone.
+                    let tag = if formulation == Formulation::ThreePlusTwo { c } else { z };
+                    let i = match cache.iter().position(|(t, _)| *t == tag) {
+                        Some(i) => i,
+                        None => {
+                            cache.push((tag, network.oriented(&o)));
+                            cache.len() - 1
+                        }
+                    };
+                    plan_zone(&cache[i].1, Some(zoning), label, &params)
+                }
+            };
+            match result {
+                Ok(plan) => plans.push(plan),
+                Err(StrategyError::EmptyZone { .. }) => {}
+                Err(e) => return Err(OptimError::Model(format!("planning zone {z}: {e}"))),
+            }
+        }
+        Ok((plans, oriented.violation))
+    }
+
+    /// S3: Annex E on each zone's PCA rectangle (rotated by its orientation),
+    /// plus transitions between consecutive zone means (12.7).
+    fn s3(&self, zp: &ZonePartition, formulation: Formulation, design: &Design) -> Assessment {
+        let oriented = self.orient(zp, formulation, design);
+        let mut total = 0.0;
+        let mut previous: Option<Point3> = None;
+        for (z, zone) in zp.partition.zones.iter().enumerate() {
+            let Some(g) = &zone.geometry else { continue };
+            let c = zone.cluster as usize;
+            let pca = match &oriented.orientations[z] {
+                None => g.pca,
+                Some(o) => rotated_pca(&g.moments, o),
+            };
+            total += annex_e_time(
+                &pca,
+                design.theta[c],
+                &self.settings.tool,
+                self.settings.scallop_height,
+                &self.settings.machine,
+            );
+            let mean = g.moments.mean();
+            if let Some(p) = previous {
+                total += self.settings.transitions.time(&p, &mean, &self.settings.machine).0;
+            }
+            previous = Some(mean);
+        }
+        Assessment { time_s: total, violation: oriented.violation }
+    }
+}
+
+/// The heuristic tool axis of a zone (12.5): rotation 1 brings the PCA normal
+/// `X_III` onto Z, rotation 2 turns by `zeta` about `X_II`; in the part frame the
+/// axis is `cos(zeta) X_III + sin(zeta) X_I`.
+fn heuristic_axis(pca: Option<&Pca>, zeta: f64) -> Vec3 {
+    let Some(pca) = pca else { return Vec3::z() };
+    let [x1, _, x3] = pca.axes;
+    let (s, c) = zeta.sin_cos();
+    (x3 * c + x1 * s).normalize()
+}
+
+/// The PCA of a zone seen in an oriented frame.
+fn rotated_pca(moments: &Moments, o: &Orientation) -> Pca {
+    let r: Matrix3<f64> = Matrix3::from_columns(&[o.rotate(&Vec3::x()), o.rotate(&Vec3::y()), o.rotate(&Vec3::z())]);
+    let cov = r * moments.covariance() * r.transpose();
+    Pca::from_covariance(&o.to_machine(&moments.mean()), &cov)
+}
+
+/// Doubled-angle circular mean of directions (modulo pi), in `(-pi/2, pi/2]`.
+fn mean_direction(angles: impl Iterator<Item = f64>) -> f64 {
+    let (mut s, mut c) = (0.0, 0.0);
+    for a in angles {
+        let (sa, ca) = (2.0 * a).sin_cos();
+        s += sa;
+        c += ca;
+    }
+    if s == 0.0 && c == 0.0 { 0.0 } else { 0.5 * s.atan2(c) }
+}
+
+impl MachiningModel for SurfaceModel {
+    type Partition = ZonePartition;
+
+    fn partition(&self, k: usize, omega: &[f64; 4], fidelity: Fidelity) -> Result<ZonePartition, OptimError> {
+        let level = self.level(fidelity);
+        let params = ClusterParams {
+            k,
+            omega: *omega,
+            metric: Metric::Euclidean,
+            method: Method::KMeans,
+            ..ClusterParams::default()
+        };
+        let partition =
+            partition(&level.features, &params).map_err(|e| OptimError::Model(format!("clustering K = {k}: {e}")))?;
+        let zoning = match &level.network {
+            Some(network) => {
+                let labels = CellLabels {
+                    cells_u: partition.grid[0],
+                    cells_v: partition.grid[1],
+                    labels: partition.zone_of_cell.clone(),
+                };
+                Some(Zoning::new(network, &labels).map_err(|e| OptimError::Model(format!("zones K = {k}: {e}")))?)
+            }
+            None => None,
+        };
+        Ok(ZonePartition { fidelity, partition, zoning })
+    }
+
+    fn assess(
+        &self,
+        zp: &ZonePartition,
+        formulation: Formulation,
+        design: &Design,
+        fidelity: Fidelity,
+    ) -> Result<Assessment, OptimError> {
+        if fidelity == Fidelity::S3 {
+            return Ok(self.s3(zp, formulation, design));
+        }
+        let (plans, violation) = self.plan(zp, formulation, design)?;
+        let time = surface_time(&plans, &self.settings.transitions, &self.settings.machine);
+        Ok(Assessment { time_s: time.total_s, violation })
+    }
+
+    fn initial_design(&self, k: usize, formulation: Formulation, zp: &ZonePartition) -> Result<Design, OptimError> {
+        let level = self.level(zp.fidelity);
+        let p = &zp.partition;
+        let mut design = Design::zeros(k);
+        // Reachability: a zone is reachable when the vertical axis or its mean normal sees
+        // every sample (a sufficient test; 3+2 and heuristic only).
+        if formulation != Formulation::ThreeAxis {
+            for (z, zone) in p.zones.iter().enumerate() {
+                let normals: Vec<Vec3> = self.zone_samples(level, &zone.cells).map(|(_, n)| *n).collect();
+                let mean: Vec3 = normals.iter().sum::<Vec3>();
+                let sees = |a: &Vec3| normals.iter().all(|n| n.dot(a) >= 0.0);
+                if !sees(&Vec3::z()) && (mean.norm() == 0.0 || !sees(&mean.normalize())) {
+                    return Err(OptimError::Model(format!(
+                        "K = {k}: zone {z} (cluster {}, {} cells): no tool orientation reaches all its samples \
+                         (its normals spread over more than a hemisphere); machine it in 3-axis or split the surface",
+                        zone.cluster,
+                        zone.len()
+                    )));
+                }
+            }
+        }
+        for c in 0..k.min(p.clusters) {
+            let cells = p.cluster_of_cell.iter().enumerate().filter(|(_, l)| **l as usize == c).map(|(i, _)| i);
+            design.theta[c] = match formulation {
+                Formulation::ThreeAxis | Formulation::ThreePlusTwo => mean_direction(cells.filter_map(|cell| {
+                    level.features.point_of_cell(cell).map(|i| level.features.feature(i).slope_direction)
+                })),
+                Formulation::Heuristic => {
+                    // The largest zone of the cluster, after its heuristic orientation (zeta = 0).
+                    let zone = p.zones.iter().filter(|z| z.cluster as usize == c).max_by_key(|z| z.len());
+                    zone.map_or(0.0, |zone| {
+                        let axis = heuristic_axis(zone.geometry.as_ref().map(|g| &g.pca), 0.0);
+                        let o =
+                            Orientation::new(axis.z.clamp(-1.0, 1.0).acos(), axis.y.atan2(axis.x), Point3::origin());
+                        let (mut dx, mut dy) = (0.0, 0.0);
+                        for (_, n) in self.zone_samples(level, &zone.cells) {
+                            let r = o.rotate(n);
+                            dx += r.x;
+                            dy += r.y;
+                        }
+                        direction_angle_xy(dx, dy)
+                    })
+                }
+            };
+        }
+        Ok(design)
+    }
+
+    fn describe(
+        &self,
+        zp: &ZonePartition,
+        formulation: Formulation,
+        design: &Design,
+    ) -> Result<PlanReport, OptimError> {
+        let (plans, violation) = self.plan(zp, formulation, design)?;
+        let time = surface_time(&plans, &self.settings.transitions, &self.settings.machine);
+        let oriented = self.orient(zp, formulation, design);
+        let p = &zp.partition;
+        let zones = p
+            .zones
+            .iter()
+            .enumerate()
+            .map(|(z, zone)| {
+                let c = zone.cluster as usize;
+                let plan = plans.iter().find(|pl| pl.zone as usize == z);
+                let (phi, psi) = oriented.orientations[z].map_or((0.0, 0.0), |o| (o.tilt, o.azimuth));
+                ZoneReport {
+                    zone: z,
+                    cluster: c,
+                    cells: zone.len(),
+                    theta_deg: design.theta[c].to_degrees(),
+                    phi_deg: phi.to_degrees(),
+                    psi_deg: psi.to_degrees(),
+                    zeta_deg: design.zeta[c].to_degrees(),
+                    time_s: plan.map_or(0.0, |pl| pl.time_s),
+                    length_mm: plan.map_or(0.0, |pl| pl.cut_length_mm + pl.link_length_mm),
+                    passes: plan.map_or(0, |pl| pl.passes),
+                }
+            })
+            .collect();
+        let level = self.level(zp.fidelity);
+        let cell_xy = (0..p.zone_of_cell.len())
+            .map(|cell| {
+                level.features.point_of_cell(cell).map_or([f64::NAN; 2], |i| [level.points[i].x, level.points[i].y])
+            })
+            .collect();
+        Ok(PlanReport {
+            time_s: time.total_s,
+            transition_time_s: time.transitions_s,
+            violation,
+            grid: p.grid,
+            labels: p.zone_of_cell.clone(),
+            cell_xy,
+            zones,
+        })
+    }
+}
