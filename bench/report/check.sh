@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Issue 7: open the HTML reports in headless Chromium and check that they work.
-# Builds the demo's finishing report (`scallop demo`) and the simulation report
-# of its program (`scallop simulate`), then for each:
+# Builds the demo's finishing report (`scallop demo`), the simulation report of its
+# program (`scallop simulate`) and the report of a small optimisation study
+# (`scallop optimize`), then for each:
 #   chromium --headless ... --screenshot   (1200 x 800)
 #   chromium --headless ... --dump-dom
 # and checks with bench/report/page_check.py that the viewer set its drawn
@@ -40,6 +41,10 @@ mkdir -p "$OUT"
 "$SCALLOP" demo -o "$OUT/demo" >/dev/null
 "$SCALLOP" simulate --part choi --program "$OUT/demo/program.nc" --cutter bull --diameter 10 --corner-radius 2 \
     --flute-length 30 --resolution 0.2 --gouge-tolerance 0.0125 -o "$OUT/sim" >/dev/null
+# A small optimisation study (K = 2..3, 30 evaluations per K) for the optimisation report.
+sed -e 's/^k_max = .*/k_max = 3/' -e 's/^budget = .*/budget = 30/' \
+    examples/jobs/optimize-choi-3axis.toml > "$OUT/optimize-small.toml"
+"$SCALLOP" optimize "$OUT/optimize-small.toml" -o "$OUT/optimize" >/dev/null
 
 # Chromium stalls on connection attempts without these flags (no network here).
 # WebGL runs on SwiftShader (software): --disable-gpu plus --enable-unsafe-swiftshader.
@@ -54,7 +59,7 @@ browse() {
 }
 
 status=0
-for page in "$OUT/demo/report.html" "$OUT/sim/report.html"; do
+for page in "$OUT/demo/report.html" "$OUT/sim/report.html" "$OUT/optimize/report.html"; do
     url="file://$(cd "$(dirname "$page")" && pwd)/$(basename "$page")"
     shot="${page%.html}.png"
     dom="${page%.html}.dom.html"

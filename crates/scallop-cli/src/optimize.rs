@@ -164,6 +164,8 @@ pub fn run(args: &OptimizeArgs) -> CliResult<()> {
     write_atomic(&out.join("convergence.svg"), |w| w.write_all(convergence_svg(&study).as_bytes()))?;
     let title = format!("{part_name}, {}, K = {}", formulation_name(settings.formulation), best.k);
     write_atomic(&out.join("zones.svg"), |w| w.write_all(zones_svg(&best.plan, &title).as_bytes()))?;
+    let page = scallop_report::html::report_html(&optimisation_report(&patch, &study, &title, &name, &file.cutter));
+    write_atomic(&out.join("report.html"), |w| w.write_all(page.as_bytes()))?;
     if args.json {
         return print_json(&file);
     }
@@ -201,6 +203,72 @@ pub fn run(args: &OptimizeArgs) -> CliResult<()> {
         out.display()
     ));
     print_text(&text)
+}
+
+/// The page of a study (`report.html`): the part, the key figures of the best plan,
+/// the per-zone times of the best plan and one convergence curve per K. The plans
+/// of a study are contact-point passes without a cutter-location toolpath, so the
+/// 3D view shows the part only (zones are pictured in `zones.svg`).
+fn optimisation_report(
+    patch: &scallop_surface::Patch,
+    study: &scallop_optim::study::Study,
+    title: &str,
+    command: &str,
+    cutter: &str,
+) -> scallop_report::ReportData {
+    use scallop_report::{Convergence, Curve, Figure, ReportData, Zones};
+    let best = &study.results[study.best];
+    let mut data = ReportData::new(&format!("optimisation: {title}"));
+    data.command = format!("scallop optimize {command}");
+    data.part = patch.tessellate(tol_display(patch)).ok().map(|t| t.mesh);
+    data.figures = vec![
+        Figure::count("best K", best.k),
+        Figure::number("best plan time", best.f_best, 2, "s"),
+        Figure::number("start plan time (same K)", best.f0, 2, "s"),
+        Figure::number("gain at the best K", 100.0 * best.eta, 1, "%"),
+        Figure::number("mean gain over K", 100.0 * study.mean_eta, 1, "%"),
+        Figure::count("zones of the best plan", best.plan.zones.len()),
+        Figure::number("transition time (best plan)", best.plan.transition_time_s, 2, "s"),
+    ];
+    data.settings = vec![
+        Figure::text("formulation", formulation_name(study.settings.formulation)),
+        Figure::text("cutter", cutter),
+        Figure::text("K range", format!("{} to {}", study.settings.k_min, study.settings.k_max)),
+        Figure::number("budget per K", study.settings.budget, 0, "black-box evaluations"),
+    ];
+    for r in &study.results {
+        data.figures.push(Figure::number(
+            &format!("K = {}: start / best", r.k),
+            r.f_best,
+            2,
+            &format!("s (from {:.2} s, {} evaluations)", r.f0, r.evaluations),
+        ));
+    }
+    data.zones = Some(Zones {
+        of_move: Vec::new(),
+        names: best.plan.zones.iter().map(|z| format!("{} ({:.0} deg)", z.zone, z.theta_deg)).collect(),
+        times_s: best.plan.zones.iter().map(|z| z.time_s).collect(),
+    });
+    data.convergence = vec![Convergence {
+        title: "Best plan time against the budget spent, per K".into(),
+        x_label: "budget spent (black-box evaluations)".into(),
+        y_label: "best time (s)".into(),
+        curves: study
+            .results
+            .iter()
+            .map(|r| Curve {
+                name: format!("K = {}", r.k),
+                points: r.history.iter().map(|h| [h.spent, h.best]).collect(),
+            })
+            .collect(),
+    }];
+    data
+}
+
+/// A display tessellation tolerance: a thousandth of the control net's extent.
+fn tol_display(patch: &scallop_surface::Patch) -> f64 {
+    let b = patch.control_bounds();
+    ((b.max - b.min).norm() * 1e-3).max(1e-3)
 }
 
 fn formulation_name(f: Formulation) -> &'static str {
