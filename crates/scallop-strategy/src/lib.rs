@@ -94,6 +94,13 @@
 //!   edge: the strips along the boundary get half a step-over, as between passes,
 //!   and the pass count is `ceil(width / sod)`, the analytic count rounded up
 //!   (on the spec's 56 x 28 plane: 85 passes for 84.7, 45 for 44.3).
+//! - **Gaps between ranges.** Between two ranges the cutter has no interior
+//!   contact (it would ride on the part's open boundary, e.g. a raised edge), yet
+//!   the surface between the last plane of one range and the first of the next
+//!   can stand above `sh`. The sweep then bridges the gap with planes whose passes
+//!   accept any contact with the part, within the feed span of the two planes'
+//!   passes widened by the cutter radius, spaced by the same measured rule; the
+//!   final verification checks every pair, bridges included.
 //! - **Links.** Zigzag: the next pass starts where the previous one ended, on the
 //!   adjacent plane; if the cutter rests on the part all along the straight XY
 //!   segment between them, the link follows its drop-cutter points (sampled and

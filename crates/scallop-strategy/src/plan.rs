@@ -51,6 +51,9 @@ pub(crate) struct Planner<'a> {
     pub(crate) d_range: [f64; 2],
     pub(crate) feed_samples: Vec<f64>,
     pub(crate) drops: usize,
+    /// While bridging a gap between two ranges (see [`Planner::bridge`]): the
+    /// feed interval in which any contact with the part counts as inside.
+    bridge_span: Option<[f64; 2]>,
 }
 
 /// One plane with its passes and the samples the spacing rule reads.
@@ -134,6 +137,7 @@ impl<'a> Planner<'a> {
             d_range,
             feed_samples,
             drops: 0,
+            bridge_span: None,
         })
     }
 
@@ -143,6 +147,10 @@ impl<'a> Planner<'a> {
     }
 
     fn is_inside(&self, cl: &ClPoint, _scratch: &mut Vec<u32>) -> bool {
+        if let Some([t0, t1]) = self.bridge_span {
+            let t = self.frame.t(&cl.tip);
+            return !matches!(cl.contact, Contact::Floor) && t >= t0 && t <= t1;
+        }
         match self.params.boundary {
             Boundary::ContactInside => self.part_boundary.is_interior_contact(self.index, &self.slots, cl),
         }
@@ -396,6 +404,13 @@ impl<'a> Planner<'a> {
                 }
                 delta = spacing.max(tol::MIN_SPACING);
             }
+            if let Some(previous) = planes.pop() {
+                // The planes between two ranges have no passes: the cutter would
+                // ride on the part's open boundary there. Bridge the gap when
+                // the surface between the ranges is left above sh.
+                let bridged = self.bridge(previous, &first)?;
+                planes.extend(bridged);
+            }
             planes.push(first);
             loop {
                 // INVARIANT: a plane was pushed above.
@@ -451,6 +466,80 @@ impl<'a> Planner<'a> {
             return Err(StrategyError::EmptyRegion { direction_deg: self.params.direction.to_degrees() });
         }
         Ok(planes)
+    }
+
+    /// The planes from `previous` (the last plane of a range, returned first)
+    /// up to the first plane `next` of the following range (excluded) such that
+    /// every pair of neighbours holds `sh` by the refined measure. Between two
+    /// ranges no cutter location has an interior contact (the cutter rides on
+    /// the part's open boundary), yet the surface between the ranges' passes may
+    /// stand above `sh` (a raised edge that only the boundary-riding cutter
+    /// reaches). The bridge planes accept any contact with the part, within the
+    /// feed span of the two neighbours' passes widened by the cutter radius: the
+    /// cutter only lowers material there (every CL point is a drop-cutter
+    /// point, so no gouge) and the final verification covers the new pairs.
+    ///
+    /// # Errors
+    /// [`StrategyError::Unreachable`] when no spacing above
+    /// [`tol::MIN_SPACING`] holds `sh` between bridge planes.
+    fn bridge(&mut self, previous: PlanePasses, next: &PlanePasses) -> Result<Vec<PlanePasses>, StrategyError> {
+        let sh = self.params.scallop_height;
+        let (h, _) = self.measured(&previous, next, true);
+        if h <= sh {
+            return Ok(vec![previous]);
+        }
+        let radius = self.cutter.radius();
+        let (mut t0, mut t1) = (f64::INFINITY, f64::NEG_INFINITY);
+        for p in previous.plane.passes.iter().chain(&next.plane.passes).flatten() {
+            let t = self.frame.t(p);
+            t0 = t0.min(t);
+            t1 = t1.max(t);
+        }
+        self.bridge_span = Some([t0 - radius, t1 + radius]);
+        let result = self.bridge_planes(previous, next);
+        self.bridge_span = None;
+        result
+    }
+
+    fn bridge_planes(&mut self, previous: PlanePasses, next: &PlanePasses) -> Result<Vec<PlanePasses>, StrategyError> {
+        let sh = self.params.scallop_height;
+        let end = next.plane.offset;
+        let mut out = vec![previous];
+        loop {
+            // INVARIANT: `out` starts with `previous`.
+            let current = out.last().expect("the previous plane");
+            let d = current.plane.offset;
+            let (h, at) = self.measured(current, next, true);
+            if h <= sh {
+                return Ok(out);
+            }
+            let (spacing, _) = self.spacing(current).unwrap_or((end - d, at));
+            let mut gap = spacing.min(end - d).max(tol::MIN_SPACING);
+            let mut accepted = None;
+            for retry in 0..tol::MAX_SPACING_RETRIES {
+                let candidate = self.plane(d + gap);
+                // INVARIANT: as above.
+                let current = out.last().expect("the previous plane");
+                let (h, place) = if candidate.plane.passes.is_empty() {
+                    (f64::INFINITY, at)
+                } else {
+                    self.measured(current, &candidate, true)
+                };
+                if h <= sh {
+                    accepted = Some(candidate);
+                    break;
+                }
+                let ratio = if h.is_finite() { (sh / h).sqrt() * tol::SPACING_SAFETY } else { 0.5 };
+                gap *= if retry == 0 { ratio } else { ratio.min(tol::SPACING_MIN_SHRINK) };
+                if gap < tol::MIN_SPACING {
+                    return Err(self.unreachable(gap, place));
+                }
+            }
+            let Some(candidate) = accepted else {
+                return Err(self.unreachable(gap, at));
+            };
+            out.push(candidate);
+        }
     }
 
     /// CL points of a straight link from `a` to `b` on the CL surface (every

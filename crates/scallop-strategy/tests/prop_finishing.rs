@@ -145,15 +145,15 @@ fn output_is_identical_on_one_and_two_threads() {
     assert_eq!(a, b);
 }
 
-/// A case the bull-nose property test found (session of 2026-11-23): planning returns
-/// its own safety error ("scallop 0.0683 mm between planes 22 and 23 near (2.358,
-/// 22.706) mm exceeds 0.0532 mm") instead of a plan: the plane accepted by the sweep
-/// measures over sh in the final check. Never an unsafe output, but a missing plan;
-/// kept here, visible and runnable (`cargo test -p scallop-strategy --test
-/// prop_finishing -- --ignored`), until the planner is fixed (open item of issue 3).
+/// A case the bull-nose property test found (2026-11-23): near the corner at
+/// (0, 24) the planes between offsets 15.9 and 21.7 have no interior contact (the
+/// cutter rides on the patch's raised edge), so the sweep makes two ranges, and the
+/// surface between the last plane of the first range and the first of the second
+/// stood 0.068 mm > sh above the cutter. The sweep now bridges such gaps with
+/// planes that accept boundary contacts (`Planner::bridge`), and the final check
+/// holds. Before the fix planning failed with its own safety error.
 #[test]
-#[ignore = "known planner defect: final scallop check rejects an accepted plane on this patch"]
-fn known_defect_bull_plane_accepted_then_rejected() {
+fn bull_gap_between_ranges_is_bridged() {
     let z = [
         -1.1328400216447208,
         -0.5500051951164447,
