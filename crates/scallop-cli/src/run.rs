@@ -120,6 +120,7 @@ fn finish_job(spec: &JobFile, folder: &Path) -> CliResult<FinishJob> {
         strategy: match (spec.finishing.strategy.as_str(), spec.finishing.iso_direction.as_str()) {
             ("isoparametric", "v") => Strategy::Isoparametric(IsoDirection::V),
             ("isoparametric", _) => Strategy::Isoparametric(IsoDirection::U),
+            ("network", _) => Strategy::NetworkPlanes,
             _ => Strategy::ParallelPlanes,
         },
         leads: match spec.finishing.lead.as_str() {

@@ -279,6 +279,21 @@ fn run_plans_a_job_file_and_rejects_bad_keys() {
 }
 
 #[test]
+fn run_with_the_network_planner_writes_a_verified_program() {
+    let dir = scratch("run-network");
+    let job = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/jobs/choi-network.toml");
+    let out = scallop().current_dir(&dir).args(["run", job, "-o", "out", "--json"]).output().expect("run");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
+    let bound = v["sim_resolution_bound_mm"].as_f64().expect("number");
+    let scallop = v["plan"]["max_scallop_mm"].as_f64().expect("number");
+    assert!(scallop > 0.0 && scallop <= 0.01 + bound, "{scallop} {bound}");
+    assert!(v["plan"]["passes"].as_u64().expect("passes") > 50);
+    let program = std::fs::read_to_string(dir.join("out/program.nc")).expect("program");
+    assert!(program.lines().filter(|l| l.starts_with("G1")).count() > 1000);
+}
+
+#[test]
 fn optimize_writes_the_study_and_rejects_bad_settings() {
     let dir = scratch("optimize");
     let job = "[part]\nbuiltin = \"rubio\"\n[cutter]\nshape = \"bull\"\ndiameter = 10\ncorner_radius = 2\n\

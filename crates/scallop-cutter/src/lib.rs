@@ -28,5 +28,7 @@
 mod drop;
 mod shape;
 
-pub use drop::{ClPoint, Contact, drop_cutter, drop_cutter_brute_force, drop_grid, drop_points, drop_triangle};
+pub use drop::{
+    ClPoint, Contact, drop_cutter, drop_cutter_brute_force, drop_grid, drop_path, drop_points, drop_triangle,
+};
 pub use shape::{Cutter, CutterError, CutterShape, HolderSegment};

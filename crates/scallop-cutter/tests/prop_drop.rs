@@ -6,7 +6,9 @@
 //! translation invariance, monotone under adding triangles, and analytic cases.
 
 use proptest::prelude::*;
-use scallop_cutter::{ClPoint, Contact, Cutter, CutterShape, drop_cutter, drop_cutter_brute_force, drop_grid};
+use scallop_cutter::{
+    ClPoint, Contact, Cutter, CutterShape, drop_cutter, drop_cutter_brute_force, drop_grid, drop_path,
+};
 use scallop_geom::{Point2, Point3, Vec3, assert_near};
 use scallop_mesh::{MeshIndex, TriMesh};
 
@@ -100,6 +102,30 @@ proptest! {
             let xy = Point2::new(xs[k % xs.len()], ys[k / xs.len()]);
             let slow = drop_cutter_brute_force(&c, &index, xy, FLOOR);
             prop_assert_eq!(cl.tip.z.to_bits(), slow.tip.z.to_bits(), "at {:?}: {:?} vs {:?}", xy, cl, slow);
+        }
+    }
+
+    /// A wandering path (small steps with occasional jumps, so blocks of many
+    /// points and blocks of one) gives the brute-force heights bit for bit.
+    #[test]
+    fn path_equals_brute_force(soup in soup_strategy(80), shape in shape_strategy(),
+                               x0 in -3.0f64..12.0, y0 in -3.0f64..12.0,
+                               steps in prop::collection::vec((-0.6f64..0.6, -0.6f64..0.6, 0u8..20), 1..150)) {
+        let Some((_, index)) = build(&soup) else { return Ok(()) };
+        let c = cutter(shape);
+        let mut p = Point2::new(x0, y0);
+        let mut path = Vec::new();
+        for (dx, dy, jump) in steps {
+            let k = if jump == 0 { 12.0 } else { 1.0 };
+            p = Point2::new((p.x + k * dx).clamp(-3.0, 13.0), (p.y + k * dy).clamp(-3.0, 13.0));
+            path.push(p);
+        }
+        let fast = drop_path(&c, &index, &path, FLOOR);
+        prop_assert_eq!(fast.len(), path.len());
+        for (cl, xy) in fast.iter().zip(&path) {
+            let slow = drop_cutter_brute_force(&c, &index, *xy, FLOOR);
+            prop_assert_eq!(cl.tip.z.to_bits(), slow.tip.z.to_bits(), "at {:?}: {:?} vs {:?}", xy, cl, slow);
+            prop_assert_eq!((cl.tip.x, cl.tip.y), (xy.x, xy.y));
         }
     }
 

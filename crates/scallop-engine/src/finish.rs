@@ -296,6 +296,22 @@ pub fn run_finishing(job: &FinishJob) -> Result<FinishOutput, EngineError> {
             let p = plan_finishing(&prepared.index, &job.cutter, &params, &tolerances)?;
             Plan { toolpath: p.toolpath, report: p.report, scallop: Some(p.scallop) }
         }
+        Strategy::NetworkPlanes => {
+            let Part::Surfaces(set) = &job.part else {
+                return Err(EngineError::Output {
+                    what: "the network planner on a mesh part".into(),
+                    fix: "use a parametric part (builtin or a surface file) or finishing.strategy = \"parallel\""
+                        .into(),
+                });
+            };
+            if job.setup.is_some() {
+                return Err(EngineError::Output {
+                    what: "the network planner in a 3+2 setup".into(),
+                    fix: "remove [setup] or use finishing.strategy = \"parallel\"".into(),
+                });
+            }
+            network_planes(set, &prepared, job, &params, &tolerances)?
+        }
         Strategy::Isoparametric(direction) => {
             let Part::Surfaces(set) = &job.part else {
                 return Err(EngineError::Output {
@@ -348,6 +364,27 @@ pub fn run_finishing(job: &FinishJob) -> Result<FinishOutput, EngineError> {
         scallop_sim::VerifyOptions { gouge_tolerance, scallop_margin: radius, ..scallop_sim::VerifyOptions::default() };
     let sim =
         scallop_sim::simulate(stock, job.sim_resolution, &job.cutter, &planned.toolpath, &prepared.index, &options)?;
+    if job.strategy == Strategy::NetworkPlanes {
+        // No planner measure: the simulation is the scallop verification, and a
+        // scallop over sh (beyond the grid's bound) fails the job.
+        let bound = sim.zmap.resolution_bound(job.cutter.shape());
+        let v = &sim.verification;
+        if v.max_thickness > job.scallop_height + bound {
+            let at = v.max_thickness_at.unwrap_or_else(|| scallop_geom::Point2::new(f64::NAN, f64::NAN));
+            return Err(EngineError::ScallopNotHeld {
+                measured: v.max_thickness,
+                x: at.x,
+                y: at.y,
+                limit: job.scallop_height,
+                bound,
+            });
+        }
+        planned.report.max_scallop_mm = v.max_thickness;
+        // The mean: material left above the part per unit of its area (vertical).
+        #[allow(clippy::cast_precision_loss, reason = "cell counts")]
+        let cells = v.part_cells.max(1) as f64;
+        planned.report.mean_scallop_mm = v.excess_volume / (cells * job.sim_resolution * job.sim_resolution);
+    }
 
     let cutter_text = match *job.cutter.shape() {
         CutterShape::Bull { radius, corner } => format!("bull-nose R{radius} r{corner} mm"),
@@ -427,6 +464,85 @@ pub enum Strategy {
     ParallelPlanes,
     /// Isoparametric passes on every patch of a parametric part.
     Isoparametric(IsoDirection),
+    /// Parallel vertical planes placed by the fast network planner
+    /// (`scallop_strategy::network`, finishing.md 6.3 to 6.5) on every patch of a
+    /// parametric part, cutter locations by drop-cutter
+    /// (`scallop_strategy::network::network_toolpath`); the scallop is verified by
+    /// the stock simulation only.
+    NetworkPlanes,
+}
+
+/// The machining-mesh step of the network planner (mm): the specification's
+/// 0.5 mm machining mesh (finishing.md 6.3).
+pub const NETWORK_STEP_MM: f64 = 0.5;
+
+/// Parallel planes by the network planner, patch after patch (see
+/// [`Strategy::NetworkPlanes`]); the scallop figures are filled in from the
+/// simulation by the caller.
+fn network_planes(
+    set: &scallop_surface::SurfaceSet,
+    prepared: &PreparedPart,
+    job: &FinishJob,
+    params: &FinishingParams,
+    tolerances: &Tolerances,
+) -> Result<Plan, EngineError> {
+    use scallop_strategy::network::{Margins, Network, ZoneParams, network_toolpath, plan_zone};
+    let tool = match *job.cutter.shape() {
+        CutterShape::Ball { radius } => scallop_analysis::Cutter::Ball { radius },
+        CutterShape::Bull { radius, corner } => scallop_analysis::Cutter::Toroidal { radius, corner },
+        CutterShape::Flat { radius } => scallop_analysis::Cutter::Toroidal { radius, corner: 0.0 },
+        CutterShape::Cone { .. } => return Err(scallop_strategy::StrategyError::Unsupported { shape: "cone" }.into()),
+    };
+    let zone = ZoneParams {
+        direction: params.direction,
+        tool,
+        scallop_height: params.scallop_height,
+        margins: Margins::HalfStep,
+        sharp_corner: params.sharp_corner,
+        machine: params.machine,
+    };
+    let mut toolpath = Toolpath::new(params.machine.feed * 60.0);
+    toolpath.plunge_feed = params.plunge_feed * 60.0;
+    let (mut passes, mut planes, mut links, mut drops) = (0, 0, 0, 0);
+    for patch in set.patches() {
+        let network = Network::new(patch, NETWORK_STEP_MM)?;
+        let plan = plan_zone(&network, None, 0, &zone)?;
+        planes += plan.planes.len();
+        let made =
+            network_toolpath(&network, std::slice::from_ref(&plan), &prepared.index, &job.cutter, params, tolerances)?;
+        passes += made.passes;
+        links += made.links;
+        drops += made.drops;
+        for m in made.toolpath.moves() {
+            toolpath.push(*m);
+        }
+    }
+    let (a, b) = (stop_to_stop_time(&toolpath, params), lookahead_time(&toolpath, params));
+    let feed = toolpath.length(MoveKind::Feed);
+    let link = toolpath.length(MoveKind::Link);
+    let report = scallop_strategy::Report {
+        machining_time_s: a.cutting,
+        machining_time_lookahead_s: b.cutting,
+        rapid_time_s: a.rapid,
+        plunge_time_s: a.plunge,
+        total_time_s: a.total(),
+        path_length_mm: feed + link,
+        feed_length_mm: feed,
+        link_length_mm: link,
+        rapid_length_mm: toolpath.length(MoveKind::Rapid) + toolpath.length(MoveKind::Retract),
+        plunge_length_mm: toolpath.length(MoveKind::Plunge),
+        passes,
+        planes,
+        links,
+        retracts: toolpath.count(MoveKind::Retract),
+        // Filled in from the simulation (the planner measures no scallop).
+        max_scallop_mm: 0.0,
+        mean_scallop_mm: 0.0,
+        points: toolpath.moves().len(),
+        cl_points_dropped: drops,
+        planning_time_s: 0.0,
+    };
+    Ok(Plan { toolpath, report, scallop: None })
 }
 
 /// A toolpath and its figures, whatever the strategy.
@@ -612,6 +728,27 @@ mod tests {
         let mut mesh_job = job.clone();
         let mesh = prepare_part(&job.part, &job.tolerances).unwrap().mesh;
         mesh_job.part = Part::Mesh(mesh);
+        assert!(matches!(run_finishing(&mesh_job), Err(EngineError::Output { .. })));
+    }
+
+    /// The demo job with the network planner: no gouge (the simulation would
+    /// fail the job), the simulated scallop within sh plus the grid's bound, and
+    /// a pass count near the drop-cutter planner's.
+    #[test]
+    fn network_finishing_of_choi_holds_the_scallop_in_the_simulation() {
+        let mut job = FinishJob::choi_demo();
+        job.sim_resolution = 0.1;
+        let reference = run_finishing(&job).unwrap();
+        job.strategy = Strategy::NetworkPlanes;
+        let out = run_finishing(&job).unwrap();
+        let (r, sim) = (&out.report, &out.details.simulation);
+        assert!(sim.verification.max_thickness <= r.scallop_height_mm + r.sim_resolution_bound_mm, "{r:?}");
+        assert_eq!(r.plan.max_scallop_mm.to_bits(), sim.verification.max_thickness.to_bits());
+        let (a, b) = (r.plan.passes as f64, reference.report.plan.passes as f64);
+        assert!((a - b).abs() <= 0.2 * b, "network {a} passes, drop-cutter planner {b}");
+        // A mesh part has no network; nor has a 3+2 setup.
+        let mut mesh_job = job.clone();
+        mesh_job.part = Part::Mesh(prepare_part(&job.part, &job.tolerances).unwrap().mesh);
         assert!(matches!(run_finishing(&mesh_job), Err(EngineError::Output { .. })));
     }
 }

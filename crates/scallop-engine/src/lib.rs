@@ -56,6 +56,26 @@ pub enum EngineError {
     /// collision) or could not run.
     #[error("verification: {0}")]
     Verification(#[from] scallop_sim::SimError),
+    /// The simulated stock holds more than the scallop height between passes
+    /// (beyond the simulator's resolution bound) where the planner measures no
+    /// scallop itself (the network planner).
+    #[error(
+        "verification: the simulated scallop {measured:.4} mm near ({x:.3}, {y:.3}) mm exceeds sh {limit} mm \
+         plus the stock's resolution bound {bound:.4} mm; fix: use finishing.strategy = \"parallel\" \
+         (measured spacing) or a finer verify.resolution"
+    )]
+    ScallopNotHeld {
+        /// Largest simulated scallop (normal thickness, mm).
+        measured: f64,
+        /// Where (mm).
+        x: f64,
+        /// Where (mm).
+        y: f64,
+        /// The scallop height asked for (mm).
+        limit: f64,
+        /// The simulator's resolution bound (mm).
+        bound: f64,
+    },
     /// The program cannot be written as asked (dialect, machine, 3+2 setup).
     #[error("output: {what}; fix: {fix}")]
     Output {

@@ -145,7 +145,9 @@ pub struct FinishingSpec {
     /// Longest forward step between drop-cutter samples (mm).
     #[serde(default = "default_max_step")]
     pub max_step: f64,
-    /// `parallel` (default: parallel vertical planes) or `isoparametric` (parametric parts).
+    /// `parallel` (default: parallel vertical planes, drop-cutter planner with a measured
+    /// scallop), `network` (parallel planes by the fast network planner, parametric parts)
+    /// or `isoparametric` (parametric parts).
     #[serde(default = "default_strategy")]
     pub strategy: String,
     /// Isoparametric passes along `u` (default) or `v`.
@@ -498,11 +500,11 @@ pub fn parse_job(text: &str) -> Result<JobFile, JobError> {
             fix: "use \"zigzag\" or \"one-way\"",
         });
     }
-    if !matches!(job.finishing.strategy.as_str(), "parallel" | "isoparametric") {
+    if !matches!(job.finishing.strategy.as_str(), "parallel" | "isoparametric" | "network") {
         return Err(JobError::Value {
             key: "finishing.strategy",
             value: job.finishing.strategy.clone(),
-            fix: "use \"parallel\" or \"isoparametric\"",
+            fix: "use \"parallel\", \"network\" or \"isoparametric\"",
         });
     }
     if !matches!(job.finishing.iso_direction.as_str(), "u" | "v") {

@@ -8,6 +8,10 @@
 //!   3+2 orientation for the rotation only);
 //! - `whole_surface/<surface>`: one zone, feed along the PCA steepest-slope
 //!   direction, plus the surface time (issue 3's "planning one finishing");
+//! - `whole_surface_toolpath/<surface>`: the same plan turned into a toolpath
+//!   (`network_toolpath`: drop-cutter locations on the part tessellated at the
+//!   default tolerances, links, retracts), on one rayon thread: what
+//!   `finishing.strategy = "network"` plans before the post and the simulation;
 //! - `black_box_80x80_k<K>/<surface>`: one black-box evaluation (12.2) after the
 //!   clustering: a K-zone 80 x 80 labelling prepared ([`Zoning::new`]), zone `i`
 //!   planned along `theta + 0.37 i` (directions all around, as an optimiser
@@ -19,9 +23,14 @@ use std::f64::consts::PI;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use scallop_analysis::{Cutter, GridOptions, MachineLimits, ToolOptions, analyze, sample_patch};
+use scallop_cutter::CutterShape;
+use scallop_geom::Tolerances;
+use scallop_mesh::MeshIndex;
 use scallop_strategy::network::{
-    CellLabels, Margins, Network, Transitions, ZoneParams, Zoning, plan_zone, plan_zones, surface_time,
+    CellLabels, Margins, Network, Transitions, ZoneParams, Zoning, network_toolpath, plan_zone, plan_zones,
+    surface_time,
 };
+use scallop_strategy::{Boundary, FinishingParams, Pattern};
 
 /// A deterministic K-zone labelling of an 80 x 80 grid: K angular sectors
 /// around an off-centre point, with wavy borders (non-convex zones).
@@ -67,6 +76,39 @@ fn bench(c: &mut Criterion) {
             b.iter(|| {
                 let plan = plan_zone(&network, None, 0, &params(theta)).expect("plan");
                 surface_time(std::slice::from_ref(&plan), &transitions, &machine).total_s
+            });
+        });
+        // Issue 3's finishing with cutter locations: the plan above, then the
+        // drop-cutter locations of its passes on the tessellated part (the
+        // engine's default tolerances), links and retracts: a whole toolpath.
+        let tolerances = Tolerances { path: 0.01, gouge: 0.0 }; // the demo job's
+        let mesh = set.tessellate(tolerances.tessellation()).expect("tessellation").mesh;
+        let index = MeshIndex::build(&mesh);
+        let cutter = scallop_cutter::Cutter::new(CutterShape::Bull { radius: 5.0, corner: 2.0 }, 30.0).expect("cutter");
+        let finishing = FinishingParams {
+            direction: theta,
+            pattern: Pattern::Zigzag,
+            scallop_height: 0.01,
+            boundary: Boundary::ContactInside,
+            max_step: 0.5,
+            clearance: 5.0,
+            machine,
+            plunge_feed: machine.feed / 4.0,
+            rapid_rate: 1000.0,
+            sharp_corner: 30f64.to_radians(),
+            blend_tolerance: tolerances.path,
+        };
+        let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().expect("pool");
+        group.bench_function(format!("whole_surface_toolpath/{name}"), |b| {
+            b.iter(|| {
+                one.install(|| {
+                    let plan = plan_zone(&network, None, 0, &params(theta)).expect("plan");
+                    network_toolpath(&network, std::slice::from_ref(&plan), &index, &cutter, &finishing, &tolerances)
+                        .expect("toolpath")
+                        .toolpath
+                        .moves()
+                        .len()
+                })
             });
         });
         for (k, spread) in [(3u32, 0.37), (6, 0.37), (10, 0.37), (10, 0.0)] {

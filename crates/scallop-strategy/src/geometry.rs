@@ -194,3 +194,18 @@ impl PartBoundary {
         })
     }
 }
+
+/// From a contact point with upward unit normal `n` to the tip of the vertical
+/// cutter touching the surface there: the corner circle's centre is `r n` from
+/// the contact, the axis `(R - r)` from it along the horizontal part of `n`
+/// (downhill: the cutter touches a slope with its uphill side), the tip `r`
+/// below (ball `r = R`, flat and cone `r = 0`).
+pub(crate) fn contact_to_tip(shape: &CutterShape, n: &Vec3) -> Vec3 {
+    let (radius, corner) = match *shape {
+        CutterShape::Ball { radius } => (radius, radius),
+        CutterShape::Bull { radius, corner } => (radius, corner),
+        CutterShape::Flat { radius } | CutterShape::Cone { radius, .. } => (radius, 0.0),
+    };
+    let side = n.xy().try_normalize(tol::HORIZONTAL_XY).map_or(Vec3::zeros(), |h| Vec3::new(h.x, h.y, 0.0));
+    n * corner + side * (radius - corner) - Vec3::z() * corner
+}

@@ -331,14 +331,11 @@ fn radii(cutter: &Cutter) -> (f64, f64) {
     }
 }
 
-/// The tip of the cutter touching `S(u, v)` with the surface normal there (upward):
-/// the corner circle's centre is `S + r n`, the axis `(R - r)` inward of it.
+/// The tip of the cutter touching `S(u, v)` with the surface normal there (upward).
 fn touching_tip(patch: &Patch, cutter: &Cutter, u: f64, v: f64) -> Point3 {
-    let (radius, corner) = radii(cutter);
     let n = patch.normal(u, v);
     let n = if n.z < 0.0 { -n } else { n };
-    let side = n.xy().try_normalize(tol::HORIZONTAL_XY).map_or(Vec3::zeros(), |h| Vec3::new(h.x, h.y, 0.0));
-    patch.point(u, v) + n * corner - side * (radius - corner) - Vec3::z() * corner
+    patch.point(u, v) + crate::geometry::contact_to_tip(cutter.shape(), &n)
 }
 
 /// Distance (mm) from `p` to the cutter body with its tip at `tip` (0 inside):
@@ -467,4 +464,40 @@ pub fn iso_scallop(
         out.push(worst);
     }
     out
+}
+
+#[cfg(test)]
+mod touching_tests {
+    use super::*;
+    use scallop_cutter::{Contact, drop_cutter};
+    use scallop_mesh::{MeshIndex, TriMesh};
+
+    /// The drop-cutter location at the XY of `touching_tip` touches an inclined
+    /// plane exactly at the isoline point.
+    #[test]
+    fn touching_tip_touches_the_surface_point() {
+        let s = 30f64.to_radians();
+        let p = |x: f64, y: f64| Point3::new(x, y, s.tan() * x);
+        let control = vec![vec![p(-40., -40.), p(-40., 40.)], vec![p(40., -40.), p(40., 40.)]];
+        let patch = Patch::bezier("incline", [1, 1], &control, None).unwrap_or_else(|e| panic!("{e}"));
+        let (mesh, _) = TriMesh::from_soup(&[
+            [p(-40., -40.), p(40., -40.), p(40., 40.)],
+            [p(-40., -40.), p(40., 40.), p(-40., 40.)],
+        ])
+        .unwrap_or_else(|e| panic!("{e}"));
+        let index = MeshIndex::build(&mesh);
+        for shape in [
+            CutterShape::Bull { radius: 5.0, corner: 2.0 },
+            CutterShape::Flat { radius: 3.0 },
+            CutterShape::Ball { radius: 4.0 },
+        ] {
+            let cutter = Cutter::new(shape, 20.0).unwrap_or_else(|e| panic!("{e}"));
+            let (u, v) = (0.55, 0.4);
+            let tip = touching_tip(&patch, &cutter, u, v);
+            let cl = drop_cutter(&cutter, &index, scallop_geom::Point2::new(tip.x, tip.y), -100.0);
+            let Contact::Facet { point, .. } = cl.contact else { panic!("{:?}", cl.contact) };
+            assert!((point - patch.point(u, v)).norm() < 1e-9, "{shape:?}: {point:?} vs {:?}", patch.point(u, v));
+            assert!((cl.tip - tip).norm() < 1e-9, "{shape:?}");
+        }
+    }
 }

@@ -228,7 +228,7 @@ pub fn drop_grid(
                 end += 1;
             }
             let (x0, x1) = (xs[start].min(xs[end - 1]), xs[start].max(xs[end - 1]));
-            scratch.fill(index, &profile, x0, x1, y);
+            scratch.fill(index, &profile, [x0, y], [x1, y]);
             for (slot_out, &x) in row[start..end].iter_mut().zip(&xs[start..end]) {
                 let (cl, slot) = drop_candidates(&profile, index, &scratch.sorted, Point2::new(x, y), floor, seed);
                 seed = slot;
@@ -237,6 +237,64 @@ pub fn drop_grid(
             start = end;
         }
         progress(done.fetch_add(1, Ordering::Relaxed) + 1);
+    });
+    out
+}
+
+/// Drop-cutter at a sequence of nearby points (a path sampled densely), in
+/// parallel over blocks of consecutive points; the output is in input order.
+///
+/// Consecutive points whose XY box stays within one cutter diameter (at most
+/// 64 points) share one candidate list, as the rows of [`drop_grid`] do, each
+/// point seeded with its predecessor's contact triangle. The result equals
+/// [`drop_cutter`] at every point, bit for bit, and does not depend on the
+/// number of threads. Far-apart points simply make blocks of one.
+#[must_use]
+pub fn drop_path(cutter: &Cutter, index: &MeshIndex, points: &[Point2], floor: f64) -> Vec<ClPoint> {
+    let profile = Profile::new(cutter.shape());
+    let span = 2.0 * profile.radius;
+    // Blocks: [start, end) with their boxes.
+    let mut blocks: Vec<(usize, usize, [f64; 2], [f64; 2])> = Vec::new();
+    let mut start = 0;
+    while start < points.len() {
+        let (mut lo, mut hi) = ([points[start].x, points[start].y], [points[start].x, points[start].y]);
+        let mut end = start + 1;
+        while end < points.len() && end - start < BLOCK_POINTS {
+            let p = points[end];
+            let (nlo, nhi) = ([lo[0].min(p.x), lo[1].min(p.y)], [hi[0].max(p.x), hi[1].max(p.y)]);
+            // Negated so that a NaN coordinate ends the block.
+            if !(nhi[0] - nlo[0] <= span && nhi[1] - nlo[1] <= span) {
+                break;
+            }
+            (lo, hi) = (nlo, nhi);
+            end += 1;
+        }
+        blocks.push((start, end, lo, hi));
+        start = end;
+    }
+    let mut out: Vec<ClPoint> = points.iter().map(|&p| ClPoint::floor(p, floor)).collect();
+    let mut chunks: Vec<&mut [ClPoint]> = Vec::with_capacity(blocks.len());
+    let mut rest: &mut [ClPoint] = &mut out;
+    for &(start, end, _, _) in &blocks {
+        let (head, tail) = rest.split_at_mut(end - start);
+        chunks.push(head);
+        rest = tail;
+    }
+    chunks.into_par_iter().zip(blocks.par_iter()).for_each_init(BlockScratch::default, |scratch, (chunk, block)| {
+        let &(start, end, lo, hi) = block;
+        if lo.iter().chain(&hi).all(|v| v.is_finite()) {
+            scratch.fill(index, &profile, lo, hi);
+            let mut seed = None;
+            for (slot_out, &xy) in chunk.iter_mut().zip(&points[start..end]) {
+                let (cl, slot) = drop_candidates(&profile, index, &scratch.sorted, xy, floor, seed);
+                seed = slot;
+                *slot_out = cl;
+            }
+        } else {
+            for (slot_out, &xy) in chunk.iter_mut().zip(&points[start..end]) {
+                *slot_out = drop_cutter(cutter, index, xy, floor);
+            }
+        }
     });
     out
 }
@@ -251,22 +309,24 @@ struct BlockScratch {
 }
 
 impl BlockScratch {
-    /// The triangles within reach of the block `[x0, x1] x {y}`, sorted by
-    /// decreasing bound (ties by slot, so the order is deterministic).
-    fn fill(&mut self, index: &MeshIndex, profile: &Profile, x0: f64, x1: f64, y: f64) {
+    /// The triangles within reach of the block's box `[lo, hi]` (a segment
+    /// `[x0, x1] x {y}` for a grid row), sorted by decreasing bound (ties by
+    /// slot, so the order is deterministic).
+    fn fill(&mut self, index: &MeshIndex, profile: &Profile, lo: [f64; 2], hi: [f64; 2]) {
         let radius = profile.radius;
-        let reach = Aabb2 { min: Point2::new(x0 - radius, y - radius), max: Point2::new(x1 + radius, y + radius) };
+        let ([x0, y0], [x1, y1]) = (lo, hi);
+        let reach = Aabb2 { min: Point2::new(x0 - radius, y0 - radius), max: Point2::new(x1 + radius, y1 + radius) };
         self.slots.clear();
         index.collect_box(&reach, &mut self.slots);
         // Bound valid for every point of the block: the triangle's top lifted by
-        // the profile at its distance to the block's segment [x0, x1] x {y}.
+        // the profile at its distance to the block's box.
         self.unsorted.clear();
         self.unsorted.extend(self.slots.iter().map(|&slot| {
             let slot = slot as usize;
             let b = index.xy_box(slot);
             let zmax = index.zmax(slot);
             let dx = (b.min.x - x1).max(0.0).max(x0 - b.max.x);
-            let dy = (b.min.y - y).max(0.0).max(y - b.max.y);
+            let dy = (b.min.y - y1).max(0.0).max(y0 - b.max.y);
             let d2 = (dx * dx + dy * dy).min(radius * radius);
             let ub = zmax - profile.height(d2.sqrt());
             Candidate { ub, zmax, min: [b.min.x, b.min.y], max: [b.max.x, b.max.y], slot }

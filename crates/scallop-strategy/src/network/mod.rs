@@ -94,6 +94,7 @@ mod normals;
 mod passes;
 mod spacing;
 mod time;
+mod toolpath;
 mod zone;
 
 use scallop_analysis::{Cutter, MachineLimits};
@@ -105,6 +106,7 @@ use serde::{Deserialize, Serialize};
 use crate::{StrategyError, tol};
 
 pub use time::{SurfaceTime, TransitionModel, Transitions, surface_time};
+pub use toolpath::{NetworkToolpath, network_toolpath};
 pub use zone::{plan_zone, plan_zones, plane_passes};
 
 /// The isoparametric machining network of a patch (finishing.md 6.3): `(N_u + 1)
