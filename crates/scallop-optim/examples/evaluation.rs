@@ -1,0 +1,40 @@
+//! One black-box evaluation of the 3-axis zone study (clustering, zones, plans,
+//! time) on a built-in surface, repeated N times, for instruction counts:
+//!
+//! ```text
+//! cargo build --release -p scallop-optim --example evaluation
+//! valgrind --tool=callgrind --toggle-collect='evaluation::evaluate' \
+//!     target/release/examples/evaluation choi 10 20
+//! ```
+//!
+//! Arguments: surface (`choi`, `rubio`), K, repetitions. Prints the time of the
+//! last evaluation's plan, so the work cannot be optimised away.
+
+use scallop_optim::study::{Fidelity, Formulation, MachiningModel};
+use scallop_optim::surface::{SurfaceModel, SurfaceSettings};
+
+#[inline(never)]
+fn evaluate(model: &SurfaceModel, k: usize, omega: &[f64; 4], directions_from: &scallop_optim::study::Design) -> f64 {
+    let p = model.partition(k, omega, Fidelity::BlackBox).expect("clusters");
+    let d = directions_from;
+    model.assess(&p, Formulation::ThreeAxis, d, Fidelity::BlackBox).expect("plan").time_s
+}
+
+fn main() {
+    let mut args = std::env::args().skip(1);
+    let surface = args.next().unwrap_or_else(|| "choi".into());
+    let k: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(10);
+    let n: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(10);
+    let set = scallop_surface::builtin(&surface).expect("choi or rubio");
+    let model = SurfaceModel::new(&set.patches()[0], SurfaceSettings::default()).expect("valid settings");
+    let omega = [0.9, 0.8, 1.0, 0.7];
+    let p = model.partition(k, &omega, Fidelity::BlackBox).expect("clusters");
+    let start = model.initial_design(k, Formulation::ThreeAxis, &p).expect("start");
+    let mut time = 0.0;
+    for i in 0..n {
+        // Slightly different weights each time: the optimiser's polls move omega.
+        let w = 0.01 * (i % 7) as f64;
+        time = evaluate(&model, k, &[omega[0] - w, omega[1], omega[2] - w, omega[3]], &start);
+    }
+    println!("{surface} K = {k}: {n} evaluations, last plan {time:.3} s");
+}
