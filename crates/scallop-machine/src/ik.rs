@@ -86,7 +86,13 @@ impl IkSolutions {
 }
 
 fn normalize_angle(a: f64) -> f64 {
-    let r = a.rem_euclid(2.0 * PI);
+    // `rem_euclid` is `a % 2 pi` (exact, a call to fmod) then `+ 2 pi` for a negative
+    // remainder; for |a| < 2 pi the remainder is `a` itself: same value without fmod.
+    let r = if a.abs() < 2.0 * PI {
+        if a < 0.0 { a + 2.0 * PI } else { a }
+    } else {
+        a.rem_euclid(2.0 * PI)
+    };
     if r > PI { r - 2.0 * PI } else { r }
 }
 
@@ -149,20 +155,27 @@ impl Kinematics {
     }
 
     /// [`Kinematics::solution`] with the rotaries' `(sin, cos)` known (the closed forms get
-    /// them from the tool axis's components without evaluating `sin_cos`).
+    /// them from the tool axis's components without evaluating `sin_cos`); `x_m` is
+    /// `W0 tip` when the position step is closed (`linear_first`), computed once for both
+    /// branches.
     fn solution_trig(
         &self,
         tip: &Point3,
+        x_m: &Point3,
         (theta_primary, trig_primary): (f64, (f64, f64)),
         (theta_secondary, trig_secondary): (f64, (f64, f64)),
     ) -> IkSolution {
         let mut q = Joints::zeros();
         q[self.primary] = normalize_angle(theta_primary);
         q[self.secondary] = normalize_angle(theta_secondary);
-        let mut trig = [(0.0, 1.0); 5];
-        trig[self.primary] = trig_primary;
-        trig[self.secondary] = trig_secondary;
-        self.solve_linear_trig(tip, &mut q, &trig);
+        if self.linear_first {
+            let mut trig = [(0.0, 1.0); 5];
+            trig[self.primary] = trig_primary;
+            trig[self.secondary] = trig_secondary;
+            self.solve_linear_machine(x_m, &mut q, &trig);
+        } else {
+            self.solve_linear_affine(tip, &mut q);
+        }
         IkSolution { joints: q, branch: Branch::of_tilt(q[self.tilt]), at_pole: false }
     }
 
@@ -171,53 +184,59 @@ impl Kinematics {
     /// `q_lin = M^-1 D` (spec 3.2). Otherwise the tip is affine in the linear joints for
     /// fixed rotaries: `P(q_lin) = P(0) + A q_lin`, with A from three forward evaluations.
     pub(crate) fn solve_linear(&self, tip: &Point3, q: &mut Joints) {
-        let mut trig = [(0.0, 1.0); 5];
-        for (i, t) in trig.iter_mut().enumerate() {
-            if self.machine.axes[i].kind == AxisKind::Rotary {
-                *t = q[i].sin_cos();
+        if self.linear_first {
+            let mut trig = [(0.0, 1.0); 5];
+            for (i, t) in trig.iter_mut().enumerate() {
+                if self.machine.axes[i].kind == AxisKind::Rotary {
+                    *t = q[i].sin_cos();
+                }
             }
+            self.solve_linear_machine(&(self.w0 * tip), q, &trig);
+        } else {
+            self.solve_linear_affine(tip, q);
         }
-        self.solve_linear_trig(tip, q, &trig);
     }
 
-    /// [`Kinematics::solve_linear`] with `trig[i] = (sin q_i, cos q_i)` given for the rotaries.
-    fn solve_linear_trig(&self, tip: &Point3, q: &mut Joints, trig: &[(f64, f64); 5]) {
-        if self.linear_first {
-            let x = self.w0 * tip;
-            // The chain's rotaries applied to a point, innermost first, each by Rodrigues'
-            // formula from one sin_cos (no quaternion or isometry composition).
-            let rotary_only = |chain: &[usize], p: Point3| {
-                let mut p = p;
-                for &i in chain.iter().rev() {
-                    let a = &self.machine.axes[i];
-                    if a.kind == AxisKind::Rotary {
-                        p = rotate_about(&a.direction, &a.point, trig[i], &p);
-                    }
+    /// The closed position step (`linear_first`) with `trig[i] = (sin q_i, cos q_i)` given
+    /// for the rotaries and the tip `x` in the machine frame.
+    fn solve_linear_machine(&self, x: &Point3, q: &mut Joints, trig: &[(f64, f64); 5]) {
+        // The chain's rotaries applied to a point, innermost first, each by Rodrigues'
+        // formula from one sin_cos (no quaternion or isometry composition).
+        let rotary_only = |chain: &[usize], p: Point3| {
+            let mut p = p;
+            for &i in chain.iter().rev() {
+                let a = &self.machine.axes[i];
+                if a.kind == AxisKind::Rotary {
+                    p = rotate_about(&a.direction, &a.point, trig[i], &p);
                 }
-                p
-            };
-            let d = rotary_only(&self.machine.part_chain, x) - rotary_only(&self.machine.tool_chain, self.t0);
-            let lin = self.linear_inverse * d;
-            q[0] = lin[0];
-            q[1] = lin[1];
-            q[2] = lin[2];
-        } else {
-            q[0] = 0.0;
-            q[1] = 0.0;
-            q[2] = 0.0;
-            let p0 = self.fk(q).tip;
-            let mut a = Matrix3::zeros();
-            for i in 0..3 {
-                let mut qi = *q;
-                qi[i] = 1.0;
-                a.set_column(i, &(self.fk(&qi).tip - p0));
             }
-            // INVARIANT: rigid motions keep the three linear directions independent.
-            let lin = a.lu().solve(&(tip - p0)).unwrap_or_else(Vec3::zeros);
-            q[0] = lin[0];
-            q[1] = lin[1];
-            q[2] = lin[2];
+            p
+        };
+        let d = rotary_only(&self.machine.part_chain, *x) - rotary_only(&self.machine.tool_chain, self.t0);
+        let lin = self.linear_inverse * d;
+        q[0] = lin[0];
+        q[1] = lin[1];
+        q[2] = lin[2];
+    }
+
+    /// The affine position step (a linear axis carried by a rotary): the tip is affine in
+    /// the linear joints for fixed rotaries.
+    fn solve_linear_affine(&self, tip: &Point3, q: &mut Joints) {
+        q[0] = 0.0;
+        q[1] = 0.0;
+        q[2] = 0.0;
+        let p0 = self.fk(q).tip;
+        let mut a = Matrix3::zeros();
+        for i in 0..3 {
+            let mut qi = *q;
+            qi[i] = 1.0;
+            a.set_column(i, &(self.fk(&qi).tip - p0));
         }
+        // INVARIANT: rigid motions keep the three linear directions independent.
+        let lin = a.lu().solve(&(tip - p0)).unwrap_or_else(Vec3::zeros);
+        q[0] = lin[0];
+        q[1] = lin[1];
+        q[2] = lin[2];
     }
 
     fn ik_closed(&self, family: Family, pose: &Pose, hold: &Joints) -> Result<IkSolutions, MachineError> {
@@ -236,24 +255,34 @@ impl Kinematics {
         let r = rho.hypot(v.z);
         // atan2 is odd in its first argument (exactly: the sign is applied last).
         let tilt_positive = rho.atan2(v.z);
+        // The machine-frame tip of the closed position step, shared by both branches.
+        let x_m = if self.linear_first { self.w0 * pose.tip } else { pose.tip };
+        // gamma = atan2(y, x) with (y, x) of length rho, on the branch k = +1; the branch
+        // k = -1 has (-y, -x): its angle is gamma -+ pi (no second atan2; the two agree
+        // after `normalize_angle`, which maps -pi and pi to pi), and its sines and cosines
+        // are the exact negatives.
+        let (y, x) = match family {
+            Family::TtAc => (v.x, v.y),
+            Family::TtBc => (v.y, -v.x),
+            Family::HhCa => (v.x, -v.y),
+            Family::HhCb => (v.y, v.x),
+            Family::HtBc => (-v.y, v.x),
+            Family::HtAc => (-v.x, -v.y),
+        };
+        let gamma = y.atan2(x);
+        let gamma_other = if gamma > 0.0 { gamma - PI } else { gamma + PI };
         for (slot, k) in items.iter_mut().zip([1.0, -1.0]) {
-            let tilt = if k > 0.0 { tilt_positive } else { -tilt_positive };
-            // gamma = atan2(y, x) with (y, x) of length rho.
-            let (y, x) = match family {
-                Family::TtAc => (k * v.x, k * v.y),
-                Family::TtBc => (k * v.y, -k * v.x),
-                Family::HhCa => (k * v.x, -k * v.y),
-                Family::HhCb => (k * v.y, k * v.x),
-                Family::HtBc => (-k * v.y, k * v.x),
-                Family::HtAc => (-k * v.x, -k * v.y),
+            let (tilt, gamma, y, x) = if k > 0.0 {
+                (tilt_positive, gamma, y, x)
+            } else {
+                (-tilt_positive, gamma_other, -y, -x)
             };
-            let gamma = y.atan2(x);
             // The sines and cosines from the same components (no sin_cos of the angles).
             let tilt_trig = (s_tilt * k * rho / r, v.z / r);
             let pole_trig = (s_pole * y / rho, x / rho);
             let (q_tilt, q_pole) = ((s_tilt * tilt, tilt_trig), (s_pole * gamma, pole_trig));
             let (primary, secondary) = if self.tilt == self.primary { (q_tilt, q_pole) } else { (q_pole, q_tilt) };
-            *slot = self.solution_trig(&pose.tip, primary, secondary);
+            *slot = self.solution_trig(&pose.tip, &x_m, primary, secondary);
         }
         Ok(IkSolutions { items, len: 2 })
     }

@@ -144,14 +144,47 @@ pub struct Selected {
     pub at_pole: bool,
 }
 
+/// The strokes of a machine per joint, read once: the joint limits ([`Axis::joint_limits`])
+/// and the accepted range with [`tol::LIMIT_SLACK`] (infinite without limits).
+///
+/// [`Axis::joint_limits`]: crate::desc::Axis::joint_limits
+struct Strokes {
+    limits: [Option<(f64, f64)>; 5],
+    accepted: [(f64, f64); 5],
+}
+
+impl Strokes {
+    fn new(machine: &Machine) -> Strokes {
+        let mut limits = [None; 5];
+        let mut accepted = [(f64::NEG_INFINITY, f64::INFINITY); 5];
+        for (i, axis) in machine.axes().iter().enumerate().take(5) {
+            limits[i] = axis.joint_limits();
+            if let Some((lo, hi)) = limits[i] {
+                accepted[i] = (lo - tol::LIMIT_SLACK, hi + tol::LIMIT_SLACK);
+            }
+        }
+        Strokes { limits, accepted }
+    }
+
+    /// [`check_limits`] without the error: whether every joint is within its stroke.
+    fn inside(&self, q: &Joints) -> bool {
+        // Written as `!(outside)` so that a NaN passes, as in `check_limits`.
+        (0..5).all(|i| !(q[i] < self.accepted[i].0 || q[i] > self.accepted[i].1))
+    }
+}
+
 /// Unwraps `sol` against `previous` (rotaries) and checks all strokes.
-fn admissible(machine: &Machine, sol: &IkSolution, previous: Option<&Joints>) -> Result<Selected, MachineError> {
+fn admissible(
+    machine: &Machine,
+    strokes: &Strokes,
+    sol: &IkSolution,
+    previous: Option<&Joints>,
+) -> Result<Selected, MachineError> {
     let mut q = sol.joints;
     let mut unwound = [false; 5];
     for i in 3..5 {
-        let axis = &machine.axes()[i];
         let prev = previous.map_or(0.0, |p| p[i]);
-        match unwrap_angle(q[i], prev, axis.joint_limits()) {
+        match unwrap_angle(q[i], prev, strokes.limits[i]) {
             Some((v, u)) => {
                 q[i] = v;
                 if u && previous.is_some() {
@@ -164,7 +197,9 @@ fn admissible(machine: &Machine, sol: &IkSolution, previous: Option<&Joints>) ->
             }
         }
     }
-    check_limits(machine, &q, None)?;
+    if !strokes.inside(&q) {
+        check_limits(machine, &q, None)?;
+    }
     Ok(Selected { joints: q, branch: sol.branch, unwound, at_pole: sol.at_pole })
 }
 
@@ -216,8 +251,9 @@ pub fn select(
         });
         (u8::from(!preferred), s.joints[kin.tilt_axis()].abs(), s.joints[kin.pole_axis()].abs())
     };
+    let strokes = Strokes::new(machine);
     for sol in solutions {
-        match admissible(machine, sol, previous) {
+        match admissible(machine, &strokes, sol, previous) {
             Ok(s) => {
                 let cost = previous.map_or(0.0, |p| move_time(machine, p, &s.joints));
                 let better = match &best {
@@ -431,6 +467,7 @@ pub fn plan_path(
         });
     }
     let machine = kin.machine();
+    let strokes = Strokes::new(machine);
     let pole = kin.pole_axis();
     let pole_dir = pole_direction(kin);
     let eps = machine.pole_eps();
@@ -460,7 +497,7 @@ pub fn plan_path(
             let sols = if polar && pi > 0 { kin.ik(pose, &p.q).map_err(|e| e.at_block(i))? } else { shared };
             for sol in sols.as_slice() {
                 let has_previous = i > 0 || start.is_some();
-                let cand = match admissible(machine, sol, has_previous.then_some(&p.q)) {
+                let cand = match admissible(machine, &strokes, sol, has_previous.then_some(&p.q)) {
                     Ok(c) => c,
                     Err(e) => {
                         first_error.get_or_insert(e.at_block(i));
@@ -469,17 +506,19 @@ pub fn plan_path(
                 };
                 let (cost, edge) = if has_previous {
                     let dq = cand.joints - p.q;
-                    let t = move_time(machine, &p.q, &cand.joints);
                     let jump = [3, 4].map(|j| dq[j].abs() > options.flip_threshold);
+                    // The move time only for candidates that are kept (a jump while
+                    // cutting is dropped before it is needed).
+                    let t = || move_time(machine, &p.q, &cand.joints);
                     if jump == [false, false] {
-                        (t, Edge::Plain)
+                        (t(), Edge::Plain)
                     } else {
                         let only_pole = (0..2).all(|r| jump[r] == (r + 3 == pole));
                         let crosses = p.at_pole
                             || cand.at_pole
                             || (i > 0 && arc_passes(&poses[i - 1].axis, &pose.axis, &pole_dir, eps));
                         if only_pole && crosses {
-                            (t, Edge::PoleFlip)
+                            (t(), Edge::PoleFlip)
                         } else if cutting[i] {
                             let j = if dq[3].abs() >= dq[4].abs() { 3 } else { 4 };
                             if smallest_jump.is_none_or(|(_, d)| dq[j].abs() < d) {
@@ -488,7 +527,7 @@ pub fn plan_path(
                             continue;
                         } else {
                             let j = if dq[3].abs() >= dq[4].abs() { 3 } else { 4 };
-                            (t + options.reorient_penalty, Edge::Reorient(j))
+                            (t() + options.reorient_penalty, Edge::Reorient(j))
                         }
                     }
                 } else {

@@ -7,7 +7,7 @@
 
 use crate::chain::{Joints, Kinematics, Pose};
 use crate::error::MachineError;
-use crate::feed::{deviation, inverse_time_feed, subdivide};
+use crate::feed::{BlockEnd, deviation, inverse_time_feed, subdivide_into};
 use crate::plan::{Event, PlanOptions, check_limits, move_time, plan_path};
 use crate::tol;
 
@@ -164,15 +164,20 @@ pub fn to_program(
     };
     let mut blocks: Vec<ProgramBlock> = Vec::with_capacity(path.joints.len());
     let mut previous: Option<(Pose, Joints)> = start.map(|q| (kin.fk(&q), q));
+    // Block ends of one CL move, reused move after move.
+    let mut ends: Vec<BlockEnd> = Vec::new();
     for (q, &i) in path.joints.iter().zip(&path.pose_index) {
         let rec = &records[i];
-        let ends = match (rec.motion, previous) {
-            (Motion::Rapid, _) | (_, None) => vec![crate::feed::BlockEnd { pose: rec.pose, joints: *q }],
+        ends.clear();
+        match (rec.motion, previous) {
+            (Motion::Rapid, _) | (_, None) => ends.push(BlockEnd { pose: rec.pose, joints: *q }),
             // In-place rotations (pole flips) are subdivided too: joint-linear X/Y/C
             // motion does not keep the tip still.
-            (_, Some((pa, qa))) => subdivide(kin, &pa, &rec.pose, &qa, q, options.tol_pos, options.tol_ang, i)?,
-        };
-        for end in ends {
+            (_, Some((pa, qa))) => {
+                subdivide_into(kin, (&pa, &qa), (&rec.pose, q), (options.tol_pos, options.tol_ang), i, &mut ends)?;
+            }
+        }
+        for end in &ends {
             check_limits(machine, &end.joints, Some(i))?;
             let inverse_time = match (rec.motion, previous) {
                 (Motion::Rapid, _) | (_, None) => None,

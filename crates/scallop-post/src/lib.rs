@@ -94,13 +94,15 @@ fn fmt_number_exact(v: f64, decimals: usize) -> String {
 /// value is an exact integer range. `None` sends the caller to the
 /// exact formatter. The text is written at the end of `bytes`, from the returned index.
 fn number_fast(bytes: &mut [u8; 32], v: f64, decimals: usize) -> Option<usize> {
-    const POW10_U64: [u64; 10] =
-        [1, 10, 100, 1_000, 10_000, 100_000, 1_000_000, 10_000_000, 100_000_000, 1_000_000_000];
-    const DIGIT_PAIRS: &[u8; 200] = b"0001020304050607080910111213141516171819\
-        2021222324252627282930313233343536373839\
-        4041424344454647484950515253545556575859\
-        6061626364656667686970717273747576777879\
-        8081828384858687888990919293949596979899";
+    scaled_key(v, decimals).map(|key| write_key(bytes, key, decimals))
+}
+
+/// The number `fmt_number(v, decimals)` writes, as a signed integer in units of the last
+/// digit (`-0` is `0`), where the integer fast path answers (see [`number_fast`]): two
+/// values format to the same text exactly when their keys are equal, so modal words are
+/// compared without formatting.
+#[inline]
+pub(crate) fn scaled_key(v: f64, decimals: usize) -> Option<i64> {
     const POW10: [f64; 10] = [1.0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9];
     let &scale = POW10.get(decimals)?;
     let x = v.abs() * scale;
@@ -113,11 +115,26 @@ fn number_fast(bytes: &mut [u8; 32], v: f64, decimals: usize) -> Option<usize> {
     if (frac - 0.5).abs() < tol::FAST_FORMAT_TIE_MARGIN {
         return None;
     }
-    let mut n = if frac > 0.5 { floor + 1.0 } else { floor } as u64;
+    // INVARIANT: 0 <= x < 1e9, an exact integer after rounding.
+    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "0 <= x < 1e9")]
+    let n = if frac > 0.5 { floor + 1.0 } else { floor } as i64;
+    Some(if v < 0.0 { -n } else { n })
+}
+
+/// Writes the number of a [`scaled_key`] with `decimals` digits at the end of `bytes`;
+/// returns the index of its first byte.
+pub(crate) fn write_key(bytes: &mut [u8; 32], key: i64, decimals: usize) -> usize {
+    const POW10_U64: [u64; 10] =
+        [1, 10, 100, 1_000, 10_000, 100_000, 1_000_000, 10_000_000, 100_000_000, 1_000_000_000];
+    const DIGIT_PAIRS: &[u8; 200] = b"0001020304050607080910111213141516171819\
+        2021222324252627282930313233343536373839\
+        4041424344454647484950515253545556575859\
+        6061626364656667686970717273747576777879\
+        8081828384858687888990919293949596979899";
+    let mut n = key.unsigned_abs();
     // Written right to left into a stack buffer: at least decimals + 1 digits (leading
     // zeros), the point, the sign; then appended in one copy.
     let mut at = bytes.len();
-    let nonzero = n != 0;
     let mut k = 0;
     if decimals > 0 {
         // The fraction digits, two at a time, then the point.
@@ -137,20 +154,25 @@ fn number_fast(bytes: &mut [u8; 32], v: f64, decimals: usize) -> Option<usize> {
         at -= 1;
         bytes[at] = b'.';
     }
-    // The integer digits (at least one).
-    loop {
-        at -= 1;
-        bytes[at] = b'0' + (n % 10) as u8;
-        n /= 10;
-        if n == 0 {
-            break;
-        }
+    // The integer digits (at least one), two at a time.
+    while n >= 100 {
+        let pair = (n % 100) as usize;
+        n /= 100;
+        at -= 2;
+        bytes[at..at + 2].copy_from_slice(&DIGIT_PAIRS[2 * pair..2 * pair + 2]);
     }
-    if v < 0.0 && nonzero {
+    if n >= 10 {
+        at -= 2;
+        bytes[at..at + 2].copy_from_slice(&DIGIT_PAIRS[2 * n as usize..2 * n as usize + 2]);
+    } else {
+        at -= 1;
+        bytes[at] = b'0' + n as u8;
+    }
+    if key < 0 {
         at -= 1;
         bytes[at] = b'-';
     }
-    Some(at)
+    at
 }
 
 /// Writes `path` as G-code. `comments` go into the header (one line each).

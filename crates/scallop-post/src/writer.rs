@@ -230,11 +230,14 @@ pub fn program_text(
     };
     let mut previous: Option<&ProgramBlock> = None;
     let mut plane: Option<(Vec3, Rotation3<f64>)> = None;
-    // One token string per written axis, reused block after block (no allocation per token).
-    let mut words: Vec<(&str, Vec<u8>)> = (0..machine.axes().len())
-        .filter(|&i| write_axis[i])
-        .map(|i| (letters[i].as_str(), Vec::with_capacity(24)))
+    // One word per written axis, reused block after block: numbers are compared with the
+    // modal words as scaled integers and formatted only when written.
+    let written: Vec<usize> = (0..machine.axes().len()).filter(|&i| write_axis[i]).collect();
+    let mut words: Vec<Word> = written.iter().map(|&i| Word::new(letters[i].as_str())).collect();
+    let modulo: Vec<usize> = (0..machine.axes().len())
+        .filter(|&i| machine.axes()[i].kind == AxisKind::Rotary && machine.axes()[i].wrap != Wrap::Absolute)
         .collect();
+    let caps = RateCaps::new(machine, dialect);
     for b in &program.blocks {
         if planes {
             let needs_new = plane.as_ref().is_none_or(|(axis, _)| angle(axis, &b.pose.axis) > params.tol_ang);
@@ -266,29 +269,27 @@ pub fn program_text(
             previous = Some(b);
             continue;
         }
-        let pieces = previous.map_or(1, |p| pieces(machine, p, b));
+        let pieces = previous.map_or(1, |p| pieces(&modulo, p, b));
         for piece in 1..=pieces {
             let s = f64::from(piece) / f64::from(pieces);
             let (words_a, tip_a) = previous.map_or((b.words, b.pose.tip), |p| (p.words, p.pose.tip));
             let word_at = |i: usize| words_a[i] + (b.words[i] - words_a[i]) * s;
-            let tip: Point3 = tip_a + (b.pose.tip - tip_a) * s;
-            let mut slot = 0;
-            for i in 0..machine.axes().len() {
-                if !write_axis[i] {
-                    continue;
-                }
+            for (word, &i) in words.iter_mut().zip(&written) {
                 let axis = &machine.axes()[i];
-                let w = word_at(i);
-                let token = &mut words[slot].1;
-                slot += 1;
                 match axis.kind {
                     AxisKind::Linear if mode == OutputMode::Tcp => {
-                        e.token_into(token, &letters[i], tip[linear_component(i)?], dialect.decimals);
+                        let tip: Point3 = tip_a + (b.pose.tip - tip_a) * s;
+                        word.set_number(tip[linear_component(i)?], dialect.decimals);
                     }
-                    AxisKind::Linear => e.token_into(token, &letters[i], w, dialect.decimals),
+                    AxisKind::Linear => word.set_number(word_at(i), dialect.decimals),
+                    AxisKind::Rotary if axis.wrap == Wrap::Absolute => {
+                        word.set_number(word_at(i), dialect.rotary_decimals);
+                    }
                     AxisKind::Rotary => {
+                        let w = word_at(i);
                         let before = word_at_prev(&words_a, &b.words, i, piece, pieces);
-                        e.rotary_into(token, &letters[i], w, w - before, axis.wrap);
+                        let token = e.rotary(word.letter, w, w - before, axis.wrap);
+                        word.set_token(token.as_bytes());
                     }
                 }
             }
@@ -300,7 +301,7 @@ pub fn program_text(
                     let f_inv = b.inverse_time.unwrap_or_else(|| {
                         scallop_machine::feed::inverse_time_feed(kin, &p.pose, &b.pose, &p.joints, &b.joints, b.feed)
                     }) * f64::from(pieces);
-                    let f_inv = rounding_cap(machine, dialect, &p.words, &b.words, pieces, f_inv);
+                    let f_inv = caps.cap(&p.words, &b.words, pieces, f_inv);
                     match dialect.feed_by_time {
                         FeedByTime::G93 => FeedWord::InverseTime(f_inv),
                         FeedByTime::BlockSeconds => FeedWord::Seconds(60.0 / f_inv),
@@ -312,7 +313,7 @@ pub fn program_text(
                     }
                 }
             };
-            e.motion_tokens(&words, feed);
+            e.motion_words(&mut words, feed);
         }
         previous = Some(b);
     }
@@ -331,30 +332,41 @@ pub fn program_text(
     Ok(String::from_utf8(e.text).unwrap_or_else(|err| String::from_utf8_lossy(err.as_bytes()).into_owned()))
 }
 
-/// Caps an inverse-time word so that no axis exceeds its velocity even when its rounded
-/// words move it by one rounding unit more than the exact delta.
-fn rounding_cap(
-    machine: &scallop_machine::Machine,
-    dialect: &Dialect,
-    a: &[f64; 5],
-    b: &[f64; 5],
-    pieces: u32,
-    f_inv: f64,
-) -> f64 {
-    let mut cap = f_inv;
-    for (i, axis) in machine.axes().iter().enumerate() {
-        let delta = (b[i] - a[i]).abs() / f64::from(pieces);
-        if delta == 0.0 {
-            continue;
-        }
-        let (decimals, vmax) = match axis.kind {
-            AxisKind::Linear => (dialect.decimals, axis.dynamics.vmax),
-            AxisKind::Rotary => (dialect.rotary_decimals, axis.dynamics.vmax.to_degrees()),
-        };
-        let unit = pow10i(-i32::try_from(decimals).unwrap_or(4));
-        cap = cap.min(60.0 * vmax / (delta + unit));
+/// Per-axis data of [`RateCaps::cap`], computed once per program.
+struct RateCaps {
+    /// `(rounding unit of the word, vmax in word units per second)` per axis.
+    axes: Vec<(f64, f64)>,
+}
+
+impl RateCaps {
+    fn new(machine: &scallop_machine::Machine, dialect: &Dialect) -> RateCaps {
+        let axes = machine
+            .axes()
+            .iter()
+            .map(|axis| {
+                let (decimals, vmax) = match axis.kind {
+                    AxisKind::Linear => (dialect.decimals, axis.dynamics.vmax),
+                    AxisKind::Rotary => (dialect.rotary_decimals, axis.dynamics.vmax.to_degrees()),
+                };
+                (pow10i(-i32::try_from(decimals).unwrap_or(4)), vmax)
+            })
+            .collect();
+        RateCaps { axes }
     }
-    cap
+
+    /// Caps an inverse-time word so that no axis exceeds its velocity even when its
+    /// rounded words move it by one rounding unit more than the exact delta.
+    fn cap(&self, a: &[f64; 5], b: &[f64; 5], pieces: u32, f_inv: f64) -> f64 {
+        let mut cap = f_inv;
+        for (i, &(unit, vmax)) in self.axes.iter().enumerate() {
+            let delta = (b[i] - a[i]).abs() / f64::from(pieces);
+            if delta == 0.0 {
+                continue;
+            }
+            cap = cap.min(60.0 * vmax / (delta + unit));
+        }
+        cap
+    }
 }
 
 fn word_at_prev(a: &[f64; 5], b: &[f64; 5], i: usize, piece: u32, pieces: u32) -> f64 {
@@ -366,14 +378,12 @@ pub(crate) fn angle(a: &Vec3, b: &Vec3) -> f64 {
     a.cross(b).norm().atan2(a.dot(b))
 }
 
-/// Number of equal pieces so that no modulo-360 rotary turns 180 deg or more in one
-/// block (spec 3.7: the control takes the shortest path).
-fn pieces(machine: &scallop_machine::Machine, a: &ProgramBlock, b: &ProgramBlock) -> u32 {
+/// Number of equal pieces so that no modulo-360 rotary (`modulo`: their joint indices)
+/// turns 180 deg or more in one block (spec 3.7: the control takes the shortest path).
+fn pieces(modulo: &[usize], a: &ProgramBlock, b: &ProgramBlock) -> u32 {
     let mut n = 1.0f64;
-    for (i, axis) in machine.axes().iter().enumerate() {
-        if axis.kind == AxisKind::Rotary && axis.wrap != Wrap::Absolute {
-            n = n.max(((b.words[i] - a.words[i]).abs() / tol::MODULO_HALF_TURN).floor() + 1.0);
-        }
+    for &i in modulo {
+        n = n.max(((b.words[i] - a.words[i]).abs() / tol::MODULO_HALF_TURN).floor() + 1.0);
     }
     // INVARIANT: n is a small positive integer (a block turns a few revolutions at most).
     #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "small positive integer")]
@@ -419,26 +429,60 @@ enum FeedWord {
     Seconds(f64),
 }
 
+/// One word of a motion block: a number, compared with the modal word as a scaled
+/// integer ([`crate::scaled_key`]) and formatted only when it is written, or a ready
+/// token (modulo rotary words, tilted-plane words).
+struct Word<'l> {
+    letter: &'l str,
+    /// `(value, decimals)`; `None`: the word is `token`.
+    number: Option<(f64, usize)>,
+    /// The full token when `number` is `None`; scratch otherwise.
+    token: Vec<u8>,
+}
+
+impl<'l> Word<'l> {
+    fn new(letter: &'l str) -> Word<'l> {
+        Word { letter, number: None, token: Vec::with_capacity(24) }
+    }
+
+    fn set_number(&mut self, v: f64, decimals: usize) {
+        self.number = Some((v, decimals));
+    }
+
+    fn set_token(&mut self, token: &[u8]) {
+        self.number = None;
+        self.token.clear();
+        self.token.extend_from_slice(token);
+    }
+}
+
+/// The last written value of a word letter (or of the feed word).
+#[derive(Clone, Debug, PartialEq)]
+enum Modal {
+    /// A number written by the integer fast path: `(scaled key, decimals)`.
+    Key(i64, usize),
+    /// Any other token, as written.
+    Token(Vec<u8>),
+}
+
 /// Line writer with numbering and modal state.
 struct Emitter<'a> {
     d: &'a Dialect,
     /// The program text, UTF-8 built as bytes (numbers are written as ASCII bytes).
     text: Vec<u8>,
     number: u64,
-    /// Last written token per word letter, `(letter, token)`, in first-use order: a few
-    /// entries searched linearly (cheaper than a map for five axes), strings reused.
-    last_words: Vec<(String, Vec<u8>)>,
+    /// Last written value per word letter, `(letter, value)`, in first-use order: a few
+    /// entries searched linearly (cheaper than a map for five axes).
+    last_words: Vec<(String, Modal)>,
     last_motion: Option<&'static str>,
-    last_feed: Option<Vec<u8>>,
+    /// Last written feed number (without its letter).
+    last_feed: Option<Modal>,
     g93: bool,
-    /// Reused line buffer of `motion_tokens`.
-    buf: Vec<u8>,
-    /// Reused feed-word buffer of `motion_tokens`.
-    feed: Vec<u8>,
-    /// Reused per-word "differs from the modal word" flags of `motion_tokens`.
-    changed: Vec<bool>,
-    /// Reused per-word indices into `last_words` of `motion_tokens`.
-    slots: Vec<Option<usize>>,
+    /// Reused per-word state of `motion_words`: `(index in last_words, scaled key,
+    /// differs from the modal word)`.
+    state: Vec<(Option<usize>, Option<i64>, bool)>,
+    /// Scratch token buffers for the slow comparisons.
+    scratch: (Vec<u8>, Vec<u8>),
 }
 
 impl<'a> Emitter<'a> {
@@ -451,14 +495,11 @@ impl<'a> Emitter<'a> {
             last_motion: None,
             last_feed: None,
             g93: false,
-            buf: Vec::new(),
-            feed: Vec::new(),
-            changed: Vec::new(),
-            slots: Vec::new(),
+            state: Vec::new(),
+            scratch: (Vec::new(), Vec::new()),
         }
     }
 
-    /// The last token written for `letter`.
     /// The index in `last_words` of `letter`, tried first at `hint` (blocks list their
     /// words in one order, so the hint is almost always right).
     fn last_index(&self, hint: usize, letter: &str) -> Option<usize> {
@@ -472,14 +513,22 @@ impl<'a> Emitter<'a> {
         self.line_bytes(s.as_bytes());
     }
 
-    fn line_bytes(&mut self, s: &[u8]) {
-        if let Some(n) = &self.d.line_numbers
-            && s != b"%"
-        {
+    /// Starts a line: the line number when the dialect numbers lines.
+    fn line_start(&mut self) {
+        if let Some(n) = &self.d.line_numbers {
             self.text.extend_from_slice(n.prefix.as_bytes());
-            self.text.extend_from_slice(self.number.to_string().as_bytes());
+            let mut bytes = [0u8; 32];
+            // INVARIANT: line numbers stay far below i64::MAX.
+            let at = crate::write_key(&mut bytes, i64::try_from(self.number).unwrap_or(i64::MAX), 0);
+            self.text.extend_from_slice(&bytes[at..]);
             self.text.push(b' ');
             self.number += n.step;
+        }
+    }
+
+    fn line_bytes(&mut self, s: &[u8]) {
+        if s != b"%" {
+            self.line_start();
         }
         self.text.extend_from_slice(s);
         self.text.push(b'\n');
@@ -507,28 +556,37 @@ impl<'a> Emitter<'a> {
         s
     }
 
-    /// [`Emitter::token`] as bytes into `s` (cleared first; its allocation is reused).
-    fn token_into(&self, s: &mut Vec<u8>, letter: &str, v: f64, decimals: usize) {
-        s.clear();
-        s.extend_from_slice(letter.as_bytes());
-        if self.d.explicit_plus {
-            s.push(b'+');
-        }
-        let at = s.len();
-        crate::push_number_bytes(s, v, decimals);
-        if self.d.explicit_plus && s.get(at) == Some(&b'-') {
-            s.remove(at - 1);
+    /// Appends `letter` and the number `v` (its scaled key when known) as
+    /// [`Emitter::token`] writes them.
+    fn push_number_token(out: &mut Vec<u8>, explicit_plus: bool, letter: &str, v: f64, key: Option<i64>, dec: usize) {
+        out.extend_from_slice(letter.as_bytes());
+        match key {
+            Some(key) => {
+                if explicit_plus && key >= 0 {
+                    out.push(b'+');
+                }
+                let mut bytes = [0u8; 32];
+                let at = crate::write_key(&mut bytes, key, dec);
+                out.extend_from_slice(&bytes[at..]);
+            }
+            None => {
+                if explicit_plus {
+                    out.push(b'+');
+                }
+                let at = out.len();
+                crate::push_number_bytes(out, v, dec);
+                if explicit_plus && out.get(at) == Some(&b'-') {
+                    out.remove(at - 1);
+                }
+            }
         }
     }
 
-    /// [`Emitter::rotary`] as bytes into `s` (cleared first; its allocation is reused).
-    fn rotary_into(&self, s: &mut Vec<u8>, letter: &str, word: f64, delta: f64, wrap: Wrap) {
-        if wrap == Wrap::Absolute {
-            self.token_into(s, letter, word, self.d.rotary_decimals);
-        } else {
-            let t = self.rotary(letter, word, delta, wrap);
-            s.clear();
-            s.extend_from_slice(t.as_bytes());
+    /// Appends the modal value `m` of `letter` as it was written.
+    fn push_modal_token(out: &mut Vec<u8>, explicit_plus: bool, letter: &str, m: &Modal) {
+        match m {
+            Modal::Key(key, dec) => Self::push_number_token(out, explicit_plus, letter, 0.0, Some(*key), *dec),
+            Modal::Token(t) => out.extend_from_slice(t),
         }
     }
 
@@ -564,114 +622,190 @@ impl<'a> Emitter<'a> {
 
     /// A motion block from `(letter, number)` pairs.
     fn motion(&mut self, words: &[(&str, String)], feed: FeedWord) {
-        let tokens: Vec<(&str, Vec<u8>)> = words.iter().map(|(l, v)| (*l, format!("{l}{v}").into_bytes())).collect();
-        self.motion_tokens(&tokens, feed);
+        let mut tokens: Vec<Word> = words
+            .iter()
+            .map(|(l, v)| {
+                let mut w = Word::new(l);
+                w.set_token(format!("{l}{v}").as_bytes());
+                w
+            })
+            .collect();
+        self.motion_words(&mut tokens, feed);
     }
 
-    /// A motion block from `(letter, full token)` pairs. Hot path of every program:
-    /// one line buffer reused, modal words compared in place, no per-token allocation
-    /// beyond the tokens themselves.
-    fn motion_tokens(&mut self, words: &[(&str, Vec<u8>)], feed: FeedWord) {
-        let mut changed = std::mem::take(&mut self.changed);
-        changed.clear();
-        let mut slots = std::mem::take(&mut self.slots);
-        slots.clear();
-        for (k, (letter, token)) in words.iter().enumerate() {
-            let slot = self.last_index(k, letter);
-            slots.push(slot);
-            changed.push(!self.d.modal || slot.is_none_or(|j| !short_eq(&self.last_words[j].1, token)));
+    /// Whether `word` (with its scaled key) writes the same token as the modal value `last`.
+    fn same_as(scratch: &mut (Vec<u8>, Vec<u8>), plus: bool, last: &Modal, word: &Word, key: Option<i64>) -> bool {
+        match (last, word.number, key) {
+            (Modal::Key(k, d), Some((_, dw)), Some(kw)) if *d == dw => *k == kw,
+            _ => {
+                let (a, b) = scratch;
+                a.clear();
+                b.clear();
+                Self::push_modal_token(a, plus, word.letter, last);
+                match word.number {
+                    Some((v, dec)) => Self::push_number_token(b, plus, word.letter, v, key, dec),
+                    None => b.extend_from_slice(&word.token),
+                }
+                short_eq(a, b)
+            }
         }
-        if !changed.contains(&true) {
-            self.changed = changed;
-            self.slots = slots;
+    }
+
+    /// Whether two modal feed values write the same number.
+    fn same_feed(scratch: &mut (Vec<u8>, Vec<u8>), last: &Modal, new: &Modal) -> bool {
+        match (last, new) {
+            (Modal::Key(k, d), Modal::Key(kn, dn)) if d == dn => k == kn,
+            _ => {
+                let (a, b) = scratch;
+                a.clear();
+                b.clear();
+                Self::push_modal_token(a, false, "", last);
+                Self::push_modal_token(b, false, "", new);
+                short_eq(a, b)
+            }
+        }
+    }
+
+    /// Appends a space (unless the line is still empty after `start`), then `word`.
+    fn push_word(&mut self, start: usize, word: &Word, key: Option<i64>) {
+        if self.text.len() > start {
+            self.text.push(b' ');
+        }
+        match word.number {
+            Some((v, dec)) => Self::push_number_token(&mut self.text, self.d.explicit_plus, word.letter, v, key, dec),
+            None => self.text.extend_from_slice(&word.token),
+        }
+    }
+
+    /// Appends a space (unless the line is still empty after `start`), then `t`.
+    fn push_piece(&mut self, start: usize, t: &[u8]) {
+        if self.text.len() > start {
+            self.text.push(b' ');
+        }
+        self.text.extend_from_slice(t);
+    }
+
+    /// The feed number `f` (rounded down to `dec`) after `letter`, unless it equals the
+    /// modal feed and `always` is false. Updates the modal feed.
+    fn feed_word(&mut self, start: usize, letter: &[u8], f: f64, dec: usize, always: bool) {
+        let f = round_down(f, dec);
+        let key = crate::scaled_key(f, dec);
+        let value = match key {
+            Some(k) => Modal::Key(k, dec),
+            None => Modal::Token(fmt_number(f, dec).into_bytes()),
+        };
+        if always
+            || !self.d.modal
+            || !self.last_feed.as_ref().is_some_and(|last| Self::same_feed(&mut self.scratch, last, &value))
+        {
+            self.push_piece(start, letter);
+            match &value {
+                Modal::Key(k, dec) => {
+                    let mut bytes = [0u8; 32];
+                    let at = crate::write_key(&mut bytes, *k, *dec);
+                    self.text.extend_from_slice(&bytes[at..]);
+                }
+                Modal::Token(t) => self.text.extend_from_slice(t),
+            }
+            self.last_feed = Some(value);
+        }
+    }
+
+    /// A motion block. Hot path of every program: the modal comparison is done on scaled
+    /// integers, and only the words that change are formatted, straight into the text.
+    fn motion_words(&mut self, words: &mut [Word], feed: FeedWord) {
+        let mut state = std::mem::take(&mut self.state);
+        state.clear();
+        let mut any = false;
+        for (k, word) in words.iter().enumerate() {
+            let slot = self.last_index(k, word.letter);
+            let key = word.number.and_then(|(v, dec)| crate::scaled_key(v, dec));
+            let changed = !self.d.modal
+                || match slot {
+                    None => true,
+                    Some(j) => {
+                        !Self::same_as(&mut self.scratch, self.d.explicit_plus, &self.last_words[j].1, word, key)
+                    }
+                };
+            any |= changed;
+            state.push((slot, key, changed));
+        }
+        if !any {
+            self.state = state;
             return;
         }
-        let mut buf = std::mem::take(&mut self.buf);
-        buf.clear();
-        let push = |buf: &mut Vec<u8>, t: &[u8]| {
-            if !buf.is_empty() {
-                buf.push(b' ');
-            }
-            buf.extend_from_slice(t);
-        };
+        self.line_start();
+        let start = self.text.len();
         match self.d.syntax {
             Syntax::Iso => {
                 let want_g93 = matches!(feed, FeedWord::InverseTime(_));
                 if want_g93 != self.g93 {
-                    push(&mut buf, if want_g93 { b"G93" } else { b"G94" });
+                    self.push_piece(start, if want_g93 { b"G93" } else { b"G94" });
                     self.g93 = want_g93;
                     self.last_feed = None;
                 }
                 let code = if matches!(feed, FeedWord::Rapid) { "G0" } else { "G1" };
                 if !self.d.modal || self.last_motion != Some(code) {
-                    push(&mut buf, code.as_bytes());
+                    self.push_piece(start, code.as_bytes());
                     self.last_motion = Some(code);
                 }
-                for ((_, token), &c) in words.iter().zip(&changed) {
+                for (word, &(_, key, c)) in words.iter().zip(&state) {
                     if c {
-                        push(&mut buf, token);
+                        self.push_word(start, word, key);
                     }
                 }
                 // G93 needs F on every block (`always`).
-                let (dec, always) = match feed {
-                    FeedWord::Rapid | FeedWord::Seconds(_) => (None, false),
-                    FeedWord::PerMinute(_) => (Some(self.d.feed_decimals), false),
-                    FeedWord::InverseTime(_) => (Some(self.d.inverse_time_decimals), true),
-                };
-                if let (Some(dec), FeedWord::PerMinute(f) | FeedWord::InverseTime(f)) = (dec, feed) {
-                    self.feed.clear();
-                    crate::push_number_bytes(&mut self.feed, round_down(f, dec), dec);
-                    if always || !self.d.modal || self.last_feed.as_ref() != Some(&self.feed) {
-                        push(&mut buf, b"F");
-                        buf.extend_from_slice(&self.feed);
-                        match &mut self.last_feed {
-                            Some(l) => l.clone_from(&self.feed),
-                            None => self.last_feed = Some(self.feed.clone()),
-                        }
-                    }
+                match feed {
+                    FeedWord::Rapid | FeedWord::Seconds(_) => {}
+                    FeedWord::PerMinute(f) => self.feed_word(start, b"F", f, self.d.feed_decimals, false),
+                    FeedWord::InverseTime(f) => self.feed_word(start, b"F", f, self.d.inverse_time_decimals, true),
                 }
             }
             Syntax::Heidenhain => {
-                push(&mut buf, b"L");
-                for ((_, token), &c) in words.iter().zip(&changed) {
+                self.push_piece(start, b"L");
+                for (word, &(_, key, c)) in words.iter().zip(&state) {
                     if c {
-                        push(&mut buf, token);
+                        self.push_word(start, word, key);
                     }
                 }
                 match feed {
                     FeedWord::Rapid => {
-                        push(&mut buf, b"FMAX");
+                        self.push_piece(start, b"FMAX");
                         self.last_feed = None;
                     }
                     FeedWord::Seconds(t) => {
                         let dec = self.d.inverse_time_decimals;
-                        push(&mut buf, format!("FT{}", fmt_number(round_up(t, dec), dec)).as_bytes());
+                        let ft = format!("FT{}", fmt_number(round_up(t, dec), dec));
+                        self.push_piece(start, ft.as_bytes());
                         self.last_feed = None;
                     }
                     FeedWord::PerMinute(f) | FeedWord::InverseTime(f) => {
-                        let f = fmt_number(round_down(f, self.d.feed_decimals), self.d.feed_decimals).into_bytes();
-                        if !self.d.modal || self.last_feed.as_ref() != Some(&f) {
-                            push(&mut buf, format!("F{}", String::from_utf8_lossy(&f)).as_bytes());
-                            self.last_feed = Some(f);
-                        }
+                        self.feed_word(start, b"F", f, self.d.feed_decimals, false);
                     }
                 }
             }
         }
-        for ((letter, token), slot) in words.iter().zip(&slots) {
+        self.text.push(b'\n');
+        for (word, &(slot, key, _)) in words.iter().zip(&state) {
+            let value = match (word.number, key) {
+                (Some((_, dec)), Some(k)) => Modal::Key(k, dec),
+                (Some((v, dec)), None) => {
+                    let mut t = Vec::new();
+                    Self::push_number_token(&mut t, self.d.explicit_plus, word.letter, v, None, dec);
+                    Modal::Token(t)
+                }
+                (None, _) => Modal::Token(word.token.clone()),
+            };
             match slot {
-                Some(j) => self.last_words[*j].1.clone_from(token),
+                Some(j) => self.last_words[j].1 = value,
                 // A letter twice in one block: the later token is the modal one.
-                None => match self.last_words.iter_mut().find(|(l, _)| l == letter) {
-                    Some((_, t)) => t.clone_from(token),
-                    None => self.last_words.push(((*letter).to_string(), token.clone())),
+                None => match self.last_words.iter_mut().find(|(l, _)| l == word.letter) {
+                    Some((_, t)) => *t = value,
+                    None => self.last_words.push((word.letter.to_string(), value)),
                 },
             }
         }
-        self.slots = slots;
-        self.line_bytes(&buf);
-        self.buf = buf;
-        self.changed = changed;
+        self.state = state;
     }
 
     /// Activates a tilted plane `r` (columns x_f, y_f, z_f in the part frame) at the
