@@ -117,6 +117,32 @@ pub struct Kinematics {
     pub(crate) linear_inverse: Matrix3<f64>,
     /// Every linear axis is nearer the bed than the rotaries of its chain (closed position step).
     pub(crate) linear_first: bool,
+    /// For a tool chain of linear axes and a part chain of rotaries only: the first part
+    /// rotary's point `p1` and the constant `K` of the distance bound
+    /// `D0 <= |tip_M - p1| + K` of `feed::deviation_bound_relaxed`.
+    pub(crate) ball_bound: Option<(Point3, f64)>,
+}
+
+/// `(p1, K)` of [`Kinematics::ball_bound`]: walking the part chain from the bed, the tip
+/// carried back through rotary `k` lies within `|tip - p1| + sum_{j < k} |p_j - p_{j+1}|`
+/// of `p_k`, so its distance to line `k + 1` is at most that plus the distance from `p_k`
+/// to line `k + 1` (line 1: at most `|tip - p1|`).
+fn ball_bound(machine: &Machine) -> Option<(Point3, f64)> {
+    let tool_linear = machine.tool_chain.iter().all(|&i| machine.axes[i].kind == AxisKind::Linear);
+    let part_rotary = machine.part_chain.iter().all(|&i| machine.axes[i].kind == AxisKind::Rotary);
+    let first = *machine.part_chain.first()?;
+    if !(tool_linear && part_rotary) {
+        return None;
+    }
+    let (mut k, mut walked) = (0.0f64, 0.0f64);
+    for w in machine.part_chain.windows(2) {
+        let (a, b) = (&machine.axes[w[0]], &machine.axes[w[1]]);
+        let off = a.point - b.point;
+        let to_line = (off - b.direction * off.dot(&b.direction)).norm();
+        k = k.max(walked + to_line);
+        walked += off.norm();
+    }
+    Some((machine.axes[first].point, k))
 }
 
 pub(crate) fn joint_isometry(direction: &Vec3, point: &Point3, kind: AxisKind, q: f64) -> Isometry3<f64> {
@@ -225,6 +251,7 @@ impl Kinematics {
             solver,
             linear_inverse,
             linear_first,
+            ball_bound: ball_bound(machine),
         }
     }
 

@@ -189,6 +189,16 @@ fn exact_d0(kin: &Kinematics, qa: &Joints) -> f64 {
 /// absolute slack so that it also bounds the rounded [`exact_d0`].
 fn relaxed_d0(kin: &Kinematics, qa: &Joints) -> f64 {
     let machine = kin.machine();
+    if let Some((p1, k)) = kin.ball_bound {
+        // Tool chain of linear axes: the tip in M is exact; part chain of rotaries: the
+        // precomputed ball walk (see `chain::ball_bound`).
+        let mut tip = kin.t0;
+        for &i in machine.tool_chain.iter().rev() {
+            tip += machine.axes[i].direction * qa[i];
+        }
+        let d0 = (tip - p1).norm() + k;
+        return d0 * (1.0 + tol::BOUND_PRETEST_SLACK) + tol::BOUND_PRETEST_SLACK;
+    }
     let (mut tip, mut r) = (kin.t0, 0.0f64);
     for &i in machine.tool_chain.iter().rev() {
         let a = &machine.axes[i];
@@ -365,6 +375,40 @@ fn split(
     split(kin, (&mid, &q_mid), b, tolerance, block, depth + 1, out)
 }
 
+/// `x.round()` (half away from zero, signed zero kept) without the library call for
+/// |x| < 2^52, where truncation and the fraction are exact.
+#[inline]
+pub(crate) fn round_fast(x: f64) -> f64 {
+    if x.abs() < 4_503_599_627_370_496.0 {
+        #[allow(clippy::cast_possible_truncation, clippy::cast_precision_loss, reason = "|x| < 2^52, exact")]
+        let t = x as i64 as f64;
+        let f = x - t;
+        let r = if f >= 0.5 {
+            t + 1.0
+        } else if f <= -0.5 {
+            t - 1.0
+        } else {
+            t
+        };
+        r.copysign(x)
+    } else {
+        x.round()
+    }
+}
+
+/// `x.floor()` (signed zero kept) without the library call for |x| < 2^52.
+#[inline]
+pub(crate) fn floor_fast(x: f64) -> f64 {
+    if x.abs() < 4_503_599_627_370_496.0 {
+        #[allow(clippy::cast_possible_truncation, clippy::cast_precision_loss, reason = "|x| < 2^52, exact")]
+        let t = x as i64 as f64;
+        let r = if t > x { t - 1.0 } else { t };
+        r.copysign(x)
+    } else {
+        x.floor()
+    }
+}
+
 /// `10f64.powi(e)` by table for `|e| <= 9`, bit for bit: the exponentiation by squaring
 /// is exact for these powers and a negative power is the reciprocal of the positive one.
 pub(crate) fn pow10i(e: i32) -> f64 {
@@ -409,10 +453,6 @@ pub fn inverse_time_feed(kin: &Kinematics, pose_a: &Pose, pose_b: &Pose, qa: &Jo
     let scale = pow10i(i32::from(machine.nc().decimals.feed));
     let exact = 60.0 / t;
     // Round down, but keep an exact value when it is already representable.
-    let rounded = (exact * scale).floor() / scale;
-    if (exact - (exact * scale).round() / scale).abs() <= tol::FEED_ROUNDING * exact {
-        (exact * scale).round() / scale
-    } else {
-        rounded
-    }
+    let nearest = round_fast(exact * scale) / scale;
+    if (exact - nearest).abs() <= tol::FEED_ROUNDING * exact { nearest } else { floor_fast(exact * scale) / scale }
 }

@@ -29,7 +29,7 @@ use crate::tol;
 pub fn unwrap_angle(raw: f64, previous: f64, limits: Option<(f64, f64)>) -> Option<(f64, bool)> {
     let turn = 2.0 * PI;
     let nearest = (previous - raw) / turn;
-    let n_near = nearest.round();
+    let n_near = crate::feed::round_fast(nearest);
     let value = raw + n_near * turn;
     let Some((lo, hi)) = limits else {
         return Some((value, false));
@@ -148,13 +148,13 @@ pub struct Selected {
 /// and the accepted range with [`tol::LIMIT_SLACK`] (infinite without limits).
 ///
 /// [`Axis::joint_limits`]: crate::desc::Axis::joint_limits
-struct Strokes {
+pub(crate) struct Strokes {
     limits: [Option<(f64, f64)>; 5],
     accepted: [(f64, f64); 5],
 }
 
 impl Strokes {
-    fn new(machine: &Machine) -> Strokes {
+    pub(crate) fn new(machine: &Machine) -> Strokes {
         let mut limits = [None; 5];
         let mut accepted = [(f64::NEG_INFINITY, f64::INFINITY); 5];
         for (i, axis) in machine.axes().iter().enumerate().take(5) {
@@ -164,6 +164,11 @@ impl Strokes {
             }
         }
         Strokes { limits, accepted }
+    }
+
+    /// [`check_limits`], the error built only on a violation.
+    pub(crate) fn check(&self, machine: &Machine, q: &Joints, block: Option<usize>) -> Result<(), MachineError> {
+        if self.inside(q) { Ok(()) } else { check_limits(machine, q, block) }
     }
 
     /// [`check_limits`] without the error: whether every joint is within its stroke.

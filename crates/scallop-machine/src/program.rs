@@ -164,6 +164,7 @@ pub fn to_program(
     };
     let mut blocks: Vec<ProgramBlock> = Vec::with_capacity(path.joints.len());
     let mut previous: Option<(Pose, Joints)> = start.map(|q| (kin.fk(&q), q));
+    let strokes = crate::plan::Strokes::new(machine);
     // Block ends of one CL move, reused move after move.
     let mut ends: Vec<BlockEnd> = Vec::new();
     for (q, &i) in path.joints.iter().zip(&path.pose_index) {
@@ -178,7 +179,7 @@ pub fn to_program(
             }
         }
         for end in &ends {
-            check_limits(machine, &end.joints, Some(i))?;
+            strokes.check(machine, &end.joints, Some(i))?;
             let inverse_time = match (rec.motion, previous) {
                 (Motion::Rapid, _) | (_, None) => None,
                 _ if !machine.nc().inverse_time => None,

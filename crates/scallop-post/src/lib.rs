@@ -110,15 +110,69 @@ pub(crate) fn scaled_key(v: f64, decimals: usize) -> Option<i64> {
     if x.is_nan() || x >= 1e9 {
         return None;
     }
-    let floor = x.floor();
-    let frac = x - floor;
+    // 0 <= x < 1e9: truncation is the floor, and both conversions are exact.
+    #[allow(clippy::cast_possible_truncation, reason = "0 <= x < 1e9")]
+    let floor = x as i64;
+    #[allow(clippy::cast_precision_loss, reason = "below 1e9, exact")]
+    let frac = x - floor as f64;
     if (frac - 0.5).abs() < tol::FAST_FORMAT_TIE_MARGIN {
         return None;
     }
-    // INVARIANT: 0 <= x < 1e9, an exact integer after rounding.
-    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "0 <= x < 1e9")]
-    let n = if frac > 0.5 { floor + 1.0 } else { floor } as i64;
+    let n = floor + i64::from(frac > 0.5);
     Some(if v < 0.0 { -n } else { n })
+}
+
+/// `x.round()` (half away from zero, signed zero kept) without the library call for
+/// |x| < 2^52, where truncation and the fraction are exact.
+#[inline]
+pub(crate) fn round_fast(x: f64) -> f64 {
+    if x.abs() < 4_503_599_627_370_496.0 {
+        #[allow(clippy::cast_possible_truncation, clippy::cast_precision_loss, reason = "|x| < 2^52, exact")]
+        let t = x as i64 as f64;
+        let f = x - t;
+        let r = if f >= 0.5 {
+            t + 1.0
+        } else if f <= -0.5 {
+            t - 1.0
+        } else {
+            t
+        };
+        r.copysign(x)
+    } else {
+        x.round()
+    }
+}
+
+/// `x.floor()` (signed zero kept) without the library call for |x| < 2^52.
+#[inline]
+pub(crate) fn floor_fast(x: f64) -> f64 {
+    if x.abs() < 4_503_599_627_370_496.0 {
+        #[allow(clippy::cast_possible_truncation, clippy::cast_precision_loss, reason = "|x| < 2^52, exact")]
+        let t = x as i64 as f64;
+        let r = if t > x { t - 1.0 } else { t };
+        r.copysign(x)
+    } else {
+        x.floor()
+    }
+}
+
+/// Appends the number of a [`scaled_key`] with `decimals` digits.
+#[inline]
+pub(crate) fn push_key(out: &mut Vec<u8>, key: i64, decimals: usize) {
+    // A key is below 1e9 + 1 in magnitude: at most 10 digits, the point and the sign, so
+    // the number ends at byte 32 and starts at byte 20 or later. A fixed-length copy of
+    // 16 bytes (inlined, no memcpy call) followed by a truncation appends exactly it.
+    let mut bytes = [0u8; 48];
+    let mut head = [0u8; 32];
+    let at = write_key(&mut head, key, decimals);
+    if at < 20 {
+        out.extend_from_slice(&head[at..]);
+        return;
+    }
+    bytes[..32].copy_from_slice(&head);
+    let len = out.len() + 32 - at;
+    out.extend_from_slice(&bytes[at..at + 16]);
+    out.truncate(len);
 }
 
 /// Writes the number of a [`scaled_key`] with `decimals` digits at the end of `bytes`;
@@ -131,15 +185,22 @@ pub(crate) fn write_key(bytes: &mut [u8; 32], key: i64, decimals: usize) -> usiz
         4041424344454647484950515253545556575859\
         6061626364656667686970717273747576777879\
         8081828384858687888990919293949596979899";
-    let mut n = key.unsigned_abs();
+    let n = key.unsigned_abs();
     // Written right to left into a stack buffer: at least decimals + 1 digits (leading
-    // zeros), the point, the sign; then appended in one copy.
+    // zeros), the point, the sign; then appended in one copy. Constant divisors (no
+    // hardware division) for the usual decimals.
+    let (mut n, mut f) = match decimals {
+        0 => (n, 0),
+        1 => (n / 10, n % 10),
+        2 => (n / 100, n % 100),
+        3 => (n / 1_000, n % 1_000),
+        4 => (n / 10_000, n % 10_000),
+        _ => (n / POW10_U64[decimals], n % POW10_U64[decimals]),
+    };
     let mut at = bytes.len();
     let mut k = 0;
     if decimals > 0 {
         // The fraction digits, two at a time, then the point.
-        let mut f = n % POW10_U64[decimals];
-        n /= POW10_U64[decimals];
         while k + 2 <= decimals {
             let pair = (f % 100) as usize;
             f /= 100;

@@ -82,8 +82,8 @@ pub(crate) fn pow10i(e: i32) -> f64 {
 /// Rounds `v` down to `decimals` (an exactly representable value is kept).
 pub(crate) fn round_down(v: f64, decimals: usize) -> f64 {
     let s = pow10i(i32::try_from(decimals).unwrap_or(9));
-    let r = (v * s).round();
-    if ((v * s) - r).abs() <= tol::ROUNDING_SLACK * r.abs().max(1.0) { r / s } else { (v * s).floor() / s }
+    let r = crate::round_fast(v * s);
+    if ((v * s) - r).abs() <= tol::ROUNDING_SLACK * r.abs().max(1.0) { r / s } else { crate::floor_fast(v * s) / s }
 }
 
 /// Rounds `v` up to `decimals` (an exactly representable value is kept).
@@ -456,6 +456,9 @@ impl<'l> Word<'l> {
     }
 }
 
+/// Most words of a block the fast modal comparison handles.
+const FAST_WORDS: usize = 8;
+
 /// The last written value of a word letter (or of the feed word).
 #[derive(Clone, Debug, PartialEq)]
 enum Modal {
@@ -559,15 +562,16 @@ impl<'a> Emitter<'a> {
     /// Appends `letter` and the number `v` (its scaled key when known) as
     /// [`Emitter::token`] writes them.
     fn push_number_token(out: &mut Vec<u8>, explicit_plus: bool, letter: &str, v: f64, key: Option<i64>, dec: usize) {
-        out.extend_from_slice(letter.as_bytes());
+        match letter.as_bytes() {
+            &[l] => out.push(l),
+            l => out.extend_from_slice(l),
+        }
         match key {
             Some(key) => {
                 if explicit_plus && key >= 0 {
                     out.push(b'+');
                 }
-                let mut bytes = [0u8; 32];
-                let at = crate::write_key(&mut bytes, key, dec);
-                out.extend_from_slice(&bytes[at..]);
+                crate::push_key(out, key, dec);
             }
             None => {
                 if explicit_plus {
@@ -700,20 +704,109 @@ impl<'a> Emitter<'a> {
         {
             self.push_piece(start, letter);
             match &value {
-                Modal::Key(k, dec) => {
-                    let mut bytes = [0u8; 32];
-                    let at = crate::write_key(&mut bytes, *k, *dec);
-                    self.text.extend_from_slice(&bytes[at..]);
-                }
+                Modal::Key(k, dec) => crate::push_key(&mut self.text, *k, *dec),
                 Modal::Token(t) => self.text.extend_from_slice(t),
             }
             self.last_feed = Some(value);
         }
     }
 
+    /// The codes of a motion block before its words: G93/G94 and the motion code (ISO),
+    /// `L` (Heidenhain).
+    fn motion_codes(&mut self, start: usize, feed: FeedWord) {
+        match self.d.syntax {
+            Syntax::Iso => {
+                let want_g93 = matches!(feed, FeedWord::InverseTime(_));
+                if want_g93 != self.g93 {
+                    self.push_piece(start, if want_g93 { b"G93" } else { b"G94" });
+                    self.g93 = want_g93;
+                    self.last_feed = None;
+                }
+                let code = if matches!(feed, FeedWord::Rapid) { "G0" } else { "G1" };
+                if !self.d.modal || self.last_motion != Some(code) {
+                    self.push_piece(start, code.as_bytes());
+                    self.last_motion = Some(code);
+                }
+            }
+            Syntax::Heidenhain => self.push_piece(start, b"L"),
+        }
+    }
+
+    /// The feed word of a motion block, after its words.
+    fn feed_codes(&mut self, start: usize, feed: FeedWord) {
+        match self.d.syntax {
+            // G93 needs F on every block (`always`).
+            Syntax::Iso => match feed {
+                FeedWord::Rapid | FeedWord::Seconds(_) => {}
+                FeedWord::PerMinute(f) => self.feed_word(start, b"F", f, self.d.feed_decimals, false),
+                FeedWord::InverseTime(f) => self.feed_word(start, b"F", f, self.d.inverse_time_decimals, true),
+            },
+            Syntax::Heidenhain => match feed {
+                FeedWord::Rapid => {
+                    self.push_piece(start, b"FMAX");
+                    self.last_feed = None;
+                }
+                FeedWord::Seconds(t) => {
+                    let dec = self.d.inverse_time_decimals;
+                    let ft = format!("FT{}", fmt_number(round_up(t, dec), dec));
+                    self.push_piece(start, ft.as_bytes());
+                    self.last_feed = None;
+                }
+                FeedWord::PerMinute(f) | FeedWord::InverseTime(f) => {
+                    self.feed_word(start, b"F", f, self.d.feed_decimals, false);
+                }
+            },
+        }
+    }
+
+    /// The fast form of the modal comparison of [`Emitter::motion_words`]: every word is a
+    /// number with a scaled key, and the modal word at its position has its letter and a
+    /// key with its decimals (the steady state of joint-space output). Returns the keys and
+    /// the bit mask of the words that change; `None` sends the block to the general path.
+    fn fast_changes(&self, words: &[Word]) -> Option<([i64; FAST_WORDS], u32)> {
+        if words.len() > FAST_WORDS || !self.d.modal || words.len() > self.last_words.len() {
+            return None;
+        }
+        let mut keys = [0i64; FAST_WORDS];
+        let mut mask = 0u32;
+        for (k, (word, (letter, last))) in words.iter().zip(&self.last_words).enumerate() {
+            let (v, dec) = word.number?;
+            let key = crate::scaled_key(v, dec)?;
+            match last {
+                Modal::Key(last_key, last_dec) if *last_dec == dec && short_eq(letter.as_bytes(), word.letter.as_bytes()) => {
+                    if *last_key != key {
+                        mask |= 1 << k;
+                    }
+                }
+                _ => return None,
+            }
+            keys[k] = key;
+        }
+        Some((keys, mask))
+    }
+
     /// A motion block. Hot path of every program: the modal comparison is done on scaled
     /// integers, and only the words that change are formatted, straight into the text.
     fn motion_words(&mut self, words: &mut [Word], feed: FeedWord) {
+        if let Some((keys, mask)) = self.fast_changes(words) {
+            if mask == 0 {
+                return;
+            }
+            self.line_start();
+            let start = self.text.len();
+            self.motion_codes(start, feed);
+            for (k, word) in words.iter().enumerate() {
+                if mask & (1 << k) != 0 {
+                    self.push_word(start, word, Some(keys[k]));
+                    if let Modal::Key(last_key, _) = &mut self.last_words[k].1 {
+                        *last_key = keys[k];
+                    }
+                }
+            }
+            self.feed_codes(start, feed);
+            self.text.push(b'\n');
+            return;
+        }
         let mut state = std::mem::take(&mut self.state);
         state.clear();
         let mut any = false;
@@ -736,55 +829,13 @@ impl<'a> Emitter<'a> {
         }
         self.line_start();
         let start = self.text.len();
-        match self.d.syntax {
-            Syntax::Iso => {
-                let want_g93 = matches!(feed, FeedWord::InverseTime(_));
-                if want_g93 != self.g93 {
-                    self.push_piece(start, if want_g93 { b"G93" } else { b"G94" });
-                    self.g93 = want_g93;
-                    self.last_feed = None;
-                }
-                let code = if matches!(feed, FeedWord::Rapid) { "G0" } else { "G1" };
-                if !self.d.modal || self.last_motion != Some(code) {
-                    self.push_piece(start, code.as_bytes());
-                    self.last_motion = Some(code);
-                }
-                for (word, &(_, key, c)) in words.iter().zip(&state) {
-                    if c {
-                        self.push_word(start, word, key);
-                    }
-                }
-                // G93 needs F on every block (`always`).
-                match feed {
-                    FeedWord::Rapid | FeedWord::Seconds(_) => {}
-                    FeedWord::PerMinute(f) => self.feed_word(start, b"F", f, self.d.feed_decimals, false),
-                    FeedWord::InverseTime(f) => self.feed_word(start, b"F", f, self.d.inverse_time_decimals, true),
-                }
-            }
-            Syntax::Heidenhain => {
-                self.push_piece(start, b"L");
-                for (word, &(_, key, c)) in words.iter().zip(&state) {
-                    if c {
-                        self.push_word(start, word, key);
-                    }
-                }
-                match feed {
-                    FeedWord::Rapid => {
-                        self.push_piece(start, b"FMAX");
-                        self.last_feed = None;
-                    }
-                    FeedWord::Seconds(t) => {
-                        let dec = self.d.inverse_time_decimals;
-                        let ft = format!("FT{}", fmt_number(round_up(t, dec), dec));
-                        self.push_piece(start, ft.as_bytes());
-                        self.last_feed = None;
-                    }
-                    FeedWord::PerMinute(f) | FeedWord::InverseTime(f) => {
-                        self.feed_word(start, b"F", f, self.d.feed_decimals, false);
-                    }
-                }
+        self.motion_codes(start, feed);
+        for (word, &(_, key, c)) in words.iter().zip(&state) {
+            if c {
+                self.push_word(start, word, key);
             }
         }
+        self.feed_codes(start, feed);
         self.text.push(b'\n');
         for (word, &(slot, key, _)) in words.iter().zip(&state) {
             let value = match (word.number, key) {
