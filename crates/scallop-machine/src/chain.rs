@@ -121,6 +121,30 @@ pub struct Kinematics {
     /// rotary's point `p1` and the constant `K` of the distance bound
     /// `D0 <= |tip_M - p1| + K` of `feed::deviation_bound_relaxed`.
     pub(crate) ball_bound: Option<(Point3, f64)>,
+    /// Per joint: `Some((k, sign))` when the direction is exactly `sign e_k` (the closed
+    /// forms rotate about it without the general Rodrigues formula).
+    pub(crate) principal: [Option<(usize, f64)>; 5],
+    /// The part frame W0 is exactly the identity (its transforms are skipped).
+    pub(crate) w0_identity: bool,
+}
+
+/// `Some((k, sign))` when `d` is exactly `sign e_k`.
+fn principal_direction(d: &Vec3) -> Option<(usize, f64)> {
+    let k = (0..3).find(|&k| d[k].abs() == 1.0)?;
+    ((0..3).all(|j| j == k || d[j] == 0.0)).then_some((k, d[k]))
+}
+
+/// `p` rotated by the angle with `(s, c)` about the line through `point` along
+/// `sign e_k`: [`rotate_about`] for a principal direction, two terms per component.
+pub(crate) fn rotate_about_principal(k: usize, sign: f64, point: &Point3, (s, c): (f64, f64), p: &Point3) -> Point3 {
+    let v = p - point;
+    let s = sign * s;
+    let r = match k {
+        0 => Vec3::new(v.x, c * v.y - s * v.z, s * v.y + c * v.z),
+        1 => Vec3::new(c * v.x + s * v.z, v.y, c * v.z - s * v.x),
+        _ => Vec3::new(c * v.x - s * v.y, s * v.x + c * v.y, v.z),
+    };
+    point + r
 }
 
 /// `(p1, K)` of [`Kinematics::ball_bound`]: walking the part chain from the bed, the tip
@@ -252,6 +276,8 @@ impl Kinematics {
             linear_inverse,
             linear_first,
             ball_bound: ball_bound(machine),
+            principal: std::array::from_fn(|i| machine.axes.get(i).and_then(|a| principal_direction(&a.direction))),
+            w0_identity: machine.part_frame == Isometry3::identity(),
         }
     }
 
@@ -310,6 +336,7 @@ impl Kinematics {
     #[must_use]
     pub fn with_part_frame(mut self, part_frame: Isometry3<f64>) -> Kinematics {
         self.w0 = part_frame;
+        self.w0_identity = part_frame == Isometry3::identity();
         self
     }
 

@@ -22,7 +22,7 @@ use std::f64::consts::PI;
 use scallop_geom::nalgebra::{Matrix3, SMatrix, Unit, UnitQuaternion};
 use scallop_geom::{Point3, Vec3};
 
-use crate::chain::{Class, Family, Joints, Kinematics, Pose, Solver, rotate_about};
+use crate::chain::{Class, Family, Joints, Kinematics, Pose, Solver, rotate_about, rotate_about_principal};
 use crate::desc::AxisKind;
 use crate::error::MachineError;
 use crate::tol;
@@ -85,6 +85,26 @@ impl IkSolutions {
     }
 }
 
+/// The inverse solutions of one pose, the position step of each closed-form branch done
+/// on demand ([`Kinematics::ik_lazy`], [`Kinematics::complete`]).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct LazyIk {
+    /// The solutions; the linear joints of a pending one are zero.
+    pub(crate) sols: IkSolutions,
+    /// Per solution, the `(sin, cos)` of its joints while its linear joints are pending.
+    pending: [Option<[(f64, f64); 5]>; 2],
+    /// `W0 tip` (closed position step) or the tip (affine position step).
+    x_m: Point3,
+    tip: Point3,
+}
+
+impl LazyIk {
+    /// Solutions with nothing pending.
+    pub(crate) fn complete(sols: IkSolutions) -> LazyIk {
+        LazyIk { sols, pending: [None; 2], x_m: Point3::origin(), tip: Point3::origin() }
+    }
+}
+
 fn normalize_angle(a: f64) -> f64 {
     // `rem_euclid` is `a % 2 pi` (exact, a call to fmod) then `+ 2 pi` for a negative
     // remainder; for |a| < 2 pi the remainder is `a` itself: same value without fmod.
@@ -140,9 +160,42 @@ impl Kinematics {
         }
         let pose = Pose { tip: pose.tip, axis: pose.axis / n };
         match self.solver {
-            Solver::Closed(f) => self.ik_closed(f, &pose, hold),
+            Solver::Closed(f) => {
+                let mut lazy = self.ik_closed(f, &pose, hold)?;
+                self.complete(&mut lazy, 0);
+                self.complete(&mut lazy, 1);
+                Ok(lazy.sols)
+            }
             Solver::Generic => self.ik_generic(&pose, hold),
             Solver::Numeric => self.ik_numeric_both(&pose, hold),
+        }
+    }
+
+    /// [`Kinematics::ik`] with the position step of each closed-form branch left to
+    /// [`Kinematics::complete`]: the planner drops most candidates on their rotary values
+    /// alone. Same solutions, bit for bit, once completed.
+    pub(crate) fn ik_lazy(&self, pose: &Pose, hold: &Joints) -> Result<LazyIk, MachineError> {
+        match self.solver {
+            Solver::Closed(f) => {
+                let n = pose.axis.norm();
+                if !(n.is_finite() && n > 0.0 && pose.tip.coords.iter().all(|c| c.is_finite())) {
+                    return self.ik(pose, hold).map(LazyIk::complete);
+                }
+                self.ik_closed(f, &Pose { tip: pose.tip, axis: pose.axis / n }, hold)
+            }
+            Solver::Generic | Solver::Numeric => self.ik(pose, hold).map(LazyIk::complete),
+        }
+    }
+
+    /// Solves the linear joints of solution `k` of `lazy` if they are still pending.
+    pub(crate) fn complete(&self, lazy: &mut LazyIk, k: usize) {
+        if let Some(trig) = lazy.pending[k].take() {
+            let q = &mut lazy.sols.items[k].joints;
+            if self.linear_first {
+                self.solve_linear_machine(&lazy.x_m, q, &trig);
+            } else {
+                self.solve_linear_affine(&lazy.tip, q);
+            }
         }
     }
 
@@ -154,29 +207,22 @@ impl Kinematics {
         IkSolution { joints: q, branch: Branch::of_tilt(q[self.tilt]), at_pole }
     }
 
-    /// [`Kinematics::solution`] with the rotaries' `(sin, cos)` known (the closed forms get
-    /// them from the tool axis's components without evaluating `sin_cos`); `x_m` is
-    /// `W0 tip` when the position step is closed (`linear_first`), computed once for both
-    /// branches.
-    fn solution_trig(
+    /// The rotary part of [`Kinematics::solution`] with the rotaries' `(sin, cos)` known
+    /// (the closed forms get them from the tool axis's components without evaluating
+    /// `sin_cos`); the linear joints are left at zero and the trigonometry is returned for
+    /// [`Kinematics::complete`].
+    fn rotary_solution(
         &self,
-        tip: &Point3,
-        x_m: &Point3,
         (theta_primary, trig_primary): (f64, (f64, f64)),
         (theta_secondary, trig_secondary): (f64, (f64, f64)),
-    ) -> IkSolution {
+    ) -> (IkSolution, [(f64, f64); 5]) {
         let mut q = Joints::zeros();
         q[self.primary] = normalize_angle(theta_primary);
         q[self.secondary] = normalize_angle(theta_secondary);
-        if self.linear_first {
-            let mut trig = [(0.0, 1.0); 5];
-            trig[self.primary] = trig_primary;
-            trig[self.secondary] = trig_secondary;
-            self.solve_linear_machine(x_m, &mut q, &trig);
-        } else {
-            self.solve_linear_affine(tip, &mut q);
-        }
-        IkSolution { joints: q, branch: Branch::of_tilt(q[self.tilt]), at_pole: false }
+        let mut trig = [(0.0, 1.0); 5];
+        trig[self.primary] = trig_primary;
+        trig[self.secondary] = trig_secondary;
+        (IkSolution { joints: q, branch: Branch::of_tilt(q[self.tilt]), at_pole: false }, trig)
     }
 
     /// Fills the linear joints of `q` (rotaries given) so that the controlled point is at
@@ -207,7 +253,10 @@ impl Kinematics {
             for &i in chain.iter().rev() {
                 let a = &self.machine.axes[i];
                 if a.kind == AxisKind::Rotary {
-                    p = rotate_about(&a.direction, &a.point, trig[i], &p);
+                    p = match self.principal[i] {
+                        Some((k, sign)) => rotate_about_principal(k, sign, &a.point, trig[i], &p),
+                        None => rotate_about(&a.direction, &a.point, trig[i], &p),
+                    };
                 }
             }
             p
@@ -239,11 +288,11 @@ impl Kinematics {
         q[2] = lin[2];
     }
 
-    fn ik_closed(&self, family: Family, pose: &Pose, hold: &Joints) -> Result<IkSolutions, MachineError> {
-        let v = self.w0.rotation * pose.axis;
+    fn ik_closed(&self, family: Family, pose: &Pose, hold: &Joints) -> Result<LazyIk, MachineError> {
+        let v = if self.w0_identity { pose.axis } else { self.w0.rotation * pose.axis };
         let rho = v.x.hypot(v.y);
         if rho < self.machine.pole_eps {
-            return self.ik_generic(pose, hold);
+            return self.ik_generic(pose, hold).map(LazyIk::complete);
         }
         let sign = |i: usize| {
             let d = &self.machine.axes[i].direction;
@@ -252,11 +301,12 @@ impl Kinematics {
         };
         let (s_tilt, s_pole) = (sign(self.tilt), sign(self.pole));
         let mut items = [IkSolution { joints: Joints::zeros(), branch: Branch::Positive, at_pole: false }; 2];
+        let mut pending = [None; 2];
         let r = rho.hypot(v.z);
         // atan2 is odd in its first argument (exactly: the sign is applied last).
         let tilt_positive = rho.atan2(v.z);
         // The machine-frame tip of the closed position step, shared by both branches.
-        let x_m = if self.linear_first { self.w0 * pose.tip } else { pose.tip };
+        let x_m = if self.linear_first && !self.w0_identity { self.w0 * pose.tip } else { pose.tip };
         // gamma = atan2(y, x) with (y, x) of length rho, on the branch k = +1; the branch
         // k = -1 has (-y, -x): its angle is gamma -+ pi (no second atan2; the two agree
         // after `normalize_angle`, which maps -pi and pi to pi), and its sines and cosines
@@ -271,7 +321,7 @@ impl Kinematics {
         };
         let gamma = y.atan2(x);
         let gamma_other = if gamma > 0.0 { gamma - PI } else { gamma + PI };
-        for (slot, k) in items.iter_mut().zip([1.0, -1.0]) {
+        for ((slot, trig), k) in items.iter_mut().zip(&mut pending).zip([1.0, -1.0]) {
             let (tilt, gamma, y, x) = if k > 0.0 {
                 (tilt_positive, gamma, y, x)
             } else {
@@ -282,9 +332,11 @@ impl Kinematics {
             let pole_trig = (s_pole * y / rho, x / rho);
             let (q_tilt, q_pole) = ((s_tilt * tilt, tilt_trig), (s_pole * gamma, pole_trig));
             let (primary, secondary) = if self.tilt == self.primary { (q_tilt, q_pole) } else { (q_pole, q_tilt) };
-            *slot = self.solution_trig(&pose.tip, &x_m, primary, secondary);
+            let (solution, t) = self.rotary_solution(primary, secondary);
+            *slot = solution;
+            *trig = Some(t);
         }
-        Ok(IkSolutions { items, len: 2 })
+        Ok(LazyIk { sols: IkSolutions { items, len: 2 }, pending, x_m, tip: pose.tip })
     }
 
     /// The subproblem-2 vectors `(u1, u2, b, a)` for the class (see the module docs).

@@ -208,6 +208,35 @@ fn admissible(
     Ok(Selected { joints: q, branch: sol.branch, unwound, at_pole: sol.at_pole })
 }
 
+/// Whether the candidate `sol` from the state `p` is dropped as a jump while cutting
+/// (spec 3.6 rule 3): its rotaries unwrapped as [`admissible`] does, a jump above
+/// `flip_threshold` that is not a pole flip (`crosses`: the tool axis crosses the pole in
+/// the block). Such a candidate is dropped whether or not its strokes hold.
+fn jumps_on_rotaries(
+    strokes: &Strokes,
+    sol: &IkSolution,
+    p: &State,
+    flip_threshold: f64,
+    pole: usize,
+    crosses: impl Fn() -> bool,
+) -> bool {
+    let mut dq = [0.0; 2];
+    for (r, i) in (3..5).enumerate() {
+        let raw = sol.joints[i];
+        let v = match unwrap_angle(raw, p.q[i], strokes.limits[i]) {
+            Some((v, _)) => v,
+            None => unwrap_angle(raw, p.q[i], None).map_or(raw, |(v, _)| v),
+        };
+        dq[r] = v - p.q[i];
+    }
+    let jump = dq.map(|d| d.abs() > flip_threshold);
+    if jump == [false, false] {
+        return false;
+    }
+    let only_pole = (0..2).all(|r| jump[r] == (r + 3 == pole));
+    !(only_pole && (p.at_pole || sol.at_pole || crosses()))
+}
+
 /// Velocity-limited time of the move `a -> b`: `max_j |dq_j| / vmax_j` (spec 3.5).
 ///
 /// ```
@@ -492,63 +521,94 @@ pub fn plan_path(
     let mut next: Vec<State> = Vec::new();
     for (i, pose) in poses.iter().enumerate() {
         let preds: &[State] = if i == 0 { std::slice::from_ref(&root) } else { &arena[offsets[i - 1]..offsets[i]] };
-        next.clear();
         let mut first_error: Option<MachineError> = None;
         let mut smallest_jump: Option<(usize, f64)> = None;
-        // Off the pole the inverse does not depend on the held joints: solve once.
-        let shared = kin.ik(pose, &preds[0].q).map_err(|e| e.at_block(i))?;
-        let polar = shared.as_slice().iter().any(|s| s.at_pole) || kin.solver() == crate::chain::Solver::Numeric;
-        for (pi, p) in preds.iter().enumerate() {
-            let sols = if polar && pi > 0 { kin.ik(pose, &p.q).map_err(|e| e.at_block(i))? } else { shared };
-            for sol in sols.as_slice() {
+        // Off the pole the inverse does not depend on the held joints: solve once (the
+        // position step of each branch only when a candidate needs it).
+        let mut shared = kin.ik_lazy(pose, &preds[0].q).map_err(|e| e.at_block(i))?;
+        let polar = shared.sols.as_slice().iter().any(|s| s.at_pole) || kin.solver() == crate::chain::Solver::Numeric;
+        // A candidate that jumps while cutting is dropped on its rotary values alone,
+        // before its linear joints are solved and its strokes checked: kept candidates are
+        // the same. When that leaves the layer empty, it is expanded again without the
+        // shortcut, for the error the full checks give.
+        for shortcut in [true, false] {
+            next.clear();
+            let mut dropped = false;
+            for (pi, p) in preds.iter().enumerate() {
+                let mut own;
+                let sols = if polar && pi > 0 {
+                    own = crate::ik::LazyIk::complete(kin.ik(pose, &p.q).map_err(|e| e.at_block(i))?);
+                    &mut own
+                } else {
+                    &mut shared
+                };
                 let has_previous = i > 0 || start.is_some();
-                let cand = match admissible(machine, &strokes, sol, has_previous.then_some(&p.q)) {
-                    Ok(c) => c,
-                    Err(e) => {
-                        first_error.get_or_insert(e.at_block(i));
+                for k in 0..sols.sols.as_slice().len() {
+                    if shortcut
+                        && has_previous
+                        && cutting[i]
+                        && jumps_on_rotaries(&strokes, &sols.sols.as_slice()[k], p, options.flip_threshold, pole, || {
+                            i > 0 && arc_passes(&poses[i - 1].axis, &pose.axis, &pole_dir, eps)
+                        })
+                    {
+                        dropped = true;
                         continue;
                     }
-                };
-                let (cost, edge) = if has_previous {
-                    let dq = cand.joints - p.q;
-                    let jump = [3, 4].map(|j| dq[j].abs() > options.flip_threshold);
-                    // The move time only for candidates that are kept (a jump while
-                    // cutting is dropped before it is needed).
-                    let t = || move_time(machine, &p.q, &cand.joints);
-                    if jump == [false, false] {
-                        (t(), Edge::Plain)
-                    } else {
-                        let only_pole = (0..2).all(|r| jump[r] == (r + 3 == pole));
-                        let crosses = p.at_pole
-                            || cand.at_pole
-                            || (i > 0 && arc_passes(&poses[i - 1].axis, &pose.axis, &pole_dir, eps));
-                        if only_pole && crosses {
-                            (t(), Edge::PoleFlip)
-                        } else if cutting[i] {
-                            let j = if dq[3].abs() >= dq[4].abs() { 3 } else { 4 };
-                            if smallest_jump.is_none_or(|(_, d)| dq[j].abs() < d) {
-                                smallest_jump = Some((j, dq[j].abs()));
+                    kin.complete(sols, k);
+                    let sol = &sols.sols.as_slice()[k];
+                        let cand = match admissible(machine, &strokes, sol, has_previous.then_some(&p.q)) {
+                            Ok(c) => c,
+                            Err(e) => {
+                                first_error.get_or_insert(e.at_block(i));
+                                continue;
                             }
-                            continue;
+                        };
+                        let (cost, edge) = if has_previous {
+                            let dq = cand.joints - p.q;
+                            let jump = [3, 4].map(|j| dq[j].abs() > options.flip_threshold);
+                            // The move time only for candidates that are kept (a jump while
+                            // cutting is dropped before it is needed).
+                            let t = || move_time(machine, &p.q, &cand.joints);
+                            if jump == [false, false] {
+                                (t(), Edge::Plain)
+                            } else {
+                                let only_pole = (0..2).all(|r| jump[r] == (r + 3 == pole));
+                                let crosses = p.at_pole
+                                    || cand.at_pole
+                                    || (i > 0 && arc_passes(&poses[i - 1].axis, &pose.axis, &pole_dir, eps));
+                                if only_pole && crosses {
+                                    (t(), Edge::PoleFlip)
+                                } else if cutting[i] {
+                                    let j = if dq[3].abs() >= dq[4].abs() { 3 } else { 4 };
+                                    if smallest_jump.is_none_or(|(_, d)| dq[j].abs() < d) {
+                                        smallest_jump = Some((j, dq[j].abs()));
+                                    }
+                                    continue;
+                                } else {
+                                    let j = if dq[3].abs() >= dq[4].abs() { 3 } else { 4 };
+                                    (t() + options.reorient_penalty, Edge::Reorient(j))
+                                }
+                            }
                         } else {
-                            let j = if dq[3].abs() >= dq[4].abs() { 3 } else { 4 };
-                            (t() + options.reorient_penalty, Edge::Reorient(j))
+                            (0.0, Edge::Plain)
+                        };
+                        let first = if i == 0 { preference_key(kin, &cand.joints) } else { p.first };
+                        let state = State { q: cand.joints, at_pole: cand.at_pole, cost: p.cost + cost, first, back: pi, edge };
+                        match next.iter_mut().find(|s| (s.q - state.q).amax() < tol::SAME_JOINTS) {
+                            Some(existing) => {
+                                if better(&state, existing) {
+                                    *existing = state;
+                                }
+                            }
+                            None => next.push(state),
                         }
-                    }
-                } else {
-                    (0.0, Edge::Plain)
-                };
-                let first = if i == 0 { preference_key(kin, &cand.joints) } else { p.first };
-                let state = State { q: cand.joints, at_pole: cand.at_pole, cost: p.cost + cost, first, back: pi, edge };
-                match next.iter_mut().find(|s| (s.q - state.q).amax() < tol::SAME_JOINTS) {
-                    Some(existing) => {
-                        if better(&state, existing) {
-                            *existing = state;
-                        }
-                    }
-                    None => next.push(state),
                 }
             }
+            if !(next.is_empty() && dropped) {
+                break;
+            }
+            first_error = None;
+            smallest_jump = None;
         }
         if next.is_empty() {
             if let Some((j, d)) = smallest_jump {
