@@ -130,8 +130,13 @@ pub struct Kinematics {
 
 /// `Some((k, sign))` when `d` is exactly `sign e_k`.
 fn principal_direction(d: &Vec3) -> Option<(usize, f64)> {
+    // Exact comparisons on purpose: only an exactly axis-aligned direction (as the
+    // closed-form families have) takes the short formula.
+    #[allow(clippy::float_cmp, reason = "exactly a unit axis")]
     let k = (0..3).find(|&k| d[k].abs() == 1.0)?;
-    ((0..3).all(|j| j == k || d[j] == 0.0)).then_some((k, d[k]))
+    #[allow(clippy::float_cmp, reason = "exact zeros")]
+    let rest_zero = (0..3).all(|j| j == k || d[j] == 0.0);
+    rest_zero.then_some((k, d[k]))
 }
 
 /// `p` rotated by the angle with `(s, c)` about the line through `point` along

@@ -108,11 +108,7 @@ impl LazyIk {
 fn normalize_angle(a: f64) -> f64 {
     // `rem_euclid` is `a % 2 pi` (exact, a call to fmod) then `+ 2 pi` for a negative
     // remainder; for |a| < 2 pi the remainder is `a` itself: same value without fmod.
-    let r = if a.abs() < 2.0 * PI {
-        if a < 0.0 { a + 2.0 * PI } else { a }
-    } else {
-        a.rem_euclid(2.0 * PI)
-    };
+    let r = if a.abs() < 2.0 * PI { if a < 0.0 { a + 2.0 * PI } else { a } } else { a.rem_euclid(2.0 * PI) };
     if r > PI { r - 2.0 * PI } else { r }
 }
 
@@ -322,11 +318,8 @@ impl Kinematics {
         let gamma = y.atan2(x);
         let gamma_other = if gamma > 0.0 { gamma - PI } else { gamma + PI };
         for ((slot, trig), k) in items.iter_mut().zip(&mut pending).zip([1.0, -1.0]) {
-            let (tilt, gamma, y, x) = if k > 0.0 {
-                (tilt_positive, gamma, y, x)
-            } else {
-                (-tilt_positive, gamma_other, -y, -x)
-            };
+            let (tilt, gamma, y, x) =
+                if k > 0.0 { (tilt_positive, gamma, y, x) } else { (-tilt_positive, gamma_other, -y, -x) };
             // The sines and cosines from the same components (no sin_cos of the angles).
             let tilt_trig = (s_tilt * k * rho / r, v.z / r);
             let pole_trig = (s_pole * y / rho, x / rho);

@@ -773,7 +773,9 @@ impl<'a> Emitter<'a> {
             let (v, dec) = word.number?;
             let key = crate::scaled_key(v, dec)?;
             match last {
-                Modal::Key(last_key, last_dec) if *last_dec == dec && short_eq(letter.as_bytes(), word.letter.as_bytes()) => {
+                Modal::Key(last_key, last_dec)
+                    if *last_dec == dec && short_eq(letter.as_bytes(), word.letter.as_bytes()) =>
+                {
                     if *last_key != key {
                         mask |= 1 << k;
                     }
