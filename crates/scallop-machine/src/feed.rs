@@ -456,3 +456,27 @@ pub fn inverse_time_feed(kin: &Kinematics, pose_a: &Pose, pose_b: &Pose, qa: &Jo
     let nearest = round_fast(exact * scale) / scale;
     if (exact - nearest).abs() <= tol::FEED_ROUNDING * exact { nearest } else { floor_fast(exact * scale) / scale }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::{floor_fast, round_fast};
+
+    #[test]
+    fn the_fast_roundings_equal_the_library_bit_for_bit() {
+        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        for _ in 0..100_000 {
+            let magnitude = 10f64.powi(i32::try_from(next() % 20).unwrap_or(0) - 4);
+            let v = ((next() >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 2.0 * magnitude;
+            for x in [v, v.trunc() + 0.5, v.trunc() - 0.5, -0.0, 0.0, 4.6e15, -4.6e15, f64::NAN] {
+                assert_eq!(round_fast(x).to_bits(), x.round().to_bits(), "round {x:e}");
+                assert_eq!(floor_fast(x).to_bits(), x.floor().to_bits(), "floor {x:e}");
+            }
+        }
+    }
+}

@@ -279,7 +279,33 @@ pub fn write_gcode(path: &Toolpath, dialect: &Dialect, comments: &[&str], out: &
 
 #[cfg(test)]
 mod tests {
-    use super::fmt_number;
+    use super::{floor_fast, fmt_number, push_key, round_fast, scaled_key};
+
+    #[test]
+    fn keys_format_as_the_exact_formatter_and_the_fast_roundings_equal_the_library() {
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        for _ in 0..100_000 {
+            let magnitude = 10f64.powi(i32::try_from(next() % 16).unwrap_or(0) - 6);
+            let v = ((next() >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 2.0 * magnitude;
+            for d in [0, 1, 3, 4, 6, 9] {
+                if let Some(key) = scaled_key(v, d) {
+                    let mut out = b"X".to_vec();
+                    push_key(&mut out, key, d);
+                    assert_eq!(out[1..], *fmt_number(v, d).as_bytes(), "{v:e} at {d}");
+                }
+            }
+            for x in [v, v * 1e3, v + 0.5, -v - 0.5, v.trunc() + 0.5, -0.0, 0.0, 4.6e15, -4.6e15] {
+                assert_eq!(round_fast(x).to_bits(), x.round().to_bits(), "round {x:e}");
+                assert_eq!(floor_fast(x).to_bits(), x.floor().to_bits(), "floor {x:e}");
+            }
+        }
+    }
 
     fn exact(v: f64, decimals: usize) -> String {
         let s = format!("{v:.decimals$}");
