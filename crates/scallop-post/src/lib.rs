@@ -156,6 +156,82 @@ pub(crate) fn floor_fast(x: f64) -> f64 {
     }
 }
 
+const DIGIT_PAIRS: &[u8; 200] = b"0001020304050607080910111213141516171819\
+    2021222324252627282930313233343536373839\
+    4041424344454647484950515253545556575859\
+    6061626364656667686970717273747576777879\
+    8081828384858687888990919293949596979899";
+
+/// Appends `prefix` (a space, a word letter, a `+`) and the number of a [`scaled_key`]
+/// with `decimals` digits: the hot path of every motion block. For 3 and 4 decimals the
+/// digits are written with constant divisors into a stack buffer and appended with one
+/// fixed-length copy; other cases go through [`push_key`].
+#[inline]
+pub(crate) fn push_token_key(out: &mut Vec<u8>, prefix: &[u8], key: i64, decimals: usize) {
+    if prefix.len() <= 4 && key.unsigned_abs() <= 1_000_000_001 {
+        match decimals {
+            3 => return push_token_dec::<3>(out, prefix, key),
+            4 => return push_token_dec::<4>(out, prefix, key),
+            _ => {}
+        }
+    }
+    out.extend_from_slice(prefix);
+    push_key(out, key, decimals);
+}
+
+/// [`push_token_key`] for `D` decimals (3 or 4), `|key| <= 1e9 + 1` and a prefix of at most
+/// 4 bytes: at most 6 integer digits, the point, `D` digits and the sign, so the token is
+/// at most 16 bytes and ends at byte 32 of the buffer.
+fn push_token_dec<const D: usize>(out: &mut Vec<u8>, prefix: &[u8], key: i64) {
+    let mut buf = [0u8; 48];
+    let mut at = 32;
+    let scale: u64 = if D == 3 { 1_000 } else { 10_000 };
+    let n = key.unsigned_abs();
+    let (mut int, mut frac) = (n / scale, n % scale);
+    let mut k = 0;
+    while k + 2 <= D {
+        let pair = 2 * (frac % 100) as usize;
+        frac /= 100;
+        at -= 2;
+        buf[at] = DIGIT_PAIRS[pair];
+        buf[at + 1] = DIGIT_PAIRS[pair + 1];
+        k += 2;
+    }
+    if k < D {
+        at -= 1;
+        buf[at] = b'0' + (frac % 10) as u8;
+    }
+    at -= 1;
+    buf[at] = b'.';
+    while int >= 100 {
+        let pair = 2 * (int % 100) as usize;
+        int /= 100;
+        at -= 2;
+        buf[at] = DIGIT_PAIRS[pair];
+        buf[at + 1] = DIGIT_PAIRS[pair + 1];
+    }
+    if int >= 10 {
+        let pair = 2 * int as usize;
+        at -= 2;
+        buf[at] = DIGIT_PAIRS[pair];
+        buf[at + 1] = DIGIT_PAIRS[pair + 1];
+    } else {
+        at -= 1;
+        buf[at] = b'0' + int as u8;
+    }
+    if key < 0 {
+        at -= 1;
+        buf[at] = b'-';
+    }
+    for &b in prefix.iter().rev() {
+        at -= 1;
+        buf[at] = b;
+    }
+    let len = out.len() + 32 - at;
+    out.extend_from_slice(&buf[at..at + 16]);
+    out.truncate(len);
+}
+
 /// Appends the number of a [`scaled_key`] with `decimals` digits.
 #[inline]
 pub(crate) fn push_key(out: &mut Vec<u8>, key: i64, decimals: usize) {

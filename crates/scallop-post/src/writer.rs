@@ -672,7 +672,16 @@ impl<'a> Emitter<'a> {
 
     /// Appends a space (unless the line is still empty after `start`), then `word`.
     fn push_word(&mut self, start: usize, word: &Word, key: Option<i64>) {
-        if self.text.len() > start {
+        let space = self.text.len() > start;
+        if let (Some((_, dec)), Some(key), &[letter]) = (word.number, key, word.letter.as_bytes()) {
+            // One letter and a scaled key: the token in one piece.
+            let plus = self.d.explicit_plus && key >= 0;
+            let prefix = [b' ', letter, b'+'];
+            let (from, to) = (usize::from(!space), 2 + usize::from(plus));
+            crate::push_token_key(&mut self.text, &prefix[from..to], key, dec);
+            return;
+        }
+        if space {
             self.text.push(b' ');
         }
         match word.number {
@@ -702,10 +711,21 @@ impl<'a> Emitter<'a> {
             || !self.d.modal
             || !self.last_feed.as_ref().is_some_and(|last| Self::same_feed(&mut self.scratch, last, &value))
         {
-            self.push_piece(start, letter);
             match &value {
-                Modal::Key(k, dec) => crate::push_key(&mut self.text, *k, *dec),
-                Modal::Token(t) => self.text.extend_from_slice(t),
+                Modal::Key(k, dec) if letter.len() <= 3 => {
+                    let mut prefix = [b' '; 4];
+                    let from = usize::from(self.text.len() <= start);
+                    prefix[1..=letter.len()].copy_from_slice(letter);
+                    crate::push_token_key(&mut self.text, &prefix[from..=letter.len()], *k, *dec);
+                }
+                Modal::Key(k, dec) => {
+                    self.push_piece(start, letter);
+                    crate::push_key(&mut self.text, *k, *dec);
+                }
+                Modal::Token(t) => {
+                    self.push_piece(start, letter);
+                    self.text.extend_from_slice(t);
+                }
             }
             self.last_feed = Some(value);
         }
