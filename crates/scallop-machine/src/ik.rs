@@ -286,7 +286,10 @@ impl Kinematics {
 
     fn ik_closed(&self, family: Family, pose: &Pose, hold: &Joints) -> Result<LazyIk, MachineError> {
         let v = if self.w0_identity { pose.axis } else { self.w0.rotation * pose.axis };
-        let rho = v.x.hypot(v.y);
+        // `v` is a unit vector: no overflow, and an underflowing square only makes rho
+        // smaller than pole_eps, where hypot would be too (square roots instead of hypot).
+        let rho_sq = v.x * v.x + v.y * v.y;
+        let rho = rho_sq.sqrt();
         if rho < self.machine.pole_eps {
             return self.ik_generic(pose, hold).map(LazyIk::complete);
         }
@@ -298,7 +301,7 @@ impl Kinematics {
         let (s_tilt, s_pole) = (sign(self.tilt), sign(self.pole));
         let mut items = [IkSolution { joints: Joints::zeros(), branch: Branch::Positive, at_pole: false }; 2];
         let mut pending = [None; 2];
-        let r = rho.hypot(v.z);
+        let r = (rho_sq + v.z * v.z).sqrt();
         // atan2 is odd in its first argument (exactly: the sign is applied last).
         let tilt_positive = rho.atan2(v.z);
         // The machine-frame tip of the closed position step, shared by both branches.
