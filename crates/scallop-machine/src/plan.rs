@@ -500,6 +500,50 @@ pub fn plan_path(
             fix: "give one cutting flag per pose".into(),
         });
     }
+    plan_input(kin, &(poses, cutting), start, options)
+}
+
+/// The poses of a path and whether the move into each is in the material: what
+/// [`plan_path`] reads (slices, or the CL records themselves without copies).
+pub(crate) trait PathInput {
+    /// Number of poses.
+    fn len(&self) -> usize;
+    /// Pose `i`.
+    fn pose(&self, i: usize) -> &Pose;
+    /// Whether the move into pose `i` is in the material.
+    fn cutting(&self, i: usize) -> bool;
+}
+
+impl PathInput for (&[Pose], &[bool]) {
+    fn len(&self) -> usize {
+        self.0.len()
+    }
+    fn pose(&self, i: usize) -> &Pose {
+        &self.0[i]
+    }
+    fn cutting(&self, i: usize) -> bool {
+        self.1[i]
+    }
+}
+
+/// One state of the beam kept for the backtracking: the joints, how it was reached and
+/// its predecessor in the previous layer.
+#[derive(Clone, Copy, Debug)]
+struct Node {
+    q: Joints,
+    edge: Edge,
+    back: u8,
+    at_pole: bool,
+}
+
+/// [`plan_path`] on any [`PathInput`].
+pub(crate) fn plan_input(
+    kin: &Kinematics,
+    input: &impl PathInput,
+    start: Option<Joints>,
+    options: &PlanOptions,
+) -> Result<JointPath, MachineError> {
+    let n_poses = input.len();
     let machine = kin.machine();
     let strokes = Strokes::new(machine);
     let pole = kin.pole_axis();
@@ -513,14 +557,17 @@ pub fn plan_path(
         back: 0,
         edge: Edge::Plain,
     };
-    // The layers in one arena: layer i is `arena[offsets[i]..offsets[i + 1]]` (no
-    // allocation per pose); `next` is reused.
-    let mut arena: Vec<State> = Vec::with_capacity(poses.len() * 2);
-    let mut offsets: Vec<usize> = Vec::with_capacity(poses.len() + 1);
+    // The layers' nodes in one arena: layer i is `arena[offsets[i]..offsets[i + 1]]` (no
+    // allocation per pose); the full states of the previous and the next layer in two
+    // reused vectors.
+    let mut arena: Vec<Node> = Vec::with_capacity(n_poses + n_poses / 4);
+    let mut offsets: Vec<u32> = Vec::with_capacity(n_poses + 1);
     offsets.push(0);
     let mut next: Vec<State> = Vec::new();
-    for (i, pose) in poses.iter().enumerate() {
-        let preds: &[State] = if i == 0 { std::slice::from_ref(&root) } else { &arena[offsets[i - 1]..offsets[i]] };
+    let mut previous: Vec<State> = vec![root];
+    for i in 0..n_poses {
+        let pose = input.pose(i);
+        let preds: &[State] = &previous;
         let mut first_error: Option<MachineError> = None;
         let mut smallest_jump: Option<(usize, f64)> = None;
         // Off the pole the inverse does not depend on the held joints: solve once (the
@@ -546,14 +593,14 @@ pub fn plan_path(
                 for k in 0..sols.sols.as_slice().len() {
                     if shortcut
                         && has_previous
-                        && cutting[i]
+                        && input.cutting(i)
                         && jumps_on_rotaries(
                             &strokes,
                             &sols.sols.as_slice()[k],
                             p,
                             options.flip_threshold,
                             pole,
-                            || i > 0 && arc_passes(&poses[i - 1].axis, &pose.axis, &pole_dir, eps),
+                            || i > 0 && arc_passes(&input.pose(i - 1).axis, &pose.axis, &pole_dir, eps),
                         )
                     {
                         dropped = true;
@@ -580,10 +627,10 @@ pub fn plan_path(
                             let only_pole = (0..2).all(|r| jump[r] == (r + 3 == pole));
                             let crosses = p.at_pole
                                 || cand.at_pole
-                                || (i > 0 && arc_passes(&poses[i - 1].axis, &pose.axis, &pole_dir, eps));
+                                || (i > 0 && arc_passes(&input.pose(i - 1).axis, &pose.axis, &pole_dir, eps));
                             if only_pole && crosses {
                                 (t(), Edge::PoleFlip)
-                            } else if cutting[i] {
+                            } else if input.cutting(i) {
                                 let j = if dq[3].abs() >= dq[4].abs() { 3 } else { 4 };
                                 if smallest_jump.is_none_or(|(_, d)| dq[j].abs() < d) {
                                     smallest_jump = Some((j, dq[j].abs()));
@@ -640,25 +687,33 @@ pub fn plan_path(
             }
         });
         next.truncate(tol::PLAN_BEAM);
-        arena.extend_from_slice(&next);
-        offsets.push(arena.len());
+        arena.extend(next.iter().map(|s| Node {
+            q: s.q,
+            edge: s.edge,
+            // INVARIANT: `back` indexes the previous layer, at most PLAN_BEAM states.
+            back: u8::try_from(s.back).unwrap_or(u8::MAX),
+            at_pole: s.at_pole,
+        }));
+        // INVARIANT: a path has fewer than 2^32 / PLAN_BEAM poses.
+        offsets.push(u32::try_from(arena.len()).unwrap_or(u32::MAX));
+        std::mem::swap(&mut previous, &mut next);
     }
-    let layers = offsets.windows(2).map(|w| &arena[w[0]..w[1]]);
+    let layers = offsets.windows(2).map(|w| &arena[w[0] as usize..w[1] as usize]);
     // Backtrack from the best final state.
-    let mut chain: Vec<&State> = Vec::with_capacity(poses.len());
+    let mut chain: Vec<&Node> = Vec::with_capacity(n_poses);
     if let Some(last) = layers.clone().next_back() {
         let mut idx = 0; // layers are sorted: the best is first
         for layer in layers.rev() {
             let s = &layer[idx];
             chain.push(s);
-            idx = s.back;
+            idx = usize::from(s.back);
         }
-        debug_assert_eq!(chain.len(), poses.len());
+        debug_assert_eq!(chain.len(), n_poses);
         debug_assert!(!last.is_empty());
     }
     chain.reverse();
-    let mut joints = Vec::with_capacity(poses.len() + 2);
-    let mut pose_index = Vec::with_capacity(poses.len() + 2);
+    let mut joints = Vec::with_capacity(n_poses + 2);
+    let mut pose_index = Vec::with_capacity(n_poses + 2);
     let mut events = Vec::new();
     for (i, s) in chain.iter().enumerate() {
         let prev = if i == 0 { start } else { Some(chain[i - 1].q) };
@@ -676,13 +731,13 @@ pub fn plan_path(
                     // Turn in place at the previous (polar) pose.
                     let mut q = pq;
                     q[pole] = s.q[pole];
-                    kin.solve_linear(&poses[i - 1].tip, &mut q);
+                    kin.solve_linear(&input.pose(i - 1).tip, &mut q);
                     joints.push(q);
                     pose_index.push(i - 1);
                 } else if s.at_pole {
                     let mut q = s.q;
                     q[pole] = pq[pole];
-                    kin.solve_linear(&poses[i].tip, &mut q);
+                    kin.solve_linear(&input.pose(i).tip, &mut q);
                     joints.push(q);
                     pose_index.push(i);
                 }

@@ -8,7 +8,7 @@
 use crate::chain::{Joints, Kinematics, Pose};
 use crate::error::MachineError;
 use crate::feed::{BlockEnd, deviation, inverse_time_feed, subdivide_into};
-use crate::plan::{Event, PlanOptions, check_limits, move_time, plan_path};
+use crate::plan::{Event, PlanOptions, check_limits, move_time};
 use crate::tol;
 
 /// What a CL move is (spec 1.1).
@@ -143,7 +143,7 @@ pub struct MachineProgram {
 /// ```
 ///
 /// # Errors
-/// As [`plan_path`] (limit violations name the block and the axis), and
+/// As [`plan_path`](crate::plan::plan_path) (limit violations name the block and the axis), and
 /// [`MachineError::SubdivisionFailed`].
 pub fn to_program(
     kin: &Kinematics,
@@ -152,9 +152,7 @@ pub fn to_program(
     options: &ProgramOptions,
 ) -> Result<MachineProgram, MachineError> {
     let machine = kin.machine();
-    let poses: Vec<Pose> = records.iter().map(|r| r.pose).collect();
-    let cutting: Vec<bool> = records.iter().map(|r| r.motion.is_cutting()).collect();
-    let path = plan_path(kin, &poses, &cutting, start, &options.plan)?;
+    let path = crate::plan::plan_input(kin, &Records(records), start, &options.plan)?;
     let words = |q: &Joints| {
         let mut w = [0.0; 5];
         for (i, a) in machine.axes().iter().enumerate() {
@@ -202,6 +200,21 @@ pub fn to_program(
         blocks,
         events: path.events,
     })
+}
+
+/// The CL records as the planner's input (no copies of the poses).
+struct Records<'a>(&'a [ClRecord]);
+
+impl crate::plan::PathInput for Records<'_> {
+    fn len(&self) -> usize {
+        self.0.len()
+    }
+    fn pose(&self, i: usize) -> &Pose {
+        &self.0[i].pose
+    }
+    fn cutting(&self, i: usize) -> bool {
+        self.0[i].motion.is_cutting()
+    }
 }
 
 /// What [`verify`] measured.
