@@ -91,8 +91,9 @@ impl IkSolutions {
 pub(crate) struct LazyIk {
     /// The solutions; the linear joints of a pending one are zero.
     pub(crate) sols: IkSolutions,
-    /// Per solution, the `(sin, cos)` of its joints while its linear joints are pending.
-    pending: [Option<[(f64, f64); 5]>; 2],
+    /// Per solution, the `(sin, cos)` of its primary and secondary rotaries while its
+    /// linear joints are pending.
+    pending: [Option<[(f64, f64); 2]>; 2],
     /// `W0 tip` (closed position step) or the tip (affine position step).
     x_m: Point3,
     tip: Point3,
@@ -185,9 +186,12 @@ impl Kinematics {
 
     /// Solves the linear joints of solution `k` of `lazy` if they are still pending.
     pub(crate) fn complete(&self, lazy: &mut LazyIk, k: usize) {
-        if let Some(trig) = lazy.pending[k].take() {
+        if let Some([trig_primary, trig_secondary]) = lazy.pending[k].take() {
             let q = &mut lazy.sols.items[k].joints;
             if self.linear_first {
+                let mut trig = [(0.0, 1.0); 5];
+                trig[self.primary] = trig_primary;
+                trig[self.secondary] = trig_secondary;
                 self.solve_linear_machine(&lazy.x_m, q, &trig);
             } else {
                 self.solve_linear_affine(&lazy.tip, q);
@@ -211,14 +215,11 @@ impl Kinematics {
         &self,
         (theta_primary, trig_primary): (f64, (f64, f64)),
         (theta_secondary, trig_secondary): (f64, (f64, f64)),
-    ) -> (IkSolution, [(f64, f64); 5]) {
+    ) -> (IkSolution, [(f64, f64); 2]) {
         let mut q = Joints::zeros();
         q[self.primary] = normalize_angle(theta_primary);
         q[self.secondary] = normalize_angle(theta_secondary);
-        let mut trig = [(0.0, 1.0); 5];
-        trig[self.primary] = trig_primary;
-        trig[self.secondary] = trig_secondary;
-        (IkSolution { joints: q, branch: Branch::of_tilt(q[self.tilt]), at_pole: false }, trig)
+        (IkSolution { joints: q, branch: Branch::of_tilt(q[self.tilt]), at_pole: false }, [trig_primary, trig_secondary])
     }
 
     /// Fills the linear joints of `q` (rotaries given) so that the controlled point is at

@@ -185,27 +185,47 @@ fn admissible(
     sol: &IkSolution,
     previous: Option<&Joints>,
 ) -> Result<Selected, MachineError> {
-    let mut q = sol.joints;
-    let mut unwound = [false; 5];
-    for i in 3..5 {
+    admissible_with(machine, strokes, sol, unwrap_rotaries(strokes, &sol.joints, previous))
+}
+
+/// The rotaries (joints 3 and 4) of `raw` unwrapped against `previous` within their
+/// strokes, and whether each took an unwinding move; with no admissible winding, the
+/// shortest-path value (the stroke check then reports it).
+fn unwrap_rotaries(strokes: &Strokes, raw: &Joints, previous: Option<&Joints>) -> ([f64; 2], [bool; 2]) {
+    let (mut values, mut unwound) = ([0.0; 2], [false; 2]);
+    for (r, i) in (3..5).enumerate() {
         let prev = previous.map_or(0.0, |p| p[i]);
-        match unwrap_angle(q[i], prev, strokes.limits[i]) {
+        match unwrap_angle(raw[i], prev, strokes.limits[i]) {
             Some((v, u)) => {
-                q[i] = v;
-                if u && previous.is_some() {
-                    unwound[i] = true;
-                }
+                values[r] = v;
+                unwound[r] = u && previous.is_some();
             }
-            None => {
-                // No winding fits: report the shortest-path value.
-                q[i] = unwrap_angle(q[i], prev, None).map_or(q[i], |(v, _)| v);
-            }
+            // No winding fits: report the shortest-path value.
+            None => values[r] = unwrap_angle(raw[i], prev, None).map_or(raw[i], |(v, _)| v),
         }
     }
+    (values, unwound)
+}
+
+/// [`admissible`] with the rotaries already unwrapped ([`unwrap_rotaries`]).
+fn admissible_with(
+    machine: &Machine,
+    strokes: &Strokes,
+    sol: &IkSolution,
+    (values, unwound): ([f64; 2], [bool; 2]),
+) -> Result<Selected, MachineError> {
+    let mut q = sol.joints;
+    q[3] = values[0];
+    q[4] = values[1];
     if !strokes.inside(&q) {
         check_limits(machine, &q, None)?;
     }
-    Ok(Selected { joints: q, branch: sol.branch, unwound, at_pole: sol.at_pole })
+    Ok(Selected {
+        joints: q,
+        branch: sol.branch,
+        unwound: [false, false, false, unwound[0], unwound[1]],
+        at_pole: sol.at_pole,
+    })
 }
 
 /// Whether the candidate `sol` from the state `p` is dropped as a jump while cutting
@@ -219,22 +239,15 @@ fn jumps_on_rotaries(
     flip_threshold: f64,
     pole: usize,
     crosses: impl Fn() -> bool,
-) -> bool {
-    let mut dq = [0.0; 2];
-    for (r, i) in (3..5).enumerate() {
-        let raw = sol.joints[i];
-        let v = match unwrap_angle(raw, p.q[i], strokes.limits[i]) {
-            Some((v, _)) => v,
-            None => unwrap_angle(raw, p.q[i], None).map_or(raw, |(v, _)| v),
-        };
-        dq[r] = v - p.q[i];
-    }
+) -> (bool, ([f64; 2], [bool; 2])) {
+    let unwrapped = unwrap_rotaries(strokes, &sol.joints, Some(&p.q));
+    let dq = [unwrapped.0[0] - p.q[3], unwrapped.0[1] - p.q[4]];
     let jump = dq.map(|d| d.abs() > flip_threshold);
     if jump == [false, false] {
-        return false;
+        return (false, unwrapped);
     }
     let only_pole = (0..2).all(|r| jump[r] == (r + 3 == pole));
-    !(only_pole && (p.at_pole || sol.at_pole || crosses()))
+    (!(only_pole && (p.at_pole || sol.at_pole || crosses())), unwrapped)
 }
 
 /// Velocity-limited time of the move `a -> b`: `max_j |dq_j| / vmax_j` (spec 3.5).
@@ -591,24 +604,25 @@ pub(crate) fn plan_input(
                 };
                 let has_previous = i > 0 || start.is_some();
                 for k in 0..sols.sols.as_slice().len() {
-                    if shortcut
-                        && has_previous
-                        && input.cutting(i)
-                        && jumps_on_rotaries(
-                            &strokes,
-                            &sols.sols.as_slice()[k],
-                            p,
-                            options.flip_threshold,
-                            pole,
-                            || i > 0 && arc_passes(&input.pose(i - 1).axis, &pose.axis, &pole_dir, eps),
-                        )
-                    {
-                        dropped = true;
-                        continue;
+                    let mut unwrapped = None;
+                    if shortcut && has_previous && input.cutting(i) {
+                        let (jumps, u) =
+                            jumps_on_rotaries(&strokes, &sols.sols.as_slice()[k], p, options.flip_threshold, pole, || {
+                                i > 0 && arc_passes(&input.pose(i - 1).axis, &pose.axis, &pole_dir, eps)
+                            });
+                        if jumps {
+                            dropped = true;
+                            continue;
+                        }
+                        unwrapped = Some(u);
                     }
                     kin.complete(sols, k);
                     let sol = &sols.sols.as_slice()[k];
-                    let cand = match admissible(machine, &strokes, sol, has_previous.then_some(&p.q)) {
+                    let checked = match unwrapped {
+                        Some(u) => admissible_with(machine, &strokes, sol, u),
+                        None => admissible(machine, &strokes, sol, has_previous.then_some(&p.q)),
+                    };
+                    let cand = match checked {
                         Ok(c) => c,
                         Err(e) => {
                             first_error.get_or_insert(e.at_block(i));

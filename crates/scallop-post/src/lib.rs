@@ -185,8 +185,9 @@ pub(crate) fn push_token_key(out: &mut Vec<u8>, prefix: &[u8], key: i64, decimal
 fn push_token_dec<const D: usize>(out: &mut Vec<u8>, prefix: &[u8], key: i64) {
     let mut buf = [0u8; 48];
     let mut at = 32;
-    let scale: u64 = if D == 3 { 1_000 } else { 10_000 };
-    let n = key.unsigned_abs();
+    let scale: u32 = if D == 3 { 1_000 } else { 10_000 };
+    // |key| <= 1e9 + 1 < 2^32: 32-bit arithmetic (cheaper constant divisions).
+    let n = u32::try_from(key.unsigned_abs()).unwrap_or(u32::MAX);
     let (mut int, mut frac) = (n / scale, n % scale);
     let mut k = 0;
     while k + 2 <= D {

@@ -238,6 +238,19 @@ pub fn program_text(
         .filter(|&i| machine.axes()[i].kind == AxisKind::Rotary && machine.axes()[i].wrap != Wrap::Absolute)
         .collect();
     let caps = RateCaps::new(machine, dialect);
+    // Per written word: the decimals when it is the joint word itself (joint-space output
+    // of a linear or absolute rotary axis), the common case decided once.
+    let joint_decimals: Vec<Option<usize>> = written
+        .iter()
+        .map(|&i| {
+            let axis = &machine.axes()[i];
+            match axis.kind {
+                AxisKind::Linear if mode != OutputMode::Tcp => Some(dialect.decimals),
+                AxisKind::Rotary if axis.wrap == Wrap::Absolute => Some(dialect.rotary_decimals),
+                _ => None,
+            }
+        })
+        .collect();
     for b in &program.blocks {
         if planes {
             let needs_new = plane.as_ref().is_none_or(|(axis, _)| angle(axis, &b.pose.axis) > params.tol_ang);
@@ -272,13 +285,20 @@ pub fn program_text(
         let pieces = previous.map_or(1, |p| pieces(&modulo, p, b));
         for piece in 1..=pieces {
             let s = f64::from(piece) / f64::from(pieces);
-            let (words_a, tip_a) = previous.map_or((b.words, b.pose.tip), |p| (p.words, p.pose.tip));
+            let (words_a, tip_a) = match previous {
+                Some(p) => (&p.words, &p.pose.tip),
+                None => (&b.words, &b.pose.tip),
+            };
             let word_at = |i: usize| words_a[i] + (b.words[i] - words_a[i]) * s;
-            for (word, &i) in words.iter_mut().zip(&written) {
+            for ((word, &i), &joint_dec) in words.iter_mut().zip(&written).zip(&joint_decimals) {
+                if let Some(dec) = joint_dec {
+                    word.set_number(word_at(i), dec);
+                    continue;
+                }
                 let axis = &machine.axes()[i];
                 match axis.kind {
                     AxisKind::Linear if mode == OutputMode::Tcp => {
-                        let tip: Point3 = tip_a + (b.pose.tip - tip_a) * s;
+                        let tip: Point3 = tip_a + (b.pose.tip - *tip_a) * s;
                         word.set_number(tip[linear_component(i)?], dialect.decimals);
                     }
                     AxisKind::Linear => word.set_number(word_at(i), dialect.decimals),
@@ -287,7 +307,7 @@ pub fn program_text(
                     }
                     AxisKind::Rotary => {
                         let w = word_at(i);
-                        let before = word_at_prev(&words_a, &b.words, i, piece, pieces);
+                        let before = word_at_prev(words_a, &b.words, i, piece, pieces);
                         let token = e.rotary(word.letter, w, w - before, axis.wrap);
                         word.set_token(token.as_bytes());
                     }
@@ -703,6 +723,17 @@ impl<'a> Emitter<'a> {
     fn feed_word(&mut self, start: usize, letter: &[u8], f: f64, dec: usize, always: bool) {
         let f = round_down(f, dec);
         let key = crate::scaled_key(f, dec);
+        if let (true, Some(k), &[l]) = (always, key, letter) {
+            // Written on every block (G93): no comparison, one token.
+            let prefix = [b' ', l];
+            let from = usize::from(self.text.len() <= start);
+            crate::push_token_key(&mut self.text, &prefix[from..], k, dec);
+            match &mut self.last_feed {
+                Some(Modal::Key(last, last_dec)) => (*last, *last_dec) = (k, dec),
+                last => *last = Some(Modal::Key(k, dec)),
+            }
+            return;
+        }
         let value = match key {
             Some(k) => Modal::Key(k, dec),
             None => Modal::Token(fmt_number(f, dec).into_bytes()),
