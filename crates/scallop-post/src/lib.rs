@@ -156,80 +156,52 @@ pub(crate) fn floor_fast(x: f64) -> f64 {
     }
 }
 
-const DIGIT_PAIRS: &[u8; 200] = b"0001020304050607080910111213141516171819\
-    2021222324252627282930313233343536373839\
-    4041424344454647484950515253545556575859\
-    6061626364656667686970717273747576777879\
-    8081828384858687888990919293949596979899";
-
-/// Appends `prefix` (a space, a word letter, a `+`) and the number of a [`scaled_key`]
-/// with `decimals` digits: the hot path of every motion block. For 3 and 4 decimals the
-/// digits are written with constant divisors into a stack buffer and appended with one
-/// fixed-length copy; other cases go through [`push_key`].
+/// Appends a prefix (the last `prefix_len` bytes of `prefix`: a space, a word letter, a
+/// `+`) and the number of a [`scaled_key`] with `decimals` digits: the hot path of every
+/// motion block. For 3 and 4 decimals and fewer than 8 digits, [`push_token_dec`]; other
+/// cases go through [`push_key`].
 #[inline]
-pub(crate) fn push_token_key(out: &mut Vec<u8>, prefix: &[u8], key: i64, decimals: usize) {
-    if prefix.len() <= 4 && key.unsigned_abs() <= 1_000_000_001 {
+pub(crate) fn push_token_key(out: &mut Vec<u8>, prefix: [u8; 4], prefix_len: usize, key: i64, decimals: usize) {
+    if key.unsigned_abs() < 100_000_000 && prefix_len <= 4 {
         match decimals {
-            3 => return push_token_dec::<3>(out, prefix, key),
-            4 => return push_token_dec::<4>(out, prefix, key),
+            3 => return push_token_dec::<3>(out, prefix, prefix_len, key),
+            4 => return push_token_dec::<4>(out, prefix, prefix_len, key),
             _ => {}
         }
     }
-    out.extend_from_slice(prefix);
+    out.extend_from_slice(&prefix[4 - prefix_len.min(4)..]);
     push_key(out, key, decimals);
 }
 
-/// [`push_token_key`] for `D` decimals (3 or 4), `|key| <= 1e9 + 1` and a prefix of at most
-/// 4 bytes: at most 6 integer digits, the point, `D` digits and the sign, so the token is
-/// at most 16 bytes and ends at byte 32 of the buffer.
-fn push_token_dec<const D: usize>(out: &mut Vec<u8>, prefix: &[u8], key: i64) {
-    let mut buf = [0u8; 48];
-    let mut at = 32;
-    let scale: u32 = if D == 3 { 1_000 } else { 10_000 };
-    // |key| <= 1e9 + 1 < 2^32: 32-bit arithmetic (cheaper constant divisions).
-    let n = u32::try_from(key.unsigned_abs()).unwrap_or(u32::MAX);
-    let (mut int, mut frac) = (n / scale, n % scale);
-    let mut k = 0;
-    while k + 2 <= D {
-        let pair = 2 * (frac % 100) as usize;
-        frac /= 100;
-        at -= 2;
-        buf[at] = DIGIT_PAIRS[pair];
-        buf[at + 1] = DIGIT_PAIRS[pair + 1];
-        k += 2;
-    }
-    if k < D {
-        at -= 1;
-        buf[at] = b'0' + (frac % 10) as u8;
-    }
-    at -= 1;
-    buf[at] = b'.';
-    while int >= 100 {
-        let pair = 2 * (int % 100) as usize;
-        int /= 100;
-        at -= 2;
-        buf[at] = DIGIT_PAIRS[pair];
-        buf[at + 1] = DIGIT_PAIRS[pair + 1];
-    }
-    if int >= 10 {
-        let pair = 2 * int as usize;
-        at -= 2;
-        buf[at] = DIGIT_PAIRS[pair];
-        buf[at + 1] = DIGIT_PAIRS[pair + 1];
-    } else {
-        at -= 1;
-        buf[at] = b'0' + int as u8;
-    }
+/// [`push_token_key`] for `D` decimals (3 or 4) and `|key| < 1e8`: the eight digits of
+/// `|key|` (leading zeros included) are computed at once in the lanes of a `u64` (two
+/// 4-digit lanes, then four 2-digit lanes, then eight 1-digit lanes, by multiplications
+/// that divide every lane by 100 and 10 without carries between lanes), the point is
+/// inserted, the integer part's leading zeros are skipped, and the token (at most 16
+/// bytes with its prefix and sign) is appended with one fixed-length copy.
+fn push_token_dec<const D: usize>(out: &mut Vec<u8>, prefix: [u8; 4], prefix_len: usize, key: i64) {
+    let n = key.unsigned_abs();
+    let merged = (n / 10_000) | ((n % 10_000) << 32);
+    let hundreds = ((merged * 10_486) >> 20) & 0x0000_007f_0000_007f;
+    let merged = hundreds | ((merged - 100 * hundreds) << 16);
+    let tens = ((merged * 103) >> 10) & 0x000f_000f_000f_000f;
+    let merged = tens | ((merged - 10 * tens) << 8);
+    let digits = (merged + 0x3030_3030_3030_3030).to_le_bytes();
+    let int = n / if D == 3 { 1_000 } else { 10_000 };
+    let int_len = 1 + usize::from(int >= 10) + usize::from(int >= 100) + usize::from(int >= 1_000) + usize::from(int >= 10_000);
+    let mut buf = [0u8; 40];
+    buf[16..24].copy_from_slice(&digits);
+    buf[24 - D] = b'.';
+    buf[25 - D..25].copy_from_slice(&digits[8 - D..]);
+    let mut start = 24 - D - int_len;
     if key < 0 {
-        at -= 1;
-        buf[at] = b'-';
+        start -= 1;
+        buf[start] = b'-';
     }
-    for &b in prefix.iter().rev() {
-        at -= 1;
-        buf[at] = b;
-    }
-    let len = out.len() + 32 - at;
-    out.extend_from_slice(&buf[at..at + 16]);
+    buf[start - 4..start].copy_from_slice(&prefix);
+    start -= prefix_len;
+    let len = out.len() + 25 - start;
+    out.extend_from_slice(&buf[start..start + 16]);
     out.truncate(len);
 }
 
@@ -356,7 +328,7 @@ pub fn write_gcode(path: &Toolpath, dialect: &Dialect, comments: &[&str], out: &
 
 #[cfg(test)]
 mod tests {
-    use super::{floor_fast, fmt_number, push_key, round_fast, scaled_key};
+    use super::{floor_fast, fmt_number, push_key, push_token_key, round_fast, scaled_key};
 
     #[test]
     fn keys_format_as_the_exact_formatter_and_the_fast_roundings_equal_the_library() {
@@ -372,9 +344,16 @@ mod tests {
             let v = ((next() >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 2.0 * magnitude;
             for d in [0, 1, 3, 4, 6, 9] {
                 if let Some(key) = scaled_key(v, d) {
+                    let exact = fmt_number(v, d);
                     let mut out = b"X".to_vec();
                     push_key(&mut out, key, d);
-                    assert_eq!(out[1..], *fmt_number(v, d).as_bytes(), "{v:e} at {d}");
+                    assert_eq!(out[1..], *exact.as_bytes(), "{v:e} at {d}");
+                    out.clear();
+                    push_token_key(&mut out, [0, b' ', b'X', b'+'], 3, key, d);
+                    assert_eq!(out, format!(" X+{exact}").into_bytes(), "{v:e} at {d}");
+                    out.clear();
+                    push_token_key(&mut out, [b'a', b'b', b'c', b'Y'], 1, key, d);
+                    assert_eq!(out, format!("Y{exact}").into_bytes(), "{v:e} at {d}");
                 }
             }
             for x in [v, v * 1e3, v + 0.5, -v - 0.5, v.trunc() + 0.5, -0.0, 0.0, 4.6e15, -4.6e15] {

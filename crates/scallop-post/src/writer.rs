@@ -695,10 +695,13 @@ impl<'a> Emitter<'a> {
         let space = self.text.len() > start;
         if let (Some((_, dec)), Some(key), &[letter]) = (word.number, key, word.letter.as_bytes()) {
             // One letter and a scaled key: the token in one piece.
-            let plus = self.d.explicit_plus && key >= 0;
-            let prefix = [b' ', letter, b'+'];
-            let (from, to) = (usize::from(!space), 2 + usize::from(plus));
-            crate::push_token_key(&mut self.text, &prefix[from..to], key, dec);
+            // The prefix right-aligned in four bytes: [space] letter [+].
+            let (prefix, len) = if self.d.explicit_plus && key >= 0 {
+                ([0, b' ', letter, b'+'], 2 + usize::from(space))
+            } else {
+                ([0, 0, b' ', letter], 1 + usize::from(space))
+            };
+            crate::push_token_key(&mut self.text, prefix, len, key, dec);
             return;
         }
         if space {
@@ -725,9 +728,8 @@ impl<'a> Emitter<'a> {
         let key = crate::scaled_key(f, dec);
         if let (true, Some(k), &[l]) = (always, key, letter) {
             // Written on every block (G93): no comparison, one token.
-            let prefix = [b' ', l];
-            let from = usize::from(self.text.len() <= start);
-            crate::push_token_key(&mut self.text, &prefix[from..], k, dec);
+            let len = 1 + usize::from(self.text.len() > start);
+            crate::push_token_key(&mut self.text, [0, 0, b' ', l], len, k, dec);
             match &mut self.last_feed {
                 Some(Modal::Key(last, last_dec)) => (*last, *last_dec) = (k, dec),
                 last => *last = Some(Modal::Key(k, dec)),
@@ -745,9 +747,9 @@ impl<'a> Emitter<'a> {
             match &value {
                 Modal::Key(k, dec) if letter.len() <= 3 => {
                     let mut prefix = [b' '; 4];
-                    let from = usize::from(self.text.len() <= start);
-                    prefix[1..=letter.len()].copy_from_slice(letter);
-                    crate::push_token_key(&mut self.text, &prefix[from..=letter.len()], *k, *dec);
+                    prefix[4 - letter.len()..].copy_from_slice(letter);
+                    let len = letter.len() + usize::from(self.text.len() > start);
+                    crate::push_token_key(&mut self.text, prefix, len, *k, *dec);
                 }
                 Modal::Key(k, dec) => {
                     self.push_piece(start, letter);
