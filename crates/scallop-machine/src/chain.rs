@@ -126,6 +126,16 @@ pub struct Kinematics {
     pub(crate) principal: [Option<(usize, f64)>; 5],
     /// The part frame W0 is exactly the identity (its transforms are skipped).
     pub(crate) w0_identity: bool,
+    /// The rotaries of the part chain and of the tool chain, innermost first (the
+    /// closed position step applies them in this order).
+    pub(crate) rotaries_inward: (Vec<usize>, Vec<usize>),
+    /// Per joint: rotary (else linear).
+    pub(crate) rotary: [bool; 5],
+}
+
+/// The rotary joints of `chain`, innermost first.
+fn rotaries_inward(machine: &Machine, chain: &[usize]) -> Vec<usize> {
+    chain.iter().rev().copied().filter(|&i| machine.axes[i].kind == AxisKind::Rotary).collect()
 }
 
 /// `Some((k, sign))` when `d` is exactly `sign e_k`.
@@ -283,6 +293,8 @@ impl Kinematics {
             ball_bound: ball_bound(machine),
             principal: std::array::from_fn(|i| machine.axes.get(i).and_then(|a| principal_direction(&a.direction))),
             w0_identity: machine.part_frame == Isometry3::identity(),
+            rotaries_inward: (rotaries_inward(machine, &machine.part_chain), rotaries_inward(machine, &machine.tool_chain)),
+            rotary: std::array::from_fn(|i| machine.axes.get(i).is_some_and(|a| a.kind == AxisKind::Rotary)),
         }
     }
 

@@ -124,13 +124,13 @@ enum Rates {
 }
 
 fn rotation_and_translation(kin: &Kinematics, qa: &Joints, qb: &Joints) -> Rates {
-    let machine = kin.machine();
     let dq = qb - qa;
     let (mut omega, mut b) = (0.0, 0.0);
-    for (i, axis) in machine.axes().iter().enumerate().take(5) {
-        match axis.kind {
-            crate::AxisKind::Rotary => omega += dq[i].abs(),
-            crate::AxisKind::Linear => b += dq[i].abs(),
+    for (i, &rotary) in kin.rotary.iter().enumerate() {
+        if rotary {
+            omega += dq[i].abs();
+        } else {
+            b += dq[i].abs();
         }
     }
     if omega == 0.0 {

@@ -243,23 +243,19 @@ impl Kinematics {
     /// The closed position step (`linear_first`) with `trig[i] = (sin q_i, cos q_i)` given
     /// for the rotaries and the tip `x` in the machine frame.
     fn solve_linear_machine(&self, x: &Point3, q: &mut Joints, trig: &[(f64, f64); 5]) {
-        // The chain's rotaries applied to a point, innermost first, each by Rodrigues'
-        // formula from one sin_cos (no quaternion or isometry composition).
-        let rotary_only = |chain: &[usize], p: Point3| {
-            let mut p = p;
-            for &i in chain.iter().rev() {
-                let a = &self.machine.axes[i];
-                if a.kind == AxisKind::Rotary {
-                    p = match self.principal[i] {
-                        Some((k, sign)) => rotate_about_principal(k, sign, &a.point, trig[i], &p),
-                        None => rotate_about(&a.direction, &a.point, trig[i], &p),
-                    };
-                }
+        // The chains' rotaries applied to a point, innermost first, each by Rodrigues'
+        // formula (or its principal-axis form) from one sin_cos (no quaternion or
+        // isometry composition).
+        let rotate = |i: usize, p: Point3| {
+            let a = &self.machine.axes[i];
+            match self.principal[i] {
+                Some((k, sign)) => rotate_about_principal(k, sign, &a.point, trig[i], &p),
+                None => rotate_about(&a.direction, &a.point, trig[i], &p),
             }
-            p
         };
-        let d = rotary_only(&self.machine.part_chain, *x) - rotary_only(&self.machine.tool_chain, self.t0);
-        let lin = self.linear_inverse * d;
+        let part = self.rotaries_inward.0.iter().fold(*x, |p, &i| rotate(i, p));
+        let tool = self.rotaries_inward.1.iter().fold(self.t0, |p, &i| rotate(i, p));
+        let lin = self.linear_inverse * (part - tool);
         q[0] = lin[0];
         q[1] = lin[1];
         q[2] = lin[2];
