@@ -238,6 +238,28 @@ pub fn program_text(
         .filter(|&i| machine.axes()[i].kind == AxisKind::Rotary && machine.axes()[i].wrap != Wrap::Absolute)
         .collect();
     let caps = RateCaps::new(machine, dialect);
+    // Joint-space output whose words are all joint words with one-letter names: the
+    // steady-state G93 blocks go through `Emitter::joint_block`.
+    let fast_joint: Option<(Vec<u8>, Vec<usize>)> = (mode == OutputMode::Joint && written.len() <= 5)
+        .then(|| {
+            written
+                .iter()
+                .map(|&i| {
+                    let axis = &machine.axes()[i];
+                    let dec = match axis.kind {
+                        AxisKind::Linear => dialect.decimals,
+                        AxisKind::Rotary if axis.wrap == Wrap::Absolute => dialect.rotary_decimals,
+                        AxisKind::Rotary => return None,
+                    };
+                    match letters[i].as_bytes() {
+                        &[l] => Some((l, dec)),
+                        _ => None,
+                    }
+                })
+                .collect::<Option<Vec<(u8, usize)>>>()
+        })
+        .flatten()
+        .map(|v| v.into_iter().unzip());
     // Per written word: the decimals when it is the joint word itself (joint-space output
     // of a linear or absolute rotary axis), the common case decided once.
     let joint_decimals: Vec<Option<usize>> = written
@@ -290,6 +312,35 @@ pub fn program_text(
                 None => (&b.words, &b.pose.tip),
             };
             let word_at = |i: usize| words_a[i] + (b.words[i] - words_a[i]) * s;
+            let feed = match (b.motion, previous) {
+                (Motion::Rapid, _) => FeedWord::Rapid,
+                (_, None) => FeedWord::PerMinute(b.feed),
+                (_, Some(_)) if mode == OutputMode::Tcp => FeedWord::PerMinute(b.feed),
+                (_, Some(p)) => {
+                    let f_inv = b.inverse_time.unwrap_or_else(|| {
+                        scallop_machine::feed::inverse_time_feed(kin, &p.pose, &b.pose, &p.joints, &b.joints, b.feed)
+                    }) * f64::from(pieces);
+                    let f_inv = caps.cap(&p.words, &b.words, pieces, f_inv);
+                    match dialect.feed_by_time {
+                        FeedByTime::G93 => FeedWord::InverseTime(f_inv),
+                        FeedByTime::BlockSeconds => FeedWord::Seconds(60.0 / f_inv),
+                        FeedByTime::None => {
+                            let delta: Vec<f64> =
+                                (0..5).map(|i| (b.words[i] - p.words[i]) / f64::from(pieces)).collect();
+                            FeedWord::PerMinute(controller_length(machine, &delta) * f_inv)
+                        }
+                    }
+                }
+            };
+            if let (Some((letters, decimals)), FeedWord::InverseTime(f_inv)) = (&fast_joint, feed) {
+                let mut values = [0.0; 5];
+                for (v, &i) in values.iter_mut().zip(&written) {
+                    *v = word_at(i);
+                }
+                if e.joint_block(letters, decimals, &values[..written.len()], f_inv) {
+                    continue;
+                }
+            }
             for ((word, &i), &joint_dec) in words.iter_mut().zip(&written).zip(&joint_decimals) {
                 if let Some(dec) = joint_dec {
                     word.set_number(word_at(i), dec);
@@ -313,26 +364,6 @@ pub fn program_text(
                     }
                 }
             }
-            let feed = match (b.motion, previous) {
-                (Motion::Rapid, _) => FeedWord::Rapid,
-                (_, None) => FeedWord::PerMinute(b.feed),
-                (_, Some(_)) if mode == OutputMode::Tcp => FeedWord::PerMinute(b.feed),
-                (_, Some(p)) => {
-                    let f_inv = b.inverse_time.unwrap_or_else(|| {
-                        scallop_machine::feed::inverse_time_feed(kin, &p.pose, &b.pose, &p.joints, &b.joints, b.feed)
-                    }) * f64::from(pieces);
-                    let f_inv = caps.cap(&p.words, &b.words, pieces, f_inv);
-                    match dialect.feed_by_time {
-                        FeedByTime::G93 => FeedWord::InverseTime(f_inv),
-                        FeedByTime::BlockSeconds => FeedWord::Seconds(60.0 / f_inv),
-                        FeedByTime::None => {
-                            let delta: Vec<f64> =
-                                (0..5).map(|i| (b.words[i] - p.words[i]) / f64::from(pieces)).collect();
-                            FeedWord::PerMinute(controller_length(machine, &delta) * f_inv)
-                        }
-                    }
-                }
-            };
             e.motion_words(&mut words, feed);
         }
         previous = Some(b);
@@ -506,6 +537,9 @@ struct Emitter<'a> {
     state: Vec<(Option<usize>, Option<i64>, bool)>,
     /// Scratch token buffers for the slow comparisons.
     scratch: (Vec<u8>, Vec<u8>),
+    /// The modal state was checked to be the steady state of [`Emitter::joint_block`]
+    /// (reset by every other motion or plane output).
+    joint_steady: bool,
 }
 
 impl<'a> Emitter<'a> {
@@ -520,6 +554,7 @@ impl<'a> Emitter<'a> {
             g93: false,
             state: Vec::new(),
             scratch: (Vec::new(), Vec::new()),
+            joint_steady: false,
         }
     }
 
@@ -812,6 +847,61 @@ impl<'a> Emitter<'a> {
         }
     }
 
+    /// A joint-space G93 block in the steady state of modal ISO output (G93 and G1 in
+    /// force, the words `letters` with `decimals` modal in this order, no explicit plus):
+    /// exactly the text [`Emitter::motion_words`] writes for it, without its general
+    /// machinery. Returns `false`, having written nothing, when the state or a number is
+    /// not of that form (the caller then uses [`Emitter::motion_words`]).
+    fn joint_block(&mut self, letters: &[u8], decimals: &[usize], values: &[f64], f_inv: f64) -> bool {
+        let n = values.len();
+        if !self.joint_steady {
+            let steady = self.d.modal
+                && self.d.syntax == Syntax::Iso
+                && !self.d.explicit_plus
+                && self.g93
+                && self.last_motion == Some("G1")
+                && self.last_words.len() >= n
+                && letters.len() == n
+                && decimals.len() == n
+                && self.last_words.iter().zip(letters.iter().zip(decimals)).all(|((l, m), (letter, dec))| {
+                    short_eq(l.as_bytes(), &[*letter]) && matches!(m, Modal::Key(_, d) if d == dec)
+                });
+            if !steady {
+                return false;
+            }
+            self.joint_steady = true;
+        }
+        let mut keys = [0i64; 5];
+        let mut mask = 0u32;
+        for k in 0..n {
+            let Some(key) = crate::scaled_key(values[k], decimals[k]) else { return false };
+            keys[k] = key;
+            if matches!(self.last_words[k].1, Modal::Key(last, _) if last != key) {
+                mask |= 1 << k;
+            }
+        }
+        if mask == 0 {
+            return true;
+        }
+        let dec = self.d.inverse_time_decimals;
+        let Some(feed_key) = crate::scaled_key(round_down(f_inv, dec), dec) else { return false };
+        self.line_start();
+        let start = self.text.len();
+        for k in 0..n {
+            if mask & (1 << k) != 0 {
+                let len = 1 + usize::from(self.text.len() > start);
+                crate::push_token_key(&mut self.text, [0, 0, b' ', letters[k]], len, keys[k], decimals[k]);
+                if let Modal::Key(last, _) = &mut self.last_words[k].1 {
+                    *last = keys[k];
+                }
+            }
+        }
+        crate::push_token_key(&mut self.text, [0, 0, b' ', b'F'], 2, feed_key, dec);
+        self.text.push(b'\n');
+        self.last_feed = Some(Modal::Key(feed_key, dec));
+        true
+    }
+
     /// The fast form of the modal comparison of [`Emitter::motion_words`]: every word is a
     /// number with a scaled key, and the modal word at its position has its letter and a
     /// key with its decimals (the steady state of joint-space output). Returns the keys and
@@ -843,6 +933,7 @@ impl<'a> Emitter<'a> {
     /// A motion block. Hot path of every program: the modal comparison is done on scaled
     /// integers, and only the words that change are formatted, straight into the text.
     fn motion_words(&mut self, words: &mut [Word], feed: FeedWord) {
+        self.joint_steady = false;
         if let Some((keys, mask)) = self.fast_changes(words) {
             if mask == 0 {
                 return;
@@ -917,6 +1008,7 @@ impl<'a> Emitter<'a> {
     /// Activates a tilted plane `r` (columns x_f, y_f, z_f in the part frame) at the
     /// part origin; `dir` selects the rotary solution (sign of the tilt word).
     fn plane_on(&mut self, r: &Rotation3<f64>, dir: i32) {
+        self.joint_steady = false;
         let dec = self.d.rotary_decimals;
         let deg = |v: f64| self.num(v.to_degrees(), dec);
         let lines: Vec<String> = match self.d.tilted_plane {
@@ -943,6 +1035,7 @@ impl<'a> Emitter<'a> {
     }
 
     fn plane_off(&mut self) {
+        self.joint_steady = false;
         let l = match self.d.tilted_plane {
             TiltedPlane::None => return,
             TiltedPlane::G68_2 => "G69",
