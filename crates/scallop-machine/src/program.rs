@@ -161,27 +161,31 @@ pub fn to_program(
         w
     };
     let mut blocks: Vec<ProgramBlock> = Vec::with_capacity(path.joints.len());
-    let mut previous: Option<(Pose, Joints)> = start.map(|q| (kin.fk(&q), q));
+    // The machine state before the first block; afterwards the previous block's end is
+    // read in place (no copies of poses and joints per block).
+    let before: Option<(Pose, Joints)> = start.map(|q| (kin.fk(&q), q));
     let strokes = crate::plan::Strokes::new(machine);
     // Block ends of one CL move, reused move after move.
     let mut ends: Vec<BlockEnd> = Vec::new();
     for (q, &i) in path.joints.iter().zip(&path.pose_index) {
         let rec = &records[i];
         ends.clear();
+        let previous = blocks.last().map(|b| (&b.pose, &b.joints)).or(before.as_ref().map(|(p, q)| (p, q)));
         match (rec.motion, previous) {
             (Motion::Rapid, _) | (_, None) => ends.push(BlockEnd { pose: rec.pose, joints: *q }),
             // In-place rotations (pole flips) are subdivided too: joint-linear X/Y/C
             // motion does not keep the tip still.
             (_, Some((pa, qa))) => {
-                subdivide_into(kin, (&pa, &qa), (&rec.pose, q), (options.tol_pos, options.tol_ang), i, &mut ends)?;
+                subdivide_into(kin, (pa, qa), (&rec.pose, q), (options.tol_pos, options.tol_ang), i, &mut ends)?;
             }
         }
         for end in &ends {
             strokes.check(machine, &end.joints, Some(i))?;
+            let previous = blocks.last().map(|b| (&b.pose, &b.joints)).or(before.as_ref().map(|(p, q)| (p, q)));
             let inverse_time = match (rec.motion, previous) {
                 (Motion::Rapid, _) | (_, None) => None,
                 _ if !machine.nc().inverse_time => None,
-                (_, Some((pa, qa))) => Some(inverse_time_feed(kin, &pa, &end.pose, &qa, &end.joints, rec.feed)),
+                (_, Some((pa, qa))) => Some(inverse_time_feed(kin, pa, &end.pose, qa, &end.joints, rec.feed)),
             };
             blocks.push(ProgramBlock {
                 motion: rec.motion,
@@ -192,7 +196,6 @@ pub fn to_program(
                 inverse_time,
                 cl_index: i,
             });
-            previous = Some((end.pose, end.joints));
         }
     }
     Ok(MachineProgram {

@@ -160,7 +160,7 @@ pub(crate) fn floor_fast(x: f64) -> f64 {
 /// `+`) and the number of a [`scaled_key`] with `decimals` digits: the hot path of every
 /// motion block. For 3 and 4 decimals and fewer than 8 digits, [`push_token_dec`]; other
 /// cases go through [`push_key`].
-#[inline]
+#[inline(always)]
 pub(crate) fn push_token_key(out: &mut Vec<u8>, prefix: [u8; 4], prefix_len: usize, key: i64, decimals: usize) {
     if key.unsigned_abs() < 100_000_000 && prefix_len <= 4 {
         match decimals {
@@ -179,6 +179,7 @@ pub(crate) fn push_token_key(out: &mut Vec<u8>, prefix: [u8; 4], prefix_len: usi
 /// that divide every lane by 100 and 10 without carries between lanes), the point is
 /// inserted, the integer part's leading zeros are skipped, and the token (at most 16
 /// bytes with its prefix and sign) is appended with one fixed-length copy.
+#[inline(always)]
 fn push_token_dec<const D: usize>(out: &mut Vec<u8>, prefix: [u8; 4], prefix_len: usize, key: i64) {
     let n = key.unsigned_abs();
     let merged = (n / 10_000) | ((n % 10_000) << 32);
