@@ -317,12 +317,16 @@ impl Kinematics {
         };
         let gamma = y.atan2(x);
         let gamma_other = if gamma > 0.0 { gamma - PI } else { gamma + PI };
+        // The sines and cosines from the same components (no sin_cos of the angles); the
+        // branch k = -1 negates the tilt sine and both pole terms (exactly).
+        let (tilt_sin, tilt_cos) = (s_tilt * rho / r, v.z / r);
+        let (pole_sin, pole_cos) = (s_pole * y / rho, x / rho);
         for ((slot, trig), k) in items.iter_mut().zip(&mut pending).zip([1.0, -1.0]) {
-            let (tilt, gamma, y, x) =
-                if k > 0.0 { (tilt_positive, gamma, y, x) } else { (-tilt_positive, gamma_other, -y, -x) };
-            // The sines and cosines from the same components (no sin_cos of the angles).
-            let tilt_trig = (s_tilt * k * rho / r, v.z / r);
-            let pole_trig = (s_pole * y / rho, x / rho);
+            let (tilt, gamma, tilt_trig, pole_trig) = if k > 0.0 {
+                (tilt_positive, gamma, (tilt_sin, tilt_cos), (pole_sin, pole_cos))
+            } else {
+                (-tilt_positive, gamma_other, (-tilt_sin, tilt_cos), (-pole_sin, -pole_cos))
+            };
             let (q_tilt, q_pole) = ((s_tilt * tilt, tilt_trig), (s_pole * gamma, pole_trig));
             let (primary, secondary) = if self.tilt == self.primary { (q_tilt, q_pole) } else { (q_pole, q_tilt) };
             let (solution, t) = self.rotary_solution(primary, secondary);
