@@ -100,6 +100,12 @@ pub(crate) struct LazyIk {
 }
 
 impl LazyIk {
+    /// No solutions (a buffer for [`Kinematics::ik_lazy`]).
+    pub(crate) fn empty() -> LazyIk {
+        let none = IkSolution { joints: Joints::zeros(), branch: Branch::Positive, at_pole: false };
+        LazyIk::complete(IkSolutions { items: [none; 2], len: 0 })
+    }
+
     /// Solutions with nothing pending.
     pub(crate) fn complete(sols: IkSolutions) -> LazyIk {
         LazyIk { sols, pending: [None; 2], x_m: Point3::origin(), tip: Point3::origin() }
@@ -158,7 +164,8 @@ impl Kinematics {
         let pose = Pose { tip: pose.tip, axis: pose.axis / n };
         match self.solver {
             Solver::Closed(f) => {
-                let mut lazy = self.ik_closed(f, &pose, hold)?;
+                let mut lazy = LazyIk::empty();
+                self.ik_closed(f, &pose, hold, &mut lazy)?;
                 self.complete(&mut lazy, 0);
                 self.complete(&mut lazy, 1);
                 Ok(lazy.sols)
@@ -171,16 +178,20 @@ impl Kinematics {
     /// [`Kinematics::ik`] with the position step of each closed-form branch left to
     /// [`Kinematics::complete`]: the planner drops most candidates on their rotary values
     /// alone. Same solutions, bit for bit, once completed.
-    pub(crate) fn ik_lazy(&self, pose: &Pose, hold: &Joints) -> Result<LazyIk, MachineError> {
+    pub(crate) fn ik_lazy(&self, pose: &Pose, hold: &Joints, out: &mut LazyIk) -> Result<(), MachineError> {
         match self.solver {
             Solver::Closed(f) => {
                 let n = pose.axis.norm();
                 if !(n.is_finite() && n > 0.0 && pose.tip.coords.iter().all(|c| c.is_finite())) {
-                    return self.ik(pose, hold).map(LazyIk::complete);
+                    *out = LazyIk::complete(self.ik(pose, hold)?);
+                    return Ok(());
                 }
-                self.ik_closed(f, &Pose { tip: pose.tip, axis: pose.axis / n }, hold)
+                self.ik_closed(f, &Pose { tip: pose.tip, axis: pose.axis / n }, hold, out)
             }
-            Solver::Generic | Solver::Numeric => self.ik(pose, hold).map(LazyIk::complete),
+            Solver::Generic | Solver::Numeric => {
+                *out = LazyIk::complete(self.ik(pose, hold)?);
+                Ok(())
+            }
         }
     }
 
@@ -281,14 +292,15 @@ impl Kinematics {
         q[2] = lin[2];
     }
 
-    fn ik_closed(&self, family: Family, pose: &Pose, hold: &Joints) -> Result<LazyIk, MachineError> {
+    fn ik_closed(&self, family: Family, pose: &Pose, hold: &Joints, out: &mut LazyIk) -> Result<(), MachineError> {
         let v = if self.w0_identity { pose.axis } else { self.w0.rotation * pose.axis };
         // `v` is a unit vector: no overflow, and an underflowing square only makes rho
         // smaller than pole_eps, where hypot would be too (square roots instead of hypot).
         let rho_sq = v.x * v.x + v.y * v.y;
         let rho = rho_sq.sqrt();
         if rho < self.machine.pole_eps {
-            return self.ik_generic(pose, hold).map(LazyIk::complete);
+            *out = LazyIk::complete(self.ik_generic(pose, hold)?);
+            return Ok(());
         }
         let sign = |i: usize| {
             let d = &self.machine.axes[i].direction;
@@ -296,8 +308,6 @@ impl Kinematics {
             d.x + d.y + d.z
         };
         let (s_tilt, s_pole) = (sign(self.tilt), sign(self.pole));
-        let mut items = [IkSolution { joints: Joints::zeros(), branch: Branch::Positive, at_pole: false }; 2];
-        let mut pending = [None; 2];
         let r = (rho_sq + v.z * v.z).sqrt();
         // atan2 is odd in its first argument (exactly: the sign is applied last).
         let tilt_positive = rho.atan2(v.z);
@@ -321,7 +331,10 @@ impl Kinematics {
         // branch k = -1 negates the tilt sine and both pole terms (exactly).
         let (tilt_sin, tilt_cos) = (s_tilt * rho / r, v.z / r);
         let (pole_sin, pole_cos) = (s_pole * y / rho, x / rho);
-        for ((slot, trig), k) in items.iter_mut().zip(&mut pending).zip([1.0, -1.0]) {
+        out.sols.len = 2;
+        out.x_m = x_m;
+        out.tip = pose.tip;
+        for ((slot, trig), k) in out.sols.items.iter_mut().zip(&mut out.pending).zip([1.0, -1.0]) {
             let (tilt, gamma, tilt_trig, pole_trig) = if k > 0.0 {
                 (tilt_positive, gamma, (tilt_sin, tilt_cos), (pole_sin, pole_cos))
             } else {
@@ -333,7 +346,7 @@ impl Kinematics {
             *slot = solution;
             *trig = Some(t);
         }
-        Ok(LazyIk { sols: IkSolutions { items, len: 2 }, pending, x_m, tip: pose.tip })
+        Ok(())
     }
 
     /// The subproblem-2 vectors `(u1, u2, b, a)` for the class (see the module docs).

@@ -192,19 +192,18 @@ fn admissible(
 /// strokes, and whether each took an unwinding move; with no admissible winding, the
 /// shortest-path value (the stroke check then reports it).
 fn unwrap_rotaries(strokes: &Strokes, raw: &Joints, previous: Option<&Joints>) -> ([f64; 2], [bool; 2]) {
-    let (mut values, mut unwound) = ([0.0; 2], [false; 2]);
-    for (r, i) in (3..5).enumerate() {
-        let prev = previous.map_or(0.0, |p| p[i]);
-        match unwrap_angle(raw[i], prev, strokes.limits[i]) {
-            Some((v, u)) => {
-                values[r] = v;
-                unwound[r] = u && previous.is_some();
-            }
-            // No winding fits: report the shortest-path value.
-            None => values[r] = unwrap_angle(raw[i], prev, None).map_or(raw[i], |(v, _)| v),
-        }
+    let (a, b) = (unwrap_one(strokes, raw, previous, 3), unwrap_one(strokes, raw, previous, 4));
+    ([a.0, b.0], [a.1, b.1])
+}
+
+/// Joint `i` of [`unwrap_rotaries`].
+fn unwrap_one(strokes: &Strokes, raw: &Joints, previous: Option<&Joints>, i: usize) -> (f64, bool) {
+    let prev = previous.map_or(0.0, |p| p[i]);
+    match unwrap_angle(raw[i], prev, strokes.limits[i]) {
+        Some((v, u)) => (v, u && previous.is_some()),
+        // No winding fits: report the shortest-path value.
+        None => (unwrap_angle(raw[i], prev, None).map_or(raw[i], |(v, _)| v), false),
     }
-    (values, unwound)
 }
 
 /// [`admissible`] with the rotaries already unwrapped ([`unwrap_rotaries`]).
@@ -231,7 +230,9 @@ fn admissible_with(
 /// Whether the candidate `sol` from the state `p` is dropped as a jump while cutting
 /// (spec 3.6 rule 3): its rotaries unwrapped as [`admissible`] does, a jump above
 /// `flip_threshold` that is not a pole flip (`crosses`: the tool axis crosses the pole in
-/// the block). Such a candidate is dropped whether or not its strokes hold.
+/// the block). Such a candidate is dropped whether or not its strokes hold. Also returns
+/// the unwrapped rotaries ([`unwrap_rotaries`]) of a kept candidate. `pole` is joint 3 or
+/// 4 (the rotaries), the tilt axis the other one.
 fn jumps_on_rotaries(
     strokes: &Strokes,
     sol: &IkSolution,
@@ -240,7 +241,16 @@ fn jumps_on_rotaries(
     pole: usize,
     crosses: impl Fn() -> bool,
 ) -> (bool, ([f64; 2], [bool; 2])) {
-    let unwrapped = unwrap_rotaries(strokes, &sol.joints, Some(&p.q));
+    // A jump of the tilt axis (not the pole axis) drops the candidate whatever the pole
+    // axis does: decided on one unwrapping.
+    let tilt = 7 - pole;
+    let t = unwrap_one(strokes, &sol.joints, Some(&p.q), tilt);
+    if (t.0 - p.q[tilt]).abs() > flip_threshold {
+        return (true, ([0.0; 2], [false; 2]));
+    }
+    let c = unwrap_one(strokes, &sol.joints, Some(&p.q), pole);
+    let (a, b) = if tilt == 3 { (t, c) } else { (c, t) };
+    let unwrapped = ([a.0, b.0], [a.1, b.1]);
     let dq = [unwrapped.0[0] - p.q[3], unwrapped.0[1] - p.q[4]];
     let jump = dq.map(|d| d.abs() > flip_threshold);
     if jump == [false, false] {
@@ -578,6 +588,8 @@ pub(crate) fn plan_input(
     offsets.push(0);
     let mut next: Vec<State> = Vec::new();
     let mut previous: Vec<State> = vec![root];
+    // The inverse of the current pose, reused pose after pose.
+    let mut shared = crate::ik::LazyIk::empty();
     for i in 0..n_poses {
         let pose = input.pose(i);
         let preds: &[State] = &previous;
@@ -585,7 +597,7 @@ pub(crate) fn plan_input(
         let mut smallest_jump: Option<(usize, f64)> = None;
         // Off the pole the inverse does not depend on the held joints: solve once (the
         // position step of each branch only when a candidate needs it).
-        let mut shared = kin.ik_lazy(pose, &preds[0].q).map_err(|e| e.at_block(i))?;
+        kin.ik_lazy(pose, &preds[0].q, &mut shared).map_err(|e| e.at_block(i))?;
         let polar = shared.sols.as_slice().iter().any(|s| s.at_pole) || kin.solver() == crate::chain::Solver::Numeric;
         // A candidate that jumps while cutting is dropped on its rotary values alone,
         // before its linear joints are solved and its strokes checked: kept candidates are
