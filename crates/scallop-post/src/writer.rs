@@ -133,6 +133,19 @@ pub fn program_text(
     dialect: &Dialect,
     params: &PostParams,
 ) -> Result<String, PostError> {
+    program_text_with(program, kin, dialect, params, true)
+}
+
+/// [`program_text`]; `fast: false` writes every block through the general path with
+/// modal words compared as formatted text (the reference the fast paths are tested
+/// against).
+fn program_text_with(
+    program: &MachineProgram,
+    kin: &Kinematics,
+    dialect: &Dialect,
+    params: &PostParams,
+    fast: bool,
+) -> Result<String, PostError> {
     let machine = kin.machine();
     let unsupported =
         |what: String, fix: &str| PostError::Unsupported { dialect: dialect.name.clone(), what, fix: fix.to_string() };
@@ -188,6 +201,7 @@ pub fn program_text(
         ],
     };
     let mut e = Emitter::new(dialect);
+    e.fast = fast;
     for c in &dialect.header_comments {
         e.comment(&vars.render(c));
     }
@@ -240,7 +254,7 @@ pub fn program_text(
     let caps = RateCaps::new(machine, dialect);
     // Joint-space output whose words are all joint words with one-letter names: the
     // steady-state G93 blocks go through `Emitter::joint_block`.
-    let fast_joint: Option<(Vec<u8>, Vec<usize>)> = (mode == OutputMode::Joint && written.len() <= 5)
+    let fast_joint: Option<(Vec<u8>, Vec<usize>)> = (fast && mode == OutputMode::Joint && written.len() <= 5)
         .then(|| {
             written
                 .iter()
@@ -540,6 +554,8 @@ struct Emitter<'a> {
     /// The modal state was checked to be the steady state of [`Emitter::joint_block`]
     /// (reset by every other motion or plane output).
     joint_steady: bool,
+    /// The fast paths are enabled (`false` only in tests: text comparison throughout).
+    fast: bool,
 }
 
 impl<'a> Emitter<'a> {
@@ -555,6 +571,7 @@ impl<'a> Emitter<'a> {
             state: Vec::new(),
             scratch: (Vec::new(), Vec::new()),
             joint_steady: false,
+            fast: true,
         }
     }
 
@@ -693,9 +710,16 @@ impl<'a> Emitter<'a> {
     }
 
     /// Whether `word` (with its scaled key) writes the same token as the modal value `last`.
-    fn same_as(scratch: &mut (Vec<u8>, Vec<u8>), plus: bool, last: &Modal, word: &Word, key: Option<i64>) -> bool {
+    fn same_as(
+        scratch: &mut (Vec<u8>, Vec<u8>),
+        plus: bool,
+        last: &Modal,
+        word: &Word,
+        key: Option<i64>,
+        by_key: bool,
+    ) -> bool {
         match (last, word.number, key) {
-            (Modal::Key(k, d), Some((_, dw)), Some(kw)) if *d == dw => *k == kw,
+            (Modal::Key(k, d), Some((_, dw)), Some(kw)) if by_key && *d == dw => *k == kw,
             _ => {
                 let (a, b) = scratch;
                 a.clear();
@@ -728,7 +752,7 @@ impl<'a> Emitter<'a> {
     /// Appends a space (unless the line is still empty after `start`), then `word`.
     fn push_word(&mut self, start: usize, word: &Word, key: Option<i64>) {
         let space = self.text.len() > start;
-        if let (Some((_, dec)), Some(key), &[letter]) = (word.number, key, word.letter.as_bytes()) {
+        if let (true, Some((_, dec)), Some(key), &[letter]) = (self.fast, word.number, key, word.letter.as_bytes()) {
             // One letter and a scaled key: the token in one piece.
             // The prefix right-aligned in four bytes: [space] letter [+].
             let (prefix, len) = if self.d.explicit_plus && key >= 0 {
@@ -761,7 +785,7 @@ impl<'a> Emitter<'a> {
     fn feed_word(&mut self, start: usize, letter: &[u8], f: f64, dec: usize, always: bool) {
         let f = round_down(f, dec);
         let key = crate::scaled_key(f, dec);
-        if let (true, Some(k), &[l]) = (always, key, letter) {
+        if let (true, true, Some(k), &[l]) = (self.fast, always, key, letter) {
             // Written on every block (G93): no comparison, one token.
             let len = 1 + usize::from(self.text.len() > start);
             crate::push_token_key(&mut self.text, [0, 0, b' ', l], len, k, dec);
@@ -780,7 +804,7 @@ impl<'a> Emitter<'a> {
             || !self.last_feed.as_ref().is_some_and(|last| Self::same_feed(&mut self.scratch, last, &value))
         {
             match &value {
-                Modal::Key(k, dec) if letter.len() <= 3 => {
+                Modal::Key(k, dec) if self.fast && letter.len() <= 3 => {
                     let mut prefix = [b' '; 4];
                     prefix[4 - letter.len()..].copy_from_slice(letter);
                     let len = letter.len() + usize::from(self.text.len() > start);
@@ -907,7 +931,7 @@ impl<'a> Emitter<'a> {
     /// key with its decimals (the steady state of joint-space output). Returns the keys and
     /// the bit mask of the words that change; `None` sends the block to the general path.
     fn fast_changes(&self, words: &[Word]) -> Option<([i64; FAST_WORDS], u32)> {
-        if words.len() > FAST_WORDS || !self.d.modal || words.len() > self.last_words.len() {
+        if !self.fast || words.len() > FAST_WORDS || !self.d.modal || words.len() > self.last_words.len() {
             return None;
         }
         let mut keys = [0i64; FAST_WORDS];
@@ -962,9 +986,14 @@ impl<'a> Emitter<'a> {
             let changed = !self.d.modal
                 || match slot {
                     None => true,
-                    Some(j) => {
-                        !Self::same_as(&mut self.scratch, self.d.explicit_plus, &self.last_words[j].1, word, key)
-                    }
+                    Some(j) => !Self::same_as(
+                        &mut self.scratch,
+                        self.d.explicit_plus,
+                        &self.last_words[j].1,
+                        word,
+                        key,
+                        self.fast,
+                    ),
                 };
             any |= changed;
             state.push((slot, key, changed));
@@ -1068,4 +1097,73 @@ pub fn cycle800_angles(r: &Rotation3<f64>) -> (f64, f64, f64) {
     let m = r.matrix();
     let b = m[(0, 2)].atan2(m[(0, 0)].hypot(m[(0, 1)]));
     ((-m[(1, 2)]).atan2(m[(2, 2)]), b, (-m[(0, 1)]).atan2(m[(0, 0)]))
+}
+
+#[cfg(test)]
+mod tests {
+    use scallop_geom::{Point3, Vec3};
+    use scallop_machine::program::{ClRecord, Motion, ProgramOptions, to_program};
+    use scallop_machine::{Kinematics, Machine, Pose};
+
+    use super::{OutputMode, PostParams, program_text_with};
+    use crate::Dialect;
+
+    /// The fast paths (scaled-integer modal comparison, steady-state joint blocks) write
+    /// exactly what the general path with text comparison writes, on every shipped
+    /// machine and dialect, in joint and TCP output.
+    #[test]
+    fn fast_paths_write_the_same_text_as_the_general_path() {
+        let tilt = 25f64.to_radians();
+        let mut records = vec![ClRecord {
+            pose: Pose::new(Point3::new(0.0, 0.0, 60.0), Vec3::new(0.1, 0.0, 1.0)),
+            motion: Motion::Rapid,
+            feed: 2000.0,
+        }];
+        for i in 0..400 {
+            let t = f64::from(i) * 0.01;
+            // Values that hit rounding ties now and then (multiples of 0.00005) and a
+            // slow precession with pauses (unchanged words).
+            let x = (20.0 * (t * 1.3).cos() * 2e4).round() / 2e4;
+            let precess = 0.9 * (t * 0.7).sin() + if i % 50 < 5 { 0.0 } else { 0.01 * t };
+            let axis = Vec3::new(tilt.sin() * precess.cos(), tilt.sin() * precess.sin(), tilt.cos());
+            let motion = if i % 97 == 0 { Motion::Rapid } else { Motion::Feed };
+            records.push(ClRecord {
+                pose: Pose::new(Point3::new(x, 15.0 * (t * 0.9).sin(), 30.0 + (i % 7) as f64 * 0.5), axis),
+                motion,
+                feed: if i % 40 < 20 { 1500.0 } else { 2500.0 },
+            });
+        }
+        let mut compared = 0;
+        for name in Machine::builtin_names() {
+            let machine = Machine::builtin(name).expect("shipped machine");
+            let kin = Kinematics::new(&machine, 0.0);
+            let Ok(program) = to_program(&kin, &records, None, &ProgramOptions::default()) else { continue };
+            for dialect_name in Dialect::builtin_names() {
+                let dialect = Dialect::builtin(dialect_name).expect("shipped dialect");
+                for mode in [OutputMode::Joint, OutputMode::Tcp] {
+                    let params = PostParams {
+                        program: "7".into(),
+                        mode,
+                        tool: 3,
+                        tool_length: 0.0,
+                        spindle: 9000.0,
+                        tol_pos: 0.005,
+                        tol_ang: 0.001,
+                        predicted_time: None,
+                    };
+                    let fast = program_text_with(&program, &kin, &dialect, &params, true);
+                    let general = program_text_with(&program, &kin, &dialect, &params, false);
+                    match (fast, general) {
+                        (Ok(a), Ok(b)) => {
+                            assert_eq!(a, b, "{name} {dialect_name} {mode:?}");
+                            compared += 1;
+                        }
+                        (Err(a), Err(b)) => assert_eq!(a.to_string(), b.to_string()),
+                        (a, b) => panic!("{name} {dialect_name} {mode:?}: {a:?} vs {b:?}"),
+                    }
+                }
+            }
+        }
+        assert!(compared >= 20, "only {compared} programs compared");
+    }
 }
