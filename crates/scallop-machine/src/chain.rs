@@ -293,7 +293,10 @@ impl Kinematics {
             ball_bound: ball_bound(machine),
             principal: std::array::from_fn(|i| machine.axes.get(i).and_then(|a| principal_direction(&a.direction))),
             w0_identity: machine.part_frame == Isometry3::identity(),
-            rotaries_inward: (rotaries_inward(machine, &machine.part_chain), rotaries_inward(machine, &machine.tool_chain)),
+            rotaries_inward: (
+                rotaries_inward(machine, &machine.part_chain),
+                rotaries_inward(machine, &machine.tool_chain),
+            ),
             rotary: std::array::from_fn(|i| machine.axes.get(i).is_some_and(|a| a.kind == AxisKind::Rotary)),
         }
     }

@@ -230,7 +230,10 @@ impl Kinematics {
         let mut q = Joints::zeros();
         q[self.primary] = normalize_angle(theta_primary);
         q[self.secondary] = normalize_angle(theta_secondary);
-        (IkSolution { joints: q, branch: Branch::of_tilt(q[self.tilt]), at_pole: false }, [trig_primary, trig_secondary])
+        (
+            IkSolution { joints: q, branch: Branch::of_tilt(q[self.tilt]), at_pole: false },
+            [trig_primary, trig_secondary],
+        )
     }
 
     /// Fills the linear joints of `q` (rotaries given) so that the controlled point is at

@@ -618,10 +618,14 @@ pub(crate) fn plan_input(
                 for k in 0..sols.sols.as_slice().len() {
                     let mut unwrapped = None;
                     if shortcut && has_previous && input.cutting(i) {
-                        let (jumps, u) =
-                            jumps_on_rotaries(&strokes, &sols.sols.as_slice()[k], p, options.flip_threshold, pole, || {
-                                i > 0 && arc_passes(&input.pose(i - 1).axis, &pose.axis, &pole_dir, eps)
-                            });
+                        let (jumps, u) = jumps_on_rotaries(
+                            &strokes,
+                            &sols.sols.as_slice()[k],
+                            p,
+                            options.flip_threshold,
+                            pole,
+                            || i > 0 && arc_passes(&input.pose(i - 1).axis, &pose.axis, &pole_dir, eps),
+                        );
                         if jumps {
                             dropped = true;
                             continue;

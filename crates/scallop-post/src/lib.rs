@@ -189,7 +189,8 @@ fn push_token_dec<const D: usize>(out: &mut Vec<u8>, prefix: [u8; 4], prefix_len
     let merged = tens | ((merged - 10 * tens) << 8);
     let digits = (merged + 0x3030_3030_3030_3030).to_le_bytes();
     let int = n / if D == 3 { 1_000 } else { 10_000 };
-    let int_len = 1 + usize::from(int >= 10) + usize::from(int >= 100) + usize::from(int >= 1_000) + usize::from(int >= 10_000);
+    let int_len =
+        1 + usize::from(int >= 10) + usize::from(int >= 100) + usize::from(int >= 1_000) + usize::from(int >= 10_000);
     let mut buf = [0u8; 40];
     buf[16..24].copy_from_slice(&digits);
     buf[24 - D] = b'.';
