@@ -117,6 +117,71 @@ pub struct Kinematics {
     pub(crate) linear_inverse: Matrix3<f64>,
     /// Every linear axis is nearer the bed than the rotaries of its chain (closed position step).
     pub(crate) linear_first: bool,
+    /// For a tool chain of linear axes and a part chain of rotaries only: the first part
+    /// rotary's point `p1` and the constant `K` of the distance bound
+    /// `D0 <= |tip_M - p1| + K` of `feed::deviation_bound_relaxed`.
+    pub(crate) ball_bound: Option<(Point3, f64)>,
+    /// Per joint: `Some((k, sign))` when the direction is exactly `sign e_k` (the closed
+    /// forms rotate about it without the general Rodrigues formula).
+    pub(crate) principal: [Option<(usize, f64)>; 5],
+    /// The part frame W0 is exactly the identity (its transforms are skipped).
+    pub(crate) w0_identity: bool,
+    /// The rotaries of the part chain and of the tool chain, innermost first (the
+    /// closed position step applies them in this order).
+    pub(crate) rotaries_inward: (Vec<usize>, Vec<usize>),
+    /// Per joint: rotary (else linear).
+    pub(crate) rotary: [bool; 5],
+}
+
+/// The rotary joints of `chain`, innermost first.
+fn rotaries_inward(machine: &Machine, chain: &[usize]) -> Vec<usize> {
+    chain.iter().rev().copied().filter(|&i| machine.axes[i].kind == AxisKind::Rotary).collect()
+}
+
+/// `Some((k, sign))` when `d` is exactly `sign e_k`.
+fn principal_direction(d: &Vec3) -> Option<(usize, f64)> {
+    // Exact comparisons on purpose: only an exactly axis-aligned direction (as the
+    // closed-form families have) takes the short formula.
+    #[allow(clippy::float_cmp, reason = "exactly a unit axis")]
+    let k = (0..3).find(|&k| d[k].abs() == 1.0)?;
+    #[allow(clippy::float_cmp, reason = "exact zeros")]
+    let rest_zero = (0..3).all(|j| j == k || d[j] == 0.0);
+    rest_zero.then_some((k, d[k]))
+}
+
+/// `p` rotated by the angle with `(s, c)` about the line through `point` along
+/// `sign e_k`: [`rotate_about`] for a principal direction, two terms per component.
+pub(crate) fn rotate_about_principal(k: usize, sign: f64, point: &Point3, (s, c): (f64, f64), p: &Point3) -> Point3 {
+    let v = p - point;
+    let s = sign * s;
+    let r = match k {
+        0 => Vec3::new(v.x, c * v.y - s * v.z, s * v.y + c * v.z),
+        1 => Vec3::new(c * v.x + s * v.z, v.y, c * v.z - s * v.x),
+        _ => Vec3::new(c * v.x - s * v.y, s * v.x + c * v.y, v.z),
+    };
+    point + r
+}
+
+/// `(p1, K)` of [`Kinematics::ball_bound`]: walking the part chain from the bed, the tip
+/// carried back through rotary `k` lies within `|tip - p1| + sum_{j < k} |p_j - p_{j+1}|`
+/// of `p_k`, so its distance to line `k + 1` is at most that plus the distance from `p_k`
+/// to line `k + 1` (line 1: at most `|tip - p1|`).
+fn ball_bound(machine: &Machine) -> Option<(Point3, f64)> {
+    let tool_linear = machine.tool_chain.iter().all(|&i| machine.axes[i].kind == AxisKind::Linear);
+    let part_rotary = machine.part_chain.iter().all(|&i| machine.axes[i].kind == AxisKind::Rotary);
+    let first = *machine.part_chain.first()?;
+    if !(tool_linear && part_rotary) {
+        return None;
+    }
+    let (mut k, mut walked) = (0.0f64, 0.0f64);
+    for w in machine.part_chain.windows(2) {
+        let (a, b) = (&machine.axes[w[0]], &machine.axes[w[1]]);
+        let off = a.point - b.point;
+        let to_line = (off - b.direction * off.dot(&b.direction)).norm();
+        k = k.max(walked + to_line);
+        walked += off.norm();
+    }
+    Some((machine.axes[first].point, k))
 }
 
 pub(crate) fn joint_isometry(direction: &Vec3, point: &Point3, kind: AxisKind, q: f64) -> Isometry3<f64> {
@@ -225,6 +290,14 @@ impl Kinematics {
             solver,
             linear_inverse,
             linear_first,
+            ball_bound: ball_bound(machine),
+            principal: std::array::from_fn(|i| machine.axes.get(i).and_then(|a| principal_direction(&a.direction))),
+            w0_identity: machine.part_frame == Isometry3::identity(),
+            rotaries_inward: (
+                rotaries_inward(machine, &machine.part_chain),
+                rotaries_inward(machine, &machine.tool_chain),
+            ),
+            rotary: std::array::from_fn(|i| machine.axes.get(i).is_some_and(|a| a.kind == AxisKind::Rotary)),
         }
     }
 
@@ -283,6 +356,7 @@ impl Kinematics {
     #[must_use]
     pub fn with_part_frame(mut self, part_frame: Isometry3<f64>) -> Kinematics {
         self.w0 = part_frame;
+        self.w0_identity = part_frame == Isometry3::identity();
         self
     }
 

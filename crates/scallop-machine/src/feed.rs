@@ -81,27 +81,82 @@ pub fn deviation(kin: &Kinematics, pose_a: &Pose, pose_b: &Pose, qa: &Joints, qb
 /// ```
 #[must_use]
 pub fn deviation_bound(kin: &Kinematics, qa: &Joints, qb: &Joints) -> Option<(f64, f64)> {
-    let machine = kin.machine();
+    let (omega, b) = match rotation_and_translation(kin, qa, qb) {
+        Rates::Translation => return Some((0.0, 0.0)),
+        Rates::TooFar => return None,
+        Rates::Screw(omega, b) => (omega, b),
+    };
+    Some(bound_from(exact_d0(kin, qa), omega, b))
+}
+
+/// [`deviation_bound`] with the distance `D0` replaced by a cheaper upper bound (no
+/// trigonometry: the tip is only known to lie within a radius of a point once it is
+/// carried back through a rotary). The bound is monotone in `D0`, so this is at least
+/// [`deviation_bound`]: when it passes the tolerance, so does the exact bound. `None`
+/// exactly when [`deviation_bound`] is `None`.
+///
+/// ```
+/// use scallop_machine::{Kinematics, Machine, Joints, feed::{deviation_bound, deviation_bound_relaxed}};
+/// let k = Kinematics::new(&Machine::builtin("ucp710").unwrap(), 0.0);
+/// let qa = Joints::new(0.0, 0.0, 50.0, 0.5, 0.0);
+/// let qb = Joints::new(1.0, 0.0, 50.0, 0.5, 0.01);
+/// let (bp, ba) = deviation_bound(&k, &qa, &qb).unwrap();
+/// let (rp, ra) = deviation_bound_relaxed(&k, &qa, &qb).unwrap();
+/// assert!(bp <= rp && ba == ra);
+/// ```
+#[must_use]
+pub fn deviation_bound_relaxed(kin: &Kinematics, qa: &Joints, qb: &Joints) -> Option<(f64, f64)> {
+    let (omega, b) = match rotation_and_translation(kin, qa, qb) {
+        Rates::Translation => return Some((0.0, 0.0)),
+        Rates::TooFar => return None,
+        Rates::Screw(omega, b) => (omega, b),
+    };
+    Some(bound_from(relaxed_d0(kin, qa), omega, b))
+}
+
+enum Rates {
+    /// No rotary moves.
+    Translation,
+    /// The block turns too far for the bound (or a joint is not finite).
+    TooFar,
+    /// `(Omega, B)`.
+    Screw(f64, f64),
+}
+
+fn rotation_and_translation(kin: &Kinematics, qa: &Joints, qb: &Joints) -> Rates {
     let dq = qb - qa;
     let (mut omega, mut b) = (0.0, 0.0);
-    for (i, axis) in machine.axes().iter().enumerate().take(5) {
-        match axis.kind {
-            crate::AxisKind::Rotary => omega += dq[i].abs(),
-            crate::AxisKind::Linear => b += dq[i].abs(),
+    for (i, &rotary) in kin.rotary.iter().enumerate() {
+        if rotary {
+            omega += dq[i].abs();
+        } else {
+            b += dq[i].abs();
         }
     }
     if omega == 0.0 {
         // Translations only: the tip moves on the chord, the axis does not turn.
-        return Some((0.0, 0.0));
+        return Rates::Translation;
     }
     if omega.is_nan() || omega >= tol::BOUND_MAX_ROTATION {
-        return None;
+        return Rates::TooFar;
     }
-    // D0: distance from the tip to each rotary line at the start, both in M. A joint's
-    // line is carried by the joints before it in its chain; the distance is invariant
-    // under rigid motion, so the tip is carried back instead: walking down the chain,
-    // the tip in the frame of joint k is the previous one moved by the inverse of joint
-    // k - 1 (one sin_cos per rotary, no transform composition).
+    Rates::Screw(omega, b)
+}
+
+fn bound_from(d0: f64, omega: f64, b: f64) -> (f64, f64) {
+    let d = (d0 + 2.0 * b) / (1.0 - 3.0 * omega);
+    let pos = (4.0 * omega * omega * d + 3.0 * omega * b) / 8.0;
+    let ang = std::f64::consts::FRAC_PI_2 * 3.0 * omega * omega / 8.0;
+    (pos, ang)
+}
+
+/// D0: distance from the tip to each rotary line at the start, both in M. A joint's
+/// line is carried by the joints before it in its chain; the distance is invariant
+/// under rigid motion, so the tip is carried back instead: walking down the chain,
+/// the tip in the frame of joint k is the previous one moved by the inverse of joint
+/// k - 1 (one sin_cos per rotary, no transform composition).
+fn exact_d0(kin: &Kinematics, qa: &Joints) -> f64 {
+    let machine = kin.machine();
     let mut tip_m = kin.t0;
     for &i in machine.tool_chain.iter().rev() {
         let a = &machine.axes[i];
@@ -124,10 +179,54 @@ pub fn deviation_bound(kin: &Kinematics, qa: &Joints, qb: &Joints) -> Option<(f6
             }
         }
     }
-    let d = (d0 + 2.0 * b) / (1.0 - 3.0 * omega);
-    let pos = (4.0 * omega * omega * d + 3.0 * omega * b) / 8.0;
-    let ang = std::f64::consts::FRAC_PI_2 * 3.0 * omega * omega / 8.0;
-    Some((pos, ang))
+    d0
+}
+
+/// An upper bound of [`exact_d0`] without trigonometry: the carried tip is tracked as a
+/// ball `(c, r)`. A translation moves the centre; a rotation about a line through `p`
+/// keeps the distance to `p`, so the ball becomes `(p, |c - p| + r)`; the distance to a
+/// line is at most the centre's distance plus `r`. Inflated by a relative and an
+/// absolute slack so that it also bounds the rounded [`exact_d0`].
+fn relaxed_d0(kin: &Kinematics, qa: &Joints) -> f64 {
+    let machine = kin.machine();
+    if let Some((p1, k)) = kin.ball_bound {
+        // Tool chain of linear axes: the tip in M is exact; part chain of rotaries: the
+        // precomputed ball walk (see `chain::ball_bound`).
+        let mut tip = kin.t0;
+        for &i in machine.tool_chain.iter().rev() {
+            tip += machine.axes[i].direction * qa[i];
+        }
+        let d0 = (tip - p1).norm() + k;
+        return d0 * (1.0 + tol::BOUND_PRETEST_SLACK) + tol::BOUND_PRETEST_SLACK;
+    }
+    let (mut tip, mut r) = (kin.t0, 0.0f64);
+    for &i in machine.tool_chain.iter().rev() {
+        let a = &machine.axes[i];
+        match a.kind {
+            crate::AxisKind::Linear => tip += a.direction * qa[i],
+            crate::AxisKind::Rotary => {
+                r += (tip - a.point).norm();
+                tip = a.point;
+            }
+        }
+    }
+    let mut d0 = 0.0f64;
+    for chain in [&machine.part_chain, &machine.tool_chain] {
+        let (mut c, mut rc) = (tip, r);
+        for &i in chain {
+            let a = &machine.axes[i];
+            match a.kind {
+                crate::AxisKind::Rotary => {
+                    let off = c - a.point;
+                    d0 = d0.max((off - a.direction * off.dot(&a.direction)).norm() + rc);
+                    rc += off.norm();
+                    c = a.point;
+                }
+                crate::AxisKind::Linear => c -= a.direction * qa[i],
+            }
+        }
+    }
+    d0 * (1.0 + tol::BOUND_PRETEST_SLACK) + tol::BOUND_PRETEST_SLACK
 }
 
 /// Max of `f` on [0, 1]: uniform samples, then golden section around the best.
@@ -205,8 +304,24 @@ pub fn subdivide(
     block: usize,
 ) -> Result<Vec<BlockEnd>, MachineError> {
     let mut out = Vec::new();
-    split(kin, (pose_a, qa), (pose_b, qb), (tol_pos, tol_ang), block, 0, &mut out)?;
+    subdivide_into(kin, (pose_a, qa), (pose_b, qb), (tol_pos, tol_ang), block, &mut out)?;
     Ok(out)
+}
+
+/// [`subdivide`] appending the block ends to `out` (no allocation per block when `out`
+/// is reused). `a` and `b` are `(pose, joints)`, `tolerance` is `(tol_pos, tol_ang)`.
+///
+/// # Errors
+/// As [`subdivide`].
+pub fn subdivide_into(
+    kin: &Kinematics,
+    a: (&Pose, &Joints),
+    b: (&Pose, &Joints),
+    tolerance: (f64, f64),
+    block: usize,
+    out: &mut Vec<BlockEnd>,
+) -> Result<(), MachineError> {
+    split(kin, a, b, tolerance, block, 0, out)
 }
 
 fn split(
@@ -218,6 +333,15 @@ fn split(
     depth: usize,
     out: &mut Vec<BlockEnd>,
 ) -> Result<(), MachineError> {
+    // The trigonometry-free bound first: it settles nearly every block of a dense path;
+    // when it passes, the exact bound (never smaller) would pass too.
+    if let Some((pos, ang)) = deviation_bound_relaxed(kin, a.1, b.1)
+        && pos <= tolerance.0
+        && ang <= tolerance.1
+    {
+        out.push(BlockEnd { pose: *b.0, joints: *b.1 });
+        return Ok(());
+    }
     if let Some((pos, ang)) = deviation_bound(kin, a.1, b.1)
         && pos <= tolerance.0
         && ang <= tolerance.1
@@ -251,6 +375,40 @@ fn split(
     split(kin, (&mid, &q_mid), b, tolerance, block, depth + 1, out)
 }
 
+/// `x.round()` (half away from zero, signed zero kept) without the library call for
+/// |x| < 2^52, where truncation and the fraction are exact.
+#[inline]
+pub(crate) fn round_fast(x: f64) -> f64 {
+    if x.abs() < 4_503_599_627_370_496.0 {
+        #[allow(clippy::cast_possible_truncation, clippy::cast_precision_loss, reason = "|x| < 2^52, exact")]
+        let t = x as i64 as f64;
+        let f = x - t;
+        let r = if f >= 0.5 {
+            t + 1.0
+        } else if f <= -0.5 {
+            t - 1.0
+        } else {
+            t
+        };
+        r.copysign(x)
+    } else {
+        x.round()
+    }
+}
+
+/// `x.floor()` (signed zero kept) without the library call for |x| < 2^52.
+#[inline]
+pub(crate) fn floor_fast(x: f64) -> f64 {
+    if x.abs() < 4_503_599_627_370_496.0 {
+        #[allow(clippy::cast_possible_truncation, clippy::cast_precision_loss, reason = "|x| < 2^52, exact")]
+        let t = x as i64 as f64;
+        let r = if t > x { t - 1.0 } else { t };
+        r.copysign(x)
+    } else {
+        x.floor()
+    }
+}
+
 /// `10f64.powi(e)` by table for `|e| <= 9`, bit for bit: the exponentiation by squaring
 /// is exact for these powers and a negative power is the reciprocal of the positive one.
 pub(crate) fn pow10i(e: i32) -> f64 {
@@ -279,16 +437,46 @@ pub fn inverse_time_feed(kin: &Kinematics, pose_a: &Pose, pose_b: &Pose, qa: &Jo
     let machine = kin.machine();
     let f = feed / 60.0; // mm/s
     let length = (pose_b.tip - pose_a.tip).norm();
-    let dphi = pose_a.axis.cross(&pose_b.axis).norm().atan2(pose_a.axis.dot(&pose_b.axis));
     let rate = crate::plan::move_time(machine, qa, qb);
-    let t = (length / f).max(machine.nc().r_ref * dphi / f).max(rate).max(machine.nc().min_block_time);
+    let others = (length / f).max(rate).max(machine.nc().min_block_time);
+    // The rotation term needs its atan2 only when it may be the largest: for an angle
+    // below 90 deg, dphi = atan(s / c) <= s / c, so a slightly inflated r_ref s / c / F
+    // below the other terms proves that the maximum is theirs (the same value).
+    let (sin_phi, cos_phi) = (pose_a.axis.cross(&pose_b.axis).norm(), pose_a.axis.dot(&pose_b.axis));
+    let r_ref = machine.nc().r_ref;
+    let t = if cos_phi > 0.0 && r_ref * (sin_phi / cos_phi) / f * (1.0 + tol::ROTATION_TERM_SLACK) < others {
+        others
+    } else {
+        let dphi = sin_phi.atan2(cos_phi);
+        (length / f).max(r_ref * dphi / f).max(rate).max(machine.nc().min_block_time)
+    };
     let scale = pow10i(i32::from(machine.nc().decimals.feed));
     let exact = 60.0 / t;
     // Round down, but keep an exact value when it is already representable.
-    let rounded = (exact * scale).floor() / scale;
-    if (exact - (exact * scale).round() / scale).abs() <= tol::FEED_ROUNDING * exact {
-        (exact * scale).round() / scale
-    } else {
-        rounded
+    let nearest = round_fast(exact * scale) / scale;
+    if (exact - nearest).abs() <= tol::FEED_ROUNDING * exact { nearest } else { floor_fast(exact * scale) / scale }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{floor_fast, round_fast};
+
+    #[test]
+    fn the_fast_roundings_equal_the_library_bit_for_bit() {
+        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        for _ in 0..100_000 {
+            let magnitude = 10f64.powi(i32::try_from(next() % 20).unwrap_or(0) - 4);
+            let v = ((next() >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 2.0 * magnitude;
+            for x in [v, v.trunc() + 0.5, v.trunc() - 0.5, -0.0, 0.0, 4.6e15, -4.6e15, f64::NAN] {
+                assert_eq!(round_fast(x).to_bits(), x.round().to_bits(), "round {x:e}");
+                assert_eq!(floor_fast(x).to_bits(), x.floor().to_bits(), "floor {x:e}");
+            }
+        }
     }
 }

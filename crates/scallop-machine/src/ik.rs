@@ -22,7 +22,7 @@ use std::f64::consts::PI;
 use scallop_geom::nalgebra::{Matrix3, SMatrix, Unit, UnitQuaternion};
 use scallop_geom::{Point3, Vec3};
 
-use crate::chain::{Class, Family, Joints, Kinematics, Pose, Solver, rotate_about};
+use crate::chain::{Class, Family, Joints, Kinematics, Pose, Solver, rotate_about, rotate_about_principal};
 use crate::desc::AxisKind;
 use crate::error::MachineError;
 use crate::tol;
@@ -85,8 +85,37 @@ impl IkSolutions {
     }
 }
 
+/// The inverse solutions of one pose, the position step of each closed-form branch done
+/// on demand ([`Kinematics::ik_lazy`], [`Kinematics::complete`]).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct LazyIk {
+    /// The solutions; the linear joints of a pending one are zero.
+    pub(crate) sols: IkSolutions,
+    /// Per solution, the `(sin, cos)` of its primary and secondary rotaries while its
+    /// linear joints are pending.
+    pending: [Option<[(f64, f64); 2]>; 2],
+    /// `W0 tip` (closed position step) or the tip (affine position step).
+    x_m: Point3,
+    tip: Point3,
+}
+
+impl LazyIk {
+    /// No solutions (a buffer for [`Kinematics::ik_lazy`]).
+    pub(crate) fn empty() -> LazyIk {
+        let none = IkSolution { joints: Joints::zeros(), branch: Branch::Positive, at_pole: false };
+        LazyIk::complete(IkSolutions { items: [none; 2], len: 0 })
+    }
+
+    /// Solutions with nothing pending.
+    pub(crate) fn complete(sols: IkSolutions) -> LazyIk {
+        LazyIk { sols, pending: [None; 2], x_m: Point3::origin(), tip: Point3::origin() }
+    }
+}
+
 fn normalize_angle(a: f64) -> f64 {
-    let r = a.rem_euclid(2.0 * PI);
+    // `rem_euclid` is `a % 2 pi` (exact, a call to fmod) then `+ 2 pi` for a negative
+    // remainder; for |a| < 2 pi the remainder is `a` itself: same value without fmod.
+    let r = if a.abs() < 2.0 * PI { if a < 0.0 { a + 2.0 * PI } else { a } } else { a.rem_euclid(2.0 * PI) };
     if r > PI { r - 2.0 * PI } else { r }
 }
 
@@ -134,9 +163,50 @@ impl Kinematics {
         }
         let pose = Pose { tip: pose.tip, axis: pose.axis / n };
         match self.solver {
-            Solver::Closed(f) => self.ik_closed(f, &pose, hold),
+            Solver::Closed(f) => {
+                let mut lazy = LazyIk::empty();
+                self.ik_closed(f, &pose, hold, &mut lazy)?;
+                self.complete(&mut lazy, 0);
+                self.complete(&mut lazy, 1);
+                Ok(lazy.sols)
+            }
             Solver::Generic => self.ik_generic(&pose, hold),
             Solver::Numeric => self.ik_numeric_both(&pose, hold),
+        }
+    }
+
+    /// [`Kinematics::ik`] with the position step of each closed-form branch left to
+    /// [`Kinematics::complete`]: the planner drops most candidates on their rotary values
+    /// alone. Same solutions, bit for bit, once completed.
+    pub(crate) fn ik_lazy(&self, pose: &Pose, hold: &Joints, out: &mut LazyIk) -> Result<(), MachineError> {
+        match self.solver {
+            Solver::Closed(f) => {
+                let n = pose.axis.norm();
+                if !(n.is_finite() && n > 0.0 && pose.tip.coords.iter().all(|c| c.is_finite())) {
+                    *out = LazyIk::complete(self.ik(pose, hold)?);
+                    return Ok(());
+                }
+                self.ik_closed(f, &Pose { tip: pose.tip, axis: pose.axis / n }, hold, out)
+            }
+            Solver::Generic | Solver::Numeric => {
+                *out = LazyIk::complete(self.ik(pose, hold)?);
+                Ok(())
+            }
+        }
+    }
+
+    /// Solves the linear joints of solution `k` of `lazy` if they are still pending.
+    pub(crate) fn complete(&self, lazy: &mut LazyIk, k: usize) {
+        if let Some([trig_primary, trig_secondary]) = lazy.pending[k].take() {
+            let q = &mut lazy.sols.items[k].joints;
+            if self.linear_first {
+                let mut trig = [(0.0, 1.0); 5];
+                trig[self.primary] = trig_primary;
+                trig[self.secondary] = trig_secondary;
+                self.solve_linear_machine(&lazy.x_m, q, &trig);
+            } else {
+                self.solve_linear_affine(&lazy.tip, q);
+            }
         }
     }
 
@@ -148,22 +218,22 @@ impl Kinematics {
         IkSolution { joints: q, branch: Branch::of_tilt(q[self.tilt]), at_pole }
     }
 
-    /// [`Kinematics::solution`] with the rotaries' `(sin, cos)` known (the closed forms get
-    /// them from the tool axis's components without evaluating `sin_cos`).
-    fn solution_trig(
+    /// The rotary part of [`Kinematics::solution`] with the rotaries' `(sin, cos)` known
+    /// (the closed forms get them from the tool axis's components without evaluating
+    /// `sin_cos`); the linear joints are left at zero and the trigonometry is returned for
+    /// [`Kinematics::complete`].
+    fn rotary_solution(
         &self,
-        tip: &Point3,
         (theta_primary, trig_primary): (f64, (f64, f64)),
         (theta_secondary, trig_secondary): (f64, (f64, f64)),
-    ) -> IkSolution {
+    ) -> (IkSolution, [(f64, f64); 2]) {
         let mut q = Joints::zeros();
         q[self.primary] = normalize_angle(theta_primary);
         q[self.secondary] = normalize_angle(theta_secondary);
-        let mut trig = [(0.0, 1.0); 5];
-        trig[self.primary] = trig_primary;
-        trig[self.secondary] = trig_secondary;
-        self.solve_linear_trig(tip, &mut q, &trig);
-        IkSolution { joints: q, branch: Branch::of_tilt(q[self.tilt]), at_pole: false }
+        (
+            IkSolution { joints: q, branch: Branch::of_tilt(q[self.tilt]), at_pole: false },
+            [trig_primary, trig_secondary],
+        )
     }
 
     /// Fills the linear joints of `q` (rotaries given) so that the controlled point is at
@@ -171,60 +241,69 @@ impl Kinematics {
     /// `q_lin = M^-1 D` (spec 3.2). Otherwise the tip is affine in the linear joints for
     /// fixed rotaries: `P(q_lin) = P(0) + A q_lin`, with A from three forward evaluations.
     pub(crate) fn solve_linear(&self, tip: &Point3, q: &mut Joints) {
-        let mut trig = [(0.0, 1.0); 5];
-        for (i, t) in trig.iter_mut().enumerate() {
-            if self.machine.axes[i].kind == AxisKind::Rotary {
-                *t = q[i].sin_cos();
-            }
-        }
-        self.solve_linear_trig(tip, q, &trig);
-    }
-
-    /// [`Kinematics::solve_linear`] with `trig[i] = (sin q_i, cos q_i)` given for the rotaries.
-    fn solve_linear_trig(&self, tip: &Point3, q: &mut Joints, trig: &[(f64, f64); 5]) {
         if self.linear_first {
-            let x = self.w0 * tip;
-            // The chain's rotaries applied to a point, innermost first, each by Rodrigues'
-            // formula from one sin_cos (no quaternion or isometry composition).
-            let rotary_only = |chain: &[usize], p: Point3| {
-                let mut p = p;
-                for &i in chain.iter().rev() {
-                    let a = &self.machine.axes[i];
-                    if a.kind == AxisKind::Rotary {
-                        p = rotate_about(&a.direction, &a.point, trig[i], &p);
-                    }
+            let mut trig = [(0.0, 1.0); 5];
+            for (i, t) in trig.iter_mut().enumerate() {
+                if self.machine.axes[i].kind == AxisKind::Rotary {
+                    *t = q[i].sin_cos();
                 }
-                p
-            };
-            let d = rotary_only(&self.machine.part_chain, x) - rotary_only(&self.machine.tool_chain, self.t0);
-            let lin = self.linear_inverse * d;
-            q[0] = lin[0];
-            q[1] = lin[1];
-            q[2] = lin[2];
-        } else {
-            q[0] = 0.0;
-            q[1] = 0.0;
-            q[2] = 0.0;
-            let p0 = self.fk(q).tip;
-            let mut a = Matrix3::zeros();
-            for i in 0..3 {
-                let mut qi = *q;
-                qi[i] = 1.0;
-                a.set_column(i, &(self.fk(&qi).tip - p0));
             }
-            // INVARIANT: rigid motions keep the three linear directions independent.
-            let lin = a.lu().solve(&(tip - p0)).unwrap_or_else(Vec3::zeros);
-            q[0] = lin[0];
-            q[1] = lin[1];
-            q[2] = lin[2];
+            self.solve_linear_machine(&(self.w0 * tip), q, &trig);
+        } else {
+            self.solve_linear_affine(tip, q);
         }
     }
 
-    fn ik_closed(&self, family: Family, pose: &Pose, hold: &Joints) -> Result<IkSolutions, MachineError> {
-        let v = self.w0.rotation * pose.axis;
-        let rho = v.x.hypot(v.y);
+    /// The closed position step (`linear_first`) with `trig[i] = (sin q_i, cos q_i)` given
+    /// for the rotaries and the tip `x` in the machine frame.
+    fn solve_linear_machine(&self, x: &Point3, q: &mut Joints, trig: &[(f64, f64); 5]) {
+        // The chains' rotaries applied to a point, innermost first, each by Rodrigues'
+        // formula (or its principal-axis form) from one sin_cos (no quaternion or
+        // isometry composition).
+        let rotate = |i: usize, p: Point3| {
+            let a = &self.machine.axes[i];
+            match self.principal[i] {
+                Some((k, sign)) => rotate_about_principal(k, sign, &a.point, trig[i], &p),
+                None => rotate_about(&a.direction, &a.point, trig[i], &p),
+            }
+        };
+        let part = self.rotaries_inward.0.iter().fold(*x, |p, &i| rotate(i, p));
+        let tool = self.rotaries_inward.1.iter().fold(self.t0, |p, &i| rotate(i, p));
+        let lin = self.linear_inverse * (part - tool);
+        q[0] = lin[0];
+        q[1] = lin[1];
+        q[2] = lin[2];
+    }
+
+    /// The affine position step (a linear axis carried by a rotary): the tip is affine in
+    /// the linear joints for fixed rotaries.
+    fn solve_linear_affine(&self, tip: &Point3, q: &mut Joints) {
+        q[0] = 0.0;
+        q[1] = 0.0;
+        q[2] = 0.0;
+        let p0 = self.fk(q).tip;
+        let mut a = Matrix3::zeros();
+        for i in 0..3 {
+            let mut qi = *q;
+            qi[i] = 1.0;
+            a.set_column(i, &(self.fk(&qi).tip - p0));
+        }
+        // INVARIANT: rigid motions keep the three linear directions independent.
+        let lin = a.lu().solve(&(tip - p0)).unwrap_or_else(Vec3::zeros);
+        q[0] = lin[0];
+        q[1] = lin[1];
+        q[2] = lin[2];
+    }
+
+    fn ik_closed(&self, family: Family, pose: &Pose, hold: &Joints, out: &mut LazyIk) -> Result<(), MachineError> {
+        let v = if self.w0_identity { pose.axis } else { self.w0.rotation * pose.axis };
+        // `v` is a unit vector: no overflow, and an underflowing square only makes rho
+        // smaller than pole_eps, where hypot would be too (square roots instead of hypot).
+        let rho_sq = v.x * v.x + v.y * v.y;
+        let rho = rho_sq.sqrt();
         if rho < self.machine.pole_eps {
-            return self.ik_generic(pose, hold);
+            *out = LazyIk::complete(self.ik_generic(pose, hold)?);
+            return Ok(());
         }
         let sign = |i: usize| {
             let d = &self.machine.axes[i].direction;
@@ -232,30 +311,45 @@ impl Kinematics {
             d.x + d.y + d.z
         };
         let (s_tilt, s_pole) = (sign(self.tilt), sign(self.pole));
-        let mut items = [IkSolution { joints: Joints::zeros(), branch: Branch::Positive, at_pole: false }; 2];
-        let r = rho.hypot(v.z);
+        let r = (rho_sq + v.z * v.z).sqrt();
         // atan2 is odd in its first argument (exactly: the sign is applied last).
         let tilt_positive = rho.atan2(v.z);
-        for (slot, k) in items.iter_mut().zip([1.0, -1.0]) {
-            let tilt = if k > 0.0 { tilt_positive } else { -tilt_positive };
-            // gamma = atan2(y, x) with (y, x) of length rho.
-            let (y, x) = match family {
-                Family::TtAc => (k * v.x, k * v.y),
-                Family::TtBc => (k * v.y, -k * v.x),
-                Family::HhCa => (k * v.x, -k * v.y),
-                Family::HhCb => (k * v.y, k * v.x),
-                Family::HtBc => (-k * v.y, k * v.x),
-                Family::HtAc => (-k * v.x, -k * v.y),
+        // The machine-frame tip of the closed position step, shared by both branches.
+        let x_m = if self.linear_first && !self.w0_identity { self.w0 * pose.tip } else { pose.tip };
+        // gamma = atan2(y, x) with (y, x) of length rho, on the branch k = +1; the branch
+        // k = -1 has (-y, -x): its angle is gamma -+ pi (no second atan2; the two agree
+        // after `normalize_angle`, which maps -pi and pi to pi), and its sines and cosines
+        // are the exact negatives.
+        let (y, x) = match family {
+            Family::TtAc => (v.x, v.y),
+            Family::TtBc => (v.y, -v.x),
+            Family::HhCa => (v.x, -v.y),
+            Family::HhCb => (v.y, v.x),
+            Family::HtBc => (-v.y, v.x),
+            Family::HtAc => (-v.x, -v.y),
+        };
+        let gamma = y.atan2(x);
+        let gamma_other = if gamma > 0.0 { gamma - PI } else { gamma + PI };
+        // The sines and cosines from the same components (no sin_cos of the angles); the
+        // branch k = -1 negates the tilt sine and both pole terms (exactly).
+        let (tilt_sin, tilt_cos) = (s_tilt * rho / r, v.z / r);
+        let (pole_sin, pole_cos) = (s_pole * y / rho, x / rho);
+        out.sols.len = 2;
+        out.x_m = x_m;
+        out.tip = pose.tip;
+        for ((slot, trig), k) in out.sols.items.iter_mut().zip(&mut out.pending).zip([1.0, -1.0]) {
+            let (tilt, gamma, tilt_trig, pole_trig) = if k > 0.0 {
+                (tilt_positive, gamma, (tilt_sin, tilt_cos), (pole_sin, pole_cos))
+            } else {
+                (-tilt_positive, gamma_other, (-tilt_sin, tilt_cos), (-pole_sin, -pole_cos))
             };
-            let gamma = y.atan2(x);
-            // The sines and cosines from the same components (no sin_cos of the angles).
-            let tilt_trig = (s_tilt * k * rho / r, v.z / r);
-            let pole_trig = (s_pole * y / rho, x / rho);
             let (q_tilt, q_pole) = ((s_tilt * tilt, tilt_trig), (s_pole * gamma, pole_trig));
             let (primary, secondary) = if self.tilt == self.primary { (q_tilt, q_pole) } else { (q_pole, q_tilt) };
-            *slot = self.solution_trig(&pose.tip, primary, secondary);
+            let (solution, t) = self.rotary_solution(primary, secondary);
+            *slot = solution;
+            *trig = Some(t);
         }
-        Ok(IkSolutions { items, len: 2 })
+        Ok(())
     }
 
     /// The subproblem-2 vectors `(u1, u2, b, a)` for the class (see the module docs).

@@ -29,7 +29,7 @@ use crate::tol;
 pub fn unwrap_angle(raw: f64, previous: f64, limits: Option<(f64, f64)>) -> Option<(f64, bool)> {
     let turn = 2.0 * PI;
     let nearest = (previous - raw) / turn;
-    let n_near = nearest.round();
+    let n_near = crate::feed::round_fast(nearest);
     let value = raw + n_near * turn;
     let Some((lo, hi)) = limits else {
         return Some((value, false));
@@ -144,28 +144,120 @@ pub struct Selected {
     pub at_pole: bool,
 }
 
-/// Unwraps `sol` against `previous` (rotaries) and checks all strokes.
-fn admissible(machine: &Machine, sol: &IkSolution, previous: Option<&Joints>) -> Result<Selected, MachineError> {
-    let mut q = sol.joints;
-    let mut unwound = [false; 5];
-    for i in 3..5 {
-        let axis = &machine.axes()[i];
-        let prev = previous.map_or(0.0, |p| p[i]);
-        match unwrap_angle(q[i], prev, axis.joint_limits()) {
-            Some((v, u)) => {
-                q[i] = v;
-                if u && previous.is_some() {
-                    unwound[i] = true;
-                }
-            }
-            None => {
-                // No winding fits: report the shortest-path value.
-                q[i] = unwrap_angle(q[i], prev, None).map_or(q[i], |(v, _)| v);
+/// The strokes of a machine per joint, read once: the joint limits ([`Axis::joint_limits`])
+/// and the accepted range with [`tol::LIMIT_SLACK`] (infinite without limits).
+///
+/// [`Axis::joint_limits`]: crate::desc::Axis::joint_limits
+pub(crate) struct Strokes {
+    limits: [Option<(f64, f64)>; 5],
+    accepted: [(f64, f64); 5],
+}
+
+impl Strokes {
+    pub(crate) fn new(machine: &Machine) -> Strokes {
+        let mut limits = [None; 5];
+        let mut accepted = [(f64::NEG_INFINITY, f64::INFINITY); 5];
+        for (i, axis) in machine.axes().iter().enumerate().take(5) {
+            limits[i] = axis.joint_limits();
+            if let Some((lo, hi)) = limits[i] {
+                accepted[i] = (lo - tol::LIMIT_SLACK, hi + tol::LIMIT_SLACK);
             }
         }
+        Strokes { limits, accepted }
     }
-    check_limits(machine, &q, None)?;
-    Ok(Selected { joints: q, branch: sol.branch, unwound, at_pole: sol.at_pole })
+
+    /// [`check_limits`], the error built only on a violation.
+    pub(crate) fn check(&self, machine: &Machine, q: &Joints, block: Option<usize>) -> Result<(), MachineError> {
+        if self.inside(q) { Ok(()) } else { check_limits(machine, q, block) }
+    }
+
+    /// [`check_limits`] without the error: whether every joint is within its stroke.
+    fn inside(&self, q: &Joints) -> bool {
+        // Written as `!(outside)` so that a NaN passes, as in `check_limits`.
+        (0..5).all(|i| !(q[i] < self.accepted[i].0 || q[i] > self.accepted[i].1))
+    }
+}
+
+/// Unwraps `sol` against `previous` (rotaries) and checks all strokes.
+fn admissible(
+    machine: &Machine,
+    strokes: &Strokes,
+    sol: &IkSolution,
+    previous: Option<&Joints>,
+) -> Result<Selected, MachineError> {
+    admissible_with(machine, strokes, sol, unwrap_rotaries(strokes, &sol.joints, previous))
+}
+
+/// The rotaries (joints 3 and 4) of `raw` unwrapped against `previous` within their
+/// strokes, and whether each took an unwinding move; with no admissible winding, the
+/// shortest-path value (the stroke check then reports it).
+fn unwrap_rotaries(strokes: &Strokes, raw: &Joints, previous: Option<&Joints>) -> ([f64; 2], [bool; 2]) {
+    let (a, b) = (unwrap_one(strokes, raw, previous, 3), unwrap_one(strokes, raw, previous, 4));
+    ([a.0, b.0], [a.1, b.1])
+}
+
+/// Joint `i` of [`unwrap_rotaries`].
+fn unwrap_one(strokes: &Strokes, raw: &Joints, previous: Option<&Joints>, i: usize) -> (f64, bool) {
+    let prev = previous.map_or(0.0, |p| p[i]);
+    match unwrap_angle(raw[i], prev, strokes.limits[i]) {
+        Some((v, u)) => (v, u && previous.is_some()),
+        // No winding fits: report the shortest-path value.
+        None => (unwrap_angle(raw[i], prev, None).map_or(raw[i], |(v, _)| v), false),
+    }
+}
+
+/// [`admissible`] with the rotaries already unwrapped ([`unwrap_rotaries`]).
+fn admissible_with(
+    machine: &Machine,
+    strokes: &Strokes,
+    sol: &IkSolution,
+    (values, unwound): ([f64; 2], [bool; 2]),
+) -> Result<Selected, MachineError> {
+    let mut q = sol.joints;
+    q[3] = values[0];
+    q[4] = values[1];
+    if !strokes.inside(&q) {
+        check_limits(machine, &q, None)?;
+    }
+    Ok(Selected {
+        joints: q,
+        branch: sol.branch,
+        unwound: [false, false, false, unwound[0], unwound[1]],
+        at_pole: sol.at_pole,
+    })
+}
+
+/// Whether the candidate `sol` from the state `p` is dropped as a jump while cutting
+/// (spec 3.6 rule 3): its rotaries unwrapped as [`admissible`] does, a jump above
+/// `flip_threshold` that is not a pole flip (`crosses`: the tool axis crosses the pole in
+/// the block). Such a candidate is dropped whether or not its strokes hold. Also returns
+/// the unwrapped rotaries ([`unwrap_rotaries`]) of a kept candidate. `pole` is joint 3 or
+/// 4 (the rotaries), the tilt axis the other one.
+fn jumps_on_rotaries(
+    strokes: &Strokes,
+    sol: &IkSolution,
+    p: &State,
+    flip_threshold: f64,
+    pole: usize,
+    crosses: impl Fn() -> bool,
+) -> (bool, ([f64; 2], [bool; 2])) {
+    // A jump of the tilt axis (not the pole axis) drops the candidate whatever the pole
+    // axis does: decided on one unwrapping.
+    let tilt = 7 - pole;
+    let t = unwrap_one(strokes, &sol.joints, Some(&p.q), tilt);
+    if (t.0 - p.q[tilt]).abs() > flip_threshold {
+        return (true, ([0.0; 2], [false; 2]));
+    }
+    let c = unwrap_one(strokes, &sol.joints, Some(&p.q), pole);
+    let (a, b) = if tilt == 3 { (t, c) } else { (c, t) };
+    let unwrapped = ([a.0, b.0], [a.1, b.1]);
+    let dq = [unwrapped.0[0] - p.q[3], unwrapped.0[1] - p.q[4]];
+    let jump = dq.map(|d| d.abs() > flip_threshold);
+    if jump == [false, false] {
+        return (false, unwrapped);
+    }
+    let only_pole = (0..2).all(|r| jump[r] == (r + 3 == pole));
+    (!(only_pole && (p.at_pole || sol.at_pole || crosses())), unwrapped)
 }
 
 /// Velocity-limited time of the move `a -> b`: `max_j |dq_j| / vmax_j` (spec 3.5).
@@ -216,8 +308,9 @@ pub fn select(
         });
         (u8::from(!preferred), s.joints[kin.tilt_axis()].abs(), s.joints[kin.pole_axis()].abs())
     };
+    let strokes = Strokes::new(machine);
     for sol in solutions {
-        match admissible(machine, sol, previous) {
+        match admissible(machine, &strokes, sol, previous) {
             Ok(s) => {
                 let cost = previous.map_or(0.0, |p| move_time(machine, p, &s.joints));
                 let better = match &best {
@@ -430,7 +523,52 @@ pub fn plan_path(
             fix: "give one cutting flag per pose".into(),
         });
     }
+    plan_input(kin, &(poses, cutting), start, options)
+}
+
+/// The poses of a path and whether the move into each is in the material: what
+/// [`plan_path`] reads (slices, or the CL records themselves without copies).
+pub(crate) trait PathInput {
+    /// Number of poses.
+    fn len(&self) -> usize;
+    /// Pose `i`.
+    fn pose(&self, i: usize) -> &Pose;
+    /// Whether the move into pose `i` is in the material.
+    fn cutting(&self, i: usize) -> bool;
+}
+
+impl PathInput for (&[Pose], &[bool]) {
+    fn len(&self) -> usize {
+        self.0.len()
+    }
+    fn pose(&self, i: usize) -> &Pose {
+        &self.0[i]
+    }
+    fn cutting(&self, i: usize) -> bool {
+        self.1[i]
+    }
+}
+
+/// One state of the beam kept for the backtracking: the joints, how it was reached and
+/// its predecessor in the previous layer.
+#[derive(Clone, Copy, Debug)]
+struct Node {
+    q: Joints,
+    edge: Edge,
+    back: u8,
+    at_pole: bool,
+}
+
+/// [`plan_path`] on any [`PathInput`].
+pub(crate) fn plan_input(
+    kin: &Kinematics,
+    input: &impl PathInput,
+    start: Option<Joints>,
+    options: &PlanOptions,
+) -> Result<JointPath, MachineError> {
+    let n_poses = input.len();
     let machine = kin.machine();
+    let strokes = Strokes::new(machine);
     let pole = kin.pole_axis();
     let pole_dir = pole_direction(kin);
     let eps = machine.pole_eps();
@@ -442,69 +580,118 @@ pub fn plan_path(
         back: 0,
         edge: Edge::Plain,
     };
-    // The layers in one arena: layer i is `arena[offsets[i]..offsets[i + 1]]` (no
-    // allocation per pose); `next` is reused.
-    let mut arena: Vec<State> = Vec::with_capacity(poses.len() * 2);
-    let mut offsets: Vec<usize> = Vec::with_capacity(poses.len() + 1);
+    // The layers' nodes in one arena: layer i is `arena[offsets[i]..offsets[i + 1]]` (no
+    // allocation per pose); the full states of the previous and the next layer in two
+    // reused vectors.
+    let mut arena: Vec<Node> = Vec::with_capacity(n_poses + n_poses / 4);
+    let mut offsets: Vec<u32> = Vec::with_capacity(n_poses + 1);
     offsets.push(0);
     let mut next: Vec<State> = Vec::new();
-    for (i, pose) in poses.iter().enumerate() {
-        let preds: &[State] = if i == 0 { std::slice::from_ref(&root) } else { &arena[offsets[i - 1]..offsets[i]] };
-        next.clear();
+    let mut previous: Vec<State> = vec![root];
+    // The inverse of the current pose, reused pose after pose.
+    let mut shared = crate::ik::LazyIk::empty();
+    for i in 0..n_poses {
+        let pose = input.pose(i);
+        let preds: &[State] = &previous;
         let mut first_error: Option<MachineError> = None;
         let mut smallest_jump: Option<(usize, f64)> = None;
-        // Off the pole the inverse does not depend on the held joints: solve once.
-        let shared = kin.ik(pose, &preds[0].q).map_err(|e| e.at_block(i))?;
-        let polar = shared.as_slice().iter().any(|s| s.at_pole) || kin.solver() == crate::chain::Solver::Numeric;
-        for (pi, p) in preds.iter().enumerate() {
-            let sols = if polar && pi > 0 { kin.ik(pose, &p.q).map_err(|e| e.at_block(i))? } else { shared };
-            for sol in sols.as_slice() {
-                let has_previous = i > 0 || start.is_some();
-                let cand = match admissible(machine, sol, has_previous.then_some(&p.q)) {
-                    Ok(c) => c,
-                    Err(e) => {
-                        first_error.get_or_insert(e.at_block(i));
-                        continue;
-                    }
-                };
-                let (cost, edge) = if has_previous {
-                    let dq = cand.joints - p.q;
-                    let t = move_time(machine, &p.q, &cand.joints);
-                    let jump = [3, 4].map(|j| dq[j].abs() > options.flip_threshold);
-                    if jump == [false, false] {
-                        (t, Edge::Plain)
-                    } else {
-                        let only_pole = (0..2).all(|r| jump[r] == (r + 3 == pole));
-                        let crosses = p.at_pole
-                            || cand.at_pole
-                            || (i > 0 && arc_passes(&poses[i - 1].axis, &pose.axis, &pole_dir, eps));
-                        if only_pole && crosses {
-                            (t, Edge::PoleFlip)
-                        } else if cutting[i] {
-                            let j = if dq[3].abs() >= dq[4].abs() { 3 } else { 4 };
-                            if smallest_jump.is_none_or(|(_, d)| dq[j].abs() < d) {
-                                smallest_jump = Some((j, dq[j].abs()));
-                            }
-                            continue;
-                        } else {
-                            let j = if dq[3].abs() >= dq[4].abs() { 3 } else { 4 };
-                            (t + options.reorient_penalty, Edge::Reorient(j))
-                        }
-                    }
+        // Off the pole the inverse does not depend on the held joints: solve once (the
+        // position step of each branch only when a candidate needs it).
+        kin.ik_lazy(pose, &preds[0].q, &mut shared).map_err(|e| e.at_block(i))?;
+        let polar = shared.sols.as_slice().iter().any(|s| s.at_pole) || kin.solver() == crate::chain::Solver::Numeric;
+        // A candidate that jumps while cutting is dropped on its rotary values alone,
+        // before its linear joints are solved and its strokes checked: kept candidates are
+        // the same. When that leaves the layer empty, it is expanded again without the
+        // shortcut, for the error the full checks give.
+        for shortcut in [true, false] {
+            next.clear();
+            let mut dropped = false;
+            for (pi, p) in preds.iter().enumerate() {
+                let mut own;
+                let sols = if polar && pi > 0 {
+                    own = crate::ik::LazyIk::complete(kin.ik(pose, &p.q).map_err(|e| e.at_block(i))?);
+                    &mut own
                 } else {
-                    (0.0, Edge::Plain)
+                    &mut shared
                 };
-                let first = if i == 0 { preference_key(kin, &cand.joints) } else { p.first };
-                let state = State { q: cand.joints, at_pole: cand.at_pole, cost: p.cost + cost, first, back: pi, edge };
-                match next.iter_mut().find(|s| (s.q - state.q).amax() < tol::SAME_JOINTS) {
-                    Some(existing) => {
-                        if better(&state, existing) {
-                            *existing = state;
+                let has_previous = i > 0 || start.is_some();
+                for k in 0..sols.sols.as_slice().len() {
+                    let mut unwrapped = None;
+                    if shortcut && has_previous && input.cutting(i) {
+                        let (jumps, u) = jumps_on_rotaries(
+                            &strokes,
+                            &sols.sols.as_slice()[k],
+                            p,
+                            options.flip_threshold,
+                            pole,
+                            || i > 0 && arc_passes(&input.pose(i - 1).axis, &pose.axis, &pole_dir, eps),
+                        );
+                        if jumps {
+                            dropped = true;
+                            continue;
                         }
+                        unwrapped = Some(u);
                     }
-                    None => next.push(state),
+                    kin.complete(sols, k);
+                    let sol = &sols.sols.as_slice()[k];
+                    let checked = match unwrapped {
+                        Some(u) => admissible_with(machine, &strokes, sol, u),
+                        None => admissible(machine, &strokes, sol, has_previous.then_some(&p.q)),
+                    };
+                    let cand = match checked {
+                        Ok(c) => c,
+                        Err(e) => {
+                            first_error.get_or_insert(e.at_block(i));
+                            continue;
+                        }
+                    };
+                    let (cost, edge) = if has_previous {
+                        let dq = cand.joints - p.q;
+                        let jump = [3, 4].map(|j| dq[j].abs() > options.flip_threshold);
+                        // The move time only for candidates that are kept (a jump while
+                        // cutting is dropped before it is needed).
+                        let t = || move_time(machine, &p.q, &cand.joints);
+                        if jump == [false, false] {
+                            (t(), Edge::Plain)
+                        } else {
+                            let only_pole = (0..2).all(|r| jump[r] == (r + 3 == pole));
+                            let crosses = p.at_pole
+                                || cand.at_pole
+                                || (i > 0 && arc_passes(&input.pose(i - 1).axis, &pose.axis, &pole_dir, eps));
+                            if only_pole && crosses {
+                                (t(), Edge::PoleFlip)
+                            } else if input.cutting(i) {
+                                let j = if dq[3].abs() >= dq[4].abs() { 3 } else { 4 };
+                                if smallest_jump.is_none_or(|(_, d)| dq[j].abs() < d) {
+                                    smallest_jump = Some((j, dq[j].abs()));
+                                }
+                                continue;
+                            } else {
+                                let j = if dq[3].abs() >= dq[4].abs() { 3 } else { 4 };
+                                (t() + options.reorient_penalty, Edge::Reorient(j))
+                            }
+                        }
+                    } else {
+                        (0.0, Edge::Plain)
+                    };
+                    let first = if i == 0 { preference_key(kin, &cand.joints) } else { p.first };
+                    let state =
+                        State { q: cand.joints, at_pole: cand.at_pole, cost: p.cost + cost, first, back: pi, edge };
+                    match next.iter_mut().find(|s| (s.q - state.q).amax() < tol::SAME_JOINTS) {
+                        Some(existing) => {
+                            if better(&state, existing) {
+                                *existing = state;
+                            }
+                        }
+                        None => next.push(state),
+                    }
                 }
             }
+            if !(next.is_empty() && dropped) {
+                break;
+            }
+            first_error = None;
+            smallest_jump = None;
         }
         if next.is_empty() {
             if let Some((j, d)) = smallest_jump {
@@ -530,25 +717,33 @@ pub fn plan_path(
             }
         });
         next.truncate(tol::PLAN_BEAM);
-        arena.extend_from_slice(&next);
-        offsets.push(arena.len());
+        arena.extend(next.iter().map(|s| Node {
+            q: s.q,
+            edge: s.edge,
+            // INVARIANT: `back` indexes the previous layer, at most PLAN_BEAM states.
+            back: u8::try_from(s.back).unwrap_or(u8::MAX),
+            at_pole: s.at_pole,
+        }));
+        // INVARIANT: a path has fewer than 2^32 / PLAN_BEAM poses.
+        offsets.push(u32::try_from(arena.len()).unwrap_or(u32::MAX));
+        std::mem::swap(&mut previous, &mut next);
     }
-    let layers = offsets.windows(2).map(|w| &arena[w[0]..w[1]]);
+    let layers = offsets.windows(2).map(|w| &arena[w[0] as usize..w[1] as usize]);
     // Backtrack from the best final state.
-    let mut chain: Vec<&State> = Vec::with_capacity(poses.len());
+    let mut chain: Vec<&Node> = Vec::with_capacity(n_poses);
     if let Some(last) = layers.clone().next_back() {
         let mut idx = 0; // layers are sorted: the best is first
         for layer in layers.rev() {
             let s = &layer[idx];
             chain.push(s);
-            idx = s.back;
+            idx = usize::from(s.back);
         }
-        debug_assert_eq!(chain.len(), poses.len());
+        debug_assert_eq!(chain.len(), n_poses);
         debug_assert!(!last.is_empty());
     }
     chain.reverse();
-    let mut joints = Vec::with_capacity(poses.len() + 2);
-    let mut pose_index = Vec::with_capacity(poses.len() + 2);
+    let mut joints = Vec::with_capacity(n_poses + 2);
+    let mut pose_index = Vec::with_capacity(n_poses + 2);
     let mut events = Vec::new();
     for (i, s) in chain.iter().enumerate() {
         let prev = if i == 0 { start } else { Some(chain[i - 1].q) };
@@ -566,13 +761,13 @@ pub fn plan_path(
                     // Turn in place at the previous (polar) pose.
                     let mut q = pq;
                     q[pole] = s.q[pole];
-                    kin.solve_linear(&poses[i - 1].tip, &mut q);
+                    kin.solve_linear(&input.pose(i - 1).tip, &mut q);
                     joints.push(q);
                     pose_index.push(i - 1);
                 } else if s.at_pole {
                     let mut q = s.q;
                     q[pole] = pq[pole];
-                    kin.solve_linear(&poses[i].tip, &mut q);
+                    kin.solve_linear(&input.pose(i).tip, &mut q);
                     joints.push(q);
                     pose_index.push(i);
                 }

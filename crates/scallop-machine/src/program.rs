@@ -7,8 +7,8 @@
 
 use crate::chain::{Joints, Kinematics, Pose};
 use crate::error::MachineError;
-use crate::feed::{deviation, inverse_time_feed, subdivide};
-use crate::plan::{Event, PlanOptions, check_limits, move_time, plan_path};
+use crate::feed::{BlockEnd, deviation, inverse_time_feed, subdivide_into};
+use crate::plan::{Event, PlanOptions, check_limits, move_time};
 use crate::tol;
 
 /// What a CL move is (spec 1.1).
@@ -143,7 +143,7 @@ pub struct MachineProgram {
 /// ```
 ///
 /// # Errors
-/// As [`plan_path`] (limit violations name the block and the axis), and
+/// As [`plan_path`](crate::plan::plan_path) (limit violations name the block and the axis), and
 /// [`MachineError::SubdivisionFailed`].
 pub fn to_program(
     kin: &Kinematics,
@@ -152,9 +152,7 @@ pub fn to_program(
     options: &ProgramOptions,
 ) -> Result<MachineProgram, MachineError> {
     let machine = kin.machine();
-    let poses: Vec<Pose> = records.iter().map(|r| r.pose).collect();
-    let cutting: Vec<bool> = records.iter().map(|r| r.motion.is_cutting()).collect();
-    let path = plan_path(kin, &poses, &cutting, start, &options.plan)?;
+    let path = crate::plan::plan_input(kin, &Records(records), start, &options.plan)?;
     let words = |q: &Joints| {
         let mut w = [0.0; 5];
         for (i, a) in machine.axes().iter().enumerate() {
@@ -163,21 +161,31 @@ pub fn to_program(
         w
     };
     let mut blocks: Vec<ProgramBlock> = Vec::with_capacity(path.joints.len());
-    let mut previous: Option<(Pose, Joints)> = start.map(|q| (kin.fk(&q), q));
+    // The machine state before the first block; afterwards the previous block's end is
+    // read in place (no copies of poses and joints per block).
+    let before: Option<(Pose, Joints)> = start.map(|q| (kin.fk(&q), q));
+    let strokes = crate::plan::Strokes::new(machine);
+    // Block ends of one CL move, reused move after move.
+    let mut ends: Vec<BlockEnd> = Vec::new();
     for (q, &i) in path.joints.iter().zip(&path.pose_index) {
         let rec = &records[i];
-        let ends = match (rec.motion, previous) {
-            (Motion::Rapid, _) | (_, None) => vec![crate::feed::BlockEnd { pose: rec.pose, joints: *q }],
+        ends.clear();
+        let previous = blocks.last().map(|b| (&b.pose, &b.joints)).or(before.as_ref().map(|(p, q)| (p, q)));
+        match (rec.motion, previous) {
+            (Motion::Rapid, _) | (_, None) => ends.push(BlockEnd { pose: rec.pose, joints: *q }),
             // In-place rotations (pole flips) are subdivided too: joint-linear X/Y/C
             // motion does not keep the tip still.
-            (_, Some((pa, qa))) => subdivide(kin, &pa, &rec.pose, &qa, q, options.tol_pos, options.tol_ang, i)?,
-        };
-        for end in ends {
-            check_limits(machine, &end.joints, Some(i))?;
+            (_, Some((pa, qa))) => {
+                subdivide_into(kin, (pa, qa), (&rec.pose, q), (options.tol_pos, options.tol_ang), i, &mut ends)?;
+            }
+        }
+        for end in &ends {
+            strokes.check(machine, &end.joints, Some(i))?;
+            let previous = blocks.last().map(|b| (&b.pose, &b.joints)).or(before.as_ref().map(|(p, q)| (p, q)));
             let inverse_time = match (rec.motion, previous) {
                 (Motion::Rapid, _) | (_, None) => None,
                 _ if !machine.nc().inverse_time => None,
-                (_, Some((pa, qa))) => Some(inverse_time_feed(kin, &pa, &end.pose, &qa, &end.joints, rec.feed)),
+                (_, Some((pa, qa))) => Some(inverse_time_feed(kin, pa, &end.pose, qa, &end.joints, rec.feed)),
             };
             blocks.push(ProgramBlock {
                 motion: rec.motion,
@@ -188,7 +196,6 @@ pub fn to_program(
                 inverse_time,
                 cl_index: i,
             });
-            previous = Some((end.pose, end.joints));
         }
     }
     Ok(MachineProgram {
@@ -196,6 +203,21 @@ pub fn to_program(
         blocks,
         events: path.events,
     })
+}
+
+/// The CL records as the planner's input (no copies of the poses).
+struct Records<'a>(&'a [ClRecord]);
+
+impl crate::plan::PathInput for Records<'_> {
+    fn len(&self) -> usize {
+        self.0.len()
+    }
+    fn pose(&self, i: usize) -> &Pose {
+        &self.0[i].pose
+    }
+    fn cutting(&self, i: usize) -> bool {
+        self.0[i].motion.is_cutting()
+    }
 }
 
 /// What [`verify`] measured.

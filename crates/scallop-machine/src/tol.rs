@@ -128,3 +128,11 @@ pub const RELAXED_AXIS_FACTOR: f64 = 1e9;
 /// Largest total rotation of one block (rad) for which `feed::deviation_bound` holds
 /// (its distance bound needs `3 Omega < 1`); larger blocks are sampled.
 pub const BOUND_MAX_ROTATION: f64 = 0.3;
+
+/// Relative and absolute (mm) inflation of the trigonometry-free distance bound of
+/// `feed::deviation_bound_relaxed`, so that it also bounds the rounded exact distance.
+pub const BOUND_PRETEST_SLACK: f64 = 1e-9;
+
+/// Relative inflation of the atan-free upper bound `r_ref tan(phi) / F` of the rotation
+/// term of `feed::inverse_time_feed` (covers the rounding of the exact term, a few ulps).
+pub const ROTATION_TERM_SLACK: f64 = 1e-12;

@@ -1,8 +1,10 @@
 //! `feed::deviation_bound` is an upper bound of the sampled deviation of joint-linear
-//! motion, on every shipped machine, for random blocks of every size the bound accepts.
+//! motion, on every shipped machine, for random blocks of every size the bound accepts;
+//! `feed::deviation_bound_relaxed` (the subdivision's trigonometry-free pretest) is never
+//! below it.
 
 use proptest::prelude::*;
-use scallop_machine::feed::{deviation, deviation_bound};
+use scallop_machine::feed::{deviation, deviation_bound, deviation_bound_relaxed};
 use scallop_machine::{AxisKind, Joints, Kinematics, Machine};
 
 fn joints_in_strokes(m: &Machine, unit: &[f64; 5]) -> Joints {
@@ -36,6 +38,35 @@ proptest! {
             let (pos, ang) = deviation(&kin, &kin.fk(&qa), &kin.fk(&qb), &qa, &qb);
             prop_assert!(pos <= bp * (1.0 + 1e-9) + 1e-12, "tip {pos} > bound {bp}");
             prop_assert!(ang <= ba * (1.0 + 1e-9) + 1e-12, "axis {ang} > bound {ba}");
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(400))]
+    #[test]
+    fn the_relaxed_bound_is_never_below_the_exact_bound(
+        machine in 0usize..16,
+        start in prop::array::uniform5(0.0f64..1.0),
+        step in prop::array::uniform5(-1.0f64..1.0),
+        scale in prop::sample::select(vec![1e-4, 1e-3, 1e-2, 0.05, 0.1]),
+        tool_length in 0.0f64..150.0,
+    ) {
+        let names = Machine::builtin_names();
+        let m = Machine::builtin(names[machine % names.len()]).expect("shipped");
+        let kin = Kinematics::new(&m, tool_length);
+        let qa = joints_in_strokes(&m, &start);
+        let mut qb = qa;
+        for (i, a) in m.axes().iter().enumerate().take(5) {
+            qb[i] += step[i] * scale * if a.kind == AxisKind::Rotary { 1.0 } else { 100.0 };
+        }
+        match (deviation_bound(&kin, &qa, &qb), deviation_bound_relaxed(&kin, &qa, &qb)) {
+            (Some((bp, ba)), Some((rp, ra))) => {
+                prop_assert!(rp >= bp, "relaxed tip bound {rp} < exact {bp}");
+                prop_assert!(ra >= ba, "relaxed axis bound {ra} < exact {ba}");
+            }
+            (None, None) => {}
+            (exact, relaxed) => prop_assert!(false, "exact {exact:?} but relaxed {relaxed:?}"),
         }
     }
 }

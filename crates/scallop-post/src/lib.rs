@@ -94,13 +94,15 @@ fn fmt_number_exact(v: f64, decimals: usize) -> String {
 /// value is an exact integer range. `None` sends the caller to the
 /// exact formatter. The text is written at the end of `bytes`, from the returned index.
 fn number_fast(bytes: &mut [u8; 32], v: f64, decimals: usize) -> Option<usize> {
-    const POW10_U64: [u64; 10] =
-        [1, 10, 100, 1_000, 10_000, 100_000, 1_000_000, 10_000_000, 100_000_000, 1_000_000_000];
-    const DIGIT_PAIRS: &[u8; 200] = b"0001020304050607080910111213141516171819\
-        2021222324252627282930313233343536373839\
-        4041424344454647484950515253545556575859\
-        6061626364656667686970717273747576777879\
-        8081828384858687888990919293949596979899";
+    scaled_key(v, decimals).map(|key| write_key(bytes, key, decimals))
+}
+
+/// The number `fmt_number(v, decimals)` writes, as a signed integer in units of the last
+/// digit (`-0` is `0`), where the integer fast path answers (see [`number_fast`]): two
+/// values format to the same text exactly when their keys are equal, so modal words are
+/// compared without formatting.
+#[inline]
+pub(crate) fn scaled_key(v: f64, decimals: usize) -> Option<i64> {
     const POW10: [f64; 10] = [1.0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9];
     let &scale = POW10.get(decimals)?;
     let x = v.abs() * scale;
@@ -108,21 +110,148 @@ fn number_fast(bytes: &mut [u8; 32], v: f64, decimals: usize) -> Option<usize> {
     if x.is_nan() || x >= 1e9 {
         return None;
     }
-    let floor = x.floor();
-    let frac = x - floor;
+    // 0 <= x < 1e9: truncation is the floor, and both conversions are exact.
+    #[allow(clippy::cast_possible_truncation, reason = "0 <= x < 1e9")]
+    let floor = x as i64;
+    #[allow(clippy::cast_precision_loss, reason = "below 1e9, exact")]
+    let frac = x - floor as f64;
     if (frac - 0.5).abs() < tol::FAST_FORMAT_TIE_MARGIN {
         return None;
     }
-    let mut n = if frac > 0.5 { floor + 1.0 } else { floor } as u64;
+    let n = floor + i64::from(frac > 0.5);
+    Some(if v < 0.0 { -n } else { n })
+}
+
+/// `x.round()` (half away from zero, signed zero kept) without the library call for
+/// |x| < 2^52, where truncation and the fraction are exact.
+#[inline]
+pub(crate) fn round_fast(x: f64) -> f64 {
+    if x.abs() < 4_503_599_627_370_496.0 {
+        #[allow(clippy::cast_possible_truncation, clippy::cast_precision_loss, reason = "|x| < 2^52, exact")]
+        let t = x as i64 as f64;
+        let f = x - t;
+        let r = if f >= 0.5 {
+            t + 1.0
+        } else if f <= -0.5 {
+            t - 1.0
+        } else {
+            t
+        };
+        r.copysign(x)
+    } else {
+        x.round()
+    }
+}
+
+/// `x.floor()` (signed zero kept) without the library call for |x| < 2^52.
+#[inline]
+pub(crate) fn floor_fast(x: f64) -> f64 {
+    if x.abs() < 4_503_599_627_370_496.0 {
+        #[allow(clippy::cast_possible_truncation, clippy::cast_precision_loss, reason = "|x| < 2^52, exact")]
+        let t = x as i64 as f64;
+        let r = if t > x { t - 1.0 } else { t };
+        r.copysign(x)
+    } else {
+        x.floor()
+    }
+}
+
+/// Appends a prefix (the last `prefix_len` bytes of `prefix`: a space, a word letter, a
+/// `+`) and the number of a [`scaled_key`] with `decimals` digits: the hot path of every
+/// motion block. For 3 and 4 decimals and fewer than 8 digits, [`push_token_dec`]; other
+/// cases go through [`push_key`].
+#[inline(always)]
+pub(crate) fn push_token_key(out: &mut Vec<u8>, prefix: [u8; 4], prefix_len: usize, key: i64, decimals: usize) {
+    if key.unsigned_abs() < 100_000_000 && prefix_len <= 4 {
+        match decimals {
+            3 => return push_token_dec::<3>(out, prefix, prefix_len, key),
+            4 => return push_token_dec::<4>(out, prefix, prefix_len, key),
+            _ => {}
+        }
+    }
+    out.extend_from_slice(&prefix[4 - prefix_len.min(4)..]);
+    push_key(out, key, decimals);
+}
+
+/// [`push_token_key`] for `D` decimals (3 or 4) and `|key| < 1e8`: the eight digits of
+/// `|key|` (leading zeros included) are computed at once in the lanes of a `u64` (two
+/// 4-digit lanes, then four 2-digit lanes, then eight 1-digit lanes, by multiplications
+/// that divide every lane by 100 and 10 without carries between lanes), the point is
+/// inserted, the integer part's leading zeros are skipped, and the token (at most 16
+/// bytes with its prefix and sign) is appended with one fixed-length copy.
+#[inline(always)]
+fn push_token_dec<const D: usize>(out: &mut Vec<u8>, prefix: [u8; 4], prefix_len: usize, key: i64) {
+    let n = key.unsigned_abs();
+    let merged = (n / 10_000) | ((n % 10_000) << 32);
+    let hundreds = ((merged * 10_486) >> 20) & 0x0000_007f_0000_007f;
+    let merged = hundreds | ((merged - 100 * hundreds) << 16);
+    let tens = ((merged * 103) >> 10) & 0x000f_000f_000f_000f;
+    let merged = tens | ((merged - 10 * tens) << 8);
+    let digits = (merged + 0x3030_3030_3030_3030).to_le_bytes();
+    let int = n / if D == 3 { 1_000 } else { 10_000 };
+    let int_len =
+        1 + usize::from(int >= 10) + usize::from(int >= 100) + usize::from(int >= 1_000) + usize::from(int >= 10_000);
+    let mut buf = [0u8; 40];
+    buf[16..24].copy_from_slice(&digits);
+    buf[24 - D] = b'.';
+    buf[25 - D..25].copy_from_slice(&digits[8 - D..]);
+    let mut start = 24 - D - int_len;
+    if key < 0 {
+        start -= 1;
+        buf[start] = b'-';
+    }
+    buf[start - 4..start].copy_from_slice(&prefix);
+    start -= prefix_len;
+    let len = out.len() + 25 - start;
+    out.extend_from_slice(&buf[start..start + 16]);
+    out.truncate(len);
+}
+
+/// Appends the number of a [`scaled_key`] with `decimals` digits.
+#[inline]
+pub(crate) fn push_key(out: &mut Vec<u8>, key: i64, decimals: usize) {
+    // A key is below 1e9 + 1 in magnitude: at most 10 digits, the point and the sign, so
+    // the number ends at byte 32 and starts at byte 20 or later. A fixed-length copy of
+    // 16 bytes (inlined, no memcpy call) followed by a truncation appends exactly it.
+    let mut bytes = [0u8; 48];
+    let mut head = [0u8; 32];
+    let at = write_key(&mut head, key, decimals);
+    if at < 20 {
+        out.extend_from_slice(&head[at..]);
+        return;
+    }
+    bytes[..32].copy_from_slice(&head);
+    let len = out.len() + 32 - at;
+    out.extend_from_slice(&bytes[at..at + 16]);
+    out.truncate(len);
+}
+
+/// Writes the number of a [`scaled_key`] with `decimals` digits at the end of `bytes`;
+/// returns the index of its first byte.
+pub(crate) fn write_key(bytes: &mut [u8; 32], key: i64, decimals: usize) -> usize {
+    const POW10_U64: [u64; 10] =
+        [1, 10, 100, 1_000, 10_000, 100_000, 1_000_000, 10_000_000, 100_000_000, 1_000_000_000];
+    const DIGIT_PAIRS: &[u8; 200] = b"0001020304050607080910111213141516171819\
+        2021222324252627282930313233343536373839\
+        4041424344454647484950515253545556575859\
+        6061626364656667686970717273747576777879\
+        8081828384858687888990919293949596979899";
+    let n = key.unsigned_abs();
     // Written right to left into a stack buffer: at least decimals + 1 digits (leading
-    // zeros), the point, the sign; then appended in one copy.
+    // zeros), the point, the sign; then appended in one copy. Constant divisors (no
+    // hardware division) for the usual decimals.
+    let (mut n, mut f) = match decimals {
+        0 => (n, 0),
+        1 => (n / 10, n % 10),
+        2 => (n / 100, n % 100),
+        3 => (n / 1_000, n % 1_000),
+        4 => (n / 10_000, n % 10_000),
+        _ => (n / POW10_U64[decimals], n % POW10_U64[decimals]),
+    };
     let mut at = bytes.len();
-    let nonzero = n != 0;
     let mut k = 0;
     if decimals > 0 {
         // The fraction digits, two at a time, then the point.
-        let mut f = n % POW10_U64[decimals];
-        n /= POW10_U64[decimals];
         while k + 2 <= decimals {
             let pair = (f % 100) as usize;
             f /= 100;
@@ -137,20 +266,25 @@ fn number_fast(bytes: &mut [u8; 32], v: f64, decimals: usize) -> Option<usize> {
         at -= 1;
         bytes[at] = b'.';
     }
-    // The integer digits (at least one).
-    loop {
-        at -= 1;
-        bytes[at] = b'0' + (n % 10) as u8;
-        n /= 10;
-        if n == 0 {
-            break;
-        }
+    // The integer digits (at least one), two at a time.
+    while n >= 100 {
+        let pair = (n % 100) as usize;
+        n /= 100;
+        at -= 2;
+        bytes[at..at + 2].copy_from_slice(&DIGIT_PAIRS[2 * pair..2 * pair + 2]);
     }
-    if v < 0.0 && nonzero {
+    if n >= 10 {
+        at -= 2;
+        bytes[at..at + 2].copy_from_slice(&DIGIT_PAIRS[2 * n as usize..2 * n as usize + 2]);
+    } else {
+        at -= 1;
+        bytes[at] = b'0' + n as u8;
+    }
+    if key < 0 {
         at -= 1;
         bytes[at] = b'-';
     }
-    Some(at)
+    at
 }
 
 /// Writes `path` as G-code. `comments` go into the header (one line each).
@@ -196,7 +330,40 @@ pub fn write_gcode(path: &Toolpath, dialect: &Dialect, comments: &[&str], out: &
 
 #[cfg(test)]
 mod tests {
-    use super::fmt_number;
+    use super::{floor_fast, fmt_number, push_key, push_token_key, round_fast, scaled_key};
+
+    #[test]
+    fn keys_format_as_the_exact_formatter_and_the_fast_roundings_equal_the_library() {
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        for _ in 0..100_000 {
+            let magnitude = 10f64.powi(i32::try_from(next() % 16).unwrap_or(0) - 6);
+            let v = ((next() >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 2.0 * magnitude;
+            for d in [0, 1, 3, 4, 6, 9] {
+                if let Some(key) = scaled_key(v, d) {
+                    let exact = fmt_number(v, d);
+                    let mut out = b"X".to_vec();
+                    push_key(&mut out, key, d);
+                    assert_eq!(out[1..], *exact.as_bytes(), "{v:e} at {d}");
+                    out.clear();
+                    push_token_key(&mut out, [0, b' ', b'X', b'+'], 3, key, d);
+                    assert_eq!(out, format!(" X+{exact}").into_bytes(), "{v:e} at {d}");
+                    out.clear();
+                    push_token_key(&mut out, [b'a', b'b', b'c', b'Y'], 1, key, d);
+                    assert_eq!(out, format!("Y{exact}").into_bytes(), "{v:e} at {d}");
+                }
+            }
+            for x in [v, v * 1e3, v + 0.5, -v - 0.5, v.trunc() + 0.5, -0.0, 0.0, 4.6e15, -4.6e15] {
+                assert_eq!(round_fast(x).to_bits(), x.round().to_bits(), "round {x:e}");
+                assert_eq!(floor_fast(x).to_bits(), x.floor().to_bits(), "floor {x:e}");
+            }
+        }
+    }
 
     fn exact(v: f64, decimals: usize) -> String {
         let s = format!("{v:.decimals$}");

@@ -82,8 +82,8 @@ pub(crate) fn pow10i(e: i32) -> f64 {
 /// Rounds `v` down to `decimals` (an exactly representable value is kept).
 pub(crate) fn round_down(v: f64, decimals: usize) -> f64 {
     let s = pow10i(i32::try_from(decimals).unwrap_or(9));
-    let r = (v * s).round();
-    if ((v * s) - r).abs() <= tol::ROUNDING_SLACK * r.abs().max(1.0) { r / s } else { (v * s).floor() / s }
+    let r = crate::round_fast(v * s);
+    if ((v * s) - r).abs() <= tol::ROUNDING_SLACK * r.abs().max(1.0) { r / s } else { crate::floor_fast(v * s) / s }
 }
 
 /// Rounds `v` up to `decimals` (an exactly representable value is kept).
@@ -132,6 +132,19 @@ pub fn program_text(
     kin: &Kinematics,
     dialect: &Dialect,
     params: &PostParams,
+) -> Result<String, PostError> {
+    program_text_with(program, kin, dialect, params, true)
+}
+
+/// [`program_text`]; `fast: false` writes every block through the general path with
+/// modal words compared as formatted text (the reference the fast paths are tested
+/// against).
+fn program_text_with(
+    program: &MachineProgram,
+    kin: &Kinematics,
+    dialect: &Dialect,
+    params: &PostParams,
+    fast: bool,
 ) -> Result<String, PostError> {
     let machine = kin.machine();
     let unsupported =
@@ -188,6 +201,7 @@ pub fn program_text(
         ],
     };
     let mut e = Emitter::new(dialect);
+    e.fast = fast;
     for c in &dialect.header_comments {
         e.comment(&vars.render(c));
     }
@@ -230,10 +244,48 @@ pub fn program_text(
     };
     let mut previous: Option<&ProgramBlock> = None;
     let mut plane: Option<(Vec3, Rotation3<f64>)> = None;
-    // One token string per written axis, reused block after block (no allocation per token).
-    let mut words: Vec<(&str, Vec<u8>)> = (0..machine.axes().len())
-        .filter(|&i| write_axis[i])
-        .map(|i| (letters[i].as_str(), Vec::with_capacity(24)))
+    // One word per written axis, reused block after block: numbers are compared with the
+    // modal words as scaled integers and formatted only when written.
+    let written: Vec<usize> = (0..machine.axes().len()).filter(|&i| write_axis[i]).collect();
+    let mut words: Vec<Word> = written.iter().map(|&i| Word::new(letters[i].as_str())).collect();
+    let modulo: Vec<usize> = (0..machine.axes().len())
+        .filter(|&i| machine.axes()[i].kind == AxisKind::Rotary && machine.axes()[i].wrap != Wrap::Absolute)
+        .collect();
+    let caps = RateCaps::new(machine, dialect);
+    // Joint-space output whose words are all joint words with one-letter names: the
+    // steady-state G93 blocks go through `Emitter::joint_block`.
+    let fast_joint: Option<(Vec<u8>, Vec<usize>)> = (fast && mode == OutputMode::Joint && written.len() <= 5)
+        .then(|| {
+            written
+                .iter()
+                .map(|&i| {
+                    let axis = &machine.axes()[i];
+                    let dec = match axis.kind {
+                        AxisKind::Linear => dialect.decimals,
+                        AxisKind::Rotary if axis.wrap == Wrap::Absolute => dialect.rotary_decimals,
+                        AxisKind::Rotary => return None,
+                    };
+                    match letters[i].as_bytes() {
+                        &[l] => Some((l, dec)),
+                        _ => None,
+                    }
+                })
+                .collect::<Option<Vec<(u8, usize)>>>()
+        })
+        .flatten()
+        .map(|v| v.into_iter().unzip());
+    // Per written word: the decimals when it is the joint word itself (joint-space output
+    // of a linear or absolute rotary axis), the common case decided once.
+    let joint_decimals: Vec<Option<usize>> = written
+        .iter()
+        .map(|&i| {
+            let axis = &machine.axes()[i];
+            match axis.kind {
+                AxisKind::Linear if mode != OutputMode::Tcp => Some(dialect.decimals),
+                AxisKind::Rotary if axis.wrap == Wrap::Absolute => Some(dialect.rotary_decimals),
+                _ => None,
+            }
+        })
         .collect();
     for b in &program.blocks {
         if planes {
@@ -266,32 +318,14 @@ pub fn program_text(
             previous = Some(b);
             continue;
         }
-        let pieces = previous.map_or(1, |p| pieces(machine, p, b));
+        let pieces = previous.map_or(1, |p| pieces(&modulo, p, b));
         for piece in 1..=pieces {
             let s = f64::from(piece) / f64::from(pieces);
-            let (words_a, tip_a) = previous.map_or((b.words, b.pose.tip), |p| (p.words, p.pose.tip));
+            let (words_a, tip_a) = match previous {
+                Some(p) => (&p.words, &p.pose.tip),
+                None => (&b.words, &b.pose.tip),
+            };
             let word_at = |i: usize| words_a[i] + (b.words[i] - words_a[i]) * s;
-            let tip: Point3 = tip_a + (b.pose.tip - tip_a) * s;
-            let mut slot = 0;
-            for i in 0..machine.axes().len() {
-                if !write_axis[i] {
-                    continue;
-                }
-                let axis = &machine.axes()[i];
-                let w = word_at(i);
-                let token = &mut words[slot].1;
-                slot += 1;
-                match axis.kind {
-                    AxisKind::Linear if mode == OutputMode::Tcp => {
-                        e.token_into(token, &letters[i], tip[linear_component(i)?], dialect.decimals);
-                    }
-                    AxisKind::Linear => e.token_into(token, &letters[i], w, dialect.decimals),
-                    AxisKind::Rotary => {
-                        let before = word_at_prev(&words_a, &b.words, i, piece, pieces);
-                        e.rotary_into(token, &letters[i], w, w - before, axis.wrap);
-                    }
-                }
-            }
             let feed = match (b.motion, previous) {
                 (Motion::Rapid, _) => FeedWord::Rapid,
                 (_, None) => FeedWord::PerMinute(b.feed),
@@ -300,7 +334,7 @@ pub fn program_text(
                     let f_inv = b.inverse_time.unwrap_or_else(|| {
                         scallop_machine::feed::inverse_time_feed(kin, &p.pose, &b.pose, &p.joints, &b.joints, b.feed)
                     }) * f64::from(pieces);
-                    let f_inv = rounding_cap(machine, dialect, &p.words, &b.words, pieces, f_inv);
+                    let f_inv = caps.cap(&p.words, &b.words, pieces, f_inv);
                     match dialect.feed_by_time {
                         FeedByTime::G93 => FeedWord::InverseTime(f_inv),
                         FeedByTime::BlockSeconds => FeedWord::Seconds(60.0 / f_inv),
@@ -312,7 +346,39 @@ pub fn program_text(
                     }
                 }
             };
-            e.motion_tokens(&words, feed);
+            if let (Some((letters, decimals)), FeedWord::InverseTime(f_inv)) = (&fast_joint, feed) {
+                let mut values = [0.0; 5];
+                for (v, &i) in values.iter_mut().zip(&written) {
+                    *v = word_at(i);
+                }
+                if e.joint_block(letters, decimals, &values[..written.len()], f_inv) {
+                    continue;
+                }
+            }
+            for ((word, &i), &joint_dec) in words.iter_mut().zip(&written).zip(&joint_decimals) {
+                if let Some(dec) = joint_dec {
+                    word.set_number(word_at(i), dec);
+                    continue;
+                }
+                let axis = &machine.axes()[i];
+                match axis.kind {
+                    AxisKind::Linear if mode == OutputMode::Tcp => {
+                        let tip: Point3 = tip_a + (b.pose.tip - *tip_a) * s;
+                        word.set_number(tip[linear_component(i)?], dialect.decimals);
+                    }
+                    AxisKind::Linear => word.set_number(word_at(i), dialect.decimals),
+                    AxisKind::Rotary if axis.wrap == Wrap::Absolute => {
+                        word.set_number(word_at(i), dialect.rotary_decimals);
+                    }
+                    AxisKind::Rotary => {
+                        let w = word_at(i);
+                        let before = word_at_prev(words_a, &b.words, i, piece, pieces);
+                        let token = e.rotary(word.letter, w, w - before, axis.wrap);
+                        word.set_token(token.as_bytes());
+                    }
+                }
+            }
+            e.motion_words(&mut words, feed);
         }
         previous = Some(b);
     }
@@ -331,30 +397,41 @@ pub fn program_text(
     Ok(String::from_utf8(e.text).unwrap_or_else(|err| String::from_utf8_lossy(err.as_bytes()).into_owned()))
 }
 
-/// Caps an inverse-time word so that no axis exceeds its velocity even when its rounded
-/// words move it by one rounding unit more than the exact delta.
-fn rounding_cap(
-    machine: &scallop_machine::Machine,
-    dialect: &Dialect,
-    a: &[f64; 5],
-    b: &[f64; 5],
-    pieces: u32,
-    f_inv: f64,
-) -> f64 {
-    let mut cap = f_inv;
-    for (i, axis) in machine.axes().iter().enumerate() {
-        let delta = (b[i] - a[i]).abs() / f64::from(pieces);
-        if delta == 0.0 {
-            continue;
-        }
-        let (decimals, vmax) = match axis.kind {
-            AxisKind::Linear => (dialect.decimals, axis.dynamics.vmax),
-            AxisKind::Rotary => (dialect.rotary_decimals, axis.dynamics.vmax.to_degrees()),
-        };
-        let unit = pow10i(-i32::try_from(decimals).unwrap_or(4));
-        cap = cap.min(60.0 * vmax / (delta + unit));
+/// Per-axis data of [`RateCaps::cap`], computed once per program.
+struct RateCaps {
+    /// `(rounding unit of the word, vmax in word units per second)` per axis.
+    axes: Vec<(f64, f64)>,
+}
+
+impl RateCaps {
+    fn new(machine: &scallop_machine::Machine, dialect: &Dialect) -> RateCaps {
+        let axes = machine
+            .axes()
+            .iter()
+            .map(|axis| {
+                let (decimals, vmax) = match axis.kind {
+                    AxisKind::Linear => (dialect.decimals, axis.dynamics.vmax),
+                    AxisKind::Rotary => (dialect.rotary_decimals, axis.dynamics.vmax.to_degrees()),
+                };
+                (pow10i(-i32::try_from(decimals).unwrap_or(4)), vmax)
+            })
+            .collect();
+        RateCaps { axes }
     }
-    cap
+
+    /// Caps an inverse-time word so that no axis exceeds its velocity even when its
+    /// rounded words move it by one rounding unit more than the exact delta.
+    fn cap(&self, a: &[f64; 5], b: &[f64; 5], pieces: u32, f_inv: f64) -> f64 {
+        let mut cap = f_inv;
+        for (i, &(unit, vmax)) in self.axes.iter().enumerate() {
+            let delta = (b[i] - a[i]).abs() / f64::from(pieces);
+            if delta == 0.0 {
+                continue;
+            }
+            cap = cap.min(60.0 * vmax / (delta + unit));
+        }
+        cap
+    }
 }
 
 fn word_at_prev(a: &[f64; 5], b: &[f64; 5], i: usize, piece: u32, pieces: u32) -> f64 {
@@ -366,14 +443,12 @@ pub(crate) fn angle(a: &Vec3, b: &Vec3) -> f64 {
     a.cross(b).norm().atan2(a.dot(b))
 }
 
-/// Number of equal pieces so that no modulo-360 rotary turns 180 deg or more in one
-/// block (spec 3.7: the control takes the shortest path).
-fn pieces(machine: &scallop_machine::Machine, a: &ProgramBlock, b: &ProgramBlock) -> u32 {
+/// Number of equal pieces so that no modulo-360 rotary (`modulo`: their joint indices)
+/// turns 180 deg or more in one block (spec 3.7: the control takes the shortest path).
+fn pieces(modulo: &[usize], a: &ProgramBlock, b: &ProgramBlock) -> u32 {
     let mut n = 1.0f64;
-    for (i, axis) in machine.axes().iter().enumerate() {
-        if axis.kind == AxisKind::Rotary && axis.wrap != Wrap::Absolute {
-            n = n.max(((b.words[i] - a.words[i]).abs() / tol::MODULO_HALF_TURN).floor() + 1.0);
-        }
+    for &i in modulo {
+        n = n.max(((b.words[i] - a.words[i]).abs() / tol::MODULO_HALF_TURN).floor() + 1.0);
     }
     // INVARIANT: n is a small positive integer (a block turns a few revolutions at most).
     #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "small positive integer")]
@@ -419,26 +494,68 @@ enum FeedWord {
     Seconds(f64),
 }
 
+/// One word of a motion block: a number, compared with the modal word as a scaled
+/// integer ([`crate::scaled_key`]) and formatted only when it is written, or a ready
+/// token (modulo rotary words, tilted-plane words).
+struct Word<'l> {
+    letter: &'l str,
+    /// `(value, decimals)`; `None`: the word is `token`.
+    number: Option<(f64, usize)>,
+    /// The full token when `number` is `None`; scratch otherwise.
+    token: Vec<u8>,
+}
+
+impl<'l> Word<'l> {
+    fn new(letter: &'l str) -> Word<'l> {
+        Word { letter, number: None, token: Vec::with_capacity(24) }
+    }
+
+    fn set_number(&mut self, v: f64, decimals: usize) {
+        self.number = Some((v, decimals));
+    }
+
+    fn set_token(&mut self, token: &[u8]) {
+        self.number = None;
+        self.token.clear();
+        self.token.extend_from_slice(token);
+    }
+}
+
+/// Most words of a block the fast modal comparison handles.
+const FAST_WORDS: usize = 8;
+
+/// The last written value of a word letter (or of the feed word).
+#[derive(Clone, Debug, PartialEq)]
+enum Modal {
+    /// A number written by the integer fast path: `(scaled key, decimals)`.
+    Key(i64, usize),
+    /// Any other token, as written.
+    Token(Vec<u8>),
+}
+
 /// Line writer with numbering and modal state.
 struct Emitter<'a> {
     d: &'a Dialect,
     /// The program text, UTF-8 built as bytes (numbers are written as ASCII bytes).
     text: Vec<u8>,
     number: u64,
-    /// Last written token per word letter, `(letter, token)`, in first-use order: a few
-    /// entries searched linearly (cheaper than a map for five axes), strings reused.
-    last_words: Vec<(String, Vec<u8>)>,
+    /// Last written value per word letter, `(letter, value)`, in first-use order: a few
+    /// entries searched linearly (cheaper than a map for five axes).
+    last_words: Vec<(String, Modal)>,
     last_motion: Option<&'static str>,
-    last_feed: Option<Vec<u8>>,
+    /// Last written feed number (without its letter).
+    last_feed: Option<Modal>,
     g93: bool,
-    /// Reused line buffer of `motion_tokens`.
-    buf: Vec<u8>,
-    /// Reused feed-word buffer of `motion_tokens`.
-    feed: Vec<u8>,
-    /// Reused per-word "differs from the modal word" flags of `motion_tokens`.
-    changed: Vec<bool>,
-    /// Reused per-word indices into `last_words` of `motion_tokens`.
-    slots: Vec<Option<usize>>,
+    /// Reused per-word state of `motion_words`: `(index in last_words, scaled key,
+    /// differs from the modal word)`.
+    state: Vec<(Option<usize>, Option<i64>, bool)>,
+    /// Scratch token buffers for the slow comparisons.
+    scratch: (Vec<u8>, Vec<u8>),
+    /// The modal state was checked to be the steady state of [`Emitter::joint_block`]
+    /// (reset by every other motion or plane output).
+    joint_steady: bool,
+    /// The fast paths are enabled (`false` only in tests: text comparison throughout).
+    fast: bool,
 }
 
 impl<'a> Emitter<'a> {
@@ -451,14 +568,13 @@ impl<'a> Emitter<'a> {
             last_motion: None,
             last_feed: None,
             g93: false,
-            buf: Vec::new(),
-            feed: Vec::new(),
-            changed: Vec::new(),
-            slots: Vec::new(),
+            state: Vec::new(),
+            scratch: (Vec::new(), Vec::new()),
+            joint_steady: false,
+            fast: true,
         }
     }
 
-    /// The last token written for `letter`.
     /// The index in `last_words` of `letter`, tried first at `hint` (blocks list their
     /// words in one order, so the hint is almost always right).
     fn last_index(&self, hint: usize, letter: &str) -> Option<usize> {
@@ -472,14 +588,22 @@ impl<'a> Emitter<'a> {
         self.line_bytes(s.as_bytes());
     }
 
-    fn line_bytes(&mut self, s: &[u8]) {
-        if let Some(n) = &self.d.line_numbers
-            && s != b"%"
-        {
+    /// Starts a line: the line number when the dialect numbers lines.
+    fn line_start(&mut self) {
+        if let Some(n) = &self.d.line_numbers {
             self.text.extend_from_slice(n.prefix.as_bytes());
-            self.text.extend_from_slice(self.number.to_string().as_bytes());
+            let mut bytes = [0u8; 32];
+            // INVARIANT: line numbers stay far below i64::MAX.
+            let at = crate::write_key(&mut bytes, i64::try_from(self.number).unwrap_or(i64::MAX), 0);
+            self.text.extend_from_slice(&bytes[at..]);
             self.text.push(b' ');
             self.number += n.step;
+        }
+    }
+
+    fn line_bytes(&mut self, s: &[u8]) {
+        if s != b"%" {
+            self.line_start();
         }
         self.text.extend_from_slice(s);
         self.text.push(b'\n');
@@ -507,28 +631,38 @@ impl<'a> Emitter<'a> {
         s
     }
 
-    /// [`Emitter::token`] as bytes into `s` (cleared first; its allocation is reused).
-    fn token_into(&self, s: &mut Vec<u8>, letter: &str, v: f64, decimals: usize) {
-        s.clear();
-        s.extend_from_slice(letter.as_bytes());
-        if self.d.explicit_plus {
-            s.push(b'+');
+    /// Appends `letter` and the number `v` (its scaled key when known) as
+    /// [`Emitter::token`] writes them.
+    fn push_number_token(out: &mut Vec<u8>, explicit_plus: bool, letter: &str, v: f64, key: Option<i64>, dec: usize) {
+        match letter.as_bytes() {
+            &[l] => out.push(l),
+            l => out.extend_from_slice(l),
         }
-        let at = s.len();
-        crate::push_number_bytes(s, v, decimals);
-        if self.d.explicit_plus && s.get(at) == Some(&b'-') {
-            s.remove(at - 1);
+        match key {
+            Some(key) => {
+                if explicit_plus && key >= 0 {
+                    out.push(b'+');
+                }
+                crate::push_key(out, key, dec);
+            }
+            None => {
+                if explicit_plus {
+                    out.push(b'+');
+                }
+                let at = out.len();
+                crate::push_number_bytes(out, v, dec);
+                if explicit_plus && out.get(at) == Some(&b'-') {
+                    out.remove(at - 1);
+                }
+            }
         }
     }
 
-    /// [`Emitter::rotary`] as bytes into `s` (cleared first; its allocation is reused).
-    fn rotary_into(&self, s: &mut Vec<u8>, letter: &str, word: f64, delta: f64, wrap: Wrap) {
-        if wrap == Wrap::Absolute {
-            self.token_into(s, letter, word, self.d.rotary_decimals);
-        } else {
-            let t = self.rotary(letter, word, delta, wrap);
-            s.clear();
-            s.extend_from_slice(t.as_bytes());
+    /// Appends the modal value `m` of `letter` as it was written.
+    fn push_modal_token(out: &mut Vec<u8>, explicit_plus: bool, letter: &str, m: &Modal) {
+        match m {
+            Modal::Key(key, dec) => Self::push_number_token(out, explicit_plus, letter, 0.0, Some(*key), *dec),
+            Modal::Token(t) => out.extend_from_slice(t),
         }
     }
 
@@ -564,119 +698,346 @@ impl<'a> Emitter<'a> {
 
     /// A motion block from `(letter, number)` pairs.
     fn motion(&mut self, words: &[(&str, String)], feed: FeedWord) {
-        let tokens: Vec<(&str, Vec<u8>)> = words.iter().map(|(l, v)| (*l, format!("{l}{v}").into_bytes())).collect();
-        self.motion_tokens(&tokens, feed);
+        let mut tokens: Vec<Word> = words
+            .iter()
+            .map(|(l, v)| {
+                let mut w = Word::new(l);
+                w.set_token(format!("{l}{v}").as_bytes());
+                w
+            })
+            .collect();
+        self.motion_words(&mut tokens, feed);
     }
 
-    /// A motion block from `(letter, full token)` pairs. Hot path of every program:
-    /// one line buffer reused, modal words compared in place, no per-token allocation
-    /// beyond the tokens themselves.
-    fn motion_tokens(&mut self, words: &[(&str, Vec<u8>)], feed: FeedWord) {
-        let mut changed = std::mem::take(&mut self.changed);
-        changed.clear();
-        let mut slots = std::mem::take(&mut self.slots);
-        slots.clear();
-        for (k, (letter, token)) in words.iter().enumerate() {
-            let slot = self.last_index(k, letter);
-            slots.push(slot);
-            changed.push(!self.d.modal || slot.is_none_or(|j| !short_eq(&self.last_words[j].1, token)));
+    /// Whether `word` (with its scaled key) writes the same token as the modal value `last`.
+    fn same_as(
+        scratch: &mut (Vec<u8>, Vec<u8>),
+        plus: bool,
+        last: &Modal,
+        word: &Word,
+        key: Option<i64>,
+        by_key: bool,
+    ) -> bool {
+        match (last, word.number, key) {
+            (Modal::Key(k, d), Some((_, dw)), Some(kw)) if by_key && *d == dw => *k == kw,
+            _ => {
+                let (a, b) = scratch;
+                a.clear();
+                b.clear();
+                Self::push_modal_token(a, plus, word.letter, last);
+                match word.number {
+                    Some((v, dec)) => Self::push_number_token(b, plus, word.letter, v, key, dec),
+                    None => b.extend_from_slice(&word.token),
+                }
+                short_eq(a, b)
+            }
         }
-        if !changed.contains(&true) {
-            self.changed = changed;
-            self.slots = slots;
+    }
+
+    /// Whether two modal feed values write the same number.
+    fn same_feed(scratch: &mut (Vec<u8>, Vec<u8>), last: &Modal, new: &Modal) -> bool {
+        match (last, new) {
+            (Modal::Key(k, d), Modal::Key(kn, dn)) if d == dn => k == kn,
+            _ => {
+                let (a, b) = scratch;
+                a.clear();
+                b.clear();
+                Self::push_modal_token(a, false, "", last);
+                Self::push_modal_token(b, false, "", new);
+                short_eq(a, b)
+            }
+        }
+    }
+
+    /// Appends a space (unless the line is still empty after `start`), then `word`.
+    fn push_word(&mut self, start: usize, word: &Word, key: Option<i64>) {
+        let space = self.text.len() > start;
+        if let (true, Some((_, dec)), Some(key), &[letter]) = (self.fast, word.number, key, word.letter.as_bytes()) {
+            // One letter and a scaled key: the token in one piece.
+            // The prefix right-aligned in four bytes: [space] letter [+].
+            let (prefix, len) = if self.d.explicit_plus && key >= 0 {
+                ([0, b' ', letter, b'+'], 2 + usize::from(space))
+            } else {
+                ([0, 0, b' ', letter], 1 + usize::from(space))
+            };
+            crate::push_token_key(&mut self.text, prefix, len, key, dec);
             return;
         }
-        let mut buf = std::mem::take(&mut self.buf);
-        buf.clear();
-        let push = |buf: &mut Vec<u8>, t: &[u8]| {
-            if !buf.is_empty() {
-                buf.push(b' ');
+        if space {
+            self.text.push(b' ');
+        }
+        match word.number {
+            Some((v, dec)) => Self::push_number_token(&mut self.text, self.d.explicit_plus, word.letter, v, key, dec),
+            None => self.text.extend_from_slice(&word.token),
+        }
+    }
+
+    /// Appends a space (unless the line is still empty after `start`), then `t`.
+    fn push_piece(&mut self, start: usize, t: &[u8]) {
+        if self.text.len() > start {
+            self.text.push(b' ');
+        }
+        self.text.extend_from_slice(t);
+    }
+
+    /// The feed number `f` (rounded down to `dec`) after `letter`, unless it equals the
+    /// modal feed and `always` is false. Updates the modal feed.
+    fn feed_word(&mut self, start: usize, letter: &[u8], f: f64, dec: usize, always: bool) {
+        let f = round_down(f, dec);
+        let key = crate::scaled_key(f, dec);
+        if let (true, true, Some(k), &[l]) = (self.fast, always, key, letter) {
+            // Written on every block (G93): no comparison, one token.
+            let len = 1 + usize::from(self.text.len() > start);
+            crate::push_token_key(&mut self.text, [0, 0, b' ', l], len, k, dec);
+            match &mut self.last_feed {
+                Some(Modal::Key(last, last_dec)) => (*last, *last_dec) = (k, dec),
+                last => *last = Some(Modal::Key(k, dec)),
             }
-            buf.extend_from_slice(t);
+            return;
+        }
+        let value = match key {
+            Some(k) => Modal::Key(k, dec),
+            None => Modal::Token(fmt_number(f, dec).into_bytes()),
         };
+        if always
+            || !self.d.modal
+            || !self.last_feed.as_ref().is_some_and(|last| Self::same_feed(&mut self.scratch, last, &value))
+        {
+            match &value {
+                Modal::Key(k, dec) if self.fast && letter.len() <= 3 => {
+                    let mut prefix = [b' '; 4];
+                    prefix[4 - letter.len()..].copy_from_slice(letter);
+                    let len = letter.len() + usize::from(self.text.len() > start);
+                    crate::push_token_key(&mut self.text, prefix, len, *k, *dec);
+                }
+                Modal::Key(k, dec) => {
+                    self.push_piece(start, letter);
+                    crate::push_key(&mut self.text, *k, *dec);
+                }
+                Modal::Token(t) => {
+                    self.push_piece(start, letter);
+                    self.text.extend_from_slice(t);
+                }
+            }
+            self.last_feed = Some(value);
+        }
+    }
+
+    /// The codes of a motion block before its words: G93/G94 and the motion code (ISO),
+    /// `L` (Heidenhain).
+    fn motion_codes(&mut self, start: usize, feed: FeedWord) {
         match self.d.syntax {
             Syntax::Iso => {
                 let want_g93 = matches!(feed, FeedWord::InverseTime(_));
                 if want_g93 != self.g93 {
-                    push(&mut buf, if want_g93 { b"G93" } else { b"G94" });
+                    self.push_piece(start, if want_g93 { b"G93" } else { b"G94" });
                     self.g93 = want_g93;
                     self.last_feed = None;
                 }
                 let code = if matches!(feed, FeedWord::Rapid) { "G0" } else { "G1" };
                 if !self.d.modal || self.last_motion != Some(code) {
-                    push(&mut buf, code.as_bytes());
+                    self.push_piece(start, code.as_bytes());
                     self.last_motion = Some(code);
                 }
-                for ((_, token), &c) in words.iter().zip(&changed) {
-                    if c {
-                        push(&mut buf, token);
-                    }
-                }
-                // G93 needs F on every block (`always`).
-                let (dec, always) = match feed {
-                    FeedWord::Rapid | FeedWord::Seconds(_) => (None, false),
-                    FeedWord::PerMinute(_) => (Some(self.d.feed_decimals), false),
-                    FeedWord::InverseTime(_) => (Some(self.d.inverse_time_decimals), true),
-                };
-                if let (Some(dec), FeedWord::PerMinute(f) | FeedWord::InverseTime(f)) = (dec, feed) {
-                    self.feed.clear();
-                    crate::push_number_bytes(&mut self.feed, round_down(f, dec), dec);
-                    if always || !self.d.modal || self.last_feed.as_ref() != Some(&self.feed) {
-                        push(&mut buf, b"F");
-                        buf.extend_from_slice(&self.feed);
-                        match &mut self.last_feed {
-                            Some(l) => l.clone_from(&self.feed),
-                            None => self.last_feed = Some(self.feed.clone()),
-                        }
-                    }
-                }
             }
-            Syntax::Heidenhain => {
-                push(&mut buf, b"L");
-                for ((_, token), &c) in words.iter().zip(&changed) {
-                    if c {
-                        push(&mut buf, token);
-                    }
+            Syntax::Heidenhain => self.push_piece(start, b"L"),
+        }
+    }
+
+    /// The feed word of a motion block, after its words.
+    fn feed_codes(&mut self, start: usize, feed: FeedWord) {
+        match self.d.syntax {
+            // G93 needs F on every block (`always`).
+            Syntax::Iso => match feed {
+                FeedWord::Rapid | FeedWord::Seconds(_) => {}
+                FeedWord::PerMinute(f) => self.feed_word(start, b"F", f, self.d.feed_decimals, false),
+                FeedWord::InverseTime(f) => self.feed_word(start, b"F", f, self.d.inverse_time_decimals, true),
+            },
+            Syntax::Heidenhain => match feed {
+                FeedWord::Rapid => {
+                    self.push_piece(start, b"FMAX");
+                    self.last_feed = None;
                 }
-                match feed {
-                    FeedWord::Rapid => {
-                        push(&mut buf, b"FMAX");
-                        self.last_feed = None;
-                    }
-                    FeedWord::Seconds(t) => {
-                        let dec = self.d.inverse_time_decimals;
-                        push(&mut buf, format!("FT{}", fmt_number(round_up(t, dec), dec)).as_bytes());
-                        self.last_feed = None;
-                    }
-                    FeedWord::PerMinute(f) | FeedWord::InverseTime(f) => {
-                        let f = fmt_number(round_down(f, self.d.feed_decimals), self.d.feed_decimals).into_bytes();
-                        if !self.d.modal || self.last_feed.as_ref() != Some(&f) {
-                            push(&mut buf, format!("F{}", String::from_utf8_lossy(&f)).as_bytes());
-                            self.last_feed = Some(f);
-                        }
-                    }
+                FeedWord::Seconds(t) => {
+                    let dec = self.d.inverse_time_decimals;
+                    let ft = format!("FT{}", fmt_number(round_up(t, dec), dec));
+                    self.push_piece(start, ft.as_bytes());
+                    self.last_feed = None;
+                }
+                FeedWord::PerMinute(f) | FeedWord::InverseTime(f) => {
+                    self.feed_word(start, b"F", f, self.d.feed_decimals, false);
+                }
+            },
+        }
+    }
+
+    /// A joint-space G93 block in the steady state of modal ISO output (G93 and G1 in
+    /// force, the words `letters` with `decimals` modal in this order, no explicit plus):
+    /// exactly the text [`Emitter::motion_words`] writes for it, without its general
+    /// machinery. Returns `false`, having written nothing, when the state or a number is
+    /// not of that form (the caller then uses [`Emitter::motion_words`]).
+    fn joint_block(&mut self, letters: &[u8], decimals: &[usize], values: &[f64], f_inv: f64) -> bool {
+        let n = values.len();
+        if !self.joint_steady {
+            let steady = self.d.modal
+                && self.d.syntax == Syntax::Iso
+                && !self.d.explicit_plus
+                && self.g93
+                && self.last_motion == Some("G1")
+                && self.last_words.len() >= n
+                && letters.len() == n
+                && decimals.len() == n
+                && self.last_words.iter().zip(letters.iter().zip(decimals)).all(|((l, m), (letter, dec))| {
+                    short_eq(l.as_bytes(), &[*letter]) && matches!(m, Modal::Key(_, d) if d == dec)
+                });
+            if !steady {
+                return false;
+            }
+            self.joint_steady = true;
+        }
+        let mut keys = [0i64; 5];
+        let mut mask = 0u32;
+        for k in 0..n {
+            let Some(key) = crate::scaled_key(values[k], decimals[k]) else { return false };
+            keys[k] = key;
+            if matches!(self.last_words[k].1, Modal::Key(last, _) if last != key) {
+                mask |= 1 << k;
+            }
+        }
+        if mask == 0 {
+            return true;
+        }
+        let dec = self.d.inverse_time_decimals;
+        let Some(feed_key) = crate::scaled_key(round_down(f_inv, dec), dec) else { return false };
+        self.line_start();
+        let start = self.text.len();
+        for k in 0..n {
+            if mask & (1 << k) != 0 {
+                let len = 1 + usize::from(self.text.len() > start);
+                crate::push_token_key(&mut self.text, [0, 0, b' ', letters[k]], len, keys[k], decimals[k]);
+                if let Modal::Key(last, _) = &mut self.last_words[k].1 {
+                    *last = keys[k];
                 }
             }
         }
-        for ((letter, token), slot) in words.iter().zip(&slots) {
+        crate::push_token_key(&mut self.text, [0, 0, b' ', b'F'], 2, feed_key, dec);
+        self.text.push(b'\n');
+        self.last_feed = Some(Modal::Key(feed_key, dec));
+        true
+    }
+
+    /// The fast form of the modal comparison of [`Emitter::motion_words`]: every word is a
+    /// number with a scaled key, and the modal word at its position has its letter and a
+    /// key with its decimals (the steady state of joint-space output). Returns the keys and
+    /// the bit mask of the words that change; `None` sends the block to the general path.
+    fn fast_changes(&self, words: &[Word]) -> Option<([i64; FAST_WORDS], u32)> {
+        if !self.fast || words.len() > FAST_WORDS || !self.d.modal || words.len() > self.last_words.len() {
+            return None;
+        }
+        let mut keys = [0i64; FAST_WORDS];
+        let mut mask = 0u32;
+        for (k, (word, (letter, last))) in words.iter().zip(&self.last_words).enumerate() {
+            let (v, dec) = word.number?;
+            let key = crate::scaled_key(v, dec)?;
+            match last {
+                Modal::Key(last_key, last_dec)
+                    if *last_dec == dec && short_eq(letter.as_bytes(), word.letter.as_bytes()) =>
+                {
+                    if *last_key != key {
+                        mask |= 1 << k;
+                    }
+                }
+                _ => return None,
+            }
+            keys[k] = key;
+        }
+        Some((keys, mask))
+    }
+
+    /// A motion block. Hot path of every program: the modal comparison is done on scaled
+    /// integers, and only the words that change are formatted, straight into the text.
+    fn motion_words(&mut self, words: &mut [Word], feed: FeedWord) {
+        self.joint_steady = false;
+        if let Some((keys, mask)) = self.fast_changes(words) {
+            if mask == 0 {
+                return;
+            }
+            self.line_start();
+            let start = self.text.len();
+            self.motion_codes(start, feed);
+            for (k, word) in words.iter().enumerate() {
+                if mask & (1 << k) != 0 {
+                    self.push_word(start, word, Some(keys[k]));
+                    if let Modal::Key(last_key, _) = &mut self.last_words[k].1 {
+                        *last_key = keys[k];
+                    }
+                }
+            }
+            self.feed_codes(start, feed);
+            self.text.push(b'\n');
+            return;
+        }
+        let mut state = std::mem::take(&mut self.state);
+        state.clear();
+        let mut any = false;
+        for (k, word) in words.iter().enumerate() {
+            let slot = self.last_index(k, word.letter);
+            let key = word.number.and_then(|(v, dec)| crate::scaled_key(v, dec));
+            let changed = !self.d.modal
+                || match slot {
+                    None => true,
+                    Some(j) => !Self::same_as(
+                        &mut self.scratch,
+                        self.d.explicit_plus,
+                        &self.last_words[j].1,
+                        word,
+                        key,
+                        self.fast,
+                    ),
+                };
+            any |= changed;
+            state.push((slot, key, changed));
+        }
+        if !any {
+            self.state = state;
+            return;
+        }
+        self.line_start();
+        let start = self.text.len();
+        self.motion_codes(start, feed);
+        for (word, &(_, key, c)) in words.iter().zip(&state) {
+            if c {
+                self.push_word(start, word, key);
+            }
+        }
+        self.feed_codes(start, feed);
+        self.text.push(b'\n');
+        for (word, &(slot, key, _)) in words.iter().zip(&state) {
+            let value = match (word.number, key) {
+                (Some((_, dec)), Some(k)) => Modal::Key(k, dec),
+                (Some((v, dec)), None) => {
+                    let mut t = Vec::new();
+                    Self::push_number_token(&mut t, self.d.explicit_plus, word.letter, v, None, dec);
+                    Modal::Token(t)
+                }
+                (None, _) => Modal::Token(word.token.clone()),
+            };
             match slot {
-                Some(j) => self.last_words[*j].1.clone_from(token),
+                Some(j) => self.last_words[j].1 = value,
                 // A letter twice in one block: the later token is the modal one.
-                None => match self.last_words.iter_mut().find(|(l, _)| l == letter) {
-                    Some((_, t)) => t.clone_from(token),
-                    None => self.last_words.push(((*letter).to_string(), token.clone())),
+                None => match self.last_words.iter_mut().find(|(l, _)| l == word.letter) {
+                    Some((_, t)) => *t = value,
+                    None => self.last_words.push((word.letter.to_string(), value)),
                 },
             }
         }
-        self.slots = slots;
-        self.line_bytes(&buf);
-        self.buf = buf;
-        self.changed = changed;
+        self.state = state;
     }
 
     /// Activates a tilted plane `r` (columns x_f, y_f, z_f in the part frame) at the
     /// part origin; `dir` selects the rotary solution (sign of the tilt word).
     fn plane_on(&mut self, r: &Rotation3<f64>, dir: i32) {
+        self.joint_steady = false;
         let dec = self.d.rotary_decimals;
         let deg = |v: f64| self.num(v.to_degrees(), dec);
         let lines: Vec<String> = match self.d.tilted_plane {
@@ -703,6 +1064,7 @@ impl<'a> Emitter<'a> {
     }
 
     fn plane_off(&mut self) {
+        self.joint_steady = false;
         let l = match self.d.tilted_plane {
             TiltedPlane::None => return,
             TiltedPlane::G68_2 => "G69",
@@ -735,4 +1097,73 @@ pub fn cycle800_angles(r: &Rotation3<f64>) -> (f64, f64, f64) {
     let m = r.matrix();
     let b = m[(0, 2)].atan2(m[(0, 0)].hypot(m[(0, 1)]));
     ((-m[(1, 2)]).atan2(m[(2, 2)]), b, (-m[(0, 1)]).atan2(m[(0, 0)]))
+}
+
+#[cfg(test)]
+mod tests {
+    use scallop_geom::{Point3, Vec3};
+    use scallop_machine::program::{ClRecord, Motion, ProgramOptions, to_program};
+    use scallop_machine::{Kinematics, Machine, Pose};
+
+    use super::{OutputMode, PostParams, program_text_with};
+    use crate::Dialect;
+
+    /// The fast paths (scaled-integer modal comparison, steady-state joint blocks) write
+    /// exactly what the general path with text comparison writes, on every shipped
+    /// machine and dialect, in joint and TCP output.
+    #[test]
+    fn fast_paths_write_the_same_text_as_the_general_path() {
+        let tilt = 25f64.to_radians();
+        let mut records = vec![ClRecord {
+            pose: Pose::new(Point3::new(0.0, 0.0, 60.0), Vec3::new(0.1, 0.0, 1.0)),
+            motion: Motion::Rapid,
+            feed: 2000.0,
+        }];
+        for i in 0..400 {
+            let t = f64::from(i) * 0.01;
+            // Values that hit rounding ties now and then (multiples of 0.00005) and a
+            // slow precession with pauses (unchanged words).
+            let x = (20.0 * (t * 1.3).cos() * 2e4).round() / 2e4;
+            let precess = 0.9 * (t * 0.7).sin() + if i % 50 < 5 { 0.0 } else { 0.01 * t };
+            let axis = Vec3::new(tilt.sin() * precess.cos(), tilt.sin() * precess.sin(), tilt.cos());
+            let motion = if i % 97 == 0 { Motion::Rapid } else { Motion::Feed };
+            records.push(ClRecord {
+                pose: Pose::new(Point3::new(x, 15.0 * (t * 0.9).sin(), 30.0 + (i % 7) as f64 * 0.5), axis),
+                motion,
+                feed: if i % 40 < 20 { 1500.0 } else { 2500.0 },
+            });
+        }
+        let mut compared = 0;
+        for name in Machine::builtin_names() {
+            let machine = Machine::builtin(name).expect("shipped machine");
+            let kin = Kinematics::new(&machine, 0.0);
+            let Ok(program) = to_program(&kin, &records, None, &ProgramOptions::default()) else { continue };
+            for dialect_name in Dialect::builtin_names() {
+                let dialect = Dialect::builtin(dialect_name).expect("shipped dialect");
+                for mode in [OutputMode::Joint, OutputMode::Tcp] {
+                    let params = PostParams {
+                        program: "7".into(),
+                        mode,
+                        tool: 3,
+                        tool_length: 0.0,
+                        spindle: 9000.0,
+                        tol_pos: 0.005,
+                        tol_ang: 0.001,
+                        predicted_time: None,
+                    };
+                    let fast = program_text_with(&program, &kin, &dialect, &params, true);
+                    let general = program_text_with(&program, &kin, &dialect, &params, false);
+                    match (fast, general) {
+                        (Ok(a), Ok(b)) => {
+                            assert_eq!(a, b, "{name} {dialect_name} {mode:?}");
+                            compared += 1;
+                        }
+                        (Err(a), Err(b)) => assert_eq!(a.to_string(), b.to_string()),
+                        (a, b) => panic!("{name} {dialect_name} {mode:?}: {a:?} vs {b:?}"),
+                    }
+                }
+            }
+        }
+        assert!(compared >= 20, "only {compared} programs compared");
+    }
 }
