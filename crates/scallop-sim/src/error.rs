@@ -131,7 +131,9 @@ pub enum SimError {
         limit: usize,
     },
     /// A tool axis is zero or not finite.
-    #[error("move {index}: tool axis {axis:?} (or tip) is not a finite non-zero vector; give i, j, k with a length > 0")]
+    #[error(
+        "move {index}: tool axis {axis:?} (or tip) is not a finite non-zero vector; give i, j, k with a length > 0"
+    )]
     BadAxis {
         /// Index of the move.
         index: usize,

@@ -104,7 +104,8 @@ pub(crate) struct Span {
 }
 
 impl Span {
-    const ALL: Span = Span { s0: f64::NEG_INFINITY, n0: Vec3::new(0.0, 0.0, 0.0), s1: f64::INFINITY, n1: Vec3::new(0.0, 0.0, 0.0) };
+    const ALL: Span =
+        Span { s0: f64::NEG_INFINITY, n0: Vec3::new(0.0, 0.0, 0.0), s1: f64::INFINITY, n1: Vec3::new(0.0, 0.0, 0.0) };
 
     /// Intersection of two spans (the entry is the later one, with its normal).
     fn meet(self, o: Span) -> Option<Span> {
@@ -341,7 +342,8 @@ impl Body {
     pub(crate) fn holder(cutter: &Cutter, index: usize) -> Option<Body> {
         let segments = cutter.holder();
         let seg = segments.get(index)?;
-        let h0 = cutter.flute_length() + cutter.shank_length() + segments[..index].iter().map(|s| s.length).sum::<f64>();
+        let h0 =
+            cutter.flute_length() + cutter.shank_length() + segments[..index].iter().map(|s| s.length).sum::<f64>();
         let k = (seg.top_radius - seg.bottom_radius) / seg.length;
         Some(Body::new(vec![Piece::Frustum { h0, h1: h0 + seg.length, r0: seg.bottom_radius, k }]))
     }

@@ -450,8 +450,13 @@ impl DexelStock {
     }
 
     /// Splits the moves into fixed-axis sweeps.
-    fn steps(&self, body: &Body, moves: &[ToolMove], options: &DexelOptions) -> Result<Vec<Step>, SimError> {
-        let operation = self.operations;
+    fn steps(
+        &self,
+        operation: u32,
+        body: &Body,
+        moves: &[ToolMove],
+        options: &DexelOptions,
+    ) -> Result<Vec<Step>, SimError> {
         let mut steps = Vec::with_capacity(moves.len());
         let mut prev: Option<(Point3, Vec3)> = None;
         let max_turn = 2.0 * options.axis_tolerance / body.reach();
@@ -522,7 +527,12 @@ impl DexelStock {
     /// // A slot 4 mm wide and 1 mm deep through the 20 mm stock.
     /// assert!((report.removed_volume - 80.0).abs() < 1e-9);
     /// ```
-    pub fn cut(&mut self, cutter: &Cutter, moves: &[ToolMove], options: &DexelOptions) -> Result<DexelReport, SimError> {
+    pub fn cut(
+        &mut self,
+        cutter: &Cutter,
+        moves: &[ToolMove],
+        options: &DexelOptions,
+    ) -> Result<DexelReport, SimError> {
         if !(options.axis_tolerance.is_finite() && options.axis_tolerance > 0.0) {
             return Err(SimError::BadTolerance { what: "axis tolerance", value: options.axis_tolerance });
         }
@@ -530,7 +540,7 @@ impl DexelStock {
             return Err(SimError::TooManyMoves { moves: moves.len() });
         }
         let operation = self.operations;
-        self.operations = self.operations.checked_add(1).ok_or(SimError::TooManyMoves { moves: moves.len() })?;
+        let next = operation.checked_add(1).ok_or(SimError::TooManyMoves { moves: moves.len() })?;
         let flutes = Body::flutes(cutter);
         let mut guards: Vec<(Body, ToolPart)> = Vec::new();
         if options.check_collisions {
@@ -541,7 +551,8 @@ impl DexelStock {
                 i += 1;
             }
         }
-        let steps = self.steps(&flutes, moves, options)?;
+        let steps = self.steps(operation, &flutes, moves, options)?;
+        self.operations = next;
         // Boxes of each step: flutes, then each guard.
         let boxes: Vec<Vec<(Point3, Point3)>> = steps
             .iter()
@@ -551,9 +562,7 @@ impl DexelStock {
                 b
             })
             .collect();
-        let union = |bs: &[(Point3, Point3)]| {
-            bs.iter().fold(bs[0], |(lo, hi), (l, h)| (lo.inf(l), hi.sup(h)))
-        };
+        let union = |bs: &[(Point3, Point3)]| bs.iter().fold(bs[0], |(lo, hi), (l, h)| (lo.inf(l), hi.sup(h)));
         let unions: Vec<(Point3, Point3)> = boxes.iter().map(|b| union(b)).collect();
 
         let count = moves.len();

@@ -262,7 +262,8 @@ mod tests {
             let body = Body::flutes(&Cutter::new(shape, 4.0).unwrap());
             for _ in 0..200 {
                 let a = Vec3::new(rnd(), rnd(), rnd() + 1.5).normalize();
-                let sw = Sweep { p0: Point3::new(rnd(), rnd(), rnd()), v: Vec3::new(4.0 * rnd(), 4.0 * rnd(), rnd()), a };
+                let sw =
+                    Sweep { p0: Point3::new(rnd(), rnd(), rnd()), v: Vec3::new(4.0 * rnd(), 4.0 * rnd(), rnd()), a };
                 let axis = (rnd().abs() * 3.0) as usize % 3;
                 let mut d = Vec3::zeros();
                 d[axis] = 1.0;
