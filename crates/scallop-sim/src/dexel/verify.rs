@@ -14,8 +14,20 @@
 //!   `z`: exact).
 //!
 //! Each part interval end carries `|d . n|`, `n` the unit normal of the
-//! triangle there (1 at the side of an open part's footprint), so that a
-//! length along the ray converts to a thickness along the part normal.
+//! triangle there (0 where the interval is cut by the stock box or ends at
+//! the side of an open part's footprint: no part surface there), so that a
+//! length along the ray from that end converts to a thickness along the part
+//! normal (exact for a locally planar part).
+//!
+//! - **Material left**: a piece of stock outside the part that touches a
+//!   part surface end, its length along the ray and times `|d . n|`.
+//! - **Gouge depth** of a piece of part without stock: for a closed part and
+//!   on Z rays, its length from the part surface it opens times `|d . n|` (a
+//!   piece inside a part interval, a ray running just under the surface,
+//!   touches no surface and is measured by the rays that cross the surface
+//!   there); for an open part on an X or Y ray, the largest
+//!   `(surface z - ray z) |n_z|` over the piece (the distance below the
+//!   surface, exact for a locally planar part).
 
 use rayon::prelude::*;
 use scallop_geom::predicates::orient2d;
@@ -59,6 +71,12 @@ impl DexelPart {
     /// `(s0, s1, w0, w1)` (coordinates along the axis and `|d . n|` at each end).
     #[must_use]
     pub fn intervals(&self, o: &Point3, axis: usize) -> Vec<(f64, f64, f64, f64)> {
+        self.ray(o, axis).0
+    }
+
+    /// The part intervals and, for an open part on an X or Y ray, the
+    /// surface's section pieces `(s_a, z_a, s_b, z_b, |n_z|)`.
+    fn ray(&self, o: &Point3, axis: usize) -> (Vec<(f64, f64, f64, f64)>, Vec<Section>) {
         let b = self.index.bounds();
         let query = match axis {
             2 => Aabb2 { min: Point2::new(o.x, o.y), max: Point2::new(o.x, o.y) },
@@ -68,7 +86,7 @@ impl DexelPart {
         let mut slots = Vec::new();
         self.index.collect_box(&query, &mut slots);
         if self.closed {
-            self.solid(o, axis, &slots)
+            (self.solid(o, axis, &slots), Vec::new())
         } else if axis == 2 {
             let mut top: Option<(f64, f64)> = None;
             for &slot in &slots {
@@ -78,7 +96,7 @@ impl DexelPart {
                     }
                 }
             }
-            top.map(|(s, w)| vec![(f64::NEG_INFINITY, s, 1.0, w)]).unwrap_or_default()
+            (top.map(|(s, w)| vec![(f64::NEG_INFINITY, s, 0.0, w)]).unwrap_or_default(), Vec::new())
         } else {
             self.section(o, axis, &slots)
         }
@@ -124,12 +142,15 @@ impl DexelPart {
     }
 
     /// An open height field along a horizontal ray: where its section lies at
-    /// or above the ray.
-    fn section(&self, o: &Point3, axis: usize, slots: &[u32]) -> Vec<(f64, f64, f64, f64)> {
+    /// or above the ray (ends at the footprint's side carry 0: stock beyond
+    /// the footprint is no material on the part, and removed part there is
+    /// measured vertically, [`section_depth`]), with the section pieces.
+    fn section(&self, o: &Point3, axis: usize, slots: &[u32]) -> (Vec<(f64, f64, f64, f64)>, Vec<Section>) {
         // The ray runs along `axis` at height o.z in the vertical plane c = o[c].
         let c = 1 - axis;
         let level = o.z;
         let mut pieces: Vec<(f64, f64, f64, f64)> = Vec::new();
+        let mut sections: Vec<Section> = Vec::new();
         for &slot in slots {
             let t = self.index.corners(slot as usize);
             let n = self.index.normal(slot as usize);
@@ -165,12 +186,13 @@ impl DexelPart {
                 continue;
             }
             let w = n[axis].abs() / n.norm();
+            sections.push((a.0, a.1, b.0, b.1, n.z.abs() / n.norm()));
             let (above_a, above_b) = (a.1 >= level, b.1 >= level);
             let cross = || a.0 + (level - a.1) / (b.1 - a.1) * (b.0 - a.0);
             match (above_a, above_b) {
-                (true, true) => pieces.push((a.0, b.0, 1.0, 1.0)),
-                (true, false) => pieces.push((a.0, cross(), 1.0, w)),
-                (false, true) => pieces.push((cross(), b.0, w, 1.0)),
+                (true, true) => pieces.push((a.0, b.0, 0.0, 0.0)),
+                (true, false) => pieces.push((a.0, cross(), 0.0, w)),
+                (false, true) => pieces.push((cross(), b.0, w, 0.0)),
                 (false, false) => {}
             }
         }
@@ -187,8 +209,31 @@ impl DexelPart {
                 _ => out.push(p),
             }
         }
-        out
+        (out, sections)
     }
+}
+
+/// A piece of an open part's section by a vertical plane: `(s_a, z_a, s_b,
+/// z_b, |n_z|)` along the ray's axis.
+type Section = (f64, f64, f64, f64, f64);
+
+/// The depth below an open part's surface of the deepest point of
+/// `[g0, g1]` at height `level`: the largest `(z - level) |n_z|` over the
+/// section pieces above it (the normal distance for a locally planar part;
+/// the section is linear on each piece, so the ends of the overlap decide).
+fn section_depth(sections: &[Section], level: f64, g0: f64, g1: f64) -> f64 {
+    let mut depth = 0.0f64;
+    for &(sa, za, sb, zb, nz) in sections {
+        let (a, b) = (g0.max(sa), g1.min(sb));
+        if a > b {
+            continue;
+        }
+        for s in [a, b] {
+            let z = za + (s - sa) / (sb - sa) * (zb - za);
+            depth = depth.max((z - level) * nz);
+        }
+    }
+    depth
 }
 
 /// One piece of part material removed along a ray.
@@ -354,12 +399,12 @@ fn ray_findings(
         p[axis] = s;
         p
     };
-    let spans: Vec<(f64, f64, f64, f64)> = part
-        .intervals(&o, axis)
+    let (spans, sections) = part.ray(&o, axis);
+    let spans: Vec<(f64, f64, f64, f64)> = spans
         .into_iter()
         .filter(|p| p.1 > lo && p.0 < hi)
-        .map(|(a, b, wa, wb)| if a < lo { (lo, b, 1.0, wb) } else { (a, b, wa, wb) })
-        .map(|(a, b, wa, wb)| if b > hi { (a, hi, wa, 1.0) } else { (a, b, wa, wb) })
+        .map(|(a, b, wa, wb)| if a < lo { (lo, b, 0.0, wb) } else { (a, b, wa, wb) })
+        .map(|(a, b, wa, wb)| if b > hi { (a, hi, wa, 0.0) } else { (a, b, wa, wb) })
         .collect();
     if spans.is_empty() {
         return;
@@ -399,13 +444,20 @@ fn ray_findings(
         }
         for (g0, g1) in gaps {
             let len = g1 - g0;
-            let w = match (g0 <= p0, g1 >= p1) {
-                (true, true) => w0.max(w1),
-                (true, false) => w0,
-                (false, true) => w1,
-                (false, false) => 1.0,
+            let depth = if sections.is_empty() {
+                // Measured from the part surface the piece opens; a piece
+                // inside a part span (a ray running just under the surface)
+                // is measured by the rays that cross the surface there.
+                let w = match (g0 <= p0, g1 >= p1) {
+                    (true, true) => w0.max(w1),
+                    (true, false) => w0,
+                    (false, true) => w1,
+                    (false, false) => 0.0,
+                };
+                len * w
+            } else {
+                section_depth(&sections, o.z, g0, g1)
             };
-            let depth = len * w;
             if depth > limit {
                 f.gouges.push(DexelGouge {
                     axis,
@@ -455,7 +507,7 @@ fn ray_findings(
                     w = Some(w.map_or((w0, b), |x| if w0 > x.0 { (w0, b) } else { x }));
                 }
             }
-            if let Some((w, s)) = w {
+            if let Some((w, s)) = w.filter(|w| w.0 > 0.0) {
                 f.along = f.along.max(len);
                 let t = len * w;
                 if f.thickness.is_none_or(|(b, _)| t > b) {
