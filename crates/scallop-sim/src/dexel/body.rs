@@ -202,7 +202,7 @@ impl Piece {
     pub(crate) fn hit(&self, line: &Line) -> Option<Span> {
         match *self {
             Piece::Frustum { h0, h1, r0, k } => Self::slab(line, h0, h1)?.meet(Self::flank(line, h0, r0, k)?),
-            Piece::Cap { core, r } if core == 0.0 => {
+            Piece::Cap { core: 0.0, r } => {
                 // Sphere of radius r centred at h = r, below h = r.
                 let c = line.w0 - r * line.a;
                 let [Some((s0, s1)), None] = quadratic_le0(1.0, c.dot(&line.d), c.norm_squared() - r * r) else {
@@ -444,7 +444,7 @@ mod tests {
                         let h = q.dot(&a);
                         let rho = (q - h * a).norm();
                         let r = if matches!(shape, CutterShape::Flat { .. }) { 2.0 } else { shape.radius_at(h) };
-                        assert!(h >= -1e-9 && h <= 5.0 + 1e-9 && rho <= r + 1e-7, "{shape:?} end {s} outside");
+                        assert!((-1e-9..=5.0 + 1e-9).contains(&h) && rho <= r + 1e-7, "{shape:?} end {s} outside");
                     }
                 }
             }

@@ -189,7 +189,7 @@ impl Ray {
     /// Removes [a, b]; returns the removed length and the middle of the
     /// longest removed piece.
     fn subtract(&mut self, a: f64, b: f64, lo: f64, hi: f64) -> (f64, f64, f64) {
-        if !(b > a) || !self.has_material(a, b, lo, hi) {
+        if b <= a || a.is_nan() || b.is_nan() || !self.has_material(a, b, lo, hi) {
             return (0.0, 0.0, 0.0);
         }
         let old = match std::mem::replace(self, Ray::Cut(Vec::new())) {
@@ -783,15 +783,16 @@ impl Family {
                             && o[self.v] <= b.1[self.v]
                     };
                     let bx = &boxes[k as usize];
-                    if inside(&bx[0]) && ray.has_material(bx[0].0[self.axis], bx[0].1[self.axis], lo, hi) {
-                        if let Some((a, b)) = step.sweep.interval(flutes, &o, &d) {
-                            let (r, l, mid) = ray.subtract(a.max(lo), b.min(hi), lo, hi);
-                            removed += r;
-                            if l > longest {
-                                longest = l;
-                                at = o;
-                                at[self.axis] = mid;
-                            }
+                    if inside(&bx[0])
+                        && ray.has_material(bx[0].0[self.axis], bx[0].1[self.axis], lo, hi)
+                        && let Some((a, b)) = step.sweep.interval(flutes, &o, &d)
+                    {
+                        let (r, l, mid) = ray.subtract(a.max(lo), b.min(hi), lo, hi);
+                        removed += r;
+                        if l > longest {
+                            longest = l;
+                            at = o;
+                            at[self.axis] = mid;
                         }
                     }
                     for (g, (body, _)) in guards.iter().enumerate() {

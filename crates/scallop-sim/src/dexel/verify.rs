@@ -70,13 +70,13 @@ impl DexelPart {
     /// The part along the ray through `o` along `axis`: sorted disjoint
     /// `(s0, s1, w0, w1)` (coordinates along the axis and `|d . n|` at each end).
     #[must_use]
-    pub fn intervals(&self, o: &Point3, axis: usize) -> Vec<(f64, f64, f64, f64)> {
+    pub fn intervals(&self, o: &Point3, axis: usize) -> Vec<PartSpan> {
         self.ray(o, axis).0
     }
 
     /// The part intervals and, for an open part on an X or Y ray, the
     /// surface's section pieces `(s_a, z_a, s_b, z_b, |n_z|)`.
-    fn ray(&self, o: &Point3, axis: usize) -> (Vec<(f64, f64, f64, f64)>, Vec<Section>) {
+    fn ray(&self, o: &Point3, axis: usize) -> (Vec<PartSpan>, Vec<Section>) {
         let b = self.index.bounds();
         let query = match axis {
             2 => Aabb2 { min: Point2::new(o.x, o.y), max: Point2::new(o.x, o.y) },
@@ -90,10 +90,10 @@ impl DexelPart {
         } else if axis == 2 {
             let mut top: Option<(f64, f64)> = None;
             for &slot in &slots {
-                if let Some((s, w)) = self.crossing(o, axis, slot as usize) {
-                    if top.is_none_or(|(t, _)| s > t) {
-                        top = Some((s, w));
-                    }
+                if let Some((s, w)) = self.crossing(o, axis, slot as usize)
+                    && top.is_none_or(|(t, _)| s > t)
+                {
+                    top = Some((s, w));
                 }
             }
             (top.map(|(s, w)| vec![(f64::NEG_INFINITY, s, 0.0, w)]).unwrap_or_default(), Vec::new())
@@ -135,7 +135,7 @@ impl DexelPart {
     }
 
     /// A closed solid along the ray: crossings paired by parity.
-    fn solid(&self, o: &Point3, axis: usize, slots: &[u32]) -> Vec<(f64, f64, f64, f64)> {
+    fn solid(&self, o: &Point3, axis: usize, slots: &[u32]) -> Vec<PartSpan> {
         let mut hits: Vec<(f64, f64)> = slots.iter().filter_map(|&s| self.crossing(o, axis, s as usize)).collect();
         hits.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.total_cmp(&y.1)));
         hits.chunks_exact(2).map(|p| (p[0].0, p[1].0, p[0].1, p[1].1)).collect()
@@ -145,11 +145,11 @@ impl DexelPart {
     /// or above the ray (ends at the footprint's side carry 0: stock beyond
     /// the footprint is no material on the part, and removed part there is
     /// measured vertically, [`section_depth`]), with the section pieces.
-    fn section(&self, o: &Point3, axis: usize, slots: &[u32]) -> (Vec<(f64, f64, f64, f64)>, Vec<Section>) {
+    fn section(&self, o: &Point3, axis: usize, slots: &[u32]) -> (Vec<PartSpan>, Vec<Section>) {
         // The ray runs along `axis` at height o.z in the vertical plane c = o[c].
         let c = 1 - axis;
         let level = o.z;
-        let mut pieces: Vec<(f64, f64, f64, f64)> = Vec::new();
+        let mut pieces: Vec<PartSpan> = Vec::new();
         let mut sections: Vec<Section> = Vec::new();
         for &slot in slots {
             let t = self.index.corners(slot as usize);
@@ -197,7 +197,7 @@ impl DexelPart {
             }
         }
         pieces.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.total_cmp(&y.1)));
-        let mut out: Vec<(f64, f64, f64, f64)> = Vec::with_capacity(pieces.len());
+        let mut out: Vec<PartSpan> = Vec::with_capacity(pieces.len());
         for p in pieces {
             match out.last_mut() {
                 Some(last) if p.0 <= last.1 => {
@@ -212,6 +212,9 @@ impl DexelPart {
         (out, sections)
     }
 }
+
+/// A part interval along a ray: `(s0, s1, w0, w1)`, the ends and `|d . n|` there.
+type PartSpan = (f64, f64, f64, f64);
 
 /// A piece of an open part's section by a vertical plane: `(s_a, z_a, s_b,
 /// z_b, |n_z|)` along the ray's axis.
@@ -314,7 +317,7 @@ pub fn verify_dexel(
     let mut total = BandFindings { min_dev: f64::INFINITY, ..BandFindings::default() };
     let mut thickness: Option<(f64, Point3)> = None;
     let mut gouges = Vec::new();
-    for axis in 0..3 {
+    for (axis, left_along) in max_left_along.iter_mut().enumerate() {
         let (nu, nv) = stock.grid(axis);
         let bands: Vec<BandFindings> = (0..nv)
             .into_par_iter()
@@ -328,18 +331,18 @@ pub fn verify_dexel(
             .collect();
         for f in bands {
             total.part_rays += f.part_rays;
-            if let Some((s, p)) = f.scallop {
-                if total.scallop.is_none_or(|(t, _)| s > t) {
-                    total.scallop = Some((s, p));
-                }
+            if let Some((s, p)) = f.scallop
+                && total.scallop.is_none_or(|(t, _)| s > t)
+            {
+                total.scallop = Some((s, p));
             }
             total.min_dev = total.min_dev.min(f.min_dev);
             total.excess += f.excess;
-            max_left_along[axis] = f64::max(max_left_along[axis], f.along);
-            if let Some((t, p)) = f.thickness {
-                if thickness.is_none_or(|(b, _)| t > b) {
-                    thickness = Some((t, p));
-                }
+            *left_along = f64::max(*left_along, f.along);
+            if let Some((t, p)) = f.thickness
+                && thickness.is_none_or(|(b, _)| t > b)
+            {
+                thickness = Some((t, p));
             }
             gouges.extend(f.gouges);
         }
@@ -400,7 +403,7 @@ fn ray_findings(
         p
     };
     let (spans, sections) = part.ray(&o, axis);
-    let spans: Vec<(f64, f64, f64, f64)> = spans
+    let spans: Vec<PartSpan> = spans
         .into_iter()
         .filter(|p| p.1 > lo && p.0 < hi)
         .map(|(a, b, wa, wb)| if a < lo { (lo, b, 0.0, wb) } else { (a, b, wa, wb) })
@@ -497,12 +500,15 @@ fn ray_findings(
             if axis == 2 {
                 f.excess += len;
             }
-            // Touching the part: a span ends where the piece starts, or starts where it ends.
+            // Touching the part: a span ends where the piece starts, or starts
+            // where it ends (exactly: the piece was cut at those values).
             let mut w: Option<(f64, f64)> = None;
             for &(p0, p1, w0, w1) in &spans {
+                #[allow(clippy::float_cmp, reason = "the piece's ends are copies of the span's")]
                 if p1 == a {
                     w = Some(w.map_or((w1, a), |x| if w1 > x.0 { (w1, a) } else { x }));
                 }
+                #[allow(clippy::float_cmp, reason = "the piece's ends are copies of the span's")]
                 if p0 == b {
                     w = Some(w.map_or((w0, b), |x| if w0 > x.0 { (w0, b) } else { x }));
                 }
