@@ -345,45 +345,79 @@ fn lowered_3_plus_2_pass_is_a_gouge_at_that_move() {
     assert!((worst[0].at.y - (-1.0 + step * lowered as f64)).abs() < rr);
 }
 
-/// Simultaneous 5-axis: a flat end mill pivoting about a point above its tip
-/// while moving. Halving the axis tolerance changes the result by at most
-/// the two tolerances (measured along the rays' direction within the
-/// bound's geometry: material moves by at most tol / |cos| along a ray, so
-/// the volume by at most the surface area times the tolerances).
+/// Distance from `q` to a flat end mill (radius `r`, flutes `l`) with its tip at `tip` and axis `a`.
+fn flat_distance(q: &Point3, tip: &Point3, a: &Vec3, r: f64, l: f64) -> f64 {
+    let w = q - tip;
+    let h = w.dot(a);
+    let rho = (w - h * a).norm();
+    let dh = (-h).max(h - l).max(0.0);
+    (rho - r).max(0.0).hypot(dh)
+}
+
+/// Simultaneous 5-axis: a flat end mill turning by 57 degrees while it
+/// moves. Every point where the simulated stock was cut back to (an interval
+/// end inside the stock box) lies on the simulated swept solid, so within the
+/// stated bound `l dtheta / 2 <= axis_tolerance` of the true swept solid: its
+/// distance to the tool at the nearest of 20,000 true poses along the move is
+/// at most the tolerance plus the sampling's own gap. The volumes at two
+/// tolerances differ by at most the swept surface's area times the tolerances.
 #[test]
-fn five_axis_sub_steps_converge_within_the_bound() {
+fn five_axis_sub_steps_stay_within_the_bound() {
+    let (r, l) = (2.0, 6.0);
     let stock = Aabb3 { min: p(0.0, 0.0, -4.0), max: p(16.0, 10.0, 0.0) };
-    let cutter = Cutter::new(CutterShape::Bull { radius: 2.0, corner: 0.5 }, 6.0).unwrap();
-    let path = [
-        mv(MoveKind::Plunge, p(2.0, 5.0, -1.5), tilted(-0.4, 0.0)),
-        mv(MoveKind::Feed, p(14.0, 5.0, -1.0), tilted(0.5, 0.0)),
-    ];
+    let cutter = Cutter::new(CutterShape::Flat { radius: r }, l).unwrap();
+    let (p0, p1) = (p(2.0, 5.0, -1.5), p(14.0, 5.0, -1.0));
+    let (a0, a1) = (tilted(-0.4, 0.0), tilted(0.6, 0.0));
+    let path = [mv(MoveKind::Plunge, p0, a0), mv(MoveKind::Feed, p1, a1)];
     let run = |tol: f64| {
-        let mut d = DexelStock::new(stock, 0.2).unwrap();
-        let r = d.cut(&cutter, &path, &DexelOptions { axis_tolerance: tol, check_collisions: false }).unwrap();
-        (d, r)
+        let mut d = DexelStock::new(stock, 0.25).unwrap();
+        let rep = d.cut(&cutter, &path, &DexelOptions { axis_tolerance: tol, check_collisions: false }).unwrap();
+        (d, rep)
     };
-    let (coarse, rc) = run(0.02);
+    let tol = 0.02;
+    let (coarse, rc) = run(tol);
     let (fine, rf) = run(0.0005);
-    assert!(rc.sweeps > 2 && rf.sweeps > rc.sweeps, "{} {}", rc.sweeps, rf.sweeps);
-    // Swept surface area, generously: the cutter's side and ends swept 14 mm.
-    let area = (4.0 + std::f64::consts::TAU * 2.0) * 14.0 * 2.0 + 2.0 * std::f64::consts::TAU * 2.0 * 6.0;
-    let dv = (coarse.volume() - fine.volume()).abs();
-    assert!(dv <= area * (0.02 + 0.0005), "{dv}");
-    // Ray by ray on the Z rays: no interval end moves by more than the
-    // tolerances over the surface slope, for rays not grazing.
-    let (nx, ny) = coarse.grid(2);
-    let mut compared = 0;
-    for j in 0..ny {
-        for i in 0..nx {
-            let (c, f) = (coarse.intervals(2, i, j), fine.intervals(2, i, j));
-            if c.len() == 1 && f.len() == 1 {
-                compared += 1;
-                assert!((c[0][1] - f[0][1]).abs() <= 0.5, "ray ({i}, {j}): {c:?} vs {f:?}");
+    let theta = 1.0f64;
+    let reach = l.hypot(r);
+    assert_eq!(rc.sweeps, 1 + (theta / (2.0 * tol / reach)).ceil() as usize);
+    assert!(rf.sweeps > rc.sweeps);
+    // The true poses: tip on the segment, axis on the great circle (a turn about Y).
+    let n = 20_000;
+    let poses: Vec<(Point3, Vec3)> = (0..=n)
+        .map(|i| {
+            let t = f64::from(i) / f64::from(n);
+            (p0 + t * (p1 - p0), tilted(-0.4 + t * theta, 0.0))
+        })
+        .collect();
+    // Between two samples a tool point moves at most this far.
+    let gap = ((p1 - p0).norm() + reach * theta) / f64::from(n);
+    let mut checked = 0;
+    for axis in 0..3 {
+        let (nu, nv) = coarse.grid(axis);
+        let (lo, hi) = (stock.min[axis], stock.max[axis]);
+        for iv in 0..nv {
+            for iu in 0..nu {
+                for s in coarse.intervals(axis, iu, iv) {
+                    for end in s {
+                        if end <= lo || end >= hi {
+                            continue;
+                        }
+                        let mut q = coarse.ray_origin(axis, iu, iv);
+                        q[axis] = end;
+                        let dist =
+                            poses.iter().map(|(tip, a)| flat_distance(&q, tip, a, r, l)).fold(f64::INFINITY, f64::min);
+                        assert!(dist <= tol + gap + 1e-9, "axis {axis} point {q:?}: {dist} from the true sweep");
+                        checked += 1;
+                    }
+                }
             }
         }
     }
-    assert!(compared > 0);
+    assert!(checked > 1000, "{checked}");
+    // Volumes: the swept surface's area, generously (side and ends of the tool over the move).
+    let area = (2.0 * r + std::f64::consts::TAU * r) * (p1 - p0).norm() * 2.0 + std::f64::consts::TAU * r * l * 2.0;
+    let dv = (coarse.volume() - fine.volume()).abs();
+    assert!(dv <= area * (tol + 0.0005), "{dv}");
 }
 
 /// The shank of a tilted tool dragged through the stock is a collision, and
