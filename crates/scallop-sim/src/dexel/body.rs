@@ -49,11 +49,6 @@ pub(crate) struct Body {
     pieces: Vec<Piece>,
     /// Largest distance from the tip to a point of the body (mm).
     reach: f64,
-    /// Largest radius (mm).
-    radius: f64,
-    /// Height range along the axis.
-    h_lo: f64,
-    h_hi: f64,
 }
 
 /// A line `w(s) = w0 + s d` relative to the tool tip, with the tool axis `a`
@@ -286,19 +281,14 @@ impl Piece {
 impl Body {
     fn new(pieces: Vec<Piece>) -> Body {
         let mut reach = 0.0f64;
-        let mut radius = 0.0f64;
-        let (mut h_lo, mut h_hi) = (f64::INFINITY, f64::NEG_INFINITY);
         for p in &pieces {
             let (lo, hi, r_lo, r_hi) = match *p {
                 Piece::Frustum { h0, h1, r0, k } => (h0, h1, r0, r0 + k * (h1 - h0)),
                 Piece::Cap { core, r } => (0.0, r, core + r, core + r),
             };
             reach = reach.max(lo.hypot(r_lo)).max(hi.hypot(r_hi)).max(lo.abs()).max(hi.abs());
-            radius = radius.max(r_lo).max(r_hi);
-            h_lo = h_lo.min(lo);
-            h_hi = h_hi.max(hi);
         }
-        Body { pieces, reach, radius, h_lo, h_hi }
+        Body { pieces, reach }
     }
 
     /// The cutting part of `cutter` (flutes): the profile up to the flute length.
@@ -351,16 +341,6 @@ impl Body {
     /// Largest distance from the tip to the body (mm).
     pub(crate) fn reach(&self) -> f64 {
         self.reach
-    }
-
-    /// Largest radius (mm).
-    pub(crate) fn radius(&self) -> f64 {
-        self.radius
-    }
-
-    /// Lowest and highest `h`.
-    pub(crate) fn heights(&self) -> (f64, f64) {
-        (self.h_lo, self.h_hi)
     }
 
     /// The part of the line inside the body.

@@ -174,6 +174,18 @@ impl Ray {
         }
     }
 
+    /// The hull of the material inside (a, b), if any.
+    fn material_range(&self, a: f64, b: f64, lo: f64, hi: f64) -> Option<(f64, f64)> {
+        match self {
+            Ray::Full => (a < hi && b > lo).then(|| (a.max(lo), b.min(hi))),
+            Ray::Cut(v) => {
+                let first = v.iter().find(|s| s[1] > a && s[0] < b)?;
+                let last = v.iter().rev().find(|s| s[1] > a && s[0] < b)?;
+                Some((first[0].max(a), last[1].min(b)))
+            }
+        }
+    }
+
     /// Material length inside [a, b].
     fn overlap(&self, a: f64, b: f64, lo: f64, hi: f64) -> (f64, f64) {
         let piece = |s: [f64; 2]| {
@@ -248,21 +260,19 @@ pub(crate) struct Step {
     hi: Point3,
 }
 
-/// Box of a body swept with a fixed axis between two tip positions.
+/// Box of a body swept with a fixed axis between two tip positions: exact,
+/// from the body's support function in the six axis directions, grown by `margin`.
 fn swept_box(body: &Body, sweep: &Sweep, margin: f64) -> (Point3, Point3) {
-    let (h0, h1) = body.heights();
-    let r = body.radius();
-    let mut lo = Point3::new(f64::INFINITY, f64::INFINITY, f64::INFINITY);
-    let mut hi = -lo;
-    for tip in [sweep.p0, sweep.p0 + sweep.v] {
-        for h in [h0, h1] {
-            let c = tip + h * sweep.a;
-            for i in 0..3 {
-                let e = r * (1.0 - sweep.a[i] * sweep.a[i]).max(0.0).sqrt() + margin;
-                lo[i] = lo[i].min(c[i] - e);
-                hi[i] = hi[i].max(c[i] + e);
-            }
-        }
+    let mut lo = Point3::origin();
+    let mut hi = Point3::origin();
+    for i in 0..3 {
+        let mut e = Vec3::zeros();
+        e[i] = 1.0;
+        let up = body.support(&sweep.a, &e).0;
+        let down = body.support(&sweep.a, &(-e)).0;
+        let (a, b) = (sweep.p0[i], sweep.p0[i] + sweep.v[i]);
+        lo[i] = a.min(b) - down - margin;
+        hi[i] = a.max(b) + up + margin;
     }
     (lo, hi)
 }
@@ -784,8 +794,8 @@ impl Family {
                     };
                     let bx = &boxes[k as usize];
                     if inside(&bx[0])
-                        && ray.has_material(bx[0].0[self.axis], bx[0].1[self.axis], lo, hi)
-                        && let Some((a, b)) = step.sweep.interval(flutes, &o, &d)
+                        && let Some((m_lo, m_hi)) = ray.material_range(bx[0].0[self.axis], bx[0].1[self.axis], lo, hi)
+                        && let Some((a, b)) = step.sweep.interval_within(flutes, &o, &d, m_lo, m_hi)
                     {
                         let (r, l, mid) = ray.subtract(a.max(lo), b.min(hi), lo, hi);
                         removed += r;
@@ -797,10 +807,13 @@ impl Family {
                     }
                     for (g, (body, _)) in guards.iter().enumerate() {
                         let b = &bx[g + 1];
-                        if !inside(b) || !ray.has_material(b.0[self.axis], b.1[self.axis], lo, hi) {
+                        if !inside(b) {
                             continue;
                         }
-                        if let Some((a, b)) = step.sweep.interval(body, &o, &d) {
+                        let Some((m_lo, m_hi)) = ray.material_range(b.0[self.axis], b.1[self.axis], lo, hi) else {
+                            continue;
+                        };
+                        if let Some((a, b)) = step.sweep.interval_within(body, &o, &d, m_lo, m_hi) {
                             let (depth, mid) = ray.overlap(a, b, lo, hi);
                             if depth > self.eps && worst[g].is_none_or(|(w, _)| depth > w) {
                                 let mut p = o;

@@ -73,6 +73,20 @@ impl Sweep {
 
     /// The interval of the line `o + s d` (unit `d`) inside the swept body.
     pub(crate) fn interval(&self, body: &Body, o: &Point3, d: &Vec3) -> Option<(f64, f64)> {
+        self.interval_within(body, o, d, f64::NEG_INFINITY, f64::INFINITY)
+    }
+
+    /// [`Sweep::interval`] where only its overlap with `(m_lo, m_hi)` matters:
+    /// `None` as soon as the certified bounds show there is none (the entry
+    /// at or after `m_hi`, or the exit at or before `m_lo`).
+    pub(crate) fn interval_within(
+        &self,
+        body: &Body,
+        o: &Point3,
+        d: &Vec3,
+        m_lo: f64,
+        m_hi: f64,
+    ) -> Option<(f64, f64)> {
         let vv = self.v.norm_squared();
         if vv == 0.0 {
             return self.at(body, o, d, 0.0).map(|s| (s.s0, s.s1));
@@ -116,13 +130,17 @@ impl Sweep {
             let (a, b) = (h0?, h1?);
             return Some((a.s0.min(b.s0), a.s1.max(b.s1)));
         }
-        let entry = self.extreme(body, o, d, h0, h1, t_f, span_f, 1.0);
-        let exit = -self.extreme(body, o, d, h0, h1, t_f, span_f, -1.0);
-        (entry <= exit).then_some((entry, exit))
+        let entry = self.extreme(body, o, d, h0, h1, t_f, span_f, 1.0, m_hi)?;
+        if entry >= m_hi {
+            return None;
+        }
+        let exit = -self.extreme(body, o, d, h0, h1, t_f, span_f, -1.0, -m_lo)?;
+        (entry <= exit && exit > m_lo).then_some((entry, exit))
     }
 
     /// Minimum over positions of `sign * edge`, edge the entry (`sign = 1`)
-    /// or the exit (`sign = -1`), by bisection on the slope's sign.
+    /// or the exit (`sign = -1`), by bisection on the slope's sign; `None`
+    /// once its certified lower bound reaches `cutoff`.
     #[allow(clippy::too_many_arguments)] // private; the pieces of one search.
     fn extreme(
         &self,
@@ -134,7 +152,8 @@ impl Sweep {
         mut t_f: f64,
         span_f: Span,
         sign: f64,
-    ) -> f64 {
+        cutoff: f64,
+    ) -> Option<f64> {
         let probe = |t: f64, s: &Span| {
             let (value, n) = if sign > 0.0 { (s.s0, s.n0) } else { (-s.s1, s.n1) };
             let nd = n.dot(d);
@@ -156,7 +175,7 @@ impl Sweep {
             let p = probe(0.0, &s);
             best = best.min(p.value);
             if p.slope >= 0.0 {
-                return best; // Non-decreasing from the start: the minimum is there.
+                return Some(best); // Non-decreasing from the start: the minimum is there.
             }
             at_lo = p.slope.is_finite().then_some(p);
         }
@@ -164,11 +183,17 @@ impl Sweep {
             let p = probe(1.0, &s);
             best = best.min(p.value);
             if p.slope <= 0.0 {
-                return best;
+                return Some(best);
             }
             at_hi = p.slope.is_finite().then_some(p);
         }
+        // Probe at the tangents' crossing while that shrinks the bracket at
+        // least by half, else at the middle (a safeguarded cutting-plane
+        // step: superlinear on smooth minima, never slower than bisection
+        // every other step).
+        let mut cut_step = true;
         for _ in 0..MAX_BISECT {
+            let mut crossing = None;
             if let (Some(l), Some(h)) = (at_lo, at_hi) {
                 // The convex function lies above both tangents.
                 let t = (h.value - l.value + l.slope * l.t - h.slope * h.t) / (l.slope - h.slope);
@@ -176,8 +201,16 @@ impl Sweep {
                 if best - bound <= SWEEP_TOL {
                     break;
                 }
+                if bound >= cutoff {
+                    return None;
+                }
+                crossing = Some(t);
             }
-            let mid = 0.5 * (lo + hi);
+            let width = hi - lo;
+            let mid = match crossing {
+                Some(t) if cut_step && t.is_finite() => t.clamp(lo + 0.01 * width, hi - 0.01 * width),
+                _ => 0.5 * (lo + hi),
+            };
             if mid <= lo || mid >= hi {
                 break;
             }
@@ -221,8 +254,9 @@ impl Sweep {
                     }
                 }
             }
+            cut_step = hi - lo <= 0.5 * width;
         }
-        best
+        Some(best)
     }
 }
 
