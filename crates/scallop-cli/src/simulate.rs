@@ -142,7 +142,7 @@ fn read_program(args: &SimulateArgs) -> CliResult<Program> {
     for r in &rows {
         path.push(Move::new(r.kind, r.tip));
     }
-    let moves = rows.iter().map(|r| ToolMove { kind: r.kind, tip: r.tip, axis: r.axis }).collect();
+    let moves = rows.iter().map(|r| ToolMove::new(r.kind, r.tip, r.axis)).collect();
     Ok(Program { name, moves, path })
 }
 
@@ -348,7 +348,7 @@ fn simulate_dexel(
         cutter: cutter_text.to_string(),
         resolution_mm: args.resolution,
         cells: [counts[0], counts[1]],
-        moves: program.moves.len(),
+        moves: program.path.moves().len(),
         feed_moves: cut.feed_moves,
         air_cut_share: cut.air_cut_share(),
         removed_volume_mm3: cut.removed_volume,

@@ -54,13 +54,13 @@ fn raster() -> Vec<ToolMove> {
         let xs: Vec<f64> =
             if j % 2 == 0 { (0..=50).map(f64::from).collect() } else { (0..=50).rev().map(f64::from).collect() };
         let first = tip(xs[0], y);
-        moves.push(ToolMove { kind: MoveKind::Rapid, tip: Point3::new(first.x, first.y, 12.0), axis: a });
+        moves.push(ToolMove::new(MoveKind::Rapid, Point3::new(first.x, first.y, 12.0), a));
         for (k, &x) in xs.iter().enumerate() {
             let kind = if k == 0 { MoveKind::Plunge } else { MoveKind::Feed };
-            moves.push(ToolMove { kind, tip: tip(x, y), axis: a });
+            moves.push(ToolMove::new(kind, tip(x, y), a));
         }
         let last = tip(xs[50], y);
-        moves.push(ToolMove { kind: MoveKind::Retract, tip: Point3::new(last.x, last.y, 12.0), axis: a });
+        moves.push(ToolMove::new(MoveKind::Retract, Point3::new(last.x, last.y, 12.0), a));
     }
     moves
 }

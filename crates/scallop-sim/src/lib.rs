@@ -182,7 +182,7 @@ pub struct DexelSimulation {
 /// let flat = Cutter::new(CutterShape::Flat { radius: 2.0 }, 10.0).unwrap();
 /// // A flat end mill tilted 30 degrees about X, its tip 0.2 mm below the plane: a gouge.
 /// let axis = Vec3::new(0.0, -0.5, 0.75f64.sqrt());
-/// let mv = |kind, x: f64, z: f64| ToolMove { kind, tip: p(x, 5., z), axis };
+/// let mv = |kind, x: f64, z: f64| ToolMove::new(kind, p(x, 5., z), axis);
 /// let path = [mv(MoveKind::Rapid, -4., 6.), mv(MoveKind::Plunge, -4., -0.2), mv(MoveKind::Feed, 14., -0.2)];
 /// let err = simulate_dexel(stock, 0.25, &flat, &path, &part, &DexelOptions::default(), &VerifyOptions::default());
 /// let Err(SimError::DexelGouge { worst, .. }) = err else { panic!("expected a gouge") };

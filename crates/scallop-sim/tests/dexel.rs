@@ -18,7 +18,7 @@ fn p(x: f64, y: f64, z: f64) -> Point3 {
 }
 
 fn mv(kind: MoveKind, tip: Point3, axis: Vec3) -> ToolMove {
-    ToolMove { kind, tip, axis }
+    ToolMove::new(kind, tip, axis)
 }
 
 /// Axis tilted by `tilt` from +Z towards the azimuth `phi`.
@@ -495,4 +495,39 @@ fn memory_and_errors() {
     assert!(DexelStock::new(stock, 0.0).is_err());
     let e = d.cut(&cutter, &path, &DexelOptions { axis_tolerance: -1.0, ..DexelOptions::default() }).unwrap_err();
     assert!(e.to_string().contains("axis tolerance"), "{e}");
+}
+
+/// Arcs (planar and helical) are cut as chords within `ARC_SAGITTA`: the
+/// z-map cuts them exactly, and the two stocks agree up to that sagitta.
+#[test]
+fn arcs_match_the_zmap_up_to_the_sagitta() {
+    use scallop_geom::Point2;
+    use scallop_toolpath::ArcXY;
+    let stock = Aabb3 { min: p(0.0, 0.0, -4.0), max: p(12.0, 12.0, 0.0) };
+    let cutter = Cutter::new(CutterShape::Ball { radius: 1.5 }, 8.0).unwrap();
+    let mut path = Toolpath::new(1000.0);
+    path.push(Move::new(MoveKind::Rapid, p(9.0, 6.0, 3.0)));
+    path.push(Move::new(MoveKind::Plunge, p(9.0, 6.0, -1.0)));
+    // A planar half circle (G3) and a clockwise helical three-quarter turn (G2).
+    path.push_arc(
+        Move::new(MoveKind::Feed, p(3.0, 6.0, -1.0)),
+        ArcXY { center: Point2::new(6.0, 6.0), sweep: std::f64::consts::PI },
+    );
+    path.push_arc(
+        Move::new(MoveKind::Feed, p(6.0, 3.0, -2.0)),
+        ArcXY { center: Point2::new(6.0, 6.0), sweep: -1.5 * std::f64::consts::PI },
+    );
+    let mut zmap = ZMap::new(stock, 0.1).unwrap();
+    let zr = zmap.cut(&cutter, &path).unwrap();
+    let mut dexels = DexelStock::new(stock, 0.1).unwrap();
+    let moves = ToolMove::from_toolpath(&path);
+    assert!(moves[2].arc.is_some());
+    let dr = dexels.cut(&cutter, &moves, &DexelOptions::default()).unwrap();
+    assert!(dr.sweeps > 100, "{}", dr.sweeps);
+    // The footprint's edge is about 2 x 2 pi x 3 mm long, the cut up to 2 mm deep.
+    let bound = 2.0 * std::f64::consts::TAU * 4.5 * 2.0 * scallop_sim::tol::ARC_SAGITTA;
+    assert!((dr.removed_volume - zr.removed_volume).abs() <= bound, "{} vs {}", dr.removed_volume, zr.removed_volume);
+    let top = dexels.top_heights();
+    let same = top.iter().zip(zmap.heights()).filter(|(a, b)| (*a - *b).abs() <= 1e-3).count();
+    assert!(same as f64 >= 0.999 * top.len() as f64, "{same} of {}", top.len());
 }

@@ -15,9 +15,9 @@ use std::fmt;
 use rayon::prelude::*;
 use scallop_cutter::Cutter;
 use scallop_geom::{Aabb3, Eps, Point2, Point3, Vec3};
-use scallop_toolpath::{MoveKind, Toolpath};
+use scallop_toolpath::{ArcXY, MoveKind, Toolpath};
 
-use crate::tol::GRID_SNAP;
+use crate::tol::{ARC_SAGITTA, GRID_SNAP};
 use crate::{MoveId, RapidHit, SimError, ToolPart};
 use body::Body;
 use sweep::Sweep;
@@ -35,9 +35,9 @@ pub const MAX_SUBSTEPS: usize = 100_000;
 const BAND_ROWS: usize = 4;
 
 /// One move of a multi-axis program: the tool tip goes in a straight line to
-/// `tip` while the unit tool axis (from the tip towards the spindle) turns
-/// from the previous move's axis to `axis` (on the great circle, at a
-/// constant angular rate).
+/// `tip` (or along `arc`) while the unit tool axis (from the tip towards the
+/// spindle) turns from the previous move's axis to `axis` (on the great
+/// circle, at a constant angular rate).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ToolMove {
     /// Kind of move.
@@ -46,13 +46,26 @@ pub struct ToolMove {
     pub tip: Point3,
     /// Unit tool axis at the end of the move.
     pub axis: Vec3,
+    /// The XY circle of a circular (or helical) move, as in
+    /// [`Toolpath::arc`]: cut as chords within [`crate::tol::ARC_SAGITTA`].
+    pub arc: Option<ArcXY>,
 }
 
 impl ToolMove {
-    /// The moves of a 3-axis toolpath, tool axis +Z. Arcs are taken as their chords.
+    /// A straight move.
+    #[must_use]
+    pub fn new(kind: MoveKind, tip: Point3, axis: Vec3) -> ToolMove {
+        ToolMove { kind, tip, axis, arc: None }
+    }
+
+    /// The moves of a 3-axis toolpath, tool axis +Z, arcs kept.
     #[must_use]
     pub fn from_toolpath(path: &Toolpath) -> Vec<ToolMove> {
-        path.moves().iter().map(|m| ToolMove { kind: m.kind, tip: m.to, axis: Vec3::z() }).collect()
+        path.moves()
+            .iter()
+            .enumerate()
+            .map(|(i, m)| ToolMove { kind: m.kind, tip: m.to, axis: Vec3::z(), arc: path.arc(i) })
+            .collect()
     }
 }
 
@@ -479,7 +492,17 @@ impl DexelStock {
             let axis = m.axis / len;
             let (p0, a0) = prev.unwrap_or((m.tip, axis));
             let theta = a0.cross(&axis).norm().atan2(a0.dot(&axis));
-            let n = if theta == 0.0 { 1.0 } else { (theta / max_turn).ceil().max(1.0) };
+            let mut n = if theta == 0.0 { 1.0 } else { (theta / max_turn).ceil().max(1.0) };
+            // An arc: chords whose sagitta r (1 - cos(step / 2)) stays within ARC_SAGITTA.
+            let arc = m.arc.filter(|a| a.sweep != 0.0 && prev.is_some()).map(|a| {
+                let r = (p0.x - a.center.x).hypot(p0.y - a.center.y);
+                let start = (p0.y - a.center.y).atan2(p0.x - a.center.x);
+                (a, r, start)
+            });
+            if let Some((a, r, _)) = arc {
+                let step = if r > ARC_SAGITTA { 2.0 * (1.0 - ARC_SAGITTA / r).acos() } else { a.sweep.abs() };
+                n = n.max((a.sweep.abs() / step).ceil());
+            }
             if theta > std::f64::consts::PI * (1.0 - 1e-6) || n > MAX_SUBSTEPS as f64 {
                 return Err(SimError::AxisTurn { index, degrees: theta.to_degrees(), limit: MAX_SUBSTEPS });
             }
@@ -487,11 +510,19 @@ impl DexelStock {
             let n_sub = n as usize;
             let rapid = matches!(m.kind, MoveKind::Rapid | MoveKind::Retract);
             let index32 = u32::try_from(index).map_err(|_| SimError::TooManyMoves { moves: moves.len() })?;
+            let tip_at = |t: f64| match arc {
+                _ if t >= 1.0 => m.tip,
+                Some((a, r, start)) => {
+                    let th = start + a.sweep * t;
+                    Point3::new(a.center.x + r * th.cos(), a.center.y + r * th.sin(), p0.z + (m.tip.z - p0.z) * t)
+                }
+                None => p0 + t * (m.tip - p0),
+            };
             for i in 0..n_sub {
                 let (t0, t1) = (i as f64 / n, (i + 1) as f64 / n);
-                let a = if n_sub == 1 && theta == 0.0 { axis } else { slerp(&a0, &axis, theta, 0.5 * (t0 + t1)) };
-                let q0 = p0 + t0 * (m.tip - p0);
-                let q1 = if i + 1 == n_sub { m.tip } else { p0 + t1 * (m.tip - p0) };
+                let a = if theta == 0.0 { axis } else { slerp(&a0, &axis, theta, 0.5 * (t0 + t1)) };
+                let q0 = tip_at(t0);
+                let q1 = if i + 1 == n_sub { m.tip } else { tip_at(t1) };
                 let sweep = Sweep { p0: q0, v: q1 - q0, a };
                 let (lo, hi) = swept_box(body, &sweep, self.eps);
                 steps.push(Step { index: index32, operation, sweep, rapid, lo, hi });
@@ -530,7 +561,7 @@ impl DexelStock {
     /// let stock = Aabb3 { min: Point3::new(0.0, 0.0, -5.0), max: Point3::new(20.0, 10.0, 0.0) };
     /// let mut dexels = DexelStock::new(stock, 0.25).unwrap();
     /// let flat = Cutter::new(CutterShape::Flat { radius: 2.0 }, 10.0).unwrap();
-    /// let mv = |kind, x: f64, z: f64| ToolMove { kind, tip: Point3::new(x, 5.0, z), axis: Vec3::z() };
+    /// let mv = |kind, x: f64, z: f64| ToolMove::new(kind, Point3::new(x, 5.0, z), Vec3::z());
     /// let path = [mv(MoveKind::Rapid, -3.0, 5.0), mv(MoveKind::Plunge, -3.0, -1.0), mv(MoveKind::Feed, 23.0, -1.0)];
     /// let report = dexels.cut(&flat, &path, &DexelOptions::default()).unwrap();
     /// report.check().unwrap();
