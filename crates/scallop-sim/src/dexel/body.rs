@@ -432,6 +432,34 @@ mod tests {
     }
 
     #[test]
+    fn frusta_narrowing_upwards_match_sampling() {
+        // A holder taper: radius 2 at h = 1 down to 1 at h = 3.
+        let piece = Piece::Frustum { h0: 1.0, h1: 3.0, r0: 2.0, k: -0.5 };
+        let a = Vec3::new(0.6, 0.0, 0.8);
+        let mut state = 7u64;
+        let mut rnd = || {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        for _ in 0..500 {
+            let w0 = Vec3::new(3.0 * rnd(), 3.0 * rnd(), 3.0 * rnd() + 2.0);
+            let d = Vec3::new(rnd(), rnd(), rnd()).normalize();
+            let line = Line::new(a, w0, d);
+            let span = piece.hit(&line);
+            for k in -3000..3000 {
+                let s = f64::from(k) * 0.003;
+                let q = w0 + s * d;
+                let h = q.dot(&a);
+                let rho = (q - h * a).norm();
+                if (1.0..=3.0).contains(&h) && rho <= 2.0 - 0.5 * (h - 1.0) {
+                    let sp = span.unwrap();
+                    assert!(s >= sp.s0 - 1e-9 && s <= sp.s1 + 1e-9, "s {s} span {sp:?}");
+                }
+            }
+        }
+    }
+
+    #[test]
     fn support_is_the_max() {
         let cutter = Cutter::new(CutterShape::Bull { radius: 2.0, corner: 0.5 }, 4.0).unwrap();
         let body = Body::flutes(&cutter);

@@ -303,7 +303,8 @@ struct BandFindings {
 /// material removed deeper than `options.gouge_tolerance` plus the stock's
 /// epsilon, measured along the part normal; each named with the first move
 /// that cut it). Parallel over fixed bands of rays; the result does not
-/// depend on the thread count.
+/// depend on the thread count. [`VerifyOptions::scallop_margin`] is not used
+/// (no footprint margin on rays).
 ///
 /// # Errors
 /// [`SimError::DexelGouge`] with the deepest [`VerifyOptions::worst_reported`] gouges.
