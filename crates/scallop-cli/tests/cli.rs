@@ -496,8 +496,8 @@ fn simulate_runs_a_3_plus_2_toolpath_on_tri_dexels() {
     let bad = sim("low.csv", "bad");
     assert_eq!(bad.status.code(), Some(1));
     let err = String::from_utf8_lossy(&bad.stderr);
-    // Pass 9's feed is move 1 + 2 * 9 + 1 = 20 (its plunge, 19, cuts the same line).
-    assert!(err.contains("gouge") && (err.contains("move 20 ") || err.contains("move 19 ")), "{err}");
+    // Pass 9's feed is move 1 + 2 * 9 + 1 = 20 (its plunge ends beyond the part, at x = 23).
+    assert!(err.contains("gouge") && err.contains("cut by move 20 "), "{err}");
     let v: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("bad/sim.json")).expect("sim.json")).expect("json");
     assert_eq!(v["stock_model"], "tri-dexel");

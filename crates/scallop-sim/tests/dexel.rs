@@ -334,14 +334,8 @@ fn lowered_3_plus_2_pass_is_a_gouge_at_that_move() {
     let feed_index = 1 + 2 * lowered + 1;
     let depth = worst[0].depth;
     assert!((depth - 0.05).abs() < 0.005, "depth {depth}");
-    let plunge_index = feed_index - 1;
-    let cut_by = worst[0].cut_by.unwrap().index as usize;
-    assert!(cut_by == feed_index || cut_by == plunge_index, "cut by move {cut_by}");
-    assert!(
-        worst
-            .iter()
-            .all(|g| g.cut_by.is_some_and(|m| m.index as usize == feed_index || m.index as usize == plunge_index))
-    );
+    // The plunges start and end beyond the block (x = -4 or 14): the feed cut it.
+    assert!(worst.iter().all(|g| g.cut_by.is_some_and(|m| m.index as usize == feed_index)), "{worst:?}");
     assert!((worst[0].at.y - (-1.0 + step * lowered as f64)).abs() < rr);
 }
 
