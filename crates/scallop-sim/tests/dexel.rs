@@ -5,11 +5,12 @@
 #![allow(clippy::unwrap_used, clippy::float_cmp, reason = "tests: a panic is the failure report")]
 
 use proptest::prelude::*;
-use scallop_cutter::{Cutter, CutterShape};
+use scallop_cutter::{Cutter, CutterShape, HolderSegment};
 use scallop_geom::{Aabb3, Point3, Vec3};
 use scallop_mesh::TriMesh;
 use scallop_sim::{
-    DexelOptions, DexelPart, DexelStock, SimError, ToolMove, VerifyOptions, ZMap, simulate_dexel, verify_dexel,
+    DexelOptions, DexelPart, DexelStock, SimError, ToolMove, ToolPart, VerifyOptions, ZMap, simulate_dexel,
+    verify_dexel,
 };
 use scallop_toolpath::{Move, MoveKind, Toolpath};
 
@@ -432,6 +433,22 @@ fn shank_in_the_stock_is_a_collision() {
     let long = Cutter::new(CutterShape::Flat { radius: 2.0 }, 12.0).unwrap();
     let mut d = DexelStock::new(stock, 0.25).unwrap();
     d.cut(&long, &path, &DexelOptions::default()).unwrap().check().unwrap();
+    // A wide holder above a short shank, tilted towards +X: its rim dips to
+    // z = -6 + 14 cos(0.5) - 20 sin(0.5) = -3.3 ahead of the tool, inside the stock.
+    let holder = HolderSegment { length: 5.0, bottom_radius: 20.0, top_radius: 20.0 };
+    let held = long.with_shank(2.0, 2.0).unwrap().with_holder(vec![holder]).unwrap();
+    let a = tilted(0.5, 0.0);
+    let path = [mv(MoveKind::Plunge, p(-5.0, 5.0, -6.0), a), mv(MoveKind::Feed, p(25.0, 5.0, -6.0), a)];
+    let mut d = DexelStock::new(stock, 0.25).unwrap();
+    let report = d.cut(&held, &path, &DexelOptions::default()).unwrap();
+    assert!(
+        report.collisions.iter().any(|c| c.part == ToolPart::Holder(0) && c.id.index == 1),
+        "{:?}",
+        report.collisions
+    );
+    assert!(report.collisions.iter().all(|c| c.part != ToolPart::Shank));
+    let deepest = report.collisions.iter().map(|c| c.depth).fold(0.0, f64::max);
+    assert!(deepest > 1.0, "{deepest}");
 }
 
 /// The same cut on one and two threads gives identical rays and reports.
