@@ -294,13 +294,26 @@ mod tests {
         };
         for shape in shapes {
             let body = Body::flutes(&Cutter::new(shape, 4.0).unwrap());
-            for _ in 0..200 {
-                let a = Vec3::new(rnd(), rnd(), rnd() + 1.5).normalize();
-                let sw =
-                    Sweep { p0: Point3::new(rnd(), rnd(), rnd()), v: Vec3::new(4.0 * rnd(), 4.0 * rnd(), rnd()), a };
+            for case in 0..400 {
                 let axis = (rnd().abs() * 3.0) as usize % 3;
                 let mut d = Vec3::zeros();
                 d[axis] = 1.0;
+                let mut a = Vec3::new(rnd(), rnd(), rnd() + 1.5).normalize();
+                let mut v = Vec3::new(4.0 * rnd(), 4.0 * rnd(), rnd());
+                // Degenerate configurations: the axis along the ray, the move
+                // along the ray, along the axis, or no move at all.
+                match case % 8 {
+                    0 => a = d,
+                    1 => v = 3.0 * rnd() * d,
+                    2 => v = 3.0 * rnd() * a,
+                    3 => v = Vec3::zeros(),
+                    4 => {
+                        a = d;
+                        v = 2.0 * d;
+                    }
+                    _ => {}
+                }
+                let sw = Sweep { p0: Point3::new(rnd(), rnd(), rnd()), v, a };
                 let mut o = Point3::new(3.0 * rnd(), 3.0 * rnd(), 3.0 * rnd() + 1.0);
                 o[axis] = -20.0;
                 let got = sw.interval(&body, &o, &d);
