@@ -77,19 +77,31 @@ impl DexelPart {
     /// The part intervals and, for an open part on an X or Y ray, the
     /// surface's section pieces `(s_a, z_a, s_b, z_b, |n_z|)`.
     fn ray(&self, o: &Point3, axis: usize) -> (Vec<PartSpan>, Vec<Section>) {
+        let mut slots = Vec::new();
+        self.candidates(o, axis, &mut slots);
+        self.ray_in(o, axis, &slots)
+    }
+
+    /// The triangles whose XY box meets the ray's XY shadow (a point for a Z
+    /// ray, a line for an X or Y ray: shared by all rays of that line).
+    fn candidates(&self, o: &Point3, axis: usize, slots: &mut Vec<u32>) {
         let b = self.index.bounds();
         let query = match axis {
             2 => Aabb2 { min: Point2::new(o.x, o.y), max: Point2::new(o.x, o.y) },
             0 => Aabb2 { min: Point2::new(b.min.x, o.y), max: Point2::new(b.max.x, o.y) },
             _ => Aabb2 { min: Point2::new(o.x, b.min.y), max: Point2::new(o.x, b.max.y) },
         };
-        let mut slots = Vec::new();
-        self.index.collect_box(&query, &mut slots);
+        slots.clear();
+        self.index.collect_box(&query, slots);
+    }
+
+    /// [`DexelPart::ray`] among the candidate triangles `slots`.
+    fn ray_in(&self, o: &Point3, axis: usize, slots: &[u32]) -> (Vec<PartSpan>, Vec<Section>) {
         if self.closed {
-            (self.solid(o, axis, &slots), Vec::new())
+            (self.solid(o, axis, slots), Vec::new())
         } else if axis == 2 {
             let mut top: Option<(f64, f64)> = None;
-            for &slot in &slots {
+            for &slot in slots {
                 if let Some((s, w)) = self.crossing(o, axis, slot as usize)
                     && top.is_none_or(|(t, _)| s > t)
                 {
@@ -98,7 +110,7 @@ impl DexelPart {
             }
             (top.map(|(s, w)| vec![(f64::NEG_INFINITY, s, 0.0, w)]).unwrap_or_default(), Vec::new())
         } else {
-            self.section(o, axis, &slots)
+            self.section(o, axis, slots)
         }
     }
 
@@ -320,12 +332,23 @@ pub fn verify_dexel(
     let mut gouges = Vec::new();
     for (axis, left_along) in max_left_along.iter_mut().enumerate() {
         let (nu, nv) = stock.grid(axis);
-        let bands: Vec<BandFindings> = (0..nv)
+        // Rows of rays sharing the XY line of their shadow (X rays of one y,
+        // Y rays of one x): their candidate triangles are found once.
+        let (outer, inner) = if axis == 0 { (nu, nv) } else { (nv, nu) };
+        let ray_of = |a: usize, b: usize| if axis == 0 { (a, b) } else { (b, a) };
+        let bands: Vec<BandFindings> = (0..outer)
             .into_par_iter()
-            .map(|iv| {
+            .map(|a| {
                 let mut f = BandFindings { min_dev: f64::INFINITY, ..BandFindings::default() };
-                for iu in 0..nu {
-                    ray_findings(stock, part, axis, iu, iv, limit, &mut f);
+                let mut slots = Vec::new();
+                if axis != 2 {
+                    let (iu, iv) = ray_of(a, 0);
+                    part.candidates(&stock.ray_origin(axis, iu, iv), axis, &mut slots);
+                }
+                for b in 0..inner {
+                    let (iu, iv) = ray_of(a, b);
+                    let shared = (axis != 2).then_some(slots.as_slice());
+                    ray_findings(stock, part, axis, iu, iv, limit, shared, &mut f);
                 }
                 f
             })
@@ -385,7 +408,8 @@ fn first_cut(stock: &DexelStock, g: &DexelGouge) -> Option<MoveId> {
         .map(|(step, _)| step.id())
 }
 
-/// Compares one ray.
+/// Compares one ray (among the candidate triangles `slots` when given).
+#[allow(clippy::too_many_arguments)] // private; one call site.
 fn ray_findings(
     stock: &DexelStock,
     part: &DexelPart,
@@ -393,6 +417,7 @@ fn ray_findings(
     iu: usize,
     iv: usize,
     limit: f64,
+    slots: Option<&[u32]>,
     f: &mut BandFindings,
 ) {
     let box_ = stock.stock();
@@ -403,7 +428,10 @@ fn ray_findings(
         p[axis] = s;
         p
     };
-    let (spans, sections) = part.ray(&o, axis);
+    let (spans, sections) = match slots {
+        Some(slots) => part.ray_in(&o, axis, slots),
+        None => part.ray(&o, axis),
+    };
     let spans: Vec<PartSpan> = spans
         .into_iter()
         .filter(|p| p.1 > lo && p.0 < hi)
