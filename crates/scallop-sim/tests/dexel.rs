@@ -542,3 +542,47 @@ fn arcs_match_the_zmap_up_to_the_sagitta() {
     let same = top.iter().zip(zmap.heights()).filter(|(a, b)| (*a - *b).abs() <= 1e-3).count();
     assert!(same as f64 >= 0.999 * top.len() as f64, "{same} of {}", top.len());
 }
+
+/// A horizontal tool finishing the side wall of a block 0.1 mm too deep: the
+/// X rays crossing the wall see the removed part, 0.1 mm along its normal,
+/// and name the move along the wall.
+#[test]
+fn side_wall_gouge_is_found_by_the_x_rays() {
+    let part = DexelPart::new(&block(p(0.0, 0.0, -10.0), p(10.0, 10.0, 0.0)));
+    let stock = Aabb3 { min: p(-3.0, -3.0, -10.0), max: p(13.0, 13.0, 1.0) };
+    let cutter = Cutter::new(CutterShape::Flat { radius: 1.5 }, 10.0).unwrap();
+    // The spindle on the -X side: the flat face looks at the wall x = 0.
+    let a = -Vec3::x();
+    let run = |into: f64| {
+        let path = [
+            mv(MoveKind::Rapid, p(-8.0, -4.0, -5.0), a),
+            mv(MoveKind::Feed, p(into, -4.0, -5.0), a),
+            mv(MoveKind::Feed, p(into, 14.0, -5.0), a),
+        ];
+        let opts = VerifyOptions { gouge_tolerance: 0.01, ..VerifyOptions::default() };
+        simulate_dexel(stock, 0.2, &cutter, &path, &part, &DexelOptions::default(), &opts)
+    };
+    // Exactly on the wall: no gouge, and the X rays through the slot hold
+    // material from the wall on (none left before it).
+    let sim = run(0.0).unwrap();
+    let (ny, nz) = sim.stock.grid(0);
+    let mut through = 0;
+    for iz in 0..nz {
+        for iy in 0..ny {
+            let o = sim.stock.ray_origin(0, iy, iz);
+            if (o.z + 5.0).abs() < 1.4 && (0.5..9.5).contains(&o.y) {
+                let iv = sim.stock.intervals(0, iy, iz);
+                assert!(iv[0][0].abs() < 1e-9, "ray at y {} z {}: {iv:?}", o.y, o.z);
+                through += 1;
+            }
+        }
+    }
+    assert!(through > 100);
+    let err = run(0.1).unwrap_err();
+    let SimError::DexelGouge { worst, .. } = err else { panic!("expected a gouge, got {err:?}") };
+    let g = worst[0];
+    assert_eq!(g.axis, 0, "{g:?}");
+    assert!((g.depth - 0.1).abs() < 1e-9, "{g:?}");
+    assert!(g.at.x > 0.0 && g.at.x < 0.1 && (g.at.z + 5.0).abs() <= 1.5 && (0.0..=10.0).contains(&g.at.y));
+    assert_eq!(g.cut_by.map(|m| m.index), Some(2));
+}
