@@ -44,7 +44,8 @@ use super::body::{Body, Line, Span};
 /// narrow (mm).
 pub(crate) const SWEEP_TOL: f64 = 1e-9;
 
-/// Most bisection steps per extreme (the bracket in `t` is then `2^-60`).
+/// Most steps per extreme (at least every other step halves the bracket in
+/// `t`, so it is then below `2^-30`).
 const MAX_BISECT: usize = 60;
 
 /// A body swept along a straight move with a fixed unit axis `a`.
