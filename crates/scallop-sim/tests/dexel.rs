@@ -586,3 +586,32 @@ fn side_wall_gouge_is_found_by_the_x_rays() {
     assert!(g.at.x > 0.0 && g.at.x < 0.1 && (g.at.z + 5.0).abs() <= 1.5 && (0.0..=10.0).contains(&g.at.y));
     assert_eq!(g.cut_by.map(|m| m.index), Some(2));
 }
+
+/// Rays through the edges and vertices of a closed part's triangles cross
+/// it consistently (symbolic perturbation): inside, one whole interval;
+/// on its boundary, the whole interval or nothing, never half of it.
+#[test]
+fn rays_through_edges_and_vertices_of_a_closed_part() {
+    let part = DexelPart::new(&block(p(0.0, 0.0, 0.0), p(1.0, 1.0, 1.0)));
+    assert!(part.is_closed());
+    for axis in 0..3 {
+        let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+        for (cu, cv) in [(0.5, 0.5), (0.25, 0.75), (0.75, 0.25), (0.5, 0.25)] {
+            // Interior: the diagonals of the faces' triangulation and plain points.
+            let mut o = Point3::origin();
+            o[u] = cu;
+            o[v] = cv;
+            let iv = part.intervals(&o, axis);
+            assert_eq!(iv.len(), 1, "axis {axis} at ({cu}, {cv}): {iv:?}");
+            assert_eq!((iv[0].0, iv[0].1), (0.0, 1.0));
+            assert!((iv[0].2 - 1.0).abs() < 1e-12 && (iv[0].3 - 1.0).abs() < 1e-12);
+        }
+        for (cu, cv) in [(0.0, 0.0), (1.0, 1.0), (0.0, 0.5), (1.0, 0.5), (0.5, 0.0), (0.5, 1.0), (0.0, 1.0)] {
+            let mut o = Point3::origin();
+            o[u] = cu;
+            o[v] = cv;
+            let iv = part.intervals(&o, axis);
+            assert!(iv.is_empty() || (iv.len() == 1 && (iv[0].0, iv[0].1) == (0.0, 1.0)), "axis {axis}: {iv:?}");
+        }
+    }
+}
