@@ -1,12 +1,18 @@
-//! `scallop simulate`: cut a stock with a G-code program and verify it against the part.
+//! `scallop simulate`: cut a stock with a G-code program or a cutter-location
+//! file and verify it against the part, on a z-map (3-axis) or a tri-dexel
+//! stock (any tool axis).
 
 use std::path::PathBuf;
 
-use clap::Args;
+use clap::{Args, ValueEnum};
 use scallop_engine::prepare_part;
-use scallop_geom::{Aabb3, Point3, Tolerances};
+use scallop_geom::{Aabb3, Point3, Tolerances, Vec3};
+use scallop_io::cl::read_cl_csv;
 use scallop_io::gcode::{GcodeOptions, read_gcode_arcs};
-use scallop_sim::{VerifyOptions, ZMap, part_heights, verify};
+use scallop_sim::{
+    DexelOptions, DexelPart, DexelStock, ToolMove, VerifyOptions, ZMap, part_heights, verify, verify_dexel,
+};
+use scallop_toolpath::{Move, Toolpath};
 use serde::Serialize;
 
 use crate::drop::CutterArgs;
@@ -23,8 +29,20 @@ pub struct SimulateArgs {
     #[arg(long)]
     part: String,
     /// The program: plain 3-axis G-code (G0/G1/G2/G3, G20/G21, G90/G91).
+    #[arg(long, conflicts_with = "toolpath", required_unless_present = "toolpath")]
+    program: Option<PathBuf>,
+    /// The program as cutter locations: the CSV `scallop run` writes
+    /// (`kind,x,y,z` and optionally the tool axis `i,j,k` and `feed`).
     #[arg(long)]
-    program: PathBuf,
+    toolpath: Option<PathBuf>,
+    /// Stock model: `auto` takes the tri-dexel stock when any tool axis is
+    /// not +Z, else the z-map.
+    #[arg(long, value_enum, default_value = "auto")]
+    stock_model: StockModel,
+    /// Largest distance (mm) between the simulated and the true swept solid
+    /// of a simultaneous 5-axis move (tri-dexel stock; 3+2 moves are exact).
+    #[arg(long, default_value_t = 0.01, allow_hyphen_values = true)]
+    axis_tolerance: f64,
     #[command(flatten)]
     tool: CutterArgs,
     /// Stock cell size (mm).
@@ -49,8 +67,21 @@ pub struct SimulateArgs {
     json: bool,
 }
 
+/// The stock representation of `scallop simulate`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum StockModel {
+    /// Tri-dexels when any tool axis is not +Z, else the z-map.
+    Auto,
+    /// Height field (3-axis programs only).
+    Zmap,
+    /// Rays along X, Y and Z (any tool axis, undercuts).
+    Dexel,
+}
+
 #[derive(Serialize)]
 struct SimReport {
+    /// "z-map" or "tri-dexel".
+    stock_model: &'static str,
     part: String,
     program: String,
     cutter: String,
@@ -65,8 +96,54 @@ struct SimReport {
     max_scallop_at: Option<[f64; 2]>,
     min_deviation_mm: f64,
     gouge_tolerance_mm: f64,
+    /// Tri-dexel only: rays along X, Y and Z.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    rays: Option<[usize; 3]>,
+    /// Tri-dexel only: the largest material thickness along the part normal (mm).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    max_thickness_mm: Option<f64>,
+    /// Tri-dexel only: the 5-axis sub-step tolerance (mm) and the number of fixed-axis sweeps.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    axis_tolerance_mm: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    sweeps: Option<usize>,
     /// "ok", or the safety problems found (each an error).
     verdict: Vec<String>,
+}
+
+/// The program in both forms: moves with tool axes, and the 3-axis toolpath
+/// (tips; arcs kept when read from G-code).
+struct Program {
+    name: String,
+    moves: Vec<ToolMove>,
+    path: Toolpath,
+}
+
+fn read_program(args: &SimulateArgs) -> CliResult<Program> {
+    let file = args.program.as_ref().or(args.toolpath.as_ref()).ok_or_else(|| {
+        Failure::rejected("give the program with --program FILE.nc (G-code) or --toolpath FILE.csv (cutter locations)")
+    })?;
+    let name = file.display().to_string();
+    let bytes = std::fs::read(file).map_err(|e| {
+        let err = anyhow::anyhow!("{name}: cannot read the program: {e}");
+        if e.kind() == std::io::ErrorKind::NotFound { Failure::Rejected(err) } else { Failure::Io(err) }
+    })?;
+    let text = std::str::from_utf8(&bytes)
+        .map_err(|e| Failure::rejected(format!("{name}: byte {}: the program is not UTF-8 text", e.valid_up_to())))?;
+    if args.program.is_some() {
+        // Arcs stay arcs: the z-map cuts them exactly.
+        let path =
+            read_gcode_arcs(text, &GcodeOptions::default()).map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
+        let moves = ToolMove::from_toolpath(&path);
+        return Ok(Program { name, moves, path });
+    }
+    let rows = read_cl_csv(text).map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
+    let mut path = Toolpath::new(rows.iter().find_map(|r| r.feed).unwrap_or(1000.0));
+    for r in &rows {
+        path.push(Move::new(r.kind, r.tip));
+    }
+    let moves = rows.iter().map(|r| ToolMove::new(r.kind, r.tip, r.axis)).collect();
+    Ok(Program { name, moves, path })
 }
 
 fn parse_stock(text: &str) -> CliResult<Aabb3> {
@@ -89,17 +166,19 @@ pub fn run(args: &SimulateArgs) -> CliResult<()> {
     let loaded = load(&args.part, args.units)?;
     let prepared = prepare_part(&loaded.part, &Tolerances { path: 0.01, gouge: args.gouge_tolerance })
         .map_err(|e| Failure::rejected(format!("{}: {e}", args.part)))?;
-    let name = args.program.display().to_string();
-    let bytes = std::fs::read(&args.program).map_err(|e| {
-        let err = anyhow::anyhow!("{name}: cannot read the program: {e}");
-        if e.kind() == std::io::ErrorKind::NotFound { Failure::Rejected(err) } else { Failure::Io(err) }
-    })?;
-    let text = std::str::from_utf8(&bytes)
-        .map_err(|e| Failure::rejected(format!("{name}: byte {}: the program is not UTF-8 text", e.valid_up_to())))?;
-    // Arcs stay arcs: the simulator cuts them exactly.
-    let program =
-        read_gcode_arcs(text, &GcodeOptions::default()).map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
-
+    let program = read_program(args)?;
+    let name = program.name.clone();
+    let tilted = program.moves.iter().any(|m| m.axis != Vec3::z());
+    let dexel = match args.stock_model {
+        StockModel::Auto => tilted,
+        StockModel::Dexel => true,
+        StockModel::Zmap if tilted => {
+            return Err(Failure::rejected(format!(
+                "{name}: the program tilts the tool axis; a z-map holds 3-axis programs only: use --stock-model dexel"
+            )));
+        }
+        StockModel::Zmap => false,
+    };
     let b = prepared.mesh.bounds();
     let r = cutter.radius();
     let stock = match &args.stock {
@@ -109,52 +188,15 @@ pub fn run(args: &SimulateArgs) -> CliResult<()> {
             max: Point3::new(b.max.x + r, b.max.y + r, b.max.z + 1.0),
         },
     };
-    let mut zmap = ZMap::new(stock, args.resolution).map_err(|e| Failure::rejected(format!("stock: {e}")))?;
-    let cut = zmap.cut(&cutter, &program).map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
     let options =
         VerifyOptions { gouge_tolerance: args.gouge_tolerance + prepared.chordal_error, ..VerifyOptions::default() };
-    let mut verdict = Vec::new();
-    if let Err(e) = cut.check() {
-        verdict.push(e.to_string());
-    }
-    let collisions = zmap
-        .part_collisions(&prepared.index, &cutter, &program, cut.operation)
-        .map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
-    if !collisions.is_empty() {
-        verdict.push(scallop_sim::SimError::PartCollision { count: collisions.len(), collisions }.to_string());
-    }
-    let verification = match verify(&zmap, &prepared.index, &options) {
-        Ok(v) => Some(v),
-        Err(e) => {
-            verdict.push(e.to_string());
-            None
-        }
+    let (report, zmap, dev, max_dev) = if dexel {
+        simulate_dexel(args, &program, &cutter, &cutter_text, stock, &prepared, &options, &loaded.description)?
+    } else {
+        simulate_zmap(args, &program, &cutter, &cutter_text, stock, &prepared, &options, &loaded.description)?
     };
-
-    // Deviation per cell, for the picture and the figures when verify refused.
-    let top = part_heights(&zmap, &prepared.index);
-    let dev: Vec<f64> =
-        zmap.heights().iter().zip(&top).map(|(s, p)| if p.is_finite() { s - p } else { f64::NAN }).collect();
-    let finite = || dev.iter().copied().filter(|d| d.is_finite());
-    let max_dev = finite().fold(0.0f64, f64::max);
-    let min_dev = finite().fold(f64::INFINITY, f64::min);
-    let report = SimReport {
-        part: loaded.description.clone(),
-        program: name.clone(),
-        cutter: cutter_text,
-        resolution_mm: args.resolution,
-        cells: [zmap.nx(), zmap.ny()],
-        moves: program.moves().len(),
-        feed_moves: cut.feed_moves,
-        air_cut_share: cut.air_cut_share(),
-        removed_volume_mm3: cut.removed_volume,
-        remaining_volume_mm3: zmap.volume(),
-        max_scallop_mm: verification.as_ref().map_or(max_dev, |v| v.max_scallop),
-        max_scallop_at: verification.as_ref().and_then(|v| v.max_scallop_at).map(|p| [p.x, p.y]),
-        min_deviation_mm: verification.as_ref().map_or(min_dev, |v| v.min_deviation),
-        gouge_tolerance_mm: options.gouge_tolerance,
-        verdict: if verdict.is_empty() { vec!["ok".into()] } else { verdict.clone() },
-    };
+    let verdict = if report.verdict == ["ok"] { Vec::new() } else { report.verdict.clone() };
+    let program = program.path;
     let json = serde_json::to_string_pretty(&report).map_err(|e| Failure::Io(e.into()))?;
     write_atomic(&args.output.join("sim.json"), |w| std::io::Write::write_all(w, json.as_bytes()))?;
     let png = deviation_picture(&zmap, &dev, max_dev, options.gouge_tolerance).to_png();
@@ -166,11 +208,12 @@ pub fn run(args: &SimulateArgs) -> CliResult<()> {
         print_json(&report)?;
     } else {
         print_text(&format!(
-            "{} on {}: {} x {} cells of {} mm, {} moves ({:.1} % of feed moves in air)\n\
+            "{} on {}: {} stock, {} x {} cells of {} mm, {} moves ({:.1} % of feed moves in air)\n\
              \x20 material left up to {:.4} mm, deepest {:+.4} mm (gouge tolerance {:.4} mm)\n\
              \x20 removed {:.0} mm³, remaining {:.0} mm³\n  wrote {}\n",
             report.program,
             report.part,
+            report.stock_model,
             report.cells[0],
             report.cells[1],
             report.resolution_mm,
@@ -185,6 +228,142 @@ pub fn run(args: &SimulateArgs) -> CliResult<()> {
         ))?;
     }
     if verdict.is_empty() { Ok(()) } else { Err(Failure::rejected(format!("{name}: {}", verdict.join("; ")))) }
+}
+
+/// What both simulations return: the report, a z-map of the stock's grid
+/// (the cut z-map, or an uncut one on the Z rays' grid for the picture), the
+/// deviation `stock top - part top` per cell and its largest value.
+type Outcome = (SimReport, ZMap, Vec<f64>, f64);
+
+/// Deviation per cell from the stock tops, for the picture and the figures
+/// when verify refused.
+fn deviation(zmap: &ZMap, tops: &[f64], part: &scallop_mesh::MeshIndex) -> (Vec<f64>, f64, f64) {
+    let top = part_heights(zmap, part);
+    let dev: Vec<f64> = tops.iter().zip(&top).map(|(s, p)| if p.is_finite() { s - p } else { f64::NAN }).collect();
+    let finite = || dev.iter().copied().filter(|d| d.is_finite());
+    let max_dev = finite().fold(0.0f64, f64::max);
+    let min_dev = finite().fold(f64::INFINITY, f64::min);
+    (dev, max_dev, min_dev)
+}
+
+/// The 3-axis simulation on a z-map.
+#[allow(clippy::too_many_arguments)] // private; the pieces of one command.
+fn simulate_zmap(
+    args: &SimulateArgs,
+    program: &Program,
+    cutter: &scallop_cutter::Cutter,
+    cutter_text: &str,
+    stock: Aabb3,
+    prepared: &scallop_engine::PreparedPart,
+    options: &VerifyOptions,
+    part_name: &str,
+) -> CliResult<Outcome> {
+    let name = &program.name;
+    let mut zmap = ZMap::new(stock, args.resolution).map_err(|e| Failure::rejected(format!("stock: {e}")))?;
+    let cut = zmap.cut(cutter, &program.path).map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
+    let mut verdict = Vec::new();
+    if let Err(e) = cut.check() {
+        verdict.push(e.to_string());
+    }
+    let collisions = zmap
+        .part_collisions(&prepared.index, cutter, &program.path, cut.operation)
+        .map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
+    if !collisions.is_empty() {
+        verdict.push(scallop_sim::SimError::PartCollision { count: collisions.len(), collisions }.to_string());
+    }
+    let verification = match verify(&zmap, &prepared.index, options) {
+        Ok(v) => Some(v),
+        Err(e) => {
+            verdict.push(e.to_string());
+            None
+        }
+    };
+    let (dev, max_dev, min_dev) = deviation(&zmap, zmap.heights(), &prepared.index);
+    let report = SimReport {
+        stock_model: "z-map",
+        part: part_name.to_string(),
+        program: name.clone(),
+        cutter: cutter_text.to_string(),
+        resolution_mm: args.resolution,
+        cells: [zmap.nx(), zmap.ny()],
+        moves: program.path.moves().len(),
+        feed_moves: cut.feed_moves,
+        air_cut_share: cut.air_cut_share(),
+        removed_volume_mm3: cut.removed_volume,
+        remaining_volume_mm3: zmap.volume(),
+        max_scallop_mm: verification.as_ref().map_or(max_dev, |v| v.max_scallop),
+        max_scallop_at: verification.as_ref().and_then(|v| v.max_scallop_at).map(|p| [p.x, p.y]),
+        min_deviation_mm: verification.as_ref().map_or(min_dev, |v| v.min_deviation),
+        gouge_tolerance_mm: options.gouge_tolerance,
+        rays: None,
+        max_thickness_mm: None,
+        axis_tolerance_mm: None,
+        sweeps: None,
+        verdict: if verdict.is_empty() { vec!["ok".into()] } else { verdict },
+    };
+    Ok((report, zmap, dev, max_dev))
+}
+
+/// The multi-axis simulation on a tri-dexel stock.
+#[allow(clippy::too_many_arguments)] // private; the pieces of one command.
+fn simulate_dexel(
+    args: &SimulateArgs,
+    program: &Program,
+    cutter: &scallop_cutter::Cutter,
+    cutter_text: &str,
+    stock: Aabb3,
+    prepared: &scallop_engine::PreparedPart,
+    options: &VerifyOptions,
+    part_name: &str,
+) -> CliResult<Outcome> {
+    let name = &program.name;
+    let mut dexels = DexelStock::new(stock, args.resolution).map_err(|e| Failure::rejected(format!("stock: {e}")))?;
+    let dexel_options = DexelOptions { axis_tolerance: args.axis_tolerance, ..DexelOptions::default() };
+    let cut =
+        dexels.cut(cutter, &program.moves, &dexel_options).map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
+    let mut verdict = Vec::new();
+    if let Err(e) = cut.check() {
+        verdict.push(e.to_string());
+    }
+    let part = DexelPart::new(&prepared.mesh);
+    let verification = match verify_dexel(&dexels, &part, options) {
+        Ok(v) => Some(v),
+        Err(e) => {
+            verdict.push(e.to_string());
+            None
+        }
+    };
+    // An uncut z-map on the Z rays' grid: the same cells, for the picture.
+    let grid = ZMap::new(stock, args.resolution).map_err(|e| Failure::rejected(format!("stock: {e}")))?;
+    let (dev, max_dev, min_dev) = deviation(&grid, &dexels.top_heights(), &prepared.index);
+    let counts = dexels.counts();
+    let rays = [0, 1, 2].map(|k| {
+        let (nu, nv) = dexels.grid(k);
+        nu * nv
+    });
+    let report = SimReport {
+        stock_model: "tri-dexel",
+        part: part_name.to_string(),
+        program: name.clone(),
+        cutter: cutter_text.to_string(),
+        resolution_mm: args.resolution,
+        cells: [counts[0], counts[1]],
+        moves: program.path.moves().len(),
+        feed_moves: cut.feed_moves,
+        air_cut_share: cut.air_cut_share(),
+        removed_volume_mm3: cut.removed_volume,
+        remaining_volume_mm3: dexels.volume(),
+        max_scallop_mm: verification.as_ref().map_or(max_dev, |v| v.max_scallop),
+        max_scallop_at: verification.as_ref().and_then(|v| v.max_scallop_at).map(|p| [p.x, p.y]),
+        min_deviation_mm: verification.as_ref().map_or(min_dev, |v| v.min_deviation),
+        gouge_tolerance_mm: options.gouge_tolerance,
+        rays: Some(rays),
+        max_thickness_mm: verification.as_ref().map(|v| v.max_thickness),
+        axis_tolerance_mm: Some(args.axis_tolerance),
+        sweeps: Some(cut.sweeps),
+        verdict: if verdict.is_empty() { vec!["ok".into()] } else { verdict },
+    };
+    Ok((report, grid, dev, max_dev))
 }
 
 /// The HTML report of a simulation: part, stock, program, deviation and figures.
@@ -226,6 +405,7 @@ fn report_data(
         Figure::text("part", r.part.clone()),
         Figure::text("program", r.program.clone()),
         Figure::text("cutter", r.cutter.clone()),
+        Figure::text("stock model", r.stock_model.to_string()),
         Figure::number("cell size", r.resolution_mm, 3, "mm"),
         Figure::text("cells", format!("{} x {}", r.cells[0], r.cells[1])),
     ];

@@ -438,3 +438,92 @@ fn bad_jobs_name_the_key_and_the_fix_and_write_nothing() {
         assert!(!dir.join("out").exists(), "{what}: a rejected job writes nothing");
     }
 }
+
+/// A 20 x 20 plane at z = 0 as an ASCII STL (two triangles: a height field).
+fn plane_stl() -> String {
+    let tri = |a: [f64; 3], b: [f64; 3], c: [f64; 3]| {
+        format!(
+            "facet normal 0 0 1\nouter loop\nvertex {} {} {}\nvertex {} {} {}\nvertex {} {} {}\nendloop\nendfacet\n",
+            a[0], a[1], a[2], b[0], b[1], b[2], c[0], c[1], c[2]
+        )
+    };
+    format!(
+        "solid plane\n{}{}endsolid plane\n",
+        tri([0.0, 0.0, 0.0], [20.0, 0.0, 0.0], [20.0, 20.0, 0.0]),
+        tri([0.0, 0.0, 0.0], [20.0, 20.0, 0.0], [0.0, 20.0, 0.0])
+    )
+}
+
+/// A 3+2 raster of a ball tilted 20 degrees over the plane, its sphere
+/// touching the plane, every `step` mm; `lower` mm lower on pass `lowered`.
+fn tilted_raster_csv(step: f64, lowered: usize, lower: f64) -> String {
+    let (r, tilt) = (2.0f64, 20f64.to_radians());
+    let a = [0.0, -tilt.sin(), tilt.cos()];
+    let mut csv = String::from("kind,x,y,z,i,j,k,feed\n");
+    let mut row = |kind: &str, x: f64, y: f64, cz: f64| {
+        let tip = [x - r * a[0], y - r * a[1], cz - r * a[2]];
+        csv.push_str(&format!(
+            "{kind},{:.6},{:.6},{:.6},{},{:.9},{:.9},1000\n",
+            tip[0], tip[1], tip[2], a[0], a[1], a[2]
+        ));
+    };
+    row("rapid", -3.0, -1.0, 10.0);
+    let passes = (22.0 / step) as usize;
+    for k in 0..passes {
+        let y = -1.0 + step * k as f64;
+        let cz = r - if k == lowered { lower } else { 0.0 };
+        let (x0, x1) = if k % 2 == 0 { (-3.0, 23.0) } else { (23.0, -3.0) };
+        row("plunge", x0, y, cz);
+        row("feed", x1, y, cz);
+    }
+    csv
+}
+
+#[test]
+fn simulate_runs_a_3_plus_2_toolpath_on_tri_dexels() {
+    let dir = scratch("simulate-dexel");
+    std::fs::write(dir.join("plane.stl"), plane_stl()).expect("write");
+    std::fs::write(dir.join("good.csv"), tilted_raster_csv(1.0, usize::MAX, 0.0)).expect("write");
+    std::fs::write(dir.join("low.csv"), tilted_raster_csv(1.0, 9, 0.05)).expect("write");
+    let sim = |toolpath: &str, out: &str| {
+        scallop()
+            .current_dir(&dir)
+            .args(["simulate", "--part", "plane.stl", "--toolpath", toolpath, "--cutter", "ball", "--diameter", "4"])
+            .args(["--flute-length", "10", "--stock", "0,0,-2,20,20,1", "--resolution", "0.25"])
+            .args(["--gouge-tolerance", "0.005", "-o", out, "--json"])
+            .output()
+            .expect("run")
+    };
+    let good = sim("good.csv", "good");
+    assert!(good.status.success(), "{}", String::from_utf8_lossy(&good.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&good.stdout).expect("json");
+    assert_eq!(v["stock_model"], "tri-dexel");
+    assert_eq!(v["verdict"][0], "ok");
+    // Scallop of a ball R = 2 between passes 1 mm apart, within the grid's
+    // bound at the cusp (slope 0.26 times half a cell diagonal).
+    let theory = 2.0 - (4.0f64 - 0.25).sqrt();
+    let s = v["max_scallop_mm"].as_f64().expect("number");
+    assert!(s <= theory + 1e-6 && s >= theory - 0.26 * 0.18, "{s} vs {theory}");
+    for key in ["rays", "removed_volume_mm3", "remaining_volume_mm3", "max_thickness_mm", "sweeps"] {
+        assert!(!v[key].is_null(), "{key}");
+    }
+    assert!(std::fs::read(dir.join("good/deviation.png")).expect("png").starts_with(b"\x89PNG"));
+    let bad = sim("low.csv", "bad");
+    assert_eq!(bad.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&bad.stderr);
+    // Pass 9's feed is move 1 + 2 * 9 + 1 = 20 (its plunge ends beyond the part, at x = 23).
+    assert!(err.contains("gouge") && err.contains("cut by move 20 "), "{err}");
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("bad/sim.json")).expect("sim.json")).expect("json");
+    assert_eq!(v["stock_model"], "tri-dexel");
+    assert!(v["min_deviation_mm"].as_f64().expect("number") < -0.04);
+    // A z-map cannot hold a tilted program.
+    let z = scallop()
+        .current_dir(&dir)
+        .args(["simulate", "--part", "plane.stl", "--toolpath", "good.csv", "--cutter", "ball", "--diameter", "4"])
+        .args(["--stock-model", "zmap", "-o", "z"])
+        .output()
+        .expect("run");
+    assert_eq!(z.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&z.stderr).contains("--stock-model dexel"));
+}

@@ -3,7 +3,7 @@
 
 use scallop_geom::Point2;
 
-use crate::{Collision, GougeCell, MoveId, RapidHit};
+use crate::{Collision, DexelCollision, DexelGouge, GougeCell, MoveId, RapidHit};
 
 /// Why a stock cannot be built or a program is not safe. Each variant names
 /// the place and the fix.
@@ -121,5 +121,74 @@ pub enum SimError {
         stock_z: f64,
         /// Part top there.
         part_z: f64,
+    },
+    /// The tri-dexel stock would have more rays than the limit.
+    #[error("tri-dexel stock of {rays} rays exceeds the limit of {limit}; use a coarser resolution or a smaller stock")]
+    TooManyRays {
+        /// Rays asked for.
+        rays: usize,
+        /// The limit ([`crate::MAX_RAYS`]).
+        limit: usize,
+    },
+    /// A tool axis is zero or not finite.
+    #[error(
+        "move {index}: tool axis {axis:?} (or tip) is not a finite non-zero vector; give i, j, k with a length > 0"
+    )]
+    BadAxis {
+        /// Index of the move.
+        index: usize,
+        /// The axis given.
+        axis: [f64; 3],
+    },
+    /// A move turns the tool axis by (nearly) 180 degrees, or needs too many sub-steps.
+    #[error(
+        "move {index}: the tool axis turns by {degrees:.3} deg in one move, which is a reversal or needs more than \
+         {limit} sub-steps at the axis tolerance; split the move or raise the axis tolerance"
+    )]
+    AxisTurn {
+        /// Index of the move.
+        index: usize,
+        /// The turn (degrees).
+        degrees: f64,
+        /// Sub-step limit ([`crate::MAX_SUBSTEPS`]).
+        limit: usize,
+    },
+    /// A tolerance is not a finite positive number.
+    #[error("{what} must be a finite number > 0 mm, got {value}")]
+    BadTolerance {
+        /// Which tolerance.
+        what: &'static str,
+        /// The value given.
+        value: f64,
+    },
+    /// Part material was removed beyond the gouge tolerance (tri-dexel stock).
+    #[error(
+        "gouge: {count} ray pieces of the part were cut deeper than {tolerance} mm; the worst is {depth:.4} mm deep \
+         at ({x:.3}, {y:.3}, {z:.3}), cut by {cut_by}; fix the toolpath there (contact point, tool axis or linking)",
+        depth = worst.first().map_or(0.0, |g| g.depth),
+        x = worst.first().map_or(0.0, |g| g.at.x),
+        y = worst.first().map_or(0.0, |g| g.at.y),
+        z = worst.first().map_or(0.0, |g| g.at.z),
+        cut_by = worst.first().and_then(|g| g.cut_by).map_or_else(|| "no move".to_string(), |m| m.to_string())
+    )]
+    DexelGouge {
+        /// Number of gouged ray pieces.
+        count: usize,
+        /// The gouge tolerance used (mm).
+        tolerance: f64,
+        /// The deepest ones, deepest first.
+        worst: Vec<DexelGouge>,
+    },
+    /// The shank or holder touched the in-process stock (tri-dexel stock).
+    #[error(
+        "{count} moves drive the shank or holder into the stock; the first: {first}; \
+         use longer flutes or a longer shank, change the tool axis, or cut in more stepdowns",
+        first = collisions.first().map_or_else(String::new, ToString::to_string)
+    )]
+    DexelCollision {
+        /// Number of colliding moves (per part of the tool).
+        count: usize,
+        /// The collisions, in program order.
+        collisions: Vec<DexelCollision>,
     },
 }

@@ -11,6 +11,13 @@
 //! - [`verify`]: the signed deviation `stock - part` per cell against a design
 //!   part (a [`scallop_mesh::MeshIndex`]): max scallop, volumes, and gouges as errors.
 //! - [`simulate`]: both, with every safety problem as an `Err`.
+//! - [`DexelStock`]: the multi-axis stock (tri-dexels: rays along X, Y and Z,
+//!   each a list of material intervals), cut by cutters with any tool axis
+//!   along 3-axis, 3+2 and simultaneous 5-axis moves ([`ToolMove`]); the
+//!   swept solid of a fixed-axis move is solved per ray exactly or by a
+//!   certified bracket, 5-axis moves are split into fixed-axis sub-steps
+//!   within [`DexelOptions::axis_tolerance`]; [`verify_dexel`] compares
+//!   every ray with the part; [`simulate_dexel`] does both.
 //!
 //! ```
 //! use scallop_cutter::{Cutter, CutterShape};
@@ -59,6 +66,7 @@
 //!   a part outside the stock) are errors ([`SimError`]), never warnings.
 //! - Heights only decrease and never go below the stock box bottom.
 
+mod dexel;
 mod envelope;
 mod error;
 pub mod tol;
@@ -70,6 +78,10 @@ use scallop_geom::Aabb3;
 use scallop_mesh::MeshIndex;
 use scallop_toolpath::Toolpath;
 
+pub use dexel::{
+    DexelCollision, DexelGouge, DexelOptions, DexelPart, DexelReport, DexelStock, DexelVerification, MAX_RAYS,
+    MAX_SUBSTEPS, ToolMove, verify_dexel,
+};
 pub use envelope::swept_floor;
 pub use error::SimError;
 pub use verify::{GougeCell, Verification, VerifyOptions, part_heights, verify};
@@ -134,4 +146,60 @@ pub fn simulate(
     cut.check()?;
     let verification = verify(&zmap, part, options)?;
     Ok(Simulation { zmap, cut, verification })
+}
+
+/// Everything [`simulate_dexel`] found about a safe multi-axis program.
+#[derive(Debug, Clone)]
+pub struct DexelSimulation {
+    /// The stock after the program.
+    pub stock: DexelStock,
+    /// Move by move figures (removed volume, air cuts).
+    pub cut: DexelReport,
+    /// Material left and volumes.
+    pub verification: DexelVerification,
+}
+
+/// Cuts a fresh tri-dexel stock box at `resolution` with `cutter` along
+/// `moves` (any tool axes), then verifies it against `part`.
+///
+/// # Errors
+/// Stock errors of [`DexelStock::new`], move errors of [`DexelStock::cut`];
+/// then, in this order, rapids into stock ([`SimError::RapidIntoStock`]),
+/// shank or holder in the stock ([`SimError::DexelCollision`]), gouges
+/// ([`SimError::DexelGouge`]).
+///
+/// ```
+/// use scallop_cutter::{Cutter, CutterShape};
+/// use scallop_geom::{Aabb3, Point3, Vec3};
+/// use scallop_mesh::TriMesh;
+/// use scallop_sim::{DexelOptions, DexelPart, SimError, ToolMove, VerifyOptions, simulate_dexel};
+/// use scallop_toolpath::MoveKind;
+/// let p = |x, y, z| Point3::new(x, y, z);
+/// // The part: a plane at z = 0; the stock 10 x 10 x 2 (top at z = 1).
+/// let (plane, _) = TriMesh::from_soup(&[[p(-5., -5., 0.), p(30., -5., 0.), p(-5., 30., 0.)]]).unwrap();
+/// let part = DexelPart::new(&plane);
+/// let stock = Aabb3 { min: p(0., 0., -1.), max: p(10., 10., 1.) };
+/// let flat = Cutter::new(CutterShape::Flat { radius: 2.0 }, 10.0).unwrap();
+/// // A flat end mill tilted 30 degrees about X, its tip 0.2 mm below the plane: a gouge.
+/// let axis = Vec3::new(0.0, -0.5, 0.75f64.sqrt());
+/// let mv = |kind, x: f64, z: f64| ToolMove::new(kind, p(x, 5., z), axis);
+/// let path = [mv(MoveKind::Rapid, -4., 6.), mv(MoveKind::Plunge, -4., -0.2), mv(MoveKind::Feed, 14., -0.2)];
+/// let err = simulate_dexel(stock, 0.25, &flat, &path, &part, &DexelOptions::default(), &VerifyOptions::default());
+/// let Err(SimError::DexelGouge { worst, .. }) = err else { panic!("expected a gouge") };
+/// assert_eq!(worst[0].cut_by.map(|m| m.index), Some(2));
+/// ```
+pub fn simulate_dexel(
+    stock: Aabb3,
+    resolution: f64,
+    cutter: &Cutter,
+    moves: &[ToolMove],
+    part: &DexelPart,
+    options: &DexelOptions,
+    verify_options: &VerifyOptions,
+) -> Result<DexelSimulation, SimError> {
+    let mut dexels = DexelStock::new(stock, resolution)?;
+    let cut = dexels.cut(cutter, moves, options)?;
+    cut.check()?;
+    let verification = verify_dexel(&dexels, part, verify_options)?;
+    Ok(DexelSimulation { stock: dexels, cut, verification })
 }

@@ -13,3 +13,7 @@ pub const WORST_REPORTED: usize = 20;
 /// horizontal travel is then below 1e-100 of the vertical one, far below
 /// rounding, and the slope's square stays finite in the closed forms.
 pub const VERTICAL_SLOPE: f64 = 1e100;
+
+/// Largest distance (mm) between a circular or helical move of a tri-dexel
+/// cut and the chords it is cut as (their vertices lie on the arc).
+pub const ARC_SAGITTA: f64 = 1e-4;

@@ -1,0 +1,869 @@
+//! The tri-dexel stock: three families of rays along X, Y and Z, each ray a
+//! sorted list of material intervals, cut by cutters with any tool axis.
+//!
+//! See [`DexelStock`]. The swept solid of a cutter along a straight move with
+//! a fixed axis is solved per ray exactly (closed forms per piece of the
+//! cutter) or by a certified bracket ([`sweep`]); simultaneous 5-axis moves
+//! are split into sub-steps with a fixed axis each ([`DexelOptions::axis_tolerance`]).
+
+mod body;
+mod sweep;
+mod verify;
+
+use std::fmt;
+
+use rayon::prelude::*;
+use scallop_cutter::Cutter;
+use scallop_geom::{Aabb3, Eps, Point2, Point3, Vec3};
+use scallop_toolpath::{ArcXY, MoveKind, Toolpath};
+
+use crate::tol::{ARC_SAGITTA, GRID_SNAP};
+use crate::{MoveId, RapidHit, SimError, ToolPart};
+use body::Body;
+use sweep::Sweep;
+
+pub use verify::{DexelGouge, DexelPart, DexelVerification, verify_dexel};
+
+/// The largest total number of rays of a [`DexelStock`].
+pub const MAX_RAYS: usize = 32_000_000;
+
+/// The largest number of fixed-axis sub-steps of one simultaneous 5-axis move.
+pub const MAX_SUBSTEPS: usize = 100_000;
+
+/// Rows of rays per band: the unit of parallel work (fixed, so results do not
+/// depend on the thread count).
+const BAND_ROWS: usize = 4;
+
+/// One move of a multi-axis program: the tool tip goes in a straight line to
+/// `tip` (or along `arc`) while the unit tool axis (from the tip towards the
+/// spindle) turns from the previous move's axis to `axis` (on the great
+/// circle, at a constant angular rate).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ToolMove {
+    /// Kind of move.
+    pub kind: MoveKind,
+    /// End point of the tool tip (mm, part frame).
+    pub tip: Point3,
+    /// Unit tool axis at the end of the move.
+    pub axis: Vec3,
+    /// The XY circle of a circular (or helical) move, as in
+    /// [`Toolpath::arc`]: cut as chords within [`crate::tol::ARC_SAGITTA`].
+    pub arc: Option<ArcXY>,
+}
+
+impl ToolMove {
+    /// A straight move.
+    #[must_use]
+    pub fn new(kind: MoveKind, tip: Point3, axis: Vec3) -> ToolMove {
+        ToolMove { kind, tip, axis, arc: None }
+    }
+
+    /// The moves of a 3-axis toolpath, tool axis +Z, arcs kept.
+    #[must_use]
+    pub fn from_toolpath(path: &Toolpath) -> Vec<ToolMove> {
+        path.moves()
+            .iter()
+            .enumerate()
+            .map(|(i, m)| ToolMove { kind: m.kind, tip: m.to, axis: Vec3::z(), arc: path.arc(i) })
+            .collect()
+    }
+}
+
+/// Algorithm knobs of [`DexelStock::cut`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DexelOptions {
+    /// Largest distance (mm) between the simulated and the true swept solid
+    /// of a simultaneous 5-axis move. Such a move is cut as `n` sub-steps,
+    /// each a straight move with the axis fixed at its middle, where the axis
+    /// turns by at most `2 axis_tolerance / l` per sub-step, `l` the largest
+    /// distance from the tip to a point of the flutes; every point of the
+    /// cutter then lies within `l dtheta / 2 <= axis_tolerance` of where it
+    /// truly is at the same tip position (see `docs/simulation.md`). Moves
+    /// with a fixed axis (3-axis, 3+2) are exact and never split.
+    pub axis_tolerance: f64,
+    /// Check the shank and the holder against the in-process stock.
+    pub check_collisions: bool,
+}
+
+impl Default for DexelOptions {
+    /// 0.01 mm for 5-axis moves; collisions checked.
+    fn default() -> Self {
+        DexelOptions { axis_tolerance: 0.01, check_collisions: true }
+    }
+}
+
+/// A move that drove the shank or holder into the in-process stock.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DexelCollision {
+    /// The move.
+    pub id: MoveId,
+    /// The part of the tool.
+    pub part: ToolPart,
+    /// Middle of the deepest stock piece inside the part of the tool.
+    pub at: Point3,
+    /// Length of that piece along its ray (mm).
+    pub depth: f64,
+}
+
+impl fmt::Display for DexelCollision {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{} drives the {} {:.4} mm into the stock at ({:.3}, {:.3}, {:.3})",
+            self.id,
+            self.part.name(),
+            self.depth,
+            self.at.x,
+            self.at.y,
+            self.at.z
+        )
+    }
+}
+
+/// What one [`DexelStock::cut`] did, move by move.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DexelReport {
+    /// The operation number given to this call's [`MoveId`]s.
+    pub operation: u32,
+    /// Volume removed by each move (mm^3, measured on the Z rays), in program order.
+    pub removed_by_move: Vec<f64>,
+    /// Total removed volume (mm^3): the sum of `removed_by_move`.
+    pub removed_volume: f64,
+    /// Number of [`MoveKind::Feed`] moves.
+    pub feed_moves: usize,
+    /// Feed moves that removed no more than the stock's rounding epsilon from any ray.
+    pub air_feed_moves: usize,
+    /// Number of fixed-axis sweeps the moves were cut as (equal to the
+    /// number of moves for 3-axis and 3+2 programs).
+    pub sweeps: usize,
+    /// Rapid and retract moves that removed stock, in program order (errors).
+    /// `at` is the XY of the deepest removal, `depth` its length along its ray.
+    pub rapid_hits: Vec<RapidHit>,
+    /// Shank and holder collisions with the in-process stock, in program order (errors).
+    pub collisions: Vec<DexelCollision>,
+}
+
+impl DexelReport {
+    /// Share of feed moves that cut air, in [0, 1] (0 when there are none).
+    #[must_use]
+    pub fn air_cut_share(&self) -> f64 {
+        if self.feed_moves == 0 {
+            0.0
+        } else {
+            // Counts far below 2^52: exact conversions.
+            self.air_feed_moves as f64 / self.feed_moves as f64
+        }
+    }
+
+    /// The safety verdict of the cut: rapid hits first, then collisions.
+    ///
+    /// # Errors
+    /// [`SimError::RapidIntoStock`], then [`SimError::DexelCollision`].
+    pub fn check(&self) -> Result<(), SimError> {
+        if !self.rapid_hits.is_empty() {
+            return Err(SimError::RapidIntoStock { count: self.rapid_hits.len(), hits: self.rapid_hits.clone() });
+        }
+        if !self.collisions.is_empty() {
+            return Err(SimError::DexelCollision { count: self.collisions.len(), collisions: self.collisions.clone() });
+        }
+        Ok(())
+    }
+}
+
+/// The material of one ray: untouched (the whole extent, no heap), or a
+/// sorted list of disjoint intervals.
+#[derive(Debug, Clone, PartialEq)]
+enum Ray {
+    Full,
+    Cut(Vec<[f64; 2]>),
+}
+
+impl Ray {
+    /// Whether any material lies in the open interval (a, b).
+    fn has_material(&self, a: f64, b: f64, lo: f64, hi: f64) -> bool {
+        match self {
+            Ray::Full => a < hi && b > lo,
+            Ray::Cut(v) => v.iter().any(|s| s[0] < b && s[1] > a),
+        }
+    }
+
+    /// The hull of the material inside (a, b), if any.
+    fn material_range(&self, a: f64, b: f64, lo: f64, hi: f64) -> Option<(f64, f64)> {
+        match self {
+            Ray::Full => (a < hi && b > lo).then(|| (a.max(lo), b.min(hi))),
+            Ray::Cut(v) => {
+                let first = v.iter().find(|s| s[1] > a && s[0] < b)?;
+                let last = v.iter().rev().find(|s| s[1] > a && s[0] < b)?;
+                Some((first[0].max(a), last[1].min(b)))
+            }
+        }
+    }
+
+    /// Material length inside [a, b].
+    fn overlap(&self, a: f64, b: f64, lo: f64, hi: f64) -> (f64, f64) {
+        let piece = |s: [f64; 2]| {
+            let (x, y) = (s[0].max(a), s[1].min(b));
+            if y > x { (y - x, 0.5 * (x + y)) } else { (0.0, 0.0) }
+        };
+        match self {
+            Ray::Full => piece([lo, hi]),
+            Ray::Cut(v) => v.iter().map(|&s| piece(s)).fold((0.0, 0.0), |best, p| if p.0 > best.0 { p } else { best }),
+        }
+    }
+
+    /// Removes [a, b]; returns the removed length and the middle of the
+    /// longest removed piece.
+    fn subtract(&mut self, a: f64, b: f64, lo: f64, hi: f64) -> (f64, f64, f64) {
+        if b <= a || a.is_nan() || b.is_nan() || !self.has_material(a, b, lo, hi) {
+            return (0.0, 0.0, 0.0);
+        }
+        let old = match std::mem::replace(self, Ray::Cut(Vec::new())) {
+            Ray::Full => vec![[lo, hi]],
+            Ray::Cut(v) => v,
+        };
+        let mut out = Vec::with_capacity(old.len() + 1);
+        let (mut removed, mut longest, mut mid) = (0.0, 0.0, 0.0);
+        for s in old {
+            if s[1] <= a || s[0] >= b {
+                out.push(s);
+                continue;
+            }
+            let (x, y) = (s[0].max(a), s[1].min(b));
+            removed += y - x;
+            if y - x > longest {
+                longest = y - x;
+                mid = 0.5 * (x + y);
+            }
+            if s[0] < a {
+                out.push([s[0], a]);
+            }
+            if s[1] > b {
+                out.push([b, s[1]]);
+            }
+        }
+        *self = Ray::Cut(out);
+        (removed, longest, mid)
+    }
+
+    fn intervals(&self, lo: f64, hi: f64) -> Vec<[f64; 2]> {
+        match self {
+            Ray::Full => vec![[lo, hi]],
+            Ray::Cut(v) => v.clone(),
+        }
+    }
+
+    fn length(&self, lo: f64, hi: f64) -> f64 {
+        match self {
+            Ray::Full => hi - lo,
+            Ray::Cut(v) => v.iter().map(|s| s[1] - s[0]).sum(),
+        }
+    }
+}
+
+/// One fixed-axis sweep of a move (a whole move, or a sub-step of a 5-axis one).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Step {
+    /// The move's index in its toolpath.
+    index: u32,
+    operation: u32,
+    sweep: Sweep,
+    rapid: bool,
+    /// Box of the flutes' sweep.
+    lo: Point3,
+    hi: Point3,
+}
+
+/// Box of a body swept with a fixed axis between two tip positions: exact,
+/// from the body's support function in the six axis directions, grown by `margin`.
+fn swept_box(body: &Body, sweep: &Sweep, margin: f64) -> (Point3, Point3) {
+    let mut lo = Point3::origin();
+    let mut hi = Point3::origin();
+    for i in 0..3 {
+        let mut e = Vec3::zeros();
+        e[i] = 1.0;
+        let up = body.support(&sweep.a, &e).0;
+        let down = body.support(&sweep.a, &(-e)).0;
+        let (a, b) = (sweep.p0[i], sweep.p0[i] + sweep.v[i]);
+        lo[i] = a.min(b) - down - margin;
+        hi[i] = a.max(b) + up + margin;
+    }
+    (lo, hi)
+}
+
+/// Axis at fraction `t` of the great circle from `a` to `b` (unit vectors,
+/// angle `theta` between them, below pi).
+fn slerp(a: &Vec3, b: &Vec3, theta: f64, t: f64) -> Vec3 {
+    if theta < 1e-9 {
+        return (a + t * (b - a)).normalize();
+    }
+    let s = theta.sin();
+    (((1.0 - t) * theta).sin() / s * a + (t * theta).sin() / s * b).normalize()
+}
+
+/// The tri-dexel stock: for each axis `k` (0 = X, 1 = Y, 2 = Z) a regular grid
+/// of rays along `k` over the other two axes `u = (k + 1) % 3`,
+/// `v = (k + 2) % 3`, at cell centres (cells of at most the resolution, tiling
+/// the stock box exactly as in [`crate::ZMap`]), each ray holding its material
+/// as sorted disjoint intervals of the coordinate along `k`. The Z rays sit on
+/// the same XY cell centres as a `ZMap` of the same box and resolution.
+///
+/// ```
+/// use scallop_geom::{Aabb3, Point3};
+/// use scallop_sim::DexelStock;
+/// let stock = Aabb3 { min: Point3::new(0.0, 0.0, -5.0), max: Point3::new(10.0, 4.0, 0.0) };
+/// let dexels = DexelStock::new(stock, 0.5).unwrap();
+/// assert_eq!(dexels.counts(), [20, 8, 10]);
+/// assert_eq!(dexels.volume(), 200.0);
+/// assert_eq!(dexels.intervals(2, 3, 4), vec![[-5.0, 0.0]]);
+/// ```
+#[derive(Debug, Clone)]
+pub struct DexelStock {
+    stock: Aabb3,
+    n: [usize; 3],
+    cell: [f64; 3],
+    rays: [Vec<Ray>; 3],
+    eps: f64,
+    operations: u32,
+    /// Every fixed-axis sweep cut so far, with its operation's flutes (for
+    /// naming the move behind a gouge).
+    history: Vec<Step>,
+    bodies: Vec<Body>,
+}
+
+impl DexelStock {
+    /// A full stock box with rays `resolution` (mm) apart or closer.
+    ///
+    /// # Errors
+    /// [`SimError::BadResolution`], [`SimError::BadStock`],
+    /// [`SimError::TooManyRays`] beyond [`MAX_RAYS`].
+    pub fn new(stock: Aabb3, resolution: f64) -> Result<DexelStock, SimError> {
+        if !(resolution.is_finite() && resolution > 0.0) {
+            return Err(SimError::BadResolution { resolution });
+        }
+        let size = stock.size();
+        let finite = stock.min.coords.iter().chain(stock.max.coords.iter()).all(|c| c.is_finite());
+        if !(finite && size.x > 0.0 && size.y > 0.0 && size.z > 0.0) {
+            return Err(SimError::BadStock { min: stock.min.coords.into(), max: stock.max.coords.into() });
+        }
+        let count = |w: f64| {
+            let n = w / resolution;
+            let n = if (n - n.round()).abs() <= GRID_SNAP * n { n.round() } else { n.ceil() };
+            n.max(1.0)
+        };
+        let f = [count(size.x), count(size.y), count(size.z)];
+        let total = f[0] * f[1] + f[1] * f[2] + f[2] * f[0];
+        if total > MAX_RAYS as f64 {
+            // Saturating conversion: only used in the message.
+            return Err(SimError::TooManyRays { rays: total as usize, limit: MAX_RAYS });
+        }
+        // Below MAX_RAYS: exact conversions.
+        let n = [f[0] as usize, f[1] as usize, f[2] as usize];
+        let cell = [size.x / f[0], size.y / f[1], size.z / f[2]];
+        let rays = [0, 1, 2].map(|k| vec![Ray::Full; n[(k + 1) % 3] * n[(k + 2) % 3]]);
+        Ok(DexelStock {
+            stock,
+            n,
+            cell,
+            rays,
+            eps: Eps::for_bounds(&stock).0,
+            operations: 0,
+            history: Vec::new(),
+            bodies: Vec::new(),
+        })
+    }
+
+    /// Cells along X, Y and Z.
+    #[must_use]
+    pub fn counts(&self) -> [usize; 3] {
+        self.n
+    }
+
+    /// Cell size along X, Y and Z (mm), each at most the resolution asked for.
+    #[must_use]
+    pub fn cell_size(&self) -> [f64; 3] {
+        self.cell
+    }
+
+    /// The stock box.
+    #[must_use]
+    pub fn stock(&self) -> Aabb3 {
+        self.stock
+    }
+
+    /// The rounding epsilon of the stock (mm): removals below it do not count as cuts.
+    #[must_use]
+    pub fn eps(&self) -> f64 {
+        self.eps
+    }
+
+    /// Rays of family `axis` as (count along `u`, count along `v`).
+    #[must_use]
+    pub fn grid(&self, axis: usize) -> (usize, usize) {
+        (self.n[(axis + 1) % 3], self.n[(axis + 2) % 3])
+    }
+
+    /// The point of ray `(iu, iv)` of family `axis` whose coordinate along
+    /// `axis` is 0 (the ray is that point plus `s e_axis`).
+    #[must_use]
+    pub fn ray_origin(&self, axis: usize, iu: usize, iv: usize) -> Point3 {
+        let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+        let mut o = Point3::origin();
+        // Indices far below 2^52: exact.
+        o[u] = self.stock.min[u] + (iu as f64 + 0.5) * self.cell[u];
+        o[v] = self.stock.min[v] + (iv as f64 + 0.5) * self.cell[v];
+        o
+    }
+
+    /// The material intervals of ray `(iu, iv)` of family `axis` (coordinates
+    /// along `axis`, sorted); empty outside the grid.
+    #[must_use]
+    pub fn intervals(&self, axis: usize, iu: usize, iv: usize) -> Vec<[f64; 2]> {
+        let (nu, nv) = self.grid(axis);
+        if axis > 2 || iu >= nu || iv >= nv {
+            return Vec::new();
+        }
+        self.rays[axis][iv * nu + iu].intervals(self.stock.min[axis], self.stock.max[axis])
+    }
+
+    /// Whether ray `(iu, iv)` of family `axis` is still untouched (holds no heap memory).
+    #[must_use]
+    pub fn is_untouched(&self, axis: usize, iu: usize, iv: usize) -> bool {
+        let (nu, _) = self.grid(axis);
+        matches!(self.rays.get(axis).and_then(|r| r.get(iv * nu + iu)), Some(Ray::Full))
+    }
+
+    /// Highest material point of each Z ray, row-major with X fastest (the
+    /// cells of a [`crate::ZMap`] of the same box and resolution); the stock
+    /// bottom where a ray is empty.
+    #[must_use]
+    pub fn top_heights(&self) -> Vec<f64> {
+        let (lo, hi) = (self.stock.min.z, self.stock.max.z);
+        self.rays[2]
+            .iter()
+            .map(|r| match r {
+                Ray::Full => hi,
+                Ray::Cut(v) => v.last().map_or(lo, |s| s[1]),
+            })
+            .collect()
+    }
+
+    /// Volume of stock left (mm^3), summed over the rays of family `axis`
+    /// (interval lengths times the cell area, in ray order).
+    #[must_use]
+    pub fn volume_along(&self, axis: usize) -> f64 {
+        let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+        let area = self.cell[u] * self.cell[v];
+        let (lo, hi) = (self.stock.min[axis], self.stock.max[axis]);
+        let nu = self.n[u];
+        self.rays[axis].chunks(nu).map(|row| row.iter().map(|r| r.length(lo, hi)).sum::<f64>() * area).sum()
+    }
+
+    /// Volume of stock left (mm^3), measured on the Z rays.
+    #[must_use]
+    pub fn volume(&self) -> f64 {
+        self.volume_along(2)
+    }
+
+    /// Volume of the full stock box (mm^3), in the same sum as [`DexelStock::volume`].
+    #[must_use]
+    pub fn initial_volume(&self) -> f64 {
+        let area = self.cell[0] * self.cell[1];
+        let column = self.stock.max.z - self.stock.min.z;
+        (0..self.n[1]).map(|_| (0..self.n[0]).map(|_| column).sum::<f64>() * area).sum()
+    }
+
+    /// Splits the moves into fixed-axis sweeps.
+    fn steps(
+        &self,
+        operation: u32,
+        body: &Body,
+        moves: &[ToolMove],
+        options: &DexelOptions,
+    ) -> Result<Vec<Step>, SimError> {
+        let mut steps = Vec::with_capacity(moves.len());
+        let mut prev: Option<(Point3, Vec3)> = None;
+        let max_turn = 2.0 * options.axis_tolerance / body.reach();
+        for (index, m) in moves.iter().enumerate() {
+            let len = m.axis.norm();
+            let finite = m.tip.coords.iter().chain(m.axis.iter()).all(|c| c.is_finite());
+            if !(finite && len > 0.0) {
+                return Err(SimError::BadAxis { index, axis: m.axis.into() });
+            }
+            let axis = m.axis / len;
+            let (p0, a0) = prev.unwrap_or((m.tip, axis));
+            let theta = a0.cross(&axis).norm().atan2(a0.dot(&axis));
+            let mut n = if theta == 0.0 { 1.0 } else { (theta / max_turn).ceil().max(1.0) };
+            // An arc: chords whose sagitta r (1 - cos(step / 2)) stays within ARC_SAGITTA.
+            let arc = m.arc.filter(|a| a.sweep != 0.0 && prev.is_some()).map(|a| {
+                let r = (p0.x - a.center.x).hypot(p0.y - a.center.y);
+                let start = (p0.y - a.center.y).atan2(p0.x - a.center.x);
+                (a, r, start)
+            });
+            if let Some((a, r, _)) = arc {
+                let step = if r > ARC_SAGITTA { 2.0 * (1.0 - ARC_SAGITTA / r).acos() } else { a.sweep.abs() };
+                n = n.max((a.sweep.abs() / step).ceil());
+            }
+            if theta > std::f64::consts::PI * (1.0 - 1e-6) || n > MAX_SUBSTEPS as f64 {
+                return Err(SimError::AxisTurn { index, degrees: theta.to_degrees(), limit: MAX_SUBSTEPS });
+            }
+            // n <= MAX_SUBSTEPS: exact.
+            let n_sub = n as usize;
+            let rapid = matches!(m.kind, MoveKind::Rapid | MoveKind::Retract);
+            let index32 = u32::try_from(index).map_err(|_| SimError::TooManyMoves { moves: moves.len() })?;
+            let tip_at = |t: f64| match arc {
+                _ if t >= 1.0 => m.tip,
+                Some((a, r, start)) => {
+                    let th = start + a.sweep * t;
+                    Point3::new(a.center.x + r * th.cos(), a.center.y + r * th.sin(), p0.z + (m.tip.z - p0.z) * t)
+                }
+                None => p0 + t * (m.tip - p0),
+            };
+            for i in 0..n_sub {
+                let (t0, t1) = (i as f64 / n, (i + 1) as f64 / n);
+                let a = if theta == 0.0 { axis } else { slerp(&a0, &axis, theta, 0.5 * (t0 + t1)) };
+                let q0 = tip_at(t0);
+                let q1 = if i + 1 == n_sub { m.tip } else { tip_at(t1) };
+                let sweep = Sweep { p0: q0, v: q1 - q0, a };
+                let (lo, hi) = swept_box(body, &sweep, self.eps);
+                steps.push(Step { index: index32, operation, sweep, rapid, lo, hi });
+            }
+            prev = Some((m.tip, axis));
+        }
+        Ok(steps)
+    }
+
+    /// Removes the material swept by the flutes of `cutter` along `moves`.
+    /// The first move has no known start: the tool is placed at its end.
+    /// Each fixed-axis sweep (see [`DexelOptions::axis_tolerance`]) is
+    /// subtracted from every ray crossing its bounding box, exactly (see the
+    /// module `sweep`); after each sweep the shank and the holder, swept
+    /// the same way, are checked against the in-process stock (when
+    /// [`DexelOptions::check_collisions`]): material inside them longer than
+    /// the stock's epsilon along a ray goes into [`DexelReport::collisions`].
+    /// Rapid and retract moves that remove stock go into
+    /// [`DexelReport::rapid_hits`]. Neither stops the cut; use
+    /// [`DexelReport::check`].
+    ///
+    /// Work is parallel over fixed bands of rays of each family; every ray
+    /// applies the sweeps in program order, so the result does not depend on
+    /// the number of threads.
+    ///
+    /// # Errors
+    /// [`SimError::BadAxis`] (a zero or non-finite axis), [`SimError::AxisTurn`]
+    /// (an axis reversal, or more than [`MAX_SUBSTEPS`] sub-steps),
+    /// [`SimError::BadTolerance`], [`SimError::TooManyMoves`].
+    ///
+    /// ```
+    /// use scallop_cutter::{Cutter, CutterShape};
+    /// use scallop_geom::{Aabb3, Point3, Vec3};
+    /// use scallop_sim::{DexelOptions, DexelStock, ToolMove};
+    /// use scallop_toolpath::MoveKind;
+    /// let stock = Aabb3 { min: Point3::new(0.0, 0.0, -5.0), max: Point3::new(20.0, 10.0, 0.0) };
+    /// let mut dexels = DexelStock::new(stock, 0.25).unwrap();
+    /// let flat = Cutter::new(CutterShape::Flat { radius: 2.0 }, 10.0).unwrap();
+    /// let mv = |kind, x: f64, z: f64| ToolMove::new(kind, Point3::new(x, 5.0, z), Vec3::z());
+    /// let path = [mv(MoveKind::Rapid, -3.0, 5.0), mv(MoveKind::Plunge, -3.0, -1.0), mv(MoveKind::Feed, 23.0, -1.0)];
+    /// let report = dexels.cut(&flat, &path, &DexelOptions::default()).unwrap();
+    /// report.check().unwrap();
+    /// // A slot 4 mm wide and 1 mm deep through the 20 mm stock.
+    /// assert!((report.removed_volume - 80.0).abs() < 1e-9);
+    /// ```
+    pub fn cut(
+        &mut self,
+        cutter: &Cutter,
+        moves: &[ToolMove],
+        options: &DexelOptions,
+    ) -> Result<DexelReport, SimError> {
+        if !(options.axis_tolerance.is_finite() && options.axis_tolerance > 0.0) {
+            return Err(SimError::BadTolerance { what: "axis tolerance", value: options.axis_tolerance });
+        }
+        if u32::try_from(moves.len()).is_err() {
+            return Err(SimError::TooManyMoves { moves: moves.len() });
+        }
+        let operation = self.operations;
+        let next = operation.checked_add(1).ok_or(SimError::TooManyMoves { moves: moves.len() })?;
+        let flutes = Body::flutes(cutter);
+        let mut guards: Vec<(Body, ToolPart)> = Vec::new();
+        if options.check_collisions {
+            guards.push((Body::shank(cutter), ToolPart::Shank));
+            let mut i = 0;
+            while let Some(b) = Body::holder(cutter, i) {
+                guards.push((b, ToolPart::Holder(i)));
+                i += 1;
+            }
+        }
+        let steps = self.steps(operation, &flutes, moves, options)?;
+        self.operations = next;
+        // Boxes of each step: flutes, then each guard.
+        let boxes: Vec<Vec<(Point3, Point3)>> = steps
+            .iter()
+            .map(|s| {
+                let mut b = vec![(s.lo, s.hi)];
+                b.extend(guards.iter().map(|(g, _)| swept_box(g, &s.sweep, self.eps)));
+                b
+            })
+            .collect();
+        let union = |bs: &[(Point3, Point3)]| bs.iter().fold(bs[0], |(lo, hi), (l, h)| (lo.inf(l), hi.sup(h)));
+        let unions: Vec<(Point3, Point3)> = boxes.iter().map(|b| union(b)).collect();
+
+        let count = moves.len();
+        let mut removed_by_move = vec![0.0; count];
+        let mut cut_any = vec![false; count];
+        let mut rapid: Vec<Option<(f64, Point3)>> = vec![None; count];
+        let mut collided: Vec<Vec<(ToolPart, f64, Point3)>> = vec![Vec::new(); count];
+        for axis in 0..3 {
+            let outputs = self.cut_family(axis, &flutes, &guards, &steps, &boxes, &unions);
+            for out in outputs {
+                for (k, volume, longest, at) in out.removed {
+                    let step = &steps[k as usize];
+                    let m = step.index as usize;
+                    if axis == 2 {
+                        removed_by_move[m] += volume;
+                    }
+                    if longest > self.eps {
+                        cut_any[m] = true;
+                        if step.rapid && rapid[m].is_none_or(|(d, _)| longest > d) {
+                            rapid[m] = Some((longest, at));
+                        }
+                    }
+                }
+                for (k, part, depth, at) in out.collisions {
+                    let m = steps[k as usize].index as usize;
+                    let list = &mut collided[m];
+                    match list.iter_mut().find(|(p, _, _)| *p == part) {
+                        Some(entry) if depth > entry.1 => *entry = (part, depth, at),
+                        Some(_) => {}
+                        None => list.push((part, depth, at)),
+                    }
+                }
+            }
+        }
+        let id = |k: usize| MoveId { operation, index: k as u32 };
+        let feed_moves = moves.iter().filter(|m| m.kind == MoveKind::Feed).count();
+        let air_feed_moves = moves.iter().zip(&cut_any).filter(|(m, c)| m.kind == MoveKind::Feed && !**c).count();
+        let rapid_hits = rapid
+            .iter()
+            .enumerate()
+            .filter_map(|(k, r)| r.map(|(depth, at)| RapidHit { id: id(k), at: Point2::new(at.x, at.y), depth }))
+            .collect();
+        let collisions = collided
+            .iter()
+            .enumerate()
+            .flat_map(|(k, list)| list.iter().map(move |&(part, depth, at)| (k, part, depth, at)))
+            .map(|(k, part, depth, at)| DexelCollision { id: id(k), part, at, depth })
+            .collect();
+        let removed_volume = removed_by_move.iter().sum();
+        let sweeps = steps.len();
+        self.bodies.push(flutes);
+        self.history.extend(steps);
+        Ok(DexelReport {
+            operation,
+            removed_by_move,
+            removed_volume,
+            feed_moves,
+            air_feed_moves,
+            sweeps,
+            rapid_hits,
+            collisions,
+        })
+    }
+
+    /// One family: bands of rays in parallel, each applying its steps in order.
+    fn cut_family(
+        &mut self,
+        axis: usize,
+        flutes: &Body,
+        guards: &[(Body, ToolPart)],
+        steps: &[Step],
+        boxes: &[Vec<(Point3, Point3)>],
+        unions: &[(Point3, Point3)],
+    ) -> Vec<BandOutput> {
+        let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+        let (nu, nv) = (self.n[u], self.n[v]);
+        let geo = Family {
+            axis,
+            u,
+            v,
+            nu,
+            nv,
+            min: self.stock.min,
+            cell: self.cell,
+            lo: self.stock.min[axis],
+            hi: self.stock.max[axis],
+            area: self.cell[u] * self.cell[v],
+            eps: self.eps,
+        };
+        // Steps per band, in program order.
+        let bands = nv.div_ceil(BAND_ROWS);
+        let mut members: Vec<Vec<u32>> = vec![Vec::new(); bands];
+        for (k, (lo, hi)) in unions.iter().enumerate() {
+            if let Some((a, b)) = geo.index_range(v, lo[v], hi[v]) {
+                for m in &mut members[a / BAND_ROWS..=b / BAND_ROWS] {
+                    // k < moves <= u32::MAX (checked by the caller).
+                    m.push(k as u32);
+                }
+            }
+        }
+        self.rays[axis]
+            .par_chunks_mut(BAND_ROWS * nu)
+            .zip(members.par_iter())
+            .enumerate()
+            .map(|(band, (rays, ids))| geo.cut_band(band, rays, ids, flutes, guards, steps, boxes, unions))
+            .collect()
+    }
+
+    /// The fixed-axis sweeps cut so far, with the flutes of their operation.
+    pub(crate) fn history(&self) -> impl Iterator<Item = (&Step, &Body)> {
+        self.history.iter().map(|s| (s, &self.bodies[s.operation as usize]))
+    }
+
+    pub(crate) fn ray(&self, axis: usize, index: usize) -> &[[f64; 2]] {
+        match &self.rays[axis][index] {
+            Ray::Full => &[],
+            Ray::Cut(v) => v,
+        }
+    }
+
+    pub(crate) fn ray_is_full(&self, axis: usize, index: usize) -> bool {
+        matches!(self.rays[axis][index], Ray::Full)
+    }
+}
+
+impl Step {
+    /// The move this sweep belongs to.
+    pub(crate) fn id(&self) -> MoveId {
+        MoveId { operation: self.operation, index: self.index }
+    }
+
+    /// The interval of the ray along `axis` through `o` inside this sweep of `body`.
+    pub(crate) fn interval(&self, body: &Body, o: &Point3, axis: usize) -> Option<(f64, f64)> {
+        let mut d = Vec3::zeros();
+        d[axis] = 1.0;
+        self.sweep.interval(body, o, &d)
+    }
+
+    /// Whether the box of the sweep contains the ray.
+    pub(crate) fn crosses(&self, o: &Point3, axis: usize) -> bool {
+        (0..3).filter(|&i| i != axis).all(|i| o[i] >= self.lo[i] && o[i] <= self.hi[i])
+    }
+}
+
+/// What a band found, sparse per step.
+#[derive(Default)]
+struct BandOutput {
+    /// (step, removed volume, longest removed piece, its middle).
+    removed: Vec<(u32, f64, f64, Point3)>,
+    /// (step, part, depth, place).
+    collisions: Vec<(u32, ToolPart, f64, Point3)>,
+}
+
+/// The geometry of one family of rays.
+#[derive(Clone, Copy)]
+struct Family {
+    axis: usize,
+    u: usize,
+    v: usize,
+    nu: usize,
+    nv: usize,
+    min: Point3,
+    cell: [f64; 3],
+    lo: f64,
+    hi: f64,
+    area: f64,
+    eps: f64,
+}
+
+impl Family {
+    /// Ray indices along `c` (u or v) whose centres may lie in [lo, hi].
+    fn index_range(&self, c: usize, lo: f64, hi: f64) -> Option<(usize, usize)> {
+        let n = if c == self.u { self.nu } else { self.nv };
+        crate::zmap::index_range(lo, hi, self.min[c], self.cell[c], n)
+    }
+
+    fn origin(&self, iu: usize, iv: usize) -> Point3 {
+        let mut o = Point3::origin();
+        o[self.u] = self.min[self.u] + (iu as f64 + 0.5) * self.cell[self.u];
+        o[self.v] = self.min[self.v] + (iv as f64 + 0.5) * self.cell[self.v];
+        o
+    }
+
+    #[allow(clippy::too_many_arguments)] // one private call site; the pieces are unrelated borrows.
+    fn cut_band(
+        &self,
+        band: usize,
+        rays: &mut [Ray],
+        ids: &[u32],
+        flutes: &Body,
+        guards: &[(Body, ToolPart)],
+        steps: &[Step],
+        boxes: &[Vec<(Point3, Point3)>],
+        unions: &[(Point3, Point3)],
+    ) -> BandOutput {
+        let row0 = band * BAND_ROWS;
+        let rows = rays.len() / self.nu;
+        let mut out = BandOutput::default();
+        let mut d = Vec3::zeros();
+        d[self.axis] = 1.0;
+        let (lo, hi) = (self.lo, self.hi);
+        for &k in ids {
+            let step = &steps[k as usize];
+            let (ulo, uhi) = unions[k as usize];
+            let Some((v0, v1)) = self.index_range(self.v, ulo[self.v], uhi[self.v]) else { continue };
+            let Some((u0, u1)) = self.index_range(self.u, ulo[self.u], uhi[self.u]) else { continue };
+            let (v0, v1) = (v0.max(row0), v1.min(row0 + rows - 1));
+            let (mut removed, mut longest, mut at) = (0.0, 0.0, Point3::origin());
+            let mut worst: Vec<Option<(f64, Point3)>> = vec![None; guards.len()];
+            for iv in v0..=v1 {
+                for iu in u0..=u1 {
+                    let o = self.origin(iu, iv);
+                    let ray = &mut rays[(iv - row0) * self.nu + iu];
+                    let inside = |b: &(Point3, Point3)| {
+                        o[self.u] >= b.0[self.u]
+                            && o[self.u] <= b.1[self.u]
+                            && o[self.v] >= b.0[self.v]
+                            && o[self.v] <= b.1[self.v]
+                    };
+                    let bx = &boxes[k as usize];
+                    if inside(&bx[0])
+                        && let Some((m_lo, m_hi)) = ray.material_range(bx[0].0[self.axis], bx[0].1[self.axis], lo, hi)
+                        && let Some((a, b)) = step.sweep.interval_within(flutes, &o, &d, m_lo, m_hi)
+                    {
+                        let (r, l, mid) = ray.subtract(a.max(lo), b.min(hi), lo, hi);
+                        removed += r;
+                        if l > longest {
+                            longest = l;
+                            at = o;
+                            at[self.axis] = mid;
+                        }
+                    }
+                    for (g, (body, _)) in guards.iter().enumerate() {
+                        let b = &bx[g + 1];
+                        if !inside(b) {
+                            continue;
+                        }
+                        let Some((m_lo, m_hi)) = ray.material_range(b.0[self.axis], b.1[self.axis], lo, hi) else {
+                            continue;
+                        };
+                        if let Some((a, b)) = step.sweep.interval_within(body, &o, &d, m_lo, m_hi) {
+                            let (depth, mid) = ray.overlap(a, b, lo, hi);
+                            if depth > self.eps && worst[g].is_none_or(|(w, _)| depth > w) {
+                                let mut p = o;
+                                p[self.axis] = mid;
+                                worst[g] = Some((depth, p));
+                            }
+                        }
+                    }
+                }
+            }
+            if removed > 0.0 {
+                out.removed.push((k, removed * self.area, longest, at));
+            }
+            for (g, w) in worst.iter().enumerate() {
+                if let Some((depth, p)) = *w {
+                    out.collisions.push((k, guards[g].1, depth, p));
+                }
+            }
+        }
+        out
+    }
+}
