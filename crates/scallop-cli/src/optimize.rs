@@ -14,7 +14,7 @@ use scallop_optim::study::{
 };
 use scallop_optim::surface::{SurfaceModel, SurfaceSettings};
 use scallop_optim::{Barrier, CostModel, OptimError, convergence_svg, zones_svg};
-use scallop_strategy::network::{TransitionModel, Transitions};
+use scallop_strategy::network::{CellLabels, TransitionModel, Transitions};
 use serde::Serialize;
 
 use crate::output::{print_json, print_text, progress_bar, write_atomic};
@@ -70,11 +70,11 @@ struct StudyFile<'a> {
     scallop_height_mm: f64,
     threads: usize,
     wall_time_s: f64,
-    gcode: &'static str,
+    gcode: String,
     study: &'a Study,
 }
 
-/// What `report.json` holds: the best plan over all K.
+/// What `report.json` holds: the best plan over all K, and its program.
 #[derive(Serialize)]
 struct BestReport<'a> {
     part: String,
@@ -83,12 +83,50 @@ struct BestReport<'a> {
     time_s: f64,
     start_time_s: f64,
     eta: f64,
-    gcode: &'static str,
+    /// What was written: "program.nc" or why nothing was.
+    gcode: String,
+    /// The drop-cutter program of the best plan: per-zone figures, times next to the
+    /// network model's prediction, the stock simulation's scallop.
+    program: Option<&'a scallop_engine::ZoneFinishReport>,
     result: &'a KResult,
 }
 
-const NO_GCODE: &str = "not written: the engine's finishing path plans one direction over the whole part; \
-     per-zone G-code needs zone-clipped drop-cutter passes (not built yet). Times are the network planner's.";
+/// Why a formulation with tool orientations gets no program (3+2, heuristic).
+const NO_GCODE_3PLUS2: &str = "not written: the plan tilts its zones (3+2 orientations). Missing: a per-zone \
+     indexed setup sequence in the engine (finish.rs writes one tool axis per program) and a proof of \
+     multi-axis programs (the z-map stock simulation is 3-axis). Times are the network planner's.";
+
+/// The 3-axis zone program of the best plan: zones in label order with the
+/// optimiser's directions, planned by drop-cutter and proven on the stock.
+fn zone_program(
+    spec: &JobFile,
+    folder: &Path,
+    best: &KResult,
+    transitions: Transitions,
+) -> CliResult<Option<scallop_engine::ZoneFinishOutput>> {
+    let plan = &best.plan;
+    if plan.zones.iter().any(|z| z.phi_deg != 0.0) {
+        return Ok(None);
+    }
+    let job = crate::run::finish_job(spec, folder)?;
+    let zone_spec = scallop_engine::ZonePlanSpec {
+        labels: CellLabels { cells_u: plan.grid[0], cells_v: plan.grid[1], labels: plan.labels.clone() },
+        zones: plan
+            .zones
+            .iter()
+            .map(|z| scallop_engine::ZoneSpec {
+                label: u32::try_from(z.zone).unwrap_or(u32::MAX),
+                direction_deg: z.theta_deg,
+                predicted_time_s: Some(z.time_s),
+            })
+            .collect(),
+        transitions,
+        predicted_time_s: Some(plan.time_s),
+    };
+    scallop_engine::finish_zones(&job, &zone_spec)
+        .map(Some)
+        .map_err(|e| Failure::rejected(format!("the G-code of the best plan (K = {}): {e}", best.k)))
+}
 
 /// `scallop optimize`.
 pub fn run(args: &OptimizeArgs) -> CliResult<()> {
@@ -133,6 +171,25 @@ pub fn run(args: &OptimizeArgs) -> CliResult<()> {
     let _ = multi.clear();
 
     let best = &study.results[study.best];
+    let spinner = progress_bar(0, "G-code of the best plan: planning and verifying");
+    spinner.enable_steady_tick(std::time::Duration::from_millis(120));
+    let gcode_start = Instant::now();
+    let program = zone_program(&spec, folder, best, model_settings.transitions).map_err(|e| prefix(&name, e))?;
+    let gcode_seconds = gcode_start.elapsed().as_secs_f64();
+    spinner.finish_and_clear();
+    let gcode = match &program {
+        Some(p) => format!(
+            "program.nc: {} zones by drop-cutter, {:.1} s stop-to-stop ({:.1} s predicted by the network model); \
+             simulated scallop {:.4} mm <= {:.4} mm; planned and verified in {:.1} s",
+            p.report.zones.iter().filter(|z| z.passes > 0).count(),
+            p.report.plan.total_time_s,
+            best.f_best,
+            p.report.sim_max_scallop_mm,
+            p.report.sim_scallop_limit_mm,
+            gcode_seconds
+        ),
+        None => NO_GCODE_3PLUS2.to_owned(),
+    };
     let cutter = match model_settings.tool {
         Cutter::Ball { radius } => format!("ball R{radius} mm"),
         Cutter::Toroidal { radius, corner } => format!("bull-nose R{radius} r{corner} mm"),
@@ -145,7 +202,7 @@ pub fn run(args: &OptimizeArgs) -> CliResult<()> {
         scallop_height_mm: model_settings.scallop_height,
         threads: rayon::current_num_threads(),
         wall_time_s: wall,
-        gcode: NO_GCODE,
+        gcode: gcode.clone(),
         study: &study,
     };
     let report = BestReport {
@@ -155,16 +212,30 @@ pub fn run(args: &OptimizeArgs) -> CliResult<()> {
         time_s: best.f_best,
         start_time_s: best.f0,
         eta: best.eta,
-        gcode: NO_GCODE,
+        gcode: gcode.clone(),
+        program: program.as_ref().map(|p| &p.report),
         result: best,
     };
     let out = &args.output;
     write_atomic(&out.join("study.json"), |w| w.write_all(to_json(&file)?.as_bytes()))?;
     write_atomic(&out.join("report.json"), |w| w.write_all(to_json(&report)?.as_bytes()))?;
+    if let Some(p) = &program {
+        write_atomic(&out.join("program.nc"), |w| w.write_all(p.gcode.as_bytes()))?;
+        write_atomic(&out.join("toolpath.csv"), |w| {
+            w.write_all(scallop_engine::toolpath_csv(&p.toolpath).as_bytes())
+        })?;
+    }
     write_atomic(&out.join("convergence.svg"), |w| w.write_all(convergence_svg(&study).as_bytes()))?;
     let title = format!("{part_name}, {}, K = {}", formulation_name(settings.formulation), best.k);
     write_atomic(&out.join("zones.svg"), |w| w.write_all(zones_svg(&best.plan, &title).as_bytes()))?;
-    let page = scallop_report::html::report_html(&optimisation_report(&patch, &study, &title, &name, &file.cutter));
+    let page = scallop_report::html::report_html(&optimisation_report(
+        &patch,
+        &study,
+        &title,
+        &name,
+        &file.cutter,
+        program.as_ref(),
+    ));
     write_atomic(&out.join("report.html"), |w| w.write_all(page.as_bytes()))?;
     if args.json {
         return print_json(&file);
@@ -193,14 +264,17 @@ pub fn run(args: &OptimizeArgs) -> CliResult<()> {
     }
     text.push_str(&format!(
         "  best: K = {} in {:.2} s ({:.1}% below its start); mean gain {:.1}%; study {:.1} s on {} threads\n\
-         \x20 wrote {}: study.json, report.json, convergence.svg, zones.svg (no G-code: see report.json)\n",
+         \x20 {}\n\
+         \x20 wrote {}: study.json, report.json, convergence.svg, zones.svg, report.html{}\n",
         best.k,
         best.f_best,
         100.0 * best.eta,
         100.0 * study.mean_eta,
         wall,
         rayon::current_num_threads(),
-        out.display()
+        gcode,
+        out.display(),
+        if program.is_some() { ", program.nc, toolpath.csv" } else { "" }
     ));
     print_text(&text)
 }
@@ -215,6 +289,7 @@ fn optimisation_report(
     title: &str,
     command: &str,
     cutter: &str,
+    program: Option<&scallop_engine::ZoneFinishOutput>,
 ) -> scallop_report::ReportData {
     use scallop_report::{Convergence, Curve, Figure, ReportData, Zones};
     let best = &study.results[study.best];
@@ -244,8 +319,23 @@ fn optimisation_report(
             &format!("s (from {:.2} s, {} evaluations)", r.f0, r.evaluations),
         ));
     }
+    if let Some(p) = program {
+        let r = &p.report;
+        data.figures.push(Figure::number("program time (drop-cutter, stop-to-stop)", r.plan.total_time_s, 2, "s"));
+        data.figures.push(Figure::number(
+            "program time (look-ahead, cutting)",
+            r.plan.machining_time_lookahead_s,
+            2,
+            "s",
+        ));
+        data.figures.push(Figure::number("simulated scallop", r.sim_max_scallop_mm, 4, "mm"));
+        data.figures.push(Figure::number("scallop limit (sh + resolution bound)", r.sim_scallop_limit_mm, 4, "mm"));
+        data.toolpath = Some(p.toolpath.clone());
+    }
     data.zones = Some(Zones {
-        of_move: Vec::new(),
+        of_move: program.map_or_else(Vec::new, |p| {
+            p.zone_of_move.iter().map(|&z| u16::try_from(z).unwrap_or(u16::MAX)).collect()
+        }),
         names: best.plan.zones.iter().map(|z| format!("{} ({:.0} deg)", z.zone, z.theta_deg)).collect(),
         times_s: best.plan.zones.iter().map(|z| z.time_s).collect(),
     });

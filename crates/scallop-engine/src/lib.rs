@@ -17,6 +17,7 @@
 mod demo;
 mod finish;
 mod grid;
+mod zones;
 
 use scallop_geom::Tolerances;
 use scallop_mesh::{MeshIndex, TriMesh};
@@ -28,6 +29,10 @@ pub use finish::{
     toolpath_csv,
 };
 pub use grid::{GridAxis, GridError, MAX_GRID_POINTS};
+pub use zones::{
+    ZONE_MARGIN_PER_SPACING, ZONE_MARGIN_ROUNDS, ZoneFigures, ZoneFinishOutput, ZoneFinishReport, ZonePlanSpec, ZoneSpec,
+    finish_zones,
+};
 
 /// Why the engine rejected a request. Each variant says the cause and the fix.
 #[derive(Debug, thiserror::Error)]
@@ -56,6 +61,24 @@ pub enum EngineError {
     /// collision) or could not run.
     #[error("verification: {0}")]
     Verification(#[from] scallop_sim::SimError),
+    /// The stock simulation measured a scallop above the height asked plus the
+    /// simulation's resolution bound: the program does not finish the surface
+    /// as promised (a planner bug, or zones too narrow for their margins).
+    #[error(
+        "verification: the simulated scallop {height} mm near ({x:.3}, {y:.3}) mm exceeds {limit} mm \
+         (scallop height plus the simulation's resolution bound); use a finer `verify.resolution`, \
+         fewer zones, or report the job as a planner bug"
+    )]
+    ScallopExceeded {
+        /// Simulated scallop (mm).
+        height: f64,
+        /// The limit (mm).
+        limit: f64,
+        /// Place (mm).
+        x: f64,
+        /// Place (mm).
+        y: f64,
+    },
     /// The program cannot be written as asked (dialect, machine, 3+2 setup).
     #[error("output: {what}; fix: {fix}")]
     Output {

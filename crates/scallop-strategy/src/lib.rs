@@ -135,6 +135,7 @@ mod leads;
 pub mod network;
 mod params;
 mod plan;
+mod region;
 mod scallop;
 mod time;
 pub mod tol;
@@ -144,6 +145,7 @@ pub use error::StrategyError;
 pub use iso::{IsoDirection, IsoPass, IsoPlanned, iso_scallop, plan_isoparametric};
 pub use leads::{LeadFallback, LeadKind, LeadReport, apply_leads};
 pub use params::{Boundary, FinishingParams, Pattern};
+pub use region::ZoneRegion;
 pub use scallop::{PairScallop, ScallopReport, verify_scallop};
 pub use time::{ClassTimes, MoveFeed, lookahead_profile, lookahead_time, stop_to_stop_time};
 
@@ -238,7 +240,37 @@ pub fn plan_finishing(
     params: &FinishingParams,
     tol: &Tolerances,
 ) -> Result<Planned, StrategyError> {
-    let mut planner = plan::Planner::new(index, cutter, params, tol)?;
+    plan(index, cutter, params, tol, None)
+}
+
+/// [`plan_finishing`] restricted to one zone of a labelled part: a cutter
+/// location belongs to the region when it does under `params.boundary` **and**
+/// its contact lies in the dilated zone ([`ZoneRegion`]). Planes crossing a
+/// non-convex zone give several passes; the plane range is the dilated zone's.
+/// The verified scallop ([`Planned::scallop`]) is that of the zone's passes.
+/// `index` must index the mesh the region was built on.
+///
+/// # Errors
+/// As [`plan_finishing`]; [`StrategyError::EmptyRegion`] when no pass touches
+/// the dilated zone.
+pub fn plan_zone_finishing(
+    index: &MeshIndex,
+    cutter: &Cutter,
+    params: &FinishingParams,
+    tol: &Tolerances,
+    region: &ZoneRegion,
+) -> Result<Planned, StrategyError> {
+    plan(index, cutter, params, tol, Some(region))
+}
+
+fn plan(
+    index: &MeshIndex,
+    cutter: &Cutter,
+    params: &FinishingParams,
+    tol: &Tolerances,
+    region: Option<&ZoneRegion>,
+) -> Result<Planned, StrategyError> {
+    let mut planner = plan::Planner::new(index, cutter, params, tol, region)?;
     let planes = planner.sweep()?;
     let (toolpath, links, retracts) = planner.toolpath(&planes);
     let planes: Vec<Plane> = planes.into_iter().map(|p| p.plane).collect();

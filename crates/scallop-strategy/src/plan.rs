@@ -10,7 +10,7 @@ use scallop_toolpath::{Move, MoveKind, Toolpath, simplify};
 
 use crate::geometry::{Frame, PartBoundary, contact_normal, slots_by_original};
 use crate::scallop::{Curve, Measure, pair_heights};
-use crate::{Boundary, FinishingParams, Pattern, Plane, StrategyError, tol};
+use crate::{Boundary, FinishingParams, Pattern, Plane, StrategyError, ZoneRegion, tol};
 
 /// A straight XY line `origin + t dir` along which the cutter is dropped.
 #[derive(Debug, Clone, Copy)]
@@ -41,6 +41,7 @@ pub(crate) struct Planner<'a> {
     pub(crate) frame: Frame,
     slots: Vec<u32>,
     part_boundary: PartBoundary,
+    region: Option<&'a ZoneRegion>,
     measure: Measure<'a>,
     raw_measure: Measure<'a>,
     floor: f64,
@@ -66,6 +67,7 @@ impl<'a> Planner<'a> {
         cutter: &'a Cutter,
         params: &'a FinishingParams,
         tol_: &Tolerances,
+        region: Option<&'a ZoneRegion>,
     ) -> Result<Planner<'a>, StrategyError> {
         params.validate()?;
         if !(tol_.path.is_finite() && tol_.path > 0.0) {
@@ -98,6 +100,9 @@ impl<'a> Planner<'a> {
         };
         let (mut t_range, mut d_range) = ([f64::INFINITY, f64::NEG_INFINITY], [f64::INFINITY, f64::NEG_INFINITY]);
         for slot in 0..index.len() {
+            if region.is_some_and(|r| !r.contains_triangle(index.original_index(slot))) {
+                continue;
+            }
             for p in index.corners(slot) {
                 let (t, d) = (frame.t(p), frame.d(p));
                 t_range = [t_range[0].min(t), t_range[1].max(t)];
@@ -124,6 +129,7 @@ impl<'a> Planner<'a> {
             frame,
             slots: slots_by_original(index),
             part_boundary: PartBoundary::new(index),
+            region,
             measure: Measure::new(index, cutter, params.direction, sh),
             raw_measure: Measure { refine: false, ..Measure::new(index, cutter, params.direction, sh) },
             floor: bounds.min.z - bounds.diagonal() - 1.0,
@@ -144,7 +150,10 @@ impl<'a> Planner<'a> {
 
     fn is_inside(&self, cl: &ClPoint, _scratch: &mut Vec<u32>) -> bool {
         match self.params.boundary {
-            Boundary::ContactInside => self.part_boundary.is_interior_contact(self.index, &self.slots, cl),
+            Boundary::ContactInside => {
+                self.part_boundary.is_interior_contact(self.index, &self.slots, cl)
+                    && self.region.is_none_or(|r| r.contains_contact(self.index, &self.slots, cl))
+            }
         }
     }
 
