@@ -295,9 +295,26 @@ fn optimize_writes_the_study_and_rejects_bad_settings() {
         assert!(r["f_best"].as_f64().expect("f_best") <= r["f0"].as_f64().expect("f0"));
         assert!(r["evaluations"].as_u64().expect("evaluations") <= 8);
     }
-    for file in ["study.json", "report.json", "convergence.svg", "zones.svg"] {
+    for file in ["study.json", "report.json", "convergence.svg", "zones.svg", "report.html", "toolpath.csv"] {
         assert!(dir.join("out").join(file).exists(), "{file}");
     }
+    // The best plan's drop-cutter program: it parses, and report.json holds its proof.
+    let text = std::fs::read_to_string(dir.join("out/program.nc")).expect("program.nc");
+    let path = scallop_io::gcode::read_gcode(&text, &scallop_io::gcode::GcodeOptions::default()).expect("parses");
+    assert!(path.moves().len() > 100, "{}", path.moves().len());
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("out/report.json")).expect("report.json")).expect("json");
+    let program = &report["program"];
+    let simulated = program["sim_max_scallop_mm"].as_f64().expect("simulated scallop");
+    let limit = program["sim_scallop_limit_mm"].as_f64().expect("limit");
+    assert!(simulated > 0.0 && simulated <= limit && limit < 0.0115, "{program}");
+    assert!(program["plan"]["max_scallop_mm"].as_f64().expect("planner scallop") <= 0.01 * (1.0 + 1e-6));
+    assert!(program["predicted_time_s"].as_f64().expect("network time") > 0.0);
+    assert!(program["plan"]["total_time_s"].as_f64().expect("program time") > 0.0);
+    let zones = program["zones"].as_array().expect("zones");
+    let planned = report["result"]["plan"]["zones"].as_array().expect("the study's zones");
+    assert!(zones.len() == planned.len() && zones.iter().any(|z| z["passes"].as_u64() > Some(0)));
+    assert!(report["gcode"].as_str().expect("gcode").starts_with("program.nc"));
     for (bad, key) in [
         (job.replace("k_max = 3", "k_max = 1").replace("k_min = 2", "k_min = 1"), "optimize.k_max"),
         (job.replace("budget = 8", "budget = 0"), "optimize.budget"),

@@ -53,6 +53,14 @@
 //!   cutter riding on the part's edge, or touching nothing, has left it. The
 //!   contact points then sweep the surface up to its edges, so pass lengths are
 //!   the surface's (the analytic models of finishing.md 8).
+//! - **Zones.** [`plan_zone_finishing`] adds a [`ZoneRegion`]: a cutter location
+//!   also needs its contact in one zone of a per-triangle labelling of the mesh,
+//!   dilated by a margin (facet contacts by their triangle, edge and vertex
+//!   contacts by any triangle on that edge or vertex). Passes split where their
+//!   contact leaves the dilated zone, and the plane range is the dilated zone's;
+//!   the margin makes each zone finish itself up to its border (see
+//!   [`ZoneRegion`]), and the whole program's stock simulation checks it
+//!   (`scallop_engine::finish_zones`).
 //! - **Passes.** Plane `k` is the vertical plane `m . p = d_k`, `m` normal to the
 //!   feed direction `f`. Along it the cutter is dropped (exact drop-cutter) on a
 //!   uniform grid of step `max_step` (in parallel), then a step is bisected while
