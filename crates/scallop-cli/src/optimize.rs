@@ -122,6 +122,7 @@ fn zone_program(
             .collect(),
         transitions,
         predicted_time_s: Some(plan.time_s),
+        fixed_margin_mm: None,
     };
     scallop_engine::finish_zones(&job, &zone_spec)
         .map(Some)

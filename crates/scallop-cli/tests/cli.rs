@@ -281,7 +281,7 @@ fn run_plans_a_job_file_and_rejects_bad_keys() {
 #[test]
 fn optimize_writes_the_study_and_rejects_bad_settings() {
     let dir = scratch("optimize");
-    let job = "[part]\nbuiltin = \"rubio\"\n[cutter]\nshape = \"bull\"\ndiameter = 10\ncorner_radius = 2\n\
+    let job = "[part]\nbuiltin = \"rubio\"\n[cutter]\nshape = \"bull\"\ndiameter = 10\ncorner_radius = 2\nflute_length = 50\n\
                [finishing]\nscallop_height = 0.01\n[optimize]\nformulation = \"3axis\"\nk_min = 2\nk_max = 3\n\
                budget = 8\ngrid = [20, 20]\nsurrogate_grid = [10, 10]\nstep = 1.5\n";
     std::fs::write(dir.join("small.toml"), job).expect("write");

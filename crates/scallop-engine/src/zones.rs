@@ -72,6 +72,10 @@ pub struct ZonePlanSpec {
     pub transitions: Transitions,
     /// The network model's predicted total time (s), if known.
     pub predicted_time_s: Option<f64>,
+    /// `None`: the adaptive margin (see the module docs); `Some(d)`: every zone
+    /// dilated by exactly `d` mm (for experiments: with `d = 0` the borders are
+    /// left to the pass ends, and the stock simulation shows what that leaves).
+    pub fixed_margin_mm: Option<f64>,
 }
 
 /// What one zone came to.
@@ -237,7 +241,7 @@ pub fn finish_zones(job: &FinishJob, spec: &ZonePlanSpec) -> Result<ZoneFinishOu
             direction_deg: zone.direction_deg,
             triangles: labels.iter().filter(|&&l| l == zone.label).count(),
             region_triangles: 0,
-            margin_mm: start_margin,
+            margin_mm: 0.0,
             max_spacing_mm: 0.0,
             passes: 0,
             max_scallop_mm: 0.0,
@@ -251,7 +255,7 @@ pub fn finish_zones(job: &FinishJob, spec: &ZonePlanSpec) -> Result<ZoneFinishOu
             figures.push(figure);
             continue;
         }
-        let mut margin = start_margin;
+        let mut margin = spec.fixed_margin_mm.unwrap_or(start_margin);
         let mut planned = None;
         for _ in 0..ZONE_MARGIN_ROUNDS {
             let region = ZoneRegion::new(&prepared.mesh, &labels, zone.label, margin)?;
@@ -264,7 +268,7 @@ pub fn finish_zones(job: &FinishJob, spec: &ZonePlanSpec) -> Result<ZoneFinishOu
             let spacing = largest_spacing(&p.planes, cap);
             figure.margin_mm = margin;
             figure.max_spacing_mm = spacing;
-            let done = ZONE_MARGIN_PER_SPACING * spacing <= margin;
+            let done = spec.fixed_margin_mm.is_some() || ZONE_MARGIN_PER_SPACING * spacing <= margin;
             planned = Some(p);
             if done {
                 break;

@@ -70,6 +70,7 @@ fn two_zones_cover_the_hill_within_the_scallop_and_stay_in_their_regions() {
         ],
         transitions: Transitions::default(),
         predicted_time_s: None,
+        fixed_margin_mm: None,
     };
     // finish_zones fails on a gouge, a rapid into stock or a simulated scallop over the limit.
     let out = finish_zones(&job(sh), &spec).unwrap();

@@ -64,11 +64,14 @@
 //! - **Passes.** Plane `k` is the vertical plane `m . p = d_k`, `m` normal to the
 //!   feed direction `f`. Along it the cutter is dropped (exact drop-cutter) on a
 //!   uniform grid of step `max_step` (in parallel), then a step is bisected while
-//!   the CL midpoint deviates from the chord by more than `SAMPLING_SHARE * path`.
+//!   the CL midpoint lies farther than `SAMPLING_SHARE * path` above or below the
+//!   chord (vertically: gouges are heights, and on a steep pass the vertical gap
+//!   is the perpendicular one over the cosine of the slope).
 //!   Samples outside the region split the plane into passes (non-convex parts
 //!   give several); each pass end is located by bisection to
 //!   `BOUNDARY_SHARE * path`. Collinear points are merged by
-//!   `scallop_toolpath::simplify` within `SIMPLIFY_SHARE * path` (budget in [`tol`]).
+//!   `scallop_toolpath::simplify_above` within `SIMPLIFY_SHARE * path` (budget in
+//!   [`tol`]): a kept chord never passes below a removed CL point.
 //! - **Spacing rule (finishing.md 6.4, worst point).** At every CL sample of the
 //!   plane: the part normal `n` at the contact, tilt `s = acos |n_z|`, horizontal
 //!   feed angle `alpha` between `f` and `(n_x, n_y)`, effective radius

@@ -6,7 +6,7 @@ use scallop_analysis::fold_direction_angle;
 use scallop_cutter::{ClPoint, Contact, Cutter, CutterShape, drop_cutter, drop_points};
 use scallop_geom::{Point2, Point3, Tolerances, Vec2, Vec3};
 use scallop_mesh::MeshIndex;
-use scallop_toolpath::{Move, MoveKind, Toolpath, simplify};
+use scallop_toolpath::{Move, MoveKind, Toolpath, simplify_above};
 
 use crate::geometry::{Frame, PartBoundary, contact_normal, slots_by_original};
 use crate::scallop::{Curve, Measure, pair_heights};
@@ -194,7 +194,7 @@ impl<'a> Planner<'a> {
             }
             return;
         }
-        if distance_to_segment(&mid.cl.tip, &a.cl.tip, &b.cl.tip) > self.sample_tol {
+        if vertical_gap(&mid.cl.tip, &a.cl.tip, &b.cl.tip) > self.sample_tol {
             self.refine(line, a, mid, out, scratch);
             self.refine(line, mid, b, out, scratch);
         } else {
@@ -211,7 +211,7 @@ impl<'a> Planner<'a> {
             if matches!(mid.cl.contact, Contact::Floor) {
                 return None;
             }
-            if distance_to_segment(&mid.cl.tip, &a.cl.tip, &b.cl.tip) > self.sample_tol {
+            if vertical_gap(&mid.cl.tip, &a.cl.tip, &b.cl.tip) > self.sample_tol {
                 self.refine_link(line, a, mid, out)?;
                 return self.refine_link(line, mid, b, out);
             }
@@ -283,7 +283,7 @@ impl<'a> Planner<'a> {
         let mut samples = Vec::new();
         for run in runs {
             let points: Vec<Point3> = run.iter().map(|s| s.cl.tip).collect();
-            let kept = simplify(&points, self.simplify_tol);
+            let kept = simplify_above(&points, self.simplify_tol);
             passes.push(kept.iter().map(|&i| points[i]).collect::<Vec<_>>());
             samples.extend(run.iter().map(|s| s.cl));
         }
@@ -494,7 +494,7 @@ impl<'a> Planner<'a> {
         if let Some(last) = points.last_mut() {
             *last = *b;
         }
-        let kept = simplify(&points, self.simplify_tol);
+        let kept = simplify_above(&points, self.simplify_tol);
         Some(kept.iter().skip(1).map(|&i| points[i]).collect())
     }
 
@@ -548,14 +548,10 @@ impl<'a> Planner<'a> {
     }
 }
 
-fn distance_to_segment(p: &Point3, a: &Point3, b: &Point3) -> f64 {
-    let ab = b - a;
-    let len2 = ab.norm_squared();
-    let ap = p - a;
-    if len2 > 0.0 {
-        let t = (ap.dot(&ab) / len2).clamp(0.0, 1.0);
-        (ap - ab * t).norm()
-    } else {
-        ap.norm()
-    }
+/// Vertical distance of the CL point `mid`, dropped at the XY midpoint of `a`
+/// and `b`, from their chord. Gouges are heights (the stock simulation measures
+/// stock below part vertically), and on a steep pass the vertical gap is the
+/// perpendicular distance divided by the cosine of the slope.
+fn vertical_gap(mid: &Point3, a: &Point3, b: &Point3) -> f64 {
+    (mid.z - 0.5 * (a.z + b.z)).abs()
 }

@@ -7,11 +7,11 @@
 
 /// Share of the path tolerance for the chordal deviation of the sampled CL
 /// polyline (a step is bisected while the CL midpoint is farther than this
-/// share of `path` from the chord).
+/// share of `path` above or below the chord).
 pub const SAMPLING_SHARE: f64 = 0.5;
 
 /// Share of the path tolerance for merging nearly collinear CL points
-/// (`scallop_toolpath::simplify`).
+/// (`scallop_toolpath::simplify_above`: never a chord below a CL point).
 pub const SIMPLIFY_SHARE: f64 = 0.25;
 
 /// Pass ends are located by bisection of the region boundary until the bracket
