@@ -61,6 +61,16 @@ pub enum EngineError {
     /// collision) or could not run.
     #[error("verification: {0}")]
     Verification(#[from] scallop_sim::SimError),
+    /// The drop-cutter planner refused one zone of a zone plan.
+    #[error("finishing zone {zone} along {direction_deg:.2} deg: {source}")]
+    Zone {
+        /// The zone's label.
+        zone: u32,
+        /// Its feed direction (degrees).
+        direction_deg: f64,
+        /// Why.
+        source: scallop_strategy::StrategyError,
+    },
     /// The stock simulation measured a scallop above the height asked plus the
     /// simulation's resolution bound: the program does not finish the surface
     /// as promised (a planner bug, or zones too narrow for their margins).

@@ -178,7 +178,8 @@ pub struct ZoneFinishOutput {
 /// # Errors
 /// - [`EngineError::Output`]: the part is not one parametric patch, or the job
 ///   has a 3+2 setup or isoparametric strategy;
-/// - planning errors of the zones ([`EngineError::Strategy`]);
+/// - [`EngineError::Zone`]: the planner refused a zone (e.g. its direction
+///   cannot hold the scallop height there);
 /// - [`EngineError::Verification`]: the simulation found a gouge, a rapid into
 ///   stock or a collision;
 /// - [`EngineError::ScallopExceeded`]: the simulated scallop exceeds `sh` plus
@@ -263,7 +264,9 @@ pub fn finish_zones(job: &FinishJob, spec: &ZonePlanSpec) -> Result<ZoneFinishOu
             let p = match plan_zone_finishing(&prepared.index, &job.cutter, &params, &tolerances, &region) {
                 Ok(p) => p,
                 Err(StrategyError::EmptyRegion { .. }) => break,
-                Err(e) => return Err(e.into()),
+                Err(source) => {
+                    return Err(EngineError::Zone { zone: zone.label, direction_deg: zone.direction_deg, source });
+                }
             };
             let spacing = largest_spacing(&p.planes, cap);
             figure.margin_mm = margin;
@@ -352,12 +355,12 @@ pub fn finish_zones(job: &FinishJob, spec: &ZonePlanSpec) -> Result<ZoneFinishOu
     let comments = [
         format!("part: {}, tessellated within {:.5} mm", job.part_name, prepared.chordal_error),
         format!("tool: {cutter}; scallop height {} mm", job.scallop_height),
-        format!("zones: {} (directions {})", figures.iter().filter(|f| f.passes > 0).count(), directions(&figures)),
+        format!("zones: {}, feed directions {}", figures.iter().filter(|f| f.passes > 0).count(), directions(&figures)),
         format!(
             "predicted machining time {:.1} s (stop-to-stop), {:.1} s (look-ahead), rapids {:.1} s",
             plan.machining_time_s, plan.machining_time_lookahead_s, plan.rapid_time_s
         ),
-        format!("simulated scallop {:.4} mm (limit {:.4} mm)", v.max_thickness, limit),
+        format!("simulated scallop {:.4} mm, limit {:.4} mm", v.max_thickness, limit),
     ];
     let fitted = if job.output.arc_fitting {
         fit_arcs(&toolpath, ARC_SHARE * job.tolerances.path)

@@ -286,7 +286,15 @@ fn plan(
     let (toolpath, links, retracts) = planner.toolpath(&planes);
     let planes: Vec<Plane> = planes.into_iter().map(|p| p.plane).collect();
     let feed_samples = planner.feed_samples.clone();
-    let scallop = verify_scallop(index, cutter, &planes, params.direction, &feed_samples, params.scallop_height)?;
+    let scallop = scallop::verify_scallop_within(
+        index,
+        cutter,
+        &planes,
+        params.direction,
+        &feed_samples,
+        params.scallop_height,
+        plan::zone_end_margin(cutter, region),
+    )?;
     let a = stop_to_stop_time(&toolpath, params);
     let b = lookahead_time(&toolpath, params);
     let feed = toolpath.length(MoveKind::Feed);

@@ -120,6 +120,7 @@ impl<'a> Planner<'a> {
         let n = steps as usize;
         let feed_samples = (0..=n).map(|k| t_range[0] + span * (k as f64 / steps)).collect();
         let bounds = index.bounds();
+        let end_margin = zone_end_margin(cutter, region);
         Ok(Planner {
             index,
             cutter,
@@ -130,8 +131,8 @@ impl<'a> Planner<'a> {
             slots: slots_by_original(index),
             part_boundary: PartBoundary::new(index),
             region,
-            measure: Measure::new(index, cutter, params.direction, sh),
-            raw_measure: Measure { refine: false, ..Measure::new(index, cutter, params.direction, sh) },
+            measure: Measure { end_margin, ..Measure::new(index, cutter, params.direction, sh) },
+            raw_measure: Measure { refine: false, end_margin, ..Measure::new(index, cutter, params.direction, sh) },
             floor: bounds.min.z - bounds.diagonal() - 1.0,
             sample_tol: tol::SAMPLING_SHARE * tol_.path,
             simplify_tol: tol::SIMPLIFY_SHARE * tol_.path,
@@ -546,6 +547,12 @@ impl<'a> Planner<'a> {
         }
         (path, links, retracts)
     }
+}
+
+/// Sections this close to a pass end are not measured (see `Measure::end_margin`):
+/// the cutter radius in zone planning, where passes end inside the part; 0 otherwise.
+pub(crate) fn zone_end_margin(cutter: &Cutter, region: Option<&ZoneRegion>) -> f64 {
+    region.map_or(0.0, |_| cutter.radius())
 }
 
 /// Vertical distance of the CL point `mid`, dropped at the XY midpoint of `a`
