@@ -25,7 +25,10 @@ fn main() {
             u32::from(u + 0.6 * v >= 0.8)
         })
         .collect();
-    let job = FinishJob { part, part_name: name.into(), ..FinishJob::choi_demo() };
+    // Rubio is 41 mm tall and the verifying stock is a full block: 50 mm flutes.
+    let cutter = scallop_cutter::Cutter::new(scallop_cutter::CutterShape::Bull { radius: 5.0, corner: 2.0 }, 50.0)
+        .expect("a valid cutter");
+    let job = FinishJob { part, part_name: name.into(), cutter, ..FinishJob::choi_demo() };
     for margin in [None, Some(0.0), Some(1.0), Some(2.0)] {
         let spec = ZonePlanSpec {
             labels: CellLabels { cells_u: n, cells_v: n, labels: labels.clone() },
