@@ -70,8 +70,7 @@
 //!   Samples outside the region split the plane into passes (non-convex parts
 //!   give several); each pass end is located by bisection to
 //!   `BOUNDARY_SHARE * path`. Collinear points are merged by
-//!   `scallop_toolpath::simplify_above` within `SIMPLIFY_SHARE * path` (budget in
-//!   [`tol`]): a kept chord never passes below a removed CL point.
+//!   `scallop_toolpath::simplify` within `SIMPLIFY_SHARE * path` (budget in [`tol`]).
 //! - **Spacing rule (finishing.md 6.4, worst point).** At every CL sample of the
 //!   plane: the part normal `n` at the contact, tilt `s = acos |n_z|`, horizontal
 //!   feed angle `alpha` between `f` and `(n_x, n_y)`, effective radius

@@ -6,7 +6,7 @@ use scallop_analysis::fold_direction_angle;
 use scallop_cutter::{ClPoint, Contact, Cutter, CutterShape, drop_cutter, drop_points};
 use scallop_geom::{Point2, Point3, Tolerances, Vec2, Vec3};
 use scallop_mesh::MeshIndex;
-use scallop_toolpath::{Move, MoveKind, Toolpath, simplify_above};
+use scallop_toolpath::{Move, MoveKind, Toolpath, simplify};
 
 use crate::geometry::{Frame, PartBoundary, contact_normal, slots_by_original};
 use crate::scallop::{Curve, Measure, pair_heights};
@@ -284,7 +284,7 @@ impl<'a> Planner<'a> {
         let mut samples = Vec::new();
         for run in runs {
             let points: Vec<Point3> = run.iter().map(|s| s.cl.tip).collect();
-            let kept = simplify_above(&points, self.simplify_tol);
+            let kept = simplify(&points, self.simplify_tol);
             passes.push(kept.iter().map(|&i| points[i]).collect::<Vec<_>>());
             samples.extend(run.iter().map(|s| s.cl));
         }
@@ -495,7 +495,7 @@ impl<'a> Planner<'a> {
         if let Some(last) = points.last_mut() {
             *last = *b;
         }
-        let kept = simplify_above(&points, self.simplify_tol);
+        let kept = simplify(&points, self.simplify_tol);
         Some(kept.iter().skip(1).map(|&i| points[i]).collect())
     }
 

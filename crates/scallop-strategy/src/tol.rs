@@ -11,7 +11,7 @@
 pub const SAMPLING_SHARE: f64 = 0.5;
 
 /// Share of the path tolerance for merging nearly collinear CL points
-/// (`scallop_toolpath::simplify_above`: never a chord below a CL point).
+/// (`scallop_toolpath::simplify`).
 pub const SIMPLIFY_SHARE: f64 = 0.25;
 
 /// Pass ends are located by bisection of the region boundary until the bracket
