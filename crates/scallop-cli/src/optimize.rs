@@ -91,24 +91,26 @@ struct BestReport<'a> {
     result: &'a KResult,
 }
 
-/// Why a formulation with tool orientations gets no program (3+2, heuristic).
-const NO_GCODE_3PLUS2: &str = "not written: the plan tilts its zones (3+2 orientations). Missing: a per-zone \
-     indexed setup sequence in the engine (finish.rs writes one tool axis per program) and a proof of \
-     multi-axis programs (the z-map stock simulation is 3-axis). Times are the network planner's.";
+/// The machine of 3+2 zone programs when the job has no `[setup]`.
+const DEFAULT_MACHINE: &str = "linuxcnc-xyzac-trt";
 
-/// The 3-axis zone program of the best plan: zones in label order with the
-/// optimiser's directions, planned by drop-cutter and proven on the stock.
+/// The program of the best plan: zones in label order with the optimiser's
+/// directions (and 3+2 orientations), planned by drop-cutter and proven on the stock.
 fn zone_program(
     spec: &JobFile,
     folder: &Path,
     best: &KResult,
     transitions: Transitions,
-) -> CliResult<Option<scallop_engine::ZoneFinishOutput>> {
+) -> CliResult<scallop_engine::ZoneFinishOutput> {
     let plan = &best.plan;
-    if plan.zones.iter().any(|z| z.phi_deg != 0.0) {
-        return Ok(None);
-    }
-    let job = crate::run::finish_job(spec, folder)?;
+    let mut job = crate::run::finish_job(spec, folder)?;
+    // 3+2 zones are written for the job's [setup] machine (default: the LinuxCNC
+    // XYZAC trunnion); the setup's rotation is not used (each zone has its own).
+    let machine = match job.setup.take() {
+        Some(setup) => setup.machine,
+        None => scallop_machine::Machine::builtin(DEFAULT_MACHINE)
+            .map_err(|e| Failure::rejected(format!("machine `{DEFAULT_MACHINE}`: {e}")))?,
+    };
     let zone_spec = scallop_engine::ZonePlanSpec {
         labels: CellLabels { cells_u: plan.grid[0], cells_v: plan.grid[1], labels: plan.labels.clone() },
         zones: plan
@@ -117,16 +119,17 @@ fn zone_program(
             .map(|z| scallop_engine::ZoneSpec {
                 label: u32::try_from(z.zone).unwrap_or(u32::MAX),
                 direction_deg: z.theta_deg,
+                tilt_deg: z.phi_deg,
+                azimuth_deg: z.psi_deg,
                 predicted_time_s: Some(z.time_s),
             })
             .collect(),
         transitions,
         predicted_time_s: Some(plan.time_s),
         fixed_margin_mm: None,
+        machine: Some(machine),
     };
-    scallop_engine::finish_zones(&job, &zone_spec)
-        .map(Some)
-        .map_err(|e| Failure::rejected(format!("the G-code of the best plan (K = {}): {e}", best.k)))
+    scallop_engine::finish_zones(&job, &zone_spec).map_err(|e| Failure::rejected(format!("the G-code of the best plan (K = {}): {e}", best.k)))
 }
 
 /// `scallop optimize`.
@@ -178,19 +181,17 @@ pub fn run(args: &OptimizeArgs) -> CliResult<()> {
     let program = zone_program(&spec, folder, best, model_settings.transitions).map_err(|e| prefix(&name, e))?;
     let gcode_seconds = gcode_start.elapsed().as_secs_f64();
     spinner.finish_and_clear();
-    let gcode = match &program {
-        Some(p) => format!(
-            "program.nc: {} zones by drop-cutter, {:.1} s stop-to-stop ({:.1} s predicted by the network model); \
-             simulated scallop {:.4} mm <= {:.4} mm; planned and verified in {:.1} s",
-            p.report.zones.iter().filter(|z| z.passes > 0).count(),
-            p.report.plan.total_time_s,
-            best.f_best,
-            p.report.sim_max_scallop_mm,
-            p.report.sim_scallop_limit_mm,
-            gcode_seconds
-        ),
-        None => NO_GCODE_3PLUS2.to_owned(),
-    };
+    let gcode = format!(
+        "program.nc: {} zones by drop-cutter{}, {:.1} s stop-to-stop ({:.1} s predicted by the network model); \
+         simulated scallop {:.4} mm <= {:.4} mm; planned and verified in {:.1} s",
+        program.report.zones.iter().filter(|z| z.passes > 0).count(),
+        if program.report.indexed { " as indexed 3+2 setups" } else { "" },
+        program.report.plan.total_time_s,
+        best.f_best,
+        program.report.sim_max_scallop_mm,
+        program.report.sim_scallop_limit_mm,
+        gcode_seconds
+    );
     let cutter = match model_settings.tool {
         Cutter::Ball { radius } => format!("ball R{radius} mm"),
         Cutter::Toroidal { radius, corner } => format!("bull-nose R{radius} r{corner} mm"),
@@ -214,18 +215,14 @@ pub fn run(args: &OptimizeArgs) -> CliResult<()> {
         start_time_s: best.f0,
         eta: best.eta,
         gcode: gcode.clone(),
-        program: program.as_ref().map(|p| &p.report),
+        program: Some(&program.report),
         result: best,
     };
     let out = &args.output;
     write_atomic(&out.join("study.json"), |w| w.write_all(to_json(&file)?.as_bytes()))?;
     write_atomic(&out.join("report.json"), |w| w.write_all(to_json(&report)?.as_bytes()))?;
-    if let Some(p) = &program {
-        write_atomic(&out.join("program.nc"), |w| w.write_all(p.gcode.as_bytes()))?;
-        write_atomic(&out.join("toolpath.csv"), |w| {
-            w.write_all(scallop_engine::toolpath_csv(&p.toolpath).as_bytes())
-        })?;
-    }
+    write_atomic(&out.join("program.nc"), |w| w.write_all(program.gcode.as_bytes()))?;
+    write_atomic(&out.join("toolpath.csv"), |w| w.write_all(scallop_engine::toolpath_csv(&program.toolpath).as_bytes()))?;
     write_atomic(&out.join("convergence.svg"), |w| w.write_all(convergence_svg(&study).as_bytes()))?;
     let title = format!("{part_name}, {}, K = {}", formulation_name(settings.formulation), best.k);
     write_atomic(&out.join("zones.svg"), |w| w.write_all(zones_svg(&best.plan, &title).as_bytes()))?;
@@ -235,7 +232,7 @@ pub fn run(args: &OptimizeArgs) -> CliResult<()> {
         &title,
         &name,
         &file.cutter,
-        program.as_ref(),
+        Some(&program),
     ));
     write_atomic(&out.join("report.html"), |w| w.write_all(page.as_bytes()))?;
     if args.json {
@@ -275,7 +272,7 @@ pub fn run(args: &OptimizeArgs) -> CliResult<()> {
         rayon::current_num_threads(),
         gcode,
         out.display(),
-        if program.is_some() { ", program.nc, toolpath.csv" } else { "" }
+        ", program.nc, toolpath.csv"
     ));
     print_text(&text)
 }

@@ -33,12 +33,13 @@ fn main() {
         let spec = ZonePlanSpec {
             labels: CellLabels { cells_u: n, cells_v: n, labels: labels.clone() },
             zones: vec![
-                ZoneSpec { label: 0, direction_deg: a, predicted_time_s: None },
-                ZoneSpec { label: 1, direction_deg: b, predicted_time_s: None },
+                ZoneSpec { label: 0, direction_deg: a, tilt_deg: 0.0, azimuth_deg: 0.0, predicted_time_s: None },
+                ZoneSpec { label: 1, direction_deg: b, tilt_deg: 0.0, azimuth_deg: 0.0, predicted_time_s: None },
             ],
             transitions: Transitions::default(),
             predicted_time_s: None,
             fixed_margin_mm: margin,
+            machine: None,
         };
         let what = margin.map_or("adaptive".to_owned(), |m| format!("{m} mm"));
         match finish_zones(&job, &spec) {

@@ -30,8 +30,11 @@ use scallop_analysis::MachineLimits;
 use scallop_cutter::CutterShape;
 use scallop_geom::{Aabb3, Point3, Tolerances};
 use scallop_mesh::{MeshIndex, TriMesh};
-use scallop_post::{ProgramInfo, write_fitted};
-use scallop_strategy::network::{CellLabels, Transitions};
+use scallop_geom::Vec3;
+use scallop_machine::Kinematics;
+use scallop_machine::program::{ProgramOptions, records_from_toolpath, to_program};
+use scallop_post::{OutputMode, PostParams, ProgramInfo, program_text, write_fitted};
+use scallop_strategy::network::{CellLabels, Orientation, Transitions};
 use scallop_strategy::{
     Boundary, FinishingParams, StrategyError, ZoneRegion, lookahead_time, plan_zone_finishing,
     stop_to_stop_time,
@@ -49,13 +52,22 @@ pub const ZONE_MARGIN_PER_SPACING: f64 = 2.0;
 /// Plans per zone at most while the margin grows.
 pub const ZONE_MARGIN_ROUNDS: usize = 3;
 
+/// A triangle is the part's top at a stock cell when its height there is within
+/// this of the highest part height the simulation computes (mm; both are
+/// interpolations of the same triangle when it is the top).
+const FACE_MATCH_MM: f64 = 1e-6;
+
 /// One zone to machine.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ZoneSpec {
     /// Its label in the cell labelling.
     pub label: u32,
-    /// Feed direction (degrees from +X).
+    /// Feed direction (degrees from +X, in the zone's frame).
     pub direction_deg: f64,
+    /// 3+2: angle between the tool axis and Z (degrees; 0: 3-axis).
+    pub tilt_deg: f64,
+    /// 3+2: azimuth of the tool axis from X (degrees).
+    pub azimuth_deg: f64,
     /// The network model's predicted time of the zone (s), if known.
     pub predicted_time_s: Option<f64>,
 }
@@ -76,6 +88,9 @@ pub struct ZonePlanSpec {
     /// dilated by exactly `d` mm (for experiments: with `d = 0` the borders are
     /// left to the pass ends, and the stock simulation shows what that leaves).
     pub fixed_margin_mm: Option<f64>,
+    /// The machine whose kinematics write 3+2 zones as indexed setups (needed
+    /// when a zone is tilted).
+    pub machine: Option<scallop_machine::Machine>,
 }
 
 /// What one zone came to.
@@ -83,8 +98,15 @@ pub struct ZonePlanSpec {
 pub struct ZoneFigures {
     /// Its label.
     pub label: u32,
-    /// Feed direction (degrees from +X).
+    /// Feed direction (degrees from +X, in the zone's frame).
     pub direction_deg: f64,
+    /// Tool-axis tilt (degrees; 0: 3-axis).
+    pub tilt_deg: f64,
+    /// Tool-axis azimuth (degrees).
+    pub azimuth_deg: f64,
+    /// 3+2: the largest material thickness along the normal that the zone's own
+    /// program leaves on its own triangles, simulated in its frame (mm).
+    pub sim_zone_scallop_mm: Option<f64>,
     /// Triangles of the machining mesh carrying the label.
     pub triangles: usize,
     /// Triangles of the zone dilated by the margin.
@@ -135,14 +157,20 @@ pub struct ZoneFinishReport {
     pub time_ratio: Option<f64>,
     /// Cell size of the stock simulation (mm).
     pub sim_resolution_mm: f64,
+    /// 3+2: zones tilted, written as indexed setups and proven one by one in
+    /// their frames (gouges, collisions, and the scallop on the zone's own
+    /// triangles); otherwise one 3-axis program proven as a whole.
+    pub indexed: bool,
     /// The simulation's resolution bound for this cutter and cell size (mm).
     pub sim_resolution_bound_mm: f64,
     /// Largest material thickness along the part normal on the simulated stock,
-    /// farther than the cutter radius from the part's edge (mm).
+    /// farther than the cutter radius from the part's edge (mm); 3+2: the largest
+    /// over the zones of what each leaves on its own triangles.
     pub sim_max_scallop_mm: f64,
     /// Where (mm, XY).
     pub sim_max_scallop_at: Option<[f64; 2]>,
-    /// The same within the cutter radius of the part's edge (mm; not held to `sh`).
+    /// The same within the cutter radius of the part's edge (mm; not held to `sh`;
+    /// 0 in 3+2).
     pub sim_edge_max_scallop_mm: f64,
     /// `sh + sim_resolution_bound_mm`: the simulated scallop must not exceed it.
     pub sim_scallop_limit_mm: f64,
@@ -155,7 +183,7 @@ pub struct ZoneFinishReport {
 /// The outputs of [`finish_zones`].
 #[derive(Debug, Clone)]
 pub struct ZoneFinishOutput {
-    /// The joined toolpath.
+    /// The joined toolpath (part frame; 3+2 zones turned back from their frames).
     pub toolpath: Toolpath,
     /// Zone label of each move of `toolpath`.
     pub zone_of_move: Vec<u32>,
@@ -165,8 +193,8 @@ pub struct ZoneFinishOutput {
     pub report: ZoneFinishReport,
     /// The labelled machining mesh and its index.
     pub prepared: PreparedPart,
-    /// The simulated stock and its verification.
-    pub simulation: scallop_sim::Simulation,
+    /// The simulated stock of the whole 3-axis program (`None` in 3+2).
+    pub simulation: Option<scallop_sim::Simulation>,
 }
 
 /// Plans, joins, times, proves and posts the zones of `spec` (3-axis: each
@@ -230,16 +258,35 @@ pub fn finish_zones(job: &FinishJob, spec: &ZonePlanSpec) -> Result<ZoneFinishOu
     };
     let cap = 2.0 * job.cutter.radius();
 
+    let tilted = spec.zones.iter().any(|z| z.tilt_deg != 0.0);
+    let radius = job.cutter.radius();
+    let gouge_tolerance = job.tolerances.gouge + prepared.chordal_error + job.tolerances.path;
+    let options =
+        scallop_sim::VerifyOptions { gouge_tolerance, scallop_margin: radius, ..scallop_sim::VerifyOptions::default() };
+    let open_edge = open_edge_vertices(&prepared.mesh);
+
     let mut toolpath = Toolpath::new(machine.feed * 60.0);
     toolpath.plunge_feed = base.plunge_feed * 60.0;
     let mut zone_of_move = Vec::new();
+    let mut records = Vec::new();
+    let mut zone_sims: Vec<(f64, f64, f64)> = Vec::new(); // (scallop, min deviation, bound) per tilted zone
     let mut figures = Vec::with_capacity(spec.zones.len());
     let mut ends: Vec<(Point3, Point3)> = Vec::new();
     for zone in &spec.zones {
         let params = FinishingParams { direction: zone.direction_deg.to_radians(), ..base };
+        let orientation = (zone.tilt_deg != 0.0)
+            .then(|| Orientation::new(zone.tilt_deg.to_radians(), zone.azimuth_deg.to_radians(), Point3::origin()));
+        let turned = match &orientation {
+            Some(o) => Some(turn(&prepared, o)?),
+            None => None,
+        };
+        let part = turned.as_ref().unwrap_or(&prepared);
         let mut figure = ZoneFigures {
             label: zone.label,
             direction_deg: zone.direction_deg,
+            tilt_deg: zone.tilt_deg,
+            azimuth_deg: zone.azimuth_deg,
+            sim_zone_scallop_mm: None,
             triangles: labels.iter().filter(|&&l| l == zone.label).count(),
             region_triangles: 0,
             margin_mm: 0.0,
@@ -259,9 +306,9 @@ pub fn finish_zones(job: &FinishJob, spec: &ZonePlanSpec) -> Result<ZoneFinishOu
         let mut margin = spec.fixed_margin_mm.unwrap_or(start_margin);
         let mut planned = None;
         for _ in 0..ZONE_MARGIN_ROUNDS {
-            let region = ZoneRegion::new(&prepared.mesh, &labels, zone.label, margin)?;
+            let region = ZoneRegion::new(&part.mesh, &labels, zone.label, margin)?;
             figure.region_triangles = region.accepted_triangles();
-            let p = match plan_zone_finishing(&prepared.index, &job.cutter, &params, &tolerances, &region) {
+            let p = match plan_zone_finishing(&part.index, &job.cutter, &params, &tolerances, &region) {
                 Ok(p) => p,
                 Err(StrategyError::EmptyRegion { .. }) => break,
                 Err(source) => {
@@ -287,12 +334,44 @@ pub fn finish_zones(job: &FinishJob, spec: &ZonePlanSpec) -> Result<ZoneFinishOu
         figure.max_scallop_mm = p.scallop.max_mm;
         figure.machining_time_s = p.report.machining_time_s;
         figure.machining_time_lookahead_s = p.report.machining_time_lookahead_s;
-        let first = p.toolpath.moves().iter().find(|m| m.kind == MoveKind::Plunge).map(|m| m.to);
-        let last = p.toolpath.moves().iter().rev().find(|m| m.kind != MoveKind::Retract).map(|m| m.to);
+        let mut zone_path = p.toolpath;
+        if let Some(o) = &orientation {
+            // Prove the zone in its own frame: no gouge or collision anywhere, and its
+            // own triangles finished within the scallop height.
+            let b = part.mesh.bounds();
+            let stock = Aabb3 {
+                min: Point3::new(b.min.x - radius, b.min.y - radius, b.min.z - 1.0),
+                max: Point3::new(b.max.x + radius, b.max.y + radius, b.max.z + 1.0),
+            };
+            let sim = scallop_sim::simulate(stock, job.sim_resolution, &job.cutter, &zone_path, &part.index, &options)?;
+            let bound = sim.zmap.resolution_bound(job.cutter.shape());
+            let (height, at) = zone_scallop(&sim.zmap, part, &labels, zone.label, &open_edge, radius);
+            if height > job.scallop_height + bound {
+                let at = o.to_part(&Point3::new(at[0], at[1], 0.0));
+                return Err(EngineError::ScallopExceeded {
+                    height,
+                    limit: job.scallop_height + bound,
+                    x: at.x,
+                    y: at.y,
+                });
+            }
+            figure.sim_zone_scallop_mm = Some(height);
+            zone_sims.push((height, sim.verification.min_deviation, bound));
+            let mut back = Toolpath::new(zone_path.feed);
+            back.plunge_feed = zone_path.plunge_feed;
+            for m in zone_path.moves() {
+                back.push(scallop_toolpath::Move::new(m.kind, o.to_part(&m.to)));
+            }
+            zone_path = back;
+        }
+        let axis = orientation.as_ref().map_or_else(Vec3::z, Orientation::tool_axis);
+        records.extend(records_from_toolpath(&zone_path, &axis));
+        let first = zone_path.moves().iter().find(|m| m.kind == MoveKind::Plunge).map(|m| m.to);
+        let last = zone_path.moves().iter().rev().find(|m| m.kind != MoveKind::Retract).map(|m| m.to);
         if let (Some(a), Some(b)) = (first, last) {
             ends.push((a, b));
         }
-        for m in p.toolpath.moves() {
+        for m in zone_path.moves() {
             toolpath.push(*m);
             zone_of_move.push(zone.label);
         }
@@ -332,23 +411,30 @@ pub fn finish_zones(job: &FinishJob, spec: &ZonePlanSpec) -> Result<ZoneFinishOu
         planning_time_s: 0.0,
     };
 
-    // The proof: the whole program on a stock box (as `run_finishing`).
-    let radius = job.cutter.radius();
-    let bounds = prepared.mesh.bounds();
-    let stock = Aabb3 {
-        min: Point3::new(bounds.min.x - radius, bounds.min.y - radius, bounds.min.z - 1.0),
-        max: Point3::new(bounds.max.x + radius, bounds.max.y + radius, bounds.max.z + 1.0),
+    // The proof: the whole 3-axis program on a stock box (as `run_finishing`); 3+2
+    // zones were proven one by one above, each in its own frame.
+    let (sim, bound, max_scallop, max_at, edge, min_deviation) = if tilted {
+        let bound = zone_sims.iter().map(|z| z.2).fold(0.0, f64::max);
+        let height = zone_sims.iter().map(|z| z.0).fold(0.0, f64::max);
+        let deepest = zone_sims.iter().map(|z| z.1).fold(f64::INFINITY, f64::min);
+        (None, bound, height, None, 0.0, deepest)
+    } else {
+        let b = prepared.mesh.bounds();
+        let stock = Aabb3 {
+            min: Point3::new(b.min.x - radius, b.min.y - radius, b.min.z - 1.0),
+            max: Point3::new(b.max.x + radius, b.max.y + radius, b.max.z + 1.0),
+        };
+        let sim = scallop_sim::simulate(stock, job.sim_resolution, &job.cutter, &toolpath, &prepared.index, &options)?;
+        let bound = sim.zmap.resolution_bound(job.cutter.shape());
+        let v = &sim.verification;
+        let (height, at, edge, deepest) =
+            (v.max_thickness, v.max_thickness_at.map(|p| [p.x, p.y]), v.margin_max_thickness, v.min_deviation);
+        (Some(sim), bound, height, at, edge, deepest)
     };
-    let gouge_tolerance = job.tolerances.gouge + prepared.chordal_error + job.tolerances.path;
-    let options =
-        scallop_sim::VerifyOptions { gouge_tolerance, scallop_margin: radius, ..scallop_sim::VerifyOptions::default() };
-    let sim = scallop_sim::simulate(stock, job.sim_resolution, &job.cutter, &toolpath, &prepared.index, &options)?;
-    let bound = sim.zmap.resolution_bound(job.cutter.shape());
     let limit = job.scallop_height + bound;
-    let v = &sim.verification;
-    if v.max_thickness > limit {
-        let at = v.max_thickness_at.map_or([f64::NAN; 2], |p| [p.x, p.y]);
-        return Err(EngineError::ScallopExceeded { height: v.max_thickness, limit, x: at[0], y: at[1] });
+    if max_scallop > limit {
+        let at = max_at.unwrap_or([f64::NAN; 2]);
+        return Err(EngineError::ScallopExceeded { height: max_scallop, limit, x: at[0], y: at[1] });
     }
 
     let cutter = cutter_text(job.cutter.shape());
@@ -360,23 +446,28 @@ pub fn finish_zones(job: &FinishJob, spec: &ZonePlanSpec) -> Result<ZoneFinishOu
             "predicted machining time {:.1} s (stop-to-stop), {:.1} s (look-ahead), rapids {:.1} s",
             plan.machining_time_s, plan.machining_time_lookahead_s, plan.rapid_time_s
         ),
-        format!("simulated scallop {:.4} mm, limit {:.4} mm", v.max_thickness, limit),
+        format!("simulated scallop {max_scallop:.4} mm, limit {limit:.4} mm"),
     ];
-    let fitted = if job.output.arc_fitting {
-        fit_arcs(&toolpath, ARC_SHARE * job.tolerances.path)
+    let text = if tilted {
+        indexed_zones(job, spec, &records, plan.machining_time_s)?
     } else {
-        FittedPath::lines(&toolpath)
+        let fitted = if job.output.arc_fitting {
+            fit_arcs(&toolpath, ARC_SHARE * job.tolerances.path)
+        } else {
+            FittedPath::lines(&toolpath)
+        };
+        let refs: Vec<&str> = comments.iter().map(String::as_str).collect();
+        let info = ProgramInfo {
+            program: job.output.program.clone(),
+            tool: job.output.tool,
+            spindle: job.output.spindle,
+            indexed_rotaries: Vec::new(),
+        };
+        let mut text = Vec::new();
+        write_fitted(&fitted, &job.output.dialect, &info, &refs, &mut text)
+            .map_err(|e| EngineError::Output { what: format!("writing the program: {e}"), fix: String::new() })?;
+        String::from_utf8_lossy(&text).into_owned()
     };
-    let refs: Vec<&str> = comments.iter().map(String::as_str).collect();
-    let info = ProgramInfo {
-        program: job.output.program.clone(),
-        tool: job.output.tool,
-        spindle: job.output.spindle,
-        indexed_rotaries: Vec::new(),
-    };
-    let mut text = Vec::new();
-    write_fitted(&fitted, &job.output.dialect, &info, &refs, &mut text)
-        .map_err(|e| EngineError::Output { what: format!("writing the program: {e}"), fix: String::new() })?;
 
     let report = ZoneFinishReport {
         part: job.part_name.clone(),
@@ -392,17 +483,18 @@ pub fn finish_zones(job: &FinishJob, spec: &ZonePlanSpec) -> Result<ZoneFinishOu
         time_ratio: spec.predicted_time_s.filter(|&p| p > 0.0).map(|p| a.total() / p),
         sim_resolution_mm: job.sim_resolution,
         sim_resolution_bound_mm: bound,
-        sim_max_scallop_mm: v.max_thickness,
-        sim_max_scallop_at: v.max_thickness_at.map(|p| [p.x, p.y]),
-        sim_edge_max_scallop_mm: v.margin_max_thickness,
+        indexed: tilted,
+        sim_max_scallop_mm: max_scallop,
+        sim_max_scallop_at: max_at,
+        sim_edge_max_scallop_mm: edge,
         sim_scallop_limit_mm: limit,
-        sim_min_deviation_mm: v.min_deviation,
+        sim_min_deviation_mm: min_deviation,
         sim_gouge_tolerance_mm: gouge_tolerance,
     };
     Ok(ZoneFinishOutput {
         toolpath,
         zone_of_move,
-        gcode: String::from_utf8_lossy(&text).into_owned(),
+        gcode: text,
         report,
         prepared,
         simulation: sim,
@@ -451,6 +543,148 @@ fn transition_time(path: &Toolpath, zone_of_move: &[u32], params: &FinishingPara
         }
     }
     total
+}
+
+/// The machining mesh turned into the frame of a 3+2 orientation (about the
+/// origin): same vertices and triangles in the same order, so labels carry over.
+fn turn(prepared: &PreparedPart, o: &Orientation) -> Result<PreparedPart, EngineError> {
+    let vertices: Vec<Point3> = prepared.mesh.vertices().iter().map(|v| o.to_machine(v)).collect();
+    let triangles: Vec<[usize; 3]> = prepared.mesh.triangles().iter().map(|t| t.map(|i| i as usize)).collect();
+    let (mesh, _) = TriMesh::from_indexed(&vertices, &triangles).map_err(|e| EngineError::Output {
+        what: format!("the machining mesh turned to tilt {:.2} deg: {e}", o.tilt.to_degrees()),
+        fix: "check the zone orientations".into(),
+    })?;
+    if mesh.triangles().len() != triangles.len() {
+        return Err(EngineError::Output {
+            what: "the turned machining mesh lost triangles (welding)".into(),
+            fix: "use a finer path tolerance".into(),
+        });
+    }
+    let index = MeshIndex::build(&mesh);
+    Ok(PreparedPart { mesh, index, ..prepared.clone() })
+}
+
+/// Vertices on the open boundary of the mesh (edges used by one triangle).
+fn open_edge_vertices(mesh: &TriMesh) -> Vec<bool> {
+    let mut count: std::collections::HashMap<(u32, u32), u32> = std::collections::HashMap::new();
+    for t in mesh.triangles() {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            *count.entry(if a < b { (a, b) } else { (b, a) }).or_insert(0) += 1;
+        }
+    }
+    let mut open = vec![false; mesh.vertices().len()];
+    for ((a, b), n) in count {
+        if n == 1 {
+            open[a as usize] = true;
+            open[b as usize] = true;
+        }
+    }
+    open
+}
+
+/// The largest material thickness along the normal, `(stock - part) n_z`, that
+/// the simulated stock leaves over the zone's own triangles (cells whose centre
+/// lies in such a triangle, where that triangle is the part's top there), leaving
+/// out triangles within `edge` (XY) of the part's open boundary, as the whole
+/// program's verification does; with the place (XY, zone frame).
+fn zone_scallop(
+    zmap: &scallop_sim::ZMap,
+    part: &PreparedPart,
+    labels: &[u32],
+    zone: u32,
+    open_edge: &[bool],
+    edge: f64,
+) -> (f64, [f64; 2]) {
+    let top = scallop_sim::part_heights(zmap, &part.index);
+    let vertices = part.mesh.vertices();
+    let edge_points: Vec<Point3> =
+        vertices.iter().zip(open_edge).filter(|(_, o)| **o).map(|(v, _)| *v).collect();
+    let near_edge = |p: &Point3| edge_points.iter().any(|q| (q.x - p.x).hypot(q.y - p.y) < edge);
+    let (cell_x, cell_y) = zmap.cell_size();
+    let min = zmap.stock().min;
+    let (nx, ny) = (zmap.nx(), zmap.ny());
+    let mut worst = (0.0, [f64::NAN; 2]);
+    for (t, tri) in part.mesh.triangles().iter().enumerate() {
+        if labels[t] != zone {
+            continue;
+        }
+        let c = tri.map(|v| vertices[v as usize]);
+        let n = (c[1] - c[0]).cross(&(c[2] - c[0]));
+        let area = n.z; // twice the signed XY area
+        if area.abs() <= f64::MIN_POSITIVE || c.iter().any(|p| near_edge(p)) {
+            continue;
+        }
+        let nz = (n.z / n.norm()).abs();
+        let (x0, x1) = (c[0].x.min(c[1].x).min(c[2].x), c[0].x.max(c[1].x).max(c[2].x));
+        let (y0, y1) = (c[0].y.min(c[1].y).min(c[2].y), c[0].y.max(c[1].y).max(c[2].y));
+        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "clamped cell indices")]
+        let range = |lo: f64, hi: f64, origin: f64, size: f64, n: usize| {
+            let a = ((lo - origin) / size - 0.5).ceil().max(0.0) as usize;
+            let b = (((hi - origin) / size - 0.5).floor().max(-1.0) + 1.0) as usize;
+            a..b.min(n)
+        };
+        for j in range(y0, y1, min.y, cell_y, ny) {
+            for i in range(x0, x1, min.x, cell_x, nx) {
+                let p = zmap.cell_center(i, j);
+                // Barycentric weights (XY).
+                let w = |a: &Point3, b: &Point3| ((b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x)) / area;
+                let (w0, w1, w2) = (w(&c[1], &c[2]), w(&c[2], &c[0]), w(&c[0], &c[1]));
+                if w0 < 0.0 || w1 < 0.0 || w2 < 0.0 {
+                    continue;
+                }
+                let z = w0 * c[0].z + w1 * c[1].z + w2 * c[2].z;
+                let cell = j * nx + i;
+                if (top[cell] - z).abs() > FACE_MATCH_MM {
+                    continue; // another part of the surface is above: not this zone's face here
+                }
+                let Some(stock) = zmap.height(i, j) else { continue };
+                let thickness = (stock - z) * nz;
+                if thickness > worst.0 {
+                    worst = (thickness, [p.x, p.y]);
+                }
+            }
+        }
+    }
+    worst
+}
+
+/// 3+2 output: the zones' records (part frame, each with its tool axis) through the
+/// machine's inverse kinematics, written as tilted work planes (a new plane on the
+/// rapid that starts each zone), or joint space with the rotaries held where the
+/// dialect has no plane code.
+fn indexed_zones(
+    job: &FinishJob,
+    spec: &ZonePlanSpec,
+    records: &[scallop_machine::program::ClRecord],
+    time: f64,
+) -> Result<String, EngineError> {
+    let Some(machine) = &spec.machine else {
+        return Err(EngineError::Output {
+            what: "3+2 zones without a machine".into(),
+            fix: "give [setup] machine = a 5-axis machine (e.g. linuxcnc-xyzac-trt)".into(),
+        });
+    };
+    let kin = Kinematics::new(machine, 0.0);
+    let options = ProgramOptions::default();
+    let program = to_program(&kin, records, None, &options).map_err(|e| EngineError::Output {
+        what: format!("the zones' tool axes on machine `{}`: {e}", machine.name()),
+        fix: "choose a machine whose rotaries reach every zone's orientation".into(),
+    })?;
+    let params = PostParams {
+        program: job.output.program.clone(),
+        mode: OutputMode::TiltedPlane,
+        tool: job.output.tool.max(1),
+        tool_length: 0.0,
+        spindle: job.output.spindle,
+        tol_pos: options.tol_pos,
+        tol_ang: options.tol_ang,
+        predicted_time: Some(time),
+    };
+    program_text(&program, &kin, &job.output.dialect, &params).map_err(|e| EngineError::Output {
+        what: e.to_string(),
+        fix: "use a 5-axis dialect (linuxcnc, fanuc, siemens840d, heidenhain)".into(),
+    })
 }
 
 /// The part's patch tessellated on the grid `Patch::tessellate` picks within

@@ -65,12 +65,13 @@ fn two_zones_cover_the_hill_within_the_scallop_and_stay_in_their_regions() {
     let spec = ZonePlanSpec {
         labels: labels(),
         zones: vec![
-            ZoneSpec { label: 0, direction_deg: 0.0, predicted_time_s: None },
-            ZoneSpec { label: 1, direction_deg: 70.0, predicted_time_s: None },
+            ZoneSpec { label: 0, direction_deg: 0.0, tilt_deg: 0.0, azimuth_deg: 0.0, predicted_time_s: None },
+            ZoneSpec { label: 1, direction_deg: 70.0, tilt_deg: 0.0, azimuth_deg: 0.0, predicted_time_s: None },
         ],
         transitions: Transitions::default(),
         predicted_time_s: None,
         fixed_margin_mm: None,
+        machine: None,
     };
     // finish_zones fails on a gouge, a rapid into stock or a simulated scallop over the limit.
     let out = finish_zones(&job(sh), &spec).unwrap();

@@ -13,8 +13,9 @@ use crate::StrategyError;
 /// margin: the region [`crate::plan_zone_finishing`] machines.
 ///
 /// A triangle belongs to the **dilated zone** when its label is the zone's, or
-/// when one of its vertices lies within the horizontal (XY, planning frame)
-/// distance `margin` of a vertex of a triangle of the zone. A cutter location
+/// when all its vertices lie within the horizontal (XY, planning frame)
+/// distance `margin` of the zone's vertices (so the dilation reaches at least
+/// `margin` less one triangle). A cutter location
 /// belongs to the region when its contact does: a facet contact's triangle is in
 /// the dilated zone; an edge contact's triangle, or the other triangle of that
 /// edge, is; a vertex contact's vertex has a triangle in the dilated zone.
@@ -106,7 +107,7 @@ impl ZoneRegion {
         let accepted: Vec<bool> = triangles
             .iter()
             .enumerate()
-            .map(|(t, tri)| labels[t] == zone || tri.iter().any(|&v| near[v as usize]))
+            .map(|(t, tri)| labels[t] == zone || tri.iter().all(|&v| near[v as usize]))
             .collect();
         let mut vertex_accepted = vec![false; vertices.len()];
         let mut edge_accepted = HashSet::new();
