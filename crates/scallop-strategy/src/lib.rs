@@ -57,7 +57,13 @@
 //!   also needs its contact in one zone of a per-triangle labelling of the mesh,
 //!   dilated by a margin (facet contacts by their triangle, edge and vertex
 //!   contacts by any triangle on that edge or vertex). Passes split where their
-//!   contact leaves the dilated zone, and the plane range is the dilated zone's;
+//!   contact leaves the dilated zone, and the plane range is the dilated zone's.
+//!   Pass ends then lie inside the part: the scallop is measured only at
+//!   sections at least the cutter radius from both passes' ends (nearer, the
+//!   envelope lacks the cutter locations beyond the end), and collinear points are
+//!   merged by their vertical distance to the chord (the optimiser's directions
+//!   and 3+2 tilts give steep passes, where the perpendicular distance of
+//!   `simplify` allows a height error of `SIMPLIFY_SHARE * path / cos(slope)`);
 //!   the margin makes each zone finish itself up to its border (see
 //!   [`ZoneRegion`]), and the whole program's stock simulation checks it
 //!   (`scallop_engine::finish_zones`).

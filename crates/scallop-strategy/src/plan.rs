@@ -47,6 +47,9 @@ pub(crate) struct Planner<'a> {
     floor: f64,
     sample_tol: f64,
     simplify_tol: f64,
+    /// Merge by the vertical distance to the chord (zone planning), else by the
+    /// perpendicular one (`scallop_toolpath::simplify`).
+    vertical_merge: bool,
     boundary_tol: f64,
     min_step: f64,
     pub(crate) d_range: [f64; 2],
@@ -136,12 +139,18 @@ impl<'a> Planner<'a> {
             floor: bounds.min.z - bounds.diagonal() - 1.0,
             sample_tol: tol::SAMPLING_SHARE * tol_.path,
             simplify_tol: tol::SIMPLIFY_SHARE * tol_.path,
+            vertical_merge: region.is_some(),
             boundary_tol: tol::BOUNDARY_SHARE * tol_.path,
             min_step: params.max_step * tol::MIN_STEP_FRACTION,
             d_range,
             feed_samples,
             drops: 0,
         })
+    }
+
+    /// Indices of the points kept by merging nearly collinear ones.
+    fn merge(&self, points: &[Point3]) -> Vec<usize> {
+        if self.vertical_merge { simplify_vertical(points, self.simplify_tol) } else { simplify(points, self.simplify_tol) }
     }
 
     fn drop_at(&mut self, xy: Point2) -> ClPoint {
@@ -284,7 +293,7 @@ impl<'a> Planner<'a> {
         let mut samples = Vec::new();
         for run in runs {
             let points: Vec<Point3> = run.iter().map(|s| s.cl.tip).collect();
-            let kept = simplify(&points, self.simplify_tol);
+            let kept = self.merge(&points);
             passes.push(kept.iter().map(|&i| points[i]).collect::<Vec<_>>());
             samples.extend(run.iter().map(|s| s.cl));
         }
@@ -495,7 +504,7 @@ impl<'a> Planner<'a> {
         if let Some(last) = points.last_mut() {
             *last = *b;
         }
-        let kept = simplify(&points, self.simplify_tol);
+        let kept = self.merge(&points);
         Some(kept.iter().skip(1).map(|&i| points[i]).collect())
     }
 
@@ -553,6 +562,47 @@ impl<'a> Planner<'a> {
 /// the cutter radius in zone planning, where passes end inside the part; 0 otherwise.
 pub(crate) fn zone_end_margin(cutter: &Cutter, region: Option<&ZoneRegion>) -> f64 {
     region.map_or(0.0, |_| cutter.radius())
+}
+
+/// Douglas-Peucker merging of nearly collinear CL points by their **vertical**
+/// distance to the chord (at their position along the chord in XY), both sides:
+/// the indices kept, in order, first and last included. A pass or a link runs
+/// along one XY line, so this bounds the height error of the merged path (what
+/// a gouge is), which the perpendicular distance does not on steep passes.
+fn simplify_vertical(points: &[Point3], max_deviation: f64) -> Vec<usize> {
+    let n = points.len();
+    if n <= 2 {
+        return (0..n).collect();
+    }
+    let mut keep = vec![false; n];
+    keep[0] = true;
+    keep[n - 1] = true;
+    let mut stack = vec![(0, n - 1)];
+    while let Some((i, j)) = stack.pop() {
+        let (a, b) = (points[i], points[j]);
+        let ab = Vec2::new(b.x - a.x, b.y - a.y);
+        let len2 = ab.norm_squared();
+        let mut worst: Option<(f64, usize)> = None;
+        for (k, p) in points.iter().enumerate().take(j).skip(i + 1) {
+            let deviation = if len2 > 0.0 {
+                let s = (Vec2::new(p.x - a.x, p.y - a.y).dot(&ab) / len2).clamp(0.0, 1.0);
+                (p.z - (a.z + (b.z - a.z) * s)).abs()
+            } else {
+                (p - a).norm()
+            };
+            if worst.is_none_or(|(w, _)| deviation > w) {
+                worst = Some((deviation, k));
+            }
+        }
+        if let Some((deviation, k)) = worst
+            && deviation > max_deviation
+        {
+            keep[k] = true;
+            stack.push((k, j));
+            stack.push((i, k));
+        }
+    }
+    (0..n).filter(|&k| keep[k]).collect()
 }
 
 /// Vertical distance of the CL point `mid`, dropped at the XY midpoint of `a`
