@@ -335,7 +335,7 @@ pub fn finish_zones(job: &FinishJob, spec: &ZonePlanSpec) -> Result<ZoneFinishOu
         figure.machining_time_s = p.report.machining_time_s;
         figure.machining_time_lookahead_s = p.report.machining_time_lookahead_s;
         let mut zone_path = p.toolpath;
-        if let Some(o) = &orientation {
+        if tilted {
             // Prove the zone in its own frame: no gouge or collision anywhere, and its
             // own triangles finished within the scallop height.
             let b = part.mesh.bounds();
@@ -347,7 +347,7 @@ pub fn finish_zones(job: &FinishJob, spec: &ZonePlanSpec) -> Result<ZoneFinishOu
             let bound = sim.zmap.resolution_bound(job.cutter.shape());
             let (height, at) = zone_scallop(&sim.zmap, part, &labels, zone.label, &open_edge, radius);
             if height > job.scallop_height + bound {
-                let at = o.to_part(&Point3::new(at[0], at[1], 0.0));
+                let at = orientation.map_or(Point3::new(at[0], at[1], 0.0), |o| o.to_part(&Point3::new(at[0], at[1], 0.0)));
                 return Err(EngineError::ScallopExceeded {
                     height,
                     limit: job.scallop_height + bound,
@@ -357,12 +357,14 @@ pub fn finish_zones(job: &FinishJob, spec: &ZonePlanSpec) -> Result<ZoneFinishOu
             }
             figure.sim_zone_scallop_mm = Some(height);
             zone_sims.push((height, sim.verification.min_deviation, bound));
-            let mut back = Toolpath::new(zone_path.feed);
-            back.plunge_feed = zone_path.plunge_feed;
-            for m in zone_path.moves() {
-                back.push(scallop_toolpath::Move::new(m.kind, o.to_part(&m.to)));
+            if let Some(o) = &orientation {
+                let mut back = Toolpath::new(zone_path.feed);
+                back.plunge_feed = zone_path.plunge_feed;
+                for m in zone_path.moves() {
+                    back.push(scallop_toolpath::Move::new(m.kind, o.to_part(&m.to)));
+                }
+                zone_path = back;
             }
-            zone_path = back;
         }
         let axis = orientation.as_ref().map_or_else(Vec3::z, Orientation::tool_axis);
         records.extend(records_from_toolpath(&zone_path, &axis));

@@ -197,3 +197,43 @@ fn triangle_labels(mesh: &TriMesh, labels: &CellLabels) -> Vec<u32> {
         })
         .collect()
 }
+
+#[test]
+fn a_tilted_zone_is_an_indexed_setup_proven_in_its_own_frame() {
+    let sh = 0.02;
+    let spec = ZonePlanSpec {
+        labels: labels(),
+        zones: vec![
+            ZoneSpec { label: 0, direction_deg: 0.0, tilt_deg: 0.0, azimuth_deg: 0.0, predicted_time_s: None },
+            ZoneSpec { label: 1, direction_deg: 30.0, tilt_deg: 20.0, azimuth_deg: 150.0, predicted_time_s: None },
+        ],
+        transitions: Transitions::default(),
+        predicted_time_s: None,
+        fixed_margin_mm: None,
+        machine: Some(scallop_machine::Machine::builtin("linuxcnc-xyzac-trt").unwrap()),
+    };
+    let job = FinishJob { cutter: Cutter::new(CutterShape::Bull { radius: 3.0, corner: 1.0 }, 60.0).unwrap(), ..job(sh) };
+    // finish_zones fails on a gouge or collision in either frame, or a zone that
+    // leaves more than sh + the resolution bound on its own triangles.
+    let out = finish_zones(&job, &spec).unwrap();
+    let r = &out.report;
+    assert!(r.indexed && out.simulation.is_none());
+    for z in &r.zones {
+        let own = z.sim_zone_scallop_mm.unwrap();
+        assert!(own <= r.sim_scallop_limit_mm && own > 0.3 * sh, "{z:?}");
+        assert!(z.passes > 5 && z.max_scallop_mm <= sh * (1.0 + 1e-6), "{z:?}");
+    }
+    assert!(r.sim_min_deviation_mm >= -r.sim_gouge_tolerance_mm, "{r:?}");
+    // Two setups: the rotaries are positioned twice, tilt 0 then tilt 20 degrees.
+    let rotary_blocks: Vec<&str> = out.gcode.lines().filter(|l| l.contains(" A")).collect();
+    assert_eq!(rotary_blocks.len(), 2, "{rotary_blocks:?}");
+    assert!(rotary_blocks[1].contains("A20.0000") || rotary_blocks[1].contains("A-20.0000"), "{rotary_blocks:?}");
+    // The part-frame toolpath's second zone lies on the turned-back CL surface: its
+    // feed moves stay within the part's box grown by the cutter radius.
+    let b = out.prepared.mesh.bounds();
+    for (m, &zone) in out.toolpath.moves().iter().zip(&out.zone_of_move) {
+        if zone == 1 && m.kind == MoveKind::Feed {
+            assert!(m.to.x > b.min.x - 4.0 && m.to.x < b.max.x + 4.0 && m.to.z > b.min.z - 4.0, "{m:?}");
+        }
+    }
+}
