@@ -129,7 +129,8 @@ fn zone_program(
         fixed_margin_mm: None,
         machine: Some(machine),
     };
-    scallop_engine::finish_zones(&job, &zone_spec).map_err(|e| Failure::rejected(format!("the G-code of the best plan (K = {}): {e}", best.k)))
+    scallop_engine::finish_zones(&job, &zone_spec)
+        .map_err(|e| Failure::rejected(format!("the G-code of the best plan (K = {}): {e}", best.k)))
 }
 
 /// `scallop optimize`.
@@ -222,7 +223,9 @@ pub fn run(args: &OptimizeArgs) -> CliResult<()> {
     write_atomic(&out.join("study.json"), |w| w.write_all(to_json(&file)?.as_bytes()))?;
     write_atomic(&out.join("report.json"), |w| w.write_all(to_json(&report)?.as_bytes()))?;
     write_atomic(&out.join("program.nc"), |w| w.write_all(program.gcode.as_bytes()))?;
-    write_atomic(&out.join("toolpath.csv"), |w| w.write_all(scallop_engine::toolpath_csv(&program.toolpath).as_bytes()))?;
+    write_atomic(&out.join("toolpath.csv"), |w| {
+        w.write_all(scallop_engine::toolpath_csv(&program.toolpath).as_bytes())
+    })?;
     write_atomic(&out.join("convergence.svg"), |w| w.write_all(convergence_svg(&study).as_bytes()))?;
     let title = format!("{part_name}, {}, K = {}", formulation_name(settings.formulation), best.k);
     write_atomic(&out.join("zones.svg"), |w| w.write_all(zones_svg(&best.plan, &title).as_bytes()))?;
@@ -331,9 +334,8 @@ fn optimisation_report(
         data.toolpath = Some(p.toolpath.clone());
     }
     data.zones = Some(Zones {
-        of_move: program.map_or_else(Vec::new, |p| {
-            p.zone_of_move.iter().map(|&z| u16::try_from(z).unwrap_or(u16::MAX)).collect()
-        }),
+        of_move: program
+            .map_or_else(Vec::new, |p| p.zone_of_move.iter().map(|&z| u16::try_from(z).unwrap_or(u16::MAX)).collect()),
         names: best.plan.zones.iter().map(|z| format!("{} ({:.0} deg)", z.zone, z.theta_deg)).collect(),
         times_s: best.plan.zones.iter().map(|z| z.time_s).collect(),
     });

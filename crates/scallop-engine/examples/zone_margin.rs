@@ -55,7 +55,9 @@ fn main() {
                 );
             }
             Err(EngineError::ScallopExceeded { height, limit, x, y }) => {
-                println!("{name} margin {what:>9}: simulated scallop {height:.5} mm > {limit:.5} mm at ({x:.2}, {y:.2})");
+                println!(
+                    "{name} margin {what:>9}: simulated scallop {height:.5} mm > {limit:.5} mm at ({x:.2}, {y:.2})"
+                );
             }
             Err(e) => println!("{name} margin {what:>9}: {e}"),
         }

@@ -28,16 +28,15 @@
 
 use scallop_analysis::MachineLimits;
 use scallop_cutter::CutterShape;
-use scallop_geom::{Aabb3, Point3, Tolerances};
-use scallop_mesh::{MeshIndex, TriMesh};
 use scallop_geom::Vec3;
+use scallop_geom::{Aabb3, Point3, Tolerances};
 use scallop_machine::Kinematics;
 use scallop_machine::program::{ProgramOptions, records_from_toolpath, to_program};
+use scallop_mesh::{MeshIndex, TriMesh};
 use scallop_post::{OutputMode, PostParams, ProgramInfo, program_text, write_fitted};
 use scallop_strategy::network::{CellLabels, Orientation, Transitions};
 use scallop_strategy::{
-    Boundary, FinishingParams, StrategyError, ZoneRegion, lookahead_time, plan_zone_finishing,
-    stop_to_stop_time,
+    Boundary, FinishingParams, StrategyError, ZoneRegion, lookahead_time, plan_zone_finishing, stop_to_stop_time,
 };
 use scallop_surface::{Direction, Patch};
 use scallop_toolpath::{FittedPath, MoveKind, Toolpath, fit_arcs};
@@ -347,7 +346,8 @@ pub fn finish_zones(job: &FinishJob, spec: &ZonePlanSpec) -> Result<ZoneFinishOu
             let bound = sim.zmap.resolution_bound(job.cutter.shape());
             let (height, at) = zone_scallop(&sim.zmap, part, &labels, zone.label, &open_edge, radius);
             if height > job.scallop_height + bound {
-                let at = orientation.map_or(Point3::new(at[0], at[1], 0.0), |o| o.to_part(&Point3::new(at[0], at[1], 0.0)));
+                let at =
+                    orientation.map_or(Point3::new(at[0], at[1], 0.0), |o| o.to_part(&Point3::new(at[0], at[1], 0.0)));
                 return Err(EngineError::ScallopExceeded {
                     height,
                     limit: job.scallop_height + bound,
@@ -493,14 +493,7 @@ pub fn finish_zones(job: &FinishJob, spec: &ZonePlanSpec) -> Result<ZoneFinishOu
         sim_min_deviation_mm: min_deviation,
         sim_gouge_tolerance_mm: gouge_tolerance,
     };
-    Ok(ZoneFinishOutput {
-        toolpath,
-        zone_of_move,
-        gcode: text,
-        report,
-        prepared,
-        simulation: sim,
-    })
+    Ok(ZoneFinishOutput { toolpath, zone_of_move, gcode: text, report, prepared, simulation: sim })
 }
 
 fn directions(figures: &[ZoneFigures]) -> String {
@@ -600,8 +593,7 @@ fn zone_scallop(
 ) -> (f64, [f64; 2]) {
     let top = scallop_sim::part_heights(zmap, &part.index);
     let vertices = part.mesh.vertices();
-    let edge_points: Vec<Point3> =
-        vertices.iter().zip(open_edge).filter(|(_, o)| **o).map(|(v, _)| *v).collect();
+    let edge_points: Vec<Point3> = vertices.iter().zip(open_edge).filter(|(_, o)| **o).map(|(v, _)| *v).collect();
     let near_edge = |p: &Point3| edge_points.iter().any(|q| (q.x - p.x).hypot(q.y - p.y) < edge);
     let (cell_x, cell_y) = zmap.cell_size();
     let min = zmap.stock().min;
@@ -614,7 +606,7 @@ fn zone_scallop(
         let c = tri.map(|v| vertices[v as usize]);
         let n = (c[1] - c[0]).cross(&(c[2] - c[0]));
         let area = n.z; // twice the signed XY area
-        if area.abs() <= f64::MIN_POSITIVE || c.iter().any(|p| near_edge(p)) {
+        if area.abs() <= f64::MIN_POSITIVE || c.iter().any(&near_edge) {
             continue;
         }
         let nz = (n.z / n.norm()).abs();
@@ -747,9 +739,7 @@ fn labelled_mesh(patch: &Patch, tol: &Tolerances) -> Result<(PreparedPart, Vec<[
         let mut j = 0;
         for t in 0..mesh.triangles().len() {
             let corners = mesh.triangle(t);
-            while j < triangles.len()
-                && !(0..3).all(|k| (corners[k] - vertices[triangles[j][k]]).norm() <= close)
-            {
+            while j < triangles.len() && !(0..3).all(|k| (corners[k] - vertices[triangles[j][k]]).norm() <= close) {
                 j += 1;
             }
             kept.push(centroids.get(j).copied().unwrap_or([0.5, 0.5]));

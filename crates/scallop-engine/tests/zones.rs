@@ -212,7 +212,8 @@ fn a_tilted_zone_is_an_indexed_setup_proven_in_its_own_frame() {
         fixed_margin_mm: None,
         machine: Some(scallop_machine::Machine::builtin("linuxcnc-xyzac-trt").unwrap()),
     };
-    let job = FinishJob { cutter: Cutter::new(CutterShape::Bull { radius: 3.0, corner: 1.0 }, 60.0).unwrap(), ..job(sh) };
+    let job =
+        FinishJob { cutter: Cutter::new(CutterShape::Bull { radius: 3.0, corner: 1.0 }, 60.0).unwrap(), ..job(sh) };
     // finish_zones fails on a gouge or collision in either frame, or a zone that
     // leaves more than sh + the resolution bound on its own triangles.
     let out = finish_zones(&job, &spec).unwrap();

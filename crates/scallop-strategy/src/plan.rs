@@ -150,7 +150,11 @@ impl<'a> Planner<'a> {
 
     /// Indices of the points kept by merging nearly collinear ones.
     fn merge(&self, points: &[Point3]) -> Vec<usize> {
-        if self.vertical_merge { simplify_vertical(points, self.simplify_tol) } else { simplify(points, self.simplify_tol) }
+        if self.vertical_merge {
+            simplify_vertical(points, self.simplify_tol)
+        } else {
+            simplify(points, self.simplify_tol)
+        }
     }
 
     fn drop_at(&mut self, xy: Point2) -> ClPoint {

@@ -103,7 +103,8 @@ impl ZoneRegion {
                 }
             }
         }
-        let near = if margin > 0.0 { near_vertices(vertices, triangles, labels, zone, &in_zone, margin) } else { in_zone };
+        let near =
+            if margin > 0.0 { near_vertices(vertices, triangles, labels, zone, &in_zone, margin) } else { in_zone };
         let accepted: Vec<bool> = triangles
             .iter()
             .enumerate()
@@ -171,9 +172,8 @@ impl ZoneRegion {
             return self.vertex_accepted[tri[k] as usize];
         }
         // The edge nearest the contact; accepted when the other triangle on it is.
-        let k = (0..3)
-            .min_by(|&a, &b| edge_distance(c, a, &point).total_cmp(&edge_distance(c, b, &point)))
-            .unwrap_or(0);
+        let k =
+            (0..3).min_by(|&a, &b| edge_distance(c, a, &point).total_cmp(&edge_distance(c, b, &point))).unwrap_or(0);
         self.edge_accepted.contains(&edge_key(tri[k], tri[(k + 1) % 3]))
     }
 }
