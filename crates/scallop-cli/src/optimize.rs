@@ -184,7 +184,7 @@ pub fn run(args: &OptimizeArgs) -> CliResult<()> {
     spinner.finish_and_clear();
     let gcode = format!(
         "program.nc: {} zones by drop-cutter{}, {:.1} s stop-to-stop ({:.1} s predicted by the network model); \
-         simulated scallop {:.4} mm <= {:.4} mm; planned and verified in {:.1} s",
+         simulated scallop {:.5} mm <= {:.5} mm; planned and verified in {:.1} s",
         program.report.zones.iter().filter(|z| z.passes > 0).count(),
         if program.report.indexed { " as indexed 3+2 setups" } else { "" },
         program.report.plan.total_time_s,

@@ -315,6 +315,26 @@ fn optimize_writes_the_study_and_rejects_bad_settings() {
     let planned = report["result"]["plan"]["zones"].as_array().expect("the study's zones");
     assert!(zones.len() == planned.len() && zones.iter().any(|z| z["passes"].as_u64() > Some(0)));
     assert!(report["gcode"].as_str().expect("gcode").starts_with("program.nc"));
+    assert_eq!(program["indexed"].as_bool(), Some(false));
+
+    // 3+2: indexed setups, each zone proven in its own frame.
+    let tilted = job
+        .replace("formulation = \"3axis\"", "formulation = \"3+2\"")
+        .replace("flute_length = 50", "flute_length = 90");
+    std::fs::write(dir.join("tilted.toml"), &tilted).expect("write");
+    let out = scallop().current_dir(&dir).args(["optimize", "tilted.toml", "-o", "out32"]).output().expect("run");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("out32/report.json")).expect("report.json")).expect("json");
+    let program = &report["program"];
+    assert_eq!(program["indexed"].as_bool(), Some(true), "{program}");
+    let limit = program["sim_scallop_limit_mm"].as_f64().expect("limit");
+    for z in program["zones"].as_array().expect("zones").iter().filter(|z| z["passes"].as_u64() > Some(0)) {
+        let own = z["sim_zone_scallop_mm"].as_f64().expect("each zone proven in its frame");
+        assert!(own > 0.0 && own <= limit, "{z}");
+    }
+    let text = std::fs::read_to_string(dir.join("out32/program.nc")).expect("program.nc");
+    assert!(text.lines().any(|l| l.contains(" A")), "rotary words");
     for (bad, key) in [
         (job.replace("k_max = 3", "k_max = 1").replace("k_min = 2", "k_min = 1"), "optimize.k_max"),
         (job.replace("budget = 8", "budget = 0"), "optimize.budget"),
