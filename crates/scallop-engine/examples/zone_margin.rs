@@ -29,7 +29,7 @@ fn main() {
     let cutter = scallop_cutter::Cutter::new(scallop_cutter::CutterShape::Bull { radius: 5.0, corner: 2.0 }, 50.0)
         .expect("a valid cutter");
     let job = FinishJob { part, part_name: name.into(), cutter, ..FinishJob::choi_demo() };
-    for margin in [None, Some(0.0), Some(1.0), Some(2.0)] {
+    for margin in [None, Some(0.0), Some(1.0), Some(2.0), Some(3.0), Some(5.0)] {
         let spec = ZonePlanSpec {
             labels: CellLabels { cells_u: n, cells_v: n, labels: labels.clone() },
             zones: vec![

@@ -30,8 +30,8 @@ pub use finish::{
 };
 pub use grid::{GridAxis, GridError, MAX_GRID_POINTS};
 pub use zones::{
-    ZONE_MARGIN_PER_SPACING, ZONE_MARGIN_ROUNDS, ZoneFigures, ZoneFinishOutput, ZoneFinishReport, ZonePlanSpec,
-    ZoneSpec, finish_zones,
+    ZONE_MARGIN_PER_RADIUS, ZONE_MARGIN_PER_SPACING, ZONE_MARGIN_ROUNDS, ZoneFigures, ZoneFinishOutput,
+    ZoneFinishReport, ZonePlanSpec, ZoneSpec, finish_zones,
 };
 
 /// Why the engine rejected a request. Each variant says the cause and the fix.
