@@ -335,6 +335,9 @@ fn optimize_writes_the_study_and_rejects_bad_settings() {
     }
     let text = std::fs::read_to_string(dir.join("out32/program.nc")).expect("program.nc");
     assert!(text.lines().any(|l| l.contains(" A")), "rotary words");
+    let csv = std::fs::read_to_string(dir.join("out32/toolpath.csv")).expect("toolpath.csv");
+    let rows = scallop_io::cl::read_cl_csv(&csv).expect("a cutter-location file with tool axes");
+    assert!(rows.len() > 100 && csv.starts_with("kind,x,y,z,i,j,k"));
     for (bad, key) in [
         (job.replace("k_max = 3", "k_max = 1").replace("k_min = 2", "k_min = 1"), "optimize.k_max"),
         (job.replace("budget = 8", "budget = 0"), "optimize.budget"),

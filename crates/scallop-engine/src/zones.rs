@@ -192,6 +192,8 @@ pub struct ZoneFinishOutput {
     pub toolpath: Toolpath,
     /// Zone label of each move of `toolpath`.
     pub zone_of_move: Vec<u32>,
+    /// Tool axis of each move of `toolpath` (part frame; +Z in 3-axis work).
+    pub axes: Vec<Vec3>,
     /// The G-code text.
     pub gcode: String,
     /// The figures.
@@ -270,6 +272,7 @@ pub fn finish_zones(job: &FinishJob, spec: &ZonePlanSpec) -> Result<ZoneFinishOu
     let mut toolpath = Toolpath::new(machine.feed * 60.0);
     toolpath.plunge_feed = base.plunge_feed * 60.0;
     let mut zone_of_move = Vec::new();
+    let mut axes = Vec::new();
     let mut records = Vec::new();
     let mut zone_sims: Vec<(f64, f64, f64)> = Vec::new(); // (scallop, min deviation, bound) per tilted zone
     let mut figures = Vec::with_capacity(spec.zones.len());
@@ -379,6 +382,7 @@ pub fn finish_zones(job: &FinishJob, spec: &ZonePlanSpec) -> Result<ZoneFinishOu
         for m in zone_path.moves() {
             toolpath.push(*m);
             zone_of_move.push(zone.label);
+            axes.push(axis);
         }
         figures.push(figure);
     }
@@ -496,7 +500,31 @@ pub fn finish_zones(job: &FinishJob, spec: &ZonePlanSpec) -> Result<ZoneFinishOu
         sim_min_deviation_mm: min_deviation,
         sim_gouge_tolerance_mm: gouge_tolerance,
     };
-    Ok(ZoneFinishOutput { toolpath, zone_of_move, gcode: text, report, prepared, simulation: sim })
+    Ok(ZoneFinishOutput { toolpath, zone_of_move, axes, gcode: text, report, prepared, simulation: sim })
+}
+
+impl ZoneFinishOutput {
+    /// The toolpath as cutter-location CSV: `kind,x,y,z` per move, and for 3+2
+    /// programs `kind,x,y,z,i,j,k` with each move's tool axis (part frame), the
+    /// format `scallop post` reads.
+    #[must_use]
+    pub fn toolpath_csv(&self) -> String {
+        if !self.report.indexed {
+            return crate::toolpath_csv(&self.toolpath);
+        }
+        let mut out = String::from("kind,x,y,z,i,j,k\n");
+        for (m, a) in self.toolpath.moves().iter().zip(&self.axes) {
+            let kind = match m.kind {
+                MoveKind::Rapid => "rapid",
+                MoveKind::Plunge => "plunge",
+                MoveKind::Feed => "feed",
+                MoveKind::Link => "link",
+                MoveKind::Retract => "retract",
+            };
+            out.push_str(&format!("{kind},{},{},{},{},{},{}\n", m.to.x, m.to.y, m.to.z, a.x, a.y, a.z));
+        }
+        out
+    }
 }
 
 fn directions(figures: &[ZoneFigures]) -> String {
