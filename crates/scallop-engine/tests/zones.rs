@@ -90,6 +90,9 @@ fn two_zones_cover_the_hill_within_the_scallop_and_stay_in_their_regions() {
     assert!(r.transition_time_s > 0.0 && r.transition_time_model_s > 0.0);
     assert_eq!(out.zone_of_move.len(), out.toolpath.moves().len());
     assert!(out.gcode.contains("simulated scallop"));
+    // Deterministic: the same program on one thread.
+    let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
+    assert_eq!(one.install(|| finish_zones(&job(sh), &spec).unwrap()).gcode, out.gcode);
 
     // Every CL point of zone 0's passes has its contact within the margin of zone 0.
     let prepared = &out.prepared;
