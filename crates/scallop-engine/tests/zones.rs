@@ -241,3 +241,56 @@ fn a_tilted_zone_is_an_indexed_setup_proven_in_its_own_frame() {
         }
     }
 }
+
+/// A U-shaped zone (two arms joined at low y): planes along X across the arms
+/// give two passes each, and no pass point has its contact in the gap between
+/// the arms beyond the margin.
+#[test]
+fn a_non_convex_zone_splits_its_planes_into_several_passes() {
+    let sh = 0.02;
+    let tolerances = Tolerances { path: 0.01, gouge: 0.0 };
+    let mesh = SurfaceSet::new(vec![hill()]).unwrap().tessellate(tolerances.tessellation()).unwrap().mesh;
+    let index = MeshIndex::build(&mesh);
+    let in_u = |x: f64, y: f64| x < 12.0 || x > 28.0 || y < 8.0;
+    let labels: Vec<u32> = (0..mesh.triangles().len())
+        .map(|t| {
+            let c = mesh.triangle(t);
+            u32::from(!in_u((c[0].x + c[1].x + c[2].x) / 3.0, (c[0].y + c[1].y + c[2].y) / 3.0))
+        })
+        .collect();
+    let margin = 1.0;
+    let region = ZoneRegion::new(&mesh, &labels, 0, margin).unwrap();
+    let params = FinishingParams {
+        direction: 0.0,
+        pattern: Pattern::Zigzag,
+        scallop_height: sh,
+        boundary: scallop_strategy::Boundary::ContactInside,
+        max_step: 0.5,
+        clearance: 5.0,
+        machine: scallop_analysis::MachineLimits::default(),
+        plunge_feed: 20.0,
+        rapid_rate: 500.0,
+        sharp_corner: 30f64.to_radians(),
+        blend_tolerance: 0.01,
+    };
+    let planned = plan_zone_finishing(&index, &cutter(), &params, &tolerances, &region).unwrap();
+    let split = planned.planes.iter().filter(|p| p.passes.len() >= 2).count();
+    assert!(split > 10, "{split} planes cross both arms");
+    // The gap between the arms (x in [12 + margin + a triangle, 28 - margin - a triangle],
+    // y > 8 + margin + a triangle) has no contact of the zone's passes.
+    let floor = mesh.bounds().min.z - 100.0;
+    for plane in &planned.planes {
+        for pass in &plane.passes {
+            for p in pass {
+                let cl = drop_cutter(&cutter(), &index, Point2::new(p.x, p.y), floor);
+                if let Contact::Facet { point, .. } | Contact::Edge { point, .. } | Contact::Vertex { point, .. } =
+                    cl.contact
+                {
+                    let deep =
+                        point.x > 12.0 + margin + 1.0 && point.x < 28.0 - margin - 1.0 && point.y > 8.0 + margin + 1.0;
+                    assert!(!deep, "{point:?}");
+                }
+            }
+        }
+    }
+}
