@@ -247,3 +247,57 @@ fn near_vertices(
         })
         .collect()
 }
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used, reason = "tests: a panic is the failure report")]
+mod tests {
+    use super::*;
+    use crate::geometry::slots_by_original;
+
+    /// Four 1 mm strips along y, labelled 0, 0, 1, 1: triangles `2 i` and `2 i + 1` in strip `i`.
+    fn strips() -> (TriMesh, Vec<u32>) {
+        let p = |x: f64, y: f64| Point3::new(x, y, 0.0);
+        let soup: Vec<[Point3; 3]> = (0..4)
+            .flat_map(|i| {
+                let x = f64::from(i);
+                [[p(x, 0.), p(x + 1., 0.), p(x + 1., 5.)], [p(x, 0.), p(x + 1., 5.), p(x, 5.)]]
+            })
+            .collect();
+        (TriMesh::from_soup(&soup).unwrap().0, vec![0, 0, 0, 0, 1, 1, 1, 1])
+    }
+
+    /// Edge and vertex contacts count for the zone when the edge or vertex touches it.
+    #[test]
+    fn edge_and_vertex_contacts_on_the_border_belong_to_the_zone() {
+        let (mesh, labels) = strips();
+        let index = MeshIndex::build(&mesh);
+        let slots = slots_by_original(&index);
+        let region = ZoneRegion::new(&mesh, &labels, 0, 0.0).unwrap();
+        let cl = |contact| ClPoint { tip: Point3::new(0.0, 0.0, 0.0), contact };
+        let at = |x: f64, y: f64| Point3::new(x, y, 0.0);
+        // Triangle 5 = [(2,0), (3,5), (2,5)] of strip 2 (label 1); its edge x = 2 is shared with strip 1.
+        let inside = |c| region.contains_contact(&index, &slots, &cl(c));
+        assert!(inside(Contact::Edge { triangle: 5, point: at(2.0, 3.0) }));
+        assert!(!inside(Contact::Edge { triangle: 5, point: at(2.5, 5.0) })); // its top edge
+        assert!(!inside(Contact::Edge { triangle: 4, point: at(2.5, 2.5) })); // the strip's diagonal
+        assert!(inside(Contact::Vertex { triangle: 4, point: at(2.0, 0.0) }));
+        assert!(!inside(Contact::Vertex { triangle: 4, point: at(3.0, 0.0) }));
+        assert!(inside(Contact::Facet { triangle: 1, point: at(0.5, 4.0) }));
+        assert!(!inside(Contact::Facet { triangle: 6, point: at(3.5, 1.0) }));
+        assert!(!inside(Contact::Floor));
+    }
+
+    /// The dilation grows with the margin and never drops a zone triangle.
+    #[test]
+    fn dilation_is_monotone_in_the_margin() {
+        let (mesh, labels) = strips();
+        let counts: Vec<usize> = [0.0, 0.5, 1.0, 2.0, 5.0]
+            .iter()
+            .map(|&m| ZoneRegion::new(&mesh, &labels, 1, m).unwrap().accepted_triangles())
+            .collect();
+        assert_eq!(counts, vec![4, 4, 6, 8, 8]);
+        assert!(matches!(ZoneRegion::new(&mesh, &labels, 7, 1.0), Err(StrategyError::EmptyZone { zone: 7 })));
+        assert!(ZoneRegion::new(&mesh, &labels[1..], 0, 1.0).is_err());
+        assert!(ZoneRegion::new(&mesh, &labels, 0, -1.0).is_err());
+    }
+}
