@@ -251,7 +251,7 @@ fn a_non_convex_zone_splits_its_planes_into_several_passes() {
     let tolerances = Tolerances { path: 0.01, gouge: 0.0 };
     let mesh = SurfaceSet::new(vec![hill()]).unwrap().tessellate(tolerances.tessellation()).unwrap().mesh;
     let index = MeshIndex::build(&mesh);
-    let in_u = |x: f64, y: f64| x < 12.0 || x > 28.0 || y < 8.0;
+    let in_u = |x: f64, y: f64| !(12.0..=28.0).contains(&x) || y < 8.0;
     let labels: Vec<u32> = (0..mesh.triangles().len())
         .map(|t| {
             let c = mesh.triangle(t);
