@@ -232,6 +232,26 @@ fn a_tilted_zone_is_an_indexed_setup_proven_in_its_own_frame() {
     let rotary_blocks: Vec<&str> = out.gcode.lines().filter(|l| l.contains(" A")).collect();
     assert_eq!(rotary_blocks.len(), 2, "{rotary_blocks:?}");
     assert!(rotary_blocks[1].contains("A20.0000") || rotary_blocks[1].contains("A-20.0000"), "{rotary_blocks:?}");
+    // The program replays through the machine's forward kinematics onto the part-frame
+    // cutter locations with each zone's tool axis.
+    let machine = spec.machine.as_ref().unwrap();
+    let kin = scallop_machine::Kinematics::new(machine, 0.0);
+    let mut records = Vec::new();
+    let mut start = 0;
+    let moves = out.toolpath.moves();
+    while start < moves.len() {
+        let end = (start..moves.len()).find(|&k| out.zone_of_move[k] != out.zone_of_move[start]).unwrap_or(moves.len());
+        let mut piece = Toolpath::new(out.toolpath.feed);
+        piece.plunge_feed = out.toolpath.plunge_feed;
+        for m in &moves[start..end] {
+            piece.push(*m);
+        }
+        records.extend(scallop_machine::program::records_from_toolpath(&piece, &out.axes[start]));
+        start = end;
+    }
+    let blocks = scallop_post::replay(&out.gcode, &job.output.dialect, &kin).unwrap();
+    let options = scallop_machine::program::ProgramOptions::default();
+    scallop_post::check_replay(&blocks, &records, &kin, &job.output.dialect, options.tol_pos, options.tol_ang).unwrap();
     // The part-frame toolpath's second zone lies on the turned-back CL surface: its
     // feed moves stay within the part's box grown by the cutter radius.
     let b = out.prepared.mesh.bounds();
