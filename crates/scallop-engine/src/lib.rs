@@ -1,6 +1,9 @@
 //! The API boundary of scallop: a part (mesh or parametric surfaces) and the
 //! machining settings in, cutter locations, toolpaths, G-code text and
 //! reports out. Orchestration only: the geometry lives in the crates below.
+//! [`run_finishing`] machines a part in one direction or 3+2 setup;
+//! [`finish_zones`] machines a zone plan of the optimiser zone by zone (each in
+//! its direction or 3+2 orientation) and proves it on the simulated stock.
 //!
 //! ```
 //! use scallop_engine::{Part, prepare_part};

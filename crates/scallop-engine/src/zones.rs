@@ -152,7 +152,8 @@ pub struct ZoneFinishReport {
     pub plan: scallop_strategy::Report,
     /// Zone-to-zone transitions in the program.
     pub transitions: usize,
-    /// Stop-to-stop time of the program's transitions (retract, rapid, plunge) (s).
+    /// Stop-to-stop time of the program's transitions (retract, rapid, plunge) (s);
+    /// 3+2: straight moves in the part frame, without the rotaries' repositioning.
     pub transition_time_s: f64,
     /// The same transitions under the optimiser's model (s).
     pub transition_time_model_s: f64,
