@@ -11,7 +11,8 @@
 //! - **Zones.** Each zone is planned by [`scallop_strategy::plan_zone_finishing`]
 //!   in its own feed direction: a cutter location belongs to the zone when its
 //!   contact lies in the zone dilated by a margin ([`ZoneRegion`]). The margin
-//!   starts at [`ZONE_MARGIN_PER_RADIUS`] times the cutter radius and is raised
+//!   starts at the first of [`ZONE_MARGIN_PER_RADIUS`] times the cutter radius
+//!   (the next ones when the proof below fails) and is raised
 //!   to [`ZONE_MARGIN_PER_SPACING`] times the largest plane spacing of the zone's
 //!   plan, replanning until it holds (at most [`ZONE_MARGIN_ROUNDS`] plans). The
 //!   cutter locations that shape a point have their contacts within about one
@@ -46,10 +47,13 @@ use serde::Serialize;
 use crate::finish::{SHARP_CORNER_DEG, cutter_text};
 use crate::{ARC_SHARE, EngineError, FinishJob, Part, PreparedPart, Strategy};
 
-/// The margin of a zone starts at this share of the cutter radius (3 mm for
-/// R = 5 mm; chosen from the border experiment of docs/validation.md: on Choi the
-/// borders exceed the limit below 2 mm and keep 4 % of room at 3 mm).
-pub const ZONE_MARGIN_PER_RADIUS: f64 = 0.6;
+/// The margin of every zone starts at the first of these shares of the cutter
+/// radius (3 mm for R = 5 mm; chosen from the border experiment of
+/// docs/validation.md: on a two-zone Choi plan the borders exceed the limit below
+/// 2 mm and keep 4 % of room at 3 mm); when the proof finds a scallop over the
+/// limit, the whole plan is made again with the next share (more zones meet at
+/// more borders), and the job fails after the last.
+pub const ZONE_MARGIN_PER_RADIUS: [f64; 3] = [0.6, 1.0, 1.5];
 
 /// The margin of a zone is raised to this many times its largest plane spacing.
 pub const ZONE_MARGIN_PER_SPACING: f64 = 2.0;
@@ -145,6 +149,9 @@ pub struct ZoneFinishReport {
     pub scallop_height_mm: f64,
     /// Distance between the surface and the machining mesh (mm).
     pub chordal_error_mm: f64,
+    /// The start margin of the zones as a share of the cutter radius (the first of
+    /// [`ZONE_MARGIN_PER_RADIUS`] whose plan passed the proof).
+    pub margin_per_radius: f64,
     /// Per zone, in machining order.
     pub zones: Vec<ZoneFigures>,
     /// The joined program's figures (times of the whole program; `max_scallop_mm`
@@ -221,6 +228,19 @@ pub struct ZoneFinishOutput {
 /// - [`EngineError::ScallopExceeded`]: the simulated scallop exceeds `sh` plus
 ///   the resolution bound.
 pub fn finish_zones(job: &FinishJob, spec: &ZonePlanSpec) -> Result<ZoneFinishOutput, EngineError> {
+    let mut result = Err(EngineError::BadTolerance(f64::NAN));
+    for &share in &ZONE_MARGIN_PER_RADIUS {
+        result = finish_zones_with(job, spec, share);
+        match &result {
+            Err(EngineError::ScallopExceeded { .. }) if spec.fixed_margin_mm.is_none() => {}
+            _ => break,
+        }
+    }
+    result
+}
+
+/// [`finish_zones`] with the start margin `share` times the cutter radius.
+fn finish_zones_with(job: &FinishJob, spec: &ZonePlanSpec, share: f64) -> Result<ZoneFinishOutput, EngineError> {
     let Part::Surfaces(set) = &job.part else {
         return Err(EngineError::Output {
             what: "zone finishing of a mesh part".into(),
@@ -260,7 +280,7 @@ pub fn finish_zones(job: &FinishJob, spec: &ZonePlanSpec) -> Result<ZoneFinishOu
         sharp_corner: SHARP_CORNER_DEG.to_radians(),
         blend_tolerance: job.tolerances.path,
     };
-    let start_margin = ZONE_MARGIN_PER_RADIUS * job.cutter.radius();
+    let start_margin = share * job.cutter.radius();
     let cap = 2.0 * job.cutter.radius();
 
     let tilted = spec.zones.iter().any(|z| z.tilt_deg != 0.0);
@@ -484,6 +504,7 @@ pub fn finish_zones(job: &FinishJob, spec: &ZonePlanSpec) -> Result<ZoneFinishOu
         cutter,
         scallop_height_mm: job.scallop_height,
         chordal_error_mm: prepared.chordal_error,
+        margin_per_radius: share,
         zones: figures,
         plan,
         transitions,
