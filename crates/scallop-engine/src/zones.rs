@@ -25,13 +25,20 @@
 //!   top and the next starting with a rapid and a plunge: the transition model
 //!   of the optimiser (retract, traverse, approach), with the job's clearance
 //!   height (safe over any stock) instead of `c` above the higher end.
-//! - **Proof.** The whole program is cut on a z-map of the stock box; a gouge, a
-//!   rapid into stock or a collision is an error, and so is a simulated scallop
-//!   above `sh` plus the simulation's resolution bound.
+//! - **3+2.** A tilted zone is planned in its own frame (the mesh turned so that
+//!   its tool axis is vertical, same triangles, so the labels carry over), turned
+//!   back to the part frame with its tool axis, and the zones are written as
+//!   indexed setups through the machine's inverse kinematics (tilted planes, a
+//!   new one on the rapid that starts each zone).
+//! - **Proof.** 3-axis: the whole program is cut on a z-map of the stock box; a
+//!   gouge, a rapid into stock or a collision is an error, and so is a simulated
+//!   scallop above `sh` plus the simulation's resolution bound. 3+2: each zone's
+//!   program alone in its frame, with the same errors, the scallop measured on
+//!   the zone's own triangles (they tile the surface). The rotary repositioning
+//!   between setups is not checked.
 
 use scallop_analysis::MachineLimits;
-use scallop_geom::Vec3;
-use scallop_geom::{Aabb3, Point3, Tolerances};
+use scallop_geom::{Aabb3, Point3, Tolerances, Vec3};
 use scallop_machine::Kinematics;
 use scallop_machine::program::{ProgramOptions, records_from_toolpath, to_program};
 use scallop_mesh::{MeshIndex, TriMesh};
