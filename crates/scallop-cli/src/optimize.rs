@@ -14,7 +14,7 @@ use scallop_optim::study::{
 };
 use scallop_optim::surface::{SurfaceModel, SurfaceSettings};
 use scallop_optim::{Barrier, CostModel, OptimError, convergence_svg, zones_svg};
-use scallop_strategy::network::{TransitionModel, Transitions};
+use scallop_strategy::network::{CellLabels, TransitionModel, Transitions};
 use serde::Serialize;
 
 use crate::output::{print_json, print_text, progress_bar, write_atomic};
@@ -70,11 +70,11 @@ struct StudyFile<'a> {
     scallop_height_mm: f64,
     threads: usize,
     wall_time_s: f64,
-    gcode: &'static str,
+    gcode: String,
     study: &'a Study,
 }
 
-/// What `report.json` holds: the best plan over all K.
+/// What `report.json` holds: the best plan over all K, and its program.
 #[derive(Serialize)]
 struct BestReport<'a> {
     part: String,
@@ -83,12 +83,55 @@ struct BestReport<'a> {
     time_s: f64,
     start_time_s: f64,
     eta: f64,
-    gcode: &'static str,
+    /// What was written: "program.nc" or why nothing was.
+    gcode: String,
+    /// The drop-cutter program of the best plan: per-zone figures, times next to the
+    /// network model's prediction, the stock simulation's scallop.
+    program: Option<&'a scallop_engine::ZoneFinishReport>,
     result: &'a KResult,
 }
 
-const NO_GCODE: &str = "not written: the engine's finishing path plans one direction over the whole part; \
-     per-zone G-code needs zone-clipped drop-cutter passes (not built yet). Times are the network planner's.";
+/// The machine of 3+2 zone programs when the job has no `[setup]`.
+const DEFAULT_MACHINE: &str = "linuxcnc-xyzac-trt";
+
+/// The program of the best plan: zones in label order with the optimiser's
+/// directions (and 3+2 orientations), planned by drop-cutter and proven on the stock.
+fn zone_program(
+    spec: &JobFile,
+    folder: &Path,
+    best: &KResult,
+    transitions: Transitions,
+) -> CliResult<scallop_engine::ZoneFinishOutput> {
+    let plan = &best.plan;
+    let mut job = crate::run::finish_job(spec, folder)?;
+    // 3+2 zones are written for the job's [setup] machine (default: the LinuxCNC
+    // XYZAC trunnion); the setup's rotation is not used (each zone has its own).
+    let machine = match job.setup.take() {
+        Some(setup) => setup.machine,
+        None => scallop_machine::Machine::builtin(DEFAULT_MACHINE)
+            .map_err(|e| Failure::rejected(format!("machine `{DEFAULT_MACHINE}`: {e}")))?,
+    };
+    let zone_spec = scallop_engine::ZonePlanSpec {
+        labels: CellLabels { cells_u: plan.grid[0], cells_v: plan.grid[1], labels: plan.labels.clone() },
+        zones: plan
+            .zones
+            .iter()
+            .map(|z| scallop_engine::ZoneSpec {
+                label: u32::try_from(z.zone).unwrap_or(u32::MAX),
+                direction_deg: z.theta_deg,
+                tilt_deg: z.phi_deg,
+                azimuth_deg: z.psi_deg,
+                predicted_time_s: Some(z.time_s),
+            })
+            .collect(),
+        transitions,
+        predicted_time_s: Some(plan.time_s),
+        fixed_margin_mm: None,
+        machine: Some(machine),
+    };
+    scallop_engine::finish_zones(&job, &zone_spec)
+        .map_err(|e| Failure::rejected(format!("the G-code of the best plan (K = {}): {e}", best.k)))
+}
 
 /// `scallop optimize`.
 pub fn run(args: &OptimizeArgs) -> CliResult<()> {
@@ -133,6 +176,23 @@ pub fn run(args: &OptimizeArgs) -> CliResult<()> {
     let _ = multi.clear();
 
     let best = &study.results[study.best];
+    let spinner = progress_bar(0, "G-code of the best plan: planning and verifying");
+    spinner.enable_steady_tick(std::time::Duration::from_millis(120));
+    let gcode_start = Instant::now();
+    let program = zone_program(&spec, folder, best, model_settings.transitions).map_err(|e| prefix(&name, e))?;
+    let gcode_seconds = gcode_start.elapsed().as_secs_f64();
+    spinner.finish_and_clear();
+    let gcode = format!(
+        "program.nc: {} zones by drop-cutter{}, {:.1} s stop-to-stop ({:.1} s predicted by the network model); \
+         simulated scallop {:.5} mm <= {:.5} mm; planned and verified in {:.1} s",
+        program.report.zones.iter().filter(|z| z.passes > 0).count(),
+        if program.report.indexed { " as indexed 3+2 setups" } else { "" },
+        program.report.plan.total_time_s,
+        best.f_best,
+        program.report.sim_max_scallop_mm,
+        program.report.sim_scallop_limit_mm,
+        gcode_seconds
+    );
     let cutter = match model_settings.tool {
         Cutter::Ball { radius } => format!("ball R{radius} mm"),
         Cutter::Toroidal { radius, corner } => format!("bull-nose R{radius} r{corner} mm"),
@@ -145,7 +205,7 @@ pub fn run(args: &OptimizeArgs) -> CliResult<()> {
         scallop_height_mm: model_settings.scallop_height,
         threads: rayon::current_num_threads(),
         wall_time_s: wall,
-        gcode: NO_GCODE,
+        gcode: gcode.clone(),
         study: &study,
     };
     let report = BestReport {
@@ -155,16 +215,26 @@ pub fn run(args: &OptimizeArgs) -> CliResult<()> {
         time_s: best.f_best,
         start_time_s: best.f0,
         eta: best.eta,
-        gcode: NO_GCODE,
+        gcode: gcode.clone(),
+        program: Some(&program.report),
         result: best,
     };
     let out = &args.output;
     write_atomic(&out.join("study.json"), |w| w.write_all(to_json(&file)?.as_bytes()))?;
     write_atomic(&out.join("report.json"), |w| w.write_all(to_json(&report)?.as_bytes()))?;
+    write_atomic(&out.join("program.nc"), |w| w.write_all(program.gcode.as_bytes()))?;
+    write_atomic(&out.join("toolpath.csv"), |w| w.write_all(program.toolpath_csv().as_bytes()))?;
     write_atomic(&out.join("convergence.svg"), |w| w.write_all(convergence_svg(&study).as_bytes()))?;
     let title = format!("{part_name}, {}, K = {}", formulation_name(settings.formulation), best.k);
     write_atomic(&out.join("zones.svg"), |w| w.write_all(zones_svg(&best.plan, &title).as_bytes()))?;
-    let page = scallop_report::html::report_html(&optimisation_report(&patch, &study, &title, &name, &file.cutter));
+    let page = scallop_report::html::report_html(&optimisation_report(
+        &patch,
+        &study,
+        &title,
+        &name,
+        &file.cutter,
+        Some(&program),
+    ));
     write_atomic(&out.join("report.html"), |w| w.write_all(page.as_bytes()))?;
     if args.json {
         return print_json(&file);
@@ -193,14 +263,17 @@ pub fn run(args: &OptimizeArgs) -> CliResult<()> {
     }
     text.push_str(&format!(
         "  best: K = {} in {:.2} s ({:.1}% below its start); mean gain {:.1}%; study {:.1} s on {} threads\n\
-         \x20 wrote {}: study.json, report.json, convergence.svg, zones.svg (no G-code: see report.json)\n",
+         \x20 {}\n\
+         \x20 wrote {}: study.json, report.json, convergence.svg, zones.svg, report.html{}\n",
         best.k,
         best.f_best,
         100.0 * best.eta,
         100.0 * study.mean_eta,
         wall,
         rayon::current_num_threads(),
-        out.display()
+        gcode,
+        out.display(),
+        ", program.nc, toolpath.csv"
     ));
     print_text(&text)
 }
@@ -215,6 +288,7 @@ fn optimisation_report(
     title: &str,
     command: &str,
     cutter: &str,
+    program: Option<&scallop_engine::ZoneFinishOutput>,
 ) -> scallop_report::ReportData {
     use scallop_report::{Convergence, Curve, Figure, ReportData, Zones};
     let best = &study.results[study.best];
@@ -244,8 +318,22 @@ fn optimisation_report(
             &format!("s (from {:.2} s, {} evaluations)", r.f0, r.evaluations),
         ));
     }
+    if let Some(p) = program {
+        let r = &p.report;
+        data.figures.push(Figure::number("program time (drop-cutter, stop-to-stop)", r.plan.total_time_s, 2, "s"));
+        data.figures.push(Figure::number(
+            "program time (look-ahead, cutting)",
+            r.plan.machining_time_lookahead_s,
+            2,
+            "s",
+        ));
+        data.figures.push(Figure::number("simulated scallop", r.sim_max_scallop_mm, 4, "mm"));
+        data.figures.push(Figure::number("scallop limit (sh + resolution bound)", r.sim_scallop_limit_mm, 4, "mm"));
+        data.toolpath = Some(p.toolpath.clone());
+    }
     data.zones = Some(Zones {
-        of_move: Vec::new(),
+        of_move: program
+            .map_or_else(Vec::new, |p| p.zone_of_move.iter().map(|&z| u16::try_from(z).unwrap_or(u16::MAX)).collect()),
         names: best.plan.zones.iter().map(|z| format!("{} ({:.0} deg)", z.zone, z.theta_deg)).collect(),
         times_s: best.plan.zones.iter().map(|z| z.time_s).collect(),
     });

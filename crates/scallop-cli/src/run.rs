@@ -50,7 +50,7 @@ pub fn run(args: &RunArgs) -> CliResult<()> {
     write_finishing(&job, &out, start.elapsed().as_secs_f64(), &args.output, args.json, &command)
 }
 
-fn finish_job(spec: &JobFile, folder: &Path) -> CliResult<FinishJob> {
+pub(crate) fn finish_job(spec: &JobFile, folder: &Path) -> CliResult<FinishJob> {
     let units = if spec.part.units == "in" { UnitsArg::In } else { UnitsArg::Mm };
     let (part, part_name) = match (&spec.part.file, &spec.part.builtin) {
         (Some(file), _) => {

@@ -296,7 +296,7 @@ fn run_with_the_network_planner_writes_a_verified_program() {
 #[test]
 fn optimize_writes_the_study_and_rejects_bad_settings() {
     let dir = scratch("optimize");
-    let job = "[part]\nbuiltin = \"rubio\"\n[cutter]\nshape = \"bull\"\ndiameter = 10\ncorner_radius = 2\n\
+    let job = "[part]\nbuiltin = \"rubio\"\n[cutter]\nshape = \"bull\"\ndiameter = 10\ncorner_radius = 2\nflute_length = 50\n\
                [finishing]\nscallop_height = 0.01\n[optimize]\nformulation = \"3axis\"\nk_min = 2\nk_max = 3\n\
                budget = 8\ngrid = [20, 20]\nsurrogate_grid = [10, 10]\nstep = 1.5\n";
     std::fs::write(dir.join("small.toml"), job).expect("write");
@@ -310,9 +310,49 @@ fn optimize_writes_the_study_and_rejects_bad_settings() {
         assert!(r["f_best"].as_f64().expect("f_best") <= r["f0"].as_f64().expect("f0"));
         assert!(r["evaluations"].as_u64().expect("evaluations") <= 8);
     }
-    for file in ["study.json", "report.json", "convergence.svg", "zones.svg"] {
+    for file in ["study.json", "report.json", "convergence.svg", "zones.svg", "report.html", "toolpath.csv"] {
         assert!(dir.join("out").join(file).exists(), "{file}");
     }
+    // The best plan's drop-cutter program: it parses, and report.json holds its proof.
+    let text = std::fs::read_to_string(dir.join("out/program.nc")).expect("program.nc");
+    let path = scallop_io::gcode::read_gcode(&text, &scallop_io::gcode::GcodeOptions::default()).expect("parses");
+    assert!(path.moves().len() > 100, "{}", path.moves().len());
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("out/report.json")).expect("report.json")).expect("json");
+    let program = &report["program"];
+    let simulated = program["sim_max_scallop_mm"].as_f64().expect("simulated scallop");
+    let limit = program["sim_scallop_limit_mm"].as_f64().expect("limit");
+    assert!(simulated > 0.0 && simulated <= limit && limit < 0.0115, "{program}");
+    assert!(program["plan"]["max_scallop_mm"].as_f64().expect("planner scallop") <= 0.01 * (1.0 + 1e-6));
+    assert!(program["predicted_time_s"].as_f64().expect("network time") > 0.0);
+    assert!(program["plan"]["total_time_s"].as_f64().expect("program time") > 0.0);
+    let zones = program["zones"].as_array().expect("zones");
+    let planned = report["result"]["plan"]["zones"].as_array().expect("the study's zones");
+    assert!(zones.len() == planned.len() && zones.iter().any(|z| z["passes"].as_u64() > Some(0)));
+    assert!(report["gcode"].as_str().expect("gcode").starts_with("program.nc"));
+    assert_eq!(program["indexed"].as_bool(), Some(false));
+
+    // 3+2: indexed setups, each zone proven in its own frame.
+    let tilted = job
+        .replace("formulation = \"3axis\"", "formulation = \"3+2\"")
+        .replace("flute_length = 50", "flute_length = 90");
+    std::fs::write(dir.join("tilted.toml"), &tilted).expect("write");
+    let out = scallop().current_dir(&dir).args(["optimize", "tilted.toml", "-o", "out32"]).output().expect("run");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("out32/report.json")).expect("report.json")).expect("json");
+    let program = &report["program"];
+    assert_eq!(program["indexed"].as_bool(), Some(true), "{program}");
+    let limit = program["sim_scallop_limit_mm"].as_f64().expect("limit");
+    for z in program["zones"].as_array().expect("zones").iter().filter(|z| z["passes"].as_u64() > Some(0)) {
+        let own = z["sim_zone_scallop_mm"].as_f64().expect("each zone proven in its frame");
+        assert!(own > 0.0 && own <= limit, "{z}");
+    }
+    let text = std::fs::read_to_string(dir.join("out32/program.nc")).expect("program.nc");
+    assert!(text.lines().any(|l| l.contains(" A")), "rotary words");
+    let csv = std::fs::read_to_string(dir.join("out32/toolpath.csv")).expect("toolpath.csv");
+    let rows = scallop_io::cl::read_cl_csv(&csv).expect("a cutter-location file with tool axes");
+    assert!(rows.len() > 100 && csv.starts_with("kind,x,y,z,i,j,k"));
     for (bad, key) in [
         (job.replace("k_max = 3", "k_max = 1").replace("k_min = 2", "k_min = 1"), "optimize.k_max"),
         (job.replace("budget = 8", "budget = 0"), "optimize.budget"),

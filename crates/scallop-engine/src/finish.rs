@@ -386,12 +386,7 @@ pub fn run_finishing(job: &FinishJob) -> Result<FinishOutput, EngineError> {
         planned.report.mean_scallop_mm = v.excess_volume / (cells * job.sim_resolution * job.sim_resolution);
     }
 
-    let cutter_text = match *job.cutter.shape() {
-        CutterShape::Bull { radius, corner } => format!("bull-nose R{radius} r{corner} mm"),
-        CutterShape::Ball { radius } => format!("ball R{radius} mm"),
-        CutterShape::Flat { radius } => format!("flat R{radius} mm"),
-        CutterShape::Cone { radius, .. } => format!("cone R{radius} mm"),
-    };
+    let cutter_text = cutter_text(job.cutter.shape());
     let r = &planned.report;
     let comments = [
         format!("part: {}, tessellated within {:.5} mm", job.part_name, prepared.chordal_error),
@@ -657,10 +652,20 @@ fn indexed_program(job: &FinishJob, setup: &Setup, path: &Toolpath, time: f64) -
     })
 }
 
+/// A cutter as reports name it.
+pub(crate) fn cutter_text(shape: &CutterShape) -> String {
+    match *shape {
+        CutterShape::Bull { radius, corner } => format!("bull-nose R{radius} r{corner} mm"),
+        CutterShape::Ball { radius } => format!("ball R{radius} mm"),
+        CutterShape::Flat { radius } => format!("flat R{radius} mm"),
+        CutterShape::Cone { radius, .. } => format!("cone R{radius} mm"),
+    }
+}
+
 /// Rapid rate of the demo machine (mm/s).
 const RAPID_RATE: f64 = 500.0;
 /// Direction change above which the stop-to-stop model stops (degrees).
-const SHARP_CORNER_DEG: f64 = 30.0;
+pub(crate) const SHARP_CORNER_DEG: f64 = 30.0;
 
 /// The toolpath as CSV: `kind,x,y,z` per move.
 #[must_use]

@@ -1,6 +1,9 @@
 //! The API boundary of scallop: a part (mesh or parametric surfaces) and the
 //! machining settings in, cutter locations, toolpaths, G-code text and
 //! reports out. Orchestration only: the geometry lives in the crates below.
+//! [`run_finishing`] machines a part in one direction or 3+2 setup;
+//! [`finish_zones`] machines a zone plan of the optimiser zone by zone (each in
+//! its direction or 3+2 orientation) and proves it on the simulated stock.
 //!
 //! ```
 //! use scallop_engine::{Part, prepare_part};
@@ -17,6 +20,7 @@
 mod demo;
 mod finish;
 mod grid;
+mod zones;
 
 use scallop_geom::Tolerances;
 use scallop_mesh::{MeshIndex, TriMesh};
@@ -28,6 +32,10 @@ pub use finish::{
     toolpath_csv,
 };
 pub use grid::{GridAxis, GridError, MAX_GRID_POINTS};
+pub use zones::{
+    ZONE_MARGIN_PER_RADIUS, ZONE_MARGIN_PER_SPACING, ZONE_MARGIN_ROUNDS, ZoneFigures, ZoneFinishOutput,
+    ZoneFinishReport, ZonePlanSpec, ZoneSpec, finish_zones,
+};
 
 /// Why the engine rejected a request. Each variant says the cause and the fix.
 #[derive(Debug, thiserror::Error)]
@@ -75,6 +83,34 @@ pub enum EngineError {
         limit: f64,
         /// The simulator's resolution bound (mm).
         bound: f64,
+    },
+    /// The drop-cutter planner refused one zone of a zone plan.
+    #[error("finishing zone {zone} along {direction_deg:.2} deg: {source}")]
+    Zone {
+        /// The zone's label.
+        zone: u32,
+        /// Its feed direction (degrees).
+        direction_deg: f64,
+        /// Why.
+        source: scallop_strategy::StrategyError,
+    },
+    /// The stock simulation measured a scallop above the height asked plus the
+    /// simulation's resolution bound: the program does not finish the surface
+    /// as promised (a planner bug, or zones too narrow for their margins).
+    #[error(
+        "verification: the simulated scallop {height} mm near ({x:.3}, {y:.3}) mm exceeds {limit} mm \
+         (scallop height plus the simulation's resolution bound); use a finer `verify.resolution`, \
+         fewer zones, or report the job as a planner bug"
+    )]
+    ScallopExceeded {
+        /// Simulated scallop (mm).
+        height: f64,
+        /// The limit (mm).
+        limit: f64,
+        /// Place (mm).
+        x: f64,
+        /// Place (mm).
+        y: f64,
     },
     /// The program cannot be written as asked (dialect, machine, 3+2 setup).
     #[error("output: {what}; fix: {fix}")]

@@ -53,10 +53,26 @@
 //!   cutter riding on the part's edge, or touching nothing, has left it. The
 //!   contact points then sweep the surface up to its edges, so pass lengths are
 //!   the surface's (the analytic models of finishing.md 8).
+//! - **Zones.** [`plan_zone_finishing`] adds a [`ZoneRegion`]: a cutter location
+//!   also needs its contact in one zone of a per-triangle labelling of the mesh,
+//!   dilated by a margin (facet contacts by their triangle, edge and vertex
+//!   contacts by any triangle on that edge or vertex). Passes split where their
+//!   contact leaves the dilated zone, and the plane range is the dilated zone's.
+//!   Pass ends then lie inside the part: the scallop is measured only at
+//!   sections at least the cutter radius from both passes' ends (nearer, the
+//!   envelope lacks the cutter locations beyond the end), and collinear points are
+//!   merged by their vertical distance to the chord (the optimiser's directions
+//!   and 3+2 tilts give steep passes, where the perpendicular distance of
+//!   `simplify` allows a height error of `SIMPLIFY_SHARE * path / cos(slope)`);
+//!   the margin makes each zone finish itself up to its border (see
+//!   [`ZoneRegion`]), and the whole program's stock simulation checks it
+//!   (`scallop_engine::finish_zones`).
 //! - **Passes.** Plane `k` is the vertical plane `m . p = d_k`, `m` normal to the
 //!   feed direction `f`. Along it the cutter is dropped (exact drop-cutter) on a
 //!   uniform grid of step `max_step` (in parallel), then a step is bisected while
-//!   the CL midpoint deviates from the chord by more than `SAMPLING_SHARE * path`.
+//!   the CL midpoint lies farther than `SAMPLING_SHARE * path` above or below the
+//!   chord (vertically: gouges are heights, and on a steep pass the vertical gap
+//!   is the perpendicular one over the cosine of the slope).
 //!   Samples outside the region split the plane into passes (non-convex parts
 //!   give several); each pass end is located by bisection to
 //!   `BOUNDARY_SHARE * path`. Collinear points are merged by
@@ -142,6 +158,7 @@ mod leads;
 pub mod network;
 mod params;
 mod plan;
+mod region;
 mod scallop;
 mod time;
 pub mod tol;
@@ -151,6 +168,7 @@ pub use error::StrategyError;
 pub use iso::{IsoDirection, IsoPass, IsoPlanned, iso_scallop, plan_isoparametric};
 pub use leads::{LeadFallback, LeadKind, LeadReport, apply_leads};
 pub use params::{Boundary, FinishingParams, Pattern};
+pub use region::ZoneRegion;
 pub use scallop::{PairScallop, ScallopReport, verify_scallop};
 pub use time::{ClassTimes, MoveFeed, lookahead_profile, lookahead_time, stop_to_stop_time};
 
@@ -245,12 +263,50 @@ pub fn plan_finishing(
     params: &FinishingParams,
     tol: &Tolerances,
 ) -> Result<Planned, StrategyError> {
-    let mut planner = plan::Planner::new(index, cutter, params, tol)?;
+    plan(index, cutter, params, tol, None)
+}
+
+/// [`plan_finishing`] restricted to one zone of a labelled part: a cutter
+/// location belongs to the region when it does under `params.boundary` **and**
+/// its contact lies in the dilated zone ([`ZoneRegion`]). Planes crossing a
+/// non-convex zone give several passes; the plane range is the dilated zone's.
+/// The verified scallop ([`Planned::scallop`]) is that of the zone's passes.
+/// `index` must index the mesh the region was built on.
+///
+/// # Errors
+/// As [`plan_finishing`]; [`StrategyError::EmptyRegion`] when no pass touches
+/// the dilated zone.
+pub fn plan_zone_finishing(
+    index: &MeshIndex,
+    cutter: &Cutter,
+    params: &FinishingParams,
+    tol: &Tolerances,
+    region: &ZoneRegion,
+) -> Result<Planned, StrategyError> {
+    plan(index, cutter, params, tol, Some(region))
+}
+
+fn plan(
+    index: &MeshIndex,
+    cutter: &Cutter,
+    params: &FinishingParams,
+    tol: &Tolerances,
+    region: Option<&ZoneRegion>,
+) -> Result<Planned, StrategyError> {
+    let mut planner = plan::Planner::new(index, cutter, params, tol, region)?;
     let planes = planner.sweep()?;
     let (toolpath, links, retracts) = planner.toolpath(&planes);
     let planes: Vec<Plane> = planes.into_iter().map(|p| p.plane).collect();
     let feed_samples = planner.feed_samples.clone();
-    let scallop = verify_scallop(index, cutter, &planes, params.direction, &feed_samples, params.scallop_height)?;
+    let scallop = scallop::verify_scallop_within(
+        index,
+        cutter,
+        &planes,
+        params.direction,
+        &feed_samples,
+        params.scallop_height,
+        plan::zone_end_margin(cutter, region),
+    )?;
     let a = stop_to_stop_time(&toolpath, params);
     let b = lookahead_time(&toolpath, params);
     let feed = toolpath.length(MoveKind::Feed);

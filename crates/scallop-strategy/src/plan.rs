@@ -10,7 +10,7 @@ use scallop_toolpath::{Move, MoveKind, Toolpath, simplify};
 
 use crate::geometry::{Frame, PartBoundary, contact_normal, slots_by_original};
 use crate::scallop::{Curve, Measure, pair_heights};
-use crate::{Boundary, FinishingParams, Pattern, Plane, StrategyError, tol};
+use crate::{Boundary, FinishingParams, Pattern, Plane, StrategyError, ZoneRegion, tol};
 
 /// A straight XY line `origin + t dir` along which the cutter is dropped.
 #[derive(Debug, Clone, Copy)]
@@ -41,11 +41,15 @@ pub(crate) struct Planner<'a> {
     pub(crate) frame: Frame,
     slots: Vec<u32>,
     part_boundary: PartBoundary,
+    region: Option<&'a ZoneRegion>,
     measure: Measure<'a>,
     raw_measure: Measure<'a>,
     floor: f64,
     sample_tol: f64,
     simplify_tol: f64,
+    /// Merge by the vertical distance to the chord (zone planning), else by the
+    /// perpendicular one (`scallop_toolpath::simplify`).
+    vertical_merge: bool,
     boundary_tol: f64,
     min_step: f64,
     pub(crate) d_range: [f64; 2],
@@ -69,6 +73,7 @@ impl<'a> Planner<'a> {
         cutter: &'a Cutter,
         params: &'a FinishingParams,
         tol_: &Tolerances,
+        region: Option<&'a ZoneRegion>,
     ) -> Result<Planner<'a>, StrategyError> {
         params.validate()?;
         if !(tol_.path.is_finite() && tol_.path > 0.0) {
@@ -101,6 +106,9 @@ impl<'a> Planner<'a> {
         };
         let (mut t_range, mut d_range) = ([f64::INFINITY, f64::NEG_INFINITY], [f64::INFINITY, f64::NEG_INFINITY]);
         for slot in 0..index.len() {
+            if region.is_some_and(|r| !r.contains_triangle(index.original_index(slot))) {
+                continue;
+            }
             for p in index.corners(slot) {
                 let (t, d) = (frame.t(p), frame.d(p));
                 t_range = [t_range[0].min(t), t_range[1].max(t)];
@@ -118,6 +126,7 @@ impl<'a> Planner<'a> {
         let n = steps as usize;
         let feed_samples = (0..=n).map(|k| t_range[0] + span * (k as f64 / steps)).collect();
         let bounds = index.bounds();
+        let end_margin = zone_end_margin(cutter, region);
         Ok(Planner {
             index,
             cutter,
@@ -127,11 +136,13 @@ impl<'a> Planner<'a> {
             frame,
             slots: slots_by_original(index),
             part_boundary: PartBoundary::new(index),
-            measure: Measure::new(index, cutter, params.direction, sh),
-            raw_measure: Measure { refine: false, ..Measure::new(index, cutter, params.direction, sh) },
+            region,
+            measure: Measure { end_margin, ..Measure::new(index, cutter, params.direction, sh) },
+            raw_measure: Measure { refine: false, end_margin, ..Measure::new(index, cutter, params.direction, sh) },
             floor: bounds.min.z - bounds.diagonal() - 1.0,
             sample_tol: tol::SAMPLING_SHARE * tol_.path,
             simplify_tol: tol::SIMPLIFY_SHARE * tol_.path,
+            vertical_merge: region.is_some(),
             boundary_tol: tol::BOUNDARY_SHARE * tol_.path,
             min_step: params.max_step * tol::MIN_STEP_FRACTION,
             d_range,
@@ -139,6 +150,15 @@ impl<'a> Planner<'a> {
             drops: 0,
             bridge_span: None,
         })
+    }
+
+    /// Indices of the points kept by merging nearly collinear ones.
+    fn merge(&self, points: &[Point3]) -> Vec<usize> {
+        if self.vertical_merge {
+            simplify_vertical(points, self.simplify_tol)
+        } else {
+            simplify(points, self.simplify_tol)
+        }
     }
 
     fn drop_at(&mut self, xy: Point2) -> ClPoint {
@@ -149,10 +169,18 @@ impl<'a> Planner<'a> {
     fn is_inside(&self, cl: &ClPoint, _scratch: &mut Vec<u32>) -> bool {
         if let Some([t0, t1]) = self.bridge_span {
             let t = self.frame.t(&cl.tip);
-            return !matches!(cl.contact, Contact::Floor) && t >= t0 && t <= t1;
+            // Any contact with the part (its open boundary too), within the
+            // span, and within the zone when planning one.
+            return !matches!(cl.contact, Contact::Floor)
+                && t >= t0
+                && t <= t1
+                && self.region.is_none_or(|r| r.contains_contact(self.index, &self.slots, cl));
         }
         match self.params.boundary {
-            Boundary::ContactInside => self.part_boundary.is_interior_contact(self.index, &self.slots, cl),
+            Boundary::ContactInside => {
+                self.part_boundary.is_interior_contact(self.index, &self.slots, cl)
+                    && self.region.is_none_or(|r| r.contains_contact(self.index, &self.slots, cl))
+            }
         }
     }
 
@@ -193,7 +221,7 @@ impl<'a> Planner<'a> {
             }
             return;
         }
-        if distance_to_segment(&mid.cl.tip, &a.cl.tip, &b.cl.tip) > self.sample_tol {
+        if vertical_gap(&mid.cl.tip, &a.cl.tip, &b.cl.tip) > self.sample_tol {
             self.refine(line, a, mid, out, scratch);
             self.refine(line, mid, b, out, scratch);
         } else {
@@ -210,7 +238,7 @@ impl<'a> Planner<'a> {
             if matches!(mid.cl.contact, Contact::Floor) {
                 return None;
             }
-            if distance_to_segment(&mid.cl.tip, &a.cl.tip, &b.cl.tip) > self.sample_tol {
+            if vertical_gap(&mid.cl.tip, &a.cl.tip, &b.cl.tip) > self.sample_tol {
                 self.refine_link(line, a, mid, out)?;
                 return self.refine_link(line, mid, b, out);
             }
@@ -282,7 +310,7 @@ impl<'a> Planner<'a> {
         let mut samples = Vec::new();
         for run in runs {
             let points: Vec<Point3> = run.iter().map(|s| s.cl.tip).collect();
-            let kept = simplify(&points, self.simplify_tol);
+            let kept = self.merge(&points);
             passes.push(kept.iter().map(|&i| points[i]).collect::<Vec<_>>());
             samples.extend(run.iter().map(|s| s.cl));
         }
@@ -474,7 +502,8 @@ impl<'a> Planner<'a> {
     /// ranges no cutter location has an interior contact (the cutter rides on
     /// the part's open boundary), yet the surface between the ranges' passes may
     /// stand above `sh` (a raised edge that only the boundary-riding cutter
-    /// reaches). The bridge planes accept any contact with the part, within the
+    /// reaches). The bridge planes accept any contact with the part (in the zone,
+    /// when planning one), within the
     /// feed span of the two neighbours' passes widened by the cutter radius: the
     /// cutter only lowers material there (every CL point is a drop-cutter
     /// point, so no gouge) and the final verification covers the new pairs.
@@ -574,7 +603,7 @@ impl<'a> Planner<'a> {
         if let Some(last) = points.last_mut() {
             *last = *b;
         }
-        let kept = simplify(&points, self.simplify_tol);
+        let kept = self.merge(&points);
         Some(kept.iter().skip(1).map(|&i| points[i]).collect())
     }
 
@@ -628,14 +657,57 @@ impl<'a> Planner<'a> {
     }
 }
 
-fn distance_to_segment(p: &Point3, a: &Point3, b: &Point3) -> f64 {
-    let ab = b - a;
-    let len2 = ab.norm_squared();
-    let ap = p - a;
-    if len2 > 0.0 {
-        let t = (ap.dot(&ab) / len2).clamp(0.0, 1.0);
-        (ap - ab * t).norm()
-    } else {
-        ap.norm()
+/// Sections this close to a pass end are not measured (see `Measure::end_margin`):
+/// the cutter radius in zone planning, where passes end inside the part; 0 otherwise.
+pub(crate) fn zone_end_margin(cutter: &Cutter, region: Option<&ZoneRegion>) -> f64 {
+    region.map_or(0.0, |_| cutter.radius())
+}
+
+/// Douglas-Peucker merging of nearly collinear CL points by their **vertical**
+/// distance to the chord (at their position along the chord in XY), both sides:
+/// the indices kept, in order, first and last included. A pass or a link runs
+/// along one XY line, so this bounds the height error of the merged path (what
+/// a gouge is), which the perpendicular distance does not on steep passes.
+fn simplify_vertical(points: &[Point3], max_deviation: f64) -> Vec<usize> {
+    let n = points.len();
+    if n <= 2 {
+        return (0..n).collect();
     }
+    let mut keep = vec![false; n];
+    keep[0] = true;
+    keep[n - 1] = true;
+    let mut stack = vec![(0, n - 1)];
+    while let Some((i, j)) = stack.pop() {
+        let (a, b) = (points[i], points[j]);
+        let ab = Vec2::new(b.x - a.x, b.y - a.y);
+        let len2 = ab.norm_squared();
+        let mut worst: Option<(f64, usize)> = None;
+        for (k, p) in points.iter().enumerate().take(j).skip(i + 1) {
+            let deviation = if len2 > 0.0 {
+                let s = (Vec2::new(p.x - a.x, p.y - a.y).dot(&ab) / len2).clamp(0.0, 1.0);
+                (p.z - (a.z + (b.z - a.z) * s)).abs()
+            } else {
+                (p - a).norm()
+            };
+            if worst.is_none_or(|(w, _)| deviation > w) {
+                worst = Some((deviation, k));
+            }
+        }
+        if let Some((deviation, k)) = worst
+            && deviation > max_deviation
+        {
+            keep[k] = true;
+            stack.push((k, j));
+            stack.push((i, k));
+        }
+    }
+    (0..n).filter(|&k| keep[k]).collect()
+}
+
+/// Vertical distance of the CL point `mid`, dropped at the XY midpoint of `a`
+/// and `b`, from their chord. Gouges are heights (the stock simulation measures
+/// stock below part vertically), and on a steep pass the vertical gap is the
+/// perpendicular distance divided by the cosine of the slope.
+fn vertical_gap(mid: &Point3, a: &Point3, b: &Point3) -> f64 {
+    (mid.z - 0.5 * (a.z + b.z)).abs()
 }

@@ -52,9 +52,10 @@ impl Curve {
         Curve { ts, zs, d }
     }
 
-    pub(crate) fn covers(&self, t: f64) -> bool {
+    /// Whether `t` lies on the curve at least `margin` from both ends.
+    pub(crate) fn covers_inside(&self, t: f64, margin: f64) -> bool {
         match (self.ts.first(), self.ts.last()) {
-            (Some(&a), Some(&b)) => a <= t && t <= b,
+            (Some(&a), Some(&b)) => a + margin <= t && t <= b - margin,
             _ => false,
         }
     }
@@ -212,6 +213,11 @@ pub(crate) struct Measure<'a> {
     /// Whether heights above the limit are re-measured (costly: dense virtual passes).
     pub(crate) refine: bool,
     pub(crate) floor: f64,
+    /// Sections closer than this to an end of a pass (along the feed) are not
+    /// measured (0: every section both passes cover). Zone planning sets the
+    /// cutter radius: there a pass may end inside the part, and the envelope of
+    /// a section within R of such an end lacks the cutter locations beyond it.
+    pub(crate) end_margin: f64,
 }
 
 impl<'a> Measure<'a> {
@@ -225,6 +231,7 @@ impl<'a> Measure<'a> {
             limit,
             refine: true,
             floor: b.min.z - b.diagonal() - 1.0,
+            end_margin: 0.0,
         }
     }
 
@@ -438,7 +445,20 @@ pub fn verify_scallop(
     feed_samples: &[f64],
     scallop_height: f64,
 ) -> Result<ScallopReport, StrategyError> {
-    let measure = Measure::new(index, cutter, direction, scallop_height);
+    verify_scallop_within(index, cutter, planes, direction, feed_samples, scallop_height, 0.0)
+}
+
+/// [`verify_scallop`] leaving out the sections within `end_margin` of a pass end.
+pub(crate) fn verify_scallop_within(
+    index: &MeshIndex,
+    cutter: &Cutter,
+    planes: &[Plane],
+    direction: f64,
+    feed_samples: &[f64],
+    scallop_height: f64,
+    end_margin: f64,
+) -> Result<ScallopReport, StrategyError> {
+    let measure = Measure { end_margin, ..Measure::new(index, cutter, direction, scallop_height) };
     let frame = measure.frame;
     let curves: Vec<Vec<Curve>> =
         planes.iter().map(|pl| pl.passes.iter().map(|p| Curve::new(&frame, p)).collect()).collect();
@@ -525,8 +545,9 @@ pub(crate) fn pair_heights(
     let mut scratch = Vec::new();
     let mut out = Vec::new();
     for &t in feed_samples {
-        for a in first.iter().filter(|c| c.covers(t)) {
-            for b in second.iter().filter(|c| c.covers(t)) {
+        let m = measure.end_margin;
+        for a in first.iter().filter(|c| c.covers_inside(t, m)) {
+            for b in second.iter().filter(|c| c.covers_inside(t, m)) {
                 if let Some(c) = cusp(measure, a, b, t, &mut scratch) {
                     out.push(c);
                 }

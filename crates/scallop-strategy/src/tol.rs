@@ -7,7 +7,7 @@
 
 /// Share of the path tolerance for the chordal deviation of the sampled CL
 /// polyline (a step is bisected while the CL midpoint is farther than this
-/// share of `path` from the chord).
+/// share of `path` above or below the chord).
 pub const SAMPLING_SHARE: f64 = 0.5;
 
 /// Share of the path tolerance for merging nearly collinear CL points
