@@ -295,6 +295,13 @@ pub(crate) fn means(stats: &Stats, previous: &[[f64; 4]], mode: ThetaMode) -> Ve
     stats.sums.iter().zip(previous).map(|(s, p)| s.mean(mode).unwrap_or(*p)).collect()
 }
 
+/// [`means`] into a caller-owned buffer of the same length.
+pub(crate) fn means_into(stats: &Stats, previous: &[[f64; 4]], mode: ThetaMode, out: &mut [[f64; 4]]) {
+    for ((o, s), p) in out.iter_mut().zip(&stats.sums).zip(previous) {
+        *o = s.mean(mode).unwrap_or(*p);
+    }
+}
+
 /// Drops empty clusters: relabels `labels` to `0..m` keeping the order of the
 /// original cluster indices; returns `m` and the kept original indices.
 pub(crate) fn compact(labels: &mut [u32], k: usize) -> (usize, Vec<usize>) {

@@ -18,7 +18,7 @@
 
 use std::f64::consts::{FRAC_PI_2, PI};
 
-use crate::engine::{Frozen, Setup, Stats, circle_centres, compact, means};
+use crate::engine::{Frozen, Setup, Stats, circle_centres, compact, means, means_into};
 use crate::features::ThetaMode;
 #[cfg(doc)]
 use crate::features::delta;
@@ -101,6 +101,14 @@ impl Soa {
         Soa { c: std::array::from_fn(|j| centres.iter().map(|c| c[j]).collect()), d: vec![0.0; centres.len()] }
     }
 
+    fn set(&mut self, centres: &[[f64; 4]]) {
+        for (c, x) in centres.iter().enumerate() {
+            for (j, &v) in x.iter().enumerate() {
+                self.c[j][c] = v;
+            }
+        }
+    }
+
     /// Nearest and second-nearest `d^2` of `x` (lowest index on ties); the same
     /// arithmetic as [`distance2`].
     #[inline(always)]
@@ -142,6 +150,18 @@ pub(crate) fn kmeans_bounded(setup: &Setup, k: usize, max_iterations: usize) -> 
     }
 }
 
+/// What one sweep's bound upkeep needs of a centre.
+#[derive(Clone, Copy, Default)]
+struct Drift {
+    /// How far the centre moved.
+    shift: f64,
+    /// How far any other centre moved at most (the decrement of the lower bounds
+    /// of its cells).
+    others: f64,
+    /// Half the distance to the nearest other centre.
+    half_gap: f64,
+}
+
 fn bounded<const WRAPPED: bool>(setup: &Setup, k: usize, max_iterations: usize) -> Clustering {
     let f = setup.features;
     let n = f.len();
@@ -158,17 +178,18 @@ fn bounded<const WRAPPED: bool>(setup: &Setup, k: usize, max_iterations: usize) 
         lower[i] = d2.sqrt();
     }
     let mut stats = Stats::batch(setup, &labels, k);
-    let (mut shift, mut half_gap) = (vec![0.0; k], vec![0.0; k]);
+    let mut drift = vec![Drift::default(); k];
+    let mut moved_centres = centres.clone();
     let (mut iterations, mut converged) = (0, false);
     let slack = 1.0 + tol::HAMERLY_SLACK;
     for it in 1..=max_iterations {
         iterations = it;
-        let moved_centres = means(&stats, &centres, setup.mode);
+        means_into(&stats, &centres, setup.mode, &mut moved_centres);
         for c in 0..k {
-            shift[c] = distance(&centres[c], &moved_centres[c]);
+            drift[c].shift = distance(&centres[c], &moved_centres[c]);
         }
-        centres = moved_centres;
-        soa = Soa::new(&centres);
+        std::mem::swap(&mut centres, &mut moved_centres);
+        soa.set(&centres);
         for c in 0..k {
             let mut nearest = f64::INFINITY;
             for j in 0..k {
@@ -176,11 +197,12 @@ fn bounded<const WRAPPED: bool>(setup: &Setup, k: usize, max_iterations: usize) 
                     nearest = nearest.min(distance(&centres[c], &centres[j]));
                 }
             }
-            half_gap[c] = 0.5 * nearest;
+            drift[c].half_gap = 0.5 * nearest;
         }
         // Largest and second-largest centre shifts.
         let (mut top, mut top_index, mut second) = (0.0f64, usize::MAX, 0.0f64);
-        for (c, &s) in shift.iter().enumerate() {
+        for (c, d) in drift.iter().enumerate() {
+            let s = d.shift;
             if s > top {
                 second = top;
                 top = s;
@@ -189,26 +211,31 @@ fn bounded<const WRAPPED: bool>(setup: &Setup, k: usize, max_iterations: usize) 
                 second = s;
             }
         }
+        for (c, d) in drift.iter_mut().enumerate() {
+            d.others = if c == top_index { second } else { top };
+        }
         let mut moved = false;
-        for (i, x) in f.x.iter().enumerate() {
+        let (xs, labels, upper, lower) = (&f.x[..n], &mut labels[..n], &mut upper[..n], &mut lower[..n]);
+        for i in 0..n {
             let a = labels[i] as usize;
-            let mut u = upper[i] + shift[a];
-            let l = lower[i] - if a == top_index { second } else { top };
+            let Drift { shift, others, half_gap } = drift[a];
+            let mut u = upper[i] + shift;
+            let l = lower[i] - others;
             lower[i] = l;
-            let bound = half_gap[a].max(l);
+            let bound = half_gap.max(l);
             if u * slack < bound {
                 upper[i] = u;
                 continue;
             }
-            u = distance(x, &centres[a]);
+            u = distance(&xs[i], &centres[a]);
             upper[i] = u;
             if u * slack < bound {
                 continue;
             }
-            let (best, d1, d2) = soa.scan::<WRAPPED>(x, &w);
+            let (best, d1, d2) = soa.scan::<WRAPPED>(&xs[i], &w);
             upper[i] = d1.sqrt();
             lower[i] = d2.sqrt();
-            if best as usize != a {
+            if best != labels[i] {
                 moved = true;
                 stats.move_point(setup, i, labels[i], best);
                 labels[i] = best;
