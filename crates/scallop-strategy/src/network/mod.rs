@@ -547,9 +547,12 @@ impl Zoning {
             });
         }
         let (nu, nv) = network.resolution();
-        let mut zones: Vec<u32> = labels.labels.clone();
-        zones.sort_unstable();
-        zones.dedup();
+        let (zones, index) = distinct_labels(&labels.labels);
+        // INVARIANT: every label is in `zones`.
+        let zone_index = |l: u32| match &index {
+            Some(index) => index[l as usize] as usize,
+            None => zones.binary_search(&l).unwrap_or(0),
+        };
         let mut quads = vec![Vec::new(); zones.len()];
         let mut quad_label = Vec::with_capacity(nu * nv);
         let ranges_u: Vec<(usize, usize)> = (0..nu).map(|a| cell_range(a, nu, labels.cells_u)).collect();
@@ -563,8 +566,7 @@ impl Zoning {
                     labels.labels[i * labels.cells_v + j0..=i * labels.cells_v + j1].iter().all(|&l| l == first)
                 });
                 if uniform {
-                    // INVARIANT: every label is in `zones`.
-                    quads[zones.binary_search(&first).unwrap_or(0)].push(q);
+                    quads[zone_index(first)].push(q);
                     quad_label.push(first);
                     continue;
                 }
@@ -576,9 +578,8 @@ impl Zoning {
                         }
                     }
                 }
-                for l in &seen {
-                    // INVARIANT: every label is in `zones`.
-                    quads[zones.binary_search(l).unwrap_or(0)].push(q);
+                for &l in &seen {
+                    quads[zone_index(l)].push(q);
                 }
                 quad_label.push(MIXED);
             }
@@ -608,6 +609,32 @@ impl Zoning {
         let ((i0, i1), (j0, j1)) = (self.ranges_u[a], self.ranges_v[b]);
         (i0..=i1).any(|i| (j0..=j1).any(|j| self.labels.labels[i * self.labels.cells_v + j] == zone))
     }
+}
+
+/// The distinct labels, increasing, and when they are small enough for a table
+/// (below twice the number of cells, the usual dense zone numbering) the index
+/// of every label in that list.
+fn distinct_labels(labels: &[u32]) -> (Vec<u32>, Option<Vec<u32>>) {
+    let top = labels.iter().copied().max().unwrap_or(0) as usize;
+    if top >= 2 * labels.len().max(1) {
+        let mut zones = labels.to_vec();
+        zones.sort_unstable();
+        zones.dedup();
+        return (zones, None);
+    }
+    let mut index = vec![u32::MAX; top + 1];
+    for &l in labels {
+        index[l as usize] = 0;
+    }
+    let mut zones = Vec::new();
+    for (l, slot) in index.iter_mut().enumerate() {
+        if *slot == 0 {
+            // INVARIANT: l <= top < 2 * cells < u32::MAX (CellLabels are u32-indexed).
+            *slot = u32::try_from(zones.len()).unwrap_or(u32::MAX);
+            zones.push(u32::try_from(l).unwrap_or(u32::MAX));
+        }
+    }
+    (zones, Some(index))
 }
 
 /// Cells `[first, last]` overlapped (with positive area) by network interval
@@ -752,6 +779,32 @@ mod tests {
                     let k = a * vs.len() + b;
                     assert!((points[k] - patch.point(u, v)).norm() < 1e-12, "{u} {v}");
                     assert!((normals[k] - patch.normal(u, v)).norm() < 1e-12, "{u} {v}");
+                }
+            }
+        }
+    }
+
+    /// The distinct-label table equals sort + dedup, for dense and sparse labels.
+    #[test]
+    fn distinct_labels_equal_sorted_dedup() {
+        let mut seed = 7u64;
+        for case in 0..60u32 {
+            let len = 1 + (case as usize * 13) % 97;
+            let spread = if case % 3 == 0 { 1u64 << 31 } else { u64::from(case % 11 + 1) };
+            let labels: Vec<u32> = (0..len)
+                .map(|_| {
+                    seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+                    u32::try_from((seed >> 33) % spread).unwrap()
+                })
+                .collect();
+            let mut expected = labels.clone();
+            expected.sort_unstable();
+            expected.dedup();
+            let (zones, index) = distinct_labels(&labels);
+            assert_eq!(zones, expected, "case {case}");
+            if let Some(index) = index {
+                for (i, &z) in zones.iter().enumerate() {
+                    assert_eq!(index[z as usize] as usize, i, "case {case}");
                 }
             }
         }
