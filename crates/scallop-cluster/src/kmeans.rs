@@ -101,14 +101,6 @@ impl Soa {
         Soa { c: std::array::from_fn(|j| centres.iter().map(|c| c[j]).collect()), d: vec![0.0; centres.len()] }
     }
 
-    fn set(&mut self, centres: &[[f64; 4]]) {
-        for (c, x) in centres.iter().enumerate() {
-            for (j, &v) in x.iter().enumerate() {
-                self.c[j][c] = v;
-            }
-        }
-    }
-
     /// Nearest and second-nearest `d^2` of `x` (lowest index on ties); the same
     /// arithmetic as [`distance2`].
     #[inline(always)]
@@ -179,6 +171,7 @@ fn bounded<const WRAPPED: bool>(setup: &Setup, k: usize, max_iterations: usize) 
     }
     let mut stats = Stats::batch(setup, &labels, k);
     let mut drift = vec![Drift::default(); k];
+    let mut near = vec![(0.0, 0u32); k * k.saturating_sub(1)];
     let mut moved_centres = centres.clone();
     let (mut iterations, mut converged) = (0, false);
     let slack = 1.0 + tol::HAMERLY_SLACK;
@@ -189,15 +182,20 @@ fn bounded<const WRAPPED: bool>(setup: &Setup, k: usize, max_iterations: usize) 
             drift[c].shift = distance(&centres[c], &moved_centres[c]);
         }
         std::mem::swap(&mut centres, &mut moved_centres);
-        soa.set(&centres);
-        for c in 0..k {
-            let mut nearest = f64::INFINITY;
-            for j in 0..k {
-                if j != c {
-                    nearest = nearest.min(distance(&centres[c], &centres[j]));
+        // Every centre's others by increasing distance (the scan's candidates).
+        if k == 1 {
+            drift[0].half_gap = f64::INFINITY;
+        }
+        for (c, list) in near.chunks_exact_mut(k.max(2) - 1).enumerate() {
+            let others = (0..k).filter(|&j| j != c);
+            for (slot, j) in list.iter_mut().zip(others) {
+                #[allow(clippy::cast_possible_truncation)] // k <= cells < u32::MAX
+                {
+                    *slot = (distance(&centres[c], &centres[j]), j as u32);
                 }
             }
-            drift[c].half_gap = 0.5 * nearest;
+            list.sort_unstable_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+            drift[c].half_gap = 0.5 * list[0].0;
         }
         // Largest and second-largest centre shifts.
         let (mut top, mut top_index, mut second) = (0.0f64, usize::MAX, 0.0f64);
@@ -227,14 +225,36 @@ fn bounded<const WRAPPED: bool>(setup: &Setup, k: usize, max_iterations: usize) 
                 upper[i] = u;
                 continue;
             }
-            u = distance(&xs[i], &centres[a]);
+            let x = &xs[i];
+            let d2a = distance2::<WRAPPED>(x, &centres[a], &w);
+            u = d2a.sqrt();
             upper[i] = u;
             if u * slack < bound {
                 continue;
             }
-            let (best, d1, d2) = soa.scan::<WRAPPED>(&xs[i], &w);
-            upper[i] = d1.sqrt();
-            lower[i] = d2.sqrt();
+            // Scan the centres that can be nearer than `a`: those closer to `a` than
+            // 2u (plus slack); a farther centre j is at least `d(a, j) - u > u` away.
+            let limit = 2.0 * u * slack + tol::HAMERLY_ABSOLUTE;
+            #[allow(clippy::cast_possible_truncation)] // k <= cells < u32::MAX
+            let (mut best, mut d_best, mut d_second) = (a as u32, d2a, f64::INFINITY);
+            let mut beyond = f64::INFINITY;
+            for &(gap, j) in &near[a * (k - 1)..(a + 1) * (k - 1)] {
+                if gap > limit {
+                    beyond = gap - u;
+                    break;
+                }
+                let dj = distance2::<WRAPPED>(x, &centres[j as usize], &w);
+                // The plain sweep's order: the lowest index wins a tie.
+                if dj < d_best || (dj == d_best && j < best) {
+                    d_second = d_best;
+                    d_best = dj;
+                    best = j;
+                } else if dj < d_second {
+                    d_second = dj;
+                }
+            }
+            upper[i] = d_best.sqrt();
+            lower[i] = d_second.sqrt().min(beyond);
             if best != labels[i] {
                 moved = true;
                 stats.move_point(setup, i, labels[i], best);
@@ -259,7 +279,7 @@ mod tests {
     use crate::features::Features;
     use scallop_analysis::FeatureVector;
 
-    fn random_features(n: [usize; 2], mut seed: u64, clustered: bool) -> Features {
+    fn random_features(n: [usize; 2], mut seed: u64, clustered: bool, quantized: bool) -> Features {
         let mut next = || {
             seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
             (seed >> 11) as f64 / (1u64 << 53) as f64
@@ -275,6 +295,12 @@ mod tests {
                     (next() * 1.5, (next() - 0.5) * std::f64::consts::PI)
                 };
                 out.push(FeatureVector { u, v, slope: s, slope_direction: t });
+                if quantized {
+                    // Coarse values: many cells at exactly equal distances (ties).
+                    let q = |x: f64| (x * 4.0).round() / 4.0;
+                    let last = out.len() - 1;
+                    out[last] = FeatureVector { u: q(u), v: q(v), slope: q(s), slope_direction: q(t) };
+                }
             }
         }
         Features::from_grid(n, &out).unwrap()
@@ -283,7 +309,7 @@ mod tests {
     #[test]
     fn bounded_equal_plain() {
         for seed in 0..40u64 {
-            let features = random_features([17 + (seed as usize % 5), 23], seed, seed % 2 == 0);
+            let features = random_features([17 + (seed as usize % 5), 23], seed, seed % 2 == 0, seed % 4 == 1);
             for mode in [ThetaMode::Wrapped, ThetaMode::Plain] {
                 for k in [1, 2, 3, 5, 9] {
                     let omega = [1.0, 0.3 + 0.01 * seed as f64, 0.7, if seed % 3 == 0 { 0.0 } else { 1.0 }];
