@@ -220,7 +220,8 @@ fn bounded<const WRAPPED: bool>(setup: &Setup, k: usize, max_iterations: usize) 
             let mut u = upper[i] + shift;
             let l = lower[i] - others;
             lower[i] = l;
-            let bound = half_gap.max(l);
+            // max(half_gap, l) without `f64::max`'s NaN handling (no NaN here).
+            let bound = if half_gap > l { half_gap } else { l };
             if u * slack < bound {
                 upper[i] = u;
                 continue;
