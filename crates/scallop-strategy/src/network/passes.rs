@@ -132,8 +132,10 @@ impl<'a> PlaneCutter<'a> {
             let c = [net.node(a, b), net.node(a + 1, b), net.node(a + 1, b + 1), net.node(a, b + 1)];
             let (mut lo, mut hi) = (g[c[0]], g[c[0]]);
             for &k in &c[1..] {
-                lo = lo.min(g[k]);
-                hi = hi.max(g[k]);
+                // Plain comparisons: g is finite (no NaN handling needed).
+                let x = g[k];
+                lo = if x < lo { x } else { lo };
+                hi = if x > hi { x } else { hi };
             }
             Span { lo, hi, quad: u32::try_from(q).unwrap_or(u32::MAX) }
         };
@@ -167,7 +169,8 @@ impl<'a> PlaneCutter<'a> {
         let bucket = |x: f64| -> usize {
             // INVARIANT: clamped into [0, buckets - 1].
             #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
-            let b = ((x - g0) * inv_width).max(0.0) as usize;
+            // `as` saturates: a negative (or NaN) position is bucket 0.
+            let b = ((x - g0) * inv_width) as usize;
             b.min(buckets - 1)
         };
         ws.starts.clear();
@@ -198,7 +201,8 @@ impl<'a> PlaneCutter<'a> {
     fn bucket(&self, x: f64) -> usize {
         // INVARIANT: clamped into [0, buckets - 1].
         #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
-        let b = ((x - self.g0) * self.inv_width).max(0.0) as usize;
+        // `as` saturates: a negative (or NaN) position is bucket 0.
+        let b = ((x - self.g0) * self.inv_width) as usize;
         b.min(self.buckets - 1)
     }
 
@@ -517,7 +521,9 @@ fn zone_extent(
     range: (f64, f64),
 ) -> (f64, f64) {
     if zoning.quad_label[q] == zone {
-        return (range.0.min(span.lo), range.1.max(span.hi));
+        let lo = if span.lo < range.0 { span.lo } else { range.0 };
+        let hi = if span.hi > range.1 { span.hi } else { range.1 };
+        return (lo, hi);
     }
     let (nu, nv) = (net.quads_u, net.quads_v);
     let (a, b) = (q / nv, q % nv);
