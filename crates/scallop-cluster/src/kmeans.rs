@@ -89,50 +89,6 @@ fn distance2<const WRAPPED: bool>(x: &[f64; 4], c: &[f64; 4], w: &[f64; 4]) -> f
     w[0] * a * a + w[1] * b * b + w[2] * s * s + w[3] * t * t
 }
 
-/// Centres in structure-of-arrays form, so the distances of one cell to all centres
-/// vectorise.
-struct Soa {
-    c: [Vec<f64>; 4],
-    d: Vec<f64>,
-}
-
-impl Soa {
-    fn new(centres: &[[f64; 4]]) -> Soa {
-        Soa { c: std::array::from_fn(|j| centres.iter().map(|c| c[j]).collect()), d: vec![0.0; centres.len()] }
-    }
-
-    /// Nearest and second-nearest `d^2` of `x` (lowest index on ties); the same
-    /// arithmetic as [`distance2`].
-    #[inline(always)]
-    fn scan<const WRAPPED: bool>(&mut self, x: &[f64; 4], w: &[f64; 4]) -> (u32, f64, f64) {
-        let k = self.d.len();
-        let [cu, cv, cs, ct] = &self.c;
-        let (cu, cv, cs, ct, d) = (&cu[..k], &cv[..k], &cs[..k], &ct[..k], &mut self.d[..k]);
-        for c in 0..k {
-            let (a, b, s) = (x[0] - cu[c], x[1] - cv[c], x[2] - cs[c]);
-            let mut t = x[3] - ct[c];
-            if WRAPPED {
-                let up = if t >= FRAC_PI_2 { PI } else { 0.0 };
-                let down = if t < -FRAC_PI_2 { PI } else { 0.0 };
-                t = t - up + down;
-            }
-            d[c] = w[0] * a * a + w[1] * b * b + w[2] * s * s + w[3] * t * t;
-        }
-        let (mut best, mut d_best, mut d_second) = (0u32, f64::INFINITY, f64::INFINITY);
-        #[allow(clippy::cast_possible_truncation)] // k <= cells < u32::MAX
-        for (c, &dc) in d.iter().enumerate() {
-            if dc < d_best {
-                d_second = d_best;
-                d_best = dc;
-                best = c as u32;
-            } else if dc < d_second {
-                d_second = dc;
-            }
-        }
-        (best, d_best, d_second)
-    }
-}
-
 /// K-means with Hamerly's bounds (global diagonal metrics only; module docs).
 pub(crate) fn kmeans_bounded(setup: &Setup, k: usize, max_iterations: usize) -> Clustering {
     if setup.mode == ThetaMode::Wrapped {
@@ -154,27 +110,100 @@ struct Drift {
     half_gap: f64,
 }
 
+/// Every centre's others by increasing distance into `near` (`k - 1` entries per
+/// centre; ties by index), and half the distance to the nearest into `drift`.
+fn sort_neighbours(
+    centres: &[[f64; 4]],
+    near: &mut [(f64, u32)],
+    drift: &mut [Drift],
+    distance: impl Fn(&[f64; 4], &[f64; 4]) -> f64,
+) {
+    let k = centres.len();
+    if k == 1 {
+        drift[0].half_gap = f64::INFINITY;
+        return;
+    }
+    for (c, list) in near.chunks_exact_mut(k - 1).enumerate() {
+        let others = (0..k).filter(|&j| j != c);
+        for (slot, j) in list.iter_mut().zip(others) {
+            #[allow(clippy::cast_possible_truncation)] // k <= cells < u32::MAX
+            {
+                *slot = (distance(&centres[c], &centres[j]), j as u32);
+            }
+        }
+        list.sort_unstable_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+        drift[c].half_gap = 0.5 * list[0].0;
+    }
+}
+
+/// The nearest centre of `x` (lowest index on ties, as the plain sweep), given
+/// `d2a = d^2(x, c_a)` for some centre `a`, with an upper bound (its distance)
+/// and a lower bound of the distance to every other centre. Only the centres
+/// closer to `a` than `2u` (plus slack), `u = d(x, c_a)`, can be nearer than `a`:
+/// a farther centre j is at least `d(a, j) - u > u` away (triangle inequality);
+/// `near` lists them by increasing distance to `a`.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn nearest_from<const WRAPPED: bool>(
+    x: &[f64; 4],
+    a: usize,
+    d2a: f64,
+    centres: &[[f64; 4]],
+    near: &[(f64, u32)],
+    w: &[f64; 4],
+    slack: f64,
+) -> (u32, f64, f64) {
+    let k = centres.len();
+    let u = d2a.sqrt();
+    let limit = 2.0 * u * slack + tol::HAMERLY_ABSOLUTE;
+    #[allow(clippy::cast_possible_truncation)] // k <= cells < u32::MAX
+    let (mut best, mut d_best, mut d_second) = (a as u32, d2a, f64::INFINITY);
+    let mut beyond = f64::INFINITY;
+    for &(gap, j) in &near[a * (k - 1)..(a + 1) * (k - 1)] {
+        if gap > limit {
+            beyond = gap - u;
+            break;
+        }
+        let dj = distance2::<WRAPPED>(x, &centres[j as usize], w);
+        // The plain sweep's order: the lowest index wins a tie.
+        if dj < d_best || (dj == d_best && j < best) {
+            d_second = d_best;
+            d_best = dj;
+            best = j;
+        } else if dj < d_second {
+            d_second = dj;
+        }
+    }
+    (best, d_best.sqrt(), d_second.sqrt().min(beyond))
+}
+
 fn bounded<const WRAPPED: bool>(setup: &Setup, k: usize, max_iterations: usize) -> Clustering {
     let f = setup.features;
     let n = f.len();
     let q = setup.global.0;
     let w = [q[0], q[1], q[2], q[3]];
     let distance = |a: &[f64; 4], b: &[f64; 4]| distance2::<WRAPPED>(a, b, &w).sqrt();
+    let slack = 1.0 + tol::HAMERLY_SLACK;
     let mut centres = circle_centres(f, k);
-    let mut soa = Soa::new(&centres);
-    let (mut labels, mut upper, mut lower) = (vec![0u32; n], vec![0.0; n], vec![0.0; n]);
-    for (i, x) in f.x.iter().enumerate() {
-        let (best, d1, d2) = soa.scan::<WRAPPED>(x, &w);
-        labels[i] = best;
-        upper[i] = d1.sqrt();
-        lower[i] = d2.sqrt();
-    }
-    let mut stats = Stats::batch(setup, &labels, k);
     let mut drift = vec![Drift::default(); k];
     let mut near = vec![(0.0, 0u32); k * k.saturating_sub(1)];
+    sort_neighbours(&centres, &mut near, &mut drift, distance);
+    // Initial assignment: the nearest centre of a cell is often its grid
+    // predecessor's, which makes the pruned scan short.
+    let (mut labels, mut upper, mut lower) = (vec![0u32; n], vec![0.0; n], vec![0.0; n]);
+    let mut previous = 0u32;
+    for (i, x) in f.x.iter().enumerate() {
+        let a = previous as usize;
+        let d2a = distance2::<WRAPPED>(x, &centres[a], &w);
+        let (best, u, l) = nearest_from::<WRAPPED>(x, a, d2a, &centres, &near, &w, slack);
+        labels[i] = best;
+        upper[i] = u;
+        lower[i] = l;
+        previous = best;
+    }
+    let mut stats = Stats::batch(setup, &labels, k);
     let mut moved_centres = centres.clone();
     let (mut iterations, mut converged) = (0, false);
-    let slack = 1.0 + tol::HAMERLY_SLACK;
     for it in 1..=max_iterations {
         iterations = it;
         means_into(&stats, &centres, setup.mode, &mut moved_centres);
@@ -182,21 +211,7 @@ fn bounded<const WRAPPED: bool>(setup: &Setup, k: usize, max_iterations: usize) 
             drift[c].shift = distance(&centres[c], &moved_centres[c]);
         }
         std::mem::swap(&mut centres, &mut moved_centres);
-        // Every centre's others by increasing distance (the scan's candidates).
-        if k == 1 {
-            drift[0].half_gap = f64::INFINITY;
-        }
-        for (c, list) in near.chunks_exact_mut(k.max(2) - 1).enumerate() {
-            let others = (0..k).filter(|&j| j != c);
-            for (slot, j) in list.iter_mut().zip(others) {
-                #[allow(clippy::cast_possible_truncation)] // k <= cells < u32::MAX
-                {
-                    *slot = (distance(&centres[c], &centres[j]), j as u32);
-                }
-            }
-            list.sort_unstable_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
-            drift[c].half_gap = 0.5 * list[0].0;
-        }
+        sort_neighbours(&centres, &mut near, &mut drift, distance);
         // Largest and second-largest centre shifts.
         let (mut top, mut top_index, mut second) = (0.0f64, usize::MAX, 0.0f64);
         for (c, d) in drift.iter().enumerate() {
@@ -233,29 +248,9 @@ fn bounded<const WRAPPED: bool>(setup: &Setup, k: usize, max_iterations: usize) 
             if u * slack < bound {
                 continue;
             }
-            // Scan the centres that can be nearer than `a`: those closer to `a` than
-            // 2u (plus slack); a farther centre j is at least `d(a, j) - u > u` away.
-            let limit = 2.0 * u * slack + tol::HAMERLY_ABSOLUTE;
-            #[allow(clippy::cast_possible_truncation)] // k <= cells < u32::MAX
-            let (mut best, mut d_best, mut d_second) = (a as u32, d2a, f64::INFINITY);
-            let mut beyond = f64::INFINITY;
-            for &(gap, j) in &near[a * (k - 1)..(a + 1) * (k - 1)] {
-                if gap > limit {
-                    beyond = gap - u;
-                    break;
-                }
-                let dj = distance2::<WRAPPED>(x, &centres[j as usize], &w);
-                // The plain sweep's order: the lowest index wins a tie.
-                if dj < d_best || (dj == d_best && j < best) {
-                    d_second = d_best;
-                    d_best = dj;
-                    best = j;
-                } else if dj < d_second {
-                    d_second = dj;
-                }
-            }
-            upper[i] = d_best.sqrt();
-            lower[i] = d_second.sqrt().min(beyond);
+            let (best, u, l) = nearest_from::<WRAPPED>(x, a, d2a, &centres, &near, &w, slack);
+            upper[i] = u;
+            lower[i] = l;
             if best != labels[i] {
                 moved = true;
                 stats.move_point(setup, i, labels[i], best);
