@@ -181,8 +181,10 @@ fn nearest_from<const WRAPPED: bool>(
             break;
         }
         let dj = distance2::<WRAPPED>(x, &centres[j as usize], w);
-        // The plain sweep's order: the lowest index wins a tie.
-        if dj < d_best || (dj == d_best && j < best) {
+        // The plain sweep's order: the lowest index wins an exact tie.
+        #[allow(clippy::float_cmp)] // exact tie of the same arithmetic
+        let wins = dj < d_best || (dj == d_best && j < best);
+        if wins {
             d_second = d_best;
             d_best = dj;
             best = j;
@@ -278,7 +280,7 @@ fn bounded<const WRAPPED: bool>(setup: &Setup, k: usize, max_iterations: usize) 
             break;
         }
         if it % tol::BATCH_REFRESH_EVERY == 0 {
-            stats = Stats::batch(setup, &labels, k);
+            stats = Stats::batch(setup, labels, k);
         }
     }
     let (clusters, _) = compact(&mut labels, k);
