@@ -600,11 +600,17 @@ impl Zoning {
     }
 
     /// Whether quad `q` overlaps a cell of label `zone`.
+    #[inline]
     pub(crate) fn quad_in_zone(&self, q: usize, zone: u32) -> bool {
         let l = self.quad_label[q];
         if l != MIXED {
             return l == zone;
         }
+        self.mixed_quad_in_zone(q, zone)
+    }
+
+    /// [`Zoning::quad_in_zone`] of a quad over several labels.
+    fn mixed_quad_in_zone(&self, q: usize, zone: u32) -> bool {
         let (a, b) = (q / self.quads_v, q % self.quads_v);
         let ((i0, i1), (j0, j1)) = (self.ranges_u[a], self.ranges_v[b]);
         (i0..=i1).any(|i| (j0..=j1).any(|j| self.labels.labels[i * self.labels.cells_v + j] == zone))
