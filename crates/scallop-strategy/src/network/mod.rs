@@ -486,11 +486,14 @@ impl CellLabels {
         self.labels[self.cell(u, v)]
     }
 
+    #[inline]
     pub(crate) fn cell_index(t: f64, cells: usize) -> usize {
-        // INVARIANT: t is clamped into [0, 1] and the product into [0, cells - 1].
+        // INVARIANT: the index is clamped into [0, cells - 1]: `as` saturates a
+        // negative (or NaN) product to 0, `min` caps t >= 1 (the same cells as
+        // clamping t into [0, 1] first).
         #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
         // Truncation is the floor of a non-negative value (and avoids a libm call).
-        let i = (t.clamp(0.0, 1.0) * cells as f64) as usize;
+        let i = (t * cells as f64) as usize;
         i.min(cells - 1)
     }
 
@@ -813,6 +816,22 @@ mod tests {
                     assert_eq!(index[z as usize] as usize, i, "case {case}");
                 }
             }
+        }
+    }
+
+    /// `cell_index` equals the clamp-first form on and outside [0, 1].
+    #[test]
+    fn cell_index_equals_clamped_form() {
+        for cells in [1usize, 7, 80] {
+            for k in -300..=1300 {
+                let t = f64::from(k) * 1e-3 + if k % 3 == 0 { 1e-17 } else { 0.0 };
+                #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+                let clamped = ((t.clamp(0.0, 1.0) * cells as f64) as usize).min(cells - 1);
+                assert_eq!(CellLabels::cell_index(t, cells), clamped, "t {t} cells {cells}");
+            }
+            assert_eq!(CellLabels::cell_index(f64::NAN, cells), 0);
+            assert_eq!(CellLabels::cell_index(f64::INFINITY, cells), cells - 1);
+            assert_eq!(CellLabels::cell_index(f64::NEG_INFINITY, cells), 0);
         }
     }
 }
