@@ -270,6 +270,7 @@ impl Network {
 
     /// The exact unit normal (oriented, in this frame) from `(S_u, S_v)` known up
     /// to a common positive factor at domain fractions `(u, v)`.
+    #[inline]
     fn finish_normal(&self, (su, sv): (Vec3, Vec3), u: f64, v: f64) -> Vec3 {
         let n = su.cross(&sv);
         let norm = n.norm();
@@ -295,6 +296,7 @@ impl Network {
     }
 
     /// Exact normal on the u-edge row `b` (`v = b / N_v`) at `u`.
+    #[inline]
     pub(crate) fn normal_on_row(&self, b: usize, u: f64) -> Vec3 {
         let v = b as f64 / self.quads_v as f64;
         match &self.edge_normals {
@@ -304,6 +306,7 @@ impl Network {
     }
 
     /// Exact normal on the v-edge column `a` (`u = a / N_u`) at `v`.
+    #[inline]
     pub(crate) fn normal_on_column(&self, a: usize, v: f64) -> Vec3 {
         let u = a as f64 / self.quads_u as f64;
         match &self.edge_normals {

@@ -196,6 +196,7 @@ impl EdgeNormals {
     }
 
     /// `(S_u, S_v)` up to a common positive factor on the u-edge row `b` at `u`.
+    #[inline]
     pub(crate) fn on_row(&self, b: usize, u: f64) -> (Vec3, Vec3) {
         let p = self.degree[0];
         let range = b * (p + 1)..(b + 1) * (p + 1);
@@ -204,6 +205,7 @@ impl EdgeNormals {
     }
 
     /// `(S_u, S_v)` up to a common positive factor on the v-edge column `a` at `v`.
+    #[inline]
     pub(crate) fn on_column(&self, column: usize, v: f64) -> (Vec3, Vec3) {
         let q = self.degree[1];
         let range = column * (q + 1)..(column + 1) * (q + 1);
