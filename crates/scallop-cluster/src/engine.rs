@@ -81,8 +81,8 @@ impl Stats {
     pub(crate) fn batch(setup: &Setup, labels: &[u32], k: usize) -> Stats {
         let f = setup.features;
         let mut sums = vec![Sums::default(); k];
-        for (i, &l) in labels.iter().enumerate() {
-            sums[l as usize].add(&f.x[i], &f.doubled[i]);
+        for ((&l, x), d) in labels.iter().zip(&f.x).zip(&f.doubled) {
+            sums[l as usize].add(x, d);
         }
         let moments = match (&f.geometry, setup.uses_moments()) {
             (Some((points, _)), true) => {
