@@ -208,15 +208,15 @@ fn bounded<const WRAPPED: bool>(setup: &Setup, k: usize, max_iterations: usize) 
     sort_neighbours(&centres, &mut near, &mut drift, distance);
     // Initial assignment: the nearest centre of a cell is often its grid
     // predecessor's, which makes the pruned scan short.
-    let (mut labels, mut upper, mut lower) = (vec![0u32; n], vec![0.0; n], vec![0.0; n]);
+    // Per cell: `[upper, lower]` bounds side by side (one address per cell).
+    let (mut labels, mut bounds) = (vec![0u32; n], vec![[0.0f64; 2]; n]);
     let mut previous = 0u32;
     for (i, x) in f.x.iter().enumerate() {
         let a = previous as usize;
         let d2a = distance2::<WRAPPED>(x, &centres[a], &w);
         let (best, u, l) = nearest_from::<WRAPPED>(x, a, d2a, &centres, &near, &w, slack);
         labels[i] = best;
-        upper[i] = u;
-        lower[i] = l;
+        bounds[i] = [u, l];
         previous = best;
     }
     let mut stats = Stats::batch(setup, &labels, k);
@@ -246,29 +246,28 @@ fn bounded<const WRAPPED: bool>(setup: &Setup, k: usize, max_iterations: usize) 
             d.others = if c == top_index { second } else { top };
         }
         let mut moved = false;
-        let (xs, labels, upper, lower) = (&f.x[..n], &mut labels[..n], &mut upper[..n], &mut lower[..n]);
+        let (xs, labels, bounds) = (&f.x[..n], &mut labels[..n], &mut bounds[..n]);
         for i in 0..n {
             let a = labels[i] as usize;
             let Drift { shift, others, half_gap } = drift[a];
-            let mut u = upper[i] + shift;
-            let l = lower[i] - others;
-            lower[i] = l;
+            let [upper, lower] = bounds[i];
+            let u = upper + shift;
+            let l = lower - others;
             // max(half_gap, l) without `f64::max`'s NaN handling (no NaN here).
             let bound = if half_gap > l { half_gap } else { l };
             if u * slack < bound {
-                upper[i] = u;
+                bounds[i] = [u, l];
                 continue;
             }
             let x = &xs[i];
             let d2a = distance2::<WRAPPED>(x, &centres[a], &w);
-            u = d2a.sqrt();
-            upper[i] = u;
+            let u = d2a.sqrt();
             if u * slack < bound {
+                bounds[i] = [u, l];
                 continue;
             }
             let (best, u, l) = nearest_from::<WRAPPED>(x, a, d2a, &centres, &near, &w, slack);
-            upper[i] = u;
-            lower[i] = l;
+            bounds[i] = [u, l];
             if best != labels[i] {
                 moved = true;
                 stats.move_point(setup, i, labels[i], best);
