@@ -116,6 +116,7 @@ pub(crate) fn kmeans_bounded(setup: &Setup, k: usize, max_iterations: usize) -> 
 
 /// What one sweep's bound upkeep needs of a centre.
 #[derive(Clone, Copy, Default)]
+#[repr(align(32))] // a power-of-two stride: the record of a label is one shift away
 struct Drift {
     /// How far the centre moved.
     shift: f64,
