@@ -81,8 +81,8 @@ impl Stats {
     pub(crate) fn batch(setup: &Setup, labels: &[u32], k: usize) -> Stats {
         let f = setup.features;
         let mut sums = vec![Sums::default(); k];
-        for (i, &l) in labels.iter().enumerate() {
-            sums[l as usize].add(&f.x[i], &f.doubled[i]);
+        for ((&l, x), d) in labels.iter().zip(&f.x).zip(&f.doubled) {
+            sums[l as usize].add(x, d);
         }
         let moments = match (&f.geometry, setup.uses_moments()) {
             (Some((points, _)), true) => {
@@ -293,6 +293,13 @@ impl Frozen {
 /// The exact cluster means (11.2); an empty cluster keeps `previous[c]`.
 pub(crate) fn means(stats: &Stats, previous: &[[f64; 4]], mode: ThetaMode) -> Vec<[f64; 4]> {
     stats.sums.iter().zip(previous).map(|(s, p)| s.mean(mode).unwrap_or(*p)).collect()
+}
+
+/// [`means`] into a caller-owned buffer of the same length.
+pub(crate) fn means_into(stats: &Stats, previous: &[[f64; 4]], mode: ThetaMode, out: &mut [[f64; 4]]) {
+    for ((o, s), p) in out.iter_mut().zip(&stats.sums).zip(previous) {
+        *o = s.mean(mode).unwrap_or(*p);
+    }
 }
 
 /// Drops empty clusters: relabels `labels` to `0..m` keeping the order of the

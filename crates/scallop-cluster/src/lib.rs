@@ -35,8 +35,9 @@
 //!   half a cell). Likewise the PCA metric's `S(u_k, v_k)` is that cell's point.
 //! - `omega` weighs every metric as `W^(1/2) M W^(1/2)` (see [`Metric`]); for
 //!   Mahalanobis, scaling the features instead would cancel out.
-//! - K-means on the global diagonal metrics uses Hamerly's bounds, with the same
-//!   labels and sweeps as the plain algorithm (tested bit for bit).
+//! - K-means on the global diagonal metrics uses Hamerly's bounds and a scan
+//!   pruned by centre-centre distances, with the same labels and sweeps as the
+//!   plain algorithm (tested bit for bit).
 //! - HAC in [`ThetaMode::Wrapped`] embeds theta as `(cos 2 theta, sin 2 theta) / 2`;
 //!   its gap cut may return 2 clusters (see [`HacCut`]).
 //! - A global Mahalanobis covariance that is singular (a constant component) uses

@@ -63,6 +63,11 @@ pub const PARALLEL_MIN_PAIRS: usize = 1 << 17;
 /// wrong cluster.
 pub const HAMERLY_SLACK: f64 = 1e-9;
 
+/// Absolute margin (in the metric's units) added to the K-means scan's pruning
+/// radius `2 u (1 + HAMERLY_SLACK)`, so that rounding near `u = 0` never prunes
+/// a centre that could tie.
+pub const HAMERLY_ABSOLUTE: f64 = 1e-12;
+
 /// Cells per parallel assignment chunk.
 pub const PARALLEL_CHUNK: usize = 1024;
 

@@ -124,6 +124,12 @@ impl ZonePartition {
     pub fn partition_zone_count(&self) -> usize {
         self.partition.zones.len()
     }
+
+    /// The clustering itself (cluster and zone of every cell, zone records).
+    #[must_use]
+    pub fn clustering(&self) -> &Partition {
+        &self.partition
+    }
 }
 
 impl SurfaceModel {

@@ -270,6 +270,7 @@ impl Network {
 
     /// The exact unit normal (oriented, in this frame) from `(S_u, S_v)` known up
     /// to a common positive factor at domain fractions `(u, v)`.
+    #[inline]
     fn finish_normal(&self, (su, sv): (Vec3, Vec3), u: f64, v: f64) -> Vec3 {
         let n = su.cross(&sv);
         let norm = n.norm();
@@ -295,6 +296,7 @@ impl Network {
     }
 
     /// Exact normal on the u-edge row `b` (`v = b / N_v`) at `u`.
+    #[inline]
     pub(crate) fn normal_on_row(&self, b: usize, u: f64) -> Vec3 {
         let v = b as f64 / self.quads_v as f64;
         match &self.edge_normals {
@@ -304,6 +306,7 @@ impl Network {
     }
 
     /// Exact normal on the v-edge column `a` (`u = a / N_u`) at `v`.
+    #[inline]
     pub(crate) fn normal_on_column(&self, a: usize, v: f64) -> Vec3 {
         let u = a as f64 / self.quads_u as f64;
         match &self.edge_normals {
@@ -486,11 +489,14 @@ impl CellLabels {
         self.labels[self.cell(u, v)]
     }
 
+    #[inline]
     pub(crate) fn cell_index(t: f64, cells: usize) -> usize {
-        // INVARIANT: t is clamped into [0, 1] and the product into [0, cells - 1].
+        // INVARIANT: the index is clamped into [0, cells - 1]: `as` saturates a
+        // negative (or NaN) product to 0, `min` caps t >= 1 (the same cells as
+        // clamping t into [0, 1] first).
         #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
         // Truncation is the floor of a non-negative value (and avoids a libm call).
-        let i = (t.clamp(0.0, 1.0) * cells as f64) as usize;
+        let i = (t * cells as f64) as usize;
         i.min(cells - 1)
     }
 
@@ -547,9 +553,12 @@ impl Zoning {
             });
         }
         let (nu, nv) = network.resolution();
-        let mut zones: Vec<u32> = labels.labels.clone();
-        zones.sort_unstable();
-        zones.dedup();
+        let (zones, index) = distinct_labels(&labels.labels);
+        // INVARIANT: every label is in `zones`.
+        let zone_index = |l: u32| match &index {
+            Some(index) => index[l as usize] as usize,
+            None => zones.binary_search(&l).unwrap_or(0),
+        };
         let mut quads = vec![Vec::new(); zones.len()];
         let mut quad_label = Vec::with_capacity(nu * nv);
         let ranges_u: Vec<(usize, usize)> = (0..nu).map(|a| cell_range(a, nu, labels.cells_u)).collect();
@@ -563,8 +572,7 @@ impl Zoning {
                     labels.labels[i * labels.cells_v + j0..=i * labels.cells_v + j1].iter().all(|&l| l == first)
                 });
                 if uniform {
-                    // INVARIANT: every label is in `zones`.
-                    quads[zones.binary_search(&first).unwrap_or(0)].push(q);
+                    quads[zone_index(first)].push(q);
                     quad_label.push(first);
                     continue;
                 }
@@ -576,9 +584,8 @@ impl Zoning {
                         }
                     }
                 }
-                for l in &seen {
-                    // INVARIANT: every label is in `zones`.
-                    quads[zones.binary_search(l).unwrap_or(0)].push(q);
+                for &l in &seen {
+                    quads[zone_index(l)].push(q);
                 }
                 quad_label.push(MIXED);
             }
@@ -599,15 +606,47 @@ impl Zoning {
     }
 
     /// Whether quad `q` overlaps a cell of label `zone`.
+    #[inline]
     pub(crate) fn quad_in_zone(&self, q: usize, zone: u32) -> bool {
         let l = self.quad_label[q];
         if l != MIXED {
             return l == zone;
         }
+        self.mixed_quad_in_zone(q, zone)
+    }
+
+    /// [`Zoning::quad_in_zone`] of a quad over several labels.
+    fn mixed_quad_in_zone(&self, q: usize, zone: u32) -> bool {
         let (a, b) = (q / self.quads_v, q % self.quads_v);
         let ((i0, i1), (j0, j1)) = (self.ranges_u[a], self.ranges_v[b]);
         (i0..=i1).any(|i| (j0..=j1).any(|j| self.labels.labels[i * self.labels.cells_v + j] == zone))
     }
+}
+
+/// The distinct labels, increasing, and when they are small enough for a table
+/// (below twice the number of cells, the usual dense zone numbering) the index
+/// of every label in that list.
+fn distinct_labels(labels: &[u32]) -> (Vec<u32>, Option<Vec<u32>>) {
+    let top = labels.iter().copied().max().unwrap_or(0) as usize;
+    if top >= 2 * labels.len().max(1) {
+        let mut zones = labels.to_vec();
+        zones.sort_unstable();
+        zones.dedup();
+        return (zones, None);
+    }
+    let mut index = vec![u32::MAX; top + 1];
+    for &l in labels {
+        index[l as usize] = 0;
+    }
+    let mut zones = Vec::new();
+    for (l, slot) in index.iter_mut().enumerate() {
+        if *slot == 0 {
+            // INVARIANT: l <= top < 2 * cells < u32::MAX (CellLabels are u32-indexed).
+            *slot = u32::try_from(zones.len()).unwrap_or(u32::MAX);
+            zones.push(u32::try_from(l).unwrap_or(u32::MAX));
+        }
+    }
+    (zones, Some(index))
 }
 
 /// Cells `[first, last]` overlapped (with positive area) by network interval
@@ -754,6 +793,48 @@ mod tests {
                     assert!((normals[k] - patch.normal(u, v)).norm() < 1e-12, "{u} {v}");
                 }
             }
+        }
+    }
+
+    /// The distinct-label table equals sort + dedup, for dense and sparse labels.
+    #[test]
+    fn distinct_labels_equal_sorted_dedup() {
+        let mut seed = 7u64;
+        for case in 0..60u32 {
+            let len = 1 + (case as usize * 13) % 97;
+            let spread = if case % 3 == 0 { 1u64 << 31 } else { u64::from(case % 11 + 1) };
+            let labels: Vec<u32> = (0..len)
+                .map(|_| {
+                    seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+                    u32::try_from((seed >> 33) % spread).unwrap()
+                })
+                .collect();
+            let mut expected = labels.clone();
+            expected.sort_unstable();
+            expected.dedup();
+            let (zones, index) = distinct_labels(&labels);
+            assert_eq!(zones, expected, "case {case}");
+            if let Some(index) = index {
+                for (i, &z) in zones.iter().enumerate() {
+                    assert_eq!(index[z as usize] as usize, i, "case {case}");
+                }
+            }
+        }
+    }
+
+    /// `cell_index` equals the clamp-first form on and outside [0, 1].
+    #[test]
+    fn cell_index_equals_clamped_form() {
+        for cells in [1usize, 7, 80] {
+            for k in -300..=1300 {
+                let t = f64::from(k) * 1e-3 + if k % 3 == 0 { 1e-17 } else { 0.0 };
+                #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+                let clamped = ((t.clamp(0.0, 1.0) * cells as f64) as usize).min(cells - 1);
+                assert_eq!(CellLabels::cell_index(t, cells), clamped, "t {t} cells {cells}");
+            }
+            assert_eq!(CellLabels::cell_index(f64::NAN, cells), 0);
+            assert_eq!(CellLabels::cell_index(f64::INFINITY, cells), cells - 1);
+            assert_eq!(CellLabels::cell_index(f64::NEG_INFINITY, cells), 0);
         }
     }
 }

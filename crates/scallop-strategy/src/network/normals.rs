@@ -82,6 +82,7 @@ pub(crate) fn bernstein(n: usize, t: f64, values: &mut [f64; MAX_DEGREE + 1], de
     }
 }
 
+#[inline(always)]
 fn axpy(acc: &mut Homogeneous, a: f64, x: &Homogeneous) {
     for k in 0..4 {
         acc[k] += a * x[k];
@@ -92,6 +93,44 @@ fn axpy(acc: &mut Homogeneous, a: f64, x: &Homogeneous) {
 /// derivative across): the homogeneous point, its derivative along `t` and
 /// across.
 fn along(n: usize, t: f64, curve: &[Homogeneous], cross: &[Homogeneous]) -> (Homogeneous, Homogeneous, Homogeneous) {
+    // The common degrees with fixed-size tables (unrolled; the same operations
+    // in the same order as the general loop).
+    match n {
+        1 => along_fixed::<2>(t, curve, cross),
+        2 => along_fixed::<3>(t, curve, cross),
+        3 => along_fixed::<4>(t, curve, cross),
+        _ => along_general(n, t, curve, cross),
+    }
+}
+
+/// [`along`] of degree `M - 1`.
+#[inline(always)]
+fn along_fixed<const M: usize>(
+    t: f64,
+    curve: &[Homogeneous],
+    cross: &[Homogeneous],
+) -> (Homogeneous, Homogeneous, Homogeneous) {
+    let (Ok(curve), Ok(cross)) = (<&[Homogeneous; M]>::try_from(curve), <&[Homogeneous; M]>::try_from(cross)) else {
+        return along_general(M - 1, t, curve, cross);
+    };
+    let (mut values, mut derivatives) = ([0.0; MAX_DEGREE + 1], [0.0; MAX_DEGREE + 1]);
+    bernstein(M - 1, t, &mut values, &mut derivatives);
+    let (mut a, mut a_along, mut a_across) = ([0.0; 4], [0.0; 4], [0.0; 4]);
+    for i in 0..M {
+        axpy(&mut a, values[i], &curve[i]);
+        axpy(&mut a_along, derivatives[i], &curve[i]);
+        axpy(&mut a_across, values[i], &cross[i]);
+    }
+    (a, a_along, a_across)
+}
+
+/// [`along`] of any degree.
+fn along_general(
+    n: usize,
+    t: f64,
+    curve: &[Homogeneous],
+    cross: &[Homogeneous],
+) -> (Homogeneous, Homogeneous, Homogeneous) {
     let (mut values, mut derivatives) = ([0.0; MAX_DEGREE + 1], [0.0; MAX_DEGREE + 1]);
     bernstein(n, t, &mut values, &mut derivatives);
     let (mut a, mut a_along, mut a_across) = ([0.0; 4], [0.0; 4], [0.0; 4]);
@@ -157,6 +196,7 @@ impl EdgeNormals {
     }
 
     /// `(S_u, S_v)` up to a common positive factor on the u-edge row `b` at `u`.
+    #[inline]
     pub(crate) fn on_row(&self, b: usize, u: f64) -> (Vec3, Vec3) {
         let p = self.degree[0];
         let range = b * (p + 1)..(b + 1) * (p + 1);
@@ -165,6 +205,7 @@ impl EdgeNormals {
     }
 
     /// `(S_u, S_v)` up to a common positive factor on the v-edge column `a` at `v`.
+    #[inline]
     pub(crate) fn on_column(&self, column: usize, v: f64) -> (Vec3, Vec3) {
         let q = self.degree[1];
         let range = column * (q + 1)..(column + 1) * (q + 1);

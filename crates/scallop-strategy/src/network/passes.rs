@@ -41,6 +41,7 @@ pub(crate) struct Workspace {
     spans: Vec<Span>,
     sorted: Vec<Span>,
     starts: Vec<usize>,
+    fill: Vec<usize>,
     forward: Vec<Vertex>,
     backward: Vec<Vertex>,
     piece: Vec<Vertex>,
@@ -102,23 +103,6 @@ impl<'a> PlaneCutter<'a> {
         // the others are never read.
         let dot = |p: &Point3| m[0] * p.x + m[1] * p.y;
         ws.g.resize(net.points.len(), 0.0);
-        match zoning {
-            None => {
-                for (g, p) in ws.g.iter_mut().zip(&net.points) {
-                    *g = dot(p);
-                }
-            }
-            Some((zoning, zone)) => {
-                let k = zoning.zones.binary_search(&zone).ok()?;
-                let nv = net.quads_v;
-                for &q in &zoning.quads[k] {
-                    let (a, b) = (q as usize / nv, q as usize % nv);
-                    for node in [net.node(a, b), net.node(a, b) + 1, net.node(a + 1, b), net.node(a + 1, b) + 1] {
-                        ws.g[node] = dot(&net.points[node]);
-                    }
-                }
-            }
-        }
         let edges = net.quads_u * (net.quads_v + 1) + (net.quads_u + 1) * net.quads_v;
         if ws.marks.len() != edges {
             ws.marks = vec![0; edges];
@@ -126,31 +110,54 @@ impl<'a> PlaneCutter<'a> {
         }
         let (nu, nv) = (net.quads_u, net.quads_v);
         ws.spans.clear();
-        let g = &ws.g;
-        let span = |q: usize| {
-            let (a, b) = (q / nv, q % nv);
-            let c = [net.node(a, b), net.node(a + 1, b), net.node(a + 1, b + 1), net.node(a, b + 1)];
-            let (mut lo, mut hi) = (g[c[0]], g[c[0]]);
-            for &k in &c[1..] {
-                lo = lo.min(g[k]);
-                hi = hi.max(g[k]);
+        // The span of g over a quad's corners (a, b), (a + 1, b), (a + 1, b + 1),
+        // (a, b + 1); plain comparisons: g is finite (no NaN handling needed).
+        let span_of = |c: [f64; 4], q: usize| {
+            let (mut lo, mut hi) = (c[0], c[0]);
+            for &x in &c[1..] {
+                lo = if x < lo { x } else { lo };
+                hi = if x > hi { x } else { hi };
             }
             Span { lo, hi, quad: u32::try_from(q).unwrap_or(u32::MAX) }
         };
         let mut range = (f64::INFINITY, f64::NEG_INFINITY);
         match zoning {
             None => {
-                ws.spans.extend((0..nu * nv).map(span));
+                for (g, p) in ws.g.iter_mut().zip(&net.points) {
+                    *g = dot(p);
+                }
+                let g = &ws.g;
+                ws.spans.extend((0..nu * nv).map(|q| {
+                    let (a, b) = (q / nv, q % nv);
+                    let (n00, n10) = (net.node(a, b), net.node(a + 1, b));
+                    span_of([g[n00], g[n10], g[n10 + 1], g[n00 + 1]], q)
+                }));
                 for s in &ws.spans {
                     range = (range.0.min(s.lo), range.1.max(s.hi));
                 }
             }
             Some((zoning, zone)) => {
+                // One pass over the zone's quads: corner values, span, extent.
                 let k = zoning.zones.binary_search(&zone).ok()?;
-                for &q in &zoning.quads[k] {
-                    let s = span(q as usize);
+                let quads = &zoning.quads[k];
+                ws.spans.reserve(quads.len());
+                for &q in quads {
+                    let q = q as usize;
+                    let (a, b) = (q / nv, q % nv);
+                    let (n00, n10) = (net.node(a, b), net.node(a + 1, b));
+                    let c = [
+                        dot(&net.points[n00]),
+                        dot(&net.points[n10]),
+                        dot(&net.points[n10 + 1]),
+                        dot(&net.points[n00 + 1]),
+                    ];
+                    ws.g[n00] = c[0];
+                    ws.g[n10] = c[1];
+                    ws.g[n10 + 1] = c[2];
+                    ws.g[n00 + 1] = c[3];
+                    let s = span_of(c, q);
                     ws.spans.push(s);
-                    range = zone_extent(net, zoning, zone, g, q as usize, &s, range);
+                    range = zone_extent(net, zoning, zone, &ws.g, q, &s, range);
                 }
             }
         }
@@ -158,16 +165,21 @@ impl<'a> PlaneCutter<'a> {
             return None;
         }
         // Bucket the quads by their minimum (counting sort, one bucket per quad).
-        let (g0, g1) =
-            ws.spans.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |acc, s| (acc.0.min(s.lo), acc.1.max(s.lo)));
-        let extent = ws.spans.iter().fold(0.0f64, |acc, s| acc.max(s.hi - s.lo));
+        let (mut g0, mut g1, mut extent) = (f64::INFINITY, f64::NEG_INFINITY, 0.0f64);
+        for s in &ws.spans {
+            g0 = if s.lo < g0 { s.lo } else { g0 };
+            g1 = if s.lo > g1 { s.lo } else { g1 };
+            let e = s.hi - s.lo;
+            extent = if e > extent { e } else { extent };
+        }
         let buckets = ws.spans.len();
         let width = (g1 - g0) / buckets as f64;
         let inv_width = if width > 0.0 { width.recip() } else { 0.0 };
         let bucket = |x: f64| -> usize {
             // INVARIANT: clamped into [0, buckets - 1].
             #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
-            let b = ((x - g0) * inv_width).max(0.0) as usize;
+            // `as` saturates: a negative (or NaN) position is bucket 0.
+            let b = ((x - g0) * inv_width) as usize;
             b.min(buckets - 1)
         };
         ws.starts.clear();
@@ -180,11 +192,12 @@ impl<'a> PlaneCutter<'a> {
         }
         ws.sorted.clear();
         ws.sorted.resize(ws.spans.len(), Span::default());
-        let mut fill = ws.starts.clone();
+        ws.fill.clear();
+        ws.fill.extend_from_slice(&ws.starts);
         for s in &ws.spans {
             let b = bucket(s.lo);
-            ws.sorted[fill[b]] = *s;
-            fill[b] += 1;
+            ws.sorted[ws.fill[b]] = *s;
+            ws.fill[b] += 1;
         }
         Some(PlaneCutter { net, zoning, f, m, ws, g0, inv_width, buckets, extent, range, cos_sharp, machine })
     }
@@ -198,7 +211,8 @@ impl<'a> PlaneCutter<'a> {
     fn bucket(&self, x: f64) -> usize {
         // INVARIANT: clamped into [0, buckets - 1].
         #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
-        let b = ((x - self.g0) * self.inv_width).max(0.0) as usize;
+        // `as` saturates: a negative (or NaN) position is bucket 0.
+        let b = ((x - self.g0) * self.inv_width) as usize;
         b.min(self.buckets - 1)
     }
 
@@ -517,7 +531,9 @@ fn zone_extent(
     range: (f64, f64),
 ) -> (f64, f64) {
     if zoning.quad_label[q] == zone {
-        return (range.0.min(span.lo), range.1.max(span.hi));
+        let lo = if span.lo < range.0 { span.lo } else { range.0 };
+        let hi = if span.hi > range.1 { span.hi } else { range.1 };
+        return (lo, hi);
     }
     let (nu, nv) = (net.quads_u, net.quads_v);
     let (a, b) = (q / nv, q % nv);

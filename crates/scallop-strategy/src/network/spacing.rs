@@ -75,6 +75,7 @@ impl ToolModel {
 
     /// `Delta` of 6.4 at a point of (not necessarily unit) normal `n` for feed
     /// `f` and plane normal `m` (unit, horizontal).
+    #[inline]
     pub(crate) fn spacing(&self, n: &Vec3, f: [f64; 2], m: [f64; 2]) -> f64 {
         let norm2 = n.norm_squared();
         if norm2 <= 0.0 {
