@@ -10,7 +10,7 @@ use scallop_geom::{Aabb3, Point3, Tolerances, Vec3};
 use scallop_io::cl::read_cl_csv;
 use scallop_io::gcode::{GcodeOptions, read_gcode_arcs};
 use scallop_sim::{
-    DexelOptions, DexelPart, DexelStock, ToolMove, VerifyOptions, ZMap, part_heights, verify, verify_dexel,
+    DexelOptions, DexelPart, DexelStock, PartField, ToolMove, VerifyOptions, ZMap, verify_dexel, verify_in,
 };
 use scallop_toolpath::{Move, Toolpath};
 use serde::Serialize;
@@ -237,9 +237,9 @@ type Outcome = (SimReport, ZMap, Vec<f64>, f64);
 
 /// Deviation per cell from the stock tops, for the picture and the figures
 /// when verify refused.
-fn deviation(zmap: &ZMap, tops: &[f64], part: &scallop_mesh::MeshIndex) -> (Vec<f64>, f64, f64) {
-    let top = part_heights(zmap, part);
-    let dev: Vec<f64> = tops.iter().zip(&top).map(|(s, p)| if p.is_finite() { s - p } else { f64::NAN }).collect();
+fn deviation(tops: &[f64], field: &PartField) -> (Vec<f64>, f64, f64) {
+    let dev: Vec<f64> =
+        tops.iter().zip(field.heights()).map(|(s, p)| if p.is_finite() { s - p } else { f64::NAN }).collect();
     let finite = || dev.iter().copied().filter(|d| d.is_finite());
     let max_dev = finite().fold(0.0f64, f64::max);
     let min_dev = finite().fold(f64::INFINITY, f64::min);
@@ -265,20 +265,22 @@ fn simulate_zmap(
     if let Err(e) = cut.check() {
         verdict.push(e.to_string());
     }
+    // The part rasterised once: collisions, verification and the picture.
+    let field = PartField::new(&zmap, &prepared.index);
     let collisions = zmap
-        .part_collisions(&prepared.index, cutter, &program.path, cut.operation)
+        .part_collisions_in(&field, cutter, &program.path, cut.operation)
         .map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
     if !collisions.is_empty() {
         verdict.push(scallop_sim::SimError::PartCollision { count: collisions.len(), collisions }.to_string());
     }
-    let verification = match verify(&zmap, &prepared.index, options) {
+    let verification = match verify_in(&zmap, &field, options) {
         Ok(v) => Some(v),
         Err(e) => {
             verdict.push(e.to_string());
             None
         }
     };
-    let (dev, max_dev, min_dev) = deviation(&zmap, zmap.heights(), &prepared.index);
+    let (dev, max_dev, min_dev) = deviation(zmap.heights(), &field);
     let report = SimReport {
         stock_model: "z-map",
         part: part_name.to_string(),
@@ -326,6 +328,12 @@ fn simulate_dexel(
         verdict.push(e.to_string());
     }
     let part = DexelPart::new(&prepared.mesh);
+    let collisions = dexels
+        .part_collisions(&part, cutter, &program.moves, &dexel_options, cut.operation)
+        .map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
+    if !collisions.is_empty() {
+        verdict.push(scallop_sim::SimError::DexelPartCollision { count: collisions.len(), collisions }.to_string());
+    }
     let verification = match verify_dexel(&dexels, &part, options) {
         Ok(v) => Some(v),
         Err(e) => {
@@ -335,7 +343,7 @@ fn simulate_dexel(
     };
     // An uncut z-map on the Z rays' grid: the same cells, for the picture.
     let grid = ZMap::new(stock, args.resolution).map_err(|e| Failure::rejected(format!("stock: {e}")))?;
-    let (dev, max_dev, min_dev) = deviation(&grid, &dexels.top_heights(), &prepared.index);
+    let (dev, max_dev, min_dev) = deviation(&dexels.top_heights(), &PartField::new(&grid, &prepared.index));
     let counts = dexels.counts();
     let rays = [0, 1, 2].map(|k| {
         let (nu, nv) = dexels.grid(k);

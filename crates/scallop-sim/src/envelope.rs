@@ -55,7 +55,7 @@
 use scallop_cutter::CutterShape;
 use scallop_geom::tol::PARAMETER_CONVERGENCE;
 
-use crate::tol::VERTICAL_SLOPE;
+use crate::tol::{FLOOR_BOUND_MARGIN, VERTICAL_SLOPE};
 use scallop_geom::{Point2, Point3};
 
 /// Profile constants (no trigonometry per cell).
@@ -337,6 +337,20 @@ impl SweptMove {
         if lo > hi {
             return f64::INFINITY;
         }
+        if let Profile::Bull { .. } = self.profile {
+            // Lower bound without the iterative solve: the tip's lowest z
+            // over [lo, hi] plus the profile at the smallest rho there
+            // (`rho(w)` is smallest at the w nearest 0, `h` non-decreasing).
+            let w_tip = if self.slope > 0.0 { lo } else { hi };
+            let w_near = 0.0f64.clamp(lo, hi);
+            let near2 = w_near * w_near + d2;
+            let bound =
+                self.az + self.slope * (u + w_tip) + self.profile_height(0.0, near2, self.radius2 - near2) + self.lift
+                    - FLOOR_BOUND_MARGIN;
+            if bound >= limit {
+                return bound;
+            }
+        }
         let w = match self.profile {
             Profile::Flat => {
                 if self.slope > 0.0 {
@@ -462,10 +476,14 @@ impl SweptMove {
         self.radius
     }
 
-    /// `k` with `h(rho) >= k rho^2`: the floor at a point at horizontal distance
-    /// `>= d` from the move is `>= z_low + k d^2`.
-    pub(crate) fn quadratic(&self) -> f64 {
-        self.quadratic
+    /// A lower bound of the floor at every point at horizontal distance `>= d`
+    /// (`d2 = d^2`) from the tip's path: `z_low + h(min(d, R))`, less
+    /// `tol::FLOOR_BOUND_MARGIN` (rounding), and never below the quadratic
+    /// bound `z_low + k d^2` (`k` of [`SweptMove::floor_below`]).
+    pub(crate) fn floor_bound(&self, d2: f64) -> f64 {
+        let rho2 = d2.min(self.radius2);
+        let exact = self.z_low + self.profile_height(0.0, rho2, self.radius2 - rho2) - FLOOR_BOUND_MARGIN;
+        exact.max(self.z_low + self.quadratic * d2)
     }
 }
 

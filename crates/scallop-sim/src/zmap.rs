@@ -469,7 +469,7 @@ impl ZMap {
     /// Only cells within a move's reach are visited: the rows of its XY box, on
     /// each row the chord of the stadium around the segment, and on the chord
     /// only runs of cells ("tiles") whose height bound lies above a lower bound
-    /// of the move's floor there (`z_low + k d^2`, see the envelope module), so
+    /// of the move's floor there (`z_low + h(d)`, d the distance to the move, see the envelope module), so
     /// skipping never changes a result.
     ///
     /// Work is parallel over fixed bands of grid rows; each band applies the
@@ -546,13 +546,29 @@ impl ZMap {
         toolpath: &Toolpath,
         operation: u32,
     ) -> Result<Vec<Collision>, SimError> {
+        self.part_collisions_in(&crate::PartField::new(self, part), cutter, toolpath, operation)
+    }
+
+    /// [`ZMap::part_collisions`] with the part already rasterised on this grid.
+    ///
+    /// # Errors
+    /// Those of [`ZMap::part_collisions`]; [`SimError::FieldGrid`] when
+    /// `field` was built on another grid.
+    pub fn part_collisions_in(
+        &self,
+        field: &crate::PartField,
+        cutter: &Cutter,
+        toolpath: &Toolpath,
+        operation: u32,
+    ) -> Result<Vec<Collision>, SimError> {
+        field.check(self)?;
         let bottom = self.stock.min.z;
-        let mut field = self.clone();
-        field.heights = crate::part_heights(self, part)
-            .into_iter()
-            .map(|z| if z == f64::NEG_INFINITY { bottom } else { z.max(bottom) })
-            .collect();
-        Ok(field.sweep(cutter, toolpath, operation, false)?.collisions)
+        let mut solid = ZMap {
+            heights: field.heights().map(|z| if z == f64::NEG_INFINITY { bottom } else { z.max(bottom) }).collect(),
+            last_cut: vec![0; self.heights.len()],
+            ..*self
+        };
+        Ok(solid.sweep(cutter, toolpath, operation, false)?.collisions)
     }
 
     /// The body of [`ZMap::cut`]; `remove == false` only checks the discs.
@@ -802,7 +818,6 @@ impl Grid {
             let (j0, j1) = (j0.max(row0), j1.min(row0 + rows - 1));
             let (box_x0, box_x1) = (plan.box_lo.x, plan.box_hi.x);
             let (box_y0, box_y1) = (plan.box_lo.y, plan.box_hi.y);
-            let quadratic = plan.cutter.quadratic();
             // Nothing at or below this can touch a disc (collisions need > eps).
             let disc_bound = plan.disc_low + self.eps;
             let mut removed = 0.0;
@@ -818,14 +833,11 @@ impl Grid {
                     let tile = local * tiles_per_row + t;
                     let (c0, c1) = (i0.max(t * TILE), i1.min(t * TILE + TILE - 1));
                     // Lower bound of the cutter's floor on the tile's centres:
-                    // z_low + k d^2 with d the distance to the move's box.
+                    // z_low + h(d) with d the distance to the move's box.
                     let (xa, xb) = (self.x_of(c0), self.x_of(c1));
                     let dx = (box_x0 - xb).max(0.0).max(xa - box_x1);
-                    let bound = if remove {
-                        (plan.cutter.z_low + quadratic * (dx * dx + dy * dy)).min(disc_bound)
-                    } else {
-                        disc_bound
-                    };
+                    let bound =
+                        if remove { plan.cutter.floor_bound(dx * dx + dy * dy).min(disc_bound) } else { disc_bound };
                     if tile_top[tile] <= bound {
                         continue;
                     }

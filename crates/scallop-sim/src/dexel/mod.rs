@@ -612,7 +612,7 @@ impl DexelStock {
         let mut rapid: Vec<Option<(f64, Point3)>> = vec![None; count];
         let mut collided: Vec<Vec<(ToolPart, f64, Point3)>> = vec![Vec::new(); count];
         for axis in 0..3 {
-            let outputs = self.cut_family(axis, &flutes, &guards, &steps, &boxes, &unions);
+            let outputs = self.cut_family(axis, &flutes, &guards, &steps, &boxes, &unions, true);
             for out in outputs {
                 for (k, volume, longest, at) in out.removed {
                     let step = &steps[k as usize];
@@ -627,15 +627,7 @@ impl DexelStock {
                         }
                     }
                 }
-                for (k, part, depth, at) in out.collisions {
-                    let m = steps[k as usize].index as usize;
-                    let list = &mut collided[m];
-                    match list.iter_mut().find(|(p, _, _)| *p == part) {
-                        Some(entry) if depth > entry.1 => *entry = (part, depth, at),
-                        Some(_) => {}
-                        None => list.push((part, depth, at)),
-                    }
-                }
+                merge_collisions(&mut collided, &steps, out.collisions);
             }
         }
         let id = |k: usize| MoveId { operation, index: k as u32 };
@@ -646,12 +638,7 @@ impl DexelStock {
             .enumerate()
             .filter_map(|(k, r)| r.map(|(depth, at)| RapidHit { id: id(k), at: Point2::new(at.x, at.y), depth }))
             .collect();
-        let collisions = collided
-            .iter()
-            .enumerate()
-            .flat_map(|(k, list)| list.iter().map(move |&(part, depth, at)| (k, part, depth, at)))
-            .map(|(k, part, depth, at)| DexelCollision { id: id(k), part, at, depth })
-            .collect();
+        let collisions = collision_list(operation, &collided);
         let removed_volume = removed_by_move.iter().sum();
         let sweeps = steps.len();
         self.bodies.push(flutes);
@@ -668,7 +655,110 @@ impl DexelStock {
         })
     }
 
-    /// One family: bands of rays in parallel, each applying its steps in order.
+    /// Checks the shank and holder of `cutter` along `moves` against the
+    /// design part itself (not the in-process stock), as
+    /// [`crate::ZMap::part_collisions`] does on a z-map: the part is laid on
+    /// rays of its own (along X, Y and Z, at this stock's cell size, over the
+    /// part's box within the reach of the shank and holder sweeps, so part
+    /// features outside the stock box count too), and each fixed-axis sweep
+    /// of the shank and of each holder segment is checked against them as in
+    /// [`DexelStock::cut`]: part material inside them longer than the stock's
+    /// epsilon along a ray is a collision, the deepest per move and part of
+    /// the tool, in program order. The stock is not changed; `operation`
+    /// names the moves (the [`DexelReport::operation`] of the cut of the same
+    /// moves). A part wall reached by the flutes is a gouge, not a collision
+    /// (see [`verify_dexel`]).
+    ///
+    /// # Errors
+    /// Those of [`DexelStock::cut`] on the moves, and
+    /// [`SimError::TooManyRays`] when the part's rays would exceed [`MAX_RAYS`].
+    ///
+    /// ```
+    /// use scallop_cutter::{Cutter, CutterShape};
+    /// use scallop_geom::{Aabb3, Point3, Vec3};
+    /// use scallop_mesh::TriMesh;
+    /// use scallop_sim::{DexelOptions, DexelPart, DexelStock, ToolMove, ToolPart};
+    /// use scallop_toolpath::MoveKind;
+    /// let p = |x, y, z| Point3::new(x, y, z);
+    /// // An open part: a plane at z = 0, with a step up to z = 8 at x >= 14
+    /// // (outside the stock box, which ends at x = 10).
+    /// let soup = [
+    ///     [p(-5., -5., 0.), p(14., -5., 0.), p(14., 15., 0.)],
+    ///     [p(-5., -5., 0.), p(14., 15., 0.), p(-5., 15., 0.)],
+    ///     [p(14., -5., 8.), p(30., -5., 8.), p(30., 15., 8.)],
+    ///     [p(14., -5., 8.), p(30., 15., 8.), p(14., 15., 8.)],
+    /// ];
+    /// let part = DexelPart::new(&TriMesh::from_soup(&soup).unwrap().0);
+    /// let stock = Aabb3 { min: p(0., 0., -1.), max: p(10., 10., 1.) };
+    /// let dexels = DexelStock::new(stock, 0.25).unwrap();
+    /// // A ball R 1 with 4 mm of flutes, shank R 1 to 30 mm, tilted 45 degrees
+    /// // towards +X: at x = 6 the shank reaches over the step.
+    /// let ball = Cutter::new(CutterShape::Ball { radius: 1.0 }, 4.0).unwrap().with_shank(1.0, 26.0).unwrap();
+    /// let axis = Vec3::new(1.0, 0.0, 1.0).normalize();
+    /// let mv = |kind, x: f64| ToolMove::new(kind, p(x, 5., 0.), axis);
+    /// let path = [mv(MoveKind::Rapid, 0.), mv(MoveKind::Feed, 6.)];
+    /// let hits = dexels.part_collisions(&part, &ball, &path, &DexelOptions::default(), 0).unwrap();
+    /// assert_eq!((hits.len(), hits[0].id.index, hits[0].part), (1, 1, ToolPart::Shank));
+    /// assert!(hits[0].at.x >= 14.0 && hits[0].at.z <= 8.0);
+    /// ```
+    pub fn part_collisions(
+        &self,
+        part: &DexelPart,
+        cutter: &Cutter,
+        moves: &[ToolMove],
+        options: &DexelOptions,
+        operation: u32,
+    ) -> Result<Vec<DexelCollision>, SimError> {
+        if !(options.axis_tolerance.is_finite() && options.axis_tolerance > 0.0) {
+            return Err(SimError::BadTolerance { what: "axis tolerance", value: options.axis_tolerance });
+        }
+        let flutes = Body::flutes(cutter);
+        let mut guards: Vec<(Body, ToolPart)> = vec![(Body::shank(cutter), ToolPart::Shank)];
+        let mut i = 0;
+        while let Some(b) = Body::holder(cutter, i) {
+            guards.push((b, ToolPart::Holder(i)));
+            i += 1;
+        }
+        let steps = self.steps(operation, &flutes, moves, options)?;
+        let boxes: Vec<Vec<(Point3, Point3)>> = steps
+            .iter()
+            .map(|s| {
+                // No flutes box: nothing is removed.
+                let mut b = vec![(Point3::new(1.0, 1.0, 1.0), Point3::origin())];
+                b.extend(guards.iter().map(|(g, _)| swept_box(g, &s.sweep, self.eps)));
+                b
+            })
+            .collect();
+        let unions: Vec<(Point3, Point3)> =
+            boxes.iter().map(|b| b[1..].iter().fold(b[1], |(lo, hi), (l, h)| (lo.inf(l), hi.sup(h)))).collect();
+        // The part's rays: over the part's box within the reach of the sweeps.
+        let Some(&first) = unions.first() else { return Ok(Vec::new()) };
+        let (reach_lo, reach_hi) = unions.iter().fold(first, |(lo, hi), (l, h)| (lo.inf(l), hi.sup(h)));
+        let material = part.material_box();
+        let (lo, hi) = (reach_lo.sup(&material.min), reach_hi.inf(&material.max));
+        if (0..3).any(|i| !(hi[i] > lo[i])) {
+            return Ok(Vec::new());
+        }
+        let resolution = self.cell.iter().fold(0.0f64, |a, &b| a.max(b));
+        let mut solid = DexelStock::new(Aabb3 { min: lo, max: hi }, resolution)?;
+        let mut collided: Vec<Vec<(ToolPart, f64, Point3)>> = vec![Vec::new(); moves.len()];
+        for axis in 0..3 {
+            solid.rays[axis] = part.family_material(&solid, axis).into_iter().map(Ray::Cut).collect();
+            // The part's epsilon is the stock's: the same penetrations count.
+            solid.eps = self.eps;
+            let outputs = solid.cut_family(axis, &flutes, &guards, &steps, &boxes, &unions, false);
+            for out in outputs {
+                merge_collisions(&mut collided, &steps, out.collisions);
+            }
+            // Each family's rays are only needed for its own pass.
+            solid.rays[axis] = Vec::new();
+        }
+        Ok(collision_list(operation, &collided))
+    }
+
+    /// One family: bands of rays in parallel, each applying its steps in
+    /// order; `remove == false` only checks the guards (nothing is cut).
+    #[allow(clippy::too_many_arguments)] // private; the pieces of one cut.
     fn cut_family(
         &mut self,
         axis: usize,
@@ -677,6 +767,7 @@ impl DexelStock {
         steps: &[Step],
         boxes: &[Vec<(Point3, Point3)>],
         unions: &[(Point3, Point3)],
+        remove: bool,
     ) -> Vec<BandOutput> {
         let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
         let (nu, nv) = (self.n[u], self.n[v]);
@@ -708,7 +799,7 @@ impl DexelStock {
             .par_chunks_mut(BAND_ROWS * nu)
             .zip(members.par_iter())
             .enumerate()
-            .map(|(band, (rays, ids))| geo.cut_band(band, rays, ids, flutes, guards, steps, boxes, unions))
+            .map(|(band, (rays, ids))| geo.cut_band(band, rays, ids, flutes, guards, steps, boxes, unions, remove))
             .collect()
     }
 
@@ -746,6 +837,34 @@ impl Step {
     pub(crate) fn crosses(&self, o: &Point3, axis: usize) -> bool {
         (0..3).filter(|&i| i != axis).all(|i| o[i] >= self.lo[i] && o[i] <= self.hi[i])
     }
+}
+
+/// Adds a band's collisions `(step, part, depth, place)` to the deepest
+/// per move and part of the tool (`collided[move]`, in order of first finding).
+fn merge_collisions(
+    collided: &mut [Vec<(ToolPart, f64, Point3)>],
+    steps: &[Step],
+    found: Vec<(u32, ToolPart, f64, Point3)>,
+) {
+    for (k, part, depth, at) in found {
+        let list = &mut collided[steps[k as usize].index as usize];
+        match list.iter_mut().find(|(p, _, _)| *p == part) {
+            Some(entry) if depth > entry.1 => *entry = (part, depth, at),
+            Some(_) => {}
+            None => list.push((part, depth, at)),
+        }
+    }
+}
+
+/// The merged collisions in program order.
+fn collision_list(operation: u32, collided: &[Vec<(ToolPart, f64, Point3)>]) -> Vec<DexelCollision> {
+    collided
+        .iter()
+        .enumerate()
+        .flat_map(|(k, list)| list.iter().map(move |&(part, depth, at)| (k, part, depth, at)))
+        // k < moves <= u32::MAX (checked by the callers).
+        .map(|(k, part, depth, at)| DexelCollision { id: MoveId { operation, index: k as u32 }, part, at, depth })
+        .collect()
 }
 
 /// What a band found, sparse per step.
@@ -798,6 +917,7 @@ impl Family {
         steps: &[Step],
         boxes: &[Vec<(Point3, Point3)>],
         unions: &[(Point3, Point3)],
+        remove: bool,
     ) -> BandOutput {
         let row0 = band * BAND_ROWS;
         let rows = rays.len() / self.nu;
@@ -824,7 +944,8 @@ impl Family {
                             && o[self.v] <= b.1[self.v]
                     };
                     let bx = &boxes[k as usize];
-                    if inside(&bx[0])
+                    if remove
+                        && inside(&bx[0])
                         && let Some((m_lo, m_hi)) = ray.material_range(bx[0].0[self.axis], bx[0].1[self.axis], lo, hi)
                         && let Some((a, b)) = step.sweep.interval_within(flutes, &o, &d, m_lo, m_hi)
                     {
