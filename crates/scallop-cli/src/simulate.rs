@@ -16,7 +16,7 @@ use scallop_toolpath::{Move, Toolpath};
 use serde::Serialize;
 
 use crate::drop::CutterArgs;
-use crate::output::{print_json, print_text, write_atomic};
+use crate::output::{print_json, print_text, progress_bar, write_atomic};
 use crate::part::{UnitsArg, load};
 use crate::{CliResult, Failure};
 use scallop_report::png::{Image, ramp};
@@ -246,6 +246,16 @@ fn deviation(tops: &[f64], field: &PartField) -> (Vec<f64>, f64, f64) {
     (dev, max_dev, min_dev)
 }
 
+/// Moves the progress bar to `done` of `total` bands (the library calls this
+/// from its worker threads, in any order: the bar only moves forward).
+fn show(bar: &indicatif::ProgressBar, done: usize, total: usize) {
+    // Counts far below 2^64: exact conversions.
+    bar.set_length(total as u64);
+    if done as u64 > bar.position() {
+        bar.set_position(done as u64);
+    }
+}
+
 /// The 3-axis simulation on a z-map.
 #[allow(clippy::too_many_arguments)] // private; the pieces of one command.
 fn simulate_zmap(
@@ -260,7 +270,11 @@ fn simulate_zmap(
 ) -> CliResult<Outcome> {
     let name = &program.name;
     let mut zmap = ZMap::new(stock, args.resolution).map_err(|e| Failure::rejected(format!("stock: {e}")))?;
-    let cut = zmap.cut(cutter, &program.path).map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
+    let bar = progress_bar(0, "cutting the z-map stock");
+    let cut = zmap
+        .cut_with_progress(cutter, &program.path, &|done, total| show(&bar, done, total))
+        .map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
+    bar.finish_and_clear();
     let mut verdict = Vec::new();
     if let Err(e) = cut.check() {
         verdict.push(e.to_string());
@@ -321,8 +335,11 @@ fn simulate_dexel(
     let name = &program.name;
     let mut dexels = DexelStock::new(stock, args.resolution).map_err(|e| Failure::rejected(format!("stock: {e}")))?;
     let dexel_options = DexelOptions { axis_tolerance: args.axis_tolerance, ..DexelOptions::default() };
-    let cut =
-        dexels.cut(cutter, &program.moves, &dexel_options).map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
+    let bar = progress_bar(0, "cutting the tri-dexel stock");
+    let cut = dexels
+        .cut_with_progress(cutter, &program.moves, &dexel_options, &|done, total| show(&bar, done, total))
+        .map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
+    bar.finish_and_clear();
     let mut verdict = Vec::new();
     if let Err(e) = cut.check() {
         verdict.push(e.to_string());

@@ -1,6 +1,7 @@
 //! The z-map stock: a height field on a regular XY grid, cut by swept cutters.
 
 use std::fmt;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 use rayon::prelude::*;
 use scallop_cutter::{Cutter, CutterShape};
@@ -499,10 +500,47 @@ impl ZMap {
     /// assert_eq!(zmap.height(100, 50), Some(-1.0));
     /// ```
     pub fn cut(&mut self, cutter: &Cutter, toolpath: &Toolpath) -> Result<CutReport, SimError> {
+        self.cut_with_progress(cutter, toolpath, &|_, _| {})
+    }
+
+    /// [`ZMap::cut`] that reports its progress: `progress(done, total)` is
+    /// called from the worker threads (in any order) each time a band of grid
+    /// rows has applied all its moves, `total` being the number of bands.
+    /// The result does not depend on it.
+    ///
+    /// # Errors
+    /// Those of [`ZMap::cut`].
+    ///
+    /// ```
+    /// use std::sync::atomic::{AtomicUsize, Ordering};
+    /// use scallop_cutter::{Cutter, CutterShape};
+    /// use scallop_geom::{Aabb3, Point3};
+    /// use scallop_sim::ZMap;
+    /// use scallop_toolpath::{Move, MoveKind, Toolpath};
+    /// let stock = Aabb3 { min: Point3::new(0.0, 0.0, -2.0), max: Point3::new(10.0, 10.0, 0.0) };
+    /// let mut zmap = ZMap::new(stock, 0.1).unwrap();
+    /// let flat = Cutter::new(CutterShape::Flat { radius: 1.0 }, 5.0).unwrap();
+    /// let mut path = Toolpath::new(500.0);
+    /// path.push(Move::new(MoveKind::Rapid, Point3::new(-2.0, 5.0, -1.0)));
+    /// path.push(Move::new(MoveKind::Feed, Point3::new(12.0, 5.0, -1.0)));
+    /// let last = AtomicUsize::new(0);
+    /// zmap.cut_with_progress(&flat, &path, &|done, total| {
+    ///     assert!(done <= total);
+    ///     last.fetch_max(done, Ordering::Relaxed);
+    /// })
+    /// .unwrap();
+    /// assert_eq!(last.into_inner(), 13); // 100 rows in bands of 8
+    /// ```
+    pub fn cut_with_progress(
+        &mut self,
+        cutter: &Cutter,
+        toolpath: &Toolpath,
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> Result<CutReport, SimError> {
         let moves = toolpath.moves();
         let operation = self.operations;
         self.operations = self.operations.checked_add(1).ok_or(SimError::TooManyMoves { moves: moves.len() })?;
-        self.sweep(cutter, toolpath, operation, true)
+        self.sweep(cutter, toolpath, operation, true, progress)
     }
 
     /// Checks the shank and holder of `cutter` along `toolpath` against the
@@ -568,7 +606,7 @@ impl ZMap {
             last_cut: vec![0; self.heights.len()],
             ..*self
         };
-        Ok(solid.sweep(cutter, toolpath, operation, false)?.collisions)
+        Ok(solid.sweep(cutter, toolpath, operation, false, &|_, _| {})?.collisions)
     }
 
     /// The body of [`ZMap::cut`]; `remove == false` only checks the discs.
@@ -578,6 +616,7 @@ impl ZMap {
         toolpath: &Toolpath,
         operation: u32,
         remove: bool,
+        progress: &(dyn Fn(usize, usize) + Sync),
     ) -> Result<CutReport, SimError> {
         let moves = toolpath.moves();
         let n = u32::try_from(moves.len()).map_err(|_| SimError::TooManyMoves { moves: moves.len() })?;
@@ -685,6 +724,7 @@ impl ZMap {
             eps: self.eps,
         };
         let nx = self.nx;
+        let done = AtomicUsize::new(0);
         let outputs: Vec<BandOutput> = self
             .heights
             .par_chunks_mut(BAND_ROWS * nx)
@@ -692,7 +732,9 @@ impl ZMap {
             .enumerate()
             .map(|(band, (heights, last))| {
                 let ids = &members[start[band]..start[band + 1]];
-                grid.cut_band(band, heights, last, ids, &plans, &discs, &parts, operation, remove)
+                let out = grid.cut_band(band, heights, last, ids, &plans, &discs, &parts, operation, remove);
+                progress(done.fetch_add(1, Ordering::Relaxed) + 1, bands);
+                out
             })
             .collect();
 

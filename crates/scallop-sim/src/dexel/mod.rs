@@ -11,6 +11,7 @@ mod sweep;
 mod verify;
 
 use std::fmt;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 use rayon::prelude::*;
 use scallop_cutter::Cutter;
@@ -574,6 +575,23 @@ impl DexelStock {
         moves: &[ToolMove],
         options: &DexelOptions,
     ) -> Result<DexelReport, SimError> {
+        self.cut_with_progress(cutter, moves, options, &|_, _| {})
+    }
+
+    /// [`DexelStock::cut`] that reports its progress: `progress(done, total)`
+    /// is called from the worker threads (in any order) each time a band of
+    /// rays has applied all its sweeps, `total` being the number of bands of
+    /// the three families. The result does not depend on it.
+    ///
+    /// # Errors
+    /// Those of [`DexelStock::cut`].
+    pub fn cut_with_progress(
+        &mut self,
+        cutter: &Cutter,
+        moves: &[ToolMove],
+        options: &DexelOptions,
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> Result<DexelReport, SimError> {
         if !(options.axis_tolerance.is_finite() && options.axis_tolerance > 0.0) {
             return Err(SimError::BadTolerance { what: "axis tolerance", value: options.axis_tolerance });
         }
@@ -611,8 +629,11 @@ impl DexelStock {
         let mut cut_any = vec![false; count];
         let mut rapid: Vec<Option<(f64, Point3)>> = vec![None; count];
         let mut collided: Vec<Vec<(ToolPart, f64, Point3)>> = vec![Vec::new(); count];
+        let bands: usize = (0..3).map(|axis| self.grid(axis).1.div_ceil(BAND_ROWS)).sum();
+        let done = AtomicUsize::new(0);
+        let tick = || progress(done.fetch_add(1, Ordering::Relaxed) + 1, bands);
         for axis in 0..3 {
-            let outputs = self.cut_family(axis, &flutes, &guards, &steps, &boxes, &unions, true);
+            let outputs = self.cut_family(axis, &flutes, &guards, &steps, &boxes, &unions, true, &tick);
             for out in outputs {
                 for (k, volume, longest, at) in out.removed {
                     let step = &steps[k as usize];
@@ -746,7 +767,7 @@ impl DexelStock {
             solid.rays[axis] = part.family_material(&solid, axis).into_iter().map(Ray::Cut).collect();
             // The part's epsilon is the stock's: the same penetrations count.
             solid.eps = self.eps;
-            let outputs = solid.cut_family(axis, &flutes, &guards, &steps, &boxes, &unions, false);
+            let outputs = solid.cut_family(axis, &flutes, &guards, &steps, &boxes, &unions, false, &|| {});
             for out in outputs {
                 merge_collisions(&mut collided, &steps, out.collisions);
             }
@@ -768,6 +789,7 @@ impl DexelStock {
         boxes: &[Vec<(Point3, Point3)>],
         unions: &[(Point3, Point3)],
         remove: bool,
+        tick: &(dyn Fn() + Sync),
     ) -> Vec<BandOutput> {
         let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
         let (nu, nv) = (self.n[u], self.n[v]);
@@ -799,7 +821,11 @@ impl DexelStock {
             .par_chunks_mut(BAND_ROWS * nu)
             .zip(members.par_iter())
             .enumerate()
-            .map(|(band, (rays, ids))| geo.cut_band(band, rays, ids, flutes, guards, steps, boxes, unions, remove))
+            .map(|(band, (rays, ids))| {
+                let out = geo.cut_band(band, rays, ids, flutes, guards, steps, boxes, unions, remove);
+                tick();
+                out
+            })
             .collect()
     }
 
