@@ -476,6 +476,35 @@ impl SweptMove {
         self.radius
     }
 
+    /// The vertical line at (x, y) inside the swept solid of the whole
+    /// cutting body (the profile and a cylinder of radius R up to `top` above
+    /// the tip: the flutes), or `None` when the move does not reach it. The
+    /// solid is convex, so the line meets it in one interval: from the swept
+    /// floor ([`SweptMove::floor_at`]) to the highest top of the cylinder over
+    /// the positions where the axis is within R of the line (the tip's z is
+    /// linear along the move, so that is an end of the interval of positions,
+    /// `w` in `[max(-u, -c), min(L - u, c)]` in the module's notation). Exact:
+    /// closed forms, the bull-nose floor to the solver's tolerance.
+    pub(crate) fn column(&self, x: f64, y: f64, top: f64) -> Option<(f64, f64)> {
+        debug_assert!(self.arc.is_none(), "columns of straight moves only");
+        let floor = self.floor_at(x, y);
+        if !floor.is_finite() {
+            return None;
+        }
+        let (qx, qy) = (x - self.ax, y - self.ay);
+        let ceiling = if self.vertical {
+            self.az.max(self.az + self.dz)
+        } else {
+            let u = qx * self.ex + qy * self.ey;
+            let v = qx * self.ey - qy * self.ex;
+            let c = (self.radius2 - v * v).max(0.0).sqrt();
+            let (lo, hi) = ((-u).max(-c), (self.len - u).min(c));
+            let w = if self.slope > 0.0 { hi.max(lo) } else { lo.min(hi) };
+            self.az + self.dz * ((u + w) * self.inv_len).clamp(0.0, 1.0)
+        };
+        Some((floor, ceiling + top + self.lift))
+    }
+
     /// A lower bound of the floor at every point at horizontal distance `>= d`
     /// (`d2 = d^2`) from the tip's path: `z_low + h(min(d, R))`, less
     /// `tol::FLOOR_BOUND_MARGIN` (rounding), and never below the quadratic

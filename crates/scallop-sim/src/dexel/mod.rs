@@ -18,6 +18,7 @@ use scallop_cutter::Cutter;
 use scallop_geom::{Aabb3, Eps, Point2, Point3, Vec3};
 use scallop_toolpath::{ArcXY, MoveKind, Toolpath};
 
+use crate::envelope::SweptMove;
 use crate::tol::{ARC_SAGITTA, GRID_SNAP};
 use crate::{MoveId, RapidHit, SimError, ToolPart};
 use body::Body;
@@ -629,11 +630,21 @@ impl DexelStock {
         let mut cut_any = vec![false; count];
         let mut rapid: Vec<Option<(f64, Point3)>> = vec![None; count];
         let mut collided: Vec<Vec<(ToolPart, f64, Point3)>> = vec![Vec::new(); count];
+        // Sweeps with the axis +Z: their Z rays in closed form (the z-map's).
+        let columns: Vec<Option<SweptMove>> = steps
+            .iter()
+            .map(|s| {
+                let vertical = s.sweep.a.x == 0.0 && s.sweep.a.y == 0.0 && s.sweep.a.z > 0.0;
+                vertical.then(|| SweptMove::new(cutter.shape(), &s.sweep.p0, &(s.sweep.p0 + s.sweep.v)))
+            })
+            .collect();
+        let flutes_top = cutter.flute_length();
         let bands: usize = (0..3).map(|axis| self.grid(axis).1.div_ceil(BAND_ROWS)).sum();
         let done = AtomicUsize::new(0);
         let tick = || progress(done.fetch_add(1, Ordering::Relaxed) + 1, bands);
         for axis in 0..3 {
-            let outputs = self.cut_family(axis, &flutes, &guards, &steps, &boxes, &unions, true, &tick);
+            let columns = if axis == 2 { Some((columns.as_slice(), flutes_top)) } else { None };
+            let outputs = self.cut_family(axis, &flutes, &guards, &steps, &boxes, &unions, true, columns, &tick);
             for out in outputs {
                 for (k, volume, longest, at) in out.removed {
                     let step = &steps[k as usize];
@@ -767,7 +778,7 @@ impl DexelStock {
             solid.rays[axis] = part.family_material(&solid, axis).into_iter().map(Ray::Cut).collect();
             // The part's epsilon is the stock's: the same penetrations count.
             solid.eps = self.eps;
-            let outputs = solid.cut_family(axis, &flutes, &guards, &steps, &boxes, &unions, false, &|| {});
+            let outputs = solid.cut_family(axis, &flutes, &guards, &steps, &boxes, &unions, false, None, &|| {});
             for out in outputs {
                 merge_collisions(&mut collided, &steps, out.collisions);
             }
@@ -789,6 +800,7 @@ impl DexelStock {
         boxes: &[Vec<(Point3, Point3)>],
         unions: &[(Point3, Point3)],
         remove: bool,
+        columns: Option<Columns<'_>>,
         tick: &(dyn Fn() + Sync),
     ) -> Vec<BandOutput> {
         let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
@@ -822,7 +834,7 @@ impl DexelStock {
             .zip(members.par_iter())
             .enumerate()
             .map(|(band, (rays, ids))| {
-                let out = geo.cut_band(band, rays, ids, flutes, guards, steps, boxes, unions, remove);
+                let out = geo.cut_band(band, rays, ids, flutes, guards, steps, boxes, unions, remove, columns);
                 tick();
                 out
             })
@@ -893,6 +905,10 @@ fn collision_list(operation: u32, collided: &[Vec<(ToolPart, f64, Point3)>]) -> 
         .collect()
 }
 
+/// The closed-form Z rays of a cut: per step, the flutes' sweep when the
+/// axis is +Z, and the flute length.
+type Columns<'a> = (&'a [Option<SweptMove>], f64);
+
 /// What a band found, sparse per step.
 #[derive(Default)]
 struct BandOutput {
@@ -944,6 +960,7 @@ impl Family {
         boxes: &[Vec<(Point3, Point3)>],
         unions: &[(Point3, Point3)],
         remove: bool,
+        columns: Option<Columns<'_>>,
     ) -> BandOutput {
         let row0 = band * BAND_ROWS;
         let rows = rays.len() / self.nu;
@@ -973,7 +990,11 @@ impl Family {
                     if remove
                         && inside(&bx[0])
                         && let Some((m_lo, m_hi)) = ray.material_range(bx[0].0[self.axis], bx[0].1[self.axis], lo, hi)
-                        && let Some((a, b)) = step.sweep.interval_within(flutes, &o, &d, m_lo, m_hi)
+                        && let Some((a, b)) = match columns.and_then(|(c, top)| c[k as usize].map(|m| (m, top))) {
+                            // The Z ray of a vertical tool: the z-map's closed forms.
+                            Some((m, top)) => m.column(o.x, o.y, top),
+                            None => step.sweep.interval_within(flutes, &o, &d, m_lo, m_hi),
+                        }
                     {
                         let (r, l, mid) = ray.subtract(a.max(lo), b.min(hi), lo, hi);
                         removed += r;
@@ -1012,5 +1033,67 @@ impl Family {
             }
         }
         out
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used, reason = "tests: a panic is the failure report")]
+mod tests {
+    use scallop_cutter::{Cutter, CutterShape};
+
+    use super::*;
+
+    /// The closed-form Z rays of a vertical tool ([`SweptMove::column`], used
+    /// by the cut) agree with the general certified sweep of the flutes
+    /// ([`Sweep::interval`]) on scattered moves and rays: entry and exit
+    /// within the sweep's tolerance, and the same misses.
+    #[test]
+    fn vertical_columns_match_the_general_sweep() {
+        let shapes = [
+            CutterShape::Flat { radius: 2.0 },
+            CutterShape::Ball { radius: 2.0 },
+            CutterShape::Bull { radius: 2.0, corner: 0.6 },
+            CutterShape::Cone { radius: 2.0, half_angle: 0.7 },
+        ];
+        let mut state = 7u64;
+        let mut next = || {
+            state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+            // 53 random bits in [0, 1).
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut both = 0;
+        for shape in shapes {
+            let cutter = Cutter::new(shape, 7.0).unwrap();
+            let flutes = Body::flutes(&cutter);
+            for case in 0..300 {
+                let p0 = Point3::new(10.0 * next(), 10.0 * next(), 4.0 * next() - 2.0);
+                // Every tenth move vertical, every tenth horizontal.
+                let (dx, dy) = if case % 10 == 0 { (0.0, 0.0) } else { (8.0 * next() - 4.0, 8.0 * next() - 4.0) };
+                let dz = if case % 10 == 1 { 0.0 } else { 6.0 * next() - 3.0 };
+                let v = Vec3::new(dx, dy, dz);
+                let sweep = Sweep { p0, v, a: Vec3::z() };
+                let m = SweptMove::new(cutter.shape(), &p0, &(p0 + v));
+                for _ in 0..20 {
+                    let o = Point3::new(
+                        p0.x + dx * next() + 5.0 * next() - 2.5,
+                        p0.y + dy * next() + 5.0 * next() - 2.5,
+                        0.0,
+                    );
+                    let general = sweep.interval(&flutes, &o, &Vec3::z());
+                    let closed = m.column(o.x, o.y, cutter.flute_length());
+                    match (general, closed) {
+                        (Some(g), Some(c)) => {
+                            both += 1;
+                            assert!((g.0 - c.0).abs() <= 1e-7 && (g.1 - c.1).abs() <= 1e-7, "{shape:?} {g:?} {c:?}");
+                        }
+                        (None, None) => {}
+                        // A ray grazing the swept solid's side: a vanishing piece.
+                        (Some(g), None) => assert!(g.1 - g.0 <= 1e-6, "{shape:?} {g:?}"),
+                        (None, Some(c)) => assert!(c.1 - c.0 <= 1e-6, "{shape:?} {c:?}"),
+                    }
+                }
+            }
+        }
+        assert!(both > 10_000, "{both}");
     }
 }
