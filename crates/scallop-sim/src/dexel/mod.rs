@@ -768,7 +768,7 @@ impl DexelStock {
         let (reach_lo, reach_hi) = unions.iter().fold(first, |(lo, hi), (l, h)| (lo.inf(l), hi.sup(h)));
         let material = part.material_box();
         let (lo, hi) = (reach_lo.sup(&material.min), reach_hi.inf(&material.max));
-        if (0..3).any(|i| !(hi[i] > lo[i])) {
+        if (0..3).any(|i| hi[i].partial_cmp(&lo[i]) != Some(std::cmp::Ordering::Greater)) {
             return Ok(Vec::new());
         }
         let resolution = self.cell.iter().fold(0.0f64, |a, &b| a.max(b));
