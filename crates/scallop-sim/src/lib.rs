@@ -11,12 +11,16 @@
 //! - [`verify`]: the signed deviation `stock - part` per cell against a design
 //!   part (a [`scallop_mesh::MeshIndex`]): max scallop, volumes, and gouges as errors.
 //! - [`simulate`]: both, with every safety problem as an `Err`.
+//! - [`PartField`]: the part rasterised once on the grid, shared by [`simulate`]'s
+//!   [`ZMap::part_collisions_in`] and [`verify_in`].
 //! - [`DexelStock`]: the multi-axis stock (tri-dexels: rays along X, Y and Z,
 //!   each a list of material intervals), cut by cutters with any tool axis
 //!   along 3-axis, 3+2 and simultaneous 5-axis moves ([`ToolMove`]); the
 //!   swept solid of a fixed-axis move is solved per ray exactly or by a
 //!   certified bracket, 5-axis moves are split into fixed-axis sub-steps
-//!   within [`DexelOptions::axis_tolerance`]; [`verify_dexel`] compares
+//!   within [`DexelOptions::axis_tolerance`]; the shank and holder are
+//!   checked against the stock and the part ([`DexelStock::part_collisions`]);
+//!   [`verify_dexel`] compares
 //!   every ray with the part; [`simulate_dexel`] does both.
 //!
 //! ```
