@@ -10,13 +10,13 @@ use scallop_geom::{Aabb3, Point3, Tolerances, Vec3};
 use scallop_io::cl::read_cl_csv;
 use scallop_io::gcode::{GcodeOptions, read_gcode_arcs};
 use scallop_sim::{
-    DexelOptions, DexelPart, DexelStock, ToolMove, VerifyOptions, ZMap, part_heights, verify, verify_dexel,
+    DexelOptions, DexelPart, DexelStock, PartField, ToolMove, VerifyOptions, ZMap, verify_dexel, verify_in,
 };
 use scallop_toolpath::{Move, Toolpath};
 use serde::Serialize;
 
 use crate::drop::CutterArgs;
-use crate::output::{print_json, print_text, write_atomic};
+use crate::output::{print_json, print_text, progress_bar, write_atomic};
 use crate::part::{UnitsArg, load};
 use crate::{CliResult, Failure};
 use scallop_report::png::{Image, ramp};
@@ -237,13 +237,23 @@ type Outcome = (SimReport, ZMap, Vec<f64>, f64);
 
 /// Deviation per cell from the stock tops, for the picture and the figures
 /// when verify refused.
-fn deviation(zmap: &ZMap, tops: &[f64], part: &scallop_mesh::MeshIndex) -> (Vec<f64>, f64, f64) {
-    let top = part_heights(zmap, part);
-    let dev: Vec<f64> = tops.iter().zip(&top).map(|(s, p)| if p.is_finite() { s - p } else { f64::NAN }).collect();
+fn deviation(tops: &[f64], field: &PartField) -> (Vec<f64>, f64, f64) {
+    let dev: Vec<f64> =
+        tops.iter().zip(field.heights()).map(|(s, p)| if p.is_finite() { s - p } else { f64::NAN }).collect();
     let finite = || dev.iter().copied().filter(|d| d.is_finite());
     let max_dev = finite().fold(0.0f64, f64::max);
     let min_dev = finite().fold(f64::INFINITY, f64::min);
     (dev, max_dev, min_dev)
+}
+
+/// Moves the progress bar to `done` of `total` bands (the library calls this
+/// from its worker threads, in any order: the bar only moves forward).
+fn show(bar: &indicatif::ProgressBar, done: usize, total: usize) {
+    // Counts far below 2^64: exact conversions.
+    bar.set_length(total as u64);
+    if done as u64 > bar.position() {
+        bar.set_position(done as u64);
+    }
 }
 
 /// The 3-axis simulation on a z-map.
@@ -260,25 +270,31 @@ fn simulate_zmap(
 ) -> CliResult<Outcome> {
     let name = &program.name;
     let mut zmap = ZMap::new(stock, args.resolution).map_err(|e| Failure::rejected(format!("stock: {e}")))?;
-    let cut = zmap.cut(cutter, &program.path).map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
+    let bar = progress_bar(0, "cutting the z-map stock");
+    let cut = zmap
+        .cut_with_progress(cutter, &program.path, &|done, total| show(&bar, done, total))
+        .map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
+    bar.finish_and_clear();
     let mut verdict = Vec::new();
     if let Err(e) = cut.check() {
         verdict.push(e.to_string());
     }
+    // The part rasterised once: collisions, verification and the picture.
+    let field = PartField::new(&zmap, &prepared.index);
     let collisions = zmap
-        .part_collisions(&prepared.index, cutter, &program.path, cut.operation)
+        .part_collisions_in(&field, cutter, &program.path, cut.operation)
         .map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
     if !collisions.is_empty() {
         verdict.push(scallop_sim::SimError::PartCollision { count: collisions.len(), collisions }.to_string());
     }
-    let verification = match verify(&zmap, &prepared.index, options) {
+    let verification = match verify_in(&zmap, &field, options) {
         Ok(v) => Some(v),
         Err(e) => {
             verdict.push(e.to_string());
             None
         }
     };
-    let (dev, max_dev, min_dev) = deviation(&zmap, zmap.heights(), &prepared.index);
+    let (dev, max_dev, min_dev) = deviation(zmap.heights(), &field);
     let report = SimReport {
         stock_model: "z-map",
         part: part_name.to_string(),
@@ -319,13 +335,22 @@ fn simulate_dexel(
     let name = &program.name;
     let mut dexels = DexelStock::new(stock, args.resolution).map_err(|e| Failure::rejected(format!("stock: {e}")))?;
     let dexel_options = DexelOptions { axis_tolerance: args.axis_tolerance, ..DexelOptions::default() };
-    let cut =
-        dexels.cut(cutter, &program.moves, &dexel_options).map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
+    let bar = progress_bar(0, "cutting the tri-dexel stock");
+    let cut = dexels
+        .cut_with_progress(cutter, &program.moves, &dexel_options, &|done, total| show(&bar, done, total))
+        .map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
+    bar.finish_and_clear();
     let mut verdict = Vec::new();
     if let Err(e) = cut.check() {
         verdict.push(e.to_string());
     }
     let part = DexelPart::new(&prepared.mesh);
+    let collisions = dexels
+        .part_collisions(&part, cutter, &program.moves, &dexel_options, cut.operation)
+        .map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
+    if !collisions.is_empty() {
+        verdict.push(scallop_sim::SimError::DexelPartCollision { count: collisions.len(), collisions }.to_string());
+    }
     let verification = match verify_dexel(&dexels, &part, options) {
         Ok(v) => Some(v),
         Err(e) => {
@@ -335,7 +360,7 @@ fn simulate_dexel(
     };
     // An uncut z-map on the Z rays' grid: the same cells, for the picture.
     let grid = ZMap::new(stock, args.resolution).map_err(|e| Failure::rejected(format!("stock: {e}")))?;
-    let (dev, max_dev, min_dev) = deviation(&grid, &dexels.top_heights(), &prepared.index);
+    let (dev, max_dev, min_dev) = deviation(&dexels.top_heights(), &PartField::new(&grid, &prepared.index));
     let counts = dexels.counts();
     let rays = [0, 1, 2].map(|k| {
         let (nu, nv) = dexels.grid(k);

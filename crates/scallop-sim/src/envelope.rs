@@ -55,7 +55,7 @@
 use scallop_cutter::CutterShape;
 use scallop_geom::tol::PARAMETER_CONVERGENCE;
 
-use crate::tol::VERTICAL_SLOPE;
+use crate::tol::{FLOOR_BOUND_MARGIN, VERTICAL_SLOPE};
 use scallop_geom::{Point2, Point3};
 
 /// Profile constants (no trigonometry per cell).
@@ -337,6 +337,20 @@ impl SweptMove {
         if lo > hi {
             return f64::INFINITY;
         }
+        if let Profile::Bull { .. } = self.profile {
+            // Lower bound without the iterative solve: the tip's lowest z
+            // over [lo, hi] plus the profile at the smallest rho there
+            // (`rho(w)` is smallest at the w nearest 0, `h` non-decreasing).
+            let w_tip = if self.slope > 0.0 { lo } else { hi };
+            let w_near = 0.0f64.clamp(lo, hi);
+            let near2 = w_near * w_near + d2;
+            let bound =
+                self.az + self.slope * (u + w_tip) + self.profile_height(0.0, near2, self.radius2 - near2) + self.lift
+                    - FLOOR_BOUND_MARGIN;
+            if bound >= limit {
+                return bound;
+            }
+        }
         let w = match self.profile {
             Profile::Flat => {
                 if self.slope > 0.0 {
@@ -462,10 +476,43 @@ impl SweptMove {
         self.radius
     }
 
-    /// `k` with `h(rho) >= k rho^2`: the floor at a point at horizontal distance
-    /// `>= d` from the move is `>= z_low + k d^2`.
-    pub(crate) fn quadratic(&self) -> f64 {
-        self.quadratic
+    /// The vertical line at (x, y) inside the swept solid of the whole
+    /// cutting body (the profile and a cylinder of radius R up to `top` above
+    /// the tip: the flutes), or `None` when the move does not reach it. The
+    /// solid is convex, so the line meets it in one interval: from the swept
+    /// floor ([`SweptMove::floor_at`]) to the highest top of the cylinder over
+    /// the positions where the axis is within R of the line (the tip's z is
+    /// linear along the move, so that is an end of the interval of positions,
+    /// `w` in `[max(-u, -c), min(L - u, c)]` in the module's notation). Exact:
+    /// closed forms, the bull-nose floor to the solver's tolerance.
+    pub(crate) fn column(&self, x: f64, y: f64, top: f64) -> Option<(f64, f64)> {
+        debug_assert!(self.arc.is_none(), "columns of straight moves only");
+        let floor = self.floor_at(x, y);
+        if !floor.is_finite() {
+            return None;
+        }
+        let (qx, qy) = (x - self.ax, y - self.ay);
+        let ceiling = if self.vertical {
+            self.az.max(self.az + self.dz)
+        } else {
+            let u = qx * self.ex + qy * self.ey;
+            let v = qx * self.ey - qy * self.ex;
+            let c = (self.radius2 - v * v).max(0.0).sqrt();
+            let (lo, hi) = ((-u).max(-c), (self.len - u).min(c));
+            let w = if self.slope > 0.0 { hi.max(lo) } else { lo.min(hi) };
+            self.az + self.dz * ((u + w) * self.inv_len).clamp(0.0, 1.0)
+        };
+        Some((floor, ceiling + top + self.lift))
+    }
+
+    /// A lower bound of the floor at every point at horizontal distance `>= d`
+    /// (`d2 = d^2`) from the tip's path: `z_low + h(min(d, R))`, less
+    /// `tol::FLOOR_BOUND_MARGIN` (rounding), and never below the quadratic
+    /// bound `z_low + k d^2` (`k` of [`SweptMove::floor_below`]).
+    pub(crate) fn floor_bound(&self, d2: f64) -> f64 {
+        let rho2 = d2.min(self.radius2);
+        let exact = self.z_low + self.profile_height(0.0, rho2, self.radius2 - rho2) - FLOOR_BOUND_MARGIN;
+        exact.max(self.z_low + self.quadratic * d2)
     }
 }
 

@@ -122,6 +122,18 @@ pub enum SimError {
         /// Part top there.
         part_z: f64,
     },
+    /// A [`crate::PartField`] was used with a z-map of another grid.
+    #[error(
+        "the part field was built on a grid of {} x {} cells but the z-map has {} x {} (or another stock box); \
+         build the field with PartField::new on this z-map",
+        field[0], field[1], zmap[0], zmap[1]
+    )]
+    FieldGrid {
+        /// The field's cells along x and y.
+        field: [usize; 2],
+        /// The z-map's cells along x and y.
+        zmap: [usize; 2],
+    },
     /// The tri-dexel stock would have more rays than the limit.
     #[error("tri-dexel stock of {rays} rays exceeds the limit of {limit}; use a coarser resolution or a smaller stock")]
     TooManyRays {
@@ -186,6 +198,19 @@ pub enum SimError {
         first = collisions.first().map_or_else(String::new, ToString::to_string)
     )]
     DexelCollision {
+        /// Number of colliding moves (per part of the tool).
+        count: usize,
+        /// The collisions, in program order.
+        collisions: Vec<DexelCollision>,
+    },
+    /// The shank or holder touched the design part itself (tri-dexel stock).
+    #[error(
+        "{count} moves drive the shank or holder into the part; the first: {first} (part material inside the \
+         tool along a ray); use a tool with longer flutes or a longer reach, change the tool axis, or keep the \
+         passes farther from that feature",
+        first = collisions.first().map_or_else(String::new, |c| c.to_string().replace("into the stock", "into the part"))
+    )]
+    DexelPartCollision {
         /// Number of colliding moves (per part of the tool).
         count: usize,
         /// The collisions, in program order.

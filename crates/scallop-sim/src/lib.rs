@@ -11,12 +11,16 @@
 //! - [`verify`]: the signed deviation `stock - part` per cell against a design
 //!   part (a [`scallop_mesh::MeshIndex`]): max scallop, volumes, and gouges as errors.
 //! - [`simulate`]: both, with every safety problem as an `Err`.
+//! - [`PartField`]: the part rasterised once on the grid, shared by [`simulate`]'s
+//!   [`ZMap::part_collisions_in`] and [`verify_in`].
 //! - [`DexelStock`]: the multi-axis stock (tri-dexels: rays along X, Y and Z,
 //!   each a list of material intervals), cut by cutters with any tool axis
 //!   along 3-axis, 3+2 and simultaneous 5-axis moves ([`ToolMove`]); the
 //!   swept solid of a fixed-axis move is solved per ray exactly or by a
 //!   certified bracket, 5-axis moves are split into fixed-axis sub-steps
-//!   within [`DexelOptions::axis_tolerance`]; [`verify_dexel`] compares
+//!   within [`DexelOptions::axis_tolerance`]; the shank and holder are
+//!   checked against the stock and the part ([`DexelStock::part_collisions`]);
+//!   [`verify_dexel`] compares
 //!   every ray with the part; [`simulate_dexel`] does both.
 //!
 //! ```
@@ -84,7 +88,7 @@ pub use dexel::{
 };
 pub use envelope::swept_floor;
 pub use error::SimError;
-pub use verify::{GougeCell, Verification, VerifyOptions, part_heights, verify};
+pub use verify::{GougeCell, PartField, Verification, VerifyOptions, part_heights, verify, verify_in};
 pub use zmap::{Collision, CutReport, MAX_CELLS, MoveId, RapidHit, ToolPart, ZMap};
 
 /// Everything [`simulate`] found about a safe program.
@@ -139,12 +143,14 @@ pub fn simulate(
     }
     // The part under the stock means a collision with the part is one with
     // the stock too: the part's comes first, as no roughing can fix it.
-    let collisions = zmap.part_collisions(part, cutter, toolpath, cut.operation)?;
+    // The part rasterised once for both checks.
+    let field = PartField::new(&zmap, part);
+    let collisions = zmap.part_collisions_in(&field, cutter, toolpath, cut.operation)?;
     if !collisions.is_empty() {
         return Err(SimError::PartCollision { count: collisions.len(), collisions });
     }
     cut.check()?;
-    let verification = verify(&zmap, part, options)?;
+    let verification = verify_in(&zmap, &field, options)?;
     Ok(Simulation { zmap, cut, verification })
 }
 
@@ -165,7 +171,9 @@ pub struct DexelSimulation {
 /// # Errors
 /// Stock errors of [`DexelStock::new`], move errors of [`DexelStock::cut`];
 /// then, in this order, rapids into stock ([`SimError::RapidIntoStock`]),
-/// shank or holder in the stock ([`SimError::DexelCollision`]), gouges
+/// shank or holder against the part ([`SimError::DexelPartCollision`], see
+/// [`DexelStock::part_collisions`]; only when `options.check_collisions`),
+/// against the stock ([`SimError::DexelCollision`]), gouges
 /// ([`SimError::DexelGouge`]).
 ///
 /// ```
@@ -199,6 +207,15 @@ pub fn simulate_dexel(
 ) -> Result<DexelSimulation, SimError> {
     let mut dexels = DexelStock::new(stock, resolution)?;
     let cut = dexels.cut(cutter, moves, options)?;
+    if !cut.rapid_hits.is_empty() {
+        cut.check()?;
+    }
+    if options.check_collisions {
+        let collisions = dexels.part_collisions(part, cutter, moves, options, cut.operation)?;
+        if !collisions.is_empty() {
+            return Err(SimError::DexelPartCollision { count: collisions.len(), collisions });
+        }
+    }
     cut.check()?;
     let verification = verify_dexel(&dexels, part, verify_options)?;
     Ok(DexelSimulation { stock: dexels, cut, verification })

@@ -17,3 +17,10 @@ pub const VERTICAL_SLOPE: f64 = 1e100;
 /// Largest distance (mm) between a circular or helical move of a tri-dexel
 /// cut and the chords it is cut as (their vertices lie on the arc).
 pub const ARC_SAGITTA: f64 = 1e-4;
+
+/// Margin (mm) subtracted from the lower bounds of a swept floor that skip
+/// the exact per-cell solve (`z_low + h(distance)`): far above the rounding of
+/// both the bound and the solve (1e-14 mm at 100 mm), so that a skip never
+/// happens where the solve would have lowered the cell, and results are the
+/// same bits as without the bound.
+pub const FLOOR_BOUND_MARGIN: f64 = 1e-9;

@@ -2,7 +2,7 @@
 
 use rayon::prelude::*;
 use scallop_geom::predicates::{in_triangle, orient2d};
-use scallop_geom::{Aabb2, Point2, Tolerances};
+use scallop_geom::{Aabb2, Aabb3, Point2, Tolerances};
 use scallop_mesh::MeshIndex;
 
 use crate::tol::WORST_REPORTED;
@@ -127,6 +127,74 @@ pub struct Verification {
 #[must_use]
 pub fn part_heights(zmap: &ZMap, part: &MeshIndex) -> Vec<f64> {
     part_surface(zmap, part).into_iter().map(|(z, _)| z).collect()
+}
+
+/// The design part sampled once on a z-map's grid: the part's top z under
+/// each cell centre and the `|n_z|` of the triangle that gives it (see
+/// [`part_heights`]). Rasterising the part is a large share of a simulation;
+/// a field built once serves [`ZMap::part_collisions_in`], [`verify_in`] and
+/// the caller's own deviation figures. It belongs to the grid it was built on
+/// (stock box and cell counts), not to the heights, so it stays valid while
+/// the stock is cut.
+///
+/// ```
+/// use scallop_geom::{Aabb3, Point3};
+/// use scallop_mesh::{MeshIndex, TriMesh};
+/// use scallop_sim::{PartField, VerifyOptions, ZMap, part_heights, verify, verify_in};
+/// let p = |x, y, z| Point3::new(x, y, z);
+/// let (mesh, _) = TriMesh::from_soup(&[[p(-1., -1., 1.), p(9., -1., 1.), p(-1., 9., 2.)]]).unwrap();
+/// let part = MeshIndex::build(&mesh);
+/// let zmap = ZMap::new(Aabb3 { min: p(0., 0., 0.), max: p(4., 4., 3.) }, 0.5).unwrap();
+/// let field = PartField::new(&zmap, &part);
+/// assert_eq!(field.heights().collect::<Vec<_>>(), part_heights(&zmap, &part));
+/// let o = VerifyOptions::default();
+/// assert_eq!(verify_in(&zmap, &field, &o), verify(&zmap, &part, &o));
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+pub struct PartField {
+    stock: Aabb3,
+    nx: usize,
+    ny: usize,
+    surface: Vec<(f64, f64)>,
+}
+
+impl PartField {
+    /// Rasterises `part` on `zmap`'s grid (parallel, deterministic).
+    #[must_use]
+    pub fn new(zmap: &ZMap, part: &MeshIndex) -> PartField {
+        PartField { stock: zmap.stock(), nx: zmap.nx(), ny: zmap.ny(), surface: part_surface(zmap, part) }
+    }
+
+    /// The part's top z per cell, row-major with x fastest, `f64::NEG_INFINITY`
+    /// where no triangle lies under the centre (the values of [`part_heights`]).
+    pub fn heights(&self) -> impl ExactSizeIterator<Item = f64> + '_ {
+        self.surface.iter().map(|&(z, _)| z)
+    }
+
+    /// Cells along x and y.
+    #[must_use]
+    pub fn cells(&self) -> (usize, usize) {
+        (self.nx, self.ny)
+    }
+
+    /// Whether the field was built on `zmap`'s grid (same stock box and cells).
+    #[must_use]
+    pub fn fits(&self, zmap: &ZMap) -> bool {
+        self.nx == zmap.nx() && self.ny == zmap.ny() && self.stock == zmap.stock()
+    }
+
+    /// `Ok` when the field fits `zmap`.
+    pub(crate) fn check(&self, zmap: &ZMap) -> Result<(), SimError> {
+        if self.fits(zmap) {
+            Ok(())
+        } else {
+            Err(SimError::FieldGrid { field: [self.nx, self.ny], zmap: [zmap.nx(), zmap.ny()] })
+        }
+    }
+
+    pub(crate) fn surface(&self) -> &[(f64, f64)] {
+        &self.surface
+    }
 }
 
 /// [`part_heights`] with the `|n_z|` of the triangle that gives each height
@@ -305,7 +373,17 @@ fn deepest_first(a: &GougeCell, b: &GougeCell) -> std::cmp::Ordering {
 /// assert_eq!((v.scallop_cells, v.margin_max_thickness), (16, 2.0));
 /// ```
 pub fn verify(zmap: &ZMap, part: &MeshIndex, options: &VerifyOptions) -> Result<Verification, SimError> {
-    let top = part_surface(zmap, part);
+    verify_in(zmap, &PartField::new(zmap, part), options)
+}
+
+/// [`verify`] with the part already rasterised on the stock's grid.
+///
+/// # Errors
+/// Those of [`verify`]; [`SimError::FieldGrid`] when `field` was built on
+/// another grid than `zmap`'s.
+pub fn verify_in(zmap: &ZMap, field: &PartField, options: &VerifyOptions) -> Result<Verification, SimError> {
+    field.check(zmap)?;
+    let top = field.surface();
     let (nx, ny) = (zmap.nx(), zmap.ny());
     let (cell_x, cell_y) = zmap.cell_size();
     let margin = options.scallop_margin.max(0.0);

@@ -1,6 +1,7 @@
 //! The z-map stock: a height field on a regular XY grid, cut by swept cutters.
 
 use std::fmt;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 use rayon::prelude::*;
 use scallop_cutter::{Cutter, CutterShape};
@@ -469,7 +470,7 @@ impl ZMap {
     /// Only cells within a move's reach are visited: the rows of its XY box, on
     /// each row the chord of the stadium around the segment, and on the chord
     /// only runs of cells ("tiles") whose height bound lies above a lower bound
-    /// of the move's floor there (`z_low + k d^2`, see the envelope module), so
+    /// of the move's floor there (`z_low + h(d)`, d the distance to the move, see the envelope module), so
     /// skipping never changes a result.
     ///
     /// Work is parallel over fixed bands of grid rows; each band applies the
@@ -499,10 +500,47 @@ impl ZMap {
     /// assert_eq!(zmap.height(100, 50), Some(-1.0));
     /// ```
     pub fn cut(&mut self, cutter: &Cutter, toolpath: &Toolpath) -> Result<CutReport, SimError> {
+        self.cut_with_progress(cutter, toolpath, &|_, _| {})
+    }
+
+    /// [`ZMap::cut`] that reports its progress: `progress(done, total)` is
+    /// called from the worker threads (in any order) each time a band of grid
+    /// rows has applied all its moves, `total` being the number of bands.
+    /// The result does not depend on it.
+    ///
+    /// # Errors
+    /// Those of [`ZMap::cut`].
+    ///
+    /// ```
+    /// use std::sync::atomic::{AtomicUsize, Ordering};
+    /// use scallop_cutter::{Cutter, CutterShape};
+    /// use scallop_geom::{Aabb3, Point3};
+    /// use scallop_sim::ZMap;
+    /// use scallop_toolpath::{Move, MoveKind, Toolpath};
+    /// let stock = Aabb3 { min: Point3::new(0.0, 0.0, -2.0), max: Point3::new(10.0, 10.0, 0.0) };
+    /// let mut zmap = ZMap::new(stock, 0.1).unwrap();
+    /// let flat = Cutter::new(CutterShape::Flat { radius: 1.0 }, 5.0).unwrap();
+    /// let mut path = Toolpath::new(500.0);
+    /// path.push(Move::new(MoveKind::Rapid, Point3::new(-2.0, 5.0, -1.0)));
+    /// path.push(Move::new(MoveKind::Feed, Point3::new(12.0, 5.0, -1.0)));
+    /// let last = AtomicUsize::new(0);
+    /// zmap.cut_with_progress(&flat, &path, &|done, total| {
+    ///     assert!(done <= total);
+    ///     last.fetch_max(done, Ordering::Relaxed);
+    /// })
+    /// .unwrap();
+    /// assert_eq!(last.into_inner(), 13); // 100 rows in bands of 8
+    /// ```
+    pub fn cut_with_progress(
+        &mut self,
+        cutter: &Cutter,
+        toolpath: &Toolpath,
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> Result<CutReport, SimError> {
         let moves = toolpath.moves();
         let operation = self.operations;
         self.operations = self.operations.checked_add(1).ok_or(SimError::TooManyMoves { moves: moves.len() })?;
-        self.sweep(cutter, toolpath, operation, true)
+        self.sweep(cutter, toolpath, operation, true, progress)
     }
 
     /// Checks the shank and holder of `cutter` along `toolpath` against the
@@ -546,13 +584,29 @@ impl ZMap {
         toolpath: &Toolpath,
         operation: u32,
     ) -> Result<Vec<Collision>, SimError> {
+        self.part_collisions_in(&crate::PartField::new(self, part), cutter, toolpath, operation)
+    }
+
+    /// [`ZMap::part_collisions`] with the part already rasterised on this grid.
+    ///
+    /// # Errors
+    /// Those of [`ZMap::part_collisions`]; [`SimError::FieldGrid`] when
+    /// `field` was built on another grid.
+    pub fn part_collisions_in(
+        &self,
+        field: &crate::PartField,
+        cutter: &Cutter,
+        toolpath: &Toolpath,
+        operation: u32,
+    ) -> Result<Vec<Collision>, SimError> {
+        field.check(self)?;
         let bottom = self.stock.min.z;
-        let mut field = self.clone();
-        field.heights = crate::part_heights(self, part)
-            .into_iter()
-            .map(|z| if z == f64::NEG_INFINITY { bottom } else { z.max(bottom) })
-            .collect();
-        Ok(field.sweep(cutter, toolpath, operation, false)?.collisions)
+        let mut solid = ZMap {
+            heights: field.heights().map(|z| if z == f64::NEG_INFINITY { bottom } else { z.max(bottom) }).collect(),
+            last_cut: vec![0; self.heights.len()],
+            ..*self
+        };
+        Ok(solid.sweep(cutter, toolpath, operation, false, &|_, _| {})?.collisions)
     }
 
     /// The body of [`ZMap::cut`]; `remove == false` only checks the discs.
@@ -562,6 +616,7 @@ impl ZMap {
         toolpath: &Toolpath,
         operation: u32,
         remove: bool,
+        progress: &(dyn Fn(usize, usize) + Sync),
     ) -> Result<CutReport, SimError> {
         let moves = toolpath.moves();
         let n = u32::try_from(moves.len()).map_err(|_| SimError::TooManyMoves { moves: moves.len() })?;
@@ -669,6 +724,7 @@ impl ZMap {
             eps: self.eps,
         };
         let nx = self.nx;
+        let done = AtomicUsize::new(0);
         let outputs: Vec<BandOutput> = self
             .heights
             .par_chunks_mut(BAND_ROWS * nx)
@@ -676,7 +732,9 @@ impl ZMap {
             .enumerate()
             .map(|(band, (heights, last))| {
                 let ids = &members[start[band]..start[band + 1]];
-                grid.cut_band(band, heights, last, ids, &plans, &discs, &parts, operation, remove)
+                let out = grid.cut_band(band, heights, last, ids, &plans, &discs, &parts, operation, remove);
+                progress(done.fetch_add(1, Ordering::Relaxed) + 1, bands);
+                out
             })
             .collect();
 
@@ -802,7 +860,6 @@ impl Grid {
             let (j0, j1) = (j0.max(row0), j1.min(row0 + rows - 1));
             let (box_x0, box_x1) = (plan.box_lo.x, plan.box_hi.x);
             let (box_y0, box_y1) = (plan.box_lo.y, plan.box_hi.y);
-            let quadratic = plan.cutter.quadratic();
             // Nothing at or below this can touch a disc (collisions need > eps).
             let disc_bound = plan.disc_low + self.eps;
             let mut removed = 0.0;
@@ -818,14 +875,11 @@ impl Grid {
                     let tile = local * tiles_per_row + t;
                     let (c0, c1) = (i0.max(t * TILE), i1.min(t * TILE + TILE - 1));
                     // Lower bound of the cutter's floor on the tile's centres:
-                    // z_low + k d^2 with d the distance to the move's box.
+                    // z_low + h(d) with d the distance to the move's box.
                     let (xa, xb) = (self.x_of(c0), self.x_of(c1));
                     let dx = (box_x0 - xb).max(0.0).max(xa - box_x1);
-                    let bound = if remove {
-                        (plan.cutter.z_low + quadratic * (dx * dx + dy * dy)).min(disc_bound)
-                    } else {
-                        disc_bound
-                    };
+                    let bound =
+                        if remove { plan.cutter.floor_bound(dx * dx + dy * dy).min(disc_bound) } else { disc_bound };
                     if tile_top[tile] <= bound {
                         continue;
                     }

@@ -55,7 +55,9 @@ fn shapes() -> [CutterShape; 4] {
 }
 
 /// A vertical tool cuts the same as the z-map: the top of each Z ray equals
-/// the z-map cell height (both are exact at the same XY centres).
+/// the z-map cell height, bit for bit (the Z rays of a +Z axis use the
+/// z-map's closed forms; the general sweep is checked against them in the
+/// crate's unit tests).
 #[test]
 fn vertical_tools_match_the_zmap() {
     let stock = Aabb3 { min: p(0.0, 0.0, -4.0), max: p(12.0, 10.0, 0.0) };
@@ -77,9 +79,9 @@ fn vertical_tools_match_the_zmap() {
         dr.check().unwrap();
         let top = dexels.top_heights();
         assert_eq!(top.len(), zmap.heights().len());
-        let bound = zmap.resolution_bound(&shape).max(1e-7);
         for (k, (a, b)) in top.iter().zip(zmap.heights()).enumerate() {
-            assert!((a - b).abs() <= 1e-7, "{shape:?} cell {k}: dexel {a} zmap {b} (bound {bound})");
+            // The Z rays of a vertical tool use the z-map's closed forms: the same bits.
+            assert_eq!(a.to_bits(), b.to_bits(), "{shape:?} cell {k}: dexel {a} zmap {b}");
         }
         assert!((dr.removed_volume - zr.removed_volume).abs() <= 1e-6 * zr.removed_volume, "{shape:?}");
         // Below the top every Z ray is one solid interval (no undercut from a vertical tool).
@@ -449,6 +451,63 @@ fn shank_in_the_stock_is_a_collision() {
     assert!(report.collisions.iter().all(|c| c.part != ToolPart::Shank));
     let deepest = report.collisions.iter().map(|c| c.depth).fold(0.0, f64::max);
     assert!(deepest > 1.0, "{deepest}");
+}
+
+/// A tilted tool whose holder reaches over a post of the part standing
+/// outside the stock box: a collision with the part (not the stock, which
+/// the holder never reaches), named by move; none with a smaller holder.
+#[test]
+fn holder_on_a_part_feature_outside_the_stock_is_a_collision() {
+    // The part: a base slab inside the stock and a post at x in [16, 20],
+    // beyond the stock's end at x = 10.
+    let mut soup = Vec::new();
+    for mesh in [block(p(-1.0, -1.0, -5.0), p(11.0, 11.0, -2.0)), block(p(16.0, 3.0, -5.0), p(20.0, 7.0, 10.0))] {
+        for t in mesh.triangles() {
+            soup.push(t.map(|i| mesh.vertices()[i as usize]));
+        }
+    }
+    let part = DexelPart::new(&TriMesh::from_soup(&soup).unwrap().0);
+    assert!(part.is_closed());
+    let stock = Aabb3 { min: p(0.0, 0.0, -5.0), max: p(10.0, 10.0, 0.0) };
+    // Ball R 1, 6 mm of flutes, shank R 1 over 4 mm, holder R 6 over 10 mm
+    // from 10 mm up the axis; tilted 30 degrees towards +X. At a tip x the
+    // holder's lower rim reaches x + 5 + 6 cos 30 = x + 10.2 at z tip + 5.66.
+    let holder = |r: f64, length: f64| HolderSegment { length, bottom_radius: r, top_radius: r };
+    let ball = Cutter::new(CutterShape::Ball { radius: 1.0 }, 6.0).unwrap().with_shank(1.0, 4.0).unwrap();
+    let a = tilted(std::f64::consts::FRAC_PI_6, 0.0);
+    let path = [
+        mv(MoveKind::Rapid, p(2.0, 5.0, 3.0), a),
+        mv(MoveKind::Plunge, p(2.0, 5.0, -1.5), a),
+        mv(MoveKind::Feed, p(8.0, 5.0, -1.5), a),
+        // Up at feed: a tilted tool rising along Z shaves rounding-sized
+        // slivers off the walls it cut, which a retract would report.
+        mv(MoveKind::Feed, p(8.0, 5.0, 3.0), a),
+    ];
+    let options = DexelOptions::default();
+    let wide = ball.clone().with_holder(vec![holder(6.0, 10.0)]).unwrap();
+    let mut d = DexelStock::new(stock, 0.25).unwrap();
+    let report = d.cut(&wide, &path, &options).unwrap();
+    // The stock alone is safe: the holder stays above it.
+    report.check().unwrap();
+    let hits = d.part_collisions(&part, &wide, &path, &options, report.operation).unwrap();
+    let moves: Vec<u32> = hits.iter().map(|c| c.id.index).collect();
+    assert_eq!(moves, vec![2, 3], "{hits:?}");
+    for c in &hits {
+        assert_eq!(c.part, ToolPart::Holder(0));
+        // In the post, outside the stock box.
+        assert!(c.at.x >= 16.0 - 0.25 && c.at.x <= 20.0 + 0.25 && c.at.z <= 10.0 + 0.25, "{c:?}");
+        assert!(c.depth > 0.5, "{c:?}");
+    }
+    let err = simulate_dexel(stock, 0.25, &wide, &path, &part, &options, &VerifyOptions::default()).unwrap_err();
+    assert!(matches!(&err, SimError::DexelPartCollision { count: 2, .. }), "{err}");
+    assert!(err.to_string().contains("move 2 of operation 0") && err.to_string().contains("into the part"), "{err}");
+    // A holder of radius 2 over 2 mm (its top rim at most at x = 8 + 7.73
+    // < 16): safe, and the program verifies.
+    let narrow = ball.with_holder(vec![holder(2.0, 2.0)]).unwrap();
+    let d = DexelStock::new(stock, 0.25).unwrap();
+    let hits = d.part_collisions(&part, &narrow, &path, &options, 0).unwrap();
+    assert!(hits.is_empty(), "{hits:?}");
+    simulate_dexel(stock, 0.25, &narrow, &path, &part, &options, &VerifyOptions::default()).unwrap();
 }
 
 /// The same cut on one and two threads gives identical rays and reports.

@@ -11,12 +11,14 @@ mod sweep;
 mod verify;
 
 use std::fmt;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 use rayon::prelude::*;
 use scallop_cutter::Cutter;
 use scallop_geom::{Aabb3, Eps, Point2, Point3, Vec3};
 use scallop_toolpath::{ArcXY, MoveKind, Toolpath};
 
+use crate::envelope::SweptMove;
 use crate::tol::{ARC_SAGITTA, GRID_SNAP};
 use crate::{MoveId, RapidHit, SimError, ToolPart};
 use body::Body;
@@ -574,6 +576,23 @@ impl DexelStock {
         moves: &[ToolMove],
         options: &DexelOptions,
     ) -> Result<DexelReport, SimError> {
+        self.cut_with_progress(cutter, moves, options, &|_, _| {})
+    }
+
+    /// [`DexelStock::cut`] that reports its progress: `progress(done, total)`
+    /// is called from the worker threads (in any order) each time a band of
+    /// rays has applied all its sweeps, `total` being the number of bands of
+    /// the three families. The result does not depend on it.
+    ///
+    /// # Errors
+    /// Those of [`DexelStock::cut`].
+    pub fn cut_with_progress(
+        &mut self,
+        cutter: &Cutter,
+        moves: &[ToolMove],
+        options: &DexelOptions,
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> Result<DexelReport, SimError> {
         if !(options.axis_tolerance.is_finite() && options.axis_tolerance > 0.0) {
             return Err(SimError::BadTolerance { what: "axis tolerance", value: options.axis_tolerance });
         }
@@ -611,8 +630,21 @@ impl DexelStock {
         let mut cut_any = vec![false; count];
         let mut rapid: Vec<Option<(f64, Point3)>> = vec![None; count];
         let mut collided: Vec<Vec<(ToolPart, f64, Point3)>> = vec![Vec::new(); count];
+        // Sweeps with the axis +Z: their Z rays in closed form (the z-map's).
+        let columns: Vec<Option<SweptMove>> = steps
+            .iter()
+            .map(|s| {
+                let vertical = s.sweep.a.x == 0.0 && s.sweep.a.y == 0.0 && s.sweep.a.z > 0.0;
+                vertical.then(|| SweptMove::new(cutter.shape(), &s.sweep.p0, &(s.sweep.p0 + s.sweep.v)))
+            })
+            .collect();
+        let flutes_top = cutter.flute_length();
+        let bands: usize = (0..3).map(|axis| self.grid(axis).1.div_ceil(BAND_ROWS)).sum();
+        let done = AtomicUsize::new(0);
+        let tick = || progress(done.fetch_add(1, Ordering::Relaxed) + 1, bands);
         for axis in 0..3 {
-            let outputs = self.cut_family(axis, &flutes, &guards, &steps, &boxes, &unions);
+            let columns = if axis == 2 { Some((columns.as_slice(), flutes_top)) } else { None };
+            let outputs = self.cut_family(axis, &flutes, &guards, &steps, &boxes, &unions, true, columns, &tick);
             for out in outputs {
                 for (k, volume, longest, at) in out.removed {
                     let step = &steps[k as usize];
@@ -627,15 +659,7 @@ impl DexelStock {
                         }
                     }
                 }
-                for (k, part, depth, at) in out.collisions {
-                    let m = steps[k as usize].index as usize;
-                    let list = &mut collided[m];
-                    match list.iter_mut().find(|(p, _, _)| *p == part) {
-                        Some(entry) if depth > entry.1 => *entry = (part, depth, at),
-                        Some(_) => {}
-                        None => list.push((part, depth, at)),
-                    }
-                }
+                merge_collisions(&mut collided, &steps, out.collisions);
             }
         }
         let id = |k: usize| MoveId { operation, index: k as u32 };
@@ -646,12 +670,7 @@ impl DexelStock {
             .enumerate()
             .filter_map(|(k, r)| r.map(|(depth, at)| RapidHit { id: id(k), at: Point2::new(at.x, at.y), depth }))
             .collect();
-        let collisions = collided
-            .iter()
-            .enumerate()
-            .flat_map(|(k, list)| list.iter().map(move |&(part, depth, at)| (k, part, depth, at)))
-            .map(|(k, part, depth, at)| DexelCollision { id: id(k), part, at, depth })
-            .collect();
+        let collisions = collision_list(operation, &collided);
         let removed_volume = removed_by_move.iter().sum();
         let sweeps = steps.len();
         self.bodies.push(flutes);
@@ -668,7 +687,110 @@ impl DexelStock {
         })
     }
 
-    /// One family: bands of rays in parallel, each applying its steps in order.
+    /// Checks the shank and holder of `cutter` along `moves` against the
+    /// design part itself (not the in-process stock), as
+    /// [`crate::ZMap::part_collisions`] does on a z-map: the part is laid on
+    /// rays of its own (along X, Y and Z, at this stock's cell size, over the
+    /// part's box within the reach of the shank and holder sweeps, so part
+    /// features outside the stock box count too), and each fixed-axis sweep
+    /// of the shank and of each holder segment is checked against them as in
+    /// [`DexelStock::cut`]: part material inside them longer than the stock's
+    /// epsilon along a ray is a collision, the deepest per move and part of
+    /// the tool, in program order. The stock is not changed; `operation`
+    /// names the moves (the [`DexelReport::operation`] of the cut of the same
+    /// moves). A part wall reached by the flutes is a gouge, not a collision
+    /// (see [`verify_dexel`]).
+    ///
+    /// # Errors
+    /// Those of [`DexelStock::cut`] on the moves, and
+    /// [`SimError::TooManyRays`] when the part's rays would exceed [`MAX_RAYS`].
+    ///
+    /// ```
+    /// use scallop_cutter::{Cutter, CutterShape};
+    /// use scallop_geom::{Aabb3, Point3, Vec3};
+    /// use scallop_mesh::TriMesh;
+    /// use scallop_sim::{DexelOptions, DexelPart, DexelStock, ToolMove, ToolPart};
+    /// use scallop_toolpath::MoveKind;
+    /// let p = |x, y, z| Point3::new(x, y, z);
+    /// // An open part: a plane at z = 0, with a step up to z = 8 at x >= 14
+    /// // (outside the stock box, which ends at x = 10).
+    /// let soup = [
+    ///     [p(-5., -5., 0.), p(14., -5., 0.), p(14., 15., 0.)],
+    ///     [p(-5., -5., 0.), p(14., 15., 0.), p(-5., 15., 0.)],
+    ///     [p(14., -5., 8.), p(30., -5., 8.), p(30., 15., 8.)],
+    ///     [p(14., -5., 8.), p(30., 15., 8.), p(14., 15., 8.)],
+    /// ];
+    /// let part = DexelPart::new(&TriMesh::from_soup(&soup).unwrap().0);
+    /// let stock = Aabb3 { min: p(0., 0., -1.), max: p(10., 10., 1.) };
+    /// let dexels = DexelStock::new(stock, 0.25).unwrap();
+    /// // A ball R 1 with 4 mm of flutes, shank R 1 to 30 mm, tilted 45 degrees
+    /// // towards +X: at x = 6 the shank reaches over the step.
+    /// let ball = Cutter::new(CutterShape::Ball { radius: 1.0 }, 4.0).unwrap().with_shank(1.0, 26.0).unwrap();
+    /// let axis = Vec3::new(1.0, 0.0, 1.0).normalize();
+    /// let mv = |kind, x: f64| ToolMove::new(kind, p(x, 5., 0.), axis);
+    /// let path = [mv(MoveKind::Rapid, 0.), mv(MoveKind::Feed, 6.)];
+    /// let hits = dexels.part_collisions(&part, &ball, &path, &DexelOptions::default(), 0).unwrap();
+    /// assert_eq!((hits.len(), hits[0].id.index, hits[0].part), (1, 1, ToolPart::Shank));
+    /// assert!(hits[0].at.x >= 14.0 && hits[0].at.z <= 8.0);
+    /// ```
+    pub fn part_collisions(
+        &self,
+        part: &DexelPart,
+        cutter: &Cutter,
+        moves: &[ToolMove],
+        options: &DexelOptions,
+        operation: u32,
+    ) -> Result<Vec<DexelCollision>, SimError> {
+        if !(options.axis_tolerance.is_finite() && options.axis_tolerance > 0.0) {
+            return Err(SimError::BadTolerance { what: "axis tolerance", value: options.axis_tolerance });
+        }
+        let flutes = Body::flutes(cutter);
+        let mut guards: Vec<(Body, ToolPart)> = vec![(Body::shank(cutter), ToolPart::Shank)];
+        let mut i = 0;
+        while let Some(b) = Body::holder(cutter, i) {
+            guards.push((b, ToolPart::Holder(i)));
+            i += 1;
+        }
+        let steps = self.steps(operation, &flutes, moves, options)?;
+        let boxes: Vec<Vec<(Point3, Point3)>> = steps
+            .iter()
+            .map(|s| {
+                // No flutes box: nothing is removed.
+                let mut b = vec![(Point3::new(1.0, 1.0, 1.0), Point3::origin())];
+                b.extend(guards.iter().map(|(g, _)| swept_box(g, &s.sweep, self.eps)));
+                b
+            })
+            .collect();
+        let unions: Vec<(Point3, Point3)> =
+            boxes.iter().map(|b| b[1..].iter().fold(b[1], |(lo, hi), (l, h)| (lo.inf(l), hi.sup(h)))).collect();
+        // The part's rays: over the part's box within the reach of the sweeps.
+        let Some(&first) = unions.first() else { return Ok(Vec::new()) };
+        let (reach_lo, reach_hi) = unions.iter().fold(first, |(lo, hi), (l, h)| (lo.inf(l), hi.sup(h)));
+        let material = part.material_box();
+        let (lo, hi) = (reach_lo.sup(&material.min), reach_hi.inf(&material.max));
+        if (0..3).any(|i| hi[i].partial_cmp(&lo[i]) != Some(std::cmp::Ordering::Greater)) {
+            return Ok(Vec::new());
+        }
+        let resolution = self.cell.iter().fold(0.0f64, |a, &b| a.max(b));
+        let mut solid = DexelStock::new(Aabb3 { min: lo, max: hi }, resolution)?;
+        let mut collided: Vec<Vec<(ToolPart, f64, Point3)>> = vec![Vec::new(); moves.len()];
+        for axis in 0..3 {
+            solid.rays[axis] = part.family_material(&solid, axis).into_iter().map(Ray::Cut).collect();
+            // The part's epsilon is the stock's: the same penetrations count.
+            solid.eps = self.eps;
+            let outputs = solid.cut_family(axis, &flutes, &guards, &steps, &boxes, &unions, false, None, &|| {});
+            for out in outputs {
+                merge_collisions(&mut collided, &steps, out.collisions);
+            }
+            // Each family's rays are only needed for its own pass.
+            solid.rays[axis] = Vec::new();
+        }
+        Ok(collision_list(operation, &collided))
+    }
+
+    /// One family: bands of rays in parallel, each applying its steps in
+    /// order; `remove == false` only checks the guards (nothing is cut).
+    #[allow(clippy::too_many_arguments)] // private; the pieces of one cut.
     fn cut_family(
         &mut self,
         axis: usize,
@@ -677,6 +799,9 @@ impl DexelStock {
         steps: &[Step],
         boxes: &[Vec<(Point3, Point3)>],
         unions: &[(Point3, Point3)],
+        remove: bool,
+        columns: Option<Columns<'_>>,
+        tick: &(dyn Fn() + Sync),
     ) -> Vec<BandOutput> {
         let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
         let (nu, nv) = (self.n[u], self.n[v]);
@@ -708,7 +833,11 @@ impl DexelStock {
             .par_chunks_mut(BAND_ROWS * nu)
             .zip(members.par_iter())
             .enumerate()
-            .map(|(band, (rays, ids))| geo.cut_band(band, rays, ids, flutes, guards, steps, boxes, unions))
+            .map(|(band, (rays, ids))| {
+                let out = geo.cut_band(band, rays, ids, flutes, guards, steps, boxes, unions, remove, columns);
+                tick();
+                out
+            })
             .collect()
     }
 
@@ -747,6 +876,38 @@ impl Step {
         (0..3).filter(|&i| i != axis).all(|i| o[i] >= self.lo[i] && o[i] <= self.hi[i])
     }
 }
+
+/// Adds a band's collisions `(step, part, depth, place)` to the deepest
+/// per move and part of the tool (`collided[move]`, in order of first finding).
+fn merge_collisions(
+    collided: &mut [Vec<(ToolPart, f64, Point3)>],
+    steps: &[Step],
+    found: Vec<(u32, ToolPart, f64, Point3)>,
+) {
+    for (k, part, depth, at) in found {
+        let list = &mut collided[steps[k as usize].index as usize];
+        match list.iter_mut().find(|(p, _, _)| *p == part) {
+            Some(entry) if depth > entry.1 => *entry = (part, depth, at),
+            Some(_) => {}
+            None => list.push((part, depth, at)),
+        }
+    }
+}
+
+/// The merged collisions in program order.
+fn collision_list(operation: u32, collided: &[Vec<(ToolPart, f64, Point3)>]) -> Vec<DexelCollision> {
+    collided
+        .iter()
+        .enumerate()
+        .flat_map(|(k, list)| list.iter().map(move |&(part, depth, at)| (k, part, depth, at)))
+        // k < moves <= u32::MAX (checked by the callers).
+        .map(|(k, part, depth, at)| DexelCollision { id: MoveId { operation, index: k as u32 }, part, at, depth })
+        .collect()
+}
+
+/// The closed-form Z rays of a cut: per step, the flutes' sweep when the
+/// axis is +Z, and the flute length.
+type Columns<'a> = (&'a [Option<SweptMove>], f64);
 
 /// What a band found, sparse per step.
 #[derive(Default)]
@@ -798,6 +959,8 @@ impl Family {
         steps: &[Step],
         boxes: &[Vec<(Point3, Point3)>],
         unions: &[(Point3, Point3)],
+        remove: bool,
+        columns: Option<Columns<'_>>,
     ) -> BandOutput {
         let row0 = band * BAND_ROWS;
         let rows = rays.len() / self.nu;
@@ -824,9 +987,14 @@ impl Family {
                             && o[self.v] <= b.1[self.v]
                     };
                     let bx = &boxes[k as usize];
-                    if inside(&bx[0])
+                    if remove
+                        && inside(&bx[0])
                         && let Some((m_lo, m_hi)) = ray.material_range(bx[0].0[self.axis], bx[0].1[self.axis], lo, hi)
-                        && let Some((a, b)) = step.sweep.interval_within(flutes, &o, &d, m_lo, m_hi)
+                        && let Some((a, b)) = match columns.and_then(|(c, top)| c[k as usize].map(|m| (m, top))) {
+                            // The Z ray of a vertical tool: the z-map's closed forms.
+                            Some((m, top)) => m.column(o.x, o.y, top),
+                            None => step.sweep.interval_within(flutes, &o, &d, m_lo, m_hi),
+                        }
                     {
                         let (r, l, mid) = ray.subtract(a.max(lo), b.min(hi), lo, hi);
                         removed += r;
@@ -865,5 +1033,67 @@ impl Family {
             }
         }
         out
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used, reason = "tests: a panic is the failure report")]
+mod tests {
+    use scallop_cutter::{Cutter, CutterShape};
+
+    use super::*;
+
+    /// The closed-form Z rays of a vertical tool ([`SweptMove::column`], used
+    /// by the cut) agree with the general certified sweep of the flutes
+    /// ([`Sweep::interval`]) on scattered moves and rays: entry and exit
+    /// within the sweep's tolerance, and the same misses.
+    #[test]
+    fn vertical_columns_match_the_general_sweep() {
+        let shapes = [
+            CutterShape::Flat { radius: 2.0 },
+            CutterShape::Ball { radius: 2.0 },
+            CutterShape::Bull { radius: 2.0, corner: 0.6 },
+            CutterShape::Cone { radius: 2.0, half_angle: 0.7 },
+        ];
+        let mut state = 7u64;
+        let mut next = || {
+            state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+            // 53 random bits in [0, 1).
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut both = 0;
+        for shape in shapes {
+            let cutter = Cutter::new(shape, 7.0).unwrap();
+            let flutes = Body::flutes(&cutter);
+            for case in 0..300 {
+                let p0 = Point3::new(10.0 * next(), 10.0 * next(), 4.0 * next() - 2.0);
+                // Every tenth move vertical, every tenth horizontal.
+                let (dx, dy) = if case % 10 == 0 { (0.0, 0.0) } else { (8.0 * next() - 4.0, 8.0 * next() - 4.0) };
+                let dz = if case % 10 == 1 { 0.0 } else { 6.0 * next() - 3.0 };
+                let v = Vec3::new(dx, dy, dz);
+                let sweep = Sweep { p0, v, a: Vec3::z() };
+                let m = SweptMove::new(cutter.shape(), &p0, &(p0 + v));
+                for _ in 0..20 {
+                    let o = Point3::new(
+                        p0.x + dx * next() + 5.0 * next() - 2.5,
+                        p0.y + dy * next() + 5.0 * next() - 2.5,
+                        0.0,
+                    );
+                    let general = sweep.interval(&flutes, &o, &Vec3::z());
+                    let closed = m.column(o.x, o.y, cutter.flute_length());
+                    match (general, closed) {
+                        (Some(g), Some(c)) => {
+                            both += 1;
+                            assert!((g.0 - c.0).abs() <= 1e-7 && (g.1 - c.1).abs() <= 1e-7, "{shape:?} {g:?} {c:?}");
+                        }
+                        (None, None) => {}
+                        // A ray grazing the swept solid's side: a vanishing piece.
+                        (Some(g), None) => assert!(g.1 - g.0 <= 1e-6, "{shape:?} {g:?}"),
+                        (None, Some(c)) => assert!(c.1 - c.0 <= 1e-6, "{shape:?} {c:?}"),
+                    }
+                }
+            }
+        }
+        assert!(both > 10_000, "{both}");
     }
 }

@@ -31,7 +31,7 @@
 
 use rayon::prelude::*;
 use scallop_geom::predicates::orient2d;
-use scallop_geom::{Aabb2, Point2, Point3};
+use scallop_geom::{Aabb2, Aabb3, Point2, Point3};
 use scallop_mesh::{MeshIndex, TriMesh};
 
 use super::DexelStock;
@@ -72,6 +72,59 @@ impl DexelPart {
     #[must_use]
     pub fn intervals(&self, o: &Point3, axis: usize) -> Vec<PartSpan> {
         self.ray(o, axis).0
+    }
+
+    /// The box holding the part's material: the mesh's box, reaching down
+    /// without bound for an open part (a height field is everything below
+    /// its surface).
+    pub(crate) fn material_box(&self) -> Aabb3 {
+        let mut b = self.index.bounds();
+        if !self.closed {
+            b.min.z = f64::NEG_INFINITY;
+        }
+        b
+    }
+
+    /// The part's material along every ray of family `axis` of `grid`,
+    /// clipped to the ray's extent, in ray order (parallel over lines of rays
+    /// sharing their candidate triangles; each ray is computed alone, so the
+    /// result does not depend on the thread count).
+    pub(crate) fn family_material(&self, grid: &DexelStock, axis: usize) -> Vec<Vec<[f64; 2]>> {
+        let (nu, nv) = grid.grid(axis);
+        let (lo, hi) = (grid.stock().min[axis], grid.stock().max[axis]);
+        let (outer, inner) = if axis == 0 { (nu, nv) } else { (nv, nu) };
+        let ray_of = |a: usize, b: usize| if axis == 0 { (a, b) } else { (b, a) };
+        let lines: Vec<Vec<(usize, Vec<[f64; 2]>)>> = (0..outer)
+            .into_par_iter()
+            .map(|a| {
+                let mut slots = Vec::new();
+                if axis != 2 {
+                    let (iu, iv) = ray_of(a, 0);
+                    self.candidates(&grid.ray_origin(axis, iu, iv), axis, &mut slots);
+                }
+                (0..inner)
+                    .map(|b| {
+                        let (iu, iv) = ray_of(a, b);
+                        let o = grid.ray_origin(axis, iu, iv);
+                        if axis == 2 {
+                            self.candidates(&o, axis, &mut slots);
+                        }
+                        let spans = self.ray_in(&o, axis, &slots).0;
+                        let clipped = spans
+                            .iter()
+                            .map(|&(s0, s1, _, _)| [s0.max(lo), s1.min(hi)])
+                            .filter(|s| s[1] > s[0])
+                            .collect();
+                        (iv * nu + iu, clipped)
+                    })
+                    .collect()
+            })
+            .collect();
+        let mut out = vec![Vec::new(); nu * nv];
+        for (index, spans) in lines.into_iter().flatten() {
+            out[index] = spans;
+        }
+        out
     }
 
     /// The part intervals and, for an open part on an X or Y ray, the
