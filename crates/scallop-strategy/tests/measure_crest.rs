@@ -131,17 +131,19 @@ fn rest_material_under_close_planes_is_reported_as_rest_material() {
         let report =
             verify_scallop(&index, &cutter, &planes, 0.0, &samples, sh).unwrap_or_else(|e| panic!("gap {gap} mm: {e}"));
         println!("gap {gap}: max {:.6} mm, rest {:.6} mm", report.max_mm, report.rest_material_mm);
-        // The tip rests on the nearer edge at depth 5 - sqrt(25 - (1 - gap / 2)^2);
-        // the plane in the middle of the dense family touches both edges at
-        // depth 5 - sqrt(24): the pair's excess at the bottom is the difference.
-        // Heights are along the normal of a wall (n_z = cos 45 degrees).
-        let depth = |half: f64| 5.0 - (25.0 - (1.0 - half) * (1.0 - half)).sqrt();
-        let excess = (depth(0.0) - depth(0.5 * gap)) * FRAC_1_SQRT_2;
-        let residual = (1.0 - depth(0.5 * gap)) * FRAC_1_SQRT_2;
+        // The tip rests on the nearer edge at depth 5 - sqrt(25 - (1 - gap / 2)^2),
+        // and the envelope over the bottom (gap / 2 beside the pass) is higher
+        // by the ball's profile h(gap / 2); the plane in the middle of the dense
+        // family touches both edges at depth 5 - sqrt(24). Heights are along the
+        // normal of a wall (n_z = cos 45 degrees).
+        let h = |y: f64| 5.0 - (25.0 - y * y).sqrt();
+        let depth = |half: f64| h(1.0 - half);
+        let residual = (1.0 - depth(0.5 * gap) + h(0.5 * gap)) * FRAC_1_SQRT_2;
+        let excess = (depth(0.0) - depth(0.5 * gap) + h(0.5 * gap)) * FRAC_1_SQRT_2;
+        // With the allowance for the reference's own scallops, 1 / (1 - 2 / 8^2).
+        let scallop = excess / (1.0 - 2.0 / 64.0);
         assert!(report.max_mm <= sh, "gap {gap} mm: {} mm", report.max_mm);
-        // The allowance for the reference's own scallops: 1 / (1 - 2 / 8^2).
-        assert!(report.max_mm >= excess * 0.99, "gap {gap} mm: {} < {excess} mm", report.max_mm);
-        assert!(report.max_mm <= excess * 1.05, "gap {gap} mm: {} > {excess} mm", report.max_mm);
+        assert!((report.max_mm - scallop).abs() < 1e-3 * scallop, "gap {gap} mm: {} vs {scallop} mm", report.max_mm);
         assert!((report.rest_material_mm + report.max_mm - residual).abs() < 1e-6, "{report:?}");
     }
 }
