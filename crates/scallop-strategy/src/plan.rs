@@ -356,36 +356,17 @@ impl<'a> Planner<'a> {
 
     /// Largest measured scallop between two planes at the feed samples.
     fn measured(&self, a: &PlanePasses, b: &PlanePasses, refine: bool) -> (f64, Point2) {
-        let (h, at, _) = self.measured_at(a, b, refine);
-        (h, at)
-    }
-
-    /// [`Planner::measured`] with the feed coordinate of the largest scallop.
-    fn measured_at(&self, a: &PlanePasses, b: &PlanePasses, refine: bool) -> (f64, Point2, f64) {
         let measure = if refine { &self.measure } else { &self.raw_measure };
-        let none = (0.0, Point2::origin(), 0.0);
-        let chunks: Vec<(f64, Point2, f64)> = self
+        let chunks: Vec<(f64, Point2)> = self
             .feed_samples
             .par_chunks(16)
             .map(|ts| {
-                let mut worst = none;
-                for &t in ts {
-                    for c in pair_heights(measure, &a.curves, &b.curves, &[t]) {
-                        if c.height > worst.0 {
-                            worst = (c.height, c.at, t);
-                        }
-                    }
-                }
-                worst
+                let hs = pair_heights(measure, &a.curves, &b.curves, ts);
+                hs.into_iter()
+                    .fold((0.0, Point2::origin()), |acc, c| if c.height > acc.0 { (c.height, c.at) } else { acc })
             })
             .collect();
-        chunks.into_iter().fold(none, |acc, h| if h.0 > acc.0 { h } else { acc })
-    }
-
-    /// Largest refined scallop (rest material subtracted) between two planes at
-    /// the one feed coordinate `t`.
-    fn refined_at(&self, a: &PlanePasses, b: &PlanePasses, t: f64) -> f64 {
-        pair_heights(&self.measure, &a.curves, &b.curves, &[t]).iter().fold(0.0, |m, c| c.height.max(m))
+        chunks.into_iter().fold((0.0, Point2::origin()), |acc, h| if h.0 > acc.0 { h } else { acc })
     }
 
     fn unreachable(&self, spacing: f64, at: Point2) -> StrategyError {
@@ -489,13 +470,7 @@ impl<'a> Planner<'a> {
                 for retry in 0..tol::MAX_SPACING_RETRIES {
                     // INVARIANT: as above.
                     let current = planes.last().expect("a plane of this range");
-                    let (mut h, mut place, worst_t) = self.measured_at(current, &next, retry >= tol::RAW_RETRIES);
-                    if h > sh && retry < tol::RAW_RETRIES && self.refined_at(current, &next, worst_t) <= sh {
-                        // The raw measure counts rest material as scallop; where its
-                        // largest one is rest material, shrinking the gap would not
-                        // remove it: measure every cusp against the reference.
-                        (h, place) = self.measured(current, &next, true);
-                    }
+                    let (h, place) = self.measured(current, &next, retry >= tol::RAW_RETRIES);
                     if h <= sh {
                         accepted = true;
                         break;
