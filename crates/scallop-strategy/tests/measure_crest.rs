@@ -8,7 +8,8 @@
 //! - Two close planes whose flat bottoms rest on the same crest have nearly
 //!   equal envelopes whose difference can change sign far beside both passes;
 //!   the cusp belongs between their contacts: a spherical dome under a
-//!   bull-nose.
+//!   bull-nose must hold `sh` down to a 0.001 mm gap (the old measure held it
+//!   here too: on the Rubio zone the envelopes' difference was polyline noise).
 //! - No under-reporting: a ball on the dome, whose whole surface it reaches,
 //!   against a brute-force measure (dense lateral and feed sampling of both
 //!   envelopes, the contacts as the least residual).
