@@ -337,7 +337,8 @@ pub(crate) fn cusp(measure: &Measure<'_>, a: &Curve, b: &Curve, t: f64, scratch:
 
 /// The cusp between `a` and `b` at `t` searched in `[lo, hi]`: `(vertical
 /// residual, w, part height, normal z)` of the largest residual along the normal
-/// among the crossing of the envelopes (or samples of the span, see below).
+/// among the crossing of the envelopes (and samples of the span for a flat end
+/// or where the envelopes do not cross).
 fn residual_in(
     measure: &Measure<'_>,
     a: &Curve,
