@@ -93,16 +93,16 @@ fn a_plane_patch_gets_the_analytic_step_over() {
 }
 
 /// A case the property test found (2026-11-25): a bull-nose R4 r1.5 along u on this
-/// patch is refused (`Unreachable`): in a hollow near (12.0, 7.2) mm where the cutter
-/// is held up (the tip touching the surface there, dropped, stays 0.018 mm away),
-/// the measured height between two passes grows from 0.0086 mm to 0.0164 mm as the
-/// step shrinks from 0.017 to 0.005: the rest-material estimate of `iso_scallop`
-/// (one placement per surface point) does not match what the passes' own held-up
-/// placements leave, so the difference is not a scallop. Refusing is safe (no plan,
-/// no gouge) but a plan exists. Open item of issue 3; run with `--ignored`.
+/// patch. In a hollow near (12.0, 7.2) mm the cutter is held up (the tip touching the
+/// surface there, dropped, stays 0.018 mm away) and the measured height between two
+/// passes grows from 0.0086 mm to 0.0164 mm as the step shrinks from 0.017 to 0.005:
+/// the rest-material estimate of `iso_scallop` (one placement per surface point) does
+/// not match what the passes' own held-up placements leave, so the planner refuses
+/// (`Unreachable`) though a plan exists: an open defect of issue 3. Whatever it does,
+/// it must never give an unverified plan: a plan is checked like every other one, a
+/// refusal must be `Unreachable`.
 #[test]
-#[ignore = "known measure defect: iso plan refused in a hollow where the bull-nose is held up"]
-fn known_defect_iso_bull_in_a_tight_hollow() {
+fn iso_bull_in_a_tight_hollow_is_verified_or_refused() {
     let heights = [
         -1.667707237410849,
         0.0,
@@ -126,6 +126,8 @@ fn known_defect_iso_bull_in_a_tight_hollow() {
     let t = patch.tessellate(tol.tessellation()).expect("tessellates");
     let index = MeshIndex::build(&t.mesh);
     let p = params(0.0, Pattern::Zigzag, 0.01, 1.0);
-    let planned = plan_isoparametric(&patch, &index, &bull(4.0, 1.5), &p, IsoDirection::U, &tol, t.chordal_bound);
-    assert!(planned.is_ok(), "{:?}", planned.err());
+    match plan_isoparametric(&patch, &index, &bull(4.0, 1.5), &p, IsoDirection::U, &tol, t.chordal_bound) {
+        Ok(_) => check(&patch, &bull(4.0, 1.5), IsoDirection::U, 0.01),
+        Err(e) => assert!(matches!(e, StrategyError::Unreachable { .. }), "{e}"),
+    }
 }
