@@ -414,19 +414,7 @@ pub fn run_finishing(job: &FinishJob) -> Result<FinishOutput, EngineError> {
         FittedPath::lines(&planned.toolpath)
     };
     let text = match &job.setup {
-        None => {
-            let refs: Vec<&str> = comments.iter().map(String::as_str).collect();
-            let info = ProgramInfo {
-                program: job.output.program.clone(),
-                tool: job.output.tool,
-                spindle: job.output.spindle,
-                indexed_rotaries: Vec::new(),
-            };
-            let mut text = Vec::new();
-            write_fitted(&fitted, &job.output.dialect, &info, &refs, &mut text)
-                .map_err(|e| EngineError::Output { what: format!("writing the program: {e}"), fix: String::new() })?;
-            String::from_utf8_lossy(&text).into_owned()
-        }
+        None => three_axis_program(job, &fitted, &comments)?,
         Some(setup) => indexed_program(job, setup, &planned.toolpath, r.machining_time_s)?,
     };
     let report = FinishReport {
@@ -450,6 +438,25 @@ pub fn run_finishing(job: &FinishJob) -> Result<FinishOutput, EngineError> {
     };
     let details = FinishDetails { prepared, stock, params, scallop: planned.scallop, simulation: sim };
     Ok(FinishOutput { toolpath: planned.toolpath, gcode: text, report, fitted, details })
+}
+
+/// A 3-axis program of `fitted` in the job's dialect with `comments` in its header.
+pub(crate) fn three_axis_program(
+    job: &FinishJob,
+    fitted: &FittedPath,
+    comments: &[String],
+) -> Result<String, EngineError> {
+    let refs: Vec<&str> = comments.iter().map(String::as_str).collect();
+    let info = ProgramInfo {
+        program: job.output.program.clone(),
+        tool: job.output.tool,
+        spindle: job.output.spindle,
+        indexed_rotaries: Vec::new(),
+    };
+    let mut text = Vec::new();
+    write_fitted(fitted, &job.output.dialect, &info, &refs, &mut text)
+        .map_err(|e| EngineError::Output { what: format!("writing the program: {e}"), fix: String::new() })?;
+    Ok(String::from_utf8_lossy(&text).into_owned())
 }
 
 /// Which finishing strategy.

@@ -42,7 +42,7 @@ use scallop_geom::{Aabb3, Point3, Tolerances, Vec3};
 use scallop_machine::Kinematics;
 use scallop_machine::program::{ProgramOptions, records_from_toolpath, to_program};
 use scallop_mesh::{MeshIndex, TriMesh};
-use scallop_post::{OutputMode, PostParams, ProgramInfo, program_text, write_fitted};
+use scallop_post::{OutputMode, PostParams, program_text};
 use scallop_strategy::network::{CellLabels, Orientation, Transitions};
 use scallop_strategy::{
     Boundary, FinishingParams, StrategyError, ZoneRegion, lookahead_time, plan_zone_finishing, stop_to_stop_time,
@@ -493,17 +493,7 @@ fn finish_zones_with(job: &FinishJob, spec: &ZonePlanSpec, share: f64) -> Result
         } else {
             FittedPath::lines(&toolpath)
         };
-        let refs: Vec<&str> = comments.iter().map(String::as_str).collect();
-        let info = ProgramInfo {
-            program: job.output.program.clone(),
-            tool: job.output.tool,
-            spindle: job.output.spindle,
-            indexed_rotaries: Vec::new(),
-        };
-        let mut text = Vec::new();
-        write_fitted(&fitted, &job.output.dialect, &info, &refs, &mut text)
-            .map_err(|e| EngineError::Output { what: format!("writing the program: {e}"), fix: String::new() })?;
-        String::from_utf8_lossy(&text).into_owned()
+        crate::finish::three_axis_program(job, &fitted, &comments)?
     };
 
     let report = ZoneFinishReport {

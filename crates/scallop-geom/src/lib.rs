@@ -12,6 +12,7 @@
 //! - All lengths are millimetres, all angles radians.
 //! - Every numeric threshold of the workspace lives in [`tol`].
 
+pub mod num;
 pub mod predicates;
 pub mod tol;
 

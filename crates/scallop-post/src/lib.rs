@@ -122,39 +122,7 @@ pub(crate) fn scaled_key(v: f64, decimals: usize) -> Option<i64> {
     Some(if v < 0.0 { -n } else { n })
 }
 
-/// `x.round()` (half away from zero, signed zero kept) without the library call for
-/// |x| < 2^52, where truncation and the fraction are exact.
-#[inline]
-pub(crate) fn round_fast(x: f64) -> f64 {
-    if x.abs() < 4_503_599_627_370_496.0 {
-        #[allow(clippy::cast_possible_truncation, clippy::cast_precision_loss, reason = "|x| < 2^52, exact")]
-        let t = x as i64 as f64;
-        let f = x - t;
-        let r = if f >= 0.5 {
-            t + 1.0
-        } else if f <= -0.5 {
-            t - 1.0
-        } else {
-            t
-        };
-        r.copysign(x)
-    } else {
-        x.round()
-    }
-}
-
-/// `x.floor()` (signed zero kept) without the library call for |x| < 2^52.
-#[inline]
-pub(crate) fn floor_fast(x: f64) -> f64 {
-    if x.abs() < 4_503_599_627_370_496.0 {
-        #[allow(clippy::cast_possible_truncation, clippy::cast_precision_loss, reason = "|x| < 2^52, exact")]
-        let t = x as i64 as f64;
-        let r = if t > x { t - 1.0 } else { t };
-        r.copysign(x)
-    } else {
-        x.floor()
-    }
-}
+pub(crate) use scallop_geom::num::{floor_fast, round_fast};
 
 /// Appends a prefix (the last `prefix_len` bytes of `prefix`: a space, a word letter, a
 /// `+`) and the number of a [`scaled_key`] with `decimals` digits: the hot path of every
