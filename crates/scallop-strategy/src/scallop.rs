@@ -22,20 +22,6 @@
 //! normal's `n_z`, i.e. the distance along the normal to the local tangent plane.
 //! Other passes can only lower the material further, so two passes bound it.
 //!
-//! The cusp belongs between the passes' **contacts** with the part in the
-//! section (where `E - z_part` is least): beside both contacts the material is
-//! the neighbouring pairs' (the contact spans of adjacent pairs chain up). When
-//! the crossing over the envelopes' whole common span is above the limit, the
-//! search is repeated between the contacts: two nearly equal envelopes (close
-//! planes whose flat bottoms rest on the same crest) can cross far beside both
-//! passes, where the residual is material other planes cut.
-//!
-//! A cusp still above the limit is compared with a dense family of virtual
-//! passes between the two planes: what they leave too is rest material. Their
-//! own scallops, about `1 / REFERENCE_PLANES^2` of the pair's scallop, are
-//! allowed for twice, as a fraction of the scallop (not of the residual: rest
-//! material does not shrink with the spacing).
-//!
 //! The planner places each plane by this same measurement (shrinking the gap
 //! until it holds), so the verification of the final passes re-measures exactly
 //! what the planner accepted; it shares no step-over model with the planner.
@@ -291,73 +277,21 @@ pub(crate) fn cusp(measure: &Measure<'_>, a: &Curve, b: &Curve, t: f64, scratch:
     let (index, shape, frame) = (measure.index, &measure.shape, &measure.frame);
     let (a, b) = if a.d <= b.d { (a, b) } else { (b, a) };
     let radius = shape.radius();
-    // Both envelopes are finite on [b.d - R, a.d + R]. On a cross slope the
-    // contacts, hence the cusp, lie beside the pass planes, not between them.
+    // Both envelopes are finite on [b.d - R, a.d + R]; there E_A - E_B is
+    // non-decreasing (a convex profile minus its own translate), and its zero is
+    // the cusp. On a cross slope the contacts, hence the cusp, lie beside the
+    // pass planes, not between them.
     let (lo, hi) = (b.d - radius, a.d + radius);
     if lo > hi {
         // The envelopes do not meet: a strip between the passes is never cut.
         let at = frame.xy(t, 0.5 * (a.d + b.d));
         return surface_at(index, at, scratch).map(|_| Cusp { height: f64::INFINITY, rest: 0.0, at });
     }
-    // Where the crossing over the whole span is above the limit, the search is
-    // narrowed to the span between the passes' contacts with the part in this
-    // section: beside both contacts the material is the neighbouring pairs'
-    // (their contact spans chain up and cover every point between the first and
-    // the last contact). There E_A - E_B goes from <= 0 (at A's contact, where
-    // E_A is the part) to >= 0 (at B's), and its zero is the cusp. Over the
-    // whole span the difference of two nearly equal envelopes (close planes,
-    // flat bottoms resting on the same crest) can change sign far beside both
-    // passes, where the residual is material other planes cut.
-    let mut worst = residual_in(measure, a, b, t, [lo, hi], scratch)?;
-    if worst.0 * worst.3 > measure.limit
-        && let (Some(ca), Some(cb)) = (contact_hull(measure, a, t, scratch), contact_hull(measure, b, t, scratch))
-    {
-        let span = [ca[0].min(cb[0]).clamp(lo, hi), ca[1].max(cb[1]).clamp(lo, hi)];
-        if let Some(between) = residual_in(measure, a, b, t, span, scratch) {
-            worst = between;
-        }
-    }
-    let (residual, w_star, z_part, n_z) = worst;
-    let at = frame.xy(t, w_star);
-    let height = residual * n_z;
-    if height <= measure.limit || !measure.refine {
-        return Some(Cusp { height, rest: 0.0, at });
-    }
-    // Above the limit: measure against what any pass spacing could achieve.
-    // The dense family leaves rest material plus its own scallops, about
-    // (1/planes)^2 of this pair's scallop (scallop ~ gap^2; not of the residual,
-    // which includes the rest material and does not shrink with the gap). With
-    // twice that allowance, scallop - 2 scallop / planes^2 <= residual - reference.
-    let planes = tol::REFERENCE_PLANES as f64;
-    let reference = measure.dense_reference(a.d, b.d, t, w_star) - z_part;
-    let excess = (residual - reference).max(0.0);
-    let scallop = (excess / (1.0 - 2.0 / (planes * planes))).min(residual);
-    Some(Cusp { height: scallop * n_z, rest: (residual - scallop) * n_z, at })
-}
-
-/// The cusp between `a` and `b` at `t` searched in `[lo, hi]`: `(vertical
-/// residual, w, part height, normal z)` of the largest residual along the normal
-/// among the crossing of the envelopes (and samples of the span for a flat end
-/// or where the envelopes do not cross).
-fn residual_in(
-    measure: &Measure<'_>,
-    a: &Curve,
-    b: &Curve,
-    t: f64,
-    [lo, hi]: [f64; 2],
-    scratch: &mut Vec<u32>,
-) -> Option<(f64, f64, f64, f64)> {
-    let (index, shape, frame) = (measure.index, &measure.shape, &measure.frame);
-    let radius = shape.radius();
     let g = |w: f64| a.envelope(shape, t, w) - b.envelope(shape, t, w);
     let (g_lo, g_hi) = (g(lo), g(hi));
     let mut candidates = Vec::new();
-    let scale = (b.d - a.d).max(radius);
     if g_lo < 0.0 && g_hi > 0.0 {
-        candidates.push(crossing(&g, lo, hi, g_lo, g_hi, scale));
-    } else if g_lo > 0.0 && g_hi < 0.0 {
-        // Crossed contacts (B's contact before A's in this section).
-        candidates.push(crossing(&|w: f64| -g(w), lo, hi, -g_lo, -g_hi, scale));
+        candidates.push(crossing(&g, lo, hi, g_lo, g_hi, (b.d - a.d).max(radius)));
     } else if b.d - a.d < tol::MIN_SPACING {
         return None; // coincident planes
     }
@@ -367,7 +301,7 @@ fn residual_in(
         let n = tol::CUSP_SPAN_SAMPLES;
         candidates.extend((0..=n).map(|k| lo + (hi - lo) * (k as f64 / n as f64)));
     }
-    let mut worst: Option<(f64, f64, f64, f64)> = None; // (vertical residual, w, part z, normal z)
+    let mut worst: Option<(f64, f64, f64, f64)> = None; // (vertical residual, w, top, normal z)
     for w in candidates {
         let at = frame.xy(t, w);
         let ((top_a, end_a), (top_b, end_b)) = (a.envelope_at(shape, t, w), b.envelope_at(shape, t, w));
@@ -381,70 +315,19 @@ fn residual_in(
             worst = Some((residual, w, z_part, normal.z));
         }
     }
-    worst
-}
-
-/// The lateral extent `[first, last]` of the contact of pass `c` with the part
-/// in the section at `t`: where `E(w) - z_part(w)` is least over the pass's
-/// reach `|w - d| <= R` (sampled, then refined by golden section when the least
-/// sample is unique; a tie, e.g. a flat bottom on a flat face, gives the extreme
-/// tied samples). `None` when the part is nowhere under the reach.
-fn contact_hull(measure: &Measure<'_>, c: &Curve, t: f64, scratch: &mut Vec<u32>) -> Option<[f64; 2]> {
-    let (index, shape, frame) = (measure.index, &measure.shape, &measure.frame);
-    let radius = shape.radius();
-    let mut gap = |w: f64| {
-        let e = c.envelope(shape, t, w);
-        match surface_at(index, frame.xy(t, w), scratch) {
-            Some((z, _)) if e.is_finite() => e - z,
-            _ => f64::INFINITY,
-        }
-    };
-    let n = tol::CONTACT_SAMPLES;
-    let (from, to) = (c.d - radius, c.d + radius);
-    let step = (to - from) / n as f64;
-    let values: Vec<f64> = (0..=n).map(|k| gap(from + step * k as f64)).collect();
-    let least = values.iter().copied().fold(f64::INFINITY, f64::min);
-    if !least.is_finite() {
-        return None;
+    let (residual, w_star, z_part, n_z) = worst?;
+    let at = frame.xy(t, w_star);
+    let height = residual * n_z;
+    if height <= measure.limit || !measure.refine {
+        return Some(Cusp { height, rest: 0.0, at });
     }
-    let tie = least + tol::CONTACT_TIE_REL * radius;
-    let first = values.iter().position(|&v| v <= tie)?;
-    let last = values.iter().rposition(|&v| v <= tie)?;
-    if first != last {
-        return Some([from + step * first as f64, from + step * last as f64]);
-    }
-    // Golden section on the neighbouring samples (the least of the bracket kept).
-    const INV_PHI: f64 = 0.618_033_988_749_894_9;
-    let centre = from + step * first as f64;
-    let (mut x0, mut x3) = ((centre - step).max(from), (centre + step).min(to));
-    let mut x1 = x3 - INV_PHI * (x3 - x0);
-    let mut x2 = x0 + INV_PHI * (x3 - x0);
-    let (mut g1, mut g2) = (gap(x1), gap(x2));
-    let (mut best_w, mut best) = (centre, least);
-    for _ in 0..tol::GOLDEN_ITERATIONS {
-        if x3 - x0 <= tol::GOLDEN_REL_TOL * radius {
-            break;
-        }
-        if g1 <= g2 {
-            x3 = x2;
-            x2 = x1;
-            g2 = g1;
-            x1 = x3 - INV_PHI * (x3 - x0);
-            g1 = gap(x1);
-        } else {
-            x0 = x1;
-            x1 = x2;
-            g1 = g2;
-            x2 = x0 + INV_PHI * (x3 - x0);
-            g2 = gap(x2);
-        }
-        for (w, v) in [(x1, g1), (x2, g2)] {
-            if v < best {
-                (best_w, best) = (w, v);
-            }
-        }
-    }
-    Some([best_w, best_w])
+    // Above the limit: measure against what any pass spacing could achieve.
+    // The virtual family leaves its own scallops, about (1/planes)^2 of this one
+    // (scallop ~ gap^2); twice that is not counted as rest material.
+    let planes = tol::REFERENCE_PLANES as f64;
+    let own = 2.0 * residual / (planes * planes);
+    let rest = (measure.dense_reference(a.d, b.d, t, w_star) - z_part - own).max(0.0);
+    Some(Cusp { height: (residual - rest).max(0.0) * n_z, rest: rest * n_z, at })
 }
 
 /// The zero of the non-decreasing `g` on `[lo, hi]` (`g(lo) < 0 < g(hi)`) by

@@ -87,16 +87,6 @@ pub const SPACING_MIN_SHRINK: f64 = 0.9;
 /// not cross or the cutter is flat (its saw tooth need not peak at the crossing).
 pub const CUSP_SPAN_SAMPLES: usize = 32;
 
-/// Lateral samples (plus one) over a pass's reach `[d - R, d + R]` locating its
-/// contact with the part in a section (the cusp of a pair lies between the
-/// two contacts); the least sample is then refined by golden section.
-pub const CONTACT_SAMPLES: usize = 32;
-
-/// Samples of a pass's contact search within this fraction of the cutter radius
-/// of the least one are tied (a flat bottom on a flat face touches along a band):
-/// the contact spans the extreme tied samples.
-pub const CONTACT_TIE_REL: f64 = 1e-9;
-
 /// The first retries of a plane measure the scallop against the part only;
 /// later ones also subtract rest material (dense virtual passes, costly).
 pub const RAW_RETRIES: usize = 3;
