@@ -11,8 +11,8 @@
 //! last evaluation's plan, so the work cannot be optimised away, and an FNV-1a
 //! digest of the bits of every evaluation's `time_s` and of its partition's
 //! cluster and zone labels: a speed change must leave the digest unchanged.
-//! The mean wall time of one evaluation goes to stderr (the model's set-up is
-//! not counted).
+//! The mean wall time of one evaluation, and of its partition (clustering and
+//! zones) alone, goes to stderr (the model's set-up is not counted).
 
 use scallop_optim::study::{Fidelity, Formulation, MachiningModel};
 use scallop_optim::surface::{SurfaceModel, SurfaceSettings, ZonePartition};
@@ -24,12 +24,16 @@ fn evaluate(
     omega: &[f64; 4],
     directions_from: &scallop_optim::study::Design,
 ) -> (f64, ZonePartition) {
+    let c0 = std::time::Instant::now();
     let p = model.partition(k, omega, Fidelity::BlackBox).expect("clusters");
+    PART.with(|c| c.set(c.get() + c0.elapsed().as_secs_f64()));
     let d = directions_from;
     let time = model.assess(&p, Formulation::ThreeAxis, d, Fidelity::BlackBox).expect("plan").time_s;
     (time, p)
 }
 
+/// Wall time spent in the partitions (s).
+thread_local! { static PART: std::cell::Cell<f64> = const { std::cell::Cell::new(0.0) }; }
 /// FNV-1a, 64 bits.
 struct Fnv(u64);
 
@@ -72,5 +76,6 @@ fn main() {
     }
     let per = 1e3 * busy.as_secs_f64() / n.max(1) as f64;
     println!("{surface} K = {k}: {n} evaluations, last plan {time:.3} s, digest {:016x}", digest.0);
+    eprintln!("partition {:.3} ms", PART.with(|c| c.get()) * 1e3 / n as f64);
     eprintln!("{per:.3} ms per evaluation (wall clock, mean)");
 }
