@@ -32,7 +32,7 @@ fn evaluate(
     (time, p)
 }
 
-/// Wall time spent in the partitions (s).
+// Wall time spent in the partitions (s).
 thread_local! { static PART: std::cell::Cell<f64> = const { std::cell::Cell::new(0.0) }; }
 /// FNV-1a, 64 bits.
 struct Fnv(u64);
