@@ -165,7 +165,7 @@ fn sort_neighbours(
 }
 
 /// The nearest centre of `x` (lowest index on ties, as the plain sweep), given
-/// `d2a = d^2(x, c_a)` for some centre `a`, with an upper bound (its distance)
+/// `d2a = d^2(x, c_a)` and `u = sqrt(d2a)` for some centre `a`, with an upper bound (its distance)
 /// and a lower bound of the distance to every other centre. Only the centres
 /// closer to `a` than `2u` (plus slack), `u = d(x, c_a)`, can be nearer than `a`:
 /// a farther centre j is at least `d(a, j) - u > u` away (triangle inequality);
@@ -175,14 +175,13 @@ fn sort_neighbours(
 fn nearest_from<const WRAPPED: bool>(
     x: &[f64; 4],
     a: usize,
-    d2a: f64,
+    (d2a, u): (f64, f64),
     centres: &[[f64; 4]],
     near: &[(f64, u32)],
     w: &[f64; 4],
     slack: f64,
 ) -> (u32, f64, f64) {
     let k = centres.len();
-    let u = d2a.sqrt();
     let limit = 2.0 * u * slack + tol::HAMERLY_ABSOLUTE;
     #[allow(clippy::cast_possible_truncation)] // k <= cells < u32::MAX
     let (mut best, mut d_best, mut d_second) = (a as u32, d2a, f64::INFINITY);
@@ -202,7 +201,8 @@ fn nearest_from<const WRAPPED: bool>(
         d_best = if wins { dj } else { d_best };
         best = if wins { j } else { best };
     }
-    (best, d_best.sqrt(), d_second.sqrt().min(beyond))
+    let second = d_second.sqrt();
+    (best, d_best.sqrt(), if beyond < second { beyond } else { second })
 }
 
 fn bounded<const WRAPPED: bool>(setup: &Setup, k: usize, max_iterations: usize) -> Clustering {
@@ -224,7 +224,7 @@ fn bounded<const WRAPPED: bool>(setup: &Setup, k: usize, max_iterations: usize) 
     for (i, x) in f.x.iter().enumerate() {
         let a = previous as usize;
         let d2a = distance2::<WRAPPED>(x, &centres[a], &w);
-        let (best, u, l) = nearest_from::<WRAPPED>(x, a, d2a, &centres, &near, &w, slack);
+        let (best, u, l) = nearest_from::<WRAPPED>(x, a, (d2a, d2a.sqrt()), &centres, &near, &w, slack);
         labels[i] = best;
         bounds[i] = [u, l];
         previous = best;
@@ -232,7 +232,7 @@ fn bounded<const WRAPPED: bool>(setup: &Setup, k: usize, max_iterations: usize) 
     let mut stats = Stats::batch(setup, &labels, k);
     let mut moved_centres = centres.clone();
     let mut check = vec![0u32; n];
-    let mut scan = vec![(0u32, 0.0f64); n];
+    let mut scan = vec![(0u32, 0.0f64, 0.0f64); n];
     let (mut iterations, mut converged) = (0, false);
     for it in 1..=max_iterations {
         iterations = it;
@@ -291,15 +291,15 @@ fn bounded<const WRAPPED: bool>(setup: &Setup, k: usize, max_iterations: usize) 
             let d2a = distance2::<WRAPPED>(&xs[i], &centres[a], &w);
             let u = d2a.sqrt();
             bounds[i] = [u, l];
-            scan[scans] = (cell, d2a);
+            scan[scans] = (cell, d2a, u);
             scans += usize::from(u * slack >= bound);
         }
         // Pass 3: the scans, in increasing cell order (the statistics see the
         // same sequence of moves as the plain sweep).
-        for &(i, d2a) in &scan[..scans] {
+        for &(i, d2a, u) in &scan[..scans] {
             let i = i as usize;
             let a = labels[i] as usize;
-            let (best, u, l) = nearest_from::<WRAPPED>(&xs[i], a, d2a, &centres, &near, &w, slack);
+            let (best, u, l) = nearest_from::<WRAPPED>(&xs[i], a, (d2a, u), &centres, &near, &w, slack);
             bounds[i] = [u, l];
             if best != labels[i] {
                 moved = true;
