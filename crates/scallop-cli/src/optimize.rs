@@ -241,7 +241,7 @@ pub fn run(args: &OptimizeArgs) -> CliResult<()> {
     }
     let mut text = format!(
         "zone optimisation of the {part_name}: {}, K = {}..{}, budget {} per K, surrogate {:?}\n\
-         \x20  K  zones   start (s)    best (s)   gain   evals  surr.  wall (s)\n",
+         \x20  K  zones   start (s)    best (s)   gain   evals  surr.  wall (s)  eval mean/p95/max (ms)\n",
         formulation_name(settings.formulation),
         settings.k_min,
         settings.k_max,
@@ -250,7 +250,7 @@ pub fn run(args: &OptimizeArgs) -> CliResult<()> {
     );
     for r in &study.results {
         text.push_str(&format!(
-            "  {:2}  {:5}  {:10.2}  {:10.2}  {:5.1}%  {:6}  {:5}  {:8.2}\n",
+            "  {:2}  {:5}  {:10.2}  {:10.2}  {:5.1}%  {:6}  {:5}  {:8.2}  {}\n",
             r.k,
             r.plan.zones.len(),
             r.f0,
@@ -258,7 +258,9 @@ pub fn run(args: &OptimizeArgs) -> CliResult<()> {
             100.0 * r.eta,
             r.evaluations,
             r.surrogate_evaluations,
-            r.wall_time_s.unwrap_or(f64::NAN)
+            r.wall_time_s.unwrap_or(f64::NAN),
+            r.black_box_times
+                .map_or_else(|| "-".to_string(), |t| format!("{:.2}/{:.2}/{:.2}", t.mean_ms, t.p95_ms, t.max_ms))
         ));
     }
     text.push_str(&format!(

@@ -24,7 +24,7 @@ fn colour(i: usize) -> String {
 /// # use scallop_optim::{HistoryPoint, StopReason};
 /// # let plan = PlanReport { time_s: 9.0, transition_time_s: 0.0, violation: 0.0, grid: [1, 1], labels: vec![0], cell_xy: vec![[0.0, 0.0]], zones: vec![] };
 /// # let r = KResult { k: 2, f0: 10.0, f_best: 9.0, eta: 0.1, evaluations: 5, surrogate_evaluations: 0, spent: 5.0,
-/// #   stop: StopReason::Budget, wall_time_s: None, start: Design::zeros(2), best: Design::zeros(2), plan,
+/// #   stop: StopReason::Budget, wall_time_s: None, black_box_times: None, start: Design::zeros(2), best: Design::zeros(2), plan,
 /// #   history: vec![HistoryPoint { spent: 1.0, best: 10.0 }, HistoryPoint { spent: 5.0, best: 9.0 }] };
 /// # let study = Study { settings: StudySettings::thesis(Formulation::ThreeAxis), results: vec![r], best: 0, mean_eta: 0.1 };
 /// let svg = scallop_optim::convergence_svg(&study);

@@ -439,6 +439,8 @@ pub struct KResult {
     pub stop: StopReason,
     /// Wall time of the run (s), when a [`Stopwatch`] was given.
     pub wall_time_s: Option<f64>,
+    /// Wall time of its black-box evaluations, when a [`Stopwatch`] was given.
+    pub black_box_times: Option<EvaluationTimes>,
     /// Start design.
     pub start: Design,
     /// Best design.
@@ -447,6 +449,40 @@ pub struct KResult {
     pub plan: PlanReport,
     /// Best value after each improvement.
     pub history: Vec<HistoryPoint>,
+}
+
+/// The wall times of the black-box evaluations of one run (each runs on one
+/// thread: the study parallelises over `K`).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct EvaluationTimes {
+    /// Number of timed evaluations.
+    pub count: usize,
+    /// Mean (ms).
+    pub mean_ms: f64,
+    /// Median (ms).
+    pub median_ms: f64,
+    /// 95th percentile (ms; nearest rank).
+    pub p95_ms: f64,
+    /// Largest (ms).
+    pub max_ms: f64,
+}
+
+impl EvaluationTimes {
+    /// The summary of `seconds` (None when empty or not all finite).
+    #[must_use]
+    pub fn from_seconds(seconds: &[f64]) -> Option<EvaluationTimes> {
+        if seconds.is_empty() || !seconds.iter().all(|s| s.is_finite()) {
+            return None;
+        }
+        let mut ms: Vec<f64> = seconds.iter().map(|s| 1e3 * s).collect();
+        ms.sort_by(f64::total_cmp);
+        let n = ms.len();
+        #[allow(clippy::cast_precision_loss, clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+        let rank = |q: f64| ms[((q * n as f64).ceil() as usize).clamp(1, n) - 1];
+        #[allow(clippy::cast_precision_loss)]
+        let mean_ms = ms.iter().sum::<f64>() / n as f64;
+        Some(EvaluationTimes { count: n, mean_ms, median_ms: rank(0.5), p95_ms: rank(0.95), max_ms: ms[n - 1] })
+    }
 }
 
 /// A whole study.
@@ -473,6 +509,8 @@ struct KObjective<'a, M: MachiningModel> {
     spent: f64,
     black_box_seconds: f64,
     black_box_count: usize,
+    /// Every black-box evaluation's wall time (s), when a clock is given.
+    black_box_times: Vec<f64>,
     last_surrogate_seconds: f64,
     /// The first model error met (reported if the start point fails).
     first_error: Option<String>,
@@ -517,7 +555,11 @@ impl<M: MachiningModel> Objective for KObjective<'_, M> {
     fn evaluate(&mut self, x: &[f64]) -> Evaluation {
         let t0 = self.seconds();
         let e = self.run(x, Fidelity::BlackBox);
-        self.black_box_seconds += self.seconds() - t0;
+        let dt = self.seconds() - t0;
+        self.black_box_seconds += dt;
+        if self.clock.is_some() {
+            self.black_box_times.push(dt);
+        }
         self.black_box_count += 1;
         self.spent += 1.0;
         self.observer.progress(self.layout.k, self.spent);
@@ -608,6 +650,7 @@ pub fn run_k<M: MachiningModel>(
         spent: 0.0,
         black_box_seconds: 0.0,
         black_box_count: 0,
+        black_box_times: Vec::new(),
         last_surrogate_seconds: 0.0,
         first_error: None,
     };
@@ -640,9 +683,35 @@ pub fn run_k<M: MachiningModel>(
         spent: outcome.spent,
         stop: outcome.stop,
         wall_time_s: t0.and_then(|t| clock.map(|c| c.seconds() - t)),
+        black_box_times: EvaluationTimes::from_seconds(&objective.black_box_times),
         start: layout.design(&outcome.start),
         best,
         plan,
         history: outcome.history,
     })
+}
+
+#[cfg(test)]
+mod evaluation_times_tests {
+    use super::EvaluationTimes;
+
+    #[test]
+    fn summary_of_one_to_a_hundred_milliseconds() {
+        // Shuffled 1..=100 ms: mean 50.5, nearest-rank median 50, p95 95, max 100.
+        let seconds: Vec<f64> = (0..100).map(|i| f64::from((i * 37) % 100 + 1) * 1e-3).collect();
+        let t = EvaluationTimes::from_seconds(&seconds).expect("finite");
+        assert_eq!(t.count, 100);
+        assert!((t.mean_ms - 50.5).abs() < 1e-9, "{t:?}");
+        assert!((t.median_ms - 50.0).abs() < 1e-9, "{t:?}");
+        assert!((t.p95_ms - 95.0).abs() < 1e-9, "{t:?}");
+        assert!((t.max_ms - 100.0).abs() < 1e-9, "{t:?}");
+    }
+
+    #[test]
+    fn no_summary_of_nothing_or_of_a_nan() {
+        assert_eq!(EvaluationTimes::from_seconds(&[]), None);
+        assert_eq!(EvaluationTimes::from_seconds(&[1e-3, f64::NAN]), None);
+        let one = EvaluationTimes::from_seconds(&[2e-3]).expect("one");
+        assert!((one.median_ms - 2.0).abs() < 1e-12 && (one.p95_ms - 2.0).abs() < 1e-12);
+    }
 }
