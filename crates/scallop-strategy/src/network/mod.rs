@@ -525,8 +525,9 @@ pub struct Zoning {
     quads_u: usize,
     quads_v: usize,
     zones: Vec<u32>,
-    /// Per zone (index into `zones`), the quads overlapping it, increasing.
-    quads: Vec<Vec<u32>>,
+    /// Per zone (index into `zones`), the quads `[a, b]` overlapping it, in
+    /// increasing index `a N_v + b` (pairs: no division per quad and zone).
+    quads: Vec<Vec<[u32; 2]>>,
     /// Per quad: the label of its cells when they all agree, else `MIXED`.
     quad_label: Vec<u32>,
     /// Cells `[first, last]` overlapped by each network column `a` and row `b`.
@@ -566,7 +567,7 @@ impl Zoning {
         let mut seen: Vec<u32> = Vec::new();
         for (a, &(i0, i1)) in ranges_u.iter().enumerate() {
             for (b, &(j0, j1)) in ranges_v.iter().enumerate() {
-                let q = u32::try_from(a * nv + b).unwrap_or(u32::MAX);
+                let q = [u32::try_from(a).unwrap_or(u32::MAX), u32::try_from(b).unwrap_or(u32::MAX)];
                 let first = labels.labels[i0 * labels.cells_v + j0];
                 let uniform = (i0..=i1).all(|i| {
                     labels.labels[i * labels.cells_v + j0..=i * labels.cells_v + j1].iter().all(|&l| l == first)
