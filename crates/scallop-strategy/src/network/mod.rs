@@ -268,14 +268,13 @@ impl Network {
         a * (self.quads_v + 1) + b
     }
 
-    /// The exact unit normal (oriented, in this frame) from `(S_u, S_v)` known up
-    /// to a common positive factor at domain fractions `(u, v)`.
+    /// The exact unit normal (oriented, in this frame) of `raw` at domain
+    /// fractions `(u, v)` (the patch's own normal where `raw` is degenerate).
     #[inline]
-    fn finish_normal(&self, (su, sv): (Vec3, Vec3), u: f64, v: f64) -> Vec3 {
-        let n = su.cross(&sv);
-        let norm = n.norm();
-        let n = if norm > scallop_surface::tol::NORMAL_DEGENERATE_REL * (su.norm_squared() + sv.norm_squared()) {
-            n / norm
+    pub(crate) fn unit_normal(&self, raw: &RawNormal, u: f64, v: f64) -> Vec3 {
+        let norm = raw.cross.norm();
+        let n = if norm > raw.degenerate {
+            raw.cross / norm
         } else {
             let (pu, pv) = self.patch.domain().lerp(u, v);
             self.patch.normal(pu, pv)
@@ -283,41 +282,82 @@ impl Network {
         self.orientation.as_ref().map_or(n, |o| o.matrix * n)
     }
 
+    /// The direction of [`Network::unit_normal`] (any length, equal to it up to
+    /// rounding) without a square root or a division; `None` near the
+    /// degenerate test, where the unit normal may be the patch's fallback.
+    #[inline]
+    pub(crate) fn normal_direction(&self, raw: &RawNormal) -> Option<Vec3> {
+        // |cross| > degenerate for certain (the margin dwarfs the rounding of
+        // the square root).
+        if !(raw.cross.norm_squared() > raw.degenerate * raw.degenerate * (1.0 + 1e-6)) {
+            return None;
+        }
+        let w = raw.cross * self.normal_sign;
+        Some(self.orientation.as_ref().map_or(w, |o| o.matrix * w))
+    }
+
     /// Exact normal at domain fractions `(u, v)`.
     pub(crate) fn normal_at(&self, u: f64, v: f64) -> Vec3 {
+        self.unit_normal(&self.raw_normal_at(u, v), u, v)
+    }
+
+    /// [`Network::normal_at`] before its normalisation.
+    pub(crate) fn raw_normal_at(&self, u: f64, v: f64) -> RawNormal {
         match &self.edge_normals {
-            Some(e) => self.finish_normal(e.at(u, v), u, v),
+            Some(e) => RawNormal::new(e.at(u, v)),
             None => {
                 let (pu, pv) = self.patch.domain().lerp(u, v);
                 let d = self.patch.derivatives(pu, pv);
-                self.finish_normal((d.du, d.dv), u, v)
+                RawNormal::new((d.du, d.dv))
             }
         }
     }
 
-    /// Exact normal on the u-edge row `b` (`v = b / N_v`) at `u`.
+    /// The normal on the u-edge row `b` (`v = b / N_v`) at `u`, before its
+    /// normalisation.
     #[inline]
-    pub(crate) fn normal_on_row(&self, b: usize, u: f64) -> Vec3 {
-        let v = b as f64 / self.quads_v as f64;
+    pub(crate) fn raw_normal_on_row(&self, b: usize, u: f64) -> RawNormal {
         match &self.edge_normals {
-            Some(e) => self.finish_normal(e.on_row(b, u), u, v),
-            None => self.normal_at(u, v),
+            Some(e) => RawNormal::new(e.on_row(b, u)),
+            None => self.raw_normal_at(u, b as f64 / self.quads_v as f64),
         }
     }
 
-    /// Exact normal on the v-edge column `a` (`u = a / N_u`) at `v`.
+    /// The normal on the v-edge column `a` (`u = a / N_u`) at `v`, before its
+    /// normalisation.
     #[inline]
-    pub(crate) fn normal_on_column(&self, a: usize, v: f64) -> Vec3 {
-        let u = a as f64 / self.quads_u as f64;
+    pub(crate) fn raw_normal_on_column(&self, a: usize, v: f64) -> RawNormal {
         match &self.edge_normals {
-            Some(e) => self.finish_normal(e.on_column(a, v), u, v),
-            None => self.normal_at(u, v),
+            Some(e) => RawNormal::new(e.on_column(a, v)),
+            None => self.raw_normal_at(a as f64 / self.quads_u as f64, v),
         }
     }
 
     /// A point of this frame back in the part frame.
     pub(crate) fn to_part(&self, p: &Point3) -> Point3 {
         self.orientation.as_ref().map_or(*p, |o| o.to_part(p))
+    }
+}
+
+/// A surface normal before its normalisation: `S_u x S_v` (up to a positive
+/// factor) and the bound of its degenerate test. [`Network::unit_normal`]
+/// finishes it as an eager evaluation would, bit for bit; the planner finishes
+/// only the normals whose spacing it needs (6.4).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct RawNormal {
+    cross: Vec3,
+    /// `NORMAL_DEGENERATE_REL (|S_u|^2 + |S_v|^2)`: a `|cross|` at or below it
+    /// takes the patch's own (fallback) normal.
+    degenerate: f64,
+}
+
+impl RawNormal {
+    #[inline]
+    fn new((su, sv): (Vec3, Vec3)) -> RawNormal {
+        RawNormal {
+            cross: su.cross(&sv),
+            degenerate: scallop_surface::tol::NORMAL_DEGENERATE_REL * (su.norm_squared() + sv.norm_squared()),
+        }
     }
 }
 

@@ -7,26 +7,29 @@
 //! `(a, b)`, 1 = v-edge `(a + 1, b)`, 2 = u-edge `(a, b + 1)`, 3 = v-edge `(a, b)`.
 //! A node is "above" when `m . Q >= d`; an edge crosses when its nodes differ.
 
-use scallop_geom::{Point3, Vec3};
+use scallop_geom::Point3;
 
 use super::spacing::ToolModel;
 use super::time::pass_length_time;
-use super::{CellLabels, Network, Pass, Zoning};
+use super::{CellLabels, Network, Pass, RawNormal, Zoning};
 use crate::tol;
 
 /// A point of a pass under construction.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Vertex {
     pub(crate) p: Point3,
-    pub(crate) n: Vec3,
+    /// The exact normal at `uv`, finished only when the spacing needs it.
+    pub(crate) n: RawNormal,
     pub(crate) uv: [f64; 2],
 }
 
 impl Vertex {
+    /// The point at `t` between two vertices, with `self`'s normal (the
+    /// caller sets the normal at the new `uv`).
     fn lerp(&self, other: &Vertex, t: f64) -> Vertex {
         Vertex {
             p: self.p + (other.p - self.p) * t,
-            n: self.n + (other.n - self.n) * t,
+            n: self.n,
             uv: [self.uv[0] + (other.uv[0] - self.uv[0]) * t, self.uv[1] + (other.uv[1] - self.uv[1]) * t],
         }
     }
@@ -280,12 +283,12 @@ impl<'a> PlaneCutter<'a> {
             0 | 2 => {
                 let row = if k == 0 { b } else { b + 1 };
                 let u = (a as f64 + t) / nu;
-                ([u, row as f64 / nv], self.net.normal_on_row(row, u))
+                ([u, row as f64 / nv], self.net.raw_normal_on_row(row, u))
             }
             _ => {
                 let column = if k == 1 { a + 1 } else { a };
                 let v = (b as f64 + t) / nv;
-                ([column as f64 / nu, v], self.net.normal_on_column(column, v))
+                ([column as f64 / nu, v], self.net.raw_normal_on_column(column, v))
             }
         };
         Vertex { p, n, uv }
@@ -437,7 +440,7 @@ impl<'a> PlaneCutter<'a> {
                     &zoning.labels,
                     zone,
                     &mut piece,
-                    |uv| net.normal_at(uv[0], uv[1]),
+                    |uv| net.raw_normal_at(uv[0], uv[1]),
                     |p| {
                         self.finish(p, tool, cut);
                     },
@@ -450,7 +453,17 @@ impl<'a> PlaneCutter<'a> {
     /// Counts a piece's vertices for the spacing and keeps it as a pass unless short.
     fn finish(&self, piece: &[Vertex], tool: &ToolModel, cut: &mut PlaneCut) {
         for v in piece {
-            let spacing = tool.spacing(&v.n, self.f, self.m);
+            // Most vertices allow more than the plane's spacing so far: a
+            // conservative test on the raw normal spares them the square roots
+            // and divisions of the normalisation and of the exact spacing (the
+            // minimum and the vertex that sets it stay the same, bit for bit).
+            if let Some(w) = self.net.normal_direction(&v.n)
+                && tool.exceeds(&w, self.f, self.m, cut.spacing)
+            {
+                continue;
+            }
+            let n = self.net.unit_normal(&v.n, v.uv[0], v.uv[1]);
+            let spacing = tool.spacing(&n, self.f, self.m);
             if spacing < cut.spacing {
                 cut.spacing = spacing;
                 cut.worst = v.p;
@@ -477,7 +490,7 @@ fn clip(
     labels: &CellLabels,
     zone: u32,
     piece: &mut Vec<Vertex>,
-    normal: impl Fn([f64; 2]) -> Vec3,
+    normal: impl Fn([f64; 2]) -> RawNormal,
     mut out: impl FnMut(&[Vertex]),
 ) {
     let (cu, cv) = (labels.cells_u, labels.cells_v);
