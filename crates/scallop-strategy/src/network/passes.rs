@@ -59,14 +59,16 @@ struct Quad {
     b: usize,
 }
 
-/// A quad's range of `g` and its indices (stored, not divided out of the quad
-/// index on every plane).
+/// A quad's range of `g`, its indices (stored, not divided out of the quad
+/// index on every plane) and its corner values (read in sequence by the planes
+/// instead of gathered from the nodes).
 #[derive(Debug, Clone, Copy, Default)]
 struct Span {
     lo: f64,
     hi: f64,
     a: u32,
     b: u32,
+    c: [f64; 4],
 }
 
 /// The passes of one plane and its NEXT_SPACING.
@@ -131,7 +133,7 @@ impl<'a> PlaneCutter<'a> {
             }
             // INVARIANT: a < N_u, b < N_v, both below MAX_NETWORK_QUADS.
             #[allow(clippy::cast_possible_truncation)]
-            Span { lo, hi, a: a as u32, b: b as u32 }
+            Span { lo, hi, a: a as u32, b: b as u32, c }
         };
         let mut range = (f64::INFINITY, f64::NEG_INFINITY);
         match zoning {
@@ -397,7 +399,7 @@ impl<'a> PlaneCutter<'a> {
             // The crossing edges not yet traced, as bits; most cut quads have
             // none left (their curve came through already), so the loop below
             // rarely runs. Marks are read again there: a trace marks edges.
-            let mut todo = Self::crossings(&self.corners(quad), d);
+            let mut todo = Self::crossings(&span.c, d);
             for (k, &id) in ids.iter().enumerate() {
                 todo &= !(usize::from(self.ws.marks[id] == self.ws.stamp) << k);
             }
@@ -506,7 +508,29 @@ fn clip(
     for w in line.windows(2) {
         let (a, b) = (&w[0], &w[1]);
         let target = cell(b);
-        if target != current {
+        let (du, dv) = (target.0.abs_diff(current.0), target.1.abs_diff(current.1));
+        if du + dv == 1 {
+            // One cell boundary crossed (the common case): no list to sort, and
+            // its fraction (two divisions) only where the label changes there;
+            // the same values as the general path below.
+            let now = label(target) == zone;
+            if now != inside {
+                let t = if du == 1 {
+                    boundary_at(a.uv[0], b.uv[0], current.0.max(target.0), cu)
+                } else {
+                    boundary_at(a.uv[1], b.uv[1], current.1.max(target.1), cv)
+                };
+                let mut x = a.lerp(b, t);
+                x.n = normal(x.uv);
+                piece.push(x);
+                if inside {
+                    out(piece);
+                    piece.clear();
+                }
+                inside = now;
+            }
+            current = target;
+        } else if target != current {
             crossings.clear();
             boundary_crossings(a.uv[0], b.uv[0], current.0, target.0, cu, |t, step| crossings.push((t, step, 0)));
             boundary_crossings(a.uv[1], b.uv[1], current.1, target.1, cv, |t, step| crossings.push((t, 0, step)));
@@ -554,7 +578,7 @@ fn clip(
 /// Calls `push(t, step)` for each cell boundary `k / cells` crossed between
 /// parameters `a` (cell `from`) and `b` (cell `to`), `t` the fraction along.
 fn boundary_crossings(a: f64, b: f64, from: usize, to: usize, cells: usize, mut push: impl FnMut(f64, isize)) {
-    let at = |k: usize| (((k as f64 / cells as f64) - a) / (b - a)).clamp(0.0, 1.0);
+    let at = |k: usize| boundary_at(a, b, k, cells);
     if to > from {
         for k in from + 1..=to {
             push(at(k), 1);
@@ -564,6 +588,12 @@ fn boundary_crossings(a: f64, b: f64, from: usize, to: usize, cells: usize, mut 
             push(at(k), -1);
         }
     }
+}
+
+/// The fraction along `[a, b]` of the cell boundary `k / cells`.
+#[inline]
+fn boundary_at(a: f64, b: f64, k: usize, cells: usize) -> f64 {
+    (((k as f64 / cells as f64) - a) / (b - a)).clamp(0.0, 1.0)
 }
 
 /// Widens `range` by the extent along `m` of quad `q`'s part in `zone`: its
