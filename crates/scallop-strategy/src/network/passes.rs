@@ -509,10 +509,12 @@ fn clip(
         let (a, b) = (&w[0], &w[1]);
         let target = cell(b);
         let (du, dv) = (target.0.abs_diff(current.0), target.1.abs_diff(current.1));
-        if du + dv == 1 {
-            // One cell boundary crossed (the common case): no list to sort, and
-            // its fraction (two divisions) only where the label changes there;
-            // the same values as the general path below.
+        if du + dv <= 1 {
+            // No or one cell boundary crossed (the common cases, one predictable
+            // branch): no list to sort, and the boundary's fraction (two
+            // divisions) only where the label changes there; the same values as
+            // the general path below. (`inside` is the label test of `current`,
+            // so a segment within its cell changes nothing.)
             let now = label(target) == zone;
             if now != inside {
                 let t = if du == 1 {
@@ -530,7 +532,7 @@ fn clip(
                 inside = now;
             }
             current = target;
-        } else if target != current {
+        } else {
             crossings.clear();
             boundary_crossings(a.uv[0], b.uv[0], current.0, target.0, cu, |t, step| crossings.push((t, step, 0)));
             boundary_crossings(a.uv[1], b.uv[1], current.1, target.1, cv, |t, step| crossings.push((t, 0, step)));

@@ -124,39 +124,24 @@ impl ToolModel {
     pub(crate) fn exceeds(&self, w: &Vec3, f: [f64; 2], m: [f64; 2], best: f64) -> bool {
         const SLACK: f64 = 1e-9;
         const ABS: f64 = 1e-12;
-        if self.flat || !best.is_finite() {
-            return false;
-        }
+        // Every condition is evaluated and combined without branches (the
+        // caller branches once, on the result); values out of range give
+        // infinities or NaN, which fail the comparisons or are not selected.
         let n2 = w.x * w.x + w.y * w.y + w.z * w.z;
-        // Scaled so that the powers below (up to N^7) stay normal numbers.
-        if !(1e-20..=1e20).contains(&n2) {
-            return false;
-        }
+        // N scaled so that the powers below (up to N^7) stay normal numbers.
+        let valid = !self.flat & best.is_finite() & (n2 >= 1e-20) & (n2 <= 1e20);
         let b = best * best * (1.0 + SLACK);
         let wm = w.x * m[0] + w.y * m[1];
-        // N F from below.
+        // N F from below; the spacing is at most cap sqrt(F) whatever the radius.
         let f_lo = (n2 - wm * wm) - ABS * n2;
-        if !(f_lo > 0.0 && self.cap * self.cap * f_lo >= b * n2) {
-            return false;
-        }
-        if self.ball {
-            return true;
-        }
+        let cap_ok = (f_lo > 0.0) & (self.cap * self.cap * f_lo >= b * n2);
         let s2 = scallop_analysis::tol::SIN_SLOPE_HORIZONTAL * scallop_analysis::tol::SIN_SLOPE_HORIZONTAL;
         let hx = w.x * w.x + w.y * w.y;
-        if hx < s2 * n2 * (1.0 - SLACK) {
-            // Clearly horizontal: the spacing is cap * sqrt(F), tested above.
-            return true;
-        }
-        if !(hx > s2 * n2 * (1.0 + SLACK)) {
-            return false;
-        }
+        // Clearly horizontal: the spacing is cap sqrt(F), tested above.
+        let horizontal = hx < s2 * n2 * (1.0 - SLACK);
+        let sloped = hx > s2 * n2 * (1.0 + SLACK);
         let sh = self.scallop_height;
         let u = b * n2 - 4.0 * sh * (2.0 * self.corner - sh) * f_lo;
-        if u <= 0.0 {
-            // Even R_eff = r allows more than best.
-            return true;
-        }
         let wf = w.x * f[0] + w.y * f[1];
         let x_lo = (wf * wf - ABS * n2).max(0.0);
         let a_hi = ((wf * wf + ABS * n2) * n2 + (wm * wm + ABS * n2) * (w.z * w.z)) * (1.0 + SLACK);
@@ -165,7 +150,9 @@ impl ToolModel {
             t * t * n2
         };
         let rhs = u * u * hx * a_hi * a_hi * (1.0 + SLACK);
-        lhs.is_finite() && rhs.is_finite() && rhs > 0.0 && lhs >= rhs
+        // `u <= 0`: even R_eff = r allows more than best.
+        let radius_ok = (u <= 0.0) | (lhs.is_finite() & rhs.is_finite() & (rhs > 0.0) & (lhs >= rhs));
+        valid & cap_ok & (self.ball | horizontal | (sloped & radius_ok))
     }
 }
 
