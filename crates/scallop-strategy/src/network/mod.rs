@@ -609,6 +609,31 @@ impl Zoning {
             for (b, &(j0, j1)) in ranges_v.iter().enumerate() {
                 let q = [u32::try_from(a).unwrap_or(u32::MAX), u32::try_from(b).unwrap_or(u32::MAX)];
                 let first = labels.labels[i0 * labels.cells_v + j0];
+                if i1 - i0 <= 1 && j1 - j0 <= 1 {
+                    // At most 2 x 2 cells (a network finer than the grid, the
+                    // usual case): the four corner cells' labels (repeated where
+                    // the quad has one row or column of cells) compared without
+                    // loops, their distinct labels pushed in the same sets.
+                    let at = |i: usize, j: usize| labels.labels[i * labels.cells_v + j];
+                    let (l01, l10, l11) = (at(i0, j1), at(i1, j0), at(i1, j1));
+                    if (first == l01) & (first == l10) & (first == l11) {
+                        quads[zone_index(first)].push(q);
+                        quad_label.push(first);
+                        continue;
+                    }
+                    quads[zone_index(first)].push(q);
+                    if l01 != first {
+                        quads[zone_index(l01)].push(q);
+                    }
+                    if l10 != first && l10 != l01 {
+                        quads[zone_index(l10)].push(q);
+                    }
+                    if l11 != first && l11 != l01 && l11 != l10 {
+                        quads[zone_index(l11)].push(q);
+                    }
+                    quad_label.push(MIXED);
+                    continue;
+                }
                 let uniform = (i0..=i1).all(|i| {
                     labels.labels[i * labels.cells_v + j0..=i * labels.cells_v + j1].iter().all(|&l| l == first)
                 });
