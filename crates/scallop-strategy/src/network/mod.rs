@@ -289,7 +289,8 @@ impl Network {
     pub(crate) fn normal_direction(&self, raw: &RawNormal) -> Option<Vec3> {
         // |cross| > degenerate for certain (the margin dwarfs the rounding of
         // the square root).
-        if !(raw.cross.norm_squared() > raw.degenerate * raw.degenerate * (1.0 + 1e-6)) {
+        let clear = raw.cross.norm_squared() > raw.degenerate * raw.degenerate * (1.0 + 1e-6);
+        if !clear {
             return None;
         }
         let w = raw.cross * self.normal_sign;

@@ -97,7 +97,6 @@ pub(crate) struct PlaneCutter<'a> {
     u_edges: usize,
 }
 
-
 impl<'a> PlaneCutter<'a> {
     /// Prepares planes of direction `theta` over the zone's quads (all quads
     /// without a zoning). `None` when the zone has no quad.
@@ -172,7 +171,7 @@ impl<'a> PlaneCutter<'a> {
                     ws.g[n00 + 1] = c[3];
                     let s = span_of(c, a, b);
                     ws.spans.push(s);
-                    range = zone_extent(net, zoning, zone, &ws.g, a, b, &s, range);
+                    range = zone_extent(net, zoning, zone, &ws.g, (a, b), &s, range);
                 }
             }
         }
@@ -606,8 +605,7 @@ fn zone_extent(
     zoning: &Zoning,
     zone: u32,
     g: &[f64],
-    a: usize,
-    b: usize,
+    (a, b): (usize, usize),
     span: &Span,
     range: (f64, f64),
 ) -> (f64, f64) {

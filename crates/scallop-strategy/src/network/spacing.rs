@@ -129,7 +129,7 @@ impl ToolModel {
         // infinities or NaN, which fail the comparisons or are not selected.
         let n2 = w.x * w.x + w.y * w.y + w.z * w.z;
         // N scaled so that the powers below (up to N^7) stay normal numbers.
-        let valid = !self.flat & best.is_finite() & (n2 >= 1e-20) & (n2 <= 1e20);
+        let valid = !self.flat & best.is_finite() & (1e-20..=1e20).contains(&n2);
         let b = best * best * (1.0 + SLACK);
         let wm = w.x * m[0] + w.y * m[1];
         // N F from below; the spacing is at most cap sqrt(F) whatever the radius.
