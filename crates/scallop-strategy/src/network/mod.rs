@@ -268,14 +268,13 @@ impl Network {
         a * (self.quads_v + 1) + b
     }
 
-    /// The exact unit normal (oriented, in this frame) from `(S_u, S_v)` known up
-    /// to a common positive factor at domain fractions `(u, v)`.
+    /// The exact unit normal (oriented, in this frame) of `raw` at domain
+    /// fractions `(u, v)` (the patch's own normal where `raw` is degenerate).
     #[inline]
-    fn finish_normal(&self, (su, sv): (Vec3, Vec3), u: f64, v: f64) -> Vec3 {
-        let n = su.cross(&sv);
-        let norm = n.norm();
-        let n = if norm > scallop_surface::tol::NORMAL_DEGENERATE_REL * (su.norm_squared() + sv.norm_squared()) {
-            n / norm
+    pub(crate) fn unit_normal(&self, raw: &RawNormal, u: f64, v: f64) -> Vec3 {
+        let norm = raw.cross.norm();
+        let n = if norm > raw.degenerate {
+            raw.cross / norm
         } else {
             let (pu, pv) = self.patch.domain().lerp(u, v);
             self.patch.normal(pu, pv)
@@ -283,41 +282,83 @@ impl Network {
         self.orientation.as_ref().map_or(n, |o| o.matrix * n)
     }
 
+    /// The direction of [`Network::unit_normal`] (any length, equal to it up to
+    /// rounding) without a square root or a division; `None` near the
+    /// degenerate test, where the unit normal may be the patch's fallback.
+    #[inline]
+    pub(crate) fn normal_direction(&self, raw: &RawNormal) -> Option<Vec3> {
+        // |cross| > degenerate for certain (the margin dwarfs the rounding of
+        // the square root).
+        let clear = raw.cross.norm_squared() > raw.degenerate * raw.degenerate * (1.0 + 1e-6);
+        if !clear {
+            return None;
+        }
+        let w = raw.cross * self.normal_sign;
+        Some(self.orientation.as_ref().map_or(w, |o| o.matrix * w))
+    }
+
     /// Exact normal at domain fractions `(u, v)`.
     pub(crate) fn normal_at(&self, u: f64, v: f64) -> Vec3 {
+        self.unit_normal(&self.raw_normal_at(u, v), u, v)
+    }
+
+    /// [`Network::normal_at`] before its normalisation.
+    pub(crate) fn raw_normal_at(&self, u: f64, v: f64) -> RawNormal {
         match &self.edge_normals {
-            Some(e) => self.finish_normal(e.at(u, v), u, v),
+            Some(e) => RawNormal::new(e.at(u, v)),
             None => {
                 let (pu, pv) = self.patch.domain().lerp(u, v);
                 let d = self.patch.derivatives(pu, pv);
-                self.finish_normal((d.du, d.dv), u, v)
+                RawNormal::new((d.du, d.dv))
             }
         }
     }
 
-    /// Exact normal on the u-edge row `b` (`v = b / N_v`) at `u`.
+    /// The normal on the u-edge row `b` (`v = b / N_v`) at `u`, before its
+    /// normalisation.
     #[inline]
-    pub(crate) fn normal_on_row(&self, b: usize, u: f64) -> Vec3 {
-        let v = b as f64 / self.quads_v as f64;
+    pub(crate) fn raw_normal_on_row(&self, b: usize, u: f64) -> RawNormal {
         match &self.edge_normals {
-            Some(e) => self.finish_normal(e.on_row(b, u), u, v),
-            None => self.normal_at(u, v),
+            Some(e) => RawNormal::new(e.on_row(b, u)),
+            None => self.raw_normal_at(u, b as f64 / self.quads_v as f64),
         }
     }
 
-    /// Exact normal on the v-edge column `a` (`u = a / N_u`) at `v`.
+    /// The normal on the v-edge column `a` (`u = a / N_u`) at `v`, before its
+    /// normalisation.
     #[inline]
-    pub(crate) fn normal_on_column(&self, a: usize, v: f64) -> Vec3 {
-        let u = a as f64 / self.quads_u as f64;
+    pub(crate) fn raw_normal_on_column(&self, a: usize, v: f64) -> RawNormal {
         match &self.edge_normals {
-            Some(e) => self.finish_normal(e.on_column(a, v), u, v),
-            None => self.normal_at(u, v),
+            Some(e) => RawNormal::new(e.on_column(a, v)),
+            None => self.raw_normal_at(a as f64 / self.quads_u as f64, v),
         }
     }
 
     /// A point of this frame back in the part frame.
     pub(crate) fn to_part(&self, p: &Point3) -> Point3 {
         self.orientation.as_ref().map_or(*p, |o| o.to_part(p))
+    }
+}
+
+/// A surface normal before its normalisation: `S_u x S_v` (up to a positive
+/// factor) and the bound of its degenerate test. [`Network::unit_normal`]
+/// finishes it as an eager evaluation would, bit for bit; the planner finishes
+/// only the normals whose spacing it needs (6.4).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct RawNormal {
+    cross: Vec3,
+    /// `NORMAL_DEGENERATE_REL (|S_u|^2 + |S_v|^2)`: a `|cross|` at or below it
+    /// takes the patch's own (fallback) normal.
+    degenerate: f64,
+}
+
+impl RawNormal {
+    #[inline]
+    fn new((su, sv): (Vec3, Vec3)) -> RawNormal {
+        RawNormal {
+            cross: su.cross(&sv),
+            degenerate: scallop_surface::tol::NORMAL_DEGENERATE_REL * (su.norm_squared() + sv.norm_squared()),
+        }
     }
 }
 
@@ -525,8 +566,9 @@ pub struct Zoning {
     quads_u: usize,
     quads_v: usize,
     zones: Vec<u32>,
-    /// Per zone (index into `zones`), the quads overlapping it, increasing.
-    quads: Vec<Vec<u32>>,
+    /// Per zone (index into `zones`), the quads `[a, b]` overlapping it, in
+    /// increasing index `a N_v + b` (pairs: no division per quad and zone).
+    quads: Vec<Vec<[u32; 2]>>,
     /// Per quad: the label of its cells when they all agree, else `MIXED`.
     quad_label: Vec<u32>,
     /// Cells `[first, last]` overlapped by each network column `a` and row `b`.
@@ -566,8 +608,33 @@ impl Zoning {
         let mut seen: Vec<u32> = Vec::new();
         for (a, &(i0, i1)) in ranges_u.iter().enumerate() {
             for (b, &(j0, j1)) in ranges_v.iter().enumerate() {
-                let q = u32::try_from(a * nv + b).unwrap_or(u32::MAX);
+                let q = [u32::try_from(a).unwrap_or(u32::MAX), u32::try_from(b).unwrap_or(u32::MAX)];
                 let first = labels.labels[i0 * labels.cells_v + j0];
+                if i1 - i0 <= 1 && j1 - j0 <= 1 {
+                    // At most 2 x 2 cells (a network finer than the grid, the
+                    // usual case): the four corner cells' labels (repeated where
+                    // the quad has one row or column of cells) compared without
+                    // loops, their distinct labels pushed in the same sets.
+                    let at = |i: usize, j: usize| labels.labels[i * labels.cells_v + j];
+                    let (l01, l10, l11) = (at(i0, j1), at(i1, j0), at(i1, j1));
+                    if (first == l01) & (first == l10) & (first == l11) {
+                        quads[zone_index(first)].push(q);
+                        quad_label.push(first);
+                        continue;
+                    }
+                    quads[zone_index(first)].push(q);
+                    if l01 != first {
+                        quads[zone_index(l01)].push(q);
+                    }
+                    if l10 != first && l10 != l01 {
+                        quads[zone_index(l10)].push(q);
+                    }
+                    if l11 != first && l11 != l01 && l11 != l10 {
+                        quads[zone_index(l11)].push(q);
+                    }
+                    quad_label.push(MIXED);
+                    continue;
+                }
                 let uniform = (i0..=i1).all(|i| {
                     labels.labels[i * labels.cells_v + j0..=i * labels.cells_v + j1].iter().all(|&l| l == first)
                 });

@@ -7,26 +7,29 @@
 //! `(a, b)`, 1 = v-edge `(a + 1, b)`, 2 = u-edge `(a, b + 1)`, 3 = v-edge `(a, b)`.
 //! A node is "above" when `m . Q >= d`; an edge crosses when its nodes differ.
 
-use scallop_geom::{Point3, Vec3};
+use scallop_geom::Point3;
 
 use super::spacing::ToolModel;
 use super::time::pass_length_time;
-use super::{CellLabels, Network, Pass, Zoning};
+use super::{CellLabels, Network, Pass, RawNormal, Zoning};
 use crate::tol;
 
 /// A point of a pass under construction.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Vertex {
     pub(crate) p: Point3,
-    pub(crate) n: Vec3,
+    /// The exact normal at `uv`, finished only when the spacing needs it.
+    pub(crate) n: RawNormal,
     pub(crate) uv: [f64; 2],
 }
 
 impl Vertex {
+    /// The point at `t` between two vertices, with `self`'s normal (the
+    /// caller sets the normal at the new `uv`).
     fn lerp(&self, other: &Vertex, t: f64) -> Vertex {
         Vertex {
             p: self.p + (other.p - self.p) * t,
-            n: self.n + (other.n - self.n) * t,
+            n: self.n,
             uv: [self.uv[0] + (other.uv[0] - self.uv[0]) * t, self.uv[1] + (other.uv[1] - self.uv[1]) * t],
         }
     }
@@ -40,6 +43,8 @@ pub(crate) struct Workspace {
     stamp: u32,
     spans: Vec<Span>,
     sorted: Vec<Span>,
+    /// The spans of a plane's bucket window that it cuts.
+    live: Vec<u32>,
     starts: Vec<usize>,
     fill: Vec<usize>,
     forward: Vec<Vertex>,
@@ -54,11 +59,16 @@ struct Quad {
     b: usize,
 }
 
+/// A quad's range of `g`, its indices (stored, not divided out of the quad
+/// index on every plane) and its corner values (read in sequence by the planes
+/// instead of gathered from the nodes).
 #[derive(Debug, Clone, Copy, Default)]
 struct Span {
     lo: f64,
     hi: f64,
-    quad: u32,
+    a: u32,
+    b: u32,
+    c: [f64; 4],
 }
 
 /// The passes of one plane and its NEXT_SPACING.
@@ -83,6 +93,8 @@ pub(crate) struct PlaneCutter<'a> {
     range: (f64, f64),
     cos_sharp: f64,
     machine: scallop_analysis::MachineLimits,
+    /// `N_u (N_v + 1)`: the first v-edge id.
+    u_edges: usize,
 }
 
 impl<'a> PlaneCutter<'a> {
@@ -112,13 +124,15 @@ impl<'a> PlaneCutter<'a> {
         ws.spans.clear();
         // The span of g over a quad's corners (a, b), (a + 1, b), (a + 1, b + 1),
         // (a, b + 1); plain comparisons: g is finite (no NaN handling needed).
-        let span_of = |c: [f64; 4], q: usize| {
+        let span_of = |c: [f64; 4], a: usize, b: usize| {
             let (mut lo, mut hi) = (c[0], c[0]);
             for &x in &c[1..] {
                 lo = if x < lo { x } else { lo };
                 hi = if x > hi { x } else { hi };
             }
-            Span { lo, hi, quad: u32::try_from(q).unwrap_or(u32::MAX) }
+            // INVARIANT: a < N_u, b < N_v, both below MAX_NETWORK_QUADS.
+            #[allow(clippy::cast_possible_truncation)]
+            Span { lo, hi, a: a as u32, b: b as u32, c }
         };
         let mut range = (f64::INFINITY, f64::NEG_INFINITY);
         match zoning {
@@ -127,10 +141,11 @@ impl<'a> PlaneCutter<'a> {
                     *g = dot(p);
                 }
                 let g = &ws.g;
-                ws.spans.extend((0..nu * nv).map(|q| {
-                    let (a, b) = (q / nv, q % nv);
-                    let (n00, n10) = (net.node(a, b), net.node(a + 1, b));
-                    span_of([g[n00], g[n10], g[n10 + 1], g[n00 + 1]], q)
+                ws.spans.extend((0..nu).flat_map(|a| {
+                    (0..nv).map(move |b| {
+                        let (n00, n10) = (net.node(a, b), net.node(a + 1, b));
+                        span_of([g[n00], g[n10], g[n10 + 1], g[n00 + 1]], a, b)
+                    })
                 }));
                 for s in &ws.spans {
                     range = (range.0.min(s.lo), range.1.max(s.hi));
@@ -141,9 +156,8 @@ impl<'a> PlaneCutter<'a> {
                 let k = zoning.zones.binary_search(&zone).ok()?;
                 let quads = &zoning.quads[k];
                 ws.spans.reserve(quads.len());
-                for &q in quads {
-                    let q = q as usize;
-                    let (a, b) = (q / nv, q % nv);
+                for &[a, b] in quads {
+                    let (a, b) = (a as usize, b as usize);
                     let (n00, n10) = (net.node(a, b), net.node(a + 1, b));
                     let c = [
                         dot(&net.points[n00]),
@@ -155,9 +169,9 @@ impl<'a> PlaneCutter<'a> {
                     ws.g[n10] = c[1];
                     ws.g[n10 + 1] = c[2];
                     ws.g[n00 + 1] = c[3];
-                    let s = span_of(c, q);
+                    let s = span_of(c, a, b);
                     ws.spans.push(s);
-                    range = zone_extent(net, zoning, zone, &ws.g, q, &s, range);
+                    range = zone_extent(net, zoning, zone, &ws.g, (a, b), &s, range);
                 }
             }
         }
@@ -199,7 +213,8 @@ impl<'a> PlaneCutter<'a> {
             ws.sorted[ws.fill[b]] = *s;
             ws.fill[b] += 1;
         }
-        Some(PlaneCutter { net, zoning, f, m, ws, g0, inv_width, buckets, extent, range, cos_sharp, machine })
+        let u_edges = nu * (nv + 1);
+        Some(PlaneCutter { net, zoning, f, m, ws, g0, inv_width, buckets, extent, range, cos_sharp, machine, u_edges })
     }
 
     /// `(d_min, d_max)`: the extent of the zone along `m` (its cells clipped to
@@ -220,24 +235,23 @@ impl<'a> PlaneCutter<'a> {
         self.zoning.is_none_or(|(z, zone)| z.quad_in_zone(q, zone))
     }
 
-    /// The quad `(a, b)` of index `q`.
-    fn quad(&self, q: usize) -> Quad {
+    /// The ids of local edges 0 to 3 of a quad (arrays indexed by the local
+    /// edge: loads instead of a `match` on a data-dependent `k`).
+    #[inline]
+    fn edge_ids(&self, quad: Quad) -> [usize; 4] {
         let nv = self.net.quads_v;
-        Quad { a: q / nv, b: q % nv }
+        // u-edge (a, b) has the id of node (a, b); v-edge (a, b) is `u_edges + a N_v + b`.
+        let e0 = self.net.node(quad.a, quad.b);
+        let e3 = self.u_edges + quad.a * nv + quad.b;
+        [e0, e3 + nv, e0 + 1, e3]
     }
 
-    /// `(node0, node1, edge id)` of local edge `k` of quad `(a, b)`.
-    fn edge(&self, quad: Quad, k: usize) -> (usize, usize, usize) {
-        let (nu, nv) = (self.net.quads_u, self.net.quads_v);
-        let Quad { a, b } = quad;
-        let u_edges = nu * (nv + 1);
-        let n = |a, b| self.net.node(a, b);
-        match k {
-            0 => (n(a, b), n(a + 1, b), a * (nv + 1) + b),
-            1 => (n(a + 1, b), n(a + 1, b + 1), u_edges + (a + 1) * nv + b),
-            2 => (n(a, b + 1), n(a + 1, b + 1), a * (nv + 1) + b + 1),
-            _ => (n(a, b), n(a, b + 1), u_edges + a * nv + b),
-        }
+    /// `(node0, node1)` of local edge `k` of a quad.
+    #[inline]
+    fn edge_nodes(&self, quad: Quad, k: usize) -> (usize, usize) {
+        let n00 = self.net.node(quad.a, quad.b);
+        let n10 = n00 + self.net.quads_v + 1;
+        ([n00, n10, n00 + 1, n00][k & 3], [n10, n10 + 1, n10 + 1, n00 + 1][k & 3])
     }
 
     /// `g` at the corners `(a, b), (a + 1, b), (a + 1, b + 1), (a, b + 1)`.
@@ -248,15 +262,17 @@ impl<'a> PlaneCutter<'a> {
         [g[n00], g[n10], g[n10 + 1], g[n00 + 1]]
     }
 
-    /// Which local edges cross the plane, from the corner values.
-    fn crossings(c: &[f64; 4], d: f64) -> [bool; 4] {
-        let s = c.map(|x| x >= d);
-        [s[0] != s[1], s[1] != s[2], s[3] != s[2], s[0] != s[3]]
+    /// Which local edges cross the plane, from the corner values: bit `k` for
+    /// local edge `k`.
+    #[inline]
+    fn crossings(c: &[f64; 4], d: f64) -> usize {
+        let s = c.map(|x| usize::from(x >= d));
+        (s[0] ^ s[1]) | (s[1] ^ s[2]) << 1 | (s[3] ^ s[2]) << 2 | (s[0] ^ s[3]) << 3
     }
 
     /// The crossing point of local edge `k` of a quad (the same from both quads).
     fn point(&self, quad: Quad, k: usize, d: f64) -> Vertex {
-        let (i, j, _) = self.edge(quad, k);
+        let (i, j) = self.edge_nodes(quad, k);
         let (gi, gj) = (self.ws.g[i], self.ws.g[j]);
         let t = ((d - gi) / (gj - gi)).clamp(0.0, 1.0);
         let (nu, nv) = (self.net.quads_u as f64, self.net.quads_v as f64);
@@ -268,12 +284,12 @@ impl<'a> PlaneCutter<'a> {
             0 | 2 => {
                 let row = if k == 0 { b } else { b + 1 };
                 let u = (a as f64 + t) / nu;
-                ([u, row as f64 / nv], self.net.normal_on_row(row, u))
+                ([u, row as f64 / nv], self.net.raw_normal_on_row(row, u))
             }
             _ => {
                 let column = if k == 1 { a + 1 } else { a };
                 let v = (b as f64 + t) / nv;
-                ([column as f64 / nu, v], self.net.normal_on_column(column, v))
+                ([column as f64 / nu, v], self.net.raw_normal_on_column(column, v))
             }
         };
         Vertex { p, n, uv }
@@ -282,21 +298,25 @@ impl<'a> PlaneCutter<'a> {
     /// The exit edge of a curve entering a quad of corner values `c` by local
     /// edge `k` (marching squares; a saddle is resolved by the sign at the
     /// quad centre).
+    #[inline]
     fn partner(c: &[f64; 4], k: usize, d: f64) -> usize {
         let crossing = Self::crossings(c, d);
-        if crossing.iter().all(|&x| x) {
+        if crossing == 15 {
             let centre = 0.25 * (c[0] + c[1] + c[2] + c[3]);
             // Same side as corner 0 at the centre: corners 1 and 3 are cut off.
             let pairs = if (centre >= d) == (c[0] >= d) { [1, 0, 3, 2] } else { [3, 2, 1, 0] };
             return pairs[k];
         }
-        (0..4).find(|&e| e != k && crossing[e]).unwrap_or(k)
+        (0..4).find(|&e| e != k && crossing & (1 << e) != 0).unwrap_or(k)
     }
 
     /// The quad across local edge `k`, and that edge's local index there.
+    #[inline]
     fn neighbour(&self, quad: Quad, k: usize) -> Option<(Quad, usize)> {
         let (nu, nv) = (self.net.quads_u, self.net.quads_v);
         let Quad { a, b } = quad;
+        // Tables indexed by the local edge (no `match` on a data-dependent k):
+        // whether a quad lies across, its offset, and the edge's index there.
         let next = match k {
             0 => (b > 0).then(|| (Quad { a, b: b - 1 }, 2)),
             1 => (a + 1 < nu).then(|| (Quad { a: a + 1, b }, 3)),
@@ -311,7 +331,7 @@ impl<'a> PlaneCutter<'a> {
     fn walk(&mut self, mut quad: Quad, mut k: usize, d: f64, into: &mut Vec<Vertex>) -> bool {
         loop {
             let exit = Self::partner(&self.corners(quad), k, d);
-            let (_, _, id) = self.edge(quad, exit);
+            let id = self.edge_ids(quad)[exit];
             if self.ws.marks[id] == self.ws.stamp {
                 return true;
             }
@@ -330,7 +350,7 @@ impl<'a> PlaneCutter<'a> {
         let mut backward = std::mem::take(&mut self.ws.backward);
         forward.clear();
         backward.clear();
-        let (_, _, id) = self.edge(quad, k);
+        let id = self.edge_ids(quad)[k & 3];
         self.ws.marks[id] = self.ws.stamp;
         forward.push(self.point(quad, k, d));
         if self.walk(quad, k, d, &mut forward) {
@@ -358,22 +378,41 @@ impl<'a> PlaneCutter<'a> {
         }
         let mut cut = PlaneCut { passes: Vec::new(), spacing: f64::INFINITY, worst: Point3::origin() };
         let (first, last) = (self.bucket(d - self.extent), self.bucket(d));
-        for i in self.ws.starts[first]..self.ws.starts[last + 1] {
-            let span = self.ws.sorted[i];
-            if !(span.lo < d && span.hi >= d) {
-                continue;
+        // The spans of the window that the plane cuts, listed without a branch
+        // (the index is written always, the count moves when the span is cut).
+        let window = self.ws.starts[first]..self.ws.starts[last + 1];
+        let mut live = std::mem::take(&mut self.ws.live);
+        live.resize(window.len(), 0);
+        let mut count = 0;
+        for (i, span) in window.clone().zip(&self.ws.sorted[window]) {
+            // INVARIANT: fewer spans than quads (u32-indexed).
+            #[allow(clippy::cast_possible_truncation)]
+            let i = i as u32;
+            live[count] = i;
+            count += usize::from(span.lo < d && span.hi >= d);
+        }
+        for &i in &live[..count] {
+            let span = self.ws.sorted[i as usize];
+            let quad = Quad { a: span.a as usize, b: span.b as usize };
+            let ids = self.edge_ids(quad);
+            // The crossing edges not yet traced, as bits; most cut quads have
+            // none left (their curve came through already), so the loop below
+            // rarely runs. Marks are read again there: a trace marks edges.
+            let mut todo = Self::crossings(&span.c, d);
+            for (k, &id) in ids.iter().enumerate() {
+                todo &= !(usize::from(self.ws.marks[id] == self.ws.stamp) << k);
             }
-            let quad = self.quad(span.quad as usize);
-            let crossing = Self::crossings(&self.corners(quad), d);
-            for (k, &crosses) in crossing.iter().enumerate() {
-                let (_, _, id) = self.edge(quad, k);
-                if crosses && self.ws.marks[id] != self.ws.stamp {
+            while todo != 0 {
+                let k = todo.trailing_zeros() as usize;
+                todo &= todo - 1;
+                if self.ws.marks[ids[k]] != self.ws.stamp {
                     let mut line = self.trace(quad, k, d);
                     self.emit(&mut line, tool, &mut cut);
                     self.ws.forward = line;
                 }
             }
         }
+        self.ws.live = live;
         cut.passes.sort_by(|a, b| self.mid(a).total_cmp(&self.mid(b)));
         cut
     }
@@ -402,7 +441,7 @@ impl<'a> PlaneCutter<'a> {
                     &zoning.labels,
                     zone,
                     &mut piece,
-                    |uv| net.normal_at(uv[0], uv[1]),
+                    |uv| net.raw_normal_at(uv[0], uv[1]),
                     |p| {
                         self.finish(p, tool, cut);
                     },
@@ -415,7 +454,17 @@ impl<'a> PlaneCutter<'a> {
     /// Counts a piece's vertices for the spacing and keeps it as a pass unless short.
     fn finish(&self, piece: &[Vertex], tool: &ToolModel, cut: &mut PlaneCut) {
         for v in piece {
-            let spacing = tool.spacing(&v.n, self.f, self.m);
+            // Most vertices allow more than the plane's spacing so far: a
+            // conservative test on the raw normal spares them the square roots
+            // and divisions of the normalisation and of the exact spacing (the
+            // minimum and the vertex that sets it stay the same, bit for bit).
+            if let Some(w) = self.net.normal_direction(&v.n)
+                && tool.exceeds(&w, self.f, self.m, cut.spacing)
+            {
+                continue;
+            }
+            let n = self.net.unit_normal(&v.n, v.uv[0], v.uv[1]);
+            let spacing = tool.spacing(&n, self.f, self.m);
             if spacing < cut.spacing {
                 cut.spacing = spacing;
                 cut.worst = v.p;
@@ -442,7 +491,7 @@ fn clip(
     labels: &CellLabels,
     zone: u32,
     piece: &mut Vec<Vertex>,
-    normal: impl Fn([f64; 2]) -> Vec3,
+    normal: impl Fn([f64; 2]) -> RawNormal,
     mut out: impl FnMut(&[Vertex]),
 ) {
     let (cu, cv) = (labels.cells_u, labels.cells_v);
@@ -458,7 +507,31 @@ fn clip(
     for w in line.windows(2) {
         let (a, b) = (&w[0], &w[1]);
         let target = cell(b);
-        if target != current {
+        let (du, dv) = (target.0.abs_diff(current.0), target.1.abs_diff(current.1));
+        if du + dv <= 1 {
+            // No or one cell boundary crossed (the common cases, one predictable
+            // branch): no list to sort, and the boundary's fraction (two
+            // divisions) only where the label changes there; the same values as
+            // the general path below. (`inside` is the label test of `current`,
+            // so a segment within its cell changes nothing.)
+            let now = label(target) == zone;
+            if now != inside {
+                let t = if du == 1 {
+                    boundary_at(a.uv[0], b.uv[0], current.0.max(target.0), cu)
+                } else {
+                    boundary_at(a.uv[1], b.uv[1], current.1.max(target.1), cv)
+                };
+                let mut x = a.lerp(b, t);
+                x.n = normal(x.uv);
+                piece.push(x);
+                if inside {
+                    out(piece);
+                    piece.clear();
+                }
+                inside = now;
+            }
+            current = target;
+        } else {
             crossings.clear();
             boundary_crossings(a.uv[0], b.uv[0], current.0, target.0, cu, |t, step| crossings.push((t, step, 0)));
             boundary_crossings(a.uv[1], b.uv[1], current.1, target.1, cv, |t, step| crossings.push((t, 0, step)));
@@ -506,7 +579,7 @@ fn clip(
 /// Calls `push(t, step)` for each cell boundary `k / cells` crossed between
 /// parameters `a` (cell `from`) and `b` (cell `to`), `t` the fraction along.
 fn boundary_crossings(a: f64, b: f64, from: usize, to: usize, cells: usize, mut push: impl FnMut(f64, isize)) {
-    let at = |k: usize| (((k as f64 / cells as f64) - a) / (b - a)).clamp(0.0, 1.0);
+    let at = |k: usize| boundary_at(a, b, k, cells);
     if to > from {
         for k in from + 1..=to {
             push(at(k), 1);
@@ -518,6 +591,12 @@ fn boundary_crossings(a: f64, b: f64, from: usize, to: usize, cells: usize, mut 
     }
 }
 
+/// The fraction along `[a, b]` of the cell boundary `k / cells`.
+#[inline]
+fn boundary_at(a: f64, b: f64, k: usize, cells: usize) -> f64 {
+    (((k as f64 / cells as f64) - a) / (b - a)).clamp(0.0, 1.0)
+}
+
 /// Widens `range` by the extent along `m` of quad `q`'s part in `zone`: its
 /// corners when all its cells are the zone's, else the corners of its
 /// intersection with each cell of the zone, on the bilinear quad.
@@ -526,17 +605,16 @@ fn zone_extent(
     zoning: &Zoning,
     zone: u32,
     g: &[f64],
-    q: usize,
+    (a, b): (usize, usize),
     span: &Span,
     range: (f64, f64),
 ) -> (f64, f64) {
-    if zoning.quad_label[q] == zone {
+    let (nu, nv) = (net.quads_u, net.quads_v);
+    if zoning.quad_label[a * nv + b] == zone {
         let lo = if span.lo < range.0 { span.lo } else { range.0 };
         let hi = if span.hi > range.1 { span.hi } else { range.1 };
         return (lo, hi);
     }
-    let (nu, nv) = (net.quads_u, net.quads_v);
-    let (a, b) = (q / nv, q % nv);
     let gc = [g[net.node(a, b)], g[net.node(a + 1, b)], g[net.node(a, b + 1)], g[net.node(a + 1, b + 1)]];
     let labels = &zoning.labels;
     let ((i0, i1), (j0, j1)) = (zoning.ranges_u[a], zoning.ranges_v[b]);

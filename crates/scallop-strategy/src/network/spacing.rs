@@ -104,11 +104,130 @@ impl ToolModel {
         }
         sod * factor
     }
+
+    /// Whether [`ToolModel::spacing`] at the unit normal `w / |w|` (`w` of any
+    /// length, the normal up to rounding) is certainly above `best`: a
+    /// conservative test without square root or division, false whenever in
+    /// doubt (a flat end, `best` not finite, `w` badly scaled, a point near the
+    /// horizontal-slope threshold, ...).
+    ///
+    /// With `N = |w|^2`, `W_m = w . m`, `W_f = w . f`, `H = w_x^2 + w_y^2` the
+    /// exact quantities are `F = 1 - (n . m)^2 = (N - W_m^2) / N`, `h^2 = H / N`,
+    /// `across = (W_f^2 N + W_m^2 w_z^2) / N^2`, `R_eff = r + (R - r) W_f^2
+    /// N^1.5 / (sqrt(H) A)` with `A = N^2 across`, and `spacing^2 = min(4 sh (2
+    /// R_eff - sh), cap^2) F`. The test bounds `F` and `W_f^2` from below by
+    /// `1e-12 N` (far above the rounding of either evaluation, and of their
+    /// cancellations), `A` from above, adds a relative slack of `1e-9` to `best^2`
+    /// and compares squares: `4 sh (2 R_eff - sh) F >= B` is `8 sh (R_eff - r)
+    /// (N F) >= U = B N - 4 sh (2 r - sh) (N F)`, squared on both sides.
+    #[inline]
+    pub(crate) fn exceeds(&self, w: &Vec3, f: [f64; 2], m: [f64; 2], best: f64) -> bool {
+        const SLACK: f64 = 1e-9;
+        const ABS: f64 = 1e-12;
+        // Every condition is evaluated and combined without branches (the
+        // caller branches once, on the result); values out of range give
+        // infinities or NaN, which fail the comparisons or are not selected.
+        let n2 = w.x * w.x + w.y * w.y + w.z * w.z;
+        // N scaled so that the powers below (up to N^7) stay normal numbers.
+        let valid = !self.flat & best.is_finite() & (1e-20..=1e20).contains(&n2);
+        let b = best * best * (1.0 + SLACK);
+        let wm = w.x * m[0] + w.y * m[1];
+        // N F from below; the spacing is at most cap sqrt(F) whatever the radius.
+        let f_lo = (n2 - wm * wm) - ABS * n2;
+        let cap_ok = (f_lo > 0.0) & (self.cap * self.cap * f_lo >= b * n2);
+        let s2 = scallop_analysis::tol::SIN_SLOPE_HORIZONTAL * scallop_analysis::tol::SIN_SLOPE_HORIZONTAL;
+        let hx = w.x * w.x + w.y * w.y;
+        // Clearly horizontal: the spacing is cap sqrt(F), tested above.
+        let horizontal = hx < s2 * n2 * (1.0 - SLACK);
+        let sloped = hx > s2 * n2 * (1.0 + SLACK);
+        let sh = self.scallop_height;
+        let u = b * n2 - 4.0 * sh * (2.0 * self.corner - sh) * f_lo;
+        let wf = w.x * f[0] + w.y * f[1];
+        let x_lo = (wf * wf - ABS * n2).max(0.0);
+        let a_hi = ((wf * wf + ABS * n2) * n2 + (wm * wm + ABS * n2) * (w.z * w.z)) * (1.0 + SLACK);
+        let lhs = {
+            let t = 8.0 * sh * self.flat_part * x_lo * n2 * f_lo;
+            t * t * n2
+        };
+        let rhs = u * u * hx * a_hi * a_hi * (1.0 + SLACK);
+        // `u <= 0`: even R_eff = r allows more than best.
+        let radius_ok = (u <= 0.0) | (lhs.is_finite() & rhs.is_finite() & (rhs > 0.0) & (lhs >= rhs));
+        valid & cap_ok & (self.ball | horizontal | (sloped & radius_ok))
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `exceeds` never claims a spacing above `best` that the exact evaluation
+    /// (normalise, then `spacing`) does not give, on random and on adversarial
+    /// normals (nearly along `m`, nearly across `f`, at the horizontal-slope
+    /// threshold, badly scaled) with `best` at and around the exact value; and
+    /// it does skip most points well above `best`.
+    #[test]
+    fn exceeds_is_conservative() {
+        let tools = [
+            Cutter::Toroidal { radius: 5.0, corner: 2.0 },
+            Cutter::Toroidal { radius: 6.0, corner: 0.5 },
+            Cutter::Ball { radius: 3.0 },
+            Cutter::Toroidal { radius: 4.0, corner: 0.0 },
+        ];
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut random = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let sin_h = scallop_analysis::tol::SIN_SLOPE_HORIZONTAL;
+        for tool in tools {
+            let model = ToolModel::new(&tool, 0.01).unwrap_or_else(|e| panic!("{e}"));
+            let (mut skipped, mut clear) = (0usize, 0usize);
+            for case in 0..40_000 {
+                let theta = random() * std::f64::consts::TAU;
+                let f = [theta.cos(), theta.sin()];
+                let m = [-f[1], f[0]];
+                let (slope, azimuth) = (random() * 1.55, random() * std::f64::consts::TAU);
+                let mut n = Vec3::new(slope.sin() * azimuth.cos(), slope.sin() * azimuth.sin(), slope.cos());
+                let tiny = 1e-9 * (random() - 0.5);
+                match case % 6 {
+                    // Nearly along m (F near 0).
+                    1 => n = Vec3::new(m[0] + tiny, m[1], tiny.abs() * 1e-3),
+                    // Nearly across f (f . n near 0).
+                    2 => n = Vec3::new(m[0] * n.x.abs() + f[0] * tiny, m[1] * n.x.abs() + f[1] * tiny, n.z),
+                    // At the horizontal-slope threshold.
+                    3 => {
+                        let h = sin_h * (1.0 + tiny);
+                        n = Vec3::new(h * azimuth.cos(), h * azimuth.sin(), (1.0 - h * h).sqrt());
+                    }
+                    _ => {}
+                }
+                let w = n * 10f64.powf(random() * 24.0 - 12.0);
+                let unit = w / w.norm();
+                let exact = model.spacing(&unit, f, m);
+                for best in [
+                    exact,
+                    exact * (1.0 + 1e-15),
+                    exact * (1.0 - 1e-15),
+                    exact * (1.0 - 1e-10),
+                    exact * (1.0 - 1e-6),
+                    exact * 0.5,
+                    exact * random(),
+                ] {
+                    if model.exceeds(&w, f, m, best) {
+                        assert!(exact > best, "{tool:?} case {case}: w {w:?} spacing {exact} best {best}");
+                        skipped += usize::from(best <= exact * 0.5);
+                    }
+                }
+                clear += usize::from(case % 6 == 0 || case % 6 >= 4);
+            }
+            if !matches!(tool, Cutter::Toroidal { corner, .. } if corner == 0.0) {
+                // Half the exact spacing is skipped on ordinary normals.
+                assert!(skipped * 10 >= clear * 9, "{tool:?}: {skipped} of {clear}");
+            }
+        }
+    }
 
     /// The trigonometry-free form equals `Cutter::step_over` times `|c . m|`.
     #[test]

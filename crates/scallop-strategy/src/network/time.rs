@@ -134,23 +134,33 @@ pub(crate) fn pass_length_time(points: &[Point3], cos_sharp: f64, machine: &Mach
     let mut total = 0.0;
     let mut time = 0.0;
     let mut chain = 0.0;
-    let mut previous: Option<scallop_geom::Vec3> = None;
+    // The previous segment and its length.
+    let mut previous: Option<(scallop_geom::Vec3, f64)> = None;
     for w in points.windows(2) {
         let v = w[1] - w[0];
         let l = v.norm();
         if l <= crate::tol::ZERO_LENGTH {
             continue;
         }
-        let dir = v / l;
-        if let Some(p) = previous
-            && p.dot(&dir) < cos_sharp
-        {
-            time += machine.segment_time(chain);
-            chain = 0.0;
+        if let Some((p, pl)) = previous {
+            // The turn's cosine (p / |p|) . (v / |v|) against cos_sharp, decided
+            // without the six divisions unless within far more than the
+            // rounding of either form (a few 1e-16 of |p| |v|): then the unit
+            // directions as always.
+            let (dot, scale) = (p.dot(&v), pl * l);
+            let sharp = if (dot - cos_sharp * scale).abs() > 1e-12 * scale {
+                dot < cos_sharp * scale
+            } else {
+                (p / pl).dot(&(v / l)) < cos_sharp
+            };
+            if sharp {
+                time += machine.segment_time(chain);
+                chain = 0.0;
+            }
         }
         chain += l;
         total += l;
-        previous = Some(dir);
+        previous = Some((v, l));
     }
     (total, time + machine.segment_time(chain))
 }
