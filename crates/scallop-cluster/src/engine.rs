@@ -81,8 +81,18 @@ impl Stats {
     pub(crate) fn batch(setup: &Setup, labels: &[u32], k: usize) -> Stats {
         let f = setup.features;
         let mut sums = vec![Sums::default(); k];
-        for ((&l, x), d) in labels.iter().zip(&f.x).zip(&f.doubled) {
-            sums[l as usize].add(x, d);
+        // A run of cells of one label accumulates in registers (grid neighbours
+        // share labels): the same additions in the same order as one
+        // `sums[l].add` per cell, without a store-to-load chain through memory.
+        let (mut i, n) = (0, labels.len().min(f.x.len()).min(f.doubled.len()));
+        while i < n {
+            let l = labels[i] as usize;
+            let mut acc = sums[l];
+            while i < n && labels[i] as usize == l {
+                acc.add(&f.x[i], &f.doubled[i]);
+                i += 1;
+            }
+            sums[l] = acc;
         }
         let moments = match (&f.geometry, setup.uses_moments()) {
             (Some((points, _)), true) => {
