@@ -80,20 +80,7 @@ pub(crate) struct Stats {
 impl Stats {
     pub(crate) fn batch(setup: &Setup, labels: &[u32], k: usize) -> Stats {
         let f = setup.features;
-        let mut sums = vec![Sums::default(); k];
-        // A run of cells of one label accumulates in registers (grid neighbours
-        // share labels): the same additions in the same order as one
-        // `sums[l].add` per cell, without a store-to-load chain through memory.
-        let (mut i, n) = (0, labels.len().min(f.x.len()).min(f.doubled.len()));
-        while i < n {
-            let l = labels[i] as usize;
-            let mut acc = sums[l];
-            while i < n && labels[i] as usize == l {
-                acc.add(&f.x[i], &f.doubled[i]);
-                i += 1;
-            }
-            sums[l] = acc;
-        }
+        let sums = Sums::per_label(labels, f, k);
         let moments = match (&f.geometry, setup.uses_moments()) {
             (Some((points, _)), true) => {
                 let mut m = vec![Moments::new(); k];

@@ -307,6 +307,25 @@ pub(crate) struct Sums {
 }
 
 impl Sums {
+    /// The sums of every label `0..k` over the points (`labels[i]` of point `i`).
+    /// A run of points of one label accumulates in registers (grid neighbours
+    /// share labels): the same additions in the same order as one `add` per
+    /// point into `sums[label]`, without a store-to-load chain through memory.
+    pub(crate) fn per_label(labels: &[u32], f: &Features, k: usize) -> Vec<Sums> {
+        let mut sums = vec![Sums::default(); k];
+        let (mut i, n) = (0, labels.len().min(f.x.len()).min(f.doubled.len()));
+        while i < n {
+            let l = labels[i] as usize;
+            let mut acc = sums[l];
+            while i < n && labels[i] as usize == l {
+                acc.add(&f.x[i], &f.doubled[i]);
+                i += 1;
+            }
+            sums[l] = acc;
+        }
+        sums
+    }
+
     #[inline]
     pub(crate) fn add(&mut self, x: &[f64; 4], d: &[f64; 2]) {
         self.n += 1;

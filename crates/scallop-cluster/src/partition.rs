@@ -351,10 +351,7 @@ pub fn partition(features: &Features, params: &ClusterParams) -> Result<Partitio
     let (zone_of_cell, count) = connected_components(features.grid(), &cluster_of_cell)?;
     let zones = zone_records(features, &zone_of_cell, &cluster_of_cell, count, params.theta);
     let zone_cluster = zones.iter().map(|z| z.cluster).collect();
-    let mut sums = vec![Sums::default(); clustering.clusters];
-    for (i, &label) in clustering.labels.iter().enumerate() {
-        sums[label as usize].add(&features.x[i], &features.doubled[i]);
-    }
+    let sums = Sums::per_label(&clustering.labels, features, clustering.clusters);
     let cluster_means = sums
         .iter()
         .map(|s| {
