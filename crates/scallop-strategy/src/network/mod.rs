@@ -59,7 +59,12 @@
 //!   components without trigonometry) and `n_i` the **exact** normal at the
 //!   vertex's `(u, v)`: on a network edge one parameter is fixed, so the patch
 //!   restricted to that isoline is tabulated once per network row and column and
-//!   a crossing costs one degree-`p` Bernstein evaluation (`normals.rs`).
+//!   a crossing costs one degree-`p` Bernstein evaluation (`normals.rs`). The
+//!   vertices carry `S_u x S_v` unnormalised; a conservative test without square
+//!   root or division (`spacing.rs`, `ToolModel::exceeds`) rules out the
+//!   vertices whose spacing is certainly above the plane's minimum so far, and
+//!   only the others are normalised and evaluated exactly: the minimum and the
+//!   vertex that sets it are those of the eager evaluation, bit for bit.
 //! - **Look-ahead** \[DECISION\]: the next plane at `d + Delta` is accepted only if its
 //!   own spacing is at least `Delta`; otherwise it moves to `d + Delta'` and is
 //!   checked again. Every vertex of both planes of a gap then sees the gap within
