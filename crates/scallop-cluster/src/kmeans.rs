@@ -40,8 +40,15 @@
 //! groups of 16 cells whose bounds all hold (cells near cluster borders spoil
 //! almost every group), sleeping cells in per-cluster heaps keyed by the drift
 //! their bounds can absorb (most cells skip by the half-gap test, whose margin
-//! does not accumulate), a branch-free first pass listing the failing cells, an
-//! out-of-line slow path, and centres in padded SIMD blocks.
+//! does not accumulate), an out-of-line slow path, and centres in padded SIMD
+//! blocks. (A branch-free first pass was on that list too, judged by
+//! instruction counts; by wall time it is the three passes above.) Tried and
+//! dropped by wall time: sleeping cells woken by the accumulated largest shift
+//! (half the cells of a Rubio K = 10 run have margins below two sweeps' drift,
+//! so the full passes that re-sort them cost more than they save); a second
+//! lower bound for the cell's second-nearest centre (22 % fewer scans, but the
+//! first pass's extra gather costs more); the initial assignment against every
+//! centre without the chained scan (no faster).
 
 use std::f64::consts::{FRAC_PI_2, PI};
 
