@@ -14,8 +14,8 @@ use scallop_geom::nalgebra::Matrix3;
 use scallop_geom::{Point3, Vec3};
 use scallop_strategy::StrategyError;
 use scallop_strategy::network::{
-    CellLabels, Margins, Network, Orientation, Transitions, ZoneParams, ZonePlan, Zoning, plan_zone, plan_zones,
-    surface_time,
+    CellLabels, Margins, Network, Orientation, Transitions, ZoneParams, ZonePlan, ZoneWorkspace, Zoning,
+    plan_zone_with, plan_zones, surface_time,
 };
 use scallop_surface::Patch;
 
@@ -255,27 +255,40 @@ impl SurfaceModel {
             }
         }
         let mut plans = Vec::with_capacity(zp.partition.zones.len());
-        // One oriented network per distinct orientation (3+2: per cluster).
+        // One oriented network per distinct orientation (3+2: per cluster), with
+        // only the nodes of that orientation's zones rotated; one workspace.
         let mut cache: Vec<(usize, Network)> = Vec::new();
+        let mut workspace = ZoneWorkspace::default();
         for (z, zone) in zp.partition.zones.iter().enumerate() {
             let c = zone.cluster as usize;
             let params = self.params(zp.fidelity, design.theta[c]);
             #[allow(clippy::cast_possible_truncation)]
             let label = z as u32;
             let result = match oriented.orientations[z] {
-                None => plan_zone(network, Some(zoning), label, &params),
+                None => plan_zone_with(network, Some(zoning), label, &params, &mut workspace),
                 Some(o) => {
                     // 3+2: one orientation per cluster (times do not depend on the
                     // rotation centre, 4.5); heuristic: one per zone.
-                    let tag = if formulation == Formulation::ThreePlusTwo { c } else { z };
+                    let three_plus_two = formulation == Formulation::ThreePlusTwo;
+                    let tag = if three_plus_two { c } else { z };
                     let i = match cache.iter().position(|(t, _)| *t == tag) {
                         Some(i) => i,
                         None => {
-                            cache.push((tag, network.oriented(&o)));
+                            #[allow(clippy::cast_possible_truncation)]
+                            let zones: Vec<u32> = if three_plus_two {
+                                let of_cluster = zp.partition.zones.iter().enumerate();
+                                of_cluster
+                                    .filter(|(_, other)| other.cluster == zone.cluster)
+                                    .map(|(y, _)| y as u32)
+                                    .collect()
+                            } else {
+                                vec![label]
+                            };
+                            cache.push((tag, network.oriented_for(&o, zoning, &zones)));
                             cache.len() - 1
                         }
                     };
-                    plan_zone(&cache[i].1, Some(zoning), label, &params)
+                    plan_zone_with(&cache[i].1, Some(zoning), label, &params, &mut workspace)
                 }
             };
             match result {

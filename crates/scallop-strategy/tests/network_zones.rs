@@ -158,3 +158,37 @@ fn bad_inputs_are_errors_naming_the_fix() {
     ));
     assert!(matches!(Network::new(&inclined_plane(20.0, 10.0, 0.3), 0.0), Err(StrategyError::BadParameter { .. })));
 }
+
+/// `oriented_for` rotates the nodes of the given zones exactly as `oriented`
+/// does, leaves the others NaN, and a zone plans the same on both, with one
+/// reused workspace or a fresh one.
+#[test]
+fn a_zone_plans_the_same_on_a_partly_oriented_network() {
+    use scallop_strategy::network::{Orientation, ZoneWorkspace, plan_zone_with};
+    let set = scallop_surface::builtin("rubio").unwrap();
+    let network = Network::new(&set.patches()[0], 1.0).unwrap();
+    let zoning = Zoning::new(&network, &u_shape(40)).unwrap();
+    let o = Orientation::new(0.4, 2.1, scallop_geom::Point3::new(3.0, -2.0, 1.0));
+    let full = network.oriented(&o);
+    let part = network.oriented_for(&o, &zoning, &[1]);
+    let (rotated, untouched) = full.points().iter().zip(part.points()).fold((0, 0), |(r, u), (a, b)| {
+        if b.x.is_nan() {
+            (r, u + 1)
+        } else {
+            assert_eq!(a.coords.map(f64::to_bits), b.coords.map(f64::to_bits));
+            (r + 1, u)
+        }
+    });
+    assert!(rotated > 0 && untouched > 0, "{rotated} rotated, {untouched} left");
+    assert!(!part.is_accessible());
+    let mut workspace = ZoneWorkspace::default();
+    for cutter in [TORUS, BALL] {
+        let p = params(0.7, cutter, 0.01);
+        let on_full = plan_zone(&full, Some(&zoning), 1, &p).unwrap();
+        let on_part = plan_zone_with(&part, Some(&zoning), 1, &p, &mut workspace).unwrap();
+        assert_eq!(on_full, on_part);
+        // The workspace also serves another zone on another network.
+        let other = plan_zone_with(&network, Some(&zoning), 0, &p, &mut workspace).unwrap();
+        assert_eq!(other, plan_zone(&network, Some(&zoning), 0, &p).unwrap());
+    }
+}

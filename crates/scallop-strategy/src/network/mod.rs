@@ -112,7 +112,7 @@ use crate::{StrategyError, tol};
 
 pub use time::{SurfaceTime, TransitionModel, Transitions, surface_time};
 pub use toolpath::{NetworkToolpath, network_toolpath};
-pub use zone::{plan_zone, plan_zones, plane_passes};
+pub use zone::{ZoneWorkspace, plan_zone, plan_zone_with, plan_zones, plane_passes};
 
 /// The isoparametric machining network of a patch (finishing.md 6.3): `(N_u + 1)
 /// x (N_v + 1)` nodes `Q_ab = S(a / N_u, b / N_v)` with exact unit normals,
@@ -254,6 +254,43 @@ impl Network {
             quads_v: self.quads_v,
             points: self.points.iter().map(|p| orientation.to_machine(&back(p))).collect(),
             normals: self.normals.iter().map(|n| orientation.matrix * back_n(n)).collect(),
+            orientation: Some(*orientation),
+            patch: self.patch.clone(),
+            edge_normals: self.edge_normals.clone(),
+            normal_sign: self.normal_sign,
+        }
+    }
+
+    /// [`Network::oriented`] for planning `zones` of `zoning` only: the points and
+    /// normals of the nodes of those zones' quads are rotated (the same
+    /// operations as `oriented`, so the same bits), every other node is NaN. A
+    /// 3+2 evaluation orients one network per cluster; rotating only the
+    /// cluster's nodes makes that one network's worth of work in all, not K.
+    /// Plan only the given zones on the result ([`plan_zone`] reads no node
+    /// outside its zone's quads); [`Network::is_accessible`] is false on it.
+    #[must_use]
+    pub fn oriented_for(&self, orientation: &Orientation, zoning: &Zoning, zones: &[u32]) -> Network {
+        let back = |p: &Point3| self.orientation.as_ref().map_or(*p, |o| o.to_part(p));
+        let back_n = |n: &Vec3| self.orientation.as_ref().map_or(*n, |o| o.matrix.transpose() * n);
+        let nan = f64::NAN;
+        let mut points = vec![Point3::new(nan, nan, nan); self.points.len()];
+        let mut normals = vec![Vec3::new(nan, nan, nan); self.normals.len()];
+        for zone in zones {
+            let Ok(k) = zoning.zones.binary_search(zone) else { continue };
+            for &[a, b] in &zoning.quads[k] {
+                let (a, b) = (a as usize, b as usize);
+                for (i, j) in [(a, b), (a + 1, b), (a, b + 1), (a + 1, b + 1)] {
+                    let n = self.node(i, j);
+                    points[n] = orientation.to_machine(&back(&self.points[n]));
+                    normals[n] = orientation.matrix * back_n(&self.normals[n]);
+                }
+            }
+        }
+        Network {
+            quads_u: self.quads_u,
+            quads_v: self.quads_v,
+            points,
+            normals,
             orientation: Some(*orientation),
             patch: self.patch.clone(),
             edge_normals: self.edge_normals.clone(),

@@ -30,6 +30,26 @@ pub fn plan_zone(
     plan_in(network, zoning, zone, params, &mut ws)
 }
 
+/// Buffers of [`plan_zone_with`], reused from one zone to the next (their
+/// sizes follow the network: one value per node, one mark per edge).
+#[derive(Debug, Default)]
+pub struct ZoneWorkspace(Workspace);
+
+/// [`plan_zone`] with reused buffers: the same plan, without allocating and
+/// clearing per-node and per-edge buffers for every zone.
+///
+/// # Errors
+/// As [`plan_zone`].
+pub fn plan_zone_with(
+    network: &Network,
+    zoning: Option<&Zoning>,
+    zone: u32,
+    params: &ZoneParams,
+    workspace: &mut ZoneWorkspace,
+) -> Result<ZonePlan, StrategyError> {
+    plan_in(network, zoning, zone, params, &mut workspace.0)
+}
+
 /// PLANE_PASSES and NEXT_SPACING (finishing.md 6.3, 6.4) of one plane `m . P =
 /// offset` (`m = (-sin t, cos t, 0)`, `t = params.direction`): the passes of
 /// `zone` (the whole surface without a zoning), oriented along the feed and
