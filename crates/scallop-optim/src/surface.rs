@@ -254,47 +254,50 @@ impl SurfaceModel {
                 return Ok((plans, oriented.violation));
             }
         }
-        let mut plans = Vec::with_capacity(zp.partition.zones.len());
-        // One oriented network per distinct orientation (3+2: per cluster), with
-        // only the nodes of that orientation's zones rotated; one workspace.
-        let mut cache: Vec<(usize, Network)> = Vec::new();
+        let zones = &zp.partition.zones;
         let mut workspace = ZoneWorkspace::default();
-        for (z, zone) in zp.partition.zones.iter().enumerate() {
-            let c = zone.cluster as usize;
-            let params = self.params(zp.fidelity, design.theta[c]);
+        // Per zone, in zone order: its plan, or `None` for a zone without passes.
+        let mut results: Vec<Option<Result<ZonePlan, StrategyError>>> = (0..zones.len()).map(|_| None).collect();
+        // Zones planned by orientation group (3+2: a cluster; heuristic: one
+        // zone; 3-axis: one zone, unoriented): one network buffer, rotated for
+        // the group's zones only (`orient_into`), one workspace. The results are
+        // then read in zone order, as the plans were made before.
+        let mut buffer: Option<Network> = None;
+        let mut done = vec![false; zones.len()];
+        for z in 0..zones.len() {
+            if done[z] {
+                continue;
+            }
             #[allow(clippy::cast_possible_truncation)]
-            let label = z as u32;
-            let result = match oriented.orientations[z] {
-                None => plan_zone_with(network, Some(zoning), label, &params, &mut workspace),
+            let group: Vec<u32> = if formulation == Formulation::ThreePlusTwo && oriented.orientations[z].is_some() {
+                let c = zones[z].cluster;
+                (z..zones.len()).filter(|&y| zones[y].cluster == c).map(|y| y as u32).collect()
+            } else {
+                vec![z as u32]
+            };
+            let net = match oriented.orientations[z] {
+                None => network,
                 Some(o) => {
-                    // 3+2: one orientation per cluster (times do not depend on the
-                    // rotation centre, 4.5); heuristic: one per zone.
-                    let three_plus_two = formulation == Formulation::ThreePlusTwo;
-                    let tag = if three_plus_two { c } else { z };
-                    let i = match cache.iter().position(|(t, _)| *t == tag) {
-                        Some(i) => i,
-                        None => {
-                            #[allow(clippy::cast_possible_truncation)]
-                            let zones: Vec<u32> = if three_plus_two {
-                                let of_cluster = zp.partition.zones.iter().enumerate();
-                                of_cluster
-                                    .filter(|(_, other)| other.cluster == zone.cluster)
-                                    .map(|(y, _)| y as u32)
-                                    .collect()
-                            } else {
-                                vec![label]
-                            };
-                            cache.push((tag, network.oriented_for(&o, zoning, &zones)));
-                            cache.len() - 1
-                        }
-                    };
-                    plan_zone_with(&cache[i].1, Some(zoning), label, &params, &mut workspace)
+                    let out = buffer.get_or_insert_with(|| network.clone());
+                    network.orient_into(&o, zoning, &group, out);
+                    &*out
                 }
             };
+            for &y in &group {
+                let y = y as usize;
+                done[y] = true;
+                let params = self.params(zp.fidelity, design.theta[zones[y].cluster as usize]);
+                #[allow(clippy::cast_possible_truncation)]
+                let result = plan_zone_with(net, Some(zoning), y as u32, &params, &mut workspace);
+                results[y] = Some(result);
+            }
+        }
+        let mut plans = Vec::with_capacity(zones.len());
+        for (z, result) in results.into_iter().enumerate() {
             match result {
-                Ok(plan) => plans.push(plan),
-                Err(StrategyError::EmptyZone { .. }) => {}
-                Err(e) => return Err(OptimError::Model(format!("planning zone {z}: {e}"))),
+                Some(Ok(plan)) => plans.push(plan),
+                Some(Err(StrategyError::EmptyZone { .. })) | None => {}
+                Some(Err(e)) => return Err(OptimError::Model(format!("planning zone {z}: {e}"))),
             }
         }
         Ok((plans, oriented.violation))

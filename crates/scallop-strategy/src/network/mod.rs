@@ -270,32 +270,44 @@ impl Network {
     /// outside its zone's quads); [`Network::is_accessible`] is false on it.
     #[must_use]
     pub fn oriented_for(&self, orientation: &Orientation, zoning: &Zoning, zones: &[u32]) -> Network {
+        let nan = f64::NAN;
+        let mut out = Network {
+            points: vec![Point3::new(nan, nan, nan); self.points.len()],
+            normals: vec![Vec3::new(nan, nan, nan); self.normals.len()],
+            ..self.clone()
+        };
+        self.orient_into(orientation, zoning, zones, &mut out);
+        out
+    }
+
+    /// [`Network::oriented_for`] into `out`, a clone of this network or the
+    /// result of an earlier call (a network of another surface or resolution is
+    /// first replaced by a clone): the nodes of `zones` are rotated, the others
+    /// keep what they held. One buffer serves the clusters of an evaluation one
+    /// after another, without allocating per cluster.
+    pub fn orient_into(&self, orientation: &Orientation, zoning: &Zoning, zones: &[u32], out: &mut Network) {
+        let same = (out.quads_u, out.quads_v) == (self.quads_u, self.quads_v)
+            && out.points.len() == self.points.len()
+            && out.normals.len() == self.normals.len()
+            && out.normal_sign.to_bits() == self.normal_sign.to_bits()
+            && out.patch == self.patch; // the edge normals follow from patch and resolution
+        if !same {
+            *out = self.clone();
+        }
         let back = |p: &Point3| self.orientation.as_ref().map_or(*p, |o| o.to_part(p));
         let back_n = |n: &Vec3| self.orientation.as_ref().map_or(*n, |o| o.matrix.transpose() * n);
-        let nan = f64::NAN;
-        let mut points = vec![Point3::new(nan, nan, nan); self.points.len()];
-        let mut normals = vec![Vec3::new(nan, nan, nan); self.normals.len()];
         for zone in zones {
             let Ok(k) = zoning.zones.binary_search(zone) else { continue };
             for &[a, b] in &zoning.quads[k] {
                 let (a, b) = (a as usize, b as usize);
                 for (i, j) in [(a, b), (a + 1, b), (a, b + 1), (a + 1, b + 1)] {
                     let n = self.node(i, j);
-                    points[n] = orientation.to_machine(&back(&self.points[n]));
-                    normals[n] = orientation.matrix * back_n(&self.normals[n]);
+                    out.points[n] = orientation.to_machine(&back(&self.points[n]));
+                    out.normals[n] = orientation.matrix * back_n(&self.normals[n]);
                 }
             }
         }
-        Network {
-            quads_u: self.quads_u,
-            quads_v: self.quads_v,
-            points,
-            normals,
-            orientation: Some(*orientation),
-            patch: self.patch.clone(),
-            edge_normals: self.edge_normals.clone(),
-            normal_sign: self.normal_sign,
-        }
+        out.orientation = Some(*orientation);
     }
 
     /// Whether every node normal satisfies `n . Z >= 0` in this frame (the 3+2
