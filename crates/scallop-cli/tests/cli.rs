@@ -309,6 +309,12 @@ fn optimize_writes_the_study_and_rejects_bad_settings() {
     for r in results {
         assert!(r["f_best"].as_f64().expect("f_best") <= r["f0"].as_f64().expect("f0"));
         assert!(r["evaluations"].as_u64().expect("evaluations") <= 8);
+        // Every black-box evaluation timed: count, and ordered statistics.
+        let t = &r["black_box_times"];
+        assert_eq!(t["count"].as_u64(), r["evaluations"].as_u64(), "{t}");
+        let ms = |k: &str| t[k].as_f64().expect("milliseconds");
+        assert!(ms("mean_ms") > 0.0 && ms("median_ms") <= ms("p95_ms") && ms("p95_ms") <= ms("max_ms"), "{t}");
+        assert!(ms("mean_ms") <= ms("max_ms"), "{t}");
     }
     for file in ["study.json", "report.json", "convergence.svg", "zones.svg", "report.html", "toolpath.csv"] {
         assert!(dir.join("out").join(file).exists(), "{file}");
