@@ -256,7 +256,8 @@ impl SurfaceModel {
         }
         let zones = &zp.partition.zones;
         let mut workspace = ZoneWorkspace::default();
-        // Per zone, in zone order: its plan, or `None` for a zone without passes.
+        // Per zone, in zone order: the result of planning it (each zone is planned
+        // once, in the group of its first zone; `None` only until then).
         let mut results: Vec<Option<Result<ZonePlan, StrategyError>>> = (0..zones.len()).map(|_| None).collect();
         // Zones planned by orientation group (3+2: a cluster; heuristic: one
         // zone; 3-axis: one zone, unoriented): one network buffer, rotated for
