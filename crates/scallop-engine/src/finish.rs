@@ -278,19 +278,7 @@ pub fn run_finishing(job: &FinishJob) -> Result<FinishOutput, EngineError> {
     } else {
         analysis.slope_direction_deg
     });
-    let params = FinishingParams {
-        direction: direction_deg.to_radians(),
-        pattern: job.pattern,
-        scallop_height: job.scallop_height,
-        boundary: Boundary::ContactInside,
-        max_step: job.max_step,
-        clearance: job.clearance,
-        machine,
-        plunge_feed: machine.feed / 4.0,
-        rapid_rate: job.rapid_rate,
-        sharp_corner: SHARP_CORNER_DEG.to_radians(),
-        blend_tolerance: job.tolerances.path,
-    };
+    let params = finishing_params(job, direction_deg.to_radians());
     let mut planned = match job.strategy {
         Strategy::ParallelPlanes => {
             let p = plan_finishing(&prepared.index, &job.cutter, &params, &tolerances)?;
@@ -441,6 +429,26 @@ pub fn run_finishing(job: &FinishJob) -> Result<FinishOutput, EngineError> {
 }
 
 /// A 3-axis program of `fitted` in the job's dialect with `comments` in its header.
+/// The planner's settings of a finishing job along `direction` (rad from +X):
+/// the job's pattern, scallop height, steps and tolerances, its machine
+/// (plunges at a quarter of the feed), boundary contacts inside the part.
+pub(crate) fn finishing_params(job: &FinishJob, direction: f64) -> FinishingParams {
+    let machine = MachineLimits::from_thesis_units(job.machine[0], job.machine[1], job.machine[2]);
+    FinishingParams {
+        direction,
+        pattern: job.pattern,
+        scallop_height: job.scallop_height,
+        boundary: Boundary::ContactInside,
+        max_step: job.max_step,
+        clearance: job.clearance,
+        machine,
+        plunge_feed: machine.feed / 4.0,
+        rapid_rate: job.rapid_rate,
+        sharp_corner: SHARP_CORNER_DEG.to_radians(),
+        blend_tolerance: job.tolerances.path,
+    }
+}
+
 pub(crate) fn three_axis_program(
     job: &FinishJob,
     fitted: &FittedPath,

@@ -45,13 +45,13 @@ use scallop_mesh::{MeshIndex, TriMesh};
 use scallop_post::{OutputMode, PostParams, program_text};
 use scallop_strategy::network::{CellLabels, Orientation, Transitions};
 use scallop_strategy::{
-    Boundary, FinishingParams, StrategyError, ZoneRegion, lookahead_time, plan_zone_finishing, stop_to_stop_time,
+    FinishingParams, StrategyError, ZoneRegion, lookahead_time, plan_zone_finishing, stop_to_stop_time,
 };
 use scallop_surface::{Direction, Patch};
 use scallop_toolpath::{FittedPath, MoveKind, Toolpath, fit_arcs};
 use serde::Serialize;
 
-use crate::finish::{SHARP_CORNER_DEG, cutter_text};
+use crate::finish::{cutter_text, finishing_params};
 use crate::{ARC_SHARE, EngineError, FinishJob, Part, PreparedPart, Strategy};
 
 /// The margin of every zone starts at the first of these shares of the cutter
@@ -273,20 +273,8 @@ fn finish_zones_with(job: &FinishJob, spec: &ZonePlanSpec, share: f64) -> Result
     };
     let (prepared, uv) = labelled_mesh(patch, &tolerances)?;
     let labels: Vec<u32> = uv.iter().map(|&[u, v]| spec.labels.label_at(u, v)).collect();
-    let machine = MachineLimits::from_thesis_units(job.machine[0], job.machine[1], job.machine[2]);
-    let base = FinishingParams {
-        direction: 0.0,
-        pattern: job.pattern,
-        scallop_height: job.scallop_height,
-        boundary: Boundary::ContactInside,
-        max_step: job.max_step,
-        clearance: job.clearance,
-        machine,
-        plunge_feed: machine.feed / 4.0,
-        rapid_rate: job.rapid_rate,
-        sharp_corner: SHARP_CORNER_DEG.to_radians(),
-        blend_tolerance: job.tolerances.path,
-    };
+    let base = finishing_params(job, 0.0);
+    let machine = base.machine;
     let start_margin = share * job.cutter.radius();
     let cap = 2.0 * job.cutter.radius();
 
