@@ -223,7 +223,7 @@ pub fn run(args: &OptimizeArgs) -> CliResult<()> {
     write_atomic(&out.join("study.json"), |w| w.write_all(to_json(&file)?.as_bytes()))?;
     write_atomic(&out.join("report.json"), |w| w.write_all(to_json(&report)?.as_bytes()))?;
     write_atomic(&out.join("program.nc"), |w| w.write_all(program.gcode.as_bytes()))?;
-    write_atomic(&out.join("toolpath.csv"), |w| w.write_all(program.toolpath_csv().as_bytes()))?;
+    write_atomic(&out.join("toolpath.csv"), |w| w.write_all(scallop_io::cl::write_cl(&program.toolpath).as_bytes()))?;
     write_atomic(&out.join("convergence.svg"), |w| w.write_all(convergence_svg(&study).as_bytes()))?;
     let title = format!("{part_name}, {}, K = {}", formulation_name(settings.formulation), best.k);
     write_atomic(&out.join("zones.svg"), |w| w.write_all(zones_svg(&best.plan, &title).as_bytes()))?;

@@ -114,7 +114,7 @@ pub fn write_finishing(
     write_atomic(&nc, |w| w.write_all(out.gcode.as_bytes()))?;
     let text = serde_json::to_string_pretty(&report).map_err(|e| Failure::Io(e.into()))?;
     write_atomic(&folder.join("report.json"), |w| w.write_all(text.as_bytes()))?;
-    let csv = scallop_engine::toolpath_csv(&out.toolpath);
+    let csv = scallop_io::cl::write_cl(&out.toolpath);
     write_atomic(&folder.join("toolpath.csv"), |w| w.write_all(csv.as_bytes()))?;
     let data = scallop_report::ReportData::from_finishing(job, out, seconds, command);
     write_atomic(&folder.join("report.html"), |w| w.write_all(scallop_report::html::report_html(&data).as_bytes()))?;

@@ -6,12 +6,11 @@
 use std::path::{Path, PathBuf};
 
 use clap::{Args, ValueEnum};
-use scallop_io::cl::{ClRow, read_cl_csv};
-use scallop_machine::program::{ClRecord, Motion, ProgramOptions, to_program};
+use scallop_io::cl::read_cl;
+use scallop_machine::program::{Motion, ProgramOptions, records_of, to_program};
 use scallop_machine::time::{path_time, rapid_time};
-use scallop_machine::{Joints, Kinematics, Machine, Pose};
+use scallop_machine::{Joints, Kinematics, Machine};
 use scallop_post::{Dialect, OutputMode, PostParams, check_replay, program_text, replay};
-use scallop_toolpath::MoveKind;
 use serde::Serialize;
 
 use crate::output::{print_json, print_text, write_atomic};
@@ -132,21 +131,6 @@ fn load_dialect(name: &str) -> CliResult<Dialect> {
     }
 }
 
-/// CL rows into CL records: rapids and retracts are rapids, the rest keep their kind.
-fn records(rows: &[ClRow], feed: f64) -> Vec<ClRecord> {
-    rows.iter()
-        .map(|r| {
-            let motion = match r.kind {
-                MoveKind::Rapid | MoveKind::Retract => Motion::Rapid,
-                MoveKind::Plunge => Motion::Plunge,
-                MoveKind::Link => Motion::Link,
-                _ => Motion::Feed,
-            };
-            ClRecord { pose: Pose::new(r.tip, r.axis), motion, feed: r.feed.unwrap_or(feed) }
-        })
-        .collect()
-}
-
 /// `scallop post`.
 pub fn run(args: &PostArgs) -> CliResult<()> {
     for (flag, v) in [("--feed", args.feed), ("--tolerance", args.tolerance), ("--spindle", args.spindle)] {
@@ -160,8 +144,8 @@ pub fn run(args: &PostArgs) -> CliResult<()> {
     let machine = load_machine(&args.machine)?;
     let dialect = load_dialect(&args.dialect)?;
     let text = read_text(&args.cl_file)?;
-    let rows = read_cl_csv(&text).map_err(|e| Failure::rejected(format!("{}: {e}", args.cl_file.display())))?;
-    let records = records(&rows, args.feed);
+    let path = read_cl(&text, args.feed).map_err(|e| Failure::rejected(format!("{}: {e}", args.cl_file.display())))?;
+    let records = records_of(&path);
     let kin = Kinematics::new(&machine, args.tool_length);
     let options = ProgramOptions { tol_pos: args.tolerance, ..ProgramOptions::default() };
     let program = to_program(&kin, &records, None, &options)

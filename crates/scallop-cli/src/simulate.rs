@@ -7,12 +7,12 @@ use std::path::PathBuf;
 use clap::{Args, ValueEnum};
 use scallop_engine::prepare_part;
 use scallop_geom::{Aabb3, Point3, Tolerances, Vec3};
-use scallop_io::cl::read_cl_csv;
+use scallop_io::cl::read_cl;
 use scallop_io::gcode::{GcodeOptions, read_gcode_arcs};
 use scallop_sim::{
     DexelOptions, DexelPart, DexelStock, PartField, ToolMove, VerifyOptions, ZMap, verify_dexel, verify_in,
 };
-use scallop_toolpath::{Move, Toolpath};
+use scallop_toolpath::Toolpath;
 use serde::Serialize;
 
 use crate::drop::CutterArgs;
@@ -137,14 +137,14 @@ fn read_program(args: &SimulateArgs) -> CliResult<Program> {
         let moves = ToolMove::from_toolpath(&path);
         return Ok(Program { name, moves, path });
     }
-    let rows = read_cl_csv(text).map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
-    let mut path = Toolpath::new(rows.iter().find_map(|r| r.feed).unwrap_or(1000.0));
-    for r in &rows {
-        path.push(Move::new(r.kind, r.tip));
-    }
-    let moves = rows.iter().map(|r| ToolMove::new(r.kind, r.tip, r.axis)).collect();
+    let path = read_cl(text, DEFAULT_CL_FEED).map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
+    let moves = ToolMove::from_toolpath(&path);
     Ok(Program { name, moves, path })
 }
+
+/// Cutting feed of CL rows without a feed of their own (mm/min); the
+/// simulation's verdict does not depend on feeds.
+const DEFAULT_CL_FEED: f64 = 1000.0;
 
 fn parse_stock(text: &str) -> CliResult<Aabb3> {
     let v: Vec<f64> =

@@ -682,23 +682,6 @@ const RAPID_RATE: f64 = 500.0;
 /// Direction change above which the stop-to-stop model stops (degrees).
 pub(crate) const SHARP_CORNER_DEG: f64 = 30.0;
 
-/// The toolpath as CSV: `kind,x,y,z` per move.
-#[must_use]
-pub fn toolpath_csv(path: &Toolpath) -> String {
-    let mut out = String::from("kind,x,y,z\n");
-    for m in path.moves() {
-        let kind = match m.kind {
-            MoveKind::Rapid => "rapid",
-            MoveKind::Plunge => "plunge",
-            MoveKind::Feed => "feed",
-            MoveKind::Link => "link",
-            MoveKind::Retract => "retract",
-        };
-        out.push_str(&format!("{kind},{},{},{}\n", m.to.x, m.to.y, m.to.z));
-    }
-    out
-}
-
 #[cfg(test)]
 #[allow(clippy::unwrap_used, reason = "tests: a panic is the failure report")]
 mod tests {

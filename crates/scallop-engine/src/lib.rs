@@ -29,7 +29,6 @@ use scallop_surface::SurfaceSet;
 pub use demo::{DemoOutput, DemoSettings, DemoSummary, run_demo};
 pub use finish::{
     ARC_SHARE, FinishDetails, FinishJob, FinishOutput, FinishReport, OutputOptions, Setup, Strategy, run_finishing,
-    toolpath_csv,
 };
 pub use grid::{GridAxis, GridError, MAX_GRID_POINTS};
 pub use zones::{

@@ -207,8 +207,6 @@ pub struct ZoneFinishOutput {
     pub toolpath: Toolpath,
     /// Zone label of each move of `toolpath`.
     pub zone_of_move: Vec<u32>,
-    /// Tool axis of each move of `toolpath` (part frame; +Z in 3-axis work).
-    pub axes: Vec<Vec3>,
     /// The G-code text.
     pub gcode: String,
     /// The figures.
@@ -288,7 +286,6 @@ fn finish_zones_with(job: &FinishJob, spec: &ZonePlanSpec, share: f64) -> Result
     let mut toolpath = Toolpath::new(machine.feed * 60.0);
     toolpath.plunge_feed = base.plunge_feed * 60.0;
     let mut zone_of_move = Vec::new();
-    let mut axes = Vec::new();
     let mut records = Vec::new();
     let mut zone_sims: Vec<(f64, f64, f64)> = Vec::new(); // (scallop, min deviation, bound) per tilted zone
     let mut figures = Vec::with_capacity(spec.zones.len());
@@ -396,9 +393,8 @@ fn finish_zones_with(job: &FinishJob, spec: &ZonePlanSpec, share: f64) -> Result
             ends.push((a, b));
         }
         for m in zone_path.moves() {
-            toolpath.push(*m);
+            toolpath.push_with_axis(*m, axis);
             zone_of_move.push(zone.label);
-            axes.push(axis);
         }
         figures.push(figure);
     }
@@ -507,31 +503,7 @@ fn finish_zones_with(job: &FinishJob, spec: &ZonePlanSpec, share: f64) -> Result
         sim_min_deviation_mm: min_deviation,
         sim_gouge_tolerance_mm: gouge_tolerance,
     };
-    Ok(ZoneFinishOutput { toolpath, zone_of_move, axes, gcode: text, report, prepared, simulation: sim })
-}
-
-impl ZoneFinishOutput {
-    /// The toolpath as cutter-location CSV: `kind,x,y,z` per move, and for 3+2
-    /// programs `kind,x,y,z,i,j,k` with each move's tool axis (part frame), the
-    /// format `scallop post` reads.
-    #[must_use]
-    pub fn toolpath_csv(&self) -> String {
-        if !self.report.indexed {
-            return crate::toolpath_csv(&self.toolpath);
-        }
-        let mut out = String::from("kind,x,y,z,i,j,k\n");
-        for (m, a) in self.toolpath.moves().iter().zip(&self.axes) {
-            let kind = match m.kind {
-                MoveKind::Rapid => "rapid",
-                MoveKind::Plunge => "plunge",
-                MoveKind::Feed => "feed",
-                MoveKind::Link => "link",
-                MoveKind::Retract => "retract",
-            };
-            out.push_str(&format!("{kind},{},{},{},{},{},{}\n", m.to.x, m.to.y, m.to.z, a.x, a.y, a.z));
-        }
-        out
-    }
+    Ok(ZoneFinishOutput { toolpath, zone_of_move, gcode: text, report, prepared, simulation: sim })
 }
 
 fn directions(figures: &[ZoneFigures]) -> String {

@@ -246,7 +246,7 @@ fn a_tilted_zone_is_an_indexed_setup_proven_in_its_own_frame() {
         for m in &moves[start..end] {
             piece.push(*m);
         }
-        records.extend(scallop_machine::program::records_from_toolpath(&piece, &out.axes[start]));
+        records.extend(scallop_machine::program::records_from_toolpath(&piece, &out.toolpath.axis(start)));
         start = end;
     }
     let blocks = scallop_post::replay(&out.gcode, &job.output.dialect, &kin).unwrap();

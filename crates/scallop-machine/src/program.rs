@@ -77,6 +77,40 @@ pub fn records_from_toolpath(path: &scallop_toolpath::Toolpath, axis: &scallop_g
         .collect()
 }
 
+/// CL records of a toolpath with its own tool axes ([`Toolpath::axis`]) and feeds
+/// ([`Toolpath::feed_of`]): rapids and retracts become [`Motion::Rapid`], plunges
+/// [`Motion::Plunge`], feeds and links keep their kind.
+///
+/// [`Toolpath::axis`]: scallop_toolpath::Toolpath::axis
+/// [`Toolpath::feed_of`]: scallop_toolpath::Toolpath::feed_of
+///
+/// ```
+/// use scallop_geom::{Point3, Vec3};
+/// use scallop_toolpath::{Move, MoveKind, Toolpath};
+/// let mut tp = Toolpath::new(1200.0);
+/// tp.push(Move::new(MoveKind::Rapid, Point3::new(0.0, 0.0, 10.0)));
+/// tp.push_with_axis(Move::new(MoveKind::Plunge, Point3::new(0.0, 0.0, 0.0)), Vec3::x());
+/// let cl = scallop_machine::program::records_of(&tp);
+/// assert_eq!((cl[1].feed, cl[1].pose.axis), (600.0, Vec3::x()));
+/// ```
+#[must_use]
+pub fn records_of(path: &scallop_toolpath::Toolpath) -> Vec<ClRecord> {
+    use scallop_toolpath::MoveKind;
+    path.moves()
+        .iter()
+        .enumerate()
+        .map(|(i, m)| {
+            let motion = match m.kind {
+                MoveKind::Rapid | MoveKind::Retract => Motion::Rapid,
+                MoveKind::Plunge => Motion::Plunge,
+                MoveKind::Feed => Motion::Feed,
+                MoveKind::Link => Motion::Link,
+            };
+            ClRecord { pose: Pose::new(m.to, path.axis(i)), motion, feed: path.feed_of(i) }
+        })
+        .collect()
+}
+
 /// Options of [`to_program`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ProgramOptions {

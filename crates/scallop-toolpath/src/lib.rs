@@ -13,9 +13,12 @@
 //!
 //! # Invariants
 //! - Never performs I/O. Coordinates are finite (checked by [`Toolpath::push`] in debug builds).
-//! - The tool axis is +Z (3-axis); multi-axis poses come with the machine layer.
+//! - Positions are tool tips in the part frame. The tool axis of a move is +Z
+//!   unless the path carries tool axes ([`Toolpath::push_with_axis`]): a
+//!   run-length side list, so a 3-axis path pays nothing and a 3+2 path one
+//!   entry. Per-move feeds work the same way ([`Toolpath::set_feed_from`]).
 
-use scallop_geom::{Point2, Point3};
+use scallop_geom::{Point2, Point3, Vec3};
 
 mod arcs;
 
@@ -77,13 +80,157 @@ pub struct Toolpath {
     moves: Vec<Move>,
     /// (move index, arc), increasing indices; empty for straight-line paths.
     arcs: Vec<(usize, ArcXY)>,
+    /// (first move index, unit tool axis), increasing indices: the axis of a
+    /// move is that of the last entry at or before it, +Z before the first.
+    axes: Vec<(usize, Vec3)>,
+    /// (first move index, programmed feed in mm/min), increasing indices: the
+    /// feed of a move is that of the last entry at or before it; before the
+    /// first, the path's feed by kind ([`Toolpath::feed_of`]).
+    feeds: Vec<(usize, f64)>,
 }
 
 impl Toolpath {
     /// An empty toolpath with the cutting feed; the plunge feed is half of it.
     #[must_use]
     pub fn new(feed: f64) -> Toolpath {
-        Toolpath { feed, plunge_feed: 0.5 * feed, moves: Vec::new(), arcs: Vec::new() }
+        Toolpath {
+            feed,
+            plunge_feed: 0.5 * feed,
+            moves: Vec::new(),
+            arcs: Vec::new(),
+            axes: Vec::new(),
+            feeds: Vec::new(),
+        }
+    }
+
+    /// Appends a move with the tool axis `axis` (normalised here; part frame,
+    /// from the tip towards the spindle). The axis holds for the following
+    /// moves pushed with [`Toolpath::push`] too.
+    ///
+    /// ```
+    /// use scallop_geom::{Point3, Vec3};
+    /// use scallop_toolpath::{Move, MoveKind, Toolpath};
+    /// let mut path = Toolpath::new(1000.0);
+    /// path.push(Move::new(MoveKind::Rapid, Point3::new(0.0, 0.0, 10.0)));
+    /// path.push_with_axis(Move::new(MoveKind::Feed, Point3::new(1.0, 0.0, 0.0)), Vec3::new(0.0, 3.0, 4.0));
+    /// path.push(Move::new(MoveKind::Feed, Point3::new(2.0, 0.0, 0.0)));
+    /// assert_eq!(path.axis(0), Vec3::z());
+    /// assert_eq!(path.axis(2), Vec3::new(0.0, 0.6, 0.8));
+    /// assert!(path.has_tool_axes());
+    /// ```
+    pub fn push_with_axis(&mut self, m: Move, axis: Vec3) {
+        let n = axis.norm();
+        debug_assert!(n.is_finite() && n > 0.0, "bad tool axis {axis:?}");
+        let unit = axis / n;
+        if self.current_axis() != unit {
+            self.axes.push((self.moves.len(), unit));
+        }
+        self.push(m);
+    }
+
+    /// The tool axis of move `index` (unit, part frame).
+    #[must_use]
+    pub fn axis(&self, index: usize) -> Vec3 {
+        match self.axes.partition_point(|&(k, _)| k <= index) {
+            0 => Vec3::z(),
+            slot => self.axes[slot - 1].1,
+        }
+    }
+
+    /// Whether any move has a tool axis other than +Z.
+    #[must_use]
+    pub fn has_tool_axes(&self) -> bool {
+        self.axes.iter().any(|&(_, a)| a != Vec3::z())
+    }
+
+    fn current_axis(&self) -> Vec3 {
+        self.axes.last().map_or(Vec3::z(), |&(_, a)| a)
+    }
+
+    /// Sets the programmed feed (mm/min) of the moves from the next one pushed
+    /// on; `None` returns to the path's feeds by kind.
+    ///
+    /// ```
+    /// use scallop_geom::Point3;
+    /// use scallop_toolpath::{Move, MoveKind, Toolpath};
+    /// let mut path = Toolpath::new(1000.0);
+    /// path.push(Move::new(MoveKind::Plunge, Point3::new(0.0, 0.0, 0.0)));
+    /// path.set_feed_from(Some(250.0));
+    /// path.push(Move::new(MoveKind::Feed, Point3::new(1.0, 0.0, 0.0)));
+    /// assert_eq!((path.feed_of(0), path.feed_of(1)), (500.0, 250.0));
+    /// assert!(path.has_feeds());
+    /// ```
+    pub fn set_feed_from(&mut self, feed: Option<f64>) {
+        let feed = feed.unwrap_or(f64::NAN);
+        debug_assert!(feed.is_nan() || (feed.is_finite() && feed > 0.0), "bad feed {feed}");
+        let current = self.feeds.last().map_or(f64::NAN, |&(_, f)| f);
+        if current.to_bits() != feed.to_bits() {
+            match self.feeds.last_mut() {
+                Some(last) if last.0 == self.moves.len() => last.1 = feed,
+                _ => self.feeds.push((self.moves.len(), feed)),
+            }
+        }
+    }
+
+    /// The programmed feed of move `index` (mm/min): the one set by
+    /// [`Toolpath::set_feed_from`], else the plunge feed for plunges and the
+    /// cutting feed for the rest (rapids included: their rate is the machine's).
+    #[must_use]
+    pub fn feed_of(&self, index: usize) -> f64 {
+        let set = match self.feeds.partition_point(|&(k, _)| k <= index) {
+            0 => f64::NAN,
+            slot => self.feeds[slot - 1].1,
+        };
+        if !set.is_nan() {
+            return set;
+        }
+        match self.moves.get(index).map(|m| m.kind) {
+            Some(MoveKind::Plunge) => self.plunge_feed,
+            _ => self.feed,
+        }
+    }
+
+    /// Whether some moves carry a feed of their own.
+    #[must_use]
+    pub fn has_feeds(&self) -> bool {
+        self.feeds.iter().any(|&(_, f)| !f.is_nan())
+    }
+
+    /// Appends the moves of `other` with their arcs, tool axes and feeds.
+    ///
+    /// ```
+    /// use scallop_geom::{Point3, Vec3};
+    /// use scallop_toolpath::{Move, MoveKind, Toolpath};
+    /// let mut a = Toolpath::new(1000.0);
+    /// a.push(Move::new(MoveKind::Feed, Point3::new(0.0, 0.0, 0.0)));
+    /// let mut b = Toolpath::new(1000.0);
+    /// b.push_with_axis(Move::new(MoveKind::Feed, Point3::new(1.0, 0.0, 0.0)), Vec3::x());
+    /// a.extend_from(&b);
+    /// assert_eq!((a.moves().len(), a.axis(1)), (2, Vec3::x()));
+    /// ```
+    pub fn extend_from(&mut self, other: &Toolpath) {
+        for (i, m) in other.moves.iter().enumerate() {
+            self.set_feed_from(other.feed_override(i));
+            let axis = other.axis(i);
+            if axis != self.current_axis() {
+                self.axes.push((self.moves.len(), axis));
+            }
+            match other.arc(i) {
+                Some(arc) => self.push_arc(*m, arc),
+                None => self.push(*m),
+            }
+        }
+        self.set_feed_from(None);
+    }
+
+    /// The feed move `index` carries of its own (mm/min), `None` when it takes
+    /// the path's feed by kind.
+    #[must_use]
+    pub fn feed_override(&self, index: usize) -> Option<f64> {
+        match self.feeds.partition_point(|&(k, _)| k <= index) {
+            0 => None,
+            slot => Some(self.feeds[slot - 1].1).filter(|f| !f.is_nan()),
+        }
     }
 
     /// Appends a move along a circular arc in the XY plane ending at `m.to`

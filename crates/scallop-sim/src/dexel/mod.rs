@@ -60,13 +60,14 @@ impl ToolMove {
         ToolMove { kind, tip, axis, arc: None }
     }
 
-    /// The moves of a 3-axis toolpath, tool axis +Z, arcs kept.
+    /// The moves of a toolpath with their tool axes ([`Toolpath::axis`]: +Z for
+    /// a 3-axis path), arcs kept.
     #[must_use]
     pub fn from_toolpath(path: &Toolpath) -> Vec<ToolMove> {
         path.moves()
             .iter()
             .enumerate()
-            .map(|(i, m)| ToolMove { kind: m.kind, tip: m.to, axis: Vec3::z(), arc: path.arc(i) })
+            .map(|(i, m)| ToolMove { kind: m.kind, tip: m.to, axis: path.axis(i), arc: path.arc(i) })
             .collect()
     }
 }
