@@ -179,14 +179,9 @@ pub fn run(args: &SimulateArgs) -> CliResult<()> {
         }
         StockModel::Zmap => false,
     };
-    let b = prepared.mesh.bounds();
-    let r = cutter.radius();
     let stock = match &args.stock {
         Some(s) => parse_stock(s)?,
-        None => Aabb3 {
-            min: Point3::new(b.min.x - r, b.min.y - r, b.min.z - 1.0),
-            max: Point3::new(b.max.x + r, b.max.y + r, b.max.z + 1.0),
-        },
+        None => scallop_engine::stock_box(&prepared.mesh, cutter.radius()),
     };
     let options =
         VerifyOptions { gouge_tolerance: args.gouge_tolerance + prepared.chordal_error, ..VerifyOptions::default() };

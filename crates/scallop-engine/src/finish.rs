@@ -233,12 +233,45 @@ pub struct FinishDetails {
 /// Bad settings, an unknown part, a plan that cannot hold the scallop height,
 /// or a safety problem found by the stock simulation.
 pub fn run_finishing(job: &FinishJob) -> Result<FinishOutput, EngineError> {
-    // With arcs on, planning gets `1 - ARC_SHARE` of the path tolerance.
-    let tolerances = if job.output.arc_fitting {
-        Tolerances { path: job.tolerances.path * (1.0 - ARC_SHARE), ..job.tolerances }
-    } else {
-        job.tolerances
+    let tolerances = planning_tolerances(job)?;
+    let prepared = prepare_part(&job.part, &tolerances)?;
+    let prepared = match &job.setup {
+        Some(setup) => rotate_prepared(&prepared, &setup.rotation)?,
+        None => prepared,
     };
+    let stock = stock_box(&prepared.mesh, job.cutter.radius());
+    let mut op = plan_operation(job, &prepared, &tolerances, None)?;
+    let (gouge_tolerance, options) = verify_options(job, &prepared);
+    let sim =
+        scallop_sim::simulate(stock, job.sim_resolution, &job.cutter, &op.plan.toolpath, &prepared.index, &options)?;
+    if job.strategy == Strategy::NetworkPlanes {
+        network_scallop_from(&sim, job, &mut op.plan.report)?;
+    }
+    let (fitted, comments) = fit_and_comment(job, &op, &prepared, &tolerances);
+    let text = match &job.setup {
+        None => three_axis_program(job, &fitted, &comments)?,
+        Some(setup) => indexed_program(job, setup, &op.plan.toolpath, op.plan.report.machining_time_s)?,
+    };
+    let report = finish_report(job, &op, &prepared, &sim, gouge_tolerance);
+    let details = FinishDetails { prepared, stock, params: op.params, scallop: op.plan.scallop, simulation: sim };
+    Ok(FinishOutput { toolpath: op.plan.toolpath, gcode: text, report, fitted, details })
+}
+
+/// The stock box of a part when the job gives none: the part's box grown by
+/// the cutter radius in X and Y, from 1 mm below to 1 mm above the part (the
+/// one rule of the engine, also used by the CLI's `simulate`).
+#[must_use]
+pub fn stock_box(mesh: &TriMesh, radius: f64) -> Aabb3 {
+    let b = mesh.bounds();
+    Aabb3 {
+        min: Point3::new(b.min.x - radius, b.min.y - radius, b.min.z - 1.0),
+        max: Point3::new(b.max.x + radius, b.max.y + radius, b.max.z + 1.0),
+    }
+}
+
+/// The job's checks on its output settings and the tolerances its planning
+/// runs with: with arcs on, planning gets `1 - ARC_SHARE` of the path tolerance.
+pub(crate) fn planning_tolerances(job: &FinishJob) -> Result<Tolerances, EngineError> {
     if job.setup.is_none() && job.output.dialect.syntax != scallop_post::Syntax::Iso {
         return Err(EngineError::Output {
             what: format!("3-axis output in the plain-language dialect `{}`", job.output.dialect.name),
@@ -251,11 +284,47 @@ pub fn run_finishing(job: &FinishJob) -> Result<FinishOutput, EngineError> {
             fix: "set output.arc_fitting = false for a job with a [setup]".into(),
         });
     }
-    let prepared = prepare_part(&job.part, &tolerances)?;
-    let prepared = match &job.setup {
-        Some(setup) => rotate_prepared(&prepared, &setup.rotation)?,
-        None => prepared,
+    Ok(if job.output.arc_fitting {
+        Tolerances { path: job.tolerances.path * (1.0 - ARC_SHARE), ..job.tolerances }
+    } else {
+        job.tolerances
+    })
+}
+
+/// The simulation's allowance and options: the program follows the
+/// tessellation (within the chordal error of the surface), and between samples
+/// the planner keeps moves within the path tolerance of the CL surface; the
+/// scallop is held beyond the cutter radius from the part's edge (see
+/// `VerifyOptions::scallop_margin`), the edge strip's figure reported too.
+pub(crate) fn verify_options(job: &FinishJob, prepared: &PreparedPart) -> (f64, scallop_sim::VerifyOptions) {
+    let gouge_tolerance = job.tolerances.gouge + prepared.chordal_error + job.tolerances.path;
+    let options = scallop_sim::VerifyOptions {
+        gouge_tolerance,
+        scallop_margin: job.cutter.radius(),
+        ..scallop_sim::VerifyOptions::default()
     };
+    (gouge_tolerance, options)
+}
+
+/// What the planning of one finishing operation produced, before the
+/// simulation and the program text.
+pub(crate) struct PlannedOperation {
+    pub(crate) plan: Plan,
+    pub(crate) params: FinishingParams,
+    pub(crate) direction_deg: f64,
+    pub(crate) analysis: scallop_analysis::AnalysisReport,
+    pub(crate) leads: LeadReport,
+}
+
+/// Plans one finishing operation on a prepared part: the analysis, the
+/// direction, the passes and the leads. `clearance` overrides the job's
+/// clearance above the part's top (a stock above it, see `run_job`).
+pub(crate) fn plan_operation(
+    job: &FinishJob,
+    prepared: &PreparedPart,
+    tolerances: &Tolerances,
+    clearance: Option<f64>,
+) -> Result<PlannedOperation, EngineError> {
     let machine = MachineLimits::from_thesis_units(job.machine[0], job.machine[1], job.machine[2]);
     let samples = match (&job.part, &job.setup) {
         (Part::Surfaces(set), None) => {
@@ -278,43 +347,22 @@ pub fn run_finishing(job: &FinishJob) -> Result<FinishOutput, EngineError> {
     } else {
         analysis.slope_direction_deg
     });
-    let params = finishing_params(job, direction_deg.to_radians());
+    let mut params = finishing_params(job, direction_deg.to_radians());
+    if let Some(c) = clearance {
+        params.clearance = c;
+    }
     let mut planned = match job.strategy {
         Strategy::ParallelPlanes => {
-            let p = plan_finishing(&prepared.index, &job.cutter, &params, &tolerances)?;
+            let p = plan_finishing(&prepared.index, &job.cutter, &params, tolerances)?;
             Plan { toolpath: p.toolpath, report: p.report, scallop: Some(p.scallop) }
         }
         Strategy::NetworkPlanes => {
-            let Part::Surfaces(set) = &job.part else {
-                return Err(EngineError::Output {
-                    what: "the network planner on a mesh part".into(),
-                    fix: "use a parametric part (builtin or a surface file) or finishing.strategy = \"parallel\""
-                        .into(),
-                });
-            };
-            if job.setup.is_some() {
-                return Err(EngineError::Output {
-                    what: "the network planner in a 3+2 setup".into(),
-                    fix: "remove [setup] or use finishing.strategy = \"parallel\"".into(),
-                });
-            }
-            network_planes(set, &prepared, job, &params, &tolerances)?
+            let set = parametric_only(job, "the network planner")?;
+            network_planes(set, prepared, job, &params, tolerances)?
         }
         Strategy::Isoparametric(direction) => {
-            let Part::Surfaces(set) = &job.part else {
-                return Err(EngineError::Output {
-                    what: "isoparametric passes on a mesh part".into(),
-                    fix: "use a parametric part (builtin or a surface file) or finishing.strategy = \"parallel\""
-                        .into(),
-                });
-            };
-            if job.setup.is_some() {
-                return Err(EngineError::Output {
-                    what: "isoparametric passes in a 3+2 setup".into(),
-                    fix: "remove [setup] or use finishing.strategy = \"parallel\"".into(),
-                });
-            }
-            isoparametric(set, &prepared, job, &params, &tolerances, direction)?
+            let set = parametric_only(job, "isoparametric passes")?;
+            isoparametric(set, prepared, job, &params, tolerances, direction)?
         }
     };
     let (led, leads) =
@@ -333,64 +381,76 @@ pub fn run_finishing(job: &FinishJob) -> Result<FinishOutput, EngineError> {
         r.points = led.moves().len();
         planned.toolpath = led;
     }
+    Ok(PlannedOperation { plan: planned, params, direction_deg, analysis, leads })
+}
 
-    // Prove the program on a simulated stock before anyone runs it: the part's
-    // box grown by the cutter radius, from 1 mm below to 1 mm above the part.
-    let b = prepared.mesh.bounds();
-    let stock = Aabb3 {
-        min: Point3::new(b.min.x - radius, b.min.y - radius, b.min.z - 1.0),
-        max: Point3::new(b.max.x + radius, b.max.y + radius, b.max.z + 1.0),
+/// The surfaces of a parametric part, for a strategy that needs them, or the
+/// error that names the key selecting it.
+fn parametric_only<'j>(job: &'j FinishJob, what: &str) -> Result<&'j scallop_surface::SurfaceSet, EngineError> {
+    let Part::Surfaces(set) = &job.part else {
+        return Err(EngineError::Output {
+            what: format!("{what} on a mesh part"),
+            fix: "use a parametric part (builtin or a surface file) or finishing.strategy = \"parallel\"".into(),
+        });
     };
-    // The program follows the tessellation (within the chordal error of the
-    // surface); between samples the planner keeps moves within the path
-    // tolerance of the CL surface.
-    let gouge_tolerance = job.tolerances.gouge + prepared.chordal_error + job.tolerances.path;
-    // The scallop is held where neighbouring passes shape the surface: beyond
-    // the cutter radius from the part's edge (see `VerifyOptions::scallop_margin`);
-    // the edge strip's figure is reported too.
-    let options =
-        scallop_sim::VerifyOptions { gouge_tolerance, scallop_margin: radius, ..scallop_sim::VerifyOptions::default() };
-    let sim =
-        scallop_sim::simulate(stock, job.sim_resolution, &job.cutter, &planned.toolpath, &prepared.index, &options)?;
-    if job.strategy == Strategy::NetworkPlanes {
-        // No planner measure: the simulation is the scallop verification, and a
-        // scallop over sh (beyond the grid's bound) fails the job.
-        let bound = sim.zmap.resolution_bound(job.cutter.shape());
-        let v = &sim.verification;
-        if v.max_thickness > job.scallop_height + bound {
-            let at = v.max_thickness_at.unwrap_or_else(|| scallop_geom::Point2::new(f64::NAN, f64::NAN));
-            return Err(EngineError::ScallopNotHeld {
-                measured: v.max_thickness,
-                x: at.x,
-                y: at.y,
-                limit: job.scallop_height,
-                bound,
-            });
-        }
-        planned.report.max_scallop_mm = v.max_thickness;
-        // The mean: material left above the part per unit of its area (vertical).
-        #[allow(clippy::cast_precision_loss, reason = "cell counts")]
-        let cells = v.part_cells.max(1) as f64;
-        planned.report.mean_scallop_mm = v.excess_volume / (cells * job.sim_resolution * job.sim_resolution);
+    if job.setup.is_some() {
+        return Err(EngineError::Output {
+            what: format!("{what} in a 3+2 setup"),
+            fix: "remove [setup] or use finishing.strategy = \"parallel\"".into(),
+        });
     }
+    Ok(set)
+}
 
-    let cutter_text = cutter_text(job.cutter.shape());
-    let r = &planned.report;
-    let comments = [
-        format!("part: {}, tessellated within {:.5} mm", job.part_name, prepared.chordal_error),
-        format!("tool: {cutter_text}; scallop height {} mm", job.scallop_height),
+/// The network planner measures no scallop: the simulation is its scallop
+/// verification, and a scallop over sh (beyond the grid's bound) fails the job.
+pub(crate) fn network_scallop_from(
+    sim: &scallop_sim::Simulation,
+    job: &FinishJob,
+    report: &mut scallop_strategy::Report,
+) -> Result<(), EngineError> {
+    let bound = sim.zmap.resolution_bound(job.cutter.shape());
+    let v = &sim.verification;
+    if v.max_thickness > job.scallop_height + bound {
+        let at = v.max_thickness_at.unwrap_or_else(|| scallop_geom::Point2::new(f64::NAN, f64::NAN));
+        return Err(EngineError::ScallopNotHeld {
+            measured: v.max_thickness,
+            x: at.x,
+            y: at.y,
+            limit: job.scallop_height,
+            bound,
+        });
+    }
+    report.max_scallop_mm = v.max_thickness;
+    // The mean: material left above the part per unit of its area (vertical).
+    #[allow(clippy::cast_precision_loss, reason = "cell counts")]
+    let cells = v.part_cells.max(1) as f64;
+    report.mean_scallop_mm = v.excess_volume / (cells * job.sim_resolution * job.sim_resolution);
+    Ok(())
+}
+
+/// The program's path (arcs fitted when asked) and its header comments.
+pub(crate) fn fit_and_comment(
+    job: &FinishJob,
+    op: &PlannedOperation,
+    prepared: &PreparedPart,
+    tolerances: &Tolerances,
+) -> (FittedPath, Vec<String>) {
+    let r = &op.plan.report;
+    let mut comments = vec![
+        format!("part: {}, {}", job.part_name, chordal_text(prepared)),
+        format!("tool: {}; scallop height {} mm", cutter_text(job.cutter.shape()), job.scallop_height),
         format!(
             "path tolerance {} mm; gouge tolerance {} mm; feed direction {:.2} deg",
-            job.tolerances.path, job.tolerances.gouge, direction_deg
+            job.tolerances.path, job.tolerances.gouge, op.direction_deg
         ),
         format!(
             "predicted machining time {:.1} s (stop-to-stop), {:.1} s (look-ahead), rapids {:.1} s",
             r.machining_time_s, r.machining_time_lookahead_s, r.rapid_time_s
         ),
     ];
-    let mut comments = comments.to_vec();
     let fitted = if job.output.arc_fitting {
-        let f = fit_arcs(&planned.toolpath, ARC_SHARE * job.tolerances.path);
+        let f = fit_arcs(&op.plan.toolpath, ARC_SHARE * job.tolerances.path);
         comments.push(format!(
             "arcs: {} G2/G3 within {} mm of the planned path; planning within {} mm",
             f.arcs(),
@@ -399,22 +459,39 @@ pub fn run_finishing(job: &FinishJob) -> Result<FinishOutput, EngineError> {
         ));
         f
     } else {
-        FittedPath::lines(&planned.toolpath)
+        FittedPath::lines(&op.plan.toolpath)
     };
-    let text = match &job.setup {
-        None => three_axis_program(job, &fitted, &comments)?,
-        Some(setup) => indexed_program(job, setup, &planned.toolpath, r.machining_time_s)?,
-    };
-    let report = FinishReport {
+    (fitted, comments)
+}
+
+/// How the part's approximation reads in a program's header: the chordal bound
+/// of a tessellated surface, or a mesh taken as it is.
+fn chordal_text(prepared: &PreparedPart) -> String {
+    if prepared.chordal_error > 0.0 {
+        format!("tessellated within {:.5} mm", prepared.chordal_error)
+    } else {
+        "a mesh, machined as given".into()
+    }
+}
+
+/// The report of one finishing operation proven by `sim`.
+pub(crate) fn finish_report(
+    job: &FinishJob,
+    op: &PlannedOperation,
+    prepared: &PreparedPart,
+    sim: &scallop_sim::Simulation,
+    gouge_tolerance: f64,
+) -> FinishReport {
+    FinishReport {
         part: job.part_name.clone(),
-        cutter: cutter_text,
+        cutter: cutter_text(job.cutter.shape()),
         scallop_height_mm: job.scallop_height,
-        direction_deg,
-        recommendation: analysis.recommendation,
-        slope_deg: analysis.slope_deg,
-        critical_slope_deg: analysis.critical_slope_deg,
+        direction_deg: op.direction_deg,
+        recommendation: op.analysis.recommendation,
+        slope_deg: op.analysis.slope_deg,
+        critical_slope_deg: op.analysis.critical_slope_deg,
         chordal_error_mm: prepared.chordal_error,
-        plan: planned.report.clone(),
+        plan: op.plan.report.clone(),
         sim_resolution_mm: job.sim_resolution,
         sim_max_material_mm: sim.verification.max_scallop,
         sim_max_scallop_mm: sim.verification.max_thickness,
@@ -422,10 +499,8 @@ pub fn run_finishing(job: &FinishJob) -> Result<FinishOutput, EngineError> {
         sim_resolution_bound_mm: sim.zmap.resolution_bound(job.cutter.shape()),
         sim_min_deviation_mm: sim.verification.min_deviation,
         sim_gouge_tolerance_mm: gouge_tolerance,
-        leads,
-    };
-    let details = FinishDetails { prepared, stock, params, scallop: planned.scallop, simulation: sim };
-    Ok(FinishOutput { toolpath: planned.toolpath, gcode: text, report, fitted, details })
+        leads: op.leads.clone(),
+    }
 }
 
 /// A 3-axis program of `fitted` in the job's dialect with `comments` in its header.
@@ -556,10 +631,10 @@ fn network_planes(
 }
 
 /// A toolpath and its figures, whatever the strategy.
-struct Plan {
-    toolpath: Toolpath,
-    report: scallop_strategy::Report,
-    scallop: Option<scallop_strategy::ScallopReport>,
+pub(crate) struct Plan {
+    pub(crate) toolpath: Toolpath,
+    pub(crate) report: scallop_strategy::Report,
+    pub(crate) scallop: Option<scallop_strategy::ScallopReport>,
 }
 
 /// Isoparametric passes patch after patch; the report's times and lengths are those

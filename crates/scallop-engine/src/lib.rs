@@ -2,6 +2,7 @@
 //! machining settings in, cutter locations, toolpaths, G-code text and
 //! reports out. Orchestration only: the geometry lives in the crates below.
 //! [`run_finishing`] machines a part in one direction or 3+2 setup;
+//! [`run_job`] runs a job's operations in order on one simulated stock;
 //! [`finish_zones`] machines a zone plan of the optimiser zone by zone (each in
 //! its direction or 3+2 orientation) and proves it on the simulated stock.
 //!
@@ -20,6 +21,7 @@
 mod demo;
 mod finish;
 mod grid;
+mod job;
 mod zones;
 
 use scallop_geom::Tolerances;
@@ -29,8 +31,10 @@ use scallop_surface::SurfaceSet;
 pub use demo::{DemoOutput, DemoSettings, DemoSummary, run_demo};
 pub use finish::{
     ARC_SHARE, FinishDetails, FinishJob, FinishOutput, FinishReport, OutputOptions, Setup, Strategy, run_finishing,
+    stock_box,
 };
 pub use grid::{GridAxis, GridError, MAX_GRID_POINTS};
+pub use job::{Job, JobOutput, JobReport, Operation, OperationReport, STOCK_CLEARANCE_MM, StockFigures, run_job};
 pub use zones::{
     ZONE_MARGIN_PER_RADIUS, ZONE_MARGIN_PER_SPACING, ZONE_MARGIN_ROUNDS, ZoneFigures, ZoneFinishOutput,
     ZoneFinishReport, ZonePlanSpec, ZoneSpec, finish_zones,

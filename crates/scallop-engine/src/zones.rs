@@ -38,7 +38,7 @@
 //!   between setups is not checked.
 
 use scallop_analysis::MachineLimits;
-use scallop_geom::{Aabb3, Point3, Tolerances, Vec3};
+use scallop_geom::{Point3, Tolerances, Vec3};
 use scallop_machine::Kinematics;
 use scallop_machine::program::{ProgramOptions, records_from_toolpath, to_program};
 use scallop_mesh::{MeshIndex, TriMesh};
@@ -356,11 +356,7 @@ fn finish_zones_with(job: &FinishJob, spec: &ZonePlanSpec, share: f64) -> Result
         if tilted {
             // Prove the zone in its own frame: no gouge or collision anywhere, and its
             // own triangles finished within the scallop height.
-            let b = part.mesh.bounds();
-            let stock = Aabb3 {
-                min: Point3::new(b.min.x - radius, b.min.y - radius, b.min.z - 1.0),
-                max: Point3::new(b.max.x + radius, b.max.y + radius, b.max.z + 1.0),
-            };
+            let stock = crate::stock_box(&part.mesh, radius);
             let sim = scallop_sim::simulate(stock, job.sim_resolution, &job.cutter, &zone_path, &part.index, &options)?;
             let bound = sim.zmap.resolution_bound(job.cutter.shape());
             let (height, at) = zone_scallop(&sim.zmap, part, &labels, zone.label, &open_edge, radius);
@@ -440,11 +436,7 @@ fn finish_zones_with(job: &FinishJob, spec: &ZonePlanSpec, share: f64) -> Result
         let deepest = zone_sims.iter().map(|z| z.1).fold(f64::INFINITY, f64::min);
         (None, bound, height, None, 0.0, deepest)
     } else {
-        let b = prepared.mesh.bounds();
-        let stock = Aabb3 {
-            min: Point3::new(b.min.x - radius, b.min.y - radius, b.min.z - 1.0),
-            max: Point3::new(b.max.x + radius, b.max.y + radius, b.max.z + 1.0),
-        };
+        let stock = crate::stock_box(&prepared.mesh, radius);
         let sim = scallop_sim::simulate(stock, job.sim_resolution, &job.cutter, &toolpath, &prepared.index, &options)?;
         let bound = sim.zmap.resolution_bound(job.cutter.shape());
         let v = &sim.verification;

@@ -73,21 +73,105 @@ pub fn write_fitted(
     comments: &[&str],
     out: &mut impl Write,
 ) -> io::Result<()> {
+    write_header(dialect, info, comments, out)?;
+    write_section(path, dialect, info, out)?;
+    write_footer(dialect, info, out)
+}
+
+/// One operation of a program written by [`write_sections`]: its moves, its
+/// tool and spindle (`info.program` is not used) and a comment line naming it.
+#[derive(Debug, Clone)]
+pub struct Section<'a> {
+    /// The moves (lines and arcs).
+    pub path: &'a FittedPath,
+    /// Tool number, spindle speed and indexed rotaries of the operation.
+    pub info: ProgramInfo,
+    /// A comment written before the operation's tool change.
+    pub title: String,
+}
+
+/// A program of several operations (one tool change each): the dialect's header
+/// once with `comments`, then per section its title, `M5` before every tool
+/// change but the first (the spindle stops before the change), the tool change,
+/// the length offset, the spindle start and the moves, then the footer. With one
+/// section the text is that of [`write_fitted`] plus the title comment.
+///
+/// ```
+/// use scallop_geom::Point3;
+/// use scallop_post::{Dialect, ProgramInfo, Section, write_sections};
+/// use scallop_toolpath::{FittedPath, Move, MoveKind, Toolpath};
+/// let mut tp = Toolpath::new(1000.0);
+/// tp.push(Move::new(MoveKind::Rapid, Point3::new(0.0, 0.0, 5.0)));
+/// tp.push(Move::new(MoveKind::Feed, Point3::new(10.0, 0.0, 0.0)));
+/// let lines = FittedPath::lines(&tp);
+/// let tool = |t: u32| ProgramInfo { tool: t, spindle: 8000.0, ..ProgramInfo::anonymous() };
+/// let sections = [
+///     Section { path: &lines, info: tool(1), title: "rough".into() },
+///     Section { path: &lines, info: tool(2), title: "finish".into() },
+/// ];
+/// let mut text = Vec::new();
+/// write_sections(&sections, &Dialect::builtin("linuxcnc").unwrap(), "1", &[], &mut text).unwrap();
+/// let text = String::from_utf8(text).unwrap();
+/// assert!(text.contains("T1 M6\nG43 H1\nS8000 M3"));
+/// assert!(text.contains("(finish)\nM5\nT2 M6\nG43 H2\nS8000 M3"), "{text}");
+/// assert!(text.ends_with("M2\n"));
+/// ```
+///
+/// # Errors
+/// Any error of `out`.
+pub fn write_sections(
+    sections: &[Section<'_>],
+    dialect: &Dialect,
+    program: &str,
+    comments: &[&str],
+    out: &mut impl Write,
+) -> io::Result<()> {
+    let info = ProgramInfo { program: program.to_string(), ..ProgramInfo::anonymous() };
+    write_header(dialect, &info, comments, out)?;
     let (open, close) = (&dialect.comment.0, &dialect.comment.1);
-    let clean = |c: &str| -> String { c.chars().map(|ch| if ch == '(' || ch == ')' { '_' } else { ch }).collect() };
+    for (k, section) in sections.iter().enumerate() {
+        writeln!(out, "{open}{}{close}", clean_comment(&section.title))?;
+        if k > 0 && section.info.tool > 0 {
+            writeln!(out, "M5")?;
+        }
+        write_section(section.path, dialect, &section.info, out)?;
+    }
+    write_footer(dialect, &info, out)
+}
+
+fn clean_comment(c: &str) -> String {
+    c.chars().map(|ch| if ch == '(' || ch == ')' { '_' } else { ch }).collect()
+}
+
+/// The program's first lines: tape start, the scallop comment, `comments`, the
+/// dialect's header.
+fn write_header(dialect: &Dialect, info: &ProgramInfo, comments: &[&str], out: &mut impl Write) -> io::Result<()> {
+    let (open, close) = (&dialect.comment.0, &dialect.comment.1);
     let mut header = dialect.header.iter();
     // A leading `%` (tape start) must stay the first line.
     if dialect.header.first().is_some_and(|h| h == "%") {
         writeln!(out, "%")?;
         header.next();
     }
-    writeln!(out, "{open}scallop {}, dialect: {}{close}", env!("CARGO_PKG_VERSION"), clean(&dialect.name))?;
+    writeln!(out, "{open}scallop {}, dialect: {}{close}", env!("CARGO_PKG_VERSION"), clean_comment(&dialect.name))?;
     for c in comments {
-        writeln!(out, "{open}{}{close}", clean(c))?;
+        writeln!(out, "{open}{}{close}", clean_comment(c))?;
     }
     for h in header {
         writeln!(out, "{}", info.render(dialect, h))?;
     }
+    Ok(())
+}
+
+fn write_footer(dialect: &Dialect, info: &ProgramInfo, out: &mut impl Write) -> io::Result<()> {
+    for f in &dialect.footer {
+        writeln!(out, "{}", info.render(dialect, f))?;
+    }
+    Ok(())
+}
+
+/// One operation: tool change, length offset, spindle, indexed rotaries, moves.
+fn write_section(path: &FittedPath, dialect: &Dialect, info: &ProgramInfo, out: &mut impl Write) -> io::Result<()> {
     if info.tool > 0 {
         for t in &dialect.tool_change {
             writeln!(out, "{}", info.render(dialect, t))?;
@@ -165,9 +249,6 @@ pub fn write_fitted(
     }
     if plane != ArcPlane::Xy {
         writeln!(out, "G17")?;
-    }
-    for f in &dialect.footer {
-        writeln!(out, "{}", info.render(dialect, f))?;
     }
     Ok(())
 }

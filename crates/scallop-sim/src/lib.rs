@@ -13,6 +13,8 @@
 //! - [`simulate`]: both, with every safety problem as an `Err`.
 //! - [`PartField`]: the part rasterised once on the grid, shared by [`simulate`]'s
 //!   [`ZMap::part_collisions_in`] and [`verify_in`].
+//! - [`StockView`]: the read-only view of either stock that an operation gets
+//!   of what the operations before it left.
 //! - [`DexelStock`]: the multi-axis stock (tri-dexels: rays along X, Y and Z,
 //!   each a list of material intervals), cut by cutters with any tool axis
 //!   along 3-axis, 3+2 and simultaneous 5-axis moves ([`ToolMove`]); the
@@ -75,6 +77,7 @@ mod envelope;
 mod error;
 pub mod tol;
 mod verify;
+mod view;
 mod zmap;
 
 use scallop_cutter::Cutter;
@@ -89,6 +92,7 @@ pub use dexel::{
 pub use envelope::swept_floor;
 pub use error::SimError;
 pub use verify::{GougeCell, PartField, Verification, VerifyOptions, part_heights, verify, verify_in};
+pub use view::StockView;
 pub use zmap::{Collision, CutReport, MAX_CELLS, MoveId, RapidHit, ToolPart, ZMap};
 
 /// Everything [`simulate`] found about a safe program.

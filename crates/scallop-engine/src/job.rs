@@ -1,0 +1,365 @@
+//! Jobs as a sequence of operations on one stock ([`run_job`]): each operation
+//! is planned on the part, cut from the one simulated stock that the
+//! operations before it left (it reads that stock through
+//! [`scallop_sim::StockView`]), and the proof (gouges, collisions, material
+//! left) runs on the stock they all left. One program with a tool change per
+//! operation.
+
+use scallop_geom::{Aabb3, Tolerances};
+use scallop_post::{ProgramInfo, Section, write_sections};
+use scallop_sim::{PartField, StockView, ZMap, verify_in};
+use scallop_toolpath::{FittedPath, Toolpath};
+use serde::Serialize;
+
+use crate::finish::{
+    PlannedOperation, cutter_text, fit_and_comment, network_scallop_from, plan_operation, planning_tolerances,
+    verify_options,
+};
+use crate::{EngineError, FinishJob, PreparedPart, Strategy, prepare_part, stock_box};
+
+/// Height kept between the highest material of the in-process stock and the
+/// rapids of an operation (mm): an operation's clearance plane is at least
+/// this far above what the operations before it left.
+pub const STOCK_CLEARANCE_MM: f64 = 2.0;
+
+/// One operation of a [`Job`].
+#[derive(Debug, Clone)]
+pub struct Operation {
+    /// How the program and the report name it.
+    pub name: String,
+    /// What it does: a finishing operation (its part, tolerances, machine,
+    /// verification and output settings must be those of the job's other
+    /// operations; its tool and spindle are its own).
+    pub finish: FinishJob,
+}
+
+/// A job: operations in order on one stock.
+#[derive(Debug, Clone)]
+pub struct Job {
+    /// The stock box (mm, part frame); `None`: [`stock_box`] of the part with
+    /// the largest cutter of the operations.
+    pub stock: Option<Aabb3>,
+    /// The operations, in machining order (at least one).
+    pub operations: Vec<Operation>,
+}
+
+/// What one operation met on the stock and what it removed.
+#[derive(Debug, Clone, Serialize)]
+pub struct StockFigures {
+    /// Highest material of the stock the operation received (mm).
+    pub top_before_mm: f64,
+    /// Volume of that stock (mm^3).
+    pub volume_before_mm3: f64,
+    /// Volume this operation removed (mm^3).
+    pub removed_mm3: f64,
+    /// Share of its feed moves that removed nothing (air), in [0, 1].
+    pub air_cut_share: f64,
+    /// The clearance above the part's top its rapids ran at (mm): the job's,
+    /// raised to clear the stock by [`STOCK_CLEARANCE_MM`].
+    pub clearance_mm: f64,
+}
+
+/// The report of one operation.
+#[derive(Debug, Clone, Serialize)]
+pub struct OperationReport {
+    /// Its name.
+    pub name: String,
+    /// Its cutter.
+    pub cutter: String,
+    /// Tool number in the program.
+    pub tool: u32,
+    /// Scallop height asked (mm).
+    pub scallop_height_mm: f64,
+    /// Feed direction from +X (degrees).
+    pub direction_deg: f64,
+    /// The planner's figures (times, lengths, passes, measured scallop).
+    pub plan: scallop_strategy::Report,
+    /// What it met on the stock.
+    pub stock: StockFigures,
+}
+
+/// The report of a job (`report.json`).
+#[derive(Debug, Clone, Serialize)]
+pub struct JobReport {
+    /// Part.
+    pub part: String,
+    /// The stock box (mm): min and max corners.
+    pub stock_mm: [[f64; 3]; 2],
+    /// One entry per operation, in order.
+    pub operations: Vec<OperationReport>,
+    /// Predicted time of the whole program (s, stop-to-stop model, rapids included).
+    pub total_time_s: f64,
+    /// Cell size of the stock simulation (mm).
+    pub sim_resolution_mm: f64,
+    /// Largest material thickness along the part normal on the final stock,
+    /// beyond the last cutter's radius from the part's edge (mm).
+    pub sim_max_scallop_mm: f64,
+    /// The simulation's resolution bound for the last cutter (mm).
+    pub sim_resolution_bound_mm: f64,
+    /// Deepest stock-minus-part deviation on the final stock (mm).
+    pub sim_min_deviation_mm: f64,
+    /// Gouge tolerance the simulation enforced (mm).
+    pub sim_gouge_tolerance_mm: f64,
+}
+
+/// The outputs of [`run_job`].
+#[derive(Debug, Clone)]
+pub struct JobOutput {
+    /// Each operation's toolpath (part frame), in order.
+    pub toolpaths: Vec<Toolpath>,
+    /// All toolpaths joined (the program's moves), each operation's moves in order.
+    pub toolpath: Toolpath,
+    /// The G-code text: one program, a tool change per operation.
+    pub gcode: String,
+    /// The figures.
+    pub report: JobReport,
+    /// The mesh the cutters were dropped on.
+    pub prepared: PreparedPart,
+    /// The final stock and its verification.
+    pub simulation: scallop_sim::Simulation,
+}
+
+/// Runs the operations of `job` in order on one simulated stock and proves
+/// the result (see the module documentation).
+///
+/// # Errors
+/// No operation; operations that disagree on the shared settings; a 3+2
+/// setup in a job of several operations (not supported yet); every error of
+/// [`crate::run_finishing`] (planning, safety problems found by the
+/// simulation of each operation on the stock the others left).
+pub fn run_job(job: &Job) -> Result<JobOutput, EngineError> {
+    let first = &check_operations(job)?.finish;
+    let tolerances = planning_tolerances(first)?;
+    let prepared = prepare_part(&first.part, &tolerances)?;
+    let radius = job.operations.iter().map(|o| o.finish.cutter.radius()).fold(0.0, f64::max);
+    let stock = job.stock.unwrap_or_else(|| stock_box(&prepared.mesh, radius));
+    let mut zmap = ZMap::new(stock, first.sim_resolution)?;
+    let field = PartField::new(&zmap, &prepared.index);
+    let part_top = prepared.mesh.bounds().max.z;
+    let mut planned: Vec<(PlannedOperation, StockFigures)> = Vec::with_capacity(job.operations.len());
+    for op in &job.operations {
+        let f = &op.finish;
+        let top_before = zmap.max_top().unwrap_or(stock.min.z);
+        let clearance = f.clearance.max(top_before + STOCK_CLEARANCE_MM - part_top);
+        let p = plan_operation(f, &prepared, &tolerances, Some(clearance))?;
+        let volume_before = zmap.volume();
+        let cut = zmap.cut(&f.cutter, &p.plan.toolpath)?;
+        if !cut.rapid_hits.is_empty() {
+            cut.check()?;
+        }
+        let collisions = zmap.part_collisions_in(&field, &f.cutter, &p.plan.toolpath, cut.operation)?;
+        if !collisions.is_empty() {
+            return Err(scallop_sim::SimError::PartCollision { count: collisions.len(), collisions }.into());
+        }
+        cut.check()?;
+        let figures = StockFigures {
+            top_before_mm: top_before,
+            volume_before_mm3: volume_before,
+            removed_mm3: cut.removed_volume,
+            air_cut_share: cut.air_cut_share(),
+            clearance_mm: clearance,
+        };
+        planned.push((p, figures));
+    }
+    let Some(last) = job.operations.last().map(|o| &o.finish) else {
+        return Err(no_operation());
+    };
+    let (gouge_tolerance, options) = verify_options(last, &prepared);
+    let verification = verify_in(&zmap, &field, &options)?;
+    let simulation = scallop_sim::Simulation { zmap, cut: empty_cut(), verification };
+    if last.strategy == Strategy::NetworkPlanes {
+        if let Some((p, _)) = planned.last_mut() {
+            network_scallop_from(&simulation, last, &mut p.plan.report)?;
+        }
+    }
+    let gcode = program(job, &planned, &prepared, &tolerances)?;
+    let mut toolpath = Toolpath::new(first.machine[0] * 1000.0);
+    let mut reports = Vec::with_capacity(planned.len());
+    let mut total_time = 0.0;
+    for ((p, figures), (k, op)) in planned.iter().zip(job.operations.iter().enumerate()) {
+        toolpath.extend_from(&p.plan.toolpath);
+        total_time += p.plan.report.total_time_s;
+        reports.push(OperationReport {
+            name: op.name.clone(),
+            cutter: cutter_text(op.finish.cutter.shape()),
+            tool: tool_number(&op.finish, k),
+            scallop_height_mm: op.finish.scallop_height,
+            direction_deg: p.direction_deg,
+            plan: p.plan.report.clone(),
+            stock: figures.clone(),
+        });
+    }
+    let v = &simulation.verification;
+    let report = JobReport {
+        part: first.part_name.clone(),
+        stock_mm: [stock.min.coords.into(), stock.max.coords.into()],
+        operations: reports,
+        total_time_s: total_time,
+        sim_resolution_mm: first.sim_resolution,
+        sim_max_scallop_mm: v.max_thickness,
+        sim_resolution_bound_mm: simulation.zmap.resolution_bound(last.cutter.shape()),
+        sim_min_deviation_mm: v.min_deviation,
+        sim_gouge_tolerance_mm: gouge_tolerance,
+    };
+    let toolpaths = planned.into_iter().map(|(p, _)| p.plan.toolpath).collect();
+    Ok(JobOutput { toolpaths, toolpath, gcode, report, prepared, simulation })
+}
+
+fn no_operation() -> EngineError {
+    EngineError::Output { what: "a job without operations".into(), fix: "give at least one [[operation]]".into() }
+}
+
+/// The first operation, once the operations agree on what they share.
+fn check_operations(job: &Job) -> Result<&Operation, EngineError> {
+    let first = job.operations.first().ok_or_else(no_operation)?;
+    let f = &first.finish;
+    for (k, op) in job.operations.iter().enumerate() {
+        let o = &op.finish;
+        if o.setup.is_some() && job.operations.len() > 1 {
+            return Err(EngineError::Output {
+                what: format!("operation {} (`{}`) has a 3+2 [setup] in a job of several operations", k + 1, op.name),
+                fix: "run 3+2 operations as jobs of their own (one stock per setup is not supported yet)".into(),
+            });
+        }
+        let same = o.tolerances == f.tolerances
+            && o.sim_resolution.to_bits() == f.sim_resolution.to_bits()
+            && o.output.dialect.name == f.output.dialect.name
+            && o.output.arc_fitting == f.output.arc_fitting
+            && o.part_name == f.part_name;
+        if !same {
+            return Err(EngineError::Output {
+                what: format!(
+                    "operation {} (`{}`) differs from the first in its part, tolerances, verify resolution or output",
+                    k + 1,
+                    op.name
+                ),
+                fix: "give the operations of one job the same part and the job-level settings".into(),
+            });
+        }
+    }
+    Ok(first)
+}
+
+/// The tool number of operation `k`: its own, else `k + 1`.
+fn tool_number(job: &FinishJob, k: usize) -> u32 {
+    if job.output.tool > 0 { job.output.tool } else { u32::try_from(k + 1).unwrap_or(u32::MAX) }
+}
+
+fn empty_cut() -> scallop_sim::CutReport {
+    scallop_sim::CutReport {
+        operation: 0,
+        removed_by_move: Vec::new(),
+        removed_volume: 0.0,
+        feed_moves: 0,
+        air_feed_moves: 0,
+        rapid_hits: Vec::new(),
+        collisions: Vec::new(),
+    }
+}
+
+/// One program: the job's header comments, then each operation's section.
+fn program(
+    job: &Job,
+    planned: &[(PlannedOperation, StockFigures)],
+    prepared: &PreparedPart,
+    tolerances: &Tolerances,
+) -> Result<String, EngineError> {
+    let mut fitted: Vec<(FittedPath, Vec<String>)> = Vec::with_capacity(planned.len());
+    let mut header: Vec<String> = Vec::new();
+    for (k, ((p, _), op)) in planned.iter().zip(&job.operations).enumerate() {
+        let (f, comments) = fit_and_comment(&op.finish, p, prepared, tolerances);
+        if k == 0 {
+            header.push(comments[0].clone());
+        }
+        fitted.push((f, comments));
+    }
+    let sections: Vec<Section<'_>> = fitted
+        .iter()
+        .zip(&job.operations)
+        .enumerate()
+        .map(|(k, ((f, comments), op))| Section {
+            path: f,
+            info: ProgramInfo {
+                program: String::new(),
+                tool: tool_number(&op.finish, k),
+                spindle: op.finish.output.spindle,
+                indexed_rotaries: Vec::new(),
+            },
+            title: format!("operation {} `{}`: {}", k + 1, op.name, comments[1..].join("; ")),
+        })
+        .collect();
+    let first = &job.operations[0].finish;
+    let refs: Vec<&str> = header.iter().map(String::as_str).collect();
+    let mut text = Vec::new();
+    write_sections(&sections, &first.output.dialect, &first.output.program, &refs, &mut text)
+        .map_err(|e| EngineError::Output { what: format!("writing the program: {e}"), fix: String::new() })?;
+    Ok(String::from_utf8_lossy(&text).into_owned())
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used, reason = "tests: a panic is the failure report")]
+mod tests {
+    use super::*;
+    use scallop_cutter::{Cutter, CutterShape};
+
+    fn coarse_then_fine() -> Job {
+        let mut coarse = FinishJob::choi_demo();
+        coarse.cutter = Cutter::new(CutterShape::Ball { radius: 4.0 }, 40.0).unwrap();
+        coarse.scallop_height = 0.2;
+        let mut fine = FinishJob::choi_demo();
+        fine.scallop_height = 0.03;
+        // Flutes long enough to cut the whole stock alone (the comparison below).
+        fine.cutter = Cutter::new(CutterShape::Bull { radius: 5.0, corner: 2.0 }, 60.0).unwrap();
+        let mut stock = stock_box(&prepare_part(&fine.part, &fine.tolerances).unwrap().mesh, 5.0);
+        stock.max.z += 9.0;
+        Job {
+            stock: Some(stock),
+            operations: vec![
+                Operation { name: "coarse ball".into(), finish: coarse },
+                Operation { name: "fine bull-nose".into(), finish: fine },
+            ],
+        }
+    }
+
+    /// The second operation sees the stock the first one left: it receives
+    /// the volume the first left and removes far less than it would from the
+    /// fresh stock; the rapids of both clear the tall stock's untouched
+    /// corners (a rapid into stock would fail the job); the program changes
+    /// tools between them and the final stock holds the fine scallop.
+    #[test]
+    fn the_second_operation_sees_the_stock_the_first_left() {
+        let job = coarse_then_fine();
+        let out = run_job(&job).unwrap();
+        let [a, b] = [&out.report.operations[0], &out.report.operations[1]];
+        let part_top = out.prepared.mesh.bounds().max.z;
+        let stock_top = job.stock.unwrap().max.z;
+        assert_eq!(a.stock.top_before_mm, stock_top);
+        assert!((a.stock.clearance_mm - (stock_top + STOCK_CLEARANCE_MM - part_top)).abs() < 1e-9, "{:?}", a.stock);
+        assert!(a.stock.clearance_mm > job.operations[0].finish.clearance, "{:?}", a.stock);
+        let after_first = a.stock.volume_before_mm3 - a.stock.removed_mm3;
+        assert!((b.stock.volume_before_mm3 - after_first).abs() < 1e-9 * a.stock.volume_before_mm3, "{a:?} {b:?}");
+        let alone = Job { stock: job.stock, operations: vec![job.operations[1].clone()] };
+        let alone = run_job(&alone).unwrap();
+        let fresh = &alone.report.operations[0].stock;
+        assert!(b.stock.removed_mm3 < 0.05 * fresh.removed_mm3, "{:?} vs {fresh:?}", b.stock);
+        assert!((fresh.volume_before_mm3 - a.stock.volume_before_mm3).abs() < 1e-9 * fresh.volume_before_mm3);
+        // One program, two tools, the spindle stopped before the second change.
+        let text = &out.gcode;
+        let (t1, t2) = (text.find("T1 M6").unwrap(), text.find("T2 M6").unwrap());
+        assert!(t1 < t2 && text[t1..t2].contains("M5"), "{text}");
+        assert_eq!(text.matches("M2").count(), 1);
+        // The final stock: no gouge (run_job would fail) and the fine scallop.
+        let r = &out.report;
+        assert!(r.sim_max_scallop_mm <= 0.03 + r.sim_resolution_bound_mm, "{r:?}");
+        assert_eq!(out.toolpath.moves().len(), out.toolpaths.iter().map(|t| t.moves().len()).sum::<usize>());
+    }
+
+    #[test]
+    fn operations_must_share_the_job_settings() {
+        let mut job = coarse_then_fine();
+        job.operations[1].finish.sim_resolution = 0.2;
+        assert!(matches!(run_job(&job), Err(EngineError::Output { .. })));
+        job.operations.clear();
+        assert!(matches!(run_job(&job), Err(EngineError::Output { .. })));
+    }
+}
