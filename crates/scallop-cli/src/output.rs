@@ -97,6 +97,78 @@ pub fn demo(args: &DemoArgs) -> CliResult<()> {
     write_finishing(&job, &out, seconds, &args.output, args.json, "scallop demo")
 }
 
+/// Writes `program.nc`, `report.json` and `toolpath.csv` of a job of several
+/// operations into `folder` and prints the summary (or the report as JSON).
+pub fn write_job(out: &scallop_engine::JobOutput, seconds: f64, folder: &Path, json: bool) -> CliResult<()> {
+    let nc = folder.join("program.nc");
+    write_atomic(&nc, |w| w.write_all(out.gcode.as_bytes()))?;
+    let text = serde_json::to_string_pretty(&out.report).map_err(|e| Failure::Io(e.into()))?;
+    write_atomic(&folder.join("report.json"), |w| w.write_all(text.as_bytes()))?;
+    let csv = scallop_io::cl::write_cl(&out.toolpath);
+    write_atomic(&folder.join("toolpath.csv"), |w| w.write_all(csv.as_bytes()))?;
+    if json {
+        return print_json(&out.report);
+    }
+    let r = &out.report;
+    let mut text = format!(
+        "{} operations on one stock, {}\n  stock      [{:.2}, {:.2}, {:.2}] to [{:.2}, {:.2}, {:.2}] mm\n",
+        r.operations.len(),
+        r.part,
+        r.stock_mm[0][0],
+        r.stock_mm[0][1],
+        r.stock_mm[0][2],
+        r.stock_mm[1][0],
+        r.stock_mm[1][1],
+        r.stock_mm[1][2]
+    );
+    for (k, op) in r.operations.iter().enumerate() {
+        text.push_str(&format!(
+            "  {}. {} (T{}): {}, scallop height {} mm, feed at {:.2}° from X; {} passes, {} + {:.1} s rapids; \
+             removed {:.0} mm³ of the {:.0} mm³ it met, {:.0} % of its feed moves in air\n",
+            k + 1,
+            op.name,
+            op.tool,
+            op.cutter,
+            op.scallop_height_mm,
+            op.direction_deg,
+            op.plan.passes,
+            hms(op.plan.machining_time_s),
+            op.plan.rapid_time_s,
+            op.stock.removed_mm3,
+            op.stock.volume_before_mm3,
+            100.0 * op.stock.air_cut_share
+        ));
+    }
+    text.push_str(&format!(
+        "  time       {} in all (stop-to-stop, rapids included)\n\
+         \x20 simulated  no gouge on the final {} mm stock; deepest {:+.4} mm (tolerance {:.4} mm); \
+         scallop {:.4} mm along the normal beyond R from the edge (last operation's limit: sh + {:.5} mm)\n\
+         \x20 planned    in {}\n\
+         \x20 wrote      {}, report.json, toolpath.csv\n",
+        hms(r.total_time_s),
+        r.sim_resolution_mm,
+        r.sim_min_deviation_mm,
+        r.sim_gouge_tolerance_mm,
+        r.sim_max_scallop_mm,
+        r.sim_resolution_bound_mm,
+        hms(seconds),
+        nc.display()
+    ));
+    print_text(&text)
+}
+
+/// A duration as people read it: seconds under a minute, else h:mm:ss.
+#[must_use]
+pub fn hms(seconds: f64) -> String {
+    if !seconds.is_finite() || seconds < 60.0 {
+        return format!("{seconds:.1} s");
+    }
+    // Rounded to whole seconds: far below 2^52.
+    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+    let s = seconds.round() as u64;
+    format!("{}:{:02}:{:02}", s / 3600, (s / 60) % 60, s % 60)
+}
+
 /// Writes `program.nc`, `report.json`, `toolpath.csv`, `report.html` and
 /// `scene.glb` of a finishing job into `folder` and prints the summary (or the
 /// report as JSON).

@@ -4,13 +4,14 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use scallop_cutter::{Cutter, CutterShape};
-use scallop_engine::{FinishJob, OutputOptions, Setup, Strategy, run_finishing};
+use scallop_engine::{FinishJob, Job, Operation, OutputOptions, Setup, StockShape, Strategy, run_finishing, run_job};
+use scallop_geom::Aabb3;
 use scallop_geom::Tolerances;
 use scallop_geom::nalgebra::Rotation3;
 use scallop_io::job::{DirectionSpec, JobFile, parse_job};
 use scallop_strategy::{IsoDirection, LeadKind, Pattern};
 
-use crate::output::{progress_bar, write_finishing};
+use crate::output::{progress_bar, write_finishing, write_job};
 use crate::part::{UnitsArg, load};
 use crate::{CliResult, Failure};
 
@@ -41,6 +42,18 @@ pub fn run(args: &RunArgs) -> CliResult<()> {
         Failure::Rejected(e) => Failure::Rejected(anyhow::anyhow!("{name}: {e:#}")),
         other => other,
     })?;
+    if spec.operation_list {
+        let engine_job = operations_job(&spec, job).map_err(|e| match e {
+            Failure::Rejected(e) => Failure::Rejected(anyhow::anyhow!("{name}: {e:#}")),
+            other => other,
+        })?;
+        let spinner = progress_bar(0, "planning, cutting and verifying the operations");
+        spinner.enable_steady_tick(std::time::Duration::from_millis(120));
+        let start = std::time::Instant::now();
+        let out = run_job(&engine_job).map_err(|e| Failure::rejected(format!("{name}: {e}{}", job_keys(&e))))?;
+        spinner.finish_and_clear();
+        return write_job(&out, start.elapsed().as_secs_f64(), &args.output, args.json);
+    }
     let spinner = progress_bar(0, "planning and verifying");
     spinner.enable_steady_tick(std::time::Duration::from_millis(120));
     let start = std::time::Instant::now();
@@ -48,6 +61,64 @@ pub fn run(args: &RunArgs) -> CliResult<()> {
     spinner.finish_and_clear();
     let command = format!("scallop run {name}");
     write_finishing(&job, &out, start.elapsed().as_secs_f64(), &args.output, args.json, &command)
+}
+
+/// The engine job of a file with `[[operation]]`s: one finishing job per
+/// operation, each a copy of `first` (the job-level settings, the part loaded
+/// once) with the operation's cutter, finishing settings, tool and spindle.
+fn operations_job(spec: &JobFile, first: FinishJob) -> CliResult<Job> {
+    let mut operations = Vec::with_capacity(spec.operations.len());
+    for (k, op) in spec.operations.iter().enumerate() {
+        let mut finish = first.clone();
+        finish.cutter = cutter_of(&op.cutter).map_err(|e| match e {
+            Failure::Rejected(e) => Failure::rejected(format!("operation {} (`{}`): {e:#}", k + 1, op.name)),
+            other => other,
+        })?;
+        apply_finishing(&mut finish, &op.finishing);
+        finish.output.tool = op.tool.unwrap_or(spec.output.tool);
+        finish.output.spindle = op.spindle.unwrap_or(spec.output.spindle);
+        operations.push(Operation { name: op.name.clone(), finish });
+    }
+    let stock = spec.stock.as_ref().map(|s| match (s.min, s.max) {
+        (Some(min), Some(max)) => StockShape::Box(Aabb3 { min: min.into(), max: max.into() }),
+        _ => StockShape::AroundPart { margin: s.margin, top: s.top.unwrap_or(1.0), bottom: s.bottom.unwrap_or(1.0) },
+    });
+    Ok(Job { stock, operations })
+}
+
+/// The cutter of a `[cutter]` table.
+fn cutter_of(spec: &scallop_io::job::CutterSpec) -> CliResult<Cutter> {
+    let radius = spec.diameter / 2.0;
+    let shape = match spec.shape.as_str() {
+        "ball" => CutterShape::Ball { radius },
+        "flat" => CutterShape::Flat { radius },
+        _ => CutterShape::Bull { radius, corner: spec.corner_radius.unwrap_or(radius) },
+    };
+    let flute = spec.flute_length.unwrap_or(4.0 * spec.diameter);
+    Cutter::new(shape, flute)
+        .map_err(|e| Failure::rejected(format!("[cutter] (diameter, corner_radius, flute_length): {e}")))
+}
+
+/// The settings of a `[finishing]` table on a finishing job.
+fn apply_finishing(job: &mut FinishJob, f: &scallop_io::job::FinishingSpec) {
+    job.scallop_height = f.scallop_height;
+    job.direction_deg = match f.direction {
+        DirectionSpec::Degrees(d) => Some(d),
+        DirectionSpec::Named(_) | DirectionSpec::Auto => None,
+    };
+    job.pattern = if f.pattern == "one-way" { Pattern::OneWay } else { Pattern::Zigzag };
+    job.max_step = f.max_step;
+    job.strategy = match (f.strategy.as_str(), f.iso_direction.as_str()) {
+        ("isoparametric", "v") => Strategy::Isoparametric(IsoDirection::V),
+        ("isoparametric", _) => Strategy::Isoparametric(IsoDirection::U),
+        ("network", _) => Strategy::NetworkPlanes,
+        _ => Strategy::ParallelPlanes,
+    };
+    job.leads = match f.lead.as_str() {
+        "arc" => LeadKind::Arc { radius: f.lead_radius },
+        "ramp" => LeadKind::Ramp { length: f.lead_length, angle: f.lead_angle_deg.to_radians() },
+        _ => LeadKind::None,
+    };
 }
 
 pub(crate) fn finish_job(spec: &JobFile, folder: &Path) -> CliResult<FinishJob> {
@@ -66,15 +137,7 @@ pub(crate) fn finish_job(spec: &JobFile, folder: &Path) -> CliResult<FinishJob> 
         }
         (None, None) => return Err(Failure::rejected("part: give `file` or `builtin`")),
     };
-    let radius = spec.cutter.diameter / 2.0;
-    let shape = match spec.cutter.shape.as_str() {
-        "ball" => CutterShape::Ball { radius },
-        "flat" => CutterShape::Flat { radius },
-        _ => CutterShape::Bull { radius, corner: spec.cutter.corner_radius.unwrap_or(radius) },
-    };
-    let flute = spec.cutter.flute_length.unwrap_or(4.0 * spec.cutter.diameter);
-    let cutter = Cutter::new(shape, flute)
-        .map_err(|e| Failure::rejected(format!("[cutter] (diameter, corner_radius, flute_length): {e}")))?;
+    let cutter = cutter_of(&spec.cutter)?;
     let o = &spec.output;
     let dialect = scallop_post::Dialect::builtin(&o.dialect).map_err(|_| {
         Failure::rejected(format!(
@@ -99,38 +162,26 @@ pub(crate) fn finish_job(spec: &JobFile, folder: &Path) -> CliResult<FinishJob> 
             Some(Setup { rotation: Rotation3::from_euler_angles(rx, ry, rz), machine, tool_length: s.tool_length })
         }
     };
-    Ok(FinishJob {
+    let mut job = FinishJob {
         part,
         part_name,
         cutter,
-        scallop_height: spec.finishing.scallop_height,
-        direction_deg: match spec.finishing.direction {
-            DirectionSpec::Degrees(d) => Some(d),
-            DirectionSpec::Named(_) | DirectionSpec::Auto => None,
-        },
-        pattern: if spec.finishing.pattern == "one-way" { Pattern::OneWay } else { Pattern::Zigzag },
+        scallop_height: 0.0,
+        direction_deg: None,
+        pattern: Pattern::Zigzag,
         machine: [spec.machine.feed, spec.machine.acceleration, spec.machine.jerk],
         rapid_rate: spec.machine.rapid * 1000.0 / 60.0,
         clearance: spec.machine.clearance,
         tolerances: Tolerances { path: spec.tolerances.path, gouge: spec.tolerances.gouge },
-        max_step: spec.finishing.max_step,
+        max_step: 0.0,
         sim_resolution: spec.verify.resolution,
         output,
         setup,
-        strategy: match (spec.finishing.strategy.as_str(), spec.finishing.iso_direction.as_str()) {
-            ("isoparametric", "v") => Strategy::Isoparametric(IsoDirection::V),
-            ("isoparametric", _) => Strategy::Isoparametric(IsoDirection::U),
-            ("network", _) => Strategy::NetworkPlanes,
-            _ => Strategy::ParallelPlanes,
-        },
-        leads: match spec.finishing.lead.as_str() {
-            "arc" => LeadKind::Arc { radius: spec.finishing.lead_radius },
-            "ramp" => {
-                LeadKind::Ramp { length: spec.finishing.lead_length, angle: spec.finishing.lead_angle_deg.to_radians() }
-            }
-            _ => LeadKind::None,
-        },
-    })
+        strategy: Strategy::ParallelPlanes,
+        leads: LeadKind::None,
+    };
+    apply_finishing(&mut job, &spec.finishing);
+    Ok(job)
 }
 
 /// The job keys behind a planning failure, so the message names what to change.

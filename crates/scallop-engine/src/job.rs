@@ -33,12 +33,29 @@ pub struct Operation {
     pub finish: FinishJob,
 }
 
+/// The stock of a [`Job`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum StockShape {
+    /// A box (mm, part frame).
+    Box(Aabb3),
+    /// The part's box grown by `margin` in X and Y (default: the largest
+    /// cutter radius of the operations), `top` above and `bottom` below (mm).
+    AroundPart {
+        /// Margin in X and Y; `None`: the largest cutter radius.
+        margin: Option<f64>,
+        /// Stock above the part's top.
+        top: f64,
+        /// Stock below the part's bottom.
+        bottom: f64,
+    },
+}
+
 /// A job: operations in order on one stock.
 #[derive(Debug, Clone)]
 pub struct Job {
-    /// The stock box (mm, part frame); `None`: [`stock_box`] of the part with
-    /// the largest cutter of the operations.
-    pub stock: Option<Aabb3>,
+    /// The stock; `None`: [`stock_box`] of the part with the largest cutter
+    /// of the operations.
+    pub stock: Option<StockShape>,
     /// The operations, in machining order (at least one).
     pub operations: Vec<Operation>,
 }
@@ -132,7 +149,16 @@ pub fn run_job(job: &Job) -> Result<JobOutput, EngineError> {
     let tolerances = planning_tolerances(first)?;
     let prepared = prepare_part(&first.part, &tolerances)?;
     let radius = job.operations.iter().map(|o| o.finish.cutter.radius()).fold(0.0, f64::max);
-    let stock = job.stock.unwrap_or_else(|| stock_box(&prepared.mesh, radius));
+    let stock = match job.stock {
+        None => stock_box(&prepared.mesh, radius),
+        Some(StockShape::Box(b)) => b,
+        Some(StockShape::AroundPart { margin, top, bottom }) => {
+            let mut b = stock_box(&prepared.mesh, margin.unwrap_or(radius));
+            b.max.z += top - 1.0;
+            b.min.z -= bottom - 1.0;
+            b
+        }
+    };
     let mut zmap = ZMap::new(stock, first.sim_resolution)?;
     let field = PartField::new(&zmap, &prepared.index);
     let part_top = prepared.mesh.bounds().max.z;
@@ -313,7 +339,7 @@ mod tests {
         let mut stock = stock_box(&prepare_part(&fine.part, &fine.tolerances).unwrap().mesh, 5.0);
         stock.max.z += 9.0;
         Job {
-            stock: Some(stock),
+            stock: Some(StockShape::Box(stock)),
             operations: vec![
                 Operation { name: "coarse ball".into(), finish: coarse },
                 Operation { name: "fine bull-nose".into(), finish: fine },

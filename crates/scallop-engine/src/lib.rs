@@ -34,7 +34,9 @@ pub use finish::{
     stock_box,
 };
 pub use grid::{GridAxis, GridError, MAX_GRID_POINTS};
-pub use job::{Job, JobOutput, JobReport, Operation, OperationReport, STOCK_CLEARANCE_MM, StockFigures, run_job};
+pub use job::{
+    Job, JobOutput, JobReport, Operation, OperationReport, STOCK_CLEARANCE_MM, StockFigures, StockShape, run_job,
+};
 pub use zones::{
     ZONE_MARGIN_PER_RADIUS, ZONE_MARGIN_PER_SPACING, ZONE_MARGIN_ROUNDS, ZoneFigures, ZoneFinishOutput,
     ZoneFinishReport, ZonePlanSpec, ZoneSpec, finish_zones,

@@ -20,33 +20,104 @@
 
 use serde::Deserialize;
 
-/// A job file.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields)]
+/// A job file: a part, a stock and operations in order. A job without
+/// `[[operation]]` is one finishing operation given by `[cutter]` and
+/// `[finishing]`.
+#[derive(Debug, Clone, PartialEq)]
 pub struct JobFile {
     /// The part.
     pub part: PartSpec,
-    /// The cutter.
+    /// The cutter of the first operation.
     pub cutter: CutterSpec,
-    /// The finishing operation.
+    /// The finishing settings of the first operation.
     pub finishing: FinishingSpec,
+    /// The stock; `None`: the part's box grown by the largest cutter radius,
+    /// 1 mm below and above the part.
+    pub stock: Option<StockSpec>,
+    /// The operations in machining order (at least one).
+    pub operations: Vec<OperationSpec>,
+    /// Whether the file lists `[[operation]]`s (else it is a one-operation job
+    /// of `[cutter]` and `[finishing]`).
+    pub operation_list: bool,
     /// Tolerances (mm).
-    #[serde(default)]
     pub tolerances: TolerancesSpec,
     /// Machine limits.
-    #[serde(default)]
     pub machine: MachineSpec,
     /// Stock simulation that proves the program.
-    #[serde(default)]
     pub verify: VerifySpec,
     /// Zone-optimisation study (`scallop optimize`).
-    #[serde(default)]
     pub optimize: Option<OptimizeSpec>,
     /// How the program is written.
-    #[serde(default)]
     pub output: OutputSpec,
     /// 3+2 setup (indexed rotaries); absent for 3-axis work.
     pub setup: Option<SetupSpec>,
+}
+
+/// The file as written, before the operations are normalised.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawJob {
+    part: PartSpec,
+    cutter: Option<CutterSpec>,
+    finishing: Option<FinishingSpec>,
+    stock: Option<StockSpec>,
+    #[serde(default)]
+    operation: Vec<OperationSpec>,
+    #[serde(default)]
+    tolerances: TolerancesSpec,
+    #[serde(default)]
+    machine: MachineSpec,
+    #[serde(default)]
+    verify: VerifySpec,
+    #[serde(default)]
+    optimize: Option<OptimizeSpec>,
+    #[serde(default)]
+    output: OutputSpec,
+    setup: Option<SetupSpec>,
+}
+
+/// `[stock]`: a box given by its corners, or margins around the part's box
+/// (mm). Corners and margins exclude each other.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StockSpec {
+    /// Lowest corner `[x, y, z]` (part frame).
+    pub min: Option<[f64; 3]>,
+    /// Highest corner `[x, y, z]`.
+    pub max: Option<[f64; 3]>,
+    /// Margin around the part's box in X and Y (default: the largest cutter radius).
+    pub margin: Option<f64>,
+    /// Stock above the part's top (default 1).
+    pub top: Option<f64>,
+    /// Stock below the part's bottom (default 1).
+    pub bottom: Option<f64>,
+}
+
+/// What an operation does.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum OperationKind {
+    /// Finishing with a guaranteed scallop height (`[operation.finishing]`).
+    Finish,
+}
+
+/// `[[operation]]`: one operation with its own cutter, tool and spindle.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OperationSpec {
+    /// What it does.
+    pub kind: OperationKind,
+    /// How the program and the report name it (default: `operation N`).
+    #[serde(default)]
+    pub name: String,
+    /// Tool number in the program (default: `output.tool`, else the operation's number).
+    pub tool: Option<u32>,
+    /// Spindle speed (1/min; default `output.spindle`).
+    pub spindle: Option<f64>,
+    /// `[operation.cutter]`.
+    pub cutter: CutterSpec,
+    /// `[operation.finishing]`.
+    pub finishing: FinishingSpec,
 }
 
 /// `[output]`.
@@ -414,6 +485,16 @@ pub enum JobError {
     /// Syntax, unknown key, missing key or wrong type (line and column included).
     #[error("{0}")]
     Toml(String),
+    /// A value of one `[[operation]]` that makes no sense.
+    #[error("operation {index} (`{name}`): {source}")]
+    Operation {
+        /// 1-based position in the file.
+        index: usize,
+        /// Its name.
+        name: String,
+        /// What is wrong (keys relative to the operation).
+        source: Box<JobError>,
+    },
     /// A value that makes no sense.
     #[error("`{key}` = {value}: {fix}")]
     Value {
@@ -426,12 +507,99 @@ pub enum JobError {
     },
 }
 
+/// The operations of a job file: its `[[operation]]`s, or one finishing
+/// operation of `[cutter]` and `[finishing]`.
+fn normalise(raw: RawJob) -> Result<JobFile, JobError> {
+    let missing =
+        |key| JobError::Value { key, value: "missing".into(), fix: "give [cutter] and [finishing], or [[operation]]s" };
+    let operation_list = !raw.operation.is_empty();
+    let operations = if operation_list {
+        if raw.cutter.is_some() || raw.finishing.is_some() {
+            return Err(JobError::Value {
+                key: "cutter, finishing",
+                value: "given with [[operation]]".into(),
+                fix: "put the cutter and the finishing settings in each [[operation]] ([operation.cutter], [operation.finishing])",
+            });
+        }
+        let mut ops = raw.operation;
+        for (k, op) in ops.iter_mut().enumerate() {
+            if op.name.is_empty() {
+                op.name = format!("operation {}", k + 1);
+            }
+        }
+        ops
+    } else {
+        let cutter = raw.cutter.ok_or_else(|| missing("cutter"))?;
+        let finishing = raw.finishing.ok_or_else(|| missing("finishing"))?;
+        vec![OperationSpec {
+            kind: OperationKind::Finish,
+            name: "finish".into(),
+            tool: None,
+            spindle: None,
+            cutter,
+            finishing,
+        }]
+    };
+    if let Some(stock) = &raw.stock {
+        check_stock(stock)?;
+    }
+    Ok(JobFile {
+        part: raw.part,
+        cutter: operations[0].cutter.clone(),
+        finishing: operations[0].finishing.clone(),
+        stock: raw.stock,
+        operations,
+        operation_list,
+        tolerances: raw.tolerances,
+        machine: raw.machine,
+        verify: raw.verify,
+        optimize: raw.optimize,
+        output: raw.output,
+        setup: raw.setup,
+    })
+}
+
+fn check_stock(stock: &StockSpec) -> Result<(), JobError> {
+    let bad = |key, value: String, fix| Err(JobError::Value { key, value, fix });
+    match (stock.min, stock.max) {
+        (Some(min), Some(max)) => {
+            if stock.margin.is_some() || stock.top.is_some() || stock.bottom.is_some() {
+                return bad(
+                    "stock",
+                    "corners and margins".into(),
+                    "give either min and max, or margin, top and bottom",
+                );
+            }
+            let finite = min.iter().chain(&max).all(|v| v.is_finite());
+            if !finite || (0..3).any(|i| max[i] <= min[i]) {
+                return bad(
+                    "stock.max",
+                    format!("{max:?} (min {min:?})"),
+                    "give finite corners with max > min on every axis",
+                );
+            }
+        }
+        (None, None) => {
+            for (key, v) in [("stock.margin", stock.margin), ("stock.top", stock.top), ("stock.bottom", stock.bottom)] {
+                if let Some(v) = v
+                    && !(v.is_finite() && v >= 0.0)
+                {
+                    return bad(key, v.to_string(), "give a margin in mm, >= 0");
+                }
+            }
+        }
+        _ => return bad("stock", "one corner".into(), "give both min and max"),
+    }
+    Ok(())
+}
+
 /// Parses and checks a job file.
 ///
 /// # Errors
 /// [`JobError`] naming the line or the key.
 pub fn parse_job(text: &str) -> Result<JobFile, JobError> {
-    let job: JobFile = toml::from_str(text).map_err(|e| JobError::Toml(e.to_string().trim_end().to_string()))?;
+    let raw: RawJob = toml::from_str(text).map_err(|e| JobError::Toml(e.to_string().trim_end().to_string()))?;
+    let job = normalise(raw)?;
     let bad = |key, value: f64, fix| Err(JobError::Value { key, value: value.to_string(), fix });
     match (&job.part.file, &job.part.builtin) {
         (Some(_), Some(_)) | (None, None) => {
@@ -446,89 +614,32 @@ pub fn parse_job(text: &str) -> Result<JobFile, JobError> {
     if !matches!(job.part.units.as_str(), "mm" | "in") {
         return Err(JobError::Value { key: "part.units", value: job.part.units.clone(), fix: "use \"mm\" or \"in\"" });
     }
-    if !matches!(job.cutter.shape.as_str(), "ball" | "flat" | "bull") {
-        return Err(JobError::Value {
-            key: "cutter.shape",
-            value: job.cutter.shape.clone(),
-            fix: "use \"ball\", \"flat\" or \"bull\" (finishing)",
-        });
-    }
     let positive = |v: f64| v.is_finite() && v > 0.0;
-    if !positive(job.cutter.diameter) {
-        return bad("cutter.diameter", job.cutter.diameter, "give the diameter in mm, > 0");
-    }
-    if job.cutter.shape == "bull" {
-        match job.cutter.corner_radius {
-            Some(r) if positive(r) && r <= job.cutter.diameter / 2.0 => {}
-            Some(r) => return bad("cutter.corner_radius", r, "need 0 < r <= diameter / 2"),
-            None => {
-                return Err(JobError::Value {
-                    key: "cutter.corner_radius",
-                    value: "missing".into(),
-                    fix: "a bull-nose cutter needs its corner radius",
-                });
+    let operations = job.operations.clone();
+    for (k, op) in operations.iter().enumerate() {
+        check_cutting(&op.cutter, &op.finishing).map_err(|e| {
+            if job.operation_list {
+                JobError::Operation { index: k + 1, name: op.name.clone(), source: Box::new(e) }
+            } else {
+                e
             }
+        })?;
+        if let Some(t) = op.spindle
+            && !(t.is_finite() && t >= 0.0)
+        {
+            return Err(JobError::Operation {
+                index: k + 1,
+                name: op.name.clone(),
+                source: Box::new(JobError::Value {
+                    key: "spindle",
+                    value: t.to_string(),
+                    fix: "give the spindle speed in 1/min, >= 0",
+                }),
+            });
         }
     }
     let sh = job.finishing.scallop_height;
-    if !positive(sh) || sh >= job.cutter.diameter / 2.0 {
-        return bad("finishing.scallop_height", sh, "need 0 < sh < the cutter radius (diameter / 2)");
-    }
-    if job.cutter.shape == "bull" && job.cutter.corner_radius.is_some_and(|r| sh >= r) {
-        return bad("finishing.scallop_height", sh, "need 0 < sh < the bull-nose corner radius");
-    }
-    if let Some(f) = job.cutter.flute_length
-        && !positive(f)
-    {
-        return bad("cutter.flute_length", f, "give the flute length in mm, > 0");
-    }
-    match &job.finishing.direction {
-        DirectionSpec::Named(n) if n != "auto" => {
-            return Err(JobError::Value {
-                key: "finishing.direction",
-                value: n.clone(),
-                fix: "use \"auto\" or an angle in degrees",
-            });
-        }
-        DirectionSpec::Degrees(d) if !d.is_finite() => return bad("finishing.direction", *d, "give a finite angle"),
-        _ => {}
-    }
-    if !matches!(job.finishing.pattern.as_str(), "zigzag" | "one-way") {
-        return Err(JobError::Value {
-            key: "finishing.pattern",
-            value: job.finishing.pattern.clone(),
-            fix: "use \"zigzag\" or \"one-way\"",
-        });
-    }
-    if !matches!(job.finishing.strategy.as_str(), "parallel" | "isoparametric" | "network") {
-        return Err(JobError::Value {
-            key: "finishing.strategy",
-            value: job.finishing.strategy.clone(),
-            fix: "use \"parallel\", \"network\" or \"isoparametric\"",
-        });
-    }
-    if !matches!(job.finishing.iso_direction.as_str(), "u" | "v") {
-        return Err(JobError::Value {
-            key: "finishing.iso_direction",
-            value: job.finishing.iso_direction.clone(),
-            fix: "use \"u\" or \"v\"",
-        });
-    }
-    if !matches!(job.finishing.lead.as_str(), "none" | "arc" | "ramp") {
-        return Err(JobError::Value {
-            key: "finishing.lead",
-            value: job.finishing.lead.clone(),
-            fix: "use \"none\", \"arc\" or \"ramp\"",
-        });
-    }
-    let angle = job.finishing.lead_angle_deg;
-    if !(angle.is_finite() && angle > 0.0 && angle < 90.0) {
-        return bad("finishing.lead_angle_deg", angle, "need 0 < angle < 90 degrees");
-    }
     for (key, v) in [
-        ("finishing.lead_radius", job.finishing.lead_radius),
-        ("finishing.lead_length", job.finishing.lead_length),
-        ("finishing.max_step", job.finishing.max_step),
         ("tolerances.path", job.tolerances.path),
         ("machine.feed", job.machine.feed),
         ("machine.acceleration", job.machine.acceleration),
@@ -566,6 +677,101 @@ pub fn parse_job(text: &str) -> Result<JobFile, JobError> {
         check_optimize(o, sh)?;
     }
     Ok(job)
+}
+
+/// The checks of one cutter and its finishing settings (keys named as in a
+/// single-operation job).
+fn check_cutting(cutter: &CutterSpec, finishing: &FinishingSpec) -> Result<(), JobError> {
+    let bad = |key, value: f64, fix| Err(JobError::Value { key, value: value.to_string(), fix });
+    if !matches!(cutter.shape.as_str(), "ball" | "flat" | "bull") {
+        return Err(JobError::Value {
+            key: "cutter.shape",
+            value: cutter.shape.clone(),
+            fix: "use \"ball\", \"flat\" or \"bull\" (finishing)",
+        });
+    }
+    let positive = |v: f64| v.is_finite() && v > 0.0;
+    if !positive(cutter.diameter) {
+        return bad("cutter.diameter", cutter.diameter, "give the diameter in mm, > 0");
+    }
+    if cutter.shape == "bull" {
+        match cutter.corner_radius {
+            Some(r) if positive(r) && r <= cutter.diameter / 2.0 => {}
+            Some(r) => return bad("cutter.corner_radius", r, "need 0 < r <= diameter / 2"),
+            None => {
+                return Err(JobError::Value {
+                    key: "cutter.corner_radius",
+                    value: "missing".into(),
+                    fix: "a bull-nose cutter needs its corner radius",
+                });
+            }
+        }
+    }
+    let sh = finishing.scallop_height;
+    if !positive(sh) || sh >= cutter.diameter / 2.0 {
+        return bad("finishing.scallop_height", sh, "need 0 < sh < the cutter radius (diameter / 2)");
+    }
+    if cutter.shape == "bull" && cutter.corner_radius.is_some_and(|r| sh >= r) {
+        return bad("finishing.scallop_height", sh, "need 0 < sh < the bull-nose corner radius");
+    }
+    if let Some(f) = cutter.flute_length
+        && !positive(f)
+    {
+        return bad("cutter.flute_length", f, "give the flute length in mm, > 0");
+    }
+    match &finishing.direction {
+        DirectionSpec::Named(n) if n != "auto" => {
+            return Err(JobError::Value {
+                key: "finishing.direction",
+                value: n.clone(),
+                fix: "use \"auto\" or an angle in degrees",
+            });
+        }
+        DirectionSpec::Degrees(d) if !d.is_finite() => return bad("finishing.direction", *d, "give a finite angle"),
+        _ => {}
+    }
+    if !matches!(finishing.pattern.as_str(), "zigzag" | "one-way") {
+        return Err(JobError::Value {
+            key: "finishing.pattern",
+            value: finishing.pattern.clone(),
+            fix: "use \"zigzag\" or \"one-way\"",
+        });
+    }
+    if !matches!(finishing.strategy.as_str(), "parallel" | "isoparametric" | "network") {
+        return Err(JobError::Value {
+            key: "finishing.strategy",
+            value: finishing.strategy.clone(),
+            fix: "use \"parallel\", \"network\" or \"isoparametric\"",
+        });
+    }
+    if !matches!(finishing.iso_direction.as_str(), "u" | "v") {
+        return Err(JobError::Value {
+            key: "finishing.iso_direction",
+            value: finishing.iso_direction.clone(),
+            fix: "use \"u\" or \"v\"",
+        });
+    }
+    if !matches!(finishing.lead.as_str(), "none" | "arc" | "ramp") {
+        return Err(JobError::Value {
+            key: "finishing.lead",
+            value: finishing.lead.clone(),
+            fix: "use \"none\", \"arc\" or \"ramp\"",
+        });
+    }
+    let angle = finishing.lead_angle_deg;
+    if !(angle.is_finite() && angle > 0.0 && angle < 90.0) {
+        return bad("finishing.lead_angle_deg", angle, "need 0 < angle < 90 degrees");
+    }
+    for (key, v) in [
+        ("finishing.lead_radius", finishing.lead_radius),
+        ("finishing.lead_length", finishing.lead_length),
+        ("finishing.max_step", finishing.max_step),
+    ] {
+        if !positive(v) {
+            return bad(key, v, "must be a finite number > 0");
+        }
+    }
+    Ok(())
 }
 
 fn check_optimize(o: &OptimizeSpec, sh: f64) -> Result<(), JobError> {
