@@ -8,7 +8,10 @@ use std::time::Instant;
 use clap::Args;
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget};
 use scallop_analysis::{Cutter, MachineLimits};
-use scallop_io::job::{JobFile, OptimizeSpec, SurrogateCostSpec, parse_job};
+use scallop_io::job::{
+    BarrierWord, FormulationWord, JobFile, OptimizeSpec, ShapeWord, SurrogateCostSpec, SurrogateWord, TransitionWord,
+    parse_job,
+};
 use scallop_optim::study::{
     Formulation, KResult, Stopwatch, Study, StudyObserver, StudySettings, Surrogate, run_study,
 };
@@ -419,27 +422,29 @@ fn load_patch(spec: &JobFile, folder: &Path) -> CliResult<(scallop_surface::Patc
 
 /// Study and model settings from the job.
 fn settings(spec: &JobFile, o: &OptimizeSpec) -> CliResult<(StudySettings, SurfaceSettings)> {
-    let formulation = match o.formulation.as_str() {
-        "3axis" => Formulation::ThreeAxis,
-        "3+2" => Formulation::ThreePlusTwo,
-        _ => Formulation::Heuristic,
+    let formulation = match o.formulation {
+        FormulationWord::ThreeAxis => Formulation::ThreeAxis,
+        FormulationWord::ThreePlusTwo => Formulation::ThreePlusTwo,
+        FormulationWord::Heuristic => Formulation::Heuristic,
     };
     let radius = spec.cutter.diameter / 2.0;
-    let tool = match spec.cutter.shape.as_str() {
-        "ball" => Cutter::Ball { radius },
-        "bull" => Cutter::Toroidal { radius, corner: spec.cutter.corner_radius.unwrap_or(radius) },
+    let tool = match spec.cutter.shape {
+        ShapeWord::Ball => Cutter::Ball { radius },
+        ShapeWord::Bull => Cutter::Toroidal { radius, corner: spec.cutter.corner_radius.unwrap_or(radius) },
         other => {
             return Err(Failure::rejected(format!(
-                "cutter.shape = \"{other}\": zone optimisation plans ball or bull-nose cutters"
+                "cutter.shape = \"{}\": zone optimisation plans ball or bull-nose cutters",
+                other.word()
             )));
         }
     };
     let machine = MachineLimits::from_thesis_units(spec.machine.feed, spec.machine.acceleration, spec.machine.jerk);
     let transitions = Transitions {
-        model: if o.transition == "linear" {
-            TransitionModel::Linear
-        } else {
-            TransitionModel::RetractTraverse { clearance: o.transition_clearance, rapid_feed: None }
+        model: match o.transition {
+            TransitionWord::Linear => TransitionModel::Linear,
+            TransitionWord::Retract => {
+                TransitionModel::RetractTraverse { clearance: o.transition_clearance, rapid_feed: None }
+            }
         },
         reorientation_s: 0.0,
     };
@@ -452,10 +457,10 @@ fn settings(spec: &JobFile, o: &OptimizeSpec) -> CliResult<(StudySettings, Surfa
         k_min,
         k_max,
         budget: o.budget,
-        surrogate: match o.surrogate.as_str() {
-            "none" => Surrogate::None,
-            "s4" => Surrogate::S4,
-            _ => Surrogate::S3,
+        surrogate: match o.surrogate {
+            SurrogateWord::None => Surrogate::None,
+            SurrogateWord::S3 => Surrogate::S3,
+            SurrogateWord::S4 => Surrogate::S4,
         },
         seed: o.seed,
         cost: match o.surrogate_cost {
@@ -463,7 +468,10 @@ fn settings(spec: &JobFile, o: &OptimizeSpec) -> CliResult<(StudySettings, Surfa
             SurrogateCostSpec::Named(_) => CostModel::Measured,
         },
         model_search: o.model_search,
-        barrier: if o.barrier == "extreme" { Barrier::Extreme } else { Barrier::Progressive },
+        barrier: match o.barrier {
+            BarrierWord::Extreme => Barrier::Extreme,
+            BarrierWord::Progressive => Barrier::Progressive,
+        },
         start_omega: o.omega,
     };
     let model = SurfaceSettings {

@@ -18,6 +18,15 @@ pub enum UnitsArg {
     In,
 }
 
+impl From<scallop_io::job::UnitsWord> for UnitsArg {
+    fn from(u: scallop_io::job::UnitsWord) -> UnitsArg {
+        match u {
+            scallop_io::job::UnitsWord::Mm => UnitsArg::Mm,
+            scallop_io::job::UnitsWord::In => UnitsArg::In,
+        }
+    }
+}
+
 impl From<UnitsArg> for Units {
     fn from(u: UnitsArg) -> Units {
         match u {

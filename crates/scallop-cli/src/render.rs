@@ -100,7 +100,7 @@ fn job_part(spec: &str) -> Option<(String, UnitsArg)> {
     }
     let text = std::fs::read_to_string(path).ok()?;
     let job = scallop_io::job::parse_job(&text).ok()?;
-    let units = if job.part.units == "in" { UnitsArg::In } else { UnitsArg::Mm };
+    let units = UnitsArg::from(job.part.units);
     match (&job.part.file, &job.part.builtin) {
         (Some(file), _) => {
             Some((path.parent().unwrap_or(Path::new(".")).join(file).to_string_lossy().into_owned(), units))

@@ -8,7 +8,7 @@ use scallop_engine::{FinishJob, Job, Operation, OutputOptions, Setup, StockShape
 use scallop_geom::Aabb3;
 use scallop_geom::Tolerances;
 use scallop_geom::nalgebra::Rotation3;
-use scallop_io::job::{DirectionSpec, JobFile, parse_job};
+use scallop_io::job::{DirectionSpec, IsoWord, JobFile, LeadWord, PatternWord, ShapeWord, StrategyWord, parse_job};
 use scallop_strategy::{IsoDirection, LeadKind, Pattern};
 
 use crate::output::{progress_bar, write_finishing, write_job};
@@ -89,10 +89,10 @@ fn operations_job(spec: &JobFile, first: FinishJob) -> CliResult<Job> {
 /// The cutter of a `[cutter]` table.
 fn cutter_of(spec: &scallop_io::job::CutterSpec) -> CliResult<Cutter> {
     let radius = spec.diameter / 2.0;
-    let shape = match spec.shape.as_str() {
-        "ball" => CutterShape::Ball { radius },
-        "flat" => CutterShape::Flat { radius },
-        _ => CutterShape::Bull { radius, corner: spec.corner_radius.unwrap_or(radius) },
+    let shape = match spec.shape {
+        ShapeWord::Ball => CutterShape::Ball { radius },
+        ShapeWord::Flat => CutterShape::Flat { radius },
+        ShapeWord::Bull => CutterShape::Bull { radius, corner: spec.corner_radius.unwrap_or(radius) },
     };
     let flute = spec.flute_length.unwrap_or(4.0 * spec.diameter);
     Cutter::new(shape, flute)
@@ -106,23 +106,26 @@ fn apply_finishing(job: &mut FinishJob, f: &scallop_io::job::FinishingSpec) {
         DirectionSpec::Degrees(d) => Some(d),
         DirectionSpec::Named(_) | DirectionSpec::Auto => None,
     };
-    job.pattern = if f.pattern == "one-way" { Pattern::OneWay } else { Pattern::Zigzag };
-    job.max_step = f.max_step;
-    job.strategy = match (f.strategy.as_str(), f.iso_direction.as_str()) {
-        ("isoparametric", "v") => Strategy::Isoparametric(IsoDirection::V),
-        ("isoparametric", _) => Strategy::Isoparametric(IsoDirection::U),
-        ("network", _) => Strategy::NetworkPlanes,
-        _ => Strategy::ParallelPlanes,
+    job.pattern = match f.pattern {
+        PatternWord::OneWay => Pattern::OneWay,
+        PatternWord::Zigzag => Pattern::Zigzag,
     };
-    job.leads = match f.lead.as_str() {
-        "arc" => LeadKind::Arc { radius: f.lead_radius },
-        "ramp" => LeadKind::Ramp { length: f.lead_length, angle: f.lead_angle_deg.to_radians() },
-        _ => LeadKind::None,
+    job.max_step = f.max_step;
+    job.strategy = match (f.strategy, f.iso_direction) {
+        (StrategyWord::Isoparametric, IsoWord::V) => Strategy::Isoparametric(IsoDirection::V),
+        (StrategyWord::Isoparametric, IsoWord::U) => Strategy::Isoparametric(IsoDirection::U),
+        (StrategyWord::Network, _) => Strategy::NetworkPlanes,
+        (StrategyWord::Parallel, _) => Strategy::ParallelPlanes,
+    };
+    job.leads = match f.lead {
+        LeadWord::Arc => LeadKind::Arc { radius: f.lead_radius },
+        LeadWord::Ramp => LeadKind::Ramp { length: f.lead_length, angle: f.lead_angle_deg.to_radians() },
+        LeadWord::None => LeadKind::None,
     };
 }
 
 pub(crate) fn finish_job(spec: &JobFile, folder: &Path) -> CliResult<FinishJob> {
-    let units = if spec.part.units == "in" { UnitsArg::In } else { UnitsArg::Mm };
+    let units = UnitsArg::from(spec.part.units);
     let (part, part_name) = match (&spec.part.file, &spec.part.builtin) {
         (Some(file), _) => {
             let path = folder.join(file);

@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
-use scallop_engine::prepare_part;
+use scallop_engine::{Budget, prepare_part};
 use scallop_geom::{Aabb3, Point3, Tolerances, Vec3};
 use scallop_io::cl::read_cl;
 use scallop_io::gcode::{GcodeOptions, read_gcode_arcs};
@@ -52,10 +52,16 @@ pub struct SimulateArgs {
     /// the cutter radius in X and Y, from 1 mm below to 1 mm above the part.
     #[arg(long, allow_hyphen_values = true)]
     stock: Option<String>,
-    /// Allowed penetration below the part (mm); for surfaces the tessellation's
-    /// chordal error is added.
+    /// Allowed penetration below the part (mm), as `tolerances.gouge` of a job; the
+    /// path tolerance and, for surfaces, the tessellation's chordal error are added
+    /// (the allowance `scallop run` proves its programs with).
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     gouge_tolerance: f64,
+    /// The path tolerance the program was planned with (mm), as `tolerances.path`
+    /// of a job (default 0.01, the job default): chords between cutter locations
+    /// may dip below the CL surface by this much.
+    #[arg(long, default_value_t = 0.01, allow_hyphen_values = true)]
+    path_tolerance: f64,
     /// Unit of mesh coordinates.
     #[arg(long, value_enum, default_value = "mm")]
     units: UnitsArg,
@@ -160,12 +166,16 @@ fn parse_stock(text: &str) -> CliResult<Aabb3> {
 /// `scallop simulate`.
 pub fn run(args: &SimulateArgs) -> CliResult<()> {
     let (cutter, cutter_text) = args.tool.build()?;
-    if !(args.gouge_tolerance.is_finite() && args.gouge_tolerance >= 0.0) {
-        return Err(Failure::rejected(format!("--gouge-tolerance {}: must be >= 0", args.gouge_tolerance)));
-    }
+    let tolerances = Tolerances { path: args.path_tolerance, gouge: args.gouge_tolerance };
+    let budget = Budget::new(tolerances, false).map_err(|_| {
+        Failure::rejected(format!(
+            "--path-tolerance {} / --gouge-tolerance {}: need a path tolerance > 0 and a gouge tolerance >= 0 (mm)",
+            args.path_tolerance, args.gouge_tolerance
+        ))
+    })?;
     let loaded = load(&args.part, args.units)?;
-    let prepared = prepare_part(&loaded.part, &Tolerances { path: 0.01, gouge: args.gouge_tolerance })
-        .map_err(|e| Failure::rejected(format!("{}: {e}", args.part)))?;
+    let prepared =
+        prepare_part(&loaded.part, &tolerances).map_err(|e| Failure::rejected(format!("{}: {e}", args.part)))?;
     let program = read_program(args)?;
     let name = program.name.clone();
     let tilted = program.moves.iter().any(|m| m.axis != Vec3::z());
@@ -184,7 +194,7 @@ pub fn run(args: &SimulateArgs) -> CliResult<()> {
         None => scallop_engine::stock_box(&prepared.mesh, cutter.radius()),
     };
     let options =
-        VerifyOptions { gouge_tolerance: args.gouge_tolerance + prepared.chordal_error, ..VerifyOptions::default() };
+        VerifyOptions { gouge_tolerance: budget.gouge_allowance(prepared.chordal_error), ..VerifyOptions::default() };
     let (report, zmap, dev, max_dev) = if dexel {
         simulate_dexel(args, &program, &cutter, &cutter_text, stock, &prepared, &options, &loaded.description)?
     } else {

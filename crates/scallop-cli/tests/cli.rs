@@ -573,3 +573,53 @@ fn simulate_runs_a_3_plus_2_toolpath_on_tri_dexels() {
     assert_eq!(z.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&z.stderr).contains("--stock-model dexel"));
 }
+
+/// A job of two operations on a pyramid mesh: one program with two tool
+/// changes, a report per operation, and the second operation meeting the
+/// stock the first left; the written CL file reads back and is accepted by
+/// `simulate --toolpath` (the same CL format in and out).
+#[test]
+fn run_machines_two_operations_on_one_stock() {
+    let dir = scratch("two-operations");
+    std::fs::write(dir.join("pyramid.stl"), pyramid_stl()).expect("write");
+    let job = "[part]\nfile = \"pyramid.stl\"\n[stock]\ntop = 3\n\
+        [[operation]]\nkind = \"finish\"\nname = \"coarse\"\n[operation.cutter]\nshape = \"ball\"\ndiameter = 6\n\
+        [operation.finishing]\nscallop_height = 0.3\n\
+        [[operation]]\nkind = \"finish\"\nname = \"fine\"\nspindle = 10000\n[operation.cutter]\nshape = \"ball\"\ndiameter = 4\n\
+        [operation.finishing]\nscallop_height = 0.05\n[verify]\nresolution = 0.1\n";
+    std::fs::write(dir.join("job.toml"), job).expect("write");
+    let out = scallop()
+        .arg("run")
+        .arg(dir.join("job.toml"))
+        .arg("-o")
+        .arg(dir.join("out"))
+        .arg("--json")
+        .output()
+        .expect("run");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
+    let ops = report["operations"].as_array().expect("operations");
+    assert_eq!(ops.len(), 2);
+    let (a, b) = (&ops[0]["stock"], &ops[1]["stock"]);
+    let left = a["volume_before_mm3"].as_f64().unwrap() - a["removed_mm3"].as_f64().unwrap();
+    assert!((b["volume_before_mm3"].as_f64().unwrap() - left).abs() <= 1e-6 * left, "{report}");
+    assert!(b["removed_mm3"].as_f64().unwrap() < a["removed_mm3"].as_f64().unwrap(), "{report}");
+    let program = std::fs::read_to_string(dir.join("out/program.nc")).expect("program");
+    let (t1, t2) = (program.find("T1 M6").expect("T1"), program.find("T2 M6").expect("T2"));
+    assert!(t1 < t2 && program[t2..].contains("S10000 M3"), "{program}");
+    let csv = std::fs::read_to_string(dir.join("out/toolpath.csv")).expect("toolpath.csv");
+    let path = scallop_io::cl::read_cl(&csv, 1000.0).expect("the CL file reads back");
+    assert_eq!(path.moves().len(), csv.lines().count() - 1);
+    // Both operations' moves cut with the smaller ball from the part's box: the
+    // same CL file accepted by the simulator (no gouge, no rapid into stock).
+    let sim = scallop()
+        .args(["simulate", "--toolpath"])
+        .arg(dir.join("out/toolpath.csv"))
+        .arg("--part")
+        .arg(dir.join("pyramid.stl"))
+        .args(["--cutter", "ball", "--diameter", "4", "-o"])
+        .arg(dir.join("sim"))
+        .output()
+        .expect("simulate");
+    assert!(sim.status.success(), "{}", String::from_utf8_lossy(&sim.stderr));
+}

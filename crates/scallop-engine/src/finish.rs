@@ -23,12 +23,7 @@ use scallop_strategy::{
 use scallop_toolpath::{FittedPath, Move, MoveKind, Toolpath, fit_arcs};
 use serde::Serialize;
 
-use crate::{EngineError, Part, PreparedPart, prepare_part};
-
-/// Share of the path tolerance given to arc fitting when it is on: the planning
-/// (tessellation, sampling, merging) then runs with `1 - ARC_SHARE` of it, and every
-/// toolpath vertex and chord midpoint lies within `ARC_SHARE * path` of its arc.
-pub const ARC_SHARE: f64 = 0.25;
+use crate::{ARC_SHARE, EngineError, Part, PreparedPart, prepare_part};
 
 /// How the program is written.
 #[derive(Debug, Clone)]
@@ -284,11 +279,7 @@ pub(crate) fn planning_tolerances(job: &FinishJob) -> Result<Tolerances, EngineE
             fix: "set output.arc_fitting = false for a job with a [setup]".into(),
         });
     }
-    Ok(if job.output.arc_fitting {
-        Tolerances { path: job.tolerances.path * (1.0 - ARC_SHARE), ..job.tolerances }
-    } else {
-        job.tolerances
-    })
+    Ok(crate::Budget::new(job.tolerances, job.output.arc_fitting)?.planning())
 }
 
 /// The simulation's allowance and options: the program follows the
@@ -297,7 +288,8 @@ pub(crate) fn planning_tolerances(job: &FinishJob) -> Result<Tolerances, EngineE
 /// scallop is held beyond the cutter radius from the part's edge (see
 /// `VerifyOptions::scallop_margin`), the edge strip's figure reported too.
 pub(crate) fn verify_options(job: &FinishJob, prepared: &PreparedPart) -> (f64, scallop_sim::VerifyOptions) {
-    let gouge_tolerance = job.tolerances.gouge + prepared.chordal_error + job.tolerances.path;
+    let gouge_tolerance =
+        crate::Budget { tolerances: job.tolerances, arc_fitting: false }.gouge_allowance(prepared.chordal_error);
     let options = scallop_sim::VerifyOptions {
         gouge_tolerance,
         scallop_margin: job.cutter.radius(),

@@ -358,7 +358,8 @@ mod tests {
         let out = run_job(&job).unwrap();
         let [a, b] = [&out.report.operations[0], &out.report.operations[1]];
         let part_top = out.prepared.mesh.bounds().max.z;
-        let stock_top = job.stock.unwrap().max.z;
+        let Some(StockShape::Box(stock)) = job.stock else { panic!("a box stock") };
+        let stock_top = stock.max.z;
         assert_eq!(a.stock.top_before_mm, stock_top);
         assert!((a.stock.clearance_mm - (stock_top + STOCK_CLEARANCE_MM - part_top)).abs() < 1e-9, "{:?}", a.stock);
         assert!(a.stock.clearance_mm > job.operations[0].finish.clearance, "{:?}", a.stock);

@@ -18,6 +18,7 @@
 //! - Never performs I/O and never prints; progress goes through callbacks.
 //! - Deterministic: the same inputs give the same outputs on any thread count.
 
+mod budget;
 mod demo;
 mod finish;
 mod grid;
@@ -28,10 +29,10 @@ use scallop_geom::Tolerances;
 use scallop_mesh::{MeshIndex, TriMesh};
 use scallop_surface::SurfaceSet;
 
+pub use budget::{ARC_SHARE, Budget};
 pub use demo::{DemoOutput, DemoSettings, DemoSummary, run_demo};
 pub use finish::{
-    ARC_SHARE, FinishDetails, FinishJob, FinishOutput, FinishReport, OutputOptions, Setup, Strategy, run_finishing,
-    stock_box,
+    FinishDetails, FinishJob, FinishOutput, FinishReport, OutputOptions, Setup, Strategy, run_finishing, stock_box,
 };
 pub use grid::{GridAxis, GridError, MAX_GRID_POINTS};
 pub use job::{

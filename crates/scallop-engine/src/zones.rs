@@ -264,11 +264,7 @@ fn finish_zones_with(job: &FinishJob, spec: &ZonePlanSpec, share: f64) -> Result
             fix: "remove [setup] and use finishing.strategy = \"parallel\"".into(),
         });
     }
-    let tolerances = if job.output.arc_fitting {
-        Tolerances { path: job.tolerances.path * (1.0 - ARC_SHARE), ..job.tolerances }
-    } else {
-        job.tolerances
-    };
+    let tolerances = crate::Budget::new(job.tolerances, job.output.arc_fitting)?.planning();
     let (prepared, uv) = labelled_mesh(patch, &tolerances)?;
     let labels: Vec<u32> = uv.iter().map(|&[u, v]| spec.labels.label_at(u, v)).collect();
     let base = finishing_params(job, 0.0);
