@@ -286,109 +286,35 @@ fn finish_zones_with(job: &FinishJob, spec: &ZonePlanSpec, share: f64) -> Result
     let mut zone_sims: Vec<(f64, f64, f64)> = Vec::new(); // (scallop, min deviation, bound) per tilted zone
     let mut figures = Vec::with_capacity(spec.zones.len());
     let mut ends: Vec<(Point3, Point3)> = Vec::new();
+    let ctx = ZoneContext {
+        job,
+        spec,
+        prepared: &prepared,
+        labels: &labels,
+        base,
+        tolerances,
+        start_margin,
+        cap,
+        options: &options,
+        open_edge: &open_edge,
+        tilted,
+    };
     for zone in &spec.zones {
-        let params = FinishingParams { direction: zone.direction_deg.to_radians(), ..base };
-        let orientation = (zone.tilt_deg != 0.0)
-            .then(|| Orientation::new(zone.tilt_deg.to_radians(), zone.azimuth_deg.to_radians(), Point3::origin()));
-        let turned = match &orientation {
-            Some(o) => Some(turn(&prepared, o)?),
-            None => None,
-        };
-        let part = turned.as_ref().unwrap_or(&prepared);
-        let mut figure = ZoneFigures {
-            label: zone.label,
-            direction_deg: zone.direction_deg,
-            tilt_deg: zone.tilt_deg,
-            azimuth_deg: zone.azimuth_deg,
-            sim_zone_scallop_mm: None,
-            triangles: labels.iter().filter(|&&l| l == zone.label).count(),
-            region_triangles: 0,
-            margin_mm: 0.0,
-            max_spacing_mm: 0.0,
-            passes: 0,
-            max_scallop_mm: 0.0,
-            machining_time_s: 0.0,
-            machining_time_lookahead_s: 0.0,
-            predicted_time_s: zone.predicted_time_s,
-            skipped: None,
-        };
-        if figure.triangles == 0 {
-            figure.skipped = Some("no triangle of the machining mesh carries this label".into());
-            figures.push(figure);
-            continue;
-        }
-        let mut margin = spec.fixed_margin_mm.unwrap_or(start_margin);
-        let mut planned = None;
-        for _ in 0..ZONE_MARGIN_ROUNDS {
-            let region = ZoneRegion::new(&part.mesh, &labels, zone.label, margin)?;
-            figure.region_triangles = region.accepted_triangles();
-            let p = match plan_zone_finishing(&part.index, &job.cutter, &params, &tolerances, &region) {
-                Ok(p) => p,
-                Err(StrategyError::EmptyRegion { .. }) => break,
-                Err(source) => {
-                    return Err(EngineError::Zone { zone: zone.label, direction_deg: zone.direction_deg, source });
-                }
-            };
-            let spacing = largest_spacing(&p.planes, cap);
-            figure.margin_mm = margin;
-            figure.max_spacing_mm = spacing;
-            let done = spec.fixed_margin_mm.is_some() || ZONE_MARGIN_PER_SPACING * spacing <= margin;
-            planned = Some(p);
-            if done {
-                break;
+        let planned = plan_zone_of(&ctx, zone)?;
+        if let Some((zone_path, axis, sim)) = planned.path {
+            zone_sims.extend(sim);
+            records.extend(records_from_toolpath(&zone_path, &axis));
+            let first = zone_path.moves().iter().find(|m| m.kind == MoveKind::Plunge).map(|m| m.to);
+            let last = zone_path.moves().iter().rev().find(|m| m.kind != MoveKind::Retract).map(|m| m.to);
+            if let (Some(a), Some(b)) = (first, last) {
+                ends.push((a, b));
             }
-            margin = ZONE_MARGIN_PER_SPACING * spacing;
-        }
-        let Some(p) = planned else {
-            figure.skipped = Some("no cutter location has its contact in the zone".into());
-            figures.push(figure);
-            continue;
-        };
-        figure.passes = p.report.passes;
-        figure.max_scallop_mm = p.scallop.max_mm;
-        figure.machining_time_s = p.report.machining_time_s;
-        figure.machining_time_lookahead_s = p.report.machining_time_lookahead_s;
-        let mut zone_path = p.toolpath;
-        if tilted {
-            // Prove the zone in its own frame: no gouge or collision anywhere, and its
-            // own triangles finished within the scallop height.
-            let stock = crate::stock_box(&part.mesh, radius);
-            let sim = scallop_sim::simulate(stock, job.sim_resolution, &job.cutter, &zone_path, &part.index, &options)?;
-            let bound = sim.zmap.resolution_bound(job.cutter.shape());
-            let (height, at) = zone_scallop(&sim.zmap, part, &labels, zone.label, &open_edge, radius);
-            if height > job.scallop_height + bound {
-                let at =
-                    orientation.map_or(Point3::new(at[0], at[1], 0.0), |o| o.to_part(&Point3::new(at[0], at[1], 0.0)));
-                return Err(EngineError::ScallopExceeded {
-                    height,
-                    limit: job.scallop_height + bound,
-                    x: at.x,
-                    y: at.y,
-                });
-            }
-            figure.sim_zone_scallop_mm = Some(height);
-            zone_sims.push((height, sim.verification.min_deviation, bound));
-            if let Some(o) = &orientation {
-                let mut back = Toolpath::new(zone_path.feed);
-                back.plunge_feed = zone_path.plunge_feed;
-                for m in zone_path.moves() {
-                    back.push(scallop_toolpath::Move::new(m.kind, o.to_part(&m.to)));
-                }
-                zone_path = back;
+            for m in zone_path.moves() {
+                toolpath.push_with_axis(*m, axis);
+                zone_of_move.push(zone.label);
             }
         }
-        let axis = orientation.as_ref().map_or_else(Vec3::z, Orientation::tool_axis);
-        records.extend(records_from_toolpath(&zone_path, &axis));
-        let first = zone_path.moves().iter().find(|m| m.kind == MoveKind::Plunge).map(|m| m.to);
-        let last = zone_path.moves().iter().rev().find(|m| m.kind != MoveKind::Retract).map(|m| m.to);
-        if let (Some(a), Some(b)) = (first, last) {
-            ends.push((a, b));
-        }
-        for m in zone_path.moves() {
-            toolpath.push_with_axis(*m, axis);
-            zone_of_move.push(zone.label);
-        }
-        figures.push(figure);
+        figures.push(planned.figure);
     }
     if toolpath.moves().is_empty() {
         return Err(StrategyError::EmptyRegion { direction_deg: 0.0 }.into());
@@ -492,6 +418,122 @@ fn finish_zones_with(job: &FinishJob, spec: &ZonePlanSpec, share: f64) -> Result
         sim_gouge_tolerance_mm: gouge_tolerance,
     };
     Ok(ZoneFinishOutput { toolpath, zone_of_move, gcode: text, report, prepared, simulation: sim })
+}
+
+/// What every zone of one [`finish_zones_with`] run shares.
+struct ZoneContext<'a> {
+    job: &'a FinishJob,
+    spec: &'a ZonePlanSpec,
+    prepared: &'a PreparedPart,
+    labels: &'a [u32],
+    base: FinishingParams,
+    tolerances: Tolerances,
+    start_margin: f64,
+    cap: f64,
+    options: &'a scallop_sim::VerifyOptions,
+    open_edge: &'a [bool],
+    tilted: bool,
+}
+
+/// One zone planned: its figures and, unless skipped, its toolpath (part
+/// frame), its tool axis and, for a 3+2 zone, its own proof (scallop, deepest
+/// deviation, resolution bound).
+struct PlannedZone {
+    figure: ZoneFigures,
+    path: Option<(Toolpath, Vec3, Option<(f64, f64, f64)>)>,
+}
+
+/// Plans one zone: its region grown until the margin covers its spacing, its
+/// passes by drop-cutter, and for a 3+2 zone its proof in its own frame.
+fn plan_zone_of(ctx: &ZoneContext<'_>, zone: &ZoneSpec) -> Result<PlannedZone, EngineError> {
+    let ZoneContext { job, spec, prepared, labels, base, tolerances, start_margin, cap, options, open_edge, tilted } =
+        *ctx;
+    let radius = job.cutter.radius();
+    let mut zone_sim = None;
+    let params = FinishingParams { direction: zone.direction_deg.to_radians(), ..base };
+    let orientation = (zone.tilt_deg != 0.0)
+        .then(|| Orientation::new(zone.tilt_deg.to_radians(), zone.azimuth_deg.to_radians(), Point3::origin()));
+    let turned = match &orientation {
+        Some(o) => Some(turn(&prepared, o)?),
+        None => None,
+    };
+    let part = turned.as_ref().unwrap_or(prepared);
+    let mut figure = ZoneFigures {
+        label: zone.label,
+        direction_deg: zone.direction_deg,
+        tilt_deg: zone.tilt_deg,
+        azimuth_deg: zone.azimuth_deg,
+        sim_zone_scallop_mm: None,
+        triangles: labels.iter().filter(|&&l| l == zone.label).count(),
+        region_triangles: 0,
+        margin_mm: 0.0,
+        max_spacing_mm: 0.0,
+        passes: 0,
+        max_scallop_mm: 0.0,
+        machining_time_s: 0.0,
+        machining_time_lookahead_s: 0.0,
+        predicted_time_s: zone.predicted_time_s,
+        skipped: None,
+    };
+    if figure.triangles == 0 {
+        figure.skipped = Some("no triangle of the machining mesh carries this label".into());
+        return Ok(PlannedZone { figure, path: None });
+    }
+    let mut margin = spec.fixed_margin_mm.unwrap_or(start_margin);
+    let mut planned = None;
+    for _ in 0..ZONE_MARGIN_ROUNDS {
+        let region = ZoneRegion::new(&part.mesh, &labels, zone.label, margin)?;
+        figure.region_triangles = region.accepted_triangles();
+        let p = match plan_zone_finishing(&part.index, &job.cutter, &params, &tolerances, &region) {
+            Ok(p) => p,
+            Err(StrategyError::EmptyRegion { .. }) => break,
+            Err(source) => {
+                return Err(EngineError::Zone { zone: zone.label, direction_deg: zone.direction_deg, source });
+            }
+        };
+        let spacing = largest_spacing(&p.planes, cap);
+        figure.margin_mm = margin;
+        figure.max_spacing_mm = spacing;
+        let done = spec.fixed_margin_mm.is_some() || ZONE_MARGIN_PER_SPACING * spacing <= margin;
+        planned = Some(p);
+        if done {
+            break;
+        }
+        margin = ZONE_MARGIN_PER_SPACING * spacing;
+    }
+    let Some(p) = planned else {
+        figure.skipped = Some("no cutter location has its contact in the zone".into());
+        return Ok(PlannedZone { figure, path: None });
+    };
+    figure.passes = p.report.passes;
+    figure.max_scallop_mm = p.scallop.max_mm;
+    figure.machining_time_s = p.report.machining_time_s;
+    figure.machining_time_lookahead_s = p.report.machining_time_lookahead_s;
+    let mut zone_path = p.toolpath;
+    if tilted {
+        // Prove the zone in its own frame: no gouge or collision anywhere, and its
+        // own triangles finished within the scallop height.
+        let stock = crate::stock_box(&part.mesh, radius);
+        let sim = scallop_sim::simulate(stock, job.sim_resolution, &job.cutter, &zone_path, &part.index, &options)?;
+        let bound = sim.zmap.resolution_bound(job.cutter.shape());
+        let (height, at) = zone_scallop(&sim.zmap, part, &labels, zone.label, &open_edge, radius);
+        if height > job.scallop_height + bound {
+            let at = orientation.map_or(Point3::new(at[0], at[1], 0.0), |o| o.to_part(&Point3::new(at[0], at[1], 0.0)));
+            return Err(EngineError::ScallopExceeded { height, limit: job.scallop_height + bound, x: at.x, y: at.y });
+        }
+        figure.sim_zone_scallop_mm = Some(height);
+        zone_sim = Some((height, sim.verification.min_deviation, bound));
+        if let Some(o) = &orientation {
+            let mut back = Toolpath::new(zone_path.feed);
+            back.plunge_feed = zone_path.plunge_feed;
+            for m in zone_path.moves() {
+                back.push(scallop_toolpath::Move::new(m.kind, o.to_part(&m.to)));
+            }
+            zone_path = back;
+        }
+    }
+    let axis = orientation.as_ref().map_or_else(Vec3::z, Orientation::tool_axis);
+    Ok(PlannedZone { figure, path: Some((zone_path, axis, zone_sim)) })
 }
 
 fn directions(figures: &[ZoneFigures]) -> String {
