@@ -57,6 +57,10 @@ pub struct PostArgs {
     /// Tip tolerance of joint-space interpolation (mm).
     #[arg(long, default_value_t = 0.01, allow_hyphen_values = true)]
     tolerance: f64,
+    /// Retract distance along the tool axis of a link that changes branch or unwinds (mm):
+    /// the tool backs off this far, the rotaries turn, and it comes back.
+    #[arg(long, default_value_t = 10.0, allow_hyphen_values = true)]
+    retract: f64,
     /// Program file to write (default: the CL file's name with .nc).
     #[arg(short, long)]
     output: Option<PathBuf>,
@@ -149,7 +153,12 @@ fn records(rows: &[ClRow], feed: f64) -> Vec<ClRecord> {
 
 /// `scallop post`.
 pub fn run(args: &PostArgs) -> CliResult<()> {
-    for (flag, v) in [("--feed", args.feed), ("--tolerance", args.tolerance), ("--spindle", args.spindle)] {
+    for (flag, v) in [
+        ("--feed", args.feed),
+        ("--tolerance", args.tolerance),
+        ("--spindle", args.spindle),
+        ("--retract", args.retract),
+    ] {
         if !(v.is_finite() && v > 0.0) {
             return Err(Failure::rejected(format!("{flag} {v}: must be a finite number > 0")));
         }
@@ -163,7 +172,7 @@ pub fn run(args: &PostArgs) -> CliResult<()> {
     let rows = read_cl_csv(&text).map_err(|e| Failure::rejected(format!("{}: {e}", args.cl_file.display())))?;
     let records = records(&rows, args.feed);
     let kin = Kinematics::new(&machine, args.tool_length);
-    let options = ProgramOptions { tol_pos: args.tolerance, ..ProgramOptions::default() };
+    let options = ProgramOptions { tol_pos: args.tolerance, retract: args.retract, ..ProgramOptions::default() };
     let program = to_program(&kin, &records, None, &options)
         .map_err(|e| Failure::rejected(format!("{} on {}: {e}", args.cl_file.display(), machine.name())))?;
     let time = program_time(&kin, &program.blocks.iter().map(|b| (b.motion, b.joints, b.feed)).collect::<Vec<_>>())

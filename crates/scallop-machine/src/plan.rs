@@ -260,6 +260,81 @@ fn jumps_on_rotaries(
     (!(only_pole && (p.at_pole || sol.at_pole || crosses())), unwrapped)
 }
 
+/// The joints reached by following the CL move `a -> b` continuously from `qa`: the tool
+/// axis is swept along the great circle (`slerp`, the tip along the chord) in steps small
+/// enough that every rotary turns at most [`tol::TRACK_STEP`] per step, each step taking
+/// the inverse solution nearest the previous one. The rotaries keep their windings (a
+/// continuous turn of more than 180 deg is not reduced), so the result is the one joint
+/// vector that a continuous motion of the machine along this move reaches: a large
+/// rotary change near the pole or of a genuine reorientation, not a branch flip (the
+/// other inverse solution) nor an unwinding. `None` when a step has no inverse or the
+/// steps do not resolve the motion (an exact singularity inside the move).
+///
+/// ```
+/// use scallop_geom::{Point3, Vec3};
+/// use scallop_machine::{Kinematics, Machine, Pose, plan::{select, track}};
+/// let k = Kinematics::new(&Machine::builtin("linuxcnc-xyzac-trt").unwrap(), 0.0);
+/// // Near the pole: the axis turns 7 deg, C about 40 deg.
+/// let a = Pose::new(Point3::new(0.0, 0.0, 0.0), Vec3::new(0.036833608501, -0.078989928337, 0.996194698092));
+/// let b = Pose::new(Point3::new(0.5, 0.0, 0.0), Vec3::new(-0.044943455528, -0.167731259497, 0.984807753012));
+/// let qa = select(&k, k.ik(&a, &scallop_machine::Joints::zeros()).unwrap().as_slice(), None, None).unwrap().joints;
+/// let qb = track(&k, &a, &b, &qa).unwrap();
+/// assert!((k.fk(&qb).axis - b.axis).norm() < 1e-9);
+/// assert!((qb[4] - qa[4]).abs().to_degrees() > 30.0 && (qb[3] - qa[3]).abs().to_degrees() < 10.0);
+/// ```
+#[must_use]
+pub fn track(kin: &Kinematics, a: &Pose, b: &Pose, qa: &Joints) -> Option<Joints> {
+    let rotaries = [3, 4];
+    let mut q = *qa;
+    let mut s = 0.0f64;
+    let mut step = tol::TRACK_FIRST_STEP;
+    let mut evaluations = 0usize;
+    while s < 1.0 {
+        evaluations += 1;
+        if evaluations > tol::TRACK_MAX_EVALUATIONS {
+            return None;
+        }
+        let t = (s + step).min(1.0);
+        let pose = crate::feed::interpolate(a, b, t);
+        let sols = kin.ik(&pose, &q).ok()?;
+        let mut best: Option<(f64, Joints)> = None;
+        for sol in sols.as_slice() {
+            let mut c = sol.joints;
+            for &i in &rotaries {
+                c[i] = unwrap_angle(c[i], q[i], None).map_or(c[i], |(v, _)| v);
+            }
+            let turn = rotaries.iter().map(|&i| (c[i] - q[i]).abs()).fold(0.0, f64::max);
+            if best.as_ref().is_none_or(|(d, _)| turn < *d) {
+                best = Some((turn, c));
+            }
+        }
+        let (turn, c) = best?;
+        if turn > tol::TRACK_STEP {
+            if step <= tol::TRACK_MIN_STEP {
+                return None; // a discontinuity: no continuous motion follows the move
+            }
+            step /= 2.0;
+            continue;
+        }
+        q = c;
+        s = t;
+        step = (step * 2.0).min(tol::TRACK_FIRST_STEP);
+    }
+    Some(q)
+}
+
+/// The rotaries of `tracked` (unwound: `false`) when the rotaries of the inverse solution
+/// `raw` equal them modulo a turn, i.e. when `raw` is the pose that the continuous motion
+/// reaches; `None` for another branch.
+fn continuation(raw: &Joints, tracked: &Joints) -> Option<([f64; 2], [bool; 2])> {
+    let turn = 2.0 * PI;
+    let same = |i: usize| {
+        let d = (raw[i] - tracked[i]) / turn;
+        ((d - d.round()) * turn).abs() <= tol::TRACK_MATCH
+    };
+    (same(3) && same(4)).then_some(([tracked[3], tracked[4]], [false, false]))
+}
+
 /// Velocity-limited time of the move `a -> b`: `max_j |dq_j| / vmax_j` (spec 3.5).
 ///
 /// ```
@@ -615,9 +690,13 @@ pub(crate) fn plan_input(
                     &mut shared
                 };
                 let has_previous = i > 0 || start.is_some();
+                // The continuous motion along this cutting move from `p` (computed once per
+                // predecessor, only when a candidate jumps).
+                let mut tracked: Option<Option<Joints>> = None;
                 for k in 0..sols.sols.as_slice().len() {
                     let mut unwrapped = None;
-                    if shortcut && has_previous && input.cutting(i) {
+                    let mut continuous = false;
+                    if has_previous && input.cutting(i) {
                         let (jumps, u) = jumps_on_rotaries(
                             &strokes,
                             &sols.sols.as_slice()[k],
@@ -627,10 +706,26 @@ pub(crate) fn plan_input(
                             || i > 0 && arc_passes(&input.pose(i - 1).axis, &pose.axis, &pole_dir, eps),
                         );
                         if jumps {
-                            dropped = true;
-                            continue;
+                            // A large rotary change is allowed while cutting when it is the
+                            // continuous motion along the move (near the pole, or a genuine
+                            // reorientation): the candidate is the tracked joints modulo a
+                            // turn, and takes the tracked windings.
+                            let from = if i > 0 { *input.pose(i - 1) } else { kin.fk(&p.q) };
+                            let t = tracked.get_or_insert_with(|| track(kin, &from, pose, &p.q));
+                            match t.as_ref().and_then(|t| continuation(&sols.sols.as_slice()[k].joints, t)) {
+                                Some(u) => {
+                                    unwrapped = Some(u);
+                                    continuous = true;
+                                }
+                                None if shortcut => {
+                                    dropped = true;
+                                    continue;
+                                }
+                                None => {}
+                            }
+                        } else if shortcut {
+                            unwrapped = Some(u);
                         }
-                        unwrapped = Some(u);
                     }
                     kin.complete(sols, k);
                     let sol = &sols.sols.as_slice()[k];
@@ -645,13 +740,28 @@ pub(crate) fn plan_input(
                             continue;
                         }
                     };
+                    // Off the material the pole axis may also unwind by a turn either way
+                    // (within its stroke): the windings a later cut needs.
+                    let mut variants = [None, None, None];
+                    if !input.cutting(i) {
+                        for (slot, sign) in [(1, 1.0), (2, -1.0)] {
+                            let mut v = cand.clone();
+                            v.joints[pole] += sign * 2.0 * PI;
+                            if strokes.inside(&v.joints) {
+                                v.unwound[pole] = true;
+                                variants[slot] = Some(v);
+                            }
+                        }
+                    }
+                    variants[0] = Some(cand);
+                    for cand in variants.into_iter().flatten() {
                     let (cost, edge) = if has_previous {
                         let dq = cand.joints - p.q;
                         let jump = [3, 4].map(|j| dq[j].abs() > options.flip_threshold);
                         // The move time only for candidates that are kept (a jump while
                         // cutting is dropped before it is needed).
                         let t = || move_time(machine, &p.q, &cand.joints);
-                        if jump == [false, false] {
+                        if jump == [false, false] || continuous {
                             (t(), Edge::Plain)
                         } else {
                             let only_pole = (0..2).all(|r| jump[r] == (r + 3 == pole));
@@ -684,6 +794,7 @@ pub(crate) fn plan_input(
                             }
                         }
                         None => next.push(state),
+                    }
                     }
                 }
             }
