@@ -755,46 +755,46 @@ pub(crate) fn plan_input(
                     }
                     variants[0] = Some(cand);
                     for cand in variants.into_iter().flatten() {
-                    let (cost, edge) = if has_previous {
-                        let dq = cand.joints - p.q;
-                        let jump = [3, 4].map(|j| dq[j].abs() > options.flip_threshold);
-                        // The move time only for candidates that are kept (a jump while
-                        // cutting is dropped before it is needed).
-                        let t = || move_time(machine, &p.q, &cand.joints);
-                        if jump == [false, false] || continuous {
-                            (t(), Edge::Plain)
-                        } else {
-                            let only_pole = (0..2).all(|r| jump[r] == (r + 3 == pole));
-                            let crosses = p.at_pole
-                                || cand.at_pole
-                                || (i > 0 && arc_passes(&input.pose(i - 1).axis, &pose.axis, &pole_dir, eps));
-                            if only_pole && crosses {
-                                (t(), Edge::PoleFlip)
-                            } else if input.cutting(i) {
-                                let j = if dq[3].abs() >= dq[4].abs() { 3 } else { 4 };
-                                if smallest_jump.is_none_or(|(_, d)| dq[j].abs() < d) {
-                                    smallest_jump = Some((j, dq[j].abs()));
-                                }
-                                continue;
+                        let (cost, edge) = if has_previous {
+                            let dq = cand.joints - p.q;
+                            let jump = [3, 4].map(|j| dq[j].abs() > options.flip_threshold);
+                            // The move time only for candidates that are kept (a jump while
+                            // cutting is dropped before it is needed).
+                            let t = || move_time(machine, &p.q, &cand.joints);
+                            if jump == [false, false] || continuous {
+                                (t(), Edge::Plain)
                             } else {
-                                let j = if dq[3].abs() >= dq[4].abs() { 3 } else { 4 };
-                                (t() + options.reorient_penalty, Edge::Reorient(j))
+                                let only_pole = (0..2).all(|r| jump[r] == (r + 3 == pole));
+                                let crosses = p.at_pole
+                                    || cand.at_pole
+                                    || (i > 0 && arc_passes(&input.pose(i - 1).axis, &pose.axis, &pole_dir, eps));
+                                if only_pole && crosses {
+                                    (t(), Edge::PoleFlip)
+                                } else if input.cutting(i) {
+                                    let j = if dq[3].abs() >= dq[4].abs() { 3 } else { 4 };
+                                    if smallest_jump.is_none_or(|(_, d)| dq[j].abs() < d) {
+                                        smallest_jump = Some((j, dq[j].abs()));
+                                    }
+                                    continue;
+                                } else {
+                                    let j = if dq[3].abs() >= dq[4].abs() { 3 } else { 4 };
+                                    (t() + options.reorient_penalty, Edge::Reorient(j))
+                                }
                             }
-                        }
-                    } else {
-                        (0.0, Edge::Plain)
-                    };
-                    let first = if i == 0 { preference_key(kin, &cand.joints) } else { p.first };
-                    let state =
-                        State { q: cand.joints, at_pole: cand.at_pole, cost: p.cost + cost, first, back: pi, edge };
-                    match next.iter_mut().find(|s| (s.q - state.q).amax() < tol::SAME_JOINTS) {
-                        Some(existing) => {
-                            if better(&state, existing) {
-                                *existing = state;
+                        } else {
+                            (0.0, Edge::Plain)
+                        };
+                        let first = if i == 0 { preference_key(kin, &cand.joints) } else { p.first };
+                        let state =
+                            State { q: cand.joints, at_pole: cand.at_pole, cost: p.cost + cost, first, back: pi, edge };
+                        match next.iter_mut().find(|s| (s.q - state.q).amax() < tol::SAME_JOINTS) {
+                            Some(existing) => {
+                                if better(&state, existing) {
+                                    *existing = state;
+                                }
                             }
+                            None => next.push(state),
                         }
-                        None => next.push(state),
-                    }
                     }
                 }
             }
