@@ -634,12 +634,35 @@ struct Node {
     at_pole: bool,
 }
 
-/// [`plan_path`] on any [`PathInput`].
+/// [`plan_path`] on any [`PathInput`]. When no way through fits the strokes, the path is
+/// planned again with the pole axis free to take the windings one turn either way on the
+/// non-cutting moves (rapids and links may unwind for a later cut): three times the
+/// candidates, so only when they are needed.
 pub(crate) fn plan_input(
     kin: &Kinematics,
     input: &impl PathInput,
     start: Option<Joints>,
     options: &PlanOptions,
+) -> Result<JointPath, MachineError> {
+    match plan_layers(kin, input, start, options, false) {
+        Err(e @ (MachineError::LimitViolation { .. } | MachineError::FlipWhileCutting { .. }))
+            if kin.machine().axes()[kin.pole_axis()].joint_limits().is_some()
+                && (0..input.len()).any(|i| !input.cutting(i)) =>
+        {
+            plan_layers(kin, input, start, options, true).map_err(|_| e)
+        }
+        other => other,
+    }
+}
+
+/// [`plan_input`]; `unwind`: the pole axis may also take the windings one turn either way
+/// on non-cutting moves.
+fn plan_layers(
+    kin: &Kinematics,
+    input: &impl PathInput,
+    start: Option<Joints>,
+    options: &PlanOptions,
+    unwind: bool,
 ) -> Result<JointPath, MachineError> {
     let n_poses = input.len();
     let machine = kin.machine();
@@ -693,11 +716,16 @@ pub(crate) fn plan_input(
                 // The continuous motion along this cutting move from `p` (computed once per
                 // predecessor, only when a candidate jumps).
                 let mut tracked: Option<Option<Joints>> = None;
-                for k in 0..sols.sols.as_slice().len() {
-                    let mut unwrapped = None;
-                    let mut continuous = false;
-                    if has_previous && input.cutting(i) {
-                        let (jumps, u) = jumps_on_rotaries(
+                let check_cut = has_previous && input.cutting(i);
+                // The jump test of each candidate (at most two inverse solutions), and
+                // whether one of them needs no jump: then that one is the continuation
+                // (the two solutions differ by half a turn of the pole axis) and the others
+                // are not tracked (the dense-path case costs nothing more).
+                let mut pre = [(false, ([0.0; 2], [false; 2])); 2];
+                let mut any_plain = false;
+                if check_cut {
+                    for (k, slot) in pre.iter_mut().enumerate().take(sols.sols.as_slice().len()) {
+                        *slot = jumps_on_rotaries(
                             &strokes,
                             &sols.sols.as_slice()[k],
                             p,
@@ -705,7 +733,20 @@ pub(crate) fn plan_input(
                             pole,
                             || i > 0 && arc_passes(&input.pose(i - 1).axis, &pose.axis, &pole_dir, eps),
                         );
-                        if jumps {
+                        any_plain |= !slot.0;
+                    }
+                }
+                for k in 0..sols.sols.as_slice().len() {
+                    let mut unwrapped = None;
+                    let mut continuous = false;
+                    if check_cut {
+                        let (jumps, u) = pre[k];
+                        if jumps && any_plain {
+                            if shortcut {
+                                dropped = true;
+                                continue;
+                            }
+                        } else if jumps {
                             // A large rotary change is allowed while cutting when it is the
                             // continuous motion along the move (near the pole, or a genuine
                             // reorientation): the candidate is the tracked joints modulo a
@@ -743,7 +784,7 @@ pub(crate) fn plan_input(
                     // Off the material the pole axis may also unwind by a turn either way
                     // (within its stroke): the windings a later cut needs.
                     let mut variants = [None, None, None];
-                    if !input.cutting(i) {
+                    if unwind && !input.cutting(i) {
                         for (slot, sign) in [(1, 1.0), (2, -1.0)] {
                             let mut v = cand.clone();
                             v.joints[pole] += sign * 2.0 * PI;
