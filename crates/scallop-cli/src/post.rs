@@ -61,6 +61,10 @@ pub struct PostArgs {
     /// the tool backs off this far, the rotaries turn, and it comes back.
     #[arg(long, default_value_t = 10.0, allow_hyphen_values = true)]
     retract: f64,
+    /// Rapids bring the pole axis (C) back to its winding nearest zero, the long way if
+    /// need be (instead of the shortest move).
+    #[arg(long)]
+    unwind_rapids: bool,
     /// Program file to write (default: the CL file's name with .nc).
     #[arg(short, long)]
     output: Option<PathBuf>,
@@ -172,7 +176,8 @@ pub fn run(args: &PostArgs) -> CliResult<()> {
     let rows = read_cl_csv(&text).map_err(|e| Failure::rejected(format!("{}: {e}", args.cl_file.display())))?;
     let records = records(&rows, args.feed);
     let kin = Kinematics::new(&machine, args.tool_length);
-    let options = ProgramOptions { tol_pos: args.tolerance, retract: args.retract, ..ProgramOptions::default() };
+    let mut options = ProgramOptions { tol_pos: args.tolerance, retract: args.retract, ..ProgramOptions::default() };
+    options.plan.unwind_rapids = args.unwind_rapids;
     let program = to_program(&kin, &records, None, &options)
         .map_err(|e| Failure::rejected(format!("{} on {}: {e}", args.cl_file.display(), machine.name())))?;
     let time = program_time(&kin, &program.blocks.iter().map(|b| (b.motion, b.joints, b.feed)).collect::<Vec<_>>())

@@ -495,11 +495,19 @@ pub struct PlanOptions {
     pub flip_threshold: f64,
     /// Time charged for a jump on a non-cutting move (retract, reorient, approach; s).
     pub reorient_penalty: f64,
+    /// Rapids bring the pole axis back to its winding nearest zero (within its stroke),
+    /// the long way if need be: the job asks to unwind (cable wraps, a controller that
+    /// counts turns), instead of the shortest move.
+    pub unwind_rapids: bool,
 }
 
 impl Default for PlanOptions {
     fn default() -> Self {
-        PlanOptions { flip_threshold: tol::FLIP_THRESHOLD_DEFAULT, reorient_penalty: tol::REORIENT_PENALTY_DEFAULT }
+        PlanOptions {
+            flip_threshold: tol::FLIP_THRESHOLD_DEFAULT,
+            reorient_penalty: tol::REORIENT_PENALTY_DEFAULT,
+            unwind_rapids: false,
+        }
     }
 }
 
@@ -610,6 +618,10 @@ pub(crate) trait PathInput {
     fn pose(&self, i: usize) -> &Pose;
     /// Whether the move into pose `i` is in the material.
     fn cutting(&self, i: usize) -> bool;
+    /// Whether the move into pose `i` is a rapid (links are not).
+    fn is_rapid(&self, i: usize) -> bool {
+        !self.cutting(i)
+    }
 }
 
 impl PathInput for (&[Pose], &[bool]) {
@@ -774,13 +786,22 @@ fn plan_layers(
                         Some(u) => admissible_with(machine, &strokes, sol, u),
                         None => admissible(machine, &strokes, sol, has_previous.then_some(&p.q)),
                     };
-                    let cand = match checked {
+                    let mut cand = match checked {
                         Ok(c) => c,
                         Err(e) => {
                             first_error.get_or_insert(e.at_block(i));
                             continue;
                         }
                     };
+                    if options.unwind_rapids && input.is_rapid(i) {
+                        let turn = 2.0 * PI;
+                        let mut q = cand.joints;
+                        q[pole] -= turn * (q[pole] / turn).round();
+                        if strokes.inside(&q) && (q[pole] - cand.joints[pole]).abs() > 0.0 {
+                            cand.joints = q;
+                            cand.unwound[pole] = true;
+                        }
+                    }
                     // Off the material the pole axis may also unwind by a turn either way
                     // (within its stroke): the windings a later cut needs.
                     let mut variants = [None, None, None];

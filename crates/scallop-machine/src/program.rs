@@ -256,6 +256,9 @@ impl crate::plan::PathInput for Records<'_> {
     fn cutting(&self, i: usize) -> bool {
         self.0[i].motion.is_cutting()
     }
+    fn is_rapid(&self, i: usize) -> bool {
+        self.0[i].motion == Motion::Rapid
+    }
 }
 
 /// What [`verify`] measured.

@@ -290,3 +290,38 @@ fn corpus_branch_changes_on_links_are_the_minimum() {
         }
     }
 }
+
+#[test]
+fn corpus_windings_unwind_on_rapids_when_the_job_asks() {
+    // On the trunnion's +-36000 deg C stroke the windings accumulate (the shortest moves);
+    // with `unwind_rapids` every rapid brings C back within half a turn of zero.
+    let kin = trunnion();
+    let passes = 3;
+    let records = windings(&kin, passes);
+    let c = kin.pole_axis();
+    let mut opts = ProgramOptions::default();
+    let free = to_program(&kin, &records, None, &opts).expect("posts");
+    let peak = |p: &MachineProgram| p.blocks.iter().map(|b| b.words[c].abs()).fold(0.0, f64::max);
+    assert!(peak(&free) > 2.0 * 360.0, "windings accumulate: {}", peak(&free));
+    opts.plan.unwind_rapids = true;
+    let unwound = to_program(&kin, &records, None, &opts).expect("posts");
+    verify(&kin, &unwound, &opts).expect("verifies");
+    for b in unwound.blocks.iter().filter(|b| b.motion == Motion::Rapid) {
+        assert!(b.words[c].abs() <= 180.0 + 1e-9, "rapid at C {}", b.words[c]);
+    }
+    assert!(peak(&unwound) <= 360.0 + 1e-9, "{}", peak(&unwound));
+    let d = Dialect::builtin("linuxcnc").expect("shipped");
+    let params = PostParams {
+        program: "1".into(),
+        mode: OutputMode::Joint,
+        tool: 1,
+        tool_length: 0.0,
+        spindle: 8000.0,
+        tol_pos: opts.tol_pos,
+        tol_ang: opts.tol_ang,
+        predicted_time: None,
+    };
+    let text = program_text(&unwound, &kin, &d, &params).expect("writes");
+    check_replay(&replay(&text, &d, &kin).expect("reads"), &records, &kin, &d, opts.tol_pos, opts.tol_ang)
+        .expect("replays");
+}
