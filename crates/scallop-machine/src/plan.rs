@@ -748,11 +748,11 @@ fn plan_layers(
                         any_plain |= !slot.0;
                     }
                 }
-                for k in 0..sols.sols.as_slice().len() {
+                let n_sols = sols.sols.as_slice().len();
+                for (k, &(jumps, u)) in pre.iter().enumerate().take(n_sols) {
                     let mut unwrapped = None;
                     let mut continuous = false;
                     if check_cut {
-                        let (jumps, u) = pre[k];
                         if jumps && any_plain {
                             if shortcut {
                                 dropped = true;

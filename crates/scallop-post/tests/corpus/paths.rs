@@ -17,8 +17,11 @@ pub fn short_c_trunnion() -> Machine {
     Machine::from_toml_str(&text).expect("machine")
 }
 
+/// A named path generator.
+pub type Case = (&'static str, fn() -> Vec<ClRecord>);
+
 /// The minimal cases by name (the files of the issue, generated).
-pub const CASES: [(&str, fn() -> Vec<ClRecord>); 5] = [
+pub const CASES: [Case; 5] = [
     ("same-tip", same_tip),
     ("same-tip-feed", same_tip_feed),
     ("near-pole-cut", near_pole_cut),
