@@ -8,6 +8,8 @@
 # and fails on a non-zero status, on an error message, or when the canonical
 # STRAIGHT_FEED/STRAIGHT_TRAVERSE coordinates differ from our words by more than 1e-4, or
 # when a G93 SET_FEED_RATE differs from L_ctrl * F_inv (block time 1/F_inv).
+# It also runs the generated 5-axis corpus of issue 19 (`--example post_corpus`: joint
+# and TCP output; the TCP programs' X/Y/Z are the tip, compared word for word the same way).
 # It also runs two finishing jobs through `scallop run` with the LinuxCNC dialect: an
 # arc-fitted 3-axis program (examples/jobs/choi-arcs.toml: G18 arcs, checked against the
 # canonical ARC_FEED end point, centre and turning direction) and a 3+2 program
@@ -59,6 +61,15 @@ programs=()
 for m in "${machines[@]}"; do
     cargo run -q -p scallop-post --example post_demo -- "$m" linuxcnc joint >"$work/$m.ngc"
     programs+=("$m")
+done
+# The generated 5-axis corpus of issue 19 (minimal cases, impeller channel, hull through the
+# pole, C windings, branch changes on links), joint and TCP output, each already replayed.
+mkdir -p "$work/corpus"
+cargo run -q -p scallop-post --example post_corpus -- "$work/corpus"
+for f in "$work"/corpus/*.ngc; do
+    name="corpus-$(basename "$f" .ngc)"
+    cp "$f" "$work/$name.ngc"
+    programs+=("$name")
 done
 for job in choi-arcs choi-3plus2; do
     cargo run -q -p scallop-cli -- run "examples/jobs/$job.toml" -o "$work/$job" >/dev/null

@@ -56,6 +56,14 @@ pub struct PostArgs {
     /// Tip tolerance of joint-space interpolation (mm).
     #[arg(long, default_value_t = 0.01, allow_hyphen_values = true)]
     tolerance: f64,
+    /// Retract distance along the tool axis of a link that changes branch or unwinds (mm):
+    /// the tool backs off this far, the rotaries turn, and it comes back.
+    #[arg(long, default_value_t = 10.0, allow_hyphen_values = true)]
+    retract: f64,
+    /// Rapids bring the pole axis (C) back to its winding nearest zero, the long way if
+    /// need be (instead of the shortest move).
+    #[arg(long)]
+    unwind_rapids: bool,
     /// Program file to write (default: the CL file's name with .nc).
     #[arg(short, long)]
     output: Option<PathBuf>,
@@ -133,7 +141,12 @@ fn load_dialect(name: &str) -> CliResult<Dialect> {
 
 /// `scallop post`.
 pub fn run(args: &PostArgs) -> CliResult<()> {
-    for (flag, v) in [("--feed", args.feed), ("--tolerance", args.tolerance), ("--spindle", args.spindle)] {
+    for (flag, v) in [
+        ("--feed", args.feed),
+        ("--tolerance", args.tolerance),
+        ("--spindle", args.spindle),
+        ("--retract", args.retract),
+    ] {
         if !(v.is_finite() && v > 0.0) {
             return Err(Failure::rejected(format!("{flag} {v}: must be a finite number > 0")));
         }
@@ -147,7 +160,8 @@ pub fn run(args: &PostArgs) -> CliResult<()> {
     let path = read_cl(&text, args.feed).map_err(|e| Failure::rejected(format!("{}: {e}", args.cl_file.display())))?;
     let records = records_of(&path);
     let kin = Kinematics::new(&machine, args.tool_length);
-    let options = ProgramOptions { tol_pos: args.tolerance, ..ProgramOptions::default() };
+    let mut options = ProgramOptions { tol_pos: args.tolerance, retract: args.retract, ..ProgramOptions::default() };
+    options.plan.unwind_rapids = args.unwind_rapids;
     let program = to_program(&kin, &records, None, &options)
         .map_err(|e| Failure::rejected(format!("{} on {}: {e}", args.cl_file.display(), machine.name())))?;
     let time = program_time(&kin, &program.blocks.iter().map(|b| (b.motion, b.joints, b.feed)).collect::<Vec<_>>())

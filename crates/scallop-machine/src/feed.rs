@@ -23,6 +23,12 @@ fn slerp(a: &Vec3, b: &Vec3, s: f64) -> Vec3 {
     UnitQuaternion::rotation_between(a, b).map_or(*a, |r| UnitQuaternion::identity().slerp(&r, s) * a)
 }
 
+/// The pose at `s` in [0, 1] of the CL move `a -> b`: the tip on the chord, the tool axis
+/// on the great circle.
+pub(crate) fn interpolate(a: &Pose, b: &Pose, s: f64) -> Pose {
+    Pose::new(Point3::from(a.tip.coords + (b.tip.coords - a.tip.coords) * s), slerp(&a.axis, &b.axis, s))
+}
+
 /// Deviation of the joint-linear motion `qa -> qb` from the part-frame block
 /// `pose_a -> pose_b`: the largest tip distance to the segment `[P_a, P_b]` and the
 /// largest angle (rad) between the tool axis and `slerp(O_a, O_b, s)`, over 16 uniform
@@ -364,7 +370,11 @@ fn split(
     let mut hold = *a.1;
     hold[pole] = (a.1[pole] + b.1[pole]) / 2.0;
     let sols = kin.ik(&mid, &hold).map_err(|e| e.at_block(block))?;
-    let mut q_mid = select(kin, sols.as_slice(), Some(a.1), Some(block))?.joints;
+    // The solution nearest the joint-space midpoint: the continuation of a large but
+    // continuous rotary move (near the pole, a reorientation) is nearer to it than to
+    // either end, and the windings are those between the ends.
+    let halfway = (a.1 + b.1) / 2.0;
+    let mut q_mid = select(kin, sols.as_slice(), Some(&halfway), Some(block))?.joints;
     if (q_mid - a.1).amax() > (b.1 - a.1).amax() + tol::BRANCH_JUMP {
         // The midpoint jumped branch (a flip inside the block): interpolate the pole
         // axis and solve the rest for it.

@@ -260,6 +260,81 @@ fn jumps_on_rotaries(
     (!(only_pole && (p.at_pole || sol.at_pole || crosses())), unwrapped)
 }
 
+/// The joints reached by following the CL move `a -> b` continuously from `qa`: the tool
+/// axis is swept along the great circle (`slerp`, the tip along the chord) in steps small
+/// enough that every rotary turns at most [`tol::TRACK_STEP`] per step, each step taking
+/// the inverse solution nearest the previous one. The rotaries keep their windings (a
+/// continuous turn of more than 180 deg is not reduced), so the result is the one joint
+/// vector that a continuous motion of the machine along this move reaches: a large
+/// rotary change near the pole or of a genuine reorientation, not a branch flip (the
+/// other inverse solution) nor an unwinding. `None` when a step has no inverse or the
+/// steps do not resolve the motion (an exact singularity inside the move).
+///
+/// ```
+/// use scallop_geom::{Point3, Vec3};
+/// use scallop_machine::{Kinematics, Machine, Pose, plan::{select, track}};
+/// let k = Kinematics::new(&Machine::builtin("linuxcnc-xyzac-trt").unwrap(), 0.0);
+/// // Near the pole: the axis turns 7 deg, C about 40 deg.
+/// let a = Pose::new(Point3::new(0.0, 0.0, 0.0), Vec3::new(0.036833608501, -0.078989928337, 0.996194698092));
+/// let b = Pose::new(Point3::new(0.5, 0.0, 0.0), Vec3::new(-0.044943455528, -0.167731259497, 0.984807753012));
+/// let qa = select(&k, k.ik(&a, &scallop_machine::Joints::zeros()).unwrap().as_slice(), None, None).unwrap().joints;
+/// let qb = track(&k, &a, &b, &qa).unwrap();
+/// assert!((k.fk(&qb).axis - b.axis).norm() < 1e-9);
+/// assert!((qb[4] - qa[4]).abs().to_degrees() > 30.0 && (qb[3] - qa[3]).abs().to_degrees() < 10.0);
+/// ```
+#[must_use]
+pub fn track(kin: &Kinematics, a: &Pose, b: &Pose, qa: &Joints) -> Option<Joints> {
+    let rotaries = [3, 4];
+    let mut q = *qa;
+    let mut s = 0.0f64;
+    let mut step = tol::TRACK_FIRST_STEP;
+    let mut evaluations = 0usize;
+    while s < 1.0 {
+        evaluations += 1;
+        if evaluations > tol::TRACK_MAX_EVALUATIONS {
+            return None;
+        }
+        let t = (s + step).min(1.0);
+        let pose = crate::feed::interpolate(a, b, t);
+        let sols = kin.ik(&pose, &q).ok()?;
+        let mut best: Option<(f64, Joints)> = None;
+        for sol in sols.as_slice() {
+            let mut c = sol.joints;
+            for &i in &rotaries {
+                c[i] = unwrap_angle(c[i], q[i], None).map_or(c[i], |(v, _)| v);
+            }
+            let turn = rotaries.iter().map(|&i| (c[i] - q[i]).abs()).fold(0.0, f64::max);
+            if best.as_ref().is_none_or(|(d, _)| turn < *d) {
+                best = Some((turn, c));
+            }
+        }
+        let (turn, c) = best?;
+        if turn > tol::TRACK_STEP {
+            if step <= tol::TRACK_MIN_STEP {
+                return None; // a discontinuity: no continuous motion follows the move
+            }
+            step /= 2.0;
+            continue;
+        }
+        q = c;
+        s = t;
+        step = (step * 2.0).min(tol::TRACK_FIRST_STEP);
+    }
+    Some(q)
+}
+
+/// The rotaries of `tracked` (unwound: `false`) when the rotaries of the inverse solution
+/// `raw` equal them modulo a turn, i.e. when `raw` is the pose that the continuous motion
+/// reaches; `None` for another branch.
+fn continuation(raw: &Joints, tracked: &Joints) -> Option<([f64; 2], [bool; 2])> {
+    let turn = 2.0 * PI;
+    let same = |i: usize| {
+        let d = (raw[i] - tracked[i]) / turn;
+        ((d - d.round()) * turn).abs() <= tol::TRACK_MATCH
+    };
+    (same(3) && same(4)).then_some(([tracked[3], tracked[4]], [false, false]))
+}
+
 /// Velocity-limited time of the move `a -> b`: `max_j |dq_j| / vmax_j` (spec 3.5).
 ///
 /// ```
@@ -420,11 +495,19 @@ pub struct PlanOptions {
     pub flip_threshold: f64,
     /// Time charged for a jump on a non-cutting move (retract, reorient, approach; s).
     pub reorient_penalty: f64,
+    /// Rapids bring the pole axis back to its winding nearest zero (within its stroke),
+    /// the long way if need be: the job asks to unwind (cable wraps, a controller that
+    /// counts turns), instead of the shortest move.
+    pub unwind_rapids: bool,
 }
 
 impl Default for PlanOptions {
     fn default() -> Self {
-        PlanOptions { flip_threshold: tol::FLIP_THRESHOLD_DEFAULT, reorient_penalty: tol::REORIENT_PENALTY_DEFAULT }
+        PlanOptions {
+            flip_threshold: tol::FLIP_THRESHOLD_DEFAULT,
+            reorient_penalty: tol::REORIENT_PENALTY_DEFAULT,
+            unwind_rapids: false,
+        }
     }
 }
 
@@ -535,6 +618,10 @@ pub(crate) trait PathInput {
     fn pose(&self, i: usize) -> &Pose;
     /// Whether the move into pose `i` is in the material.
     fn cutting(&self, i: usize) -> bool;
+    /// Whether the move into pose `i` is a rapid (links are not).
+    fn is_rapid(&self, i: usize) -> bool {
+        !self.cutting(i)
+    }
 }
 
 impl PathInput for (&[Pose], &[bool]) {
@@ -559,12 +646,35 @@ struct Node {
     at_pole: bool,
 }
 
-/// [`plan_path`] on any [`PathInput`].
+/// [`plan_path`] on any [`PathInput`]. When no way through fits the strokes, the path is
+/// planned again with the pole axis free to take the windings one turn either way on the
+/// non-cutting moves (rapids and links may unwind for a later cut): three times the
+/// candidates, so only when they are needed.
 pub(crate) fn plan_input(
     kin: &Kinematics,
     input: &impl PathInput,
     start: Option<Joints>,
     options: &PlanOptions,
+) -> Result<JointPath, MachineError> {
+    match plan_layers(kin, input, start, options, false) {
+        Err(e @ (MachineError::LimitViolation { .. } | MachineError::FlipWhileCutting { .. }))
+            if kin.machine().axes()[kin.pole_axis()].joint_limits().is_some()
+                && (0..input.len()).any(|i| !input.cutting(i)) =>
+        {
+            plan_layers(kin, input, start, options, true).map_err(|_| e)
+        }
+        other => other,
+    }
+}
+
+/// [`plan_input`]; `unwind`: the pole axis may also take the windings one turn either way
+/// on non-cutting moves.
+fn plan_layers(
+    kin: &Kinematics,
+    input: &impl PathInput,
+    start: Option<Joints>,
+    options: &PlanOptions,
+    unwind: bool,
 ) -> Result<JointPath, MachineError> {
     let n_poses = input.len();
     let machine = kin.machine();
@@ -615,10 +725,19 @@ pub(crate) fn plan_input(
                     &mut shared
                 };
                 let has_previous = i > 0 || start.is_some();
-                for k in 0..sols.sols.as_slice().len() {
-                    let mut unwrapped = None;
-                    if shortcut && has_previous && input.cutting(i) {
-                        let (jumps, u) = jumps_on_rotaries(
+                // The continuous motion along this cutting move from `p` (computed once per
+                // predecessor, only when a candidate jumps).
+                let mut tracked: Option<Option<Joints>> = None;
+                let check_cut = has_previous && input.cutting(i);
+                // The jump test of each candidate (at most two inverse solutions), and
+                // whether one of them needs no jump: then that one is the continuation
+                // (the two solutions differ by half a turn of the pole axis) and the others
+                // are not tracked (the dense-path case costs nothing more).
+                let mut pre = [(false, ([0.0; 2], [false; 2])); 2];
+                let mut any_plain = false;
+                if check_cut {
+                    for (k, slot) in pre.iter_mut().enumerate().take(sols.sols.as_slice().len()) {
+                        *slot = jumps_on_rotaries(
                             &strokes,
                             &sols.sols.as_slice()[k],
                             p,
@@ -626,11 +745,40 @@ pub(crate) fn plan_input(
                             pole,
                             || i > 0 && arc_passes(&input.pose(i - 1).axis, &pose.axis, &pole_dir, eps),
                         );
-                        if jumps {
-                            dropped = true;
-                            continue;
+                        any_plain |= !slot.0;
+                    }
+                }
+                let n_sols = sols.sols.as_slice().len();
+                for (k, &(jumps, u)) in pre.iter().enumerate().take(n_sols) {
+                    let mut unwrapped = None;
+                    let mut continuous = false;
+                    if check_cut {
+                        if jumps && any_plain {
+                            if shortcut {
+                                dropped = true;
+                                continue;
+                            }
+                        } else if jumps {
+                            // A large rotary change is allowed while cutting when it is the
+                            // continuous motion along the move (near the pole, or a genuine
+                            // reorientation): the candidate is the tracked joints modulo a
+                            // turn, and takes the tracked windings.
+                            let from = if i > 0 { *input.pose(i - 1) } else { kin.fk(&p.q) };
+                            let t = tracked.get_or_insert_with(|| track(kin, &from, pose, &p.q));
+                            match t.as_ref().and_then(|t| continuation(&sols.sols.as_slice()[k].joints, t)) {
+                                Some(u) => {
+                                    unwrapped = Some(u);
+                                    continuous = true;
+                                }
+                                None if shortcut => {
+                                    dropped = true;
+                                    continue;
+                                }
+                                None => {}
+                            }
+                        } else if shortcut {
+                            unwrapped = Some(u);
                         }
-                        unwrapped = Some(u);
                     }
                     kin.complete(sols, k);
                     let sol = &sols.sols.as_slice()[k];
@@ -638,52 +786,77 @@ pub(crate) fn plan_input(
                         Some(u) => admissible_with(machine, &strokes, sol, u),
                         None => admissible(machine, &strokes, sol, has_previous.then_some(&p.q)),
                     };
-                    let cand = match checked {
+                    let mut cand = match checked {
                         Ok(c) => c,
                         Err(e) => {
                             first_error.get_or_insert(e.at_block(i));
                             continue;
                         }
                     };
-                    let (cost, edge) = if has_previous {
-                        let dq = cand.joints - p.q;
-                        let jump = [3, 4].map(|j| dq[j].abs() > options.flip_threshold);
-                        // The move time only for candidates that are kept (a jump while
-                        // cutting is dropped before it is needed).
-                        let t = || move_time(machine, &p.q, &cand.joints);
-                        if jump == [false, false] {
-                            (t(), Edge::Plain)
-                        } else {
-                            let only_pole = (0..2).all(|r| jump[r] == (r + 3 == pole));
-                            let crosses = p.at_pole
-                                || cand.at_pole
-                                || (i > 0 && arc_passes(&input.pose(i - 1).axis, &pose.axis, &pole_dir, eps));
-                            if only_pole && crosses {
-                                (t(), Edge::PoleFlip)
-                            } else if input.cutting(i) {
-                                let j = if dq[3].abs() >= dq[4].abs() { 3 } else { 4 };
-                                if smallest_jump.is_none_or(|(_, d)| dq[j].abs() < d) {
-                                    smallest_jump = Some((j, dq[j].abs()));
-                                }
-                                continue;
+                    if options.unwind_rapids && input.is_rapid(i) {
+                        let turn = 2.0 * PI;
+                        let mut q = cand.joints;
+                        q[pole] -= turn * (q[pole] / turn).round();
+                        if strokes.inside(&q) && (q[pole] - cand.joints[pole]).abs() > 0.0 {
+                            cand.joints = q;
+                            cand.unwound[pole] = true;
+                        }
+                    }
+                    // Off the material the pole axis may also unwind by a turn either way
+                    // (within its stroke): the windings a later cut needs.
+                    let mut variants = [None, None, None];
+                    if unwind && !input.cutting(i) {
+                        for (slot, sign) in [(1, 1.0), (2, -1.0)] {
+                            let mut v = cand.clone();
+                            v.joints[pole] += sign * 2.0 * PI;
+                            if strokes.inside(&v.joints) {
+                                v.unwound[pole] = true;
+                                variants[slot] = Some(v);
+                            }
+                        }
+                    }
+                    variants[0] = Some(cand);
+                    for cand in variants.into_iter().flatten() {
+                        let (cost, edge) = if has_previous {
+                            let dq = cand.joints - p.q;
+                            let jump = [3, 4].map(|j| dq[j].abs() > options.flip_threshold);
+                            // The move time only for candidates that are kept (a jump while
+                            // cutting is dropped before it is needed).
+                            let t = || move_time(machine, &p.q, &cand.joints);
+                            if jump == [false, false] || continuous {
+                                (t(), Edge::Plain)
                             } else {
-                                let j = if dq[3].abs() >= dq[4].abs() { 3 } else { 4 };
-                                (t() + options.reorient_penalty, Edge::Reorient(j))
+                                let only_pole = (0..2).all(|r| jump[r] == (r + 3 == pole));
+                                let crosses = p.at_pole
+                                    || cand.at_pole
+                                    || (i > 0 && arc_passes(&input.pose(i - 1).axis, &pose.axis, &pole_dir, eps));
+                                if only_pole && crosses {
+                                    (t(), Edge::PoleFlip)
+                                } else if input.cutting(i) {
+                                    let j = if dq[3].abs() >= dq[4].abs() { 3 } else { 4 };
+                                    if smallest_jump.is_none_or(|(_, d)| dq[j].abs() < d) {
+                                        smallest_jump = Some((j, dq[j].abs()));
+                                    }
+                                    continue;
+                                } else {
+                                    let j = if dq[3].abs() >= dq[4].abs() { 3 } else { 4 };
+                                    (t() + options.reorient_penalty, Edge::Reorient(j))
+                                }
                             }
-                        }
-                    } else {
-                        (0.0, Edge::Plain)
-                    };
-                    let first = if i == 0 { preference_key(kin, &cand.joints) } else { p.first };
-                    let state =
-                        State { q: cand.joints, at_pole: cand.at_pole, cost: p.cost + cost, first, back: pi, edge };
-                    match next.iter_mut().find(|s| (s.q - state.q).amax() < tol::SAME_JOINTS) {
-                        Some(existing) => {
-                            if better(&state, existing) {
-                                *existing = state;
+                        } else {
+                            (0.0, Edge::Plain)
+                        };
+                        let first = if i == 0 { preference_key(kin, &cand.joints) } else { p.first };
+                        let state =
+                            State { q: cand.joints, at_pole: cand.at_pole, cost: p.cost + cost, first, back: pi, edge };
+                        match next.iter_mut().find(|s| (s.q - state.q).amax() < tol::SAME_JOINTS) {
+                            Some(existing) => {
+                                if better(&state, existing) {
+                                    *existing = state;
+                                }
                             }
+                            None => next.push(state),
                         }
-                        None => next.push(state),
                     }
                 }
             }

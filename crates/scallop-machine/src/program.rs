@@ -120,6 +120,10 @@ pub struct ProgramOptions {
     pub tol_ang: f64,
     /// Branch-selection options.
     pub plan: PlanOptions,
+    /// Retract distance (mm) along the tool axis of a link that changes branch or unwinds:
+    /// the tool backs off this far from the last cutting pose, the rotaries turn (a rapid),
+    /// and it comes back along the new tool axis to the link's end.
+    pub retract: f64,
 }
 
 impl Default for ProgramOptions {
@@ -128,6 +132,7 @@ impl Default for ProgramOptions {
             tol_pos: tol::JOINT_INTERPOLATION_DEFAULT,
             tol_ang: tol::JOINT_ANGLE_DEFAULT,
             plan: PlanOptions::default(),
+            retract: tol::LINK_RETRACT_DEFAULT,
         }
     }
 }
@@ -205,7 +210,26 @@ pub fn to_program(
         let rec = &records[i];
         ends.clear();
         let previous = blocks.last().map(|b| (&b.pose, &b.joints)).or(before.as_ref().map(|(p, q)| (p, q)));
+        // A link that is not the continuous motion along its move (a branch change or an
+        // unwinding): retract along the old tool axis, turn the rotaries at the retract
+        // distance (a rapid), come back along the new tool axis.
+        let detour = match (rec.motion, previous) {
+            (Motion::Link, Some((pa, qa))) if is_jump(kin, pa, &rec.pose, qa, q, &options.plan) => {
+                let mut back = *qa;
+                let tip_a = pa.tip + pa.axis * options.retract;
+                kin.solve_linear(&tip_a, &mut back);
+                let mut over = *q;
+                let tip_b = rec.pose.tip + rec.pose.axis * options.retract;
+                kin.solve_linear(&tip_b, &mut over);
+                ends.push(BlockEnd { pose: Pose::new(tip_a, pa.axis), joints: back });
+                ends.push(BlockEnd { pose: Pose::new(tip_b, rec.pose.axis), joints: over });
+                ends.push(BlockEnd { pose: rec.pose, joints: *q });
+                true
+            }
+            _ => false,
+        };
         match (rec.motion, previous) {
+            _ if detour => {}
             (Motion::Rapid, _) | (_, None) => ends.push(BlockEnd { pose: rec.pose, joints: *q }),
             // In-place rotations (pole flips) are subdivided too: joint-linear X/Y/C
             // motion does not keep the tip still.
@@ -213,16 +237,18 @@ pub fn to_program(
                 subdivide_into(kin, (pa, qa), (&rec.pose, q), (options.tol_pos, options.tol_ang), i, &mut ends)?;
             }
         }
-        for end in &ends {
+        for (k, end) in ends.iter().enumerate() {
             strokes.check(machine, &end.joints, Some(i))?;
             let previous = blocks.last().map(|b| (&b.pose, &b.joints)).or(before.as_ref().map(|(p, q)| (p, q)));
-            let inverse_time = match (rec.motion, previous) {
+            // The detour's middle block (the reorientation) is a rapid.
+            let motion = if detour && k == 1 { Motion::Rapid } else { rec.motion };
+            let inverse_time = match (motion, previous) {
                 (Motion::Rapid, _) | (_, None) => None,
                 _ if !machine.nc().inverse_time => None,
                 (_, Some((pa, qa))) => Some(inverse_time_feed(kin, pa, &end.pose, qa, &end.joints, rec.feed)),
             };
             blocks.push(ProgramBlock {
-                motion: rec.motion,
+                motion,
                 joints: end.joints,
                 words: words(&end.joints),
                 pose: end.pose,
@@ -239,6 +265,18 @@ pub fn to_program(
     })
 }
 
+/// Whether the joint move `qa -> qb` of the CL move `pa -> pb` is a jump: some rotary
+/// turns more than the flip threshold and the move is not the continuous motion along
+/// the CL move ([`crate::plan::track`] reaches other joints or other windings).
+fn is_jump(kin: &Kinematics, pa: &Pose, pb: &Pose, qa: &Joints, qb: &Joints, plan: &PlanOptions) -> bool {
+    let turn = (qb[3] - qa[3]).abs().max((qb[4] - qa[4]).abs());
+    if turn <= plan.flip_threshold {
+        return false;
+    }
+    crate::plan::track(kin, pa, pb, qa)
+        .is_none_or(|t| (t[3] - qb[3]).abs() > tol::TRACK_MATCH || (t[4] - qb[4]).abs() > tol::TRACK_MATCH)
+}
+
 /// The CL records as the planner's input (no copies of the poses).
 struct Records<'a>(&'a [ClRecord]);
 
@@ -251,6 +289,9 @@ impl crate::plan::PathInput for Records<'_> {
     }
     fn cutting(&self, i: usize) -> bool {
         self.0[i].motion.is_cutting()
+    }
+    fn is_rapid(&self, i: usize) -> bool {
+        self.0[i].motion == Motion::Rapid
     }
 }
 

@@ -136,3 +136,29 @@ pub const BOUND_PRETEST_SLACK: f64 = 1e-9;
 /// Relative inflation of the atan-free upper bound `r_ref tan(phi) / F` of the rotation
 /// term of `feed::inverse_time_feed` (covers the rounding of the exact term, a few ulps).
 pub const ROTATION_TERM_SLACK: f64 = 1e-12;
+
+/// Largest rotary turn (rad, 5 deg) of one step of `plan::track`, which follows a CL move
+/// continuously: well below the 180 deg between the two inverse branches on the pole
+/// axis, so the nearest solution of each step is the continuation.
+pub const TRACK_STEP: f64 = std::f64::consts::PI / 36.0;
+
+/// First (and largest) step of `plan::track` as a fraction of the move.
+pub const TRACK_FIRST_STEP: f64 = 1.0 / 8.0;
+
+/// Smallest step of `plan::track` (fraction of the move): a turn above `TRACK_STEP` over
+/// a step this small is a discontinuity (an exact singularity), not a motion.
+pub const TRACK_MIN_STEP: f64 = 1.0 / 1_073_741_824.0;
+
+/// Most inverse evaluations of one `plan::track` (a guard; a move turning several full
+/// revolutions near the pole needs a few thousand).
+pub const TRACK_MAX_EVALUATIONS: usize = 200_000;
+
+/// An inverse solution is the end of `plan::track`'s continuous motion when its rotaries
+/// equal the tracked ones within this (rad) modulo a turn; the tracked values are inverse
+/// solutions of the same pose, so only rounding separates them.
+pub const TRACK_MATCH: f64 = 1e-6;
+
+/// Default retract distance (mm) along the tool axis of a link that changes branch or
+/// unwinds (`program::ProgramOptions::retract`) [PLACEHOLDER: a job's clearance should
+/// set it].
+pub const LINK_RETRACT_DEFAULT: f64 = 10.0;

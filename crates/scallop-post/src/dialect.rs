@@ -171,6 +171,12 @@ pub struct Dialect {
     /// applies the length in the controller (`tool_length_mode = "controller"`).
     #[serde(default)]
     pub length_offset: Vec<String>,
+    /// Lines written before joint-space and tilted-plane output so that the controller is
+    /// in its joint (identity) kinematics whatever state a previous program left it in
+    /// (e.g. `["{machine_tcp_off}"]`: LinuxCNC's M429); empty lines are skipped. The
+    /// reader takes them as TCP off.
+    #[serde(default)]
+    pub joint_kinematics: Vec<String>,
     /// Line numbering; `None` writes none.
     #[serde(default)]
     pub line_numbers: Option<LineNumbers>,
@@ -232,6 +238,7 @@ impl Dialect {
             footer: vec!["M5".into(), "M30".into()],
             tool_change: vec!["T{tool} M6".into()],
             length_offset: vec!["G43 H{tool}".into()],
+            joint_kinematics: Vec::new(),
             line_numbers: None,
             modal: true,
             axis_words: BTreeMap::new(),

@@ -59,12 +59,17 @@ fn tcp_keys(dialect: &Dialect, kin: &Kinematics) -> (Vec<String>, Vec<String>) {
             .replace("{machine_tcp_off}", tcp.off.as_deref().unwrap_or(""));
         s.split('{').next().unwrap_or("").trim().to_string()
     };
-    dialect.tcp.as_ref().map_or((Vec::new(), Vec::new()), |c| {
+    // The tool length offset written with TCP on (LinuxCNC: `G43 H{tool}` before M428) is
+    // also written in joint output: it does not switch TCP on.
+    let length: Vec<String> = dialect.length_offset.iter().map(key).collect();
+    let (on, mut off) = dialect.tcp.as_ref().map_or((Vec::new(), Vec::new()), |c| {
         (
-            c.on.iter().map(key).filter(|k| !k.is_empty()).collect(),
-            c.off.iter().map(key).filter(|k| !k.is_empty()).collect(),
+            c.on.iter().map(key).filter(|k| !k.is_empty() && !length.contains(k)).collect::<Vec<_>>(),
+            c.off.iter().map(key).filter(|k| !k.is_empty()).collect::<Vec<_>>(),
         )
-    })
+    });
+    off.extend(dialect.joint_kinematics.iter().map(key).filter(|k| !k.is_empty()));
+    (on, off)
 }
 
 fn number(line: usize, text: &str) -> Result<f64, PostError> {
@@ -437,6 +442,12 @@ pub struct RoundTrip {
     pub max_rate_ratio: f64,
 }
 
+/// Distance from `p` to the ray from `a` along the unit vector `d`.
+fn distance_to_ray(p: &Point3, a: &Point3, d: &Vec3) -> f64 {
+    let t = (p - a).dot(d).max(0.0);
+    (p - (a + d * t)).norm()
+}
+
 fn distance_to_segment(p: &Point3, a: &Point3, b: &Point3) -> f64 {
     let ab = b - a;
     let len2 = ab.norm_squared();
@@ -446,8 +457,11 @@ fn distance_to_segment(p: &Point3, a: &Point3, b: &Point3) -> f64 {
 
 /// Checks replayed blocks against the input CL records (spec K16): every block end and
 /// every sample of a joint-space block lies within `tol_pos` plus the word rounding of the
-/// CL segment it belongs to, every CL record is reached in order with its tool axis within
-/// `tol_ang` plus rounding, and no time-word block asks an axis for more than its velocity.
+/// CL segment it belongs to (off the material, rapids and links, also of the tool-axis
+/// rays at its ends: a retract and an approach), every CL record is reached in order by a
+/// block at its tip with its tool axis within `tol_ang` plus rounding (blocks and records
+/// are paired by order: records sharing a tip are reached one after the other), and no
+/// time-word block asks an axis for more than its velocity.
 ///
 /// ```
 /// use scallop_geom::{Point3, Vec3};
@@ -492,15 +506,30 @@ pub fn check_replay(
         deviation,
         allowed,
     };
+    // A CL record whose tip a block reached with another tool axis: an in-place
+    // reorientation pending, or the error to report if the record is never reached.
+    let mut axis_miss: Option<(usize, f64)> = None;
     for b in blocks {
         if next >= records.len() {
             return Err(fail(b.line, "motion after the last CL record: tip (mm)", f64::INFINITY, 0.0));
         }
-        let a_pt = records[next.saturating_sub(1)].pose.tip;
-        let b_pt = records[next].pose.tip;
+        let a_rec = &records[next.saturating_sub(1)];
+        let b_rec = &records[next];
+        let (a_pt, b_pt) = (a_rec.pose.tip, b_rec.pose.tip);
         let allowed = tol_pos * (1.0 + tol::CHECK_SLACK) + allow_pos;
-        let mut worst = distance_to_segment(&b.pose.tip, &a_pt, &b_pt);
-        let cutting = !b.rapid && records[next].motion != Motion::Rapid;
+        // Off the material (rapids, links) the tool may leave the segment along the tool
+        // axes of its ends (a link that changes branch retracts, reorients and comes back).
+        let off_material = !b_rec.motion.is_cutting();
+        let distance = |tip: &Point3| {
+            let d = distance_to_segment(tip, &a_pt, &b_pt);
+            if off_material {
+                d.min(distance_to_ray(tip, &a_pt, &a_rec.pose.axis)).min(distance_to_ray(tip, &b_pt, &b_rec.pose.axis))
+            } else {
+                d
+            }
+        };
+        let mut worst = distance(&b.pose.tip);
+        let cutting = !b.rapid && b_rec.motion != Motion::Rapid;
         if let Some(p) = previous
             && cutting
             && !b.tcp
@@ -509,10 +538,14 @@ pub fn check_replay(
             for k in 1..tol::CHECK_SAMPLES {
                 let s = f64::from(k) / f64::from(tol::CHECK_SAMPLES);
                 let tip = kin.fk(&(p.joints + (b.joints - p.joints) * s)).tip;
-                worst = worst.max(distance_to_segment(&tip, &a_pt, &b_pt));
+                worst = worst.max(distance(&tip));
             }
         }
         if worst > allowed {
+            // A record left at its tip with the wrong tool axis is the cause.
+            if let Some((line, ang)) = axis_miss {
+                return Err(fail(line, "tool axis (rad)", ang, tol_ang + allow_ang));
+            }
             return Err(fail(b.line, "tip (mm)", worst, allowed));
         }
         result.max_tip_deviation = result.max_tip_deviation.max(worst);
@@ -527,15 +560,24 @@ pub fn check_replay(
                 result.max_rate_ratio = result.max_rate_ratio.max(ratio);
             }
         }
+        // Records are paired with blocks in order: a block reaches the next record when
+        // both its tip and its tool axis are there (consecutive records may share a tip:
+        // a reorientation in place). A block at the tip with another axis leaves the
+        // record pending for a later block.
         while next < records.len() && (b.pose.tip - records[next].pose.tip).norm() <= allowed {
             let ang = angle(&b.pose.axis, &records[next].pose.axis);
             if ang > tol_ang + allow_ang {
-                return Err(fail(b.line, "tool axis (rad)", ang, tol_ang + allow_ang));
+                axis_miss = Some((b.line, ang));
+                break;
             }
+            axis_miss = None;
             result.max_axis_deviation = result.max_axis_deviation.max(ang);
             next += 1;
         }
         previous = Some(b);
+    }
+    if let (true, Some((line, ang))) = (next < records.len(), axis_miss) {
+        return Err(fail(line, "tool axis (rad)", ang, tol_ang + allow_ang));
     }
     if next < records.len() {
         return Err(fail(

@@ -222,9 +222,17 @@ fn program_text_with(
             }
             e.line(&text);
         }
-    } else if machine.tool_length_mode() == ToolLengthMode::Controller {
-        for l in &dialect.length_offset {
-            e.line(&vars.render(l));
+    } else {
+        for l in &dialect.joint_kinematics {
+            let text = vars.render(l);
+            if !text.trim().is_empty() {
+                e.line(&text);
+            }
+        }
+        if machine.tool_length_mode() == ToolLengthMode::Controller {
+            for l in &dialect.length_offset {
+                e.line(&vars.render(l));
+            }
         }
     }
     let letters: Vec<String> = machine.axes().iter().map(|a| dialect.axis_word(&a.name).to_string()).collect();

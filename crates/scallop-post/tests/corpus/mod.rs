@@ -1,0 +1,3 @@
+//! The generated paths (see `paths.rs`).
+
+pub mod paths;
