@@ -12,12 +12,12 @@ use scallop_io::job::{
     BarrierWord, FormulationWord, JobFile, OptimizeSpec, ShapeWord, SurrogateCostSpec, SurrogateWord, TransitionWord,
     parse_job,
 };
+use scallop_network::{CellLabels, TransitionModel, Transitions};
 use scallop_optim::study::{
     Formulation, KResult, Stopwatch, Study, StudyObserver, StudySettings, Surrogate, run_study,
 };
 use scallop_optim::surface::{SurfaceModel, SurfaceSettings};
 use scallop_optim::{Barrier, CostModel, OptimError, convergence_svg, zones_svg};
-use scallop_strategy::network::{CellLabels, TransitionModel, Transitions};
 use serde::Serialize;
 
 use crate::output::{print_json, print_text, progress_bar, write_atomic};

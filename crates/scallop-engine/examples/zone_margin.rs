@@ -6,7 +6,7 @@
 //! `cargo run --release -p scallop-engine --example zone_margin -- choi 0 45`
 
 use scallop_engine::{EngineError, FinishJob, Part, ZonePlanSpec, ZoneSpec, finish_zones};
-use scallop_strategy::network::{CellLabels, Transitions};
+use scallop_network::{CellLabels, Transitions};
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();

@@ -542,9 +542,9 @@ pub enum Strategy {
     /// Isoparametric passes on every patch of a parametric part.
     Isoparametric(IsoDirection),
     /// Parallel vertical planes placed by the fast network planner
-    /// (`scallop_strategy::network`, finishing.md 6.3 to 6.5) on every patch of a
+    /// (`scallop_network`, finishing.md 6.3 to 6.5) on every patch of a
     /// parametric part, cutter locations by drop-cutter
-    /// (`scallop_strategy::network::network_toolpath`); the scallop is verified by
+    /// (`scallop_network::network_toolpath`); the scallop is verified by
     /// the stock simulation only.
     NetworkPlanes,
 }
@@ -563,7 +563,7 @@ fn network_planes(
     params: &FinishingParams,
     tolerances: &Tolerances,
 ) -> Result<Plan, EngineError> {
-    use scallop_strategy::network::{Margins, Network, ZoneParams, network_toolpath, plan_zone};
+    use scallop_network::{Margins, Network, ZoneParams, network_toolpath, plan_zone};
     let tool = match *job.cutter.shape() {
         CutterShape::Ball { radius } => scallop_analysis::Cutter::Ball { radius },
         CutterShape::Bull { radius, corner } => scallop_analysis::Cutter::Toroidal { radius, corner },

@@ -42,8 +42,8 @@ use scallop_geom::{Point3, Tolerances, Vec3};
 use scallop_machine::Kinematics;
 use scallop_machine::program::{ProgramOptions, records_from_toolpath, to_program};
 use scallop_mesh::{MeshIndex, TriMesh};
+use scallop_network::{CellLabels, Orientation, Transitions};
 use scallop_post::{OutputMode, PostParams, program_text};
-use scallop_strategy::network::{CellLabels, Orientation, Transitions};
 use scallop_strategy::{
     FinishingParams, StrategyError, ZoneRegion, lookahead_time, plan_zone_finishing, stop_to_stop_time,
 };

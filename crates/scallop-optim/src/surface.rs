@@ -1,7 +1,7 @@
 //! The real black box of chapter 4 on one parametric patch: K-means with the
 //! weighted pseudo-metric (`scallop-cluster`), connected components, per-zone
 //! orientation, the fast parallel-planes planner on the isoparametric network
-//! (`scallop_strategy::network`) and the jerk-limited time with inter-zone
+//! (`scallop_network`) and the jerk-limited time with inter-zone
 //! transitions; and its static surrogates S3 (Annex E on the zones' PCA
 //! rectangles) and S4 (the planner on a 5 mm network at `sh = 0.1 mm`), both
 //! on a coarser clustering grid (finishing.md 12.2, 12.6).
@@ -12,11 +12,11 @@ use scallop_analysis::{
 use scallop_cluster::{ClusterParams, Features, Method, Metric, Partition, partition};
 use scallop_geom::nalgebra::Matrix3;
 use scallop_geom::{Point3, Vec3};
-use scallop_strategy::StrategyError;
-use scallop_strategy::network::{
+use scallop_network::{
     CellLabels, Margins, Network, Orientation, Transitions, ZoneParams, ZonePlan, ZoneWorkspace, Zoning,
     plan_zone_with, plan_zones, surface_time,
 };
+use scallop_strategy::StrategyError;
 use scallop_surface::Patch;
 
 use crate::error::OptimError;

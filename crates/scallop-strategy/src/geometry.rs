@@ -200,7 +200,7 @@ impl PartBoundary {
 /// the contact, the axis `(R - r)` from it along the horizontal part of `n`
 /// (downhill: the cutter touches a slope with its uphill side), the tip `r`
 /// below (ball `r = R`, flat and cone `r = 0`).
-pub(crate) fn contact_to_tip(shape: &CutterShape, n: &Vec3) -> Vec3 {
+pub fn contact_to_tip(shape: &CutterShape, n: &Vec3) -> Vec3 {
     let (radius, corner) = match *shape {
         CutterShape::Ball { radius } => (radius, radius),
         CutterShape::Bull { radius, corner } => (radius, corner),

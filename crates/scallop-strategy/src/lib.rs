@@ -155,7 +155,6 @@ mod error;
 mod geometry;
 mod iso;
 mod leads;
-pub mod network;
 mod params;
 mod plan;
 mod region;
@@ -165,6 +164,7 @@ pub mod tol;
 pub mod trochoid;
 
 pub use error::StrategyError;
+pub use geometry::contact_to_tip;
 pub use iso::{IsoDirection, IsoPass, IsoPlanned, iso_scallop, plan_isoparametric};
 pub use leads::{LeadFallback, LeadKind, LeadReport, apply_leads};
 pub use params::{Boundary, FinishingParams, Pattern};

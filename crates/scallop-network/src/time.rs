@@ -91,7 +91,7 @@ pub struct SurfaceTime {
 ///
 /// ```
 /// use scallop_geom::Point3;
-/// use scallop_strategy::network::{Transitions, TransitionModel};
+/// use scallop_network::{Transitions, TransitionModel};
 /// let m = scallop_analysis::MachineLimits::default();
 /// let t = Transitions { model: TransitionModel::Linear, reorientation_s: 0.0 };
 /// let (time, length) = t.time(&Point3::origin(), &Point3::new(3.0, 4.0, 0.0), &m);
@@ -139,7 +139,7 @@ pub(crate) fn pass_length_time(points: &[Point3], cos_sharp: f64, machine: &Mach
     for w in points.windows(2) {
         let v = w[1] - w[0];
         let l = v.norm();
-        if l <= crate::tol::ZERO_LENGTH {
+        if l <= scallop_strategy::tol::ZERO_LENGTH {
             continue;
         }
         if let Some((p, pl)) = previous {

@@ -17,7 +17,7 @@
 use scallop_analysis::Cutter;
 use scallop_geom::Vec3;
 
-use crate::StrategyError;
+use scallop_strategy::StrategyError;
 
 /// The cutter's step-over constants for one scallop height.
 #[derive(Debug, Clone, Copy)]

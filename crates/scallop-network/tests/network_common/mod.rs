@@ -3,7 +3,7 @@
 
 use scallop_analysis::{Cutter, MachineLimits};
 use scallop_geom::{Point3, Vec3};
-use scallop_strategy::network::{Margins, ZoneParams, ZonePlan};
+use scallop_network::{Margins, ZoneParams, ZonePlan};
 use scallop_surface::Patch;
 
 /// The spec's fixture (finishing.md 14.1) generalised: a `width` (along Y, u) x

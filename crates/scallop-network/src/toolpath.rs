@@ -34,7 +34,7 @@ use scallop_mesh::MeshIndex;
 use scallop_toolpath::{Move, MoveKind, Toolpath, simplify};
 
 use super::{Network, ZonePlan};
-use crate::{FinishingParams, StrategyError, tol};
+use scallop_strategy::{FinishingParams, StrategyError, tol};
 
 /// A toolpath made from network plans, with what it took.
 #[derive(Debug, Clone, PartialEq)]
@@ -113,7 +113,7 @@ fn distance_to_segment(p: &Point3, a: &Point3, b: &Point3) -> f64 {
 /// The XY of the cutter location that touches contact point `p` with unit
 /// normal `n` (see the module docs).
 fn location_xy(shape: &CutterShape, p: &Point3, n: &Vec3) -> Point2 {
-    let tip = p + crate::geometry::contact_to_tip(shape, n);
+    let tip = p + scallop_strategy::contact_to_tip(shape, n);
     Point2::new(tip.x, tip.y)
 }
 
@@ -121,7 +121,7 @@ fn location_xy(shape: &CutterShape, p: &Point3, n: &Vec3) -> Point2 {
 /// orientation) on the part indexed by `index`, joined into one toolpath (see
 /// the module docs). `params` gives the feed, plunge feed, clearance, pattern
 /// is zigzag (the network's order); `tolerances.path` is shared as in
-/// [`crate::plan_finishing`].
+/// [`scallop_strategy::plan_finishing`].
 ///
 /// # Errors
 /// - [`StrategyError::Unsupported`]: a cone cutter, or plans made on an

@@ -12,7 +12,7 @@ use scallop_geom::Point3;
 use super::spacing::ToolModel;
 use super::time::pass_length_time;
 use super::{CellLabels, Network, Pass, RawNormal, Zoning};
-use crate::tol;
+use scallop_strategy::tol;
 
 /// A point of a pass under construction.
 #[derive(Debug, Clone, Copy)]

@@ -10,10 +10,10 @@ use std::f64::consts::FRAC_PI_2;
 use network_common::{inclined_plane, params, rel};
 use proptest::prelude::*;
 use scallop_analysis::{Cutter, MachineLimits};
-use scallop_strategy::StrategyError;
-use scallop_strategy::network::{
+use scallop_network::{
     CellLabels, Network, Pass, TransitionModel, Transitions, Zoning, plan_zone, plan_zones, plane_passes, surface_time,
 };
+use scallop_strategy::StrategyError;
 
 const TORUS: Cutter = Cutter::Toroidal { radius: 5.0, corner: 2.0 };
 const BALL: Cutter = Cutter::Ball { radius: 5.0 };
@@ -164,7 +164,7 @@ fn bad_inputs_are_errors_naming_the_fix() {
 /// reused workspace or a fresh one.
 #[test]
 fn a_zone_plans_the_same_on_a_partly_oriented_network() {
-    use scallop_strategy::network::{Orientation, ZoneWorkspace, plan_zone_with};
+    use scallop_network::{Orientation, ZoneWorkspace, plan_zone_with};
     let set = scallop_surface::builtin("rubio").unwrap();
     let network = Network::new(&set.patches()[0], 1.0).unwrap();
     let zoning = Zoning::new(&network, &u_shape(40)).unwrap();

@@ -12,7 +12,7 @@ use network_common::{inclined_plane, params, rel, spacing_at};
 use proptest::prelude::*;
 use scallop_analysis::{Cutter, FeedDirection, MachineLimits, Rectangle, plane_time};
 use scallop_geom::{Point3, Vec3};
-use scallop_strategy::network::{Margins, Network, Orientation, Transitions, plan_zone, surface_time};
+use scallop_network::{Margins, Network, Orientation, Transitions, plan_zone, surface_time};
 
 const TORUS: Cutter = Cutter::Toroidal { radius: 5.0, corner: 2.0 };
 const BALL: Cutter = Cutter::Ball { radius: 5.0 };

@@ -6,7 +6,7 @@ use scallop_geom::Point3;
 use super::passes::{PlaneCut, PlaneCutter, Workspace};
 use super::spacing::ToolModel;
 use super::{Margins, Network, NetworkPlane, ZoneParams, ZonePlan, Zoning};
-use crate::{StrategyError, tol};
+use scallop_strategy::{StrategyError, tol};
 
 /// Plans zone `zone` of `zoning` on `network` (the whole surface when `zoning` is
 /// `None`; `zone` is then only recorded) along `params.direction` in the

@@ -12,7 +12,7 @@ use network_common::{params, step_over_and_factor, vertices};
 use proptest::prelude::*;
 use scallop_analysis::{Cutter, effective_radius_for_step_over};
 use scallop_geom::Point3;
-use scallop_strategy::network::{Network, plan_zone};
+use scallop_network::{Network, plan_zone};
 use scallop_surface::Patch;
 
 /// Relative slack of the check: rounding (the planner evaluates the same exact

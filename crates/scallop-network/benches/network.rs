@@ -26,7 +26,7 @@ use scallop_analysis::{Cutter, GridOptions, MachineLimits, ToolOptions, analyze,
 use scallop_cutter::CutterShape;
 use scallop_geom::Tolerances;
 use scallop_mesh::MeshIndex;
-use scallop_strategy::network::{
+use scallop_network::{
     CellLabels, Margins, Network, Transitions, ZoneParams, Zoning, network_toolpath, plan_zone, plan_zones,
     surface_time,
 };

@@ -7,14 +7,14 @@
 //! mesh is about 15 to 35 million instructions, a few milliseconds (figures in
 //! `docs/benchmarks.md`).
 //!
-//! Unlike [`crate::plan_finishing`] it drops no cutter and writes no toolpath:
+//! Unlike [`scallop_strategy::plan_finishing`] it drops no cutter and writes no toolpath:
 //! the passes are **contact** polylines on the network, lengths are measured
 //! on them (6.5 \[DECISION\]), and the result is a [`ZonePlan`] with lengths and
 //! times.
 //!
 //! ```
 //! use scallop_analysis::{Cutter, MachineLimits};
-//! use scallop_strategy::network::{Margins, Network, Transitions, ZoneParams, plan_zone, surface_time};
+//! use scallop_network::{Margins, Network, Transitions, ZoneParams, plan_zone, surface_time};
 //!
 //! let set = scallop_surface::builtin("choi").unwrap();
 //! let network = Network::new(&set.patches()[0], 0.5).unwrap();   // 0.5 mm machining mesh
@@ -50,7 +50,7 @@
 //!   of the clustering cell containing it; segments are split at the exact
 //!   crossing of the axis-aligned cell boundaries (the boundary point is
 //!   inserted) and the passes are the maximal sub-polylines of the zone. Passes
-//!   shorter than [`crate::tol::MIN_PASS_LENGTH`] are dropped but their vertices
+//!   shorter than [`scallop_strategy::tol::MIN_PASS_LENGTH`] are dropped but their vertices
 //!   still count for the spacing.
 //! - **NEXT_SPACING** (6.4): the minimum over the vertices of the plane's passes of
 //!   `sod_i |c_i . m| = sod_i sqrt(1 - (n_i . m)^2)` with `sod_i` the step-over of
@@ -108,7 +108,7 @@ use scallop_geom::{Point3, Vec3};
 use scallop_surface::Patch;
 use serde::{Deserialize, Serialize};
 
-use crate::{StrategyError, tol};
+use scallop_strategy::{StrategyError, tol};
 
 pub use time::{SurfaceTime, TransitionModel, Transitions, surface_time};
 pub use toolpath::{NetworkToolpath, network_toolpath};
@@ -141,7 +141,7 @@ impl Network {
     ///
     /// ```
     /// let set = scallop_surface::builtin("rubio").unwrap();
-    /// let n = scallop_strategy::network::Network::new(&set.patches()[0], 5.0).unwrap();
+    /// let n = scallop_network::Network::new(&set.patches()[0], 5.0).unwrap();
     /// let (nu, nv) = n.resolution();
     /// assert!(nu >= 2 && nv >= 2);
     /// ```
@@ -515,7 +515,7 @@ impl Orientation {
     ///
     /// ```
     /// use scallop_geom::{Point3, Vec3};
-    /// use scallop_strategy::network::Orientation;
+    /// use scallop_network::Orientation;
     /// let o = Orientation::new(0.3, 1.0, Point3::origin());
     /// let z = o.rotate(&o.tool_axis());
     /// assert!((z - Vec3::z()).norm() < 1e-12);
