@@ -111,7 +111,11 @@ pub struct PostReport {
 }
 
 fn read_text(path: &Path) -> CliResult<String> {
-    std::fs::read_to_string(path).map_err(|e| Failure::Io(anyhow::anyhow!("{}: cannot read: {e}", path.display())))
+    let bytes = std::fs::read(path).map_err(|e| {
+        let err = anyhow::anyhow!("{}: cannot read: {e}", path.display());
+        if e.kind() == std::io::ErrorKind::NotFound { Failure::Rejected(err) } else { Failure::Io(err) }
+    })?;
+    scallop_io::utf8_text(&bytes).map(str::to_owned).map_err(|e| Failure::rejected(format!("{}: {e}", path.display())))
 }
 
 fn load_machine(name: &str) -> CliResult<Machine> {

@@ -58,6 +58,34 @@ pub enum GcodeError {
     /// The program has no motion at all.
     #[error("the program has no motion (no G0/G1/G2/G3 move with coordinates)")]
     Empty,
+    /// A coordinate, centre offset or radius outside the machinable range
+    /// ([`MAX_COORDINATE`]) once inch scaling and incremental accumulation are applied.
+    #[error(
+        "G-code line {line}: {what} = {value:e} mm is outside +-{max:e} mm (after G20 inch scaling and G91 accumulation); fix the number on this line"
+    )]
+    OutOfRange {
+        /// Line number.
+        line: usize,
+        /// Which value (`X`, `arc centre`, `R`, ...).
+        what: String,
+        /// The value in mm (possibly infinite).
+        value: f64,
+        /// The bound, [`MAX_COORDINATE`].
+        max: f64,
+    },
+}
+
+/// Largest absolute coordinate (mm) a program may reach, and largest arc radius: 100 m,
+/// far beyond any machine's stroke; beyond it a number is a typo, and near `f64::MAX`
+/// arithmetic overflows to infinity.
+pub const MAX_COORDINATE: f64 = 1e5;
+
+fn in_range(line: usize, what: &str, value: f64) -> Result<f64, GcodeError> {
+    if value.is_finite() && value.abs() <= MAX_COORDINATE {
+        Ok(value)
+    } else {
+        Err(GcodeError::OutOfRange { line, what: what.to_string(), value, max: MAX_COORDINATE })
+    }
 }
 
 /// Options of [`read_gcode`].
@@ -185,6 +213,14 @@ fn read(text: &str, options: &GcodeOptions, keep_arcs: bool) -> Result<Toolpath,
                 } else {
                     let (u, v, _) = state.plane;
                     let offsets = [i, j, kk].map(|o| o.map(|x| x * state.scale));
+                    for (o, name) in offsets.iter().zip(["I", "J", "K"]) {
+                        if let Some(o) = o {
+                            in_range(line, name, *o)?;
+                        }
+                    }
+                    if let Some(r) = r {
+                        in_range(line, "R", r * state.scale)?;
+                    }
                     let centre = arc_centre(
                         (from[u], from[v]),
                         (to[u], to[v]),
@@ -193,6 +229,8 @@ fn read(text: &str, options: &GcodeOptions, keep_arcs: bool) -> Result<Toolpath,
                         motion == 2,
                         line,
                     )?;
+                    in_range(line, "arc centre", centre.0)?;
+                    in_range(line, "arc centre", centre.1)?;
                     if keep_arcs && state.plane == (0, 1, 2) {
                         let sweep = arc_sweep(from, to, centre, motion == 2);
                         let arc = ArcXY { center: Point2::new(centre.0, centre.1), sweep };
@@ -270,6 +308,9 @@ impl State {
                     });
                 }
             };
+        }
+        for (v, name) in p.iter().zip(["X", "Y", "Z"]) {
+            in_range(line, name, *v)?;
         }
         Ok(Point3::new(p[0], p[1], p[2]))
     }
@@ -476,6 +517,26 @@ mod tests {
         assert!(matches!(read("G0 X1\n").unwrap_err(), GcodeError::State { line: 1, .. }));
         assert_eq!(read("(only a comment)\nM30\n").unwrap_err(), GcodeError::Empty);
         assert!(matches!(read("G0 X0 Y0 Z0\nG28\n").unwrap_err(), GcodeError::Unsupported { line: 2, .. }));
+    }
+
+    #[test]
+    fn coordinates_are_bounded_after_scaling_and_accumulation() {
+        // The cases: a finite number that G20 turns into infinity, G91 steps that
+        // sum to infinity, an arc centre offset near f64::MAX.
+        let big = "9".repeat(308);
+        let g20 = format!("G21 G90\nG0 X10 Y10 Z50\nG1 Z38 F100\nG20\nG1 X{big}\n");
+        assert!(matches!(read(&g20).unwrap_err(), GcodeError::OutOfRange { line: 5, .. }));
+        let g91 = format!("G21 G90\nG0 X10 Y10 Z50\nG1 Z38 F100\nG91\nG1 X{big}\nG1 X{big}\n");
+        assert!(matches!(read(&g91).unwrap_err(), GcodeError::OutOfRange { line: 5, .. }));
+        let arc = format!("G21 G90\nG0 X10 Y10 Z50\nG1 Z45 F100\nG2 X10 Y10 I17{}\n", "0".repeat(307));
+        let e = read(&arc).unwrap_err();
+        assert!(matches!(e, GcodeError::OutOfRange { line: 4, .. }), "{e}");
+        // Accumulation: 2000 steps of 60 mm pass +-1e5 on step 1667.
+        let steps = "G1 X60\n".repeat(2000);
+        let e = read(&format!("G0 X0 Y0 Z0\nF100 G91\n{steps}")).unwrap_err();
+        assert!(matches!(e, GcodeError::OutOfRange { line: 1669, .. }), "{e}");
+        // The bound itself is accepted.
+        assert!(read(&format!("G0 X0 Y0 Z0\nG1 X{MAX_COORDINATE} F100\n")).is_ok());
     }
 
     #[test]
