@@ -1,4 +1,4 @@
-//! A short fuzzing campaign in the normal test suite: a few hundred mutated inputs per
+//! A short fuzzing campaign in the normal test suite: two thousand mutated inputs per
 
 #![allow(clippy::unwrap_used, reason = "tests fail loudly by design")]
 //! target (seconds); the long campaign is `scallop-fuzz` (docs/fuzzing.md).
@@ -9,8 +9,8 @@ use scallop_fuzz::{Target, campaign, run_one, seeds};
 fn every_target_survives_a_short_campaign() {
     std::panic::set_hook(Box::new(|_| {}));
     for target in Target::ALL {
-        let report = campaign(target, 2026, 0..300, &|_| {});
-        assert_eq!(report.executions, 300);
+        let report = campaign(target, 2026, 0..2000, &|_| {});
+        assert_eq!(report.executions, 2000);
         assert!(
             report.failures.is_empty(),
             "{}: {:?}",

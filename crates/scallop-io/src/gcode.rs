@@ -9,6 +9,11 @@
 //! effect on the path. Anything else that moves the tool (canned cycles, `G28`, `G53`, `G92`, rotary words `A B C`, ...) is an error naming
 //! the line: a simulation must never silently skip motion.
 //!
+//! Until the tool's position is known, rapids may give it one axis at a time (`G0 Z50`
+//! then `G0 X0 Y0`, as programs for real controllers start); the tool is placed when X, Y
+//! and Z are all known, and a feed move before that is an error. Coordinates are bounded by
+//! [`MAX_COORDINATE`] after inch scaling and incremental accumulation.
+//!
 //! Arcs are replaced by chords within `arc_tolerance` (sagitta), so every move
 //! of the result is straight.
 
@@ -149,8 +154,16 @@ pub fn read_gcode_arcs(text: &str, options: &GcodeOptions) -> Result<Toolpath, G
 }
 
 fn read(text: &str, options: &GcodeOptions, keep_arcs: bool) -> Result<Toolpath, GcodeError> {
-    let mut state =
-        State { pos: options.start, scale: 1.0, absolute: true, motion: None, feed: None, plane: (0, 1, 2) };
+    let mut state = State {
+        pos: options.start,
+        partial: [None; 3],
+        partial_line: 0,
+        scale: 1.0,
+        absolute: true,
+        motion: None,
+        feed: None,
+        plane: (0, 1, 2),
+    };
     let mut path = Toolpath::new(0.0);
     let mut feeds: Vec<f64> = Vec::new();
     for (k, raw) in text.lines().enumerate() {
@@ -191,6 +204,34 @@ fn read(text: &str, options: &GcodeOptions, keep_arcs: bool) -> Result<Toolpath,
         let Some(motion) = state.motion else {
             return Err(GcodeError::State { line, why: "coordinates without a motion mode (G0/G1/G2/G3)" });
         };
+        if state.pos.is_none() && target.iter().any(Option::is_none) {
+            // Unknown start, as on a controller after homing: rapids may give the axes one
+            // at a time (`G0 Z50` then `G0 X0 Y0`); the tool is placed once all are known.
+            if motion != 0 {
+                return Err(GcodeError::State {
+                    line,
+                    why: "a feed move before X, Y and Z are all known; start with G0 moves that give every axis",
+                });
+            }
+            if !state.absolute {
+                return Err(GcodeError::State {
+                    line,
+                    why: "an incremental (G91) move from an unknown position; give absolute X, Y and Z first",
+                });
+            }
+            for (axis, name) in ["X", "Y", "Z"].into_iter().enumerate() {
+                if let Some(v) = target[axis] {
+                    state.partial[axis] = Some(in_range(line, name, v * state.scale)?);
+                }
+                state.partial_line = line;
+            }
+            if let [Some(x), Some(y), Some(z)] = state.partial {
+                let to = Point3::new(x, y, z);
+                path.push(Move::new(MoveKind::Rapid, to));
+                state.pos = Some(to);
+            }
+            continue;
+        }
         let to = state.resolve(target, line)?;
         let Some(from) = state.pos else {
             // Unknown start: place the tool.
@@ -247,6 +288,12 @@ fn read(text: &str, options: &GcodeOptions, keep_arcs: bool) -> Result<Toolpath,
         state.pos = Some(to);
     }
     if path.moves().is_empty() {
+        if state.partial.iter().any(Option::is_some) {
+            return Err(GcodeError::State {
+                line: state.partial_line,
+                why: "X, Y and Z are never all given, so the tool's position is never known",
+            });
+        }
         return Err(GcodeError::Empty);
     }
     // One feed for the path: the most common programmed feed (mm/min), for time estimates.
@@ -258,6 +305,10 @@ fn read(text: &str, options: &GcodeOptions, keep_arcs: bool) -> Result<Toolpath,
 
 struct State {
     pos: Option<Point3>,
+    /// The axes known so far while `pos` is unknown (rapids giving one axis at a time).
+    partial: [Option<f64>; 3],
+    /// The last line that gave one of them.
+    partial_line: usize,
     scale: f64,
     absolute: bool,
     motion: Option<u8>,
@@ -515,8 +566,21 @@ mod tests {
         assert!(matches!(read("G0 X0 Y0 Z0\nG1 X1Q F100\n").unwrap_err(), GcodeError::Syntax { line: 2, .. }));
         assert!(matches!(read("G0 X0 Y0 Z0\nG2 X1 Y1 I3 F100\n").unwrap_err(), GcodeError::BadArc { line: 2, .. }));
         assert!(matches!(read("G0 X1\n").unwrap_err(), GcodeError::State { line: 1, .. }));
+        assert!(matches!(read("G0 Z50\nG1 X1 F100\n").unwrap_err(), GcodeError::State { line: 2, .. }));
         assert_eq!(read("(only a comment)\nM30\n").unwrap_err(), GcodeError::Empty);
         assert!(matches!(read("G0 X0 Y0 Z0\nG28\n").unwrap_err(), GcodeError::Unsupported { line: 2, .. }));
+    }
+
+    #[test]
+    fn a_program_may_give_the_start_one_axis_at_a_time() {
+        // As controllers read it: a safe Z first, then X and Y; the tool is placed then.
+        let p = read("G21 G90\nG0 Z50\nG0 X10 Y-5\nG1 Z0 F300\nG1 X20\n").unwrap();
+        let to: Vec<Point3> = p.moves().iter().map(|m| m.to).collect();
+        assert_eq!(to, vec![Point3::new(10.0, -5.0, 50.0), Point3::new(10.0, -5.0, 0.0), Point3::new(20.0, -5.0, 0.0)]);
+        assert_eq!(p.moves()[0].kind, MoveKind::Rapid);
+        // Inches apply to the partial axes too.
+        let p = read("G20\nG0 Z2\nG0 X1 Y1\n").unwrap();
+        assert_eq!(p.moves()[0].to, Point3::new(25.4, 25.4, 50.8));
     }
 
     #[test]
