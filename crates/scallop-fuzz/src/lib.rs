@@ -232,21 +232,30 @@ fn replace_number(input: &mut Vec<u8>, rng: &mut Rng) {
 pub fn input(target: Target, seeds: &[Vec<u8>], seed: u64, iteration: u64) -> Vec<u8> {
     let tag = target.name().bytes().fold(0u64, |h, b| h.rotate_left(7) ^ u64::from(b));
     let mut rng = Rng::new(seed ^ tag.wrapping_mul(0x100_0000_01b3) ^ iteration.wrapping_mul(0x9e37_79b9));
-    let mut bytes = seeds[rng.below(seeds.len())].clone();
+    // 3MF: half the inputs mutate the model XML and zip it (the zip stays valid), the other
+    // half mutate the zip's bytes.
+    let xml = target == Target::ThreeMf && rng.below(2) == 0;
+    let mut bytes = if xml {
+        let models = threemf_models();
+        models[rng.below(models.len())].clone().into_bytes()
+    } else {
+        seeds[rng.below(seeds.len())].clone()
+    };
     // Half the inputs stack a second round of mutations.
     mutate(&mut bytes, &mut rng);
     if rng.below(2) == 0 {
         mutate(&mut bytes, &mut rng);
     }
-    bytes
+    if xml { threemf(&bytes) } else { bytes }
 }
 
-/// Runs one input through `target`. `Err` is a failure: a panic (with its message) or an
+/// Runs one input through `target`: `Ok(true)` when it was accepted, `Ok(false)` when it
+/// was refused with an error. `Err` is a failure: a panic (with its message) or an
 /// accepted result that breaks the parser's promise.
 ///
 /// # Errors
 /// The failure, in words.
-pub fn run_one(target: Target, bytes: &[u8]) -> Result<(), String> {
+pub fn run_one(target: Target, bytes: &[u8]) -> Result<bool, String> {
     let result = catch_unwind(AssertUnwindSafe(|| check(target, bytes)));
     match result {
         Ok(r) => r,
@@ -261,18 +270,17 @@ pub fn run_one(target: Target, bytes: &[u8]) -> Result<(), String> {
     }
 }
 
-fn check(target: Target, bytes: &[u8]) -> Result<(), String> {
-    let mesh = |format: MeshFormat| -> Result<(), String> {
-        if let Ok(m) = scallop_io::read_mesh(bytes, format, Units::Millimetres) {
-            let n = m.mesh.vertices().len();
-            if !m.mesh.vertices().iter().all(|p| p.coords.iter().all(|c| c.is_finite())) {
-                return Err("a mesh with a non-finite vertex was accepted".into());
-            }
-            if !m.mesh.triangles().iter().flatten().all(|&i| (i as usize) < n) {
-                return Err("a mesh with an index out of range was accepted".into());
-            }
+fn check(target: Target, bytes: &[u8]) -> Result<bool, String> {
+    let mesh = |format: MeshFormat| -> Result<bool, String> {
+        let Ok(m) = scallop_io::read_mesh(bytes, format, Units::Millimetres) else { return Ok(false) };
+        let n = m.mesh.vertices().len();
+        if !m.mesh.vertices().iter().all(|p| p.coords.iter().all(|c| c.is_finite())) {
+            return Err("a mesh with a non-finite vertex was accepted".into());
         }
-        Ok(())
+        if !m.mesh.triangles().iter().flatten().all(|&i| (i as usize) < n) {
+            return Err("a mesh with an index out of range was accepted".into());
+        }
+        Ok(true)
     };
     let text = || scallop_io::utf8_text(bytes).ok();
     match target {
@@ -281,57 +289,55 @@ fn check(target: Target, bytes: &[u8]) -> Result<(), String> {
         Target::Ply => mesh(MeshFormat::Ply),
         Target::ThreeMf => mesh(MeshFormat::ThreeMf),
         Target::Gcode => {
-            let Some(text) = text() else { return Ok(()) };
+            let Some(text) = text() else { return Ok(false) };
             let options = scallop_io::gcode::GcodeOptions::default();
+            let mut accepted = false;
             for path in
                 [scallop_io::gcode::read_gcode(text, &options), scallop_io::gcode::read_gcode_arcs(text, &options)]
                     .into_iter()
                     .flatten()
             {
+                accepted = true;
                 let bound = scallop_io::gcode::MAX_COORDINATE;
                 if !path.moves().iter().all(|m| m.to.coords.iter().all(|c| c.is_finite() && c.abs() <= bound)) {
                     return Err("a program with a coordinate out of range was accepted".into());
                 }
             }
-            Ok(())
+            Ok(accepted)
         }
         Target::Cl => {
-            let Some(text) = text() else { return Ok(()) };
-            if let Ok(rows) = scallop_io::cl::read_cl_csv(text)
-                && !rows.iter().all(|r| r.tip.coords.iter().chain(r.axis.iter()).all(|c| c.is_finite()))
-            {
+            let Some(text) = text() else { return Ok(false) };
+            let Ok(rows) = scallop_io::cl::read_cl_csv(text) else { return Ok(false) };
+            if !rows.iter().all(|r| r.tip.coords.iter().chain(r.axis.iter()).all(|c| c.is_finite())) {
                 return Err("a CL row with a non-finite value was accepted".into());
             }
-            Ok(())
+            Ok(true)
         }
         Target::Job => {
-            let Some(text) = text() else { return Ok(()) };
-            let _ = scallop_io::job::parse_job(text).map_err(|e| e.to_string());
-            Ok(())
+            let Some(text) = text() else { return Ok(false) };
+            Ok(scallop_io::job::parse_job(text).is_ok())
         }
         Target::Surface => {
-            let Some(text) = text() else { return Ok(()) };
-            if let Ok(set) = scallop_surface::toml_format::parse_surfaces(text) {
-                for patch in set.patches() {
-                    let d = patch.domain();
-                    let p = patch.point(d.u[0], d.v[0]);
-                    if !p.coords.iter().all(|c| c.is_finite()) {
-                        return Err("a surface evaluating to a non-finite point was accepted".into());
-                    }
+            let Some(text) = text() else { return Ok(false) };
+            let Ok(set) = scallop_surface::toml_format::parse_surfaces(text) else { return Ok(false) };
+            for patch in set.patches() {
+                let d = patch.domain();
+                let p = patch.point(d.u[0], d.v[0]);
+                if !p.coords.iter().all(|c| c.is_finite()) {
+                    return Err("a surface evaluating to a non-finite point was accepted".into());
                 }
             }
-            Ok(())
+            Ok(true)
         }
         Target::Machine => {
-            let Some(text) = text() else { return Ok(()) };
-            if let Ok(m) = scallop_machine::Machine::from_toml_str(text) {
-                let g = m.gauge_point();
-                let frame = m.part_frame().to_homogeneous();
-                if !(g.coords.iter().chain(frame.iter()).all(|c| c.is_finite())) {
-                    return Err("a machine with a non-finite frame or point was accepted".into());
-                }
+            let Some(text) = text() else { return Ok(false) };
+            let Ok(m) = scallop_machine::Machine::from_toml_str(text) else { return Ok(false) };
+            let g = m.gauge_point();
+            let frame = m.part_frame().to_homogeneous();
+            if !(g.coords.iter().chain(frame.iter()).all(|c| c.is_finite())) {
+                return Err("a machine with a non-finite frame or point was accepted".into());
             }
-            Ok(())
+            Ok(true)
         }
     }
 }
@@ -341,6 +347,8 @@ fn check(target: Target, bytes: &[u8]) -> Result<(), String> {
 pub struct Report {
     /// Inputs run.
     pub executions: u64,
+    /// Inputs accepted (the rest were refused with an error).
+    pub accepted: u64,
     /// The slowest input: its time and iteration.
     pub slowest: (Duration, u64),
     /// Failures: iteration and message.
@@ -362,8 +370,9 @@ pub fn campaign(target: Target, seed: u64, iterations: std::ops::Range<u64>, bef
         if took > report.slowest.0 {
             report.slowest = (took, iteration);
         }
-        if let Err(message) = result {
-            report.failures.push((iteration, message));
+        match result {
+            Ok(accepted) => report.accepted += u64::from(accepted),
+            Err(message) => report.failures.push((iteration, message)),
         }
     }
     report
@@ -478,17 +487,17 @@ fn threemf_object(id: u32, v: &[[f64; 3]], t: &[[usize; 3]]) -> String {
 
 /// A 3MF package with `model` at `3D/3dmodel.model`.
 #[must_use]
-pub fn threemf(model: &str) -> Vec<u8> {
+pub fn threemf(model: &[u8]) -> Vec<u8> {
     let rels = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<Relationships \
         xmlns=\"http://schemas.openxmlformats.org/package/2006/relationships\"><Relationship \
         Target=\"/3D/3dmodel.model\" Id=\"rel0\" \
         Type=\"http://schemas.microsoft.com/3dmanufacturing/2013/01/3dmodel\"/></Relationships>\n";
     let options = zip::write::SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
     let mut writer = zip::ZipWriter::new(Cursor::new(Vec::new()));
-    for (name, content) in [("_rels/.rels", rels), ("3D/3dmodel.model", model)] {
+    for (name, content) in [("_rels/.rels", rels.as_bytes()), ("3D/3dmodel.model", model)] {
         // Writing into memory cannot fail; a failure leaves a shorter (still useful) seed.
         if writer.start_file(name, options).is_ok() {
-            let _ = writer.write_all(content.as_bytes());
+            let _ = writer.write_all(content);
         }
     }
     writer.finish().map(Cursor::into_inner).unwrap_or_default()
@@ -504,10 +513,8 @@ pub fn threemf_model(resources: &str, build: &str) -> String {
     )
 }
 
-/// A 3MF whose `levels` nested objects each place the one below `copies` times: a small
-/// file that places `triangles * copies^levels` triangles (the issue's instancing case).
-#[must_use]
-pub fn threemf_instancing(levels: u32, copies: u32) -> Vec<u8> {
+/// The model XML of [`threemf_instancing`].
+fn instancing_model(levels: u32, copies: u32) -> String {
     let (v, t) = seed_mesh();
     let mut resources = threemf_object(1, &v, &t);
     for level in 0..levels {
@@ -522,7 +529,24 @@ pub fn threemf_instancing(levels: u32, copies: u32) -> Vec<u8> {
         }
         resources.push_str("</components></object>\n");
     }
-    threemf(&threemf_model(&resources, &format!("<item objectid=\"{}\"/>\n", levels + 1)))
+    threemf_model(&resources, &format!("<item objectid=\"{}\"/>\n", levels + 1))
+}
+
+/// A 3MF whose `levels` nested objects each place the one below `copies` times: a small
+/// file that places `triangles * copies^levels` triangles (the issue's instancing case).
+#[must_use]
+pub fn threemf_instancing(levels: u32, copies: u32) -> Vec<u8> {
+    threemf(instancing_model(levels, copies).as_bytes())
+}
+
+/// The model XML documents the 3MF seeds are made of.
+fn threemf_models() -> Vec<String> {
+    let (v, t) = seed_mesh();
+    vec![
+        threemf_model(&threemf_object(1, &v, &t), "<item objectid=\"1\"/>\n"),
+        instancing_model(2, 4),
+        instancing_model(13, 4),
+    ]
 }
 
 /// The seed inputs of a target: small valid files and the issue's bad cases.
@@ -538,11 +562,7 @@ pub fn seeds(target: Target) -> Vec<Vec<u8>> {
         }
         Target::Obj => vec![obj(&v, &t)],
         Target::Ply => vec![ply(&v, &t, false), ply(&v, &t, true)],
-        Target::ThreeMf => vec![
-            threemf(&threemf_model(&threemf_object(1, &v, &t), "<item objectid=\"1\"/>\n")),
-            threemf_instancing(2, 4),
-            threemf_instancing(13, 4),
-        ],
+        Target::ThreeMf => threemf_models().iter().map(|m| threemf(m.as_bytes())).collect(),
         Target::Gcode => vec![
             text(
                 "%\nO1000 (seed)\nG21 G90 G17 G94\nG0 X0 Y0 Z5\nG1 Z0 F300\nG1 X10 Y0\nG2 X20 Y0 I5 J0\n\

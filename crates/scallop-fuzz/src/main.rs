@@ -133,9 +133,10 @@ fn main() -> std::process::ExitCode {
         let report = campaign(target, o.seed, 0..o.iterations, &before);
         total += report.executions;
         println!(
-            "{:>8}: {} inputs in {:.1} s, slowest {:.3} s (iteration {}), {} failures",
+            "{:>8}: {} inputs ({} accepted) in {:.1} s, slowest {:.3} s (iteration {}), {} failures",
             target.name(),
             report.executions,
+            report.accepted,
             t0.elapsed().as_secs_f64(),
             report.slowest.0.as_secs_f64(),
             report.slowest.1,

@@ -11,6 +11,8 @@ fn every_target_survives_a_short_campaign() {
     for target in Target::ALL {
         let report = campaign(target, 2026, 0..2000, &|_| {});
         assert_eq!(report.executions, 2000);
+        // The mutations keep a share of the inputs valid, so the parsers' inner code runs.
+        assert!(report.accepted > 0, "{}: no input was accepted", target.name());
         assert!(
             report.failures.is_empty(),
             "{}: {:?}",
@@ -49,7 +51,7 @@ fn the_valid_seeds_parse_and_the_bad_cases_are_refused() {
         let s = seeds(target);
         assert!(accepted(target, &s[0]), "{}: the first seed must be valid", target.name());
         for bytes in &s {
-            assert_eq!(run_one(target, bytes), Ok(()), "{}", target.name());
+            assert!(run_one(target, bytes).is_ok(), "{}", target.name());
         }
     }
     // The cases among the seeds are refused, not accepted.
