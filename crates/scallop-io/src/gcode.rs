@@ -9,6 +9,9 @@
 //! effect on the path. Anything else that moves the tool (canned cycles, `G28`, `G53`, `G92`, rotary words `A B C`, ...) is an error naming
 //! the line: a simulation must never silently skip motion.
 //!
+//! `T` selects a tool and `M6` loads it; the simulation uses one cutter, so a change to
+//! another tool after the first feed move is an error naming its line.
+//!
 //! Until the tool's position is known, rapids may give it one axis at a time (`G0 Z50`
 //! then `G0 X0 Y0`, as programs for real controllers start); the tool is placed when X, Y
 //! and Z are all known, and a feed move before that is an error. Coordinates are bounded by
@@ -166,11 +169,13 @@ fn read(text: &str, options: &GcodeOptions, keep_arcs: bool) -> Result<Toolpath,
     };
     let mut path = Toolpath::new(0.0);
     let mut feeds: Vec<f64> = Vec::new();
+    let mut tool = Tools::default();
     for (k, raw) in text.lines().enumerate() {
         let line = k + 1;
         let words = words(raw, line)?;
         let mut target = [None::<f64>; 3];
         let (mut i, mut j, mut kk, mut r) = (None, None, None, None);
+        let mut m6 = false;
         for (letter, value) in words {
             match letter {
                 'G' => state.g_code(value, line)?,
@@ -187,7 +192,9 @@ fn read(text: &str, options: &GcodeOptions, keep_arcs: bool) -> Result<Toolpath,
                     }
                     state.feed = Some(value);
                 }
-                'N' | 'S' | 'T' | 'M' | 'O' | 'P' | 'H' | 'D' => {}
+                'T' => tool.selected = Some(value),
+                'M' if (value - 6.0).abs() < 1e-9 => m6 = true,
+                'N' | 'S' | 'M' | 'O' | 'P' | 'H' | 'D' => {}
                 'A' | 'B' | 'C' | 'U' | 'V' | 'W' => {
                     return Err(GcodeError::Unsupported {
                         line,
@@ -197,6 +204,10 @@ fn read(text: &str, options: &GcodeOptions, keep_arcs: bool) -> Result<Toolpath,
                 }
                 other => return Err(GcodeError::Syntax { line, word: other.to_string() }),
             }
+        }
+        if m6 {
+            // After the block's T word, whatever their order (as controllers do).
+            tool.change(line)?;
         }
         if target.iter().all(Option::is_none) {
             continue;
@@ -243,6 +254,7 @@ fn read(text: &str, options: &GcodeOptions, keep_arcs: bool) -> Result<Toolpath,
             0 => path.push(Move::new(MoveKind::Rapid, to)),
             1..=3 => {
                 let feed = state.feed.ok_or(GcodeError::State { line, why: "a feed move before any F word" })?;
+                tool.cut = true;
                 feeds.push(feed * state.scale);
                 let kind = if (to.x - from.x).abs() + (to.y - from.y).abs() == 0.0 && to.z < from.z {
                     MoveKind::Plunge
@@ -301,6 +313,33 @@ fn read(text: &str, options: &GcodeOptions, keep_arcs: bool) -> Result<Toolpath,
     path.feed = feeds.get(feeds.len() / 2).copied().unwrap_or(0.0);
     path.plunge_feed = path.feed;
     Ok(path)
+}
+
+/// Tool words: the program is simulated with one cutter, so a tool change (`M6`) to
+/// another tool after cutting has begun is refused with its line.
+#[derive(Default)]
+struct Tools {
+    /// The last `T` word.
+    selected: Option<f64>,
+    /// The tool in the spindle (set by `M6`).
+    current: Option<f64>,
+    /// A feed move has been read.
+    cut: bool,
+}
+
+impl Tools {
+    fn change(&mut self, line: usize) -> Result<(), GcodeError> {
+        if self.cut && self.selected != self.current {
+            return Err(GcodeError::Unsupported {
+                line,
+                code: "M6".into(),
+                why: "a change to another tool after cutting began: the simulation uses one cutter; \
+                      split the program at this line and simulate each tool with its own --cutter",
+            });
+        }
+        self.current = self.selected;
+        Ok(())
+    }
 }
 
 struct State {
@@ -569,6 +608,18 @@ mod tests {
         assert!(matches!(read("G0 Z50\nG1 X1 F100\n").unwrap_err(), GcodeError::State { line: 2, .. }));
         assert_eq!(read("(only a comment)\nM30\n").unwrap_err(), GcodeError::Empty);
         assert!(matches!(read("G0 X0 Y0 Z0\nG28\n").unwrap_err(), GcodeError::Unsupported { line: 2, .. }));
+    }
+
+    #[test]
+    fn a_tool_change_after_cutting_is_refused_with_its_line() {
+        // Before cutting, T1 M6 (and re-selecting the same tool) is the program's own tool.
+        let ok = "T1 M6\nG0 X0 Y0 Z5\nG1 Z0 F100\nG1 X5\nT1\nM6\nG1 X6\n";
+        assert_eq!(read(ok).unwrap().moves().len(), 4);
+        let e = read("T1 M6\nG0 X0 Y0 Z5\nG1 Z0 F100\nG1 X5\nG0 Z5\nT2\nM06\nG1 Z0\n").unwrap_err();
+        assert!(matches!(e, GcodeError::Unsupported { line: 7, .. }), "{e}");
+        let e = read("T1 M6\nG0 X0 Y0 Z5\nG1 Z0 F100\nG1 X5\nM6 T3\n").unwrap_err();
+        assert!(matches!(e, GcodeError::Unsupported { line: 5, .. }), "{e}");
+        assert!(e.to_string().contains("one cutter"), "{e}");
     }
 
     #[test]
