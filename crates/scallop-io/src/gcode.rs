@@ -131,7 +131,7 @@ const MM_PER_INCH: f64 = 25.4;
 /// assert!(read_gcode("G0 X0 Y0 Z0\nG28\n", &GcodeOptions::default()).unwrap_err().to_string().contains("line 2"));
 /// ```
 pub fn read_gcode(text: &str, options: &GcodeOptions) -> Result<Toolpath, GcodeError> {
-    read(text, options, false)
+    read(text, options, false).map(|(path, _)| path)
 }
 
 /// Reads a program like [`read_gcode`], but keeps every `G2`/`G3` in the XY plane (G17) as one move
@@ -153,10 +153,27 @@ pub fn read_gcode(text: &str, options: &GcodeOptions) -> Result<Toolpath, GcodeE
 /// assert!((path.arc(3).unwrap().sweep - std::f64::consts::PI).abs() < 1e-12);
 /// ```
 pub fn read_gcode_arcs(text: &str, options: &GcodeOptions) -> Result<Toolpath, GcodeError> {
+    read(text, options, true).map(|(path, _)| path)
+}
+
+/// Reads a program like [`read_gcode_arcs`] and also returns, for every move of the
+/// toolpath, the line (from 1) of the block it comes from, so that a simulation fault on
+/// a move can name the G-code line.
+///
+/// # Errors
+/// As [`read_gcode`].
+///
+/// ```
+/// use scallop_io::gcode::{read_gcode_lines, GcodeOptions};
+/// let (path, lines) = read_gcode_lines("G21\nG0 Z5\nG0 X0 Y0\nG1 Z0 F100\n(c)\nG1 X4\n", &GcodeOptions::default()).unwrap();
+/// assert_eq!(path.moves().len(), 3);
+/// assert_eq!(lines, [3, 4, 6]);
+/// ```
+pub fn read_gcode_lines(text: &str, options: &GcodeOptions) -> Result<(Toolpath, Vec<usize>), GcodeError> {
     read(text, options, true)
 }
 
-fn read(text: &str, options: &GcodeOptions, keep_arcs: bool) -> Result<Toolpath, GcodeError> {
+fn read(text: &str, options: &GcodeOptions, keep_arcs: bool) -> Result<(Toolpath, Vec<usize>), GcodeError> {
     let mut state = State {
         pos: options.start,
         partial: [None; 3],
@@ -170,6 +187,7 @@ fn read(text: &str, options: &GcodeOptions, keep_arcs: bool) -> Result<Toolpath,
     let mut path = Toolpath::new(0.0);
     let mut feeds: Vec<f64> = Vec::new();
     let mut tool = Tools::default();
+    let mut lines: Vec<usize> = Vec::new();
     for (k, raw) in text.lines().enumerate() {
         let line = k + 1;
         let words = words(raw, line)?;
@@ -240,6 +258,7 @@ fn read(text: &str, options: &GcodeOptions, keep_arcs: bool) -> Result<Toolpath,
                 let to = Point3::new(x, y, z);
                 path.push(Move::new(MoveKind::Rapid, to));
                 state.pos = Some(to);
+                lines.push(line);
             }
             continue;
         }
@@ -248,6 +267,7 @@ fn read(text: &str, options: &GcodeOptions, keep_arcs: bool) -> Result<Toolpath,
             // Unknown start: place the tool.
             path.push(Move::new(MoveKind::Rapid, to));
             state.pos = Some(to);
+            lines.push(line);
             continue;
         };
         match motion {
@@ -282,8 +302,10 @@ fn read(text: &str, options: &GcodeOptions, keep_arcs: bool) -> Result<Toolpath,
                         motion == 2,
                         line,
                     )?;
-                    in_range(line, "arc centre", centre.0)?;
-                    in_range(line, "arc centre", centre.1)?;
+                    // The whole circle stays in range (an arc may sweep most of it).
+                    let radius = (from[u] - centre.0).hypot(from[v] - centre.1);
+                    in_range(line, "arc extent (|centre| + radius)", centre.0.abs() + radius)?;
+                    in_range(line, "arc extent (|centre| + radius)", centre.1.abs() + radius)?;
                     if keep_arcs && state.plane == (0, 1, 2) {
                         let sweep = arc_sweep(from, to, centre, motion == 2);
                         let arc = ArcXY { center: Point2::new(centre.0, centre.1), sweep };
@@ -298,6 +320,7 @@ fn read(text: &str, options: &GcodeOptions, keep_arcs: bool) -> Result<Toolpath,
             _ => unreachable!("motion modes are 0..=3"),
         }
         state.pos = Some(to);
+        lines.resize(path.moves().len(), line);
     }
     if path.moves().is_empty() {
         if state.partial.iter().any(Option::is_some) {
@@ -312,7 +335,8 @@ fn read(text: &str, options: &GcodeOptions, keep_arcs: bool) -> Result<Toolpath,
     feeds.sort_by(f64::total_cmp);
     path.feed = feeds.get(feeds.len() / 2).copied().unwrap_or(0.0);
     path.plunge_feed = path.feed;
-    Ok(path)
+    debug_assert_eq!(lines.len(), path.moves().len());
+    Ok((path, lines))
 }
 
 /// Tool words: the program is simulated with one cutter, so a tool change (`M6`) to
@@ -645,6 +669,10 @@ mod tests {
         assert!(matches!(read(&g91).unwrap_err(), GcodeError::OutOfRange { line: 5, .. }));
         let arc = format!("G21 G90\nG0 X10 Y10 Z50\nG1 Z45 F100\nG2 X10 Y10 I17{}\n", "0".repeat(307));
         let e = read(&arc).unwrap_err();
+        assert!(matches!(e, GcodeError::OutOfRange { line: 4, .. }), "{e}");
+        // An arc whose circle leaves the range (found by the fuzzer: centre 92243 mm, radius
+        // 92233 mm, a clockwise sweep of almost a full turn).
+        let e = read("G21 G90\nG0 X10 Y10 Z50\nG1 Z45 F100\nG2 X90 Y10 I92233\n").unwrap_err();
         assert!(matches!(e, GcodeError::OutOfRange { line: 4, .. }), "{e}");
         // Accumulation: 2000 steps of 60 mm pass +-1e5 on step 1667.
         let steps = "G1 X60\n".repeat(2000);
