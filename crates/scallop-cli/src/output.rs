@@ -39,7 +39,7 @@ pub fn write_atomic(
 }
 
 /// `value` as a JSON object with a `written` list of the files written (paths as given).
-fn with_written(value: &impl Serialize, written: &[PathBuf]) -> CliResult<serde_json::Value> {
+pub(crate) fn with_written(value: &impl Serialize, written: &[PathBuf]) -> CliResult<serde_json::Value> {
     let mut v = serde_json::to_value(value).map_err(|e| Failure::Io(e.into()))?;
     if let Some(map) = v.as_object_mut() {
         let files = written.iter().map(|p| serde_json::Value::from(p.display().to_string())).collect();
