@@ -11,8 +11,9 @@
 //! - Files in the target folder that are not part of this kind of set (another command's
 //!   outputs, the user's own files) are carried over into the new set by hard links; the
 //!   previous set's own files are listed in its manifest `.scallop-set-KIND.json` and are
-//!   not carried over, so sets never mix. A target folder holding sub-folders (or on a
-//!   file system without hard links) falls back to replacing the files one by one.
+//!   not carried over, so sets never mix. A target folder holding sub-folders or the
+//!   working folder (`-o .`), or on a file system without hard links, falls back to
+//!   replacing the files one by one (each file whole, the set not atomic).
 //! - Leftovers of killed runs (staging and old folders, `.FILE.tmp-PID` files) whose
 //!   process is gone are removed (or, for an old set, restored) by the next run.
 
@@ -30,6 +31,8 @@ pub struct OutputSet {
     kind: &'static str,
     files: Vec<String>,
     committed: bool,
+    /// The target holds the working folder: files are replaced one by one, never the folder.
+    in_place: bool,
 }
 
 fn io_err(path: &Path, what: &str, e: &std::io::Error) -> Failure {
@@ -98,6 +101,14 @@ impl OutputSet {
     /// # Errors
     /// I/O failures (exit code 2).
     pub fn begin(target: &Path, kind: &'static str) -> CliResult<OutputSet> {
+        // `-o .` or `-o ..`: the folder by its real name. The working folder (or one
+        // above it) is never exchanged: its files are replaced one by one instead.
+        let real = std::fs::canonicalize(target).ok();
+        let holds_cwd = real.as_ref().is_some_and(|r| std::env::current_dir().is_ok_and(|cwd| cwd.starts_with(r)));
+        let target = match &real {
+            Some(r) if target.file_name().is_none() => r.as_path(),
+            _ => target,
+        };
         let parent = target.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new(".")).to_path_buf();
         let name = target
             .file_name()
@@ -116,7 +127,16 @@ impl OutputSet {
             std::fs::remove_dir_all(&staging).map_err(|e| io_err(&staging, "remove", &e))?;
         }
         std::fs::create_dir(&staging).map_err(|e| io_err(&staging, "create the staging folder", &e))?;
-        Ok(OutputSet { parent, name, target: target.to_path_buf(), staging, kind, files: Vec::new(), committed: false })
+        Ok(OutputSet {
+            parent,
+            name,
+            target: target.to_path_buf(),
+            staging,
+            kind,
+            files: Vec::new(),
+            committed: false,
+            in_place: holds_cwd,
+        })
     }
 
     /// The final path of `file` in the target folder (for messages).
@@ -193,7 +213,7 @@ impl OutputSet {
             self.committed = true;
             return Ok(written);
         }
-        let Some(keep) = self.carried_over() else {
+        let Some(keep) = self.carried_over().filter(|_| !self.in_place) else {
             self.commit_file_by_file()?;
             return Ok(written);
         };
