@@ -102,3 +102,30 @@ fn sigkill_at_random_moments_leaves_one_complete_set() {
     assert_eq!(signature(&dir.join("out")), sets[1]);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn leftovers_of_killed_runs_are_restored_or_removed() {
+    // A run killed between the two renames of the fallback commit leaves the previous set in
+    // `.out.old-PID` and no `out`; one killed while writing leaves `.out.tmp-PID`, and older
+    // versions left `.FILE.tmp-PID` files. PID 99999999 is above Linux's pid_max: dead.
+    let dir = std::env::temp_dir().join(format!("scallop-leftovers-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("a.toml"), job(0.05)).unwrap();
+    assert!(run(&dir, "a.toml", "out").wait().unwrap().success());
+    std::fs::write(dir.join("out/mine.txt"), "the user's own file").unwrap();
+    std::fs::rename(dir.join("out"), dir.join(".out.old-99999999")).unwrap();
+    std::fs::create_dir(dir.join(".out.tmp-99999999")).unwrap();
+    std::fs::write(dir.join(".out.tmp-99999999/program.nc"), "half a program").unwrap();
+    assert!(run(&dir, "a.toml", "out").wait().unwrap().success());
+    // The previous set was put back, then replaced; the user's file survived; nothing is left.
+    assert_eq!(std::fs::read_to_string(dir.join("out/mine.txt")).unwrap(), "the user's own file");
+    assert_eq!(temporaries(&dir), Vec::<PathBuf>::new());
+    std::fs::write(dir.join("out/.report.html.tmp-99999999"), "half a page").unwrap();
+    assert!(run(&dir, "a.toml", "out").wait().unwrap().success());
+    assert_eq!(temporaries(&dir), Vec::<PathBuf>::new());
+    for file in FILES {
+        assert!(dir.join("out").join(file).is_file(), "{file}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
