@@ -25,6 +25,21 @@ pub enum AnalysisError {
         /// Cells along v.
         cells_v: usize,
     },
+    /// A sampling grid over the budget ([`crate::tol::MAX_GRID_CELLS`], about 100 bytes a
+    /// cell), refused before anything is allocated. Fix: fewer cells per direction.
+    #[error(
+        "sampling grid {cells_u} x {cells_v} = {cells} cells is over the budget of {max} cells (about 100 bytes each); use fewer cells"
+    )]
+    TooManyCells {
+        /// Cells along u.
+        cells_u: usize,
+        /// Cells along v.
+        cells_v: usize,
+        /// Their product (saturating).
+        cells: u128,
+        /// The budget.
+        max: usize,
+    },
     /// A cutter size that is not a real tool.
     /// Fix: radii finite and > 0 mm, corner radius in `[0, R]`.
     #[error("cutter {what} = {value} mm is not valid (radii finite and > 0, corner radius in [0, R])")]

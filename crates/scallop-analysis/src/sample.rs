@@ -466,6 +466,10 @@ fn grid_samples(
     if nu == 0 || nv == 0 {
         return Err(AnalysisError::EmptyGrid { cells_u: nu, cells_v: nv });
     }
+    let cells = nu as u128 * nv as u128;
+    if cells > crate::tol::MAX_GRID_CELLS as u128 {
+        return Err(AnalysisError::TooManyCells { cells_u: nu, cells_v: nv, cells, max: crate::tol::MAX_GRID_CELLS });
+    }
     let fractions = |n: usize| -> Vec<f64> { (0..n).map(|a| (a as f64 + 0.5) / n as f64).collect() };
     let (fu, fv) = (fractions(nu), fractions(nv));
     let domain = patch.domain();

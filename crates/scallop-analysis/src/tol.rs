@@ -42,3 +42,7 @@ pub const REDUCTION_CHUNK: usize = 4096;
 
 /// Number of points of the critical curve `s_c(mu)` drawn by [`crate::plot_svg`].
 pub const PLOT_CURVE_POINTS: usize = 241;
+
+/// Largest sampling grid of a patch (cells): 4 million, about 400 MB of samples and a few
+/// seconds; the CLI's `--cells 2000` is the largest square grid under it.
+pub const MAX_GRID_CELLS: usize = 4_000_000;

@@ -136,16 +136,27 @@ fn cutter_from(args: &CutterArgs) -> CliResult<(Cutter, String)> {
     Ok((cutter, text))
 }
 
+/// Budget of one `scallop drop` grid: 20 million points, about 2 GB with the CSV text
+/// ([`BYTES_PER_POINT`]) and a few minutes of drop-cutter on 2 cores.
+const MAX_DROP_POINTS: usize = 20_000_000;
+
+/// Memory per grid point: the cutter location (with its contact) and its CSV row.
+const BYTES_PER_POINT: usize = 100;
+
 /// `scallop drop`.
 pub fn run(args: &DropArgs) -> CliResult<()> {
     let (cutter, cutter_text) = args.tool.build()?;
     let xs = GridAxis::parse(&args.x).map_err(|e| Failure::rejected(format!("--x {e}")))?;
     let ys = GridAxis::parse(&args.y).map_err(|e| Failure::rejected(format!("--y {e}")))?;
     let total = xs.len().saturating_mul(ys.len());
-    if total > scallop_engine::MAX_GRID_POINTS {
+    let cap = MAX_DROP_POINTS.min(scallop_engine::MAX_GRID_POINTS);
+    if total > cap {
         return Err(Failure::rejected(format!(
-            "the grid has {total} points, more than {}; use larger steps or split the job",
-            scallop_engine::MAX_GRID_POINTS
+            "--x {} --y {}: the grid has {total} points (about {} MB of cutter locations and CSV), \
+             over the budget of {cap} points; use larger steps or split the grid",
+            args.x,
+            args.y,
+            total.saturating_mul(BYTES_PER_POINT) >> 20
         )));
     }
     if let Some(f) = args.floor.filter(|f| !f.is_finite()) {

@@ -6,6 +6,7 @@ mod analyze;
 mod drop;
 mod optimize;
 mod output;
+mod outset;
 mod part;
 mod post;
 mod render;

@@ -1,7 +1,6 @@
 //! `scallop optimize JOB.toml -o OUTDIR`: the zone-optimisation study of
 //! finishing.md chapter 4 (`docs/job.md`, table `[optimize]`).
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -20,7 +19,8 @@ use scallop_optim::surface::{SurfaceModel, SurfaceSettings};
 use scallop_optim::{Barrier, CostModel, OptimError, convergence_svg, zones_svg};
 use serde::Serialize;
 
-use crate::output::{print_json, print_text, progress_bar, write_atomic};
+use crate::output::{print_json, print_text, progress_bar, with_written};
+use crate::outset::OutputSet;
 use crate::{CliResult, Failure};
 
 /// Arguments of `scallop optimize`.
@@ -222,14 +222,15 @@ pub fn run(args: &OptimizeArgs) -> CliResult<()> {
         program: Some(&program.report),
         result: best,
     };
-    let out = &args.output;
-    write_atomic(&out.join("study.json"), |w| w.write_all(to_json(&file)?.as_bytes()))?;
-    write_atomic(&out.join("report.json"), |w| w.write_all(to_json(&report)?.as_bytes()))?;
-    write_atomic(&out.join("program.nc"), |w| w.write_all(program.gcode.as_bytes()))?;
-    write_atomic(&out.join("toolpath.csv"), |w| w.write_all(scallop_io::cl::write_cl(&program.toolpath).as_bytes()))?;
-    write_atomic(&out.join("convergence.svg"), |w| w.write_all(convergence_svg(&study).as_bytes()))?;
+    // The seven files replace the previous set in one step (`outset.rs`).
+    let mut set = OutputSet::begin(&args.output, "optimize")?;
+    set.write("study.json", to_json(&file).map_err(|e| Failure::Io(e.into()))?.as_bytes())?;
+    set.write("report.json", to_json(&report).map_err(|e| Failure::Io(e.into()))?.as_bytes())?;
+    set.write("program.nc", program.gcode.as_bytes())?;
+    set.write("toolpath.csv", scallop_io::cl::write_cl(&program.toolpath).as_bytes())?;
+    set.write("convergence.svg", convergence_svg(&study).as_bytes())?;
     let title = format!("{part_name}, {}, K = {}", formulation_name(settings.formulation), best.k);
-    write_atomic(&out.join("zones.svg"), |w| w.write_all(zones_svg(&best.plan, &title).as_bytes()))?;
+    set.write("zones.svg", zones_svg(&best.plan, &title).as_bytes())?;
     let page = scallop_report::html::report_html(&optimisation_report(
         &patch,
         &study,
@@ -238,9 +239,10 @@ pub fn run(args: &OptimizeArgs) -> CliResult<()> {
         &file.cutter,
         Some(&program),
     ));
-    write_atomic(&out.join("report.html"), |w| w.write_all(page.as_bytes()))?;
+    set.write("report.html", page.as_bytes())?;
+    let written = set.commit()?;
     if args.json {
-        return print_json(&file);
+        return print_json(&with_written(&file, &written)?);
     }
     let mut text = format!(
         "zone optimisation of the {part_name}: {}, K = {}..{}, budget {} per K, surrogate {:?}\n\
@@ -277,7 +279,7 @@ pub fn run(args: &OptimizeArgs) -> CliResult<()> {
         wall,
         rayon::current_num_threads(),
         gcode,
-        out.display(),
+        args.output.display(),
         ", program.nc, toolpath.csv"
     ));
     print_text(&text)

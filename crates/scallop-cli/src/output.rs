@@ -8,6 +8,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use scallop_engine::{DemoSettings, run_demo};
 use serde::Serialize;
 
+use crate::outset::{OutputSet, remove_stale_temporaries};
 use crate::{CliResult, Failure};
 
 /// Writes `bytes` to `path` atomically: a temporary file beside it, then a
@@ -20,6 +21,8 @@ pub fn write_atomic(
     std::fs::create_dir_all(dir)
         .map_err(|e| Failure::Io(anyhow::anyhow!("{}: cannot create the folder: {e}", dir.display())))?;
     let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "output".into());
+    // Temporaries of earlier killed runs go first.
+    remove_stale_temporaries(dir);
     let tmp: PathBuf = dir.join(format!(".{name}.tmp-{}", std::process::id()));
     let result = (|| -> std::io::Result<()> {
         let file = std::fs::File::create(&tmp)?;
@@ -33,6 +36,16 @@ pub fn write_atomic(
         let _ = std::fs::remove_file(&tmp);
         Failure::Io(anyhow::anyhow!("{}: cannot write: {e}", path.display()))
     })
+}
+
+/// `value` as a JSON object with a `written` list of the files written (paths as given).
+pub(crate) fn with_written(value: &impl Serialize, written: &[PathBuf]) -> CliResult<serde_json::Value> {
+    let mut v = serde_json::to_value(value).map_err(|e| Failure::Io(e.into()))?;
+    if let Some(map) = v.as_object_mut() {
+        let files = written.iter().map(|p| serde_json::Value::from(p.display().to_string())).collect();
+        map.insert("written".into(), serde_json::Value::Array(files));
+    }
+    Ok(v)
 }
 
 /// Prints one JSON object on stdout.
@@ -100,14 +113,16 @@ pub fn demo(args: &DemoArgs) -> CliResult<()> {
 /// Writes `program.nc`, `report.json` and `toolpath.csv` of a job of several
 /// operations into `folder` and prints the summary (or the report as JSON).
 pub fn write_job(out: &scallop_engine::JobOutput, seconds: f64, folder: &Path, json: bool) -> CliResult<()> {
-    let nc = folder.join("program.nc");
-    write_atomic(&nc, |w| w.write_all(out.gcode.as_bytes()))?;
+    // The three files replace the previous set in one step (`outset.rs`).
+    let mut set = OutputSet::begin(folder, "job")?;
+    let nc = set.final_path("program.nc");
+    set.write("program.nc", out.gcode.as_bytes())?;
     let text = serde_json::to_string_pretty(&out.report).map_err(|e| Failure::Io(e.into()))?;
-    write_atomic(&folder.join("report.json"), |w| w.write_all(text.as_bytes()))?;
-    let csv = scallop_io::cl::write_cl(&out.toolpath);
-    write_atomic(&folder.join("toolpath.csv"), |w| w.write_all(csv.as_bytes()))?;
+    set.write("report.json", text.as_bytes())?;
+    set.write("toolpath.csv", scallop_io::cl::write_cl(&out.toolpath).as_bytes())?;
+    let written = set.commit()?;
     if json {
-        return print_json(&out.report);
+        return print_json(&with_written(&out.report, &written)?);
     }
     let r = &out.report;
     let mut text = format!(
@@ -182,18 +197,20 @@ pub fn write_finishing(
 ) -> CliResult<()> {
     let mut report = out.report.clone();
     report.plan.planning_time_s = seconds;
-    let nc = folder.join("program.nc");
-    write_atomic(&nc, |w| w.write_all(out.gcode.as_bytes()))?;
+    // All five files go into a staging folder and replace the previous set in one step.
+    let mut set = OutputSet::begin(folder, "finishing")?;
+    let nc = set.final_path("program.nc");
+    set.write("program.nc", out.gcode.as_bytes())?;
     let text = serde_json::to_string_pretty(&report).map_err(|e| Failure::Io(e.into()))?;
-    write_atomic(&folder.join("report.json"), |w| w.write_all(text.as_bytes()))?;
-    let csv = scallop_io::cl::write_cl(&out.toolpath);
-    write_atomic(&folder.join("toolpath.csv"), |w| w.write_all(csv.as_bytes()))?;
+    set.write("report.json", text.as_bytes())?;
+    set.write("toolpath.csv", scallop_io::cl::write_cl(&out.toolpath).as_bytes())?;
     let data = scallop_report::ReportData::from_finishing(job, out, seconds, command);
-    write_atomic(&folder.join("report.html"), |w| w.write_all(scallop_report::html::report_html(&data).as_bytes()))?;
+    set.write("report.html", scallop_report::html::report_html(&data).as_bytes())?;
     let glb = scallop_report::glb::scene_glb(&data).map_err(|e| Failure::Io(anyhow::anyhow!("scene.glb: {e}")))?;
-    write_atomic(&folder.join("scene.glb"), |w| w.write_all(&glb))?;
+    set.write("scene.glb", &glb)?;
+    let written = set.commit()?;
     if json {
-        return print_json(&report);
+        return print_json(&with_written(&report, &written)?);
     }
     let (r, p) = (&report, &report.plan);
     print_text(&format!(
@@ -256,12 +273,14 @@ fn raster_demo(args: &DemoArgs) -> CliResult<()> {
     .map_err(|e| Failure::Io(anyhow::anyhow!("the built-in demo failed: {e}")))?;
     bar.finish_and_clear();
     let seconds = start.elapsed().as_secs_f64();
-    let nc = args.output.join("demo.nc");
-    write_atomic(&nc, |w| w.write_all(out.gcode.as_bytes()))?;
+    let mut set = OutputSet::begin(&args.output, "raster")?;
+    let nc = set.final_path("demo.nc");
+    set.write("demo.nc", out.gcode.as_bytes())?;
     let json = serde_json::to_string_pretty(&out.summary).map_err(|e| Failure::Io(e.into()))?;
-    write_atomic(&args.output.join("summary.json"), |w| w.write_all(json.as_bytes()))?;
+    set.write("summary.json", json.as_bytes())?;
+    let written = set.commit()?;
     if args.json {
-        return print_json(&out.summary);
+        return print_json(&with_written(&out.summary, &written)?);
     }
     let s = &out.summary;
     let text = format!(

@@ -118,6 +118,7 @@ struct InspectReport {
     triangles: Option<usize>,
     vertices: Option<usize>,
     degenerate_dropped: Option<usize>,
+    kept_unwelded: Option<usize>,
     boundary_edges: Option<usize>,
     non_manifold_edges: Option<usize>,
     weld_distance_mm: Option<f64>,
@@ -141,6 +142,7 @@ pub fn inspect(args: &InspectArgs) -> CliResult<()> {
         triangles: tris,
         vertices: verts,
         degenerate_dropped: d.map(|d| d.degenerate_dropped),
+        kept_unwelded: d.map(|d| d.kept_unwelded),
         boundary_edges: d.map(|d| d.boundary_edges),
         non_manifold_edges: d.map(|d| d.non_manifold_edges),
         weld_distance_mm: d.map(|d| d.weld_distance),
@@ -155,8 +157,8 @@ pub fn inspect(args: &InspectArgs) -> CliResult<()> {
     );
     if let Some(d) = d {
         text.push_str(&format!(
-            "  welded   {} vertex references -> {} vertices (weld distance {:.3e} mm)\n  dropped  {} degenerate triangles\n  edges    {} open (boundary), {} non-manifold\n",
-            d.input_vertices, d.welded_vertices, d.weld_distance, d.degenerate_dropped, d.boundary_edges, d.non_manifold_edges
+            "  welded   {} vertex references -> {} vertices (weld distance {:.3e} mm); {} triangles kept unwelded\n  dropped  {} degenerate triangles\n  edges    {} open (boundary), {} non-manifold\n",
+            d.input_vertices, d.welded_vertices, d.weld_distance, d.kept_unwelded, d.degenerate_dropped, d.boundary_edges, d.non_manifold_edges
         ));
     }
     output::print_text(&text)

@@ -118,7 +118,11 @@ pub struct PostReport {
 }
 
 fn read_text(path: &Path) -> CliResult<String> {
-    std::fs::read_to_string(path).map_err(|e| Failure::Io(anyhow::anyhow!("{}: cannot read: {e}", path.display())))
+    let bytes = std::fs::read(path).map_err(|e| {
+        let err = anyhow::anyhow!("{}: cannot read: {e}", path.display());
+        if e.kind() == std::io::ErrorKind::NotFound { Failure::Rejected(err) } else { Failure::Io(err) }
+    })?;
+    scallop_io::utf8_text(&bytes).map(str::to_owned).map_err(|e| Failure::rejected(format!("{}: {e}", path.display())))
 }
 
 fn load_machine(name: &str) -> CliResult<Machine> {
@@ -184,9 +188,13 @@ pub fn run(args: &PostArgs) -> CliResult<()> {
     let nc = program_text(&program, &kin, &dialect, &params)
         .map_err(|e| Failure::rejected(format!("{} in {}: {e}", args.cl_file.display(), dialect.name)))?;
     // The proof: parse our own output back into joint motion, replay the kinematics.
-    let blocks = replay(&nc, &dialect, &kin).map_err(|e| Failure::Io(anyhow::anyhow!("replay of our output: {e}")))?;
+    // Failures name the program (not yet written) and its block, and the CL file.
+    let output = args.output.clone().unwrap_or_else(|| args.cl_file.with_extension("nc"));
+    let place = format!("{} (program for {}, block = line of the program)", output.display(), args.cl_file.display());
+    let blocks = replay(&nc, &dialect, &kin)
+        .map_err(|e| Failure::Io(anyhow::anyhow!("{place}: our output does not read back: {e}")))?;
     let trip = check_replay(&blocks, &records, &kin, &dialect, options.tol_pos, options.tol_ang)
-        .map_err(|e| Failure::Io(anyhow::anyhow!("the program does not replay to the CL path: {e}")))?;
+        .map_err(|e| Failure::Io(anyhow::anyhow!("{place}: the program does not replay to the CL path: {e}")))?;
     let axes = machine
         .axes()
         .iter()
@@ -215,7 +223,6 @@ pub fn run(args: &PostArgs) -> CliResult<()> {
         replay_axis_deviation_deg: trip.max_axis_deviation.to_degrees(),
         events: program.events.iter().map(|e| format!("{e:?}")).collect(),
     };
-    let output = args.output.clone().unwrap_or_else(|| args.cl_file.with_extension("nc"));
     let report_path = args.report.clone().unwrap_or_else(|| {
         output.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new(".")).join("post.json")
     });

@@ -197,6 +197,10 @@ fn job_keys(e: &scallop_engine::EngineError) -> &'static str {
         }
         E::Strategy(S::EmptyRegion { .. }) => " (job keys: part, finishing.max_step, cutter.diameter)",
         E::Strategy(S::ScallopTooLarge { .. }) => " (job keys: finishing.scallop_height, cutter.corner_radius)",
+        E::Strategy(S::TooMuchWork { .. }) => " (job keys: finishing.max_step, finishing.scallop_height)",
+        E::Verification(scallop_sim::SimError::TooManyCells { .. } | scallop_sim::SimError::BadResolution { .. }) => {
+            " (job key: verify.resolution)"
+        }
         E::Verification(_) => " (job keys: cutter.flute_length, machine.clearance, tolerances.gouge)",
         E::Output { .. } => " (job keys: [output], [setup])",
         _ => "",

@@ -134,8 +134,7 @@ fn read_program(args: &SimulateArgs) -> CliResult<Program> {
         let err = anyhow::anyhow!("{name}: cannot read the program: {e}");
         if e.kind() == std::io::ErrorKind::NotFound { Failure::Rejected(err) } else { Failure::Io(err) }
     })?;
-    let text = std::str::from_utf8(&bytes)
-        .map_err(|e| Failure::rejected(format!("{name}: byte {}: the program is not UTF-8 text", e.valid_up_to())))?;
+    let text = scallop_io::utf8_text(&bytes).map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
     if args.program.is_some() {
         // Arcs stay arcs: the z-map cuts them exactly.
         let path =

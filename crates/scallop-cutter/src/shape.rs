@@ -14,6 +14,20 @@ pub enum CutterError {
         /// The value given.
         value: f64,
     },
+    /// A size outside the physical range of cutters ([`crate::tol`]).
+    #[error(
+        "{what} {value:?} mm is outside the range of real cutters [{min}, {max}] mm; check the units (mm) and the digits"
+    )]
+    OutOfRange {
+        /// Which size.
+        what: &'static str,
+        /// The value given.
+        value: f64,
+        /// Smallest accepted (mm).
+        min: f64,
+        /// Largest accepted (mm).
+        max: f64,
+    },
     /// Bull-nose corner radius larger than the cutter radius.
     #[error("corner radius {corner} mm is larger than the cutter radius {radius} mm; use r <= D/2")]
     CornerTooLarge {
@@ -150,6 +164,7 @@ impl CutterShape {
     fn validate(&self) -> Result<(), CutterError> {
         let r = self.radius();
         positive("cutter radius", r)?;
+        in_range("cutter radius", r, crate::tol::MIN_RADIUS, crate::tol::MAX_RADIUS)?;
         match *self {
             CutterShape::Bull { radius, corner } => {
                 positive("corner radius", corner)?;
@@ -211,6 +226,15 @@ impl Profile {
     }
 }
 
+fn in_range(what: &'static str, value: f64, min: f64, max: f64) -> Result<(), CutterError> {
+    if (min..=max).contains(&value) { Ok(()) } else { Err(CutterError::OutOfRange { what, value, min, max }) }
+}
+
+fn length(what: &'static str, value: f64) -> Result<(), CutterError> {
+    positive(what, value)?;
+    in_range(what, value, 0.0, crate::tol::MAX_LENGTH)
+}
+
 fn positive(what: &'static str, value: f64) -> Result<(), CutterError> {
     if value.is_finite() && value > 0.0 { Ok(()) } else { Err(CutterError::NotPositive { what, value }) }
 }
@@ -243,7 +267,7 @@ impl Cutter {
     /// [`Cutter::with_holder`].
     ///
     /// # Errors
-    /// Non-positive or non-finite sizes, r > R, a cone angle outside (0, 90) deg,
+    /// Non-positive or non-finite sizes, a radius or length outside [`crate::tol`], r > R, a cone angle outside (0, 90) deg,
     /// flutes shorter than the profile.
     ///
     /// ```
@@ -253,7 +277,7 @@ impl Cutter {
     /// ```
     pub fn new(shape: CutterShape, flute_length: f64) -> Result<Cutter, CutterError> {
         shape.validate()?;
-        positive("flute length", flute_length)?;
+        length("flute length", flute_length)?;
         let profile = shape.profile_height();
         if flute_length < profile {
             return Err(CutterError::FluteTooShort { flute: flute_length, profile });
@@ -264,10 +288,10 @@ impl Cutter {
     /// Sets the shank (above the flutes).
     ///
     /// # Errors
-    /// Non-positive sizes.
+    /// Non-positive sizes or sizes over [`crate::tol::MAX_LENGTH`].
     pub fn with_shank(mut self, radius: f64, length: f64) -> Result<Cutter, CutterError> {
-        positive("shank radius", radius)?;
-        positive("shank length", length)?;
+        self::length("shank radius", radius)?;
+        self::length("shank length", length)?;
         self.shank_radius = radius;
         self.shank_length = length;
         Ok(self)
@@ -276,12 +300,12 @@ impl Cutter {
     /// Sets the holder stack (bottom segment first).
     ///
     /// # Errors
-    /// Non-positive sizes.
+    /// Non-positive sizes or sizes over [`crate::tol::MAX_LENGTH`].
     pub fn with_holder(mut self, segments: Vec<HolderSegment>) -> Result<Cutter, CutterError> {
         for s in &segments {
-            positive("holder segment length", s.length)?;
-            positive("holder segment bottom radius", s.bottom_radius)?;
-            positive("holder segment top radius", s.top_radius)?;
+            length("holder segment length", s.length)?;
+            length("holder segment bottom radius", s.bottom_radius)?;
+            length("holder segment top radius", s.top_radius)?;
         }
         self.holder = segments;
         Ok(self)

@@ -28,6 +28,11 @@ pub const REL_ROUNDING: f64 = 1e-12;
 /// Relative weld distance for mesh vertices: this times the model's bounding-box diagonal.
 pub const REL_WELD: f64 = 1e-9;
 
+/// A mesh vertex farther than this many times the size of the box holding the bulk
+/// of the vertices (5 % to 95 % quantiles per axis) from that box is an outlier, an
+/// error: one corrupt vertex would otherwise set the weld distance and the bounds.
+pub const OUTLIER_FACTOR: f64 = 1e4;
+
 /// Relative tolerance under which a drop-cutter result counts as touching the
 /// mesh in tests and verification (times the model scale).
 pub const REL_CONTACT: f64 = 1e-9;

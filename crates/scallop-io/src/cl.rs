@@ -111,8 +111,10 @@ pub struct ClRow {
 #[non_exhaustive]
 pub enum ClError {
     /// The header misses a column or repeats one.
-    #[error("line 1: {problem}; the header must name kind,x,y,z and optionally i,j,k and feed")]
+    #[error("line {line}: {problem}; the header must name kind,x,y,z and optionally i,j,k and feed")]
     Header {
+        /// 1-based line of the header (after blank and `#` lines).
+        line: usize,
         /// What is wrong.
         problem: String,
     },
@@ -137,25 +139,34 @@ pub enum ClError {
 /// [`ClError`] naming the line and column of the first problem.
 pub fn read_cl_csv(text: &str) -> Result<Vec<ClRow>, ClError> {
     let mut lines = text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
-    let Some((_, header)) = lines.next() else { return Err(ClError::Empty) };
+    let Some((header_index, header)) = lines.next() else { return Err(ClError::Empty) };
+    let header_line = header_index + 1;
     let names: Vec<String> = header.split(',').map(|c| c.trim().to_ascii_lowercase()).collect();
     let find = |name: &str| -> Result<Option<usize>, ClError> {
         let hits: Vec<usize> = names.iter().enumerate().filter(|(_, n)| *n == name).map(|(i, _)| i).collect();
         match hits.len() {
             0 => Ok(None),
             1 => Ok(Some(hits[0])),
-            _ => Err(ClError::Header { problem: format!("column `{name}` appears {} times", hits.len()) }),
+            _ => Err(ClError::Header {
+                line: header_line,
+                problem: format!("column `{name}` appears {} times", hits.len()),
+            }),
         }
     };
     let required = |name: &str| -> Result<usize, ClError> {
-        find(name)?.ok_or_else(|| ClError::Header { problem: format!("no `{name}` column") })
+        find(name)?.ok_or_else(|| ClError::Header { line: header_line, problem: format!("no `{name}` column") })
     };
     let (ck, cx, cy, cz) = (required("kind")?, required("x")?, required("y")?, required("z")?);
     let axis_cols = [find("i")?, find("j")?, find("k")?];
     let axis_cols = match axis_cols {
         [Some(i), Some(j), Some(k)] => Some([i, j, k]),
         [None, None, None] => None,
-        _ => return Err(ClError::Header { problem: "the tool axis needs all of i, j, k (or none)".into() }),
+        _ => {
+            return Err(ClError::Header {
+                line: header_line,
+                problem: "the tool axis needs all of i, j, k (or none)".into(),
+            });
+        }
     };
     let cf = find("feed")?;
     let mut rows = Vec::new();
@@ -179,10 +190,17 @@ pub fn read_cl_csv(text: &str) -> Result<Vec<ClRow>, ClError> {
                 column: names[c].clone(),
                 problem: format!("`{}` is not a number", fields[c]),
             })?;
-            if v.is_finite() {
+            if v.is_finite() && v.abs() <= crate::gcode::MAX_COORDINATE {
                 Ok(v)
             } else {
-                Err(ClError::Value { line: line_no, column: names[c].clone(), problem: "not a finite number".into() })
+                Err(ClError::Value {
+                    line: line_no,
+                    column: names[c].clone(),
+                    problem: format!(
+                        "{v:e} is not a finite number within +-{:e} (mm, mm/min or a unit axis); fix the value",
+                        crate::gcode::MAX_COORDINATE
+                    ),
+                })
             }
         };
         let word = fields[ck].to_ascii_lowercase();
@@ -307,6 +325,11 @@ mod tests {
         let e = read_cl_csv("kind,x,y,z\nfeed,1,2\n").unwrap_err();
         assert!(e.to_string().contains("3 fields where the header names 4"), "{e}");
         assert_eq!(read_cl_csv("kind,x,y,z\n"), Err(ClError::Empty));
+        // The header's own line, after comments and blank lines.
+        let e = read_cl_csv("# exported\n\n# by hand\nkind,x,y\nfeed,1,2\n").unwrap_err();
+        assert!(e.to_string().starts_with("line 4: no `z` column"), "{e}");
+        let e = read_cl_csv("kind,x,y,z\nfeed,1e300,2,3\n").unwrap_err();
+        assert!(e.to_string().starts_with("line 2, column `x`"), "{e}");
         assert_eq!(read_cl_csv(""), Err(ClError::Empty));
     }
 }

@@ -9,6 +9,14 @@
 //! effect on the path. Anything else that moves the tool (canned cycles, `G28`, `G53`, `G92`, rotary words `A B C`, ...) is an error naming
 //! the line: a simulation must never silently skip motion.
 //!
+//! `T` selects a tool and `M6` loads it; the simulation uses one cutter, so a change to
+//! another tool after the first feed move is an error naming its line.
+//!
+//! Until the tool's position is known, rapids may give it one axis at a time (`G0 Z50`
+//! then `G0 X0 Y0`, as programs for real controllers start); the tool is placed when X, Y
+//! and Z are all known, and a feed move before that is an error. Coordinates are bounded by
+//! [`MAX_COORDINATE`] after inch scaling and incremental accumulation.
+//!
 //! Arcs are replaced by chords within `arc_tolerance` (sagitta), so every move
 //! of the result is straight.
 
@@ -58,6 +66,34 @@ pub enum GcodeError {
     /// The program has no motion at all.
     #[error("the program has no motion (no G0/G1/G2/G3 move with coordinates)")]
     Empty,
+    /// A coordinate, centre offset or radius outside the machinable range
+    /// ([`MAX_COORDINATE`]) once inch scaling and incremental accumulation are applied.
+    #[error(
+        "G-code line {line}: {what} = {value:e} mm is outside +-{max:e} mm (after G20 inch scaling and G91 accumulation); fix the number on this line"
+    )]
+    OutOfRange {
+        /// Line number.
+        line: usize,
+        /// Which value (`X`, `arc centre`, `R`, ...).
+        what: String,
+        /// The value in mm (possibly infinite).
+        value: f64,
+        /// The bound, [`MAX_COORDINATE`].
+        max: f64,
+    },
+}
+
+/// Largest absolute coordinate (mm) a program may reach, and largest arc radius: 100 m,
+/// far beyond any machine's stroke; beyond it a number is a typo, and near `f64::MAX`
+/// arithmetic overflows to infinity.
+pub const MAX_COORDINATE: f64 = 1e5;
+
+fn in_range(line: usize, what: &str, value: f64) -> Result<f64, GcodeError> {
+    if value.is_finite() && value.abs() <= MAX_COORDINATE {
+        Ok(value)
+    } else {
+        Err(GcodeError::OutOfRange { line, what: what.to_string(), value, max: MAX_COORDINATE })
+    }
 }
 
 /// Options of [`read_gcode`].
@@ -95,7 +131,7 @@ const MM_PER_INCH: f64 = 25.4;
 /// assert!(read_gcode("G0 X0 Y0 Z0\nG28\n", &GcodeOptions::default()).unwrap_err().to_string().contains("line 2"));
 /// ```
 pub fn read_gcode(text: &str, options: &GcodeOptions) -> Result<Toolpath, GcodeError> {
-    read(text, options, false)
+    read(text, options, false).map(|(path, _)| path)
 }
 
 /// Reads a program like [`read_gcode`], but keeps every `G2`/`G3` in the XY plane (G17) as one move
@@ -117,19 +153,47 @@ pub fn read_gcode(text: &str, options: &GcodeOptions) -> Result<Toolpath, GcodeE
 /// assert!((path.arc(3).unwrap().sweep - std::f64::consts::PI).abs() < 1e-12);
 /// ```
 pub fn read_gcode_arcs(text: &str, options: &GcodeOptions) -> Result<Toolpath, GcodeError> {
+    read(text, options, true).map(|(path, _)| path)
+}
+
+/// Reads a program like [`read_gcode_arcs`] and also returns, for every move of the
+/// toolpath, the line (from 1) of the block it comes from, so that a simulation fault on
+/// a move can name the G-code line.
+///
+/// # Errors
+/// As [`read_gcode`].
+///
+/// ```
+/// use scallop_io::gcode::{read_gcode_lines, GcodeOptions};
+/// let (path, lines) = read_gcode_lines("G21\nG0 Z5\nG0 X0 Y0\nG1 Z0 F100\n(c)\nG1 X4\n", &GcodeOptions::default()).unwrap();
+/// assert_eq!(path.moves().len(), 3);
+/// assert_eq!(lines, [3, 4, 6]);
+/// ```
+pub fn read_gcode_lines(text: &str, options: &GcodeOptions) -> Result<(Toolpath, Vec<usize>), GcodeError> {
     read(text, options, true)
 }
 
-fn read(text: &str, options: &GcodeOptions, keep_arcs: bool) -> Result<Toolpath, GcodeError> {
-    let mut state =
-        State { pos: options.start, scale: 1.0, absolute: true, motion: None, feed: None, plane: (0, 1, 2) };
+fn read(text: &str, options: &GcodeOptions, keep_arcs: bool) -> Result<(Toolpath, Vec<usize>), GcodeError> {
+    let mut state = State {
+        pos: options.start,
+        partial: [None; 3],
+        partial_line: 0,
+        scale: 1.0,
+        absolute: true,
+        motion: None,
+        feed: None,
+        plane: (0, 1, 2),
+    };
     let mut path = Toolpath::new(0.0);
     let mut feeds: Vec<f64> = Vec::new();
+    let mut tool = Tools::default();
+    let mut lines: Vec<usize> = Vec::new();
     for (k, raw) in text.lines().enumerate() {
         let line = k + 1;
         let words = words(raw, line)?;
         let mut target = [None::<f64>; 3];
         let (mut i, mut j, mut kk, mut r) = (None, None, None, None);
+        let mut m6 = false;
         for (letter, value) in words {
             match letter {
                 'G' => state.g_code(value, line)?,
@@ -146,7 +210,9 @@ fn read(text: &str, options: &GcodeOptions, keep_arcs: bool) -> Result<Toolpath,
                     }
                     state.feed = Some(value);
                 }
-                'N' | 'S' | 'T' | 'M' | 'O' | 'P' | 'H' | 'D' => {}
+                'T' => tool.selected = Some(value),
+                'M' if (value - 6.0).abs() < 1e-9 => m6 = true,
+                'N' | 'S' | 'M' | 'O' | 'P' | 'H' | 'D' => {}
                 'A' | 'B' | 'C' | 'U' | 'V' | 'W' => {
                     return Err(GcodeError::Unsupported {
                         line,
@@ -157,23 +223,58 @@ fn read(text: &str, options: &GcodeOptions, keep_arcs: bool) -> Result<Toolpath,
                 other => return Err(GcodeError::Syntax { line, word: other.to_string() }),
             }
         }
+        if m6 {
+            // After the block's T word, whatever their order (as controllers do).
+            tool.change(line)?;
+        }
         if target.iter().all(Option::is_none) {
             continue;
         }
         let Some(motion) = state.motion else {
             return Err(GcodeError::State { line, why: "coordinates without a motion mode (G0/G1/G2/G3)" });
         };
+        if state.pos.is_none() && target.iter().any(Option::is_none) {
+            // Unknown start, as on a controller after homing: rapids may give the axes one
+            // at a time (`G0 Z50` then `G0 X0 Y0`); the tool is placed once all are known.
+            if motion != 0 {
+                return Err(GcodeError::State {
+                    line,
+                    why: "a feed move before X, Y and Z are all known; start with G0 moves that give every axis",
+                });
+            }
+            if !state.absolute {
+                return Err(GcodeError::State {
+                    line,
+                    why: "an incremental (G91) move from an unknown position; give absolute X, Y and Z first",
+                });
+            }
+            for (axis, name) in ["X", "Y", "Z"].into_iter().enumerate() {
+                if let Some(v) = target[axis] {
+                    state.partial[axis] = Some(in_range(line, name, v * state.scale)?);
+                }
+                state.partial_line = line;
+            }
+            if let [Some(x), Some(y), Some(z)] = state.partial {
+                let to = Point3::new(x, y, z);
+                path.push(Move::new(MoveKind::Rapid, to));
+                state.pos = Some(to);
+                lines.push(line);
+            }
+            continue;
+        }
         let to = state.resolve(target, line)?;
         let Some(from) = state.pos else {
             // Unknown start: place the tool.
             path.push(Move::new(MoveKind::Rapid, to));
             state.pos = Some(to);
+            lines.push(line);
             continue;
         };
         match motion {
             0 => path.push(Move::new(MoveKind::Rapid, to)),
             1..=3 => {
                 let feed = state.feed.ok_or(GcodeError::State { line, why: "a feed move before any F word" })?;
+                tool.cut = true;
                 feeds.push(feed * state.scale);
                 let kind = if (to.x - from.x).abs() + (to.y - from.y).abs() == 0.0 && to.z < from.z {
                     MoveKind::Plunge
@@ -185,6 +286,14 @@ fn read(text: &str, options: &GcodeOptions, keep_arcs: bool) -> Result<Toolpath,
                 } else {
                     let (u, v, _) = state.plane;
                     let offsets = [i, j, kk].map(|o| o.map(|x| x * state.scale));
+                    for (o, name) in offsets.iter().zip(["I", "J", "K"]) {
+                        if let Some(o) = o {
+                            in_range(line, name, *o)?;
+                        }
+                    }
+                    if let Some(r) = r {
+                        in_range(line, "R", r * state.scale)?;
+                    }
                     let centre = arc_centre(
                         (from[u], from[v]),
                         (to[u], to[v]),
@@ -193,6 +302,10 @@ fn read(text: &str, options: &GcodeOptions, keep_arcs: bool) -> Result<Toolpath,
                         motion == 2,
                         line,
                     )?;
+                    // The whole circle stays in range (an arc may sweep most of it).
+                    let radius = (from[u] - centre.0).hypot(from[v] - centre.1);
+                    in_range(line, "arc extent (|centre| + radius)", centre.0.abs() + radius)?;
+                    in_range(line, "arc extent (|centre| + radius)", centre.1.abs() + radius)?;
                     if keep_arcs && state.plane == (0, 1, 2) {
                         let sweep = arc_sweep(from, to, centre, motion == 2);
                         let arc = ArcXY { center: Point2::new(centre.0, centre.1), sweep };
@@ -207,19 +320,58 @@ fn read(text: &str, options: &GcodeOptions, keep_arcs: bool) -> Result<Toolpath,
             _ => unreachable!("motion modes are 0..=3"),
         }
         state.pos = Some(to);
+        lines.resize(path.moves().len(), line);
     }
     if path.moves().is_empty() {
+        if state.partial.iter().any(Option::is_some) {
+            return Err(GcodeError::State {
+                line: state.partial_line,
+                why: "X, Y and Z are never all given, so the tool's position is never known",
+            });
+        }
         return Err(GcodeError::Empty);
     }
     // One feed for the path: the most common programmed feed (mm/min), for time estimates.
     feeds.sort_by(f64::total_cmp);
     path.feed = feeds.get(feeds.len() / 2).copied().unwrap_or(0.0);
     path.plunge_feed = path.feed;
-    Ok(path)
+    debug_assert_eq!(lines.len(), path.moves().len());
+    Ok((path, lines))
+}
+
+/// Tool words: the program is simulated with one cutter, so a tool change (`M6`) to
+/// another tool after cutting has begun is refused with its line.
+#[derive(Default)]
+struct Tools {
+    /// The last `T` word.
+    selected: Option<f64>,
+    /// The tool in the spindle (set by `M6`).
+    current: Option<f64>,
+    /// A feed move has been read.
+    cut: bool,
+}
+
+impl Tools {
+    fn change(&mut self, line: usize) -> Result<(), GcodeError> {
+        if self.cut && self.selected != self.current {
+            return Err(GcodeError::Unsupported {
+                line,
+                code: "M6".into(),
+                why: "a change to another tool after cutting began: the simulation uses one cutter; \
+                      split the program at this line and simulate each tool with its own --cutter",
+            });
+        }
+        self.current = self.selected;
+        Ok(())
+    }
 }
 
 struct State {
     pos: Option<Point3>,
+    /// The axes known so far while `pos` is unknown (rapids giving one axis at a time).
+    partial: [Option<f64>; 3],
+    /// The last line that gave one of them.
+    partial_line: usize,
     scale: f64,
     absolute: bool,
     motion: Option<u8>,
@@ -270,6 +422,9 @@ impl State {
                     });
                 }
             };
+        }
+        for (v, name) in p.iter().zip(["X", "Y", "Z"]) {
+            in_range(line, name, *v)?;
         }
         Ok(Point3::new(p[0], p[1], p[2]))
     }
@@ -474,8 +629,57 @@ mod tests {
         assert!(matches!(read("G0 X0 Y0 Z0\nG1 X1Q F100\n").unwrap_err(), GcodeError::Syntax { line: 2, .. }));
         assert!(matches!(read("G0 X0 Y0 Z0\nG2 X1 Y1 I3 F100\n").unwrap_err(), GcodeError::BadArc { line: 2, .. }));
         assert!(matches!(read("G0 X1\n").unwrap_err(), GcodeError::State { line: 1, .. }));
+        assert!(matches!(read("G0 Z50\nG1 X1 F100\n").unwrap_err(), GcodeError::State { line: 2, .. }));
         assert_eq!(read("(only a comment)\nM30\n").unwrap_err(), GcodeError::Empty);
         assert!(matches!(read("G0 X0 Y0 Z0\nG28\n").unwrap_err(), GcodeError::Unsupported { line: 2, .. }));
+    }
+
+    #[test]
+    fn a_tool_change_after_cutting_is_refused_with_its_line() {
+        // Before cutting, T1 M6 (and re-selecting the same tool) is the program's own tool.
+        let ok = "T1 M6\nG0 X0 Y0 Z5\nG1 Z0 F100\nG1 X5\nT1\nM6\nG1 X6\n";
+        assert_eq!(read(ok).unwrap().moves().len(), 4);
+        let e = read("T1 M6\nG0 X0 Y0 Z5\nG1 Z0 F100\nG1 X5\nG0 Z5\nT2\nM06\nG1 Z0\n").unwrap_err();
+        assert!(matches!(e, GcodeError::Unsupported { line: 7, .. }), "{e}");
+        let e = read("T1 M6\nG0 X0 Y0 Z5\nG1 Z0 F100\nG1 X5\nM6 T3\n").unwrap_err();
+        assert!(matches!(e, GcodeError::Unsupported { line: 5, .. }), "{e}");
+        assert!(e.to_string().contains("one cutter"), "{e}");
+    }
+
+    #[test]
+    fn a_program_may_give_the_start_one_axis_at_a_time() {
+        // As controllers read it: a safe Z first, then X and Y; the tool is placed then.
+        let p = read("G21 G90\nG0 Z50\nG0 X10 Y-5\nG1 Z0 F300\nG1 X20\n").unwrap();
+        let to: Vec<Point3> = p.moves().iter().map(|m| m.to).collect();
+        assert_eq!(to, vec![Point3::new(10.0, -5.0, 50.0), Point3::new(10.0, -5.0, 0.0), Point3::new(20.0, -5.0, 0.0)]);
+        assert_eq!(p.moves()[0].kind, MoveKind::Rapid);
+        // Inches apply to the partial axes too.
+        let p = read("G20\nG0 Z2\nG0 X1 Y1\n").unwrap();
+        assert_eq!(p.moves()[0].to, Point3::new(25.4, 25.4, 50.8));
+    }
+
+    #[test]
+    fn coordinates_are_bounded_after_scaling_and_accumulation() {
+        // The issue's cases: a finite number that G20 turns into infinity, G91 steps that
+        // sum to infinity, an arc centre offset near f64::MAX.
+        let big = "9".repeat(308);
+        let g20 = format!("G21 G90\nG0 X10 Y10 Z50\nG1 Z38 F100\nG20\nG1 X{big}\n");
+        assert!(matches!(read(&g20).unwrap_err(), GcodeError::OutOfRange { line: 5, .. }));
+        let g91 = format!("G21 G90\nG0 X10 Y10 Z50\nG1 Z38 F100\nG91\nG1 X{big}\nG1 X{big}\n");
+        assert!(matches!(read(&g91).unwrap_err(), GcodeError::OutOfRange { line: 5, .. }));
+        let arc = format!("G21 G90\nG0 X10 Y10 Z50\nG1 Z45 F100\nG2 X10 Y10 I17{}\n", "0".repeat(307));
+        let e = read(&arc).unwrap_err();
+        assert!(matches!(e, GcodeError::OutOfRange { line: 4, .. }), "{e}");
+        // An arc whose circle leaves the range (found by the fuzzer: centre 92243 mm, radius
+        // 92233 mm, a clockwise sweep of almost a full turn).
+        let e = read("G21 G90\nG0 X10 Y10 Z50\nG1 Z45 F100\nG2 X90 Y10 I92233\n").unwrap_err();
+        assert!(matches!(e, GcodeError::OutOfRange { line: 4, .. }), "{e}");
+        // Accumulation: 2000 steps of 60 mm pass +-1e5 on step 1667.
+        let steps = "G1 X60\n".repeat(2000);
+        let e = read(&format!("G0 X0 Y0 Z0\nF100 G91\n{steps}")).unwrap_err();
+        assert!(matches!(e, GcodeError::OutOfRange { line: 1669, .. }), "{e}");
+        // The bound itself is accepted.
+        assert!(read(&format!("G0 X0 Y0 Z0\nG1 X{MAX_COORDINATE} F100\n")).is_ok());
     }
 
     #[test]

@@ -260,6 +260,37 @@ impl Hasher for WordHasher {
     }
 }
 
+/// Text that is not UTF-8, with its place: the line (from 1) and the byte offset (from 0)
+/// of the first bad byte.
+///
+/// ```
+/// let e = scallop_io::utf8_text(b"kind,x,y,z\nfeed,1,\xff,3\n").unwrap_err();
+/// assert_eq!((e.line, e.byte, e.value), (2, 18, 0xff));
+/// assert!(e.to_string().starts_with("line 2, byte 18: 0xFF"), "{e}");
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error("line {line}, byte {byte}: 0x{value:02X} is not UTF-8 text; save the file as plain (ASCII or UTF-8) text")]
+pub struct NotUtf8 {
+    /// Line of the bad byte (from 1).
+    pub line: usize,
+    /// Offset of the bad byte from the start of the file (from 0).
+    pub byte: usize,
+    /// The bad byte.
+    pub value: u8,
+}
+
+/// The bytes as text, or the place of the first byte that is not UTF-8.
+///
+/// # Errors
+/// [`NotUtf8`] with the line and byte offset.
+pub fn utf8_text(bytes: &[u8]) -> Result<&str, NotUtf8> {
+    std::str::from_utf8(bytes).map_err(|e| {
+        let byte = e.valid_up_to();
+        let line = 1 + bytes[..byte].iter().filter(|&&b| b == b'\n').count();
+        NotUtf8 { line, byte, value: bytes.get(byte).copied().unwrap_or(0) }
+    })
+}
+
 /// Vertices (mm, finite) and index triples (in range) as a parser produces them.
 #[derive(Debug, Default)]
 pub(crate) struct Geometry {

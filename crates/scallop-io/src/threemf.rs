@@ -37,12 +37,15 @@ const RELS: &str = "_rels/.rels";
 const RULE: &str = "3MF indices count from 0 within the object's <vertices>";
 /// Deepest component nesting accepted (deeper means a cycle or an abuse).
 const MAX_DEPTH: usize = 32;
-/// Most triangles that instancing may produce (protects memory from tiny files that repeat a mesh).
-const MAX_TRIANGLES: usize = 1 << 26;
+/// Most triangles that instancing may produce (protects memory from tiny files that repeat a
+/// mesh): about 8.4 million, 1 to 2 GB once placed, welded and indexed. Counted before
+/// anything is placed.
+pub const MAX_TRIANGLES: usize = 1 << 23;
 /// Most objects that build items and components may place (protects time the same way).
 const MAX_PLACEMENTS: usize = 1 << 20;
-/// Largest XML part read (decompressed), to stop zip bombs.
-const MAX_PART_BYTES: u64 = 1 << 32;
+/// Largest XML part read (decompressed), to stop zip bombs: 1 GiB, about 8 million triangles
+/// of 3MF XML. The size the zip declares is checked before reading, the bytes read after.
+pub const MAX_PART_BYTES: u64 = 1 << 30;
 
 /// The unit a 3MF model declares.
 #[derive(Debug, Clone, Copy)]
@@ -112,7 +115,7 @@ struct Part {
 }
 
 pub(crate) fn read(bytes: &[u8], user_scale: f64) -> Result<(Geometry, FileUnit, f64), MeshReadError> {
-    let mut zip = ZipArchive::new(Cursor::new(bytes)).map_err(|e| MeshReadError::NotZip { reason: e.to_string() })?;
+    let mut zip = ZipArchive::new(Cursor::new(bytes)).map_err(|e| MeshReadError::NotZip { reason: zip_words(&e) })?;
     let root = root_part_name(&mut zip);
     let root_xml = read_entry(&mut zip, &root)?;
     let mut parts: HashMap<String, Part> = HashMap::new();
@@ -138,6 +141,22 @@ pub(crate) fn read(bytes: &[u8], user_scale: f64) -> Result<(Geometry, FileUnit,
         }
     }
 
+    // What the build would place, counted before anything is placed.
+    let mut memo = HashMap::new();
+    let mut total: u128 = 0;
+    for item in &parts[&root].items {
+        total = total.saturating_add(count_triangles(&parts, item, 0, &mut memo));
+    }
+    if total > MAX_TRIANGLES as u128 {
+        return Err(MeshReadError::Syntax {
+            format: FORMAT,
+            place: Place::Entry { entry: root },
+            problem: format!(
+                "the build places {total} triangles by instancing (objects repeated by <component> and <item>), \
+                 over the cap of {MAX_TRIANGLES}; place fewer copies, or merge the part into one mesh"
+            ),
+        });
+    }
     let scale = unit.mm * user_scale;
     let mut out = Geometry::default();
     let mut placements = 0;
@@ -207,6 +226,65 @@ fn place_object(
     Ok(())
 }
 
+/// Triangles `reference` places (saturating), memoised per object; a missing object or a
+/// nesting deeper than [`MAX_DEPTH`] counts 0 here and is reported by [`place_object`].
+fn count_triangles(
+    parts: &HashMap<String, Part>,
+    reference: &Reference,
+    depth: usize,
+    memo: &mut HashMap<(String, String), u128>,
+) -> u128 {
+    if depth > MAX_DEPTH {
+        return 0;
+    }
+    let key = (reference.part.clone(), reference.id.clone());
+    if let Some(&n) = memo.get(&key) {
+        return n;
+    }
+    let Some(object) = parts.get(&reference.part).and_then(|p| p.objects.get(&reference.id)) else { return 0 };
+    let mut n = object.triangles.len() as u128;
+    for c in &object.components {
+        n = n.saturating_add(count_triangles(parts, c, depth + 1, memo));
+    }
+    memo.insert(key, n);
+    n
+}
+
+/// A zip reader's complaint in words (its messages may name internal types).
+fn zip_words(e: &zip::result::ZipError) -> String {
+    use zip::result::ZipError;
+    match e {
+        ZipError::Io(io) if io.kind() == std::io::ErrorKind::UnexpectedEof => {
+            "the archive ends early: it is truncated (an incomplete download or copy)".to_string()
+        }
+        ZipError::Io(io) => format!("the archive cannot be read: {io}"),
+        ZipError::InvalidArchive(msg) => {
+            let what = if msg.contains("EOCD") {
+                "the zip's end record (end of central directory) is missing: the file is cut short or is not a zip"
+            } else if msg.contains("CentralEntry") {
+                "an entry of the zip's table of contents (central directory) is cut short or damaged"
+            } else if msg.contains("LocalEntry") {
+                "the header of a file inside the zip is cut short or damaged"
+            } else if msg.contains("CentralDirectoryEnd") || msg.to_lowercase().contains("central directory") {
+                "the zip's table of contents (central directory) is missing or damaged"
+            } else {
+                "the zip structure is damaged"
+            };
+            let detail: Vec<&str> = msg.split_whitespace().map(|w| w.rsplit("::").next().unwrap_or(w)).collect();
+            format!("{what}; the file is not a complete zip archive ({})", detail.join(" "))
+        }
+        ZipError::UnsupportedArchive(what) => {
+            format!("the archive uses a zip feature this reader does not support ({what})")
+        }
+        ZipError::FileNotFound => "a file the archive lists is missing from it".to_string(),
+        ZipError::InvalidPassword => "the archive is encrypted".to_string(),
+        ZipError::CompressionMethodNotSupported(m) => {
+            format!("a file is compressed with method {m}, which this reader does not support (use deflate or store)")
+        }
+        other => other.to_string(),
+    }
+}
+
 /// The model part named by the root relationship, else the usual name.
 fn root_part_name(zip: &mut ZipArchive<Cursor<&[u8]>>) -> String {
     let Ok(rels) = read_entry(zip, RELS) else { return DEFAULT_MODEL.to_string() };
@@ -247,16 +325,29 @@ fn read_entry(zip: &mut ZipArchive<Cursor<&[u8]>>, name: &str) -> Result<Vec<u8>
         return Err(MeshReadError::MissingModel { looked_for: wanted.to_string(), entries: zip.len() });
     };
     let place = || Place::Entry { entry: wanted.to_string() };
-    let entry = zip.by_index(index).map_err(|e| MeshReadError::ZipEntry { place: place(), reason: e.to_string() })?;
-    let mut data = Vec::new();
+    let entry = zip.by_index(index).map_err(|e| MeshReadError::ZipEntry { place: place(), reason: zip_words(&e) })?;
+    let declared = entry.size();
+    if declared > MAX_PART_BYTES {
+        return Err(MeshReadError::ZipEntry {
+            place: place(),
+            reason: format!(
+                "it declares {declared} bytes once decompressed, over the cap of {MAX_PART_BYTES} bytes (1 GiB); \
+                 a 3MF part that large is a zip bomb or a part to split"
+            ),
+        });
+    }
+    let mut data = Vec::with_capacity(usize::try_from(declared.min(1 << 24)).unwrap_or(0));
     entry
         .take(MAX_PART_BYTES + 1)
         .read_to_end(&mut data)
-        .map_err(|e| MeshReadError::ZipEntry { place: place(), reason: e.to_string() })?;
+        .map_err(|e| MeshReadError::ZipEntry { place: place(), reason: format!("its data is damaged: {e}") })?;
     if data.len() as u64 > MAX_PART_BYTES {
         return Err(MeshReadError::ZipEntry {
             place: place(),
-            reason: format!("it decompresses to more than {MAX_PART_BYTES} bytes"),
+            reason: format!(
+                "it decompresses to more than {MAX_PART_BYTES} bytes (1 GiB) although it declares {declared}; \
+                 the archive is damaged or a zip bomb"
+            ),
         });
     }
     Ok(data)

@@ -448,6 +448,18 @@ fn unit_direction(a: [f64; 3], place: &str) -> Result<Vec3, MachineError> {
     Ok(v / n)
 }
 
+/// A point of the description: finite and within [`tol::MAX_COORDINATE`] of the origin.
+fn point_in_range(a: [f64; 3], place: &str) -> Result<Point3, MachineError> {
+    if a.iter().all(|v| v.is_finite() && v.abs() <= tol::MAX_COORDINATE) {
+        return Ok(Point3::new(a[0], a[1], a[2]));
+    }
+    Err(MachineError::invalid(
+        place,
+        format!("point [{:?}, {:?}, {:?}] is not finite or outside +-{:e} mm", a[0], a[1], a[2], tol::MAX_COORDINATE),
+        "give finite coordinates in mm (machine frame at q = 0)",
+    ))
+}
+
 fn line_column(text: &str, offset: usize) -> (usize, usize) {
     let before = &text[..offset.min(text.len())];
     let line = before.matches('\n').count() + 1;
@@ -545,7 +557,7 @@ impl Machine {
                 }
             };
             let point = match (a.kind, a.point) {
-                (AxisKind::Rotary, Some(p)) => Point3::from(vec3(p)),
+                (AxisKind::Rotary, Some(p)) => point_in_range(p, &format!("{place}.point"))?,
                 (AxisKind::Rotary, None) => {
                     return Err(MachineError::invalid(
                         format!("{place}.point"),
@@ -689,13 +701,14 @@ impl Machine {
             ));
         }
         let tool_axis = unit_direction(raw.spindle.tool_axis, "spindle.tool_axis")?;
-        let gauge_point = Point3::from(vec3(raw.spindle.gauge_point));
+        let gauge_point = point_in_range(raw.spindle.gauge_point, "spindle.gauge_point")?;
         let part_frame = match raw.part_frame {
             None => Isometry3::identity(),
             Some(f) => {
                 let m = Matrix3::from_fn(|r, c| f.rotation[r][c]);
                 let err = (m.transpose() * m - Matrix3::identity()).norm();
-                if err > tol::DIRECTION_NORM || m.determinant() < 0.0 {
+                // `!(err <= ..)`: a NaN or infinite entry makes `err` NaN and is refused.
+                if !(err <= tol::DIRECTION_NORM && m.determinant() > 0.0) {
                     return Err(MachineError::invalid(
                         "part_frame.rotation",
                         "not a proper rotation matrix (orthonormal, det +1)",
@@ -703,7 +716,8 @@ impl Machine {
                     ));
                 }
                 let rot = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(m));
-                Isometry3::from_parts(Translation3::from(vec3(f.origin)), rot)
+                let origin = point_in_range(f.origin, "part_frame.origin")?;
+                Isometry3::from_parts(Translation3::from(origin.coords), rot)
             }
         };
         let preferred_branch = match raw.kinematics.preferred_branch {

@@ -12,6 +12,11 @@ pub const DIRECTION_NORM: f64 = 1e-6;
 /// closed-form families when it differs from it by less than this).
 pub const PARALLEL: f64 = 1e-9;
 
+/// Largest absolute coordinate (mm) of a point in a description (part-frame origin,
+/// gauge point, pivot points): 100 m, beyond any machine; past it a value is a typo and
+/// the kinematics would overflow.
+pub const MAX_COORDINATE: f64 = 1e5;
+
 /// The three linear axes must span space: `|det [d_1 d_2 d_3]|` above this.
 pub const LINEAR_INDEPENDENCE: f64 = 1e-6;
 

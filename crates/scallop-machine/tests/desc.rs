@@ -103,3 +103,43 @@ fn four_axis_machines_are_unsupported_for_now() {
     let t = t.replace("A = [90.0, 298.8, 1800]\n", "").replace("preferred_branch = { axis = \"A\", sign = 1 }\n", "");
     assert!(matches!(Machine::from_toml_str(&t), Err(MachineError::Unsupported { .. })));
 }
+
+#[test]
+fn nan_inf_and_huge_frames_and_points_are_refused_with_their_key() {
+    // Issue 21: these passed validation and reached the kinematics (a panic, or a program
+    // "deviating inf" with no key named).
+    let text = ucp_text();
+    let frame = "part_frame = { origin = [0, 0, 0], rotation = [[1, 0, 0], [0, 1, 0], [0, 0, 1]] }";
+    let cases = [
+        (
+            frame,
+            "part_frame = { origin = [0, 0, 0], rotation = [[1, 0, 0], [0, nan, 0], [0, 0, 1]] }",
+            "part_frame.rotation",
+        ),
+        (
+            frame,
+            "part_frame = { origin = [0, 0, 0], rotation = [[1, 0, 0], [0, 1, 0], [0, 0, inf]] }",
+            "part_frame.rotation",
+        ),
+        (
+            frame,
+            "part_frame = { origin = [nan, 0, 0], rotation = [[1, 0, 0], [0, 1, 0], [0, 0, 1]] }",
+            "part_frame.origin",
+        ),
+        (
+            frame,
+            "part_frame = { origin = [0, 2e5, 0], rotation = [[1, 0, 0], [0, 1, 0], [0, 0, 1]] }",
+            "part_frame.origin",
+        ),
+        ("gauge_point = [0, 0, 0]", "gauge_point = [nan, 0, 0]", "spindle.gauge_point"),
+        ("point = [0, 0, -100]", "point = [0, 0, nan]", "axes.A.point"),
+        ("point = [0, 0, -100]", "point = [0, 0, 1e308]", "axes.A.point"),
+    ];
+    for (from, to, key) in cases {
+        assert!(text.contains(from), "{from}");
+        assert_eq!(invalid_place(&text.replacen(from, to, 1)), key, "{to}");
+    }
+    // At the bound itself a point is accepted.
+    let edge = text.replacen("point = [0, 0, -100]", "point = [0, 0, -100000]", 1);
+    assert!(Machine::from_toml_str(&edge).is_ok());
+}

@@ -37,6 +37,29 @@ pub enum MeshError {
         /// How many vertices there are.
         vertex_count: usize,
     },
+    /// A vertex far outside the box that holds the bulk of the mesh (more than
+    /// [`tol::OUTLIER_FACTOR`] times its size away): a corrupt or mis-scaled vertex that
+    /// would inflate the weld distance and the bounds. Fix: remove or repair that vertex.
+    #[error(
+        "triangle {triangle}, vertex {vertex} (vertex {index} of the file) at ({x:e}, {y:e}, {z:e}) mm is an outlier: {distance:e} mm outside the box [{lo:?} .. {hi:?}] that holds 90 % of the vertices, over {factor:e} times its size; remove or repair this vertex (or check its units)",
+        x = position[0], y = position[1], z = position[2], factor = tol::OUTLIER_FACTOR
+    )]
+    Outlier {
+        /// First triangle (input order) that uses the vertex.
+        triangle: usize,
+        /// Corner of that triangle (0..3).
+        vertex: usize,
+        /// Index of the vertex in the input vertex list (3 t + k for a soup).
+        index: usize,
+        /// Its coordinates (mm).
+        position: [f64; 3],
+        /// Distance from the bulk box (mm).
+        distance: f64,
+        /// Lower corner of the bulk box (5 % quantiles per axis).
+        lo: [f64; 3],
+        /// Upper corner of the bulk box (95 % quantiles per axis).
+        hi: [f64; 3],
+    },
     /// A scale factor that is not finite and positive.
     #[error("scale factor {0} is not a finite positive number")]
     BadScale(f64),
@@ -53,8 +76,12 @@ pub struct MeshDiagnostics {
     pub welded_vertices: usize,
     /// Weld distance used (mm): `tol::REL_WELD` times the model diagonal.
     pub weld_distance: f64,
-    /// Triangles dropped because they had zero area (after welding).
+    /// Triangles dropped because they had zero area in the input (a repeated or exactly
+    /// collinear corner before welding).
     pub degenerate_dropped: usize,
+    /// Triangles of non-zero area whose corners welding merged: kept with their own
+    /// (unwelded) corners, never dropped, and counted here.
+    pub kept_unwelded: usize,
     /// Edges used by one triangle only (open mesh).
     pub boundary_edges: usize,
     /// Edges used by more than two triangles.
@@ -103,18 +130,35 @@ impl TriMesh {
                 }
             }
         }
+        check_outliers(vertices, triangles)?;
         // INVARIANT: triangles is non-empty and every index was checked above.
         let bounds = Aabb3::from_points(triangles.iter().flatten().map(|&i| vertices[i])).ok_or(MeshError::Empty)?;
         let weld_distance = tol::REL_WELD * bounds.diagonal();
-        let (welded, remap) = weld(vertices, weld_distance);
+        let (mut welded, remap) = weld(vertices, weld_distance);
 
         let mut kept: Vec<[u32; 3]> = Vec::with_capacity(triangles.len());
         let mut degenerate = 0usize;
+        let mut kept_unwelded = 0usize;
         for tri in triangles {
+            let original = tri.map(|i| vertices[i]);
+            if original[0] == original[1]
+                || original[1] == original[2]
+                || original[0] == original[2]
+                || is_collinear(&original)
+            {
+                degenerate += 1;
+                continue;
+            }
             let t = [remap[tri[0]], remap[tri[1]], remap[tri[2]]];
             let pts = t.map(|i| welded[i as usize]);
             if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] || is_collinear(&pts) {
-                degenerate += 1;
+                // Welding collapsed a real triangle: keep it on its own corners.
+                kept_unwelded += 1;
+                let own = original.map(|p| {
+                    welded.push(p);
+                    u32::try_from(welded.len() - 1).unwrap_or(u32::MAX)
+                });
+                kept.push(own);
             } else {
                 kept.push(t);
             }
@@ -143,6 +187,7 @@ impl TriMesh {
             welded_vertices: used.len(),
             weld_distance,
             degenerate_dropped: degenerate,
+            kept_unwelded,
             boundary_edges,
             non_manifold_edges,
         };
@@ -283,6 +328,57 @@ fn weld(points: &[Point3], dist: f64) -> (Vec<Point3>, Vec<u32>) {
     (kept, remap)
 }
 
+/// Refuses a vertex more than [`tol::OUTLIER_FACTOR`] times the size of the bulk box
+/// (5 % to 95 % quantiles of the used vertices per axis, estimated on at most
+/// [`OUTLIER_SAMPLE`] evenly strided corners) away from that box. A bulk box of zero size
+/// (almost every vertex at one point) decides nothing.
+fn check_outliers(vertices: &[Point3], triangles: &[[usize; 3]]) -> Result<(), MeshError> {
+    let corners = triangles.len() * 3;
+    let stride = corners.div_ceil(OUTLIER_SAMPLE).max(1);
+    let mut lo = [0.0; 3];
+    let mut hi = [0.0; 3];
+    for axis in 0..3 {
+        let mut sample: Vec<f64> =
+            (0..corners).step_by(stride).map(|c| vertices[triangles[c / 3][c % 3]][axis]).collect();
+        let n = sample.len();
+        // INVARIANT: n >= 1 (triangles is non-empty), so both ranks are in range.
+        let (k_lo, k_hi) = (n / 20, (n - 1) - n / 20);
+        lo[axis] = *sample.select_nth_unstable_by(k_lo, f64::total_cmp).1;
+        hi[axis] = *sample.select_nth_unstable_by(k_hi, f64::total_cmp).1;
+    }
+    let size = (0..3).map(|a| hi[a] - lo[a]).fold(0.0, f64::max);
+    if size <= 0.0 {
+        return Ok(());
+    }
+    let limit = tol::OUTLIER_FACTOR * size;
+    for (t, tri) in triangles.iter().enumerate() {
+        for (k, &i) in tri.iter().enumerate() {
+            let p = vertices[i];
+            let outside = Vec3::new(
+                (lo[0] - p.x).max(p.x - hi[0]).max(0.0),
+                (lo[1] - p.y).max(p.y - hi[1]).max(0.0),
+                (lo[2] - p.z).max(p.z - hi[2]).max(0.0),
+            );
+            let distance = outside.norm();
+            if distance > limit {
+                return Err(MeshError::Outlier {
+                    triangle: t,
+                    vertex: k,
+                    index: i,
+                    position: [p.x, p.y, p.z],
+                    distance,
+                    lo,
+                    hi,
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Largest number of corners sampled for the bulk box of [`check_outliers`].
+const OUTLIER_SAMPLE: usize = 200_000;
+
 /// Weld grid cell size in weld distances.
 const WELD_CELL_FACTOR: f64 = 64.0;
 
@@ -374,6 +470,65 @@ mod tests {
         let v = [p(0., 0., 0.), p(1., 0., 0.), p(0., 1., 0.)];
         let err = TriMesh::from_indexed(&v, &[[0, 1, 3]]).unwrap_err();
         assert_eq!(err, MeshError::IndexOutOfRange { triangle: 0, index: 3, vertex_count: 3 });
+    }
+
+    /// A closed grid surface of `n x n` quads over `[0, size]^2` (z a gentle bump).
+    fn grid(n: usize, size: f64) -> Vec<[Point3; 3]> {
+        #[allow(clippy::cast_precision_loss)]
+        let at = |i: usize, j: usize| {
+            let (x, y) = (size * i as f64 / n as f64, size * j as f64 / n as f64);
+            p(x, y, (x * 0.1).sin() + (y * 0.07).cos())
+        };
+        let mut soup = Vec::new();
+        for i in 0..n {
+            for j in 0..n {
+                soup.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+                soup.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+            }
+        }
+        soup
+    }
+
+    #[test]
+    fn an_outlier_vertex_is_refused_with_its_place() {
+        // The case: one corner moved to 1e10 mm (and 1e12) of a 100 mm part.
+        for far in [1e10, 1e12, 1e7] {
+            let mut soup = grid(8, 100.0);
+            let t = soup.len() / 3;
+            soup[t][2] = p(far, 5.0, 0.0);
+            let err = TriMesh::from_soup(&soup).unwrap_err();
+            match err {
+                MeshError::Outlier { triangle, vertex, index, position, .. } => {
+                    assert_eq!((triangle, vertex, index), (t, 2, 3 * t + 2));
+                    assert_eq!(position, [far, 5.0, 0.0]);
+                }
+                other => panic!("{far}: {other}"),
+            }
+        }
+        // A vertex within the factor is no outlier: a long part, a far but sane corner.
+        let mut soup = grid(8, 100.0);
+        soup[3][1] = p(100.0 * tol::OUTLIER_FACTOR * 0.5, 5.0, 0.0);
+        assert!(TriMesh::from_soup(&soup).is_ok());
+    }
+
+    #[test]
+    fn welding_never_drops_a_triangle_of_nonzero_area() {
+        // A sliver whose apex is within the weld distance of a base corner, next to a
+        // large triangle that sets the diagonal: welding merges the corners, the
+        // sliver is kept on its own corners and counted.
+        let big = 1e6;
+        let d = 1e-4; // below REL_WELD * diagonal = 1.4e-3
+        let soup = [
+            [p(0., 0., 0.), p(big, 0., 0.), p(0., big, 0.)],
+            [p(1., 1., 0.), p(2., 1., 0.), p(1. + d, 1. + d, 0.)],
+            [p(1., 1., 0.), p(1., 1., 0.), p(3., 3., 0.)],
+        ];
+        let (m, diag) = TriMesh::from_soup(&soup).unwrap();
+        assert!(diag.weld_distance > d * 2.0_f64.sqrt(), "{}", diag.weld_distance);
+        assert_eq!(diag.kept_unwelded, 1);
+        assert_eq!(diag.degenerate_dropped, 1);
+        assert_eq!(m.triangles().len(), 2);
+        assert_eq!(m.triangle(1), soup[1]);
     }
 
     #[test]

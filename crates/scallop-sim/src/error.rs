@@ -26,7 +26,8 @@ pub enum SimError {
     },
     /// The grid would have more cells than the limit.
     #[error(
-        "z-map of {nx} x {ny} cells exceeds the limit of {limit} cells; use a coarser resolution or a smaller stock"
+        "a z-map of {nx} x {ny} cells (about {} MB) exceeds the budget of {limit} cells; use a coarser resolution or a smaller stock",
+        (*nx as u128 * *ny as u128 * 32) >> 20
     )]
     TooManyCells {
         /// Cells along x.

@@ -13,8 +13,10 @@ use crate::SimError;
 use crate::envelope::SweptMove;
 use crate::tol::GRID_SNAP;
 
-/// The largest number of cells a [`ZMap`] may have (16 bytes each).
-pub const MAX_CELLS: usize = 64_000_000;
+/// The largest number of cells a [`ZMap`] may have (16 bytes each): 16 million, 256 MB
+/// for the stock and as much again for the part's height field, and a few minutes of
+/// cutting and verification on 2 cores (docs/simulation.md); refused before any allocation.
+pub const MAX_CELLS: usize = 16_000_000;
 
 /// Rows per band: the unit of parallel work. Fixed, so the partition (and so
 /// the order of every floating-point sum) does not depend on the thread count.

@@ -5,7 +5,7 @@
 #[non_exhaustive]
 pub enum StrategyError {
     /// A parameter that must be a finite number in a range.
-    #[error("parameter `{name}` = {value} is invalid: {fix}")]
+    #[error("parameter `{name}` = {value:?} is invalid: {fix}")]
     BadParameter {
         /// Parameter name (as in [`crate::FinishingParams`] or [`scallop_geom::Tolerances`]).
         name: &'static str,
@@ -13,6 +13,29 @@ pub enum StrategyError {
         value: f64,
         /// What to do instead.
         fix: &'static str,
+    },
+    /// The plan would need more work than the budget allows, estimated before planning:
+    /// forward samples (drop-cutter queries) per pass times the fewest passes the
+    /// scallop height allows. Fix: a larger `max_step`, scallop height or cutter, or a
+    /// smaller part.
+    #[error(
+        "the plan needs at least {passes:.0} passes x {samples:.0} forward samples = {estimate:.3e} drop-cutter queries \
+         (part {span:.1} mm along the feed, max_step {max_step:?} mm), over the budget of {budget:.0e}; \
+         use a larger max_step or scallop height"
+    )]
+    TooMuchWork {
+        /// Lower bound of the passes (the width over the flat-surface spacing).
+        passes: f64,
+        /// Forward samples per pass (`span / max_step`).
+        samples: f64,
+        /// Their product.
+        estimate: f64,
+        /// Extent of the part along the feed plus the cutter (mm).
+        span: f64,
+        /// The step asked for (mm).
+        max_step: f64,
+        /// The budget, [`crate::tol::MAX_PLAN_SAMPLES`].
+        budget: f64,
     },
     /// The scallop height is not smaller than the cutter's radius (or corner radius).
     #[error(

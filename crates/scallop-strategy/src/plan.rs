@@ -76,11 +76,11 @@ impl<'a> Planner<'a> {
         region: Option<&'a ZoneRegion>,
     ) -> Result<Planner<'a>, StrategyError> {
         params.validate()?;
-        if !(tol_.path.is_finite() && tol_.path > 0.0) {
+        if !(tol_.path.is_finite() && tol_.path >= tol::MIN_PATH_TOLERANCE) {
             return Err(StrategyError::BadParameter {
                 name: "tolerances.path",
                 value: tol_.path,
-                fix: "give a positive chordal tolerance in mm (e.g. 0.01)",
+                fix: "give a chordal tolerance of at least 1e-4 mm (e.g. 0.01)",
             });
         }
         let shape = *cutter.shape();
@@ -122,6 +122,21 @@ impl<'a> Planner<'a> {
         d_range = [d_range[0] - reach, d_range[1] + reach];
         let span = t_range[1] - t_range[0];
         let steps = (span / params.max_step).ceil().max(1.0);
+        // The work, bounded before it is spent: the fewest passes (flat-surface spacing)
+        // times the forward samples of each.
+        let width = d_range[1] - d_range[0];
+        let passes = (width / model.max_step_over(sh).min(2.0 * cutter.radius())).ceil().max(1.0);
+        let estimate = passes * (steps + 1.0);
+        if !(steps <= tol::MAX_PASS_SAMPLES && estimate <= tol::MAX_PLAN_SAMPLES) {
+            return Err(StrategyError::TooMuchWork {
+                passes,
+                samples: steps + 1.0,
+                estimate,
+                span,
+                max_step: params.max_step,
+                budget: tol::MAX_PLAN_SAMPLES,
+            });
+        }
         // INVARIANT: span / max_step is finite and positive, so steps fits a usize.
         let n = steps as usize;
         let feed_samples = (0..=n).map(|k| t_range[0] + span * (k as f64 / steps)).collect();

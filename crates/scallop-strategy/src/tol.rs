@@ -161,3 +161,18 @@ pub const ISO_WINDOW_MISSES: usize = 8;
 /// An isoparametric step whose measured scallop lies between this fraction of
 /// `sh` and `sh` is accepted without trying a larger one.
 pub const ISO_FIT_ACCEPT: f64 = 0.8;
+
+/// Budget of one plan in drop-cutter queries, checked before planning on a lower bound
+/// (forward samples per pass at `max_step` times the passes at the flat-surface spacing):
+/// 5e7 queries, a few minutes on 2 cores and about 1 GB of samples; a request over it is
+/// refused with the estimate.
+pub const MAX_PLAN_SAMPLES: f64 = 5e7;
+
+/// Forward samples of one pass at `max_step` (the samples of a plane are held at once):
+/// 1e7, 80 MB of abscissae and 0.6 GB of cutter locations.
+pub const MAX_PASS_SAMPLES: f64 = 1e7;
+
+/// The smallest path tolerance (mm) a plan accepts: a tenth of a micron, below the
+/// resolution of machine axes and of the G-code's four decimals; a smaller tolerance
+/// only multiplies samples, with forward steps bisected down to `MIN_STEP_FRACTION`.
+pub const MIN_PATH_TOLERANCE: f64 = 1e-4;

@@ -77,3 +77,27 @@ fn oblique_feed_keeps_the_scallop() {
     assert_eq!(s.histogram.last(), Some(&0));
     assert!(planned.report.retracts + 1 == planned.report.passes);
 }
+
+#[test]
+fn work_over_the_budget_is_refused_with_the_estimate() {
+    // Issue 21: max_step = 1e-6 mm on a 20 mm part planned for minutes and gigabytes.
+    let index = inclined_plane(20.0, 10.0, 30.0);
+    let e = plan_finishing(&index, &ball(3.0), &params(0.0, Pattern::Zigzag, 0.01, 1e-6), &TOL).unwrap_err();
+    match &e {
+        StrategyError::TooMuchWork { passes, samples, estimate, budget, .. } => {
+            assert!(*samples > 1.0e7 && *passes >= 1.0, "{e}");
+            assert!((*estimate - passes * samples).abs() <= 1e-9 * estimate);
+            assert!(estimate > budget);
+        }
+        other => panic!("{other:?}"),
+    }
+    assert!(e.to_string().contains("max_step"), "{e}");
+    // An ordinary plan is under the budget.
+    assert!(plan_finishing(&index, &ball(3.0), &params(0.0, Pattern::Zigzag, 0.01, 0.5), &TOL).is_ok());
+    // A path tolerance below 1e-4 mm only multiplies samples.
+    let fine = Tolerances { path: 1e-12, gouge: 0.0 };
+    assert!(matches!(
+        plan_finishing(&index, &ball(3.0), &params(0.0, Pattern::Zigzag, 0.01, 0.5), &fine),
+        Err(StrategyError::BadParameter { name: "tolerances.path", .. })
+    ));
+}

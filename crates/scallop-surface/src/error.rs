@@ -88,6 +88,21 @@ pub enum SurfaceError {
         /// The given degree.
         degree: usize,
     },
+    /// A degree above [`crate::tol::MAX_DEGREE`], checked before anything is allocated.
+    /// Fix: split the patch or lower the degree (CAD exports stay far below the cap).
+    #[error(
+        "{patch}: degree in {direction} is {degree}; the largest accepted is {max} (evaluation cost and rounding grow with it); lower the degree or split the patch"
+    )]
+    DegreeTooHigh {
+        /// The patch.
+        patch: PatchLabel,
+        /// The direction whose degree is too high.
+        direction: Direction,
+        /// The given degree.
+        degree: usize,
+        /// The cap, [`crate::tol::MAX_DEGREE`].
+        max: usize,
+    },
     /// The control net has the wrong number of rows (u direction, index `i`).
     /// Fix: a Bezier patch of degree p in u has p + 1 rows; a NURBS patch has at
     /// least p + 1 rows and exactly (number of u knots) - p - 1.
@@ -291,6 +306,7 @@ macro_rules! patch_of {
     ($error:expr) => {
         match $error {
             SurfaceError::DegreeTooLow { patch, .. }
+            | SurfaceError::DegreeTooHigh { patch, .. }
             | SurfaceError::ControlRows { patch, .. }
             | SurfaceError::ControlColumns { patch, .. }
             | SurfaceError::KnotCount { patch, .. }

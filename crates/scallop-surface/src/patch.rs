@@ -479,6 +479,14 @@ fn check_degrees(label: &PatchLabel, degree: [usize; 2]) -> Result<(), SurfaceEr
         if d < 1 {
             return Err(SurfaceError::DegreeTooLow { patch: label.clone(), direction, degree: d });
         }
+        if d > tol::MAX_DEGREE {
+            return Err(SurfaceError::DegreeTooHigh {
+                patch: label.clone(),
+                direction,
+                degree: d,
+                max: tol::MAX_DEGREE,
+            });
+        }
     }
     Ok(())
 }
@@ -498,7 +506,9 @@ fn flatten_control(
             reason,
         });
     }
-    let mut flat = Vec::with_capacity(shape[0] * shape[1]);
+    // The capacity comes from what was given (its rows already checked), never from a
+    // degree alone: a huge degree must fail on the shape, not on an allocation.
+    let mut flat = Vec::with_capacity(control.iter().map(Vec::len).sum());
     for (i, row) in control.iter().enumerate() {
         if row.len() != shape[1] {
             return Err(SurfaceError::ControlColumns {
@@ -534,7 +544,7 @@ fn flatten_weights(
             expected: shape[0],
         });
     }
-    let mut flat = Vec::with_capacity(shape[0] * shape[1]);
+    let mut flat = Vec::with_capacity(weights.iter().map(Vec::len).sum());
     for (i, row) in weights.iter().enumerate() {
         if row.len() != shape[1] {
             return Err(SurfaceError::WeightsShape {

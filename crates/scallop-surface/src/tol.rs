@@ -47,3 +47,8 @@ pub const MAX_TESSELLATION_CELLS: usize = 4_000_000;
 
 /// Composite Gauss-Legendre area integration: sub-intervals per knot span and direction.
 pub const AREA_SUBDIVISIONS_PER_SPAN: usize = 8;
+
+/// Largest degree of a patch in either direction. CAD systems export degree 3 to 9
+/// (some allow up to 25); past this a degree is a typo, and the control net and the
+/// basis tables it implies are allocated only after this check.
+pub const MAX_DEGREE: usize = 32;

@@ -87,3 +87,21 @@ fn sets_need_patches_with_distinct_names() {
     let err = Patch::bezier("x", [1, 1], &net(3, 2), None).expect_err("rows").with_patch_index(4);
     assert!(err.to_string().starts_with("patch #4 \"x\": the control net has 3 rows"), "{err}");
 }
+
+#[test]
+fn huge_degrees_are_refused_before_any_allocation() {
+    // Issue 21: degree 2^31 tried to allocate 154 GB, 2^63 - 1 overflowed a capacity.
+    for degree in [2_147_483_648usize, 9_223_372_036_854_775_807, usize::MAX, scallop_surface::tol::MAX_DEGREE + 1] {
+        let err = Patch::bezier("a", [2, degree], &net(3, 3), None).expect_err("degree");
+        assert!(
+            matches!(err, SurfaceError::DegreeTooHigh { degree: d, direction: Direction::V, .. } if d == degree),
+            "{err:?}"
+        );
+        let err = Patch::nurbs("a", [degree, 1], [vec![0.0; 4], vec![0.0, 0.0, 1.0, 1.0]], &net(3, 2), None)
+            .expect_err("degree");
+        assert!(matches!(err, SurfaceError::DegreeTooHigh { direction: Direction::U, .. }), "{err:?}");
+    }
+    // The cap itself is a valid degree.
+    let d = scallop_surface::tol::MAX_DEGREE;
+    assert!(Patch::bezier("a", [1, d], &net(2, d + 1), None).is_ok());
+}
