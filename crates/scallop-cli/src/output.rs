@@ -216,7 +216,7 @@ pub fn write_finishing(
     print_text(&format!(
         "finishing the {part}\n\
          \x20 analysis   PCA slope {slope:.2}°, critical slope {crit:.2}°: {rec}; feed at {dir:.2}° from X\n\
-         \x20 cutter     {cutter}, scallop height {sh} mm, surface tessellated within {chord:.4} mm\n\
+         \x20 cutter     {cutter}, scallop height {sh} mm, {chord}\n\
          \x20 toolpath   {passes} passes on {planes} planes, {points} points, {links} links, {retracts} retracts\n\
          \x20 scallop    verified max {smax:.5} mm, mean {smean:.5} mm (<= {sh} mm)\n\
          \x20 time       {t1:.1} s stop-to-stop, {t2:.1} s look-ahead, + {tr:.1} s rapids\n\
@@ -235,7 +235,11 @@ pub fn write_finishing(
         },
         cutter = r.cutter,
         sh = r.scallop_height_mm,
-        chord = r.chordal_error_mm,
+        chord = if r.chordal_error_mm > 0.0 {
+            format!("surface tessellated within {:.4} mm", r.chordal_error_mm)
+        } else {
+            "a mesh, machined as given".to_string()
+        },
         passes = p.passes,
         planes = p.planes,
         points = p.points,
