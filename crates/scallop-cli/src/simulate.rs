@@ -8,7 +8,7 @@ use clap::{Args, ValueEnum};
 use scallop_engine::{Budget, prepare_part};
 use scallop_geom::{Aabb3, Point3, Tolerances, Vec3};
 use scallop_io::cl::read_cl;
-use scallop_io::gcode::{GcodeOptions, read_gcode_arcs};
+use scallop_io::gcode::{GcodeOptions, read_gcode_lines};
 use scallop_sim::{
     DexelOptions, DexelPart, DexelStock, PartField, ToolMove, VerifyOptions, ZMap, verify_dexel, verify_in,
 };
@@ -123,6 +123,33 @@ struct Program {
     name: String,
     moves: Vec<ToolMove>,
     path: Toolpath,
+    /// The G-code line of each move (G-code programs only).
+    lines: Option<Vec<usize>>,
+}
+
+impl Program {
+    /// `text` with the G-code line added after every "move N of operation 0"
+    /// it names, so a fault points at the program's line, not a move index.
+    fn with_lines(&self, text: &str) -> String {
+        let Some(lines) = &self.lines else { return text.to_string() };
+        let (marker, tail) = ("move ", " of operation 0");
+        let mut out = String::with_capacity(text.len() + 32);
+        let mut rest = text;
+        while let Some(at) = rest.find(marker) {
+            let after = &rest[at + marker.len()..];
+            let digits = after.bytes().take_while(u8::is_ascii_digit).count();
+            out.push_str(&rest[..at + marker.len() + digits]);
+            rest = &after[digits..];
+            let line = after[..digits].parse::<usize>().ok().and_then(|k| lines.get(k));
+            if let (Some(line), true) = (line, rest.starts_with(tail)) {
+                out.push_str(tail);
+                out.push_str(&format!(" (G-code line {line})"));
+                rest = &rest[tail.len()..];
+            }
+        }
+        out.push_str(rest);
+        out
+    }
 }
 
 fn read_program(args: &SimulateArgs) -> CliResult<Program> {
@@ -138,13 +165,14 @@ fn read_program(args: &SimulateArgs) -> CliResult<Program> {
     if args.program.is_some() {
         // Arcs stay arcs: the z-map cuts them exactly.
         let path =
-            read_gcode_arcs(text, &GcodeOptions::default()).map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
+            read_gcode_lines(text, &GcodeOptions::default()).map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
+        let (path, lines) = path;
         let moves = ToolMove::from_toolpath(&path);
-        return Ok(Program { name, moves, path });
+        return Ok(Program { name, moves, path, lines: Some(lines) });
     }
     let path = read_cl(text, DEFAULT_CL_FEED).map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
     let moves = ToolMove::from_toolpath(&path);
-    Ok(Program { name, moves, path })
+    Ok(Program { name, moves, path, lines: None })
 }
 
 /// Cutting feed of CL rows without a feed of their own (mm/min); the
@@ -319,7 +347,11 @@ fn simulate_zmap(
         max_thickness_mm: None,
         axis_tolerance_mm: None,
         sweeps: None,
-        verdict: if verdict.is_empty() { vec!["ok".into()] } else { verdict },
+        verdict: if verdict.is_empty() {
+            vec!["ok".into()]
+        } else {
+            verdict.iter().map(|v| program.with_lines(v)).collect()
+        },
     };
     Ok((report, zmap, dev, max_dev))
 }
@@ -390,7 +422,11 @@ fn simulate_dexel(
         max_thickness_mm: verification.as_ref().map(|v| v.max_thickness),
         axis_tolerance_mm: Some(args.axis_tolerance),
         sweeps: Some(cut.sweeps),
-        verdict: if verdict.is_empty() { vec!["ok".into()] } else { verdict },
+        verdict: if verdict.is_empty() {
+            vec!["ok".into()]
+        } else {
+            verdict.iter().map(|v| program.with_lines(v)).collect()
+        },
     };
     Ok((report, grid, dev, max_dev))
 }

@@ -257,7 +257,13 @@ fn simulate_passes_the_demo_and_catches_a_lowered_copy() {
     assert!(String::from_utf8_lossy(&bad.stderr).contains("gouge"));
     let v: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("bad/sim.json")).expect("sim.json")).expect("json");
-    assert!(v["verdict"][0].as_str().expect("text").contains("gouge"));
+    let verdict = v["verdict"][0].as_str().expect("text");
+    assert!(verdict.contains("gouge"), "{verdict}");
+    // The fault names the G-code line of the move, and that line is a cutting move.
+    let at = verdict.find("(G-code line ").expect("a G-code line") + "(G-code line ".len();
+    let line: usize = verdict[at..].split(')').next().and_then(|n| n.parse().ok()).expect("a line number");
+    let text = std::fs::read_to_string(dir.join("low.nc")).expect("low.nc");
+    assert!(text.lines().nth(line - 1).is_some_and(|l| l.starts_with("G1")), "line {line}");
     assert!(v["min_deviation_mm"].as_f64().expect("number") < -0.04);
 }
 
