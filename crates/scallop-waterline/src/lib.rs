@@ -395,6 +395,13 @@ impl<'a> WaterlineGrid<'a> {
         (self.nx, self.ny)
     }
 
+    /// The first sample (lowest x and y), mm; sample (i, j) is at
+    /// `origin + (i, j) * step`.
+    #[must_use]
+    pub fn origin(&self) -> Point2 {
+        self.origin
+    }
+
     /// The grid step (mm).
     #[must_use]
     pub fn step(&self) -> f64 {
@@ -415,8 +422,13 @@ impl<'a> WaterlineGrid<'a> {
     /// [`WaterlineError::NonFiniteZ`], [`WaterlineError::ZOutsidePart`].
     pub fn loops(&self, z: f64) -> Result<Vec<Loop>, WaterlineError> {
         check_z(self.index, z)?;
-        let probe =
-            refine::Probe { cutter: self.cutter, index: self.index, z, tolerance: self.options.crossing_tolerance };
+        let probe = refine::Probe {
+            cutter: self.cutter,
+            index: self.index,
+            z,
+            tolerance: self.options.crossing_tolerance,
+            step: self.step,
+        };
         let chains = contour::trace(self, &probe);
         Ok(refine::refine_loops(&probe, &chains, self.options.chord_tolerance, z))
     }

@@ -15,6 +15,8 @@ pub(crate) struct Probe<'a> {
     pub(crate) z: f64,
     /// Width of the final bisection bracket.
     pub(crate) tolerance: f64,
+    /// The grid step.
+    pub(crate) step: f64,
 }
 
 impl Probe<'_> {
@@ -42,20 +44,26 @@ impl Probe<'_> {
 
     /// The contour near `mid` along `normal` (unit, pointing inside), found
     /// by bisection within `reach` of `mid`; `None` if no change of side there.
+    /// Probes at a quarter of `reach`, then at doubling distances up to
+    /// `reach` (the first change of side found is bisected).
     fn contour_near(&self, mid: Point2, normal: Vec2, reach: f64) -> Option<Point2> {
         let mid_in = self.is_inside(mid);
         let towards = if mid_in { -normal } else { normal };
-        for r in [reach * QUARTER, reach] {
+        let mut r = reach * QUARTER;
+        loop {
             let p = mid + towards * r;
             if self.is_inside(p) != mid_in {
                 return Some(if mid_in { self.bisect(mid, p) } else { self.bisect(p, mid) });
             }
+            if r >= reach {
+                return None;
+            }
+            r = (2.0 * r).min(reach);
         }
-        None
     }
 }
 
-/// The first probe distance, as a fraction of the chord length.
+/// The first probe distance, as a fraction of the reach.
 const QUARTER: f64 = 0.25;
 
 /// Points strictly between `a` and `b` that bring every chord within
@@ -69,7 +77,9 @@ fn refine_chord(probe: &Probe<'_>, a: Point2, b: Point2, chord_tolerance: f64, d
     }
     let normal = Vec2::new(-d.y, d.x) / length; // left of a -> b: the inside
     let mid = Point2::new(0.5 * (a.x + b.x), 0.5 * (a.y + b.y));
-    let Some(on) = probe.contour_near(mid, normal, length) else { return };
+    // Within a grid cell the contour may bulge up to about a cell away from the
+    // chord joining its two crossings (a ridge along the diagonal): reach that far.
+    let Some(on) = probe.contour_near(mid, normal, length.max(probe.step)) else { return };
     if (on - mid).norm() <= chord_tolerance || on == a || on == b {
         return;
     }
