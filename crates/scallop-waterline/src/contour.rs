@@ -58,7 +58,10 @@ pub(crate) fn trace(grid: &WaterlineGrid<'_>, probe: &Probe<'_>) -> Vec<Vec<Poin
     let points: Vec<Point2> = edges
         .par_iter()
         .with_min_len(16)
-        .map(|&(_, [ia, ja], [ib, jb])| probe.bisect(grid.point(ia, ja), grid.point(ib, jb)))
+        .map(|&(_, [ia, ja], [ib, jb])| {
+            let (h_in, h_out) = (grid.heights[ja * nx + ia] - z, grid.heights[jb * nx + ib] - z);
+            probe.bisect_heights(grid.point(ia, ja), h_in, grid.point(ib, jb), h_out)
+        })
         .collect();
     let slot = |id: usize| {
         // INVARIANT: only called with the number of a crossing edge, which is in `edges`.

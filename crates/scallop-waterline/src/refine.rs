@@ -20,40 +20,90 @@ pub(crate) struct Probe<'a> {
 }
 
 impl Probe<'_> {
-    /// Exact: the drop-cutter (floored at z, which only prunes more) rises above z.
-    pub(crate) fn is_inside(&self, p: Point2) -> bool {
-        drop_cutter(self.cutter, self.index, p, self.z).tip.z > self.z
+    /// Tip height of the exact drop-cutter at `p` minus z, floored at
+    /// `-step` (a floor only prunes the search; it never changes the sign, so
+    /// `height(p) > 0` is exactly "the cutter at z cuts into the part at p").
+    pub(crate) fn height(&self, p: Point2) -> f64 {
+        drop_cutter(self.cutter, self.index, p, self.z - self.step).tip.z - self.z
     }
 
-    /// Bisection between an inside and an outside point down to the tolerance;
-    /// returns the outside end of the final bracket.
-    pub(crate) fn bisect(&self, mut inside: Point2, mut outside: Point2) -> Point2 {
-        while (outside - inside).norm() > self.tolerance {
-            let mid = Point2::new(0.5 * (inside.x + outside.x), 0.5 * (inside.y + outside.y));
-            if mid == inside || mid == outside {
-                break; // the bracket is down to adjacent floats
+    /// Exact: the cutter with its tip at z cuts into the part at `p`.
+    pub(crate) fn is_inside(&self, p: Point2) -> bool {
+        self.height(p) > 0.0
+    }
+
+    /// Shrinks the bracket from `inside` (height `h_in > 0`) to `outside`
+    /// (height `h_out <= 0`) to the tolerance and returns its outside end.
+    ///
+    /// Every step keeps a true bracket (each new point is classified by the
+    /// exact drop-cutter). Where the height is smooth, the secant guess
+    /// `t = h_in / (h_in - h_out)` lands within the tolerance of the contour and
+    /// two probes half a tolerance either side of it close the bracket; where it
+    /// is not (vertical walls, creases), a step that did not halve the bracket
+    /// is followed by a bisection, so the worst case is twice plain bisection.
+    pub(crate) fn bisect_heights(
+        &self,
+        mut inside: Point2,
+        mut h_in: f64,
+        mut outside: Point2,
+        mut h_out: f64,
+    ) -> Point2 {
+        let mut bisect_next = false;
+        loop {
+            let width = (outside - inside).norm();
+            if width <= self.tolerance {
+                return outside;
             }
-            if self.is_inside(mid) {
-                inside = mid;
+            let secant = h_in - h_out;
+            let use_secant = !bisect_next && secant.is_finite() && secant > 0.0;
+            let (a, b) = (inside, outside);
+            let steps: [Option<f64>; 2] = if use_secant {
+                let t = (h_in / secant).clamp(0.0, 1.0);
+                let half = SECANT_PROBE * self.tolerance / width;
+                [Some((t - half).max(0.0)), Some((t + half).min(1.0))]
             } else {
-                outside = mid;
+                [Some(0.5), None]
+            };
+            for s in steps.into_iter().flatten() {
+                let p = a + (b - a) * s;
+                if p == inside || p == outside {
+                    continue;
+                }
+                let h = self.height(p);
+                if h > 0.0 {
+                    (inside, h_in) = (p, h);
+                } else {
+                    (outside, h_out) = (p, h);
+                    break;
+                }
             }
+            let after = (outside - inside).norm();
+            if after >= width {
+                // Down to adjacent floats (or a guess on an end): stop on the outside.
+                return outside;
+            }
+            bisect_next = use_secant && after > 0.5 * width;
         }
-        outside
     }
 
     /// The contour near `mid` along `normal` (unit, pointing inside), found
-    /// by bisection within `reach` of `mid`; `None` if no change of side there.
-    /// Probes at a quarter of `reach`, then at doubling distances up to
-    /// `reach` (the first change of side found is bisected).
+    /// within `reach` of `mid`; `None` if no change of side there. Probes at a
+    /// quarter of `reach`, then at doubling distances up to `reach` (the first
+    /// change of side found is refined).
     fn contour_near(&self, mid: Point2, normal: Vec2, reach: f64) -> Option<Point2> {
-        let mid_in = self.is_inside(mid);
+        let h_mid = self.height(mid);
+        let mid_in = h_mid > 0.0;
         let towards = if mid_in { -normal } else { normal };
         let mut r = reach * QUARTER;
         loop {
             let p = mid + towards * r;
-            if self.is_inside(p) != mid_in {
-                return Some(if mid_in { self.bisect(mid, p) } else { self.bisect(p, mid) });
+            let h = self.height(p);
+            if (h > 0.0) != mid_in {
+                return Some(if mid_in {
+                    self.bisect_heights(mid, h_mid, p, h)
+                } else {
+                    self.bisect_heights(p, h, mid, h_mid)
+                });
             }
             if r >= reach {
                 return None;
@@ -62,6 +112,10 @@ impl Probe<'_> {
         }
     }
 }
+
+/// Probe offset either side of a secant guess, in crossing tolerances: just
+/// under a half, so that two probes that straddle the contour close the bracket.
+const SECANT_PROBE: f64 = 0.45;
 
 /// The first probe distance, as a fraction of the reach.
 const QUARTER: f64 = 0.25;
