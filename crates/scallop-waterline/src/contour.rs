@@ -59,7 +59,8 @@ pub(crate) fn trace(grid: &WaterlineGrid<'_>, probe: &Probe<'_>) -> Vec<Vec<Poin
         .par_iter()
         .with_min_len(16)
         .map(|&(_, [ia, ja], [ib, jb])| {
-            let (h_in, h_out) = (grid.heights[ja * nx + ia] - z, grid.heights[jb * nx + ib] - z);
+            // Floored as `Probe::height` floors them, so the secant sees one function.
+            let (h_in, h_out) = (grid.heights[ja * nx + ia] - z, (grid.heights[jb * nx + ib] - z).max(-grid.step));
             probe.bisect_heights(grid.point(ia, ja), h_in, grid.point(ib, jb), h_out)
         })
         .collect();

@@ -82,43 +82,58 @@ impl Probe<'_> {
                 // Down to adjacent floats (or a guess on an end): stop on the outside.
                 return outside;
             }
-            bisect_next = use_secant && after > 0.5 * width;
+            // A secant step that did not halve the bracket: the height is not
+            // smooth here (a wall, a crease): plain bisection from now on.
+            bisect_next |= use_secant && after > 0.5 * width;
         }
     }
 
-    /// The contour near `mid` along `normal` (unit, pointing inside), found
-    /// within `reach` of `mid`; `None` if no change of side there. Probes at a
-    /// quarter of `reach`, then at doubling distances up to `reach` (the first
-    /// change of side found is refined).
-    fn contour_near(&self, mid: Point2, normal: Vec2, reach: f64) -> Option<Point2> {
+    /// Where the contour crosses the line through `mid` along `normal` (unit,
+    /// pointing inside): [`Near::Within`] if it does within `accept` of `mid`
+    /// (one probe); otherwise probes at doubling distances up to `reach` and
+    /// refines the first change of side found; [`Near::Missing`] if none.
+    fn contour_near(&self, mid: Point2, normal: Vec2, accept: f64, reach: f64) -> Near {
         let h_mid = self.height(mid);
         let mid_in = h_mid > 0.0;
         let towards = if mid_in { -normal } else { normal };
-        let mut r = reach * QUARTER;
+        let mut r = accept;
         loop {
             let p = mid + towards * r;
             let h = self.height(p);
             if (h > 0.0) != mid_in {
-                return Some(if mid_in {
+                if r <= accept {
+                    return Near::Within;
+                }
+                return Near::Found(if mid_in {
                     self.bisect_heights(mid, h_mid, p, h)
                 } else {
                     self.bisect_heights(p, h, mid, h_mid)
                 });
             }
             if r >= reach {
-                return None;
+                return Near::Missing;
             }
-            r = (2.0 * r).min(reach);
+            r = (PROBE_GROWTH * r).min(reach);
         }
     }
 }
 
+/// What [`Probe::contour_near`] found.
+enum Near {
+    /// The contour is within the accepted distance.
+    Within,
+    /// The contour point found (farther).
+    Found(Point2),
+    /// No change of side within reach.
+    Missing,
+}
+
+/// Growth of the probe distance from one probe to the next.
+const PROBE_GROWTH: f64 = 8.0;
+
 /// Probe offset either side of a secant guess, in crossing tolerances: just
 /// under a half, so that two probes that straddle the contour close the bracket.
 const SECANT_PROBE: f64 = 0.45;
-
-/// The first probe distance, as a fraction of the reach.
-const QUARTER: f64 = 0.25;
 
 /// Points strictly between `a` and `b` that bring every chord within
 /// `chord_tolerance` of the contour at its midpoint (as far as the probe
@@ -133,8 +148,8 @@ fn refine_chord(probe: &Probe<'_>, a: Point2, b: Point2, chord_tolerance: f64, d
     let mid = Point2::new(0.5 * (a.x + b.x), 0.5 * (a.y + b.y));
     // Within a grid cell the contour may bulge up to about a cell away from the
     // chord joining its two crossings (a ridge along the diagonal): reach that far.
-    let Some(on) = probe.contour_near(mid, normal, length.max(probe.step)) else { return };
-    if (on - mid).norm() <= chord_tolerance || on == a || on == b {
+    let Near::Found(on) = probe.contour_near(mid, normal, chord_tolerance, length.max(probe.step)) else { return };
+    if on == a || on == b {
         return;
     }
     refine_chord(probe, a, on, chord_tolerance, depth + 1, out);
