@@ -61,7 +61,9 @@ pub(crate) fn trace(grid: &WaterlineGrid<'_>, probe: &Probe<'_>) -> Vec<Vec<Poin
         .map(|&(_, [ia, ja], [ib, jb])| {
             // Floored as `Probe::height` floors them, so the secant sees one function.
             let (h_in, h_out) = (grid.heights[ja * nx + ia] - z, (grid.heights[jb * nx + ib] - z).max(-grid.step));
-            probe.bisect_heights(grid.point(ia, ja), h_in, grid.point(ib, jb), h_out)
+            let (a, b) = (grid.point(ia, ja), grid.point(ib, jb));
+            let local = probe.local(Point2::new(a.x.min(b.x), a.y.min(b.y)), Point2::new(a.x.max(b.x), a.y.max(b.y)));
+            local.bisect_heights(a, h_in, b, h_out)
         })
         .collect();
     let slot = |id: usize| {

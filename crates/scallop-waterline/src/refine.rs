@@ -1,8 +1,8 @@
 //! Bisection on the exact drop-cutter, and the adaptive splitting of chords.
 
 use rayon::prelude::*;
-use scallop_cutter::{Cutter, drop_cutter};
-use scallop_geom::{Point2, Vec2};
+use scallop_cutter::{ClPoint, Cutter, drop_cutter, drop_triangle};
+use scallop_geom::{Aabb2, Point2, Vec2};
 use scallop_mesh::MeshIndex;
 
 use crate::{Loop, tol};
@@ -19,7 +19,7 @@ pub(crate) struct Probe<'a> {
     pub(crate) step: f64,
 }
 
-impl Probe<'_> {
+impl<'a> Probe<'a> {
     /// Tip height of the exact drop-cutter at `p` minus z, floored at
     /// `-step` (a floor only prunes the search; it never changes the sign, so
     /// `height(p) > 0` is exactly "the cutter at z cuts into the part at p").
@@ -30,6 +30,85 @@ impl Probe<'_> {
     /// Exact: the cutter with its tip at z cuts into the part at `p`.
     pub(crate) fn is_inside(&self, p: Point2) -> bool {
         self.height(p) > 0.0
+    }
+
+    /// The probe restricted to points of the box `[lo, hi]`: the triangles
+    /// within the cutter's reach of the box, sorted by decreasing top, so that
+    /// each evaluation scans a short list instead of searching the index.
+    pub(crate) fn local(&'a self, lo: Point2, hi: Point2) -> Local<'a> {
+        let radius = self.cutter.radius();
+        let reach =
+            Aabb2 { min: Point2::new(lo.x - radius, lo.y - radius), max: Point2::new(hi.x + radius, hi.y + radius) };
+        let mut slots = Vec::new();
+        self.index.collect_box(&reach, &mut slots);
+        let floor = self.z - self.step;
+        let mut candidates: Vec<Candidate> = slots
+            .into_iter()
+            .map(|slot| {
+                let slot = slot as usize;
+                let b = self.index.xy_box(slot);
+                Candidate { zmax: self.index.zmax(slot), min: b.min, max: b.max, slot }
+            })
+            .filter(|c| c.zmax + self.index.slack() > floor)
+            .collect();
+        // Decreasing top, ties by slot: a deterministic order.
+        candidates.sort_unstable_by(|a, b| b.zmax.total_cmp(&a.zmax).then(a.slot.cmp(&b.slot)));
+        Local { probe: self, lo, hi, candidates }
+    }
+}
+
+/// A triangle within reach of a [`Local`] box.
+struct Candidate {
+    zmax: f64,
+    min: Point2,
+    max: Point2,
+    slot: usize,
+}
+
+/// A [`Probe`] with the candidate triangles of one box (a chord's or a grid
+/// edge's neighbourhood). Heights equal [`Probe::height`] bit for bit: the
+/// same per-triangle contacts (`drop_triangle`, as `drop_cutter` evaluates
+/// them), maximised over every triangle that can raise the result; points
+/// outside the box fall back to the index.
+pub(crate) struct Local<'a> {
+    probe: &'a Probe<'a>,
+    lo: Point2,
+    hi: Point2,
+    candidates: Vec<Candidate>,
+}
+
+impl Local<'_> {
+    /// [`Probe::height`] through the candidate list.
+    fn height(&self, p: Point2) -> f64 {
+        let probe = self.probe;
+        if !(p.x >= self.lo.x && p.x <= self.hi.x && p.y >= self.lo.y && p.y <= self.hi.y) {
+            return probe.height(p);
+        }
+        let radius = probe.cutter.radius();
+        let shape = probe.cutter.shape();
+        let mut best = ClPoint::floor(p, probe.z - probe.step);
+        // The index's rounding slack on its bounds, as `drop_cutter` prunes.
+        let slack = probe.index.slack();
+        for c in &self.candidates {
+            if c.zmax + slack <= best.tip.z {
+                break; // sorted: no later triangle reaches above the best contact
+            }
+            let dx = (c.min.x - p.x).max(0.0).max(p.x - c.max.x);
+            let dy = (c.min.y - p.y).max(0.0).max(p.y - c.max.y);
+            let distance = dx.hypot(dy);
+            if distance > radius || c.zmax - shape.height_at(distance) + slack <= best.tip.z {
+                continue;
+            }
+            let slot = c.slot;
+            drop_triangle(
+                probe.cutter,
+                probe.index.corners(slot),
+                probe.index.normal(slot),
+                probe.index.original_index(slot),
+                &mut best,
+            );
+        }
+        best.tip.z - probe.z
     }
 
     /// Shrinks the bracket from `inside` (height `h_in > 0`) to `outside`
@@ -51,7 +130,7 @@ impl Probe<'_> {
         let mut bisect_next = false;
         loop {
             let width = (outside - inside).norm();
-            if width <= self.tolerance {
+            if width <= self.probe.tolerance {
                 return outside;
             }
             let secant = h_in - h_out;
@@ -59,7 +138,7 @@ impl Probe<'_> {
             let (a, b) = (inside, outside);
             let steps: [Option<f64>; 2] = if use_secant {
                 let t = (h_in / secant).clamp(0.0, 1.0);
-                let half = SECANT_PROBE * self.tolerance / width;
+                let half = SECANT_PROBE * self.probe.tolerance / width;
                 [Some((t - half).max(0.0)), Some((t + half).min(1.0))]
             } else {
                 [Some(0.5), None]
@@ -118,7 +197,7 @@ impl Probe<'_> {
     }
 }
 
-/// What [`Probe::contour_near`] found.
+/// What [`Local::contour_near`] found.
 enum Near {
     /// The contour is within the accepted distance.
     Within,
@@ -127,6 +206,9 @@ enum Near {
     /// No change of side within reach.
     Missing,
 }
+
+/// Margin of a chord's candidate box, in reaches (chord length or grid step).
+const CHORD_MARGIN: f64 = 1.5;
 
 /// Growth of the probe distance from one probe to the next.
 const PROBE_GROWTH: f64 = 8.0;
@@ -138,7 +220,8 @@ const SECANT_PROBE: f64 = 0.45;
 /// Points strictly between `a` and `b` that bring every chord within
 /// `chord_tolerance` of the contour at its midpoint (as far as the probe
 /// along the chord's normal finds the contour), in order from `a` to `b`.
-fn refine_chord(probe: &Probe<'_>, a: Point2, b: Point2, chord_tolerance: f64, depth: u32, out: &mut Vec<Point2>) {
+fn refine_chord(local: &Local<'_>, a: Point2, b: Point2, chord_tolerance: f64, depth: u32, out: &mut Vec<Point2>) {
+    let probe = local.probe;
     let d = b - a;
     let length = d.norm();
     if depth >= tol::MAX_REFINE_DEPTH || length <= tol::MIN_CHORD_PER_CROSSING * probe.tolerance {
@@ -148,13 +231,13 @@ fn refine_chord(probe: &Probe<'_>, a: Point2, b: Point2, chord_tolerance: f64, d
     let mid = Point2::new(0.5 * (a.x + b.x), 0.5 * (a.y + b.y));
     // Within a grid cell the contour may bulge up to about a cell away from the
     // chord joining its two crossings (a ridge along the diagonal): reach that far.
-    let Near::Found(on) = probe.contour_near(mid, normal, chord_tolerance, length.max(probe.step)) else { return };
+    let Near::Found(on) = local.contour_near(mid, normal, chord_tolerance, length.max(probe.step)) else { return };
     if on == a || on == b {
         return;
     }
-    refine_chord(probe, a, on, chord_tolerance, depth + 1, out);
+    refine_chord(local, a, on, chord_tolerance, depth + 1, out);
     out.push(on);
-    refine_chord(probe, on, b, chord_tolerance, depth + 1, out);
+    refine_chord(local, on, b, chord_tolerance, depth + 1, out);
 }
 
 /// Closed loops from the grid chains, every chord refined (in parallel over
@@ -167,7 +250,11 @@ pub(crate) fn refine_loops(probe: &Probe<'_>, chains: &[Vec<Point2>], chord_tole
         .with_min_len(4)
         .map(|&(a, b)| {
             let mut out = Vec::new();
-            refine_chord(probe, a, b, chord_tolerance, 0, &mut out);
+            // Probes stay within about one reach (the chord or a grid step) of the chord.
+            let margin = CHORD_MARGIN * (a - b).norm().max(probe.step);
+            let lo = Point2::new(a.x.min(b.x) - margin, a.y.min(b.y) - margin);
+            let hi = Point2::new(a.x.max(b.x) + margin, a.y.max(b.y) + margin);
+            refine_chord(&probe.local(lo, hi), a, b, chord_tolerance, 0, &mut out);
             out
         })
         .collect();
@@ -183,4 +270,44 @@ pub(crate) fn refine_loops(probe: &Probe<'_>, chains: &[Vec<Point2>], chord_tole
         loops.push(Loop { z, points });
     }
     loops
+}
+
+#[cfg(test)]
+mod tests {
+    use scallop_cutter::{Cutter, CutterShape};
+    use scallop_geom::{Point2, Point3};
+    use scallop_mesh::{MeshIndex, TriMesh};
+
+    use super::Probe;
+
+    /// The candidate list gives the index's heights bit for bit, inside its box and out.
+    #[test]
+    fn local_heights_equal_the_index_heights() {
+        let height =
+            |i: usize, j: usize| ((i * 7 + j * 13) % 11) as f64 * 0.7 + if (i + j) % 5 == 0 { 4.0 } else { 0.0 };
+        let at = |i: usize, j: usize| Point3::new(i as f64 * 3.0, j as f64 * 3.0, height(i, j));
+        let mut soup = Vec::new();
+        for j in 0..6 {
+            for i in 0..6 {
+                soup.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+                soup.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+            }
+        }
+        let mesh = TriMesh::from_soup(&soup).expect("terrain").0;
+        let index = MeshIndex::build(&mesh);
+        for shape in [
+            CutterShape::Flat { radius: 1.5 },
+            CutterShape::Ball { radius: 2.0 },
+            CutterShape::Bull { radius: 2.0, corner: 0.5 },
+            CutterShape::Cone { radius: 2.0, half_angle: 0.5 },
+        ] {
+            let cutter = Cutter::new(shape, 30.0).expect("cutter");
+            let probe = Probe { cutter: &cutter, index: &index, z: 3.3, tolerance: 1e-7, step: 0.5 };
+            let local = probe.local(Point2::new(4.0, 5.0), Point2::new(9.0, 8.0));
+            for k in 0..400 {
+                let p = Point2::new(2.0 + (k % 20) as f64 * 0.41, 3.0 + (k / 20) as f64 * 0.33);
+                assert_eq!(local.height(p).to_bits(), probe.height(p).to_bits(), "{shape:?} at {p:?}");
+            }
+        }
+    }
 }
