@@ -16,7 +16,7 @@ pub const STEP_PER_RADIUS: f64 = 0.25;
 
 /// Most samples in the drop-cutter grid of one waterline computation
 /// (8 bytes each, plus a bit per level): a larger grid is an input error.
-pub const MAX_SAMPLES: usize = 200_000_000;
+pub const MAX_SAMPLES: usize = 50_000_000;
 
 /// Grid cells of padding around the mesh footprint widened by the cutter
 /// radius: every border sample is outside, so loops never reach the border.
