@@ -3,6 +3,8 @@
 #
 #   bash bench/ocl/compare.sh [--reduced] [--ocl-only] [--markdown FILE] [--cutters LIST]
 #                             [--keep-csv] [--adjudicate N] [--adjudicate-random N] [MESH.stl ...]
+#   bash bench/ocl/compare.sh --waterline [--reduced] [--markdown FILE] [--cutters LIST] [MESH.stl ...]
+#       (waterline mode: OpenCAMLib Waterline vs `scallop waterline`, bench/ocl/waterline.py)
 #
 # Without meshes it uses every ../shared/models/ocl/*.stl (relative to the repository
 # root); if ../shared is absent it says so and exits 0 without comparing.
@@ -19,10 +21,12 @@ venv=bench/ocl/.venv
 py_args=()
 meshes=()
 ocl_only=0
+script=bench/ocl/compare.py
 while [ $# -gt 0 ]; do
     case "$1" in
         --reduced|--keep-csv) py_args+=("$1") ;;
         --ocl-only) py_args+=("$1"); ocl_only=1 ;;
+        --waterline) script=bench/ocl/waterline.py ;;
         --markdown|--cutters|--workdir|--adjudicate|--adjudicate-random)
             [ $# -ge 2 ] || { echo "compare.sh: $1 needs a value" >&2; exit 2; }
             val=$2
@@ -30,7 +34,7 @@ while [ $# -gt 0 ]; do
                 case "$val" in /*) ;; *) val="$caller_dir/$val" ;; esac
             fi
             py_args+=("$1" "$val"); shift ;;
-        -h|--help) sed -n '2,11p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+        -h|--help) sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
         -*) echo "compare.sh: unknown option $1" >&2; exit 2 ;;
         *) case "$1" in /*) meshes+=("$1") ;; *) meshes+=("$caller_dir/$1") ;; esac ;;
     esac
@@ -77,4 +81,4 @@ if [ "$ocl_only" -eq 0 ]; then
     cargo build --release -p scallop-cli
 fi
 
-exec "$venv/bin/python" bench/ocl/compare.py "${py_args[@]}" "${meshes[@]}"
+exec "$venv/bin/python" "$script" "${py_args[@]}" "${meshes[@]}"

@@ -12,6 +12,7 @@ mod post;
 mod render;
 mod run;
 mod simulate;
+mod waterline;
 
 use std::process::ExitCode;
 
@@ -61,6 +62,8 @@ enum Command {
     Post(post::PostArgs),
     /// Render a part (and a toolpath) to a PNG picture, without a browser.
     Render(render::RenderArgs),
+    /// The closed contours where a cutter with its tip at height z touches a mesh (CSV or JSON loops).
+    Waterline(waterline::WaterlineArgs),
     /// Load a part and report what was read (size, welding, open and non-manifold edges).
     Inspect(part::InspectArgs),
 }
@@ -85,6 +88,7 @@ fn main() -> ExitCode {
         Command::Optimize(args) => optimize::run(&args),
         Command::Post(args) => post::run(&args),
         Command::Render(args) => render::run(&args),
+        Command::Waterline(args) => waterline::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,0 +1,343 @@
+#!/usr/bin/env python3
+"""Side-by-side waterline comparison: OpenCAMLib `Waterline` vs `scallop waterline`.
+
+Run through `bash bench/ocl/compare.sh --waterline` (which provides a Python 3.11
+virtualenv with the `opencamlib` wheel and builds scallop). OpenCAMLib (LGPL) is only
+*run* here, as a separate installed package; none of its code is copied.
+
+For every mesh, cutter (ball, flat, bull r = D/4, cone 90 deg included angle; D = 1/20 of
+the mesh's larger XY extent, as in compare.py) and z level, both engines compute the
+waterline loops at the same tip height, single-threaded:
+- agreement: every OpenCAMLib loop point (a push-cutter contact on an X or Y fibre, on
+  the true contour up to its root finder) is measured to scallop's loops (closed
+  polylines); target 1e-5 mm. The other direction (scallop points to OpenCAMLib's
+  polylines) is printed too: it includes OpenCAMLib's own chord error between fibre
+  points, about sampling^2 / (8 radius of curvature), so it has no target;
+- loop counts per level;
+- speed: OpenCAMLib `Waterline.run()` summed over the levels vs scallop's whole
+  command time for all levels (grid + contours, from `--json`), both on one thread;
+  scallop runs twice: for the agreement, with its grid step equal to OpenCAMLib's fibre
+  spacing (the same feature resolution) and chord tolerance 2e-6 mm; then with its
+  defaults (step R/4, chord tolerance 1e-4 mm, still far closer to the contour than
+  OpenCAMLib's own chords: the last distance column).
+
+Exit status: 0 all cases within tolerance, 1 some case exceeds it, 2 usage or run error.
+"""
+
+import argparse
+import json
+import math
+import os
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from compare import load_stl, fmt, brute_drop, CONE_INCLUDED_ANGLE_DEG  # noqa: E402
+
+try:
+    from opencamlib import ocl
+except ImportError:  # pragma: no cover - reported plainly below
+    ocl = None
+
+CUTTERS = ("ball", "flat", "bull", "cone")
+TOLERANCE = 1e-5  # mm, OpenCAMLib point to scallop loop
+# scallop's chord tolerance for the comparison: its chords stay this close to the
+# contour at their midpoints, well inside TOLERANCE.
+CHORD_TOLERANCE = 2e-6
+FULL_LEVELS = 5
+REDUCED_LEVELS = 1
+# OpenCAMLib fibre spacing as a fraction of the cutter diameter.
+SAMPLING_PER_DIAMETER = 0.05
+REDUCED_MESHES = ("sphere_on_plate.stl", "cone_on_side.stl")
+# Adjudication of an OpenCAMLib point away from scallop's loops: the independent numpy
+# brute-force drop-cutter of compare.py on a circle of this radius around it. A point on
+# the true contour has both sides on every small circle; a circle all on one side proves
+# the point is not on the contour.
+ADJUDICATE_RADIUS = 1e-4
+ADJUDICATE_SAMPLES = 16
+ADJUDICATE_POINTS = 5
+
+
+def make_ocl_cutter(name, d, length):
+    """OpenCAMLib cutters as in compare.py, with a given length: a waterline from
+    above needs the cutter (and its shank) to reach above the part, as scallop's
+    drop-cutter does (its cutter continues upwards as a cylinder of radius R)."""
+    if name == "ball":
+        return ocl.BallCutter(d, length)
+    if name == "flat":
+        return ocl.CylCutter(d, length)
+    if name == "bull":
+        return ocl.BullCutter(d, d / 4.0, length)
+    if name == "cone":  # OCL takes the half-angle in radians
+        return ocl.ConeCutter(d, math.radians(CONE_INCLUDED_ANGLE_DEG / 2.0), length)
+    raise ValueError(name)
+
+
+def levels_of(zmin, zmax, count):
+    """Heights spread over (zmin, zmax), off any round fraction of the range."""
+    return [zmin + (k + 0.382) / count * (zmax - zmin) for k in range(count)]
+
+
+def run_ocl(surf, cutter, z, sampling):
+    w = ocl.Waterline()
+    w.setThreads(1)
+    w.setSTL(surf)
+    w.setCutter(cutter)
+    w.setZ(z)
+    w.setSampling(sampling)
+    t = time.perf_counter()
+    w.run()
+    dt = time.perf_counter() - t
+    loops = [np.array([(p.x, p.y) for p in lp], dtype=np.float64) for lp in w.getLoops()]
+    return [lp for lp in loops if len(lp)], dt
+
+
+def run_scallop(exe, mesh, cname, d, zs, out_csv, chord, step):
+    cmd = [exe, "waterline", "--mesh", mesh, "--cutter", cname, "--diameter", fmt(d)]
+    if cname == "bull":
+        cmd += ["--corner-radius", fmt(d / 4.0)]
+    if cname == "cone":
+        cmd += ["--angle", fmt(CONE_INCLUDED_ANGLE_DEG)]
+    for z in zs:
+        cmd += ["--z", fmt(z)]
+    if chord is not None:
+        cmd += ["--chord-tolerance", fmt(chord)]
+    if step is not None:
+        cmd += ["--step", fmt(step)]
+    cmd += ["--threads", "1", "-o", out_csv, "--json"]
+    r = subprocess.run(cmd, capture_output=True, text=True)
+    if r.returncode != 0:
+        raise RuntimeError(f"scallop failed ({r.returncode}): {' '.join(cmd)}\n{r.stderr.strip()}")
+    info = json.loads(r.stdout)
+    data = np.loadtxt(out_csv, delimiter=",", skiprows=1, ndmin=2)
+    loops = {}
+    for k in np.unique(data[:, 0]).astype(int):
+        rows = data[data[:, 0] == k]
+        loops.setdefault(float(rows[0, 3]), []).append(rows[:, 1:3].copy())
+    return loops, info, " ".join(cmd)
+
+
+class Segments:
+    """The chords of closed polylines, bucketed on a uniform grid for nearest queries."""
+
+    def __init__(self, loops):
+        a = [lp for lp in loops if len(lp) >= 2]
+        self.a = np.concatenate(a) if a else np.zeros((0, 2))
+        self.b = np.concatenate([np.roll(lp, -1, axis=0) for lp in a]) if a else np.zeros((0, 2))
+        lengths = np.hypot(*(self.b - self.a).T)
+        self.cell = max(float(lengths.max()) if len(lengths) else 1.0, 1e-6)
+        mid = 0.5 * (self.a + self.b)
+        keys = np.floor(mid / self.cell).astype(np.int64)
+        self.buckets = {}
+        for i, (kx, ky) in enumerate(keys.tolist()):
+            self.buckets.setdefault((kx, ky), []).append(i)
+        self.buckets = {k: np.array(v) for k, v in self.buckets.items()}
+
+    def distance(self, p):
+        """Distance from p to the nearest chord; inf if none within one cell."""
+        kx, ky = (int(math.floor(p[0] / self.cell)), int(math.floor(p[1] / self.cell)))
+        idx = [self.buckets[(kx + i, ky + j)] for i in (-1, 0, 1) for j in (-1, 0, 1) if (kx + i, ky + j) in self.buckets]
+        if not idx:
+            return math.inf
+        idx = np.concatenate(idx)
+        a, b = self.a[idx], self.b[idx]
+        d = b - a
+        t = np.clip(((p - a) * d).sum(1) / np.maximum((d * d).sum(1), 1e-300), 0.0, 1.0)
+        q = a + d * t[:, None]
+        best = float(np.hypot(*(q - p).T).min())
+        return best if best <= 0.5 * self.cell else math.inf
+
+
+def distances(points, loops):
+    seg = Segments(loops)
+    return np.array([seg.distance(p) for p in points]) if len(points) else np.zeros(0)
+
+
+def adjudicate(tris, cname, d, z, points):
+    """For OCL points away from scallop's loops: (not on the contour, undecided) counts
+    and a few lines, by the brute force on a small circle around each point."""
+    wrong, lines = 0, []
+    for x, y in points:
+        ang = np.linspace(0.0, 2 * math.pi, ADJUDICATE_SAMPLES, endpoint=False)
+        inside = [brute_drop(tris, cname, d, x + ADJUDICATE_RADIUS * math.cos(t), y + ADJUDICATE_RADIUS * math.sin(t)) > z
+                  for t in ang]
+        if all(inside) or not any(inside):
+            wrong += 1
+            side = "inside the material (the cutter at z cuts there)" if all(inside) else "outside, away from the part"
+            lines.append(f"    OCL point ({x:.6f}, {y:.6f}) at z {z:.6f} is not on the contour: all {ADJUDICATE_SAMPLES} "
+                         f"brute-force samples within {ADJUDICATE_RADIUS:g} mm are {side}")
+        else:
+            lines.append(f"    OCL point ({x:.6f}, {y:.6f}) at z {z:.6f}: the contour passes within "
+                         f"{ADJUDICATE_RADIUS:g} mm (scallop misses it)")
+    return wrong, lines
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("meshes", nargs="+", help="STL files (binary or ASCII)")
+    ap.add_argument("--reduced", action="store_true",
+                    help=f"{REDUCED_LEVELS} levels on {', '.join(REDUCED_MESHES)} only (CI)")
+    ap.add_argument("--scallop", default=os.path.join("target", "release", "scallop"), help="scallop binary")
+    ap.add_argument("--cutters", default=",".join(CUTTERS), help="comma-separated subset of " + ",".join(CUTTERS))
+    ap.add_argument("--workdir", default=os.path.join("bench", "ocl", "results"), help="where loop CSV files go")
+    ap.add_argument("--markdown", help="also write the table as Markdown to this file")
+    ap.add_argument("--keep-csv", action="store_true", help="keep scallop's loop CSV files in --workdir")
+    ap.add_argument("--known-ocl-defect", default="",
+                    help="comma-separated cutters whose OpenCAMLib waterline is known to be wrong: reported, not failed")
+    a = ap.parse_args()
+    if ocl is None:
+        print("error: the opencamlib module is not importable (needs CPython 3.11 + `pip install opencamlib`)", file=sys.stderr)
+        return 2
+    cutters = [c for c in a.cutters.split(",") if c]
+    for c in cutters:
+        if c not in CUTTERS:
+            ap.error(f"unknown cutter {c!r}")
+    known = {c for c in a.known_ocl_defect.split(",") if c}
+    os.makedirs(a.workdir, exist_ok=True)
+    meshes = [m for m in a.meshes if not a.reduced or os.path.basename(m) in REDUCED_MESHES] or a.meshes[:1]
+    nlev = REDUCED_LEVELS if a.reduced else FULL_LEVELS
+    head = ["mesh", "triangles", "cutter", "levels", "loops OCL/scallop", "OCL points", "max OCL->scallop (mm)",
+            "mean OCL->scallop (mm)", "over tol", "max scallop->OCL polyline (mm)", "OCL s 1 thr",
+            f"scallop s 1 thr (step = OCL sampling, chord {CHORD_TOLERANCE:g})", "OCL/scallop",
+            "scallop s 1 thr (defaults: step R/4, chord 1e-4)", "OCL/scallop defaults"]
+    print(f"# OpenCAMLib {ocl.version()} Waterline; mode {'reduced' if a.reduced else 'full'}; tolerance {TOLERANCE:g} mm "
+          f"(OCL point to scallop loop); scallop chord tolerance {CHORD_TOLERANCE:g} mm; OCL sampling "
+          f"{SAMPLING_PER_DIAMETER:g} D", flush=True)
+    print(" | ".join(head), flush=True)
+    rows, notes, failures = [], [], []
+    status = 0
+    load0 = os.getloadavg()
+    ratios = []
+    for mesh in meshes:
+        base = os.path.basename(mesh)
+        tris, kind = load_stl(mesh)
+        v = tris.reshape(-1, 3)
+        lo, hi = v.min(0), v.max(0)
+        big = float(max(hi[0] - lo[0], hi[1] - lo[1]))
+        d = big / 20.0
+        sampling = SAMPLING_PER_DIAMETER * d
+        zs = levels_of(float(lo[2]), float(hi[2]), nlev)
+        notes.append(f"{base}: {kind} STL, {len(tris)} triangles, D = {d:.6g} mm, OCL sampling {sampling:.6g} mm, "
+                     f"levels {', '.join(f'{z:.4f}' for z in zs)}")
+        surf = ocl.STLSurf()
+        for t in tris:
+            surf.addTriangle(ocl.Triangle(*(ocl.Point(*map(float, p)) for p in t)))
+        for cname in cutters:
+            cutter = make_ocl_cutter(cname, d, float(hi[2] - lo[2]) + 4.0 * d)
+            stem = os.path.join(a.workdir, f"{os.path.splitext(base)[0]}_{cname}_waterline.csv")
+            try:
+                ours, info, cmd = run_scallop(a.scallop, mesh, cname, d, zs, stem, CHORD_TOLERANCE, sampling)
+                _, info_default, _ = run_scallop(a.scallop, mesh, cname, d, zs, stem, None, None)
+            except (RuntimeError, OSError, ValueError) as e:
+                print(f"error: {e}", file=sys.stderr)
+                return 2
+            if not a.keep_csv:
+                os.remove(stem)
+            t_ocl, n_ocl, n_ours, npts = 0.0, 0, 0, 0
+            d_o2s, d_s2o, far_ocl, far_ours = [], [], [], []
+            for z in zs:
+                theirs, dt = run_ocl(surf, cutter, z, sampling)
+                t_ocl += dt
+                mine = ours.get(float(z), [])
+                n_ocl += len(theirs)
+                n_ours += len(mine)
+                pts = np.concatenate(theirs) if theirs else np.zeros((0, 2))
+                npts += len(pts)
+                dz = distances(pts, mine)
+                d_o2s.append(dz)
+                worst = np.argsort(-dz)[:ADJUDICATE_POINTS]
+                far_ocl += [(z, pts[i]) for i in worst if dz[i] > TOLERANCE]
+                mpts = np.concatenate(mine) if mine else np.zeros((0, 2))
+                ds = distances(mpts, theirs)
+                d_s2o.append(ds)
+                far_ours += [(z, mpts[i]) for i in np.where(~np.isfinite(ds))[0][:ADJUDICATE_POINTS]]
+            d_o2s = np.concatenate(d_o2s)
+            d_s2o = np.concatenate(d_s2o)
+            over = int((d_o2s > TOLERANCE).sum())
+            t_ours = info["seconds"]
+            ratio = t_ocl / t_ours if t_ours > 0 else math.inf
+            t_default = info_default["seconds"]
+            ratio_default = t_ocl / t_default if t_default > 0 else math.inf
+            fin = d_s2o[np.isfinite(d_s2o)]
+            row = [base, str(len(tris)), cname, str(len(zs)), f"{n_ocl}/{n_ours}", str(npts),
+                   f"{d_o2s.max() if len(d_o2s) else 0:.2e}", f"{d_o2s.mean() if len(d_o2s) else 0:.2e}", str(over),
+                   f"{fin.max() if len(fin) else 0:.2e}" + ("" if len(fin) == len(d_s2o) else f" ({len(d_s2o) - len(fin)} far)"),
+                   f"{t_ocl:.3f}", f"{t_ours:.3f}", f"{ratio:.1f}", f"{t_default:.3f}", f"{ratio_default:.1f}"]
+            rows.append(row)
+            print(" | ".join(row), flush=True)
+            if cname not in known:
+                ratios.append((ratio, ratio_default))
+            # OpenCAMLib sometimes splits one contour into several loops (or adds
+            # one-point loops): the loop counts are informational. A failure is an
+            # OpenCAMLib point away from scallop's loops, or a scallop point with no
+            # OpenCAMLib polyline nearby (a loop OpenCAMLib does not have).
+            far = int((~np.isfinite(d_s2o)).sum())
+            if over or far:
+                line = (f"  {base} {cname}: {over} OCL points farther than {TOLERANCE:g} mm from scallop's loops, "
+                        f"{far} scallop points with no OCL loop nearby, loops {n_ocl} (OCL) vs {n_ours} (scallop); "
+                        f"reproduce: {cmd}")
+                checked = far_ocl[:ADJUDICATE_POINTS]
+                wrong, lines = 0, []
+                for z, (x, y) in checked:
+                    w, ls = adjudicate(tris, cname, d, z, [(x, y)])
+                    wrong += w
+                    lines += ls
+                # scallop points with no OpenCAMLib loop nearby: is the contour really there?
+                missed = 0
+                for z, (x, y) in far_ours[:ADJUDICATE_POINTS]:
+                    w, ls = adjudicate(tris, cname, d, z, [(x, y)])
+                    if w == 0:
+                        missed += 1
+                        lines.append(f"    scallop point ({x:.6f}, {y:.6f}) at z {z:.6f} with no OCL loop nearby: the brute "
+                                     f"force confirms the contour passes within {ADJUDICATE_RADIUS:g} mm (OCL misses it)")
+                    else:
+                        lines += [ln.replace("OCL point", "scallop point") for ln in ls]
+                checked_ours = min(len(far_ours), ADJUDICATE_POINTS)
+                line += "\n" + "\n".join(lines)
+                ocl_points_wrong = not checked or wrong == len(checked)
+                if over == 0 and far and missed == checked_ours:
+                    line += (f"\n    => OpenCAMLib misses a loop that the brute force confirms at every checked point "
+                             f"({missed} of {checked_ours}): accepted, not scallop's error")
+                elif over and ocl_points_wrong and missed == checked_ours:
+                    line += (f"\n    => OpenCAMLib wrong at every checked point ({wrong} of {len(checked)}, worst first)"
+                             + (f", and misses a loop the brute force confirms ({missed} of {checked_ours})" if far else "")
+                             + ": accepted, not scallop's error")
+                elif cname in known:
+                    line += "\n    => known OpenCAMLib defect: reported, not failed"
+                else:
+                    status = 1
+                    line += "\n    => FAIL"
+                failures.append(line)
+                print(line, flush=True)
+        del surf
+    if ratios:
+        r1, r2 = [r[0] for r in ratios], [r[1] for r in ratios]
+        notes.append(f"speed ratio OCL/scallop, single thread, all levels of a case: scallop at OCL's sampling and "
+                     f"chord tolerance {CHORD_TOLERANCE:g} mm min {min(r1):.1f}, median {float(np.median(r1)):.1f}; "
+                     f"scallop with its defaults (step R/4, chord 1e-4 mm) min {min(r2):.1f}, median {float(np.median(r2)):.1f}")
+    notes.append(f"load average (1/5/15 min) at start {load0[0]:.2f}/{load0[1]:.2f}/{load0[2]:.2f}, at end "
+                 "{:.2f}/{:.2f}/{:.2f} on {} CPUs".format(*os.getloadavg(), os.cpu_count()))
+    print("\nNotes:")
+    for n in notes:
+        print("  " + n)
+    if a.markdown:
+        with open(a.markdown, "w") as f:
+            f.write(f"OpenCAMLib {ocl.version()} Waterline, mode {'reduced' if a.reduced else 'full'}; tolerance "
+                    f"{TOLERANCE:g} mm; scallop chord tolerance {CHORD_TOLERANCE:g} mm.\n\n")
+            f.write("| " + " | ".join(head) + " |\n")
+            f.write("|" + "|".join("---" if i < 3 else "---:" for i in range(len(head))) + "|\n")
+            for r in rows:
+                f.write("| " + " | ".join(r) + " |\n")
+            f.write("\n")
+            for n in notes:
+                f.write(f"- {n}\n")
+            if failures:
+                f.write("\n```\n" + "\n".join(failures) + "\n```\n")
+    return status
+
+
+if __name__ == "__main__":
+    sys.exit(main())
