@@ -9,7 +9,6 @@ use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget};
 use scallop_analysis::{Cutter, MachineLimits};
 use scallop_io::job::{
     BarrierWord, FormulationWord, JobFile, OptimizeSpec, ShapeWord, SurrogateCostSpec, SurrogateWord, TransitionWord,
-    parse_job,
 };
 use scallop_network::{CellLabels, TransitionModel, Transitions};
 use scallop_optim::study::{
@@ -138,14 +137,7 @@ fn zone_program(
 
 /// `scallop optimize`.
 pub fn run(args: &OptimizeArgs) -> CliResult<()> {
-    let name = args.job.display().to_string();
-    let bytes = std::fs::read(&args.job).map_err(|e| {
-        let err = anyhow::anyhow!("{name}: cannot read the job file: {e}");
-        if e.kind() == std::io::ErrorKind::NotFound { Failure::Rejected(err) } else { Failure::Io(err) }
-    })?;
-    let text = std::str::from_utf8(&bytes)
-        .map_err(|e| Failure::rejected(format!("{name}: byte {}: the job file is not UTF-8 text", e.valid_up_to())))?;
-    let spec = parse_job(text).map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
+    let (name, spec) = crate::run::read_job(&args.job)?;
     let Some(opt) = &spec.optimize else {
         return Err(Failure::rejected(format!(
             "{name}: the job has no [optimize] table; add one with at least `formulation` (docs/job.md)"

@@ -30,14 +30,7 @@ pub struct RunArgs {
 
 /// `scallop run`.
 pub fn run(args: &RunArgs) -> CliResult<()> {
-    let name = args.job.display().to_string();
-    let bytes = std::fs::read(&args.job).map_err(|e| {
-        let err = anyhow::anyhow!("{name}: cannot read the job file: {e}");
-        if e.kind() == std::io::ErrorKind::NotFound { Failure::Rejected(err) } else { Failure::Io(err) }
-    })?;
-    let text = std::str::from_utf8(&bytes)
-        .map_err(|e| Failure::rejected(format!("{name}: byte {}: the job file is not UTF-8 text", e.valid_up_to())))?;
-    let spec = parse_job(text).map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
+    let (name, spec) = read_job(&args.job)?;
     let job = finish_job(&spec, args.job.parent().unwrap_or(Path::new("."))).map_err(|e| match e {
         Failure::Rejected(e) => Failure::Rejected(anyhow::anyhow!("{name}: {e:#}")),
         other => other,
@@ -122,6 +115,20 @@ fn apply_finishing(job: &mut FinishJob, f: &scallop_io::job::FinishingSpec) {
         LeadWord::Ramp => LeadKind::Ramp { length: f.lead_length, angle: f.lead_angle_deg.to_radians() },
         LeadWord::None => LeadKind::None,
     };
+}
+
+/// Reads and checks a job file: its name for messages and its contents; a
+/// missing or non-UTF-8 file or a bad job is rejected naming the file.
+pub(crate) fn read_job(path: &Path) -> CliResult<(String, JobFile)> {
+    let name = path.display().to_string();
+    let bytes = std::fs::read(path).map_err(|e| {
+        let err = anyhow::anyhow!("{name}: cannot read the job file: {e}");
+        if e.kind() == std::io::ErrorKind::NotFound { Failure::Rejected(err) } else { Failure::Io(err) }
+    })?;
+    let text = std::str::from_utf8(&bytes)
+        .map_err(|e| Failure::rejected(format!("{name}: byte {}: the job file is not UTF-8 text", e.valid_up_to())))?;
+    let spec = parse_job(text).map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
+    Ok((name, spec))
 }
 
 pub(crate) fn finish_job(spec: &JobFile, folder: &Path) -> CliResult<FinishJob> {

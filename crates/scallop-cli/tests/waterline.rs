@@ -1,38 +1,8 @@
 //! Smoke tests of `scallop waterline`: CSV and JSON output, summary, errors.
 
-use std::path::PathBuf;
-use std::process::Command;
+mod common;
 
-fn scallop() -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_scallop"));
-    c.env("CI", "true");
-    c
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("scallop-waterline-test-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("scratch dir");
-    dir
-}
-
-/// A binary STL of a 10 x 10 pyramid of height 5 (4 faces, slopes of 45 degrees).
-fn pyramid_stl() -> Vec<u8> {
-    let apex = [5.0f32, 5.0, 5.0];
-    let base = [[0.0f32, 0.0, 0.0], [10.0, 0.0, 0.0], [10.0, 10.0, 0.0], [0.0, 10.0, 0.0]];
-    let mut out = vec![0u8; 80];
-    out.extend_from_slice(&4u32.to_le_bytes());
-    for k in 0..4 {
-        out.extend_from_slice(&[0u8; 12]);
-        for p in [base[k], base[(k + 1) % 4], apex] {
-            for c in p {
-                out.extend_from_slice(&c.to_le_bytes());
-            }
-        }
-        out.extend_from_slice(&[0u8; 2]);
-    }
-    out
-}
+use common::{pyramid_stl, scallop, scratch};
 
 /// A flat cutter of radius 1 with its tip at z cuts the pyramid where its disk
 /// meets the pyramid's cross-section above z (the square of half-width 5 - z

@@ -660,30 +660,18 @@ fn isoparametric(
             toolpath.push(*m);
         }
     }
-    let (a, b) = (stop_to_stop_time(&toolpath, params), lookahead_time(&toolpath, params));
     let feed = toolpath.length(MoveKind::Feed);
     #[allow(clippy::cast_precision_loss, reason = "patch counts")]
     let mean = mean_sum / set.patches().len().max(1) as f64;
+    // Isoparametric passes are joined without links: the path is the feed moves.
     let report = scallop_strategy::Report {
-        machining_time_s: a.cutting,
-        machining_time_lookahead_s: b.cutting,
-        rapid_time_s: a.rapid,
-        plunge_time_s: a.plunge,
-        total_time_s: a.total(),
         path_length_mm: feed,
-        feed_length_mm: feed,
         link_length_mm: 0.0,
-        rapid_length_mm: toolpath.length(MoveKind::Rapid) + toolpath.length(MoveKind::Retract),
-        plunge_length_mm: toolpath.length(MoveKind::Plunge),
         passes,
         planes: passes,
-        links: 0,
-        retracts: toolpath.count(MoveKind::Retract),
         max_scallop_mm: max_h,
         mean_scallop_mm: mean,
-        points: toolpath.moves().len(),
-        cl_points_dropped: 0,
-        planning_time_s: 0.0,
+        ..scallop_strategy::Report::timed(&toolpath, params)
     };
     Ok(Plan { toolpath, report, scallop: None })
 }

@@ -44,9 +44,7 @@ use scallop_machine::program::{ProgramOptions, records_from_toolpath, to_program
 use scallop_mesh::{MeshIndex, TriMesh};
 use scallop_network::{CellLabels, Orientation, Transitions};
 use scallop_post::{OutputMode, PostParams, program_text};
-use scallop_strategy::{
-    FinishingParams, StrategyError, ZoneRegion, lookahead_time, plan_zone_finishing, stop_to_stop_time,
-};
+use scallop_strategy::{FinishingParams, StrategyError, ZoneRegion, plan_zone_finishing};
 use scallop_surface::{Direction, Patch};
 use scallop_toolpath::{FittedPath, MoveKind, Toolpath, fit_arcs};
 use serde::Serialize;
@@ -173,7 +171,7 @@ pub struct ZoneFinishReport {
     pub transition_time_model_s: f64,
     /// The network model's predicted total (s), if given.
     pub predicted_time_s: Option<f64>,
-    /// `plan.total_time_s / predicted_time_s`.
+    /// `total / predicted_time_s`.
     pub time_ratio: Option<f64>,
     /// Cell size of the stock simulation (mm).
     pub sim_resolution_mm: f64,
@@ -321,34 +319,16 @@ fn finish_zones_with(job: &FinishJob, spec: &ZonePlanSpec, share: f64) -> Result
     }
 
     // Times and lengths of the joined program.
-    let (a, b) = (stop_to_stop_time(&toolpath, &base), lookahead_time(&toolpath, &base));
-    let feed = toolpath.length(MoveKind::Feed);
-    let link = toolpath.length(MoveKind::Link);
     let transitions = ends.len().saturating_sub(1);
     let transition_time_model_s: f64 =
         ends.windows(2).map(|w| spec.transitions.time(&w[0].1, &w[1].0, &machine).0).sum();
     let transition_time_s = transition_time(&toolpath, &zone_of_move, &base);
     let plan = scallop_strategy::Report {
-        machining_time_s: a.cutting,
-        machining_time_lookahead_s: b.cutting,
-        rapid_time_s: a.rapid,
-        plunge_time_s: a.plunge,
-        total_time_s: a.total(),
-        path_length_mm: feed + link,
-        feed_length_mm: feed,
-        link_length_mm: link,
-        rapid_length_mm: toolpath.length(MoveKind::Rapid) + toolpath.length(MoveKind::Retract),
-        plunge_length_mm: toolpath.length(MoveKind::Plunge),
         passes: figures.iter().map(|f| f.passes).sum(),
-        planes: 0,
-        links: 0,
-        retracts: toolpath.count(MoveKind::Retract),
         max_scallop_mm: figures.iter().map(|f| f.max_scallop_mm).fold(0.0, f64::max),
-        mean_scallop_mm: 0.0,
-        points: toolpath.moves().len(),
-        cl_points_dropped: 0,
-        planning_time_s: 0.0,
+        ..scallop_strategy::Report::timed(&toolpath, &base)
     };
+    let total = plan.total_time_s;
 
     // The proof: the whole 3-axis program on a stock box (as `run_finishing`); 3+2
     // zones were proven one by one above, each in its own frame.
@@ -406,7 +386,7 @@ fn finish_zones_with(job: &FinishJob, spec: &ZonePlanSpec, share: f64) -> Result
         transition_time_s,
         transition_time_model_s,
         predicted_time_s: spec.predicted_time_s,
-        time_ratio: spec.predicted_time_s.filter(|&p| p > 0.0).map(|p| a.total() / p),
+        time_ratio: spec.predicted_time_s.filter(|&p| p > 0.0).map(|p| total / p),
         sim_resolution_mm: job.sim_resolution,
         sim_resolution_bound_mm: bound,
         indexed: tilted,

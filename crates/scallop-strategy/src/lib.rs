@@ -231,6 +231,41 @@ pub struct Report {
     pub planning_time_s: f64,
 }
 
+impl Report {
+    /// The times and lengths of `toolpath` under `params` (the stop-to-stop
+    /// and look-ahead models, lengths by move kind, retracts and points); the
+    /// planner's own counts (passes, planes, links, scallop, drops) are zero,
+    /// for the caller to fill in.
+    #[must_use]
+    pub fn timed(toolpath: &Toolpath, params: &FinishingParams) -> Report {
+        let a = stop_to_stop_time(toolpath, params);
+        let b = lookahead_time(toolpath, params);
+        let feed = toolpath.length(MoveKind::Feed);
+        let link = toolpath.length(MoveKind::Link);
+        Report {
+            machining_time_s: a.cutting,
+            machining_time_lookahead_s: b.cutting,
+            rapid_time_s: a.rapid,
+            plunge_time_s: a.plunge,
+            total_time_s: a.total(),
+            path_length_mm: feed + link,
+            feed_length_mm: feed,
+            link_length_mm: link,
+            rapid_length_mm: toolpath.length(MoveKind::Rapid) + toolpath.length(MoveKind::Retract),
+            plunge_length_mm: toolpath.length(MoveKind::Plunge),
+            passes: 0,
+            planes: 0,
+            links: 0,
+            retracts: toolpath.count(MoveKind::Retract),
+            max_scallop_mm: 0.0,
+            mean_scallop_mm: 0.0,
+            points: toolpath.moves().len(),
+            cl_points_dropped: 0,
+            planning_time_s: 0.0,
+        }
+    }
+}
+
 /// The result of [`plan_finishing`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct Planned {
@@ -307,30 +342,15 @@ fn plan(
         params.scallop_height,
         plan::zone_end_margin(cutter, region),
     )?;
-    let a = stop_to_stop_time(&toolpath, params);
-    let b = lookahead_time(&toolpath, params);
-    let feed = toolpath.length(MoveKind::Feed);
-    let link = toolpath.length(MoveKind::Link);
     let report = Report {
-        machining_time_s: a.cutting,
-        machining_time_lookahead_s: b.cutting,
-        rapid_time_s: a.rapid,
-        plunge_time_s: a.plunge,
-        total_time_s: a.total(),
-        path_length_mm: feed + link,
-        feed_length_mm: feed,
-        link_length_mm: link,
-        rapid_length_mm: toolpath.length(MoveKind::Rapid) + toolpath.length(MoveKind::Retract),
-        plunge_length_mm: toolpath.length(MoveKind::Plunge),
         passes: planes.iter().map(|p| p.passes.len()).sum(),
         planes: planes.len(),
         links,
         retracts,
         max_scallop_mm: scallop.max_mm,
         mean_scallop_mm: scallop.mean_mm,
-        points: toolpath.moves().len(),
         cl_points_dropped: planner.drops,
-        planning_time_s: 0.0,
+        ..Report::timed(&toolpath, params)
     };
     Ok(Planned { toolpath, planes, feed_samples, scallop, report })
 }
