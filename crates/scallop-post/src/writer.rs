@@ -7,7 +7,9 @@ use std::io::Write;
 
 use scallop_geom::nalgebra::Rotation3;
 use scallop_geom::{Point3, Vec3};
-use scallop_machine::program::{MachineProgram, Motion, ProgramBlock};
+use scallop_machine::feed::pow10i;
+use scallop_machine::frame::SetupFrame;
+use scallop_machine::program::{MachineProgram, Motion, ProgramBlock, ProgramOptions};
 use scallop_machine::{AxisKind, Kinematics, ToolLengthMode, Wrap};
 
 use crate::dialect::{Dialect, FeedByTime, Syntax, TcpCodes, TiltedPlane};
@@ -68,14 +70,36 @@ pub struct PostParams {
     pub predicted_time: Option<f64>,
 }
 
-/// `10f64.powi(e)` by table for `|e| <= 9`, bit for bit: the exponentiation by squaring
-/// is exact for these powers and a negative power is the reciprocal of the positive one.
-pub(crate) fn pow10i(e: i32) -> f64 {
-    const POW10: [f64; 10] = [1.0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9];
-    match usize::try_from(e.unsigned_abs()).ok().and_then(|k| POW10.get(k)) {
-        Some(&p) if e >= 0 => p,
-        Some(&p) => 1.0 / p,
-        None => 10f64.powi(e),
+impl PostParams {
+    /// The parameters of a program whose header prints the interpolation tolerances of
+    /// `options` (the ones it was planned with), without a predicted time.
+    ///
+    /// ```
+    /// use scallop_machine::program::ProgramOptions;
+    /// use scallop_post::{OutputMode, PostParams};
+    /// let options = ProgramOptions::default();
+    /// let p = PostParams::new("1", OutputMode::Joint, 1, 0.0, 12000.0, &options);
+    /// assert_eq!((p.tol_pos, p.tol_ang, p.predicted_time), (options.tol_pos, options.tol_ang, None));
+    /// ```
+    #[must_use]
+    pub fn new(
+        program: &str,
+        mode: OutputMode,
+        tool: u32,
+        tool_length: f64,
+        spindle: f64,
+        options: &ProgramOptions,
+    ) -> PostParams {
+        PostParams {
+            program: program.to_string(),
+            mode,
+            tool,
+            tool_length,
+            spindle,
+            tol_pos: options.tol_pos,
+            tol_ang: options.tol_ang,
+            predicted_time: None,
+        }
     }
 }
 
@@ -383,7 +407,8 @@ fn write_plane_blocks(
 ) -> Result<(), PostError> {
     let (machine, dialect) = (kin.machine(), e.d);
     let mut previous: Option<&ProgramBlock> = None;
-    let mut plane: Option<(Vec3, Rotation3<f64>)> = None;
+    // The tool axis of the plane in force (as its first block has it) and its frame.
+    let mut plane: Option<(Vec3, SetupFrame)> = None;
     for b in &program.blocks {
         let needs_new = plane.as_ref().is_none_or(|(axis, _)| angle(axis, &b.pose.axis) > params.tol_ang);
         if needs_new {
@@ -397,13 +422,12 @@ fn write_plane_blocks(
             if plane.is_some() {
                 e.plane_off();
             }
-            let r = scallop_machine::frame::tilted_plane(&b.pose.axis);
+            let frame = SetupFrame::tilted_plane(&b.pose.axis);
             let dir = if b.words[kin.tilt_axis()] >= 0.0 { 1 } else { -1 };
-            e.plane_on(&r, dir);
-            plane = Some((b.pose.axis, r));
+            e.plane_on(&frame.plane(), dir);
+            plane = Some((b.pose.axis, frame));
         }
-        let r = &plane.as_ref().map_or_else(Rotation3::identity, |p| p.1);
-        let local = r.inverse() * b.pose.tip;
+        let local = plane.as_ref().map_or(b.pose.tip, |(_, frame)| frame.to_setup(&b.pose.tip));
         let mut words = Vec::new();
         for i in 0..machine.axes().len() {
             if machine.axes()[i].kind == AxisKind::Linear {
@@ -1289,24 +1313,16 @@ mod tests {
                 feed: if i % 40 < 20 { 1500.0 } else { 2500.0 },
             });
         }
+        let options = ProgramOptions::default();
         let mut compared = 0;
         for name in Machine::builtin_names() {
             let machine = Machine::builtin(name).expect("shipped machine");
             let kin = Kinematics::new(&machine, 0.0);
-            let Ok(program) = to_program(&kin, &records, None, &ProgramOptions::default()) else { continue };
+            let Ok(program) = to_program(&kin, &records, None, &options) else { continue };
             for dialect_name in Dialect::builtin_names() {
                 let dialect = Dialect::builtin(dialect_name).expect("shipped dialect");
                 for mode in [OutputMode::Joint, OutputMode::Tcp] {
-                    let params = PostParams {
-                        program: "7".into(),
-                        mode,
-                        tool: 3,
-                        tool_length: 0.0,
-                        spindle: 9000.0,
-                        tol_pos: 0.005,
-                        tol_ang: 0.001,
-                        predicted_time: None,
-                    };
+                    let params = PostParams::new("7", mode, 3, 0.0, 9000.0, &options);
                     let fast = program_text_with(&program, &kin, &dialect, &params, true);
                     let general = program_text_with(&program, &kin, &dialect, &params, false);
                     match (fast, general) {
