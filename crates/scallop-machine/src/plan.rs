@@ -750,6 +750,10 @@ impl Beam {
     }
 }
 
+/// The two rotaries (joints 3 and 4) unwrapped, and whether each took an unwinding move
+/// ([`unwrap_rotaries`]).
+type Rotaries = ([f64; 2], [bool; 2]);
+
 /// Why candidates of a layer were not kept: the first stroke or reach error, the smallest
 /// rotary jump while cutting (joint, size), and whether the jump shortcut dropped one.
 #[derive(Default)]
@@ -947,11 +951,11 @@ impl<'a, I: PathInput> Planner<'a, I> {
         i: usize,
         p: &State,
         raw: &Joints,
-        (jumps, u): (bool, ([f64; 2], [bool; 2])),
+        (jumps, u): (bool, Rotaries),
         any_plain: bool,
         shortcut: bool,
         tracked: &mut Option<Option<Joints>>,
-    ) -> Option<(Option<([f64; 2], [bool; 2])>, bool)> {
+    ) -> Option<(Option<Rotaries>, bool)> {
         if !jumps {
             return Some((shortcut.then_some(u), false));
         }
