@@ -12,6 +12,7 @@ use scallop_analysis::{
 use scallop_cutter::{Cutter, CutterShape};
 use scallop_geom::nalgebra::Rotation3;
 use scallop_geom::{Aabb3, Point3, Tolerances, Vec3};
+use scallop_machine::frame::SetupFrame;
 use scallop_machine::program::{ProgramOptions, records_from_toolpath, to_program};
 use scallop_machine::{Kinematics, Machine};
 use scallop_mesh::{MeshIndex, TriMesh};
@@ -692,13 +693,13 @@ fn rotate_prepared(prepared: &PreparedPart, rotation: &Rotation3<f64>) -> Result
 /// `rotation^-1 z`, through the machine's inverse kinematics, written in tilted work
 /// planes (joint space with the rotaries held where the dialect has no plane code).
 fn indexed_program(job: &FinishJob, setup: &Setup, path: &Toolpath, time: f64) -> Result<String, EngineError> {
-    let back = setup.rotation.inverse();
+    let frame = SetupFrame::about_origin(setup.rotation);
     let mut part_frame = Toolpath::new(path.feed);
     part_frame.plunge_feed = path.plunge_feed;
     for m in path.moves() {
-        part_frame.push(Move::new(m.kind, back * m.to));
+        part_frame.push(Move::new(m.kind, frame.to_part(&m.to)));
     }
-    let axis: Vec3 = back * Vec3::z();
+    let axis: Vec3 = frame.tool_axis();
     let kin = Kinematics::new(&setup.machine, setup.tool_length);
     let options = ProgramOptions::default();
     let records = records_from_toolpath(&part_frame, &axis);

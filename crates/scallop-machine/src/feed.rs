@@ -389,7 +389,16 @@ pub(crate) use scallop_geom::num::{floor_fast, round_fast};
 
 /// `10f64.powi(e)` by table for `|e| <= 9`, bit for bit: the exponentiation by squaring
 /// is exact for these powers and a negative power is the reciprocal of the positive one.
-pub(crate) fn pow10i(e: i32) -> f64 {
+/// The scale of a word rounded to `e` decimals, here and in `scallop-post`.
+///
+/// ```
+/// use scallop_machine::feed::pow10i;
+/// for e in -9..=9 {
+///     assert_eq!(pow10i(e).to_bits(), 10f64.powi(e).to_bits());
+/// }
+/// ```
+#[must_use]
+pub fn pow10i(e: i32) -> f64 {
     const POW10: [f64; 10] = [1.0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9];
     match usize::try_from(e.unsigned_abs()).ok().and_then(|k| POW10.get(k)) {
         Some(&p) if e >= 0 => p,
@@ -433,28 +442,4 @@ pub fn inverse_time_feed(kin: &Kinematics, pose_a: &Pose, pose_b: &Pose, qa: &Jo
     // Round down, but keep an exact value when it is already representable.
     let nearest = round_fast(exact * scale) / scale;
     if (exact - nearest).abs() <= tol::FEED_ROUNDING * exact { nearest } else { floor_fast(exact * scale) / scale }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::{floor_fast, round_fast};
-
-    #[test]
-    fn the_fast_roundings_equal_the_library_bit_for_bit() {
-        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
-        for _ in 0..100_000 {
-            let magnitude = 10f64.powi(i32::try_from(next() % 20).unwrap_or(0) - 4);
-            let v = ((next() >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 2.0 * magnitude;
-            for x in [v, v.trunc() + 0.5, v.trunc() - 0.5, -0.0, 0.0, 4.6e15, -4.6e15, f64::NAN] {
-                assert_eq!(round_fast(x).to_bits(), x.round().to_bits(), "round {x:e}");
-                assert_eq!(floor_fast(x).to_bits(), x.floor().to_bits(), "floor {x:e}");
-            }
-        }
-    }
 }

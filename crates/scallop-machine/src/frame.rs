@@ -1,9 +1,10 @@
 //! Tilted work planes for indexed (3+2) operations (spec 3.13): the frame F with
-//! `z_f = O`, and its angles in the controllers' conventions. Formatting is done by
-//! `scallop-post`; the frames are computed here because frames change only in this crate.
+//! `z_f = O`, and its angles in the controllers' conventions; [`SetupFrame`], the frame
+//! of a 3+2 setup. Formatting is done by `scallop-post`; the frames are computed here
+//! because frames change only in this crate.
 
-use scallop_geom::Vec3;
 use scallop_geom::nalgebra::Rotation3;
+use scallop_geom::{Point3, Vec3};
 
 use crate::tol;
 
@@ -61,4 +62,63 @@ pub fn plane_spatial(r: &Rotation3<f64>) -> (f64, f64, f64) {
     let m = r.matrix();
     let b = (-m[(2, 0)]).atan2(m[(0, 0)].hypot(m[(1, 0)]));
     (m[(2, 1)].atan2(m[(2, 2)]), b, m[(1, 0)].atan2(m[(0, 0)]))
+}
+
+/// The frame of a 3+2 (indexed) setup: the part frame turned by `rotation` about
+/// `centre` into the setup frame, where the tool axis is +Z:
+/// `p_setup = c + R (p_part - c)`, and back `p_part = c + R^T (p_setup - c)`.
+///
+/// ```
+/// use scallop_geom::{Point3, Vec3};
+/// use scallop_machine::frame::SetupFrame;
+/// let f = SetupFrame::tilted_plane(&Vec3::new(0.0, -1.0, 1.0));
+/// assert!((f.tool_axis() - Vec3::new(0.0, -1.0, 1.0).normalize()).norm() < 1e-15);
+/// let p = Point3::new(1.0, 2.0, 3.0);
+/// assert!((f.to_part(&f.to_setup(&p)) - p).norm() < 1e-14);
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SetupFrame {
+    /// Part frame -> setup frame.
+    pub rotation: Rotation3<f64>,
+    /// Centre of the rotation (part frame).
+    pub centre: Point3,
+}
+
+impl SetupFrame {
+    /// The setup turned by `rotation` (part frame -> setup frame) about the part origin.
+    #[must_use]
+    pub fn about_origin(rotation: Rotation3<f64>) -> SetupFrame {
+        SetupFrame { rotation, centre: Point3::origin() }
+    }
+
+    /// The tilted work plane of the tool axis `axis` ([`tilted_plane`]) at the part origin.
+    #[must_use]
+    pub fn tilted_plane(axis: &Vec3) -> SetupFrame {
+        SetupFrame::about_origin(tilted_plane(axis).inverse())
+    }
+
+    /// The tilted-plane rotation `R_f` (columns `x_f, y_f, z_f` in the part frame): the
+    /// inverse of `rotation`, what [`fanuc_g68_2`] and [`plane_spatial`] read.
+    #[must_use]
+    pub fn plane(&self) -> Rotation3<f64> {
+        self.rotation.inverse()
+    }
+
+    /// The tool axis (+Z of the setup frame) in the part frame.
+    #[must_use]
+    pub fn tool_axis(&self) -> Vec3 {
+        self.rotation.inverse() * Vec3::z()
+    }
+
+    /// A part-frame point in the setup frame.
+    #[must_use]
+    pub fn to_setup(&self, p: &Point3) -> Point3 {
+        self.centre + self.rotation * (p - self.centre)
+    }
+
+    /// A setup-frame point in the part frame.
+    #[must_use]
+    pub fn to_part(&self, p: &Point3) -> Point3 {
+        self.centre + self.rotation.inverse() * (p - self.centre)
+    }
 }

@@ -668,7 +668,9 @@ pub(crate) fn plan_input(
 }
 
 /// [`plan_input`]; `unwind`: the pole axis may also take the windings one turn either way
-/// on non-cutting moves.
+/// on non-cutting moves. One layer of candidate states per pose ([`Planner::layer`]),
+/// kept in a [`Beam`], then the best chain backtracked and turned into joints and events
+/// ([`Planner::joint_path`]).
 fn plan_layers(
     kin: &Kinematics,
     input: &impl PathInput,
@@ -677,11 +679,7 @@ fn plan_layers(
     unwind: bool,
 ) -> Result<JointPath, MachineError> {
     let n_poses = input.len();
-    let machine = kin.machine();
-    let strokes = Strokes::new(machine);
-    let pole = kin.pole_axis();
-    let pole_dir = pole_direction(kin);
-    let eps = machine.pole_eps();
+    let planner = Planner::new(kin, input, start.is_some(), options, unwind);
     let root = State {
         q: start.unwrap_or_else(Joints::zeros),
         at_pole: false,
@@ -690,191 +688,165 @@ fn plan_layers(
         back: 0,
         edge: Edge::Plain,
     };
-    // The layers' nodes in one arena: layer i is `arena[offsets[i]..offsets[i + 1]]` (no
-    // allocation per pose); the full states of the previous and the next layer in two
-    // reused vectors.
-    let mut arena: Vec<Node> = Vec::with_capacity(n_poses + n_poses / 4);
-    let mut offsets: Vec<u32> = Vec::with_capacity(n_poses + 1);
-    offsets.push(0);
+    let mut beam = Beam::with_capacity(n_poses);
+    // The full states of the previous and the next layer in two reused vectors.
     let mut next: Vec<State> = Vec::new();
     let mut previous: Vec<State> = vec![root];
     // The inverse of the current pose, reused pose after pose.
     let mut shared = crate::ik::LazyIk::empty();
     for i in 0..n_poses {
-        let pose = input.pose(i);
-        let preds: &[State] = &previous;
-        let mut first_error: Option<MachineError> = None;
-        let mut smallest_jump: Option<(usize, f64)> = None;
+        planner.layer(i, &previous, &mut next, &mut shared)?;
+        beam.push(&next);
+        std::mem::swap(&mut previous, &mut next);
+    }
+    let chain = beam.backtrack(n_poses);
+    Ok(planner.joint_path(&chain, start))
+}
+
+/// The layers' nodes in one arena: layer i is `arena[offsets[i]..offsets[i + 1]]` (no
+/// allocation per pose).
+struct Beam {
+    arena: Vec<Node>,
+    offsets: Vec<u32>,
+}
+
+impl Beam {
+    fn with_capacity(n_poses: usize) -> Beam {
+        let mut offsets: Vec<u32> = Vec::with_capacity(n_poses + 1);
+        offsets.push(0);
+        Beam { arena: Vec::with_capacity(n_poses + n_poses / 4), offsets }
+    }
+
+    /// Appends the (sorted, truncated) states of the next layer.
+    fn push(&mut self, layer: &[State]) {
+        self.arena.extend(layer.iter().map(|s| Node {
+            q: s.q,
+            edge: s.edge,
+            // INVARIANT: `back` indexes the previous layer, at most PLAN_BEAM states.
+            back: u8::try_from(s.back).unwrap_or(u8::MAX),
+            at_pole: s.at_pole,
+        }));
+        // INVARIANT: a path has fewer than 2^32 / PLAN_BEAM poses.
+        self.offsets.push(u32::try_from(self.arena.len()).unwrap_or(u32::MAX));
+    }
+
+    /// The chain of nodes from the first pose to the best final state (layers are
+    /// sorted: the best is first).
+    fn backtrack(&self, n_poses: usize) -> Vec<&Node> {
+        let layers = self.offsets.windows(2).map(|w| &self.arena[w[0] as usize..w[1] as usize]);
+        let mut chain: Vec<&Node> = Vec::with_capacity(n_poses);
+        if let Some(last) = layers.clone().next_back() {
+            let mut idx = 0;
+            for layer in layers.rev() {
+                let s = &layer[idx];
+                chain.push(s);
+                idx = usize::from(s.back);
+            }
+            debug_assert_eq!(chain.len(), n_poses);
+            debug_assert!(!last.is_empty());
+        }
+        chain.reverse();
+        chain
+    }
+}
+
+/// The two rotaries (joints 3 and 4) unwrapped, and whether each took an unwinding move
+/// ([`unwrap_rotaries`]).
+type Rotaries = ([f64; 2], [bool; 2]);
+
+/// Why candidates of a layer were not kept: the first stroke or reach error, the smallest
+/// rotary jump while cutting (joint, size), and whether the jump shortcut dropped one.
+#[derive(Default)]
+struct Rejected {
+    first_error: Option<MachineError>,
+    smallest_jump: Option<(usize, f64)>,
+    dropped: bool,
+}
+
+/// What one run of [`plan_layers`] reads at every pose.
+struct Planner<'a, I: PathInput> {
+    kin: &'a Kinematics,
+    machine: &'a Machine,
+    input: &'a I,
+    options: &'a PlanOptions,
+    strokes: Strokes,
+    pole: usize,
+    pole_dir: scallop_geom::Vec3,
+    eps: f64,
+    /// A machine state precedes the first pose.
+    has_start: bool,
+    /// The pole axis may unwind by a turn either way on non-cutting moves.
+    unwind: bool,
+}
+
+impl<'a, I: PathInput> Planner<'a, I> {
+    fn new(kin: &'a Kinematics, input: &'a I, has_start: bool, options: &'a PlanOptions, unwind: bool) -> Self {
+        let machine = kin.machine();
+        Planner {
+            kin,
+            machine,
+            input,
+            options,
+            strokes: Strokes::new(machine),
+            pole: kin.pole_axis(),
+            pole_dir: pole_direction(kin),
+            eps: machine.pole_eps(),
+            has_start,
+            unwind,
+        }
+    }
+
+    /// Whether the tool axis crosses the pole on the move into pose `i > 0`.
+    fn crosses_pole(&self, i: usize) -> bool {
+        arc_passes(&self.input.pose(i - 1).axis, &self.input.pose(i).axis, &self.pole_dir, self.eps)
+    }
+
+    /// The states of pose `i` reached from `preds` into `next`, sorted best first and cut
+    /// to the beam; an error naming the block when none is left.
+    fn layer(
+        &self,
+        i: usize,
+        preds: &[State],
+        next: &mut Vec<State>,
+        shared: &mut crate::ik::LazyIk,
+    ) -> Result<(), MachineError> {
+        let pose = self.input.pose(i);
         // Off the pole the inverse does not depend on the held joints: solve once (the
         // position step of each branch only when a candidate needs it).
-        kin.ik_lazy(pose, &preds[0].q, &mut shared).map_err(|e| e.at_block(i))?;
-        let polar = shared.sols.as_slice().iter().any(|s| s.at_pole) || kin.solver() == crate::chain::Solver::Numeric;
+        self.kin.ik_lazy(pose, &preds[0].q, shared).map_err(|e| e.at_block(i))?;
+        let polar =
+            shared.sols.as_slice().iter().any(|s| s.at_pole) || self.kin.solver() == crate::chain::Solver::Numeric;
         // A candidate that jumps while cutting is dropped on its rotary values alone,
         // before its linear joints are solved and its strokes checked: kept candidates are
         // the same. When that leaves the layer empty, it is expanded again without the
         // shortcut, for the error the full checks give.
+        let mut rejected = Rejected::default();
         for shortcut in [true, false] {
             next.clear();
-            let mut dropped = false;
+            rejected = Rejected::default();
             for (pi, p) in preds.iter().enumerate() {
                 let mut own;
                 let sols = if polar && pi > 0 {
-                    own = crate::ik::LazyIk::complete(kin.ik(pose, &p.q).map_err(|e| e.at_block(i))?);
+                    own = crate::ik::LazyIk::complete(self.kin.ik(pose, &p.q).map_err(|e| e.at_block(i))?);
                     &mut own
                 } else {
-                    &mut shared
+                    &mut *shared
                 };
-                let has_previous = i > 0 || start.is_some();
-                // The continuous motion along this cutting move from `p` (computed once per
-                // predecessor, only when a candidate jumps).
-                let mut tracked: Option<Option<Joints>> = None;
-                let check_cut = has_previous && input.cutting(i);
-                // The jump test of each candidate (at most two inverse solutions), and
-                // whether one of them needs no jump: then that one is the continuation
-                // (the two solutions differ by half a turn of the pole axis) and the others
-                // are not tracked (the dense-path case costs nothing more).
-                let mut pre = [(false, ([0.0; 2], [false; 2])); 2];
-                let mut any_plain = false;
-                if check_cut {
-                    for (k, slot) in pre.iter_mut().enumerate().take(sols.sols.as_slice().len()) {
-                        *slot = jumps_on_rotaries(
-                            &strokes,
-                            &sols.sols.as_slice()[k],
-                            p,
-                            options.flip_threshold,
-                            pole,
-                            || i > 0 && arc_passes(&input.pose(i - 1).axis, &pose.axis, &pole_dir, eps),
-                        );
-                        any_plain |= !slot.0;
-                    }
-                }
-                let n_sols = sols.sols.as_slice().len();
-                for (k, &(jumps, u)) in pre.iter().enumerate().take(n_sols) {
-                    let mut unwrapped = None;
-                    let mut continuous = false;
-                    if check_cut {
-                        if jumps && any_plain {
-                            if shortcut {
-                                dropped = true;
-                                continue;
-                            }
-                        } else if jumps {
-                            // A large rotary change is allowed while cutting when it is the
-                            // continuous motion along the move (near the pole, or a genuine
-                            // reorientation): the candidate is the tracked joints modulo a
-                            // turn, and takes the tracked windings.
-                            let from = if i > 0 { *input.pose(i - 1) } else { kin.fk(&p.q) };
-                            let t = tracked.get_or_insert_with(|| track(kin, &from, pose, &p.q));
-                            match t.as_ref().and_then(|t| continuation(&sols.sols.as_slice()[k].joints, t)) {
-                                Some(u) => {
-                                    unwrapped = Some(u);
-                                    continuous = true;
-                                }
-                                None if shortcut => {
-                                    dropped = true;
-                                    continue;
-                                }
-                                None => {}
-                            }
-                        } else if shortcut {
-                            unwrapped = Some(u);
-                        }
-                    }
-                    kin.complete(sols, k);
-                    let sol = &sols.sols.as_slice()[k];
-                    let checked = match unwrapped {
-                        Some(u) => admissible_with(machine, &strokes, sol, u),
-                        None => admissible(machine, &strokes, sol, has_previous.then_some(&p.q)),
-                    };
-                    let mut cand = match checked {
-                        Ok(c) => c,
-                        Err(e) => {
-                            first_error.get_or_insert(e.at_block(i));
-                            continue;
-                        }
-                    };
-                    if options.unwind_rapids && input.is_rapid(i) {
-                        let turn = 2.0 * PI;
-                        let mut q = cand.joints;
-                        q[pole] -= turn * (q[pole] / turn).round();
-                        if strokes.inside(&q) && (q[pole] - cand.joints[pole]).abs() > 0.0 {
-                            cand.joints = q;
-                            cand.unwound[pole] = true;
-                        }
-                    }
-                    // Off the material the pole axis may also unwind by a turn either way
-                    // (within its stroke): the windings a later cut needs.
-                    let mut variants = [None, None, None];
-                    if unwind && !input.cutting(i) {
-                        for (slot, sign) in [(1, 1.0), (2, -1.0)] {
-                            let mut v = cand.clone();
-                            v.joints[pole] += sign * 2.0 * PI;
-                            if strokes.inside(&v.joints) {
-                                v.unwound[pole] = true;
-                                variants[slot] = Some(v);
-                            }
-                        }
-                    }
-                    variants[0] = Some(cand);
-                    for cand in variants.into_iter().flatten() {
-                        let (cost, edge) = if has_previous {
-                            let dq = cand.joints - p.q;
-                            let jump = [3, 4].map(|j| dq[j].abs() > options.flip_threshold);
-                            // The move time only for candidates that are kept (a jump while
-                            // cutting is dropped before it is needed).
-                            let t = || move_time(machine, &p.q, &cand.joints);
-                            if jump == [false, false] || continuous {
-                                (t(), Edge::Plain)
-                            } else {
-                                let only_pole = (0..2).all(|r| jump[r] == (r + 3 == pole));
-                                let crosses = p.at_pole
-                                    || cand.at_pole
-                                    || (i > 0 && arc_passes(&input.pose(i - 1).axis, &pose.axis, &pole_dir, eps));
-                                if only_pole && crosses {
-                                    (t(), Edge::PoleFlip)
-                                } else if input.cutting(i) {
-                                    let j = if dq[3].abs() >= dq[4].abs() { 3 } else { 4 };
-                                    if smallest_jump.is_none_or(|(_, d)| dq[j].abs() < d) {
-                                        smallest_jump = Some((j, dq[j].abs()));
-                                    }
-                                    continue;
-                                } else {
-                                    let j = if dq[3].abs() >= dq[4].abs() { 3 } else { 4 };
-                                    (t() + options.reorient_penalty, Edge::Reorient(j))
-                                }
-                            }
-                        } else {
-                            (0.0, Edge::Plain)
-                        };
-                        let first = if i == 0 { preference_key(kin, &cand.joints) } else { p.first };
-                        let state =
-                            State { q: cand.joints, at_pole: cand.at_pole, cost: p.cost + cost, first, back: pi, edge };
-                        match next.iter_mut().find(|s| (s.q - state.q).amax() < tol::SAME_JOINTS) {
-                            Some(existing) => {
-                                if better(&state, existing) {
-                                    *existing = state;
-                                }
-                            }
-                            None => next.push(state),
-                        }
-                    }
-                }
+                self.expand(i, pi, p, sols, shortcut, next, &mut rejected);
             }
-            if !(next.is_empty() && dropped) {
+            if !(next.is_empty() && rejected.dropped) {
                 break;
             }
-            first_error = None;
-            smallest_jump = None;
         }
         if next.is_empty() {
-            if let Some((j, d)) = smallest_jump {
+            if let Some((j, d)) = rejected.smallest_jump {
                 return Err(MachineError::FlipWhileCutting {
                     block: i,
-                    axis: machine.axes()[j].name.clone(),
+                    axis: self.machine.axes()[j].name.clone(),
                     delta_deg: d.to_degrees(),
                 });
             }
-            return Err(first_error.unwrap_or(MachineError::Unreachable {
+            return Err(rejected.first_error.unwrap_or(MachineError::Unreachable {
                 block: Some(i),
                 axis: [pose.axis.x, pose.axis.y, pose.axis.z],
             }));
@@ -890,73 +862,254 @@ fn plan_layers(
             }
         });
         next.truncate(tol::PLAN_BEAM);
-        arena.extend(next.iter().map(|s| Node {
-            q: s.q,
-            edge: s.edge,
-            // INVARIANT: `back` indexes the previous layer, at most PLAN_BEAM states.
-            back: u8::try_from(s.back).unwrap_or(u8::MAX),
-            at_pole: s.at_pole,
-        }));
-        // INVARIANT: a path has fewer than 2^32 / PLAN_BEAM poses.
-        offsets.push(u32::try_from(arena.len()).unwrap_or(u32::MAX));
-        std::mem::swap(&mut previous, &mut next);
+        Ok(())
     }
-    let layers = offsets.windows(2).map(|w| &arena[w[0] as usize..w[1] as usize]);
-    // Backtrack from the best final state.
-    let mut chain: Vec<&Node> = Vec::with_capacity(n_poses);
-    if let Some(last) = layers.clone().next_back() {
-        let mut idx = 0; // layers are sorted: the best is first
-        for layer in layers.rev() {
-            let s = &layer[idx];
-            chain.push(s);
-            idx = usize::from(s.back);
+
+    /// The states of pose `i` reached from the predecessor `p` (index `pi`) through the
+    /// inverse solutions `sols`, merged into `next`.
+    #[allow(clippy::too_many_arguments, reason = "the loop state of one layer")]
+    fn expand(
+        &self,
+        i: usize,
+        pi: usize,
+        p: &State,
+        sols: &mut crate::ik::LazyIk,
+        shortcut: bool,
+        next: &mut Vec<State>,
+        rejected: &mut Rejected,
+    ) {
+        let has_previous = i > 0 || self.has_start;
+        // The continuous motion along this cutting move from `p` (computed once per
+        // predecessor, only when a candidate jumps).
+        let mut tracked: Option<Option<Joints>> = None;
+        let check_cut = has_previous && self.input.cutting(i);
+        // The jump test of each candidate (at most two inverse solutions), and whether one
+        // of them needs no jump: then that one is the continuation (the two solutions
+        // differ by half a turn of the pole axis) and the others are not tracked (the
+        // dense-path case costs nothing more).
+        let mut pre = [(false, ([0.0; 2], [false; 2])); 2];
+        let mut any_plain = false;
+        if check_cut {
+            for (k, slot) in pre.iter_mut().enumerate().take(sols.sols.as_slice().len()) {
+                *slot = jumps_on_rotaries(
+                    &self.strokes,
+                    &sols.sols.as_slice()[k],
+                    p,
+                    self.options.flip_threshold,
+                    self.pole,
+                    || i > 0 && self.crosses_pole(i),
+                );
+                any_plain |= !slot.0;
+            }
         }
-        debug_assert_eq!(chain.len(), n_poses);
-        debug_assert!(!last.is_empty());
+        let n_sols = sols.sols.as_slice().len();
+        for (k, &(jumps, u)) in pre.iter().enumerate().take(n_sols) {
+            let (unwrapped, continuous) = if check_cut {
+                let raw = &sols.sols.as_slice()[k].joints;
+                match self.cut_rotaries(i, p, raw, (jumps, u), any_plain, shortcut, &mut tracked) {
+                    Some(kept) => kept,
+                    None => {
+                        rejected.dropped = true;
+                        continue;
+                    }
+                }
+            } else {
+                (None, false)
+            };
+            self.kin.complete(sols, k);
+            let sol = &sols.sols.as_slice()[k];
+            let checked = match unwrapped {
+                Some(u) => admissible_with(self.machine, &self.strokes, sol, u),
+                None => admissible(self.machine, &self.strokes, sol, has_previous.then_some(&p.q)),
+            };
+            let cand = match checked {
+                Ok(c) => c,
+                Err(e) => {
+                    rejected.first_error.get_or_insert(e.at_block(i));
+                    continue;
+                }
+            };
+            for cand in self.variants(i, cand).into_iter().flatten() {
+                let Some((cost, edge)) = self.edge(i, p, &cand, has_previous, continuous, rejected) else {
+                    continue;
+                };
+                let first = if i == 0 { preference_key(self.kin, &cand.joints) } else { p.first };
+                let state = State { q: cand.joints, at_pole: cand.at_pole, cost: p.cost + cost, first, back: pi, edge };
+                merge_state(next, state);
+            }
+        }
     }
-    chain.reverse();
-    let mut joints = Vec::with_capacity(n_poses + 2);
-    let mut pose_index = Vec::with_capacity(n_poses + 2);
-    let mut events = Vec::new();
-    for (i, s) in chain.iter().enumerate() {
-        let prev = if i == 0 { start } else { Some(chain[i - 1].q) };
-        match (s.edge, prev) {
-            (Edge::PoleFlip, Some(pq)) => {
-                let delta = s.q[pole] - pq[pole];
-                let axis = &machine.axes()[pole];
-                events.push(Event::PoleFlip {
-                    block: i,
-                    axis: axis.name.clone(),
-                    delta_deg: delta.to_degrees(),
-                    seconds: delta.abs() / axis.dynamics.vmax,
-                });
-                if i > 0 && chain[i - 1].at_pole {
-                    // Turn in place at the previous (polar) pose.
-                    let mut q = pq;
-                    q[pole] = s.q[pole];
-                    kin.solve_linear(&input.pose(i - 1).tip, &mut q);
-                    joints.push(q);
-                    pose_index.push(i - 1);
-                } else if s.at_pole {
-                    let mut q = s.q;
-                    q[pole] = pq[pole];
-                    kin.solve_linear(&input.pose(i).tip, &mut q);
-                    joints.push(q);
-                    pose_index.push(i);
+
+    /// The rotaries of a candidate (inverse solution `raw`) on a cutting move from `p`,
+    /// from its jump test `(jumps, unwrapped)`: `None` drops it (a jump while cutting,
+    /// under the shortcut); else the unwrapped rotaries when already known and whether the
+    /// candidate is the continuous motion along the move ([`track`], a large rotary change
+    /// allowed while cutting, near the pole or a genuine reorientation).
+    #[allow(clippy::too_many_arguments, reason = "the loop state of one candidate")]
+    fn cut_rotaries(
+        &self,
+        i: usize,
+        p: &State,
+        raw: &Joints,
+        (jumps, u): (bool, Rotaries),
+        any_plain: bool,
+        shortcut: bool,
+        tracked: &mut Option<Option<Joints>>,
+    ) -> Option<(Option<Rotaries>, bool)> {
+        if !jumps {
+            return Some((shortcut.then_some(u), false));
+        }
+        if any_plain {
+            return if shortcut { None } else { Some((None, false)) };
+        }
+        // The candidate is the tracked joints modulo a turn, and takes the tracked windings.
+        let from = if i > 0 { *self.input.pose(i - 1) } else { self.kin.fk(&p.q) };
+        let t = tracked.get_or_insert_with(|| track(self.kin, &from, self.input.pose(i), &p.q));
+        match t.as_ref().and_then(|t| continuation(raw, t)) {
+            Some(u) => Some((Some(u), true)),
+            None if shortcut => None,
+            None => Some((None, false)),
+        }
+    }
+
+    /// The candidate `cand` of pose `i`, and off the material the windings of the pole
+    /// axis one turn either way (within its stroke) that a later cut may need; on a rapid
+    /// of a job that unwinds, the pole axis at its winding nearest zero.
+    fn variants(&self, i: usize, mut cand: Selected) -> [Option<Selected>; 3] {
+        let pole = self.pole;
+        if self.options.unwind_rapids && self.input.is_rapid(i) {
+            let turn = 2.0 * PI;
+            let mut q = cand.joints;
+            q[pole] -= turn * (q[pole] / turn).round();
+            if self.strokes.inside(&q) && (q[pole] - cand.joints[pole]).abs() > 0.0 {
+                cand.joints = q;
+                cand.unwound[pole] = true;
+            }
+        }
+        let mut variants = [None, None, None];
+        if self.unwind && !self.input.cutting(i) {
+            for (slot, sign) in [(1, 1.0), (2, -1.0)] {
+                let mut v = cand.clone();
+                v.joints[pole] += sign * 2.0 * PI;
+                if self.strokes.inside(&v.joints) {
+                    v.unwound[pole] = true;
+                    variants[slot] = Some(v);
                 }
             }
-            (Edge::Reorient(j), Some(pq)) => events.push(Event::Reorient {
-                block: i,
-                axis: machine.axes()[j].name.clone(),
-                delta_deg: (s.q[j] - pq[j]).to_degrees(),
-            }),
-            _ => {}
         }
-        if s.at_pole {
-            events.push(Event::PoleHold { block: i });
-        }
-        joints.push(s.q);
-        pose_index.push(i);
+        variants[0] = Some(cand);
+        variants
     }
-    Ok(JointPath { joints, pose_index, events })
+
+    /// The cost and kind of the move from `p` to `cand` at pose `i`: the move time, a pole
+    /// flip, or a reorientation with its penalty off the material; `None` for a jump while
+    /// cutting (recorded in `rejected` for the error).
+    fn edge(
+        &self,
+        i: usize,
+        p: &State,
+        cand: &Selected,
+        has_previous: bool,
+        continuous: bool,
+        rejected: &mut Rejected,
+    ) -> Option<(f64, Edge)> {
+        if !has_previous {
+            return Some((0.0, Edge::Plain));
+        }
+        let dq = cand.joints - p.q;
+        let jump = [3, 4].map(|j| dq[j].abs() > self.options.flip_threshold);
+        // The move time only for candidates that are kept (a jump while cutting is
+        // dropped before it is needed).
+        let t = || move_time(self.machine, &p.q, &cand.joints);
+        if jump == [false, false] || continuous {
+            return Some((t(), Edge::Plain));
+        }
+        let only_pole = (0..2).all(|r| jump[r] == (r + 3 == self.pole));
+        let crosses = p.at_pole || cand.at_pole || (i > 0 && self.crosses_pole(i));
+        let j = if dq[3].abs() >= dq[4].abs() { 3 } else { 4 };
+        if only_pole && crosses {
+            Some((t(), Edge::PoleFlip))
+        } else if self.input.cutting(i) {
+            if rejected.smallest_jump.is_none_or(|(_, d)| dq[j].abs() < d) {
+                rejected.smallest_jump = Some((j, dq[j].abs()));
+            }
+            None
+        } else {
+            Some((t() + self.options.reorient_penalty, Edge::Reorient(j)))
+        }
+    }
+
+    /// The joints and events of the backtracked `chain`: a pole flip at a pose on the
+    /// pole adds the in-place rotation as an extra joint vector.
+    fn joint_path(&self, chain: &[&Node], start: Option<Joints>) -> JointPath {
+        let (pole, machine) = (self.pole, self.machine);
+        let mut joints = Vec::with_capacity(chain.len() + 2);
+        let mut pose_index = Vec::with_capacity(chain.len() + 2);
+        let mut events = Vec::new();
+        for (i, s) in chain.iter().enumerate() {
+            let prev = if i == 0 { start } else { Some(chain[i - 1].q) };
+            match (s.edge, prev) {
+                (Edge::PoleFlip, Some(pq)) => {
+                    let delta = s.q[pole] - pq[pole];
+                    let axis = &machine.axes()[pole];
+                    events.push(Event::PoleFlip {
+                        block: i,
+                        axis: axis.name.clone(),
+                        delta_deg: delta.to_degrees(),
+                        seconds: delta.abs() / axis.dynamics.vmax,
+                    });
+                    if let Some((q, at)) = self.turn_in_place(chain, i, pq) {
+                        joints.push(q);
+                        pose_index.push(at);
+                    }
+                }
+                (Edge::Reorient(j), Some(pq)) => events.push(Event::Reorient {
+                    block: i,
+                    axis: machine.axes()[j].name.clone(),
+                    delta_deg: (s.q[j] - pq[j]).to_degrees(),
+                }),
+                _ => {}
+            }
+            if s.at_pole {
+                events.push(Event::PoleHold { block: i });
+            }
+            joints.push(s.q);
+            pose_index.push(i);
+        }
+        JointPath { joints, pose_index, events }
+    }
+
+    /// The in-place rotation of the pole flip into pose `i` (from the joints `pq`) and
+    /// the pose it turns at: the previous pose when it is on the pole, else pose `i` when
+    /// it is; `None` when neither is (a flip crossing the pole inside the block).
+    fn turn_in_place(&self, chain: &[&Node], i: usize, pq: Joints) -> Option<(Joints, usize)> {
+        let (pole, s) = (self.pole, chain[i]);
+        if i > 0 && chain[i - 1].at_pole {
+            // Turn in place at the previous (polar) pose.
+            let mut q = pq;
+            q[pole] = s.q[pole];
+            self.kin.solve_linear(&self.input.pose(i - 1).tip, &mut q);
+            Some((q, i - 1))
+        } else if s.at_pole {
+            let mut q = s.q;
+            q[pole] = pq[pole];
+            self.kin.solve_linear(&self.input.pose(i).tip, &mut q);
+            Some((q, i))
+        } else {
+            None
+        }
+    }
+}
+
+/// Adds `state` to the layer `next`, or keeps the better of it and a state with the same
+/// joints.
+fn merge_state(next: &mut Vec<State>, state: State) {
+    match next.iter_mut().find(|s| (s.q - state.q).amax() < tol::SAME_JOINTS) {
+        Some(existing) => {
+            if better(&state, existing) {
+                *existing = state;
+            }
+        }
+        None => next.push(state),
+    }
 }

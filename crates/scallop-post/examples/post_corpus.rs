@@ -27,16 +27,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for (name, kin, records) in &corpus {
         let program = to_program(kin, records, None, &opts)?;
         for mode in [OutputMode::Joint, OutputMode::Tcp] {
-            let params = PostParams {
-                program: "1019".into(),
-                mode,
-                tool: 1,
-                tool_length: 0.0,
-                spindle: 12000.0,
-                tol_pos: opts.tol_pos,
-                tol_ang: opts.tol_ang,
-                predicted_time: None,
-            };
+            let params = PostParams::new("1019", mode, 1, 0.0, 12000.0, &opts);
             let text = program_text(&program, kin, &dialect, &params)?;
             check_replay(&replay(&text, &dialect, kin)?, records, kin, &dialect, opts.tol_pos, opts.tol_ang)?;
             std::fs::write(dir.join(format!("{name}-{}.ngc", mode.name())), text)?;

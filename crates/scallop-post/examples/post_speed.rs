@@ -25,16 +25,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let t0 = std::time::Instant::now();
     let program = to_program(&kin, &records, None, &options)?;
     let t1 = t0.elapsed();
-    let params = PostParams {
-        program: "1".into(),
-        mode: OutputMode::Joint,
-        tool: 1,
-        tool_length: 0.0,
-        spindle: 12000.0,
-        tol_pos: options.tol_pos,
-        tol_ang: options.tol_ang,
-        predicted_time: None,
-    };
+    let params = PostParams::new("1", OutputMode::Joint, 1, 0.0, 12000.0, &options);
     let text = program_text(&program, &kin, &Dialect::builtin("linuxcnc")?, &params)?;
     let t2 = t0.elapsed();
     let hash = text.bytes().fold(0xcbf2_9ce4_8422_2325_u64, |h, b| (h ^ u64::from(b)).wrapping_mul(0x100_0000_01b3));

@@ -300,15 +300,19 @@ pub fn write_gcode(path: &Toolpath, dialect: &Dialect, comments: &[&str], out: &
 mod tests {
     use super::{floor_fast, fmt_number, push_key, push_token_key, round_fast, scaled_key};
 
-    #[test]
-    fn keys_format_as_the_exact_formatter_and_the_fast_roundings_equal_the_library() {
-        let mut state = 0x2545_f491_4f6c_dd1d_u64;
-        let mut next = || {
+    /// A deterministic xorshift sequence of 64-bit words from `state`.
+    fn xorshift(mut state: u64) -> impl FnMut() -> u64 {
+        move || {
             state ^= state << 13;
             state ^= state >> 7;
             state ^= state << 17;
             state
-        };
+        }
+    }
+
+    #[test]
+    fn keys_format_as_the_exact_formatter_and_the_fast_roundings_equal_the_library() {
+        let mut next = xorshift(0x2545_f491_4f6c_dd1d);
         for _ in 0..100_000 {
             let magnitude = 10f64.powi(i32::try_from(next() % 16).unwrap_or(0) - 6);
             let v = ((next() >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 2.0 * magnitude;
@@ -326,7 +330,9 @@ mod tests {
                     assert_eq!(out, format!("Y{exact}").into_bytes(), "{v:e} at {d}");
                 }
             }
-            for x in [v, v * 1e3, v + 0.5, -v - 0.5, v.trunc() + 0.5, -0.0, 0.0, 4.6e15, -4.6e15] {
+            for x in
+                [v, v * 1e3, v + 0.5, -v - 0.5, v.trunc() + 0.5, v.trunc() - 0.5, -0.0, 0.0, 4.6e15, -4.6e15, f64::NAN]
+            {
                 assert_eq!(round_fast(x).to_bits(), x.round().to_bits(), "round {x:e}");
                 assert_eq!(floor_fast(x).to_bits(), x.floor().to_bits(), "floor {x:e}");
             }
@@ -341,13 +347,7 @@ mod tests {
     #[test]
     fn the_fast_path_equals_the_exact_formatter() {
         // A deterministic sweep of magnitudes, signs, ties and near-ties.
-        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
+        let mut next = xorshift(0x9e37_79b9_7f4a_7c15);
         for _ in 0..200_000 {
             let bits = next();
             let magnitude = 10f64.powi(i32::try_from(bits % 14).unwrap_or(0) - 6);

@@ -123,155 +123,230 @@ fn strip<'a>(dialect: &Dialect, raw: &'a str) -> &'a str {
 /// [`PostError::Parse`] for a word that is not understood; [`PostError::Machine`] for an
 /// unreachable pose or a word outside its stroke, with the line.
 pub fn replay(text: &str, dialect: &Dialect, kin: &Kinematics) -> Result<Vec<ReplayedBlock>, PostError> {
-    let machine = kin.machine();
-    let letters: BTreeMap<String, usize> =
-        machine.axes().iter().enumerate().map(|(i, a)| (dialect.axis_word(&a.name).to_string(), i)).collect();
-    let (tcp_on, tcp_off) = tcp_keys(dialect, kin);
-    let mut q = Joints::zeros();
-    let mut coords = [0.0f64; 3];
-    let mut tcp = false;
-    let mut plane: Option<Plane> = None;
-    let mut reoriented = false;
-    let mut rapid = true;
-    let mut g93 = false;
+    let mut controller = Controller::new(dialect, kin);
     let mut out = Vec::new();
     for (index, raw) in text.lines().enumerate() {
         let line = index + 1;
         let s = strip(dialect, raw);
-        if s.is_empty() || s == "%" {
+        if s.is_empty() || s == "%" || controller.mode_line(line, s)? {
             continue;
         }
-        if tcp_on.iter().any(|k| s.starts_with(k.as_str())) {
-            tcp = true;
-            continue;
+        let words = match dialect.syntax {
+            Syntax::Heidenhain => controller.heidenhain_words(line, s)?,
+            Syntax::Iso => Some(controller.iso_words(line, s)?),
+        };
+        match words {
+            Some(words) if !words.words.is_empty() => out.push(controller.block(line, &words)?),
+            _ => {}
         }
-        if tcp_off.iter().any(|k| s.starts_with(k.as_str())) {
-            tcp = false;
-            continue;
-        }
-        if let Some(p) = read_plane(dialect, line, s)? {
-            plane = p;
-            reoriented = true;
-            continue;
-        }
-        // Words of the line: (address, rule, value).
-        let mut words: Vec<(String, RotaryRule, f64)> = Vec::new();
-        let mut feed = None;
-        let mut seconds = None;
-        let tokens: Vec<&str> = s.split_whitespace().collect();
-        match dialect.syntax {
-            Syntax::Heidenhain => {
-                if tokens.first() != Some(&"L") {
-                    continue;
-                }
-                rapid = false;
-                for t in &tokens[1..] {
-                    if *t == "FMAX" {
-                        rapid = true;
-                    } else if let Some(v) = t.strip_prefix("FT") {
-                        seconds = Some(number(line, v)?);
-                    } else if let Some(v) = t.strip_prefix('F') {
-                        feed = Some(number(line, v)?);
-                    } else {
-                        let (address, value) = split_word(t);
-                        if letters.contains_key(address) {
-                            words.push((address.to_string(), RotaryRule::Shortest, number(line, value)?));
-                        }
-                    }
-                }
-            }
-            Syntax::Iso => {
-                for t in &tokens {
-                    if let Some((name, rhs)) = t.split_once('=') {
-                        if !letters.contains_key(name) {
-                            continue;
-                        }
-                        let (rule, inner) = if let Some(v) = rhs.strip_prefix("DC(") {
-                            (RotaryRule::Shortest, v.trim_end_matches(')'))
-                        } else if let Some(v) = rhs.strip_prefix("ACP(") {
-                            (RotaryRule::Positive, v.trim_end_matches(')'))
-                        } else if let Some(v) = rhs.strip_prefix("ACN(") {
-                            (RotaryRule::Negative, v.trim_end_matches(')'))
-                        } else {
-                            (RotaryRule::Absolute, rhs)
-                        };
-                        words.push((name.to_string(), rule, number(line, inner)?));
-                        continue;
-                    }
-                    let (address, value) = split_word(t);
-                    if value.is_empty() {
-                        continue; // SOFT, FFWON, ORIWKS, ...
-                    }
-                    match address {
-                        "G" => match value {
-                            "0" | "00" => rapid = true,
-                            "1" | "01" => rapid = false,
-                            "93" => g93 = true,
-                            "94" => g93 = false,
-                            _ => {}
-                        },
-                        "F" => feed = Some(number(line, value)?),
-                        a if letters.contains_key(a) => {
-                            words.push((a.to_string(), RotaryRule::Shortest, number(line, value)?));
-                        }
-                        _ => {}
-                    }
-                }
-            }
-        }
-        if words.is_empty() {
-            continue;
-        }
-        let previous = q;
-        for (address, rule, value) in &words {
-            let i = letters[address];
-            let axis = &machine.axes()[i];
-            match axis.kind {
-                AxisKind::Linear => {
-                    if tcp || plane.is_some() {
-                        coords[component(dialect, line, &axis.name)?] = *value;
-                    } else {
-                        q[i] = axis.from_nc_word(*value);
-                    }
-                }
-                AxisKind::Rotary => {
-                    let current = axis.to_nc_word(q[i]);
-                    let rule = if axis.wrap == Wrap::Absolute && matches!(rule, RotaryRule::Shortest) {
-                        RotaryRule::Absolute
-                    } else {
-                        *rule
-                    };
-                    let word = match rule {
-                        RotaryRule::Absolute => *value,
-                        RotaryRule::Shortest => current + ((value - current + 180.0).rem_euclid(360.0) - 180.0),
-                        RotaryRule::Positive => current + (value - current).rem_euclid(360.0),
-                        RotaryRule::Negative => current - (current - value).rem_euclid(360.0),
-                    };
-                    q[i] = axis.from_nc_word(word);
-                }
-            }
-        }
-        let at = |e: scallop_machine::MachineError| PostError::Machine { line, source: e };
-        if let Some(p) = &plane {
-            let pose = Pose::new(p.r * Point3::new(coords[0], coords[1], coords[2]), p.r * Vec3::z());
-            q = plane_joints(kin, &pose, &previous, p.dir).map_err(at)?;
-        } else if tcp {
-            solve_linear(kin, &mut q, &Point3::new(coords[0], coords[1], coords[2]));
-        }
-        scallop_machine::plan::check_limits(machine, &q, None).map_err(at)?;
-        out.push(ReplayedBlock {
-            line,
-            rapid,
-            tcp,
-            reoriented,
-            joints: q,
-            pose: kin.fk(&q),
-            inverse_time: if g93 && !rapid { feed } else { None },
-            seconds,
-        });
-        reoriented = false;
     }
     Ok(out)
+}
+
+/// The axis words of one motion line, `(address, rule, value)`, with its feed word and
+/// its Heidenhain block time.
+#[derive(Default)]
+struct LineWords {
+    words: Vec<(String, RotaryRule, f64)>,
+    feed: Option<f64>,
+    seconds: Option<f64>,
+}
+
+/// The controller's state while a program is replayed: joints, the tip coordinates of
+/// TCP and tilted-plane blocks, and the modal modes.
+struct Controller<'a> {
+    dialect: &'a Dialect,
+    kin: &'a Kinematics,
+    /// Joint index of each axis word.
+    letters: BTreeMap<String, usize>,
+    tcp_on: Vec<String>,
+    tcp_off: Vec<String>,
+    q: Joints,
+    coords: [f64; 3],
+    tcp: bool,
+    plane: Option<Plane>,
+    reoriented: bool,
+    rapid: bool,
+    g93: bool,
+}
+
+impl<'a> Controller<'a> {
+    /// The machine at all joints zero, rapid, G94, no TCP and no plane.
+    fn new(dialect: &'a Dialect, kin: &'a Kinematics) -> Controller<'a> {
+        let letters: BTreeMap<String, usize> =
+            kin.machine().axes().iter().enumerate().map(|(i, a)| (dialect.axis_word(&a.name).to_string(), i)).collect();
+        let (tcp_on, tcp_off) = tcp_keys(dialect, kin);
+        Controller {
+            dialect,
+            kin,
+            letters,
+            tcp_on,
+            tcp_off,
+            q: Joints::zeros(),
+            coords: [0.0; 3],
+            tcp: false,
+            plane: None,
+            reoriented: false,
+            rapid: true,
+            g93: false,
+        }
+    }
+
+    /// Reads a line that switches TCP or a tilted plane on or off (`true`: consumed).
+    fn mode_line(&mut self, line: usize, s: &str) -> Result<bool, PostError> {
+        if self.tcp_on.iter().any(|k| s.starts_with(k.as_str())) {
+            self.tcp = true;
+            return Ok(true);
+        }
+        if self.tcp_off.iter().any(|k| s.starts_with(k.as_str())) {
+            self.tcp = false;
+            return Ok(true);
+        }
+        if let Some(p) = read_plane(self.dialect, line, s)? {
+            self.plane = p;
+            self.reoriented = true;
+            return Ok(true);
+        }
+        Ok(false)
+    }
+
+    /// The words of a Heidenhain `L` line (`None` for any other line): `FMAX` is a
+    /// rapid, `FT` a block time, `F` a feed.
+    fn heidenhain_words(&mut self, line: usize, s: &str) -> Result<Option<LineWords>, PostError> {
+        let tokens: Vec<&str> = s.split_whitespace().collect();
+        if tokens.first() != Some(&"L") {
+            return Ok(None);
+        }
+        self.rapid = false;
+        let mut w = LineWords::default();
+        for t in &tokens[1..] {
+            if *t == "FMAX" {
+                self.rapid = true;
+            } else if let Some(v) = t.strip_prefix("FT") {
+                w.seconds = Some(number(line, v)?);
+            } else if let Some(v) = t.strip_prefix('F') {
+                w.feed = Some(number(line, v)?);
+            } else {
+                let (address, value) = split_word(t);
+                if self.letters.contains_key(address) {
+                    w.words.push((address.to_string(), RotaryRule::Shortest, number(line, value)?));
+                }
+            }
+        }
+        Ok(Some(w))
+    }
+
+    /// The words of an ISO line: motion and feed-mode G codes, `F`, axis words and the
+    /// Siemens `NAME=DC(..)`/`ACP(..)`/`ACN(..)` rotary words.
+    fn iso_words(&mut self, line: usize, s: &str) -> Result<LineWords, PostError> {
+        let mut w = LineWords::default();
+        for t in s.split_whitespace() {
+            if let Some((name, rhs)) = t.split_once('=') {
+                if self.letters.contains_key(name) {
+                    let (rule, inner) = siemens_rotary(rhs);
+                    w.words.push((name.to_string(), rule, number(line, inner)?));
+                }
+                continue;
+            }
+            let (address, value) = split_word(t);
+            if value.is_empty() {
+                continue; // SOFT, FFWON, ORIWKS, ...
+            }
+            match address {
+                "G" => match value {
+                    "0" | "00" => self.rapid = true,
+                    "1" | "01" => self.rapid = false,
+                    "93" => self.g93 = true,
+                    "94" => self.g93 = false,
+                    _ => {}
+                },
+                "F" => w.feed = Some(number(line, value)?),
+                a if self.letters.contains_key(a) => {
+                    w.words.push((a.to_string(), RotaryRule::Shortest, number(line, value)?));
+                }
+                _ => {}
+            }
+        }
+        Ok(w)
+    }
+
+    /// Moves the machine by the words of a motion line: joints from the axis words, the
+    /// linear joints from the kinematics under TCP, all joints from the plane in a tilted
+    /// plane; checked against the strokes.
+    fn block(&mut self, line: usize, w: &LineWords) -> Result<ReplayedBlock, PostError> {
+        let previous = self.q;
+        for (address, rule, value) in &w.words {
+            self.set_word(line, self.letters[address], *rule, *value)?;
+        }
+        let kin = self.kin;
+        let at = |e: scallop_machine::MachineError| PostError::Machine { line, source: e };
+        let tip = Point3::new(self.coords[0], self.coords[1], self.coords[2]);
+        if let Some(p) = &self.plane {
+            let pose = Pose::new(p.r * tip, p.r * Vec3::z());
+            self.q = plane_joints(kin, &pose, &previous, p.dir).map_err(at)?;
+        } else if self.tcp {
+            solve_linear(kin, &mut self.q, &tip);
+        }
+        scallop_machine::plan::check_limits(kin.machine(), &self.q, None).map_err(at)?;
+        let block = ReplayedBlock {
+            line,
+            rapid: self.rapid,
+            tcp: self.tcp,
+            reoriented: self.reoriented,
+            joints: self.q,
+            pose: kin.fk(&self.q),
+            inverse_time: if self.g93 && !self.rapid { w.feed } else { None },
+            seconds: w.seconds,
+        };
+        self.reoriented = false;
+        Ok(block)
+    }
+
+    /// Axis word `value` of joint `i`: a tip coordinate under TCP or in a plane, else the
+    /// joint (rotaries by `rule` from the current value, modulo words unwrapped as the
+    /// control does).
+    fn set_word(&mut self, line: usize, i: usize, rule: RotaryRule, value: f64) -> Result<(), PostError> {
+        let kin = self.kin;
+        let axis = &kin.machine().axes()[i];
+        match axis.kind {
+            AxisKind::Linear => {
+                if self.tcp || self.plane.is_some() {
+                    self.coords[component(self.dialect, line, &axis.name)?] = value;
+                } else {
+                    self.q[i] = axis.from_nc_word(value);
+                }
+            }
+            AxisKind::Rotary => {
+                let current = axis.to_nc_word(self.q[i]);
+                let rule = if axis.wrap == Wrap::Absolute && matches!(rule, RotaryRule::Shortest) {
+                    RotaryRule::Absolute
+                } else {
+                    rule
+                };
+                let word = match rule {
+                    RotaryRule::Absolute => value,
+                    RotaryRule::Shortest => current + ((value - current + 180.0).rem_euclid(360.0) - 180.0),
+                    RotaryRule::Positive => current + (value - current).rem_euclid(360.0),
+                    RotaryRule::Negative => current - (current - value).rem_euclid(360.0),
+                };
+                self.q[i] = axis.from_nc_word(word);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The rule and the number of a Siemens rotary value: `DC(v)`, `ACP(v)`, `ACN(v)` or `v`.
+fn siemens_rotary(rhs: &str) -> (RotaryRule, &str) {
+    if let Some(v) = rhs.strip_prefix("DC(") {
+        (RotaryRule::Shortest, v.trim_end_matches(')'))
+    } else if let Some(v) = rhs.strip_prefix("ACP(") {
+        (RotaryRule::Positive, v.trim_end_matches(')'))
+    } else if let Some(v) = rhs.strip_prefix("ACN(") {
+        (RotaryRule::Negative, v.trim_end_matches(')'))
+    } else {
+        (RotaryRule::Absolute, rhs)
+    }
 }
 
 /// Splits `X-1.5` into (`X`, `-1.5`).

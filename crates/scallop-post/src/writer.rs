@@ -7,10 +7,12 @@ use std::io::Write;
 
 use scallop_geom::nalgebra::Rotation3;
 use scallop_geom::{Point3, Vec3};
-use scallop_machine::program::{MachineProgram, Motion, ProgramBlock};
+use scallop_machine::feed::pow10i;
+use scallop_machine::frame::SetupFrame;
+use scallop_machine::program::{MachineProgram, Motion, ProgramBlock, ProgramOptions};
 use scallop_machine::{AxisKind, Kinematics, ToolLengthMode, Wrap};
 
-use crate::dialect::{Dialect, FeedByTime, Syntax, TiltedPlane};
+use crate::dialect::{Dialect, FeedByTime, Syntax, TcpCodes, TiltedPlane};
 use crate::error::PostError;
 use crate::{fmt_number, tol};
 
@@ -68,14 +70,36 @@ pub struct PostParams {
     pub predicted_time: Option<f64>,
 }
 
-/// `10f64.powi(e)` by table for `|e| <= 9`, bit for bit: the exponentiation by squaring
-/// is exact for these powers and a negative power is the reciprocal of the positive one.
-pub(crate) fn pow10i(e: i32) -> f64 {
-    const POW10: [f64; 10] = [1.0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9];
-    match usize::try_from(e.unsigned_abs()).ok().and_then(|k| POW10.get(k)) {
-        Some(&p) if e >= 0 => p,
-        Some(&p) => 1.0 / p,
-        None => 10f64.powi(e),
+impl PostParams {
+    /// The parameters of a program whose header prints the interpolation tolerances of
+    /// `options` (the ones it was planned with), without a predicted time.
+    ///
+    /// ```
+    /// use scallop_machine::program::ProgramOptions;
+    /// use scallop_post::{OutputMode, PostParams};
+    /// let options = ProgramOptions::default();
+    /// let p = PostParams::new("1", OutputMode::Joint, 1, 0.0, 12000.0, &options);
+    /// assert_eq!((p.tol_pos, p.tol_ang, p.predicted_time), (options.tol_pos, options.tol_ang, None));
+    /// ```
+    #[must_use]
+    pub fn new(
+        program: &str,
+        mode: OutputMode,
+        tool: u32,
+        tool_length: f64,
+        spindle: f64,
+        options: &ProgramOptions,
+    ) -> PostParams {
+        PostParams {
+            program: program.to_string(),
+            mode,
+            tool,
+            tool_length,
+            spindle,
+            tol_pos: options.tol_pos,
+            tol_ang: options.tol_ang,
+            predicted_time: None,
+        }
     }
 }
 
@@ -147,33 +171,84 @@ fn program_text_with(
     fast: bool,
 ) -> Result<String, PostError> {
     let machine = kin.machine();
-    let unsupported =
-        |what: String, fix: &str| PostError::Unsupported { dialect: dialect.name.clone(), what, fix: fix.to_string() };
-    let rotary: Vec<usize> =
-        (0..machine.axes().len()).filter(|&i| machine.axes()[i].kind == AxisKind::Rotary).collect();
-    if machine.axes().len() > dialect.max_axes {
-        let half = 0.5 * 10f64.powi(-i32::try_from(dialect.rotary_decimals).unwrap_or(4));
-        if let Some(b) = program.blocks.iter().find(|b| rotary.iter().any(|&i| b.words[i].abs() >= half)) {
-            return Err(unsupported(
-                format!("a rotary move (block of CL {}) on a {}-axis controller", b.cl_index, dialect.max_axes),
-                "use a 5-axis dialect, or a 3-axis toolpath with the tool along the machine Z",
-            ));
+    check_axis_count(program, machine, dialect)?;
+    let tcp = tcp_codes(machine, dialect, params.mode)?;
+    let planes = params.mode == OutputMode::TiltedPlane && dialect.tilted_plane != TiltedPlane::None;
+    let vars = header_vars(machine, dialect, params, planes);
+    let mut e = Emitter::new(dialect);
+    e.fast = fast;
+    write_preamble(&mut e, machine, dialect, &vars, tcp)?;
+    let layout = AxisLayout::new(machine, dialect, params.mode, fast);
+    if planes {
+        write_plane_blocks(&mut e, program, kin, params, &layout)?;
+    } else {
+        write_joint_blocks(&mut e, program, kin, params.mode, &layout)?;
+    }
+    if let Some(codes) = tcp {
+        for l in &codes.off {
+            e.line(&vars.render(l));
         }
     }
+    for f in &dialect.footer {
+        e.line(&vars.render(f));
+    }
+    // INVARIANT: the text is built from `str` pieces and ASCII numbers only.
+    Ok(String::from_utf8(e.text).unwrap_or_else(|err| String::from_utf8_lossy(err.as_bytes()).into_owned()))
+}
+
+/// [`PostError::Unsupported`] in `dialect`.
+fn unsupported(dialect: &Dialect, what: String, fix: &str) -> PostError {
+    PostError::Unsupported { dialect: dialect.name.clone(), what, fix: fix.to_string() }
+}
+
+/// A machine with more axes than the controller drives is accepted only when its extra
+/// (rotary) words never leave zero in the dialect's rotary decimals.
+fn check_axis_count(
+    program: &MachineProgram,
+    machine: &scallop_machine::Machine,
+    dialect: &Dialect,
+) -> Result<(), PostError> {
+    if machine.axes().len() <= dialect.max_axes {
+        return Ok(());
+    }
+    let rotary: Vec<usize> =
+        (0..machine.axes().len()).filter(|&i| machine.axes()[i].kind == AxisKind::Rotary).collect();
+    let half = 0.5 * 10f64.powi(-i32::try_from(dialect.rotary_decimals).unwrap_or(4));
+    match program.blocks.iter().find(|b| rotary.iter().any(|&i| b.words[i].abs() >= half)) {
+        Some(b) => Err(unsupported(
+            dialect,
+            format!("a rotary move (block of CL {}) on a {}-axis controller", b.cl_index, dialect.max_axes),
+            "use a 5-axis dialect, or a 3-axis toolpath with the tool along the machine Z",
+        )),
+        None => Ok(()),
+    }
+}
+
+/// The dialect's TCP codes in TCP output (`None` in the other modes); an error when the
+/// dialect or the machine has no TCP.
+fn tcp_codes<'d>(
+    machine: &scallop_machine::Machine,
+    dialect: &'d Dialect,
+    mode: OutputMode,
+) -> Result<Option<&'d TcpCodes>, PostError> {
+    if mode != OutputMode::Tcp {
+        return Ok(None);
+    }
+    let codes = dialect.tcp.as_ref().ok_or_else(|| unsupported(dialect, "TCP output".into(), "use joint output"))?;
+    if !machine.tcp().supported {
+        return Err(unsupported(
+            dialect,
+            format!("TCP on machine `{}` (its [tcp] says unsupported)", machine.name()),
+            "use joint output",
+        ));
+    }
+    Ok(Some(codes))
+}
+
+/// The template variables of the header, tool change and footer lines; `planes`: the
+/// tilted-plane mode writes tilted planes (else joint space with the rotaries held).
+fn header_vars(machine: &scallop_machine::Machine, dialect: &Dialect, params: &PostParams, planes: bool) -> Vars {
     let mode = params.mode;
-    let tcp = if mode == OutputMode::Tcp {
-        let codes = dialect.tcp.as_ref().ok_or_else(|| unsupported("TCP output".into(), "use joint output"))?;
-        if !machine.tcp().supported {
-            return Err(unsupported(
-                format!("TCP on machine `{}` (its [tcp] says unsupported)", machine.name()),
-                "use joint output",
-            ));
-        }
-        Some(codes)
-    } else {
-        None
-    };
-    let planes = mode == OutputMode::TiltedPlane && dialect.tilted_plane != TiltedPlane::None;
     let mode_name = match mode {
         OutputMode::TiltedPlane if !planes => "tilted_plane (joint space, rotaries held)",
         m => m.name(),
@@ -183,7 +258,7 @@ fn program_text_with(
     } else {
         format!("baked length {} mm: this program runs only with this tool length", fmt_number(params.tool_length, 4))
     };
-    let vars = Vars {
+    Vars {
         pairs: vec![
             ("program", params.program.clone()),
             ("dialect", dialect.name.clone()),
@@ -199,210 +274,307 @@ fn program_text_with(
             ("machine_tcp_on", machine.tcp().on.clone().unwrap_or_default()),
             ("machine_tcp_off", machine.tcp().off.clone().unwrap_or_default()),
         ],
-    };
-    let mut e = Emitter::new(dialect);
-    e.fast = fast;
+    }
+}
+
+/// Header comments, header lines, the tool change, then TCP on (`tcp`) or the joint
+/// kinematics and tool length offset lines.
+fn write_preamble(
+    e: &mut Emitter,
+    machine: &scallop_machine::Machine,
+    dialect: &Dialect,
+    vars: &Vars,
+    tcp: Option<&TcpCodes>,
+) -> Result<(), PostError> {
     for c in &dialect.header_comments {
         e.comment(&vars.render(c));
     }
-    for h in &dialect.header {
+    for h in dialect.header.iter().chain(&dialect.tool_change) {
         e.line(&vars.render(h));
-    }
-    for t in &dialect.tool_change {
-        e.line(&vars.render(t));
     }
     if let Some(codes) = tcp {
         for l in &codes.on {
             let text = vars.render(l);
             if text.trim().is_empty() {
                 return Err(unsupported(
+                    dialect,
                     format!("TCP on machine `{}` without `tcp.on`/`tcp.off` codes", machine.name()),
                     "declare the configuration's TCP codes in the machine description's [tcp]",
                 ));
             }
             e.line(&text);
         }
-    } else {
-        for l in &dialect.joint_kinematics {
-            let text = vars.render(l);
-            if !text.trim().is_empty() {
-                e.line(&text);
-            }
-        }
-        if machine.tool_length_mode() == ToolLengthMode::Controller {
-            for l in &dialect.length_offset {
-                e.line(&vars.render(l));
-            }
+        return Ok(());
+    }
+    for l in &dialect.joint_kinematics {
+        let text = vars.render(l);
+        if !text.trim().is_empty() {
+            e.line(&text);
         }
     }
-    let letters: Vec<String> = machine.axes().iter().map(|a| dialect.axis_word(&a.name).to_string()).collect();
-    let write_axis: Vec<bool> =
-        machine.axes().iter().map(|a| a.kind == AxisKind::Linear || machine.axes().len() <= dialect.max_axes).collect();
-    let linear_component = |i: usize| -> Result<usize, PostError> {
-        match machine.axes()[i].name.as_str() {
-            "X" => Ok(0),
-            "Y" => Ok(1),
-            "Z" => Ok(2),
-            other => Err(PostError::Unsupported {
-                dialect: dialect.name.clone(),
-                what: format!("TCP or tilted-plane output with a linear axis named `{other}`"),
-                fix: "name the linear axes X, Y, Z, or use joint output".into(),
-            }),
+    if machine.tool_length_mode() == ToolLengthMode::Controller {
+        for l in &dialect.length_offset {
+            e.line(&vars.render(l));
         }
-    };
-    let mut previous: Option<&ProgramBlock> = None;
-    let mut plane: Option<(Vec3, Rotation3<f64>)> = None;
-    // One word per written axis, reused block after block: numbers are compared with the
-    // modal words as scaled integers and formatted only when written.
-    let written: Vec<usize> = (0..machine.axes().len()).filter(|&i| write_axis[i]).collect();
-    let mut words: Vec<Word> = written.iter().map(|&i| Word::new(letters[i].as_str())).collect();
-    let modulo: Vec<usize> = (0..machine.axes().len())
-        .filter(|&i| machine.axes()[i].kind == AxisKind::Rotary && machine.axes()[i].wrap != Wrap::Absolute)
-        .collect();
-    let caps = RateCaps::new(machine, dialect);
-    // Joint-space output whose words are all joint words with one-letter names: the
-    // steady-state G93 blocks go through `Emitter::joint_block`.
-    let fast_joint: Option<(Vec<u8>, Vec<usize>)> = (fast && mode == OutputMode::Joint && written.len() <= 5)
-        .then(|| {
-            written
-                .iter()
-                .map(|&i| {
-                    let axis = &machine.axes()[i];
-                    let dec = match axis.kind {
-                        AxisKind::Linear => dialect.decimals,
-                        AxisKind::Rotary if axis.wrap == Wrap::Absolute => dialect.rotary_decimals,
-                        AxisKind::Rotary => return None,
-                    };
-                    match letters[i].as_bytes() {
-                        &[l] => Some((l, dec)),
-                        _ => None,
-                    }
-                })
-                .collect::<Option<Vec<(u8, usize)>>>()
-        })
-        .flatten()
-        .map(|v| v.into_iter().unzip());
-    // Per written word: the decimals when it is the joint word itself (joint-space output
-    // of a linear or absolute rotary axis), the common case decided once.
-    let joint_decimals: Vec<Option<usize>> = written
-        .iter()
-        .map(|&i| {
-            let axis = &machine.axes()[i];
-            match axis.kind {
-                AxisKind::Linear if mode != OutputMode::Tcp => Some(dialect.decimals),
-                AxisKind::Rotary if axis.wrap == Wrap::Absolute => Some(dialect.rotary_decimals),
-                _ => None,
-            }
-        })
-        .collect();
-    for b in &program.blocks {
-        if planes {
-            let needs_new = plane.as_ref().is_none_or(|(axis, _)| angle(axis, &b.pose.axis) > params.tol_ang);
-            if needs_new {
-                if previous.is_some() && b.motion != Motion::Rapid {
-                    return Err(unsupported(
-                        format!("a tool-axis change on a cutting move (CL {}) in tilted-plane output", b.cl_index),
-                        "reorient on rapids only (3+2 work), or use joint or TCP output for simultaneous 5-axis moves",
-                    ));
-                }
-                if plane.is_some() {
-                    e.plane_off();
-                }
-                let r = scallop_machine::frame::tilted_plane(&b.pose.axis);
-                let dir = if b.words[kin.tilt_axis()] >= 0.0 { 1 } else { -1 };
-                e.plane_on(&r, dir);
-                plane = Some((b.pose.axis, r));
-            }
-            let r = &plane.as_ref().map_or_else(Rotation3::identity, |p| p.1);
-            let local = r.inverse() * b.pose.tip;
-            let mut words = Vec::new();
-            for i in 0..machine.axes().len() {
-                if machine.axes()[i].kind == AxisKind::Linear {
-                    words.push((letters[i].as_str(), e.num(local[linear_component(i)?], dialect.decimals)));
-                }
-            }
-            let feed = if b.motion == Motion::Rapid { FeedWord::Rapid } else { FeedWord::PerMinute(b.feed) };
-            e.motion(&words, feed);
-            previous = Some(b);
-            continue;
-        }
-        let pieces = previous.map_or(1, |p| pieces(&modulo, p, b));
-        for piece in 1..=pieces {
-            let s = f64::from(piece) / f64::from(pieces);
-            let (words_a, tip_a) = match previous {
-                Some(p) => (&p.words, &p.pose.tip),
-                None => (&b.words, &b.pose.tip),
-            };
-            let word_at = |i: usize| words_a[i] + (b.words[i] - words_a[i]) * s;
-            let feed = match (b.motion, previous) {
-                (Motion::Rapid, _) => FeedWord::Rapid,
-                (_, None) => FeedWord::PerMinute(b.feed),
-                (_, Some(_)) if mode == OutputMode::Tcp => FeedWord::PerMinute(b.feed),
-                (_, Some(p)) => {
-                    let f_inv = b.inverse_time.unwrap_or_else(|| {
-                        scallop_machine::feed::inverse_time_feed(kin, &p.pose, &b.pose, &p.joints, &b.joints, b.feed)
-                    }) * f64::from(pieces);
-                    let f_inv = caps.cap(&p.words, &b.words, pieces, f_inv);
-                    match dialect.feed_by_time {
-                        FeedByTime::G93 => FeedWord::InverseTime(f_inv),
-                        FeedByTime::BlockSeconds => FeedWord::Seconds(60.0 / f_inv),
-                        FeedByTime::None => {
-                            let delta: Vec<f64> =
-                                (0..5).map(|i| (b.words[i] - p.words[i]) / f64::from(pieces)).collect();
-                            FeedWord::PerMinute(controller_length(machine, &delta) * f_inv)
+    }
+    Ok(())
+}
+
+/// The component (0, 1, 2) of the tip that the linear axis `i` writes in TCP and
+/// tilted-plane output; an error for a linear axis not named X, Y or Z.
+fn linear_component(machine: &scallop_machine::Machine, dialect: &Dialect, i: usize) -> Result<usize, PostError> {
+    match machine.axes()[i].name.as_str() {
+        "X" => Ok(0),
+        "Y" => Ok(1),
+        "Z" => Ok(2),
+        other => Err(PostError::Unsupported {
+            dialect: dialect.name.clone(),
+            what: format!("TCP or tilted-plane output with a linear axis named `{other}`"),
+            fix: "name the linear axes X, Y, Z, or use joint output".into(),
+        }),
+    }
+}
+
+/// How the machine's axes are written in one program, decided once.
+struct AxisLayout {
+    /// The word letter of each machine axis.
+    letters: Vec<String>,
+    /// The machine axes that are written (all of them, or the linear ones when the
+    /// controller drives fewer axes than the machine has).
+    written: Vec<usize>,
+    /// The modulo-360 rotaries (their joint indices).
+    modulo: Vec<usize>,
+    /// Joint-space output whose words are all joint words with one-letter names: the
+    /// letters and decimals of the steady-state G93 blocks of `Emitter::joint_block`.
+    fast_joint: Option<(Vec<u8>, Vec<usize>)>,
+    /// Per written word: the decimals when it is the joint word itself (joint-space output
+    /// of a linear or absolute rotary axis), the common case decided once.
+    joint_decimals: Vec<Option<usize>>,
+}
+
+impl AxisLayout {
+    fn new(machine: &scallop_machine::Machine, dialect: &Dialect, mode: OutputMode, fast: bool) -> AxisLayout {
+        let axes = machine.axes();
+        let letters: Vec<String> = axes.iter().map(|a| dialect.axis_word(&a.name).to_string()).collect();
+        let written: Vec<usize> =
+            (0..axes.len()).filter(|&i| axes[i].kind == AxisKind::Linear || axes.len() <= dialect.max_axes).collect();
+        let modulo: Vec<usize> =
+            (0..axes.len()).filter(|&i| axes[i].kind == AxisKind::Rotary && axes[i].wrap != Wrap::Absolute).collect();
+        let fast_joint: Option<(Vec<u8>, Vec<usize>)> = (fast && mode == OutputMode::Joint && written.len() <= 5)
+            .then(|| {
+                written
+                    .iter()
+                    .map(|&i| {
+                        let axis = &axes[i];
+                        let dec = match axis.kind {
+                            AxisKind::Linear => dialect.decimals,
+                            AxisKind::Rotary if axis.wrap == Wrap::Absolute => dialect.rotary_decimals,
+                            AxisKind::Rotary => return None,
+                        };
+                        match letters[i].as_bytes() {
+                            &[l] => Some((l, dec)),
+                            _ => None,
                         }
-                    }
-                }
-            };
-            if let (Some((letters, decimals)), FeedWord::InverseTime(f_inv)) = (&fast_joint, feed) {
-                let mut values = [0.0; 5];
-                for (v, &i) in values.iter_mut().zip(&written) {
-                    *v = word_at(i);
-                }
-                if e.joint_block(letters, decimals, &values[..written.len()], f_inv) {
-                    continue;
-                }
-            }
-            for ((word, &i), &joint_dec) in words.iter_mut().zip(&written).zip(&joint_decimals) {
-                if let Some(dec) = joint_dec {
-                    word.set_number(word_at(i), dec);
-                    continue;
-                }
-                let axis = &machine.axes()[i];
+                    })
+                    .collect::<Option<Vec<(u8, usize)>>>()
+            })
+            .flatten()
+            .map(|v| v.into_iter().unzip());
+        let joint_decimals: Vec<Option<usize>> = written
+            .iter()
+            .map(|&i| {
+                let axis = &axes[i];
                 match axis.kind {
-                    AxisKind::Linear if mode == OutputMode::Tcp => {
-                        let tip: Point3 = tip_a + (b.pose.tip - *tip_a) * s;
-                        word.set_number(tip[linear_component(i)?], dialect.decimals);
-                    }
-                    AxisKind::Linear => word.set_number(word_at(i), dialect.decimals),
-                    AxisKind::Rotary if axis.wrap == Wrap::Absolute => {
-                        word.set_number(word_at(i), dialect.rotary_decimals);
-                    }
-                    AxisKind::Rotary => {
-                        let w = word_at(i);
-                        let before = word_at_prev(words_a, &b.words, i, piece, pieces);
-                        let token = e.rotary(word.letter, w, w - before, axis.wrap);
-                        word.set_token(token.as_bytes());
-                    }
+                    AxisKind::Linear if mode != OutputMode::Tcp => Some(dialect.decimals),
+                    AxisKind::Rotary if axis.wrap == Wrap::Absolute => Some(dialect.rotary_decimals),
+                    _ => None,
                 }
+            })
+            .collect();
+        AxisLayout { letters, written, modulo, fast_joint, joint_decimals }
+    }
+}
+
+/// 3+2 output ([`OutputMode::TiltedPlane`] in a dialect with tilted planes): a tilted
+/// plane per run of blocks with one tool axis (within `params.tol_ang`), switched on
+/// rapids only, X/Y/Z of the tip in that plane; the plane is reset at the end.
+fn write_plane_blocks(
+    e: &mut Emitter,
+    program: &MachineProgram,
+    kin: &Kinematics,
+    params: &PostParams,
+    layout: &AxisLayout,
+) -> Result<(), PostError> {
+    let (machine, dialect) = (kin.machine(), e.d);
+    let mut previous: Option<&ProgramBlock> = None;
+    // The tool axis of the plane in force (as its first block has it) and its frame.
+    let mut plane: Option<(Vec3, SetupFrame)> = None;
+    for b in &program.blocks {
+        let needs_new = plane.as_ref().is_none_or(|(axis, _)| angle(axis, &b.pose.axis) > params.tol_ang);
+        if needs_new {
+            if previous.is_some() && b.motion != Motion::Rapid {
+                return Err(unsupported(
+                    dialect,
+                    format!("a tool-axis change on a cutting move (CL {}) in tilted-plane output", b.cl_index),
+                    "reorient on rapids only (3+2 work), or use joint or TCP output for simultaneous 5-axis moves",
+                ));
             }
-            e.motion_words(&mut words, feed);
+            if plane.is_some() {
+                e.plane_off();
+            }
+            let frame = SetupFrame::tilted_plane(&b.pose.axis);
+            let dir = if b.words[kin.tilt_axis()] >= 0.0 { 1 } else { -1 };
+            e.plane_on(&frame.plane(), dir);
+            plane = Some((b.pose.axis, frame));
         }
+        let local = plane.as_ref().map_or(b.pose.tip, |(_, frame)| frame.to_setup(&b.pose.tip));
+        let mut words = Vec::new();
+        for i in 0..machine.axes().len() {
+            if machine.axes()[i].kind == AxisKind::Linear {
+                let component = linear_component(machine, dialect, i)?;
+                words.push((layout.letters[i].as_str(), e.num(local[component], dialect.decimals)));
+            }
+        }
+        let feed = if b.motion == Motion::Rapid { FeedWord::Rapid } else { FeedWord::PerMinute(b.feed) };
+        e.motion(&words, feed);
         previous = Some(b);
     }
     if plane.is_some() {
         e.plane_off();
     }
-    if let Some(codes) = tcp {
-        for l in &codes.off {
-            e.line(&vars.render(l));
+    Ok(())
+}
+
+/// Joint-space and TCP output: every block, cut into [`pieces`] so that no modulo rotary
+/// turns half a turn in one block, with its feed word ([`block_feed`]) and its words
+/// ([`fill_words`]); steady-state G93 blocks through `Emitter::joint_block`.
+fn write_joint_blocks(
+    e: &mut Emitter,
+    program: &MachineProgram,
+    kin: &Kinematics,
+    mode: OutputMode,
+    layout: &AxisLayout,
+) -> Result<(), PostError> {
+    let caps = RateCaps::new(kin.machine(), e.d);
+    // One word per written axis, reused block after block: numbers are compared with the
+    // modal words as scaled integers and formatted only when written.
+    let mut words: Vec<Word> = layout.written.iter().map(|&i| Word::new(layout.letters[i].as_str())).collect();
+    let mut previous: Option<&ProgramBlock> = None;
+    for b in &program.blocks {
+        let pieces = previous.map_or(1, |p| pieces(&layout.modulo, p, b));
+        for piece in 1..=pieces {
+            let at = Piece { from: previous.unwrap_or(b), to: b, piece, pieces };
+            let feed = block_feed(kin, e.d, mode, &caps, previous, b, pieces);
+            if let (Some((letters, decimals)), FeedWord::InverseTime(f_inv)) = (&layout.fast_joint, feed) {
+                let mut values = [0.0; 5];
+                for (v, &i) in values.iter_mut().zip(&layout.written) {
+                    *v = at.word(i);
+                }
+                if e.joint_block(letters, decimals, &values[..layout.written.len()], f_inv) {
+                    continue;
+                }
+            }
+            fill_words(e, &mut words, kin.machine(), mode, layout, &at)?;
+            e.motion_words(&mut words, feed);
+        }
+        previous = Some(b);
+    }
+    Ok(())
+}
+
+/// Piece `piece` of `pieces` of the block `from -> to` (linear in the words).
+struct Piece<'b> {
+    from: &'b ProgramBlock,
+    to: &'b ProgramBlock,
+    piece: u32,
+    pieces: u32,
+}
+
+impl Piece<'_> {
+    /// Word `i` at the end of this piece.
+    fn word(&self, i: usize) -> f64 {
+        let s = f64::from(self.piece) / f64::from(self.pieces);
+        self.from.words[i] + (self.to.words[i] - self.from.words[i]) * s
+    }
+
+    /// Word `i` at the start of this piece.
+    fn word_before(&self, i: usize) -> f64 {
+        word_at_prev(&self.from.words, &self.to.words, i, self.piece, self.pieces)
+    }
+
+    /// The tool tip at the end of this piece (part frame).
+    fn tip(&self) -> Point3 {
+        let s = f64::from(self.piece) / f64::from(self.pieces);
+        self.from.pose.tip + (self.to.pose.tip - self.from.pose.tip) * s
+    }
+}
+
+/// The feed word of a piece of the block `b` (one of `pieces`): rapid, the tip feed
+/// (first block, TCP output), or the inverse-time feed capped by the axis velocities, in
+/// the dialect's form of feed by time.
+fn block_feed(
+    kin: &Kinematics,
+    dialect: &Dialect,
+    mode: OutputMode,
+    caps: &RateCaps,
+    previous: Option<&ProgramBlock>,
+    b: &ProgramBlock,
+    pieces: u32,
+) -> FeedWord {
+    match (b.motion, previous) {
+        (Motion::Rapid, _) => FeedWord::Rapid,
+        (_, None) => FeedWord::PerMinute(b.feed),
+        (_, Some(_)) if mode == OutputMode::Tcp => FeedWord::PerMinute(b.feed),
+        (_, Some(p)) => {
+            let f_inv = b.inverse_time.unwrap_or_else(|| {
+                scallop_machine::feed::inverse_time_feed(kin, &p.pose, &b.pose, &p.joints, &b.joints, b.feed)
+            }) * f64::from(pieces);
+            let f_inv = caps.cap(&p.words, &b.words, pieces, f_inv);
+            match dialect.feed_by_time {
+                FeedByTime::G93 => FeedWord::InverseTime(f_inv),
+                FeedByTime::BlockSeconds => FeedWord::Seconds(60.0 / f_inv),
+                FeedByTime::None => {
+                    let delta: Vec<f64> = (0..5).map(|i| (b.words[i] - p.words[i]) / f64::from(pieces)).collect();
+                    FeedWord::PerMinute(controller_length(kin.machine(), &delta) * f_inv)
+                }
+            }
         }
     }
-    for f in &dialect.footer {
-        e.line(&vars.render(f));
+}
+
+/// The words of a piece: joint words, the tip in TCP output, absolute or modulo rotary
+/// words (the latter as tokens with the dialect's direction templates).
+fn fill_words(
+    e: &Emitter,
+    words: &mut [Word],
+    machine: &scallop_machine::Machine,
+    mode: OutputMode,
+    layout: &AxisLayout,
+    at: &Piece,
+) -> Result<(), PostError> {
+    let dialect = e.d;
+    for ((word, &i), &joint_dec) in words.iter_mut().zip(&layout.written).zip(&layout.joint_decimals) {
+        if let Some(dec) = joint_dec {
+            word.set_number(at.word(i), dec);
+            continue;
+        }
+        let axis = &machine.axes()[i];
+        match axis.kind {
+            AxisKind::Linear if mode == OutputMode::Tcp => {
+                word.set_number(at.tip()[linear_component(machine, dialect, i)?], dialect.decimals);
+            }
+            AxisKind::Linear => word.set_number(at.word(i), dialect.decimals),
+            AxisKind::Rotary if axis.wrap == Wrap::Absolute => {
+                word.set_number(at.word(i), dialect.rotary_decimals);
+            }
+            AxisKind::Rotary => {
+                let w = at.word(i);
+                let token = e.rotary(word.letter, w, w - at.word_before(i), axis.wrap);
+                word.set_token(token.as_bytes());
+            }
+        }
     }
-    // INVARIANT: the text is built from `str` pieces and ASCII numbers only.
-    Ok(String::from_utf8(e.text).unwrap_or_else(|err| String::from_utf8_lossy(err.as_bytes()).into_owned()))
+    Ok(())
 }
 
 /// Per-axis data of [`RateCaps::cap`], computed once per program.
@@ -1141,24 +1313,16 @@ mod tests {
                 feed: if i % 40 < 20 { 1500.0 } else { 2500.0 },
             });
         }
+        let options = ProgramOptions::default();
         let mut compared = 0;
         for name in Machine::builtin_names() {
             let machine = Machine::builtin(name).expect("shipped machine");
             let kin = Kinematics::new(&machine, 0.0);
-            let Ok(program) = to_program(&kin, &records, None, &ProgramOptions::default()) else { continue };
+            let Ok(program) = to_program(&kin, &records, None, &options) else { continue };
             for dialect_name in Dialect::builtin_names() {
                 let dialect = Dialect::builtin(dialect_name).expect("shipped dialect");
                 for mode in [OutputMode::Joint, OutputMode::Tcp] {
-                    let params = PostParams {
-                        program: "7".into(),
-                        mode,
-                        tool: 3,
-                        tool_length: 0.0,
-                        spindle: 9000.0,
-                        tol_pos: 0.005,
-                        tol_ang: 0.001,
-                        predicted_time: None,
-                    };
+                    let params = PostParams::new("7", mode, 3, 0.0, 9000.0, &options);
                     let fast = program_text_with(&program, &kin, &dialect, &params, true);
                     let general = program_text_with(&program, &kin, &dialect, &params, false);
                     match (fast, general) {

@@ -50,16 +50,7 @@ fn post_everywhere(name: &str, kin: &Kinematics, records: &[ClRecord]) -> Posted
         let dialect = Dialect::builtin(dialect_name).expect("shipped dialect");
         for mode in MODES {
             let what = format!("{name} / {dialect_name} / {}", mode.name());
-            let params = PostParams {
-                program: "19".into(),
-                mode,
-                tool: 4,
-                tool_length: 0.0,
-                spindle: 10000.0,
-                tol_pos: opts.tol_pos,
-                tol_ang: opts.tol_ang,
-                predicted_time: None,
-            };
+            let params = PostParams::new("19", mode, 4, 0.0, 10000.0, &opts);
             let text = match program_text(&program, kin, &dialect, &params) {
                 Ok(t) => t,
                 Err(PostError::Unsupported { what: w, .. })
@@ -151,16 +142,7 @@ fn issue_19_replay_pairs_records_sharing_a_tip_by_order() {
     // Drop the in-place reorientation: the cut goes on with the first axis.
     bad.blocks.retain(|b| b.cl_index != 2);
     let d = Dialect::builtin("linuxcnc").expect("shipped");
-    let params = PostParams {
-        program: "1".into(),
-        mode: OutputMode::Joint,
-        tool: 1,
-        tool_length: 0.0,
-        spindle: 8000.0,
-        tol_pos: opts.tol_pos,
-        tol_ang: opts.tol_ang,
-        predicted_time: None,
-    };
+    let params = PostParams::new("1", OutputMode::Joint, 1, 0.0, 8000.0, &opts);
     let ok = program_text(&good, &kin, &d, &params).expect("writes");
     check_replay(&replay(&ok, &d, &kin).expect("reads"), &records, &kin, &d, opts.tol_pos, opts.tol_ang)
         .expect("the good program replays");
@@ -176,16 +158,7 @@ fn issue_19_linuxcnc_applies_the_tool_offset_and_sets_the_kinematics() {
     let p = to_program(&kin, &big_reorient_cut(), None, &opts).expect("posts");
     let d = Dialect::builtin("linuxcnc").expect("shipped");
     let text = |mode| {
-        let params = PostParams {
-            program: "1".into(),
-            mode,
-            tool: 7,
-            tool_length: 0.0,
-            spindle: 8000.0,
-            tol_pos: opts.tol_pos,
-            tol_ang: opts.tol_ang,
-            predicted_time: None,
-        };
+        let params = PostParams::new("1", mode, 7, 0.0, 8000.0, &opts);
         program_text(&p, &kin, &d, &params).expect("writes")
     };
     // TCP: the trt kinematics read the tool length from the active offset, so G43 H<tool>
@@ -203,16 +176,7 @@ fn issue_19_linuxcnc_applies_the_tool_offset_and_sets_the_kinematics() {
         [("siemens840d", " TRAFOOF\n"), ("heidenhain", " FUNCTION RESET TCPM\n"), ("heidenhain-iso", " M129\n")]
     {
         let d = Dialect::builtin(name).expect("shipped");
-        let params = PostParams {
-            program: "1".into(),
-            mode: OutputMode::Joint,
-            tool: 7,
-            tool_length: 0.0,
-            spindle: 8000.0,
-            tol_pos: opts.tol_pos,
-            tol_ang: opts.tol_ang,
-            predicted_time: None,
-        };
+        let params = PostParams::new("1", OutputMode::Joint, 7, 0.0, 8000.0, &opts);
         let t = program_text(&p, &kin, &d, &params).expect("writes");
         let first_move = t.find(" G0 ").or_else(|| t.find(" L ")).expect("a move");
         assert!(t.find(cancel).is_some_and(|k| k < first_move), "{name}: {t}");
@@ -311,16 +275,7 @@ fn corpus_windings_unwind_on_rapids_when_the_job_asks() {
     }
     assert!(peak(&unwound) <= 360.0 + 1e-9, "{}", peak(&unwound));
     let d = Dialect::builtin("linuxcnc").expect("shipped");
-    let params = PostParams {
-        program: "1".into(),
-        mode: OutputMode::Joint,
-        tool: 1,
-        tool_length: 0.0,
-        spindle: 8000.0,
-        tol_pos: opts.tol_pos,
-        tol_ang: opts.tol_ang,
-        predicted_time: None,
-    };
+    let params = PostParams::new("1", OutputMode::Joint, 1, 0.0, 8000.0, &opts);
     let text = program_text(&unwound, &kin, &d, &params).expect("writes");
     check_replay(&replay(&text, &d, &kin).expect("reads"), &records, &kin, &d, opts.tol_pos, opts.tol_ang)
         .expect("replays");

@@ -31,16 +31,7 @@ fn the_slot_posts_and_replays_in_every_dialect() {
     let program = to_program(&kin, &records, None, &options).expect("reachable");
     for name in ["linuxcnc", "fanuc", "siemens840d", "heidenhain"] {
         let dialect = Dialect::builtin(name).expect("shipped");
-        let params = PostParams {
-            program: "2000".into(),
-            mode: OutputMode::Joint,
-            tool: 1,
-            tool_length: 0.0,
-            spindle: 12000.0,
-            tol_pos: options.tol_pos,
-            tol_ang: options.tol_ang,
-            predicted_time: None,
-        };
+        let params = PostParams::new("2000", OutputMode::Joint, 1, 0.0, 12000.0, &options);
         let text = program_text(&program, &kin, &dialect, &params).expect("post");
         let trip = check_replay(&replay(&text, &dialect, &kin).expect("replay"), &records, &kin, &dialect, 0.01, 1e-3)
             .expect("round trip");
