@@ -435,6 +435,171 @@ fn vec3(a: [f64; 3]) -> Vec3 {
     Vec3::new(a[0], a[1], a[2])
 }
 
+/// One axis of a machine file, checked: its direction, NC sign, pivot, stroke
+/// (NC words in mm or degrees, stored in mm or radians), dynamics, rapid rate
+/// and chain side.
+/// The part frame of a machine file (identity when absent), checked: a proper
+/// rotation and an origin in range.
+fn part_frame_of(frame: Option<&RawFrame>) -> Result<Isometry3<f64>, MachineError> {
+    Ok(match frame {
+        None => Isometry3::identity(),
+        Some(f) => {
+            let m = Matrix3::from_fn(|r, c| f.rotation[r][c]);
+            let err = (m.transpose() * m - Matrix3::identity()).norm();
+            // `!(err <= ..)`: a NaN or infinite entry makes `err` NaN and is refused.
+            if !(err <= tol::DIRECTION_NORM && m.determinant() > 0.0) {
+                return Err(MachineError::invalid(
+                    "part_frame.rotation",
+                    "not a proper rotation matrix (orthonormal, det +1)",
+                    "give the rows of a rotation matrix, e.g. [[1,0,0],[0,1,0],[0,0,1]]",
+                ));
+            }
+            let rot = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(m));
+            let origin = point_in_range(f.origin, "part_frame.origin")?;
+            Isometry3::from_parts(Translation3::from(origin.coords), rot)
+        }
+    })
+}
+
+/// The controller settings of a machine file: block time and corner tolerance
+/// >= 0, a positive reference radius, known TCP forms.
+fn check_controller(nc: &Nc, tcp: &Tcp) -> Result<(), MachineError> {
+    for (place, v) in [("nc.min_block_time", nc.min_block_time), ("nc.corner_tolerance", nc.corner_tolerance)] {
+        if !(v.is_finite() && v >= 0.0) {
+            return Err(MachineError::invalid(place, format!("{v} must be >= 0"), "give a non-negative value"));
+        }
+    }
+    if !(nc.r_ref.is_finite() && nc.r_ref > 0.0) {
+        return Err(MachineError::invalid(
+            "nc.r_ref",
+            format!("{} must be positive", nc.r_ref),
+            "give a positive radius (mm), default 50",
+        ));
+    }
+    for form in &tcp.forms {
+        if form != "rotary" && form != "vector" {
+            return Err(MachineError::invalid(
+                "tcp.forms",
+                format!("unknown form `{form}`"),
+                "use \"rotary\" and/or \"vector\"",
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn axis_of(raw: &RawMachine, name: &String) -> Result<Axis, MachineError> {
+    let a = &raw.axes[name];
+    let place = format!("axes.{name}");
+    let direction = unit_direction(a.direction, &format!("{place}.direction"))?;
+    let nc_sign = match a.nc_sign.unwrap_or(1) {
+        1 => 1.0,
+        -1 => -1.0,
+        s => {
+            return Err(MachineError::invalid(
+                format!("{place}.nc_sign"),
+                format!("{s} is not +1 or -1"),
+                "write nc_sign = 1 or nc_sign = -1",
+            ));
+        }
+    };
+    let point = match (a.kind, a.point) {
+        (AxisKind::Rotary, Some(p)) => point_in_range(p, &format!("{place}.point"))?,
+        (AxisKind::Rotary, None) => {
+            return Err(MachineError::invalid(
+                format!("{place}.point"),
+                "a rotary axis needs a pivot point",
+                "add point = [x, y, z] (mm, machine frame at q = 0)",
+            ));
+        }
+        (AxisKind::Linear, Some(_)) => {
+            return Err(MachineError::invalid(
+                format!("{place}.point"),
+                "a linear axis has no pivot point",
+                "remove `point` from this axis",
+            ));
+        }
+        (AxisKind::Linear, None) => Point3::origin(),
+    };
+    if a.kind == AxisKind::Linear && (a.continuous || a.wrap != Wrap::Absolute) {
+        return Err(MachineError::invalid(
+            place,
+            "`continuous` and `wrap` apply to rotary axes only",
+            "remove them from this linear axis",
+        ));
+    }
+    let scale = if a.kind == AxisKind::Rotary { std::f64::consts::PI / 180.0 } else { 1.0 };
+    let limits = match a.limits {
+        Some([lo, hi]) => {
+            if !(lo.is_finite() && hi.is_finite() && lo < hi) {
+                return Err(MachineError::invalid(
+                    format!("{place}.limits"),
+                    format!("stroke [{lo}, {hi}] needs finite min < max"),
+                    "write limits = [min, max] with min < max (NC words, mm or deg)",
+                ));
+            }
+            Some((lo * scale, hi * scale))
+        }
+        None if a.kind == AxisKind::Rotary && a.continuous => None,
+        None => {
+            return Err(MachineError::invalid(
+                format!("{place}.limits"),
+                "missing stroke",
+                "add limits = [min, max] (or continuous = true for a rotary without stops)",
+            ));
+        }
+    };
+    let dyn_place = format!("dynamics.{name}");
+    let d = raw.dynamics.get(name).ok_or_else(|| {
+        MachineError::invalid(
+            &dyn_place,
+            "missing feed-motion limits",
+            "add [dynamics] NAME = [vmax, amax, jmax] (mm/s, mm/s^2, mm/s^3 or deg/s, ...)",
+        )
+    })?;
+    if d.iter().any(|v| !(v.is_finite() && *v > 0.0)) {
+        return Err(MachineError::invalid(
+            dyn_place,
+            format!("limits {d:?} must be positive and finite"),
+            "give positive [vmax, amax, jmax]",
+        ));
+    }
+    let rapid = match raw.rapid.get(name) {
+        Some(r) if !(r.is_finite() && *r > 0.0) => {
+            return Err(MachineError::invalid(
+                format!("rapid.{name}"),
+                format!("rapid velocity {r} must be positive"),
+                "give a positive rapid velocity or remove it (default: vmax)",
+            ));
+        }
+        Some(r) => *r,
+        None => d[0],
+    };
+    let side = match (raw.chains.part.contains(name), raw.chains.tool.contains(name)) {
+        (true, false) => ChainSide::Part,
+        (false, true) => ChainSide::Tool,
+        _ => {
+            return Err(MachineError::invalid(
+                "chains",
+                format!("axis {name} must be in exactly one of chains.part and chains.tool"),
+                format!("list {name} once, in the chain that carries it"),
+            ));
+        }
+    };
+    Ok(Axis {
+        name: (name).clone(),
+        kind: a.kind,
+        direction,
+        point,
+        nc_sign,
+        limits,
+        continuous: a.continuous,
+        wrap: a.wrap,
+        side,
+        dynamics: Dynamics { vmax: d[0] * scale, amax: d[1] * scale, jmax: d[2] * scale, rapid: rapid * scale },
+    })
+}
+
 fn unit_direction(a: [f64; 3], place: &str) -> Result<Vec3, MachineError> {
     let v = vec3(a);
     let n = v.norm();
@@ -542,115 +707,7 @@ impl Machine {
         }
         let mut axes = Vec::with_capacity(5);
         for name in &names {
-            let a = &raw.axes[*name];
-            let place = format!("axes.{name}");
-            let direction = unit_direction(a.direction, &format!("{place}.direction"))?;
-            let nc_sign = match a.nc_sign.unwrap_or(1) {
-                1 => 1.0,
-                -1 => -1.0,
-                s => {
-                    return Err(MachineError::invalid(
-                        format!("{place}.nc_sign"),
-                        format!("{s} is not +1 or -1"),
-                        "write nc_sign = 1 or nc_sign = -1",
-                    ));
-                }
-            };
-            let point = match (a.kind, a.point) {
-                (AxisKind::Rotary, Some(p)) => point_in_range(p, &format!("{place}.point"))?,
-                (AxisKind::Rotary, None) => {
-                    return Err(MachineError::invalid(
-                        format!("{place}.point"),
-                        "a rotary axis needs a pivot point",
-                        "add point = [x, y, z] (mm, machine frame at q = 0)",
-                    ));
-                }
-                (AxisKind::Linear, Some(_)) => {
-                    return Err(MachineError::invalid(
-                        format!("{place}.point"),
-                        "a linear axis has no pivot point",
-                        "remove `point` from this axis",
-                    ));
-                }
-                (AxisKind::Linear, None) => Point3::origin(),
-            };
-            if a.kind == AxisKind::Linear && (a.continuous || a.wrap != Wrap::Absolute) {
-                return Err(MachineError::invalid(
-                    place,
-                    "`continuous` and `wrap` apply to rotary axes only",
-                    "remove them from this linear axis",
-                ));
-            }
-            let scale = if a.kind == AxisKind::Rotary { std::f64::consts::PI / 180.0 } else { 1.0 };
-            let limits = match a.limits {
-                Some([lo, hi]) => {
-                    if !(lo.is_finite() && hi.is_finite() && lo < hi) {
-                        return Err(MachineError::invalid(
-                            format!("{place}.limits"),
-                            format!("stroke [{lo}, {hi}] needs finite min < max"),
-                            "write limits = [min, max] with min < max (NC words, mm or deg)",
-                        ));
-                    }
-                    Some((lo * scale, hi * scale))
-                }
-                None if a.kind == AxisKind::Rotary && a.continuous => None,
-                None => {
-                    return Err(MachineError::invalid(
-                        format!("{place}.limits"),
-                        "missing stroke",
-                        "add limits = [min, max] (or continuous = true for a rotary without stops)",
-                    ));
-                }
-            };
-            let dyn_place = format!("dynamics.{name}");
-            let d = raw.dynamics.get(*name).ok_or_else(|| {
-                MachineError::invalid(
-                    &dyn_place,
-                    "missing feed-motion limits",
-                    "add [dynamics] NAME = [vmax, amax, jmax] (mm/s, mm/s^2, mm/s^3 or deg/s, ...)",
-                )
-            })?;
-            if d.iter().any(|v| !(v.is_finite() && *v > 0.0)) {
-                return Err(MachineError::invalid(
-                    dyn_place,
-                    format!("limits {d:?} must be positive and finite"),
-                    "give positive [vmax, amax, jmax]",
-                ));
-            }
-            let rapid = match raw.rapid.get(*name) {
-                Some(r) if !(r.is_finite() && *r > 0.0) => {
-                    return Err(MachineError::invalid(
-                        format!("rapid.{name}"),
-                        format!("rapid velocity {r} must be positive"),
-                        "give a positive rapid velocity or remove it (default: vmax)",
-                    ));
-                }
-                Some(r) => *r,
-                None => d[0],
-            };
-            let side = match (raw.chains.part.contains(*name), raw.chains.tool.contains(*name)) {
-                (true, false) => ChainSide::Part,
-                (false, true) => ChainSide::Tool,
-                _ => {
-                    return Err(MachineError::invalid(
-                        "chains",
-                        format!("axis {name} must be in exactly one of chains.part and chains.tool"),
-                        format!("list {name} once, in the chain that carries it"),
-                    ));
-                }
-            };
-            axes.push(Axis {
-                name: (*name).clone(),
-                kind: a.kind,
-                direction,
-                point,
-                nc_sign,
-                limits,
-                continuous: a.continuous,
-                wrap: a.wrap,
-                side,
-                dynamics: Dynamics { vmax: d[0] * scale, amax: d[1] * scale, jmax: d[2] * scale, rapid: rapid * scale },
-            });
+            axes.push(axis_of(&raw, name)?);
         }
         for key in raw.dynamics.keys().chain(raw.rapid.keys()) {
             if !raw.axes.contains_key(key) {
@@ -702,24 +759,7 @@ impl Machine {
         }
         let tool_axis = unit_direction(raw.spindle.tool_axis, "spindle.tool_axis")?;
         let gauge_point = point_in_range(raw.spindle.gauge_point, "spindle.gauge_point")?;
-        let part_frame = match raw.part_frame {
-            None => Isometry3::identity(),
-            Some(f) => {
-                let m = Matrix3::from_fn(|r, c| f.rotation[r][c]);
-                let err = (m.transpose() * m - Matrix3::identity()).norm();
-                // `!(err <= ..)`: a NaN or infinite entry makes `err` NaN and is refused.
-                if !(err <= tol::DIRECTION_NORM && m.determinant() > 0.0) {
-                    return Err(MachineError::invalid(
-                        "part_frame.rotation",
-                        "not a proper rotation matrix (orthonormal, det +1)",
-                        "give the rows of a rotation matrix, e.g. [[1,0,0],[0,1,0],[0,0,1]]",
-                    ));
-                }
-                let rot = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(m));
-                let origin = point_in_range(f.origin, "part_frame.origin")?;
-                Isometry3::from_parts(Translation3::from(origin.coords), rot)
-            }
-        };
+        let part_frame = part_frame_of(raw.part_frame.as_ref())?;
         let preferred_branch = match raw.kinematics.preferred_branch {
             None => None,
             Some(p) => {
@@ -752,28 +792,8 @@ impl Machine {
                 format!("give a small positive value, default {}", tol::POLE_EPS_DEFAULT),
             ));
         }
+        check_controller(&raw.nc, &raw.tcp)?;
         let nc = raw.nc;
-        for (place, v) in [("nc.min_block_time", nc.min_block_time), ("nc.corner_tolerance", nc.corner_tolerance)] {
-            if !(v.is_finite() && v >= 0.0) {
-                return Err(MachineError::invalid(place, format!("{v} must be >= 0"), "give a non-negative value"));
-            }
-        }
-        if !(nc.r_ref.is_finite() && nc.r_ref > 0.0) {
-            return Err(MachineError::invalid(
-                "nc.r_ref",
-                format!("{} must be positive", nc.r_ref),
-                "give a positive radius (mm), default 50",
-            ));
-        }
-        for form in &raw.tcp.forms {
-            if form != "rotary" && form != "vector" {
-                return Err(MachineError::invalid(
-                    "tcp.forms",
-                    format!("unknown form `{form}`"),
-                    "use \"rotary\" and/or \"vector\"",
-                ));
-            }
-        }
         Ok(Machine {
             name: raw.name,
             source: raw.source,
