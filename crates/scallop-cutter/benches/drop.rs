@@ -43,10 +43,7 @@ fn bench(c: &mut Criterion) {
 /// The same kernel on 1 and 2 threads over a finer grid (250,000 points on the
 /// terrain): the ratio of the two medians is the thread scaling.
 fn scaling(c: &mut Criterion) {
-    let terrain = grid_mesh(150, |u, v| {
-        let (x, y) = (100.0 * u, 100.0 * v);
-        Point3::new(x, y, 5.0 * (x * 0.13).sin() * (y * 0.09).cos() + 2.0 * (0.31 * x + 0.17 * y).sin())
-    });
+    let terrain = common::terrain();
     let xs: Vec<f64> = (0..500).map(|i| 100.0 * f64::from(i) / 499.0).collect();
     let ys = xs.clone();
     let mut group = c.benchmark_group("drop_grid_threads/dense_freeform");
