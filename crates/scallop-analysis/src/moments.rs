@@ -252,19 +252,28 @@ fn chunk_moments(range: std::ops::Range<usize>, item: &impl Fn(usize) -> (Point3
     let mut s = [0.0; 6];
     for i in range.clone() {
         let (p, w, spread) = item(i);
-        let d = p.coords - mean;
-        s[0] += w * d.x * d.x;
-        s[1] += w * d.y * d.y;
-        s[2] += w * d.z * d.z;
-        s[3] += w * d.x * d.y;
-        s[4] += w * d.x * d.z;
-        s[5] += w * d.y * d.z;
-        if let Some(spread) = spread {
-            for (acc, v) in s.iter_mut().zip(spread) {
-                *acc += w * v;
-            }
+        add_comoments(&mut s, w, &(p.coords - mean), spread.as_ref());
+    }
+    Moments { count: range.len(), weight, mean, comoment: comoment_matrix(&s) }
+}
+
+/// Adds `w d d^T` (and `w spread`, a point's own second moments) to centred
+/// co-moments kept as `[xx, yy, zz, xy, xz, yz]`.
+pub(crate) fn add_comoments(s: &mut [f64; 6], w: f64, d: &Vec3, spread: Option<&[f64; 6]>) {
+    s[0] += w * d.x * d.x;
+    s[1] += w * d.y * d.y;
+    s[2] += w * d.z * d.z;
+    s[3] += w * d.x * d.y;
+    s[4] += w * d.x * d.z;
+    s[5] += w * d.y * d.z;
+    if let Some(spread) = spread {
+        for (acc, v) in s.iter_mut().zip(spread) {
+            *acc += w * v;
         }
     }
-    let comoment = Matrix3::new(s[0], s[3], s[4], s[3], s[1], s[5], s[4], s[5], s[2]);
-    Moments { count: range.len(), weight, mean, comoment }
+}
+
+/// The symmetric matrix of co-moments kept as `[xx, yy, zz, xy, xz, yz]`.
+pub(crate) fn comoment_matrix(s: &[f64; 6]) -> Matrix3<f64> {
+    Matrix3::new(s[0], s[3], s[4], s[3], s[1], s[5], s[4], s[5], s[2])
 }

@@ -7,10 +7,8 @@ use scallop_mesh::TriMesh;
 use scallop_surface::{Patch, SurfaceSet};
 use serde::{Deserialize, Serialize};
 
-use scallop_geom::nalgebra::Matrix3;
-
 use crate::error::AnalysisError;
-use crate::moments::Moments;
+use crate::moments::{Moments, add_comoments, comoment_matrix};
 use crate::pca::direction_angle_xy;
 use crate::tol;
 
@@ -307,25 +305,11 @@ fn chunk_statistics(part: &[Sample], spreads: Option<&[[f64; 6]]>) -> Stats {
     for (i, s) in part.iter().enumerate() {
         let own = spreads.map(|sp| &sp[i]);
         for (k, weight) in [(0, 1.0), (1, s.weight)] {
-            let d = s.point.coords - means[k];
-            let m = &mut comoments[k];
-            m[0] += weight * d.x * d.x;
-            m[1] += weight * d.y * d.y;
-            m[2] += weight * d.z * d.z;
-            m[3] += weight * d.x * d.y;
-            m[4] += weight * d.x * d.z;
-            m[5] += weight * d.y * d.z;
-            if let Some(own) = own {
-                for (acc, v) in m.iter_mut().zip(own) {
-                    *acc += weight * v;
-                }
-            }
+            add_comoments(&mut comoments[k], weight, &(s.point.coords - means[k]), own);
         }
     }
     let moments = [(0, count), (1, area)].map(|(k, weight)| {
-        let m = comoments[k];
-        let comoment = Matrix3::new(m[0], m[3], m[4], m[3], m[1], m[5], m[4], m[5], m[2]);
-        Moments::from_parts(part.len(), weight, &Point3::from(means[k]), &comoment)
+        Moments::from_parts(part.len(), weight, &Point3::from(means[k]), &comoment_matrix(&comoments[k]))
     });
     Stats { moments, slope_sums, normal_z_sums }
 }
@@ -610,15 +594,7 @@ impl BezierTables {
         let qu: &[[f64; 4]; C] = self.rows_du[a * C..(a + 1) * C].try_into().unwrap_or(&[[0.0; 4]; C]);
         let bv: &[f64; C] = self.basis_v[b * C..(b + 1) * C].try_into().unwrap_or(&[0.0; C]);
         let dbv: &[f64; C] = self.basis_dv[b * C..(b + 1) * C].try_into().unwrap_or(&[0.0; C]);
-        let (mut s, mut su, mut sv) = ([0.0; 4], [0.0; 4], [0.0; 4]);
-        for j in 0..C {
-            for k in 0..4 {
-                s[k] += bv[j] * q[j][k];
-                su[k] += bv[j] * qu[j][k];
-                sv[k] += dbv[j] * q[j][k];
-            }
-        }
-        (s, su, sv)
+        combine(q, qu, bv, dbv)
     }
 
     /// [`BezierTables::contract`] for any column count.
@@ -626,16 +602,24 @@ impl BezierTables {
         let c = self.columns;
         let (q, qu) = (&self.rows[a * c..(a + 1) * c], &self.rows_du[a * c..(a + 1) * c]);
         let (bv, dbv) = (&self.basis_v[b * c..(b + 1) * c], &self.basis_dv[b * c..(b + 1) * c]);
-        let (mut s, mut su, mut sv) = ([0.0; 4], [0.0; 4], [0.0; 4]);
-        for j in 0..c {
-            for k in 0..4 {
-                s[k] += bv[j] * q[j][k];
-                su[k] += bv[j] * qu[j][k];
-                sv[k] += dbv[j] * q[j][k];
-            }
-        }
-        (s, su, sv)
+        combine(q, qu, bv, dbv)
     }
+}
+
+/// `sum_j bv_j q_j`, `sum_j bv_j qu_j` and `sum_j dbv_j q_j` (homogeneous `A`,
+/// `A_u`, `A_v` from a cell's rows and column basis), summed in `j` order.
+/// Inlined, so that the fixed column counts of [`BezierTables::contract`] unroll.
+#[inline(always)]
+fn combine(q: &[[f64; 4]], qu: &[[f64; 4]], bv: &[f64], dbv: &[f64]) -> ([f64; 4], [f64; 4], [f64; 4]) {
+    let (mut s, mut su, mut sv) = ([0.0; 4], [0.0; 4], [0.0; 4]);
+    for (((b, db), qj), quj) in bv.iter().zip(dbv).zip(q).zip(qu) {
+        for k in 0..4 {
+            s[k] += b * qj[k];
+            su[k] += b * quj[k];
+            sv[k] += db * qj[k];
+        }
+    }
+    (s, su, sv)
 }
 
 /// Bernstein polynomials of degree `n >= 1` at `t` and their derivatives

@@ -3,33 +3,17 @@
 //! UV sphere, the worst case of many small sloped facets), per cutter shape,
 //! single-threaded. Run: `cargo bench -p scallop-cutter --bench drop`.
 
+mod common;
+
 use std::f64::consts::PI;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use scallop_cutter::{Cutter, CutterShape, drop_grid};
 use scallop_geom::Point3;
-use scallop_mesh::{MeshIndex, TriMesh};
-
-fn grid_mesh(n: u32, f: impl Fn(f64, f64) -> Point3) -> MeshIndex {
-    let mut soup = Vec::new();
-    let s = |i: u32| f64::from(i) / f64::from(n);
-    for i in 0..n {
-        for j in 0..n {
-            let (a, b, c, d) = (f(s(i), s(j)), f(s(i + 1), s(j)), f(s(i), s(j + 1)), f(s(i + 1), s(j + 1)));
-            soup.push([a, b, c]);
-            soup.push([b, d, c]);
-        }
-    }
-    let (mesh, _) = TriMesh::from_soup(&soup).expect("generated mesh is valid");
-    MeshIndex::build(&mesh)
-}
 
 fn bench(c: &mut Criterion) {
-    let terrain = grid_mesh(150, |u, v| {
-        let (x, y) = (100.0 * u, 100.0 * v);
-        Point3::new(x, y, 5.0 * (x * 0.13).sin() * (y * 0.09).cos() + 2.0 * (0.31 * x + 0.17 * y).sin())
-    });
-    let sphere = grid_mesh(100, |u, v| {
+    let terrain = common::terrain();
+    let sphere = common::grid_mesh(100, |u, v| {
         let (theta, phi) = (2.0 * PI * u, PI * (0.02 + 0.48 * v));
         Point3::new(40.0 * phi.sin() * theta.cos(), 40.0 * phi.sin() * theta.sin(), 40.0 * phi.cos())
     });
@@ -59,10 +43,7 @@ fn bench(c: &mut Criterion) {
 /// The same kernel on 1 and 2 threads over a finer grid (250,000 points on the
 /// terrain): the ratio of the two medians is the thread scaling.
 fn scaling(c: &mut Criterion) {
-    let terrain = grid_mesh(150, |u, v| {
-        let (x, y) = (100.0 * u, 100.0 * v);
-        Point3::new(x, y, 5.0 * (x * 0.13).sin() * (y * 0.09).cos() + 2.0 * (0.31 * x + 0.17 * y).sin())
-    });
+    let terrain = common::terrain();
     let xs: Vec<f64> = (0..500).map(|i| 100.0 * f64::from(i) / 499.0).collect();
     let ys = xs.clone();
     let mut group = c.benchmark_group("drop_grid_threads/dense_freeform");

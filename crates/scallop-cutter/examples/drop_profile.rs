@@ -3,9 +3,10 @@
 //! `cargo build --release --example drop_profile -p scallop-cutter` then
 //! `valgrind --tool=callgrind target/release/examples/drop_profile bull`.
 
+#[path = "../benches/common/mod.rs"]
+mod common;
+
 use scallop_cutter::{Cutter, CutterShape, drop_grid};
-use scallop_geom::Point3;
-use scallop_mesh::{MeshIndex, TriMesh};
 
 fn main() {
     let shape = match std::env::args().nth(1).as_deref() {
@@ -14,22 +15,7 @@ fn main() {
         Some("cone") => CutterShape::Cone { radius: 2.5, half_angle: std::f64::consts::FRAC_PI_4 },
         _ => CutterShape::Ball { radius: 2.5 },
     };
-    let n = 150u32;
-    let f = |u: f64, v: f64| {
-        let (x, y) = (100.0 * u, 100.0 * v);
-        Point3::new(x, y, 5.0 * (x * 0.13).sin() * (y * 0.09).cos() + 2.0 * (0.31 * x + 0.17 * y).sin())
-    };
-    let s = |i: u32| f64::from(i) / f64::from(n);
-    let mut soup = Vec::new();
-    for i in 0..n {
-        for j in 0..n {
-            let (a, b, c, d) = (f(s(i), s(j)), f(s(i + 1), s(j)), f(s(i), s(j + 1)), f(s(i + 1), s(j + 1)));
-            soup.push([a, b, c]);
-            soup.push([b, d, c]);
-        }
-    }
-    let (mesh, _) = TriMesh::from_soup(&soup).expect("valid mesh");
-    let index = MeshIndex::build(&mesh);
+    let index = common::terrain();
     let cutter = Cutter::new(shape, 20.0).expect("valid cutter");
     let xs: Vec<f64> = (0..200).map(|i| f64::from(i) * 0.5).collect();
     let ys: Vec<f64> = (0..50).map(|i| 10.0 + f64::from(i) * 0.5).collect();

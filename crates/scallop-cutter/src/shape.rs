@@ -349,11 +349,8 @@ impl Cutter {
 }
 
 #[cfg(test)]
-#[allow(
-    clippy::unwrap_used,
-    clippy::float_cmp,
-    reason = "tests: a panic is the failure report; exact values are intended"
-)]
+// `unwrap` is allowed in tests by clippy.toml.
+#[allow(clippy::float_cmp, reason = "tests: exact values are intended")]
 mod tests {
     use super::*;
 

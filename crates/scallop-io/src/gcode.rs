@@ -307,7 +307,7 @@ fn read(text: &str, options: &GcodeOptions, keep_arcs: bool) -> Result<(Toolpath
                     in_range(line, "arc extent (|centre| + radius)", centre.0.abs() + radius)?;
                     in_range(line, "arc extent (|centre| + radius)", centre.1.abs() + radius)?;
                     if keep_arcs && state.plane == (0, 1, 2) {
-                        let sweep = arc_sweep(from, to, centre, motion == 2);
+                        let (_, sweep) = arc_sweep(from, to, centre, (0, 1), motion == 2);
                         let arc = ArcXY { center: Point2::new(centre.0, centre.1), sweep };
                         path.push_arc(Move::new(MoveKind::Feed, to), arc);
                     } else {
@@ -504,33 +504,9 @@ fn arc_centre(
 /// Relative mismatch of start and end radii accepted in an arc.
 const ARC_RADIUS_MISMATCH: f64 = 1e-3;
 
-/// Signed sweep of an arc (rad; negative clockwise), a full turn when the
-/// ends coincide.
-fn arc_sweep(from: Point3, to: Point3, c: (f64, f64), clockwise: bool) -> f64 {
-    let a0 = (from.y - c.1).atan2(from.x - c.0);
-    let a1 = (to.y - c.1).atan2(to.x - c.0);
-    let mut sweep = a1 - a0;
-    if clockwise {
-        while sweep >= 0.0 {
-            sweep -= std::f64::consts::TAU;
-        }
-    } else {
-        while sweep <= 0.0 {
-            sweep += std::f64::consts::TAU;
-        }
-    }
-    sweep
-}
-
-fn arc_points(
-    from: Point3,
-    to: Point3,
-    c: (f64, f64),
-    (u, v, n): (usize, usize, usize),
-    clockwise: bool,
-    tolerance: f64,
-) -> Vec<Point3> {
-    let radius = (from[u] - c.0).hypot(from[v] - c.1);
+/// Start angle and signed sweep of an arc about `c` in the plane of axes
+/// `(u, v)` (rad; the sweep negative clockwise), a full turn when the ends coincide.
+fn arc_sweep(from: Point3, to: Point3, c: (f64, f64), (u, v): (usize, usize), clockwise: bool) -> (f64, f64) {
     let a0 = (from[v] - c.1).atan2(from[u] - c.0);
     let a1 = (to[v] - c.1).atan2(to[u] - c.0);
     let mut sweep = a1 - a0;
@@ -543,6 +519,19 @@ fn arc_points(
             sweep += std::f64::consts::TAU;
         }
     }
+    (a0, sweep)
+}
+
+fn arc_points(
+    from: Point3,
+    to: Point3,
+    c: (f64, f64),
+    (u, v, n): (usize, usize, usize),
+    clockwise: bool,
+    tolerance: f64,
+) -> Vec<Point3> {
+    let radius = (from[u] - c.0).hypot(from[v] - c.1);
+    let (a0, sweep) = arc_sweep(from, to, c, (u, v), clockwise);
     // Chord sagitta r (1 - cos(theta / 2)) <= tolerance.
     let max_step = if radius > tolerance { 2.0 * (1.0 - tolerance / radius).acos() } else { std::f64::consts::PI };
     #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
@@ -564,11 +553,8 @@ fn arc_points(
 }
 
 #[cfg(test)]
-#[allow(
-    clippy::unwrap_used,
-    clippy::float_cmp,
-    reason = "tests: a panic is the failure report; exact values are intended"
-)]
+// `unwrap` is allowed in tests by clippy.toml.
+#[allow(clippy::float_cmp, reason = "tests: exact values are intended")]
 mod tests {
     use super::*;
 

@@ -30,11 +30,10 @@ mod stl;
 mod text;
 mod threemf;
 
-use std::collections::HashMap;
 use std::fmt;
-use std::hash::{BuildHasherDefault, Hasher};
 
 use scallop_geom::Point3;
+use scallop_mesh::FastMap;
 pub use scallop_mesh::{MeshDiagnostics, MeshError, TriMesh};
 
 pub mod cl;
@@ -211,8 +210,7 @@ pub fn read_mesh(bytes: &[u8], format: MeshFormat, units: Units) -> Result<Loade
 /// triangle soups (STL, where each vertex appears about six times).
 fn merge_identical(geometry: Geometry) -> Geometry {
     let Geometry { vertices, mut triangles } = geometry;
-    let mut first: HashMap<[u64; 3], usize, BuildHasherDefault<WordHasher>> =
-        HashMap::with_capacity_and_hasher(vertices.len() / 4, BuildHasherDefault::default());
+    let mut first: FastMap<[u64; 3], usize> = FastMap::with_capacity_and_hasher(vertices.len() / 4, Default::default());
     let mut unique = Vec::with_capacity(vertices.len() / 4);
     let remap: Vec<usize> = vertices
         .iter()
@@ -228,36 +226,6 @@ fn merge_identical(geometry: Geometry) -> Geometry {
         *corner = remap[*corner];
     }
     Geometry { vertices: unique, triangles }
-}
-
-/// A fast hasher for keys made of 64-bit words (multiply-rotate per word, then
-/// a full avalanche, so float bit patterns with zero low bits spread well).
-/// Not DoS-resistant, which a local batch reader does not need.
-#[derive(Default)]
-struct WordHasher(u64);
-
-impl Hasher for WordHasher {
-    fn write(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            self.write_u64(u64::from(b));
-        }
-    }
-
-    fn write_u64(&mut self, word: u64) {
-        self.0 = (self.0.rotate_left(5) ^ word).wrapping_mul(0x517c_c1b7_2722_0a95);
-    }
-
-    fn write_usize(&mut self, word: usize) {
-        self.write_u64(word as u64);
-    }
-
-    fn finish(&self) -> u64 {
-        // SplitMix64 finaliser.
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
 }
 
 /// Text that is not UTF-8, with its place: the line (from 1) and the byte offset (from 0)

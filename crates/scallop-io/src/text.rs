@@ -94,9 +94,7 @@ impl<'a> Lexer<'a> {
             return None;
         }
         let start = self.pos;
-        while self.pos < self.bytes.len() && !is_space(self.bytes[self.pos]) {
-            self.pos += 1;
-        }
+        self.pos = token_end(self.bytes, start);
         Some(Token { text: &self.bytes[start..self.pos], offset: start, line: self.line })
     }
 
@@ -205,11 +203,16 @@ impl<'a> Iterator for Tokens<'a> {
             return None;
         }
         let start = self.pos;
-        while self.pos < self.text.len() && !is_space(self.text[self.pos]) {
-            self.pos += 1;
-        }
+        self.pos = token_end(self.text, start);
         Some(Token { text: &self.text[start..self.pos], offset: self.base + start, line: self.line })
     }
+}
+
+/// The end of the token that starts at `start`: the first white space after it,
+/// or the end of `bytes`.
+#[inline]
+fn token_end(bytes: &[u8], start: usize) -> usize {
+    bytes[start..].iter().position(|&b| is_space(b)).map_or(bytes.len(), |n| start + n)
 }
 
 #[cfg(test)]

@@ -21,8 +21,10 @@
 //!   indices and no degenerate (exactly collinear) triangle. Nothing re-validates it.
 //! - Never performs I/O.
 
+mod hash;
 mod index;
 mod trimesh;
 
+pub use hash::{FastMap, WordHasher};
 pub use index::MeshIndex;
 pub use trimesh::{MeshDiagnostics, MeshError, TriMesh};

@@ -1,5 +1,4 @@
-use std::collections::HashMap;
-use std::hash::{BuildHasherDefault, Hasher};
+use crate::FastMap;
 
 use scallop_geom::{Aabb3, Eps, Point2, Point3, Vec3, predicates::orient2d, tol};
 
@@ -382,37 +381,6 @@ const OUTLIER_SAMPLE: usize = 200_000;
 /// Weld grid cell size in weld distances.
 const WELD_CELL_FACTOR: f64 = 64.0;
 
-/// A multiply-rotate hasher (the Fx hash of rustc) for integer keys: the
-/// keys are our own cell numbers and indices, so no hash flooding can occur,
-/// and iteration order never reaches an output.
-#[derive(Default)]
-struct FxHasher(u64);
-
-impl Hasher for FxHasher {
-    fn finish(&self) -> u64 {
-        self.0
-    }
-    fn write(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            self.write_u64(u64::from(b));
-        }
-    }
-    fn write_u64(&mut self, v: u64) {
-        self.0 = (self.0.rotate_left(5) ^ v).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
-    }
-    fn write_u32(&mut self, v: u32) {
-        self.write_u64(u64::from(v));
-    }
-    fn write_i64(&mut self, v: i64) {
-        self.write_u64(v.cast_unsigned());
-    }
-    fn write_usize(&mut self, v: usize) {
-        self.write_u64(v as u64);
-    }
-}
-
-type FastMap<K, V> = HashMap<K, V, BuildHasherDefault<FxHasher>>;
-
 fn edge_counts(triangles: &[[u32; 3]]) -> (usize, usize) {
     let mut edges: FastMap<(u32, u32), u32> =
         FastMap::with_capacity_and_hasher(triangles.len() * 3 / 2, Default::default());
@@ -428,11 +396,8 @@ fn edge_counts(triangles: &[[u32; 3]]) -> (usize, usize) {
 }
 
 #[cfg(test)]
-#[allow(
-    clippy::unwrap_used,
-    clippy::float_cmp,
-    reason = "tests: a panic is the failure report; exact values are intended"
-)]
+// `unwrap` is allowed in tests by clippy.toml.
+#[allow(clippy::float_cmp, reason = "tests: exact values are intended")]
 mod tests {
     use super::*;
 

@@ -9,6 +9,9 @@
 //! thread and exits, for instruction counts:
 //! `SCALLOP_BENCH_ONCE=1 valgrind --tool=callgrind target/release/deps/dexel-*`.
 
+#[path = "../tests/common/mod.rs"]
+mod common;
+
 use criterion::{Criterion, criterion_group};
 use scallop_cutter::{Cutter, CutterShape};
 use scallop_geom::{Aabb3, Point3, Vec3};
@@ -27,16 +30,7 @@ fn surface(x: f64, y: f64) -> (f64, Vec3) {
 }
 
 fn part() -> DexelPart {
-    let n = 100u32;
-    let s = |i: u32| SIZE * f64::from(i) / f64::from(n);
-    let q = |i: u32, j: u32| Point3::new(s(i), s(j), surface(s(i), s(j)).0);
-    let mut soup = Vec::new();
-    for i in 0..n {
-        for j in 0..n {
-            soup.push([q(i, j), q(i + 1, j), q(i + 1, j + 1)]);
-            soup.push([q(i, j), q(i + 1, j + 1), q(i, j + 1)]);
-        }
-    }
+    let soup = common::height_field(SIZE, 100, |x, y| surface(x, y).0);
     DexelPart::new(&TriMesh::from_soup(&soup).expect("generated mesh is valid").0)
 }
 

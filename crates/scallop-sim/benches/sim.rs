@@ -4,6 +4,9 @@
 //! (36,600 moves), simulated and verified on a 0.05 mm z-map (1,440,000
 //! cells), on 1 and 2 threads. Run: `cargo bench -p scallop-sim --bench sim`.
 
+#[path = "../tests/common/mod.rs"]
+mod common;
+
 use criterion::{Criterion, criterion_group, criterion_main};
 use scallop_cutter::{Cutter, CutterShape, drop_grid};
 use scallop_geom::{Aabb3, Point3};
@@ -18,16 +21,7 @@ fn surface(x: f64, y: f64) -> f64 {
 }
 
 fn part() -> MeshIndex {
-    let n = 120u32;
-    let s = |i: u32| SIZE * f64::from(i) / f64::from(n);
-    let q = |i: u32, j: u32| Point3::new(s(i), s(j), surface(s(i), s(j)));
-    let mut soup = Vec::new();
-    for i in 0..n {
-        for j in 0..n {
-            soup.push([q(i, j), q(i + 1, j), q(i + 1, j + 1)]);
-            soup.push([q(i, j), q(i + 1, j + 1), q(i, j + 1)]);
-        }
-    }
+    let soup = common::height_field(SIZE, 120, surface);
     MeshIndex::build(&TriMesh::from_soup(&soup).expect("generated mesh is valid").0)
 }
 

@@ -62,12 +62,9 @@ pub enum SimError {
     },
     /// Rapid (or retract) moves went through stock.
     #[error(
-        "{count} rapid moves hit the stock; the first is {first} at ({x:.3}, {y:.3}), {depth:.4} mm deep; \
+        "{count} rapid moves hit the stock; the first is {first}; \
          raise the clearance height or turn the move into a feed move",
-        first = hits.first().map_or(MoveId { operation: 0, index: 0 }, |h| h.id),
-        x = hits.first().map_or(0.0, |h| h.at.x),
-        y = hits.first().map_or(0.0, |h| h.at.y),
-        depth = hits.first().map_or(0.0, |h| h.depth)
+        first = FirstPlace(hits.first().map(|h| (h.id, h.at, h.depth)))
     )]
     RapidIntoStock {
         /// Number of rapid moves that removed material.
@@ -77,13 +74,10 @@ pub enum SimError {
     },
     /// The shank or holder touched the in-process stock.
     #[error(
-        "{count} moves drive the {what} into the stock; the first is {first} at ({x:.3}, {y:.3}), {depth:.4} mm deep; \
+        "{count} moves drive the {what} into the stock; the first is {first}; \
          use longer flutes or a longer shank, or cut in more stepdowns",
-        what = collisions.first().map_or("shank", |c| c.part.name()),
-        first = collisions.first().map_or(MoveId { operation: 0, index: 0 }, |c| c.id),
-        x = collisions.first().map_or(0.0, |c| c.at.x),
-        y = collisions.first().map_or(0.0, |c| c.at.y),
-        depth = collisions.first().map_or(0.0, |c| c.depth)
+        what = first_part(collisions),
+        first = first_collision(collisions)
     )]
     HolderCollision {
         /// Number of colliding moves.
@@ -93,14 +87,11 @@ pub enum SimError {
     },
     /// The shank or holder touched the design part itself.
     #[error(
-        "{count} moves drive the {what} into the part; the first is {first} at ({x:.3}, {y:.3}), {depth:.4} mm deep \
+        "{count} moves drive the {what} into the part; the first is {first} \
          (part surface above the {what}'s lower face); use a tool with longer flutes or a longer reach, \
          or keep the passes farther from that wall",
-        what = collisions.first().map_or("shank", |c| c.part.name()),
-        first = collisions.first().map_or(MoveId { operation: 0, index: 0 }, |c| c.id),
-        x = collisions.first().map_or(0.0, |c| c.at.x),
-        y = collisions.first().map_or(0.0, |c| c.at.y),
-        depth = collisions.first().map_or(0.0, |c| c.depth)
+        what = first_part(collisions),
+        first = first_collision(collisions)
     )]
     PartCollision {
         /// Number of colliding moves (per part of the tool).
@@ -217,4 +208,25 @@ pub enum SimError {
         /// The collisions, in program order.
         collisions: Vec<DexelCollision>,
     },
+}
+
+/// The first place of a list of hits or collisions, shown as
+/// `MOVE at (x, y), DEPTH mm deep` (move 0 at the origin for an empty list,
+/// which the simulator never reports).
+struct FirstPlace(Option<(MoveId, Point2, f64)>);
+
+impl std::fmt::Display for FirstPlace {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let (id, at, depth) = self.0.unwrap_or((MoveId { operation: 0, index: 0 }, Point2::origin(), 0.0));
+        write!(f, "{id} at ({:.3}, {:.3}), {depth:.4} mm deep", at.x, at.y)
+    }
+}
+
+fn first_collision(collisions: &[Collision]) -> FirstPlace {
+    FirstPlace(collisions.first().map(|c| (c.id, c.at, c.depth)))
+}
+
+/// The part of the tool of the first collision ("shank" for an empty list).
+fn first_part(collisions: &[Collision]) -> &'static str {
+    collisions.first().map_or("shank", |c| c.part.name())
 }

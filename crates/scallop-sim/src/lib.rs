@@ -75,6 +75,8 @@
 mod dexel;
 mod envelope;
 mod error;
+#[cfg(test)]
+mod test_support;
 pub mod tol;
 mod verify;
 mod view;

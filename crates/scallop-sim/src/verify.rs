@@ -255,37 +255,10 @@ pub(crate) fn part_surface(zmap: &ZMap, part: &MeshIndex) -> Vec<(f64, f64)> {
 /// the same way on any thread count.
 pub(crate) fn edge_distance2(inside: &[bool], nx: usize, ny: usize, cell_x: f64, cell_y: f64) -> Vec<f64> {
     // Along rows: the sites are the outside cells and the two virtual ones.
-    let mut rows = vec![0.0; nx * ny];
-    rows.par_chunks_mut(nx).enumerate().for_each_init(
-        || (Vec::new(), Vec::new()),
-        |(sites, env), (j, out)| {
-            sites.clear();
-            sites.push((-1.0, 0.0));
-            for i in 0..nx {
-                if !inside[j * nx + i] {
-                    // Cell indices far below 2^52: exact.
-                    sites.push((i as f64, 0.0));
-                }
-            }
-            sites.push((nx as f64, 0.0));
-            lower_envelope(sites, cell_x, env, out);
-        },
-    );
+    let rows = envelope_pass(nx, ny, cell_x, |j, i| (!inside[j * nx + i]).then_some(0.0));
     // Along columns: the sites are every cell with its row distance, plus the
     // two virtual outside cells.
-    let mut columns = vec![0.0; nx * ny];
-    columns.par_chunks_mut(ny).enumerate().for_each_init(
-        || (Vec::new(), Vec::new()),
-        |(sites, env), (i, out)| {
-            sites.clear();
-            sites.push((-1.0, 0.0));
-            for j in 0..ny {
-                sites.push((j as f64, rows[j * nx + i]));
-            }
-            sites.push((ny as f64, 0.0));
-            lower_envelope(sites, cell_y, env, out);
-        },
-    );
+    let columns = envelope_pass(ny, nx, cell_y, |i, j| Some(rows[j * nx + i]));
     let mut d2 = vec![0.0; nx * ny];
     for (i, column) in columns.chunks(ny).enumerate() {
         for (j, &v) in column.iter().enumerate() {
@@ -293,6 +266,30 @@ pub(crate) fn edge_distance2(inside: &[bool], nx: usize, ny: usize, cell_x: f64,
         }
     }
     d2
+}
+
+/// One pass of the distance transform over `lines` lines of `n` cells `step`
+/// apart: each line's lower envelope ([`lower_envelope`]) of the sites
+/// `(k, f)` with `site(line, k) == Some(f)`, plus the two virtual outside
+/// cells at -1 and `n`. Lines in parallel, line after line in the result.
+fn envelope_pass(n: usize, lines: usize, step: f64, site: impl Fn(usize, usize) -> Option<f64> + Sync) -> Vec<f64> {
+    let mut out = vec![0.0; n * lines];
+    out.par_chunks_mut(n).enumerate().for_each_init(
+        || (Vec::new(), Vec::new()),
+        |(sites, env), (line, out)| {
+            sites.clear();
+            sites.push((-1.0, 0.0));
+            for k in 0..n {
+                if let Some(f) = site(line, k) {
+                    // Cell indices far below 2^52: exact.
+                    sites.push((k as f64, f));
+                }
+            }
+            sites.push((n as f64, 0.0));
+            lower_envelope(sites, step, env, out);
+        },
+    );
+    out
 }
 
 /// `out[q] = min over sites (s, f) of ((q - s) step)^2 + f` for q in 0..out.len();

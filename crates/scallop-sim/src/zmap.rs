@@ -139,12 +139,7 @@ impl CutReport {
     /// ```
     #[must_use]
     pub fn air_cut_share(&self) -> f64 {
-        if self.feed_moves == 0 {
-            0.0
-        } else {
-            // Counts far below 2^52: exact conversions.
-            self.air_feed_moves as f64 / self.feed_moves as f64
-        }
+        air_share(self.air_feed_moves, self.feed_moves)
     }
 
     /// The safety verdict of the cut: rapid hits first, then collisions.
@@ -153,17 +148,38 @@ impl CutReport {
     /// [`SimError::RapidIntoStock`] when a rapid or retract removed stock,
     /// [`SimError::HolderCollision`] when the shank or holder touched it.
     pub fn check(&self) -> Result<(), SimError> {
-        if !self.rapid_hits.is_empty() {
-            return Err(SimError::RapidIntoStock { count: self.rapid_hits.len(), hits: self.rapid_hits.clone() });
-        }
-        if !self.collisions.is_empty() {
-            return Err(SimError::HolderCollision {
-                count: self.collisions.len(),
-                collisions: self.collisions.clone(),
-            });
-        }
-        Ok(())
+        safety_verdict(&self.rapid_hits, &self.collisions, |count, collisions| SimError::HolderCollision {
+            count,
+            collisions,
+        })
     }
+}
+
+/// Share of `feed` moves that cut air, in [0, 1] (0 when there are none): the
+/// [`CutReport::air_cut_share`] of both stocks.
+pub(crate) fn air_share(air: usize, feed: usize) -> f64 {
+    if feed == 0 {
+        0.0
+    } else {
+        // Counts far below 2^52: exact conversions.
+        air as f64 / feed as f64
+    }
+}
+
+/// The safety verdict of a cut on either stock: rapid hits first, then the
+/// collisions as `collision_error(count, collisions)`.
+pub(crate) fn safety_verdict<C: Clone>(
+    rapid_hits: &[RapidHit],
+    collisions: &[C],
+    collision_error: impl FnOnce(usize, Vec<C>) -> SimError,
+) -> Result<(), SimError> {
+    if !rapid_hits.is_empty() {
+        return Err(SimError::RapidIntoStock { count: rapid_hits.len(), hits: rapid_hits.to_vec() });
+    }
+    if !collisions.is_empty() {
+        return Err(collision_error(collisions.len(), collisions.to_vec()));
+    }
+    Ok(())
 }
 
 /// A height-field stock: one z per cell of a regular XY grid over a stock box,
@@ -264,6 +280,31 @@ struct BandOutput {
     collisions: Vec<(u32, ToolPart, f64, usize)>,
 }
 
+/// Checks the box and the resolution of a new stock.
+///
+/// # Errors
+/// [`SimError::BadResolution`], [`SimError::BadStock`] (empty or not finite).
+pub(crate) fn check_stock(stock: &Aabb3, resolution: f64) -> Result<(), SimError> {
+    if !(resolution.is_finite() && resolution > 0.0) {
+        return Err(SimError::BadResolution { resolution });
+    }
+    let size = stock.size();
+    let finite = stock.min.coords.iter().chain(stock.max.coords.iter()).all(|c| c.is_finite());
+    if !(finite && size.x > 0.0 && size.y > 0.0 && size.z > 0.0) {
+        return Err(SimError::BadStock { min: stock.min.coords.into(), max: stock.max.coords.into() });
+    }
+    Ok(())
+}
+
+/// Number of cells (at least 1) of a stock grid along a width `w` (mm):
+/// `ceil(w / resolution)`, except that a width that is a whole number of cells
+/// up to rounding is not rounded up.
+pub(crate) fn cells_along(w: f64, resolution: f64) -> f64 {
+    let n = w / resolution;
+    let n = if (n - n.round()).abs() <= GRID_SNAP * n { n.round() } else { n.ceil() };
+    n.max(1.0)
+}
+
 impl ZMap {
     /// A full stock box sampled at `resolution` (mm): `ceil(width / resolution)`
     /// cells along x (the same along y), each of width `width / nx <= resolution`,
@@ -273,21 +314,9 @@ impl ZMap {
     /// [`SimError::BadResolution`], [`SimError::BadStock`] (empty or not finite),
     /// [`SimError::TooManyCells`] beyond [`MAX_CELLS`].
     pub fn new(stock: Aabb3, resolution: f64) -> Result<ZMap, SimError> {
-        if !(resolution.is_finite() && resolution > 0.0) {
-            return Err(SimError::BadResolution { resolution });
-        }
+        check_stock(&stock, resolution)?;
         let size = stock.size();
-        let finite = stock.min.coords.iter().chain(stock.max.coords.iter()).all(|c| c.is_finite());
-        if !(finite && size.x > 0.0 && size.y > 0.0 && size.z > 0.0) {
-            return Err(SimError::BadStock { min: stock.min.coords.into(), max: stock.max.coords.into() });
-        }
-        let count = |w: f64| {
-            let n = w / resolution;
-            // A width that is a whole number of cells up to rounding is not rounded up.
-            let n = if (n - n.round()).abs() <= GRID_SNAP * n { n.round() } else { n.ceil() };
-            n.max(1.0)
-        };
-        let (fx, fy) = (count(size.x), count(size.y));
+        let (fx, fy) = (cells_along(size.x, resolution), cells_along(size.y, resolution));
         let limit = MAX_CELLS as f64;
         if fx * fy > limit {
             // Saturating float-to-int conversions: only used in the message.

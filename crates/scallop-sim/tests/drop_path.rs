@@ -5,6 +5,8 @@
 
 #![allow(clippy::unwrap_used, clippy::float_cmp, reason = "tests fail loudly by design; exact cases compare exactly")]
 
+mod common;
+
 use scallop_cutter::{Cutter, CutterShape, drop_grid};
 use scallop_geom::{Aabb3, Point3};
 use scallop_mesh::{MeshIndex, TriMesh};
@@ -19,16 +21,7 @@ fn surface(x: f64, y: f64) -> f64 {
 }
 
 fn wavy() -> MeshIndex {
-    let n = 60u32;
-    let s = |i: u32| SIZE * f64::from(i) / f64::from(n);
-    let q = |i: u32, j: u32| Point3::new(s(i), s(j), surface(s(i), s(j)));
-    let mut soup = Vec::new();
-    for i in 0..n {
-        for j in 0..n {
-            soup.push([q(i, j), q(i + 1, j), q(i + 1, j + 1)]);
-            soup.push([q(i, j), q(i + 1, j + 1), q(i, j + 1)]);
-        }
-    }
+    let soup = common::height_field(SIZE, 60, surface);
     MeshIndex::build(&TriMesh::from_soup(&soup).unwrap().0)
 }
 

@@ -6,6 +6,8 @@
 
 #![allow(clippy::unwrap_used, clippy::float_cmp, reason = "tests fail loudly by design; exact cases compare exactly")]
 
+mod common;
+
 use proptest::prelude::*;
 use scallop_cutter::CutterShape;
 use scallop_geom::{Point2, Point3};
@@ -51,12 +53,7 @@ fn oracle(shape: &CutterShape, a: &Point3, b: &Point3, p: &Point2) -> Option<f64
 }
 
 fn shapes() -> impl Strategy<Value = CutterShape> {
-    prop_oneof![
-        (0.5..5.0f64).prop_map(|radius| CutterShape::Flat { radius }),
-        (0.5..5.0f64).prop_map(|radius| CutterShape::Ball { radius }),
-        (0.5..5.0f64, 0.05..1.0f64).prop_map(|(radius, k)| CutterShape::Bull { radius, corner: k * radius }),
-        (0.5..5.0f64, 0.1..1.4f64).prop_map(|(radius, half_angle)| CutterShape::Cone { radius, half_angle }),
-    ]
+    common::shapes(0.5..5.0, 0.05..1.0, 0.1..1.4)
 }
 
 fn point() -> impl Strategy<Value = Point3> {

@@ -5,6 +5,8 @@
 
 #![allow(clippy::unwrap_used, reason = "tests fail loudly by design")]
 
+mod common;
+
 use proptest::prelude::*;
 use scallop_cutter::{Cutter, CutterShape};
 use scallop_geom::{Aabb3, Point3};
@@ -12,12 +14,7 @@ use scallop_sim::{ZMap, swept_floor};
 use scallop_toolpath::{Move, MoveKind, Toolpath};
 
 fn shapes() -> impl Strategy<Value = CutterShape> {
-    prop_oneof![
-        (0.3..3.0f64).prop_map(|radius| CutterShape::Flat { radius }),
-        (0.3..3.0f64).prop_map(|radius| CutterShape::Ball { radius }),
-        (0.3..3.0f64, 0.1..1.0f64).prop_map(|(radius, k)| CutterShape::Bull { radius, corner: k * radius }),
-        (0.3..3.0f64, 0.2..1.4f64).prop_map(|(radius, half_angle)| CutterShape::Cone { radius, half_angle }),
-    ]
+    common::shapes(0.3..3.0, 0.1..1.0, 0.2..1.4)
 }
 
 fn points() -> impl Strategy<Value = Vec<Point3>> {

@@ -211,11 +211,8 @@ fn bull_maximiser(a: f64, r: f64, m: f64, d: f64, s_lo: f64, s_hi: f64, s_start:
 }
 
 #[cfg(test)]
-#[allow(
-    clippy::unwrap_used,
-    clippy::float_cmp,
-    reason = "tests: a panic is the failure report; exact values are intended"
-)]
+// `unwrap` is allowed in tests by clippy.toml.
+#[allow(clippy::float_cmp, reason = "tests: exact values are intended")]
 mod tests {
     use super::*;
 

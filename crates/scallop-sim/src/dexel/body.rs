@@ -386,38 +386,39 @@ mod tests {
         rho <= r
     }
 
+    /// A line through a random point of `[-scale, scale]^2 x [2 - scale, 2 + scale]`
+    /// in a random direction: `(origin, unit direction)`.
+    fn random_line(rng: &mut crate::test_support::Lcg, scale: f64) -> (Vec3, Vec3) {
+        let w0 = Vec3::new(scale * rng.signed(), scale * rng.signed(), scale * rng.signed() + 2.0);
+        (w0, Vec3::new(rng.signed(), rng.signed(), rng.signed()).normalize())
+    }
+
+    /// Samples the line `w0 + s d` every 0.003 mm for `|s| < 0.003 n`: every
+    /// sample `inside` the solid lies in `span`.
+    fn assert_samples_in_span(w0: Vec3, d: Vec3, n: i32, span: Option<Span>, inside: impl Fn(&Vec3) -> bool) {
+        for k in -n..n {
+            let s = f64::from(k) * 0.003;
+            if inside(&(w0 + s * d)) {
+                let sp = span.unwrap();
+                assert!(s >= sp.s0 - 1e-9 && s <= sp.s1 + 1e-9, "s {s} span {sp:?}");
+            }
+        }
+    }
+
     #[test]
     fn hits_match_the_profile() {
-        let shapes = [
-            CutterShape::Flat { radius: 2.0 },
-            CutterShape::Ball { radius: 2.0 },
-            CutterShape::Bull { radius: 2.0, corner: 0.7 },
-            CutterShape::Cone { radius: 2.0, half_angle: 0.5 },
-        ];
+        let shapes = crate::test_support::shapes(2.0, 0.7, 0.5);
         let a = Vec3::new(0.3, -0.4, 0.8).normalize();
-        let mut state = 12345u64;
-        let mut rnd = || {
-            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
+        let mut rng = crate::test_support::Lcg(12345);
         for shape in shapes {
             let cutter = Cutter::new(shape, 5.0).unwrap();
             let body = Body::flutes(&cutter);
             for _ in 0..300 {
-                let w0 = Vec3::new(4.0 * rnd(), 4.0 * rnd(), 4.0 * rnd() + 2.0);
-                let d = Vec3::new(rnd(), rnd(), rnd()).normalize();
-                let line = Line::new(a, w0, d);
-                let span = body.hit(&line);
-                // Sample the line densely; every inside sample lies in the span
-                // and the span's ends are (nearly) inside.
-                for k in -4000..4000 {
-                    let s = f64::from(k) * 0.003;
-                    let q = w0 + s * d;
-                    if inside(&shape, 5.0, &a, &q) {
-                        let sp = span.unwrap();
-                        assert!(s >= sp.s0 - 1e-9 && s <= sp.s1 + 1e-9, "{shape:?} s {s} span {sp:?}");
-                    }
-                }
+                let (w0, d) = random_line(&mut rng, 4.0);
+                let span = body.hit(&Line::new(a, w0, d));
+                // Every inside sample lies in the span and the span's ends are
+                // (nearly) inside.
+                assert_samples_in_span(w0, d, 4000, span, |q| inside(&shape, 5.0, &a, q));
                 if let Some(sp) = span {
                     for s in [sp.s0, sp.s1, 0.5 * (sp.s0 + sp.s1)] {
                         let q = w0 + s * d;
@@ -436,26 +437,15 @@ mod tests {
         // A holder taper: radius 2 at h = 1 down to 1 at h = 3.
         let piece = Piece::Frustum { h0: 1.0, h1: 3.0, r0: 2.0, k: -0.5 };
         let a = Vec3::new(0.6, 0.0, 0.8);
-        let mut state = 7u64;
-        let mut rnd = || {
-            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
+        let mut rng = crate::test_support::Lcg(7);
         for _ in 0..500 {
-            let w0 = Vec3::new(3.0 * rnd(), 3.0 * rnd(), 3.0 * rnd() + 2.0);
-            let d = Vec3::new(rnd(), rnd(), rnd()).normalize();
-            let line = Line::new(a, w0, d);
-            let span = piece.hit(&line);
-            for k in -3000..3000 {
-                let s = f64::from(k) * 0.003;
-                let q = w0 + s * d;
+            let (w0, d) = random_line(&mut rng, 3.0);
+            let span = piece.hit(&Line::new(a, w0, d));
+            assert_samples_in_span(w0, d, 3000, span, |q| {
                 let h = q.dot(&a);
                 let rho = (q - h * a).norm();
-                if (1.0..=3.0).contains(&h) && rho <= 2.0 - 0.5 * (h - 1.0) {
-                    let sp = span.unwrap();
-                    assert!(s >= sp.s0 - 1e-9 && s <= sp.s1 + 1e-9, "s {s} span {sp:?}");
-                }
-            }
+                (1.0..=3.0).contains(&h) && rho <= 2.0 - 0.5 * (h - 1.0)
+            });
         }
     }
 

@@ -19,7 +19,7 @@ use scallop_geom::{Aabb3, Eps, Point2, Point3, Vec3};
 use scallop_toolpath::{ArcXY, MoveKind, Toolpath};
 
 use crate::envelope::SweptMove;
-use crate::tol::{ARC_SAGITTA, GRID_SNAP};
+use crate::tol::ARC_SAGITTA;
 use crate::{MoveId, RapidHit, SimError, ToolPart};
 use body::Body;
 use sweep::Sweep;
@@ -150,12 +150,7 @@ impl DexelReport {
     /// Share of feed moves that cut air, in [0, 1] (0 when there are none).
     #[must_use]
     pub fn air_cut_share(&self) -> f64 {
-        if self.feed_moves == 0 {
-            0.0
-        } else {
-            // Counts far below 2^52: exact conversions.
-            self.air_feed_moves as f64 / self.feed_moves as f64
-        }
+        crate::zmap::air_share(self.air_feed_moves, self.feed_moves)
     }
 
     /// The safety verdict of the cut: rapid hits first, then collisions.
@@ -163,13 +158,10 @@ impl DexelReport {
     /// # Errors
     /// [`SimError::RapidIntoStock`], then [`SimError::DexelCollision`].
     pub fn check(&self) -> Result<(), SimError> {
-        if !self.rapid_hits.is_empty() {
-            return Err(SimError::RapidIntoStock { count: self.rapid_hits.len(), hits: self.rapid_hits.clone() });
-        }
-        if !self.collisions.is_empty() {
-            return Err(SimError::DexelCollision { count: self.collisions.len(), collisions: self.collisions.clone() });
-        }
-        Ok(())
+        crate::zmap::safety_verdict(&self.rapid_hits, &self.collisions, |count, collisions| SimError::DexelCollision {
+            count,
+            collisions,
+        })
     }
 }
 
@@ -340,20 +332,9 @@ impl DexelStock {
     /// [`SimError::BadResolution`], [`SimError::BadStock`],
     /// [`SimError::TooManyRays`] beyond [`MAX_RAYS`].
     pub fn new(stock: Aabb3, resolution: f64) -> Result<DexelStock, SimError> {
-        if !(resolution.is_finite() && resolution > 0.0) {
-            return Err(SimError::BadResolution { resolution });
-        }
+        crate::zmap::check_stock(&stock, resolution)?;
         let size = stock.size();
-        let finite = stock.min.coords.iter().chain(stock.max.coords.iter()).all(|c| c.is_finite());
-        if !(finite && size.x > 0.0 && size.y > 0.0 && size.z > 0.0) {
-            return Err(SimError::BadStock { min: stock.min.coords.into(), max: stock.max.coords.into() });
-        }
-        let count = |w: f64| {
-            let n = w / resolution;
-            let n = if (n - n.round()).abs() <= GRID_SNAP * n { n.round() } else { n.ceil() };
-            n.max(1.0)
-        };
-        let f = [count(size.x), count(size.y), count(size.z)];
+        let f = [size.x, size.y, size.z].map(|w| crate::zmap::cells_along(w, resolution));
         let total = f[0] * f[1] + f[1] * f[2] + f[2] * f[0];
         if total > MAX_RAYS as f64 {
             // Saturating conversion: only used in the message.
@@ -603,15 +584,7 @@ impl DexelStock {
         let operation = self.operations;
         let next = operation.checked_add(1).ok_or(SimError::TooManyMoves { moves: moves.len() })?;
         let flutes = Body::flutes(cutter);
-        let mut guards: Vec<(Body, ToolPart)> = Vec::new();
-        if options.check_collisions {
-            guards.push((Body::shank(cutter), ToolPart::Shank));
-            let mut i = 0;
-            while let Some(b) = Body::holder(cutter, i) {
-                guards.push((b, ToolPart::Holder(i)));
-                i += 1;
-            }
-        }
+        let guards = if options.check_collisions { guards(cutter) } else { Vec::new() };
         let steps = self.steps(operation, &flutes, moves, options)?;
         self.operations = next;
         // Boxes of each step: flutes, then each guard.
@@ -643,9 +616,10 @@ impl DexelStock {
         let bands: usize = (0..3).map(|axis| self.grid(axis).1.div_ceil(BAND_ROWS)).sum();
         let done = AtomicUsize::new(0);
         let tick = || progress(done.fetch_add(1, Ordering::Relaxed) + 1, bands);
+        let removal = FamilyCut::removal(&flutes, &guards, &steps, &boxes, &unions);
         for axis in 0..3 {
             let columns = if axis == 2 { Some((columns.as_slice(), flutes_top)) } else { None };
-            let outputs = self.cut_family(axis, &flutes, &guards, &steps, &boxes, &unions, true, columns, &tick);
+            let outputs = self.cut_family(axis, &FamilyCut { columns, ..removal }, &tick);
             for out in outputs {
                 for (k, volume, longest, at) in out.removed {
                     let step = &steps[k as usize];
@@ -746,12 +720,7 @@ impl DexelStock {
             return Err(SimError::BadTolerance { what: "axis tolerance", value: options.axis_tolerance });
         }
         let flutes = Body::flutes(cutter);
-        let mut guards: Vec<(Body, ToolPart)> = vec![(Body::shank(cutter), ToolPart::Shank)];
-        let mut i = 0;
-        while let Some(b) = Body::holder(cutter, i) {
-            guards.push((b, ToolPart::Holder(i)));
-            i += 1;
-        }
+        let guards = guards(cutter);
         let steps = self.steps(operation, &flutes, moves, options)?;
         let boxes: Vec<Vec<(Point3, Point3)>> = steps
             .iter()
@@ -775,11 +744,13 @@ impl DexelStock {
         let resolution = self.cell.iter().fold(0.0f64, |a, &b| a.max(b));
         let mut solid = DexelStock::new(Aabb3 { min: lo, max: hi }, resolution)?;
         let mut collided: Vec<Vec<(ToolPart, f64, Point3)>> = vec![Vec::new(); moves.len()];
+        // Only the guards are checked: nothing is removed.
+        let check = FamilyCut { remove: false, ..FamilyCut::removal(&flutes, &guards, &steps, &boxes, &unions) };
         for axis in 0..3 {
             solid.rays[axis] = part.family_material(&solid, axis).into_iter().map(Ray::Cut).collect();
             // The part's epsilon is the stock's: the same penetrations count.
             solid.eps = self.eps;
-            let outputs = solid.cut_family(axis, &flutes, &guards, &steps, &boxes, &unions, false, None, &|| {});
+            let outputs = solid.cut_family(axis, &check, &|| {});
             for out in outputs {
                 merge_collisions(&mut collided, &steps, out.collisions);
             }
@@ -791,19 +762,7 @@ impl DexelStock {
 
     /// One family: bands of rays in parallel, each applying its steps in
     /// order; `remove == false` only checks the guards (nothing is cut).
-    #[allow(clippy::too_many_arguments)] // private; the pieces of one cut.
-    fn cut_family(
-        &mut self,
-        axis: usize,
-        flutes: &Body,
-        guards: &[(Body, ToolPart)],
-        steps: &[Step],
-        boxes: &[Vec<(Point3, Point3)>],
-        unions: &[(Point3, Point3)],
-        remove: bool,
-        columns: Option<Columns<'_>>,
-        tick: &(dyn Fn() + Sync),
-    ) -> Vec<BandOutput> {
+    fn cut_family(&mut self, axis: usize, cut: &FamilyCut<'_>, tick: &(dyn Fn() + Sync)) -> Vec<BandOutput> {
         let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
         let (nu, nv) = (self.n[u], self.n[v]);
         let geo = Family {
@@ -822,7 +781,7 @@ impl DexelStock {
         // Steps per band, in program order.
         let bands = nv.div_ceil(BAND_ROWS);
         let mut members: Vec<Vec<u32>> = vec![Vec::new(); bands];
-        for (k, (lo, hi)) in unions.iter().enumerate() {
+        for (k, (lo, hi)) in cut.unions.iter().enumerate() {
             if let Some((a, b)) = geo.index_range(v, lo[v], hi[v]) {
                 for m in &mut members[a / BAND_ROWS..=b / BAND_ROWS] {
                     // k < moves <= u32::MAX (checked by the caller).
@@ -835,7 +794,7 @@ impl DexelStock {
             .zip(members.par_iter())
             .enumerate()
             .map(|(band, (rays, ids))| {
-                let out = geo.cut_band(band, rays, ids, flutes, guards, steps, boxes, unions, remove, columns);
+                let out = geo.cut_band(band, rays, ids, cut);
                 tick();
                 out
             })
@@ -910,6 +869,46 @@ fn collision_list(operation: u32, collided: &[Vec<(ToolPart, f64, Point3)>]) -> 
 /// axis is +Z, and the flute length.
 type Columns<'a> = (&'a [Option<SweptMove>], f64);
 
+/// What one family's bands apply, step by step: the flutes and the guarded
+/// parts of the tool (shank, holder), the fixed-axis steps with their boxes
+/// (flutes first, then one per guard) and the union of those boxes;
+/// `remove == false` only checks the guards; `columns`: the Z rays of vertical
+/// steps in closed form, with the flutes' top.
+#[derive(Clone, Copy)]
+struct FamilyCut<'a> {
+    flutes: &'a Body,
+    guards: &'a [(Body, ToolPart)],
+    steps: &'a [Step],
+    boxes: &'a [Vec<(Point3, Point3)>],
+    unions: &'a [(Point3, Point3)],
+    remove: bool,
+    columns: Option<Columns<'a>>,
+}
+
+impl<'a> FamilyCut<'a> {
+    /// Removal by the flutes and the guards' check, every ray by the general sweep.
+    fn removal(
+        flutes: &'a Body,
+        guards: &'a [(Body, ToolPart)],
+        steps: &'a [Step],
+        boxes: &'a [Vec<(Point3, Point3)>],
+        unions: &'a [(Point3, Point3)],
+    ) -> FamilyCut<'a> {
+        FamilyCut { flutes, guards, steps, boxes, unions, remove: true, columns: None }
+    }
+}
+
+/// The parts of the tool checked for collisions: the shank, then each holder piece.
+fn guards(cutter: &Cutter) -> Vec<(Body, ToolPart)> {
+    let mut guards = vec![(Body::shank(cutter), ToolPart::Shank)];
+    let mut i = 0;
+    while let Some(b) = Body::holder(cutter, i) {
+        guards.push((b, ToolPart::Holder(i)));
+        i += 1;
+    }
+    guards
+}
+
 /// What a band found, sparse per step.
 #[derive(Default)]
 struct BandOutput {
@@ -949,20 +948,8 @@ impl Family {
         o
     }
 
-    #[allow(clippy::too_many_arguments)] // one private call site; the pieces are unrelated borrows.
-    fn cut_band(
-        &self,
-        band: usize,
-        rays: &mut [Ray],
-        ids: &[u32],
-        flutes: &Body,
-        guards: &[(Body, ToolPart)],
-        steps: &[Step],
-        boxes: &[Vec<(Point3, Point3)>],
-        unions: &[(Point3, Point3)],
-        remove: bool,
-        columns: Option<Columns<'_>>,
-    ) -> BandOutput {
+    fn cut_band(&self, band: usize, rays: &mut [Ray], ids: &[u32], cut: &FamilyCut<'_>) -> BandOutput {
+        let FamilyCut { flutes, guards, steps, boxes, unions, remove, columns } = *cut;
         let row0 = band * BAND_ROWS;
         let rows = rays.len() / self.nu;
         let mut out = BandOutput::default();
@@ -1040,7 +1027,7 @@ impl Family {
 #[cfg(test)]
 #[allow(clippy::unwrap_used, reason = "tests: a panic is the failure report")]
 mod tests {
-    use scallop_cutter::{Cutter, CutterShape};
+    use scallop_cutter::Cutter;
 
     use super::*;
 
@@ -1050,18 +1037,9 @@ mod tests {
     /// within the sweep's tolerance, and the same misses.
     #[test]
     fn vertical_columns_match_the_general_sweep() {
-        let shapes = [
-            CutterShape::Flat { radius: 2.0 },
-            CutterShape::Ball { radius: 2.0 },
-            CutterShape::Bull { radius: 2.0, corner: 0.6 },
-            CutterShape::Cone { radius: 2.0, half_angle: 0.7 },
-        ];
-        let mut state = 7u64;
-        let mut next = || {
-            state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
-            // 53 random bits in [0, 1).
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let shapes = crate::test_support::shapes(2.0, 0.6, 0.7);
+        let mut rng = crate::test_support::Lcg(7);
+        let mut next = || rng.unit();
         let mut both = 0;
         for shape in shapes {
             let cutter = Cutter::new(shape, 7.0).unwrap();

@@ -215,34 +215,12 @@ impl Sweep {
             if mid <= lo || mid >= hi {
                 break;
             }
-            match self.at(body, o, d, mid) {
-                None => {
-                    // Off the interval of positions that meet the line: it
-                    // lies on the side of the known position.
-                    if mid < t_f {
-                        lo = mid;
-                        at_lo = None;
-                    } else {
-                        hi = mid;
-                        at_hi = None;
-                    }
-                }
-                Some(s) => {
-                    let p = probe(mid, &s);
-                    best = best.min(p.value);
-                    if p.slope.is_nan() {
-                        // Grazing: the line touches the body there without
-                        // entering it, so `mid` bounds the positions that
-                        // meet the line; they lie on the known position's side.
-                        if mid < t_f {
-                            lo = mid;
-                            at_lo = None;
-                        } else {
-                            hi = mid;
-                            at_hi = None;
-                        }
-                        continue;
-                    }
+            let probed = self.at(body, o, d, mid).map(|s| probe(mid, &s));
+            if let Some(p) = probed {
+                best = best.min(p.value);
+            }
+            match probed {
+                Some(p) if !p.slope.is_nan() => {
                     t_f = mid;
                     if p.slope > 0.0 {
                         hi = mid;
@@ -252,6 +230,24 @@ impl Sweep {
                         at_lo = p.slope.is_finite().then_some(p);
                     } else {
                         break;
+                    }
+                }
+                _ => {
+                    // Off the interval of positions that meet the line
+                    // (`None`), or grazing (a NaN slope: the line touches the
+                    // body there without entering it): `mid` bounds the
+                    // positions that meet the line; they lie on the side of
+                    // the known position.
+                    if mid < t_f {
+                        lo = mid;
+                        at_lo = None;
+                    } else {
+                        hi = mid;
+                        at_hi = None;
+                    }
+                    if probed.is_some() {
+                        // A graze keeps the kind of the next step.
+                        continue;
                     }
                 }
             }
@@ -264,7 +260,7 @@ impl Sweep {
 #[cfg(test)]
 #[allow(clippy::unwrap_used, reason = "tests: a panic is the failure report")]
 mod tests {
-    use scallop_cutter::{Cutter, CutterShape};
+    use scallop_cutter::Cutter;
 
     use super::*;
 
@@ -282,17 +278,9 @@ mod tests {
 
     #[test]
     fn sweeps_match_dense_sampling() {
-        let shapes = [
-            CutterShape::Flat { radius: 1.5 },
-            CutterShape::Ball { radius: 1.5 },
-            CutterShape::Bull { radius: 1.5, corner: 0.5 },
-            CutterShape::Cone { radius: 1.5, half_angle: 0.6 },
-        ];
-        let mut state = 99u64;
-        let mut rnd = || {
-            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
+        let shapes = crate::test_support::shapes(1.5, 0.5, 0.6);
+        let mut rng = crate::test_support::Lcg(99);
+        let mut rnd = || rng.signed();
         for shape in shapes {
             let body = Body::flutes(&Cutter::new(shape, 4.0).unwrap());
             for case in 0..400 {
