@@ -288,11 +288,7 @@ impl<'a> Planner<'a> {
             let quarters = [0.75 * a.t + 0.25 * b.t, 0.25 * a.t + 0.75 * b.t];
             let [q1, q3] = quarters.map(|t| Sample::new(t, self.drop_at(line.at(t))));
             let rises = |q: &Sample, f: f64| q.cl.tip.z - (a.cl.tip.z + f * (b.cl.tip.z - a.cl.tip.z)) > self.gouge_tol;
-            if rises(&q1, 0.25)
-                || rises(&q3, 0.75)
-                || !self.is_inside(&q1.cl, scratch)
-                || !self.is_inside(&q3.cl, scratch)
-            {
+            if rises(&q1, 0.25) || rises(&q3, 0.75) {
                 self.refine(line, a, mid, Some(q1), out, scratch);
                 self.refine(line, mid, b, Some(q3), out, scratch);
                 return;
