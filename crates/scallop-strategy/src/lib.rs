@@ -79,8 +79,9 @@
 //! - **No gouge between cutter locations.** A straight move between two exact
 //!   cutter locations gouges only where the CL surface rises above it (convex
 //!   crests, the top of steep descents). A step (of a pass or a link) is also
-//!   bisected while the CL midpoint lies more than `GOUGE_MIDPOINT_SHARE *
-//!   SAMPLING_SHARE * path` above the chord, as OpenCAMLib's adaptive path
+//!   bisected while the CL surface at its middle or quarter points (an
+//!   inflection can put the middle on the chord) lies more than
+//!   `GOUGE_MIDPOINT_SHARE * SAMPLING_SHARE * path` above the chord, as OpenCAMLib's adaptive path
 //!   drop-cutter (`AdaptivePathDropCutter`) subdivides; where the CL surface is
 //!   concave over the step the chord is then nowhere deeper than
 //!   `SAMPLING_SHARE * path` under it. A jump of the CL surface (a wall) is
@@ -89,7 +90,9 @@
 //!   vertically. With the one-sided merging, every feed and link move lies at
 //!   most `SAMPLING_SHARE * path` below the exact drop-cutter surface (property
 //!   test `tests/prop_gouge.rs`, 16 points a move, on cliffs, hemispheres and
-//!   steps).
+//!   steps); a bump of the CL surface narrower than a quarter step can still
+//!   fall between the checks, as with any sampling (keep `max_step` below the
+//!   part's smallest feature).
 //! - **Spacing rule (finishing.md 6.4, worst point).** At every CL sample of the
 //!   plane: the part normal `n` at the contact, tilt `s = acos |n_z|`, horizontal
 //!   feed angle `alpha` between `f` and `(n_x, n_y)`, effective radius
