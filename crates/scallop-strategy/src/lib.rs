@@ -73,7 +73,7 @@
 //!   Samples outside the region split the plane into passes (non-convex parts
 //!   give several); each pass end is located by bisection to
 //!   `BOUNDARY_SHARE * path`. Collinear points are merged by
-//!   `scallop_toolpath::simplify_above` within `SIMPLIFY_SHARE * path` (budget in
+//!   `scallop_toolpath::simplify_above` within `PASS_SIMPLIFY_SHARE * path` (budget in
 //!   [`tol`]): one-sided and vertical, a kept chord never passes below a point it
 //!   replaces.
 //! - **No gouge between cutter locations.** A straight move between two exact

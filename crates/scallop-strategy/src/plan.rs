@@ -171,7 +171,7 @@ impl<'a> Planner<'a> {
             floor: bounds.min.z - bounds.diagonal() - 1.0,
             sample_tol: tol::SAMPLING_SHARE * tol_.path,
             gouge_tol,
-            simplify_tol: tol::SIMPLIFY_SHARE * tol_.path,
+            simplify_tol: tol::PASS_SIMPLIFY_SHARE * tol_.path,
             boundary_tol: tol::BOUNDARY_SHARE * tol_.path,
             min_step,
             gouge_step: (gouge_tol * gouge_tol / (2.0 * cutter.radius())).min(min_step),
@@ -184,7 +184,7 @@ impl<'a> Planner<'a> {
 
     /// Indices of the points kept by merging nearly collinear ones: one-sided
     /// (`simplify_above`), a kept chord never passes below a removed point and
-    /// lies at most `SIMPLIFY_SHARE * path` above it (vertically: a pass or a
+    /// lies at most `PASS_SIMPLIFY_SHARE * path` above it (vertically: a pass or a
     /// link runs along one XY line). The merged chord is then never below the
     /// sampled polyline, which keeps the sampling's bound below the CL surface.
     fn merge(&self, points: &[Point3]) -> Vec<usize> {
