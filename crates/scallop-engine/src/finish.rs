@@ -595,30 +595,13 @@ fn network_planes(
             toolpath.push(*m);
         }
     }
-    let (a, b) = (stop_to_stop_time(&toolpath, params), lookahead_time(&toolpath, params));
-    let feed = toolpath.length(MoveKind::Feed);
-    let link = toolpath.length(MoveKind::Link);
+    // The scallop figures are filled in from the simulation (the planner measures none).
     let report = scallop_strategy::Report {
-        machining_time_s: a.cutting,
-        machining_time_lookahead_s: b.cutting,
-        rapid_time_s: a.rapid,
-        plunge_time_s: a.plunge,
-        total_time_s: a.total(),
-        path_length_mm: feed + link,
-        feed_length_mm: feed,
-        link_length_mm: link,
-        rapid_length_mm: toolpath.length(MoveKind::Rapid) + toolpath.length(MoveKind::Retract),
-        plunge_length_mm: toolpath.length(MoveKind::Plunge),
         passes,
         planes,
         links,
-        retracts: toolpath.count(MoveKind::Retract),
-        // Filled in from the simulation (the planner measures no scallop).
-        max_scallop_mm: 0.0,
-        mean_scallop_mm: 0.0,
-        points: toolpath.moves().len(),
         cl_points_dropped: drops,
-        planning_time_s: 0.0,
+        ..scallop_strategy::Report::timed(&toolpath, params)
     };
     Ok(Plan { toolpath, report, scallop: None })
 }
