@@ -60,10 +60,7 @@
 //!   contact leaves the dilated zone, and the plane range is the dilated zone's.
 //!   Pass ends then lie inside the part: the scallop is measured only at
 //!   sections at least the cutter radius from both passes' ends (nearer, the
-//!   envelope lacks the cutter locations beyond the end), and collinear points are
-//!   merged by their vertical distance to the chord (the optimiser's directions
-//!   and 3+2 tilts give steep passes, where the perpendicular distance of
-//!   `simplify` allows a height error of `SIMPLIFY_SHARE * path / cos(slope)`);
+//!   envelope lacks the cutter locations beyond the end);
 //!   the margin makes each zone finish itself up to its border (see
 //!   [`ZoneRegion`]), and the whole program's stock simulation checks it
 //!   (`scallop_engine::finish_zones`).
@@ -76,7 +73,26 @@
 //!   Samples outside the region split the plane into passes (non-convex parts
 //!   give several); each pass end is located by bisection to
 //!   `BOUNDARY_SHARE * path`. Collinear points are merged by
-//!   `scallop_toolpath::simplify` within `SIMPLIFY_SHARE * path` (budget in [`tol`]).
+//!   `scallop_toolpath::simplify_above` within `PASS_SIMPLIFY_SHARE * path` (budget in
+//!   [`tol`]): one-sided and vertical, a kept chord never passes below a point it
+//!   replaces.
+//! - **No gouge between cutter locations.** A straight move between two exact
+//!   cutter locations gouges only where the CL surface rises above it (convex
+//!   crests, the top of steep descents). A step (of a pass or a link) is also
+//!   bisected while the CL surface at its middle or quarter points (an
+//!   inflection can put the middle on the chord) lies more than
+//!   `GOUGE_MIDPOINT_SHARE * SAMPLING_SHARE * path` above the chord, as OpenCAMLib's adaptive path
+//!   drop-cutter (`AdaptivePathDropCutter`) subdivides; where the CL surface is
+//!   concave over the step the chord is then nowhere deeper than
+//!   `SAMPLING_SHARE * path` under it. A jump of the CL surface (a wall) is
+//!   bisected down to a step over which an arc of the cutter's radius rises by
+//!   less than that depth, then stepped over: up vertically, level, down
+//!   vertically. With the one-sided merging, every feed and link move lies at
+//!   most `SAMPLING_SHARE * path` below the exact drop-cutter surface (property
+//!   test `tests/prop_gouge.rs`, 16 points a move, on cliffs, hemispheres and
+//!   steps); a bump of the CL surface narrower than a quarter step can still
+//!   fall between the checks, as with any sampling (keep `max_step` below the
+//!   part's smallest feature).
 //! - **Spacing rule (finishing.md 6.4, worst point).** At every CL sample of the
 //!   plane: the part normal `n` at the contact, tilt `s = acos |n_z|`, horizontal
 //!   feed angle `alpha` between `f` and `(n_x, n_y)`, effective radius

@@ -6,7 +6,7 @@ use scallop_analysis::fold_direction_angle;
 use scallop_cutter::{ClPoint, Contact, Cutter, CutterShape, drop_cutter, drop_points};
 use scallop_geom::{Point2, Point3, Tolerances, Vec2, Vec3};
 use scallop_mesh::MeshIndex;
-use scallop_toolpath::{Move, MoveKind, Toolpath, simplify};
+use scallop_toolpath::{Move, MoveKind, Toolpath, simplify_above};
 
 use crate::geometry::{Frame, PartBoundary, contact_normal, slots_by_original};
 use crate::scallop::{Curve, Measure, pair_heights};
@@ -25,10 +25,20 @@ impl Line {
     }
 }
 
+/// A point of a pass at abscissa `t`: a cutter location, or (`lift`) a point
+/// above the CL surface where the pass steps over a jump of it (see
+/// [`Planner::lift`]); lifts are no samples of the surface.
 #[derive(Debug, Clone, Copy)]
 struct Sample {
     t: f64,
     cl: ClPoint,
+    lift: bool,
+}
+
+impl Sample {
+    fn new(t: f64, cl: ClPoint) -> Sample {
+        Sample { t, cl, lift: false }
+    }
 }
 
 /// Everything the planner needs, computed once.
@@ -46,12 +56,14 @@ pub(crate) struct Planner<'a> {
     raw_measure: Measure<'a>,
     floor: f64,
     sample_tol: f64,
+    /// A chord whose midpoint lies farther than this below the CL surface is
+    /// split ([`tol::GOUGE_MIDPOINT_SHARE`] of `sample_tol`).
+    gouge_tol: f64,
     simplify_tol: f64,
-    /// Merge by the vertical distance to the chord (zone planning), else by the
-    /// perpendicular one (`scallop_toolpath::simplify`).
-    vertical_merge: bool,
     boundary_tol: f64,
     min_step: f64,
+    /// Shortest step of the gouge bisection (see [`tol::GOUGE_MIDPOINT_SHARE`]).
+    gouge_step: f64,
     pub(crate) d_range: [f64; 2],
     pub(crate) feed_samples: Vec<f64>,
     pub(crate) drops: usize,
@@ -142,6 +154,8 @@ impl<'a> Planner<'a> {
         let feed_samples = (0..=n).map(|k| t_range[0] + span * (k as f64 / steps)).collect();
         let bounds = index.bounds();
         let end_margin = zone_end_margin(cutter, region);
+        let gouge_tol = tol::GOUGE_MIDPOINT_SHARE * tol::SAMPLING_SHARE * tol_.path;
+        let min_step = params.max_step * tol::MIN_STEP_FRACTION;
         Ok(Planner {
             index,
             cutter,
@@ -156,10 +170,11 @@ impl<'a> Planner<'a> {
             raw_measure: Measure { refine: false, end_margin, ..Measure::new(index, cutter, params.direction, sh) },
             floor: bounds.min.z - bounds.diagonal() - 1.0,
             sample_tol: tol::SAMPLING_SHARE * tol_.path,
-            simplify_tol: tol::SIMPLIFY_SHARE * tol_.path,
-            vertical_merge: region.is_some(),
+            gouge_tol,
+            simplify_tol: tol::PASS_SIMPLIFY_SHARE * tol_.path,
             boundary_tol: tol::BOUNDARY_SHARE * tol_.path,
-            min_step: params.max_step * tol::MIN_STEP_FRACTION,
+            min_step,
+            gouge_step: (gouge_tol * gouge_tol / (2.0 * cutter.radius())).min(min_step),
             d_range,
             feed_samples,
             drops: 0,
@@ -167,13 +182,26 @@ impl<'a> Planner<'a> {
         })
     }
 
-    /// Indices of the points kept by merging nearly collinear ones.
+    /// Indices of the points kept by merging nearly collinear ones: one-sided
+    /// (`simplify_above`), a kept chord never passes below a removed point and
+    /// lies at most `PASS_SIMPLIFY_SHARE * path` above it (vertically: a pass or a
+    /// link runs along one XY line). The merged chord is then never below the
+    /// sampled polyline, which keeps the sampling's bound below the CL surface.
     fn merge(&self, points: &[Point3]) -> Vec<usize> {
-        if self.vertical_merge {
-            simplify_vertical(points, self.simplify_tol)
-        } else {
-            simplify(points, self.simplify_tol)
-        }
+        simplify_above(points, self.simplify_tol)
+    }
+
+    /// The points to insert before `b` where the chord from `a` to `b`, a step
+    /// of at most `gouge_step`, still lies below the CL surface at `mid` by more
+    /// than `gouge_tol`: the CL surface jumps there (a wall, the foot of a
+    /// steep arc). The pass climbs vertically at `a` to the highest of the three
+    /// cutter locations, moves level to above `b` and descends vertically to it;
+    /// over a step this short the CL surface varies by at most `gouge_tol`
+    /// outside its jumps (a circular arc of radius up to the cutter radius `R`
+    /// rises by `sqrt(2 R step)` at most).
+    fn lift(a: &Point3, mid: &Point3, b: &Point3) -> [Option<Point3>; 2] {
+        let top = a.z.max(mid.z).max(b.z);
+        [(top > a.z).then(|| Point3::new(a.x, a.y, top)), (top > b.z).then(|| Point3::new(b.x, b.y, top))]
     }
 
     fn drop_at(&mut self, xy: Point2) -> ClPoint {
@@ -205,7 +233,7 @@ impl<'a> Planner<'a> {
             let t = 0.5 * (inside.t + outside);
             let cl = self.drop_at(line.at(t));
             if self.is_inside(&cl, scratch) {
-                inside = Sample { t, cl };
+                inside = Sample::new(t, cl);
             } else {
                 outside = t;
             }
@@ -215,47 +243,114 @@ impl<'a> Planner<'a> {
 
     /// Appends the samples after `a` up to `b` (both inside), bisecting a step
     /// while the CL midpoint is farther than the sampling tolerance from the
-    /// chord; `None` marks a gap where the midpoint left the region.
-    fn refine(&mut self, line: &Line, a: Sample, b: Sample, out: &mut Vec<Option<Sample>>, scratch: &mut Vec<u32>) {
-        if b.t - a.t <= self.min_step {
+    /// chord, or the CL surface lies above the chord by more than `gouge_tol`
+    /// at its middle or quarter points (down to `gouge_step`, then a
+    /// [`Planner::lift`]); `None` marks a gap where a point left the region.
+    /// `known` is the CL point at the middle when already dropped.
+    fn refine(
+        &mut self,
+        line: &Line,
+        a: Sample,
+        b: Sample,
+        known: Option<Sample>,
+        out: &mut Vec<Option<Sample>>,
+        scratch: &mut Vec<u32>,
+    ) {
+        let length = b.t - a.t;
+        if length <= self.gouge_step {
             out.push(Some(b));
             return;
         }
         let t = 0.5 * (a.t + b.t);
-        let mid = Sample { t, cl: self.drop_at(line.at(t)) };
+        let mid = known.unwrap_or_else(|| Sample::new(t, self.drop_at(line.at(t))));
         if !self.is_inside(&mid.cl, scratch) {
-            let end = self.bisect(line, a, t, scratch);
+            let end = self.bisect(line, a, mid.t, scratch);
             if end.t > a.t {
-                self.refine(line, a, end, out, scratch);
+                self.refine(line, a, end, None, out, scratch);
             }
             out.push(None);
-            let start = self.bisect(line, b, t, scratch);
+            let start = self.bisect(line, b, mid.t, scratch);
             out.push(Some(start));
             if b.t > start.t {
-                self.refine(line, start, b, out, scratch);
+                self.refine(line, start, b, None, out, scratch);
             }
             return;
         }
-        if vertical_gap(&mid.cl.tip, &a.cl.tip, &b.cl.tip) > self.sample_tol {
-            self.refine(line, a, mid, out, scratch);
-            self.refine(line, mid, b, out, scratch);
-        } else {
-            out.push(Some(b));
+        let (chordal, below) = self.split_tests(&mid.cl.tip, &a.cl.tip, &b.cl.tip, length);
+        if chordal || below {
+            self.refine(line, a, mid, None, out, scratch);
+            self.refine(line, mid, b, None, out, scratch);
+            return;
         }
+        if length > self.min_step {
+            // The quarter points: a CL surface with an inflection inside the
+            // step can cross the chord at its middle and still rise above it.
+            let quarters = [0.75 * a.t + 0.25 * b.t, 0.25 * a.t + 0.75 * b.t];
+            let [q1, q3] = quarters.map(|t| Sample::new(t, self.drop_at(line.at(t))));
+            let rises = |q: &Sample, f: f64| q.cl.tip.z - (a.cl.tip.z + f * (b.cl.tip.z - a.cl.tip.z)) > self.gouge_tol;
+            if rises(&q1, 0.25) || rises(&q3, 0.75) {
+                self.refine(line, a, mid, Some(q1), out, scratch);
+                self.refine(line, mid, b, Some(q3), out, scratch);
+                return;
+            }
+        }
+        if gouge_depth(&mid.cl.tip, &a.cl.tip, &b.cl.tip) > self.gouge_tol {
+            for (end, p) in [a, b].iter().zip(Self::lift(&a.cl.tip, &mid.cl.tip, &b.cl.tip)) {
+                if let Some(p) = p {
+                    out.push(Some(Sample { t: end.t, cl: ClPoint { tip: p, contact: end.cl.contact }, lift: true }));
+                }
+            }
+        }
+        out.push(Some(b));
+    }
+
+    /// Whether a step of `length` from `a` to `b` with the CL point `mid` at
+    /// its middle is split: (chordal) the midpoint is farther than the sampling
+    /// tolerance from the chord and the step longer than `min_step`; (below)
+    /// the chord passes more than `gouge_tol` below the midpoint and the step is
+    /// longer than `gouge_step` (on a part of the CL surface concave over the
+    /// step, the chord then lies at most `2 gouge_tol = sample_tol` below it
+    /// anywhere: the deepest point is at most twice the midpoint's depth).
+    fn split_tests(&self, mid: &Point3, a: &Point3, b: &Point3, length: f64) -> (bool, bool) {
+        let chordal = length > self.min_step && vertical_gap(mid, a, b) > self.sample_tol;
+        let below = length > self.gouge_step && gouge_depth(mid, a, b) > self.gouge_tol;
+        (chordal, below)
     }
 
     /// Like [`Planner::refine`] for links: every point must have a contact
     /// (on the CL surface); `None` when one has not.
-    fn refine_link(&mut self, line: &Line, a: Sample, b: Sample, out: &mut Vec<Point3>) -> Option<()> {
-        if b.t - a.t > self.min_step {
+    fn refine_link(
+        &mut self,
+        line: &Line,
+        a: Sample,
+        b: Sample,
+        known: Option<Sample>,
+        out: &mut Vec<Point3>,
+    ) -> Option<()> {
+        let length = b.t - a.t;
+        if length > self.gouge_step {
             let t = 0.5 * (a.t + b.t);
-            let mid = Sample { t, cl: self.drop_at(line.at(t)) };
+            let mid = known.unwrap_or_else(|| Sample::new(t, self.drop_at(line.at(t))));
             if matches!(mid.cl.contact, Contact::Floor) {
                 return None;
             }
-            if vertical_gap(&mid.cl.tip, &a.cl.tip, &b.cl.tip) > self.sample_tol {
-                self.refine_link(line, a, mid, out)?;
-                return self.refine_link(line, mid, b, out);
+            let (chordal, below) = self.split_tests(&mid.cl.tip, &a.cl.tip, &b.cl.tip, length);
+            if chordal || below {
+                self.refine_link(line, a, mid, None, out)?;
+                return self.refine_link(line, mid, b, None, out);
+            }
+            if length > self.min_step {
+                let quarters = [0.75 * a.t + 0.25 * b.t, 0.25 * a.t + 0.75 * b.t];
+                let [q1, q3] = quarters.map(|t| Sample::new(t, self.drop_at(line.at(t))));
+                let rises =
+                    |q: &Sample, f: f64| q.cl.tip.z - (a.cl.tip.z + f * (b.cl.tip.z - a.cl.tip.z)) > self.gouge_tol;
+                if rises(&q1, 0.25) || rises(&q3, 0.75) {
+                    self.refine_link(line, a, mid, Some(q1), out)?;
+                    return self.refine_link(line, mid, b, Some(q3), out);
+                }
+            }
+            if gouge_depth(&mid.cl.tip, &a.cl.tip, &b.cl.tip) > self.gouge_tol {
+                out.extend(Self::lift(&a.cl.tip, &mid.cl.tip, &b.cl.tip).into_iter().flatten());
             }
         }
         out.push(b.cl.tip);
@@ -272,24 +367,24 @@ impl<'a> Planner<'a> {
         let mut marks: Vec<Option<Sample>> = Vec::new();
         let mut last: Option<Sample> = None;
         for (k, (&t, cl)) in ts.iter().zip(&cls).enumerate() {
-            let s = Sample { t, cl: *cl };
+            let s = Sample::new(t, *cl);
             match (inside[k], last) {
                 (true, None) => {
                     let start = if k > 0 { self.bisect(line, s, ts[k - 1], &mut scratch) } else { s };
                     marks.push(Some(start));
                     if s.t > start.t {
-                        self.refine(line, start, s, &mut marks, &mut scratch);
+                        self.refine(line, start, s, None, &mut marks, &mut scratch);
                     }
                     last = Some(s);
                 }
                 (true, Some(prev)) => {
-                    self.refine(line, prev, s, &mut marks, &mut scratch);
+                    self.refine(line, prev, s, None, &mut marks, &mut scratch);
                     last = Some(s);
                 }
                 (false, Some(prev)) => {
                     let end = self.bisect(line, prev, t, &mut scratch);
                     if end.t > prev.t {
-                        self.refine(line, prev, end, &mut marks, &mut scratch);
+                        self.refine(line, prev, end, None, &mut marks, &mut scratch);
                     }
                     marks.push(None);
                     last = None;
@@ -327,7 +422,7 @@ impl<'a> Planner<'a> {
             let points: Vec<Point3> = run.iter().map(|s| s.cl.tip).collect();
             let kept = self.merge(&points);
             passes.push(kept.iter().map(|&i| points[i]).collect::<Vec<_>>());
-            samples.extend(run.iter().map(|s| s.cl));
+            samples.extend(run.iter().filter(|s| !s.lift).map(|s| s.cl));
         }
         let curves = passes.iter().map(|p: &Vec<Point3>| Curve::new(&self.frame, p)).collect();
         PlanePasses { plane: Plane { offset: d, passes }, samples, curves }
@@ -608,8 +703,8 @@ impl<'a> Planner<'a> {
         }
         let mut points = vec![cls[0].tip];
         for k in 1..=n {
-            let (p, q) = (Sample { t: ts[k - 1], cl: cls[k - 1] }, Sample { t: ts[k], cl: cls[k] });
-            self.refine_link(&line, p, q, &mut points)?;
+            let (p, q) = (Sample::new(ts[k - 1], cls[k - 1]), Sample::new(ts[k], cls[k]));
+            self.refine_link(&line, p, q, None, &mut points)?;
         }
         // The ends are the pass ends (same drop, same point); keep them exact.
         if let Some(first) = points.first_mut() {
@@ -678,51 +773,18 @@ pub(crate) fn zone_end_margin(cutter: &Cutter, region: Option<&ZoneRegion>) -> f
     region.map_or(0.0, |_| cutter.radius())
 }
 
-/// Douglas-Peucker merging of nearly collinear CL points by their **vertical**
-/// distance to the chord (at their position along the chord in XY), both sides:
-/// the indices kept, in order, first and last included. A pass or a link runs
-/// along one XY line, so this bounds the height error of the merged path (what
-/// a gouge is), which the perpendicular distance does not on steep passes.
-fn simplify_vertical(points: &[Point3], max_deviation: f64) -> Vec<usize> {
-    let n = points.len();
-    if n <= 2 {
-        return (0..n).collect();
-    }
-    let mut keep = vec![false; n];
-    keep[0] = true;
-    keep[n - 1] = true;
-    let mut stack = vec![(0, n - 1)];
-    while let Some((i, j)) = stack.pop() {
-        let (a, b) = (points[i], points[j]);
-        let ab = Vec2::new(b.x - a.x, b.y - a.y);
-        let len2 = ab.norm_squared();
-        let mut worst: Option<(f64, usize)> = None;
-        for (k, p) in points.iter().enumerate().take(j).skip(i + 1) {
-            let deviation = if len2 > 0.0 {
-                let s = (Vec2::new(p.x - a.x, p.y - a.y).dot(&ab) / len2).clamp(0.0, 1.0);
-                (p.z - (a.z + (b.z - a.z) * s)).abs()
-            } else {
-                (p - a).norm()
-            };
-            if worst.is_none_or(|(w, _)| deviation > w) {
-                worst = Some((deviation, k));
-            }
-        }
-        if let Some((deviation, k)) = worst
-            && deviation > max_deviation
-        {
-            keep[k] = true;
-            stack.push((k, j));
-            stack.push((i, k));
-        }
-    }
-    (0..n).filter(|&k| keep[k]).collect()
-}
-
 /// Vertical distance of the CL point `mid`, dropped at the XY midpoint of `a`
 /// and `b`, from their chord. Gouges are heights (the stock simulation measures
 /// stock below part vertically), and on a steep pass the vertical gap is the
 /// perpendicular distance divided by the cosine of the slope.
 fn vertical_gap(mid: &Point3, a: &Point3, b: &Point3) -> f64 {
     (mid.z - 0.5 * (a.z + b.z)).abs()
+}
+
+/// How far the CL point `mid`, dropped at the XY midpoint of `a` and `b`, lies
+/// above their chord (negative: below it). A straight move between two exact
+/// cutter locations gouges only where the CL surface rises above it: on convex
+/// crests and at the top of steep descents.
+fn gouge_depth(mid: &Point3, a: &Point3, b: &Point3) -> f64 {
+    mid.z - 0.5 * (a.z + b.z)
 }
