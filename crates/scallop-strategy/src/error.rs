@@ -4,6 +4,21 @@
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
 pub enum StrategyError {
+    /// The waterline kernel failed on a level of steep-and-shallow finishing.
+    #[error("waterline levels of the steep walls: {0}")]
+    Waterline(String),
+    /// Steep-and-shallow finishing would need too many waterline levels.
+    #[error(
+        "the steep walls would need more than {max} waterline levels ({levels} so far, {dz} mm apart); use a larger scallop height or a larger cutter (job keys: finishing.scallop_height, cutter.diameter)"
+    )]
+    TooManyLevels {
+        /// Levels planned when the limit was hit.
+        levels: usize,
+        /// Their spacing (mm).
+        dz: f64,
+        /// The limit.
+        max: usize,
+    },
     /// A parameter that must be a finite number in a range.
     #[error("parameter `{name}` = {value:?} is invalid: {fix}")]
     BadParameter {

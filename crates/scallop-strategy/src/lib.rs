@@ -74,8 +74,10 @@
 //!   give several); each pass end is located by bisection to
 //!   `BOUNDARY_SHARE * path`. Collinear points are merged by
 //!   `scallop_toolpath::simplify_above` within `PASS_SIMPLIFY_SHARE * path` (budget in
-//!   [`tol`]): one-sided and vertical, a kept chord never passes below a point it
-//!   replaces.
+//!   [`tol`], and at most `MERGE_SCALLOP_SHARE * sh`): one-sided and vertical, a
+//!   kept chord never passes below a point it replaces; the measured scallop of a
+//!   pair of planes counts the largest height of a chord above a point it
+//!   replaced, since that material adds to the scallop between feed samples.
 //! - **No gouge between cutter locations.** A straight move between two exact
 //!   cutter locations gouges only where the CL surface rises above it (convex
 //!   crests, the top of steep descents). A step (of a pass or a link) is also
@@ -175,6 +177,7 @@ mod params;
 mod plan;
 mod region;
 mod scallop;
+mod steep;
 mod time;
 pub mod tol;
 pub mod trochoid;
@@ -186,6 +189,7 @@ pub use leads::{LeadFallback, LeadKind, LeadReport, apply_leads};
 pub use params::{Boundary, FinishingParams, Pattern};
 pub use region::ZoneRegion;
 pub use scallop::{PairScallop, ScallopReport, verify_scallop};
+pub use steep::{SteepPlanned, SteepShallow, plan_steep_shallow};
 pub use time::{ClassTimes, MoveFeed, lookahead_profile, lookahead_time, stop_to_stop_time};
 
 use scallop_cutter::Cutter;

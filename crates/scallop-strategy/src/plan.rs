@@ -60,6 +60,8 @@ pub(crate) struct Planner<'a> {
     /// split ([`tol::GOUGE_MIDPOINT_SHARE`] of `sample_tol`).
     gouge_tol: f64,
     simplify_tol: f64,
+    /// The scallop height the spacing holds (`params.scallop_height`).
+    sh: f64,
     boundary_tol: f64,
     min_step: f64,
     /// Shortest step of the gouge bisection (see [`tol::GOUGE_MIDPOINT_SHARE`]).
@@ -77,6 +79,10 @@ pub(crate) struct PlanePasses {
     pub(crate) plane: Plane,
     samples: Vec<ClPoint>,
     curves: Vec<Curve>,
+    /// The largest height (mm) by which a merged chord rides above a point it
+    /// replaced: the material under it adds to the scallop between the feed
+    /// samples where the pair is measured.
+    lift: f64,
 }
 
 impl<'a> Planner<'a> {
@@ -156,6 +162,7 @@ impl<'a> Planner<'a> {
         let end_margin = zone_end_margin(cutter, region);
         let gouge_tol = tol::GOUGE_MIDPOINT_SHARE * tol::SAMPLING_SHARE * tol_.path;
         let min_step = params.max_step * tol::MIN_STEP_FRACTION;
+        let simplify_tol = (tol::PASS_SIMPLIFY_SHARE * tol_.path).min(tol::MERGE_SCALLOP_SHARE * sh);
         Ok(Planner {
             index,
             cutter,
@@ -171,7 +178,8 @@ impl<'a> Planner<'a> {
             floor: bounds.min.z - bounds.diagonal() - 1.0,
             sample_tol: tol::SAMPLING_SHARE * tol_.path,
             gouge_tol,
-            simplify_tol: tol::PASS_SIMPLIFY_SHARE * tol_.path,
+            simplify_tol,
+            sh,
             boundary_tol: tol::BOUNDARY_SHARE * tol_.path,
             min_step,
             gouge_step: (gouge_tol * gouge_tol / (2.0 * cutter.radius())).min(min_step),
@@ -418,20 +426,22 @@ impl<'a> Planner<'a> {
         let runs = self.runs(&line, &ts);
         let mut passes = Vec::with_capacity(runs.len());
         let mut samples = Vec::new();
+        let mut lift = 0.0_f64;
         for run in runs {
             let points: Vec<Point3> = run.iter().map(|s| s.cl.tip).collect();
             let kept = self.merge(&points);
+            lift = lift.max(merge_lift(&points, &kept));
             passes.push(kept.iter().map(|&i| points[i]).collect::<Vec<_>>());
             samples.extend(run.iter().filter(|s| !s.lift).map(|s| s.cl));
         }
         let curves = passes.iter().map(|p: &Vec<Point3>| Curve::new(&self.frame, p)).collect();
-        PlanePasses { plane: Plane { offset: d, passes }, samples, curves }
+        PlanePasses { plane: Plane { offset: d, passes }, samples, curves, lift }
     }
 
     /// NEXT_SPACING (finishing.md 6.4): the smallest horizontal plane spacing
     /// over the samples of the plane, `sod_i |c_i . m|`, with the place.
     fn spacing(&self, plane: &PlanePasses) -> Option<(f64, Point2)> {
-        let sh = self.params.scallop_height;
+        let sh = self.sh;
         let m = Vec3::new(self.frame.m.x, self.frame.m.y, 0.0);
         let mut best: Option<(f64, Point2)> = None;
         for cl in &plane.samples {
@@ -476,7 +486,8 @@ impl<'a> Planner<'a> {
                     .fold((0.0, Point2::origin()), |acc, c| if c.height > acc.0 { (c.height, c.at) } else { acc })
             })
             .collect();
-        chunks.into_iter().fold((0.0, Point2::origin()), |acc, h| if h.0 > acc.0 { h } else { acc })
+        let (h, at) = chunks.into_iter().fold((0.0, Point2::origin()), |acc, h| if h.0 > acc.0 { h } else { acc });
+        (h + a.lift.max(b.lift), at)
     }
 
     fn unreachable(&self, spacing: f64, at: Point2) -> StrategyError {
@@ -505,7 +516,7 @@ impl<'a> Planner<'a> {
     /// next plane one spacing further (shrunk until the measured scallop holds),
     /// and the last within half its spacing of the far edge.
     pub(crate) fn sweep(&mut self) -> Result<Vec<PlanePasses>, StrategyError> {
-        let sh = self.params.scallop_height;
+        let sh = self.sh;
         let [d_lo, d_hi] = self.d_range;
         let cap = self.model.max_step_over(sh).min(2.0 * self.cutter.radius());
         let mut planes: Vec<PlanePasses> = Vec::new();
@@ -622,7 +633,7 @@ impl<'a> Planner<'a> {
     /// [`StrategyError::Unreachable`] when no spacing above
     /// [`tol::MIN_SPACING`] holds `sh` between bridge planes.
     fn bridge(&mut self, previous: PlanePasses, next: &PlanePasses) -> Result<Vec<PlanePasses>, StrategyError> {
-        let sh = self.params.scallop_height;
+        let sh = self.sh;
         let (h, _) = self.measured(&previous, next, true);
         if h <= sh {
             return Ok(vec![previous]);
@@ -641,7 +652,7 @@ impl<'a> Planner<'a> {
     }
 
     fn bridge_planes(&mut self, previous: PlanePasses, next: &PlanePasses) -> Result<Vec<PlanePasses>, StrategyError> {
-        let sh = self.params.scallop_height;
+        let sh = self.sh;
         let end = next.plane.offset;
         let mut out = vec![previous];
         loop {
@@ -777,6 +788,22 @@ pub(crate) fn zone_end_margin(cutter: &Cutter, region: Option<&ZoneRegion>) -> f
 /// and `b`, from their chord. Gouges are heights (the stock simulation measures
 /// stock below part vertically), and on a steep pass the vertical gap is the
 /// perpendicular distance divided by the cosine of the slope.
+/// The largest vertical height of a kept chord above a point it replaced
+/// (`kept` from [`simplify_above`] on `points`).
+fn merge_lift(points: &[Point3], kept: &[usize]) -> f64 {
+    let mut lift = 0.0_f64;
+    for w in kept.windows(2) {
+        let (a, b) = (&points[w[0]], &points[w[1]]);
+        let ab = b - a;
+        let len2 = ab.xy().norm_squared();
+        for p in &points[w[0] + 1..w[1]] {
+            let t = if len2 > 0.0 { ((p - a).xy().dot(&ab.xy()) / len2).clamp(0.0, 1.0) } else { 0.0 };
+            lift = lift.max(a.z + ab.z * t - p.z);
+        }
+    }
+    lift
+}
+
 fn vertical_gap(mid: &Point3, a: &Point3, b: &Point3) -> f64 {
     (mid.z - 0.5 * (a.z + b.z)).abs()
 }

@@ -28,6 +28,14 @@ pub const SIMPLIFY_SHARE: f64 = 0.25;
 /// sh 0.01 mm) found 0.01035 mm, over sh plus its resolution bound (0.01031).
 pub const PASS_SIMPLIFY_SHARE: f64 = 0.125;
 
+/// The one-sided merging's tolerance is also at most this share of the
+/// scallop height. A merged chord rides above the points it replaces, and the
+/// material under it adds to the scallop between the feed samples where the
+/// planner measures a pair of planes: the measure adds the larger lift of the
+/// two planes (a small Choi zone study simulated 0.01157 mm for sh 0.01 mm
+/// with the merging budgeted in the path tolerance only, docs/validation.md).
+pub const MERGE_SCALLOP_SHARE: f64 = 0.02;
+
 /// A forward step is split while the CL point at its middle, or at one of its
 /// quarter points (an inflection inside the step can put the middle on the
 /// chord), lies more than this fraction of the sampling share above the chord.
@@ -201,3 +209,17 @@ pub const MAX_PASS_SAMPLES: f64 = 1e7;
 /// resolution of machine axes and of the G-code's four decimals; a smaller tolerance
 /// only multiplies samples, with forward steps bisected down to `MIN_STEP_FRACTION`.
 pub const MIN_PATH_TOLERANCE: f64 = 1e-4;
+
+/// Waterline levels of steep-and-shallow finishing stay this share of the path
+/// tolerance inside the steep triangles' z range and the part's (mm): the
+/// waterline exists strictly inside the part's height range.
+pub const LEVEL_EDGE_SHARE: f64 = 1.0;
+
+/// Most waterline levels of one steep-and-shallow plan (bounds the work before
+/// it is spent: a wall 1 m tall at the smallest spacing of a 0.1 mm ball).
+pub const MAX_LEVELS: usize = 20_000;
+
+/// A pass of a waterline level is linked to the previous pass's end by a
+/// straight feed move (when the move stays above the CL surface) only if they
+/// are at most this many cutter radii apart; farther, it retracts.
+pub const LEVEL_LINK_RADII: f64 = 2.0;

@@ -1,0 +1,475 @@
+//! Steep-and-shallow finishing of a mesh (issue 15, items 2 and 3): the part
+//! split by the slope of its triangles; shallow triangles finished by parallel
+//! planes restricted to them ([`crate::plan_zone_finishing`]), steep ones by
+//! waterline levels ([`scallop_waterline`]) kept where the cutter's contact is
+//! steep. The two slope ranges overlap by a band (`2 * overlap`), so the pass
+//! ends of each lie where the other holds the scallop.
+//!
+//! **Level spacing.** A wall of slope `s` (from the horizontal) finished by
+//! levels `dz` apart is crossed by the cutter's profile circles `dz / sin s`
+//! apart along the wall: the profile radius `rho` (the ball radius, the
+//! corner radius of a bull-nose) leaves the scallop `sh` when that distance is
+//! `2 sqrt(2 rho sh - sh^2)` (finishing.md Eq. 1.4 with the effective radius
+//! `rho`), so `dz = 2 sqrt(2 rho sh - sh^2) sin s`; a flat end leaves steps of
+//! normal height `dz cos s`, so `dz = sh / cos s`. Each level takes the
+//! smallest contact slope of its own kept points and of the next level's,
+//! and never more than the cutter radius. The stock simulation of the program
+//! proves the result (`scallop_engine`).
+
+use scallop_cutter::{ClPoint, Cutter, CutterShape, drop_cutter};
+use scallop_geom::{Point2, Point3, Tolerances};
+use scallop_mesh::{MeshIndex, TriMesh};
+use scallop_toolpath::{Move, MoveKind, Toolpath};
+use scallop_waterline::{WaterlineGrid, WaterlineOptions};
+
+use crate::geometry::{contact_normal, slots_by_original};
+use crate::{FinishingParams, Planned, Report, StrategyError, ZoneRegion, plan_zone_finishing, tol};
+
+/// How the part is split by slope.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SteepShallow {
+    /// Slope (rad from the horizontal) at which parallel planes give way to
+    /// waterline levels.
+    pub threshold: f64,
+    /// Half-width of the band both finish (rad): planes run up to
+    /// `threshold + overlap`, levels down to `threshold - overlap`.
+    pub overlap: f64,
+    /// Climb milling on the levels (material on the tool's right, spindle
+    /// clockwise); `false`: conventional.
+    pub climb: bool,
+}
+
+impl SteepShallow {
+    /// The split for `cutter` and scallop height `sh`: the slope at which the
+    /// horizontal spacing of parallel planes across a wall (the analysis
+    /// model's step-over times `cos s`) equals the level spacing (`dz` of the
+    /// module docs), between 30 and 70 degrees (45 for a ball); 5 degrees of
+    /// overlap; climb.
+    ///
+    /// ```
+    /// use scallop_cutter::{Cutter, CutterShape};
+    /// let ball = Cutter::new(CutterShape::Ball { radius: 3.0 }, 30.0).unwrap();
+    /// let s = scallop_strategy::SteepShallow::default_for(&ball, 0.01);
+    /// assert!((s.threshold.to_degrees() - 45.0).abs() < 0.1);
+    /// ```
+    #[must_use]
+    pub fn default_for(cutter: &Cutter, sh: f64) -> SteepShallow {
+        let (lo, hi) = (30f64.to_radians(), 70f64.to_radians());
+        let plane_width = |s: f64| plane_step(cutter.shape(), sh, s) * s.cos();
+        let level_width = |s: f64| level_dz(cutter.shape(), sh, s);
+        // The planes' spacing shrinks with the slope, the levels' grows: bisect
+        // where they cross (or take the end of the range).
+        let (mut a, mut b) = (lo, hi);
+        for _ in 0..60 {
+            let m = 0.5 * (a + b);
+            if plane_width(m) > level_width(m) {
+                a = m;
+            } else {
+                b = m;
+            }
+        }
+        SteepShallow { threshold: 0.5 * (a + b), overlap: 5f64.to_radians(), climb: true }
+    }
+
+    fn check(&self) -> Result<(), StrategyError> {
+        let ok = self.threshold.is_finite()
+            && self.overlap.is_finite()
+            && self.overlap >= 0.0
+            && self.threshold - self.overlap > 0.0
+            && self.threshold + self.overlap < std::f64::consts::FRAC_PI_2;
+        if ok {
+            Ok(())
+        } else {
+            Err(StrategyError::BadParameter {
+                name: "steep_threshold",
+                value: self.threshold.to_degrees(),
+                fix: "give a slope threshold in degrees with threshold +- overlap inside (0, 90), e.g. 45",
+            })
+        }
+    }
+}
+
+/// The plane step-over (along the wall's horizontal projection) of parallel
+/// planes across a slope `s`, from the analysis model.
+fn plane_step(shape: &CutterShape, sh: f64, s: f64) -> f64 {
+    let model = match *shape {
+        CutterShape::Ball { radius } => scallop_analysis::Cutter::Ball { radius },
+        CutterShape::Bull { radius, corner } => scallop_analysis::Cutter::Toroidal { radius, corner },
+        CutterShape::Flat { radius } | CutterShape::Cone { radius, .. } => {
+            scallop_analysis::Cutter::Toroidal { radius, corner: 0.0 }
+        }
+    };
+    model.step_over(sh, s, std::f64::consts::FRAC_PI_2)
+}
+
+/// The level spacing (mm) that holds `sh` on a wall of slope `s` (module docs).
+fn level_dz(shape: &CutterShape, sh: f64, s: f64) -> f64 {
+    let rho = match *shape {
+        CutterShape::Ball { radius } => radius,
+        CutterShape::Bull { corner, .. } => corner,
+        CutterShape::Flat { radius } | CutterShape::Cone { radius, .. } => {
+            return (sh / s.cos().max(1e-9)).min(radius);
+        }
+    };
+    let along = 2.0 * (2.0 * rho * sh - sh * sh).max(0.0).sqrt();
+    (along * s.sin()).min(shape.radius())
+}
+
+/// The result of [`plan_steep_shallow`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct SteepPlanned {
+    /// Shallow passes, then the levels.
+    pub toolpath: Toolpath,
+    /// The parallel planes of the shallow triangles (`None`: no shallow triangle).
+    pub shallow: Option<Planned>,
+    /// Waterline levels with at least one pass.
+    pub levels: usize,
+    /// Passes on the levels (runs of steep contact).
+    pub steep_passes: usize,
+    /// Times, lengths and counts of the whole toolpath; the scallop is the
+    /// shallow planner's (the levels are proven by the stock simulation).
+    pub report: Report,
+}
+
+/// Plans steep-and-shallow finishing of `mesh` (indexed by `index`): see the
+/// module docs.
+///
+/// # Errors
+/// As [`crate::plan_finishing`] for the shallow planes; a bad split
+/// ([`StrategyError::BadParameter`]); a waterline failure
+/// ([`StrategyError::Waterline`]).
+pub fn plan_steep_shallow(
+    mesh: &TriMesh,
+    index: &MeshIndex,
+    cutter: &Cutter,
+    params: &FinishingParams,
+    tol_: &Tolerances,
+    split: &SteepShallow,
+) -> Result<SteepPlanned, StrategyError> {
+    params.validate()?;
+    split.check()?;
+    if matches!(cutter.shape(), CutterShape::Cone { .. }) {
+        return Err(StrategyError::Unsupported { shape: "cone" });
+    }
+    let slopes: Vec<f64> = (0..mesh.triangles().len()).map(|t| triangle_slope(&mesh.triangle(t))).collect();
+    let labels: Vec<u32> = slopes.iter().map(|&s| u32::from(s >= split.threshold + split.overlap)).collect();
+    let shallow = if labels.contains(&0) {
+        let region = ZoneRegion::new(mesh, &labels, 0, 0.0)?;
+        match plan_zone_finishing(index, cutter, params, tol_, &region) {
+            Ok(p) => Some(p),
+            Err(StrategyError::EmptyRegion { .. }) => None,
+            Err(e) => return Err(e),
+        }
+    } else {
+        None
+    };
+    let steep_min = split.threshold - split.overlap;
+    let mut toolpath = Toolpath::new(params.machine.feed * 60.0);
+    toolpath.plunge_feed = params.plunge_feed * 60.0;
+    if let Some(p) = &shallow {
+        toolpath.extend_from(&p.toolpath);
+    }
+    let steep_z = steep_range(mesh, &slopes, steep_min);
+    let (levels, steep_passes) = match steep_z {
+        Some(range) => {
+            let levels = Levels::new(index, cutter, params, tol_, split, range)?;
+            levels.append_to(&mut toolpath)?
+        }
+        None => (0, 0),
+    };
+    let mut report = Report::timed(&toolpath, params);
+    if let Some(p) = &shallow {
+        report.passes = p.report.passes;
+        report.planes = p.report.planes;
+        report.links = p.report.links;
+        report.max_scallop_mm = p.report.max_scallop_mm;
+        report.mean_scallop_mm = p.report.mean_scallop_mm;
+        report.cl_points_dropped = p.report.cl_points_dropped;
+    }
+    report.passes += steep_passes;
+    report.planes += levels;
+    Ok(SteepPlanned { toolpath, shallow, levels, steep_passes, report })
+}
+
+/// Slope of a triangle from the horizontal (rad, 0 to pi/2; facing down
+/// counts as steep as facing up).
+fn triangle_slope(t: &[Point3; 3]) -> f64 {
+    let n = (t[1] - t[0]).cross(&(t[2] - t[0]));
+    let len = n.norm();
+    if len > 0.0 { (n.z.abs() / len).min(1.0).acos() } else { 0.0 }
+}
+
+/// The z range of the triangles at least `steep_min` steep, `None` without any.
+fn steep_range(mesh: &TriMesh, slopes: &[f64], steep_min: f64) -> Option<(f64, f64)> {
+    let mut range: Option<(f64, f64)> = None;
+    for (t, &s) in slopes.iter().enumerate() {
+        if s < steep_min {
+            continue;
+        }
+        for p in mesh.triangle(t) {
+            range = Some(range.map_or((p.z, p.z), |(lo, hi)| (lo.min(p.z), hi.max(p.z))));
+        }
+    }
+    range
+}
+
+/// The waterline levels of the steep triangles.
+struct Levels<'a> {
+    index: &'a MeshIndex,
+    cutter: &'a Cutter,
+    params: &'a FinishingParams,
+    split: &'a SteepShallow,
+    grid: WaterlineGrid<'a>,
+    slots: Vec<u32>,
+    floor: f64,
+    /// Lowest and highest level (tip heights, mm).
+    z_range: (f64, f64),
+}
+
+/// One level's passes and its smallest steep contact slope.
+struct Level {
+    z: f64,
+    passes: Vec<Vec<Point2>>,
+    min_slope: f64,
+}
+
+impl<'a> Levels<'a> {
+    fn new(
+        index: &'a MeshIndex,
+        cutter: &'a Cutter,
+        params: &'a FinishingParams,
+        tol_: &Tolerances,
+        split: &'a SteepShallow,
+        (lo, hi): (f64, f64),
+    ) -> Result<Levels<'a>, StrategyError> {
+        let options =
+            WaterlineOptions { chord_tolerance: tol::SAMPLING_SHARE * tol_.path, ..WaterlineOptions::default() };
+        let grid = WaterlineGrid::new(cutter, index, &options).map_err(|e| StrategyError::Waterline(e.to_string()))?;
+        let bounds = index.bounds();
+        // Tip heights inside the part's range, where the waterline exists.
+        let margin = tol::LEVEL_EDGE_SHARE * tol_.path;
+        let top = (hi - margin).min(bounds.max.z - margin);
+        let bottom = (lo + margin).max(bounds.min.z + margin);
+        Ok(Levels {
+            index,
+            cutter,
+            params,
+            split,
+            grid,
+            slots: slots_by_original(index),
+            floor: bounds.min.z - bounds.diagonal() - 1.0,
+            z_range: (bottom, top.max(bottom)),
+        })
+    }
+
+    /// The passes of the level at tip height `z`: runs of loop points whose
+    /// contact is at least `threshold - overlap` steep, in cutting order.
+    fn level(&self, z: f64) -> Result<Level, StrategyError> {
+        let loops = self.grid.loops(z).map_err(|e| StrategyError::Waterline(e.to_string()))?;
+        let steep_min = self.split.threshold - self.split.overlap;
+        let mut passes = Vec::new();
+        let mut min_slope = f64::INFINITY;
+        for l in loops {
+            let mut points = l.points.clone();
+            if self.split.climb {
+                // Loops have their inside (material) on the left: climb puts it right.
+                points.reverse();
+            }
+            let slopes: Vec<f64> = points.iter().map(|p| self.contact_slope(*p)).collect();
+            for &s in slopes.iter().filter(|&&s| s >= steep_min) {
+                min_slope = min_slope.min(s);
+            }
+            passes.extend(steep_runs(&points, &slopes, steep_min));
+        }
+        Ok(Level { z, passes, min_slope })
+    }
+
+    fn contact_slope(&self, p: Point2) -> f64 {
+        let cl: ClPoint = drop_cutter(self.cutter, self.index, p, self.floor);
+        let n = contact_normal(self.cutter.shape(), self.index, &self.slots, &cl);
+        n.z.abs().min(1.0).acos()
+    }
+
+    fn dz(&self, slope: f64) -> f64 {
+        let s = if slope.is_finite() { slope } else { self.split.threshold - self.split.overlap };
+        level_dz(self.cutter.shape(), self.params.scallop_height, s).max(tol::MIN_SPACING)
+    }
+
+    /// The levels from the top down (module docs), each spaced by the smaller
+    /// slope of itself and the next.
+    fn all(&self) -> Result<Vec<Level>, StrategyError> {
+        let (bottom, top) = self.z_range;
+        let mut out = Vec::new();
+        let mut current = self.level(top)?;
+        loop {
+            if current.z <= bottom {
+                out.push(current);
+                break;
+            }
+            let mut dz = self.dz(current.min_slope);
+            let mut next = self.level((current.z - dz).max(bottom))?;
+            if next.min_slope < current.min_slope {
+                dz = self.dz(next.min_slope);
+                next = self.level((current.z - dz).max(bottom))?;
+            }
+            out.push(current);
+            if out.len() > tol::MAX_LEVELS {
+                return Err(StrategyError::TooManyLevels { levels: out.len(), dz, max: tol::MAX_LEVELS });
+            }
+            current = next;
+        }
+        Ok(out)
+    }
+
+    /// Appends the levels to `path` (after what it holds), each pass entered
+    /// from the clearance height or linked from the previous pass's end when the
+    /// straight move between them stays above the CL surface; returns (levels
+    /// with a pass, passes).
+    fn append_to(&self, path: &mut Toolpath) -> Result<(usize, usize), StrategyError> {
+        let clear = self.index.bounds().max.z + self.params.clearance;
+        let mut last: Option<Point3> = None;
+        let (mut levels, mut count) = (0, 0);
+        for level in self.all()? {
+            if level.passes.is_empty() {
+                continue;
+            }
+            levels += 1;
+            for pass in order_from(level.passes, last.map(|p| p.xy())) {
+                let points: Vec<Point3> = pass.iter().map(|p| Point3::new(p.x, p.y, level.z)).collect();
+                let (Some(&start), Some(&end)) = (points.first(), points.last()) else { continue };
+                count += 1;
+                match last {
+                    Some(from) if self.safe_link(&from, &start) => path.push(Move::new(MoveKind::Link, start)),
+                    Some(from) => {
+                        path.push(Move::new(MoveKind::Retract, Point3::new(from.x, from.y, clear)));
+                        path.push(Move::new(MoveKind::Rapid, Point3::new(start.x, start.y, clear)));
+                        path.push(Move::new(MoveKind::Plunge, start));
+                    }
+                    None => {
+                        path.push(Move::new(MoveKind::Rapid, Point3::new(start.x, start.y, clear)));
+                        path.push(Move::new(MoveKind::Plunge, start));
+                    }
+                }
+                for p in &points[1..] {
+                    path.push(Move::new(MoveKind::Feed, *p));
+                }
+                last = Some(end);
+            }
+        }
+        if let Some(end) = last {
+            path.push(Move::new(MoveKind::Retract, Point3::new(end.x, end.y, clear)));
+        }
+        Ok((levels, count))
+    }
+
+    /// Whether the straight move from `a` to `b` stays on or above the
+    /// drop-cutter surface at samples a quarter of the cutter radius apart
+    /// (and is short: at most a few step-overs, so it cuts no fresh wall).
+    fn safe_link(&self, a: &Point3, b: &Point3) -> bool {
+        let radius = self.cutter.radius();
+        let length = (b - a).norm();
+        if length > tol::LEVEL_LINK_RADII * radius {
+            return false;
+        }
+        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a small positive count")]
+        let n = (length / (0.25 * radius)).ceil().max(1.0) as usize;
+        (0..=n).all(|k| {
+            #[allow(clippy::cast_precision_loss, reason = "a small count")]
+            let t = k as f64 / n as f64;
+            let p = a + (b - a) * t;
+            drop_cutter(self.cutter, self.index, p.xy(), self.floor).tip.z <= p.z
+        })
+    }
+}
+
+/// Maximal runs of `points` (a closed loop) whose `slopes` reach `steep_min`;
+/// a loop steep all around comes back closed (its first point again at the end).
+fn steep_runs(points: &[Point2], slopes: &[f64], steep_min: f64) -> Vec<Vec<Point2>> {
+    let n = points.len();
+    let keep: Vec<bool> = slopes.iter().map(|&s| s >= steep_min).collect();
+    if n < 2 || !keep.contains(&true) {
+        return Vec::new();
+    }
+    if keep.iter().all(|&k| k) {
+        let mut closed = points.to_vec();
+        closed.push(points[0]);
+        return vec![closed];
+    }
+    // Start right after a dropped point so no run wraps around the start.
+    let start = (0..n).find(|&i| !keep[i]).map_or(0, |i| (i + 1) % n);
+    let mut runs = Vec::new();
+    let mut run: Vec<Point2> = Vec::new();
+    for k in 0..n {
+        let i = (start + k) % n;
+        if keep[i] {
+            run.push(points[i]);
+        } else if !run.is_empty() {
+            let done = std::mem::take(&mut run);
+            if done.len() >= 2 {
+                runs.push(done);
+            }
+        }
+    }
+    if run.len() >= 2 {
+        runs.push(run);
+    }
+    runs
+}
+
+/// The passes of a level in a near-neighbour order from `from`; a closed pass
+/// (first point == last) is turned to start at its point nearest to where the
+/// tool is.
+fn order_from(mut passes: Vec<Vec<Point2>>, from: Option<Point2>) -> Vec<Vec<Point2>> {
+    let mut out = Vec::with_capacity(passes.len());
+    let mut at = from;
+    while !passes.is_empty() {
+        let pick = match at {
+            None => 0,
+            Some(p) => {
+                let d = |pass: &Vec<Point2>| pass.iter().map(|q| (q - p).norm_squared()).fold(f64::INFINITY, f64::min);
+                (0..passes.len()).min_by(|&i, &j| d(&passes[i]).total_cmp(&d(&passes[j]))).unwrap_or(0)
+            }
+        };
+        let mut pass = passes.swap_remove(pick);
+        if let (Some(p), true) = (at, pass.len() > 2 && pass.first() == pass.last()) {
+            pass.pop();
+            let k =
+                (0..pass.len()).min_by(|&i, &j| (pass[i] - p).norm_squared().total_cmp(&(pass[j] - p).norm_squared()));
+            pass.rotate_left(k.unwrap_or(0));
+            pass.push(pass[0]);
+        }
+        at = pass.last().copied();
+        out.push(pass);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn runs_split_a_loop_at_shallow_points_without_wrapping() {
+        let pts: Vec<Point2> = (0..6).map(|i| Point2::new(f64::from(i), 0.0)).collect();
+        let slopes = [1.0, 1.0, 0.0, 1.0, 1.0, 1.0];
+        let runs = steep_runs(&pts, &slopes, 0.5);
+        // After the dropped point 2: 3, 4, 5, then 0, 1 (one run across the loop's start).
+        assert_eq!(runs, vec![vec![pts[3], pts[4], pts[5], pts[0], pts[1]]]);
+        let all = steep_runs(&pts, &[1.0; 6], 0.5);
+        assert_eq!(all[0].len(), 7);
+        assert_eq!(all[0].first(), all[0].last());
+    }
+
+    #[test]
+    fn level_spacing_matches_the_profile_circle_on_a_vertical_wall() {
+        let ball = CutterShape::Ball { radius: 3.0 };
+        let sh: f64 = 0.01;
+        let dz = level_dz(&ball, sh, std::f64::consts::FRAC_PI_2);
+        // Two circles of radius 3 dz apart on a vertical line leave sh between them.
+        let left = 3.0 - (9.0 - (dz / 2.0).powi(2)).sqrt();
+        assert!((left - sh).abs() < 1e-12, "{left}");
+        let flat = CutterShape::Flat { radius: 3.0 };
+        let s = 60f64.to_radians();
+        assert!((level_dz(&flat, sh, s) * s.cos() - sh).abs() < 1e-15);
+    }
+}
