@@ -157,7 +157,8 @@ pub fn write_job(out: &scallop_engine::JobOutput, seconds: f64, folder: &Path, j
     text.push_str(&format!(
         "  time       {} in all (stop-to-stop, rapids included)\n\
          \x20 simulated  no gouge on the final {} mm stock; deepest {:+.4} mm (tolerance {:.4} mm); \
-         scallop {:.4} mm along the normal beyond R from the edge (last operation's limit: sh + {:.5} mm)\n\
+         scallop on the machined surface {:.4} mm along the normal beyond R from the edge (last operation's limit: sh + {:.5} mm)\n\
+         {}\
          \x20 planned    in {}\n\
          \x20 wrote      {}, report.json, toolpath.csv\n",
         hms(r.total_time_s),
@@ -166,10 +167,33 @@ pub fn write_job(out: &scallop_engine::JobOutput, seconds: f64, folder: &Path, j
         r.sim_gouge_tolerance_mm,
         r.sim_max_scallop_mm,
         r.sim_resolution_bound_mm,
+        rest_text(&r.rest),
         hms(seconds),
         nc.display()
     ));
     print_text(&text)
+}
+
+/// The summary's lines on material the cutter cannot reach (empty without any).
+#[must_use]
+pub fn rest_text(rest: &scallop_engine::RestReport) -> String {
+    if rest.area_mm2 <= 0.0 {
+        return String::new();
+    }
+    let mut text = format!(
+        "  unreachable {:.1} mm2 of material the cutter cannot remove, in {} place(s), up to {:.4} mm thick \
+         (not scallop: a corner or slot tighter than the cutter; finish it with a smaller one)\n",
+        rest.area_mm2,
+        rest.places.len(),
+        rest.depth_mm
+    );
+    for p in rest.places.iter().take(3) {
+        text.push_str(&format!(
+            "             at ({:.3}, {:.3}) mm: {:.1} mm2, up to {:.4} mm\n",
+            p.at[0], p.at[1], p.area_mm2, p.depth_mm
+        ));
+    }
+    text
 }
 
 /// A duration as people read it: seconds under a minute, else h:mm:ss.
@@ -218,11 +242,12 @@ pub fn write_finishing(
          \x20 analysis   PCA slope {slope:.2}°, critical slope {crit:.2}°: {rec}; feed at {dir:.2}° from X\n\
          \x20 cutter     {cutter}, scallop height {sh} mm, {chord}\n\
          \x20 toolpath   {passes} passes on {planes} planes, {points} points, {links} links, {retracts} retracts\n\
-         \x20 scallop    verified max {smax:.5} mm, mean {smean:.5} mm (<= {sh} mm)\n\
+         \x20 scallop    verified max {smax:.5} mm (<= {sh} mm{by_sim}), mean material left {smean:.5} mm\n\
          \x20 time       {t1:.1} s stop-to-stop, {t2:.1} s look-ahead, + {tr:.1} s rapids\n\
          \x20 lengths    feed {feed:.0} mm, links {link:.0} mm, rapid {rapid:.0} mm\n\
          \x20 simulated  no gouge on a {res} mm stock; deepest {dev:+.4} mm (tolerance {gt:.4} mm), most material left {mat:.4} mm;\n\
-         \x20            scallop {ssim:.4} mm along the normal beyond R from the edge (<= sh + {bound:.5} mm), {sedge:.4} mm within it\n\
+         \x20            scallop on the machined surface {ssim:.4} mm along the normal beyond R from the edge (<= sh + {bound:.5} mm), {sedge:.4} mm within it\n\
+         {rest}\
          \x20 planned    in {secs:.2} s\n\
          \x20 wrote      {nc}, report.json, toolpath.csv, report.html, scene.glb\n",
         part = r.part,
@@ -260,6 +285,12 @@ pub fn write_finishing(
         ssim = r.sim_max_scallop_mm,
         bound = r.sim_resolution_bound_mm,
         sedge = r.sim_edge_max_scallop_mm,
+        rest = rest_text(&r.rest),
+        by_sim = if p.max_scallop_mm > r.scallop_height_mm {
+            format!(" + {:.5} mm, the simulation's bound", r.sim_resolution_bound_mm)
+        } else {
+            String::new()
+        },
         secs = seconds,
         nc = nc.display(),
     ))

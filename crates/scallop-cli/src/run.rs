@@ -109,6 +109,11 @@ fn apply_finishing(job: &mut FinishJob, f: &scallop_io::job::FinishingSpec) {
         (StrategyWord::Isoparametric, IsoWord::U) => Strategy::Isoparametric(IsoDirection::U),
         (StrategyWord::Network, _) => Strategy::NetworkPlanes,
         (StrategyWord::Parallel, _) => Strategy::ParallelPlanes,
+        (StrategyWord::SteepShallow, _) => Strategy::SteepShallow { threshold_deg: f.steep_threshold_deg },
+        (StrategyWord::Auto, _) if matches!(job.part, scallop_engine::Part::Mesh(_)) && job.setup.is_none() => {
+            Strategy::SteepShallow { threshold_deg: f.steep_threshold_deg }
+        }
+        (StrategyWord::Auto, _) => Strategy::ParallelPlanes,
     };
     job.leads = match f.lead {
         LeadWord::Arc => LeadKind::Arc { radius: f.lead_radius },

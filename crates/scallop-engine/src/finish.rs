@@ -18,8 +18,8 @@ use scallop_machine::{Kinematics, Machine};
 use scallop_mesh::{MeshIndex, TriMesh};
 use scallop_post::{Dialect, OutputMode, PostParams, ProgramInfo, program_text, write_fitted};
 use scallop_strategy::{
-    Boundary, FinishingParams, IsoDirection, LeadKind, LeadReport, Pattern, apply_leads, lookahead_time,
-    plan_finishing, plan_isoparametric, stop_to_stop_time,
+    Boundary, FinishingParams, IsoDirection, LeadKind, LeadReport, Pattern, SteepShallow, apply_leads, lookahead_time,
+    plan_finishing, plan_isoparametric, plan_steep_shallow, stop_to_stop_time,
 };
 use scallop_toolpath::{FittedPath, Move, MoveKind, Toolpath, fit_arcs};
 use serde::Serialize;
@@ -186,6 +186,9 @@ pub struct FinishReport {
     pub sim_gouge_tolerance_mm: f64,
     /// Leads applied, and those replaced by straight plunges (with where and why).
     pub leads: LeadReport,
+    /// Material the cutter cannot reach (none when the area is 0): reported
+    /// apart from the scallop, which it never counts in.
+    pub rest: RestReport,
 }
 
 /// The job's outputs.
@@ -240,15 +243,17 @@ pub fn run_finishing(job: &FinishJob) -> Result<FinishOutput, EngineError> {
     let (gouge_tolerance, options) = verify_options(job, &prepared);
     let sim =
         scallop_sim::simulate(stock, job.sim_resolution, &job.cutter, &op.plan.toolpath, &prepared.index, &options)?;
-    if job.strategy == Strategy::NetworkPlanes {
-        network_scallop_from(&sim, job, &mut op.plan.report)?;
-    }
+    let rest = if job.strategy.simulation_verifies_scallop() {
+        network_scallop_from(&sim, job, &prepared, &options, &mut op.plan.report)?
+    } else {
+        RestReport::default()
+    };
     let (fitted, comments) = fit_and_comment(job, &op, &prepared, &tolerances);
     let text = match &job.setup {
         None => three_axis_program(job, &fitted, &comments)?,
         Some(setup) => indexed_program(job, setup, &op.plan.toolpath, op.plan.report.machining_time_s)?,
     };
-    let report = finish_report(job, &op, &prepared, &sim, gouge_tolerance);
+    let report = finish_report(job, &op, &prepared, &sim, gouge_tolerance, rest);
     let details = FinishDetails { prepared, stock, params: op.params, scallop: op.plan.scallop, simulation: sim };
     Ok(FinishOutput { toolpath: op.plan.toolpath, gcode: text, report, fitted, details })
 }
@@ -357,6 +362,14 @@ pub(crate) fn plan_operation(
             let set = parametric_only(job, "isoparametric passes")?;
             isoparametric(set, prepared, job, &params, tolerances, direction)?
         }
+        Strategy::SteepShallow { threshold_deg } => {
+            let mut split = SteepShallow::default_for(&job.cutter, job.scallop_height);
+            if let Some(t) = threshold_deg {
+                split.threshold = t.to_radians();
+            }
+            let p = plan_steep_shallow(&prepared.mesh, &prepared.index, &job.cutter, &params, tolerances, &split)?;
+            Plan { toolpath: p.toolpath, report: p.report, scallop: None }
+        }
     };
     let (led, leads) =
         apply_leads(&planned.toolpath, &prepared.index, &job.cutter, job.leads, tolerances.path, job.tolerances.gouge)?;
@@ -395,31 +408,79 @@ fn parametric_only<'j>(job: &'j FinishJob, what: &str) -> Result<&'j scallop_sur
     Ok(set)
 }
 
-/// The network planner measures no scallop: the simulation is its scallop
-/// verification, and a scallop over sh (beyond the grid's bound) fails the job.
+/// The strategies the simulation verifies (the network planner measures no
+/// scallop, steep-and-shallow's levels none): a scallop over sh beyond the
+/// grid's bound fails the job, once the material no program of this cutter
+/// can remove is told apart (`scallop_sim::split_rest`) and reported.
 pub(crate) fn network_scallop_from(
     sim: &scallop_sim::Simulation,
     job: &FinishJob,
+    prepared: &PreparedPart,
+    options: &scallop_sim::VerifyOptions,
     report: &mut scallop_strategy::Report,
-) -> Result<(), EngineError> {
+) -> Result<RestReport, EngineError> {
     let bound = sim.zmap.resolution_bound(job.cutter.shape());
+    let limit = job.scallop_height + bound;
     let v = &sim.verification;
-    if v.max_thickness > job.scallop_height + bound {
-        let at = v.max_thickness_at.unwrap_or_else(|| scallop_geom::Point2::new(f64::NAN, f64::NAN));
-        return Err(EngineError::ScallopNotHeld {
-            measured: v.max_thickness,
-            x: at.x,
-            y: at.y,
-            limit: job.scallop_height,
-            bound,
-        });
+    let (max, at, rest) = if v.max_thickness > limit {
+        let field = scallop_sim::PartField::new(&sim.zmap, &prepared.index);
+        let split = scallop_sim::split_rest(&sim.zmap, &field, &prepared.index, &job.cutter, options, limit);
+        (split.machined_max, split.machined_at, RestReport::from_split(&split))
+    } else {
+        (v.max_thickness, v.max_thickness_at, RestReport::default())
+    };
+    if max > limit {
+        let at = at.unwrap_or_else(|| scallop_geom::Point2::new(f64::NAN, f64::NAN));
+        return Err(EngineError::ScallopNotHeld { measured: max, x: at.x, y: at.y, limit: job.scallop_height, bound });
     }
-    report.max_scallop_mm = v.max_thickness;
+    report.max_scallop_mm = max;
     // The mean: material left above the part per unit of its area (vertical).
     #[allow(clippy::cast_precision_loss, reason = "cell counts")]
     let cells = v.part_cells.max(1) as f64;
     report.mean_scallop_mm = v.excess_volume / (cells * job.sim_resolution * job.sim_resolution);
-    Ok(())
+    Ok(rest)
+}
+
+/// Material the cutter cannot reach (a corner sharper than it, a slot
+/// narrower than it), found by the simulation: reported, never counted as
+/// scallop (`scallop_sim::split_rest`).
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct RestReport {
+    /// Area with rest material thicker than sh plus the resolution bound (mm^2).
+    pub area_mm2: f64,
+    /// Its largest thickness along the part normal (mm).
+    pub depth_mm: f64,
+    /// The scallop on the machined surface above the cutter's reach (mm); 0
+    /// when the simulation's scallop needed no split (then that is the figure).
+    pub machined_scallop_mm: f64,
+    /// The places, largest first: `[x, y]` of the deepest cell, area (mm^2), depth (mm).
+    pub places: Vec<RestPlaceReport>,
+}
+
+/// One place of [`RestReport`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct RestPlaceReport {
+    /// The deepest cell's centre, `[x, y]` (mm, planning frame).
+    pub at: [f64; 2],
+    /// Area (mm^2).
+    pub area_mm2: f64,
+    /// Largest thickness (mm).
+    pub depth_mm: f64,
+}
+
+impl RestReport {
+    fn from_split(split: &scallop_sim::RestSplit) -> RestReport {
+        RestReport {
+            area_mm2: split.unreachable_area,
+            depth_mm: split.unreachable_depth,
+            machined_scallop_mm: split.machined_max,
+            places: split
+                .places
+                .iter()
+                .map(|p| RestPlaceReport { at: [p.at.x, p.at.y], area_mm2: p.area, depth_mm: p.depth })
+                .collect(),
+        }
+    }
 }
 
 /// The program's path (arcs fitted when asked) and its header comments.
@@ -474,6 +535,7 @@ pub(crate) fn finish_report(
     prepared: &PreparedPart,
     sim: &scallop_sim::Simulation,
     gouge_tolerance: f64,
+    rest: RestReport,
 ) -> FinishReport {
     FinishReport {
         part: job.part_name.clone(),
@@ -487,12 +549,17 @@ pub(crate) fn finish_report(
         plan: op.plan.report.clone(),
         sim_resolution_mm: job.sim_resolution,
         sim_max_material_mm: sim.verification.max_scallop,
-        sim_max_scallop_mm: sim.verification.max_thickness,
+        sim_max_scallop_mm: if rest.machined_scallop_mm > 0.0 {
+            rest.machined_scallop_mm
+        } else {
+            sim.verification.max_thickness
+        },
         sim_edge_max_scallop_mm: sim.verification.margin_max_thickness,
         sim_resolution_bound_mm: sim.zmap.resolution_bound(job.cutter.shape()),
         sim_min_deviation_mm: sim.verification.min_deviation,
         sim_gouge_tolerance_mm: gouge_tolerance,
         leads: op.leads.clone(),
+        rest,
     }
 }
 
@@ -536,7 +603,7 @@ pub(crate) fn three_axis_program(
 }
 
 /// Which finishing strategy.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Strategy {
     /// Parallel vertical planes (`scallop_strategy::plan_finishing`).
     ParallelPlanes,
@@ -548,6 +615,23 @@ pub enum Strategy {
     /// (`scallop_network::network_toolpath`); the scallop is verified by
     /// the stock simulation only.
     NetworkPlanes,
+    /// Parallel planes on the shallow triangles of a mesh and waterline levels
+    /// on the steep ones (`scallop_strategy::plan_steep_shallow`), split at
+    /// `threshold_deg` (default from the cutter and sh); the scallop is
+    /// verified by the stock simulation.
+    SteepShallow {
+        /// Slope (degrees from the horizontal) of the split.
+        threshold_deg: Option<f64>,
+    },
+}
+
+impl Strategy {
+    /// Whether the stock simulation is the scallop's verification (the
+    /// planner measures none, or not everywhere).
+    #[must_use]
+    pub fn simulation_verifies_scallop(&self) -> bool {
+        matches!(self, Strategy::NetworkPlanes | Strategy::SteepShallow { .. })
+    }
 }
 
 /// The machining-mesh step of the network planner (mm): the specification's

@@ -15,7 +15,7 @@ use crate::finish::{
     PlannedOperation, cutter_text, fit_and_comment, network_scallop_from, plan_operation, planning_tolerances,
     verify_options,
 };
-use crate::{EngineError, FinishJob, PreparedPart, Strategy, prepare_part, stock_box};
+use crate::{EngineError, FinishJob, PreparedPart, prepare_part, stock_box};
 
 /// Height kept between the highest material of the in-process stock and the
 /// rapids of an operation (mm): an operation's clearance plane is at least
@@ -117,6 +117,8 @@ pub struct JobReport {
     pub sim_min_deviation_mm: f64,
     /// Gouge tolerance the simulation enforced (mm).
     pub sim_gouge_tolerance_mm: f64,
+    /// Material the last operation's cutter cannot reach (none when the area is 0).
+    pub rest: crate::RestReport,
 }
 
 /// The outputs of [`run_job`].
@@ -193,9 +195,10 @@ pub fn run_job(job: &Job) -> Result<JobOutput, EngineError> {
     let (gouge_tolerance, options) = verify_options(last, &prepared);
     let verification = verify_in(&zmap, &field, &options)?;
     let simulation = scallop_sim::Simulation { zmap, cut: empty_cut(), verification };
-    if last.strategy == Strategy::NetworkPlanes {
+    let mut rest = crate::RestReport::default();
+    if last.strategy.simulation_verifies_scallop() {
         if let Some((p, _)) = planned.last_mut() {
-            network_scallop_from(&simulation, last, &mut p.plan.report)?;
+            rest = network_scallop_from(&simulation, last, &prepared, &options, &mut p.plan.report)?;
         }
     }
     let gcode = program(job, &planned, &prepared, &tolerances)?;
@@ -222,10 +225,11 @@ pub fn run_job(job: &Job) -> Result<JobOutput, EngineError> {
         operations: reports,
         total_time_s: total_time,
         sim_resolution_mm: first.sim_resolution,
-        sim_max_scallop_mm: v.max_thickness,
+        sim_max_scallop_mm: if rest.machined_scallop_mm > 0.0 { rest.machined_scallop_mm } else { v.max_thickness },
         sim_resolution_bound_mm: simulation.zmap.resolution_bound(last.cutter.shape()),
         sim_min_deviation_mm: v.min_deviation,
         sim_gouge_tolerance_mm: gouge_tolerance,
+        rest,
     };
     let toolpaths = planned.into_iter().map(|(p, _)| p.plan.toolpath).collect();
     Ok(JobOutput { toolpaths, toolpath, gcode, report, prepared, simulation })

@@ -32,7 +32,8 @@ use scallop_surface::SurfaceSet;
 pub use budget::{ARC_SHARE, Budget};
 pub use demo::{DemoOutput, DemoSettings, DemoSummary, run_demo};
 pub use finish::{
-    FinishDetails, FinishJob, FinishOutput, FinishReport, OutputOptions, Setup, Strategy, run_finishing, stock_box,
+    FinishDetails, FinishJob, FinishOutput, FinishReport, OutputOptions, RestPlaceReport, RestReport, Setup, Strategy,
+    run_finishing, stock_box,
 };
 pub use grid::{GridAxis, GridError, MAX_GRID_POINTS};
 pub use job::{

@@ -220,10 +220,12 @@ word_enum! {
 }
 word_enum! {
     /// `finishing.strategy`.
-    StrategyWord { /// Parallel planes, drop-cutter planner with a measured scallop.
+    StrategyWord { /// Steep-and-shallow on a mesh part, parallel planes on a parametric one.
+        Auto = "auto", /// Parallel planes, drop-cutter planner with a measured scallop.
         Parallel = "parallel", /// Parallel planes by the network planner.
         Network = "network", /// Isoparametric passes.
-        Isoparametric = "isoparametric" }
+        Isoparametric = "isoparametric", /// Parallel planes on shallow triangles, waterline levels on steep ones.
+        SteepShallow = "steep-shallow" }
 }
 word_enum! {
     /// `finishing.iso_direction`.
@@ -293,11 +295,18 @@ pub struct FinishingSpec {
     /// Longest forward step between drop-cutter samples (mm).
     #[serde(default = "default_max_step")]
     pub max_step: f64,
-    /// `parallel` (default: parallel vertical planes, drop-cutter planner with a measured
+    /// `auto` (default: `steep-shallow` on a mesh part without a `[setup]`, else
+    /// `parallel`), `parallel` (parallel vertical planes, drop-cutter planner with a measured
     /// scallop), `network` (parallel planes by the fast network planner, parametric parts)
-    /// or `isoparametric` (parametric parts).
+    /// `isoparametric` (parametric parts) or `steep-shallow` (parallel planes on
+    /// shallow triangles, waterline levels on steep ones).
     #[serde(default = "default_strategy")]
     pub strategy: StrategyWord,
+    /// Steep-and-shallow: the slope (degrees from the horizontal) from which
+    /// waterline levels finish instead of parallel planes; default from the
+    /// cutter and sh (`scallop_strategy::SteepShallow::default_for`).
+    #[serde(default)]
+    pub steep_threshold_deg: Option<f64>,
     /// Isoparametric passes along `u` (default) or `v`.
     #[serde(default = "default_iso")]
     pub iso_direction: IsoWord,
@@ -316,7 +325,7 @@ pub struct FinishingSpec {
 }
 
 fn default_strategy() -> StrategyWord {
-    StrategyWord::Parallel
+    StrategyWord::Auto
 }
 fn default_iso() -> IsoWord {
     IsoWord::U

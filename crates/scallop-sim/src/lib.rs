@@ -75,6 +75,7 @@
 mod dexel;
 mod envelope;
 mod error;
+mod rest;
 #[cfg(test)]
 mod test_support;
 pub mod tol;
@@ -93,6 +94,7 @@ pub use dexel::{
 };
 pub use envelope::swept_floor;
 pub use error::SimError;
+pub use rest::{RestPlace, RestSplit, split_rest};
 pub use verify::{GougeCell, PartField, Verification, VerifyOptions, part_heights, verify, verify_in};
 pub use view::StockView;
 pub use zmap::{Collision, CutReport, MAX_CELLS, MoveId, RapidHit, ToolPart, ZMap};

@@ -318,7 +318,7 @@ pub fn plan_finishing(
     params: &FinishingParams,
     tol: &Tolerances,
 ) -> Result<Planned, StrategyError> {
-    plan(index, cutter, params, tol, None)
+    plan(index, cutter, params, tol, None, false)
 }
 
 /// [`plan_finishing`] restricted to one zone of a labelled part: a cutter
@@ -338,7 +338,21 @@ pub fn plan_zone_finishing(
     tol: &Tolerances,
     region: &ZoneRegion,
 ) -> Result<Planned, StrategyError> {
-    plan(index, cutter, params, tol, Some(region))
+    plan(index, cutter, params, tol, Some(region), false)
+}
+
+/// [`plan_zone_finishing`] that does not refuse the part where no spacing
+/// holds `sh` (a crease or corner the cutter cannot reach): the planes there
+/// keep the spacing rule's gap and the stock simulation tells rest material
+/// from scallop (steep-and-shallow finishing, issue 15 item 4).
+pub(crate) fn plan_zone_tolerant(
+    index: &MeshIndex,
+    cutter: &Cutter,
+    params: &FinishingParams,
+    tol: &Tolerances,
+    region: &ZoneRegion,
+) -> Result<Planned, StrategyError> {
+    plan(index, cutter, params, tol, Some(region), true)
 }
 
 fn plan(
@@ -347,8 +361,10 @@ fn plan(
     params: &FinishingParams,
     tol: &Tolerances,
     region: Option<&ZoneRegion>,
+    tolerate_rest: bool,
 ) -> Result<Planned, StrategyError> {
     let mut planner = plan::Planner::new(index, cutter, params, tol, region)?;
+    planner.tolerate_rest = tolerate_rest;
     let planes = planner.sweep()?;
     let (toolpath, links, retracts) = planner.toolpath(&planes);
     let planes: Vec<Plane> = planes.into_iter().map(|p| p.plane).collect();
@@ -361,6 +377,7 @@ fn plan(
         &feed_samples,
         params.scallop_height,
         plan::zone_end_margin(cutter, region),
+        !tolerate_rest,
     )?;
     let report = Report {
         passes: planes.iter().map(|p| p.passes.len()).sum(),

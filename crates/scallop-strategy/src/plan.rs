@@ -72,6 +72,9 @@ pub(crate) struct Planner<'a> {
     /// While bridging a gap between two ranges (see [`Planner::bridge`]): the
     /// feed interval in which any contact with the part counts as inside.
     bridge_span: Option<[f64; 2]>,
+    /// Where no spacing holds `sh`, keep the spacing rule's gap instead of
+    /// failing (the stock simulation then tells rest material from scallop).
+    pub(crate) tolerate_rest: bool,
 }
 
 /// One plane with its passes and the samples the spacing rule reads.
@@ -187,6 +190,7 @@ impl<'a> Planner<'a> {
             feed_samples,
             drops: 0,
             bridge_span: None,
+            tolerate_rest: false,
         })
     }
 
@@ -566,9 +570,11 @@ impl<'a> Planner<'a> {
                 let current = planes.last().expect("a plane of this range");
                 let d = current.plane.offset;
                 let (spacing, at) = self.spacing(current).unwrap_or((delta, self.frame.xy(0.0, d)));
-                if spacing < tol::MIN_SPACING {
-                    return Err(self.unreachable(spacing, at));
-                }
+                let spacing = match spacing {
+                    s if s >= tol::MIN_SPACING => s,
+                    _ if self.tolerate_rest => tol::REST_SPACING_SHARE * cap,
+                    s => return Err(self.unreachable(s, at)),
+                };
                 delta = spacing;
                 let mut gap = spacing;
                 let mut next = self.plane(d + gap);
@@ -588,6 +594,7 @@ impl<'a> Planner<'a> {
                     }
                 }
                 let mut accepted = false;
+                let rule_gap = gap;
                 for retry in 0..tol::MAX_SPACING_RETRIES {
                     // INVARIANT: as above.
                     let current = planes.last().expect("a plane of this range");
@@ -601,12 +608,22 @@ impl<'a> Planner<'a> {
                     let ratio = if h.is_finite() { (sh / h).sqrt() * tol::SPACING_SAFETY } else { 0.5 };
                     gap *= if retry == 0 { ratio } else { ratio.min(tol::SPACING_MIN_SHRINK) };
                     if gap < tol::MIN_SPACING {
+                        if self.tolerate_rest {
+                            break;
+                        }
                         return Err(self.unreachable(gap, place));
                     }
                     next = self.plane(d + gap);
                 }
                 if !accepted {
-                    return Err(self.unreachable(gap, at));
+                    if !self.tolerate_rest {
+                        return Err(self.unreachable(gap, at));
+                    }
+                    next = self.plane(d + rule_gap);
+                    if next.plane.passes.is_empty() {
+                        empty = d + rule_gap;
+                        continue 'ranges;
+                    }
                 }
                 planes.push(next);
             }
@@ -682,10 +699,16 @@ impl<'a> Planner<'a> {
                 let ratio = if h.is_finite() { (sh / h).sqrt() * tol::SPACING_SAFETY } else { 0.5 };
                 gap *= if retry == 0 { ratio } else { ratio.min(tol::SPACING_MIN_SHRINK) };
                 if gap < tol::MIN_SPACING {
+                    if self.tolerate_rest {
+                        return Ok(out);
+                    }
                     return Err(self.unreachable(gap, place));
                 }
             }
             let Some(candidate) = accepted else {
+                if self.tolerate_rest {
+                    return Ok(out);
+                }
                 return Err(self.unreachable(gap, at));
             };
             out.push(candidate);

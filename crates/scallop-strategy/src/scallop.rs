@@ -445,7 +445,7 @@ pub fn verify_scallop(
     feed_samples: &[f64],
     scallop_height: f64,
 ) -> Result<ScallopReport, StrategyError> {
-    verify_scallop_within(index, cutter, planes, direction, feed_samples, scallop_height, 0.0)
+    verify_scallop_within(index, cutter, planes, direction, feed_samples, scallop_height, 0.0, true)
 }
 
 /// [`verify_scallop`] leaving out the sections within `end_margin` of a pass end.
@@ -457,6 +457,7 @@ pub(crate) fn verify_scallop_within(
     feed_samples: &[f64],
     scallop_height: f64,
     end_margin: f64,
+    strict: bool,
 ) -> Result<ScallopReport, StrategyError> {
     let measure = Measure { end_margin, ..Measure::new(index, cutter, direction, scallop_height) };
     let frame = measure.frame;
@@ -503,7 +504,7 @@ pub(crate) fn verify_scallop_within(
     };
     let mut sum = 0.0;
     for (pair, heights) in pairs {
-        if pair.max_mm > limit {
+        if strict && pair.max_mm > limit {
             return Err(StrategyError::ScallopExceeded {
                 plane: pair.plane,
                 next: pair.next,

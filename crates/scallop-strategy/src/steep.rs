@@ -23,7 +23,7 @@ use scallop_toolpath::{Move, MoveKind, Toolpath};
 use scallop_waterline::{WaterlineGrid, WaterlineOptions};
 
 use crate::geometry::{contact_normal, slots_by_original};
-use crate::{FinishingParams, Planned, Report, StrategyError, ZoneRegion, plan_zone_finishing, tol};
+use crate::{FinishingParams, Planned, Report, StrategyError, ZoneRegion, tol};
 
 /// How the part is split by slope.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -43,7 +43,7 @@ impl SteepShallow {
     /// The split for `cutter` and scallop height `sh`: the slope at which the
     /// horizontal spacing of parallel planes across a wall (the analysis
     /// model's step-over times `cos s`) equals the level spacing (`dz` of the
-    /// module docs), between 30 and 70 degrees (45 for a ball); 5 degrees of
+    /// module docs), between 30 and 70 degrees (45 for a ball); `tol::STEEP_OVERLAP_DEG` of
     /// overlap; climb.
     ///
     /// ```
@@ -68,7 +68,7 @@ impl SteepShallow {
                 b = m;
             }
         }
-        SteepShallow { threshold: 0.5 * (a + b), overlap: 5f64.to_radians(), climb: true }
+        SteepShallow { threshold: 0.5 * (a + b), overlap: tol::STEEP_OVERLAP_DEG.to_radians(), climb: true }
     }
 
     fn check(&self) -> Result<(), StrategyError> {
@@ -155,7 +155,7 @@ pub fn plan_steep_shallow(
     let labels: Vec<u32> = slopes.iter().map(|&s| u32::from(s >= split.threshold + split.overlap)).collect();
     let shallow = if labels.contains(&0) {
         let region = ZoneRegion::new(mesh, &labels, 0, 0.0)?;
-        match plan_zone_finishing(index, cutter, params, tol_, &region) {
+        match crate::plan_zone_tolerant(index, cutter, params, tol_, &region) {
             Ok(p) => Some(p),
             Err(StrategyError::EmptyRegion { .. }) => None,
             Err(e) => return Err(e),
@@ -172,11 +172,15 @@ pub fn plan_steep_shallow(
     let steep_z = steep_range(mesh, &slopes, steep_min);
     let (levels, steep_passes) = match steep_z {
         Some(range) => {
-            let levels = Levels::new(index, cutter, params, tol_, split, range)?;
+            let mut levels = Levels::new(index, cutter, params, tol_, split, range)?;
+            levels.flats = flat_heights(mesh, &slopes, tol_.path);
             levels.append_to(&mut toolpath)?
         }
         None => (0, 0),
     };
+    if shallow.is_none() && steep_passes == 0 {
+        return Err(StrategyError::EmptyRegion { direction_deg: params.direction.to_degrees() });
+    }
     let mut report = Report::timed(&toolpath, params);
     if let Some(p) = &shallow {
         report.passes = p.report.passes;
@@ -213,6 +217,20 @@ fn steep_range(mesh: &TriMesh, slopes: &[f64], steep_min: f64) -> Option<(f64, f
     range
 }
 
+/// Distinct heights of the part's horizontal triangles (within `resolution`),
+/// highest first.
+fn flat_heights(mesh: &TriMesh, slopes: &[f64], resolution: f64) -> Vec<f64> {
+    let mut zs: Vec<f64> = slopes
+        .iter()
+        .enumerate()
+        .filter(|&(_, &s)| s < tol::FLAT_SLOPE)
+        .map(|(t, _)| mesh.triangle(t).iter().map(|p| p.z).fold(f64::NEG_INFINITY, f64::max))
+        .collect();
+    zs.sort_by(|a, b| b.total_cmp(a));
+    zs.dedup_by(|a, b| (*a - *b).abs() <= resolution);
+    zs
+}
+
 /// The waterline levels of the steep triangles.
 struct Levels<'a> {
     index: &'a MeshIndex,
@@ -220,10 +238,19 @@ struct Levels<'a> {
     params: &'a FinishingParams,
     split: &'a SteepShallow,
     grid: WaterlineGrid<'a>,
+    /// The loops' chord tolerance, and how far their points are pushed out
+    /// (mm): a chord of a convex contour lies inside it by up to this much,
+    /// and on a steep wall any inward step is a deep vertical gouge.
+    chord: f64,
     slots: Vec<u32>,
     floor: f64,
     /// Lowest and highest level (tip heights, mm).
     z_range: (f64, f64),
+    /// Heights of the part's flat areas, highest first: a level runs just
+    /// above each, so the foot of a wall standing on a floor is finished.
+    flats: Vec<f64>,
+    /// How far above a flat area its level runs (mm, `FLAT_LIFT_SHARE * path`).
+    lift: f64,
 }
 
 /// One level's passes and its smallest steep contact slope.
@@ -242,8 +269,8 @@ impl<'a> Levels<'a> {
         split: &'a SteepShallow,
         (lo, hi): (f64, f64),
     ) -> Result<Levels<'a>, StrategyError> {
-        let options =
-            WaterlineOptions { chord_tolerance: tol::SAMPLING_SHARE * tol_.path, ..WaterlineOptions::default() };
+        let chord = tol::LEVEL_CHORD_SHARE * tol_.path;
+        let options = WaterlineOptions { chord_tolerance: chord, ..WaterlineOptions::default() };
         let grid = WaterlineGrid::new(cutter, index, &options).map_err(|e| StrategyError::Waterline(e.to_string()))?;
         let bounds = index.bounds();
         // Tip heights inside the part's range, where the waterline exists.
@@ -256,9 +283,12 @@ impl<'a> Levels<'a> {
             params,
             split,
             grid,
+            chord,
             slots: slots_by_original(index),
             floor: bounds.min.z - bounds.diagonal() - 1.0,
             z_range: (bottom, top.max(bottom)),
+            flats: Vec::new(),
+            lift: tol::FLAT_LIFT_SHARE * tol_.path,
         })
     }
 
@@ -270,12 +300,19 @@ impl<'a> Levels<'a> {
         let mut passes = Vec::new();
         let mut min_slope = f64::INFINITY;
         for l in loops {
-            let mut points = l.points.clone();
+            let mut points = pushed_out(&l.points, tol::LEVEL_PUSH_CHORDS * self.chord);
+            // The contact that lifts the cutter above z: a little inside the
+            // loop (its points are where the cutter just clears the part, on a
+            // floor level the floor itself).
+            let mut slopes: Vec<f64> = pushed_out(&l.points, -tol::LEVEL_PROBE_CHORDS * self.chord)
+                .iter()
+                .map(|p| self.contact_slope(*p))
+                .collect();
             if self.split.climb {
                 // Loops have their inside (material) on the left: climb puts it right.
                 points.reverse();
+                slopes.reverse();
             }
-            let slopes: Vec<f64> = points.iter().map(|p| self.contact_slope(*p)).collect();
             for &s in slopes.iter().filter(|&&s| s >= steep_min) {
                 min_slope = min_slope.min(s);
             }
@@ -292,7 +329,29 @@ impl<'a> Levels<'a> {
 
     fn dz(&self, slope: f64) -> f64 {
         let s = if slope.is_finite() { slope } else { self.split.threshold - self.split.overlap };
-        level_dz(self.cutter.shape(), self.params.scallop_height, s).max(tol::MIN_SPACING)
+        // The push-out adds its width to the material left on the wall.
+        let sh = self.params.scallop_height - tol::LEVEL_PUSH_CHORDS * self.chord;
+        (tol::LEVEL_SPACING_SAFETY * level_dz(self.cutter.shape(), sh, s)).max(tol::MIN_SPACING)
+    }
+
+    /// On a wall that grows steeper downwards (convex in its vertical section,
+    /// curvature `k` from the two levels' slopes), the profile circles leave a
+    /// higher cusp than on a plane: `d^2 (1 / rho + k) / 8` instead of
+    /// `d^2 / (8 rho)`, so the spacing shrinks by `1 / sqrt(1 + rho k)`;
+    /// `None` when it would change by less than 1 %.
+    fn convex_factor(&self, upper: &Level, lower: &Level) -> Option<f64> {
+        let rho = match *self.cutter.shape() {
+            CutterShape::Ball { radius } => radius,
+            CutterShape::Bull { corner, .. } => corner,
+            CutterShape::Flat { .. } | CutterShape::Cone { .. } => return None,
+        };
+        let (s0, s1) = (upper.min_slope, lower.min_slope);
+        if !(s0.is_finite() && s1.is_finite() && s1 > s0) {
+            return None;
+        }
+        let along = (upper.z - lower.z) / (0.5 * (s0 + s1)).sin().max(1e-9);
+        let factor = 1.0 / (1.0 + rho * (s1 - s0) / along).sqrt();
+        (factor < 0.99).then_some(factor)
     }
 
     /// The levels from the top down (module docs), each spaced by the smaller
@@ -307,10 +366,13 @@ impl<'a> Levels<'a> {
                 break;
             }
             let mut dz = self.dz(current.min_slope);
-            let mut next = self.level((current.z - dz).max(bottom))?;
+            let mut next = self.level(self.next_z(current.z, dz))?;
             if next.min_slope < current.min_slope {
                 dz = self.dz(next.min_slope);
-                next = self.level((current.z - dz).max(bottom))?;
+                next = self.level(self.next_z(current.z, dz))?;
+            } else if let Some(factor) = self.convex_factor(&current, &next) {
+                dz *= factor;
+                next = self.level(self.next_z(current.z, dz))?;
             }
             out.push(current);
             if out.len() > tol::MAX_LEVELS {
@@ -319,6 +381,14 @@ impl<'a> Levels<'a> {
             current = next;
         }
         Ok(out)
+    }
+
+    /// The level `dz` below `z`, or the level just above a flat area between
+    /// them, never below the lowest level.
+    fn next_z(&self, z: f64, dz: f64) -> f64 {
+        let (bottom, _) = self.z_range;
+        let below = (z - dz).max(bottom);
+        self.flats.iter().map(|f| f + self.lift).find(|&f| f < z && f > below).unwrap_or(below)
     }
 
     /// Appends the levels to `path` (after what it holds), each pass entered
@@ -363,7 +433,7 @@ impl<'a> Levels<'a> {
     }
 
     /// Whether the straight move from `a` to `b` stays on or above the
-    /// drop-cutter surface at samples a quarter of the cutter radius apart
+    /// drop-cutter surface at samples `LEVEL_LINK_SAMPLE_CHORDS` chord tolerances apart
     /// (and is short: at most a few step-overs, so it cuts no fresh wall).
     fn safe_link(&self, a: &Point3, b: &Point3) -> bool {
         let radius = self.cutter.radius();
@@ -372,7 +442,7 @@ impl<'a> Levels<'a> {
             return false;
         }
         #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a small positive count")]
-        let n = (length / (0.25 * radius)).ceil().max(1.0) as usize;
+        let n = (length / (tol::LEVEL_LINK_SAMPLE_CHORDS * self.chord)).ceil().max(1.0) as usize;
         (0..=n).all(|k| {
             #[allow(clippy::cast_precision_loss, reason = "a small count")]
             let t = k as f64 / n as f64;
@@ -380,6 +450,25 @@ impl<'a> Levels<'a> {
             drop_cutter(self.cutter, self.index, p.xy(), self.floor).tip.z <= p.z
         })
     }
+}
+
+/// The closed loop `points` (inside on the left) with every point moved
+/// `by` mm to the right, along the bisector of its two edges' right normals.
+fn pushed_out(points: &[Point2], by: f64) -> Vec<Point2> {
+    let n = points.len();
+    let right = |a: &Point2, b: &Point2| {
+        let d = b - a;
+        let len = d.norm();
+        if len > 0.0 { scallop_geom::Vec2::new(d.y, -d.x) / len } else { scallop_geom::Vec2::zeros() }
+    };
+    (0..n)
+        .map(|i| {
+            let (prev, next) = (&points[(i + n - 1) % n], &points[(i + 1) % n]);
+            let m = right(prev, &points[i]) + right(&points[i], next);
+            let len = m.norm();
+            if len > 0.0 { points[i] + m / len * by } else { points[i] }
+        })
+        .collect()
 }
 
 /// Maximal runs of `points` (a closed loop) whose `slopes` reach `steep_min`;

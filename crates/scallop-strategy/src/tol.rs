@@ -223,3 +223,45 @@ pub const MAX_LEVELS: usize = 20_000;
 /// straight feed move (when the move stays above the CL surface) only if they
 /// are at most this many cutter radii apart; farther, it retracts.
 pub const LEVEL_LINK_RADII: f64 = 2.0;
+
+/// Chord tolerance of the waterline loops of steep-and-shallow finishing, as a
+/// share of the path tolerance; the loops' points are pushed out by
+/// [`LEVEL_PUSH_CHORDS`] of it, so no chord cuts into a convex wall, and the
+/// level spacing holds the scallop height less the push.
+pub const LEVEL_CHORD_SHARE: f64 = 0.1;
+
+/// A triangle flatter than this slope (rad) is a floor: steep-and-shallow
+/// finishing runs a waterline level just above it (at the levels' edge margin).
+pub const FLAT_SLOPE: f64 = 1e-3;
+
+/// The level of a flat area runs this share of the path tolerance above it:
+/// the waterline there is the contour where a wall lifts the cutter off the
+/// floor, and the floor is left with no more than this.
+pub const FLAT_LIFT_SHARE: f64 = 0.01;
+
+/// The contact of a waterline loop point is probed this many chord
+/// tolerances inside the loop, where the part lifts the cutter above the level.
+pub const LEVEL_PROBE_CHORDS: f64 = 4.0;
+
+/// Waterline levels are spaced this fraction of the profile rule's spacing
+/// (the rule assumes a wall of constant slope between two levels; the stock
+/// simulation proves the result).
+pub const LEVEL_SPACING_SAFETY: f64 = 0.9;
+
+/// Waterline loop points are pushed out this many chord tolerances: the
+/// kernel bounds a chord's deviation at its midpoint, and on a near-vertical
+/// wall any inward step is a deep vertical gouge.
+pub const LEVEL_PUSH_CHORDS: f64 = 2.0;
+
+/// A link between two waterline passes is checked against the drop-cutter
+/// every this many chord tolerances along it.
+pub const LEVEL_LINK_SAMPLE_CHORDS: f64 = 10.0;
+
+/// Where the spacing rule gives no usable spacing (a crease's normal) and the
+/// planner tolerates rest material, the next plane is this share of the
+/// largest step-over away (then measured as usual).
+pub const REST_SPACING_SHARE: f64 = 0.25;
+
+/// Half-width (degrees) of the slope band that both parallel planes and
+/// waterline levels finish in steep-and-shallow finishing.
+pub const STEEP_OVERLAP_DEG: f64 = 10.0;

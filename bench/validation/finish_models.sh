@@ -1,0 +1,87 @@
+#!/usr/bin/env bash
+# Issue 15 "done when": every mesh of ../shared/models/ocl and ../shared/models/mech finished
+# with the default strategy (steep-and-shallow on meshes), with a ball and a bull-nose cutter
+# sized for the part, at sh 0.01 mm and 0.05 mm. Writes one job file per case into OUT and a
+# table (markdown) of part, cutter, sh, exit code, passes, levels, predicted time, planning
+# time, simulated scallop, unreachable area.
+# Usage: bench/validation/finish_models.sh [OUT] [--reduced]
+# Env: SCALLOP (binary, default target/release/scallop, built when missing), TIMEOUT (s, 600).
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+OUT="${1:-target/finish-models}"
+REDUCED="${2:-}"
+SCALLOP="${SCALLOP:-target/release/scallop}"
+TIMEOUT="${TIMEOUT:-600}"
+MODELS=../shared/models
+if [ ! -d "$MODELS" ]; then
+    echo "finish_models.sh: ../shared/models is absent; nothing to run."
+    exit 0
+fi
+[ -x "$SCALLOP" ] || cargo build --release -q -p scallop-cli
+mkdir -p "$OUT"
+MODELS_ABS="$(cd "$MODELS" && pwd)"
+# part | units | ball D | bull D | bull r | flute length
+CASES="ocl/30sphere.stl mm 6 10 2 70
+ocl/carpet1.stl mm 10 12 2 30
+ocl/cone_on_side.stl mm 3 4 1 30
+ocl/demo.stl mm 1 2 0.5 10
+ocl/failedinpycam.stl mm 4 6 1 15
+ocl/mount_rush.stl mm 3 6 1 40
+ocl/pycam-textbox.stl mm 2 4 0.5 20
+ocl/sphere.stl mm 10 16 4 110
+ocl/sphere2.stl mm 3 4 1 35
+ocl/sphere_cutout.stl mm 6 10 2 75
+ocl/sphere_on_plate.stl mm 6 10 2 45
+mech/angle_block.STL in 6 10 2 45
+mech/idler_riser.STL in 6 10 2 30
+mech/octagonal_pocket.stl m 10 16 3 30"
+if [ "$REDUCED" = "--reduced" ]; then
+    CASES="$(printf '%s\n' "$CASES" | grep -E 'sphere_on_plate|demo.stl')"
+fi
+TABLE="$OUT/table.md"
+echo "| part | cutter | sh mm | exit | passes | levels | predicted time | planning s | simulated scallop mm | unreachable mm2 |" > "$TABLE"
+echo "|---|---|---|---|---|---|---|---|---|---|" >> "$TABLE"
+while read -r part units ball bull corner flute; do
+    for sh in 0.01 0.05; do
+        for tool in ball bull; do
+            name="$(basename "$part" | sed 's/\.[^.]*$//')-$tool-$sh"
+            job="$OUT/$name.toml"
+            {
+                echo "[part]"
+                echo "file = \"$MODELS_ABS/$part\""
+                echo "units = \"$units\""
+                echo "[cutter]"
+                if [ "$tool" = ball ]; then
+                    echo "shape = \"ball\""; echo "diameter = $ball"
+                else
+                    echo "shape = \"bull\""; echo "diameter = $bull"; echo "corner_radius = $corner"
+                fi
+                echo "flute_length = $flute"
+                echo "[finishing]"
+                echo "scallop_height = $sh"
+            } > "$job"
+            start=$(date +%s.%N)
+            set +e
+            timeout "$TIMEOUT" "$SCALLOP" run "$job" -o "$OUT/$name" --json > "$OUT/$name.json" 2> "$OUT/$name.err"
+            code=$?
+            set -e
+            secs=$(echo "$(date +%s.%N) - $start" | bc)
+            python3 - "$OUT/$name.json" "$part" "$tool" "$sh" "$code" "$secs" "$OUT/$name.err" >> "$TABLE" <<'PY'
+import json, sys
+path, part, tool, sh, code, secs, err = sys.argv[1:]
+cutter = tool
+try:
+    r = json.load(open(path))
+    p = r["plan"]
+    t = p["total_time_s"]
+    hms = f"{t:.0f} s" if t < 60 else f"{int(t)//3600}:{int(t)//60%60:02d}:{int(t)%60:02d}"
+    print(f"| {part} | {r['cutter']} | {sh} | {code} | {p['passes']} | {p['planes']} | {hms} | {float(secs):.1f} | "
+          f"{r['sim_max_scallop_mm']:.4f} | {r['rest']['area_mm2']:.0f} |")
+except Exception:
+    msg = open(err).read().strip().replace("|", "/").replace("\n", " ")[:160]
+    print(f"| {part} | {cutter} | {sh} | {code} | | | | {float(secs):.1f} | {msg} | |")
+PY
+        done
+    done
+done <<< "$CASES"
+cat "$TABLE"
