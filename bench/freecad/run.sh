@@ -2,14 +2,15 @@
 # Side by side: FreeCAD 0.20.2 Adaptive clearing vs `scallop pocket --pattern adaptive`,
 # both evaluated by the same independent measure, `scallop engagement`.
 #
-#   bash bench/freecad/run.sh [--reduced] [--workdir DIR] [--scallop BIN] [--markdown FILE]
+#   bash bench/freecad/run.sh [--reduced] [--workdir DIR] [--scallop BIN] [--pattern NAME] [--markdown FILE]
 #
 # Pockets (bench/freecad/pockets.py): rectangle 100 x 60, the same with a 24 mm round
 # island, L 100 x 80 with a 60 x 50 notch, disc 80 mm, a 16-tooth gear, a narrow branching
 # pocket, a "#" glyph; --reduced: the rectangle and the "#". Tool D 6 mm, stepover 0.2 D,
 # accuracy 0.1 mm. FreeCAD (LGPL) runs as an external program (`freecadcmd`); when it is
 # missing and apt has `freecad-python3`, it is installed (about 1.3 GB, 5 minutes).
-# scallop's side runs when `scallop pocket` exists, else it is skipped with a message.
+# scallop's side runs when `scallop pocket` exists, else it is skipped with a message;
+# --pattern gives its clearing pattern (default adaptive).
 # Outputs (pockets, G-code, JSON figures) go to the work directory, never to the repository.
 # Exit status: 0 done, 2 setup or run error.
 set -euo pipefail
@@ -21,17 +22,22 @@ workdir=/tmp/scallop-freecad-bench
 scallop=""
 reduced=()
 markdown=""
+pattern=adaptive
 while [ $# -gt 0 ]; do
     case "$1" in
         --reduced) reduced=(--reduced) ;;
-        --workdir|--scallop|--markdown)
+        --workdir|--scallop|--markdown|--pattern)
             [ $# -ge 2 ] || { echo "run.sh: $1 needs a value" >&2; exit 2; }
             val=$2
             # Relative paths from the caller's directory; a bare --scallop name is looked up in PATH.
-            if [[ "$val" != /* ]] && { [ "$1" != --scallop ] || [[ "$val" == */* ]]; }; then val="$caller_dir/$val"; fi
-            case "$1" in --workdir) workdir=$val ;; --scallop) scallop=$val ;; --markdown) markdown=$val ;; esac
+            if [ "$1" != --pattern ] && [[ "$val" != /* ]] && { [ "$1" != --scallop ] || [[ "$val" == */* ]]; }; then
+                val="$caller_dir/$val"
+            fi
+            case "$1" in
+                --workdir) workdir=$val ;; --scallop) scallop=$val ;; --markdown) markdown=$val ;; --pattern) pattern=$val ;;
+            esac
             shift ;;
-        -h|--help) sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+        -h|--help) sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
         *) echo "run.sh: unknown option $1" >&2; exit 2 ;;
     esac
     shift
@@ -90,7 +96,7 @@ while read -r name; do
         rm -rf "$out/scallop"
         start=$(date +%s.%N)
         if RAYON_NUM_THREADS=1 "$scallop" pocket --region "$workdir/pockets/$name.json" --tool-diameter 6 --stepover 0.2 \
-            --pattern adaptive -o "$out/scallop" > "$out/scallop.log" 2>&1; then
+            --pattern "$pattern" -o "$out/scallop" > "$out/scallop.log" 2>&1; then
             end=$(date +%s.%N)
             echo "{\"seconds\": $(python3 -c "print($end - $start)")}" > "$out/scallop-timing.json"
             program=$(find "$out/scallop" -maxdepth 1 \( -name '*.nc' -o -name '*.ngc' -o -name '*.gcode' \) | sort | head -1)

@@ -376,6 +376,31 @@ fn deepest(pocket: &Pocket, track: &Track, radius: f64) -> Option<(f64, Point2, 
 /// ([`SimError::TooManyCells`]), and [`SimError::PocketGouge`] when the tool
 /// at cutting depth reaches beyond a wall (the pocket's or an island's) by
 /// more than the gouge tolerance.
+///
+/// ```
+/// use scallop_geom::{Point2, Point3};
+/// use scallop_sim::{EngagementOptions, Pocket, engagement_angle, pocket_engagement};
+/// use scallop_toolpath::{Move, MoveKind, Toolpath};
+/// let square = |x0: f64, y0: f64, x1: f64, y1: f64| {
+///     vec![Point2::new(x0, y0), Point2::new(x1, y0), Point2::new(x1, y1), Point2::new(x0, y1)]
+/// };
+/// let pocket = Pocket::new(vec![square(0.0, 0.0, 60.0, 40.0)]).unwrap();
+/// // A slot along y = 20, then a pass 1.2 mm beside it (0.2 D of a 6 mm tool).
+/// let mut path = Toolpath::new(1000.0);
+/// for (y, x1) in [(20.0, 50.0), (21.2, 44.0)] {
+///     path.push(Move::new(MoveKind::Rapid, Point3::new(10.0, y, 5.0)));
+///     path.push(Move::new(MoveKind::Plunge, Point3::new(10.0, y, -1.0)));
+///     path.push(Move::new(MoveKind::Feed, Point3::new(x1, y, -1.0)));
+///     path.push(Move::new(MoveKind::Retract, Point3::new(x1, y, 5.0)));
+/// }
+/// let options = EngagementOptions::default();
+/// let target = engagement_angle(1.2, 3.0);
+/// let report = pocket_engagement(&pocket, 3.0, &path, target, &options).unwrap();
+/// assert!((report.move_phi[2] - std::f64::consts::PI).abs() <= options.angle_bound()); // the slot
+/// assert!((report.move_phi[6] - target).abs() <= options.angle_bound()); // the side cut
+/// assert!((report.slot_length - 34.0).abs() <= options.sample_step); // 40 mm less the entry
+/// assert_eq!((report.entries, report.retracts), (2, 2));
+/// ```
 pub fn pocket_engagement(
     pocket: &Pocket,
     radius: f64,
