@@ -2,7 +2,7 @@
 # Side by side: FreeCAD 0.20.2 Adaptive clearing vs `scallop pocket --pattern adaptive`,
 # both evaluated by the same independent measure, `scallop engagement`.
 #
-#   bash bench/freecad/run.sh [--reduced] [--workdir DIR] [--scallop BIN] [--pattern NAME] [--markdown FILE]
+#   bash bench/freecad/run.sh [--reduced] [--workdir DIR] [--scallop BIN] [--planner BIN] [--pattern NAME] [--markdown FILE]
 #
 # Pockets (bench/freecad/pockets.py): rectangle 100 x 60, the same with a 24 mm round
 # island, L 100 x 80 with a 60 x 50 notch, disc 80 mm, a 16-tooth gear, a narrow branching
@@ -10,7 +10,8 @@
 # accuracy 0.1 mm. FreeCAD (LGPL) runs as an external program (`freecadcmd`); when it is
 # missing and apt has `freecad-python3`, it is installed (about 1.3 GB, 5 minutes).
 # scallop's side runs when `scallop pocket` exists, else it is skipped with a message;
-# --pattern gives its clearing pattern (default adaptive).
+# --pattern gives its clearing pattern (default adaptive); --planner another scallop binary
+# that plans (`scallop pocket`) while --scallop evaluates (`scallop engagement`).
 # Outputs (pockets, G-code, JSON figures) go to the work directory, never to the repository.
 # Exit status: 0 done, 2 setup or run error.
 set -euo pipefail
@@ -23,21 +24,23 @@ scallop=""
 reduced=()
 markdown=""
 pattern=adaptive
+planner=""
 while [ $# -gt 0 ]; do
     case "$1" in
         --reduced) reduced=(--reduced) ;;
-        --workdir|--scallop|--markdown|--pattern)
+        --workdir|--scallop|--planner|--markdown|--pattern)
             [ $# -ge 2 ] || { echo "run.sh: $1 needs a value" >&2; exit 2; }
             val=$2
             # Relative paths from the caller's directory; a bare --scallop name is looked up in PATH.
-            if [ "$1" != --pattern ] && [[ "$val" != /* ]] && { [ "$1" != --scallop ] || [[ "$val" == */* ]]; }; then
+            if [ "$1" != --pattern ] && [[ "$val" != /* ]] && { [ "$1" != --scallop ] && [ "$1" != --planner ] || [[ "$val" == */* ]]; }; then
                 val="$caller_dir/$val"
             fi
             case "$1" in
                 --workdir) workdir=$val ;; --scallop) scallop=$val ;; --markdown) markdown=$val ;; --pattern) pattern=$val ;;
+                --planner) planner=$val ;;
             esac
             shift ;;
-        -h|--help) sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+        -h|--help) sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
         *) echo "run.sh: unknown option $1" >&2; exit 2 ;;
     esac
     shift
@@ -66,11 +69,12 @@ if [ -z "$scallop" ]; then
     (cd "$repo_root" && cargo build -q -p scallop-cli --profile fast)
     scallop="$repo_root/target/fast/scallop"
 fi
+planner=${planner:-$scallop}
 has_pocket=0
-if "$scallop" pocket --help > /dev/null 2>&1; then
+if "$planner" pocket --help > /dev/null 2>&1; then
     has_pocket=1
 else
-    echo "run.sh: '$scallop pocket' does not exist in this build: scallop's side is skipped (FreeCAD only)."
+    echo "run.sh: '$planner pocket' does not exist in this build: scallop's side is skipped (FreeCAD only)."
 fi
 
 mkdir -p "$workdir"
@@ -95,7 +99,7 @@ while read -r name; do
     if [ "$has_pocket" = 1 ]; then
         rm -rf "$out/scallop"
         start=$(date +%s.%N)
-        if RAYON_NUM_THREADS=1 "$scallop" pocket --region "$workdir/pockets/$name.json" --tool-diameter 6 --stepover 0.2 \
+        if RAYON_NUM_THREADS=1 "$planner" pocket --region "$workdir/pockets/$name.json" --tool-diameter 6 --stepover 0.2 \
             --pattern "$pattern" -o "$out/scallop" > "$out/scallop.log" 2>&1; then
             end=$(date +%s.%N)
             echo "{\"seconds\": $(python3 -c "print($end - $start)")}" > "$out/scallop-timing.json"
