@@ -4,6 +4,7 @@
 
 mod analyze;
 mod drop;
+mod engagement;
 mod optimize;
 mod output;
 mod outset;
@@ -66,6 +67,8 @@ enum Command {
     Waterline(waterline::WaterlineArgs),
     /// Load a part and report what was read (size, welding, open and non-manifold edges).
     Inspect(part::InspectArgs),
+    /// Measure a 2.5D pocket program's engagement, links, air cuts, uncut area and cycle time on its pocket.
+    Engagement(engagement::EngagementArgs),
 }
 
 fn main() -> ExitCode {
@@ -89,6 +92,7 @@ fn main() -> ExitCode {
         Command::Post(args) => post::run(&args),
         Command::Render(args) => render::run(&args),
         Command::Waterline(args) => waterline::run(&args),
+        Command::Engagement(args) => engagement::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -208,6 +208,39 @@ pub enum SimError {
         /// The collisions, in program order.
         collisions: Vec<DexelCollision>,
     },
+    /// A pocket ring cannot be used.
+    #[error("pocket ring {ring}: {why}; give closed rings of [x, y] points in mm, the outer boundary first")]
+    BadPocket {
+        /// The ring (0: the outer boundary).
+        ring: usize,
+        /// What is wrong.
+        why: &'static str,
+    },
+    /// An option of an engagement evaluation is out of range.
+    #[error("engagement {what} must be a finite number in range, got {value}")]
+    BadEngagement {
+        /// The option.
+        what: &'static str,
+        /// The value given.
+        value: f64,
+    },
+    /// The tool at cutting depth reaches beyond a wall of the pocket or an island.
+    #[error(
+        "gouge: the tool reaches {depth:.4} mm beyond a pocket wall (tolerance {tolerance} mm) with its centre at \
+         ({x:.3}, {y:.3}) on move {index}; keep the tool centre at least its radius inside the pocket and outside the islands",
+        x = at.x,
+        y = at.y
+    )]
+    PocketGouge {
+        /// How far beyond the wall (mm).
+        depth: f64,
+        /// The tool centre.
+        at: Point2,
+        /// The move (index in the program).
+        index: usize,
+        /// The gouge tolerance (mm).
+        tolerance: f64,
+    },
 }
 
 /// The first place of a list of hits or collisions, shown as

@@ -24,6 +24,9 @@
 //!   checked against the stock and the part ([`DexelStock::part_collisions`]);
 //!   [`verify_dexel`] compares
 //!   every ray with the part; [`simulate_dexel`] does both.
+//! - [`pocket_engagement`]: the engagement angle of a 2.5D pocket program
+//!   measured on the material it leaves ([`Pocket`]), links, air cuts and the
+//!   reachable area left uncut.
 //!
 //! ```
 //! use scallop_cutter::{Cutter, CutterShape};
@@ -73,6 +76,7 @@
 //! - Heights only decrease and never go below the stock box bottom.
 
 mod dexel;
+mod engagement;
 mod envelope;
 mod error;
 mod rest;
@@ -92,6 +96,7 @@ pub use dexel::{
     DexelCollision, DexelGouge, DexelOptions, DexelPart, DexelReport, DexelStock, DexelVerification, MAX_RAYS,
     MAX_SUBSTEPS, ToolMove, verify_dexel,
 };
+pub use engagement::{EngagementOptions, EngagementReport, Pocket, engagement_angle, pocket_engagement};
 pub use envelope::swept_floor;
 pub use error::SimError;
 pub use rest::{RestPlace, RestSplit, split_rest};

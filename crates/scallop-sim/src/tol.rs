@@ -24,3 +24,14 @@ pub const ARC_SAGITTA: f64 = 1e-4;
 /// happens where the solve would have lowered the cell, and results are the
 /// same bits as without the bound.
 pub const FLOOR_BOUND_MARGIN: f64 = 1e-9;
+
+/// A probed point of the tool's periphery counts as cut by one of the tool's
+/// recent moves only when it lies deeper than this (mm) inside the disc swept
+/// by that move: the periphery of the current position is at exactly `R`
+/// from the path's last point, and rounding must not count it as cut.
+pub const ENGAGEMENT_CONTACT: f64 = 1e-6;
+
+/// Samples per block of an engagement evaluation: a block reads the raster of
+/// older cuts as it stood before the block, its samples run in parallel. A
+/// fixed count, so the figures do not depend on the thread count.
+pub const ENGAGEMENT_BLOCK: usize = 64;

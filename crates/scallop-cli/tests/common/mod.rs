@@ -1,6 +1,8 @@
 //! What the CLI's integration tests share: the binary, scratch folders and a
 //! small mesh.
 
+#![allow(dead_code, reason = "each test binary uses a subset")]
+
 use std::path::PathBuf;
 use std::process::Command;
 
