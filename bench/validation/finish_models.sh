@@ -4,7 +4,7 @@
 # sized for the part, at sh 0.01 mm and 0.05 mm. Writes one job file per case into OUT and a
 # table (markdown) of part, cutter, sh, exit code, passes, levels, predicted time, planning
 # time, simulated scallop, unreachable area.
-# Usage: bench/validation/finish_models.sh [OUT] [--reduced]
+# Usage: bench/validation/finish_models.sh [OUT] [--reduced]   (reduced: sphere_on_plate and cone_on_side)
 # Env: SCALLOP (binary, default target/release/scallop, built when missing), TIMEOUT (s, 600).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -36,7 +36,7 @@ mech/angle_block.STL in 6 10 2 45
 mech/idler_riser.STL in 6 10 2 30
 mech/octagonal_pocket.stl m 10 16 3 30"
 if [ "$REDUCED" = "--reduced" ]; then
-    CASES="$(printf '%s\n' "$CASES" | grep -E 'sphere_on_plate|demo.stl')"
+    CASES="$(printf '%s\n' "$CASES" | grep -E 'sphere_on_plate|cone_on_side')"
 fi
 TABLE="$OUT/table.md"
 echo "| part | cutter | sh mm | exit | passes | levels | predicted time | planning s | simulated scallop mm | unreachable mm2 |" > "$TABLE"
