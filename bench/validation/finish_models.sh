@@ -60,12 +60,12 @@ while read -r part units ball bull corner flute; do
                 echo "[finishing]"
                 echo "scallop_height = $sh"
             } > "$job"
-            start=$(date +%s.%N)
+            start=$(python3 -c "import time; print(time.time())")
             set +e
             timeout "$TIMEOUT" "$SCALLOP" run "$job" -o "$OUT/$name" --json > "$OUT/$name.json" 2> "$OUT/$name.err"
             code=$?
             set -e
-            secs=$(echo "$(date +%s.%N) - $start" | bc)
+            secs=$(python3 -c "import time; print(time.time() - $start)")
             python3 - "$OUT/$name.json" "$part" "$tool" "$sh" "$code" "$secs" "$OUT/$name.err" >> "$TABLE" <<'PY'
 import json, sys
 path, part, tool, sh, code, secs, err = sys.argv[1:]
