@@ -192,7 +192,13 @@ fn zone_spec(r: &KResult, transitions: Transitions, machine: &scallop_machine::M
 
 fn zone_candidate(r: &KResult) -> Candidate {
     Candidate {
-        source: format!("K = {}", r.k),
+        // The clustering can merge clusters (e.g. omega = 0 makes every cell alike):
+        // the plan then has fewer zones than K, and says so.
+        source: if r.plan.zones.len() == r.k {
+            format!("K = {}", r.k)
+        } else {
+            format!("K = {} ({} zone{})", r.k, r.plan.zones.len(), if r.plan.zones.len() == 1 { "" } else { "s" })
+        },
         k: Some(r.k),
         zones_planned: r.plan.zones.len(),
         zones_written: 0,
@@ -219,6 +225,7 @@ fn single_zone_directions(model: &SurfaceModel, auto: f64) -> CliResult<Vec<(&'s
     let times = single_zone_times(model, &radians).map_err(|e| Failure::rejected(e.to_string()))?;
     let auto_time = times[n];
     let best = (0..n).min_by(|&a, &b| times[a].total_cmp(&times[b]).then(a.cmp(&b))).unwrap_or(0);
+    let auto = auto + 0.0; // no "-0.0" in the reports
     let mut out = vec![("single zone, automatic direction", auto, auto_time)];
     let apart = (directions[best] - auto).rem_euclid(180.0);
     if apart.min(180.0 - apart) > SAME_DIRECTION_DEG {

@@ -283,7 +283,7 @@ fn summary_text(
     }
     let best = &study.results[study.best];
     text.push_str(&format!(
-        "  model best: K = {} ({} zones) in {:.2} s; mean gain {:.1}%; study and programs {:.1} s on {} threads\n\
+        "  model best: K = {} ({} zone(s)) in {:.2} s; mean gain {:.1}%; study and programs {:.1} s on {} threads\n\
          \x20 {gcode}\n\
          \x20 wrote {}: study.json, report.json, convergence.svg, zones.svg, report.html, program.nc, toolpath.csv\n",
         best.k,
