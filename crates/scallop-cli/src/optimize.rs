@@ -504,6 +504,8 @@ fn settings(spec: &JobFile, o: &OptimizeSpec) -> CliResult<(StudySettings, Surfa
         surrogate_grid: grid(o.surrogate_grid),
         step: o.step,
         surrogate_step: o.surrogate_step,
+        // The written program dilates each zone by at least this (scallop_engine::finish_zones).
+        zone_margin_mm: scallop_engine::ZONE_MARGIN_PER_RADIUS[0] * radius,
         ..SurfaceSettings::default()
     };
     Ok((study, model))
