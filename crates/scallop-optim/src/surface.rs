@@ -365,9 +365,10 @@ fn with_margins(mut plans: Vec<ZonePlan>, overlaps: &[f64]) -> Vec<ZonePlan> {
 #[must_use]
 pub fn margin_overlaps(xy: &[[f64; 2]], grid: [usize; 2], zone_of_cell: &[u32], margin: f64) -> Vec<f64> {
     let [nu, nv] = grid;
-    let zones = zone_of_cell.iter().map(|&z| z as usize + 1).max().unwrap_or(0);
+    // Labels of masked cells (none on a whole patch) are left out.
+    let zones = zone_of_cell.iter().filter(|&&z| z != u32::MAX).map(|&z| z as usize + 1).max().unwrap_or(0);
     let mut own = vec![0usize; zones];
-    for &z in zone_of_cell {
+    for &z in zone_of_cell.iter().filter(|&&z| z != u32::MAX) {
         own[z as usize] += 1;
     }
     let distance = |a: usize, b: usize| (xy[a][0] - xy[b][0]).hypot(xy[a][1] - xy[b][1]);
@@ -386,11 +387,15 @@ pub fn margin_overlaps(xy: &[[f64; 2]], grid: [usize; 2], zone_of_cell: &[u32], 
     #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)] // capped at a quarter of the grid
     let reach = |h: f64, n: usize| if h > 0.0 { ((margin / h).ceil() as usize).min(n / 4) } else { n / 4 };
     let (ru, rv) = (reach(hu, nu), reach(hv, nv));
+    let window = border_windows(grid, zone_of_cell, ru, rv);
     let mut near = vec![0usize; zones];
     let mut seen: Vec<u32> = Vec::new();
     for a in 0..nu {
         for b in 0..nv {
             let c = a * nv + b;
+            if !window[c] {
+                continue; // one zone over the whole window: nothing foreign near
+            }
             seen.clear();
             for i in a.saturating_sub(ru)..(a + ru + 1).min(nu) {
                 for j in b.saturating_sub(rv)..(b + rv + 1).min(nv) {
@@ -401,13 +406,46 @@ pub fn margin_overlaps(xy: &[[f64; 2]], grid: [usize; 2], zone_of_cell: &[u32], 
                     }
                 }
             }
-            for &z in &seen {
+            for &z in seen.iter().filter(|&&z| z != u32::MAX) {
                 near[z as usize] += 1;
             }
         }
     }
     #[allow(clippy::cast_precision_loss)]
     near.iter().zip(&own).map(|(&n, &o)| if o == 0 { 0.0 } else { n as f64 / o as f64 }).collect()
+}
+
+/// Whether the `(2 ru + 1) x (2 rv + 1)` window of each cell holds a border cell
+/// (one with a 4-neighbour in another zone). A window without one holds one zone
+/// only (two cells of different zones in a rectangle are joined by a 4-path in it,
+/// which crosses a border), so [`margin_overlaps`] skips it. Separable box
+/// dilation of the border mask: along `u`, then along `v`.
+fn border_windows(grid: [usize; 2], zone_of_cell: &[u32], ru: usize, rv: usize) -> Vec<bool> {
+    let [nu, nv] = grid;
+    let mut border = vec![false; nu * nv];
+    for a in 0..nu {
+        for b in 0..nv {
+            let c = a * nv + b;
+            let z = zone_of_cell[c];
+            border[c] = (a + 1 < nu && zone_of_cell[c + nv] != z)
+                || (a > 0 && zone_of_cell[c - nv] != z)
+                || (b + 1 < nv && zone_of_cell[c + 1] != z)
+                || (b > 0 && zone_of_cell[c - 1] != z);
+        }
+    }
+    let mut along_u = vec![false; nu * nv];
+    for a in 0..nu {
+        for b in 0..nv {
+            along_u[a * nv + b] = (a.saturating_sub(ru)..(a + ru + 1).min(nu)).any(|i| border[i * nv + b]);
+        }
+    }
+    let mut out = vec![false; nu * nv];
+    for a in 0..nu {
+        for b in 0..nv {
+            out[a * nv + b] = (b.saturating_sub(rv)..(b + rv + 1).min(nv)).any(|j| along_u[a * nv + j]);
+        }
+    }
+    out
 }
 
 /// The heuristic tool axis of a zone (12.5): rotation 1 brings the PCA normal
