@@ -162,13 +162,16 @@ fn candidates_are_the_programs_they_name_in_order() {
         let alone = run_finishing(&FinishJob { direction_deg: Some(direction), ..job.clone() }).unwrap();
         let r = &results[k].report;
         assert_eq!(results[k].gcode, alone.gcode);
-        assert_eq!(r.plan.total_time_s, alone.report.plan.total_time_s);
-        assert_eq!((r.zones.len(), r.zones[0].direction_deg, r.transitions), (1, direction, 0));
+        assert_eq!(r.plan.total_time_s.to_bits(), alone.report.plan.total_time_s.to_bits());
+        assert_eq!((r.zones.len(), r.zones[0].direction_deg.to_bits(), r.transitions), (1, direction.to_bits(), 0));
         assert_eq!(r.zones[0].passes, alone.report.plan.passes);
         assert!(r.sim_max_scallop_mm <= r.sim_scallop_limit_mm && r.sim_max_scallop_mm > 0.3 * sh, "{r:?}");
         assert_eq!(results[k].zone_of_move.len(), results[k].toolpath.moves().len());
     }
-    assert_eq!(results[0].report.time_ratio, Some(results[0].report.plan.total_time_s / 20.0));
+    assert_eq!(
+        results[0].report.time_ratio.map(f64::to_bits),
+        Some((results[0].report.plan.total_time_s / 20.0).to_bits())
+    );
     assert_eq!(results[2].report.time_ratio, None);
     let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
     let again = one.install(|| finish_candidates(&job, &candidates));
