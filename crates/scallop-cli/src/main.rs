@@ -3,6 +3,7 @@
 //! 2 I/O or internal error). All the work is done by the libraries.
 
 mod analyze;
+mod choice;
 mod drop;
 mod engagement;
 mod optimize;

@@ -10,7 +10,7 @@ use scallop_analysis::{Cutter, MachineLimits};
 use scallop_io::job::{
     BarrierWord, FormulationWord, JobFile, OptimizeSpec, ShapeWord, SurrogateCostSpec, SurrogateWord, TransitionWord,
 };
-use scallop_network::{CellLabels, TransitionModel, Transitions};
+use scallop_network::{TransitionModel, Transitions};
 use scallop_optim::study::{
     Formulation, KResult, Stopwatch, Study, StudyObserver, StudySettings, Surrogate, run_study,
 };
@@ -18,6 +18,7 @@ use scallop_optim::surface::{SurfaceModel, SurfaceSettings};
 use scallop_optim::{Barrier, CostModel, OptimError, convergence_svg, zones_svg};
 use serde::Serialize;
 
+use crate::choice::{Candidate, Choice, choose};
 use crate::output::{print_json, print_text, progress_bar, with_written};
 use crate::outset::OutputSet;
 use crate::{CliResult, Failure};
@@ -72,67 +73,41 @@ struct StudyFile<'a> {
     scallop_height_mm: f64,
     threads: usize,
     wall_time_s: f64,
+    /// What was written, in words.
     gcode: String,
+    /// The programs the final choice planned by drop-cutter and proved, with
+    /// the model's time next to the program's; `written` marks the one written.
+    programs: &'a [Candidate],
     study: &'a Study,
 }
 
-/// What `report.json` holds: the best plan over all K, and its program.
+/// What `report.json` holds: the written program and the plan it came from.
 #[derive(Serialize)]
 struct BestReport<'a> {
     part: String,
     formulation: Formulation,
+    /// `K` of the written program (1: a single zone).
     k: usize,
-    time_s: f64,
-    start_time_s: f64,
-    eta: f64,
-    /// What was written: "program.nc" or why nothing was.
+    /// Zones planned and written.
+    zones: usize,
+    /// The network model's time of the written plan (s).
+    model_time_s: f64,
+    /// The written program's stop-to-stop time (s).
+    program_time_s: f64,
+    /// The fastest proven single-zone program (s).
+    single_zone_time_s: Option<f64>,
+    /// The study's best model time over all K (s) and its K.
+    model_best_time_s: f64,
+    model_best_k: usize,
+    /// What was written.
     gcode: String,
-    /// The drop-cutter program of the best plan: per-zone figures, times next to the
-    /// network model's prediction, the stock simulation's scallop.
-    program: Option<&'a scallop_engine::ZoneFinishReport>,
-    result: &'a KResult,
-}
-
-/// The machine of 3+2 zone programs when the job has no `[setup]`.
-const DEFAULT_MACHINE: &str = "linuxcnc-xyzac-trt";
-
-/// The program of the best plan: zones in label order with the optimiser's
-/// directions (and 3+2 orientations), planned by drop-cutter and proven on the stock.
-fn zone_program(
-    spec: &JobFile,
-    folder: &Path,
-    best: &KResult,
-    transitions: Transitions,
-) -> CliResult<scallop_engine::ZoneFinishOutput> {
-    let plan = &best.plan;
-    let mut job = crate::run::finish_job(spec, folder)?;
-    // 3+2 zones are written for the job's [setup] machine (default: the LinuxCNC
-    // XYZAC trunnion); the setup's rotation is not used (each zone has its own).
-    let machine = match job.setup.take() {
-        Some(setup) => setup.machine,
-        None => scallop_machine::Machine::builtin(DEFAULT_MACHINE)
-            .map_err(|e| Failure::rejected(format!("machine `{DEFAULT_MACHINE}`: {e}")))?,
-    };
-    let zone_spec = scallop_engine::ZonePlanSpec {
-        labels: CellLabels { cells_u: plan.grid[0], cells_v: plan.grid[1], labels: plan.labels.clone() },
-        zones: plan
-            .zones
-            .iter()
-            .map(|z| scallop_engine::ZoneSpec {
-                label: u32::try_from(z.zone).unwrap_or(u32::MAX),
-                direction_deg: z.theta_deg,
-                tilt_deg: z.phi_deg,
-                azimuth_deg: z.psi_deg,
-                predicted_time_s: Some(z.time_s),
-            })
-            .collect(),
-        transitions,
-        predicted_time_s: Some(plan.time_s),
-        fixed_margin_mm: None,
-        machine: Some(machine),
-    };
-    scallop_engine::finish_zones(&job, &zone_spec)
-        .map_err(|e| Failure::rejected(format!("the G-code of the best plan (K = {}): {e}", best.k)))
+    /// The written candidate.
+    written: &'a Candidate,
+    /// The drop-cutter program: per-zone figures, times next to the network
+    /// model's prediction, the stock simulation's scallop.
+    program: &'a scallop_engine::ZoneFinishReport,
+    /// The study's result for the written `K` (`None`: a single zone).
+    result: Option<&'a KResult>,
 }
 
 /// `scallop optimize`.
@@ -148,6 +123,71 @@ pub fn run(args: &OptimizeArgs) -> CliResult<()> {
     let (settings, model_settings) = settings(&spec, opt).map_err(|e| prefix(&name, e))?;
     let model = SurfaceModel::new(&patch, model_settings).map_err(|e| rejected(&name, &e))?;
 
+    let clock = Clock(Instant::now());
+    let study = run_with_bars(&model, &settings, &clock).map_err(|e| rejected(&name, &e))?;
+
+    let spinner = progress_bar(0, "G-code: the best plans and the single zone, planned and verified");
+    spinner.enable_steady_tick(std::time::Duration::from_millis(120));
+    let gcode_start = Instant::now();
+    let choice = choose(&spec, folder, &study, &model, model_settings.transitions).map_err(|e| prefix(&name, e))?;
+    let gcode_seconds = gcode_start.elapsed().as_secs_f64();
+    let wall = clock.seconds();
+    spinner.finish_and_clear();
+    let gcode = written_text(&choice, gcode_seconds);
+    let cutter = match model_settings.tool {
+        Cutter::Ball { radius } => format!("ball R{radius} mm"),
+        Cutter::Toroidal { radius, corner } => format!("bull-nose R{radius} r{corner} mm"),
+        Cutter::Flat { radius, .. } => format!("flat R{radius} mm"),
+    };
+    let file = StudyFile {
+        job: name.clone(),
+        part: part_name.clone(),
+        cutter,
+        scallop_height_mm: model_settings.scallop_height,
+        threads: rayon::current_num_threads(),
+        wall_time_s: wall,
+        gcode: gcode.clone(),
+        programs: &choice.candidates,
+        study: &study,
+    };
+    let written = choice.written();
+    let model_best = &study.results[study.best];
+    let report = BestReport {
+        part: part_name.clone(),
+        formulation: settings.formulation,
+        k: written.k.unwrap_or(1),
+        zones: written.zones_written,
+        model_time_s: written.model_time_s,
+        program_time_s: choice.output.report.plan.total_time_s,
+        single_zone_time_s: choice.best_single_zone().and_then(|c| c.program_time_s),
+        model_best_time_s: model_best.f_best,
+        model_best_k: model_best.k,
+        gcode: gcode.clone(),
+        written,
+        program: &choice.output.report,
+        result: written.k.and_then(|k| study.results.iter().find(|r| r.k == k)),
+    };
+    // The seven files replace the previous set in one step (`outset.rs`).
+    let mut set = OutputSet::begin(&args.output, "optimize")?;
+    set.write("study.json", to_json(&file).map_err(|e| Failure::Io(e.into()))?.as_bytes())?;
+    set.write("report.json", to_json(&report).map_err(|e| Failure::Io(e.into()))?.as_bytes())?;
+    set.write("program.nc", choice.output.gcode.as_bytes())?;
+    set.write("toolpath.csv", scallop_io::cl::write_cl(&choice.output.toolpath).as_bytes())?;
+    set.write("convergence.svg", convergence_svg(&study).as_bytes())?;
+    let title = format!("{part_name}, {}, {}", formulation_name(settings.formulation), written.source);
+    set.write("zones.svg", zones_svg(&choice.plan, &title).as_bytes())?;
+    let page =
+        scallop_report::html::report_html(&optimisation_report(&patch, &study, &title, &name, &file.cutter, &choice));
+    set.write("report.html", page.as_bytes())?;
+    let written_files = set.commit()?;
+    if args.json {
+        return print_json(&with_written(&file, &written_files)?);
+    }
+    print_text(&summary_text(&part_name, &settings, &study, &choice, wall, &gcode, &args.output))
+}
+
+/// Runs the study with one progress bar per K (on a terminal, not under CI).
+fn run_with_bars(model: &SurfaceModel, settings: &StudySettings, clock: &Clock) -> Result<Study, OptimError> {
     let visible = {
         use std::io::IsTerminal;
         std::io::stderr().is_terminal() && std::env::var_os("CI").is_none()
@@ -165,80 +205,50 @@ pub fn run(args: &OptimizeArgs) -> CliResult<()> {
             .map(|k| multi.add(progress_bar(total, &format!("K = {k:2}"))))
             .collect(),
     };
-    let clock = Clock(Instant::now());
-    let study = run_study(&model, &settings, &bars, Some(&clock)).map_err(|e| rejected(&name, &e))?;
-    let wall = clock.seconds();
+    let study = run_study(model, settings, &bars, Some(clock));
     let _ = multi.clear();
+    study
+}
 
-    let best = &study.results[study.best];
-    let spinner = progress_bar(0, "G-code of the best plan: planning and verifying");
-    spinner.enable_steady_tick(std::time::Duration::from_millis(120));
-    let gcode_start = Instant::now();
-    let program = zone_program(&spec, folder, best, model_settings.transitions).map_err(|e| prefix(&name, e))?;
-    let gcode_seconds = gcode_start.elapsed().as_secs_f64();
-    spinner.finish_and_clear();
-    let gcode = format!(
-        "program.nc: {} zones by drop-cutter{}, {:.1} s stop-to-stop ({:.1} s predicted by the network model); \
-         simulated scallop {:.5} mm <= {:.5} mm; planned and verified in {:.1} s",
-        program.report.zones.iter().filter(|z| z.passes > 0).count(),
-        if program.report.indexed { " as indexed 3+2 setups" } else { "" },
-        program.report.plan.total_time_s,
-        best.f_best,
-        program.report.sim_max_scallop_mm,
-        program.report.sim_scallop_limit_mm,
-        gcode_seconds
-    );
-    let cutter = match model_settings.tool {
-        Cutter::Ball { radius } => format!("ball R{radius} mm"),
-        Cutter::Toroidal { radius, corner } => format!("bull-nose R{radius} r{corner} mm"),
-        Cutter::Flat { radius, .. } => format!("flat R{radius} mm"),
+/// What was written, in words (`study.json`, `report.json`, the summary).
+fn written_text(choice: &Choice, seconds: f64) -> String {
+    let w = choice.written();
+    let r = &choice.output.report;
+    let single = choice.best_single_zone();
+    let versus = match (w.k, single.and_then(|c| c.program_time_s)) {
+        (None, _) => "no zone plan beats the single zone".to_string(),
+        (Some(_), Some(t)) => format!("single zone {t:.1} s"),
+        (Some(_), None) => "no single-zone program proven".to_string(),
     };
-    let file = StudyFile {
-        job: name.clone(),
-        part: part_name.clone(),
-        cutter,
-        scallop_height_mm: model_settings.scallop_height,
-        threads: rayon::current_num_threads(),
-        wall_time_s: wall,
-        gcode: gcode.clone(),
-        study: &study,
-    };
-    let report = BestReport {
-        part: part_name.clone(),
-        formulation: settings.formulation,
-        k: best.k,
-        time_s: best.f_best,
-        start_time_s: best.f0,
-        eta: best.eta,
-        gcode: gcode.clone(),
-        program: Some(&program.report),
-        result: best,
-    };
-    // The seven files replace the previous set in one step (`outset.rs`).
-    let mut set = OutputSet::begin(&args.output, "optimize")?;
-    set.write("study.json", to_json(&file).map_err(|e| Failure::Io(e.into()))?.as_bytes())?;
-    set.write("report.json", to_json(&report).map_err(|e| Failure::Io(e.into()))?.as_bytes())?;
-    set.write("program.nc", program.gcode.as_bytes())?;
-    set.write("toolpath.csv", scallop_io::cl::write_cl(&program.toolpath).as_bytes())?;
-    set.write("convergence.svg", convergence_svg(&study).as_bytes())?;
-    let title = format!("{part_name}, {}, K = {}", formulation_name(settings.formulation), best.k);
-    set.write("zones.svg", zones_svg(&best.plan, &title).as_bytes())?;
-    let page = scallop_report::html::report_html(&optimisation_report(
-        &patch,
-        &study,
-        &title,
-        &name,
-        &file.cutter,
-        Some(&program),
-    ));
-    set.write("report.html", page.as_bytes())?;
-    let written = set.commit()?;
-    if args.json {
-        return print_json(&with_written(&file, &written)?);
-    }
+    format!(
+        "program.nc: {} ({} zone{} by drop-cutter{}), {:.1} s stop-to-stop ({:.1} s by the network model; {versus}); \
+         simulated scallop {:.5} mm <= {:.5} mm; {} programs planned and verified in {seconds:.1} s",
+        w.source,
+        w.zones_written,
+        if w.zones_written == 1 { "" } else { "s" },
+        if r.indexed { " as indexed 3+2 setups" } else { "" },
+        r.plan.total_time_s,
+        w.model_time_s,
+        r.sim_max_scallop_mm,
+        r.sim_scallop_limit_mm,
+        choice.candidates.len(),
+    )
+}
+
+/// The text summary: per K the model's times and, where it was planned by
+/// drop-cutter, the program's; then every candidate of the final choice.
+fn summary_text(
+    part_name: &str,
+    settings: &StudySettings,
+    study: &Study,
+    choice: &Choice,
+    wall: f64,
+    gcode: &str,
+    output: &Path,
+) -> String {
     let mut text = format!(
         "zone optimisation of the {part_name}: {}, K = {}..{}, budget {} per K, surrogate {:?}\n\
-         \x20  K  zones   start (s)    best (s)   gain   evals  surr.  wall (s)  eval mean/p95/max (ms)\n",
+         \x20  K  zones   start (s)  model (s)  program (s)   gain   evals  surr.  wall (s)  eval mean/p95/max (ms)\n",
         formulation_name(settings.formulation),
         settings.k_min,
         settings.k_max,
@@ -246,12 +256,14 @@ pub fn run(args: &OptimizeArgs) -> CliResult<()> {
         settings.surrogate
     );
     for r in &study.results {
+        let program = choice.candidates.iter().find(|c| c.k == Some(r.k));
         text.push_str(&format!(
-            "  {:2}  {:5}  {:10.2}  {:10.2}  {:5.1}%  {:6}  {:5}  {:8.2}  {}\n",
+            "  {:2}  {:5}  {:10.2}  {:9.2}  {:>11}  {:5.1}%  {:6}  {:5}  {:8.2}  {}\n",
             r.k,
             r.plan.zones.len(),
             r.f0,
             r.f_best,
+            program_cell(program),
             100.0 * r.eta,
             r.evaluations,
             r.surrogate_evaluations,
@@ -260,81 +272,95 @@ pub fn run(args: &OptimizeArgs) -> CliResult<()> {
                 .map_or_else(|| "-".to_string(), |t| format!("{:.2}/{:.2}/{:.2}", t.mean_ms, t.p95_ms, t.max_ms))
         ));
     }
+    for c in choice.candidates.iter().filter(|c| c.k.is_none()) {
+        text.push_str(&format!(
+            "  {} ({:.1} deg): model {:.2} s, program {}\n",
+            c.source,
+            c.directions_deg[0],
+            c.model_time_s,
+            program_cell(Some(c)).trim()
+        ));
+    }
+    let best = &study.results[study.best];
     text.push_str(&format!(
-        "  best: K = {} in {:.2} s ({:.1}% below its start); mean gain {:.1}%; study {:.1} s on {} threads\n\
-         \x20 {}\n\
-         \x20 wrote {}: study.json, report.json, convergence.svg, zones.svg, report.html{}\n",
+        "  model best: K = {} ({} zone(s)) in {:.2} s; mean gain {:.1}%; study and programs {:.1} s on {} threads\n\
+         \x20 {gcode}\n\
+         \x20 wrote {}: study.json, report.json, convergence.svg, zones.svg, report.html, program.nc, toolpath.csv\n",
         best.k,
+        best.plan.zones.len(),
         best.f_best,
-        100.0 * best.eta,
         100.0 * study.mean_eta,
         wall,
         rayon::current_num_threads(),
-        gcode,
-        args.output.display(),
-        ", program.nc, toolpath.csv"
+        output.display(),
     ));
-    print_text(&text)
+    text
 }
 
-/// The page of a study (`report.html`): the part, the key figures of the best plan,
-/// the per-zone times of the best plan and one convergence curve per K. The plans
-/// of a study are contact-point passes without a cutter-location toolpath, so the
-/// 3D view shows the part only (zones are pictured in `zones.svg`).
+/// A candidate's program time for the tables: seconds, "rejected", or "-" when not planned.
+fn program_cell(c: Option<&Candidate>) -> String {
+    match c {
+        None => "-".into(),
+        Some(c) => match (c.program_time_s, c.written) {
+            (Some(t), true) => format!("{t:.2} *"),
+            (Some(t), false) => format!("{t:.2}"),
+            (None, _) => "rejected".into(),
+        },
+    }
+}
+
+/// The page of a study (`report.html`): the part, the written program with its
+/// plan's model time and the single zone's time, the model and program time per
+/// K, and one convergence curve per K.
 fn optimisation_report(
     patch: &scallop_surface::Patch,
     study: &scallop_optim::study::Study,
     title: &str,
     command: &str,
     cutter: &str,
-    program: Option<&scallop_engine::ZoneFinishOutput>,
+    choice: &Choice,
 ) -> scallop_report::ReportData {
     use scallop_report::{Convergence, Curve, Figure, ReportData, Zones};
-    let best = &study.results[study.best];
+    let written = choice.written();
+    let model_best = &study.results[study.best];
+    let r = &choice.output.report;
     let mut data = ReportData::new(&format!("optimisation: {title}"));
     data.command = format!("scallop optimize {command}");
     data.part = patch.tessellate(tol_display(patch)).ok().map(|t| t.mesh);
     data.figures = vec![
-        Figure::count("best K", best.k),
-        Figure::number("best plan time", best.f_best, 2, "s"),
-        Figure::number("start plan time (same K)", best.f0, 2, "s"),
-        Figure::number("gain at the best K", 100.0 * best.eta, 1, "%"),
-        Figure::number("mean gain over K", 100.0 * study.mean_eta, 1, "%"),
-        Figure::count("zones of the best plan", best.plan.zones.len()),
-        Figure::number("transition time (best plan)", best.plan.transition_time_s, 2, "s"),
+        Figure::text("written program", written.source.clone()),
+        Figure::count("zones written", written.zones_written),
+        Figure::number("program time (drop-cutter, stop-to-stop)", r.plan.total_time_s, 2, "s"),
+        Figure::number("model time of the written plan", written.model_time_s, 2, "s"),
+        Figure::number("program time (look-ahead, cutting)", r.plan.machining_time_lookahead_s, 2, "s"),
+        Figure::number("simulated scallop", r.sim_max_scallop_mm, 4, "mm"),
+        Figure::number("scallop limit (sh + resolution bound)", r.sim_scallop_limit_mm, 4, "mm"),
+        Figure::number("model best", model_best.f_best, 2, &format!("s (K = {})", model_best.k)),
+        Figure::number("mean gain over K (model)", 100.0 * study.mean_eta, 1, "%"),
     ];
+    if let Some(single) = choice.best_single_zone().and_then(|c| c.program_time_s) {
+        data.figures.push(Figure::number("best single-zone program", single, 2, "s"));
+    }
     data.settings = vec![
         Figure::text("formulation", formulation_name(study.settings.formulation)),
         Figure::text("cutter", cutter),
         Figure::text("K range", format!("{} to {}", study.settings.k_min, study.settings.k_max)),
         Figure::number("budget per K", study.settings.budget, 0, "black-box evaluations"),
     ];
-    for r in &study.results {
+    for k in &study.results {
+        let program = program_cell(choice.candidates.iter().find(|c| c.k == Some(k.k)));
         data.figures.push(Figure::number(
-            &format!("K = {}: start / best", r.k),
-            r.f_best,
+            &format!("K = {}: model / program", k.k),
+            k.f_best,
             2,
-            &format!("s (from {:.2} s, {} evaluations)", r.f0, r.evaluations),
+            &format!("s / {program} s (start {:.2} s, {} evaluations)", k.f0, k.evaluations),
         ));
     }
-    if let Some(p) = program {
-        let r = &p.report;
-        data.figures.push(Figure::number("program time (drop-cutter, stop-to-stop)", r.plan.total_time_s, 2, "s"));
-        data.figures.push(Figure::number(
-            "program time (look-ahead, cutting)",
-            r.plan.machining_time_lookahead_s,
-            2,
-            "s",
-        ));
-        data.figures.push(Figure::number("simulated scallop", r.sim_max_scallop_mm, 4, "mm"));
-        data.figures.push(Figure::number("scallop limit (sh + resolution bound)", r.sim_scallop_limit_mm, 4, "mm"));
-        data.toolpath = Some(p.toolpath.clone());
-    }
+    data.toolpath = Some(choice.output.toolpath.clone());
     data.zones = Some(Zones {
-        of_move: program
-            .map_or_else(Vec::new, |p| p.zone_of_move.iter().map(|&z| u16::try_from(z).unwrap_or(u16::MAX)).collect()),
-        names: best.plan.zones.iter().map(|z| format!("{} ({:.0} deg)", z.zone, z.theta_deg)).collect(),
-        times_s: best.plan.zones.iter().map(|z| z.time_s).collect(),
+        of_move: choice.output.zone_of_move.iter().map(|&z| u16::try_from(z).unwrap_or(u16::MAX)).collect(),
+        names: choice.plan.zones.iter().map(|z| format!("{} ({:.0} deg)", z.zone, z.theta_deg)).collect(),
+        times_s: choice.plan.zones.iter().map(|z| z.time_s).collect(),
     });
     data.convergence = vec![Convergence {
         title: "Best plan time against the budget spent, per K".into(),
@@ -478,6 +504,8 @@ fn settings(spec: &JobFile, o: &OptimizeSpec) -> CliResult<(StudySettings, Surfa
         surrogate_grid: grid(o.surrogate_grid),
         step: o.step,
         surrogate_step: o.surrogate_step,
+        // The written program dilates each zone by at least this (scallop_engine::finish_zones).
+        zone_margin_mm: scallop_engine::ZONE_MARGIN_PER_RADIUS[0] * radius,
         ..SurfaceSettings::default()
     };
     Ok((study, model))

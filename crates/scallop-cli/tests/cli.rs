@@ -311,10 +311,26 @@ fn optimize_writes_the_study_and_rejects_bad_settings() {
     assert!(program["predicted_time_s"].as_f64().expect("network time") > 0.0);
     assert!(program["plan"]["total_time_s"].as_f64().expect("program time") > 0.0);
     let zones = program["zones"].as_array().expect("zones");
-    let planned = report["result"]["plan"]["zones"].as_array().expect("the study's zones");
-    assert!(zones.len() == planned.len() && zones.iter().any(|z| z["passes"].as_u64() > Some(0)));
+    let written = &report["written"];
+    assert!(zones.len() == written["zones_planned"].as_u64().expect("zones planned") as usize, "{written}");
+    assert!(zones.iter().any(|z| z["passes"].as_u64() > Some(0)));
+    if let Some(k) = written["k"].as_u64() {
+        let planned = report["result"]["plan"]["zones"].as_array().expect("the study's zones");
+        assert_eq!((zones.len(), report["k"].as_u64()), (planned.len(), Some(k)));
+    }
     assert!(report["gcode"].as_str().expect("gcode").starts_with("program.nc"));
     assert_eq!(program["indexed"].as_bool(), Some(false));
+    // The final choice (issue 20): the written program is the fastest proven
+    // candidate, and a single zone is among them.
+    let programs = v["programs"].as_array().expect("programs");
+    let time = |c: &serde_json::Value| c["program_time_s"].as_f64();
+    let fastest = programs.iter().filter_map(time).fold(f64::INFINITY, f64::min);
+    let chosen: Vec<_> = programs.iter().filter(|c| c["written"].as_bool() == Some(true)).collect();
+    assert_eq!(chosen.len(), 1, "{programs:?}");
+    assert_eq!(time(chosen[0]).map(f64::to_bits), Some(fastest.to_bits()));
+    assert_eq!(report["program_time_s"].as_f64().map(f64::to_bits), Some(fastest.to_bits()));
+    assert!(programs.iter().any(|c| c["k"].is_null() && time(c).is_some()), "{programs:?}");
+    assert!(fastest <= report["single_zone_time_s"].as_f64().expect("single zone"));
 
     // 3+2: indexed setups, each zone proven in its own frame.
     let tilted = job
@@ -326,17 +342,24 @@ fn optimize_writes_the_study_and_rejects_bad_settings() {
     let report: serde_json::Value =
         serde_json::from_slice(&std::fs::read(dir.join("out32/report.json")).expect("report.json")).expect("json");
     let program = &report["program"];
-    assert_eq!(program["indexed"].as_bool(), Some(true), "{program}");
     let limit = program["sim_scallop_limit_mm"].as_f64().expect("limit");
-    for z in program["zones"].as_array().expect("zones").iter().filter(|z| z["passes"].as_u64() > Some(0)) {
-        let own = z["sim_zone_scallop_mm"].as_f64().expect("each zone proven in its frame");
-        assert!(own > 0.0 && own <= limit, "{z}");
+    // A tilted zone plan is written as indexed setups; when a single zone is
+    // faster (the final choice), the program is 3-axis.
+    if program["indexed"].as_bool() == Some(true) {
+        for z in program["zones"].as_array().expect("zones").iter().filter(|z| z["passes"].as_u64() > Some(0)) {
+            let own = z["sim_zone_scallop_mm"].as_f64().expect("each zone proven in its frame");
+            assert!(own > 0.0 && own <= limit, "{z}");
+        }
+        let text = std::fs::read_to_string(dir.join("out32/program.nc")).expect("program.nc");
+        assert!(text.lines().any(|l| l.contains(" A")), "rotary words");
+        let csv = std::fs::read_to_string(dir.join("out32/toolpath.csv")).expect("toolpath.csv");
+        let rows = scallop_io::cl::read_cl_csv(&csv).expect("a cutter-location file with tool axes");
+        assert!(rows.len() > 100 && csv.starts_with("kind,x,y,z,i,j,k"));
+    } else {
+        assert!(report["written"]["k"].is_null(), "{report}");
+        let simulated = program["sim_max_scallop_mm"].as_f64().expect("simulated scallop");
+        assert!(simulated > 0.0 && simulated <= limit, "{program}");
     }
-    let text = std::fs::read_to_string(dir.join("out32/program.nc")).expect("program.nc");
-    assert!(text.lines().any(|l| l.contains(" A")), "rotary words");
-    let csv = std::fs::read_to_string(dir.join("out32/toolpath.csv")).expect("toolpath.csv");
-    let rows = scallop_io::cl::read_cl_csv(&csv).expect("a cutter-location file with tool axes");
-    assert!(rows.len() > 100 && csv.starts_with("kind,x,y,z,i,j,k"));
     for (bad, key) in [
         (job.replace("k_max = 3", "k_max = 1").replace("k_min = 2", "k_min = 1"), "optimize.k_max"),
         (job.replace("budget = 8", "budget = 0"), "optimize.budget"),

@@ -332,19 +332,8 @@ pub(crate) fn plan_operation(
         // 3+2: analyse the part as the cutter sees it, in the planning frame.
         (_, Some(_)) => sample_mesh(&prepared.mesh),
     };
-    let radius = job.cutter.radius();
-    let (corner, is_ball) = match *job.cutter.shape() {
-        CutterShape::Bull { corner, .. } => (corner, false),
-        CutterShape::Ball { .. } => (radius / 2.0, true),
-        _ => (radius / 2.0, false),
-    };
-    let tools = ToolOptions { ball_radius: radius, toroidal_radius: radius, corner_radius: corner };
-    let analysis = analyze(&samples, &tools, &machine, job.scallop_height).map_err(EngineError::Analysis)?;
-    let direction_deg = job.direction_deg.unwrap_or(if is_ball {
-        analysis.principal_direction_deg
-    } else {
-        analysis.slope_direction_deg
-    });
+    let (analysis, auto_deg) = analysis_of(job, &samples, &machine)?;
+    let direction_deg = job.direction_deg.unwrap_or(auto_deg);
     let mut params = finishing_params(job, direction_deg.to_radians());
     if let Some(c) = clearance {
         params.clearance = c;
@@ -388,6 +377,44 @@ pub(crate) fn plan_operation(
         planned.toolpath = led;
     }
     Ok(PlannedOperation { plan: planned, params, direction_deg, analysis, leads })
+}
+
+/// The part's analysis for the job's cutter, and the feed direction `scallop run`
+/// takes when the job gives none (degrees from +X): the principal direction for a
+/// ball, the steepest slope of the PCA plane otherwise.
+fn analysis_of(
+    job: &FinishJob,
+    samples: &scallop_analysis::Samples,
+    machine: &MachineLimits,
+) -> Result<(scallop_analysis::AnalysisReport, f64), EngineError> {
+    let radius = job.cutter.radius();
+    let (corner, is_ball) = match *job.cutter.shape() {
+        CutterShape::Bull { corner, .. } => (corner, false),
+        CutterShape::Ball { .. } => (radius / 2.0, true),
+        _ => (radius / 2.0, false),
+    };
+    let tools = ToolOptions { ball_radius: radius, toroidal_radius: radius, corner_radius: corner };
+    let analysis = analyze(samples, &tools, machine, job.scallop_height).map_err(EngineError::Analysis)?;
+    let direction = if is_ball { analysis.principal_direction_deg } else { analysis.slope_direction_deg };
+    Ok((analysis, direction))
+}
+
+/// The feed direction `scallop run` takes for a parametric part without a
+/// `[setup]` when the job gives none (degrees from +X; see [`FinishJob::direction_deg`]).
+///
+/// # Errors
+/// [`EngineError::Output`] for a mesh part or a job with a setup;
+/// [`EngineError::Analysis`] when the surface cannot be sampled.
+pub fn auto_direction_deg(job: &FinishJob) -> Result<f64, EngineError> {
+    let (Part::Surfaces(set), None) = (&job.part, &job.setup) else {
+        return Err(EngineError::Output {
+            what: "the automatic direction of a mesh part or a 3+2 setup".into(),
+            fix: "give a parametric part without [setup]".into(),
+        });
+    };
+    let machine = MachineLimits::from_thesis_units(job.machine[0], job.machine[1], job.machine[2]);
+    let samples = sample_surface_set(set, &GridOptions::default()).map_err(EngineError::Analysis)?;
+    Ok(analysis_of(job, &samples, &machine)?.1)
 }
 
 /// The surfaces of a parametric part, for a strategy that needs them, or the

@@ -33,15 +33,15 @@ pub use budget::{ARC_SHARE, Budget};
 pub use demo::{DemoOutput, DemoSettings, DemoSummary, run_demo};
 pub use finish::{
     FinishDetails, FinishJob, FinishOutput, FinishReport, OutputOptions, RestPlaceReport, RestReport, Setup, Strategy,
-    run_finishing, stock_box,
+    auto_direction_deg, run_finishing, stock_box,
 };
 pub use grid::{GridAxis, GridError, MAX_GRID_POINTS};
 pub use job::{
     Job, JobOutput, JobReport, Operation, OperationReport, STOCK_CLEARANCE_MM, StockFigures, StockShape, run_job,
 };
 pub use zones::{
-    ZONE_MARGIN_PER_RADIUS, ZONE_MARGIN_PER_SPACING, ZONE_MARGIN_ROUNDS, ZoneFigures, ZoneFinishOutput,
-    ZoneFinishReport, ZonePlanSpec, ZoneSpec, finish_zones,
+    ProgramCandidate, ZONE_MARGIN_PER_RADIUS, ZONE_MARGIN_PER_SPACING, ZONE_MARGIN_ROUNDS, ZoneFigures,
+    ZoneFinishOutput, ZoneFinishReport, ZonePlanSpec, ZoneSpec, finish_candidates, finish_zones,
 };
 
 /// Why the engine rejected a request. Each variant says the cause and the fix.

@@ -50,7 +50,7 @@ use scallop_toolpath::{FittedPath, MoveKind, Toolpath, fit_arcs};
 use serde::Serialize;
 
 use crate::finish::{cutter_text, finishing_params};
-use crate::{ARC_SHARE, EngineError, FinishJob, Part, PreparedPart, Strategy};
+use crate::{ARC_SHARE, EngineError, FinishJob, Part, PreparedPart, Strategy, run_finishing};
 
 /// The margin of every zone starts at the first of these shares of the cutter
 /// radius (3 mm for R = 5 mm; chosen from the border experiment of
@@ -105,6 +105,109 @@ pub struct ZonePlanSpec {
     /// The machine whose kinematics write 3+2 zones as indexed setups (needed
     /// when a zone is tilted).
     pub machine: Option<scallop_machine::Machine>,
+}
+
+/// One program for [`finish_candidates`] to plan and prove.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ProgramCandidate {
+    /// A zone plan, planned by [`finish_zones`].
+    Zones(ZonePlanSpec),
+    /// The whole part in one feed direction, planned by [`run_finishing`]: the
+    /// program of `scallop run` with `direction = direction_deg` (the single zone a
+    /// zone plan has to beat).
+    SingleZone {
+        /// Feed direction (degrees from +X).
+        direction_deg: f64,
+        /// The network model's time of it (s), if known.
+        predicted_time_s: Option<f64>,
+    },
+}
+
+/// Plans and proves every candidate on the part of `job` (no `[setup]`), in
+/// parallel (rayon; each result depends on its candidate only, so the results are
+/// the same on any number of threads), results in the order of `candidates`. A
+/// single-zone program whose simulated scallop exceeds `sh` plus the resolution
+/// bound is an [`EngineError::ScallopExceeded`], as a zone program's is.
+#[must_use]
+pub fn finish_candidates(
+    job: &FinishJob,
+    candidates: &[ProgramCandidate],
+) -> Vec<Result<ZoneFinishOutput, EngineError>> {
+    use rayon::prelude::*;
+    candidates
+        .par_iter()
+        .map(|c| match c {
+            ProgramCandidate::Zones(spec) => finish_zones(job, spec),
+            ProgramCandidate::SingleZone { direction_deg, predicted_time_s } => {
+                single_zone(job, *direction_deg, *predicted_time_s)
+            }
+        })
+        .collect()
+}
+
+/// The program of `scallop run` along `direction_deg`, proven and reported as a
+/// one-zone program (label 0).
+fn single_zone(job: &FinishJob, direction_deg: f64, predicted: Option<f64>) -> Result<ZoneFinishOutput, EngineError> {
+    let job = FinishJob { direction_deg: Some(direction_deg), ..job.clone() };
+    let out = run_finishing(&job)?;
+    let r = out.report;
+    let limit = job.scallop_height + r.sim_resolution_bound_mm;
+    let v = &out.details.simulation.verification;
+    if r.sim_max_scallop_mm > limit {
+        let at = v.max_thickness_at.map_or([f64::NAN; 2], |p| [p.x, p.y]);
+        return Err(EngineError::ScallopExceeded { height: r.sim_max_scallop_mm, limit, x: at[0], y: at[1] });
+    }
+    let triangles = out.details.prepared.mesh.triangles().len();
+    let figure = ZoneFigures {
+        label: 0,
+        direction_deg: r.direction_deg,
+        tilt_deg: 0.0,
+        azimuth_deg: 0.0,
+        sim_zone_scallop_mm: None,
+        triangles,
+        region_triangles: triangles,
+        margin_mm: 0.0,
+        max_spacing_mm: 0.0,
+        passes: r.plan.passes,
+        max_scallop_mm: r.plan.max_scallop_mm,
+        machining_time_s: r.plan.machining_time_s,
+        machining_time_lookahead_s: r.plan.machining_time_lookahead_s,
+        predicted_time_s: predicted,
+        skipped: None,
+    };
+    let total = r.plan.total_time_s;
+    let report = ZoneFinishReport {
+        part: r.part,
+        cutter: r.cutter,
+        scallop_height_mm: r.scallop_height_mm,
+        chordal_error_mm: r.chordal_error_mm,
+        margin_per_radius: 0.0,
+        zones: vec![figure],
+        plan: r.plan,
+        transitions: 0,
+        transition_time_s: 0.0,
+        transition_time_model_s: 0.0,
+        predicted_time_s: predicted,
+        time_ratio: predicted.filter(|&p| p > 0.0).map(|p| total / p),
+        sim_resolution_mm: r.sim_resolution_mm,
+        indexed: false,
+        sim_resolution_bound_mm: r.sim_resolution_bound_mm,
+        sim_max_scallop_mm: r.sim_max_scallop_mm,
+        sim_max_scallop_at: v.max_thickness_at.map(|p| [p.x, p.y]),
+        sim_edge_max_scallop_mm: r.sim_edge_max_scallop_mm,
+        sim_scallop_limit_mm: limit,
+        sim_min_deviation_mm: r.sim_min_deviation_mm,
+        sim_gouge_tolerance_mm: r.sim_gouge_tolerance_mm,
+    };
+    let zone_of_move = vec![0; out.toolpath.moves().len()];
+    Ok(ZoneFinishOutput {
+        toolpath: out.toolpath,
+        zone_of_move,
+        gcode: out.gcode,
+        report,
+        prepared: out.details.prepared,
+        simulation: Some(out.details.simulation),
+    })
 }
 
 /// What one zone came to.

@@ -13,7 +13,9 @@
 #![allow(clippy::unwrap_used, reason = "tests fail loudly by design")]
 
 use scallop_cutter::{Contact, Cutter, CutterShape, drop_cutter};
-use scallop_engine::{FinishJob, Part, ZonePlanSpec, ZoneSpec, finish_zones};
+use scallop_engine::{
+    FinishJob, Part, ProgramCandidate, ZonePlanSpec, ZoneSpec, finish_candidates, finish_zones, run_finishing,
+};
 use scallop_geom::{Aabb3, Point2, Point3, Tolerances};
 use scallop_mesh::{MeshIndex, TriMesh};
 use scallop_network::{CellLabels, Transitions};
@@ -128,6 +130,54 @@ fn two_zones_cover_the_hill_within_the_scallop_and_stay_in_their_regions() {
         checked += 1;
     }
     assert!(checked > 100, "{checked}");
+}
+
+/// The final choice's candidates (issue 20): each result is the program its
+/// candidate gives alone (a zone plan: `finish_zones`; a single zone: the
+/// program of `run_finishing` along that direction, proven), in input order, and
+/// the same on one thread.
+#[test]
+fn candidates_are_the_programs_they_name_in_order() {
+    let sh = 0.02;
+    let spec = ZonePlanSpec {
+        labels: labels(),
+        zones: vec![
+            ZoneSpec { label: 0, direction_deg: 0.0, tilt_deg: 0.0, azimuth_deg: 0.0, predicted_time_s: Some(10.0) },
+            ZoneSpec { label: 1, direction_deg: 70.0, tilt_deg: 0.0, azimuth_deg: 0.0, predicted_time_s: Some(10.0) },
+        ],
+        transitions: Transitions::default(),
+        predicted_time_s: Some(20.0),
+        fixed_margin_mm: None,
+        machine: None,
+    };
+    let candidates = [
+        ProgramCandidate::SingleZone { direction_deg: 70.0, predicted_time_s: Some(20.0) },
+        ProgramCandidate::Zones(spec.clone()),
+        ProgramCandidate::SingleZone { direction_deg: 0.0, predicted_time_s: None },
+    ];
+    let job = job(sh);
+    let results: Vec<_> = finish_candidates(&job, &candidates).into_iter().map(Result::unwrap).collect();
+    assert_eq!(results[1].gcode, finish_zones(&job, &spec).unwrap().gcode);
+    for (k, direction) in [(0, 70.0), (2, 0.0)] {
+        let alone = run_finishing(&FinishJob { direction_deg: Some(direction), ..job.clone() }).unwrap();
+        let r = &results[k].report;
+        assert_eq!(results[k].gcode, alone.gcode);
+        assert_eq!(r.plan.total_time_s.to_bits(), alone.report.plan.total_time_s.to_bits());
+        assert_eq!((r.zones.len(), r.zones[0].direction_deg.to_bits(), r.transitions), (1, direction.to_bits(), 0));
+        assert_eq!(r.zones[0].passes, alone.report.plan.passes);
+        assert!(r.sim_max_scallop_mm <= r.sim_scallop_limit_mm && r.sim_max_scallop_mm > 0.3 * sh, "{r:?}");
+        assert_eq!(results[k].zone_of_move.len(), results[k].toolpath.moves().len());
+    }
+    assert_eq!(
+        results[0].report.time_ratio.map(f64::to_bits),
+        Some((results[0].report.plan.total_time_s / 20.0).to_bits())
+    );
+    assert_eq!(results[2].report.time_ratio, None);
+    let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
+    let again = one.install(|| finish_candidates(&job, &candidates));
+    for (a, b) in again.iter().zip(&results) {
+        assert_eq!(a.as_ref().unwrap().gcode, b.gcode);
+    }
 }
 
 #[test]

@@ -691,6 +691,33 @@ pub fn run_k<M: MachiningModel>(
     })
 }
 
+/// The model's time of the whole surface as one 3-axis zone along each of
+/// `directions` (rad), in their order: the single-zone plans a zone plan has to
+/// beat (one cluster, `omega = 1`).
+///
+/// # Errors
+/// A clustering or planning failure of the model.
+pub fn single_zone_times<M: MachiningModel>(model: &M, directions: &[f64]) -> Result<Vec<f64>, OptimError> {
+    let partition = model.partition(1, &[1.0; 4], Fidelity::BlackBox)?;
+    directions
+        .iter()
+        .map(|&theta| {
+            let design = Design { theta: vec![theta], ..Design::zeros(1) };
+            model.assess(&partition, Formulation::ThreeAxis, &design, Fidelity::BlackBox).map(|a| a.time_s)
+        })
+        .collect()
+}
+
+/// The model's plan of the whole surface as one 3-axis zone along `theta` (rad).
+///
+/// # Errors
+/// A clustering or planning failure of the model.
+pub fn single_zone_plan<M: MachiningModel>(model: &M, theta: f64) -> Result<PlanReport, OptimError> {
+    let partition = model.partition(1, &[1.0; 4], Fidelity::BlackBox)?;
+    let design = Design { theta: vec![theta], ..Design::zeros(1) };
+    model.describe(&partition, Formulation::ThreeAxis, &design)
+}
+
 #[cfg(test)]
 mod evaluation_times_tests {
     use super::EvaluationTimes;

@@ -45,6 +45,11 @@ pub struct SurfaceSettings {
     pub surrogate_step: f64,
     /// Direction change that splits a pass into two stop-to-stop moves (rad).
     pub sharp_corner: f64,
+    /// The margin by which the written program dilates each zone (mm, XY; 0: not
+    /// counted). The border strips are then machined by both zones: each zone's
+    /// time is scaled by its share of cells within this distance of it in
+    /// other zones (see [`margin_overlaps`]).
+    pub zone_margin_mm: f64,
 }
 
 impl Default for SurfaceSettings {
@@ -63,6 +68,7 @@ impl Default for SurfaceSettings {
             step: 0.5,
             surrogate_step: 5.0,
             sharp_corner: 30f64.to_radians(),
+            zone_margin_mm: 0.0,
         }
     }
 }
@@ -110,6 +116,8 @@ pub struct ZonePartition {
     fidelity: Fidelity,
     partition: Partition,
     zoning: Option<Zoning>,
+    /// Per zone label: cells of other zones within the margin, over its own cells.
+    overlaps: Vec<f64>,
 }
 
 /// The orientation of each zone and its accessibility violation.
@@ -251,7 +259,7 @@ impl SurfaceModel {
             // fail, and the loop below then skips that zone.
             let directions: Vec<f64> = zp.partition.zones.iter().map(|z| design.theta[z.cluster as usize]).collect();
             if let Ok(plans) = plan_zones(network, zoning, &directions, &self.params(zp.fidelity, 0.0)) {
-                return Ok((plans, oriented.violation));
+                return Ok((with_margins(plans, &zp.overlaps), oriented.violation));
             }
         }
         let zones = &zp.partition.zones;
@@ -301,7 +309,7 @@ impl SurfaceModel {
                 Some(Err(e)) => return Err(OptimError::Model(format!("planning zone {z}: {e}"))),
             }
         }
-        Ok((plans, oriented.violation))
+        Ok((with_margins(plans, &zp.overlaps), oriented.violation))
     }
 
     /// S3: Annex E on each zone's PCA rectangle (rotated by its orientation),
@@ -332,6 +340,112 @@ impl SurfaceModel {
         }
         Assessment { time_s: total, violation: oriented.violation }
     }
+}
+
+/// Each zone's time and lengths scaled by `1 + overlaps[zone]` (the border
+/// strips its margin adds; no scaling without overlaps).
+fn with_margins(mut plans: Vec<ZonePlan>, overlaps: &[f64]) -> Vec<ZonePlan> {
+    for plan in &mut plans {
+        if let Some(&o) = overlaps.get(plan.zone as usize) {
+            plan.time_s *= 1.0 + o;
+            plan.cut_length_mm *= 1.0 + o;
+            plan.link_length_mm *= 1.0 + o;
+        }
+    }
+    plans
+}
+
+/// Per zone label, the cells of other zones within `margin` (XY) of one of its
+/// cells, over its own cell count: the share of border strip that the written
+/// program's zone dilation adds (zones are cut over their cells grown by the
+/// margin, `scallop_engine::finish_zones`). `xy` is one point per cell (NaN: no
+/// point), index `a * grid[1] + b`. The neighbourhood of a cell is the
+/// `(u, v)` window that the smallest neighbour spacing of the grid needs to
+/// reach `margin`, capped at a quarter of the grid.
+#[must_use]
+pub fn margin_overlaps(xy: &[[f64; 2]], grid: [usize; 2], zone_of_cell: &[u32], margin: f64) -> Vec<f64> {
+    let [nu, nv] = grid;
+    // Labels of masked cells (none on a whole patch) are left out.
+    let zones = zone_of_cell.iter().filter(|&&z| z != u32::MAX).map(|&z| z as usize + 1).max().unwrap_or(0);
+    let mut own = vec![0usize; zones];
+    for &z in zone_of_cell.iter().filter(|&&z| z != u32::MAX) {
+        own[z as usize] += 1;
+    }
+    let distance = |a: usize, b: usize| (xy[a][0] - xy[b][0]).hypot(xy[a][1] - xy[b][1]);
+    let (mut hu, mut hv) = (f64::INFINITY, f64::INFINITY);
+    for a in 0..nu {
+        for b in 0..nv {
+            let c = a * nv + b;
+            if a + 1 < nu {
+                hu = hu.min(distance(c, c + nv));
+            }
+            if b + 1 < nv {
+                hv = hv.min(distance(c, c + 1));
+            }
+        }
+    }
+    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)] // capped at a quarter of the grid
+    let reach = |h: f64, n: usize| if h > 0.0 { ((margin / h).ceil() as usize).min(n / 4) } else { n / 4 };
+    let (ru, rv) = (reach(hu, nu), reach(hv, nv));
+    let window = border_windows(grid, zone_of_cell, ru, rv);
+    let mut near = vec![0usize; zones];
+    let mut seen: Vec<u32> = Vec::new();
+    for a in 0..nu {
+        for b in 0..nv {
+            let c = a * nv + b;
+            if !window[c] {
+                continue; // one zone over the whole window: nothing foreign near
+            }
+            seen.clear();
+            for i in a.saturating_sub(ru)..(a + ru + 1).min(nu) {
+                for j in b.saturating_sub(rv)..(b + rv + 1).min(nv) {
+                    let d = i * nv + j;
+                    let z = zone_of_cell[d];
+                    if z != zone_of_cell[c] && !seen.contains(&z) && distance(c, d) <= margin {
+                        seen.push(z);
+                    }
+                }
+            }
+            for &z in seen.iter().filter(|&&z| z != u32::MAX) {
+                near[z as usize] += 1;
+            }
+        }
+    }
+    #[allow(clippy::cast_precision_loss)]
+    near.iter().zip(&own).map(|(&n, &o)| if o == 0 { 0.0 } else { n as f64 / o as f64 }).collect()
+}
+
+/// Whether the `(2 ru + 1) x (2 rv + 1)` window of each cell holds a border cell
+/// (one with a 4-neighbour in another zone). A window without one holds one zone
+/// only (two cells of different zones in a rectangle are joined by a 4-path in it,
+/// which crosses a border), so [`margin_overlaps`] skips it. Separable box
+/// dilation of the border mask: along `u`, then along `v`.
+fn border_windows(grid: [usize; 2], zone_of_cell: &[u32], ru: usize, rv: usize) -> Vec<bool> {
+    let [nu, nv] = grid;
+    let mut border = vec![false; nu * nv];
+    for a in 0..nu {
+        for b in 0..nv {
+            let c = a * nv + b;
+            let z = zone_of_cell[c];
+            border[c] = (a + 1 < nu && zone_of_cell[c + nv] != z)
+                || (a > 0 && zone_of_cell[c - nv] != z)
+                || (b + 1 < nv && zone_of_cell[c + 1] != z)
+                || (b > 0 && zone_of_cell[c - 1] != z);
+        }
+    }
+    let mut along_u = vec![false; nu * nv];
+    for a in 0..nu {
+        for b in 0..nv {
+            along_u[a * nv + b] = (a.saturating_sub(ru)..(a + ru + 1).min(nu)).any(|i| border[i * nv + b]);
+        }
+    }
+    let mut out = vec![false; nu * nv];
+    for a in 0..nu {
+        for b in 0..nv {
+            out[a * nv + b] = (b.saturating_sub(rv)..(b + rv + 1).min(nv)).any(|j| along_u[a * nv + j]);
+        }
+    }
+    out
 }
 
 /// The heuristic tool axis of a zone (12.5): rotation 1 brings the PCA normal
@@ -387,7 +501,17 @@ impl MachiningModel for SurfaceModel {
             }
             None => None,
         };
-        Ok(ZonePartition { fidelity, partition, zoning })
+        let overlaps = if self.settings.zone_margin_mm > 0.0 {
+            let xy: Vec<[f64; 2]> = (0..partition.zone_of_cell.len())
+                .map(|c| {
+                    level.features.point_of_cell(c).map_or([f64::NAN; 2], |i| [level.points[i].x, level.points[i].y])
+                })
+                .collect();
+            margin_overlaps(&xy, partition.grid, &partition.zone_of_cell, self.settings.zone_margin_mm)
+        } else {
+            Vec::new()
+        };
+        Ok(ZonePartition { fidelity, partition, zoning, overlaps })
     }
 
     fn assess(
@@ -500,5 +624,71 @@ impl MachiningModel for SurfaceModel {
             cell_xy,
             zones,
         })
+    }
+}
+
+#[cfg(test)]
+mod margin_tests {
+    use super::margin_overlaps;
+    use proptest::prelude::*;
+
+    /// A separable grid: `x` from the `u` index, `y` from the `v` index.
+    fn grid(xs: &[f64], ys: &[f64]) -> Vec<[f64; 2]> {
+        xs.iter().flat_map(|&x| ys.iter().map(move |&y| [x, y])).collect()
+    }
+
+    fn brute_force(xy: &[[f64; 2]], zone_of_cell: &[u32], margin: f64) -> Vec<f64> {
+        let zones = zone_of_cell.iter().map(|&z| z as usize + 1).max().unwrap_or(0);
+        (0..zones)
+            .map(|z| {
+                let z = u32::try_from(z).unwrap_or(u32::MAX);
+                let own: Vec<usize> = (0..xy.len()).filter(|&c| zone_of_cell[c] == z).collect();
+                let near = (0..xy.len())
+                    .filter(|&d| zone_of_cell[d] != z)
+                    .filter(|&d| own.iter().any(|&c| (xy[c][0] - xy[d][0]).hypot(xy[c][1] - xy[d][1]) <= margin))
+                    .count();
+                #[allow(clippy::cast_precision_loss)]
+                if own.is_empty() { 0.0 } else { near as f64 / own.len() as f64 }
+            })
+            .collect()
+    }
+
+    /// Two halves of a 1 mm grid, margin 2.5 mm: each zone gains the two nearest
+    /// columns of the other, 40 of its 200 cells.
+    #[test]
+    fn two_halves_gain_two_columns_each() {
+        let xs: Vec<f64> = (0..20).map(f64::from).collect();
+        let xy = grid(&xs, &xs);
+        let labels: Vec<u32> = (0..400).map(|c| u32::from(c / 20 >= 10)).collect();
+        let o = margin_overlaps(&xy, [20, 20], &labels, 2.5);
+        assert_eq!(o.len(), 2);
+        assert!((o[0] - 0.2).abs() < 1e-12 && (o[1] - 0.2).abs() < 1e-12, "{o:?}");
+        // One zone: no border, nothing to add.
+        assert_eq!(margin_overlaps(&xy, [20, 20], &[0; 400], 2.5), vec![0.0]);
+    }
+
+    proptest! {
+        /// The windowed count equals the brute force over all cell pairs on
+        /// uneven (separable, increasing) grids with blocky random labels.
+        #[test]
+        fn window_matches_brute_force(
+            dx in proptest::collection::vec(0.5f64..1.5, 23),
+            dy in proptest::collection::vec(0.5f64..1.5, 23),
+            seeds in proptest::collection::vec(0u32..4, 16),
+            margin in 0.5f64..3.0,
+        ) {
+            let along = |d: &[f64]| -> Vec<f64> {
+                std::iter::once(0.0).chain(d.iter().scan(0.0, |s, x| { *s += x; Some(*s) })).collect()
+            };
+            let xy = grid(&along(&dx), &along(&dy));
+            // 4 x 4 blocks of 6 x 6 cells, each block a random label.
+            let labels: Vec<u32> = (0..24 * 24).map(|c| seeds[(c / 24 / 6) * 4 + (c % 24) / 6]).collect();
+            let got = margin_overlaps(&xy, [24, 24], &labels, margin);
+            let want = brute_force(&xy, &labels, margin);
+            prop_assert_eq!(got.len(), want.len());
+            for (g, w) in got.iter().zip(&want) {
+                prop_assert!((g - w).abs() < 1e-12, "{:?} vs {:?}", got, want);
+            }
+        }
     }
 }
