@@ -8,7 +8,10 @@ use scallop_engine::{FinishJob, Job, Operation, OutputOptions, Setup, StockShape
 use scallop_geom::Aabb3;
 use scallop_geom::Tolerances;
 use scallop_geom::nalgebra::Rotation3;
-use scallop_io::job::{DirectionSpec, IsoWord, JobFile, LeadWord, PatternWord, ShapeWord, StrategyWord, parse_job};
+use scallop_io::job::{
+    DirectionSpec, IsoWord, JobFile, LeadWord, PatternWord, ShapeWord, StrategyWord, parse_job_with_tools,
+    tool_library_of,
+};
 use scallop_strategy::{IsoDirection, LeadKind, Pattern};
 
 use crate::output::{progress_bar, write_finishing, write_job};
@@ -70,6 +73,9 @@ fn operations_job(spec: &JobFile, first: FinishJob) -> CliResult<Job> {
         apply_finishing(&mut finish, &op.finishing);
         finish.output.tool = op.tool.unwrap_or(spec.output.tool);
         finish.output.spindle = op.spindle.unwrap_or(spec.output.spindle);
+        if let Some(feed) = op.feed {
+            finish.machine[0] = feed / 1000.0; // mm/min -> m/min
+        }
         operations.push(Operation { name: op.name.clone(), finish });
     }
     let stock = spec.stock.as_ref().map(|s| match (s.min, s.max) {
@@ -79,17 +85,36 @@ fn operations_job(spec: &JobFile, first: FinishJob) -> CliResult<Job> {
     Ok(Job { stock, operations })
 }
 
-/// The cutter of a `[cutter]` table.
+/// The cutter of a `[cutter]` table (or a library tool): profile, flutes
+/// (default 4 D, or the cone's height if longer), shank and holder stack.
 fn cutter_of(spec: &scallop_io::job::CutterSpec) -> CliResult<Cutter> {
     let radius = spec.diameter / 2.0;
     let shape = match spec.shape {
         ShapeWord::Ball => CutterShape::Ball { radius },
         ShapeWord::Flat => CutterShape::Flat { radius },
         ShapeWord::Bull => CutterShape::Bull { radius, corner: spec.corner_radius.unwrap_or(radius) },
+        ShapeWord::Cone => {
+            CutterShape::Cone { radius, half_angle: (0.5 * spec.angle_deg.unwrap_or(90.0)).to_radians() }
+        }
     };
-    let flute = spec.flute_length.unwrap_or(4.0 * spec.diameter);
-    Cutter::new(shape, flute)
-        .map_err(|e| Failure::rejected(format!("[cutter] (diameter, corner_radius, flute_length): {e}")))
+    let flute = spec.flute_length.unwrap_or((4.0 * spec.diameter).max(shape.profile_height()));
+    let shank = (spec.shank_diameter.unwrap_or(spec.diameter) / 2.0, spec.shank_length.unwrap_or(flute));
+    let holder = spec
+        .holder
+        .iter()
+        .map(|h| scallop_cutter::HolderSegment {
+            length: h.length,
+            bottom_radius: h.diameter / 2.0,
+            top_radius: h.top_diameter.unwrap_or(h.diameter) / 2.0,
+        })
+        .collect();
+    Cutter::new(shape, flute).and_then(|c| c.with_shank(shank.0, shank.1)).and_then(|c| c.with_holder(holder)).map_err(
+        |e| {
+            Failure::rejected(format!(
+                "[cutter] (diameter, corner_radius, angle_deg, flute_length, shank_diameter, shank_length, holder): {e}"
+            ))
+        },
+    )
 }
 
 /// The settings of a `[finishing]` table on a finishing job.
@@ -127,8 +152,30 @@ pub(crate) fn read_job(path: &Path) -> CliResult<(String, JobFile)> {
     })?;
     let text = std::str::from_utf8(&bytes)
         .map_err(|e| Failure::rejected(format!("{name}: byte {}: the job file is not UTF-8 text", e.valid_up_to())))?;
-    let spec = parse_job(text).map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
+    let library_file = tool_library_of(text);
+    let library = match &library_file {
+        Some(file) => Some(read_tool_library(&path.parent().unwrap_or(Path::new(".")).join(file))?),
+        None => None,
+    };
+    let spec = parse_job_with_tools(text, library.as_ref()).map_err(|e| match (&e, &library_file) {
+        (scallop_io::job::JobError::UnknownTool { .. }, Some(lib)) => {
+            Failure::rejected(format!("{name}: {e} (tool library {lib})"))
+        }
+        _ => Failure::rejected(format!("{name}: {e}")),
+    })?;
     Ok((name, spec))
+}
+
+/// Reads a tool library (docs/job.md, "Tool library"); errors name the file,
+/// the line and the fix.
+pub(crate) fn read_tool_library(path: &Path) -> CliResult<scallop_io::tools::ToolLibrary> {
+    let name = path.display().to_string();
+    let bytes = std::fs::read(path).map_err(|e| {
+        let err = anyhow::anyhow!("{name}: cannot read the tool library (`tool_library` of the job): {e}");
+        if e.kind() == std::io::ErrorKind::NotFound { Failure::Rejected(err) } else { Failure::Io(err) }
+    })?;
+    let text = scallop_io::utf8_text(&bytes).map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
+    scallop_io::tools::parse_tool_library(text).map_err(|e| Failure::rejected(format!("{name}: {e}")))
 }
 
 pub(crate) fn finish_job(spec: &JobFile, folder: &Path) -> CliResult<FinishJob> {
@@ -148,6 +195,7 @@ pub(crate) fn finish_job(spec: &JobFile, folder: &Path) -> CliResult<FinishJob> 
         (None, None) => return Err(Failure::rejected("part: give `file` or `builtin`")),
     };
     let cutter = cutter_of(&spec.cutter)?;
+    let first = &spec.operations[0];
     let o = &spec.output;
     let dialect = scallop_post::Dialect::builtin(&o.dialect).map_err(|_| {
         Failure::rejected(format!(
@@ -161,13 +209,12 @@ pub(crate) fn finish_job(spec: &JobFile, folder: &Path) -> CliResult<FinishJob> 
         arc_fitting: o.arc_fitting,
         program: o.program.clone(),
         tool: o.tool,
-        spindle: o.spindle,
+        spindle: first.spindle.unwrap_or(o.spindle),
     };
     let setup = match &spec.setup {
         None => None,
         Some(s) => {
-            let machine = scallop_machine::Machine::builtin(&s.machine)
-                .map_err(|e| Failure::rejected(format!("`setup.machine` = \"{}\": {e}", s.machine)))?;
+            let machine = crate::post::load_machine(&s.machine, folder, "setup.machine")?;
             let [rx, ry, rz] = s.rotation_deg.map(f64::to_radians);
             Some(Setup { rotation: Rotation3::from_euler_angles(rx, ry, rz), machine, tool_length: s.tool_length })
         }
@@ -179,7 +226,7 @@ pub(crate) fn finish_job(spec: &JobFile, folder: &Path) -> CliResult<FinishJob> 
         scallop_height: 0.0,
         direction_deg: None,
         pattern: Pattern::Zigzag,
-        machine: [spec.machine.feed, spec.machine.acceleration, spec.machine.jerk],
+        machine: [first.feed.map_or(spec.machine.feed, |f| f / 1000.0), spec.machine.acceleration, spec.machine.jerk],
         rapid_rate: spec.machine.rapid * 1000.0 / 60.0,
         clearance: spec.machine.clearance,
         tolerances: Tolerances { path: spec.tolerances.path, gouge: spec.tolerances.gouge },

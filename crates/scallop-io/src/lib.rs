@@ -39,6 +39,7 @@ pub use scallop_mesh::{MeshDiagnostics, MeshError, TriMesh};
 pub mod cl;
 pub mod gcode;
 pub mod job;
+pub mod tools;
 
 pub use error::{MeshReadError, Place};
 

@@ -42,6 +42,11 @@ impl ProgramInfo {
     }
 }
 
+/// The comment written where a section has no spindle speed (no `S.. M3`):
+/// the spindle must already turn, or the job gives the speed.
+pub const NO_SPINDLE: &str =
+    "no spindle start: no speed given (job: output.spindle, the operation's spindle or the tool library's vc)";
+
 /// Writes `path` (lines and arcs) in `dialect`. `comments` go into the header, one
 /// line each. Coordinates are absolute (`G90`, set by the dialect's header) in mm;
 /// arcs select their plane (`G17`/`G18`/`G19`) when it changes and carry the
@@ -182,6 +187,10 @@ fn write_section(path: &FittedPath, dialect: &Dialect, info: &ProgramInfo, out: 
     }
     if info.spindle > 0.0 {
         writeln!(out, "S{} M3", fmt_number(info.spindle, 0))?;
+    } else {
+        // The footer stops the spindle (`M5`): say that this program never started it.
+        let (open, close) = (&dialect.comment.0, &dialect.comment.1);
+        writeln!(out, "{open}{NO_SPINDLE}{close}")?;
     }
     if !info.indexed_rotaries.is_empty() {
         let words: Vec<String> = info

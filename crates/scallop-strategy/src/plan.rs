@@ -106,7 +106,11 @@ impl<'a> Planner<'a> {
             CutterShape::Flat { radius } => {
                 (scallop_analysis::Cutter::Toroidal { radius, corner: 0.0 }, radius, "radius")
             }
-            CutterShape::Cone { .. } => return Err(StrategyError::Unsupported { shape: "cone" }),
+            // A cone is planned from the sharp-tip rule below; the torus with r = 0
+            // only caps the step at the diameter.
+            CutterShape::Cone { radius, .. } => {
+                (scallop_analysis::Cutter::Toroidal { radius, corner: 0.0 }, radius, "radius")
+            }
         };
         if sh >= bound {
             return Err(StrategyError::ScallopTooLarge { scallop_height: sh, what, radius: bound });
@@ -453,6 +457,9 @@ impl<'a> Planner<'a> {
                 }
                 sod = sod.min(2.0 * radius);
             }
+            if let CutterShape::Cone { radius, half_angle } = self.shape {
+                sod = cone_step(sh, slope, half_angle).min(2.0 * radius);
+            }
             let tau = m.cross(&n);
             let cross = if tau.norm() > 0.0 { n.cross(&(tau / tau.norm())) } else { Vec3::zeros() };
             let factor = if cross.norm() > 0.0 { (cross / cross.norm()).dot(&m).abs() } else { 0.0 };
@@ -787,4 +794,38 @@ fn vertical_gap(mid: &Point3, a: &Point3, b: &Point3) -> f64 {
 /// crests and at the top of steep descents.
 fn gouge_depth(mid: &Point3, a: &Point3, b: &Point3) -> f64 {
     mid.z - 0.5 * (a.z + b.z)
+}
+
+/// The start spacing of a cone (V) cutter of half angle `alpha` across a
+/// plane of slope `slope` for a scallop `sh`: the ridge between two grooves
+/// is a triangle on the surface whose base angles are `90° - alpha -+ slope`,
+/// so its base is `sh (tan(alpha + slope) + tan(alpha - slope))`. Where the
+/// uphill flank is flatter than the surface (`alpha + slope >= 90°`) the rim
+/// cuts, as with a flat end: `sh / sin(slope)`. The measured scallop corrects
+/// either start.
+fn cone_step(sh: f64, slope: f64, alpha: f64) -> f64 {
+    if alpha + slope < std::f64::consts::FRAC_PI_2 - 1e-9 {
+        sh * ((alpha + slope).tan() + (alpha - slope).tan())
+    } else {
+        sh / slope.sin().max(1e-9)
+    }
+}
+
+#[cfg(test)]
+mod cone_tests {
+    use super::cone_step;
+
+    /// On a flat floor the ridge between two V grooves `w` apart is `w / (2 tan alpha)` high.
+    #[test]
+    fn cone_step_on_a_floor_is_twice_sh_tan_alpha() {
+        for deg in [15.0_f64, 30.0, 45.0, 60.0] {
+            let a = deg.to_radians();
+            let w = cone_step(0.05, 0.0, a);
+            assert!((w / (2.0 * a.tan()) - 0.05).abs() < 1e-12, "{deg}: {w}");
+        }
+        // Symmetric in the slope's sign, and growing with the slope below the rim limit.
+        let a = 45f64.to_radians();
+        assert!((cone_step(0.05, 0.2, a) - cone_step(0.05, -0.2, a)).abs() < 1e-12);
+        assert!(cone_step(0.05, 0.3, a) > cone_step(0.05, 0.1, a));
+    }
 }
