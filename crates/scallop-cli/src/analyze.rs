@@ -161,8 +161,8 @@ fn human(part: &str, r: &AnalysisReport) -> String {
     let side = if r.slope_deg > r.critical_slope_deg { "steeper" } else { "flatter" };
     let option = |o: &scallop_analysis::ToolOption| {
         format!(
-            "{:.1} s, {:.0} mm, step-over {:.3} mm, feed at {:.1}°",
-            o.estimate.time,
+            "{}, {:.0} mm, step-over {:.3} mm, feed at {:.1}°",
+            crate::output::hms(o.estimate.time),
             o.estimate.length,
             o.estimate.step_over,
             direction(o.feed_angle_deg)

@@ -243,7 +243,7 @@ pub fn run(args: &PostArgs) -> CliResult<()> {
     } else {
         let mut s = format!(
             "{} -> {} ({}, {}): {} CL records, {} blocks, replay within {:.2e} mm\n\
-             predicted time {:.2} s (feed {:.2} s, floor at the programmed feed {:.2} s, rapid {:.2} s)\n",
+             predicted time {} (feed {}, floor at the programmed feed {}, rapid {})\n",
             args.cl_file.display(),
             output.display(),
             report.machine,
@@ -251,10 +251,10 @@ pub fn run(args: &PostArgs) -> CliResult<()> {
             report.cl_records,
             report.blocks,
             report.replay_tip_deviation_mm,
-            report.total_time_s,
-            report.feed_time_s,
-            report.feed_floor_s,
-            report.rapid_time_s
+            crate::output::hms(report.total_time_s),
+            crate::output::hms(report.feed_time_s),
+            crate::output::hms(report.feed_floor_s),
+            crate::output::hms(report.rapid_time_s)
         );
         for a in &report.axes {
             s.push_str(&format!(

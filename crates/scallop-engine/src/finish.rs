@@ -350,11 +350,11 @@ pub(crate) fn plan_operation(
             Plan { toolpath: p.toolpath, report: p.report, scallop: Some(p.scallop) }
         }
         Strategy::NetworkPlanes => {
-            let set = parametric_only(job, "the network planner")?;
+            let set = parametric_only(job, "the network planner (finishing.strategy = \"network\")")?;
             network_planes(set, prepared, job, &params, tolerances)?
         }
         Strategy::Isoparametric(direction) => {
-            let set = parametric_only(job, "isoparametric passes")?;
+            let set = parametric_only(job, "isoparametric passes (finishing.strategy = \"isoparametric\")")?;
             isoparametric(set, prepared, job, &params, tolerances, direction)?
         }
     };
