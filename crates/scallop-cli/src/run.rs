@@ -204,6 +204,12 @@ pub(crate) fn finish_job(spec: &JobFile, folder: &Path) -> CliResult<FinishJob> 
             scallop_post::Dialect::builtin_names()
         ))
     })?;
+    let dialect = match o.units {
+        scallop_io::job::UnitsWord::In => dialect.in_inches().map_err(|e| {
+            Failure::rejected(format!("`output.units` = \"in\" with `output.dialect` = \"{}\": {e}", o.dialect))
+        })?,
+        _ => dialect,
+    };
     let output = OutputOptions {
         dialect,
         arc_fitting: o.arc_fitting,

@@ -706,3 +706,47 @@ fn run_takes_tools_and_cutting_data_from_the_library() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("tools.toml: line 9: tool 12: `fz`"), "{err}");
 }
+
+/// Units out as in: a pyramid given in centimetres (0.5 cm high) is machined
+/// as the 5 mm pyramid, the program written in inches (`G20`) replays in mm
+/// within the words' resolution to the tool tips of `toolpath.csv`; and
+/// `analyze` takes the job file (its part, cutter and scallop height).
+#[test]
+fn run_writes_inch_programs_and_reads_centimetres() {
+    let dir = scratch("units");
+    let cm: Vec<u8> = {
+        // The pyramid STL with every coordinate divided by 10 (cm).
+        let mm = pyramid_stl();
+        let mut out = mm[..84].to_vec();
+        for tri in mm[84..].chunks(50) {
+            out.extend_from_slice(&tri[..12]);
+            for c in tri[12..48].chunks(4) {
+                let v = f32::from_le_bytes(c.try_into().expect("4 bytes")) / 10.0;
+                out.extend_from_slice(&v.to_le_bytes());
+            }
+            out.extend_from_slice(&tri[48..50]);
+        }
+        out
+    };
+    std::fs::write(dir.join("pyramid.stl"), cm).expect("write");
+    let job = "[part]\nfile = \"pyramid.stl\"\nunits = \"cm\"\n[cutter]\nshape = \"ball\"\ndiameter = 4\n\
+        [finishing]\nscallop_height = 0.05\n[output]\nunits = \"in\"\nspindle = 10000\n";
+    std::fs::write(dir.join("job.toml"), job).expect("write");
+    let out = scallop().arg("run").arg(dir.join("job.toml")).arg("-o").arg(dir.join("out")).output().expect("run");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let program = std::fs::read_to_string(dir.join("out/program.nc")).expect("program");
+    assert!(program.lines().any(|l| l.split_whitespace().any(|w| w == "G20")), "{program}");
+    let back = scallop_io::gcode::read_gcode(&program, &scallop_io::gcode::GcodeOptions::default()).expect("reads");
+    let csv = std::fs::read_to_string(dir.join("out/toolpath.csv")).expect("csv");
+    let path = scallop_io::cl::read_cl(&csv, 1000.0).expect("CL");
+    assert_eq!(back.moves().len(), path.moves().len());
+    let top = path.moves().iter().map(|m| m.to.z).fold(f64::NEG_INFINITY, f64::max);
+    assert!(top > 5.0 && top < 20.0, "the part is 5 mm high: {top}");
+    for (a, b) in back.moves().iter().zip(path.moves()) {
+        assert!((a.to - b.to).abs().max() <= 0.5e-5 * 25.4 + 1e-9, "{:?} vs {:?}", a.to, b.to);
+    }
+    let analysis = scallop().args(["analyze", "--json"]).arg(dir.join("job.toml")).output().expect("analyze");
+    assert!(analysis.status.success(), "{}", String::from_utf8_lossy(&analysis.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&analysis.stdout).expect("json");
+    assert_eq!(report["scallop_height_mm"].as_f64(), Some(0.05), "{report}");
+}

@@ -145,6 +145,9 @@ pub struct OutputSpec {
     /// Spindle speed (1/min; 0: no spindle word).
     #[serde(default)]
     pub spindle: f64,
+    /// Units of the program: `mm` (default, `G21`) or `in` (`G20`, 3-axis output).
+    #[serde(default = "default_units")]
+    pub units: UnitsWord,
 }
 
 fn default_dialect() -> String {
@@ -156,7 +159,14 @@ fn default_program() -> String {
 
 impl Default for OutputSpec {
     fn default() -> Self {
-        OutputSpec { dialect: default_dialect(), arc_fitting: false, program: default_program(), tool: 0, spindle: 0.0 }
+        OutputSpec {
+            dialect: default_dialect(),
+            arc_fitting: false,
+            program: default_program(),
+            tool: 0,
+            spindle: 0.0,
+            units: default_units(),
+        }
     }
 }
 
@@ -212,7 +222,9 @@ word_enum! {
     /// `part.units`.
     UnitsWord { /// Millimetres.
         Mm = "mm", /// Inches.
-        In = "in" }
+        In = "in", /// Metres.
+        M = "m", /// Centimetres.
+        Cm = "cm" }
 }
 word_enum! {
     /// `cutter.shape`.
@@ -891,7 +903,7 @@ pub fn parse_job(text: &str) -> Result<JobFile, JobError> {
 /// let job = parse_job_with_tools(job, Some(&lib)).unwrap();
 /// assert_eq!((job.cutter.diameter, job.operations[0].spindle, job.operations[0].feed), (6.0, Some(12000.0), Some(1200.0)));
 /// let err = parse_job_with_tools(&job_text_with_tool(9), Some(&lib)).unwrap_err().to_string();
-/// assert!(err.starts_with("line 4: tool 9 is not in the tool library"), "{err}");
+/// assert!(err.starts_with("line 6: tool 9 is not in the tool library"), "{err}");
 /// # fn job_text_with_tool(n: u32) -> String { format!("tool_library = \"t.toml\"\n[part]\nbuiltin = \"choi\"\n[[operation]]\nkind = \"finish\"\ntool = {n}\n[operation.finishing]\nscallop_height = 0.01\n") }
 /// ```
 ///
@@ -975,12 +987,26 @@ pub fn parse_job_with_tools(text: &str, library: Option<&ToolLibrary>) -> Result
     if !(job.output.spindle.is_finite() && job.output.spindle >= 0.0) {
         return bad("output.spindle", job.output.spindle, "give the spindle speed in 1/min, >= 0");
     }
+    if matches!(job.output.units, UnitsWord::M | UnitsWord::Cm) {
+        return Err(JobError::Value {
+            key: "output.units",
+            value: job.output.units.word().into(),
+            fix: "programs are written in \"mm\" (G21) or \"in\" (G20)",
+        });
+    }
     if let Some(setup) = &job.setup {
         if let Some(a) = setup.rotation_deg.iter().find(|a| !a.is_finite()) {
             return bad("setup.rotation_deg", *a, "give three finite angles in degrees");
         }
         if !(setup.tool_length.is_finite() && setup.tool_length >= 0.0) {
             return bad("setup.tool_length", setup.tool_length, "give the tool length in mm, >= 0");
+        }
+        if job.output.units != UnitsWord::Mm {
+            return Err(JobError::Value {
+                key: "output.units",
+                value: job.output.units.word().into(),
+                fix: "3+2 programs are written in mm: set it to \"mm\" or remove [setup]",
+            });
         }
         if job.output.arc_fitting {
             return Err(JobError::Value {
@@ -1222,6 +1248,12 @@ mod tests {
             (BASE.replace("scallop_height = 0.01", "scallop_height = 3"), "corner radius"),
             (BASE.replace("diameter = 10", "diameter = 10\nflute_length = -3"), "cutter.flute_length"),
             (format!("{BASE}[output]\nspindle = -1\n"), "output.spindle"),
+            (format!("{BASE}[output]\nunits = \"m\"\n"), "output.units"),
+            (format!("{BASE}[output]\nunits = \"ft\"\n"), "output.units"),
+            (
+                format!("{BASE}[setup]\nrotation_deg = [0, 30, 0]\nmachine = \"m\"\n[output]\nunits = \"in\"\n"),
+                "output.units",
+            ),
             (format!("{BASE}lead = \"loop\"\n"), "finishing.lead"),
             (format!("{BASE}strategy = \"spiral\"\n"), "finishing.strategy"),
             (format!("{BASE}iso_direction = \"w\"\n"), "finishing.iso_direction"),
