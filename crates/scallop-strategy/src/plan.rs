@@ -458,7 +458,10 @@ impl<'a> Planner<'a> {
                 sod = sod.min(2.0 * radius);
             }
             if let CutterShape::Cone { radius, half_angle } = self.shape {
-                sod = cone_step(sh, slope, half_angle).min(2.0 * radius);
+                // The V's ridge lies in the section across the feed, whose slope is
+                // atan(tan s |sin alpha|) (0 when feeding down the slope).
+                let across = (slope.tan() * alpha.sin().abs()).atan();
+                sod = cone_step(sh, if across.is_nan() { slope } else { across }, half_angle).min(2.0 * radius);
             }
             let tau = m.cross(&n);
             let cross = if tau.norm() > 0.0 { n.cross(&(tau / tau.norm())) } else { Vec3::zeros() };
