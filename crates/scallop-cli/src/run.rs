@@ -29,6 +29,10 @@ pub struct RunArgs {
     /// Print the report as JSON.
     #[arg(long)]
     json: bool,
+    /// Print what each operation will do (strategy, direction, expected planes, length and
+    /// time) from the analysis and the spacing rule, without planning; writes nothing.
+    #[arg(long)]
+    plan_only: bool,
 }
 
 /// `scallop run`.
@@ -38,6 +42,14 @@ pub fn run(args: &RunArgs) -> CliResult<()> {
         Failure::Rejected(e) => Failure::Rejected(anyhow::anyhow!("{name}: {e:#}")),
         other => other,
     })?;
+    if args.plan_only {
+        let operations = if spec.operation_list {
+            operations_job(&spec, job)?.operations
+        } else {
+            vec![Operation { name: "finish".into(), finish: job }]
+        };
+        return plan_only(&name, &operations, args.json);
+    }
     if spec.operation_list {
         let engine_job = operations_job(&spec, job).map_err(|e| match e {
             Failure::Rejected(e) => Failure::Rejected(anyhow::anyhow!("{name}: {e:#}")),
@@ -57,6 +69,38 @@ pub fn run(args: &RunArgs) -> CliResult<()> {
     spinner.finish_and_clear();
     let command = format!("scallop run {name}");
     write_finishing(&job, &out, start.elapsed().as_secs_f64(), &args.output, args.json, &command)
+}
+
+/// `scallop run --plan-only`: the estimate of every operation (docs/job.md).
+fn plan_only(name: &str, operations: &[Operation], json: bool) -> CliResult<()> {
+    let mut estimates = Vec::with_capacity(operations.len());
+    for op in operations {
+        let e = scallop_engine::estimate_operation(&op.finish)
+            .map_err(|e| Failure::rejected(format!("{name}: operation `{}`: {e}", op.name)))?;
+        estimates.push((op.name.clone(), e));
+    }
+    if json {
+        let list: Vec<serde_json::Value> =
+            estimates.iter().map(|(n, e)| serde_json::json!({ "name": n, "estimate": e })).collect();
+        return crate::output::print_json(&list);
+    }
+    let mut text = format!("{name}: estimate before planning (no drop-cutter, no simulation)\n");
+    for (k, (n, e)) in estimates.iter().enumerate() {
+        text.push_str(&format!(
+            "  {}. {n}: {}, feed at {:.2}° from X ({}); ~{} planes at {:.3} to {:.3} mm; ~{:.0} mm of feed, \
+             >= {} at the programmed feed\n",
+            k + 1,
+            e.strategy,
+            e.direction_deg,
+            if e.direction_given { "given" } else { "from the analysis" },
+            e.planes,
+            e.spacing_mm[0],
+            e.spacing_mm[1],
+            e.feed_length_mm,
+            crate::output::hms(e.time_at_feed_s)
+        ));
+    }
+    crate::output::print_text(&text)
 }
 
 /// The engine job of a file with `[[operation]]`s: one finishing job per

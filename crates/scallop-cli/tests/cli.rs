@@ -582,6 +582,21 @@ fn run_machines_two_operations_on_one_stock() {
     let left = a["volume_before_mm3"].as_f64().unwrap() - a["removed_mm3"].as_f64().unwrap();
     assert!((b["volume_before_mm3"].as_f64().unwrap() - left).abs() <= 1e-6 * left, "{report}");
     assert!(b["removed_mm3"].as_f64().unwrap() < a["removed_mm3"].as_f64().unwrap(), "{report}");
+    // The estimate before planning (--plan-only) expects each operation's pass count within 10 %.
+    let estimate = scallop()
+        .arg("run")
+        .arg(dir.join("job.toml"))
+        .args(["--plan-only", "--json", "-o"])
+        .arg(dir.join("est"))
+        .output()
+        .expect("run");
+    assert!(estimate.status.success(), "{}", String::from_utf8_lossy(&estimate.stderr));
+    assert!(!dir.join("est").exists(), "--plan-only writes nothing");
+    let estimate: serde_json::Value = serde_json::from_slice(&estimate.stdout).expect("json");
+    for (op, e) in ops.iter().zip(estimate.as_array().expect("list")) {
+        let (real, expected) = (op["plan"]["passes"].as_f64().unwrap(), e["estimate"]["planes"].as_f64().unwrap());
+        assert!((expected - real).abs() <= 0.1 * real, "estimated {expected} passes, planned {real}");
+    }
     let program = std::fs::read_to_string(dir.join("out/program.nc")).expect("program");
     let (t1, t2) = (program.find("T1 M6").expect("T1"), program.find("T2 M6").expect("T2"));
     assert!(t1 < t2 && program[t2..].contains("S10000 M3"), "{program}");

@@ -318,7 +318,6 @@ pub(crate) fn plan_operation(
     tolerances: &Tolerances,
     clearance: Option<f64>,
 ) -> Result<PlannedOperation, EngineError> {
-    let machine = MachineLimits::from_thesis_units(job.machine[0], job.machine[1], job.machine[2]);
     let samples = match (&job.part, &job.setup) {
         (Part::Surfaces(set), None) => {
             sample_surface_set(set, &GridOptions::default()).map_err(EngineError::Analysis)?
@@ -327,19 +326,7 @@ pub(crate) fn plan_operation(
         // 3+2: analyse the part as the cutter sees it, in the planning frame.
         (_, Some(_)) => sample_mesh(&prepared.mesh),
     };
-    let radius = job.cutter.radius();
-    let (corner, is_ball) = match *job.cutter.shape() {
-        CutterShape::Bull { corner, .. } => (corner, false),
-        CutterShape::Ball { .. } => (radius / 2.0, true),
-        _ => (radius / 2.0, false),
-    };
-    let tools = ToolOptions { ball_radius: radius, toroidal_radius: radius, corner_radius: corner };
-    let analysis = analyze(&samples, &tools, &machine, job.scallop_height).map_err(EngineError::Analysis)?;
-    let direction_deg = job.direction_deg.unwrap_or(if is_ball {
-        analysis.principal_direction_deg
-    } else {
-        analysis.slope_direction_deg
-    });
+    let (analysis, direction_deg) = analyse(job, &samples)?;
     let mut params = finishing_params(job, direction_deg.to_radians());
     if let Some(c) = clearance {
         params.clearance = c;
@@ -375,6 +362,30 @@ pub(crate) fn plan_operation(
         planned.toolpath = led;
     }
     Ok(PlannedOperation { plan: planned, params, direction_deg, analysis, leads })
+}
+
+/// The analysis of a part's samples with the job's cutter (finishing.md 4) and
+/// the feed direction: the job's, else the PCA principal direction for a ball
+/// and the steepest slope for the other cutters.
+pub(crate) fn analyse(
+    job: &FinishJob,
+    samples: &scallop_analysis::Samples,
+) -> Result<(scallop_analysis::AnalysisReport, f64), EngineError> {
+    let machine = MachineLimits::from_thesis_units(job.machine[0], job.machine[1], job.machine[2]);
+    let radius = job.cutter.radius();
+    let (corner, is_ball) = match *job.cutter.shape() {
+        CutterShape::Bull { corner, .. } => (corner, false),
+        CutterShape::Ball { .. } => (radius / 2.0, true),
+        _ => (radius / 2.0, false),
+    };
+    let tools = ToolOptions { ball_radius: radius, toroidal_radius: radius, corner_radius: corner };
+    let analysis = analyze(samples, &tools, &machine, job.scallop_height).map_err(EngineError::Analysis)?;
+    let direction_deg = job.direction_deg.unwrap_or(if is_ball {
+        analysis.principal_direction_deg
+    } else {
+        analysis.slope_direction_deg
+    });
+    Ok((analysis, direction_deg))
 }
 
 /// The surfaces of a parametric part, for a strategy that needs them, or the

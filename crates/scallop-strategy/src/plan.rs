@@ -97,21 +97,7 @@ impl<'a> Planner<'a> {
         }
         let shape = *cutter.shape();
         let sh = params.scallop_height;
-        let (model, bound, what) = match shape {
-            CutterShape::Ball { radius } => (scallop_analysis::Cutter::Ball { radius }, radius, "radius"),
-            CutterShape::Bull { radius, corner } => {
-                (scallop_analysis::Cutter::Toroidal { radius, corner }, corner, "corner radius")
-            }
-            // A flat end is the torus with r = 0 in Eq. 1.5 (R / sin s along the slope).
-            CutterShape::Flat { radius } => {
-                (scallop_analysis::Cutter::Toroidal { radius, corner: 0.0 }, radius, "radius")
-            }
-            // A cone is planned from the sharp-tip rule below; the torus with r = 0
-            // only caps the step at the diameter.
-            CutterShape::Cone { radius, .. } => {
-                (scallop_analysis::Cutter::Toroidal { radius, corner: 0.0 }, radius, "radius")
-            }
-        };
+        let (model, bound, what) = spacing_model(&shape);
         if sh >= bound {
             return Err(StrategyError::ScallopTooLarge { scallop_height: sh, what, radius: bound });
         }
@@ -440,33 +426,7 @@ impl<'a> Planner<'a> {
         let mut best: Option<(f64, Point2)> = None;
         for cl in &plane.samples {
             let n = contact_normal(&self.shape, self.index, &self.slots, cl);
-            let slope = n.z.abs().min(1.0).acos();
-            let horizontal = n.x.hypot(n.y);
-            let alpha = if horizontal < tol::HORIZONTAL_XY {
-                0.0
-            } else {
-                fold_direction_angle(n.y.atan2(n.x) - self.params.direction)
-            };
-            let mut sod = self.model.step_over(sh, slope, alpha);
-            if let CutterShape::Flat { radius } = self.shape {
-                // A sharp rim leaves a saw tooth, not a circle: start from sh / sin s
-                // (the measured scallop corrects it); never more than the diameter.
-                let sin_s = slope.sin();
-                if sin_s > 0.0 {
-                    sod = sod.max(sh / sin_s);
-                }
-                sod = sod.min(2.0 * radius);
-            }
-            if let CutterShape::Cone { radius, half_angle } = self.shape {
-                // The V's ridge lies in the section across the feed, whose slope is
-                // atan(tan s |sin alpha|) (0 when feeding down the slope).
-                let across = (slope.tan() * alpha.sin().abs()).atan();
-                sod = cone_step(sh, if across.is_nan() { slope } else { across }, half_angle).min(2.0 * radius);
-            }
-            let tau = m.cross(&n);
-            let cross = if tau.norm() > 0.0 { n.cross(&(tau / tau.norm())) } else { Vec3::zeros() };
-            let factor = if cross.norm() > 0.0 { (cross / cross.norm()).dot(&m).abs() } else { 0.0 };
-            let delta = sod * factor;
+            let delta = spacing_at(&self.shape, &self.model, sh, &n, self.params.direction, &m);
             if best.is_none_or(|(b, _)| delta < b) {
                 best = Some((delta, Point2::new(cl.tip.x, cl.tip.y)));
             }
@@ -812,6 +772,74 @@ fn cone_step(sh: f64, slope: f64, alpha: f64) -> f64 {
     } else {
         sh / slope.sin().max(1e-9)
     }
+}
+
+/// The horizontal plane spacing the rule gives at a contact of unit normal `n`
+/// for passes in `direction` (rad from +X; `m` the unit horizontal normal of the
+/// planes): the step-over `sod` of the cutter's model at the contact's slope and
+/// feed angle, with the sharp-rim and V rules of the flat end and the cone,
+/// projected to the planes' normal (finishing.md 6.4).
+fn spacing_at(
+    shape: &CutterShape,
+    model: &scallop_analysis::Cutter,
+    sh: f64,
+    n: &Vec3,
+    direction: f64,
+    m: &Vec3,
+) -> f64 {
+    let slope = n.z.abs().min(1.0).acos();
+    let horizontal = n.x.hypot(n.y);
+    let alpha = if horizontal < tol::HORIZONTAL_XY { 0.0 } else { fold_direction_angle(n.y.atan2(n.x) - direction) };
+    let mut sod = model.step_over(sh, slope, alpha);
+    if let CutterShape::Flat { radius } = *shape {
+        // A sharp rim leaves a saw tooth, not a circle: start from sh / sin s
+        // (the measured scallop corrects it); never more than the diameter.
+        let sin_s = slope.sin();
+        if sin_s > 0.0 {
+            sod = sod.max(sh / sin_s);
+        }
+        sod = sod.min(2.0 * radius);
+    }
+    if let CutterShape::Cone { radius, half_angle } = *shape {
+        // The V's ridge lies in the section across the feed, whose slope is
+        // atan(tan s |sin alpha|) (0 when feeding down the slope).
+        let across = (slope.tan() * alpha.sin().abs()).atan();
+        sod = cone_step(sh, if across.is_nan() { slope } else { across }, half_angle).min(2.0 * radius);
+    }
+    let tau = m.cross(n);
+    let cross = if tau.norm() > 0.0 { n.cross(&(tau / tau.norm())) } else { Vec3::zeros() };
+    let factor = if cross.norm() > 0.0 { (cross / cross.norm()).dot(m).abs() } else { 0.0 };
+    sod * factor
+}
+
+/// The spacing model of a cutter: the step-over rule's cutter, and the radius
+/// the scallop height must stay below (with its name).
+fn spacing_model(shape: &CutterShape) -> (scallop_analysis::Cutter, f64, &'static str) {
+    match *shape {
+        CutterShape::Ball { radius } => (scallop_analysis::Cutter::Ball { radius }, radius, "radius"),
+        CutterShape::Bull { radius, corner } => {
+            (scallop_analysis::Cutter::Toroidal { radius, corner }, corner, "corner radius")
+        }
+        // A flat end is the torus with r = 0 in Eq. 1.5 (R / sin s along the slope);
+        // a cone is planned from the sharp-tip rule, the torus only caps the step.
+        CutterShape::Flat { radius } | CutterShape::Cone { radius, .. } => {
+            (scallop_analysis::Cutter::Toroidal { radius, corner: 0.0 }, radius, "radius")
+        }
+    }
+}
+
+/// The start spacing of parallel planes at a surface point of unit normal
+/// `normal` (mm, horizontal, across planes in `direction` rad from +X), by the
+/// planner's own rule before any scallop is measured: the cheap estimate of
+/// a plan (`scallop run --plan-only`). `f64::INFINITY` where the planes run
+/// along the normal's horizontal part (no spacing limit there).
+#[must_use]
+pub fn rule_spacing(shape: &CutterShape, scallop_height: f64, normal: &Vec3, direction: f64) -> f64 {
+    let (model, _, _) = spacing_model(shape);
+    let m = Vec3::new(-direction.sin(), direction.cos(), 0.0);
+    let delta = spacing_at(shape, &model, scallop_height, normal, direction, &m);
+    let cap = model.max_step_over(scallop_height).min(2.0 * shape.radius());
+    if delta > 0.0 { delta.min(cap) } else { cap }
 }
 
 #[cfg(test)]
