@@ -265,6 +265,34 @@ mod tests {
         assert_eq!(lib.tools[1].1, 9);
     }
 
+    /// Jobs take a library tool's cutter, speed and feed where they give none.
+    #[test]
+    fn jobs_resolve_library_tools() {
+        use crate::job::{parse_job, parse_job_with_tools};
+        let lib = parse_tool_library(LIB).unwrap();
+        let single = "tool_library = \"t.toml\"\n[part]\nbuiltin = \"choi\"\n[finishing]\nscallop_height = 0.01\n[output]\ntool = 1\n";
+        let job = parse_job_with_tools(single, Some(&lib)).unwrap();
+        assert_eq!((job.cutter.shape, job.cutter.diameter), (ShapeWord::Flat, 10.0));
+        assert_eq!(job.operations[0].spindle, lib.get(1).unwrap().spindle_speed());
+        // A library named but not read, and a job without cutter or library.
+        assert!(parse_job(single).unwrap_err().to_string().contains("tool_library"));
+        let err = parse_job(&single.replace("tool_library = \"t.toml\"\n", "")).unwrap_err().to_string();
+        assert!(err.contains("cutter"), "{err}");
+        // An operation with its own cutter keeps it (its number need not be in the library);
+        // an operation's own spindle and feed win over the library's.
+        let ops = "tool_library = \"t.toml\"\n[part]\nbuiltin = \"choi\"\n\
+            [[operation]]\nkind = \"finish\"\ntool = 9\n[operation.cutter]\nshape = \"ball\"\ndiameter = 6\n[operation.finishing]\nscallop_height = 0.01\n\
+            [[operation]]\nkind = \"finish\"\ntool = 4\nspindle = 9000\nfeed = 700\n[operation.finishing]\nscallop_height = 0.01\n";
+        let job = parse_job_with_tools(ops, Some(&lib)).unwrap();
+        assert_eq!((job.operations[0].cutter.diameter, job.operations[0].spindle), (6.0, None));
+        let cone = &job.operations[1];
+        assert_eq!(
+            (cone.cutter.shape, cone.cutter.angle_deg, cone.spindle, cone.feed),
+            (ShapeWord::Cone, Some(90.0), Some(9000.0), Some(700.0))
+        );
+        assert_eq!(cone.cutter.holder.len(), 1);
+    }
+
     #[test]
     fn bad_libraries_name_the_line_and_the_key() {
         let cases = [
