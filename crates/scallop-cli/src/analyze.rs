@@ -12,11 +12,14 @@ use scallop_engine::Part;
 use crate::output::{print_json, print_text, write_atomic};
 use crate::part::{UnitsArg, load};
 use crate::{CliResult, Failure};
+use scallop_io::job::ShapeWord;
 
 /// Arguments of `scallop analyze`.
 #[derive(Args, Debug)]
 pub struct AnalyzeArgs {
-    /// Part: mesh file (.stl .obj .ply .3mf), surface file (.toml) or built-in name (choi, rubio).
+    /// Part: mesh file (.stl .obj .ply .3mf), surface file (.toml), built-in name (choi, rubio),
+    /// or a job file (.toml with a [part]): its part with its first operation's cutter, scallop
+    /// height and [machine] limits (the cutter and machine flags are then not used).
     part: String,
     /// Unit of mesh coordinates.
     #[arg(long, value_enum, default_value = "mm")]
@@ -71,6 +74,9 @@ pub fn run(args: &AnalyzeArgs) -> CliResult<()> {
     if args.cells == 0 {
         return Err(Failure::rejected("--cells 0: give at least 1"));
     }
+    if let Some(job_args) = job_args(args)? {
+        return run(&job_args);
+    }
     let loaded = load(&args.part, args.units)?;
     let samples = match &loaded.part {
         Part::Surfaces(set) => sample_surface_set(set, &GridOptions { cells_u: args.cells, cells_v: args.cells })
@@ -94,6 +100,52 @@ pub fn run(args: &AnalyzeArgs) -> CliResult<()> {
         return print_json(&report);
     }
     print_text(&human(&loaded.description, &report))
+}
+
+/// The arguments that analyse a job file's part with its first operation's
+/// cutter, scallop height and machine limits; `None` when `args.part` is not a
+/// job file (a `.toml` with a `[part]` table).
+fn job_args(args: &AnalyzeArgs) -> CliResult<Option<AnalyzeArgs>> {
+    let path = std::path::Path::new(&args.part);
+    if !path.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml")) {
+        return Ok(None);
+    }
+    let is_job =
+        std::fs::read_to_string(path).ok().is_some_and(|t| t.lines().any(|l| l.trim_start().starts_with("[part]")));
+    if !is_job {
+        return Ok(None);
+    }
+    let (name, job) = crate::run::read_job(path)?;
+    let part = match (&job.part.file, &job.part.builtin) {
+        (Some(file), _) => path.parent().unwrap_or(std::path::Path::new(".")).join(file).to_string_lossy().into_owned(),
+        (None, Some(builtin)) => builtin.clone(),
+        (None, None) => return Err(Failure::rejected(format!("{name}: part: give `file` or `builtin`"))),
+    };
+    let (c, radius) = (&job.cutter, job.cutter.diameter / 2.0);
+    let (ball_radius, bull_radius, corner_radius) = match c.shape {
+        ShapeWord::Ball => (radius, radius, args.corner_radius.min(radius)),
+        ShapeWord::Bull => (radius, radius, c.corner_radius.unwrap_or(radius)),
+        other => {
+            return Err(Failure::rejected(format!(
+                "{name}: cutter.shape = \"{}\": the analysis compares ball and bull-nose cutters",
+                other.word()
+            )));
+        }
+    };
+    Ok(Some(AnalyzeArgs {
+        part,
+        units: UnitsArg::from(job.part.units),
+        ball_radius,
+        bull_radius,
+        corner_radius,
+        scallop: job.finishing.scallop_height,
+        feed: job.operations[0].feed.map_or(job.machine.feed, |f| f / 1000.0),
+        acceleration: job.machine.acceleration,
+        jerk: job.machine.jerk,
+        cells: args.cells,
+        plot: args.plot.clone(),
+        json: args.json,
+    }))
 }
 
 /// The (mu, s) decision plane as a PNG: the ball region (s > s_c) blue, the
@@ -161,8 +213,8 @@ fn human(part: &str, r: &AnalysisReport) -> String {
     let side = if r.slope_deg > r.critical_slope_deg { "steeper" } else { "flatter" };
     let option = |o: &scallop_analysis::ToolOption| {
         format!(
-            "{:.1} s, {:.0} mm, step-over {:.3} mm, feed at {:.1}°",
-            o.estimate.time,
+            "{}, {:.0} mm, step-over {:.3} mm, feed at {:.1}°",
+            crate::output::hms(o.estimate.time),
             o.estimate.length,
             o.estimate.step_over,
             direction(o.feed_angle_deg)

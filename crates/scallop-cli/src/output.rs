@@ -145,7 +145,7 @@ pub fn write_job(out: &scallop_engine::JobOutput, seconds: f64, folder: &Path, j
             op.tool,
             op.cutter,
             op.scallop_height_mm,
-            op.direction_deg,
+            op.direction_deg + 0.0,
             op.plan.passes,
             hms(op.plan.machining_time_s),
             op.plan.rapid_time_s,
@@ -243,7 +243,7 @@ pub fn write_finishing(
          \x20 cutter     {cutter}, scallop height {sh} mm, {chord}\n\
          \x20 toolpath   {passes} passes on {planes} planes, {points} points, {links} links, {retracts} retracts\n\
          \x20 scallop    verified max {smax:.5} mm (<= {sh} mm{by_sim}), mean material left {smean:.5} mm\n\
-         \x20 time       {t1:.1} s stop-to-stop, {t2:.1} s look-ahead, + {tr:.1} s rapids\n\
+         \x20 time       {t1} stop-to-stop, {t2} look-ahead, + {tr} rapids\n\
          \x20 lengths    feed {feed:.0} mm, links {link:.0} mm, rapid {rapid:.0} mm\n\
          \x20 simulated  no gouge on a {res} mm stock; deepest {dev:+.4} mm (tolerance {gt:.4} mm), most material left {mat:.4} mm;\n\
          \x20            scallop on the machined surface {ssim:.4} mm along the normal beyond R from the edge (<= sh + {bound:.5} mm), {sedge:.4} mm within it\n\
@@ -272,9 +272,9 @@ pub fn write_finishing(
         retracts = p.retracts,
         smax = p.max_scallop_mm,
         smean = p.mean_scallop_mm,
-        t1 = p.machining_time_s,
-        t2 = p.machining_time_lookahead_s,
-        tr = p.rapid_time_s,
+        t1 = hms(p.machining_time_s),
+        t2 = hms(p.machining_time_lookahead_s),
+        tr = hms(p.rapid_time_s),
         feed = p.feed_length_mm,
         link = p.link_length_mm,
         rapid = p.rapid_length_mm,

@@ -16,6 +16,10 @@ pub enum UnitsArg {
     Mm,
     /// Inches (scaled by 25.4).
     In,
+    /// Metres (scaled by 1000).
+    M,
+    /// Centimetres (scaled by 10).
+    Cm,
 }
 
 impl From<scallop_io::job::UnitsWord> for UnitsArg {
@@ -23,6 +27,8 @@ impl From<scallop_io::job::UnitsWord> for UnitsArg {
         match u {
             scallop_io::job::UnitsWord::Mm => UnitsArg::Mm,
             scallop_io::job::UnitsWord::In => UnitsArg::In,
+            scallop_io::job::UnitsWord::M => UnitsArg::M,
+            scallop_io::job::UnitsWord::Cm => UnitsArg::Cm,
         }
     }
 }
@@ -32,6 +38,8 @@ impl From<UnitsArg> for Units {
         match u {
             UnitsArg::Mm => Units::Millimetres,
             UnitsArg::In => Units::Inches,
+            UnitsArg::M => Units::Metres,
+            UnitsArg::Cm => Units::Centimetres,
         }
     }
 }

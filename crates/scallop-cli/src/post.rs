@@ -125,12 +125,21 @@ fn read_text(path: &Path) -> CliResult<String> {
     scallop_io::utf8_text(&bytes).map(str::to_owned).map_err(|e| Failure::rejected(format!("{}: {e}", path.display())))
 }
 
-fn load_machine(name: &str) -> CliResult<Machine> {
-    if name.ends_with(".toml") || Path::new(name).is_file() {
-        let text = read_text(Path::new(name))?;
-        Machine::from_toml_str(&text).map_err(|e| Failure::rejected(format!("{name}: {e}")))
+/// A machine by shipped name or by TOML file (a relative path taken from
+/// `folder`: the job file's folder, or the working folder for `--machine`);
+/// `what` names the flag or key in messages.
+pub(crate) fn load_machine(name: &str, folder: &Path, what: &str) -> CliResult<Machine> {
+    let path = folder.join(name);
+    if name.ends_with(".toml") || path.is_file() {
+        let text = read_text(&path)?;
+        Machine::from_toml_str(&text).map_err(|e| Failure::rejected(format!("{}: {e}", path.display())))
     } else {
-        Machine::builtin(name).map_err(|e| Failure::rejected(format!("--machine {name}: {e}")))
+        Machine::builtin(name).map_err(|e| {
+            Failure::rejected(format!(
+                "{what} = \"{name}\": {e}; give a shipped name ({}) or a machine file (.toml)",
+                Machine::builtin_names().join(", ")
+            ))
+        })
     }
 }
 
@@ -158,7 +167,7 @@ pub fn run(args: &PostArgs) -> CliResult<()> {
     if !(args.tool_length.is_finite() && args.tool_length >= 0.0) {
         return Err(Failure::rejected(format!("--tool-length {}: must be a finite number >= 0", args.tool_length)));
     }
-    let machine = load_machine(&args.machine)?;
+    let machine = load_machine(&args.machine, Path::new(""), "--machine")?;
     let dialect = load_dialect(&args.dialect)?;
     let text = read_text(&args.cl_file)?;
     let path = read_cl(&text, args.feed).map_err(|e| Failure::rejected(format!("{}: {e}", args.cl_file.display())))?;
@@ -234,7 +243,7 @@ pub fn run(args: &PostArgs) -> CliResult<()> {
     } else {
         let mut s = format!(
             "{} -> {} ({}, {}): {} CL records, {} blocks, replay within {:.2e} mm\n\
-             predicted time {:.2} s (feed {:.2} s, floor at the programmed feed {:.2} s, rapid {:.2} s)\n",
+             predicted time {} (feed {}, floor at the programmed feed {}, rapid {})\n",
             args.cl_file.display(),
             output.display(),
             report.machine,
@@ -242,10 +251,10 @@ pub fn run(args: &PostArgs) -> CliResult<()> {
             report.cl_records,
             report.blocks,
             report.replay_tip_deviation_mm,
-            report.total_time_s,
-            report.feed_time_s,
-            report.feed_floor_s,
-            report.rapid_time_s
+            crate::output::hms(report.total_time_s),
+            crate::output::hms(report.feed_time_s),
+            crate::output::hms(report.feed_floor_s),
+            crate::output::hms(report.rapid_time_s)
         );
         for a in &report.axes {
             s.push_str(&format!(

@@ -98,8 +98,7 @@ fn job_part(spec: &str) -> Option<(String, UnitsArg)> {
     if !path.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml")) {
         return None;
     }
-    let text = std::fs::read_to_string(path).ok()?;
-    let job = scallop_io::job::parse_job(&text).ok()?;
+    let (_, job) = crate::run::read_job(path).ok()?;
     let units = UnitsArg::from(job.part.units);
     match (&job.part.file, &job.part.builtin) {
         (Some(file), _) => {

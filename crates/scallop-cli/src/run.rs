@@ -8,7 +8,10 @@ use scallop_engine::{FinishJob, Job, Operation, OutputOptions, Setup, StockShape
 use scallop_geom::Aabb3;
 use scallop_geom::Tolerances;
 use scallop_geom::nalgebra::Rotation3;
-use scallop_io::job::{DirectionSpec, IsoWord, JobFile, LeadWord, PatternWord, ShapeWord, StrategyWord, parse_job};
+use scallop_io::job::{
+    DirectionSpec, IsoWord, JobFile, LeadWord, PatternWord, ShapeWord, StrategyWord, parse_job_with_tools,
+    tool_library_of,
+};
 use scallop_strategy::{IsoDirection, LeadKind, Pattern};
 
 use crate::output::{progress_bar, write_finishing, write_job};
@@ -26,6 +29,10 @@ pub struct RunArgs {
     /// Print the report as JSON.
     #[arg(long)]
     json: bool,
+    /// Print what each operation will do (strategy, direction, expected planes, length and
+    /// time) from the analysis and the spacing rule, without planning; writes nothing.
+    #[arg(long)]
+    plan_only: bool,
 }
 
 /// `scallop run`.
@@ -35,6 +42,14 @@ pub fn run(args: &RunArgs) -> CliResult<()> {
         Failure::Rejected(e) => Failure::Rejected(anyhow::anyhow!("{name}: {e:#}")),
         other => other,
     })?;
+    if args.plan_only {
+        let operations = if spec.operation_list {
+            operations_job(&spec, job)?.operations
+        } else {
+            vec![Operation { name: "finish".into(), finish: job }]
+        };
+        return plan_only(&name, &operations, args.json);
+    }
     if spec.operation_list {
         let engine_job = operations_job(&spec, job).map_err(|e| match e {
             Failure::Rejected(e) => Failure::Rejected(anyhow::anyhow!("{name}: {e:#}")),
@@ -56,6 +71,38 @@ pub fn run(args: &RunArgs) -> CliResult<()> {
     write_finishing(&job, &out, start.elapsed().as_secs_f64(), &args.output, args.json, &command)
 }
 
+/// `scallop run --plan-only`: the estimate of every operation (docs/job.md).
+fn plan_only(name: &str, operations: &[Operation], json: bool) -> CliResult<()> {
+    let mut estimates = Vec::with_capacity(operations.len());
+    for op in operations {
+        let e = scallop_engine::estimate_operation(&op.finish)
+            .map_err(|e| Failure::rejected(format!("{name}: operation `{}`: {e}", op.name)))?;
+        estimates.push((op.name.clone(), e));
+    }
+    if json {
+        let list: Vec<serde_json::Value> =
+            estimates.iter().map(|(n, e)| serde_json::json!({ "name": n, "estimate": e })).collect();
+        return crate::output::print_json(&list);
+    }
+    let mut text = format!("{name}: estimate before planning (no drop-cutter, no simulation)\n");
+    for (k, (n, e)) in estimates.iter().enumerate() {
+        text.push_str(&format!(
+            "  {}. {n}: {}, feed at {:.2}° from X ({}); ~{} planes at {:.3} to {:.3} mm; ~{:.0} mm of feed, \
+             >= {} at the programmed feed\n",
+            k + 1,
+            e.strategy,
+            e.direction_deg,
+            if e.direction_given { "given" } else { "from the analysis" },
+            e.planes,
+            e.spacing_mm[0],
+            e.spacing_mm[1],
+            e.feed_length_mm,
+            crate::output::hms(e.time_at_feed_s)
+        ));
+    }
+    crate::output::print_text(&text)
+}
+
 /// The engine job of a file with `[[operation]]`s: one finishing job per
 /// operation, each a copy of `first` (the job-level settings, the part loaded
 /// once) with the operation's cutter, finishing settings, tool and spindle.
@@ -70,6 +117,9 @@ fn operations_job(spec: &JobFile, first: FinishJob) -> CliResult<Job> {
         apply_finishing(&mut finish, &op.finishing);
         finish.output.tool = op.tool.unwrap_or(spec.output.tool);
         finish.output.spindle = op.spindle.unwrap_or(spec.output.spindle);
+        if let Some(feed) = op.feed {
+            finish.machine[0] = feed / 1000.0; // mm/min -> m/min
+        }
         operations.push(Operation { name: op.name.clone(), finish });
     }
     let stock = spec.stock.as_ref().map(|s| match (s.min, s.max) {
@@ -79,17 +129,36 @@ fn operations_job(spec: &JobFile, first: FinishJob) -> CliResult<Job> {
     Ok(Job { stock, operations })
 }
 
-/// The cutter of a `[cutter]` table.
+/// The cutter of a `[cutter]` table (or a library tool): profile, flutes
+/// (default 4 D, or the cone's height if longer), shank and holder stack.
 fn cutter_of(spec: &scallop_io::job::CutterSpec) -> CliResult<Cutter> {
     let radius = spec.diameter / 2.0;
     let shape = match spec.shape {
         ShapeWord::Ball => CutterShape::Ball { radius },
         ShapeWord::Flat => CutterShape::Flat { radius },
         ShapeWord::Bull => CutterShape::Bull { radius, corner: spec.corner_radius.unwrap_or(radius) },
+        ShapeWord::Cone => {
+            CutterShape::Cone { radius, half_angle: (0.5 * spec.angle_deg.unwrap_or(90.0)).to_radians() }
+        }
     };
-    let flute = spec.flute_length.unwrap_or(4.0 * spec.diameter);
-    Cutter::new(shape, flute)
-        .map_err(|e| Failure::rejected(format!("[cutter] (diameter, corner_radius, flute_length): {e}")))
+    let flute = spec.flute_length.unwrap_or((4.0 * spec.diameter).max(shape.profile_height()));
+    let shank = (spec.shank_diameter.unwrap_or(spec.diameter) / 2.0, spec.shank_length.unwrap_or(flute));
+    let holder = spec
+        .holder
+        .iter()
+        .map(|h| scallop_cutter::HolderSegment {
+            length: h.length,
+            bottom_radius: h.diameter / 2.0,
+            top_radius: h.top_diameter.unwrap_or(h.diameter) / 2.0,
+        })
+        .collect();
+    Cutter::new(shape, flute).and_then(|c| c.with_shank(shank.0, shank.1)).and_then(|c| c.with_holder(holder)).map_err(
+        |e| {
+            Failure::rejected(format!(
+                "[cutter] (diameter, corner_radius, angle_deg, flute_length, shank_diameter, shank_length, holder): {e}"
+            ))
+        },
+    )
 }
 
 /// The settings of a `[finishing]` table on a finishing job.
@@ -132,8 +201,30 @@ pub(crate) fn read_job(path: &Path) -> CliResult<(String, JobFile)> {
     })?;
     let text = std::str::from_utf8(&bytes)
         .map_err(|e| Failure::rejected(format!("{name}: byte {}: the job file is not UTF-8 text", e.valid_up_to())))?;
-    let spec = parse_job(text).map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
+    let library_file = tool_library_of(text);
+    let library = match &library_file {
+        Some(file) => Some(read_tool_library(&path.parent().unwrap_or(Path::new(".")).join(file))?),
+        None => None,
+    };
+    let spec = parse_job_with_tools(text, library.as_ref()).map_err(|e| match (&e, &library_file) {
+        (scallop_io::job::JobError::UnknownTool { .. }, Some(lib)) => {
+            Failure::rejected(format!("{name}: {e} (tool library {lib})"))
+        }
+        _ => Failure::rejected(format!("{name}: {e}")),
+    })?;
     Ok((name, spec))
+}
+
+/// Reads a tool library (docs/job.md, "Tool library"); errors name the file,
+/// the line and the fix.
+pub(crate) fn read_tool_library(path: &Path) -> CliResult<scallop_io::tools::ToolLibrary> {
+    let name = path.display().to_string();
+    let bytes = std::fs::read(path).map_err(|e| {
+        let err = anyhow::anyhow!("{name}: cannot read the tool library (`tool_library` of the job): {e}");
+        if e.kind() == std::io::ErrorKind::NotFound { Failure::Rejected(err) } else { Failure::Io(err) }
+    })?;
+    let text = scallop_io::utf8_text(&bytes).map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
+    scallop_io::tools::parse_tool_library(text).map_err(|e| Failure::rejected(format!("{name}: {e}")))
 }
 
 pub(crate) fn finish_job(spec: &JobFile, folder: &Path) -> CliResult<FinishJob> {
@@ -153,6 +244,7 @@ pub(crate) fn finish_job(spec: &JobFile, folder: &Path) -> CliResult<FinishJob> 
         (None, None) => return Err(Failure::rejected("part: give `file` or `builtin`")),
     };
     let cutter = cutter_of(&spec.cutter)?;
+    let first = &spec.operations[0];
     let o = &spec.output;
     let dialect = scallop_post::Dialect::builtin(&o.dialect).map_err(|_| {
         Failure::rejected(format!(
@@ -161,18 +253,23 @@ pub(crate) fn finish_job(spec: &JobFile, folder: &Path) -> CliResult<FinishJob> 
             scallop_post::Dialect::builtin_names()
         ))
     })?;
+    let dialect = match o.units {
+        scallop_io::job::UnitsWord::In => dialect.in_inches().map_err(|e| {
+            Failure::rejected(format!("`output.units` = \"in\" with `output.dialect` = \"{}\": {e}", o.dialect))
+        })?,
+        _ => dialect,
+    };
     let output = OutputOptions {
         dialect,
         arc_fitting: o.arc_fitting,
         program: o.program.clone(),
         tool: o.tool,
-        spindle: o.spindle,
+        spindle: first.spindle.unwrap_or(o.spindle),
     };
     let setup = match &spec.setup {
         None => None,
         Some(s) => {
-            let machine = scallop_machine::Machine::builtin(&s.machine)
-                .map_err(|e| Failure::rejected(format!("`setup.machine` = \"{}\": {e}", s.machine)))?;
+            let machine = crate::post::load_machine(&s.machine, folder, "setup.machine")?;
             let [rx, ry, rz] = s.rotation_deg.map(f64::to_radians);
             Some(Setup { rotation: Rotation3::from_euler_angles(rx, ry, rz), machine, tool_length: s.tool_length })
         }
@@ -184,7 +281,7 @@ pub(crate) fn finish_job(spec: &JobFile, folder: &Path) -> CliResult<FinishJob> 
         scallop_height: 0.0,
         direction_deg: None,
         pattern: Pattern::Zigzag,
-        machine: [spec.machine.feed, spec.machine.acceleration, spec.machine.jerk],
+        machine: [first.feed.map_or(spec.machine.feed, |f| f / 1000.0), spec.machine.acceleration, spec.machine.jerk],
         rapid_rate: spec.machine.rapid * 1000.0 / 60.0,
         clearance: spec.machine.clearance,
         tolerances: Tolerances { path: spec.tolerances.path, gouge: spec.tolerances.gouge },

@@ -605,6 +605,21 @@ fn run_machines_two_operations_on_one_stock() {
     let left = a["volume_before_mm3"].as_f64().unwrap() - a["removed_mm3"].as_f64().unwrap();
     assert!((b["volume_before_mm3"].as_f64().unwrap() - left).abs() <= 1e-6 * left, "{report}");
     assert!(b["removed_mm3"].as_f64().unwrap() < a["removed_mm3"].as_f64().unwrap(), "{report}");
+    // The estimate before planning (--plan-only) expects each operation's pass count within 10 %.
+    let estimate = scallop()
+        .arg("run")
+        .arg(dir.join("job.toml"))
+        .args(["--plan-only", "--json", "-o"])
+        .arg(dir.join("est"))
+        .output()
+        .expect("run");
+    assert!(estimate.status.success(), "{}", String::from_utf8_lossy(&estimate.stderr));
+    assert!(!dir.join("est").exists(), "--plan-only writes nothing");
+    let estimate: serde_json::Value = serde_json::from_slice(&estimate.stdout).expect("json");
+    for (op, e) in ops.iter().zip(estimate.as_array().expect("list")) {
+        let (real, expected) = (op["plan"]["passes"].as_f64().unwrap(), e["estimate"]["planes"].as_f64().unwrap());
+        assert!((expected - real).abs() <= 0.1 * real, "estimated {expected} passes, planned {real}");
+    }
     let program = std::fs::read_to_string(dir.join("out/program.nc")).expect("program");
     let (t1, t2) = (program.find("T1 M6").expect("T1"), program.find("T2 M6").expect("T2"));
     assert!(t1 < t2 && program[t2..].contains("S10000 M3"), "{program}");
@@ -623,4 +638,153 @@ fn run_machines_two_operations_on_one_stock() {
         .output()
         .expect("simulate");
     assert!(sim.status.success(), "{}", String::from_utf8_lossy(&sim.stderr));
+}
+
+/// The words of a G-code line without its comments: `(letter, number)` pairs.
+fn nc_words(line: &str) -> Vec<(char, f64)> {
+    let mut text = String::new();
+    let mut depth = 0;
+    for c in line.chars() {
+        match c {
+            '(' => depth += 1,
+            ')' => depth -= 1,
+            _ if depth == 0 => text.push(c),
+            _ => {}
+        }
+    }
+    let mut words = Vec::new();
+    let mut chars = text.trim().chars().peekable();
+    while let Some(c) = chars.next() {
+        if !c.is_ascii_alphabetic() {
+            continue;
+        }
+        let mut number = String::new();
+        while let Some(&d) = chars.peek() {
+            if d.is_ascii_digit() || d == '.' || d == '-' {
+                number.push(d);
+                chars.next();
+            } else {
+                break;
+            }
+        }
+        words.push((c.to_ascii_uppercase(), number.parse().expect("a number after a letter")));
+    }
+    words
+}
+
+/// A job of two operations whose tools come from a tool library (in another
+/// folder, named relative to the job): the program of each dialect, parsed
+/// back word by word, changes to each tool (`T.. M6`; grbl: a pause `M0`),
+/// starts the spindle at `1000 Vc / (pi D)` (`S.. M3`) and feeds at
+/// `f_z * teeth * n` (`F..`), stopping the spindle before the second change.
+#[test]
+fn run_takes_tools_and_cutting_data_from_the_library() {
+    let dir = scratch("tool-library");
+    std::fs::create_dir_all(dir.join("jobs")).expect("dir");
+    std::fs::write(dir.join("jobs/pyramid.stl"), pyramid_stl()).expect("write");
+    let library = "[[tool]]\nnumber = 3\nshape = \"ball\"\ndiameter = 6\nflutes = 2\nflute_length = 20\nvc = 150\nfz = 0.04\n\
+        [[tool]]\nnumber = 12\nshape = \"ball\"\ndiameter = 4\nflutes = 3\nflute_length = 16\nspindle = 15000\nfz = 0.02\n";
+    std::fs::write(dir.join("tools.toml"), library).expect("write");
+    let n3 = 1000.0 * 150.0 / (std::f64::consts::PI * 6.0);
+    let expected = [(3.0, n3, 0.04 * 2.0 * n3), (12.0, 15000.0, 0.02 * 3.0 * 15000.0)];
+    for dialect in ["linuxcnc", "fanuc", "grbl"] {
+        let job = format!(
+            "tool_library = \"../tools.toml\"\n[part]\nfile = \"pyramid.stl\"\n[stock]\ntop = 3\n\
+            [[operation]]\nkind = \"finish\"\ntool = 3\n[operation.finishing]\nscallop_height = 0.3\n\
+            [[operation]]\nkind = \"finish\"\ntool = 12\n[operation.finishing]\nscallop_height = 0.05\n\
+            [verify]\nresolution = 0.1\n[output]\ndialect = \"{dialect}\"\n"
+        );
+        std::fs::write(dir.join("jobs/job.toml"), &job).expect("write");
+        let out =
+            scallop().arg("run").arg(dir.join("jobs/job.toml")).arg("-o").arg(dir.join(dialect)).output().expect("run");
+        assert!(out.status.success(), "{dialect}: {}", String::from_utf8_lossy(&out.stderr));
+        let program = std::fs::read_to_string(dir.join(dialect).join("program.nc")).expect("program");
+        // Split the program at its tool changes and read each section's words.
+        let lines: Vec<&str> = program.lines().collect();
+        let changes: Vec<usize> = if dialect == "grbl" {
+            let at: Vec<usize> = (0..lines.len()).filter(|&i| nc_words(lines[i]) == [('M', 0.0)]).collect();
+            for (&i, (tool, ..)) in at.iter().zip(&expected) {
+                assert!(lines[i - 1].contains(&format!("load tool {tool}")), "{dialect}: {}", lines[i - 1]);
+            }
+            at.iter().map(|i| i - 1).collect()
+        } else {
+            let at: Vec<usize> = (0..lines.len()).filter(|&i| nc_words(lines[i]).contains(&('M', 6.0))).collect();
+            for (&i, (tool, ..)) in at.iter().zip(&expected) {
+                assert!(nc_words(lines[i]).contains(&('T', *tool)), "{dialect}: {}", lines[i]);
+            }
+            at
+        };
+        assert_eq!(changes.len(), 2, "{dialect}: {program}");
+        assert!(lines[changes[1] - 1].trim() == "M5", "{dialect}: the spindle stops before the second change");
+        for (k, (_, n, f)) in expected.iter().enumerate() {
+            let end = changes.get(k + 1).copied().unwrap_or(lines.len());
+            let words: Vec<Vec<(char, f64)>> = lines[changes[k]..end].iter().map(|l| nc_words(l)).collect();
+            let start = words.iter().find(|w| w.contains(&('M', 3.0))).expect("M3");
+            let s = start.iter().find(|(c, _)| *c == 'S').expect("S word").1;
+            assert!((s - n.round()).abs() < 0.5, "{dialect}: S{s}, expected {n}");
+            let feeds: Vec<f64> = words.iter().flatten().filter(|(c, _)| *c == 'F').map(|w| w.1).collect();
+            let resolution = if dialect == "grbl" { 1.0 } else { 0.1 }; // the dialects' feed decimals
+            assert!(feeds.iter().any(|v| (v - f).abs() <= 0.5 * resolution + 1e-9), "{dialect}: {feeds:?} {f}");
+        }
+    }
+    // An unknown tool number names the job file, the line and the fix.
+    std::fs::write(
+        dir.join("jobs/bad.toml"),
+        "tool_library = \"../tools.toml\"\n[part]\nfile = \"pyramid.stl\"\n[[operation]]\nkind = \"finish\"\ntool = 7\n[operation.finishing]\nscallop_height = 0.3\n",
+    )
+    .expect("write");
+    let out = scallop().arg("run").arg(dir.join("jobs/bad.toml")).arg("-o").arg(dir.join("bad")).output().expect("run");
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("bad.toml: line 6: tool 7 is not in the tool library") && err.contains("[3, 12]"), "{err}");
+    // A bad library names its own file and line.
+    std::fs::write(dir.join("tools.toml"), library.replace("fz = 0.02", "fz = -0.02")).expect("write");
+    let out = scallop().arg("run").arg(dir.join("jobs/job.toml")).arg("-o").arg(dir.join("bad")).output().expect("run");
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("tools.toml: line 9: tool 12: `fz`"), "{err}");
+}
+
+/// Units out as in: a pyramid given in centimetres (0.5 cm high) is machined
+/// as the 5 mm pyramid, the program written in inches (`G20`) replays in mm
+/// within the words' resolution to the tool tips of `toolpath.csv`; and
+/// `analyze` takes the job file (its part, cutter and scallop height).
+#[test]
+fn run_writes_inch_programs_and_reads_centimetres() {
+    let dir = scratch("units");
+    let cm: Vec<u8> = {
+        // The pyramid STL with every coordinate divided by 10 (cm).
+        let mm = pyramid_stl();
+        let mut out = mm[..84].to_vec();
+        for tri in mm[84..].chunks(50) {
+            out.extend_from_slice(&tri[..12]);
+            for c in tri[12..48].chunks(4) {
+                let v = f32::from_le_bytes(c.try_into().expect("4 bytes")) / 10.0;
+                out.extend_from_slice(&v.to_le_bytes());
+            }
+            out.extend_from_slice(&tri[48..50]);
+        }
+        out
+    };
+    std::fs::write(dir.join("pyramid.stl"), cm).expect("write");
+    let job = "[part]\nfile = \"pyramid.stl\"\nunits = \"cm\"\n[cutter]\nshape = \"ball\"\ndiameter = 4\n\
+        [finishing]\nscallop_height = 0.05\n[output]\nunits = \"in\"\nspindle = 10000\n";
+    std::fs::write(dir.join("job.toml"), job).expect("write");
+    let out = scallop().arg("run").arg(dir.join("job.toml")).arg("-o").arg(dir.join("out")).output().expect("run");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let program = std::fs::read_to_string(dir.join("out/program.nc")).expect("program");
+    assert!(program.lines().any(|l| l.split_whitespace().any(|w| w == "G20")), "{program}");
+    let back = scallop_io::gcode::read_gcode(&program, &scallop_io::gcode::GcodeOptions::default()).expect("reads");
+    let csv = std::fs::read_to_string(dir.join("out/toolpath.csv")).expect("csv");
+    let path = scallop_io::cl::read_cl(&csv, 1000.0).expect("CL");
+    assert_eq!(back.moves().len(), path.moves().len());
+    let top = path.moves().iter().map(|m| m.to.z).fold(f64::NEG_INFINITY, f64::max);
+    assert!(top > 5.0 && top < 20.0, "the part is 5 mm high: {top}");
+    for (a, b) in back.moves().iter().zip(path.moves()) {
+        assert!((a.to - b.to).abs().max() <= 0.5e-5 * 25.4 + 1e-9, "{:?} vs {:?}", a.to, b.to);
+    }
+    let analysis = scallop().args(["analyze", "--json"]).arg(dir.join("job.toml")).output().expect("analyze");
+    assert!(analysis.status.success(), "{}", String::from_utf8_lossy(&analysis.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&analysis.stdout).expect("json");
+    assert_eq!(report["scallop_height_mm"].as_f64(), Some(0.05), "{report}");
 }

@@ -323,7 +323,6 @@ pub(crate) fn plan_operation(
     tolerances: &Tolerances,
     clearance: Option<f64>,
 ) -> Result<PlannedOperation, EngineError> {
-    let machine = MachineLimits::from_thesis_units(job.machine[0], job.machine[1], job.machine[2]);
     let samples = match (&job.part, &job.setup) {
         (Part::Surfaces(set), None) => {
             sample_surface_set(set, &GridOptions::default()).map_err(EngineError::Analysis)?
@@ -332,8 +331,7 @@ pub(crate) fn plan_operation(
         // 3+2: analyse the part as the cutter sees it, in the planning frame.
         (_, Some(_)) => sample_mesh(&prepared.mesh),
     };
-    let (analysis, auto_deg) = analysis_of(job, &samples, &machine)?;
-    let direction_deg = job.direction_deg.unwrap_or(auto_deg);
+    let (analysis, direction_deg) = analyse(job, &samples)?;
     let mut params = finishing_params(job, direction_deg.to_radians());
     if let Some(c) = clearance {
         params.clearance = c;
@@ -344,11 +342,11 @@ pub(crate) fn plan_operation(
             Plan { toolpath: p.toolpath, report: p.report, scallop: Some(p.scallop) }
         }
         Strategy::NetworkPlanes => {
-            let set = parametric_only(job, "the network planner")?;
+            let set = parametric_only(job, "the network planner (finishing.strategy = \"network\")")?;
             network_planes(set, prepared, job, &params, tolerances)?
         }
         Strategy::Isoparametric(direction) => {
-            let set = parametric_only(job, "isoparametric passes")?;
+            let set = parametric_only(job, "isoparametric passes (finishing.strategy = \"isoparametric\")")?;
             isoparametric(set, prepared, job, &params, tolerances, direction)?
         }
         Strategy::SteepShallow { threshold_deg } => {
@@ -415,6 +413,17 @@ pub fn auto_direction_deg(job: &FinishJob) -> Result<f64, EngineError> {
     let machine = MachineLimits::from_thesis_units(job.machine[0], job.machine[1], job.machine[2]);
     let samples = sample_surface_set(set, &GridOptions::default()).map_err(EngineError::Analysis)?;
     Ok(analysis_of(job, &samples, &machine)?.1)
+}
+
+/// The analysis of a part's samples with the job's cutter (finishing.md 4) and
+/// the feed direction: the job's, else the one [`analysis_of`] takes.
+pub(crate) fn analyse(
+    job: &FinishJob,
+    samples: &scallop_analysis::Samples,
+) -> Result<(scallop_analysis::AnalysisReport, f64), EngineError> {
+    let machine = MachineLimits::from_thesis_units(job.machine[0], job.machine[1], job.machine[2]);
+    let (analysis, auto_deg) = analysis_of(job, samples, &machine)?;
+    Ok((analysis, job.direction_deg.unwrap_or(auto_deg)))
 }
 
 /// The surfaces of a parametric part, for a strategy that needs them, or the

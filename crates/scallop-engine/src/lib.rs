@@ -20,6 +20,7 @@
 
 mod budget;
 mod demo;
+mod estimate;
 mod finish;
 mod grid;
 mod job;
@@ -31,6 +32,7 @@ use scallop_surface::SurfaceSet;
 
 pub use budget::{ARC_SHARE, Budget};
 pub use demo::{DemoOutput, DemoSettings, DemoSummary, run_demo};
+pub use estimate::{Estimate, estimate_operation};
 pub use finish::{
     FinishDetails, FinishJob, FinishOutput, FinishReport, OutputOptions, RestPlaceReport, RestReport, Setup, Strategy,
     auto_direction_deg, run_finishing, stock_box,

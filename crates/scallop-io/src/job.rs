@@ -20,6 +20,8 @@
 
 use serde::Deserialize;
 
+use crate::tools::ToolLibrary;
+
 /// A job file: a part, a stock and operations in order. A job without
 /// `[[operation]]` is one finishing operation given by `[cutter]` and
 /// `[finishing]`.
@@ -51,6 +53,8 @@ pub struct JobFile {
     pub output: OutputSpec,
     /// 3+2 setup (indexed rotaries); absent for 3-axis work.
     pub setup: Option<SetupSpec>,
+    /// The tool library (`tool_library`, relative to the job file), if named.
+    pub tool_library: Option<String>,
 }
 
 /// The file as written, before the operations are normalised.
@@ -73,6 +77,7 @@ struct RawJob {
     #[serde(default)]
     output: OutputSpec,
     setup: Option<SetupSpec>,
+    tool_library: Option<String>,
 }
 
 /// `[stock]`: a box given by its corners, or margins around the part's box
@@ -111,8 +116,12 @@ pub struct OperationSpec {
     pub tool: Option<u32>,
     /// Spindle speed (1/min; default `output.spindle`).
     pub spindle: Option<f64>,
-    /// `[operation.cutter]`.
+    /// `[operation.cutter]`; left out when `tool` names a tool of the job's
+    /// tool library, which gives it ([`CutterSpec::unset`] until then).
+    #[serde(default = "CutterSpec::unset")]
     pub cutter: CutterSpec,
+    /// Feed (mm/min; default: the tool library's `f_z * flutes * n`, else `machine.feed`).
+    pub feed: Option<f64>,
     /// `[operation.finishing]`.
     pub finishing: FinishingSpec,
 }
@@ -136,6 +145,9 @@ pub struct OutputSpec {
     /// Spindle speed (1/min; 0: no spindle word).
     #[serde(default)]
     pub spindle: f64,
+    /// Units of the program: `mm` (default, `G21`) or `in` (`G20`, 3-axis output).
+    #[serde(default = "default_units")]
+    pub units: UnitsWord,
 }
 
 fn default_dialect() -> String {
@@ -147,7 +159,14 @@ fn default_program() -> String {
 
 impl Default for OutputSpec {
     fn default() -> Self {
-        OutputSpec { dialect: default_dialect(), arc_fitting: false, program: default_program(), tool: 0, spindle: 0.0 }
+        OutputSpec {
+            dialect: default_dialect(),
+            arc_fitting: false,
+            program: default_program(),
+            tool: 0,
+            spindle: 0.0,
+            units: default_units(),
+        }
     }
 }
 
@@ -203,14 +222,17 @@ word_enum! {
     /// `part.units`.
     UnitsWord { /// Millimetres.
         Mm = "mm", /// Inches.
-        In = "in" }
+        In = "in", /// Metres.
+        M = "m", /// Centimetres.
+        Cm = "cm" }
 }
 word_enum! {
     /// `cutter.shape`.
     ShapeWord { /// Ball end.
         Ball = "ball", /// Flat end.
         Flat = "flat", /// Bull-nose (toroidal).
-        Bull = "bull" }
+        Bull = "bull", /// Cone (V) cutter.
+        Cone = "cone" }
 }
 word_enum! {
     /// `finishing.pattern`.
@@ -278,6 +300,51 @@ pub struct CutterSpec {
     pub corner_radius: Option<f64>,
     /// Flute length (mm); default 4 D.
     pub flute_length: Option<f64>,
+    /// Included tip angle of a cone (degrees, 0 < angle < 180; cone only).
+    pub angle_deg: Option<f64>,
+    /// Shank diameter (mm; default D).
+    pub shank_diameter: Option<f64>,
+    /// Shank length above the flutes (mm; default the flute length).
+    pub shank_length: Option<f64>,
+    /// Holder stack, bottom segment first.
+    #[serde(default)]
+    pub holder: Vec<HolderSpec>,
+}
+
+impl CutterSpec {
+    /// The cutter of an operation that gives none: to be taken from the tool
+    /// library (its diameter is NaN, which no file can mean for a cutter).
+    #[must_use]
+    pub fn unset() -> CutterSpec {
+        CutterSpec {
+            shape: ShapeWord::Flat,
+            diameter: f64::NAN,
+            corner_radius: None,
+            flute_length: None,
+            angle_deg: None,
+            shank_diameter: None,
+            shank_length: None,
+            holder: Vec::new(),
+        }
+    }
+
+    /// Whether this is [`CutterSpec::unset`].
+    #[must_use]
+    pub fn is_unset(&self) -> bool {
+        self.diameter.is_nan()
+    }
+}
+
+/// One solid of a holder stack: a cylinder of `diameter`, or a frustum to
+/// `top_diameter` (mm).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+pub struct HolderSpec {
+    /// Height (mm).
+    pub length: f64,
+    /// Diameter at the bottom (mm).
+    pub diameter: f64,
+    /// Diameter at the top (mm; default `diameter`).
+    pub top_diameter: Option<f64>,
 }
 
 /// `[finishing]`.
@@ -583,6 +650,19 @@ pub enum JobError {
         /// What is wrong (keys relative to the operation).
         source: Box<JobError>,
     },
+    /// An operation names a tool number that the tool library lacks.
+    #[error(
+        "{}tool {number} is not in the tool library: add a [[tool]] with number = {number} to it, or use one of {known:?}",
+        line.map(|l| format!("line {l}: ")).unwrap_or_default()
+    )]
+    UnknownTool {
+        /// The number asked for.
+        number: u32,
+        /// The line of the `tool = ` key, when found.
+        line: Option<usize>,
+        /// The numbers the library has.
+        known: Vec<u32>,
+    },
     /// A value that makes no sense.
     #[error("`{key}` = {value}: {fix}")]
     Value {
@@ -624,7 +704,7 @@ fn parse_raw(text: &str) -> Result<RawJob, JobError> {
 
 /// The dotted key set on the line holding byte `offset` (`table.key`), when
 /// that line is a `key = value` line.
-fn key_at(text: &str, offset: usize) -> Option<String> {
+pub(crate) fn key_at(text: &str, offset: usize) -> Option<String> {
     let start = text.get(..offset)?.rfind('\n').map_or(0, |i| i + 1);
     let line = text[start..].lines().next()?;
     let key = line.split_once('=')?.0.trim();
@@ -645,7 +725,7 @@ fn key_at(text: &str, offset: usize) -> Option<String> {
 
 /// The 1-based line where the last part of a dotted key path is set, if
 /// found (`name = ...` or `[name]`, the first such line).
-fn line_of(text: &str, path: &str) -> Option<usize> {
+pub(crate) fn line_of(text: &str, path: &str) -> Option<usize> {
     let key = path.rsplit('.').next()?;
     text.lines()
         .position(|l| {
@@ -658,7 +738,7 @@ fn line_of(text: &str, path: &str) -> Option<usize> {
 
 /// The operations of a job file: its `[[operation]]`s, or one finishing
 /// operation of `[cutter]` and `[finishing]`.
-fn normalise(raw: RawJob) -> Result<JobFile, JobError> {
+fn normalise(raw: RawJob, text: &str, library: Option<&ToolLibrary>) -> Result<JobFile, JobError> {
     let missing =
         |key| JobError::Value { key, value: "missing".into(), fix: "give [cutter] and [finishing], or [[operation]]s" };
     let operation_list = !raw.operation.is_empty();
@@ -678,17 +758,24 @@ fn normalise(raw: RawJob) -> Result<JobFile, JobError> {
         }
         ops
     } else {
-        let cutter = raw.cutter.ok_or_else(|| missing("cutter"))?;
+        let cutter = match raw.cutter {
+            Some(cutter) => cutter,
+            None if library.is_some() && raw.output.tool > 0 => CutterSpec::unset(),
+            None => return Err(missing("cutter")),
+        };
         let finishing = raw.finishing.ok_or_else(|| missing("finishing"))?;
         vec![OperationSpec {
             kind: OperationKind::Finish,
             name: "finish".into(),
-            tool: None,
+            tool: (library.is_some() && raw.output.tool > 0).then_some(raw.output.tool),
             spindle: None,
             cutter,
+            feed: None,
             finishing,
         }]
     };
+    let mut operations = operations;
+    resolve_tools(&mut operations, text, library, operation_list)?;
     if let Some(stock) = &raw.stock {
         check_stock(stock)?;
     }
@@ -705,7 +792,71 @@ fn normalise(raw: RawJob) -> Result<JobFile, JobError> {
         optimize: raw.optimize,
         output: raw.output,
         setup: raw.setup,
+        tool_library: raw.tool_library,
     })
+}
+
+/// Gives every operation that names a tool of `library` (and no cutter of its
+/// own) that tool's cutter, and its spindle speed and feed where the operation
+/// gives none; an operation left without a cutter is an error naming its line.
+fn resolve_tools(
+    ops: &mut [OperationSpec],
+    text: &str,
+    library: Option<&ToolLibrary>,
+    listed: bool,
+) -> Result<(), JobError> {
+    for (k, op) in ops.iter_mut().enumerate() {
+        if !op.cutter.is_unset() {
+            continue;
+        }
+        let line = if listed { operation_key_line(text, k, "tool") } else { line_of(text, "output.tool") };
+        let (Some(library), Some(number)) = (library, op.tool) else {
+            return Err(JobError::Operation {
+                index: k + 1,
+                name: op.name.clone(),
+                source: Box::new(JobError::Value {
+                    key: "cutter",
+                    value: "missing".into(),
+                    fix: "give [operation.cutter], or `tool = N` with `tool_library = \"tools.toml\"` at the top of the job",
+                }),
+            });
+        };
+        let Some(tool) = library.get(number) else {
+            return Err(JobError::UnknownTool { number, line, known: library.numbers() });
+        };
+        op.cutter = tool.cutter();
+        op.spindle = op.spindle.or(tool.spindle_speed());
+        op.feed = op.feed.or(tool.feed());
+    }
+    Ok(())
+}
+
+/// The 1-based line of `key = ...` inside the `k`-th `[[operation]]` (0-based),
+/// before the next table header.
+fn operation_key_line(text: &str, k: usize, key: &str) -> Option<usize> {
+    let mut seen = 0;
+    let mut inside = false;
+    for (i, line) in text.lines().enumerate() {
+        let l = line.trim_start();
+        if l.starts_with("[[operation]]") {
+            inside = seen == k;
+            seen += 1;
+        } else if l.starts_with('[') {
+            inside = inside && l.starts_with("[operation.");
+        } else if inside && l.strip_prefix(key).is_some_and(|r| r.trim_start().starts_with('=')) {
+            return Some(i + 1);
+        }
+    }
+    None
+}
+
+/// The `tool_library` path a job file names (relative to the job file), read
+/// before the job is parsed: the caller reads that library and passes it to
+/// [`parse_job_with_tools`]. `None` for text that is not TOML or names none.
+#[must_use]
+pub fn tool_library_of(text: &str) -> Option<String> {
+    let table: toml::Table = toml::from_str(text).ok()?;
+    table.get("tool_library")?.as_str().map(str::to_string)
 }
 
 fn check_stock(stock: &StockSpec) -> Result<(), JobError> {
@@ -747,8 +898,36 @@ fn check_stock(stock: &StockSpec) -> Result<(), JobError> {
 /// # Errors
 /// [`JobError`] naming the line or the key.
 pub fn parse_job(text: &str) -> Result<JobFile, JobError> {
+    parse_job_with_tools(text, None)
+}
+
+/// Parses and checks a job file whose operations may name tools of `library`
+/// (the file its `tool_library` names, [`tool_library_of`]).
+///
+/// ```
+/// use scallop_io::{job::parse_job_with_tools, tools::parse_tool_library};
+/// let lib = parse_tool_library("[[tool]]\nnumber = 2\nshape = \"ball\"\ndiameter = 6\nflutes = 2\nflute_length = 20\nspindle = 12000\nfz = 0.05\n").unwrap();
+/// let job = "tool_library = \"tools.toml\"\n[part]\nbuiltin = \"choi\"\n\
+///     [[operation]]\nkind = \"finish\"\ntool = 2\n[operation.finishing]\nscallop_height = 0.01\n";
+/// let job = parse_job_with_tools(job, Some(&lib)).unwrap();
+/// assert_eq!((job.cutter.diameter, job.operations[0].spindle, job.operations[0].feed), (6.0, Some(12000.0), Some(1200.0)));
+/// let err = parse_job_with_tools(&job_text_with_tool(9), Some(&lib)).unwrap_err().to_string();
+/// assert!(err.starts_with("line 6: tool 9 is not in the tool library"), "{err}");
+/// # fn job_text_with_tool(n: u32) -> String { format!("tool_library = \"t.toml\"\n[part]\nbuiltin = \"choi\"\n[[operation]]\nkind = \"finish\"\ntool = {n}\n[operation.finishing]\nscallop_height = 0.01\n") }
+/// ```
+///
+/// # Errors
+/// [`JobError`] naming the line or the key.
+pub fn parse_job_with_tools(text: &str, library: Option<&ToolLibrary>) -> Result<JobFile, JobError> {
     let raw = parse_raw(text)?;
-    let job = normalise(raw)?;
+    if raw.tool_library.is_some() && library.is_none() {
+        return Err(JobError::Value {
+            key: "tool_library",
+            value: "not read".into(),
+            fix: "read the library it names and parse with parse_job_with_tools",
+        });
+    }
+    let job = normalise(raw, text, library)?;
     let bad = |key, value: f64, fix| Err(JobError::Value { key, value: value.to_string(), fix });
     match (&job.part.file, &job.part.builtin) {
         (Some(_), Some(_)) | (None, None) => {
@@ -783,6 +962,19 @@ pub fn parse_job(text: &str) -> Result<JobFile, JobError> {
                 }),
             });
         }
+        if let Some(f) = op.feed
+            && !positive(f)
+        {
+            return Err(JobError::Operation {
+                index: k + 1,
+                name: op.name.clone(),
+                source: Box::new(JobError::Value {
+                    key: "feed",
+                    value: f.to_string(),
+                    fix: "give the feed in mm/min, > 0",
+                }),
+            });
+        }
     }
     let sh = job.finishing.scallop_height;
     for (key, v) in [
@@ -804,12 +996,26 @@ pub fn parse_job(text: &str) -> Result<JobFile, JobError> {
     if !(job.output.spindle.is_finite() && job.output.spindle >= 0.0) {
         return bad("output.spindle", job.output.spindle, "give the spindle speed in 1/min, >= 0");
     }
+    if matches!(job.output.units, UnitsWord::M | UnitsWord::Cm) {
+        return Err(JobError::Value {
+            key: "output.units",
+            value: job.output.units.word().into(),
+            fix: "programs are written in \"mm\" (G21) or \"in\" (G20)",
+        });
+    }
     if let Some(setup) = &job.setup {
         if let Some(a) = setup.rotation_deg.iter().find(|a| !a.is_finite()) {
             return bad("setup.rotation_deg", *a, "give three finite angles in degrees");
         }
         if !(setup.tool_length.is_finite() && setup.tool_length >= 0.0) {
             return bad("setup.tool_length", setup.tool_length, "give the tool length in mm, >= 0");
+        }
+        if job.output.units != UnitsWord::Mm {
+            return Err(JobError::Value {
+                key: "output.units",
+                value: job.output.units.word().into(),
+                fix: "3+2 programs are written in mm: set it to \"mm\" or remove [setup]",
+            });
         }
         if job.output.arc_fitting {
             return Err(JobError::Value {
@@ -830,6 +1036,21 @@ pub fn parse_job(text: &str) -> Result<JobFile, JobError> {
 fn check_cutting(cutter: &CutterSpec, finishing: &FinishingSpec) -> Result<(), JobError> {
     let bad = |key, value: f64, fix| Err(JobError::Value { key, value: value.to_string(), fix });
     let positive = |v: f64| v.is_finite() && v > 0.0;
+    check_cutter(cutter)?;
+    let sh = finishing.scallop_height;
+    if !positive(sh) || sh >= cutter.diameter / 2.0 {
+        return bad("finishing.scallop_height", sh, "need 0 < sh < the cutter radius (diameter / 2)");
+    }
+    if cutter.shape == ShapeWord::Bull && cutter.corner_radius.is_some_and(|r| sh >= r) {
+        return bad("finishing.scallop_height", sh, "need 0 < sh < the bull-nose corner radius");
+    }
+    check_direction_and_leads(finishing)
+}
+
+/// The checks of a cutter alone (a job's `[cutter]` or a library tool).
+pub(crate) fn check_cutter(cutter: &CutterSpec) -> Result<(), JobError> {
+    let bad = |key, value: f64, fix| Err(JobError::Value { key, value: value.to_string(), fix });
+    let positive = |v: f64| v.is_finite() && v > 0.0;
     if !positive(cutter.diameter) {
         return bad("cutter.diameter", cutter.diameter, "give the diameter in mm, > 0");
     }
@@ -846,18 +1067,46 @@ fn check_cutting(cutter: &CutterSpec, finishing: &FinishingSpec) -> Result<(), J
             }
         }
     }
-    let sh = finishing.scallop_height;
-    if !positive(sh) || sh >= cutter.diameter / 2.0 {
-        return bad("finishing.scallop_height", sh, "need 0 < sh < the cutter radius (diameter / 2)");
+    match (cutter.shape, cutter.angle_deg) {
+        (ShapeWord::Cone, Some(a)) if a.is_finite() && a > 0.0 && a < 180.0 => {}
+        (ShapeWord::Cone, Some(a)) => {
+            return bad("cutter.angle_deg", a, "give the included tip angle, 0 < angle < 180");
+        }
+        (ShapeWord::Cone, None) => {
+            return Err(JobError::Value {
+                key: "cutter.angle_deg",
+                value: "missing".into(),
+                fix: "a cone cutter needs its included tip angle in degrees (90 for a 90° V cutter)",
+            });
+        }
+        (_, Some(a)) => return bad("cutter.angle_deg", a, "only a cone cutter has a tip angle: remove it"),
+        (_, None) => {}
     }
-    if cutter.shape == ShapeWord::Bull && cutter.corner_radius.is_some_and(|r| sh >= r) {
-        return bad("finishing.scallop_height", sh, "need 0 < sh < the bull-nose corner radius");
+    for (key, v) in [
+        ("cutter.flute_length", cutter.flute_length),
+        ("cutter.shank_diameter", cutter.shank_diameter),
+        ("cutter.shank_length", cutter.shank_length),
+    ] {
+        if let Some(v) = v
+            && !positive(v)
+        {
+            return bad(key, v, "give the length in mm, > 0");
+        }
     }
-    if let Some(f) = cutter.flute_length
-        && !positive(f)
-    {
-        return bad("cutter.flute_length", f, "give the flute length in mm, > 0");
+    for h in &cutter.holder {
+        for v in [Some(h.length), Some(h.diameter), h.top_diameter].into_iter().flatten() {
+            if !positive(v) {
+                return bad("cutter.holder", v, "give each holder segment's length and diameters in mm, > 0");
+            }
+        }
     }
+    Ok(())
+}
+
+/// The checks of a `[finishing]` table's direction, leads and step.
+fn check_direction_and_leads(finishing: &FinishingSpec) -> Result<(), JobError> {
+    let bad = |key, value: f64, fix| Err(JobError::Value { key, value: value.to_string(), fix });
+    let positive = |v: f64| v.is_finite() && v > 0.0;
     match &finishing.direction {
         DirectionSpec::Named(n) if n != "auto" => {
             return Err(JobError::Value {
@@ -1008,6 +1257,12 @@ mod tests {
             (BASE.replace("scallop_height = 0.01", "scallop_height = 3"), "corner radius"),
             (BASE.replace("diameter = 10", "diameter = 10\nflute_length = -3"), "cutter.flute_length"),
             (format!("{BASE}[output]\nspindle = -1\n"), "output.spindle"),
+            (format!("{BASE}[output]\nunits = \"m\"\n"), "output.units"),
+            (format!("{BASE}[output]\nunits = \"ft\"\n"), "output.units"),
+            (
+                format!("{BASE}[setup]\nrotation_deg = [0, 30, 0]\nmachine = \"m\"\n[output]\nunits = \"in\"\n"),
+                "output.units",
+            ),
             (format!("{BASE}lead = \"loop\"\n"), "finishing.lead"),
             (format!("{BASE}strategy = \"spiral\"\n"), "finishing.strategy"),
             (format!("{BASE}iso_direction = \"w\"\n"), "finishing.iso_direction"),

@@ -39,6 +39,7 @@ pub use scallop_mesh::{MeshDiagnostics, MeshError, TriMesh};
 pub mod cl;
 pub mod gcode;
 pub mod job;
+pub mod tools;
 
 pub use error::{MeshReadError, Place};
 
@@ -104,6 +105,10 @@ pub enum Units {
     Millimetres,
     /// Coordinates are inches (factor 25.4).
     Inches,
+    /// Coordinates are metres (factor 1000; some exporters write metres).
+    Metres,
+    /// Coordinates are centimetres (factor 10).
+    Centimetres,
 }
 
 impl Units {
@@ -117,6 +122,8 @@ impl Units {
         match self {
             Units::Millimetres => 1.0,
             Units::Inches => MM_PER_INCH,
+            Units::Metres => 1000.0,
+            Units::Centimetres => 10.0,
         }
     }
 }
@@ -182,6 +189,8 @@ pub fn read_mesh(bytes: &[u8], format: MeshFormat, units: Units) -> Result<Loade
     let unit_name = match units {
         Units::Millimetres => "millimetres",
         Units::Inches => "inches",
+        Units::Metres => "metres",
+        Units::Centimetres => "centimetres",
     };
     let (geometry, scale, units_note) = match format {
         MeshFormat::Stl => (stl::read(bytes, user_scale)?, user_scale, format!("coordinates taken as {unit_name}")),

@@ -204,6 +204,14 @@ pub struct Dialect {
     /// Centre words of `G2`/`G3` arcs ([`crate::write_fitted`]).
     #[serde(default)]
     pub arc_words: ArcWords,
+    /// Decimals of linear words in inch programs (default `decimals + 1`: 0.00001 in
+    /// = 0.000254 mm, the resolution of the 4-decimal mm words).
+    #[serde(default)]
+    pub inch_decimals: Option<usize>,
+    /// Whether linear words and feeds are written in inches and in/min (`G20`); set
+    /// by [`Dialect::in_inches`], never in a dialect file.
+    #[serde(skip)]
+    pub inch: bool,
 }
 
 const BUILTIN: &[(&str, &str)] = &[
@@ -248,7 +256,51 @@ impl Dialect {
             tcp: None,
             tilted_plane: TiltedPlane::None,
             arc_words: ArcWords::Ijk,
+            inch_decimals: None,
+            inch: false,
         }
+    }
+
+    /// The same dialect writing inch programs (3-axis output, [`crate::write_fitted`]):
+    /// `G20` in place of the header's `G21` (or first, when it has none), linear words
+    /// with `inch_decimals` (default one more than in mm), feeds in in/min with one more
+    /// decimal. Units inside stay mm: the writer converts.
+    ///
+    /// ```
+    /// let d = scallop_post::Dialect::builtin("fanuc").unwrap().in_inches().unwrap();
+    /// assert!(d.inch && d.header.iter().any(|h| h.starts_with("G20 ")) && d.decimals == 5);
+    /// assert!(scallop_post::Dialect::builtin("heidenhain").unwrap().in_inches().is_err());
+    /// ```
+    ///
+    /// # Errors
+    /// [`PostError::Unsupported`] for the Heidenhain plain-language syntax (its
+    /// `BEGIN PGM .. MM` programs are written in mm only).
+    pub fn in_inches(&self) -> Result<Dialect, PostError> {
+        if self.syntax != Syntax::Iso {
+            return Err(PostError::Unsupported {
+                dialect: self.name.clone(),
+                what: "an inch program".into(),
+                fix: "use millimetres (output.units = \"mm\") or an ISO dialect".into(),
+            });
+        }
+        let mut d = self.clone();
+        let mut replaced = false;
+        for h in &mut d.header {
+            let words: Vec<&str> = h.split_whitespace().collect();
+            if words.contains(&"G21") {
+                *h = words.iter().map(|w| if *w == "G21" { "G20" } else { w }).collect::<Vec<_>>().join(" ");
+                replaced = true;
+            }
+        }
+        if !replaced {
+            let at = d.header.iter().take_while(|h| *h == "%" || h.starts_with('O')).count();
+            d.header.insert(at, "G20".into());
+        }
+        d.decimals = self.inch_decimals.unwrap_or(self.decimals + 1);
+        d.feed_decimals = self.feed_decimals + 1;
+        d.name = format!("{}, inch", self.name);
+        d.inch = true;
+        Ok(d)
     }
 
     /// Parses a dialect from TOML (the fields of [`Dialect`]; see `docs/post.md`).

@@ -7,6 +7,9 @@ use std::io::{self, Write};
 use scallop_toolpath::{ArcPlane, FittedPath, MoveKind, Segment, Toolpath};
 
 use crate::dialect::{ArcWords, Dialect};
+
+/// Millimetres per inch (exact by definition).
+const MM_PER_INCH: f64 = 25.4;
 use crate::fmt_number;
 
 /// Job data printed in a 3-axis program (header templates `{program}`, `{tool}`,
@@ -41,6 +44,11 @@ impl ProgramInfo {
             .replace("{version}", env!("CARGO_PKG_VERSION"))
     }
 }
+
+/// The comment written where a section has no spindle speed (no `S.. M3`):
+/// the spindle must already turn, or the job gives the speed.
+pub const NO_SPINDLE: &str =
+    "no spindle start: no speed given (job: output.spindle, the operation's spindle or the tool library's vc)";
 
 /// Writes `path` (lines and arcs) in `dialect`. `comments` go into the header, one
 /// line each. Coordinates are absolute (`G90`, set by the dialect's header) in mm;
@@ -182,6 +190,10 @@ fn write_section(path: &FittedPath, dialect: &Dialect, info: &ProgramInfo, out: 
     }
     if info.spindle > 0.0 {
         writeln!(out, "S{} M3", fmt_number(info.spindle, 0))?;
+    } else {
+        // The footer stops the spindle (`M5`): say that this program never started it.
+        let (open, close) = (&dialect.comment.0, &dialect.comment.1);
+        writeln!(out, "{open}{NO_SPINDLE}{close}")?;
     }
     if !info.indexed_rotaries.is_empty() {
         let words: Vec<String> = info
@@ -192,8 +204,11 @@ fn write_section(path: &FittedPath, dialect: &Dialect, info: &ProgramInfo, out: 
         writeln!(out, "G0 {}", words.join(" "))?;
     }
     let d = dialect.decimals;
-    let xyz =
-        |p: &scallop_geom::Point3| format!("X{} Y{} Z{}", fmt_number(p.x, d), fmt_number(p.y, d), fmt_number(p.z, d));
+    // Inch programs: every linear word and feed divided by 25.4 (units inside are mm).
+    let k = if dialect.inch { 1.0 / MM_PER_INCH } else { 1.0 };
+    let xyz = |p: &scallop_geom::Point3| {
+        format!("X{} Y{} Z{}", fmt_number(k * p.x, d), fmt_number(k * p.y, d), fmt_number(k * p.z, d))
+    };
     let mut last_feed: Option<f64> = None;
     let mut plane = ArcPlane::Xy; // every ISO header selects G17
     let mut from: Option<scallop_geom::Point3> = None;
@@ -204,7 +219,7 @@ fn write_section(path: &FittedPath, dialect: &Dialect, info: &ProgramInfo, out: 
                 String::new()
             } else {
                 *last = Some(feed);
-                format!(" F{}", fmt_number(feed, dialect.feed_decimals))
+                format!(" F{}", fmt_number(k * feed, dialect.feed_decimals))
             }
         };
         match seg {
@@ -223,7 +238,7 @@ fn write_section(path: &FittedPath, dialect: &Dialect, info: &ProgramInfo, out: 
                 plane = a.plane;
                 let code = if a.ccw { "G3" } else { "G2" };
                 let centre = match dialect.arc_words {
-                    ArcWords::Radius => format!("R{}", fmt_number(a.radius(), d)),
+                    ArcWords::Radius => format!("R{}", fmt_number(k * a.radius(), d)),
                     ArcWords::Ijk => {
                         let start = from.unwrap_or(a.to);
                         let (u, v, _) = a.plane.axes();
@@ -235,9 +250,9 @@ fn write_section(path: &FittedPath, dialect: &Dialect, info: &ProgramInfo, out: 
                         format!(
                             "{}{} {}{}",
                             letter(first),
-                            fmt_number(a.center[first] - start[first], d),
+                            fmt_number(k * (a.center[first] - start[first]), d),
                             letter(second),
-                            fmt_number(a.center[second] - start[second], d)
+                            fmt_number(k * (a.center[second] - start[second]), d)
                         )
                     }
                 };

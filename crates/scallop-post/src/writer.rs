@@ -157,6 +157,13 @@ pub fn program_text(
     dialect: &Dialect,
     params: &PostParams,
 ) -> Result<String, PostError> {
+    if dialect.inch {
+        return Err(PostError::Unsupported {
+            dialect: dialect.name.clone(),
+            what: "a 5-axis or 3+2 program in inches".into(),
+            fix: "write it in millimetres (inch output is 3-axis only)".into(),
+        });
+    }
     program_text_with(program, kin, dialect, params, true)
 }
 

@@ -80,7 +80,11 @@ impl ReportData {
             Figure::number("path tolerance", job.tolerances.path, 4, "mm"),
             Figure::number("gouge tolerance", job.tolerances.gouge, 4, "mm"),
             Figure::number("max forward step", job.max_step, 3, "mm"),
-            Figure::number("chordal error of the tessellation", r.chordal_error_mm, 5, "mm"),
+            if r.chordal_error_mm > 0.0 {
+                Figure::number("chordal error of the tessellation", r.chordal_error_mm, 5, "mm")
+            } else {
+                Figure::text("part", "a mesh, machined as given (no tessellation)")
+            },
             Figure::number("simulation cell", r.sim_resolution_mm, 3, "mm"),
             Figure::number("PCA slope", r.slope_deg, 2, "deg"),
             Figure::number("critical slope", r.critical_slope_deg, 2, "deg"),

@@ -194,20 +194,77 @@ pub fn line_chart(title: &str, x_label: &str, y_label: &str, series: &[Series]) 
             }
             last_y = Some(y);
         }
+        let _ = write!(out, "<path d=\"{d}\" fill=\"none\" stroke=\"{colour}\" stroke-width=\"1.2\"/>");
+    }
+    let names: Vec<&str> = series.iter().map(|s| s.name.as_str()).collect();
+    for item in legend(&names) {
+        let colour = SERIES[item.index % SERIES.len()];
         let _ = write!(
             out,
-            "<path d=\"{d}\" fill=\"none\" stroke=\"{colour}\" stroke-width=\"1.2\"/>\
-             <rect x=\"{lx}\" y=\"{ly}\" width=\"12\" height=\"3\" fill=\"{colour}\"/>\
-             <text x=\"{tx}\" y=\"{ty}\">{name}</text>",
-            lx = x1 - 150.0,
-            ly = y0 + 10.0 + 14.0 * k as f64,
-            tx = x1 - 134.0,
-            ty = y0 + 15.0 + 14.0 * k as f64,
-            name = escape(&s.name)
+            "<rect x=\"{:.1}\" y=\"{:.1}\" width=\"12\" height=\"3\" fill=\"{colour}\"/>\
+             <text x=\"{:.1}\" y=\"{:.1}\">{}</text>",
+            item.x,
+            item.y - 5.0,
+            item.x + 16.0,
+            item.y,
+            escape(&item.text)
         );
     }
     out.push_str("</svg>");
     out
+}
+
+/// Width of one character of the plots' 11-unit font, a generous average
+/// (sans-serif glyphs average about 0.55 em).
+const CHAR_WIDTH: f64 = 6.6;
+/// Height of one legend row.
+const LEGEND_ROW: f64 = 14.0;
+
+/// One legend entry: the series, its text (shortened to fit) and the baseline
+/// of its text; the colour swatch is drawn at `x`.
+#[derive(Debug, Clone, PartialEq)]
+struct LegendItem {
+    index: usize,
+    text: String,
+    x: f64,
+    y: f64,
+}
+
+/// The legend of a line chart inside its frame, in the top right corner:
+/// rows of [`LEGEND_ROW`] while they fit the frame's height, then more
+/// columns to the left; names shortened (with `…`) so that the columns fit
+/// the frame's width.
+fn legend(names: &[&str]) -> Vec<LegendItem> {
+    let (x0, x1, y0, y1) = (M[0], W - M[1], M[2], H - M[3]);
+    if names.is_empty() {
+        return Vec::new();
+    }
+    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a few rows")]
+    let rows = (((y1 - y0 - 8.0) / LEGEND_ROW).floor().max(1.0) as usize).min(names.len());
+    let columns = names.len().div_ceil(rows);
+    let longest = names.iter().map(|n| n.chars().count()).max().unwrap_or(0);
+    #[allow(clippy::cast_precision_loss, reason = "small counts")]
+    let (columns_f, longest_f) = (columns as f64, longest as f64);
+    // Each column: swatch 12, gap 4, text, gap 8; at most the frame's width less 8.
+    let room = (x1 - x0 - 8.0) / columns_f;
+    let column = (24.0 + CHAR_WIDTH * longest_f).min(room);
+    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a few characters")]
+    let chars = ((column - 24.0) / CHAR_WIDTH).floor().max(1.0) as usize;
+    let left = x1 - 4.0 - columns_f * column;
+    names
+        .iter()
+        .enumerate()
+        .map(|(k, name)| {
+            let text = if name.chars().count() > chars {
+                name.chars().take(chars.saturating_sub(1)).chain(['…']).collect()
+            } else {
+                (*name).to_string()
+            };
+            #[allow(clippy::cast_precision_loss, reason = "small counts")]
+            let (col, row) = ((k / rows) as f64, (k % rows) as f64);
+            LegendItem { index: k, text, x: left + col * column + 4.0, y: y0 + 15.0 + LEGEND_ROW * row }
+        })
+        .collect()
 }
 
 /// A bar chart: one bar per label.
@@ -246,4 +303,33 @@ pub fn bar_chart(title: &str, x_label: &str, y_label: &str, labels: &[String], v
     }
     out.push_str("</svg>");
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{CHAR_WIDTH, H, LEGEND_ROW, M, W, legend};
+
+    /// Every legend entry (swatch and text at the generous glyph width) stays
+    /// inside the plot frame, for short, long and many series names, and no two
+    /// entries overlap.
+    #[test]
+    fn legends_stay_inside_their_frames() {
+        let (x0, x1, y0, y1) = (M[0], W - M[1], M[2], H - M[3]);
+        let long = "a series name much longer than any legend column could ever hold in a plot";
+        for (count, name) in [(1, "K = 2"), (3, long), (9, "K = 10"), (40, "zone 12 (3+2)"), (64, long)] {
+            let names: Vec<String> = (0..count).map(|k| format!("{name} {k}")).collect();
+            let refs: Vec<&str> = names.iter().map(String::as_str).collect();
+            let items = legend(&refs);
+            assert_eq!(items.len(), count);
+            for it in &items {
+                #[allow(clippy::cast_precision_loss, reason = "short texts")]
+                let right = it.x + 16.0 + CHAR_WIDTH * it.text.chars().count() as f64;
+                assert!(it.x >= x0 && right <= x1, "{count} x {name:?}: {it:?} ends at {right}");
+                assert!(it.y - LEGEND_ROW >= y0 && it.y <= y1, "{count}: {it:?}");
+            }
+            for (a, b) in items.iter().zip(items.iter().skip(1)) {
+                assert!(a.x != b.x || (a.y - b.y).abs() >= LEGEND_ROW, "{a:?} {b:?}");
+            }
+        }
+    }
 }

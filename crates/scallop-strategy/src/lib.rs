@@ -187,6 +187,7 @@ pub use geometry::contact_to_tip;
 pub use iso::{IsoDirection, IsoPass, IsoPlanned, iso_scallop, plan_isoparametric};
 pub use leads::{LeadFallback, LeadKind, LeadReport, apply_leads};
 pub use params::{Boundary, FinishingParams, Pattern};
+pub use plan::rule_spacing;
 pub use region::ZoneRegion;
 pub use scallop::{PairScallop, ScallopReport, verify_scallop};
 pub use steep::{SteepPlanned, SteepShallow, plan_steep_shallow};

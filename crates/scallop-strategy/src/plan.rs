@@ -106,17 +106,7 @@ impl<'a> Planner<'a> {
         }
         let shape = *cutter.shape();
         let sh = params.scallop_height;
-        let (model, bound, what) = match shape {
-            CutterShape::Ball { radius } => (scallop_analysis::Cutter::Ball { radius }, radius, "radius"),
-            CutterShape::Bull { radius, corner } => {
-                (scallop_analysis::Cutter::Toroidal { radius, corner }, corner, "corner radius")
-            }
-            // A flat end is the torus with r = 0 in Eq. 1.5 (R / sin s along the slope).
-            CutterShape::Flat { radius } => {
-                (scallop_analysis::Cutter::Toroidal { radius, corner: 0.0 }, radius, "radius")
-            }
-            CutterShape::Cone { .. } => return Err(StrategyError::Unsupported { shape: "cone" }),
-        };
+        let (model, bound, what) = spacing_model(&shape);
         if sh >= bound {
             return Err(StrategyError::ScallopTooLarge { scallop_height: sh, what, radius: bound });
         }
@@ -450,27 +440,7 @@ impl<'a> Planner<'a> {
         let mut best: Option<(f64, Point2)> = None;
         for cl in &plane.samples {
             let n = contact_normal(&self.shape, self.index, &self.slots, cl);
-            let slope = n.z.abs().min(1.0).acos();
-            let horizontal = n.x.hypot(n.y);
-            let alpha = if horizontal < tol::HORIZONTAL_XY {
-                0.0
-            } else {
-                fold_direction_angle(n.y.atan2(n.x) - self.params.direction)
-            };
-            let mut sod = self.model.step_over(sh, slope, alpha);
-            if let CutterShape::Flat { radius } = self.shape {
-                // A sharp rim leaves a saw tooth, not a circle: start from sh / sin s
-                // (the measured scallop corrects it); never more than the diameter.
-                let sin_s = slope.sin();
-                if sin_s > 0.0 {
-                    sod = sod.max(sh / sin_s);
-                }
-                sod = sod.min(2.0 * radius);
-            }
-            let tau = m.cross(&n);
-            let cross = if tau.norm() > 0.0 { n.cross(&(tau / tau.norm())) } else { Vec3::zeros() };
-            let factor = if cross.norm() > 0.0 { (cross / cross.norm()).dot(&m).abs() } else { 0.0 };
-            let delta = sod * factor;
+            let delta = spacing_at(&self.shape, &self.model, sh, &n, self.params.direction, &m);
             if best.is_none_or(|(b, _)| delta < b) {
                 best = Some((delta, Point2::new(cl.tip.x, cl.tip.y)));
             }
@@ -837,4 +807,106 @@ fn vertical_gap(mid: &Point3, a: &Point3, b: &Point3) -> f64 {
 /// crests and at the top of steep descents.
 fn gouge_depth(mid: &Point3, a: &Point3, b: &Point3) -> f64 {
     mid.z - 0.5 * (a.z + b.z)
+}
+
+/// The start spacing of a cone (V) cutter of half angle `alpha` across a
+/// plane of slope `slope` for a scallop `sh`: the ridge between two grooves
+/// is a triangle on the surface whose base angles are `90° - alpha -+ slope`,
+/// so its base is `sh (tan(alpha + slope) + tan(alpha - slope))`. Where the
+/// uphill flank is flatter than the surface (`alpha + slope >= 90°`) the rim
+/// cuts, as with a flat end: `sh / sin(slope)`. The measured scallop corrects
+/// either start.
+fn cone_step(sh: f64, slope: f64, alpha: f64) -> f64 {
+    if alpha + slope < std::f64::consts::FRAC_PI_2 - 1e-9 {
+        sh * ((alpha + slope).tan() + (alpha - slope).tan())
+    } else {
+        sh / slope.sin().max(1e-9)
+    }
+}
+
+/// The horizontal plane spacing the rule gives at a contact of unit normal `n`
+/// for passes in `direction` (rad from +X; `m` the unit horizontal normal of the
+/// planes): the step-over `sod` of the cutter's model at the contact's slope and
+/// feed angle, with the sharp-rim and V rules of the flat end and the cone,
+/// projected to the planes' normal (finishing.md 6.4).
+fn spacing_at(
+    shape: &CutterShape,
+    model: &scallop_analysis::Cutter,
+    sh: f64,
+    n: &Vec3,
+    direction: f64,
+    m: &Vec3,
+) -> f64 {
+    let slope = n.z.abs().min(1.0).acos();
+    let horizontal = n.x.hypot(n.y);
+    let alpha = if horizontal < tol::HORIZONTAL_XY { 0.0 } else { fold_direction_angle(n.y.atan2(n.x) - direction) };
+    let mut sod = model.step_over(sh, slope, alpha);
+    if let CutterShape::Flat { radius } = *shape {
+        // A sharp rim leaves a saw tooth, not a circle: start from sh / sin s
+        // (the measured scallop corrects it); never more than the diameter.
+        let sin_s = slope.sin();
+        if sin_s > 0.0 {
+            sod = sod.max(sh / sin_s);
+        }
+        sod = sod.min(2.0 * radius);
+    }
+    if let CutterShape::Cone { radius, half_angle } = *shape {
+        // The V's ridge lies in the section across the feed, whose slope is
+        // atan(tan s |sin alpha|) (0 when feeding down the slope).
+        let across = (slope.tan() * alpha.sin().abs()).atan();
+        sod = cone_step(sh, if across.is_nan() { slope } else { across }, half_angle).min(2.0 * radius);
+    }
+    let tau = m.cross(n);
+    let cross = if tau.norm() > 0.0 { n.cross(&(tau / tau.norm())) } else { Vec3::zeros() };
+    let factor = if cross.norm() > 0.0 { (cross / cross.norm()).dot(m).abs() } else { 0.0 };
+    sod * factor
+}
+
+/// The spacing model of a cutter: the step-over rule's cutter, and the radius
+/// the scallop height must stay below (with its name).
+fn spacing_model(shape: &CutterShape) -> (scallop_analysis::Cutter, f64, &'static str) {
+    match *shape {
+        CutterShape::Ball { radius } => (scallop_analysis::Cutter::Ball { radius }, radius, "radius"),
+        CutterShape::Bull { radius, corner } => {
+            (scallop_analysis::Cutter::Toroidal { radius, corner }, corner, "corner radius")
+        }
+        // A flat end is the torus with r = 0 in Eq. 1.5 (R / sin s along the slope);
+        // a cone is planned from the sharp-tip rule, the torus only caps the step.
+        CutterShape::Flat { radius } | CutterShape::Cone { radius, .. } => {
+            (scallop_analysis::Cutter::Toroidal { radius, corner: 0.0 }, radius, "radius")
+        }
+    }
+}
+
+/// The start spacing of parallel planes at a surface point of unit normal
+/// `normal` (mm, horizontal, across planes in `direction` rad from +X), by the
+/// planner's own rule before any scallop is measured: the cheap estimate of
+/// a plan (`scallop run --plan-only`). `f64::INFINITY` where the planes run
+/// along the normal's horizontal part (no spacing limit there).
+#[must_use]
+pub fn rule_spacing(shape: &CutterShape, scallop_height: f64, normal: &Vec3, direction: f64) -> f64 {
+    let (model, _, _) = spacing_model(shape);
+    let m = Vec3::new(-direction.sin(), direction.cos(), 0.0);
+    let delta = spacing_at(shape, &model, scallop_height, normal, direction, &m);
+    let cap = model.max_step_over(scallop_height).min(2.0 * shape.radius());
+    if delta > 0.0 { delta.min(cap) } else { cap }
+}
+
+#[cfg(test)]
+mod cone_tests {
+    use super::cone_step;
+
+    /// On a flat floor the ridge between two V grooves `w` apart is `w / (2 tan alpha)` high.
+    #[test]
+    fn cone_step_on_a_floor_is_twice_sh_tan_alpha() {
+        for deg in [15.0_f64, 30.0, 45.0, 60.0] {
+            let a = deg.to_radians();
+            let w = cone_step(0.05, 0.0, a);
+            assert!((w / (2.0 * a.tan()) - 0.05).abs() < 1e-12, "{deg}: {w}");
+        }
+        // Symmetric in the slope's sign, and growing with the slope below the rim limit.
+        let a = 45f64.to_radians();
+        assert!((cone_step(0.05, 0.2, a) - cone_step(0.05, -0.2, a)).abs() < 1e-12);
+        assert!(cone_step(0.05, 0.3, a) > cone_step(0.05, 0.1, a));
+    }
 }

@@ -50,12 +50,23 @@ fn scallop_height_must_be_below_the_radius() {
     assert!(e.to_string().contains("corner radius"), "{e}");
 }
 
+/// A cone (V) cutter feeding down a 30° plane: the section across the feed is
+/// level, so the grooves start `2 sh tan(half angle)` apart (conservative: the
+/// scallop is measured along the normal); the measured scallop holds and the
+/// pass count is the width over that spacing.
 #[test]
-fn cone_cutters_are_unsupported() {
-    let index = inclined_plane(20.0, 10.0, 30.0);
-    let cone = Cutter::new(CutterShape::Cone { radius: 3.0, half_angle: 0.5 }, 20.0).unwrap();
-    let e = plan_finishing(&index, &cone, &params(0.0, Pattern::Zigzag, 0.01, 0.5), &TOL).unwrap_err();
-    assert!(matches!(e, StrategyError::Unsupported { shape: "cone" }));
+fn cone_cutters_plan_at_the_v_spacing() {
+    let (width, half_angle, sh) = (20.0, 0.5_f64, 0.05);
+    let index = inclined_plane(width, 10.0, 30.0);
+    let cone = Cutter::new(CutterShape::Cone { radius: 3.0, half_angle }, 20.0).unwrap();
+    let planned = plan_finishing(&index, &cone, &params(0.0, Pattern::Zigzag, sh, 0.5), &TOL).unwrap();
+    let r = &planned.report;
+    // Measured along the normal: the level ridge's height times cos 30° (0.0433 mm).
+    assert!(r.max_scallop_mm <= sh && r.max_scallop_mm > 0.75 * sh, "{r:?}");
+    let spacing = 2.0 * sh * half_angle.tan();
+    #[allow(clippy::cast_precision_loss, reason = "a few hundred passes")]
+    let passes = r.passes as f64;
+    assert!((passes - width / spacing).abs() <= 2.0, "{passes} passes, {} expected", width / spacing);
 }
 
 #[test]
