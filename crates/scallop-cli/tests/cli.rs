@@ -585,9 +585,9 @@ fn run_machines_two_operations_on_one_stock() {
     std::fs::write(dir.join("pyramid.stl"), pyramid_stl()).expect("write");
     let job = "[part]\nfile = \"pyramid.stl\"\n[stock]\ntop = 3\n\
         [[operation]]\nkind = \"finish\"\nname = \"coarse\"\n[operation.cutter]\nshape = \"ball\"\ndiameter = 6\n\
-        [operation.finishing]\nscallop_height = 0.3\n\
+        [operation.finishing]\nscallop_height = 0.3\nstrategy = \"parallel\"\n\
         [[operation]]\nkind = \"finish\"\nname = \"fine\"\nspindle = 10000\n[operation.cutter]\nshape = \"ball\"\ndiameter = 4\n\
-        [operation.finishing]\nscallop_height = 0.05\n[verify]\nresolution = 0.1\n";
+        [operation.finishing]\nscallop_height = 0.05\nstrategy = \"parallel\"\n[verify]\nresolution = 0.1\n";
     std::fs::write(dir.join("job.toml"), job).expect("write");
     let out = scallop()
         .arg("run")

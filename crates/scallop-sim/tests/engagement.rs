@@ -225,7 +225,8 @@ proptest! {
         }
         let opts = options(0.1);
         let report = pocket_engagement(&pocket, radius, &path, 1.0, &opts).unwrap();
-        prop_assert!(path.moves().len() > 20 && report.max > 0.5);
+        // A walk that hardly moved (boxed in by the island) says nothing: draw another.
+        prop_assume!(path.moves().len() > 20 && report.max > 0.5);
         let brute = brute_force_move_phi(&pocket, radius, &path, &opts);
         let step = std::f64::consts::TAU / opts.angle_samples as f64;
         for (i, (got, want)) in report.move_phi.iter().zip(&brute).enumerate() {
