@@ -51,15 +51,14 @@ fn arc_through(points: &[P2], i: usize, j: usize, n: usize, tolerance: f64) -> O
         (d + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI
     };
     let mut sweep = 0.0;
-    let mut sign = 0.0_f64;
+    let mut ccw: Option<bool> = None;
     for k in i..j {
         let (p, q) = (at(k), at(k + 1));
         let t = turn(p, q);
-        if sign == 0.0 {
-            sign = t.signum();
-        } else if t.signum() != sign || t == 0.0 {
+        if t.abs() <= f64::EPSILON || ccw.is_some_and(|c| c != (t > 0.0)) {
             return None;
         }
+        ccw = Some(t > 0.0);
         sweep += t;
         let mid = [(p[0] + q[0]) / 2.0, (p[1] + q[1]) / 2.0];
         // The chord midpoint lies inside the circle by the sagitta.
@@ -87,4 +86,43 @@ fn circle(a: P2, b: P2, c: P2) -> Option<(P2, f64)> {
     let ux = (cy * b2 - by * c2) / d;
     let uy = (bx * c2 - cx * b2) / d;
     Some(([a[0] + ux, a[1] + uy], ux.hypot(uy)))
+}
+
+/// The closed ring `points` with the points Douglas-Peucker drops at `eps`
+/// (Douglas and Peucker, Cartographica 10(2), 1973): every dropped point is
+/// within `eps` of the chord that replaces it.
+pub(crate) fn simplify_ring(points: &[P2], eps: f64) -> Vec<P2> {
+    let n = points.len();
+    if n < 4 {
+        return points.to_vec();
+    }
+    let far = (1..n).max_by(|&a, &b| d2(points[0], points[a]).total_cmp(&d2(points[0], points[b]))).unwrap_or(n / 2);
+    let mut keep = vec![false; n];
+    keep[0] = true;
+    keep[far] = true;
+    let mut stack = vec![(0, far), (far, n)];
+    while let Some((a, b)) = stack.pop() {
+        let (p, q) = (points[a], points[b % n]);
+        let worst = (a + 1..b).map(|i| (off_chord(points[i], p, q), i)).max_by(|x, y| x.0.total_cmp(&y.0));
+        if let Some((d, i)) = worst
+            && d > eps
+        {
+            keep[i] = true;
+            stack.push((a, i));
+            stack.push((i, b));
+        }
+    }
+    points.iter().zip(keep).filter(|(_, k)| *k).map(|(p, _)| *p).collect()
+}
+
+fn d2(a: P2, b: P2) -> f64 {
+    (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)
+}
+
+/// Distance from `x` to the segment `p q`.
+fn off_chord(x: P2, p: P2, q: P2) -> f64 {
+    let (dx, dy) = (q[0] - p[0], q[1] - p[1]);
+    let l2 = dx * dx + dy * dy;
+    let t = if l2 > 0.0 { (((x[0] - p[0]) * dx + (x[1] - p[1]) * dy) / l2).clamp(0.0, 1.0) } else { 0.0 };
+    (x[0] - p[0] - t * dx).hypot(x[1] - p[1] - t * dy)
 }
