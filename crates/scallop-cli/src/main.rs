@@ -8,6 +8,7 @@ mod optimize;
 mod output;
 mod outset;
 mod part;
+mod pocket;
 mod post;
 mod render;
 mod run;
@@ -64,6 +65,8 @@ enum Command {
     Render(render::RenderArgs),
     /// The closed contours where a cutter with its tip at height z touches a mesh (CSV or JSON loops).
     Waterline(waterline::WaterlineArgs),
+    /// Clear a 2D pocket (region JSON: outer boundary, then islands) and write G-code and CL.
+    Pocket(pocket::PocketArgs),
     /// Load a part and report what was read (size, welding, open and non-manifold edges).
     Inspect(part::InspectArgs),
 }
@@ -89,6 +92,7 @@ fn main() -> ExitCode {
         Command::Post(args) => post::run(&args),
         Command::Render(args) => render::run(&args),
         Command::Waterline(args) => waterline::run(&args),
+        Command::Pocket(args) => pocket::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
