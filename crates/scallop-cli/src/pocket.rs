@@ -82,6 +82,7 @@ struct PocketReport {
     passes: usize,
     links: usize,
     retracts: usize,
+    helical_entries: usize,
     arcs: usize,
     feed_length_mm: f64,
     link_length_mm: f64,
@@ -140,7 +141,8 @@ pub fn run(args: &PocketArgs) -> CliResult<()> {
         )));
     }
     let direction = if args.conventional { Direction::Conventional } else { Direction::Climb };
-    let options = ClearOptions { stepover: args.stepover * d, direction, chord_tolerance: args.tolerance };
+    let options =
+        ClearOptions { tool_radius: d / 2.0, stepover: args.stepover * d, direction, chord_tolerance: args.tolerance };
     let motion = Motion { clearance_z: args.clearance, feed: args.feed };
     let plan = pocket_toolpath(&region, &options, -args.depth, 0.0, &motion)
         .map_err(|e| Failure::rejected(format!("{}: {e}", args.region.display())))?;
@@ -162,6 +164,7 @@ pub fn run(args: &PocketArgs) -> CliResult<()> {
         passes: plan.passes,
         links: plan.links,
         retracts: plan.retracts,
+        helical_entries: plan.helices,
         arcs: fitted.arcs(),
         feed_length_mm: plan.toolpath.length(MoveKind::Feed),
         link_length_mm: plan.toolpath.length(MoveKind::Link),
@@ -172,10 +175,11 @@ pub fn run(args: &PocketArgs) -> CliResult<()> {
         return print_json(&report);
     }
     print_text(&format!(
-        "{} passes, {} tool-down links, {} retracts, {} arcs; feed {:.1} mm, links {:.1} mm; planned in {:.3} s\n  wrote {}\n",
+        "{} passes, {} tool-down links, {} retracts, {} helical entries, {} arcs; feed {:.1} mm, links {:.1} mm; planned in {:.3} s\n  wrote {}\n",
         report.passes,
         report.links,
         report.retracts,
+        report.helical_entries,
         report.arcs,
         report.feed_length_mm,
         report.link_length_mm,

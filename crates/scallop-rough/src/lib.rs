@@ -76,6 +76,8 @@ pub enum Pattern {
 /// Settings of the clearing of one region in the plane.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ClearOptions {
+    /// Tool radius R (mm): sizes the helical entries.
+    pub tool_radius: f64,
     /// Radial depth of cut ae between passes (mm), `0 < ae <= R`.
     pub stepover: f64,
     /// Milling direction.
@@ -155,6 +157,8 @@ pub struct RoughPlan {
     pub links: usize,
     /// Retract-rapid-plunge connections.
     pub retracts: usize,
+    /// Helical entries (the other entries are straight plunges).
+    pub helices: usize,
 }
 
 /// The tool-tip heights of the levels, top down: every `stepdown` below the
@@ -271,16 +275,24 @@ pub fn plan_rough(
     let zs = level_heights(index, stock, settings);
     let levels = level_regions(index, cutter, stock, settings, &zs, tolerance)?;
     let options = ClearOptions {
+        tool_radius: cutter.radius(),
         stepover: settings.stepover * 2.0 * cutter.radius(),
         direction: settings.direction,
         chord_tolerance: tolerance,
     };
     let nodes = build_tree(&levels, &options)?;
-    let mut out = Emitter::new(motion, stock.max.z, tolerance);
+    let mut out = Emitter::new(motion, stock.max.z, &options);
     let roots: Vec<usize> = (0..nodes.len()).filter(|&k| nodes[k].parent.is_none()).collect();
     visit_all(&nodes, &roots, &mut out);
     out.finish();
-    Ok(RoughPlan { toolpath: out.path, levels, passes: out.passes, links: out.links, retracts: out.retracts })
+    Ok(RoughPlan {
+        toolpath: out.path,
+        levels,
+        passes: out.passes,
+        links: out.links,
+        retracts: out.retracts,
+        helices: out.helices,
+    })
 }
 
 /// The nodes of all levels with their parents and plans (planned in parallel).
@@ -356,6 +368,10 @@ struct Emitter {
     stock_top: f64,
     /// Chord tolerance of the link checks (mm).
     chord: f64,
+    /// Radius of the tool centre's circle on helical entries (mm).
+    helix_radius: f64,
+    /// Helical entries made.
+    helices: usize,
     /// The node last cut.
     last: Option<usize>,
     passes: usize,
@@ -364,12 +380,14 @@ struct Emitter {
 }
 
 impl Emitter {
-    fn new(motion: &Motion, stock_top: f64, chord: f64) -> Emitter {
+    fn new(motion: &Motion, stock_top: f64, options: &ClearOptions) -> Emitter {
         Emitter {
             path: Toolpath::new(motion.feed),
             clearance: motion.clearance_z,
             stock_top,
-            chord,
+            chord: options.chord_tolerance,
+            helix_radius: tol::HELIX_RADIUS_SHARE * options.tool_radius,
+            helices: 0,
             last: None,
             passes: 0,
             links: 0,
@@ -407,7 +425,7 @@ impl Emitter {
                             self.path.push(Move::new(MoveKind::Link, Point3::new(s[0], s[1], node.z)));
                             self.links += 1;
                         } else {
-                            self.retract_to(s, above, node.z);
+                            self.retract_to(s, above, node.z, &node.region);
                         }
                     }
                 }
@@ -425,7 +443,7 @@ impl Emitter {
         let above = node.parent.map_or(self.stock_top, |p| nodes[p].z);
         let (Some(here), Some(last)) = (self.at(), self.last) else {
             self.path.push(Move::new(MoveKind::Rapid, Point3::new(s[0], s[1], self.clearance)));
-            self.plunge(s, above, node.z);
+            self.plunge(s, above, node.z, &node.region);
             return;
         };
         let ancestors = chain(nodes, k);
@@ -448,35 +466,66 @@ impl Emitter {
                 }
                 self.path.push(Move::new(MoveKind::Link, Point3::new(s[0], s[1], zc)));
                 self.links += 1;
-                self.plunge(s, above.min(zc), node.z);
+                self.plunge(s, above.min(zc), node.z, &node.region);
             }
             None => {
                 self.retracts += 1;
                 self.path.push(Move::new(MoveKind::Retract, Point3::new(here.x, here.y, self.clearance)));
                 self.path.push(Move::new(MoveKind::Rapid, Point3::new(s[0], s[1], self.clearance)));
-                self.plunge(s, above, node.z);
+                self.plunge(s, above, node.z, &node.region);
             }
         }
     }
 
-    /// Rapid down to `APPROACH` above the cleared height `above` (when higher),
-    /// then a plunge to `z`.
-    fn plunge(&mut self, s: P2, above: f64, z: f64) {
+    /// Down from the cleared height `above` to `z` at `s`: a rapid to
+    /// `APPROACH` above it (when higher), then a helix about `s` when its
+    /// circle fits in `region` (the tool centre's circle of
+    /// [`tol::HELIX_RADIUS_SHARE`] R, descending at [`tol::HELIX_SLOPE`], one
+    /// full turn at `z`, counter-clockwise: climb in the bore), else a
+    /// straight plunge.
+    fn plunge(&mut self, s: P2, above: f64, z: f64, region: &Region) {
         let current = self.at().map_or(self.clearance, |p| p.z);
         let approach = above + tol::APPROACH;
+        let rh = self.helix_radius;
+        let depth = above - z;
+        let fits = rh > 0.0 && depth > 0.0 && region.offset(rh).contains(s);
+        let start = if fits { [s[0] + rh, s[1]] } else { s };
         if current > approach {
-            self.path.push(Move::new(MoveKind::Rapid, Point3::new(s[0], s[1], approach)));
+            self.path.push(Move::new(MoveKind::Rapid, Point3::new(start[0], start[1], approach)));
+        } else if fits {
+            self.path.push(Move::new(MoveKind::Link, Point3::new(start[0], start[1], current)));
         }
-        self.path.push(Move::new(MoveKind::Plunge, Point3::new(s[0], s[1], z)));
+        if !fits {
+            self.path.push(Move::new(MoveKind::Plunge, Point3::new(s[0], s[1], z)));
+            return;
+        }
+        self.path.push(Move::new(MoveKind::Plunge, Point3::new(start[0], start[1], above.min(current))));
+        let per_turn = std::f64::consts::TAU * rh * tol::HELIX_SLOPE;
+        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a small positive count")]
+        let quarters = 4 * ((above.min(current) - z) / per_turn).ceil().max(1.0) as usize + 4;
+        let top = above.min(current);
+        #[allow(clippy::cast_precision_loss, reason = "a small count")]
+        let descent = quarters as f64 - 4.0;
+        for i in 1..=quarters {
+            #[allow(clippy::cast_precision_loss, reason = "a small count")]
+            let a = std::f64::consts::FRAC_PI_2 * i as f64;
+            #[allow(clippy::cast_precision_loss, reason = "a small count")]
+            let zi = if (i as f64) < descent { top - (top - z) * i as f64 / descent } else { z };
+            let arc = ArcXY { center: Point2::new(s[0], s[1]), sweep: std::f64::consts::FRAC_PI_2 };
+            self.path
+                .push_arc(Move::new(MoveKind::Feed, Point3::new(s[0] + rh * a.cos(), s[1] + rh * a.sin(), zi)), arc);
+        }
+        self.path.push(Move::new(MoveKind::Feed, Point3::new(s[0], s[1], z)));
+        self.helices += 1;
     }
 
     /// A retract within a level: up to the clearance, over, and down.
-    fn retract_to(&mut self, s: P2, above: f64, z: f64) {
+    fn retract_to(&mut self, s: P2, above: f64, z: f64, region: &Region) {
         let Some(here) = self.at() else { return };
         self.retracts += 1;
         self.path.push(Move::new(MoveKind::Retract, Point3::new(here.x, here.y, self.clearance)));
         self.path.push(Move::new(MoveKind::Rapid, Point3::new(s[0], s[1], self.clearance)));
-        self.plunge(s, above, z);
+        self.plunge(s, above, z, region);
     }
 
     /// The last retract to the clearance height.
@@ -551,7 +600,7 @@ pub fn pocket_toolpath(
     top: f64,
     motion: &Motion,
 ) -> Result<RoughPlan, RoughError> {
-    let mut out = Emitter::new(motion, top, options.chord_tolerance);
+    let mut out = Emitter::new(motion, top, options);
     let mut nodes = Vec::new();
     for part in region.components() {
         let steps = plan_offset(&part, options)?;
@@ -567,5 +616,6 @@ pub fn pocket_toolpath(
         passes: out.passes,
         links: out.links,
         retracts: out.retracts,
+        helices: out.helices,
     })
 }

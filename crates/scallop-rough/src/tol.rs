@@ -44,3 +44,11 @@ pub const LINK_GROW: f64 = 1e-4;
 /// (1e-4 mm) of each other's chords, far denser than a roughing region needs.
 /// The region's boundary moves by at most this.
 pub const SIMPLIFY: f64 = 1e-3;
+
+/// Helical entries: the tool centre's circle has this share of the tool
+/// radius (the bore is 1.5 D wide, no core left in its middle).
+pub const HELIX_RADIUS_SHARE: f64 = 0.5;
+
+/// Helical entries descend this much per unit of length along the circle
+/// (tan of about 3 degrees).
+pub const HELIX_SLOPE: f64 = 0.05;

@@ -140,7 +140,7 @@ proptest! {
             vec![Contour::circle([w / 2.0, h / 2.0], isl).unwrap()],
         ).unwrap();
         let region = wall.offset(r);
-        let options = ClearOptions { stepover: f * 2.0 * r, direction: Direction::Climb, chord_tolerance: 1e-3 };
+        let options = ClearOptions { tool_radius: r, stepover: f * 2.0 * r, direction: Direction::Climb, chord_tolerance: 1e-3 };
         let steps = plan_offset(&region, &options).unwrap();
         for s in &steps {
             if let Step::Cut(c) = s {
