@@ -243,7 +243,10 @@ pub fn level_regions(
             }
             let loops = grid.loops(contact.max(zmin))?;
             let rings: Vec<Vec<P2>> = loops.iter().map(|l| l.points.iter().map(|p| [p.x, p.y]).collect()).collect();
-            let inside = Region::from_polygons_simplified(&rings, true, tol::SIMPLIFY);
+            // Thinned, then grown back by the thinning and the links' slack: the
+            // region never reaches past the exact contour.
+            let inside =
+                Region::from_polygons_simplified(&rings, true, tol::SIMPLIFY).offset(-(tol::SIMPLIFY + tol::LINK_GROW));
             Ok(Level { z, region: rect.difference(&inside, tolerance) })
         })
         .collect()

@@ -42,7 +42,8 @@ pub const LINK_GROW: f64 = 1e-4;
 /// Waterline loops are thinned by Douglas-Peucker at this before the region
 /// booleans (mm): their points lie within the waterline's chord tolerance
 /// (1e-4 mm) of each other's chords, far denser than a roughing region needs.
-/// The region's boundary moves by at most this.
+/// The thinned inside is then grown by this plus [`LINK_GROW`], so the region
+/// keeps clear of the exact contour (by at most twice this more than needed).
 pub const SIMPLIFY: f64 = 1e-3;
 
 /// Helical entries: the tool centre's circle has this share of the tool
