@@ -243,10 +243,7 @@ pub fn level_regions(
             }
             let loops = grid.loops(contact.max(zmin))?;
             let rings: Vec<Vec<P2>> = loops.iter().map(|l| l.points.iter().map(|p| [p.x, p.y]).collect()).collect();
-            // Thinned, then grown back by the thinning and the links' slack: the
-            // region never reaches past the exact contour.
-            let inside =
-                Region::from_polygons_simplified(&rings, true, tol::SIMPLIFY).offset(-(tol::SIMPLIFY + tol::LINK_GROW));
+            let inside = Region::from_polygons_simplified(&rings, true, tol::SIMPLIFY);
             Ok(Level { z, region: rect.difference(&inside, tolerance) })
         })
         .collect()
@@ -322,9 +319,24 @@ fn build_tree(levels: &[Level], options: &ClearOptions) -> Result<Vec<Node>, Rou
     Ok(out)
 }
 
-/// Whether `child` lies in `parent` (tested at the first vertex of its outer ring).
+/// Whether `child` lies in `parent`, tested at a point strictly inside the
+/// child (its outer ring may run on the parent's boundary: the stock box).
 fn contains_part(parent: &Region, child: &Region) -> bool {
-    child.outers().next().and_then(Contour::start).is_some_and(|p| parent.contains(p))
+    interior_point(child).is_some_and(|p| parent.contains(p))
+}
+
+/// A point inside `region`: a chord midpoint of its first outer ring moved a
+/// little to the ring's left (the filled side), the first such point inside.
+fn interior_point(region: &Region) -> Option<P2> {
+    let ring = region.outers().next()?.to_points(tol::INTERIOR_NUDGE / 4.0);
+    (0..ring.len()).find_map(|i| {
+        let (a, b) = (ring[i], ring[(i + 1) % ring.len()]);
+        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+        let len = dx.hypot(dy);
+        let d = tol::INTERIOR_NUDGE / len;
+        let p = [0.5 * (a[0] + b[0]) - dy * d, 0.5 * (a[1] + b[1]) + dx * d];
+        (len > 4.0 * tol::INTERIOR_NUDGE && region.contains(p)).then_some(p)
+    })
 }
 
 /// Cuts the trees from `roots` depth-first, each time going on with the

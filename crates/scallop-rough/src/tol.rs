@@ -42,8 +42,8 @@ pub const LINK_GROW: f64 = 1e-4;
 /// Waterline loops are thinned by Douglas-Peucker at this before the region
 /// booleans (mm): their points lie within the waterline's chord tolerance
 /// (1e-4 mm) of each other's chords, far denser than a roughing region needs.
-/// The thinned inside is then grown by this plus [`LINK_GROW`], so the region
-/// keeps clear of the exact contour (by at most twice this more than needed).
+/// The region's boundary moves by at most this (into the allowance, and with
+/// no allowance into the part: within the job's path tolerance).
 pub const SIMPLIFY: f64 = 1e-3;
 
 /// Helical entries: the tool centre's circle has this share of the tool
@@ -53,3 +53,7 @@ pub const HELIX_RADIUS_SHARE: f64 = 0.5;
 /// Helical entries descend this much per unit of length along the circle
 /// (tan of about 3 degrees).
 pub const HELIX_SLOPE: f64 = 0.05;
+
+/// A point this far inside a ring (from a chord's midpoint, along its
+/// normal) stands for the region in containment tests between levels (mm).
+pub const INTERIOR_NUDGE: f64 = 1e-3;

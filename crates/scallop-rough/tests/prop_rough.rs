@@ -122,9 +122,16 @@ proptest! {
                 }
             }
         }
+        // The thinned loops (tol::SIMPLIFY) and the links' slack (tol::LINK_GROW)
+        // may bring a tool centre that close to the exact contour, no closer.
+        let slack = scallop_rough::tol::SIMPLIFY + scallop_rough::tol::LINK_GROW;
+        let safe = |x: f64, y: f64, z: f64| drop_cutter(&cutter, &index, Point2::new(x, y), f64::NEG_INFINITY).tip.z <= z - axial + 1e-9;
         for q in samples(&plan.toolpath, 0.25) {
-            let cl = drop_cutter(&cutter, &index, Point2::new(q.x, q.y), f64::NEG_INFINITY);
-            prop_assert!(cl.tip.z <= q.z - axial + 2e-3, "{q:?} below the part + allowance: {}", cl.tip.z);
+            let near = (0..16).any(|i| {
+                let a = std::f64::consts::PI * f64::from(i) / 8.0;
+                safe(q.x + slack * a.cos(), q.y + slack * a.sin(), q.z)
+            });
+            prop_assert!(safe(q.x, q.y, q.z) || near, "{q:?} below the part + allowance");
         }
     }
 
