@@ -122,7 +122,7 @@ pub fn run(args: &PocketArgs) -> CliResult<()> {
     }
     let d = args.tool_diameter;
     let positive = |v: f64| v.is_finite() && v > 0.0;
-    if !positive(d) || !(positive(args.stepover) && args.stepover <= 0.5) || !positive(args.depth) {
+    if !(positive(d) && positive(args.stepover) && args.stepover <= 0.5 && positive(args.depth)) {
         return Err(Failure::rejected(
             "--tool-diameter and --depth must be > 0 mm and --stepover in (0, 0.5] (a fraction of D)",
         ));

@@ -1,6 +1,7 @@
 //! Smoke tests of `scallop pocket`: a rectangle with an island cleared to
 //! G-code (with arcs) and CL, the summary, and bad input (exit code 1).
 
+#[allow(dead_code, reason = "the helpers other test files use")]
 mod common;
 
 use common::{scallop, scratch};

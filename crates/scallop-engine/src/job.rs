@@ -40,8 +40,8 @@ pub struct Operation {
 
 /// What planning one operation produced.
 enum Planned {
-    Finish(PlannedOperation),
-    Rough(PlannedRough),
+    Finish(Box<PlannedOperation>),
+    Rough(Box<PlannedRough>),
 }
 
 impl Planned {
@@ -202,8 +202,8 @@ pub fn run_job(job: &Job) -> Result<JobOutput, EngineError> {
         let top_before = zmap.max_top().unwrap_or(stock.min.z);
         let clearance = f.clearance.max(top_before + STOCK_CLEARANCE_MM - part_top);
         let p = match &op.rough {
-            Some(r) => Planned::Rough(plan_rough_operation(f, r, &prepared, &stock, clearance, &tolerances)?),
-            None => Planned::Finish(plan_operation(f, &prepared, &tolerances, Some(clearance))?),
+            Some(r) => Planned::Rough(Box::new(plan_rough_operation(f, r, &prepared, &stock, clearance, &tolerances)?)),
+            None => Planned::Finish(Box::new(plan_operation(f, &prepared, &tolerances, Some(clearance))?)),
         };
         let volume_before = zmap.volume();
         let cut = zmap.cut(&f.cutter, p.toolpath())?;
