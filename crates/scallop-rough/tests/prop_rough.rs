@@ -148,13 +148,19 @@ proptest! {
         ).unwrap();
         let region = wall.offset(r);
         let options = ClearOptions { tool_radius: r, stepover: f * 2.0 * r, direction: Direction::Climb, chord_tolerance: 1e-3 };
-        let steps = plan_offset(&region, &options).unwrap();
-        for s in &steps {
-            if let Step::Cut(c) = s {
-                let a = c.signed_area();
-                // Outer rings (positive area) counter-clockwise, islands clockwise: as the region.
-                prop_assert!(a != 0.0);
-            }
+        // Climb: the last (largest) pass runs counter-clockwise along the wall,
+        // the passes around the island clockwise; conventional: the reverse.
+        for (direction, sign) in [(Direction::Climb, 1.0), (Direction::Conventional, -1.0)] {
+            let steps = plan_offset(&region, &ClearOptions { direction, ..options }).unwrap();
+            let areas: Vec<f64> = steps.iter().filter_map(|s| match s {
+                Step::Cut(c) => Some(sign * c.signed_area()),
+                Step::Link { .. } => None,
+            }).collect();
+            let largest = areas.iter().copied().fold(0.0_f64, |m, a| if a.abs() > m.abs() { a } else { m });
+            prop_assert!(largest > 0.0, "{direction:?}: {areas:?}");
+            // (The island's ring may merge with the wall's for large islands.)
+            let has_hole = region.rings().iter().any(|r| !r.is_ccw());
+            prop_assert!(!has_hole || areas.iter().any(|&a| a < 0.0), "{direction:?}: no pass around the island");
         }
         let motion = Motion { clearance_z: 5.0, feed: 1000.0 };
         let plan = pocket_toolpath(&region, &options, -1.0, 0.0, &motion).unwrap();
