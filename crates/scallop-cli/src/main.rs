@@ -10,6 +10,7 @@ mod optimize;
 mod output;
 mod outset;
 mod part;
+mod pocket;
 mod post;
 mod render;
 mod run;
@@ -66,6 +67,8 @@ enum Command {
     Render(render::RenderArgs),
     /// The closed contours where a cutter with its tip at height z touches a mesh (CSV or JSON loops).
     Waterline(waterline::WaterlineArgs),
+    /// Clear a 2D pocket (region JSON: outer boundary, then islands) and write G-code and CL.
+    Pocket(pocket::PocketArgs),
     /// Load a part and report what was read (size, welding, open and non-manifold edges).
     Inspect(part::InspectArgs),
     /// Measure a 2.5D pocket program's engagement, links, air cuts, uncut area and cycle time on its pocket.
@@ -94,6 +97,7 @@ fn main() -> ExitCode {
         Command::Render(args) => render::run(&args),
         Command::Waterline(args) => waterline::run(&args),
         Command::Engagement(args) => engagement::run(&args),
+        Command::Pocket(args) => pocket::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

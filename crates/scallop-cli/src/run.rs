@@ -46,7 +46,7 @@ pub fn run(args: &RunArgs) -> CliResult<()> {
         let operations = if spec.operation_list {
             operations_job(&spec, job)?.operations
         } else {
-            vec![Operation { name: "finish".into(), finish: job }]
+            vec![Operation { name: "finish".into(), finish: job, rough: None }]
         };
         return plan_only(&name, &operations, args.json);
     }
@@ -114,19 +114,39 @@ fn operations_job(spec: &JobFile, first: FinishJob) -> CliResult<Job> {
             Failure::Rejected(e) => Failure::rejected(format!("operation {} (`{}`): {e:#}", k + 1, op.name)),
             other => other,
         })?;
-        apply_finishing(&mut finish, &op.finishing);
+        let rough = op.roughing.as_ref().map(rough_settings);
+        if rough.is_none() {
+            apply_finishing(&mut finish, &op.finishing);
+        }
         finish.output.tool = op.tool.unwrap_or(spec.output.tool);
         finish.output.spindle = op.spindle.unwrap_or(spec.output.spindle);
         if let Some(feed) = op.feed {
             finish.machine[0] = feed / 1000.0; // mm/min -> m/min
         }
-        operations.push(Operation { name: op.name.clone(), finish });
+        operations.push(Operation { name: op.name.clone(), finish, rough });
     }
     let stock = spec.stock.as_ref().map(|s| match (s.min, s.max) {
         (Some(min), Some(max)) => StockShape::Box(Aabb3 { min: min.into(), max: max.into() }),
         _ => StockShape::AroundPart { margin: s.margin, top: s.top.unwrap_or(1.0), bottom: s.bottom.unwrap_or(1.0) },
     });
     Ok(Job { stock, operations })
+}
+
+/// The settings of an `[operation.roughing]` table.
+fn rough_settings(r: &scallop_io::job::RoughingSpec) -> scallop_rough::RoughSettings {
+    scallop_rough::RoughSettings {
+        stepdown: r.stepdown,
+        stepover: r.stepover,
+        radial_allowance: r.stock_to_leave,
+        axial_allowance: r.stock_to_leave_axial.unwrap_or(r.stock_to_leave),
+        pattern: match r.pattern {
+            scallop_io::job::RoughPatternWord::Offset => scallop_rough::Pattern::Offset,
+        },
+        direction: match r.direction {
+            scallop_io::job::MillingWord::Climb => scallop_rough::Direction::Climb,
+            scallop_io::job::MillingWord::Conventional => scallop_rough::Direction::Conventional,
+        },
+    }
 }
 
 /// The cutter of a `[cutter]` table (or a library tool): profile, flutes
@@ -312,6 +332,7 @@ fn job_keys(e: &scallop_engine::EngineError) -> &'static str {
         }
         E::Verification(_) => " (job keys: cutter.flute_length, machine.clearance, tolerances.gouge)",
         E::Output { .. } => " (job keys: [output], [setup])",
+        E::Rough(_) => " (job keys: [operation.roughing], [operation.cutter], [stock])",
         _ => "",
     }
 }

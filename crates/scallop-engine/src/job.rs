@@ -15,6 +15,7 @@ use crate::finish::{
     PlannedOperation, cutter_text, fit_and_comment, network_scallop_from, plan_operation, planning_tolerances,
     verify_options,
 };
+use crate::rough::{PlannedRough, plan_rough_operation};
 use crate::{EngineError, FinishJob, PreparedPart, prepare_part, stock_box};
 
 /// Height kept between the highest material of the in-process stock and the
@@ -31,6 +32,39 @@ pub struct Operation {
     /// verification and output settings must be those of the job's other
     /// operations; its tool and spindle are its own).
     pub finish: FinishJob,
+    /// `Some`: a roughing operation with these settings instead (its cutter,
+    /// tool, spindle, feeds and clearance are those of `finish`, whose
+    /// finishing settings are not used).
+    pub rough: Option<scallop_rough::RoughSettings>,
+}
+
+/// What planning one operation produced.
+enum Planned {
+    Finish(Box<PlannedOperation>),
+    Rough(Box<PlannedRough>),
+}
+
+impl Planned {
+    fn toolpath(&self) -> &Toolpath {
+        match self {
+            Planned::Finish(p) => &p.plan.toolpath,
+            Planned::Rough(r) => &r.toolpath,
+        }
+    }
+
+    fn report(&self) -> &scallop_strategy::Report {
+        match self {
+            Planned::Finish(p) => &p.plan.report,
+            Planned::Rough(r) => &r.report,
+        }
+    }
+
+    fn direction_deg(&self) -> f64 {
+        match self {
+            Planned::Finish(p) => p.direction_deg,
+            Planned::Rough(_) => 0.0,
+        }
+    }
 }
 
 /// The stock of a [`Job`].
@@ -164,18 +198,21 @@ pub fn run_job(job: &Job) -> Result<JobOutput, EngineError> {
     let mut zmap = ZMap::new(stock, first.sim_resolution)?;
     let field = PartField::new(&zmap, &prepared.index);
     let part_top = prepared.mesh.bounds().max.z;
-    let mut planned: Vec<(PlannedOperation, StockFigures)> = Vec::with_capacity(job.operations.len());
+    let mut planned: Vec<(Planned, StockFigures)> = Vec::with_capacity(job.operations.len());
     for op in &job.operations {
         let f = &op.finish;
         let top_before = zmap.max_top().unwrap_or(stock.min.z);
         let clearance = f.clearance.max(top_before + STOCK_CLEARANCE_MM - part_top);
-        let p = plan_operation(f, &prepared, &tolerances, Some(clearance))?;
+        let p = match &op.rough {
+            Some(r) => Planned::Rough(Box::new(plan_rough_operation(f, r, &prepared, &stock, clearance, &tolerances)?)),
+            None => Planned::Finish(Box::new(plan_operation(f, &prepared, &tolerances, Some(clearance))?)),
+        };
         let volume_before = zmap.volume();
-        let cut = zmap.cut(&f.cutter, &p.plan.toolpath)?;
+        let cut = zmap.cut(&f.cutter, p.toolpath())?;
         if !cut.rapid_hits.is_empty() {
             cut.check()?;
         }
-        let collisions = zmap.part_collisions_in(&field, &f.cutter, &p.plan.toolpath, cut.operation)?;
+        let collisions = zmap.part_collisions_in(&field, &f.cutter, p.toolpath(), cut.operation)?;
         if !collisions.is_empty() {
             return Err(scallop_sim::SimError::PartCollision { count: collisions.len(), collisions }.into());
         }
@@ -196,25 +233,25 @@ pub fn run_job(job: &Job) -> Result<JobOutput, EngineError> {
     let verification = verify_in(&zmap, &field, &options)?;
     let simulation = scallop_sim::Simulation { zmap, cut: empty_cut(), verification };
     let mut rest = crate::RestReport::default();
-    if last.strategy.simulation_verifies_scallop() {
-        if let Some((p, _)) = planned.last_mut() {
-            rest = network_scallop_from(&simulation, last, &prepared, &options, &mut p.plan.report)?;
-        }
+    if last.strategy.simulation_verifies_scallop()
+        && let Some((Planned::Finish(p), _)) = planned.last_mut()
+    {
+        rest = network_scallop_from(&simulation, last, &prepared, &options, &mut p.plan.report)?;
     }
     let gcode = program(job, &planned, &prepared, &tolerances)?;
     let mut toolpath = Toolpath::new(first.machine[0] * 1000.0);
     let mut reports = Vec::with_capacity(planned.len());
     let mut total_time = 0.0;
     for ((p, figures), (k, op)) in planned.iter().zip(job.operations.iter().enumerate()) {
-        toolpath.extend_from(&p.plan.toolpath);
-        total_time += p.plan.report.total_time_s;
+        toolpath.extend_from(p.toolpath());
+        total_time += p.report().total_time_s;
         reports.push(OperationReport {
             name: op.name.clone(),
             cutter: cutter_text(op.finish.cutter.shape()),
             tool: tool_number(&op.finish, k),
-            scallop_height_mm: op.finish.scallop_height,
-            direction_deg: p.direction_deg,
-            plan: p.plan.report.clone(),
+            scallop_height_mm: if op.rough.is_some() { 0.0 } else { op.finish.scallop_height },
+            direction_deg: p.direction_deg(),
+            plan: p.report().clone(),
             stock: figures.clone(),
         });
     }
@@ -231,7 +268,7 @@ pub fn run_job(job: &Job) -> Result<JobOutput, EngineError> {
         sim_gouge_tolerance_mm: gouge_tolerance,
         rest,
     };
-    let toolpaths = planned.into_iter().map(|(p, _)| p.plan.toolpath).collect();
+    let toolpaths = planned.iter().map(|(p, _)| p.toolpath().clone()).collect();
     Ok(JobOutput { toolpaths, toolpath, gcode, report, prepared, simulation })
 }
 
@@ -290,14 +327,17 @@ fn empty_cut() -> scallop_sim::CutReport {
 /// One program: the job's header comments, then each operation's section.
 fn program(
     job: &Job,
-    planned: &[(PlannedOperation, StockFigures)],
+    planned: &[(Planned, StockFigures)],
     prepared: &PreparedPart,
     tolerances: &Tolerances,
 ) -> Result<String, EngineError> {
     let mut fitted: Vec<(FittedPath, Vec<String>)> = Vec::with_capacity(planned.len());
     let mut header: Vec<String> = Vec::new();
     for (k, ((p, _), op)) in planned.iter().zip(&job.operations).enumerate() {
-        let (f, comments) = fit_and_comment(&op.finish, p, prepared, tolerances);
+        let (f, comments) = match p {
+            Planned::Finish(p) => fit_and_comment(&op.finish, p, prepared, tolerances),
+            Planned::Rough(r) => crate::rough::fit_and_comment(&op.finish, r),
+        };
         if k == 0 {
             header.push(comments[0].clone());
         }
@@ -345,8 +385,8 @@ mod tests {
         Job {
             stock: Some(StockShape::Box(stock)),
             operations: vec![
-                Operation { name: "coarse ball".into(), finish: coarse },
-                Operation { name: "fine bull-nose".into(), finish: fine },
+                Operation { name: "coarse ball".into(), finish: coarse, rough: None },
+                Operation { name: "fine bull-nose".into(), finish: fine, rough: None },
             ],
         }
     }

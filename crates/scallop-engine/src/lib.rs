@@ -24,6 +24,7 @@ mod estimate;
 mod finish;
 mod grid;
 mod job;
+mod rough;
 mod zones;
 
 use scallop_geom::Tolerances;
@@ -59,6 +60,9 @@ pub enum EngineError {
     /// A cutter that is not a real tool.
     #[error("cutter: {0}")]
     Cutter(#[from] scallop_cutter::CutterError),
+    /// The roughing planner refused (a setting, the part's waterline).
+    #[error("roughing: {0}")]
+    Rough(#[from] scallop_rough::RoughError),
     /// A grid that makes no sense.
     #[error("{0}")]
     Grid(#[from] GridError),

@@ -102,6 +102,8 @@ pub struct StockSpec {
 pub enum OperationKind {
     /// Finishing with a guaranteed scallop height (`[operation.finishing]`).
     Finish,
+    /// Z-level roughing from the stock (`[operation.roughing]`).
+    Rough,
 }
 
 /// `[[operation]]`: one operation with its own cutter, tool and spindle.
@@ -122,8 +124,40 @@ pub struct OperationSpec {
     pub cutter: CutterSpec,
     /// Feed (mm/min; default: the tool library's `f_z * flutes * n`, else `machine.feed`).
     pub feed: Option<f64>,
-    /// `[operation.finishing]`.
+    /// `[operation.finishing]` (finish operations; absent on rough
+    /// operations, where it reads as [`FinishingSpec::absent`]).
+    #[serde(default = "FinishingSpec::absent")]
     pub finishing: FinishingSpec,
+    /// `[operation.roughing]` (rough operations only).
+    pub roughing: Option<RoughingSpec>,
+}
+
+/// `[operation.roughing]`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+pub struct RoughingSpec {
+    /// Depth between levels (mm).
+    pub stepdown: f64,
+    /// Radial depth of cut as a fraction of the cutter diameter, in (0, 0.5].
+    pub stepover: f64,
+    /// Material left on the walls (mm, default 0).
+    #[serde(default)]
+    pub stock_to_leave: f64,
+    /// Material left on the floors (mm; default `stock_to_leave`).
+    pub stock_to_leave_axial: Option<f64>,
+    /// Clearing pattern (`offset`).
+    #[serde(default = "default_rough_pattern")]
+    pub pattern: RoughPatternWord,
+    /// `climb` (default) or `conventional`.
+    #[serde(default = "default_milling")]
+    pub direction: MillingWord,
+}
+
+fn default_rough_pattern() -> RoughPatternWord {
+    RoughPatternWord::Offset
+}
+
+fn default_milling() -> MillingWord {
+    MillingWord::Climb
 }
 
 /// `[output]`.
@@ -239,6 +273,17 @@ word_enum! {
     PatternWord { /// Back and forth.
         Zigzag = "zigzag", /// Always the same way.
         OneWay = "one-way" }
+}
+word_enum! {
+    /// `roughing.pattern`.
+    RoughPatternWord { /// Contour-parallel offsets.
+        Offset = "offset" }
+}
+word_enum! {
+    /// `roughing.direction`.
+    MillingWord { /// Climb milling.
+        Climb = "climb", /// Conventional milling.
+        Conventional = "conventional" }
 }
 word_enum! {
     /// `finishing.strategy`.
@@ -389,6 +434,27 @@ pub struct FinishingSpec {
     /// Angle of ramp leads above the pass's tangent (degrees).
     #[serde(default = "default_lead_angle")]
     pub lead_angle_deg: f64,
+}
+
+impl FinishingSpec {
+    /// The settings read where no finishing table is given (a rough
+    /// operation): the scallop height is NaN, so no finishing can run on them.
+    #[must_use]
+    pub fn absent() -> FinishingSpec {
+        FinishingSpec {
+            scallop_height: f64::NAN,
+            direction: DirectionSpec::Auto,
+            pattern: default_pattern(),
+            max_step: default_max_step(),
+            strategy: default_strategy(),
+            steep_threshold_deg: None,
+            iso_direction: default_iso(),
+            lead: default_lead(),
+            lead_radius: default_lead_size(),
+            lead_length: default_lead_size(),
+            lead_angle_deg: default_lead_angle(),
+        }
+    }
 }
 
 fn default_strategy() -> StrategyWord {
@@ -772,6 +838,7 @@ fn normalise(raw: RawJob, text: &str, library: Option<&ToolLibrary>) -> Result<J
             cutter,
             feed: None,
             finishing,
+            roughing: None,
         }]
     };
     let mut operations = operations;
@@ -779,10 +846,12 @@ fn normalise(raw: RawJob, text: &str, library: Option<&ToolLibrary>) -> Result<J
     if let Some(stock) = &raw.stock {
         check_stock(stock)?;
     }
+    // The job's finishing settings: the first finishing operation's.
+    let finishing = operations.iter().find(|o| o.kind == OperationKind::Finish).unwrap_or(&operations[0]);
     Ok(JobFile {
         part: raw.part,
         cutter: operations[0].cutter.clone(),
-        finishing: operations[0].finishing.clone(),
+        finishing: finishing.finishing.clone(),
         stock: raw.stock,
         operations,
         operation_list,
@@ -942,7 +1011,11 @@ pub fn parse_job_with_tools(text: &str, library: Option<&ToolLibrary>) -> Result
     let positive = |v: f64| v.is_finite() && v > 0.0;
     let operations = job.operations.clone();
     for (k, op) in operations.iter().enumerate() {
-        check_cutting(&op.cutter, &op.finishing).map_err(|e| {
+        let checked = match op.kind {
+            OperationKind::Finish => check_finish_kind(op).and_then(|()| check_cutting(&op.cutter, &op.finishing)),
+            OperationKind::Rough => check_rough(op),
+        };
+        checked.map_err(|e| {
             if job.operation_list {
                 JobError::Operation { index: k + 1, name: op.name.clone(), source: Box::new(e) }
             } else {
@@ -1029,6 +1102,62 @@ pub fn parse_job_with_tools(text: &str, library: Option<&ToolLibrary>) -> Result
         check_optimize(o, sh)?;
     }
     Ok(job)
+}
+
+/// The checks of one cutter and its finishing settings (keys named as in a
+/// single-operation job).
+/// A finish operation has a finishing table and no roughing table.
+fn check_finish_kind(op: &OperationSpec) -> Result<(), JobError> {
+    if op.roughing.is_some() {
+        return Err(JobError::Value {
+            key: "roughing",
+            value: "given".into(),
+            fix: "[operation.roughing] belongs to kind = \"rough\" operations",
+        });
+    }
+    if op.finishing.scallop_height.is_nan() {
+        return Err(JobError::Value {
+            key: "finishing",
+            value: "missing".into(),
+            fix: "give [operation.finishing] with scallop_height",
+        });
+    }
+    Ok(())
+}
+
+/// A rough operation: its cutter and `[operation.roughing]`, and no finishing table.
+fn check_rough(op: &OperationSpec) -> Result<(), JobError> {
+    check_cutter(&op.cutter)?;
+    let Some(r) = &op.roughing else {
+        return Err(JobError::Value {
+            key: "roughing",
+            value: "missing".into(),
+            fix: "give [operation.roughing] with stepdown and stepover",
+        });
+    };
+    if !op.finishing.scallop_height.is_nan() {
+        return Err(JobError::Value {
+            key: "finishing",
+            value: "given".into(),
+            fix: "a rough operation takes [operation.roughing], not [operation.finishing]",
+        });
+    }
+    let bad = |key, value: f64, fix| Err(JobError::Value { key, value: value.to_string(), fix });
+    if !(r.stepdown.is_finite() && r.stepdown > 0.0) {
+        return bad("roughing.stepdown", r.stepdown, "give the depth per level in mm, > 0");
+    }
+    if !(r.stepover.is_finite() && r.stepover > 0.0 && r.stepover <= 0.5) {
+        return bad("roughing.stepover", r.stepover, "give a fraction of the cutter diameter in (0, 0.5]");
+    }
+    for (key, v) in [
+        ("roughing.stock_to_leave", r.stock_to_leave),
+        ("roughing.stock_to_leave_axial", r.stock_to_leave_axial.unwrap_or(0.0)),
+    ] {
+        if !(v.is_finite() && v >= 0.0) {
+            return bad(key, v, "give the allowance in mm, >= 0");
+        }
+    }
+    Ok(())
 }
 
 /// The checks of one cutter and its finishing settings (keys named as in a
@@ -1319,7 +1448,44 @@ mod tests {
         assert!(err.contains("both min and max"), "{err}");
         let err = parse_job(&ops.replace("top = 4", "min = [0, 0, 0]\nmax = [1, 1, -1]")).unwrap_err().to_string();
         assert!(err.contains("max > min"), "{err}");
-        let err = parse_job(&ops.replace("kind = \"finish\"\nname", "kind = \"rough\"\nname")).unwrap_err().to_string();
-        assert!(err.contains("unknown variant `rough`") && err.contains("operation.kind"), "{err}");
+        let err = parse_job(&ops.replace("kind = \"finish\"\nname", "kind = \"mill\"\nname")).unwrap_err().to_string();
+        assert!(err.contains("unknown variant `mill`") && err.contains("operation.kind"), "{err}");
+    }
+
+    #[test]
+    fn rough_operations_are_read_and_checked() {
+        let rough = "[part]\nbuiltin = \"choi\"\n\
+            [[operation]]\nkind = \"rough\"\n[operation.cutter]\nshape = \"flat\"\ndiameter = 6\n\
+            [operation.roughing]\nstepdown = 2\nstepover = 0.2\nstock_to_leave = 0.3\n\
+            [[operation]]\nkind = \"finish\"\n[operation.cutter]\nshape = \"ball\"\ndiameter = 4\n[operation.finishing]\nscallop_height = 0.01\n";
+        let job = parse_job(rough).unwrap();
+        let r = job.operations[0].roughing.as_ref().unwrap();
+        assert_eq!((r.stepdown, r.stepover, r.stock_to_leave, r.stock_to_leave_axial), (2.0, 0.2, 0.3, None));
+        assert_eq!((r.pattern, r.direction), (RoughPatternWord::Offset, MillingWord::Climb));
+        // The job's finishing settings are the finishing operation's.
+        assert!((job.finishing.scallop_height - 0.01).abs() < 1e-15);
+        for (from, to, key) in [
+            ("stepover = 0.2", "stepover = 0.7", "roughing.stepover"),
+            ("stepdown = 2", "stepdown = 0", "roughing.stepdown"),
+            ("stock_to_leave = 0.3", "stock_to_leave = -1", "roughing.stock_to_leave"),
+            ("[operation.roughing]\nstepdown = 2\nstepover = 0.2\nstock_to_leave = 0.3\n", "", "roughing"),
+            ("stepover = 0.2", "stepover = 0.2\npattern = \"spiral\"", "pattern"),
+            ("stepover = 0.2", "stepover = 0.2\nstepovr = 1", "stepovr"),
+        ] {
+            let err = parse_job(&rough.replace(from, to)).unwrap_err().to_string();
+            assert!(err.contains(key), "{to}: {err}");
+        }
+        // A finishing table on a rough operation, a finish operation without one.
+        let err =
+            parse_job(&rough.replace(
+                "stock_to_leave = 0.3\n",
+                "stock_to_leave = 0.3\n[operation.finishing]\nscallop_height = 0.1\n",
+            ))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("operation 1") && err.contains("finishing"), "{err}");
+        let err =
+            parse_job(&rough.replace("[operation.finishing]\nscallop_height = 0.01\n", "")).unwrap_err().to_string();
+        assert!(err.contains("operation 2") && err.contains("finishing"), "{err}");
     }
 }

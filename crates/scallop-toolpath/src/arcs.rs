@@ -159,6 +159,41 @@ impl FittedPath {
         }
     }
 
+    /// The path with its XY arcs ([`Toolpath::arc`]) as `G17` arc segments and
+    /// every other move a line: arcs planned as arcs, written as they are.
+    ///
+    /// ```
+    /// use scallop_geom::{Point2, Point3};
+    /// use scallop_toolpath::{ArcXY, FittedPath, Move, MoveKind, Segment, Toolpath};
+    /// let mut path = Toolpath::new(1000.0);
+    /// path.push(Move::new(MoveKind::Rapid, Point3::new(10.0, 0.0, 0.0)));
+    /// let quarter = ArcXY { center: Point2::new(0.0, 0.0), sweep: -std::f64::consts::FRAC_PI_2 };
+    /// path.push_arc(Move::new(MoveKind::Feed, Point3::new(0.0, -10.0, 0.0)), quarter);
+    /// let f = FittedPath::with_xy_arcs(&path);
+    /// let Segment::Arc(a) = f.segments[1] else { panic!("an arc") };
+    /// assert!(!a.ccw && (a.sweep - std::f64::consts::FRAC_PI_2).abs() < 1e-15 && a.radius() == 10.0);
+    /// ```
+    #[must_use]
+    pub fn with_xy_arcs(path: &Toolpath) -> FittedPath {
+        let moves = path.moves();
+        let segments = moves
+            .iter()
+            .enumerate()
+            .map(|(k, m)| match (k, path.arc(k)) {
+                (1.., Some(arc)) => Segment::Arc(ArcMove {
+                    kind: m.kind,
+                    to: m.to,
+                    center: Point3::new(arc.center.x, arc.center.y, moves[k - 1].to.z),
+                    plane: ArcPlane::Xy,
+                    ccw: arc.sweep > 0.0,
+                    sweep: arc.sweep.abs(),
+                }),
+                _ => Segment::Line(*m),
+            })
+            .collect();
+        FittedPath { segments, last: (0..moves.len()).collect(), feed: path.feed, plunge_feed: path.plunge_feed }
+    }
+
     /// Number of arcs.
     #[must_use]
     pub fn arcs(&self) -> usize {

@@ -1,0 +1,109 @@
+//! A roughing operation in a job: planned from the stock, cut on the one
+//! stock and proven (a gouge or a rapid into stock fails `run_job`), the
+//! allowance left, G2/G3 in the program, and a finishing operation after it
+//! working on what the roughing left.
+#![allow(clippy::unwrap_used, reason = "tests: a panic is the failure report")]
+
+use scallop_cutter::{Cutter, CutterShape};
+use scallop_engine::{FinishJob, Job, Operation, Part, StockShape, run_job};
+use scallop_geom::{Aabb3, Point3};
+use scallop_mesh::TriMesh;
+use scallop_rough::{Direction, Pattern, RoughSettings};
+
+/// A block `[-6, 6] x [-5, 5] x [0, 6]` with a step on half of it up to 8,
+/// on a plate at z = 0 that spans the stock (closed boxes).
+fn part() -> TriMesh {
+    // Boxes as (min, max) corners: the plate and the two blocks; each box's
+    // 12 triangles from its 8 corners (corner bit i: x, y, z high).
+    let boxes = [
+        ([-15.0, -15.0, -0.5], [15.0, 15.0, 0.0]),
+        ([-6.0, -5.0, 0.0], [6.0, 5.0, 6.0]),
+        ([-6.0, -5.0, 6.0], [6.0, 0.0, 8.0]),
+    ];
+    const FACES: [[usize; 4]; 6] = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+    let mut soup = Vec::new();
+    for (lo, hi) in boxes {
+        let corner = |i: usize| {
+            let pick = |k: usize| if i >> k & 1 == 1 { hi[k] } else { lo[k] };
+            Point3::new(pick(0), pick(1), pick(2))
+        };
+        for f in FACES {
+            soup.push([corner(f[0]), corner(f[1]), corner(f[2])]);
+            soup.push([corner(f[0]), corner(f[2]), corner(f[3])]);
+        }
+    }
+    TriMesh::from_soup(&soup).unwrap().0
+}
+
+fn rough_job(allowance: f64) -> Job {
+    let mut finish = FinishJob::choi_demo();
+    finish.part = Part::Mesh(part());
+    finish.part_name = "stepped block".into();
+    finish.cutter = Cutter::new(CutterShape::Flat { radius: 3.0 }, 30.0).unwrap();
+    finish.sim_resolution = 0.2;
+    let settings = RoughSettings {
+        stepdown: 2.0,
+        stepover: 0.2,
+        radial_allowance: allowance,
+        axial_allowance: allowance,
+        pattern: Pattern::Offset,
+        direction: Direction::Climb,
+    };
+    let stock = Aabb3 { min: Point3::new(-12.0, -11.0, -1.0), max: Point3::new(12.0, 11.0, 10.0) };
+    Job {
+        stock: Some(StockShape::Box(stock)),
+        operations: vec![Operation { name: "rough".into(), finish, rough: Some(settings) }],
+    }
+}
+
+/// The roughing removes the stock down to the part plus the allowance: no
+/// gouge (run_job proves it), the deepest material left near the allowance
+/// on the part's floors, and arcs written as G2/G3.
+#[test]
+fn roughing_leaves_the_allowance() {
+    let allowance = 0.3;
+    let out = run_job(&rough_job(allowance)).unwrap();
+    let r = &out.report;
+    let op = &r.operations[0];
+    assert!(op.stock.removed_mm3 > 0.5 * op.stock.volume_before_mm3, "{:?}", op.stock);
+    assert!(op.plan.passes > 0 && op.plan.planes >= 6, "{:?}", op.plan);
+    // Nothing deeper than the allowance into it, beyond the path tolerance and the grid.
+    assert!(r.sim_min_deviation_mm > allowance - 0.02, "{}", r.sim_min_deviation_mm);
+    assert!(out.gcode.contains("G2") || out.gcode.contains("G3"), "no arcs");
+    // Two floors (the step's top and the block's top outside it) and the plate get levels.
+    assert!(op.plan.planes >= 7, "{:?}", op.plan);
+}
+
+/// A finishing operation after the roughing (the Choi surface, as
+/// `examples/jobs/choi-rough.toml`) starts from the roughed stock: it removes
+/// a small share of what the roughing removed, and the final stock holds
+/// the finishing scallop.
+#[test]
+fn finishing_after_roughing() {
+    let mut rough = FinishJob::choi_demo();
+    rough.cutter = Cutter::new(CutterShape::Flat { radius: 3.0 }, 40.0).unwrap();
+    let mut finish = FinishJob::choi_demo();
+    finish.scallop_height = 0.05;
+    finish.cutter = Cutter::new(CutterShape::Bull { radius: 5.0, corner: 2.0 }, 40.0).unwrap();
+    let settings = RoughSettings {
+        stepdown: 3.0,
+        stepover: 0.3,
+        radial_allowance: 0.5,
+        axial_allowance: 0.5,
+        pattern: Pattern::Offset,
+        direction: Direction::Climb,
+    };
+    let job = Job {
+        stock: Some(StockShape::AroundPart { margin: Some(5.0), top: 4.0, bottom: 1.0 }),
+        operations: vec![
+            Operation { name: "rough".into(), finish: rough, rough: Some(settings) },
+            Operation { name: "finish".into(), finish, rough: None },
+        ],
+    };
+    let out = run_job(&job).unwrap();
+    let [a, b] = [&out.report.operations[0], &out.report.operations[1]];
+    assert!(b.stock.removed_mm3 < 0.2 * a.stock.removed_mm3, "{a:?} {b:?}");
+    let r = &out.report;
+    assert!(r.sim_max_scallop_mm <= 0.05 + r.sim_resolution_bound_mm, "{r:?}");
+    assert!(out.gcode.contains("T2 M6"));
+}

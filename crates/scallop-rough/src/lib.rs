@@ -1,0 +1,636 @@
+//! 3-axis roughing (docs/roughing.md): z-level tool-centre regions of a part
+//! in a stock box, cleared level by level with contour-parallel offset
+//! passes, joined depth-first so the tool stays low.
+//!
+//! A level's tool-centre region is the stock's XY box grown by the tool
+//! radius (the tool may leave the stock on open sides) minus the inside of
+//! the part's waterline loops at the level, computed with the cutter grown
+//! radially by the radial allowance and at the level lowered by the axial
+//! allowance (`scallop-waterline`). Levels fall every stepdown from the stock
+//! top to the part's bottom, plus one on each horizontal facet of the part
+//! (floors are cut at their height, not left as terraces). Regions shrink
+//! going down, so each connected part of a level lies in one part of the
+//! level above: the parts form a tree, cut depth-first.
+
+use rayon::prelude::*;
+use scallop_contour::{Contour, P2, Region, Segment};
+use scallop_cutter::{Cutter, CutterShape};
+use scallop_geom::{Aabb3, Point2, Point3};
+use scallop_mesh::MeshIndex;
+use scallop_toolpath::{ArcXY, Move, MoveKind, Toolpath};
+use scallop_waterline::{WaterlineGrid, WaterlineOptions};
+
+mod offset;
+pub mod tol;
+
+pub use offset::{Step, plan_offset};
+
+/// Why a roughing plan could not be made; each variant names the setting and the fix.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum RoughError {
+    /// A setting out of range.
+    #[error("roughing.{key} = {value}: {fix}")]
+    BadSetting {
+        /// The job key.
+        key: &'static str,
+        /// Its value.
+        value: f64,
+        /// What to give instead.
+        fix: &'static str,
+    },
+    /// The cutter cannot be grown by the radial allowance (cone cutters).
+    #[error("roughing with a {0} cutter is not supported; use a flat, ball or bull-nose cutter")]
+    Cutter(&'static str),
+    /// The waterline kernel refused.
+    #[error("waterline of the part: {0}")]
+    Waterline(#[from] scallop_waterline::WaterlineError),
+    /// More work than the planner's bounds allow.
+    #[error("more than {limit} {what}; give a larger stepover or stepdown")]
+    TooMuchWork {
+        /// What grew too large.
+        what: &'static str,
+        /// The bound.
+        limit: usize,
+    },
+}
+
+/// Milling direction, for a spindle turning clockwise (M3).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Direction {
+    /// Climb (down) milling: the uncut material on the tool's right.
+    #[default]
+    Climb,
+    /// Conventional (up) milling.
+    Conventional,
+}
+
+/// How a region is cleared.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Pattern {
+    /// Contour-parallel offsets at the stepover, inside-out, then the region's contour.
+    #[default]
+    Offset,
+}
+
+/// Settings of the clearing of one region in the plane.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ClearOptions {
+    /// Tool radius R (mm): sizes the helical entries.
+    pub tool_radius: f64,
+    /// Radial depth of cut ae between passes (mm), `0 < ae <= R`.
+    pub stepover: f64,
+    /// Milling direction.
+    pub direction: Direction,
+    /// Chords stand for arcs within this in link checks (mm).
+    pub chord_tolerance: f64,
+}
+
+/// The settings of a roughing operation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RoughSettings {
+    /// Depth between levels (mm), > 0.
+    pub stepdown: f64,
+    /// Radial depth of cut as a fraction of the tool diameter, in (0, 0.5].
+    pub stepover: f64,
+    /// Material left on the part's walls (mm, >= 0).
+    pub radial_allowance: f64,
+    /// Material left on the part's floors (mm, >= 0).
+    pub axial_allowance: f64,
+    /// Clearing pattern.
+    pub pattern: Pattern,
+    /// Milling direction.
+    pub direction: Direction,
+}
+
+impl RoughSettings {
+    /// Checks the ranges.
+    ///
+    /// # Errors
+    /// [`RoughError::BadSetting`] naming the key.
+    pub fn validate(&self) -> Result<(), RoughError> {
+        let bad = |key, value, fix| Err(RoughError::BadSetting { key, value, fix });
+        if !(self.stepdown.is_finite() && self.stepdown > 0.0) {
+            return bad("stepdown", self.stepdown, "give a depth per level > 0 mm");
+        }
+        if !(self.stepover.is_finite() && self.stepover > 0.0 && self.stepover <= 0.5) {
+            return bad("stepover", self.stepover, "give a fraction of the tool diameter in (0, 0.5]");
+        }
+        if !(self.radial_allowance.is_finite() && self.radial_allowance >= 0.0) {
+            return bad("stock_to_leave", self.radial_allowance, "give an allowance >= 0 mm");
+        }
+        if !(self.axial_allowance.is_finite() && self.axial_allowance >= 0.0) {
+            return bad("stock_to_leave_axial", self.axial_allowance, "give an allowance >= 0 mm");
+        }
+        Ok(())
+    }
+}
+
+/// Heights and feeds of the moves between passes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Motion {
+    /// Height of rapids (mm, part frame), above all material.
+    pub clearance_z: f64,
+    /// Cutting feed (mm/min).
+    pub feed: f64,
+}
+
+/// One level of a plan.
+#[derive(Debug, Clone)]
+pub struct Level {
+    /// Tool tip height (mm).
+    pub z: f64,
+    /// The tool-centre region.
+    pub region: Region,
+}
+
+/// A roughing plan.
+#[derive(Debug, Clone)]
+pub struct RoughPlan {
+    /// The toolpath (tool tip, part frame), XY arcs attached as `ArcXY`.
+    pub toolpath: Toolpath,
+    /// The levels, top down.
+    pub levels: Vec<Level>,
+    /// Closed passes cut.
+    pub passes: usize,
+    /// Links at the cutting depth.
+    pub links: usize,
+    /// Retract-rapid-plunge connections.
+    pub retracts: usize,
+    /// Helical entries (the other entries are straight plunges).
+    pub helices: usize,
+}
+
+/// The tool-tip heights of the levels, top down: every `stepdown` below the
+/// stock top down to the part's bottom plus the axial allowance, and each
+/// horizontal facet's height plus the axial allowance.
+#[must_use]
+pub fn level_heights(index: &MeshIndex, stock: &Aabb3, settings: &RoughSettings) -> Vec<f64> {
+    let part = index.bounds();
+    let top = stock.max.z;
+    let bottom = (part.min.z + settings.axial_allowance + tol::FLAT_LIFT).max(stock.min.z);
+    let mut zs = Vec::new();
+    let mut k = 1.0;
+    while top - k * settings.stepdown > bottom + tol::LEVEL_MERGE && zs.len() < tol::MAX_LEVELS {
+        zs.push(top - k * settings.stepdown);
+        k += 1.0;
+    }
+    if bottom < top {
+        zs.push(bottom);
+    }
+    let mut flats: Vec<f64> = (0..index.len())
+        .filter(|&s| index.normal(s).z.abs() > tol::FLAT_NORMAL_Z)
+        .map(|s| index.corners(s).iter().map(|c| c.z).sum::<f64>() / 3.0)
+        .collect();
+    flats.sort_by(f64::total_cmp);
+    flats.dedup_by(|a, b| (*a - *b).abs() <= tol::FLAT_MERGE);
+    for f in flats {
+        let z = f + settings.axial_allowance + tol::FLAT_LIFT;
+        if z > bottom && z < top {
+            zs.push(z);
+        }
+    }
+    zs.sort_by(|a, b| b.total_cmp(a));
+    zs.dedup_by(|a, b| (*a - *b).abs() <= tol::LEVEL_MERGE);
+    zs
+}
+
+/// The cutter grown radially by `allowance` (the envelope the part must keep
+/// clear of to hold the allowance on its walls).
+///
+/// # Errors
+/// [`RoughError::Cutter`] for a cone; the cutter's own errors as a bad setting.
+pub fn grown_cutter(cutter: &Cutter, allowance: f64) -> Result<Cutter, RoughError> {
+    let shape = match *cutter.shape() {
+        CutterShape::Flat { radius } => CutterShape::Flat { radius: radius + allowance },
+        CutterShape::Ball { radius } if allowance > 0.0 => {
+            CutterShape::Bull { radius: radius + allowance, corner: radius }
+        }
+        CutterShape::Ball { radius } => CutterShape::Ball { radius },
+        CutterShape::Bull { radius, corner } => CutterShape::Bull { radius: radius + allowance, corner },
+        _ => return Err(RoughError::Cutter("cone")),
+    };
+    Cutter::new(shape, cutter.flute_length()).map_err(|_| RoughError::BadSetting {
+        key: "stock_to_leave",
+        value: allowance,
+        fix: "give an allowance that keeps the tool a valid cutter",
+    })
+}
+
+/// The tool-centre regions of the levels `zs` (see the crate documentation).
+///
+/// # Errors
+/// [`RoughError::Waterline`], [`RoughError::Cutter`].
+pub fn level_regions(
+    index: &MeshIndex,
+    cutter: &Cutter,
+    stock: &Aabb3,
+    settings: &RoughSettings,
+    zs: &[f64],
+    tolerance: f64,
+) -> Result<Vec<Level>, RoughError> {
+    let grown = grown_cutter(cutter, settings.radial_allowance)?;
+    let grid = WaterlineGrid::new(&grown, index, &WaterlineOptions::default())?;
+    let (zmin, zmax) = grid.z_range();
+    let r = cutter.radius();
+    let (lo, hi) = ([stock.min.x - r, stock.min.y - r], [stock.max.x + r, stock.max.y + r]);
+    let rect = Region::from_polygons(&[vec![lo, [hi[0], lo[1]], hi, [lo[0], hi[1]]]], false);
+    zs.par_iter()
+        .map(|&z| {
+            let contact = z - settings.axial_allowance;
+            if contact >= zmax {
+                return Ok(Level { z, region: rect.clone() });
+            }
+            let loops = grid.loops(contact.max(zmin))?;
+            let rings: Vec<Vec<P2>> = loops.iter().map(|l| l.points.iter().map(|p| [p.x, p.y]).collect()).collect();
+            let inside = Region::from_polygons_simplified(&rings, true, tol::SIMPLIFY);
+            Ok(Level { z, region: rect.difference(&inside, tolerance) })
+        })
+        .collect()
+}
+
+/// One connected part of one level, with its clearing plan.
+struct Node {
+    z: f64,
+    region: Region,
+    parent: Option<usize>,
+    steps: Vec<Step>,
+}
+
+/// Plans the roughing of the part in `index` from the stock box `stock`
+/// (see the crate documentation). `tolerance` is the chord tolerance of the
+/// region booleans and link checks (mm).
+///
+/// # Errors
+/// [`RoughError`]: bad settings, the waterline kernel's errors, too much work.
+pub fn plan_rough(
+    index: &MeshIndex,
+    cutter: &Cutter,
+    stock: &Aabb3,
+    settings: &RoughSettings,
+    motion: &Motion,
+    tolerance: f64,
+) -> Result<RoughPlan, RoughError> {
+    settings.validate()?;
+    let zs = level_heights(index, stock, settings);
+    let levels = level_regions(index, cutter, stock, settings, &zs, tolerance)?;
+    let options = ClearOptions {
+        tool_radius: cutter.radius(),
+        stepover: settings.stepover * 2.0 * cutter.radius(),
+        direction: settings.direction,
+        chord_tolerance: tolerance,
+    };
+    let nodes = build_tree(&levels, &options)?;
+    let mut out = Emitter::new(motion, stock.max.z, &options);
+    let roots: Vec<usize> = (0..nodes.len()).filter(|&k| nodes[k].parent.is_none()).collect();
+    visit_all(&nodes, &roots, &mut out);
+    out.finish();
+    Ok(RoughPlan {
+        toolpath: out.path,
+        levels,
+        passes: out.passes,
+        links: out.links,
+        retracts: out.retracts,
+        helices: out.helices,
+    })
+}
+
+/// The nodes of all levels with their parents and plans (planned in parallel).
+fn build_tree(levels: &[Level], options: &ClearOptions) -> Result<Vec<Node>, RoughError> {
+    let mut shells: Vec<(usize, Region)> = Vec::new();
+    for (k, level) in levels.iter().enumerate() {
+        shells.extend(level.region.components().into_iter().map(|c| (k, c)));
+    }
+    let first_of_level: Vec<usize> =
+        (0..=levels.len()).map(|k| shells.iter().position(|s| s.0 >= k).unwrap_or(shells.len())).collect();
+    let planned: Result<Vec<Vec<Step>>, RoughError> =
+        shells.par_iter().map(|(_, region)| plan_offset(region, options)).collect();
+    let planned = planned?;
+    // Parents are found among the previous level's nodes by containment.
+    let mut out: Vec<Node> = Vec::with_capacity(shells.len());
+    for ((k, region), steps) in shells.into_iter().zip(planned) {
+        let parent = if k == 0 {
+            None
+        } else {
+            (first_of_level[k - 1]..first_of_level[k]).find(|&p| contains_part(&out[p].region, &region))
+        };
+        out.push(Node { z: levels[k].z, region, parent, steps });
+    }
+    Ok(out)
+}
+
+/// Whether `child` lies in `parent`, tested at a point strictly inside the
+/// child (its outer ring may run on the parent's boundary: the stock box).
+fn contains_part(parent: &Region, child: &Region) -> bool {
+    interior_point(child).is_some_and(|p| parent.contains(p))
+}
+
+/// A point inside `region`: a chord midpoint of its first outer ring moved a
+/// little to the ring's left (the filled side), the first such point inside.
+fn interior_point(region: &Region) -> Option<P2> {
+    let ring = region.outers().next()?.to_points(tol::INTERIOR_NUDGE / 4.0);
+    (0..ring.len()).find_map(|i| {
+        let (a, b) = (ring[i], ring[(i + 1) % ring.len()]);
+        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+        let len = dx.hypot(dy);
+        let d = tol::INTERIOR_NUDGE / len;
+        let p = [0.5 * (a[0] + b[0]) - dy * d, 0.5 * (a[1] + b[1]) + dx * d];
+        (len > 4.0 * tol::INTERIOR_NUDGE && region.contains(p)).then_some(p)
+    })
+}
+
+/// Cuts the trees from `roots` depth-first, each time going on with the
+/// nearest uncut node among the children of the last one cut.
+fn visit_all(nodes: &[Node], roots: &[usize], out: &mut Emitter) {
+    let mut children: Vec<Vec<usize>> = vec![Vec::new(); nodes.len()];
+    for (k, n) in nodes.iter().enumerate() {
+        if let Some(p) = n.parent {
+            children[p].push(k);
+        }
+    }
+    let mut pending: Vec<usize> = roots.to_vec();
+    visit_siblings(nodes, &children, &mut pending, out);
+}
+
+fn visit_siblings(nodes: &[Node], children: &[Vec<usize>], pending: &mut Vec<usize>, out: &mut Emitter) {
+    while !pending.is_empty() {
+        let here = out.position();
+        let i = (0..pending.len())
+            .min_by(|&a, &b| distance_to(&nodes[pending[a]], here).total_cmp(&distance_to(&nodes[pending[b]], here)))
+            .unwrap_or(0);
+        let k = pending.remove(i);
+        out.node(nodes, k);
+        let mut next = children[k].clone();
+        visit_siblings(nodes, children, &mut next, out);
+    }
+}
+
+fn distance_to(node: &Node, here: Option<P2>) -> f64 {
+    let start = node.steps.iter().find_map(|s| match s {
+        Step::Cut(c) => c.start(),
+        Step::Link { .. } => None,
+    });
+    match (start, here) {
+        (Some(s), Some(h)) => (s[0] - h[0]).hypot(s[1] - h[1]),
+        _ => 0.0,
+    }
+}
+
+/// Writes nodes as moves.
+struct Emitter {
+    path: Toolpath,
+    clearance: f64,
+    stock_top: f64,
+    /// Chord tolerance of the link checks (mm).
+    chord: f64,
+    /// Radius of the tool centre's circle on helical entries (mm).
+    helix_radius: f64,
+    /// Helical entries made.
+    helices: usize,
+    /// The node last cut.
+    last: Option<usize>,
+    passes: usize,
+    links: usize,
+    retracts: usize,
+}
+
+impl Emitter {
+    fn new(motion: &Motion, stock_top: f64, options: &ClearOptions) -> Emitter {
+        Emitter {
+            path: Toolpath::new(motion.feed),
+            clearance: motion.clearance_z,
+            stock_top,
+            chord: options.chord_tolerance,
+            helix_radius: tol::HELIX_RADIUS_SHARE * options.tool_radius,
+            helices: 0,
+            last: None,
+            passes: 0,
+            links: 0,
+            retracts: 0,
+        }
+    }
+
+    fn position(&self) -> Option<P2> {
+        self.path.moves().last().map(|m| [m.to.x, m.to.y])
+    }
+
+    fn at(&self) -> Option<Point3> {
+        self.path.moves().last().map(|m| m.to)
+    }
+
+    /// The moves of node `k`: the way there, then its passes and links.
+    fn node(&mut self, nodes: &[Node], k: usize) {
+        let node = &nodes[k];
+        let above = node.parent.map_or(self.stock_top, |p| nodes[p].z);
+        let mut first = true;
+        for step in &node.steps {
+            match step {
+                Step::Cut(c) => {
+                    let Some(s) = c.start() else { continue };
+                    if first {
+                        self.enter(nodes, k, s);
+                        first = false;
+                    }
+                    self.cut(c, node.z);
+                }
+                Step::Link { tool_down } => {
+                    let next = next_start(&node.steps, step);
+                    if let Some(s) = next {
+                        if *tool_down {
+                            self.path.push(Move::new(MoveKind::Link, Point3::new(s[0], s[1], node.z)));
+                            self.links += 1;
+                        } else {
+                            self.retract_to(s, above, node.z, &node.region);
+                        }
+                    }
+                }
+            }
+        }
+        self.last = Some(k);
+    }
+
+    /// From the last node to the start `s` of node `k`: up to the deepest
+    /// level both lie in, across it when the straight move stays in its
+    /// region, else over the clearance height; then down through the cleared
+    /// levels above `k` and a plunge.
+    fn enter(&mut self, nodes: &[Node], k: usize, s: P2) {
+        let node = &nodes[k];
+        let above = node.parent.map_or(self.stock_top, |p| nodes[p].z);
+        let (Some(here), Some(last)) = (self.at(), self.last) else {
+            self.path.push(Move::new(MoveKind::Rapid, Point3::new(s[0], s[1], self.clearance)));
+            self.plunge(s, above, node.z, &node.region);
+            return;
+        };
+        let ancestors = chain(nodes, k);
+        let mut common = Some(last);
+        while let Some(c) = common {
+            if ancestors.contains(&c) {
+                break;
+            }
+            common = nodes[c].parent;
+        }
+        // The last pass ends on its region's contour: grown a hair, the
+        // region holds it.
+        let across = common
+            .filter(|&c| nodes[c].region.offset(-tol::LINK_GROW).contains_segment([here.x, here.y], s, self.chord));
+        match across {
+            Some(c) => {
+                let zc = nodes[c].z;
+                if here.z < zc {
+                    self.path.push(Move::new(MoveKind::Rapid, Point3::new(here.x, here.y, zc)));
+                }
+                self.path.push(Move::new(MoveKind::Link, Point3::new(s[0], s[1], zc)));
+                self.links += 1;
+                self.plunge(s, above.min(zc), node.z, &node.region);
+            }
+            None => {
+                self.retracts += 1;
+                self.path.push(Move::new(MoveKind::Retract, Point3::new(here.x, here.y, self.clearance)));
+                self.path.push(Move::new(MoveKind::Rapid, Point3::new(s[0], s[1], self.clearance)));
+                self.plunge(s, above, node.z, &node.region);
+            }
+        }
+    }
+
+    /// Down from the cleared height `above` to `z` at `s`: a rapid to
+    /// `APPROACH` above it (when higher), then a helix about `s` when its
+    /// circle fits in `region` (the tool centre's circle of
+    /// [`tol::HELIX_RADIUS_SHARE`] R, descending at [`tol::HELIX_SLOPE`], one
+    /// full turn at `z`, counter-clockwise: climb in the bore), else a
+    /// straight plunge.
+    fn plunge(&mut self, s: P2, above: f64, z: f64, region: &Region) {
+        let current = self.at().map_or(self.clearance, |p| p.z);
+        let approach = above + tol::APPROACH;
+        let rh = self.helix_radius;
+        let depth = above - z;
+        let fits = rh > 0.0 && depth > 0.0 && region.offset(rh).contains(s);
+        let start = if fits { [s[0] + rh, s[1]] } else { s };
+        if current > approach {
+            self.path.push(Move::new(MoveKind::Rapid, Point3::new(start[0], start[1], approach)));
+        } else if fits {
+            self.path.push(Move::new(MoveKind::Link, Point3::new(start[0], start[1], current)));
+        }
+        if !fits {
+            self.path.push(Move::new(MoveKind::Plunge, Point3::new(s[0], s[1], z)));
+            return;
+        }
+        self.path.push(Move::new(MoveKind::Plunge, Point3::new(start[0], start[1], above.min(current))));
+        let per_turn = std::f64::consts::TAU * rh * tol::HELIX_SLOPE;
+        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a small positive count")]
+        let quarters = 4 * ((above.min(current) - z) / per_turn).ceil().max(1.0) as usize + 4;
+        let top = above.min(current);
+        #[allow(clippy::cast_precision_loss, reason = "a small count")]
+        let descent = quarters as f64 - 4.0;
+        for i in 1..=quarters {
+            #[allow(clippy::cast_precision_loss, reason = "a small count")]
+            let a = std::f64::consts::FRAC_PI_2 * i as f64;
+            #[allow(clippy::cast_precision_loss, reason = "a small count")]
+            let zi = if (i as f64) < descent { top - (top - z) * i as f64 / descent } else { z };
+            let arc = ArcXY { center: Point2::new(s[0], s[1]), sweep: std::f64::consts::FRAC_PI_2 };
+            self.path
+                .push_arc(Move::new(MoveKind::Feed, Point3::new(s[0] + rh * a.cos(), s[1] + rh * a.sin(), zi)), arc);
+        }
+        self.path.push(Move::new(MoveKind::Feed, Point3::new(s[0], s[1], z)));
+        self.helices += 1;
+    }
+
+    /// A retract within a level: up to the clearance, over, and down.
+    fn retract_to(&mut self, s: P2, above: f64, z: f64, region: &Region) {
+        let Some(here) = self.at() else { return };
+        self.retracts += 1;
+        self.path.push(Move::new(MoveKind::Retract, Point3::new(here.x, here.y, self.clearance)));
+        self.path.push(Move::new(MoveKind::Rapid, Point3::new(s[0], s[1], self.clearance)));
+        self.plunge(s, above, z, region);
+    }
+
+    /// The last retract to the clearance height.
+    fn finish(&mut self) {
+        if let Some(p) = self.at() {
+            self.path.push(Move::new(MoveKind::Retract, Point3::new(p.x, p.y, self.clearance)));
+        }
+    }
+
+    fn cut(&mut self, c: &Contour, z: f64) {
+        push_contour(&mut self.path, c, z);
+        self.passes += 1;
+    }
+}
+
+/// The node and its ancestors.
+fn chain(nodes: &[Node], k: usize) -> Vec<usize> {
+    let mut out = vec![k];
+    let mut c = nodes[k].parent;
+    while let Some(p) = c {
+        out.push(p);
+        c = nodes[p].parent;
+    }
+    out
+}
+
+/// The start of the cut after `step` in `steps`.
+fn next_start(steps: &[Step], step: &Step) -> Option<P2> {
+    let i = steps.iter().position(|s| std::ptr::eq(s, step))?;
+    steps[i + 1..].iter().find_map(|s| match s {
+        Step::Cut(c) => c.start(),
+        Step::Link { .. } => None,
+    })
+}
+
+/// Appends the closed contour `c` at height `z` as feed moves from its start
+/// (the tool is there): lines, and arcs split to at most
+/// [`tol::MAX_ARC_SWEEP`] each.
+pub fn push_contour(path: &mut Toolpath, c: &Contour, z: f64) {
+    for seg in c.segments() {
+        match seg {
+            Segment::Line { to, .. } => path.push(Move::new(MoveKind::Feed, Point3::new(to[0], to[1], z))),
+            Segment::Arc { from, to, center, sweep } => {
+                #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a small positive count")]
+                let pieces = (sweep.abs() / tol::MAX_ARC_SWEEP).ceil().max(1.0) as usize;
+                let r = (from[0] - center[0]).hypot(from[1] - center[1]);
+                let a0 = (from[1] - center[1]).atan2(from[0] - center[0]);
+                #[allow(clippy::cast_precision_loss, reason = "a small count")]
+                let step = sweep / pieces as f64;
+                for i in 1..=pieces {
+                    #[allow(clippy::cast_precision_loss, reason = "a small count")]
+                    let a = a0 + step * i as f64;
+                    let p = if i == pieces { to } else { [center[0] + r * a.cos(), center[1] + r * a.sin()] };
+                    let arc = ArcXY { center: Point2::new(center[0], center[1]), sweep: step };
+                    path.push_arc(Move::new(MoveKind::Feed, Point3::new(p[0], p[1], z)), arc);
+                }
+            }
+        }
+    }
+}
+
+/// The offset clearing of one 2D pocket at height `z` from the height
+/// `top` (the material's top): a plunge at the first pass, links and
+/// retracts as planned (see [`plan_offset`]).
+///
+/// # Errors
+/// As [`plan_offset`].
+pub fn pocket_toolpath(
+    region: &Region,
+    options: &ClearOptions,
+    z: f64,
+    top: f64,
+    motion: &Motion,
+) -> Result<RoughPlan, RoughError> {
+    let mut out = Emitter::new(motion, top, options);
+    let mut nodes = Vec::new();
+    for part in region.components() {
+        let steps = plan_offset(&part, options)?;
+        nodes.push(Node { z, region: part, parent: None, steps });
+    }
+    let roots: Vec<usize> = (0..nodes.len()).collect();
+    visit_all(&nodes, &roots, &mut out);
+    out.finish();
+    let level = Level { z, region: region.clone() };
+    Ok(RoughPlan {
+        toolpath: out.path,
+        levels: vec![level],
+        passes: out.passes,
+        links: out.links,
+        retracts: out.retracts,
+        helices: out.helices,
+    })
+}

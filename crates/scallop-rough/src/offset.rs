@@ -1,0 +1,102 @@
+//! Contour-parallel offset clearing of one tool-centre region.
+//!
+//! The region (where the tool centre may go) is eroded by the stepover ae
+//! again and again: `levels[k]` is the region eroded by `k ae` (erosion by
+//! discs composes, so each is the previous one eroded by ae). The rings of
+//! each level are cut from the deepest level out (inside-out), so every pass
+//! but the first of a branch has uncut material on one side only, about ae
+//! wide, and the last pass (`k = 0`) is the contour of the region at the
+//! allowance.
+//!
+//! Cleared area. When every ring of the levels above k has been cut, the
+//! tool has swept every point within R of `levels[k + 1]` (a point of it is
+//! within ae <= R of the deepest ring around it). A tool centre at distance
+//! t from `levels[k + 1]` then meets uncut material at most `t - ae` deep,
+//! so a link inside `levels[k + 1]` grown by `2 ae` engages no more than a
+//! pass does: such links stay down at the cutting depth; any other is a
+//! retract.
+
+use scallop_contour::{Contour, P2, Region};
+
+use crate::{ClearOptions, Direction, RoughError, tol};
+
+/// One step of a clearing plan in the plane.
+#[derive(Debug, Clone)]
+pub enum Step {
+    /// A closed pass along the contour, from its first vertex back to it.
+    Cut(Contour),
+    /// The move to the next cut's start: at the cutting depth through
+    /// cleared area when `tool_down`, else by a retract.
+    Link {
+        /// Stays at the cutting depth.
+        tool_down: bool,
+    },
+}
+
+/// The offset clearing of `region` (a tool-centre region): passes and links
+/// (see the module documentation).
+///
+/// # Errors
+/// [`RoughError::TooMuchWork`] beyond [`tol::MAX_PASSES`] levels.
+pub fn plan_offset(region: &Region, options: &ClearOptions) -> Result<Vec<Step>, RoughError> {
+    let ae = options.stepover;
+    let mut levels = vec![region.clone()];
+    loop {
+        let next = levels[levels.len() - 1].offset(ae);
+        if next.is_empty() {
+            break;
+        }
+        if levels.len() >= tol::MAX_PASSES {
+            return Err(RoughError::TooMuchWork { what: "offset passes", limit: tol::MAX_PASSES });
+        }
+        levels.push(next);
+    }
+    let grow = 2.0 * ae + tol::LINK_MARGIN_SHARE * ae;
+    let bands: Vec<Option<Region>> =
+        (0..levels.len()).map(|k| levels.get(k + 1).map(|inner| inner.offset(-grow))).collect();
+    // The passes of level 0 lie on the region's contour: grown a hair, the
+    // region holds them.
+    let holder = region.offset(-tol::LINK_GROW);
+    let mut steps = Vec::new();
+    let mut pos: Option<P2> = None;
+    for k in (0..levels.len()).rev() {
+        let mut rings: Vec<&Contour> = levels[k].rings().iter().collect();
+        while !rings.is_empty() {
+            let (i, ring) = nearest(&rings, pos, options.direction);
+            rings.swap_remove(i);
+            let Some(start) = ring.start() else { continue };
+            if let Some(p) = pos {
+                let down = bands[k].as_ref().is_some_and(|band| {
+                    band.contains_segment(p, start, options.chord_tolerance)
+                        && holder.contains_segment(p, start, options.chord_tolerance)
+                });
+                steps.push(Step::Link { tool_down: down });
+            }
+            pos = Some(start);
+            steps.push(Step::Cut(ring));
+        }
+    }
+    Ok(steps)
+}
+
+/// The ring nearest `pos`, oriented for `direction` and started at its point
+/// nearest `pos`. Climb milling with a clockwise spindle keeps the uncut
+/// material on the tool's right: inside-out, that is the region's own
+/// orientation (the material lies outside each ring's filled side).
+fn nearest(rings: &[&Contour], pos: Option<P2>, direction: Direction) -> (usize, Contour) {
+    let orient = |c: &Contour| match direction {
+        Direction::Climb => c.clone(),
+        Direction::Conventional => c.reversed(),
+    };
+    let Some(p) = pos else { return (0, orient(rings[0])) };
+    let mut best: Option<(f64, usize, Contour)> = None;
+    for (i, r) in rings.iter().enumerate() {
+        let c = orient(r).starting_near(p);
+        let s = c.start().unwrap_or(p);
+        let d = (s[0] - p[0]).hypot(s[1] - p[1]);
+        if best.as_ref().is_none_or(|b| d < b.0) {
+            best = Some((d, i, c));
+        }
+    }
+    best.map_or_else(|| (0, orient(rings[0])), |(_, i, c)| (i, c))
+}

@@ -1,0 +1,59 @@
+//! Named tolerances and thresholds of the roughing planner (mm unless said).
+
+/// Extra width, as a share of the stepover, allowed around the band a
+/// tool-down link may cross: a link's radial engagement stays within about
+/// one stepover (see `offset.rs`).
+pub const LINK_MARGIN_SHARE: f64 = 0.05;
+
+/// A facet whose unit normal has `z` above this is horizontal (a floor that
+/// gets a level of its own): within 0.08 degrees of level.
+pub const FLAT_NORMAL_Z: f64 = 1.0 - 1e-6;
+
+/// Heights of flat facets closer than this are one floor.
+pub const FLAT_MERGE: f64 = 1e-3;
+
+/// Levels closer than this are one level (the higher is kept).
+pub const LEVEL_MERGE: f64 = 1e-3;
+
+/// A floor's level is this far above the floor plus the axial allowance, so
+/// the waterline height is never exactly a facet's height (where every grid
+/// sample would tie).
+pub const FLAT_LIFT: f64 = 1e-5;
+
+/// Rapids down into cleared area stop this far above the cleared level; a
+/// plunge at the plunge feed does the rest.
+pub const APPROACH: f64 = 1.0;
+
+/// Largest sweep of one arc move (rad): longer arcs are split so that no
+/// move reads as a full circle and the centre words stay well defined.
+pub const MAX_ARC_SWEEP: f64 = std::f64::consts::FRAC_PI_2;
+
+/// Most offset passes of one region (bounds the work on absurd inputs).
+pub const MAX_PASSES: usize = 100_000;
+
+/// Most levels of one plan.
+pub const MAX_LEVELS: usize = 10_000;
+
+/// A region is grown by this before testing whether a link stays in it, so
+/// that passes on its contour count as inside (mm): the tool may go this far
+/// into the allowance on a link.
+pub const LINK_GROW: f64 = 1e-4;
+
+/// Waterline loops are thinned by Douglas-Peucker at this before the region
+/// booleans (mm): their points lie within the waterline's chord tolerance
+/// (1e-4 mm) of each other's chords, far denser than a roughing region needs.
+/// The region's boundary moves by at most this (into the allowance, and with
+/// no allowance into the part: within the job's path tolerance).
+pub const SIMPLIFY: f64 = 1e-3;
+
+/// Helical entries: the tool centre's circle has this share of the tool
+/// radius (the bore is 1.5 D wide, no core left in its middle).
+pub const HELIX_RADIUS_SHARE: f64 = 0.5;
+
+/// Helical entries descend this much per unit of length along the circle
+/// (tan of about 3 degrees).
+pub const HELIX_SLOPE: f64 = 0.05;
+
+/// A point this far inside a ring (from a chord's midpoint, along its
+/// normal) stands for the region in containment tests between levels (mm).
+pub const INTERIOR_NUDGE: f64 = 1e-3;

@@ -1,0 +1,211 @@
+//! Roughing: regions inside the stock and outside the part grown by the
+//! allowances (brute-force drop-cutter), pockets cleared (a brute-force
+//! coverage oracle), climb orientation, tool-down links inside the cleared
+//! area, and the same plan on one and two threads.
+#![allow(clippy::unwrap_used, reason = "tests: a panic is the failure report")]
+
+use proptest::prelude::*;
+use scallop_contour::{Contour, Region};
+use scallop_cutter::{Cutter, CutterShape, drop_cutter};
+use scallop_geom::{Aabb3, Point2, Point3};
+use scallop_mesh::{MeshIndex, TriMesh};
+use scallop_rough::{
+    ClearOptions, Direction, Motion, Pattern, RoughSettings, Step, grown_cutter, plan_offset, plan_rough,
+    pocket_toolpath,
+};
+use scallop_toolpath::{MoveKind, Toolpath};
+
+/// A box `[x0, x1] x [y0, y1] x [0, h]` on a plate `[-p, p]^2` at z = 0 and a
+/// step `[x0, x1] x [y0, mid] x [h, h + s]`: two floors and walls.
+fn stepped_part(x0: f64, x1: f64, y0: f64, y1: f64, h: f64, s: f64) -> TriMesh {
+    let p = |x, y, z| Point3::new(x, y, z);
+    let mut soup = Vec::new();
+    let mut quad = |a: Point3, b: Point3, c: Point3, d: Point3| {
+        soup.push([a, b, c]);
+        soup.push([a, c, d]);
+    };
+    let plate = 40.0;
+    quad(p(-plate, -plate, 0.0), p(plate, -plate, 0.0), p(plate, plate, 0.0), p(-plate, plate, 0.0));
+    let mut block = |x0: f64, x1: f64, y0: f64, y1: f64, z0: f64, z1: f64| {
+        quad(p(x0, y0, z1), p(x1, y0, z1), p(x1, y1, z1), p(x0, y1, z1));
+        quad(p(x0, y0, z0), p(x1, y0, z0), p(x1, y0, z1), p(x0, y0, z1));
+        quad(p(x1, y0, z0), p(x1, y1, z0), p(x1, y1, z1), p(x1, y0, z1));
+        quad(p(x1, y1, z0), p(x0, y1, z0), p(x0, y1, z1), p(x1, y1, z1));
+        quad(p(x0, y1, z0), p(x0, y0, z0), p(x0, y0, z1), p(x0, y1, z1));
+    };
+    block(x0, x1, y0, y1, 0.0, h);
+    block(x0, x1, y0, 0.5 * (y0 + y1), h, h + s);
+    TriMesh::from_soup(&soup).unwrap().0
+}
+
+fn settings(stepdown: f64, radial: f64, axial: f64) -> RoughSettings {
+    RoughSettings {
+        stepdown,
+        stepover: 0.2,
+        radial_allowance: radial,
+        axial_allowance: axial,
+        pattern: Pattern::Offset,
+        direction: Direction::Climb,
+    }
+}
+
+/// Points along the cutting moves (feeds, links; arcs as chords) every `step` mm.
+fn samples(path: &Toolpath, step: f64) -> Vec<Point3> {
+    let mut out = Vec::new();
+    let moves = path.moves();
+    for k in 1..moves.len() {
+        let m = moves[k];
+        if !matches!(m.kind, MoveKind::Feed | MoveKind::Link | MoveKind::Plunge) {
+            continue;
+        }
+        let a = moves[k - 1].to;
+        let pts: Vec<Point3> = match path.arc(k) {
+            Some(arc) => {
+                let c = arc.center;
+                let r = (a.x - c.x).hypot(a.y - c.y);
+                let a0 = (a.y - c.y).atan2(a.x - c.x);
+                let n = ((arc.sweep.abs() * r / step).ceil() as usize).max(1);
+                (0..=n)
+                    .map(|i| {
+                        let t = a0 + arc.sweep * i as f64 / n as f64;
+                        Point3::new(c.x + r * t.cos(), c.y + r * t.sin(), m.to.z)
+                    })
+                    .collect()
+            }
+            None => {
+                let n = (((m.to - a).norm() / step).ceil() as usize).max(1);
+                (0..=n).map(|i| a + (m.to - a) * (i as f64 / n as f64)).collect()
+            }
+        };
+        out.extend(pts);
+    }
+    out
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(6))]
+
+    /// Every level's region lies in the stock box grown by R and outside the
+    /// part grown by the allowances: the grown cutter dropped at its ring
+    /// points stays below the level less the axial allowance; every cutting
+    /// sample of the path is as safe with the real cutter.
+    #[test]
+    fn regions_inside_stock_and_outside_the_grown_part(
+        w in 8.0..20.0_f64, d in 8.0..20.0_f64, h in 3.0..9.0_f64, s in 1.0..4.0_f64,
+        radial in 0.0..0.8_f64, axial in 0.0..0.5_f64, stepdown in 1.0..3.0_f64,
+    ) {
+        let mesh = stepped_part(-w / 2.0, w / 2.0, -d / 2.0, d / 2.0, h, s);
+        let index = MeshIndex::build(&mesh);
+        let cutter = Cutter::new(CutterShape::Flat { radius: 3.0 }, 40.0).unwrap();
+        let stock = Aabb3 { min: Point3::new(-w / 2.0 - 5.0, -d / 2.0 - 5.0, 0.0), max: Point3::new(w / 2.0 + 5.0, d / 2.0 + 5.0, h + s + 2.0) };
+        let set = settings(stepdown, radial, axial);
+        let motion = Motion { clearance_z: h + s + 10.0, feed: 1000.0 };
+        let plan = plan_rough(&index, &cutter, &stock, &set, &motion, 1e-3).unwrap();
+        // Both floors get a level: the step's top and the plate.
+        for floor in [h, h + s] {
+            prop_assert!(plan.levels.iter().any(|l| (l.z - floor - axial).abs() < 1e-3), "{:?}", plan.levels.iter().map(|l| l.z).collect::<Vec<_>>());
+        }
+        let grown = grown_cutter(&cutter, radial).unwrap();
+        for level in &plan.levels {
+            for ring in level.region.rings() {
+                for p in ring.to_points(1e-3) {
+                    prop_assert!(p[0] >= stock.min.x - 3.0 - 1e-6 && p[0] <= stock.max.x + 3.0 + 1e-6);
+                    prop_assert!(p[1] >= stock.min.y - 3.0 - 1e-6 && p[1] <= stock.max.y + 3.0 + 1e-6);
+                    let cl = drop_cutter(&grown, &index, Point2::new(p[0], p[1]), f64::NEG_INFINITY);
+                    // The loops and booleans are within 1e-3 mm of the exact contour.
+                    let ok = cl.tip.z <= level.z - axial + 1e-9
+                        || drop_cutter(&grown, &index, Point2::new(p[0], p[1]), f64::NEG_INFINITY).tip.z <= level.z - axial + 1e-9;
+                    let near = [[1e-3, 0.0], [-1e-3, 0.0], [0.0, 1e-3], [0.0, -1e-3]].iter().any(|o| {
+                        drop_cutter(&grown, &index, Point2::new(p[0] + o[0], p[1] + o[1]), f64::NEG_INFINITY).tip.z <= level.z - axial + 1e-9
+                    });
+                    prop_assert!(ok || near, "ring point {p:?} at level {} is in the grown part ({})", level.z, cl.tip.z);
+                }
+            }
+        }
+        // The thinned loops (tol::SIMPLIFY) and the links' slack (tol::LINK_GROW)
+        // may bring a tool centre that close to the exact contour, no closer.
+        let slack = scallop_rough::tol::SIMPLIFY + scallop_rough::tol::LINK_GROW;
+        let safe = |x: f64, y: f64, z: f64| drop_cutter(&cutter, &index, Point2::new(x, y), f64::NEG_INFINITY).tip.z <= z - axial + 1e-9;
+        for q in samples(&plan.toolpath, 0.25) {
+            let near = (0..16).any(|i| {
+                let a = std::f64::consts::PI * f64::from(i) / 8.0;
+                safe(q.x + slack * a.cos(), q.y + slack * a.sin(), q.z)
+            });
+            prop_assert!(safe(q.x, q.y, q.z) || near, "{q:?} below the part + allowance");
+        }
+    }
+
+    /// A rectangular pocket with a round island, cleared: every point of the
+    /// area the tool can reach (the tool-centre region grown by R) lies within
+    /// R of the cutting path (brute force), every pass is in the region, and
+    /// the outer rings run counter-clockwise (climb).
+    #[test]
+    fn pockets_are_cleared(w in 20.0..60.0_f64, h in 20.0..50.0_f64, isl in 2.0..6.0_f64, f in 0.1..0.5_f64) {
+        let r = 3.0;
+        let wall = Region::with_holes(
+            Contour::polygon(&[[0.0, 0.0], [w, 0.0], [w, h], [0.0, h]], true).unwrap(),
+            vec![Contour::circle([w / 2.0, h / 2.0], isl).unwrap()],
+        ).unwrap();
+        let region = wall.offset(r);
+        let options = ClearOptions { tool_radius: r, stepover: f * 2.0 * r, direction: Direction::Climb, chord_tolerance: 1e-3 };
+        // Climb: the last (largest) pass runs counter-clockwise along the wall,
+        // the passes around the island clockwise; conventional: the reverse.
+        for (direction, sign) in [(Direction::Climb, 1.0), (Direction::Conventional, -1.0)] {
+            let steps = plan_offset(&region, &ClearOptions { direction, ..options }).unwrap();
+            let areas: Vec<f64> = steps.iter().filter_map(|s| match s {
+                Step::Cut(c) => Some(sign * c.signed_area()),
+                Step::Link { .. } => None,
+            }).collect();
+            let largest = areas.iter().copied().fold(0.0_f64, |m, a| if a.abs() > m.abs() { a } else { m });
+            prop_assert!(largest > 0.0, "{direction:?}: {areas:?}");
+            // (The island's ring may merge with the wall's for large islands.)
+            let has_hole = region.rings().iter().any(|r| !r.is_ccw());
+            prop_assert!(!has_hole || areas.iter().any(|&a| a < 0.0), "{direction:?}: no pass around the island");
+        }
+        let motion = Motion { clearance_z: 5.0, feed: 1000.0 };
+        let plan = pocket_toolpath(&region, &options, -1.0, 0.0, &motion).unwrap();
+        let pts = samples(&plan.toolpath, 0.1);
+        let holder = region.offset(-1e-3);
+        for q in &pts {
+            if q.z < -0.5 {
+                prop_assert!(holder.contains([q.x, q.y]), "{q:?} leaves the tool-centre region");
+            }
+        }
+        let reach = region.offset(-(r - 0.02));
+        let mut grid = Vec::new();
+        for i in 0..60 { for j in 0..60 {
+            let p = [w * (i as f64 + 0.5) / 60.0, h * (j as f64 + 0.5) / 60.0];
+            if reach.contains(p) { grid.push(p); }
+        }}
+        for p in grid {
+            let covered = pts.iter().any(|q| q.z < -0.5 && (q.x - p[0]).hypot(q.y - p[1]) <= r);
+            prop_assert!(covered, "{p:?} left uncut");
+        }
+    }
+}
+
+/// The tool-down links of a pocket stay where the material is cut: the link
+/// never crosses the island, and the plan is the same on one and two threads.
+#[test]
+fn links_and_threads() {
+    let mesh = stepped_part(-6.0, 6.0, -5.0, 5.0, 6.0, 2.0);
+    let index = MeshIndex::build(&mesh);
+    let cutter = Cutter::new(CutterShape::Flat { radius: 3.0 }, 40.0).unwrap();
+    let stock = Aabb3 { min: Point3::new(-11.0, -10.0, 0.0), max: Point3::new(11.0, 10.0, 10.0) };
+    let motion = Motion { clearance_z: 20.0, feed: 1000.0 };
+    let set = settings(2.0, 0.3, 0.1);
+    let run = |threads| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| plan_rough(&index, &cutter, &stock, &set, &motion, 1e-3).unwrap())
+    };
+    let (a, b) = (run(1), run(2));
+    assert_eq!(a.toolpath, b.toolpath);
+    assert!(a.passes > 0 && a.links > 0, "{} passes {} links", a.passes, a.links);
+    let moves = a.toolpath.moves();
+    // Links are horizontal.
+    for k in 1..moves.len() {
+        if moves[k].kind == MoveKind::Link {
+            assert!((moves[k].to.z - moves[k - 1].to.z).abs() < 1e-12);
+        }
+    }
+}
