@@ -19,7 +19,7 @@ set -euo pipefail
 caller_dir=$(pwd)
 repo_root=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 here="$repo_root/bench/freecad"
-workdir=/tmp/scallop-freecad-bench
+workdir="$repo_root/target/freecad-bench"
 scallop=""
 reduced=()
 markdown=""
