@@ -342,20 +342,11 @@ pub fn plan_zone_finishing(
     plan(index, cutter, params, tol, Some(region), false)
 }
 
-/// [`plan_zone_finishing`] that does not refuse the part where no spacing
-/// holds `sh` (a crease or corner the cutter cannot reach): the planes there
-/// keep the spacing rule's gap and the stock simulation tells rest material
-/// from scallop (steep-and-shallow finishing, issue 15 item 4).
-pub(crate) fn plan_zone_tolerant(
-    index: &MeshIndex,
-    cutter: &Cutter,
-    params: &FinishingParams,
-    tol: &Tolerances,
-    region: &ZoneRegion,
-) -> Result<Planned, StrategyError> {
-    plan(index, cutter, params, tol, Some(region), true)
-}
-
+/// Plans parallel planes (in `region` when given); with `tolerate_rest` the
+/// planner keeps the spacing rule's gap where no spacing holds `sh` (a crease
+/// or corner the cutter cannot reach) instead of refusing the part, and the
+/// stock simulation tells rest material from scallop (steep-and-shallow
+/// finishing, issue 15 item 4).
 fn plan(
     index: &MeshIndex,
     cutter: &Cutter,

@@ -155,7 +155,7 @@ pub fn plan_steep_shallow(
     let labels: Vec<u32> = slopes.iter().map(|&s| u32::from(s >= split.threshold + split.overlap)).collect();
     let shallow = if labels.contains(&0) {
         let region = ZoneRegion::new(mesh, &labels, 0, 0.0)?;
-        match crate::plan_zone_tolerant(index, cutter, params, tol_, &region) {
+        match crate::plan(index, cutter, params, tol_, Some(&region), true) {
             Ok(p) => Some(p),
             Err(StrategyError::EmptyRegion { .. }) => None,
             Err(e) => return Err(e),
