@@ -204,7 +204,18 @@ pub fn run_job(job: &Job) -> Result<JobOutput, EngineError> {
         let top_before = zmap.max_top().unwrap_or(stock.min.z);
         let clearance = f.clearance.max(top_before + STOCK_CLEARANCE_MM - part_top);
         let p = match &op.rough {
-            Some(r) => Planned::Rough(Box::new(plan_rough_operation(f, r, &prepared, &stock, clearance, &tolerances)?)),
+            Some(r) => {
+                let material = crate::rough::material_of(&zmap)?;
+                Planned::Rough(Box::new(plan_rough_operation(
+                    f,
+                    r,
+                    &prepared,
+                    &stock,
+                    material.as_ref(),
+                    clearance,
+                    &tolerances,
+                )?))
+            }
             None => Planned::Finish(Box::new(plan_operation(f, &prepared, &tolerances, Some(clearance))?)),
         };
         let volume_before = zmap.volume();

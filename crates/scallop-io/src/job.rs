@@ -104,6 +104,10 @@ pub enum OperationKind {
     Finish,
     /// Z-level roughing from the stock (`[operation.roughing]`).
     Rough,
+    /// Rest roughing (`[operation.roughing]`): z-level roughing of only the
+    /// material the earlier operations left (docs/roughing.md); never the
+    /// first operation.
+    Rest,
 }
 
 /// `[[operation]]`: one operation with its own cutter, tool and spindle.
@@ -1014,6 +1018,12 @@ pub fn parse_job_with_tools(text: &str, library: Option<&ToolLibrary>) -> Result
         let checked = match op.kind {
             OperationKind::Finish => check_finish_kind(op).and_then(|()| check_cutting(&op.cutter, &op.finishing)),
             OperationKind::Rough => check_rough(op),
+            OperationKind::Rest if k == 0 => Err(JobError::Value {
+                key: "kind",
+                value: "rest".into(),
+                fix: "rest roughing machines what earlier operations left: put a kind = \"rough\" operation before it",
+            }),
+            OperationKind::Rest => check_rough(op),
         };
         checked.map_err(|e| {
             if job.operation_list {
@@ -1112,7 +1122,7 @@ fn check_finish_kind(op: &OperationSpec) -> Result<(), JobError> {
         return Err(JobError::Value {
             key: "roughing",
             value: "given".into(),
-            fix: "[operation.roughing] belongs to kind = \"rough\" operations",
+            fix: "[operation.roughing] belongs to kind = \"rough\" and \"rest\" operations",
         });
     }
     if op.finishing.scallop_height.is_nan() {
@@ -1487,5 +1497,17 @@ mod tests {
         let err =
             parse_job(&rough.replace("[operation.finishing]\nscallop_height = 0.01\n", "")).unwrap_err().to_string();
         assert!(err.contains("operation 2") && err.contains("finishing"), "{err}");
+        // Rest roughing reads as roughing, after an earlier operation only.
+        let rest = rough.replace(
+            "[[operation]]\nkind = \"finish\"",
+            "[[operation]]\nkind = \"rest\"\n[operation.cutter]\nshape = \"flat\"\ndiameter = 2\n\
+             [operation.roughing]\nstepdown = 1\nstepover = 0.2\nstock_to_leave = 0.3\n[[operation]]\nkind = \"finish\"",
+        );
+        let job = parse_job(&rest).unwrap();
+        assert_eq!(job.operations[1].kind, OperationKind::Rest);
+        assert!(job.operations[1].roughing.is_some());
+        let first = rest.replacen("kind = \"rough\"", "kind = \"rest\"", 1);
+        let err = parse_job(&first).unwrap_err().to_string();
+        assert!(err.contains("operation 1") && err.contains("kind = \"rough\" operation before it"), "{err}");
     }
 }

@@ -57,3 +57,12 @@ pub const HELIX_SLOPE: f64 = 0.05;
 /// A point this far inside a ring (from a chord's midpoint, along its
 /// normal) stands for the region in containment tests between levels (mm).
 pub const INTERIOR_NUDGE: f64 = 1e-3;
+
+/// Material less than this above a level (mm) is not worth a pass: the
+/// in-process stock's cells that hold only this much over the level count
+/// as cleared (see `material.rs`).
+pub const MIN_CHIP: f64 = 0.05;
+
+/// Most cells of an in-process stock map (bounds the memory of the outline
+/// tracing on absurd inputs).
+pub const MAX_MATERIAL_CELLS: usize = 64_000_000;
