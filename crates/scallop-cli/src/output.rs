@@ -139,7 +139,7 @@ pub fn write_job(out: &scallop_engine::JobOutput, seconds: f64, folder: &Path, j
     for (k, op) in r.operations.iter().enumerate() {
         text.push_str(&format!(
             "  {}. {} (T{}): {}, scallop height {} mm, feed at {:.2}° from X; {} passes, {} + {:.1} s rapids; \
-             removed {:.0} mm³ of the {:.0} mm³ it met, {:.0} % of its feed moves in air\n",
+             removed {:.0} mm³ of the {:.0} mm³ it met, {:.0} % of its feed length in air\n",
             k + 1,
             op.name,
             op.tool,
@@ -151,7 +151,7 @@ pub fn write_job(out: &scallop_engine::JobOutput, seconds: f64, folder: &Path, j
             op.plan.rapid_time_s,
             op.stock.removed_mm3,
             op.stock.volume_before_mm3,
-            100.0 * op.stock.air_cut_share
+            100.0 * op.stock.air_length_share
         ));
     }
     text.push_str(&format!(

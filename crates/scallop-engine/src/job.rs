@@ -105,6 +105,8 @@ pub struct StockFigures {
     pub removed_mm3: f64,
     /// Share of its feed moves that removed nothing (air), in [0, 1].
     pub air_cut_share: f64,
+    /// Share of its feed length that removed nothing (air), in [0, 1].
+    pub air_length_share: f64,
     /// The clearance above the part's top its rapids ran at (mm): the job's,
     /// raised to clear the stock by [`STOCK_CLEARANCE_MM`].
     pub clearance_mm: f64,
@@ -233,6 +235,7 @@ pub fn run_job(job: &Job) -> Result<JobOutput, EngineError> {
             volume_before_mm3: volume_before,
             removed_mm3: cut.removed_volume,
             air_cut_share: cut.air_cut_share(),
+            air_length_share: cut.air_length_share(),
             clearance_mm: clearance,
         };
         planned.push((p, figures));
@@ -330,6 +333,8 @@ fn empty_cut() -> scallop_sim::CutReport {
         removed_volume: 0.0,
         feed_moves: 0,
         air_feed_moves: 0,
+        feed_length_mm: 0.0,
+        air_feed_length_mm: 0.0,
         rapid_hits: Vec::new(),
         collisions: Vec::new(),
     }

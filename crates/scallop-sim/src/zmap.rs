@@ -111,6 +111,10 @@ pub struct CutReport {
     pub feed_moves: usize,
     /// Feed moves that lowered no cell by more than the stock's rounding epsilon.
     pub air_feed_moves: usize,
+    /// Length of the feed moves (mm).
+    pub feed_length_mm: f64,
+    /// Length of the feed moves that cut air (mm).
+    pub air_feed_length_mm: f64,
     /// Rapid and retract moves that removed stock, in program order (errors).
     pub rapid_hits: Vec<RapidHit>,
     /// Shank and holder collisions with the in-process stock, in program order (errors).
@@ -135,11 +139,20 @@ impl CutReport {
     /// let report = zmap.cut(&flat, &path).unwrap();
     /// assert_eq!((report.feed_moves, report.air_feed_moves), (2, 1));
     /// assert_eq!(report.air_cut_share(), 0.5);
+    /// assert!((report.air_length_share() - 0.5).abs() < 1e-12);
     /// assert!(report.check().is_ok());
     /// ```
     #[must_use]
     pub fn air_cut_share(&self) -> f64 {
         air_share(self.air_feed_moves, self.feed_moves)
+    }
+
+    /// Share of the feed length that cut air, in [0, 1] (0 with no feed):
+    /// a few long passes in material weigh more than many short moves of a
+    /// helix in air, unlike [`CutReport::air_cut_share`].
+    #[must_use]
+    pub fn air_length_share(&self) -> f64 {
+        if self.feed_length_mm > 0.0 { self.air_feed_length_mm / self.feed_length_mm } else { 0.0 }
     }
 
     /// The safety verdict of the cut: rapid hits first, then collisions.
@@ -800,6 +813,14 @@ impl ZMap {
         let feed_moves = moves.iter().filter(|m| m.kind == MoveKind::Feed).count();
         let air_feed_moves =
             moves.iter().zip(&lowered).filter(|(m, l)| m.kind == MoveKind::Feed && **l <= self.eps).count();
+        let (mut feed_length_mm, mut air_feed_length_mm) = (0.0, 0.0);
+        for (k, m) in moves.iter().enumerate().skip(1).filter(|(_, m)| m.kind == MoveKind::Feed) {
+            let len = (m.to - moves[k - 1].to).norm();
+            feed_length_mm += len;
+            if lowered[k] <= self.eps {
+                air_feed_length_mm += len;
+            }
+        }
         let rapid_hits = rapid
             .iter()
             .enumerate()
@@ -813,7 +834,17 @@ impl ZMap {
             .collect();
         let removed_volume = removed_by_move.iter().sum();
         debug_assert_eq!(n as usize, count);
-        Ok(CutReport { operation, removed_by_move, removed_volume, feed_moves, air_feed_moves, rapid_hits, collisions })
+        Ok(CutReport {
+            operation,
+            removed_by_move,
+            removed_volume,
+            feed_moves,
+            air_feed_moves,
+            feed_length_mm,
+            air_feed_length_mm,
+            rapid_hits,
+            collisions,
+        })
     }
 
     /// Rows whose centres may lie in [lo, hi] (one row of margin each side), or None.

@@ -440,12 +440,31 @@ impl<'a> Planner<'a> {
         let mut best: Option<(f64, Point2)> = None;
         for cl in &plane.samples {
             let n = contact_normal(&self.shape, self.index, &self.slots, cl);
+            if self.rides_sharp_edge(cl, &n) {
+                continue;
+            }
             let delta = spacing_at(&self.shape, &self.model, sh, &n, self.params.direction, &m);
             if best.is_none_or(|(b, _)| delta < b) {
                 best = Some((delta, Point2::new(cl.tip.x, cl.tip.y)));
             }
         }
         best
+    }
+
+    /// Whether the cutter at `cl` rolls over a sharp convex edge or vertex of
+    /// the mesh: an edge or vertex contact whose cutter normal `n` leans more
+    /// than [`tol::SHARP_EDGE_DEG`] from the contacted facet's normal. There
+    /// the part has no surface between passes to leave a scallop on (every
+    /// pass touches the same edge), so the contact does not set the spacing;
+    /// the measured scallop still checks the pair.
+    fn rides_sharp_edge(&self, cl: &ClPoint, n: &Vec3) -> bool {
+        let triangle = match cl.contact {
+            Contact::Vertex { triangle, .. } | Contact::Edge { triangle, .. } => triangle,
+            Contact::Floor | Contact::Facet { .. } => return false,
+        };
+        self.slots
+            .get(triangle)
+            .is_some_and(|&slot| self.index.normal(slot as usize).dot(n) < tol::SHARP_EDGE_DEG.to_radians().cos())
     }
 
     /// Largest measured scallop between two planes at the feed samples.
@@ -540,9 +559,15 @@ impl<'a> Planner<'a> {
                 let current = planes.last().expect("a plane of this range");
                 let d = current.plane.offset;
                 let (spacing, at) = self.spacing(current).unwrap_or((delta, self.frame.xy(0.0, d)));
+                // With rest tolerated, no spacing below a share of the largest:
+                // a pair that holds sh only closer than that has rest material
+                // between its passes (a wall the waterline levels finish, a
+                // corner), not a scallop, and creeping on at tiny spacings
+                // would multiply the planes.
+                let floor = if self.tolerate_rest { tol::REST_SPACING_SHARE * cap } else { tol::MIN_SPACING };
                 let spacing = match spacing {
-                    s if s >= tol::MIN_SPACING => s,
-                    _ if self.tolerate_rest => tol::REST_SPACING_SHARE * cap,
+                    s if s >= floor => s,
+                    _ if self.tolerate_rest => floor,
                     s => return Err(self.unreachable(s, at)),
                 };
                 delta = spacing;
@@ -577,7 +602,7 @@ impl<'a> Planner<'a> {
                     // least SPACING_MIN_SHRINK per retry (curvature, rest material).
                     let ratio = if h.is_finite() { (sh / h).sqrt() * tol::SPACING_SAFETY } else { 0.5 };
                     gap *= if retry == 0 { ratio } else { ratio.min(tol::SPACING_MIN_SHRINK) };
-                    if gap < tol::MIN_SPACING {
+                    if gap < floor {
                         if self.tolerate_rest {
                             break;
                         }
@@ -589,9 +614,10 @@ impl<'a> Planner<'a> {
                     if !self.tolerate_rest {
                         return Err(self.unreachable(gap, at));
                     }
-                    next = self.plane(d + rule_gap);
+                    let rest_gap = floor.min(rule_gap);
+                    next = self.plane(d + rest_gap);
                     if next.plane.passes.is_empty() {
-                        empty = d + rule_gap;
+                        empty = d + rest_gap;
                         continue 'ranges;
                     }
                 }

@@ -257,11 +257,20 @@ pub const LEVEL_PUSH_CHORDS: f64 = 2.0;
 /// every this many chord tolerances along it.
 pub const LEVEL_LINK_SAMPLE_CHORDS: f64 = 10.0;
 
-/// Where the spacing rule gives no usable spacing (a crease's normal) and the
-/// planner tolerates rest material, the next plane is this share of the
-/// largest step-over away (then measured as usual).
+/// When the planner tolerates rest material (steep-and-shallow), no plane
+/// spacing falls below this share of the largest step-over: where the
+/// spacing rule or the measured scallop asks for less (a crease's normal,
+/// the foot of a wall that the waterline levels finish), the next plane is
+/// this far away and the stock simulation reports what is left.
 pub const REST_SPACING_SHARE: f64 = 0.25;
 
 /// Half-width (degrees) of the slope band that both parallel planes and
 /// waterline levels finish in steep-and-shallow finishing.
 pub const STEEP_OVERLAP_DEG: f64 = 10.0;
+
+/// An edge or vertex contact whose cutter normal leans more than this
+/// (degrees) from the contacted facet's normal is a sharp convex feature of
+/// the part, not its tessellation: it does not set the pass spacing (see
+/// `Planner::rides_sharp_edge`). Tessellations of smooth surfaces within the
+/// usual chord tolerances bend by a few degrees between facets.
+pub const SHARP_EDGE_DEG: f64 = 30.0;
