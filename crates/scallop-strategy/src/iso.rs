@@ -374,7 +374,7 @@ fn swept_distance(p: &Point3, pass: &IsoPass, s: f64, radius: f64, corner: f64) 
             return false;
         }
         let f = |s: f64| body_distance(p, &(a + (b - a) * s), radius, corner);
-        let end = golden_section(&f, (0.0, 1.0), tol::GOLDEN_ITERATIONS, None, |f1, f2| f1 <= f2);
+        let end = golden_section(f, (0.0, 1.0), tol::GOLDEN_ITERATIONS, None, |f1, f2| f1 <= f2);
         let [(_, f1), (_, f2)] = end.inner;
         *best = best.min(f1.min(f2)).min(f(0.0)).min(f(1.0));
         true
