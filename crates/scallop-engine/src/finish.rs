@@ -13,7 +13,7 @@ use scallop_cutter::{Cutter, CutterShape};
 use scallop_geom::nalgebra::Rotation3;
 use scallop_geom::{Aabb3, Point3, Tolerances, Vec3};
 use scallop_machine::frame::SetupFrame;
-use scallop_machine::program::{ProgramOptions, records_from_toolpath, to_program};
+use scallop_machine::program::{MachineProgram, ProgramOptions, records_from_toolpath, to_program};
 use scallop_machine::{Kinematics, Machine};
 use scallop_mesh::{MeshIndex, TriMesh};
 use scallop_post::{Dialect, OutputMode, PostParams, ProgramInfo, program_text, write_fitted};
@@ -810,17 +810,30 @@ fn indexed_program(job: &FinishJob, setup: &Setup, path: &Toolpath, time: f64) -
         what: format!("the indexed tool axis on machine `{}`: {e}", setup.machine.name()),
         fix: "choose a setup rotation the machine can reach, or another machine".into(),
     })?;
+    tilted_plane_text(job, &program, (&kin, setup.tool_length), &options, time)
+}
+
+/// A 3+2 machine program written in tilted work planes (joint space with the
+/// rotaries held where the dialect has no plane code), for the kinematics `kin`
+/// with its tool length, predicted to take `time` seconds.
+pub(crate) fn tilted_plane_text(
+    job: &FinishJob,
+    program: &MachineProgram,
+    (kin, tool_length): (&Kinematics, f64),
+    options: &ProgramOptions,
+    time: f64,
+) -> Result<String, EngineError> {
     let params = PostParams {
         program: job.output.program.clone(),
         mode: OutputMode::TiltedPlane,
         tool: job.output.tool.max(1),
-        tool_length: setup.tool_length,
+        tool_length,
         spindle: job.output.spindle,
         tol_pos: options.tol_pos,
         tol_ang: options.tol_ang,
         predicted_time: Some(time),
     };
-    program_text(&program, &kin, &job.output.dialect, &params).map_err(|e| EngineError::Output {
+    program_text(program, kin, &job.output.dialect, &params).map_err(|e| EngineError::Output {
         what: e.to_string(),
         fix: "use a 5-axis dialect (linuxcnc, fanuc, siemens840d, heidenhain)".into(),
     })

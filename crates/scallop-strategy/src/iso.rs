@@ -43,6 +43,7 @@
 
 use scallop_analysis::Cutter as Model;
 use scallop_cutter::{Cutter, CutterShape, drop_cutter};
+use scallop_geom::num::golden_section;
 use scallop_geom::{Point2, Point3, Tolerances, Vec3};
 use scallop_mesh::MeshIndex;
 use scallop_surface::Patch;
@@ -373,25 +374,8 @@ fn swept_distance(p: &Point3, pass: &IsoPass, s: f64, radius: f64, corner: f64) 
             return false;
         }
         let f = |s: f64| body_distance(p, &(a + (b - a) * s), radius, corner);
-        let (mut lo, mut hi) = (0.0f64, 1.0f64);
-        let g = 0.5 * (5f64.sqrt() - 1.0);
-        let (mut x1, mut x2) = (hi - g * (hi - lo), lo + g * (hi - lo));
-        let (mut f1, mut f2) = (f(x1), f(x2));
-        for _ in 0..tol::GOLDEN_ITERATIONS {
-            if f1 <= f2 {
-                hi = x2;
-                x2 = x1;
-                f2 = f1;
-                x1 = hi - g * (hi - lo);
-                f1 = f(x1);
-            } else {
-                lo = x1;
-                x1 = x2;
-                f1 = f2;
-                x2 = lo + g * (hi - lo);
-                f2 = f(x2);
-            }
-        }
+        let end = golden_section(f, (0.0, 1.0), tol::GOLDEN_ITERATIONS, None, |f1, f2| f1 <= f2);
+        let [(_, f1), (_, f2)] = end.inner;
         *best = best.min(f1.min(f2)).min(f(0.0)).min(f(1.0));
         true
     };

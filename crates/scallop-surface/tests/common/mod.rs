@@ -75,28 +75,6 @@ pub fn set_of(patches: Vec<Patch>) -> SurfaceSet {
     SurfaceSet::new(patches).expect("valid set")
 }
 
-/// Deterministic pseudo-random numbers in [0, 1) (SplitMix64).
-pub struct Rng(u64);
-
-impl Rng {
-    pub fn new(seed: u64) -> Self {
-        Rng(seed)
-    }
-
-    pub fn next_f64(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        (z >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    pub fn range(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.next_f64()
-    }
-}
-
 /// Distance from `q` to triangle `abc` (Ericson, Real-Time Collision Detection 5.1.5).
 pub fn point_triangle_distance(q: &Point3, [a, b, c]: [Point3; 3]) -> f64 {
     let ab = b - a;
