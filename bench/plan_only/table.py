@@ -50,6 +50,8 @@ def main():
         for item, plan in zip(estimates, plans):
             e = item["estimate"]
             parts = f"{e['planes']} + {e['levels']}" if e["levels"] else f"{e['planes']}"
+            if e["strategy"] == "rough":
+                parts = f"{e['levels']} levels"
             if plan is None:
                 continue
             error = (e["passes"] - plan[0]) / max(1, plan[0])
