@@ -533,3 +533,40 @@ fn section_pieces(mesh: &TriMesh, steep: &[&Face], z: f64) -> usize {
     }
     (0..parent.len()).filter(|&k| root(&mut parent, k) == k).count()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn short_gaps_are_filled_with_the_smaller_neighbour_long_ones_kept() {
+        let inf = f64::INFINITY;
+        let mut s = vec![inf, 1.0, inf, inf, 0.5, inf, inf, inf, inf, 0.7, inf];
+        fill_gaps(&mut s, 3.0);
+        assert_eq!(s[..5], [inf, 1.0, 0.5, 0.5, 0.5]);
+        assert!(s[5..9].iter().all(|v| v.is_infinite()) && s[9] == 0.7 && s[10].is_infinite());
+    }
+
+    /// Two separate vertical walls (two quads, each two triangles) cut at
+    /// mid-height are two pieces; joined at a corner, one.
+    #[test]
+    fn section_pieces_count_separate_walls() {
+        let p = |x, y, z| Point3::new(x, y, z);
+        let quad = |a: Point3, b: Point3| {
+            let (a1, b1) = (p(a.x, a.y, 10.0), p(b.x, b.y, 10.0));
+            vec![[a, b, b1], [a, b1, a1]]
+        };
+        let count = |walls: Vec<[Point3; 3]>| {
+            let (mesh, _) = TriMesh::from_soup(&walls).unwrap();
+            let faces: Vec<Face> = (0..mesh.triangles().len())
+                .map(|t| Face { across: [0.0, 0.0], normal: Vec3::x(), area: 1.0, triangle: Some(t) })
+                .collect();
+            let refs: Vec<&Face> = faces.iter().collect();
+            section_pieces(&mesh, &refs, 5.0)
+        };
+        let apart = [quad(p(0., 0., 0.), p(10., 0., 0.)), quad(p(0., 20., 0.), p(10., 20., 0.))].concat();
+        assert_eq!(count(apart), 2);
+        let corner = [quad(p(0., 0., 0.), p(10., 0., 0.)), quad(p(10., 0., 0.), p(10., 10., 0.))].concat();
+        assert_eq!(count(corner), 1);
+    }
+}

@@ -12,7 +12,8 @@
 //! end's envelope. The offset pattern cuts the region's boundary, then every
 //! stepover inwards; each offset is as many closed passes as its boundary
 //! has loops (its connected pieces plus their holes), until nothing is left.
-//! Distances are chamfer distances (within 8 % of Euclidean).
+//! Distances are chamfer distances (1 and sqrt 2 steps: at most 8.3 % over
+//! the Euclidean distance, never under).
 
 use std::collections::VecDeque;
 
@@ -198,4 +199,47 @@ fn part_heights(mesh: &TriMesh, grid: &Grid, (x0, y0): (f64, f64), cell: f64) ->
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A grid of `n x n` cells (frame included) with the cells at distance
+    /// `inner..outer` (in cells) from the centre set.
+    fn ring(n: usize, inner: f64, outer: f64) -> (Grid, Vec<bool>) {
+        let grid = Grid { nx: n, ny: n };
+        #[allow(clippy::cast_precision_loss, reason = "small grids")]
+        let c = (n as f64 - 1.0) / 2.0;
+        #[allow(clippy::cast_precision_loss, reason = "small grids")]
+        let set = (0..n * n)
+            .map(|k| {
+                let d = ((k % n) as f64 - c).hypot((k / n) as f64 - c);
+                !grid.frame(k) && d >= inner && d < outer
+            })
+            .collect();
+        (grid, set)
+    }
+
+    #[test]
+    fn a_disc_has_one_loop_an_annulus_two_and_nothing_none() {
+        let (grid, disc) = ring(41, 0.0, 15.0);
+        assert_eq!(grid.loops(&disc), 1);
+        let (grid, annulus) = ring(41, 6.0, 15.0);
+        assert_eq!(grid.loops(&annulus), 2);
+        assert_eq!(grid.loops(&vec![false; grid.len()]), 0);
+    }
+
+    #[test]
+    fn chamfer_distances_are_within_8_3_percent_of_euclidean() {
+        let grid = Grid { nx: 61, ny: 61 };
+        let centre = 30 * 61 + 30;
+        let from: Vec<bool> = (0..grid.len()).map(|k| k == centre).collect();
+        let d = distances(&grid, &from);
+        for (k, v) in d.iter().enumerate() {
+            #[allow(clippy::cast_precision_loss, reason = "small grids")]
+            let e = ((k % 61) as f64 - 30.0).hypot((k / 61) as f64 - 30.0);
+            assert!(*v >= e - 1e-12 && *v <= 1.0825 * e + 1e-12, "cell {k}: {v} vs {e}");
+        }
+    }
 }
