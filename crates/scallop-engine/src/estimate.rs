@@ -544,7 +544,7 @@ mod tests {
         let mut s = vec![inf, 1.0, inf, inf, 0.5, inf, inf, inf, inf, 0.7, inf];
         fill_gaps(&mut s, 3.0);
         assert_eq!(s[..5], [inf, 1.0, 0.5, 0.5, 0.5]);
-        assert!(s[5..9].iter().all(|v| v.is_infinite()) && s[9] == 0.7 && s[10].is_infinite());
+        assert!(s[5..9].iter().all(|v| v.is_infinite()) && s[9].to_bits() == 0.7f64.to_bits() && s[10].is_infinite());
     }
 
     /// Two separate vertical walls (two quads, each two triangles) cut at
