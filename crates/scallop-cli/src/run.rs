@@ -43,12 +43,12 @@ pub fn run(args: &RunArgs) -> CliResult<()> {
         other => other,
     })?;
     if args.plan_only {
-        let operations = if spec.operation_list {
-            operations_job(&spec, job)?.operations
+        let job = if spec.operation_list {
+            operations_job(&spec, job)?
         } else {
-            vec![Operation { name: "finish".into(), finish: job, rough: None }]
+            Job { stock: None, operations: vec![Operation { name: "finish".into(), finish: job, rough: None }] }
         };
-        return plan_only(&name, &operations, args.json);
+        return plan_only(&name, &job, args.json);
     }
     if spec.operation_list {
         let engine_job = operations_job(&spec, job).map_err(|e| match e {
@@ -72,11 +72,10 @@ pub fn run(args: &RunArgs) -> CliResult<()> {
 }
 
 /// `scallop run --plan-only`: the estimate of every operation (docs/job.md).
-fn plan_only(name: &str, operations: &[Operation], json: bool) -> CliResult<()> {
-    let mut estimates = Vec::with_capacity(operations.len());
-    for op in operations {
-        let e = scallop_engine::estimate_operation(&op.finish)
-            .map_err(|e| Failure::rejected(format!("{name}: operation `{}`: {e}", op.name)))?;
+fn plan_only(name: &str, job: &Job, json: bool) -> CliResult<()> {
+    let mut estimates = Vec::with_capacity(job.operations.len());
+    for (op, e) in job.operations.iter().zip(scallop_engine::estimate_job(job)) {
+        let e = e.map_err(|e| Failure::rejected(format!("{name}: operation `{}`: {e}", op.name)))?;
         estimates.push((op.name.clone(), e));
     }
     if json {
@@ -86,13 +85,28 @@ fn plan_only(name: &str, operations: &[Operation], json: bool) -> CliResult<()> 
     }
     let mut text = format!("{name}: estimate before planning (no drop-cutter, no simulation)\n");
     for (k, (n, e)) in estimates.iter().enumerate() {
+        if e.strategy == "rough" {
+            text.push_str(&format!(
+                "  {}. {n}: rough, ~{} passes on {} levels, {:.3} mm stepover; ~{:.0} mm of feed, >= {} at the \
+                 programmed feed\n",
+                k + 1,
+                e.passes,
+                e.levels,
+                e.spacing_mm[0],
+                e.feed_length_mm,
+                crate::output::hms(e.time_at_feed_s)
+            ));
+            continue;
+        }
+        let levels = if e.levels > 0 { format!(" and {} waterline levels", e.levels) } else { String::new() };
         text.push_str(&format!(
-            "  {}. {n}: {}, feed at {:.2}° from X ({}); ~{} planes at {:.3} to {:.3} mm; ~{:.0} mm of feed, \
-             >= {} at the programmed feed\n",
+            "  {}. {n}: {}, feed at {:.2}° from X ({}); ~{} passes on ~{} planes{levels}, planes {:.3} to {:.3} mm \
+             apart; ~{:.0} mm of feed, >= {} at the programmed feed\n",
             k + 1,
             e.strategy,
             e.direction_deg,
             if e.direction_given { "given" } else { "from the analysis" },
+            e.passes,
             e.planes,
             e.spacing_mm[0],
             e.spacing_mm[1],

@@ -617,7 +617,7 @@ fn run_machines_two_operations_on_one_stock() {
     assert!(!dir.join("est").exists(), "--plan-only writes nothing");
     let estimate: serde_json::Value = serde_json::from_slice(&estimate.stdout).expect("json");
     for (op, e) in ops.iter().zip(estimate.as_array().expect("list")) {
-        let (real, expected) = (op["plan"]["passes"].as_f64().unwrap(), e["estimate"]["planes"].as_f64().unwrap());
+        let (real, expected) = (op["plan"]["passes"].as_f64().unwrap(), e["estimate"]["passes"].as_f64().unwrap());
         assert!((expected - real).abs() <= 0.1 * real, "estimated {expected} passes, planned {real}");
     }
     let program = std::fs::read_to_string(dir.join("out/program.nc")).expect("program");
@@ -638,6 +638,38 @@ fn run_machines_two_operations_on_one_stock() {
         .output()
         .expect("simulate");
     assert!(sim.status.success(), "{}", String::from_utf8_lossy(&sim.stderr));
+}
+
+/// `--plan-only` on a roughing operation (a generated pyramid in a stock box)
+/// expects the planner's levels exactly and its passes within 10 %.
+#[test]
+fn plan_only_estimates_the_levels_and_passes_of_roughing() {
+    let dir = scratch("rough-estimate");
+    std::fs::write(dir.join("pyramid.stl"), pyramid_stl()).expect("write");
+    let job = "[part]\nfile = \"pyramid.stl\"\n[stock]\nmargin = 4\ntop = 2\n\
+        [[operation]]\nkind = \"rough\"\n[operation.cutter]\nshape = \"flat\"\ndiameter = 4\nflute_length = 20\n\
+        [operation.roughing]\nstepdown = 1\nstepover = 0.3\nstock_to_leave = 0.3\n[verify]\nresolution = 0.1\n";
+    std::fs::write(dir.join("job.toml"), job).expect("write");
+    let run = |extra: &[&str]| {
+        let out = scallop()
+            .arg("run")
+            .arg(dir.join("job.toml"))
+            .arg("-o")
+            .arg(dir.join("out"))
+            .arg("--json")
+            .args(extra)
+            .output();
+        let out = out.expect("run");
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        serde_json::from_slice::<serde_json::Value>(&out.stdout).expect("json")
+    };
+    let estimate = run(&["--plan-only"]);
+    let e = &estimate[0]["estimate"];
+    assert_eq!(e["strategy"], "rough", "{estimate}");
+    let plan = &run(&[])["operations"][0]["plan"];
+    assert_eq!(e["levels"].as_u64(), plan["planes"].as_u64(), "levels: {estimate} {plan}");
+    let (expected, real) = (e["passes"].as_f64().unwrap(), plan["passes"].as_f64().unwrap());
+    assert!((expected - real).abs() <= 0.1 * real, "estimated {expected} passes, planned {real}");
 }
 
 /// The words of a G-code line without its comments: `(letter, number)` pairs.

@@ -6,6 +6,7 @@
 //! operation.
 
 use scallop_geom::{Aabb3, Tolerances};
+use scallop_mesh::TriMesh;
 use scallop_post::{ProgramInfo, Section, write_sections};
 use scallop_sim::{PartField, StockView, ZMap, verify_in};
 use scallop_toolpath::{FittedPath, Toolpath};
@@ -174,6 +175,21 @@ pub struct JobOutput {
     pub simulation: scallop_sim::Simulation,
 }
 
+/// The stock box of `job` around its (prepared) part `mesh`.
+pub(crate) fn job_stock(job: &Job, mesh: &TriMesh) -> Aabb3 {
+    let radius = job.operations.iter().map(|o| o.finish.cutter.radius()).fold(0.0, f64::max);
+    match job.stock {
+        None => stock_box(mesh, radius),
+        Some(StockShape::Box(b)) => b,
+        Some(StockShape::AroundPart { margin, top, bottom }) => {
+            let mut b = stock_box(mesh, margin.unwrap_or(radius));
+            b.max.z += top - 1.0;
+            b.min.z -= bottom - 1.0;
+            b
+        }
+    }
+}
+
 /// Runs the operations of `job` in order on one simulated stock and proves
 /// the result (see the module documentation).
 ///
@@ -186,17 +202,7 @@ pub fn run_job(job: &Job) -> Result<JobOutput, EngineError> {
     let first = &check_operations(job)?.finish;
     let tolerances = planning_tolerances(first)?;
     let prepared = prepare_part(&first.part, &tolerances)?;
-    let radius = job.operations.iter().map(|o| o.finish.cutter.radius()).fold(0.0, f64::max);
-    let stock = match job.stock {
-        None => stock_box(&prepared.mesh, radius),
-        Some(StockShape::Box(b)) => b,
-        Some(StockShape::AroundPart { margin, top, bottom }) => {
-            let mut b = stock_box(&prepared.mesh, margin.unwrap_or(radius));
-            b.max.z += top - 1.0;
-            b.min.z -= bottom - 1.0;
-            b
-        }
-    };
+    let stock = job_stock(job, &prepared.mesh);
     let mut zmap = ZMap::new(stock, first.sim_resolution)?;
     let field = PartField::new(&zmap, &prepared.index);
     let part_top = prepared.mesh.bounds().max.z;

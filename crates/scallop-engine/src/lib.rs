@@ -25,6 +25,7 @@ mod finish;
 mod grid;
 mod job;
 mod rough;
+mod rough_estimate;
 mod zones;
 
 use scallop_geom::Tolerances;
@@ -33,7 +34,7 @@ use scallop_surface::SurfaceSet;
 
 pub use budget::{ARC_SHARE, Budget};
 pub use demo::{DemoOutput, DemoSettings, DemoSummary, run_demo};
-pub use estimate::{Estimate, estimate_operation};
+pub use estimate::{Estimate, estimate_job, estimate_operation};
 pub use finish::{
     FinishDetails, FinishJob, FinishOutput, FinishReport, OutputOptions, RestPlaceReport, RestReport, Setup, Strategy,
     auto_direction_deg, run_finishing, stock_box,

@@ -71,6 +71,19 @@ impl SteepShallow {
         SteepShallow { threshold: 0.5 * (a + b), overlap: tol::STEEP_OVERLAP_DEG.to_radians(), climb: true }
     }
 
+    /// The spacing (mm) of two waterline levels on a wall of `slope` (rad;
+    /// not finite: the steep range's lowest slope) for `cutter`, scallop
+    /// height `sh` and path tolerance `path` (module docs; before the
+    /// convexity factor of a wall that grows steeper downwards). The planner
+    /// spaces its levels so; `scallop run --plan-only` estimates with it.
+    #[must_use]
+    pub fn level_spacing(&self, cutter: &Cutter, sh: f64, path: f64, slope: f64) -> f64 {
+        let s = if slope.is_finite() { slope } else { self.threshold - self.overlap };
+        // The push-out adds its width to the material left on the wall.
+        let sh = sh - tol::LEVEL_PUSH_CHORDS * (tol::LEVEL_CHORD_SHARE * path);
+        (tol::LEVEL_SPACING_SAFETY * level_dz(cutter.shape(), sh, s)).max(tol::MIN_SPACING)
+    }
+
     fn check(&self) -> Result<(), StrategyError> {
         let ok = self.threshold.is_finite()
             && self.overlap.is_finite()
@@ -87,6 +100,28 @@ impl SteepShallow {
             })
         }
     }
+}
+
+/// On a wall that grows steeper downwards (convex in its vertical section,
+/// curvature `k` from the slopes `s0` at the upper level `z0` and `s1` at the
+/// lower `z1`), the profile circles leave a higher cusp than on a plane:
+/// `d^2 (1 / rho + k) / 8` instead of `d^2 / (8 rho)`, so the level spacing
+/// shrinks by `1 / sqrt(1 + rho k)`; `None` when it would change by less than
+/// 1 % (or for a flat end or a cone). The planner applies it between two
+/// levels; `scallop run --plan-only` estimates with it.
+#[must_use]
+pub fn convex_factor(shape: &CutterShape, (z0, s0): (f64, f64), (z1, s1): (f64, f64)) -> Option<f64> {
+    let rho = match *shape {
+        CutterShape::Ball { radius } => radius,
+        CutterShape::Bull { corner, .. } => corner,
+        CutterShape::Flat { .. } | CutterShape::Cone { .. } => return None,
+    };
+    if !(s0.is_finite() && s1.is_finite() && s1 > s0) {
+        return None;
+    }
+    let along = (z0 - z1) / (0.5 * (s0 + s1)).sin().max(1e-9);
+    let factor = 1.0 / (1.0 + rho * (s1 - s0) / along).sqrt();
+    (factor < 0.99).then_some(factor)
 }
 
 /// The plane step-over (along the wall's horizontal projection) of parallel
@@ -242,6 +277,8 @@ struct Levels<'a> {
     /// (mm): a chord of a convex contour lies inside it by up to this much,
     /// and on a steep wall any inward step is a deep vertical gouge.
     chord: f64,
+    /// The path tolerance (mm).
+    path: f64,
     slots: Vec<u32>,
     floor: f64,
     /// Lowest and highest level (tip heights, mm).
@@ -284,6 +321,7 @@ impl<'a> Levels<'a> {
             split,
             grid,
             chord,
+            path: tol_.path,
             slots: slots_by_original(index),
             floor: bounds.min.z - bounds.diagonal() - 1.0,
             z_range: (bottom, top.max(bottom)),
@@ -328,30 +366,11 @@ impl<'a> Levels<'a> {
     }
 
     fn dz(&self, slope: f64) -> f64 {
-        let s = if slope.is_finite() { slope } else { self.split.threshold - self.split.overlap };
-        // The push-out adds its width to the material left on the wall.
-        let sh = self.params.scallop_height - tol::LEVEL_PUSH_CHORDS * self.chord;
-        (tol::LEVEL_SPACING_SAFETY * level_dz(self.cutter.shape(), sh, s)).max(tol::MIN_SPACING)
+        self.split.level_spacing(self.cutter, self.params.scallop_height, self.path, slope)
     }
 
-    /// On a wall that grows steeper downwards (convex in its vertical section,
-    /// curvature `k` from the two levels' slopes), the profile circles leave a
-    /// higher cusp than on a plane: `d^2 (1 / rho + k) / 8` instead of
-    /// `d^2 / (8 rho)`, so the spacing shrinks by `1 / sqrt(1 + rho k)`;
-    /// `None` when it would change by less than 1 %.
     fn convex_factor(&self, upper: &Level, lower: &Level) -> Option<f64> {
-        let rho = match *self.cutter.shape() {
-            CutterShape::Ball { radius } => radius,
-            CutterShape::Bull { corner, .. } => corner,
-            CutterShape::Flat { .. } | CutterShape::Cone { .. } => return None,
-        };
-        let (s0, s1) = (upper.min_slope, lower.min_slope);
-        if !(s0.is_finite() && s1.is_finite() && s1 > s0) {
-            return None;
-        }
-        let along = (upper.z - lower.z) / (0.5 * (s0 + s1)).sin().max(1e-9);
-        let factor = 1.0 / (1.0 + rho * (s1 - s0) / along).sqrt();
-        (factor < 0.99).then_some(factor)
+        convex_factor(self.cutter.shape(), (upper.z, upper.min_slope), (lower.z, lower.min_slope))
     }
 
     /// The levels from the top down (module docs), each spaced by the smaller
