@@ -35,7 +35,7 @@ impl Grid {
         // usize -> f64: exact for any limit a machine can hold in memory.
         #[allow(clippy::cast_precision_loss, reason = "sample counts far below 2^52")]
         let limit = max_samples as f64;
-        if !(samples <= limit) {
+        if samples.is_nan() || samples > limit {
             let min_voxel = h * (samples / limit).cbrt() * 1.01;
             return Err(FieldError::GridTooLarge { samples, limit: max_samples, min_voxel });
         }

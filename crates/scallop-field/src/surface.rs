@@ -111,7 +111,10 @@ impl Surface {
                 let t = self.order[slot as usize] as usize;
                 let (q, feature) = closest_on_triangle(p, &self.mesh.triangle(t));
                 let dist2 = (q - p).norm_squared();
-                if dist2 <= bound && best.is_none_or(|b| dist2 < b.dist2 || (dist2 == b.dist2 && t < b.triangle)) {
+                // Ties go to the lower triangle number, so the feature does not depend
+                // on the visiting order.
+                let better = best.is_none_or(|b| dist2.total_cmp(&b.dist2).then(t.cmp(&b.triangle)).is_lt());
+                if dist2 <= bound && better {
                     bound = dist2;
                     best = Some(Closest { point: q, dist2, triangle: t, feature });
                 }

@@ -4,6 +4,8 @@
 //! watertight on closed input, no self-intersection, a spread that shrinks
 //! with h.
 
+#![allow(clippy::unwrap_used, reason = "tests")]
+
 mod common;
 
 use common::{brute_distance, cylinder, open_and_nonmanifold_edges, self_intersections, sphere, square};

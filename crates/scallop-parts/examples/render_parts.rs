@@ -1,6 +1,6 @@
 //! Writes the pictures of the three test parts for docs/guides.md:
 //! `cargo run -p scallop-parts --example render_parts -- docs/img`.
-//! The lid (top, crossable) faces are left out so the pocket shows.
+//! Cut-away views: faces turned to the eye (near flanks, the lid) drop out.
 
 use scallop_parts::{FaceTag, TestPart, closed_pocket, fitting_pocket, impeller_channel, svg_view};
 
@@ -8,7 +8,7 @@ fn colour(tag: FaceTag) -> Option<[u8; 3]> {
     match tag {
         FaceTag::Bottom => Some([90, 150, 230]),
         FaceTag::Flank => Some([235, 160, 80]),
-        FaceTag::Top => None,
+        FaceTag::Top => Some([170, 170, 170]),
     }
 }
 

@@ -27,6 +27,8 @@ pub struct ImpellerParams {
     pub twist: f64,
     /// Sections along the channel, points across the hub and up a blade.
     pub samples: [usize; 3],
+    /// Angle of blade a's root at the inlet (about +z from +x).
+    pub phase: f64,
 }
 
 impl Default for ImpellerParams {
@@ -40,6 +42,7 @@ impl Default for ImpellerParams {
             wrap: 0.6,
             twist: 0.2,
             samples: [30, 10, 8],
+            phase: -2.8,
         }
     }
 }
@@ -61,6 +64,7 @@ impl ImpellerParams {
         check("thickness", self.thickness, 0.1, 0.8 * pitch, "a blade thinner than 80 % of the inlet pitch")?;
         check("wrap", self.wrap, -2.0, 2.0, "a wrap within +-2 rad")?;
         check("twist", self.twist, -0.5, 0.5, "a twist within +-0.5 rad")?;
+        check("phase", self.phase, -TAU, TAU, "an angle within +-2 pi")?;
         for (k, &n) in self.samples.iter().enumerate() {
             #[allow(clippy::cast_precision_loss, reason = "small counts")]
             check(["samples[0]", "samples[1]", "samples[2]"][k], n as f64, 2.0, 1000.0, "2 to 1000 samples")?;
@@ -77,7 +81,7 @@ impl ImpellerParams {
         let span = self.span[0] + u * (self.span[1] - self.span[0]);
         #[allow(clippy::cast_precision_loss, reason = "small counts")]
         let width = TAU / self.blades as f64 - self.thickness / r;
-        let theta = self.wrap * u * u + self.twist * t * (1.0 - 0.5 * u) + w * width;
+        let theta = self.phase + self.wrap * u * u + self.twist * t * (1.0 - 0.5 * u) + w * width;
         Point3::new(r * theta.cos(), r * theta.sin(), hub + t * span)
     }
 

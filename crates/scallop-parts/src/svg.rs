@@ -6,7 +6,10 @@ use scallop_geom::Vec3;
 use scallop_mesh::TriMesh;
 
 /// An SVG of `mesh` seen from the -x, -y, +z octant, `width` pixels wide;
-/// `colour(t)` gives triangle `t`'s base colour, `None` leaves it out. Shading
+/// `colour(t)` gives triangle `t`'s base colour, `None` leaves it out. Only
+/// triangles facing away from the eye are drawn: for a volume with outward
+/// normals, a cut-away view of its inside (the near walls and the lid drop out).
+/// Shading
 /// is two-sided Lambert under a light from the eye. Triangles are drawn far to
 /// near (ties by number), so the text depends only on the input.
 #[must_use]
@@ -21,6 +24,9 @@ pub fn svg_view(mesh: &TriMesh, width: f64, colour: impl Fn(usize) -> Option<[u8
         let Some(c) = colour(t) else { continue };
         let [a, b, d] = mesh.triangle(t);
         let n = (b - a).cross(&(d - a)).try_normalize(0.0).unwrap_or_else(Vec3::z);
+        if n.dot(&eye) > 0.0 {
+            continue;
+        }
         let shade = 0.3 + 0.7 * n.dot(&light).abs();
         #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "in 0..=255")]
         let rgb = c.map(|v| (f64::from(v) * shade).round().clamp(0.0, 255.0) as u8);

@@ -1,5 +1,6 @@
 //! Test geometry and brute-force oracles shared by the field's tests.
 #![allow(dead_code, reason = "each test file uses part of the helpers")]
+#![allow(clippy::unwrap_used, reason = "test geometry is valid by construction")]
 
 use scallop_geom::{Point3, Vec3};
 use scallop_mesh::{FastMap, TriMesh};
