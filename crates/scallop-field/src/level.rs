@@ -1,6 +1,7 @@
 //! Axial levels: offsets of a surface (several iso-levels of one distance
 //! field) and morph levels between two surfaces, as welded meshes.
 
+use rayon::prelude::*;
 use scallop_geom::Point3;
 use scallop_mesh::TriMesh;
 
@@ -61,10 +62,12 @@ pub fn offset_levels(surface: &Surface, distances: &[f64], options: &LevelOption
         .enumerate()
         .map(|(index, &d)| {
             let iso = iso_surface(&field, d);
+            // A centroid lies within the band (iso + 2 h) of the surface.
+            let band = d + tol::BAND_MARGIN_VOXELS * options.voxel;
             let kept = keep(&iso, |p| match options.side {
                 Side::Both => true,
-                Side::Along => surface.side(p) > 0.0,
-                Side::Against => surface.side(p) < 0.0,
+                Side::Along => surface.side_within(p, band) > 0.0,
+                Side::Against => surface.side_within(p, band) < 0.0,
             });
             to_mesh(&kept, index, d)
         })
@@ -114,17 +117,18 @@ pub fn morph_levels(
         .collect()
 }
 
-/// The triangles of `iso` whose centroid passes `test`.
-fn keep(iso: &IsoMesh, test: impl Fn(&Point3) -> bool) -> IsoMesh {
-    let triangles = iso
+/// The triangles of `iso` whose centroid passes `test`, in order (tested in
+/// parallel, collected by index).
+fn keep(iso: &IsoMesh, test: impl Fn(&Point3) -> bool + Sync) -> IsoMesh {
+    let pass: Vec<bool> = iso
         .triangles
-        .iter()
-        .filter(|t| {
+        .par_iter()
+        .map(|t| {
             let [a, b, c] = t.map(|i| iso.vertices[i]);
             test(&Point3::from((a.coords + b.coords + c.coords) / 3.0))
         })
-        .copied()
         .collect();
+    let triangles = iso.triangles.iter().zip(pass).filter(|(_, p)| *p).map(|(t, _)| *t).collect();
     IsoMesh { vertices: iso.vertices.clone(), triangles }
 }
 

@@ -142,7 +142,14 @@ impl Surface {
     /// on the surface (or when no pseudo-normal decides).
     #[must_use]
     pub fn side(&self, p: &Point3) -> f64 {
-        self.closest(p, f64::INFINITY).map_or(0.0, |c| (p - c.point).dot(&self.pseudo_normal(&c)))
+        self.side_within(p, f64::INFINITY)
+    }
+
+    /// [`Surface::side`] for a point known to lie within `max_dist` (mm) of the
+    /// surface (a bounded, faster search); zero when nothing is that close.
+    #[must_use]
+    pub fn side_within(&self, p: &Point3, max_dist: f64) -> f64 {
+        self.closest(p, max_dist).map_or(0.0, |c| (p - c.point).dot(&self.pseudo_normal(&c)))
     }
 }
 
