@@ -77,7 +77,8 @@ pub fn offset_levels(surface: &Surface, distances: &[f64], options: &LevelOption
 /// `count` morph levels between `bottom` (S_1) and `top` (S_2): the zero sets
 /// of Eq. 2.7 of Jousselin 2020 (Ch. 2 section 3.1) for `m = k / (count + 1)`,
 /// `k = 1..=count`, bottom first. Both distance fields are computed once over
-/// the box of the two surfaces. With unsigned distances Eq. 2.7 has a second,
+/// the box of the two surfaces, every sample exact (the grid gets half of
+/// `options.max_samples`, as two fields are held). With unsigned distances Eq. 2.7 has a second,
 /// spurious zero set outside the slab between the surfaces; a triangle is kept
 /// only when its centroid lies between them: the directions to its closest
 /// points on S_1 and S_2 are opposed (negative dot product).

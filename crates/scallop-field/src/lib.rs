@@ -10,7 +10,8 @@
 //! - [`iso_surface`]: marching tetrahedra (watertight, no ambiguous case), welded
 //!   by grid edge.
 //! - [`offset_levels`] (several iso-levels of one field, one side kept) and
-//!   [`morph_levels`] (the sheet between the two surfaces) return [`TriMesh`]es.
+//!   [`morph_levels`] (the sheet between the two surfaces) return
+//!   [`scallop_mesh::TriMesh`]es.
 //!
 //! Output does not depend on the thread count: fields are filled block by block
 //! with indexed collection, extraction is sequential in cell order.
