@@ -168,58 +168,89 @@ fn perturbed_sign(value: f64, c: [f64; 3], scale: f64) -> i8 {
 /// Chains keyed segments into polylines; returns them and the number of keys
 /// shared by more than two segments.
 fn chain_segments(segments: &[[(Key, Point3); 2]]) -> (Vec<Polyline3>, usize) {
+    let keys: Vec<[Key; 2]> = segments.iter().map(|s| [s[0].0, s[1].0]).collect();
+    let (chains, non_manifold) = chain_keys(&keys);
+    let lines = chains
+        .iter()
+        .map(|c| {
+            let mut points: Vec<Point3> = Vec::with_capacity(c.steps.len() + 1);
+            for (k, &(s, reversed)) in c.steps.iter().enumerate() {
+                let (a, b) = if reversed { (1, 0) } else { (0, 1) };
+                if k == 0 {
+                    points.push(segments[s][a].1);
+                }
+                if points.last() != Some(&segments[s][b].1) {
+                    points.push(segments[s][b].1);
+                }
+            }
+            if c.closed && points.len() > 1 && points.first() == points.last() {
+                points.pop();
+            }
+            Polyline3::new(points, c.closed)
+        })
+        .collect();
+    (lines, non_manifold)
+}
+
+/// One chain of [`chain_keys`]: the segments in travel order, each with
+/// whether it is travelled from its second end to its first.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct KeyChain {
+    /// `(segment, reversed)` in travel order.
+    pub steps: Vec<(usize, bool)>,
+    /// Whether the last segment leads back to the first.
+    pub closed: bool,
+}
+
+/// Chains segments whose ends carry keys: two segments join where they share
+/// a key. Open chains (from an end no other segment shares) come first, then
+/// closed ones, each started at its lowest segment number; deterministic.
+/// Returns the chains and the number of keys shared by more than two segments
+/// (those join the lowest unused segment).
+///
+/// ```
+/// let keys = [[[0, 1], [0, 2]], [[0, 3], [0, 2]], [[0, 3], [0, 1]]];
+/// let (chains, odd) = scallop_mesh::chain_keys(&keys);
+/// assert_eq!((chains.len(), odd), (1, 0));
+/// assert!(chains[0].closed);
+/// assert_eq!(chains[0].steps, vec![(0, false), (1, true), (2, false)]);
+/// ```
+#[must_use]
+pub fn chain_keys(keys: &[[[u64; 2]; 2]]) -> (Vec<KeyChain>, usize) {
     let mut at: FastMap<Key, Vec<u32>> = FastMap::default();
-    for (s, seg) in segments.iter().enumerate() {
-        for (key, _) in seg {
+    for (s, seg) in keys.iter().enumerate() {
+        for key in seg {
             at.entry(*key).or_default().push(u32::try_from(s).unwrap_or(u32::MAX));
         }
     }
     let non_manifold = at.values().filter(|v| v.len() > 2).count();
-    let mut used = vec![false; segments.len()];
+    let mut used = vec![false; keys.len()];
     let mut chains = Vec::new();
-    // Open chains first (from an end no other segment shares), then loops.
     for pass in 0..2 {
-        for s in 0..segments.len() {
+        for s in 0..keys.len() {
             if used[s] {
                 continue;
             }
             let start_end = if pass == 0 {
-                match (0..2).find(|&e| at[&segments[s][e].0].len() == 1) {
+                match (0..2).find(|&e| at[&keys[s][e]].len() == 1) {
                     Some(e) => e,
                     None => continue,
                 }
             } else {
                 0
             };
-            chains.push(walk(segments, &at, &mut used, s, start_end, pass == 1));
+            let mut steps = Vec::new();
+            let (mut seg, mut enter) = (s, start_end);
+            loop {
+                used[seg] = true;
+                steps.push((seg, enter == 1));
+                let key = keys[seg][1 - enter];
+                let Some(n) = at[&key].iter().map(|&x| x as usize).find(|&x| !used[x]) else { break };
+                enter = usize::from(keys[n][0] != key);
+                seg = n;
+            }
+            chains.push(KeyChain { steps, closed: pass == 1 });
         }
     }
     (chains, non_manifold)
-}
-
-fn walk(
-    segments: &[[(Key, Point3); 2]],
-    at: &FastMap<Key, Vec<u32>>,
-    used: &mut [bool],
-    start: usize,
-    start_end: usize,
-    closed: bool,
-) -> Polyline3 {
-    let mut points = vec![segments[start][start_end].1];
-    let (mut s, mut enter) = (start, start_end);
-    loop {
-        used[s] = true;
-        let (key, point) = segments[s][1 - enter];
-        if points.last() != Some(&point) {
-            points.push(point);
-        }
-        let next = at[&key].iter().map(|&x| x as usize).find(|&x| !used[x]);
-        let Some(n) = next else { break };
-        enter = usize::from(segments[n][0].0 != key);
-        s = n;
-    }
-    if closed && points.len() > 1 && points.first() == points.last() {
-        points.pop();
-    }
-    Polyline3::new(points, closed)
 }

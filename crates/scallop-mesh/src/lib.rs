@@ -35,7 +35,7 @@ mod trimesh;
 pub use bvh::Bvh;
 pub use hash::{FastMap, WordHasher};
 pub use index::MeshIndex;
-pub use intersect::{MeshIntersection, intersect_meshes};
+pub use intersect::{KeyChain, MeshIntersection, chain_keys, intersect_meshes};
 pub use polyline::{Polyline3, PolylineFoot, PolylineQuery, segment_parameter};
 pub use query::{ClosestPoint, MeshQuery, RayHit, closest_on_triangle, ray_triangle, triangle_box};
 pub use trimesh::{MeshDiagnostics, MeshError, TriMesh};

@@ -1,7 +1,11 @@
 //! Mesh services against brute force: closest point, ray projection,
-
-#![allow(clippy::unwrap_used, clippy::float_cmp)]
 //! point-to-polyline distance and mesh-mesh intersection chaining.
+
+#![allow(
+    clippy::unwrap_used,
+    clippy::float_cmp,
+    reason = "tests: a panic is the failure report; exact cases compare exactly"
+)]
 
 use proptest::prelude::*;
 use scallop_geom::{Point3, Vec3};

@@ -1,0 +1,2 @@
+//! Placeholder until the offsets bench lands.
+fn main() {}

@@ -1,0 +1,109 @@
+//! Path curves: iterated inward offsets of a curve on a support by Marching
+//! Facets (Jousselin 2020, Ch. 2 §3.2.1, the scalar method). Each curve is
+//! the iso-line at `a_e` of the signed distance to the previous one (one field
+//! per curve: iso-levels of one field would drift apart by more than `a_e` on
+//! curved supports), until no facet is crossed. Several loops at a step mean
+//! the offset split (Ch. 2 §3.3, Fig. 2.39b).
+
+use rayon::prelude::*;
+use scallop_geom::Point3;
+
+use crate::facets::{Isolines, march};
+use crate::field::CurveField;
+use crate::support::{Curve, Support, check_line};
+use crate::{GuideError, tol};
+
+/// One offset step.
+#[derive(Clone, Debug, PartialEq)]
+pub struct OffsetStep {
+    /// The loops (or open chains) of this offset, inside on their left.
+    pub curves: Vec<Curve>,
+    /// Whether this step has more loops than the one before (a split).
+    pub split: bool,
+    /// Facets flagged as crossed by the medial axis.
+    pub flagged: usize,
+    /// Flagged facets whose segment got a repair point.
+    pub repaired: usize,
+}
+
+/// The successive inward offsets of `limit` (inside on the left of each
+/// curve, see [`Curve::inside_left`]) on `support`, `step` (the radial
+/// engagement a_e, mm) apart, until they vanish. The first entry is the first
+/// offset (C_n itself is not repeated).
+///
+/// # Errors
+/// [`GuideError::BadLength`] for a non-positive step, [`GuideError::BadCurve`]
+/// for an unusable curve, [`GuideError::NotVanishing`] if the offsets do not
+/// vanish within `diagonal / step + 2` steps.
+pub fn offset_curves(support: &Support, limit: &[Curve], step: f64) -> Result<Vec<OffsetStep>, GuideError> {
+    check_step(step)?;
+    for (i, c) in limit.iter().enumerate() {
+        check_line(&c.line, i)?;
+    }
+    let guard = (support.mesh().bounds().diagonal() / step).ceil() as usize + tol::EXTRA_STEPS;
+    let mut active = vec![true; support.mesh().vertices().len()];
+    let mut current: Vec<Curve> = limit.to_vec();
+    let mut steps: Vec<OffsetStep> = Vec::new();
+    while !current.is_empty() {
+        if steps.len() >= guard {
+            return Err(GuideError::NotVanishing { steps: steps.len() });
+        }
+        let (iso, values) = offset_once(support, &current, step, &active);
+        if iso.curves.is_empty() {
+            break;
+        }
+        for (a, v) in active.iter_mut().zip(&values) {
+            *a = *v > 0.0;
+        }
+        let split = iso.curves.len() > current.len() && !steps.is_empty();
+        current = iso.curves.clone();
+        steps.push(OffsetStep { curves: iso.curves, split, flagged: iso.flagged, repaired: iso.repaired });
+    }
+    Ok(steps)
+}
+
+/// The iso-line at `distance` inside `curves`, and the vertex values (signed
+/// distance minus `distance`; `-inf` for vertices not `active`, known to be
+/// outside).
+///
+/// # Errors
+/// [`GuideError::BadLength`] for a non-positive distance.
+pub fn offset_curve(support: &Support, curves: &[Curve], distance: f64) -> Result<Isolines, GuideError> {
+    check_step(distance)?;
+    let active = vec![true; support.mesh().vertices().len()];
+    Ok(offset_once(support, curves, distance, &active).0)
+}
+
+fn offset_once(support: &Support, curves: &[Curve], distance: f64, active: &[bool]) -> (Isolines, Vec<f64>) {
+    let field = CurveField::new(curves);
+    let verts = support.mesh().vertices();
+    let sampled: Vec<(f64, Option<Point3>)> = (0..verts.len())
+        .into_par_iter()
+        .map(|v| {
+            if !active[v] {
+                return (f64::NEG_INFINITY, None);
+            }
+            match field.foot(&verts[v]) {
+                Some(f) => (field.signed_at(&verts[v], &f) - distance, Some(f.point)),
+                None => (f64::NEG_INFINITY, None),
+            }
+        })
+        .collect();
+    let values: Vec<f64> = sampled.iter().map(|s| s.0).collect();
+    let exact = |p: &Point3| field.signed(p) - distance;
+    let mesh = support.mesh();
+    let medial = |f: usize| {
+        let t = mesh.triangles()[f];
+        let feet = t.map(|v| sampled[v as usize].1);
+        let [Some(a), Some(b), Some(c)] = feet else { return false };
+        let spread = (a - b).norm().max((b - c).norm()).max((c - a).norm());
+        let tri = mesh.triangle(f);
+        let size = (tri[1] - tri[0]).norm().max((tri[2] - tri[1]).norm()).max((tri[0] - tri[2]).norm());
+        spread > tol::MEDIAL_FOOT_FACTOR * size
+    };
+    (march(support, &values, &exact, &medial), values)
+}
+
+pub(crate) fn check_step(step: f64) -> Result<(), GuideError> {
+    if step.is_finite() && step > 0.0 { Ok(()) } else { Err(GuideError::BadLength { name: "a_e", value: step }) }
+}
