@@ -105,7 +105,8 @@ pub(crate) fn edge_root(g: impl Fn(f64) -> f64, ga: f64, gb: f64, len: f64) -> f
         if (b - a) * len <= tol::ROOT_TOLERANCE {
             break;
         }
-        let mut t = if fa.is_finite() && fb.is_finite() && fb - fa != 0.0 { (a * fb - b * fa) / (fb - fa) } else { f64::NAN };
+        let mut t =
+            if fa.is_finite() && fb.is_finite() && fb - fa != 0.0 { (a * fb - b * fa) / (fb - fa) } else { f64::NAN };
         if t.is_nan() || t <= a || t >= b {
             t = 0.5 * (a + b);
         }

@@ -8,6 +8,9 @@
 //! - [`offset_curves`]: path curves by Marching Facets, iterated offsets of a
 //!   curve in steps of a_e until they vanish, with split detection and
 //!   medial-axis repair (Ch. 2 §3.2.1);
+//! - [`limit_curves`]: C_n, a level meets the flank offset (Ch. 2 §3.2.1);
+//! - [`morph_level`], [`pair_levels`]: tilt curves by scalar morphing on the
+//!   next level, the swap rule and the count rule (Ch. 2 §3.2.2);
 //!
 //! ```
 //! use scallop_geom::Point3;
@@ -35,6 +38,8 @@
 mod error;
 mod facets;
 mod field;
+mod limit;
+mod morph;
 mod offset;
 mod support;
 pub mod tol;
@@ -42,5 +47,7 @@ pub mod tol;
 pub use error::GuideError;
 pub use facets::Isolines;
 pub use field::CurveField;
+pub use limit::{LimitCurves, limit_curves};
+pub use morph::{GuidePairs, Level, morph_level, pair_levels, project_curve};
 pub use offset::{OffsetStep, offset_curve, offset_curves};
 pub use support::{Curve, Support};
