@@ -11,6 +11,8 @@
 //! - [`limit_curves`]: C_n, a level meets the flank offset (Ch. 2 §3.2.1);
 //! - [`morph_level`], [`pair_levels`]: tilt curves by scalar morphing on the
 //!   next level, the swap rule and the count rule (Ch. 2 §3.2.2);
+//! - [`vectorial_offset`]: the vectorial method (Eq. 2.8-2.10, Alg. 1-3), the
+//!   reference for the scalar one.
 //!
 //! ```
 //! use scallop_geom::Point3;
@@ -43,6 +45,7 @@ mod morph;
 mod offset;
 mod support;
 pub mod tol;
+mod vectorial;
 
 pub use error::GuideError;
 pub use facets::Isolines;
@@ -51,3 +54,4 @@ pub use limit::{LimitCurves, limit_curves};
 pub use morph::{GuidePairs, Level, morph_level, pair_levels, project_curve};
 pub use offset::{OffsetStep, offset_curve, offset_curves};
 pub use support::{Curve, Support};
+pub use vectorial::{VectorialOffset, VectorialOptions, vectorial_offset};

@@ -120,7 +120,7 @@ pub fn pair_levels(n: &Level, n1: &Level, a_e: f64) -> Result<GuidePairs, GuideE
     let count = |h: f64, facet: f64| ((h - facet).max(0.0) / a_e).ceil() as usize;
     let steps = m_n.max(m_n1).max(count(h_n, n.support.facet_size())).max(count(h_n1, n1.support.facet_size())).max(1);
     let path_morphed = !(keep_path && steps == m_n);
-    let tilt_morphed = !(!keep_path && steps == m_n1);
+    let tilt_morphed = keep_path || steps != m_n1;
     let path = if path_morphed { morph_family(n.support, &inner_n, n.limit, steps, "path morph")? } else { fam_n };
     let tilt = if tilt_morphed { morph_family(n1.support, &inner_n1, n1.limit, steps, "tilt morph")? } else { fam_n1 };
     Ok(GuidePairs {

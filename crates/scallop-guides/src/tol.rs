@@ -17,3 +17,9 @@ pub const MEDIAL_FOOT_FACTOR: f64 = 3.0;
 /// Offsets stop after this many curves beyond `diagonal / a_e + 2` (a guard:
 /// every step shrinks the region, so it is never reached on a valid mesh).
 pub const EXTRA_STEPS: usize = 2;
+
+/// A vertex of a curve is a corner to round in the vectorial offset (Alg. 3,
+/// Jousselin 2020, Annex A) when the curve turns there by more than this
+/// (radians): gaps on straight stretches are not filled, since the radial push
+/// would bring the points closer than the offset distance to the curve.
+pub const CORNER_TURN: f64 = 0.1;
