@@ -54,6 +54,12 @@ impl CurveField {
         self.query.closest(p)
     }
 
+    /// The nearest point of the curves to `p` if within `max_distance`.
+    #[must_use]
+    pub fn foot_within(&self, p: &Point3, max_distance: f64) -> Option<PolylineFoot> {
+        self.query.closest_within(p, max_distance)
+    }
+
     /// Signed distance from `p`: `+d` on the inside (left), `-d` outside.
     #[must_use]
     pub fn signed(&self, p: &Point3) -> f64 {

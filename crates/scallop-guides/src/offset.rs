@@ -41,20 +41,18 @@ pub fn offset_curves(support: &Support, limit: &[Curve], step: f64) -> Result<Ve
         check_line(&c.line, i)?;
     }
     let guard = (support.mesh().bounds().diagonal() / step).ceil() as usize + tol::EXTRA_STEPS;
-    let mut active = vec![true; support.mesh().vertices().len()];
     let mut current: Vec<Curve> = limit.to_vec();
+    let mut band: Option<Band> = None;
     let mut steps: Vec<OffsetStep> = Vec::new();
     while !current.is_empty() {
         if steps.len() >= guard {
             return Err(GuideError::NotVanishing { steps: steps.len() });
         }
-        let (iso, values) = offset_once(support, &current, step, &active);
+        let (iso, next) = offset_once(support, &current, step, band.as_ref());
         if iso.curves.is_empty() {
             break;
         }
-        for (a, v) in active.iter_mut().zip(&values) {
-            *a = *v > 0.0;
-        }
+        band = Some(next);
         let split = iso.curves.len() > current.len() && !steps.is_empty();
         current = iso.curves.clone();
         steps.push(OffsetStep { curves: iso.curves, split, flagged: iso.flagged, repaired: iso.repaired });
@@ -62,30 +60,56 @@ pub fn offset_curves(support: &Support, limit: &[Curve], step: f64) -> Result<Ve
     Ok(steps)
 }
 
-/// The iso-line at `distance` inside `curves`, and the vertex values (signed
-/// distance minus `distance`; `-inf` for vertices not `active`, known to be
-/// outside).
+/// The single iso-line at `distance` inside `curves` (one Marching Facets
+/// extraction over the whole support).
 ///
 /// # Errors
 /// [`GuideError::BadLength`] for a non-positive distance.
 pub fn offset_curve(support: &Support, curves: &[Curve], distance: f64) -> Result<Isolines, GuideError> {
     check_step(distance)?;
-    let active = vec![true; support.mesh().vertices().len()];
-    Ok(offset_once(support, curves, distance, &active).0)
+    Ok(offset_once(support, curves, distance, None).0)
 }
 
-fn offset_once(support: &Support, curves: &[Curve], distance: f64, active: &[bool]) -> (Isolines, Vec<f64>) {
+/// What one step leaves to the next: per vertex, the field value (distance
+/// minus the offset; `+inf` where only a bound is known, `-inf` outside) and a
+/// lower bound of the distance to the curves.
+struct Band {
+    values: Vec<f64>,
+    lower: Vec<f64>,
+}
+
+/// One Marching Facets extraction. After the first step (`prev` given) every
+/// vertex still inside lies inside `curves`, and by the triangle inequality its
+/// distance to them is at least its distance to the previous curves minus
+/// `distance`: a vertex whose bound passes `distance` plus two facets is far
+/// inside and is not measured (`+inf`); only the band around the new iso-line
+/// is, so a step costs about the curve's length, not the area left.
+fn offset_once(support: &Support, curves: &[Curve], distance: f64, prev: Option<&Band>) -> (Isolines, Band) {
     let field = CurveField::new(curves);
     let verts = support.mesh().vertices();
-    let sampled: Vec<(f64, Option<Point3>)> = (0..verts.len())
+    let reach = distance + 2.0 * support.facet_size();
+    let sampled: Vec<(f64, f64, Option<Point3>)> = (0..verts.len())
         .into_par_iter()
         .map(|v| {
-            if !active[v] {
-                return (f64::NEG_INFINITY, None);
+            let Some(prev) = prev else {
+                return match field.foot(&verts[v]) {
+                    Some(f) => {
+                        let s = field.signed_at(&verts[v], &f);
+                        (s - distance, s.abs(), Some(f.point))
+                    }
+                    None => (f64::NEG_INFINITY, 0.0, None),
+                };
+            };
+            if prev.values[v] <= 0.0 {
+                return (f64::NEG_INFINITY, 0.0, None);
             }
-            match field.foot(&verts[v]) {
-                Some(f) => (field.signed_at(&verts[v], &f) - distance, Some(f.point)),
-                None => (f64::NEG_INFINITY, None),
+            let bound = prev.lower[v] - distance;
+            if bound > reach {
+                return (f64::INFINITY, bound, None);
+            }
+            match field.foot_within(&verts[v], reach) {
+                Some(f) => (field.signed_at(&verts[v], &f) - distance, f.distance, Some(f.point)),
+                None => (f64::INFINITY, reach, None),
             }
         })
         .collect();
@@ -94,14 +118,15 @@ fn offset_once(support: &Support, curves: &[Curve], distance: f64, active: &[boo
     let mesh = support.mesh();
     let medial = |f: usize| {
         let t = mesh.triangles()[f];
-        let feet = t.map(|v| sampled[v as usize].1);
+        let feet = t.map(|v| sampled[v as usize].2);
         let [Some(a), Some(b), Some(c)] = feet else { return false };
         let spread = (a - b).norm().max((b - c).norm()).max((c - a).norm());
         let tri = mesh.triangle(f);
         let size = (tri[1] - tri[0]).norm().max((tri[2] - tri[1]).norm()).max((tri[0] - tri[2]).norm());
         spread > tol::MEDIAL_FOOT_FACTOR * size
     };
-    (march(support, &values, &exact, &medial), values)
+    let iso = march(support, &values, &exact, &medial);
+    (iso, Band { lower: sampled.iter().map(|s| s.1).collect(), values })
 }
 
 pub(crate) fn check_step(step: f64) -> Result<(), GuideError> {
