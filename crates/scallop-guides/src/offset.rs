@@ -78,7 +78,36 @@ struct Band {
     lower: Vec<f64>,
 }
 
-/// One Marching Facets extraction. After the first step (`prev` given) every
+/// Gives the vertices farther than the reach from the curves (value NaN) the
+/// side of their measured neighbours: a connected set of far vertices never
+/// crosses the curves, so it lies on one side. A far set with no measured
+/// neighbour gets its side from one exact query. Sequential, in vertex order:
+/// deterministic.
+fn flood_far_sides(support: &Support, field: &CurveField, sampled: &mut [(f64, f64, Option<Point3>)]) {
+    let far_value = |side_positive: bool| if side_positive { f64::INFINITY } else { f64::NEG_INFINITY };
+    let mut queue: std::collections::VecDeque<u32> =
+        (0..sampled.len()).filter(|&v| !sampled[v].0.is_nan()).map(|v| v as u32).collect();
+    let mut seed = 0usize;
+    loop {
+        while let Some(u) = queue.pop_front() {
+            let positive = sampled[u as usize].0 > 0.0;
+            for &w in support.neighbours(u as usize) {
+                if sampled[w as usize].0.is_nan() {
+                    sampled[w as usize].0 = far_value(positive);
+                    queue.push_back(w);
+                }
+            }
+        }
+        let Some(v) = (seed..sampled.len()).find(|&v| sampled[v].0.is_nan()) else { break };
+        seed = v;
+        sampled[v].0 = far_value(field.signed(&support.mesh().vertices()[v]) > 0.0);
+        queue.push_back(v as u32);
+    }
+}
+
+/// One Marching Facets extraction. On the first step only the vertices
+/// within the reach (`distance` plus two facets) of the curves are measured;
+/// the others take their side by a flood ([`flood_far_sides`]). After the first step (`prev` given) every
 /// vertex still inside lies inside `curves`, and by the triangle inequality its
 /// distance to them is at least its distance to the previous curves minus
 /// `distance`: a vertex whose bound passes `distance` plus two facets is far
@@ -88,31 +117,28 @@ fn offset_once(support: &Support, curves: &[Curve], distance: f64, prev: Option<
     let field = CurveField::new(curves);
     let verts = support.mesh().vertices();
     let reach = distance + 2.0 * support.facet_size();
-    let sampled: Vec<(f64, f64, Option<Point3>)> = (0..verts.len())
+    let mut sampled: Vec<(f64, f64, Option<Point3>)> = (0..verts.len())
         .into_par_iter()
         .map(|v| {
-            let Some(prev) = prev else {
-                return match field.foot(&verts[v]) {
-                    Some(f) => {
-                        let s = field.signed_at(&verts[v], &f);
-                        (s - distance, s.abs(), Some(f.point))
-                    }
-                    None => (f64::NEG_INFINITY, 0.0, None),
-                };
-            };
-            if prev.values[v] <= 0.0 {
-                return (f64::NEG_INFINITY, 0.0, None);
-            }
-            let bound = prev.lower[v] - distance;
-            if bound > reach {
-                return (f64::INFINITY, bound, None);
+            if let Some(prev) = prev {
+                if prev.values[v] <= 0.0 {
+                    return (f64::NEG_INFINITY, 0.0, None);
+                }
+                let bound = prev.lower[v] - distance;
+                if bound > reach {
+                    return (f64::INFINITY, bound, None);
+                }
             }
             match field.foot_within(&verts[v], reach) {
                 Some(f) => (field.signed_at(&verts[v], &f) - distance, f.distance, Some(f.point)),
-                None => (f64::INFINITY, reach, None),
+                // Far: inside after the first step; decided by the flood below on the first.
+                None => (if prev.is_some() { f64::INFINITY } else { f64::NAN }, reach, None),
             }
         })
         .collect();
+    if prev.is_none() {
+        flood_far_sides(support, &field, &mut sampled);
+    }
     let values: Vec<f64> = sampled.iter().map(|s| s.0).collect();
     let exact = |p: &Point3| field.signed(p) - distance;
     let mesh = support.mesh();

@@ -16,6 +16,10 @@ pub struct Support {
     query: MeshQuery,
     vertex_normals: Vec<Vec3>,
     facet_size: f64,
+    /// Vertex neighbours (compressed rows): those of `v` are
+    /// `adjacency[offsets[v]..offsets[v + 1]]`, ascending.
+    offsets: Vec<u32>,
+    adjacency: Vec<u32>,
 }
 
 impl Support {
@@ -62,7 +66,14 @@ impl Support {
             })
             .fold(0.0, f64::max);
         let query = MeshQuery::new(&mesh);
-        Support { mesh, query, vertex_normals, facet_size }
+        let (offsets, adjacency) = neighbours(&mesh);
+        Support { mesh, query, vertex_normals, facet_size, offsets, adjacency }
+    }
+
+    /// The vertices sharing an edge with vertex `v`, ascending.
+    #[must_use]
+    pub fn neighbours(&self, v: usize) -> &[u32] {
+        &self.adjacency[self.offsets[v] as usize..self.offsets[v + 1] as usize]
     }
 
     /// The mesh.
@@ -158,6 +169,28 @@ impl Curve {
     pub fn inside_left(self) -> Curve {
         if self.line.closed && self.signed_area() < 0.0 { self.reversed() } else { self }
     }
+}
+
+/// Vertex adjacency in compressed rows.
+fn neighbours(mesh: &TriMesh) -> (Vec<u32>, Vec<u32>) {
+    let mut pairs: Vec<(u32, u32)> = Vec::with_capacity(6 * mesh.triangles().len());
+    for t in mesh.triangles() {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            pairs.push((a, b));
+            pairs.push((b, a));
+        }
+    }
+    pairs.sort_unstable();
+    pairs.dedup();
+    let mut offsets = vec![0u32; mesh.vertices().len() + 1];
+    for &(a, _) in &pairs {
+        offsets[a as usize + 1] += 1;
+    }
+    for v in 0..mesh.vertices().len() {
+        offsets[v + 1] += offsets[v];
+    }
+    (offsets, pairs.into_iter().map(|p| p.1).collect())
 }
 
 pub(crate) fn check_line(line: &Polyline3, curve: usize) -> Result<(), GuideError> {

@@ -190,3 +190,16 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn a_far_mesh_component_adds_no_loop() {
+    let near = flat(0.0, 15.0, 1.0);
+    let far = flat(40.0, 15.0, 1.0);
+    let both = scallop_mesh::TriMesh::from_soup(&[near.mesh().soup(), far.mesh().soup()].concat()).unwrap().0;
+    let support = scallop_guides::Support::new(both);
+    let limit = vec![on(&support, circle(p(0.0, 0.0, 0.0), 13.0, 260))];
+    let steps = offset_curves(&support, &limit, 4.0).unwrap();
+    assert_eq!(steps.len(), 3);
+    assert!(steps.iter().all(|s| s.curves.len() == 1 && s.curves[0].line.points.iter().all(|x| x.z == 0.0)));
+    check_spacing(&limit, &steps, 4.0);
+}
