@@ -51,7 +51,7 @@ pub use error::GuideError;
 pub use facets::Isolines;
 pub use field::CurveField;
 pub use limit::{LimitCurves, limit_curves};
-pub use morph::{GuidePairs, Level, morph_level, pair_levels, project_curve};
+pub use morph::{GuidePairs, Level, morph_level, morph_vectorial, pair_levels, project_curve};
 pub use offset::{OffsetStep, offset_curve, offset_curves};
 pub use support::{Curve, Support};
 pub use vectorial::{VectorialOffset, VectorialOptions, vectorial_offset};

@@ -201,3 +201,31 @@ fn max_distance(from: &Curve, to: &Curve) -> f64 {
 fn family_spacing(fam: &[Curve]) -> f64 {
     fam.windows(2).map(|w| max_distance(&w[0], &w[1]).max(max_distance(&w[1], &w[0]))).fold(0.0, f64::max)
 }
+
+/// The vectorial morph with nearest-point pairing (Jousselin 2020, Annex A,
+/// Alg. 4): each point of `outer` walks straight towards its nearest point on
+/// `inner`; the `steps - 1` intermediate curves (innermost first, the k-th at
+/// `k / steps` of the way from `inner`) are projected onto `support` (the
+/// walk leaves curved supports) and cleaned of local loops (Alg. 2), since
+/// neighbouring walks cross where an outer point passes the inner curve's
+/// medial axis. The reference for [`morph_level`].
+#[must_use]
+pub fn morph_vectorial(support: &Support, inner: &Curve, outer: &Curve, steps: usize) -> Vec<Curve> {
+    let q = PolylineQuery::new(vec![inner.line.clone()]);
+    let near: Vec<Point3> = outer.line.points.iter().map(|p| q.closest(p).map_or(*p, |f| f.point)).collect();
+    (1..steps)
+        .map(|k| {
+            let w = 1.0 - k as f64 / steps as f64;
+            let pts: Vec<Point3> = outer
+                .line
+                .points
+                .iter()
+                .zip(&near)
+                .map(|(p, n)| support.query().closest_point(&(p + (n - p) * w)).point)
+                .collect();
+            let pts = crate::vectorial::remove_local_loops(pts, outer.line.closed);
+            let normals = pts.iter().map(|p| support.normal_at(p)).collect();
+            Curve { line: Polyline3::new(pts, outer.line.closed), normals }
+        })
+        .collect()
+}

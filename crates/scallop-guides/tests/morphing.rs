@@ -125,3 +125,30 @@ fn limit_curve_of_a_tilted_level_in_a_drafted_pocket() {
     let limits = limit_curves(&level, &both);
     assert_eq!((limits.loops.len(), limits.nested), (2, 1));
 }
+
+#[test]
+fn vectorial_morph_lands_on_the_support_and_matches_the_scalar_morph() {
+    // A sphere cap: the straight walks leave the support and are projected back.
+    let support = sphere_cap(40.0, 0.9, 1.0);
+    let lift = |r: f64, n: usize| {
+        let mut c = circle(p(0.0, 0.0, 0.0), r, n);
+        for x in &mut c.points {
+            *x = p(x.x, x.y, (1600.0 - x.x * x.x - x.y * x.y).sqrt());
+        }
+        on(&support, c)
+    };
+    let (inner, outer) = (lift(8.0, 160), lift(24.0, 480));
+    let steps = 4;
+    let vect = scallop_guides::morph_vectorial(&support, &inner, &outer, steps);
+    assert_eq!(vect.len(), steps - 1);
+    let h = support.facet_size();
+    for (k, c) in vect.iter().enumerate() {
+        assert!(on_mesh(&support, c));
+        let m = (k + 1) as f64 / steps as f64;
+        let scalar = morph_level(&support, std::slice::from_ref(&inner), std::slice::from_ref(&outer), m);
+        assert_eq!(scalar.len(), 1);
+        assert!(on_mesh(&support, &scalar[0]));
+        // Chord (3D) and geodesic ratios differ a little on the sphere: within two facets.
+        assert!(max_distance(std::slice::from_ref(c), &scalar) <= 2.0 * h, "k = {k}");
+    }
+}
