@@ -30,7 +30,8 @@ impl CurveField {
                     .map(|s| {
                         let (a, b) = c.line.segment(s);
                         let n_pts = c.line.points.len();
-                        let n = c.normals[s] + c.normals[(s + 1) % n_pts];
+                        let normal = |i: usize| c.normals.get(i).copied().unwrap_or_else(Vec3::z);
+                        let n = normal(s) + normal((s + 1) % n_pts);
                         let l = n.cross(&(b - a));
                         let len = l.norm();
                         if len > 0.0 { l / len } else { Vec3::zeros() }

@@ -10,7 +10,7 @@ use scallop_geom::Point3;
 
 use crate::facets::{Isolines, march};
 use crate::field::CurveField;
-use crate::support::{Curve, Support, check_line};
+use crate::support::{Curve, Support, check_curve};
 use crate::{GuideError, tol};
 
 /// One offset step.
@@ -38,7 +38,7 @@ pub struct OffsetStep {
 pub fn offset_curves(support: &Support, limit: &[Curve], step: f64) -> Result<Vec<OffsetStep>, GuideError> {
     check_step(step)?;
     for (i, c) in limit.iter().enumerate() {
-        check_line(&c.line, i)?;
+        check_curve(c, i)?;
     }
     let guard = (support.mesh().bounds().diagonal() / step).ceil() as usize + tol::EXTRA_STEPS;
     let mut current: Vec<Curve> = limit.to_vec();
@@ -64,9 +64,13 @@ pub fn offset_curves(support: &Support, limit: &[Curve], step: f64) -> Result<Ve
 /// extraction over the whole support).
 ///
 /// # Errors
-/// [`GuideError::BadLength`] for a non-positive distance.
+/// [`GuideError::BadLength`] for a non-positive distance,
+/// [`GuideError::BadCurve`] for an unusable curve.
 pub fn offset_curve(support: &Support, curves: &[Curve], distance: f64) -> Result<Isolines, GuideError> {
     check_step(distance)?;
+    for (i, c) in curves.iter().enumerate() {
+        check_curve(c, i)?;
+    }
     Ok(offset_once(support, curves, distance, None).0)
 }
 

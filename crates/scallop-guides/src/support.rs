@@ -157,8 +157,8 @@ impl Curve {
     pub fn signed_area(&self) -> f64 {
         let n: Vec3 = self.normals.iter().sum();
         let n = if n.norm() > 0.0 { n.normalize() } else { Vec3::z() };
-        let o = self.line.points[0];
         let pts = &self.line.points;
+        let Some(&o) = pts.first() else { return 0.0 };
         (1..pts.len().saturating_sub(1)).map(|i| 0.5 * (pts[i] - o).cross(&(pts[i + 1] - o)).dot(&n)).sum()
     }
 
@@ -191,6 +191,16 @@ fn neighbours(mesh: &TriMesh) -> (Vec<u32>, Vec<u32>) {
         offsets[v + 1] += offsets[v];
     }
     (offsets, pairs.into_iter().map(|p| p.1).collect())
+}
+
+/// [`check_line`] plus one normal per point.
+pub(crate) fn check_curve(c: &Curve, curve: usize) -> Result<(), GuideError> {
+    check_line(&c.line, curve)?;
+    if c.normals.len() == c.line.points.len() {
+        Ok(())
+    } else {
+        Err(GuideError::BadCurve { curve, reason: "not one normal per point" })
+    }
 }
 
 pub(crate) fn check_line(line: &Polyline3, curve: usize) -> Result<(), GuideError> {

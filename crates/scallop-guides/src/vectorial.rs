@@ -55,6 +55,7 @@ pub fn vectorial_offset(
             return Err(GuideError::BadLength { name, value: v });
         }
     }
+    crate::support::check_curve(curve, 0)?;
     let c = subdivide(support, curve, opts.spacing);
     let whole = PolylineQuery::new(vec![c.line.clone()]);
     let n = c.line.points.len();

@@ -203,3 +203,15 @@ fn a_far_mesh_component_adds_no_loop() {
     assert!(steps.iter().all(|s| s.curves.len() == 1 && s.curves[0].line.points.iter().all(|x| x.z == 0.0)));
     check_spacing(&limit, &steps, 4.0);
 }
+
+#[test]
+fn hand_built_curves_are_checked() {
+    let support = flat(0.0, 10.0, 1.0);
+    let mut c = on(&support, circle(p(0.0, 0.0, 0.0), 5.0, 40));
+    c.normals.pop();
+    assert!(matches!(offset_curves(&support, std::slice::from_ref(&c), 1.0), Err(GuideError::BadCurve { .. })));
+    assert!(matches!(scallop_guides::offset_curve(&support, &[c], 1.0), Err(GuideError::BadCurve { .. })));
+    let empty = Curve { line: Polyline3::new(vec![], true), normals: vec![] };
+    assert_eq!(empty.signed_area(), 0.0);
+    assert!(scallop_guides::morph_level(&support, &[empty.clone()], &[empty], 0.5).is_empty());
+}
