@@ -152,3 +152,33 @@ fn vectorial_morph_lands_on_the_support_and_matches_the_scalar_morph() {
         assert!(max_distance(std::slice::from_ref(c), &scalar) <= 2.0 * h, "k = {k}");
     }
 }
+
+#[test]
+fn pairing_does_not_depend_on_the_thread_count() {
+    let a_e = 4.5;
+    let (s0, c0, o0) = planar_level(0.0, 10.0, a_e);
+    let (s1, c1, o1) = planar_level(10.0, 12.0, a_e);
+    let run = |threads| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| {
+            pair_levels(
+                &Level { support: &s0, limit: &c0, offsets: &o0 },
+                &Level { support: &s1, limit: &c1, offsets: &o1 },
+                a_e,
+            )
+            .unwrap()
+        })
+    };
+    assert_eq!(run(1), run(2));
+}
+
+#[test]
+fn exact_normals_are_kept_and_checked() {
+    let mesh = flat(0.0, 5.0, 1.0).mesh().clone();
+    let n = mesh.vertices().len();
+    let tilted = scallop_geom::Vec3::new(0.0, 0.0, 2.0);
+    let s = Support::with_normals(mesh.clone(), vec![tilted; n]).unwrap();
+    assert_eq!(s.vertex_normal(0), scallop_geom::Vec3::z());
+    assert!(Support::with_normals(mesh.clone(), vec![tilted; n - 1]).is_err());
+    assert!(Support::with_normals(mesh, vec![scallop_geom::Vec3::zeros(); n]).is_err());
+}
