@@ -213,5 +213,8 @@ fn hand_built_curves_are_checked() {
     assert!(matches!(scallop_guides::offset_curve(&support, &[c], 1.0), Err(GuideError::BadCurve { .. })));
     let empty = Curve { line: Polyline3::new(vec![], true), normals: vec![] };
     assert_eq!(empty.signed_area(), 0.0);
-    assert!(scallop_guides::morph_level(&support, &[empty.clone()], &[empty], 0.5).is_empty());
+    assert!(
+        scallop_guides::morph_level(&support, std::slice::from_ref(&empty), std::slice::from_ref(&empty), 0.5)
+            .is_empty()
+    );
 }
