@@ -61,6 +61,15 @@ impl CurveField {
         self.query.closest_within(p, max_distance)
     }
 
+    /// As [`CurveField::foot_within`], searching from a nearby point's foot.
+    #[must_use]
+    pub fn foot_near(&self, p: &Point3, max_distance: f64, hint: Option<&PolylineFoot>) -> Option<PolylineFoot> {
+        match hint {
+            Some(h) => self.query.closest_near(p, max_distance, h),
+            None => self.query.closest_within(p, max_distance),
+        }
+    }
+
     /// Signed distance from `p`: `+d` on the inside (left), `-d` outside.
     #[must_use]
     pub fn signed(&self, p: &Point3) -> f64 {

@@ -121,25 +121,36 @@ fn offset_once(support: &Support, curves: &[Curve], distance: f64, prev: Option<
     let field = CurveField::new(curves);
     let verts = support.mesh().vertices();
     let reach = distance + 2.0 * support.facet_size();
-    let mut sampled: Vec<(f64, f64, Option<Point3>)> = (0..verts.len())
+    // Chunks of consecutive vertices (neighbours in space on most meshes)
+    // search from the last foot found: the same feet, fewer nodes visited.
+    let chunks: Vec<Vec<(f64, f64, Option<Point3>)>> = (0..verts.len().div_ceil(CHUNK))
         .into_par_iter()
-        .map(|v| {
-            if let Some(prev) = prev {
-                if prev.values[v] <= 0.0 {
-                    return (f64::NEG_INFINITY, 0.0, None);
-                }
-                let bound = prev.lower[v] - distance;
-                if bound > reach {
-                    return (f64::INFINITY, bound, None);
-                }
-            }
-            match field.foot_within(&verts[v], reach) {
-                Some(f) => (field.signed_at(&verts[v], &f) - distance, f.distance, Some(f.point)),
-                // Far: inside after the first step; decided by the flood below on the first.
-                None => (if prev.is_some() { f64::INFINITY } else { f64::NAN }, reach, None),
-            }
+        .map(|c| {
+            let mut hint = None;
+            (c * CHUNK..((c + 1) * CHUNK).min(verts.len()))
+                .map(|v| {
+                    if let Some(prev) = prev {
+                        if prev.values[v] <= 0.0 {
+                            return (f64::NEG_INFINITY, 0.0, None);
+                        }
+                        let bound = prev.lower[v] - distance;
+                        if bound > reach {
+                            return (f64::INFINITY, bound, None);
+                        }
+                    }
+                    match field.foot_near(&verts[v], reach, hint.as_ref()) {
+                        Some(f) => {
+                            hint = Some(f);
+                            (field.signed_at(&verts[v], &f) - distance, f.distance, Some(f.point))
+                        }
+                        // Far: inside after the first step; decided by the flood below on the first.
+                        None => (if prev.is_some() { f64::INFINITY } else { f64::NAN }, reach, None),
+                    }
+                })
+                .collect()
         })
         .collect();
+    let mut sampled: Vec<(f64, f64, Option<Point3>)> = chunks.into_iter().flatten().collect();
     if prev.is_none() {
         flood_far_sides(support, &field, &mut sampled);
     }
@@ -158,6 +169,9 @@ fn offset_once(support: &Support, curves: &[Curve], distance: f64, prev: Option<
     let iso = march(support, &values, &exact, &medial);
     (iso, Band { lower: sampled.iter().map(|s| s.1).collect(), values })
 }
+
+/// Vertices per parallel work item of the field evaluation.
+const CHUNK: usize = 256;
 
 pub(crate) fn check_step(step: f64) -> Result<(), GuideError> {
     if step.is_finite() && step > 0.0 { Ok(()) } else { Err(GuideError::BadLength { name: "a_e", value: step }) }

@@ -177,6 +177,22 @@ impl PolylineQuery {
         Some(PolylineFoot { curve: c as usize, segment: s as usize, t, point: a + (b - a) * t, distance: d2.sqrt() })
     }
 
+    /// As [`PolylineQuery::closest_within`], searching from the segment of
+    /// `hint` (a foot of a nearby point): its distance bounds the search, so
+    /// coherent queries prune more. The result does not depend on the hint.
+    #[must_use]
+    pub fn closest_near(&self, p: &Point3, max_distance: f64, hint: &PolylineFoot) -> Option<PolylineFoot> {
+        let Some(curve) = self.curves.get(hint.curve) else { return self.closest_within(p, max_distance) };
+        if hint.segment >= curve.segment_count() {
+            return self.closest_within(p, max_distance);
+        }
+        let (a, b) = curve.segment(hint.segment);
+        let d = (a + (b - a) * segment_parameter(p, &a, &b) - p).norm();
+        // A relative margin keeps the hint's own segment inside the bound
+        // despite rounding in the squared comparison.
+        self.closest_within(p, max_distance.min(d * (1.0 + 1e-12)))
+    }
+
     /// Distance from `p` to the set (infinite for an empty set).
     #[must_use]
     pub fn distance(&self, p: &Point3) -> f64 {

@@ -145,6 +145,16 @@ proptest! {
         prop_assert!((f.distance - brute).abs() <= 1e-12);
     }
 
+    /// A hinted search finds the same foot as a plain one, whatever the hint.
+    #[test]
+    fn hinted_polyline_search_is_the_plain_one(q in point(), h in point(), pts in prop::collection::vec(point(), 2..30)) {
+        let query = PolylineQuery::new(vec![Polyline3::new(pts, true)]);
+        let hint = query.closest(&h).unwrap();
+        for reach in [f64::INFINITY, 5.0] {
+            prop_assert_eq!(query.closest_near(&q, reach, &hint), query.closest_within(&q, reach));
+        }
+    }
+
     /// A plane through a closed sphere cuts one closed loop on the sphere and the plane.
     #[test]
     fn plane_cuts_sphere_in_one_loop(c in -7.0..7.0f64, tilt in -0.5..0.5f64) {
