@@ -2,7 +2,7 @@
 
 /// Root finding on a Marching Facets edge stops when the exact field is within
 /// this of the iso-value, or the bracket is this short (mm). Far below the
-/// spec's 1e-6 mm for edge points (Jousselin 2020, Ch. 2 §3.2.1; docs/guides-curves.md).
+/// 1e-6 mm asked of edge points (issue 17; docs/guides-curves.md).
 pub const ROOT_TOLERANCE: f64 = 1e-10;
 
 /// Iteration cap of the edge root finding (Illinois false position with
