@@ -47,6 +47,14 @@ pub enum GuideError {
         /// Number of loops found.
         loops: usize,
     },
+    /// A level or the flank offset could not be extracted from its field.
+    #[error("{what}: {reason}")]
+    Field {
+        /// Which surface.
+        what: &'static str,
+        /// The field engine's message.
+        reason: String,
+    },
     /// The projection of the innermost curve onto the next level failed.
     #[error("the innermost curve could not be projected onto the next level: {reason}")]
     Projection {

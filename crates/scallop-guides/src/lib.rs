@@ -11,6 +11,8 @@
 //! - [`limit_curves`]: C_n, a level meets the flank offset (Ch. 2 §3.2.1);
 //! - [`morph_level`], [`pair_levels`]: tilt curves by scalar morphing on the
 //!   next level, the swap rule and the count rule (Ch. 2 §3.2.2);
+//! - [`build_guides`]: levels, flank offset, limit, path and tilt curves of
+//!   a pocket (module F);
 //! - [`vectorial_offset`]: the vectorial method (Eq. 2.8-2.10, Alg. 1-3), the
 //!   reference for the scalar one.
 //!
@@ -37,6 +39,7 @@
 //! - Never performs I/O; never prints; errors are [`GuideError`].
 //! - Results do not depend on the thread count (rayon with indexed collection).
 
+mod build;
 mod error;
 mod facets;
 mod field;
@@ -47,6 +50,7 @@ mod support;
 pub mod tol;
 mod vectorial;
 
+pub use build::{GuideLevel, GuideSet, GuideSettings, build_guides};
 pub use error::GuideError;
 pub use facets::Isolines;
 pub use field::CurveField;

@@ -23,3 +23,6 @@ pub const EXTRA_STEPS: usize = 2;
 /// (radians): gaps on straight stretches are not filled, since the radial push
 /// would bring the points closer than the offset distance to the curve.
 pub const CORNER_TURN: f64 = 0.1;
+
+/// Most axial levels of one guide set (bounds the work on absurd settings).
+pub const MAX_LEVELS: usize = 1000;

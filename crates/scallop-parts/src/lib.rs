@@ -23,7 +23,7 @@ mod svg;
 pub use fitting::{FittingParams, fitting_pocket};
 pub use impeller::{ImpellerParams, impeller_channel};
 pub use pocket::{PocketParams, closed_pocket};
-pub use svg::svg_view;
+pub use svg::{svg_view, svg_view_with_lines};
 
 use scallop_geom::Aabb3;
 use scallop_mesh::{MeshError, TriMesh};

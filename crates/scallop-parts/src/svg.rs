@@ -2,7 +2,7 @@
 
 use std::fmt::Write as _;
 
-use scallop_geom::Vec3;
+use scallop_geom::{Point3, Vec3};
 use scallop_mesh::TriMesh;
 
 /// An SVG of `mesh` seen from the -x, -y, +z octant, `width` pixels wide;
@@ -14,6 +14,18 @@ use scallop_mesh::TriMesh;
 /// near (ties by number), so the text depends only on the input.
 #[must_use]
 pub fn svg_view(mesh: &TriMesh, width: f64, colour: impl Fn(usize) -> Option<[u8; 3]>) -> String {
+    svg_view_with_lines(mesh, width, colour, &[])
+}
+
+/// As [`svg_view`], with polylines `(points, closed, colour)` drawn over the
+/// triangles in the same projection (curves on the part).
+#[must_use]
+pub fn svg_view_with_lines(
+    mesh: &TriMesh,
+    width: f64,
+    colour: impl Fn(usize) -> Option<[u8; 3]>,
+    lines: &[(Vec<Point3>, bool, [u8; 3])],
+) -> String {
     let eye = Vec3::new(-1.0, -1.6, 1.3).normalize();
     let right = Vec3::z().cross(&eye).normalize();
     let up = eye.cross(&right);
@@ -60,6 +72,21 @@ pub fn svg_view(mesh: &TriMesh, width: f64, colour: impl Fn(usize) -> Option<[u8
         let _ = writeln!(
             s,
             r##"<polygon points="{}" fill="#{r:02x}{g:02x}{b:02x}" stroke="#{r:02x}{g:02x}{b:02x}" stroke-width="0.4"/>"##,
+            pts.join(" ")
+        );
+    }
+    for (points, closed, [r, g, b]) in lines {
+        let pts: Vec<String> = points
+            .iter()
+            .map(|p| {
+                let (x, y) = project(p);
+                format!("{:.1},{:.1}", (x - lo.0) * scale, (y - lo.1) * scale)
+            })
+            .collect();
+        let tag = if *closed { "polygon" } else { "polyline" };
+        let _ = writeln!(
+            s,
+            r##"<{tag} points="{}" fill="none" stroke="#{r:02x}{g:02x}{b:02x}" stroke-width="1.2"/>"##,
             pts.join(" ")
         );
     }
