@@ -6,6 +6,7 @@ mod analyze;
 mod choice;
 mod drop;
 mod engagement;
+mod guides;
 mod optimize;
 mod output;
 mod outset;
@@ -67,6 +68,8 @@ enum Command {
     Render(render::RenderArgs),
     /// The closed contours where a cutter with its tip at height z touches a mesh (CSV or JSON loops).
     Waterline(waterline::WaterlineArgs),
+    /// Guide curves of 5-axis roughing on a test part: levels, limit, path and tilt curves (docs/guides.md).
+    Guides(guides::GuidesArgs),
     /// Clear a 2D pocket (region JSON: outer boundary, then islands) and write G-code and CL.
     Pocket(pocket::PocketArgs),
     /// Load a part and report what was read (size, welding, open and non-manifold edges).
@@ -96,6 +99,7 @@ fn main() -> ExitCode {
         Command::Post(args) => post::run(&args),
         Command::Render(args) => render::run(&args),
         Command::Waterline(args) => waterline::run(&args),
+        Command::Guides(args) => guides::run(&args),
         Command::Engagement(args) => engagement::run(&args),
         Command::Pocket(args) => pocket::run(&args),
     };
