@@ -4,8 +4,8 @@
 //! Aanaes 2005, "Signed distance computation using the angle weighted
 //! pseudonormal", IEEE TVCG 11(3), section 3).
 
-use scallop_geom::{Point3, Vec3};
-use scallop_mesh::{FastMap, TriMesh};
+use scallop_geom::{Aabb3, Point3, Vec3};
+use scallop_mesh::{Bvh, FastMap, TriMesh, triangle_box};
 
 /// Where on its triangle a closest point lies.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -31,48 +31,25 @@ pub struct Closest {
     pub feature: Feature,
 }
 
-#[derive(Debug, Clone, Copy)]
-struct Node {
-    min: Point3,
-    max: Point3,
-    /// Leaf: first triangle slot; inner: index of the left child (right = left + 1).
-    first: u32,
-    /// Triangles in a leaf, 0 for an inner node.
-    count: u32,
-}
-
 /// A triangle mesh with its hierarchy and pseudo-normals.
 #[derive(Debug, Clone)]
 pub struct Surface {
     mesh: TriMesh,
-    nodes: Vec<Node>,
-    order: Vec<u32>,
+    bvh: Bvh,
     face_normals: Vec<Vec3>,
     edge_normals: Vec<[Vec3; 3]>,
     vertex_normals: Vec<Vec3>,
 }
-
-const LEAF: usize = 4;
 
 impl Surface {
     /// Prepares `mesh` (its triangle orientation gives the sides: a point is on
     /// the positive side when it lies where the normals point).
     #[must_use]
     pub fn new(mesh: &TriMesh) -> Surface {
-        let n = mesh.triangles().len();
-        let boxes: Vec<(Point3, Point3, Point3)> = (0..n)
-            .map(|t| {
-                let [a, b, c] = mesh.triangle(t);
-                (a.inf(&b).inf(&c), a.sup(&b).sup(&c), Point3::from((a.coords + b.coords + c.coords) / 3.0))
-            })
-            .collect();
-        #[allow(clippy::cast_possible_truncation, reason = "a TriMesh indexes with u32")]
-        let mut order: Vec<u32> = (0..n as u32).collect();
-        let mut nodes = Vec::with_capacity(2 * n / LEAF + 2);
-        nodes.push(Node { min: Point3::origin(), max: Point3::origin(), first: 0, count: 0 });
-        build(&mut nodes, 0, &mut order, 0, &boxes);
+        let boxes: Vec<Aabb3> = (0..mesh.triangles().len()).map(|t| triangle_box(&mesh.triangle(t))).collect();
+        let bvh = Bvh::build(&boxes);
         let (face_normals, edge_normals, vertex_normals) = pseudo_normals(mesh);
-        Surface { mesh: mesh.clone(), nodes, order, face_normals, edge_normals, vertex_normals }
+        Surface { mesh: mesh.clone(), bvh, face_normals, edge_normals, vertex_normals }
     }
 
     /// The mesh.
@@ -85,42 +62,13 @@ impl Surface {
     /// no triangle comes that close.
     #[must_use]
     pub fn closest(&self, p: &Point3, max_dist: f64) -> Option<Closest> {
-        let mut best: Option<Closest> = None;
-        let mut bound = if max_dist.is_finite() { max_dist * max_dist } else { f64::INFINITY };
-        let mut stack: Vec<(u32, f64)> = vec![(0, box_dist2(&self.nodes[0], p))];
-        while let Some((id, d2)) = stack.pop() {
-            if d2 > bound {
-                continue;
-            }
-            let node = &self.nodes[id as usize];
-            if node.count == 0 {
-                let (l, r) = (node.first, node.first + 1);
-                let dl = box_dist2(&self.nodes[l as usize], p);
-                let dr = box_dist2(&self.nodes[r as usize], p);
-                // Nearer child last, so it is popped first.
-                if dl <= dr {
-                    stack.push((r, dr));
-                    stack.push((l, dl));
-                } else {
-                    stack.push((l, dl));
-                    stack.push((r, dr));
-                }
-                continue;
-            }
-            for slot in node.first..node.first + node.count {
-                let t = self.order[slot as usize] as usize;
-                let (q, feature) = closest_on_triangle(p, &self.mesh.triangle(t));
-                let dist2 = (q - p).norm_squared();
-                // Ties go to the lower triangle number, so the feature does not depend
-                // on the visiting order.
-                let better = best.is_none_or(|b| dist2.total_cmp(&b.dist2).then(t.cmp(&b.triangle)).is_lt());
-                if dist2 <= bound && better {
-                    bound = dist2;
-                    best = Some(Closest { point: q, dist2, triangle: t, feature });
-                }
-            }
-        }
-        best
+        let bound = if max_dist.is_finite() { max_dist * max_dist } else { f64::INFINITY };
+        // Ties go to the lower triangle number (`Bvh::nearest`), so the
+        // feature does not depend on the visiting order.
+        let (t, dist2) =
+            self.bvh.nearest(p, bound, |t| (closest_on_triangle(p, &self.mesh.triangle(t)).0 - p).norm_squared())?;
+        let (point, feature) = closest_on_triangle(p, &self.mesh.triangle(t));
+        Some(Closest { point, dist2, triangle: t, feature })
     }
 
     /// The pseudo-normal of a closest point's feature: the face normal inside a
@@ -151,57 +99,6 @@ impl Surface {
     pub fn side_within(&self, p: &Point3, max_dist: f64) -> f64 {
         self.closest(p, max_dist).map_or(0.0, |c| (p - c.point).dot(&self.pseudo_normal(&c)))
     }
-}
-
-fn box_dist2(n: &Node, p: &Point3) -> f64 {
-    let mut d = 0.0;
-    for a in 0..3 {
-        let e = (n.min[a] - p[a]).max(p[a] - n.max[a]).max(0.0);
-        d += e * e;
-    }
-    d
-}
-
-/// Median split on the longest axis of the centroids; ties by triangle number,
-/// so the hierarchy depends only on the mesh.
-fn build(nodes: &mut Vec<Node>, id: usize, order: &mut [u32], first: usize, boxes: &[(Point3, Point3, Point3)]) {
-    let mut min = Point3::from(Vec3::repeat(f64::INFINITY));
-    let mut max = Point3::from(Vec3::repeat(f64::NEG_INFINITY));
-    let mut cmin = min;
-    let mut cmax = max;
-    for &t in order.iter() {
-        let (lo, hi, c) = &boxes[t as usize];
-        min = min.inf(lo);
-        max = max.sup(hi);
-        cmin = cmin.inf(c);
-        cmax = cmax.sup(c);
-    }
-    #[allow(clippy::cast_possible_truncation, reason = "a TriMesh indexes with u32")]
-    if order.len() <= LEAF {
-        nodes[id] = Node { min, max, first: first as u32, count: order.len() as u32 };
-        return;
-    }
-    let ext = cmax - cmin;
-    let axis = if ext.x >= ext.y && ext.x >= ext.z {
-        0
-    } else if ext.y >= ext.z {
-        1
-    } else {
-        2
-    };
-    order.sort_unstable_by(|&a, &b| boxes[a as usize].2[axis].total_cmp(&boxes[b as usize].2[axis]).then(a.cmp(&b)));
-    let mid = order.len() / 2;
-    let left = nodes.len();
-    #[allow(clippy::cast_possible_truncation, reason = "node count below 2^32 for a u32-indexed mesh")]
-    {
-        nodes[id] = Node { min, max, first: left as u32, count: 0 };
-    }
-    let blank = nodes[id];
-    nodes.push(blank);
-    nodes.push(blank);
-    let (lo, hi) = order.split_at_mut(mid);
-    build(nodes, left, lo, first, boxes);
-    build(nodes, left + 1, hi, first + mid, boxes);
 }
 
 /// Closest point of triangle `t` to `p` and its feature (Ericson 2005,
