@@ -559,17 +559,18 @@ impl<'a> Planner<'a> {
                 let current = planes.last().expect("a plane of this range");
                 let d = current.plane.offset;
                 let (spacing, at) = self.spacing(current).unwrap_or((delta, self.frame.xy(0.0, d)));
-                // With rest tolerated, no spacing below a share of the largest:
-                // a pair that holds sh only closer than that has rest material
-                // between its passes (a wall the waterline levels finish, a
-                // corner), not a scallop, and creeping on at tiny spacings
-                // would multiply the planes.
-                let floor = if self.tolerate_rest { tol::REST_SPACING_SHARE * cap } else { tol::MIN_SPACING };
                 let spacing = match spacing {
-                    s if s >= floor => s,
-                    _ if self.tolerate_rest => floor,
+                    s if s >= tol::MIN_SPACING => s,
+                    _ if self.tolerate_rest => tol::REST_SPACING_SHARE * cap,
                     s => return Err(self.unreachable(s, at)),
                 };
+                // With rest tolerated, a residual many times sh at the rule's
+                // spacing is rest material between the passes (the foot of a
+                // wall that the waterline levels finish, a corner), not a
+                // scallop: creeping on at tiny spacings would multiply the
+                // planes, so the next plane goes a share of the largest
+                // step-over away and the simulation reports what is left.
+                let rest_gap = (tol::REST_SPACING_SHARE * cap).min(spacing);
                 delta = spacing;
                 let mut gap = spacing;
                 let mut next = self.plane(d + gap);
@@ -589,7 +590,7 @@ impl<'a> Planner<'a> {
                     }
                 }
                 let mut accepted = false;
-                let rule_gap = gap;
+                let mut last_try: Option<(f64, f64)> = None;
                 for retry in 0..tol::MAX_SPACING_RETRIES {
                     // INVARIANT: as above.
                     let current = planes.last().expect("a plane of this range");
@@ -598,11 +599,17 @@ impl<'a> Planner<'a> {
                         accepted = true;
                         break;
                     }
+                    // A residual that does not fall as the gap shrinks is rest too.
+                    let stalled = last_try.is_some_and(|(g, hp)| gap < 0.5 * g && h > 0.5 * hp);
+                    if self.tolerate_rest && ((retry == 0 && h > tol::REST_RESIDUAL_FACTOR * sh) || stalled) {
+                        break;
+                    }
+                    last_try = Some((gap, h));
                     // Scallop ~ gap^2; after a first exact-ratio try, shrink by at
                     // least SPACING_MIN_SHRINK per retry (curvature, rest material).
                     let ratio = if h.is_finite() { (sh / h).sqrt() * tol::SPACING_SAFETY } else { 0.5 };
                     gap *= if retry == 0 { ratio } else { ratio.min(tol::SPACING_MIN_SHRINK) };
-                    if gap < floor {
+                    if gap < tol::MIN_SPACING {
                         if self.tolerate_rest {
                             break;
                         }
@@ -614,7 +621,6 @@ impl<'a> Planner<'a> {
                     if !self.tolerate_rest {
                         return Err(self.unreachable(gap, at));
                     }
-                    let rest_gap = floor.min(rule_gap);
                     next = self.plane(d + rest_gap);
                     if next.plane.passes.is_empty() {
                         empty = d + rest_gap;

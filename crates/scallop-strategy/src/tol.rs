@@ -257,11 +257,11 @@ pub const LEVEL_PUSH_CHORDS: f64 = 2.0;
 /// every this many chord tolerances along it.
 pub const LEVEL_LINK_SAMPLE_CHORDS: f64 = 10.0;
 
-/// When the planner tolerates rest material (steep-and-shallow), no plane
-/// spacing falls below this share of the largest step-over: where the
-/// spacing rule or the measured scallop asks for less (a crease's normal,
-/// the foot of a wall that the waterline levels finish), the next plane is
-/// this far away and the stock simulation reports what is left.
+/// When the planner tolerates rest material (steep-and-shallow) and no
+/// spacing holds sh (a crease's normal, the foot of a wall that the
+/// waterline levels finish), the next plane is this share of the largest
+/// step-over away (at most the rule's spacing) and the stock simulation
+/// reports what is left.
 pub const REST_SPACING_SHARE: f64 = 0.25;
 
 /// Half-width (degrees) of the slope band that both parallel planes and
@@ -274,3 +274,12 @@ pub const STEEP_OVERLAP_DEG: f64 = 10.0;
 /// `Planner::rides_sharp_edge`). Tessellations of smooth surfaces within the
 /// usual chord tolerances bend by a few degrees between facets.
 pub const SHARP_EDGE_DEG: f64 = 30.0;
+
+/// With rest tolerated, a measured residual above this many times sh at the
+/// spacing rule's gap is rest material, not a scallop (a scallop grows with
+/// the square of the gap: the rule would be 4.5 times too wide), and the
+/// next plane goes `REST_SPACING_SHARE` of the largest step-over away
+/// instead of shrinking the gap (`Planner::sweep`). So is a residual that
+/// keeps more than half its height when the gap is more than halved (a
+/// scallop would fall to a quarter).
+pub const REST_RESIDUAL_FACTOR: f64 = 20.0;
