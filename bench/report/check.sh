@@ -2,7 +2,8 @@
 # Issue 7: open the HTML reports in headless Chromium and check that they work.
 # Builds the demo's finishing report (`scallop demo`), the simulation report of its
 # program (`scallop simulate`) and the report of a small optimisation study
-# (`scallop optimize`) and the deviation view of a generated mesh part with large
+# (`scallop optimize`), the report of a job of three operations (`scallop run
+# examples/jobs/pocket-rest.toml`) and the deviation view of a generated mesh part with large
 # facets (`scallop run`, bench/report/large_facets.py), then for each:
 #   chromium --headless ... --screenshot   (1200 x 800)
 #   chromium --headless ... --dump-dom
@@ -47,6 +48,8 @@ mkdir -p "$OUT"
 sed -e 's/^k_max = .*/k_max = 3/' -e 's/^budget = .*/budget = 30/' \
     examples/jobs/optimize-choi-3axis.toml > "$OUT/optimize-small.toml"
 "$SCALLOP" optimize "$OUT/optimize-small.toml" -o "$OUT/optimize" >/dev/null
+# A job of three operations on one stock (rough, rest, finish): one colour per operation.
+"$SCALLOP" run examples/jobs/pocket-rest.toml -o "$OUT/job" >/dev/null
 
 # Chromium stalls on connection attempts without these flags (no network here).
 # WebGL runs on SwiftShader (software): --disable-gpu plus --enable-unsafe-swiftshader.
@@ -74,7 +77,7 @@ shoot() {
 }
 
 status=0
-for page in "$OUT/demo/report.html" "$OUT/sim/report.html" "$OUT/optimize/report.html"; do
+for page in "$OUT/demo/report.html" "$OUT/sim/report.html" "$OUT/optimize/report.html" "$OUT/job/report.html"; do
     if shoot "$page" ""; then
         echo "ok: $page"
     else

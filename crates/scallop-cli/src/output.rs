@@ -112,22 +112,34 @@ pub fn demo(args: &DemoArgs) -> CliResult<()> {
 
 /// Writes `program.nc`, `report.json` and `toolpath.csv` of a job of several
 /// operations into `folder` and prints the summary (or the report as JSON).
-pub fn write_job(out: &scallop_engine::JobOutput, seconds: f64, folder: &Path, json: bool) -> CliResult<()> {
-    // The three files replace the previous set in one step (`outset.rs`).
+pub fn write_job(
+    job: &scallop_engine::Job,
+    out: &scallop_engine::JobOutput,
+    seconds: f64,
+    folder: &Path,
+    json: bool,
+    command: &str,
+) -> CliResult<()> {
+    // The five files replace the previous set in one step (`outset.rs`).
     let mut set = OutputSet::begin(folder, "job")?;
     let nc = set.final_path("program.nc");
     set.write("program.nc", out.gcode.as_bytes())?;
     let text = serde_json::to_string_pretty(&out.report).map_err(|e| Failure::Io(e.into()))?;
     set.write("report.json", text.as_bytes())?;
     set.write("toolpath.csv", scallop_io::cl::write_cl(&out.toolpath).as_bytes())?;
+    let data = scallop_report::ReportData::from_job(job, out, seconds, command);
+    set.write("report.html", scallop_report::html::report_html(&data).as_bytes())?;
+    let glb = scallop_report::glb::scene_glb(&data).map_err(|e| Failure::Io(anyhow::anyhow!("scene.glb: {e}")))?;
+    set.write("scene.glb", &glb)?;
     let written = set.commit()?;
     if json {
         return print_json(&with_written(&out.report, &written)?);
     }
     let r = &out.report;
     let mut text = format!(
-        "{} operations on one stock, {}\n  stock      [{:.2}, {:.2}, {:.2}] to [{:.2}, {:.2}, {:.2}] mm\n",
+        "{} operation{} on one stock, {}\n  stock      [{:.2}, {:.2}, {:.2}] to [{:.2}, {:.2}, {:.2}] mm\n",
         r.operations.len(),
+        if r.operations.len() == 1 { "" } else { "s" },
         r.part,
         r.stock_mm[0][0],
         r.stock_mm[0][1],
@@ -136,37 +148,50 @@ pub fn write_job(out: &scallop_engine::JobOutput, seconds: f64, folder: &Path, j
         r.stock_mm[1][1],
         r.stock_mm[1][2]
     );
-    for (k, op) in r.operations.iter().enumerate() {
+    for (k, (op, spec)) in r.operations.iter().zip(&job.operations).enumerate() {
+        let what = match &spec.rough {
+            Some(s) => format!("roughing, {} mm levels, stepover {} D", s.stepdown, s.stepover),
+            None => {
+                format!("scallop height {} mm, feed at {:.2}° from X", op.scallop_height_mm, op.direction_deg + 0.0)
+            }
+        };
         text.push_str(&format!(
-            "  {}. {} (T{}): {}, scallop height {} mm, feed at {:.2}° from X; {} passes, {} + {:.1} s rapids; \
-             removed {:.0} mm³ of the {:.0} mm³ it met, {:.0} % of its feed length in air\n",
+            "  {}. {} (T{}): {}, {what}; {} passes, {} + {:.1} s rapids; \
+             removed {:.0} mm³ of the {:.0} mm³ it met, {:.0} % of its feed length in air; planned in {}\n",
             k + 1,
             op.name,
             op.tool,
             op.cutter,
-            op.scallop_height_mm,
-            op.direction_deg + 0.0,
             op.plan.passes,
             hms(op.plan.machining_time_s),
             op.plan.rapid_time_s,
             op.stock.removed_mm3,
             op.stock.volume_before_mm3,
-            100.0 * op.stock.air_length_share
+            100.0 * op.stock.air_length_share,
+            hms(op.plan.planning_time_s)
         ));
     }
+    let left = if job.operations.last().is_some_and(|o| o.rough.is_some()) {
+        format!(
+            "most material left on the part {:.4} mm (the last operation roughs: its allowance and steps)",
+            r.sim_max_scallop_mm
+        )
+    } else {
+        format!(
+            "scallop on the machined surface {:.4} mm along the normal beyond R from the edge (last operation's limit: sh + {:.5} mm)",
+            r.sim_max_scallop_mm, r.sim_resolution_bound_mm
+        )
+    };
     text.push_str(&format!(
         "  time       {} in all (stop-to-stop, rapids included)\n\
-         \x20 simulated  no gouge on the final {} mm stock; deepest {:+.4} mm (tolerance {:.4} mm); \
-         scallop on the machined surface {:.4} mm along the normal beyond R from the edge (last operation's limit: sh + {:.5} mm)\n\
+         \x20 simulated  no gouge on the final {} mm stock; deepest {:+.4} mm (tolerance {:.4} mm); {left}\n\
          {}\
-         \x20 planned    in {}\n\
-         \x20 wrote      {}, report.json, toolpath.csv\n",
+         \x20 ran        in {} (planning, cutting, proof)\n\
+         \x20 wrote      {}, report.json, toolpath.csv, report.html, scene.glb\n",
         hms(r.total_time_s),
         r.sim_resolution_mm,
         r.sim_min_deviation_mm,
         r.sim_gouge_tolerance_mm,
-        r.sim_max_scallop_mm,
-        r.sim_resolution_bound_mm,
         rest_text(&r.rest),
         hms(seconds),
         nc.display()

@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use scallop_cutter::{Cutter, CutterShape};
-use scallop_engine::{FinishJob, Job, Operation, OutputOptions, Setup, StockShape, Strategy, run_finishing, run_job};
+use scallop_engine::{FinishJob, Job, Operation, OutputOptions, Setup, StockShape, Strategy, run_finishing};
 use scallop_geom::Aabb3;
 use scallop_geom::Tolerances;
 use scallop_geom::nalgebra::Rotation3;
@@ -55,12 +55,10 @@ pub fn run(args: &RunArgs) -> CliResult<()> {
             Failure::Rejected(e) => Failure::Rejected(anyhow::anyhow!("{name}: {e:#}")),
             other => other,
         })?;
-        let spinner = progress_bar(0, "planning, cutting and verifying the operations");
-        spinner.enable_steady_tick(std::time::Duration::from_millis(120));
         let start = std::time::Instant::now();
-        let out = run_job(&engine_job).map_err(|e| Failure::rejected(format!("{name}: {e}{}", job_keys(&e))))?;
-        spinner.finish_and_clear();
-        return write_job(&out, start.elapsed().as_secs_f64(), &args.output, args.json);
+        let out = run_operations(&engine_job).map_err(|e| Failure::rejected(format!("{name}: {e}{}", job_keys(&e))))?;
+        let command = format!("scallop run {name}");
+        return write_job(&engine_job, &out, start.elapsed().as_secs_f64(), &args.output, args.json, &command);
     }
     let spinner = progress_bar(0, "planning and verifying");
     spinner.enable_steady_tick(std::time::Duration::from_millis(120));
@@ -349,4 +347,39 @@ fn job_keys(e: &scallop_engine::EngineError) -> &'static str {
         E::Rough(_) => " (job keys: [operation.roughing], [operation.cutter], [stock])",
         _ => "",
     }
+}
+
+/// Runs a job of several operations with a progress line per operation and
+/// phase; each operation's `planning_time_s` is the wall time from its
+/// planning step to its cutting step.
+fn run_operations(job: &Job) -> Result<scallop_engine::JobOutput, scallop_engine::EngineError> {
+    use scallop_engine::{JobPhase, JobStep};
+    let spinner = progress_bar(0, "planning the first operation");
+    spinner.enable_steady_tick(std::time::Duration::from_millis(120));
+    let steps: std::cell::RefCell<Vec<(JobStep, std::time::Instant)>> = std::cell::RefCell::new(Vec::new());
+    let progress = |step: JobStep| {
+        steps.borrow_mut().push((step, std::time::Instant::now()));
+        let message = match (step.phase, job.operations.get(step.index)) {
+            (JobPhase::Planning, Some(op)) => {
+                format!("operation {}/{} `{}`: planning", step.index + 1, step.count, op.name)
+            }
+            (JobPhase::Cutting, Some(op)) => {
+                format!("operation {}/{} `{}`: cutting the simulated stock", step.index + 1, step.count, op.name)
+            }
+            _ => "proving the stock all operations left, writing the program".to_string(),
+        };
+        spinner.set_message(message);
+    };
+    let mut out = scallop_engine::run_job_with_progress(job, &progress)?;
+    spinner.finish_and_clear();
+    let steps = steps.into_inner();
+    for (planning, cutting) in steps.iter().zip(steps.iter().skip(1)) {
+        if planning.0.phase == JobPhase::Planning
+            && cutting.0.phase == JobPhase::Cutting
+            && let Some(op) = out.report.operations.get_mut(planning.0.index)
+        {
+            op.plan.planning_time_s = cutting.1.duration_since(planning.1).as_secs_f64();
+        }
+    }
+    Ok(out)
 }

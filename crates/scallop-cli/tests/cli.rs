@@ -605,6 +605,11 @@ fn run_machines_two_operations_on_one_stock() {
     let left = a["volume_before_mm3"].as_f64().unwrap() - a["removed_mm3"].as_f64().unwrap();
     assert!((b["volume_before_mm3"].as_f64().unwrap() - left).abs() <= 1e-6 * left, "{report}");
     assert!(b["removed_mm3"].as_f64().unwrap() < a["removed_mm3"].as_f64().unwrap(), "{report}");
+    // Each operation's planning time is measured, and the page shows one colour per operation.
+    assert!(ops.iter().all(|o| o["plan"]["planning_time_s"].as_f64().unwrap() > 0.0), "{report}");
+    let page = std::fs::read_to_string(dir.join("out/report.html")).expect("report.html");
+    assert!(page.contains("Machining time per operation") && page.contains("2. fine"), "the job's page");
+    assert!(dir.join("out/scene.glb").exists());
     // The estimate before planning (--plan-only) expects each operation's pass count within 10 %.
     let estimate = scallop()
         .arg("run")

@@ -111,6 +111,13 @@ pub struct FinishJob {
 }
 
 impl FinishJob {
+    /// The machine and feed parameters the planners time this job's moves
+    /// with (the feed direction left at 0: timing does not use it).
+    #[must_use]
+    pub fn timing_params(&self) -> FinishingParams {
+        finishing_params(self, 0.0)
+    }
+
     /// The spec's main job: the Choi surface, bull-nose R 5 r 2, sh 0.01 mm,
     /// V 5 m/min, A 6 m/s², J 40 m/s³, along the PCA steepest slope.
     ///

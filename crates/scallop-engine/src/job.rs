@@ -199,6 +199,41 @@ pub(crate) fn job_stock(job: &Job, mesh: &TriMesh) -> Aabb3 {
 /// [`crate::run_finishing`] (planning, safety problems found by the
 /// simulation of each operation on the stock the others left).
 pub fn run_job(job: &Job) -> Result<JobOutput, EngineError> {
+    run_job_with_progress(job, &|_| {})
+}
+
+/// Where [`run_job_with_progress`] is: operation `index` (0-based) of
+/// `count` enters `phase`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct JobStep {
+    /// The operation (0-based); `count` for the final proof and the program.
+    pub index: usize,
+    /// Number of operations.
+    pub count: usize,
+    /// What starts now.
+    pub phase: JobPhase,
+}
+
+/// The phases of a job that [`run_job_with_progress`] announces.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum JobPhase {
+    /// Planning an operation's toolpath.
+    Planning,
+    /// Cutting the operation from the simulated stock and checking it.
+    Cutting,
+    /// Proving the stock all operations left, and writing the program.
+    Proving,
+}
+
+/// [`run_job`], calling `progress` as each operation enters a phase (in
+/// order: planning then cutting per operation, then proving once). The
+/// caller may time the phases: the planning time of operation `k` is the
+/// time between its `Planning` and `Cutting` steps.
+///
+/// # Errors
+/// As [`run_job`].
+pub fn run_job_with_progress(job: &Job, progress: &dyn Fn(JobStep)) -> Result<JobOutput, EngineError> {
+    let count = job.operations.len();
     let first = &check_operations(job)?.finish;
     let tolerances = planning_tolerances(first)?;
     let prepared = prepare_part(&first.part, &tolerances)?;
@@ -207,7 +242,8 @@ pub fn run_job(job: &Job) -> Result<JobOutput, EngineError> {
     let field = PartField::new(&zmap, &prepared.index);
     let part_top = prepared.mesh.bounds().max.z;
     let mut planned: Vec<(Planned, StockFigures)> = Vec::with_capacity(job.operations.len());
-    for op in &job.operations {
+    for (index, op) in job.operations.iter().enumerate() {
+        progress(JobStep { index, count, phase: JobPhase::Planning });
         let f = &op.finish;
         let top_before = zmap.max_top().unwrap_or(stock.min.z);
         let clearance = f.clearance.max(top_before + STOCK_CLEARANCE_MM - part_top);
@@ -226,6 +262,7 @@ pub fn run_job(job: &Job) -> Result<JobOutput, EngineError> {
             }
             None => Planned::Finish(Box::new(plan_operation(f, &prepared, &tolerances, Some(clearance))?)),
         };
+        progress(JobStep { index, count, phase: JobPhase::Cutting });
         let volume_before = zmap.volume();
         let cut = zmap.cut(&f.cutter, p.toolpath())?;
         if !cut.rapid_hits.is_empty() {
@@ -249,6 +286,7 @@ pub fn run_job(job: &Job) -> Result<JobOutput, EngineError> {
     let Some(last) = job.operations.last().map(|o| &o.finish) else {
         return Err(no_operation());
     };
+    progress(JobStep { index: count, count, phase: JobPhase::Proving });
     let (gouge_tolerance, options) = verify_options(last, &prepared);
     let verification = verify_in(&zmap, &field, &options)?;
     let simulation = scallop_sim::Simulation { zmap, cut: empty_cut(), verification };

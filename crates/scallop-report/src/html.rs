@@ -160,6 +160,7 @@ fn scene_json(data: &ReportData) -> Value {
         "path": path,
         "deviation": deviation,
         "zoneNames": data.zones.as_ref().map(|z| z.names.clone()),
+        "zoneLabel": data.zones.as_ref().map(|z| z.label.clone()),
         "kindNames": KIND_NAMES,
         "kindColours": KIND_COLOURS,
     })
@@ -222,7 +223,8 @@ pub fn plots(data: &ReportData) -> Vec<String> {
     if let Some(z) = &data.zones
         && !z.times_s.is_empty()
     {
-        out.push(bar_chart("Machining time per zone", "zone", "time (s)", &z.names, &z.times_s));
+        let title = format!("Machining time per {}", z.label);
+        out.push(bar_chart(&title, &z.label, "time (s)", &z.names, &z.times_s));
     }
     for c in &data.convergence {
         let series: Vec<Series> =

@@ -4,8 +4,9 @@
 //! the part, the stock and the toolpath.
 //!
 //! Everything starts from a [`ReportData`]: the commands fill it
-//! ([`ReportData::from_finishing`] for `scallop run` and `scallop demo`, the
-//! CLI for `scallop simulate`), and each writer turns it into bytes.
+//! ([`ReportData::from_finishing`] for `scallop run` and `scallop demo`,
+//! [`ReportData::from_job`] for jobs of several operations, the CLI for
+//! `scallop simulate`), and each writer turns it into bytes.
 //!
 //! ```
 //! use scallop_geom::Point3;
@@ -39,6 +40,7 @@
 mod finishing;
 pub mod glb;
 pub mod html;
+mod job;
 pub mod png;
 pub mod render;
 pub mod svg;
@@ -143,10 +145,13 @@ pub struct PathTiming {
     pub achieved: Vec<f64>,
 }
 
-/// Zones of a toolpath (filled by `scallop optimize`): a zone per move, the
-/// zones' names and machining times.
+/// Zones of a toolpath (filled by `scallop optimize`, and by jobs of several
+/// operations with an operation per zone): a zone per move, the zones' names
+/// and machining times.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Zones {
+    /// What a zone is, for legends and titles ("zone", "operation").
+    pub label: String,
     /// Zone index of each move (into `names`).
     pub of_move: Vec<u16>,
     /// Name of each zone.

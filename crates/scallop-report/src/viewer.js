@@ -225,7 +225,7 @@
   function colourModes() {
     var modes = [["kind", "move type"]];
     if (data.path && data.path.feeds) modes.push(["feed", "achieved feed"]);
-    if (data.path && data.path.zones) modes.push(["zone", "zone"]);
+    if (data.path && data.path.zones) modes.push(["zone", data.zoneLabel || "zone"]);
     if (devTexture) modes.push(["deviation", "simulated deviation"]);
     ui.colour.innerHTML = modes.map(function (m) { return "<option value=\"" + m[0] + "\">" + m[1] + "</option>"; }).join("");
   }

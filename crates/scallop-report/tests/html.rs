@@ -83,8 +83,12 @@ fn the_page_is_self_contained_and_carries_its_scene() {
     let mut data = ReportData::new("a <small> & \"quoted\" job");
     data.part = Some(mesh.clone());
     data.toolpath = Some(raster(2000));
-    data.zones =
-        Some(Zones { of_move: vec![1; 2000], names: vec!["flat".into(), "steep".into()], times_s: vec![2.0, 3.0] });
+    data.zones = Some(Zones {
+        label: "zone".into(),
+        of_move: vec![1; 2000],
+        names: vec!["flat".into(), "steep".into()],
+        times_s: vec![2.0, 3.0],
+    });
     data.figures = vec![Figure::count("moves", 2000), Figure::text("script", "</script><script>alert(1)</script>")];
     let page = report_html(&data);
     for bad in ["http://", "https://", " src=", " href=", "<link", "@import", "url(", "<iframe", "<img"] {
