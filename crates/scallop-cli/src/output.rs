@@ -110,8 +110,31 @@ pub fn demo(args: &DemoArgs) -> CliResult<()> {
     write_finishing(&job, &out, seconds, &args.output, args.json, "scallop demo")
 }
 
-/// Writes `program.nc`, `report.json` and `toolpath.csv` of a job of several
-/// operations into `folder` and prints the summary (or the report as JSON).
+/// Writes `program.nc`, `report.json`, `toolpath.csv`, `report.html` and
+/// `scene.glb` into `folder`: staged, then replacing the previous set in one
+/// step (`outset.rs`). Returns the program's final path and the files written.
+fn write_program_set(
+    folder: &Path,
+    kind: &'static str,
+    gcode: &str,
+    report: &impl serde::Serialize,
+    toolpath: &scallop_toolpath::Toolpath,
+    data: &scallop_report::ReportData,
+) -> CliResult<(std::path::PathBuf, Vec<std::path::PathBuf>)> {
+    let mut set = OutputSet::begin(folder, kind)?;
+    let nc = set.final_path("program.nc");
+    set.write("program.nc", gcode.as_bytes())?;
+    let text = serde_json::to_string_pretty(report).map_err(|e| Failure::Io(e.into()))?;
+    set.write("report.json", text.as_bytes())?;
+    set.write("toolpath.csv", scallop_io::cl::write_cl(toolpath).as_bytes())?;
+    set.write("report.html", scallop_report::html::report_html(data).as_bytes())?;
+    let glb = scallop_report::glb::scene_glb(data).map_err(|e| Failure::Io(anyhow::anyhow!("scene.glb: {e}")))?;
+    set.write("scene.glb", &glb)?;
+    Ok((nc, set.commit()?))
+}
+
+/// Writes the five files of a job of several operations into `folder` and
+/// prints the summary (or the report as JSON).
 pub fn write_job(
     job: &scallop_engine::Job,
     out: &scallop_engine::JobOutput,
@@ -120,18 +143,8 @@ pub fn write_job(
     json: bool,
     command: &str,
 ) -> CliResult<()> {
-    // The five files replace the previous set in one step (`outset.rs`).
-    let mut set = OutputSet::begin(folder, "job")?;
-    let nc = set.final_path("program.nc");
-    set.write("program.nc", out.gcode.as_bytes())?;
-    let text = serde_json::to_string_pretty(&out.report).map_err(|e| Failure::Io(e.into()))?;
-    set.write("report.json", text.as_bytes())?;
-    set.write("toolpath.csv", scallop_io::cl::write_cl(&out.toolpath).as_bytes())?;
     let data = scallop_report::ReportData::from_job(job, out, seconds, command);
-    set.write("report.html", scallop_report::html::report_html(&data).as_bytes())?;
-    let glb = scallop_report::glb::scene_glb(&data).map_err(|e| Failure::Io(anyhow::anyhow!("scene.glb: {e}")))?;
-    set.write("scene.glb", &glb)?;
-    let written = set.commit()?;
+    let (nc, written) = write_program_set(folder, "job", &out.gcode, &out.report, &out.toolpath, &data)?;
     if json {
         return print_json(&with_written(&out.report, &written)?);
     }
@@ -246,18 +259,8 @@ pub fn write_finishing(
 ) -> CliResult<()> {
     let mut report = out.report.clone();
     report.plan.planning_time_s = seconds;
-    // All five files go into a staging folder and replace the previous set in one step.
-    let mut set = OutputSet::begin(folder, "finishing")?;
-    let nc = set.final_path("program.nc");
-    set.write("program.nc", out.gcode.as_bytes())?;
-    let text = serde_json::to_string_pretty(&report).map_err(|e| Failure::Io(e.into()))?;
-    set.write("report.json", text.as_bytes())?;
-    set.write("toolpath.csv", scallop_io::cl::write_cl(&out.toolpath).as_bytes())?;
     let data = scallop_report::ReportData::from_finishing(job, out, seconds, command);
-    set.write("report.html", scallop_report::html::report_html(&data).as_bytes())?;
-    let glb = scallop_report::glb::scene_glb(&data).map_err(|e| Failure::Io(anyhow::anyhow!("scene.glb: {e}")))?;
-    set.write("scene.glb", &glb)?;
-    let written = set.commit()?;
+    let (nc, written) = write_program_set(folder, "finishing", &out.gcode, &report, &out.toolpath, &data)?;
     if json {
         return print_json(&with_written(&report, &written)?);
     }
