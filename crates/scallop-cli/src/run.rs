@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use scallop_cutter::{Cutter, CutterShape};
-use scallop_engine::{FinishJob, Job, Operation, OutputOptions, Setup, StockShape, Strategy, run_finishing};
+use scallop_engine::{FinishJob, Job, Operation, OutputOptions, Setup, StockShape, Strategy};
 use scallop_geom::Aabb3;
 use scallop_geom::Tolerances;
 use scallop_geom::nalgebra::Rotation3;
@@ -60,11 +60,8 @@ pub fn run(args: &RunArgs) -> CliResult<()> {
         let command = format!("scallop run {name}");
         return write_job(&engine_job, &out, start.elapsed().as_secs_f64(), &args.output, args.json, &command);
     }
-    let spinner = progress_bar(0, "planning and verifying");
-    spinner.enable_steady_tick(std::time::Duration::from_millis(120));
     let start = std::time::Instant::now();
-    let out = run_finishing(&job).map_err(|e| Failure::rejected(format!("{name}: {e}{}", job_keys(&e))))?;
-    spinner.finish_and_clear();
+    let out = run_one(&job).map_err(|e| Failure::rejected(format!("{name}: {e}{}", job_keys(&e))))?;
     let command = format!("scallop run {name}");
     write_finishing(&job, &out, start.elapsed().as_secs_f64(), &args.output, args.json, &command)
 }
@@ -382,4 +379,37 @@ fn run_operations(job: &Job) -> Result<scallop_engine::JobOutput, scallop_engine
         }
     }
     Ok(out)
+}
+
+/// Runs a finishing job with a progress line: the strategy while planning,
+/// a bar of the stock's bands cut (with the time left) while simulating, then the
+/// proof.
+fn run_one(job: &FinishJob) -> Result<scallop_engine::FinishOutput, scallop_engine::EngineError> {
+    use scallop_engine::FinishStep;
+    let bar = progress_bar(0, "preparing the part");
+    bar.enable_steady_tick(std::time::Duration::from_millis(120));
+    let progress = |step: FinishStep| match step {
+        FinishStep::Planning(strategy) => bar.set_message(format!("planning ({})", strategy_name(strategy))),
+        FinishStep::Cutting { done, total } => {
+            if bar.length() != Some(total as u64) {
+                bar.set_length(total as u64);
+                bar.set_message("cutting the simulated stock (bands of rows)");
+            }
+            bar.set_position(done as u64);
+        }
+        FinishStep::Verifying => bar.set_message("measuring the scallop and the material left"),
+    };
+    let out = scallop_engine::run_finishing_with_progress(job, &progress);
+    bar.finish_and_clear();
+    out
+}
+
+/// How the progress line names a strategy.
+fn strategy_name(strategy: Strategy) -> &'static str {
+    match strategy {
+        Strategy::ParallelPlanes => "parallel planes",
+        Strategy::Isoparametric(_) => "isoparametric passes",
+        Strategy::NetworkPlanes => "network planes",
+        Strategy::SteepShallow { .. } => "steep and shallow: planes and waterline levels",
+    }
 }

@@ -239,6 +239,35 @@ pub struct FinishDetails {
 /// Bad settings, an unknown part, a plan that cannot hold the scallop height,
 /// or a safety problem found by the stock simulation.
 pub fn run_finishing(job: &FinishJob) -> Result<FinishOutput, EngineError> {
+    run_finishing_with_progress(job, &|_| {})
+}
+
+/// What [`run_finishing_with_progress`] is doing.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum FinishStep {
+    /// Planning the toolpath with this strategy.
+    Planning(Strategy),
+    /// Cutting the simulated stock: `done` of `total` bands of rows
+    /// ([`scallop_sim::ZMap::cut_with_progress`]).
+    Cutting {
+        /// Bands cut.
+        done: usize,
+        /// All bands.
+        total: usize,
+    },
+    /// Measuring the scallop and the material left, writing the program.
+    Verifying,
+}
+
+/// [`run_finishing`], calling `progress` as it goes (planning, then the cut
+/// with its count of bands, then the proof).
+///
+/// # Errors
+/// As [`run_finishing`].
+pub fn run_finishing_with_progress(
+    job: &FinishJob,
+    progress: &(dyn Fn(FinishStep) + Sync),
+) -> Result<FinishOutput, EngineError> {
     let tolerances = planning_tolerances(job)?;
     let prepared = prepare_part(&job.part, &tolerances)?;
     let prepared = match &job.setup {
@@ -246,10 +275,19 @@ pub fn run_finishing(job: &FinishJob) -> Result<FinishOutput, EngineError> {
         None => prepared,
     };
     let stock = stock_box(&prepared.mesh, job.cutter.radius());
+    progress(FinishStep::Planning(job.strategy));
     let mut op = plan_operation(job, &prepared, &tolerances, None)?;
     let (gouge_tolerance, options) = verify_options(job, &prepared);
-    let sim =
-        scallop_sim::simulate(stock, job.sim_resolution, &job.cutter, &op.plan.toolpath, &prepared.index, &options)?;
+    let sim = scallop_sim::simulate_with_progress(
+        stock,
+        job.sim_resolution,
+        &job.cutter,
+        &op.plan.toolpath,
+        &prepared.index,
+        &options,
+        &|done, total| progress(FinishStep::Cutting { done, total }),
+    )?;
+    progress(FinishStep::Verifying);
     let rest = if job.strategy.simulation_verifies_scallop() {
         network_scallop_from(&sim, job, &prepared, &options, &mut op.plan.report)?
     } else {

@@ -36,8 +36,8 @@ pub use budget::{ARC_SHARE, Budget};
 pub use demo::{DemoOutput, DemoSettings, DemoSummary, run_demo};
 pub use estimate::{Estimate, estimate_job, estimate_operation};
 pub use finish::{
-    FinishDetails, FinishJob, FinishOutput, FinishReport, OutputOptions, RestPlaceReport, RestReport, Setup, Strategy,
-    auto_direction_deg, run_finishing, stock_box,
+    FinishDetails, FinishJob, FinishOutput, FinishReport, FinishStep, OutputOptions, RestPlaceReport, RestReport,
+    Setup, Strategy, auto_direction_deg, run_finishing, run_finishing_with_progress, stock_box,
 };
 pub use grid::{GridAxis, GridError, MAX_GRID_POINTS};
 pub use job::{

@@ -149,8 +149,25 @@ pub fn simulate(
     part: &MeshIndex,
     options: &VerifyOptions,
 ) -> Result<Simulation, SimError> {
+    simulate_with_progress(stock, resolution, cutter, toolpath, part, options, &|_, _| {})
+}
+
+/// [`simulate`], calling `progress(done, total)` as the cut proceeds (bands
+/// of rows cut, of all bands; see [`ZMap::cut_with_progress`]).
+///
+/// # Errors
+/// As [`simulate`].
+pub fn simulate_with_progress(
+    stock: Aabb3,
+    resolution: f64,
+    cutter: &Cutter,
+    toolpath: &Toolpath,
+    part: &MeshIndex,
+    options: &VerifyOptions,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<Simulation, SimError> {
     let mut zmap = ZMap::new(stock, resolution)?;
-    let cut = zmap.cut(cutter, toolpath)?;
+    let cut = zmap.cut_with_progress(cutter, toolpath, progress)?;
     if !cut.rapid_hits.is_empty() {
         cut.check()?;
     }
