@@ -7,6 +7,7 @@ mod choice;
 mod drop;
 mod engagement;
 mod guides;
+mod machine;
 mod optimize;
 mod output;
 mod outset;

@@ -32,7 +32,8 @@ pub enum ModeArg {
 pub struct PostArgs {
     /// Cutter-location CSV: header `kind,x,y,z[,i,j,k][,feed]` (part frame, mm, mm/min).
     cl_file: PathBuf,
-    /// Machine: a shipped name (see `machines/`, e.g. ucp710, mx330, linuxcnc-xyzac-trt) or a TOML file.
+    /// 5-axis machine: a shipped name (see `machines/`, e.g. ucp710, mx330, linuxcnc-xyzac-trt) or a TOML
+    /// file (a 3-axis machine is refused: jobs name those, docs/job.md).
     #[arg(long)]
     machine: String,
     /// Dialect: linuxcnc, fanuc, siemens840d, heidenhain, heidenhain-iso, grbl, plain, or a TOML file.
@@ -117,7 +118,7 @@ pub struct PostReport {
     pub events: Vec<String>,
 }
 
-fn read_text(path: &Path) -> CliResult<String> {
+pub(crate) fn read_text(path: &Path) -> CliResult<String> {
     let bytes = std::fs::read(path).map_err(|e| {
         let err = anyhow::anyhow!("{}: cannot read: {e}", path.display());
         if e.kind() == std::io::ErrorKind::NotFound { Failure::Rejected(err) } else { Failure::Io(err) }
@@ -125,22 +126,11 @@ fn read_text(path: &Path) -> CliResult<String> {
     scallop_io::utf8_text(&bytes).map(str::to_owned).map_err(|e| Failure::rejected(format!("{}: {e}", path.display())))
 }
 
-/// A machine by shipped name or by TOML file (a relative path taken from
+/// A 5-axis machine by shipped name or by TOML file (a relative path taken from
 /// `folder`: the job file's folder, or the working folder for `--machine`);
 /// `what` names the flag or key in messages.
 pub(crate) fn load_machine(name: &str, folder: &Path, what: &str) -> CliResult<Machine> {
-    let path = folder.join(name);
-    if name.ends_with(".toml") || path.is_file() {
-        let text = read_text(&path)?;
-        Machine::from_toml_str(&text).map_err(|e| Failure::rejected(format!("{}: {e}", path.display())))
-    } else {
-        Machine::builtin(name).map_err(|e| {
-            Failure::rejected(format!(
-                "{what} = \"{name}\": {e}; give a shipped name ({}) or a machine file (.toml)",
-                Machine::builtin_names().join(", ")
-            ))
-        })
-    }
+    crate::machine::load_five_axis(name, folder, what)
 }
 
 fn load_dialect(name: &str) -> CliResult<Dialect> {

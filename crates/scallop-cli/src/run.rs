@@ -57,13 +57,31 @@ pub fn run(args: &RunArgs) -> CliResult<()> {
         })?;
         let start = std::time::Instant::now();
         let out = run_operations(&engine_job).map_err(|e| Failure::rejected(format!("{name}: {e}{}", job_keys(&e))))?;
+        check_travel(&spec, &args.job, &name, &out.toolpath)?;
         let command = format!("scallop run {name}");
         return write_job(&engine_job, &out, start.elapsed().as_secs_f64(), &args.output, args.json, &command);
     }
     let start = std::time::Instant::now();
     let out = run_one(&job).map_err(|e| Failure::rejected(format!("{name}: {e}{}", job_keys(&e))))?;
+    check_travel(&spec, &args.job, &name, &out.toolpath)?;
     let command = format!("scallop run {name}");
     write_finishing(&job, &out, start.elapsed().as_secs_f64(), &args.output, args.json, &command)
+}
+
+/// Checks a 3-axis program against the travel of the machine the job names (a
+/// 3+2 program is checked by the kinematics of its setup's machine); nothing is
+/// written when it leaves the travel.
+fn check_travel(spec: &JobFile, job: &Path, name: &str, path: &scallop_toolpath::Toolpath) -> CliResult<()> {
+    if spec.setup.is_some() {
+        return Ok(());
+    }
+    let Some(machine) = crate::machine::job_machine(spec, job.parent().unwrap_or(Path::new(".")))? else {
+        return Ok(());
+    };
+    crate::machine::check_travel(&machine, path.moves().iter().map(|m| m.to)).map_err(|e| match e {
+        Failure::Rejected(e) => Failure::Rejected(anyhow::anyhow!("{name}: {e:#}")),
+        other => other,
+    })
 }
 
 /// `scallop run --plan-only`: the estimate of every operation (docs/job.md).
@@ -235,12 +253,23 @@ pub(crate) fn read_job(path: &Path) -> CliResult<(String, JobFile)> {
         Some(file) => Some(read_tool_library(&path.parent().unwrap_or(Path::new(".")).join(file))?),
         None => None,
     };
-    let spec = parse_job_with_tools(text, library.as_ref()).map_err(|e| match (&e, &library_file) {
+    let mut spec = parse_job_with_tools(text, library.as_ref()).map_err(|e| match (&e, &library_file) {
         (scallop_io::job::JobError::UnknownTool { .. }, Some(lib)) => {
             Failure::rejected(format!("{name}: {e} (tool library {lib})"))
         }
         _ => Failure::rejected(format!("{name}: {e}")),
     })?;
+    let in_job = |e: Failure| match e {
+        Failure::Rejected(e) => Failure::Rejected(anyhow::anyhow!("{name}: {e:#}")),
+        other => other,
+    };
+    if let Some(machine) =
+        crate::machine::job_machine(&spec, path.parent().unwrap_or(Path::new("."))).map_err(in_job)?
+    {
+        for note in crate::machine::apply(&mut spec, &machine).map_err(in_job)? {
+            eprintln!("note: {name}: {note}");
+        }
+    }
     Ok((name, spec))
 }
 
@@ -275,16 +304,19 @@ pub(crate) fn finish_job(spec: &JobFile, folder: &Path) -> CliResult<FinishJob> 
     let cutter = cutter_of(&spec.cutter)?;
     let first = &spec.operations[0];
     let o = &spec.output;
-    let dialect = scallop_post::Dialect::builtin(&o.dialect).map_err(|_| {
+    let dialect_name = o.dialect_or(None);
+    let mut dialect = scallop_post::Dialect::builtin(dialect_name).map_err(|_| {
         Failure::rejected(format!(
-            "`output.dialect` = \"{}\": no such dialect; use one of {:?}",
-            o.dialect,
+            "`output.dialect` = \"{dialect_name}\": no such dialect; use one of {:?}",
             scallop_post::Dialect::builtin_names()
         ))
     })?;
+    if let Some(machine) = crate::machine::job_machine(spec, folder)? {
+        crate::machine::manual_tool_change(&mut dialect, &machine);
+    }
     let dialect = match o.units {
         scallop_io::job::UnitsWord::In => dialect.in_inches().map_err(|e| {
-            Failure::rejected(format!("`output.units` = \"in\" with `output.dialect` = \"{}\": {e}", o.dialect))
+            Failure::rejected(format!("`output.units` = \"in\" with `output.dialect` = \"{dialect_name}\": {e}"))
         })?,
         _ => dialect,
     };
