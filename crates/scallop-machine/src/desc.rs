@@ -645,6 +645,33 @@ pub(crate) fn point_in_range(a: [f64; 3], place: &str) -> Result<Point3, Machine
     ))
 }
 
+/// Every `[dynamics]` and `[rapid]` entry names a declared axis.
+pub(crate) fn check_dynamics_keys(raw: &RawMachine) -> Result<(), MachineError> {
+    for key in raw.dynamics.keys().chain(raw.rapid.keys()) {
+        if !raw.axes.contains_key(key) {
+            return Err(MachineError::invalid(
+                format!("dynamics.{key}"),
+                format!("no axis named {key}"),
+                "remove the entry or declare the axis under [axes]",
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The first three axes (the linear ones) span space.
+pub(crate) fn check_linear_independence(axes: &[Axis]) -> Result<(), MachineError> {
+    let lin = Matrix3::from_columns(&[axes[0].direction, axes[1].direction, axes[2].direction]);
+    if lin.determinant().abs() < tol::LINEAR_INDEPENDENCE {
+        return Err(MachineError::invalid(
+            "axes",
+            "the three linear axis directions are not independent",
+            "give linear directions that span space (normally e_x, e_y, e_z)",
+        ));
+    }
+    Ok(())
+}
+
 /// The description as written (TOML errors with their line and column).
 pub(crate) fn parse_raw(text: &str) -> Result<RawMachine, MachineError> {
     toml::from_str(text).map_err(|e| {
@@ -761,15 +788,7 @@ impl Machine {
         for name in &names {
             axes.push(axis_of(&raw, name)?);
         }
-        for key in raw.dynamics.keys().chain(raw.rapid.keys()) {
-            if !raw.axes.contains_key(key) {
-                return Err(MachineError::invalid(
-                    format!("dynamics.{key}"),
-                    format!("no axis named {key}"),
-                    "remove the entry or declare the axis under [axes]",
-                ));
-            }
-        }
+        check_dynamics_keys(&raw)?;
         let index_of = |n: &String| names.iter().position(|m| *m == n);
         let chain = |list: &[String], which: &str| -> Result<Vec<usize>, MachineError> {
             let mut out = Vec::new();
@@ -794,14 +813,7 @@ impl Machine {
         };
         let part_chain = chain(&chains.part, "part")?;
         let tool_chain = chain(&chains.tool, "tool")?;
-        let lin = Matrix3::from_columns(&[axes[0].direction, axes[1].direction, axes[2].direction]);
-        if lin.determinant().abs() < tol::LINEAR_INDEPENDENCE {
-            return Err(MachineError::invalid(
-                "axes",
-                "the three linear axis directions are not independent",
-                "give linear directions that span space (normally e_x, e_y, e_z)",
-            ));
-        }
+        check_linear_independence(&axes)?;
         if axes[3].direction.cross(&axes[4].direction).norm() < tol::PARALLEL {
             return Err(MachineError::invalid(
                 format!("axes.{}.direction", axes[4].name),

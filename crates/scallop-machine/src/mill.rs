@@ -17,7 +17,7 @@
 //! ```
 
 use scallop_geom::Point3;
-use scallop_geom::nalgebra::{Isometry3, Matrix3};
+use scallop_geom::nalgebra::Isometry3;
 
 use crate::desc::{self, AxisKind, ChainSide, RawMachine};
 use crate::error::MachineError;
@@ -69,23 +69,8 @@ impl Mill {
             });
         }
         let axes = names.iter().map(|n| desc::axis_of(raw, n)).collect::<Result<Vec<_>, _>>()?;
-        for key in raw.dynamics.keys().chain(raw.rapid.keys()) {
-            if !raw.axes.contains_key(key) {
-                return Err(MachineError::invalid(
-                    format!("dynamics.{key}"),
-                    format!("no axis named {key}"),
-                    "remove the entry or declare the axis under [axes]",
-                ));
-            }
-        }
-        let lin = Matrix3::from_columns(&[axes[0].direction, axes[1].direction, axes[2].direction]);
-        if lin.determinant().abs() < tol::LINEAR_INDEPENDENCE {
-            return Err(MachineError::invalid(
-                "axes",
-                "the three linear axis directions are not independent",
-                "give linear directions that span space (normally e_x, e_y, e_z)",
-            ));
-        }
+        desc::check_dynamics_keys(raw)?;
+        desc::check_linear_independence(&axes)?;
         if let Some(a) = raw.spindle_tool_axis() {
             desc::unit_direction(a, "spindle.tool_axis")?;
         }
