@@ -40,7 +40,7 @@ pub enum Target {
     Job,
     /// The surface TOML: `parse_surfaces`.
     Surface,
-    /// The machine description: `Machine::from_toml_str`.
+    /// The machine description: `Described::from_toml_str` (3-axis mills and 5-axis machines).
     Machine,
 }
 
@@ -328,7 +328,15 @@ fn check(target: Target, bytes: &[u8]) -> Result<bool, String> {
         }
         Target::Machine => {
             let Some(text) = text() else { return Ok(false) };
-            let Ok(m) = scallop_machine::Machine::from_toml_str(text) else { return Ok(false) };
+            let Ok(d) = scallop_machine::Described::from_toml_str(text) else { return Ok(false) };
+            // A 3-axis mill: its dynamics and the travel check of a point stay finite.
+            let words = d.linear_words(scallop_geom::Point3::new(1.0, -2.0, 3.0));
+            let _ = d.check_travel([scallop_geom::Point3::origin()]);
+            let dynamics = d.linear_dynamics();
+            if !(words.iter().chain(&[dynamics.vmax, dynamics.amax, dynamics.jmax]).all(|c| c.is_finite())) {
+                return Err("a machine with non-finite travel words or dynamics was accepted".into());
+            }
+            let scallop_machine::Described::FiveAxis(m) = d else { return Ok(true) };
             let g = m.gauge_point();
             let frame = m.part_frame().to_homogeneous();
             if !(g.coords.iter().chain(frame.iter()).all(|c| c.is_finite())) {
@@ -599,6 +607,8 @@ pub fn seeds(target: Target) -> Vec<Vec<u8>> {
             include_str!("../../../machines/generic-head-head-ca.toml"),
             include_str!("../../../machines/generic-head-table-bc.toml"),
             include_str!("../../../machines/linuxcnc-xyzac-trt.toml"),
+            include_str!("../../../machines/grbl-3axis.toml"),
+            include_str!("../../../machines/fanuc-3axis.toml"),
         ]
         .map(text)
         .to_vec(),
