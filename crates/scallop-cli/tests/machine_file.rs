@@ -44,6 +44,14 @@ fn run(dir: &Path, name: &str, text: &str) -> Result<String, String> {
     Ok(std::fs::read_to_string(out_dir.join("program.nc")).expect("program.nc"))
 }
 
+/// Writes the shipped machine `shipped` with `edit.0` replaced by `edit.1` as `dir/name`.
+fn edited_machine(dir: &Path, shipped: &str, edit: (&str, &str), name: &str) {
+    let text = std::fs::read_to_string(repo(&format!("machines/{shipped}.toml"))).expect("shipped machine");
+    let edited = text.replace(edit.0, edit.1);
+    assert_ne!(edited, text, "{shipped}: {} not found", edit.0);
+    std::fs::write(dir.join(name), edited).expect("write machine");
+}
+
 /// The number after `letter` in a word of `line` (`S9549` in `S9549 M3`).
 fn word(line: &str, letter: char) -> Option<f64> {
     line.split_whitespace().find_map(|w| w.strip_prefix(letter).and_then(|v| v.parse().ok()))
@@ -135,10 +143,7 @@ fn a_machine_file_by_path_clamps_library_speeds_and_the_jobs_dialect_wins() {
     let dir = scratch("machine-path");
     // A path relative to the job file: the shipped Fanuc machine with a 6000 1/min
     // spindle, and a LinuxCNC [output].
-    let fanuc = std::fs::read_to_string(repo("machines/fanuc-3axis.toml")).expect("fanuc");
-    let slow = fanuc.replace("max_speed = 12000", "max_speed = 6000");
-    assert_ne!(slow, fanuc);
-    std::fs::write(dir.join("mill.toml"), slow).expect("write");
+    edited_machine(&dir, "fanuc-3axis", ("max_speed = 12000", "max_speed = 6000"), "mill.toml");
     let text = run(&dir, "by-path", &job("mill.toml", "[output]\ndialect = \"linuxcnc\"\n")).expect("runs");
     assert!(text.contains("dialect: LinuxCNC") && !text.lines().any(|l| l.starts_with("O1")), "the job's dialect wins");
     // Tool 6 (7162 1/min from its Vc) is clamped to 6000 and its feed scaled with it.
@@ -158,10 +163,7 @@ fn a_machine_file_by_path_clamps_library_speeds_and_the_jobs_dialect_wins() {
 fn travel_spindle_and_name_errors_name_the_fix() {
     let dir = scratch("machine-errors");
     // Part zero 50 mm above Z home: the program is above the router's Z travel.
-    let router = std::fs::read_to_string(repo("machines/grbl-3axis.toml")).expect("grbl");
-    let low = router.replace("origin = [-150, -150, -60]", "origin = [-150, -150, 50]");
-    assert_ne!(low, router);
-    std::fs::write(dir.join("low.toml"), low).expect("write");
+    edited_machine(&dir, "grbl-3axis", ("origin = [-150, -150, -60]", "origin = [-150, -150, 50]"), "low.toml");
     let err = run(&dir, "travel", &job("low.toml", "")).expect_err("outside the travel");
     assert!(err.contains("axis Z") && err.contains("travel") && err.contains("fix:"), "{err}");
     // A spindle speed the job gives above the machine's largest is refused.
