@@ -234,6 +234,13 @@ fn floor(x0: f64, x1: f64, y0: f64, y1: f64, step: f64) -> TriMesh {
     TriMesh::from_indexed(&v, &t).unwrap().0
 }
 
+/// The guides of a synthetic pocket: clearance 3 mm (R 2.5, s_f 0.5), a_p 4,
+/// a_e 4.5, voxel 0.5, levels at 4, 8 mm.
+fn synthetic_guides(bottom: &TriMesh, flanks: &TriMesh) -> GuideSet {
+    let s = GuideSettings { voxel: 0.5, depth: 12.0, ..settings(2.5, 0.0) };
+    build_guides(bottom, flanks, &s).unwrap()
+}
+
 #[test]
 fn a_dumbbell_pocket_splits_into_two_paired_zones() {
     // Clearance 3 mm: the limit's neck is 7 mm wide each side of the axis,
@@ -241,15 +248,7 @@ fn a_dumbbell_pocket_splits_into_two_paired_zones() {
     let outline = dumbbell(20.0, 28.0, 10.0, 1.0);
     let flanks = walls(&outline, true, -1.0, 20.0, 1.0);
     let bottom = floor(-55.0, 55.0, -25.0, 25.0, 2.0);
-    let s = GuideSettings {
-        tool_radius: 2.5,
-        flank_allowance: 0.5,
-        axial_step: 4.0,
-        radial_step: 4.5,
-        voxel: 0.5,
-        depth: 12.0,
-    };
-    let set = build_guides(&bottom, &flanks, &s).unwrap();
+    let set = synthetic_guides(&bottom, &flanks);
     for (k, level) in set.levels.iter().enumerate() {
         assert_eq!(level.zones.len(), 3, "level {k}: the neck zone and two lobes: {:?}", zones_of(level));
         let lobes: Vec<f64> = level.zones[1..].iter().map(|z| z.outer.line.barycentre().unwrap().x).collect();
@@ -266,15 +265,7 @@ fn a_u_channel_open_on_one_side_is_closed_by_a_virtual_flank() {
     let u = [[0.0, -20.0], [60.0, -20.0], [60.0, 20.0], [0.0, 20.0]];
     let flanks = walls(&u, false, -1.0, 20.0, 1.0);
     let bottom = floor(0.0, 70.0, -30.0, 30.0, 2.0);
-    let s = GuideSettings {
-        tool_radius: 2.5,
-        flank_allowance: 0.5,
-        axial_step: 4.0,
-        radial_step: 4.5,
-        voxel: 0.5,
-        depth: 12.0,
-    };
-    let set = build_guides(&bottom, &flanks, &s).unwrap();
+    let set = synthetic_guides(&bottom, &flanks);
     for (k, level) in set.levels.iter().enumerate() {
         assert_eq!(level.limit.closed_by_virtual_flanks, 1, "level {k}");
         let b = level.limit.loops[0].line.bounds().unwrap();
