@@ -66,11 +66,19 @@ struct LevelSummary {
     limit_open: usize,
     path_curves: usize,
     splits: usize,
+    /// Degeneracy zones of the offsets (1: no split).
+    zones: usize,
+    /// Limit loops closed by virtual flanks (open pocket).
+    closed_by_virtual_flanks: usize,
+    /// Why an open pocket could not be closed, if so.
+    closing_error: Option<String>,
 }
 
 #[derive(Serialize)]
 struct PairSummary {
     lower_level: usize,
+    /// Degeneracy zone on the lower and on the upper level (null: no partner).
+    zones: [Option<usize>; 2],
     paired: bool,
     error: Option<String>,
     steps: usize,
@@ -99,13 +107,14 @@ pub fn run(args: &GuidesArgs) -> CliResult<()> {
     let faces = |tags: &[FaceTag]| part.faces(tags).map_err(|e| Failure::rejected(format!("{name}: {e}")));
     let bottom = faces(&[FaceTag::Bottom])?;
     let flanks = faces(&[FaceTag::Flank])?;
+    let top = faces(&[FaceTag::Top])?;
     let settings = GuideSettings {
         tool_radius: args.tool_radius,
         flank_allowance: args.flank_allowance,
         axial_step: args.ap,
         radial_step: args.ae,
         voxel: args.voxel,
-        depth: part.stock.max.z - bottom.bounds().min.z,
+        depth: pocket_depth(&bottom, &top),
     };
     let set = build_guides(&bottom, &flanks, &settings)
         .map_err(|e| Failure::rejected(format!("{name}: {e} (settings: --tool-radius, --ap, --ae, --voxel)")))?;
@@ -129,16 +138,17 @@ pub fn run(args: &GuidesArgs) -> CliResult<()> {
     for (k, l) in summary.levels.iter().enumerate() {
         let _ = writeln!(
             text,
-            "  level {k} at {:.1} mm: {} limit loop(s), {} open, {} path curves",
-            l.distance_mm, l.limit_loops, l.limit_open, l.path_curves
+            "  level {k} at {:.1} mm: {} limit loop(s) ({} closed by virtual flanks), {} open chains, {} path curves, {} zones",
+            l.distance_mm, l.limit_loops, l.closed_by_virtual_flanks, l.limit_open, l.path_curves, l.zones
         );
     }
     for p in &summary.pairs {
         let _ = writeln!(
             text,
-            "  levels {} and {}: {}",
+            "  levels {} and {}, zones {:?}: {}",
             p.lower_level,
             p.lower_level + 1,
+            p.zones,
             p.error.clone().unwrap_or_else(|| format!("{} steps paired", p.steps))
         );
     }
@@ -156,6 +166,13 @@ fn test_part(which: PartArg) -> CliResult<(&'static str, TestPart)> {
     Ok((name, part.map_err(|e| Failure::Io(anyhow::anyhow!("{name}: {e}")))?))
 }
 
+/// The height of the pocket above its bottom: the largest distance from a
+/// vertex of the (crossable) top faces to the bottom faces.
+fn pocket_depth(bottom: &TriMesh, top: &TriMesh) -> f64 {
+    let q = scallop_mesh::MeshQuery::new(bottom);
+    top.vertices().iter().map(|v| (q.closest_point(v).point - v).norm()).fold(0.0, f64::max)
+}
+
 fn summarise(name: &str, part: &TestPart, s: &GuideSettings, set: &GuideSet, seconds: f64) -> GuidesSummary {
     let levels = set
         .levels
@@ -167,14 +184,19 @@ fn summarise(name: &str, part: &TestPart, s: &GuideSettings, set: &GuideSet, sec
             limit_open: l.limit.open.len(),
             path_curves: l.offsets.iter().map(|o| o.curves.len()).sum(),
             splits: l.offsets.iter().filter(|o| o.split).count(),
+            zones: l.zones.len(),
+            closed_by_virtual_flanks: l.limit.closed_by_virtual_flanks,
+            closing_error: l.closing.as_ref().map(ToString::to_string),
         })
         .collect();
     let pairs = set
         .pairs
         .iter()
-        .map(|(k, p)| match p {
+        .zip(&set.pair_zones)
+        .map(|((k, p), &zones)| match p {
             Ok(p) => PairSummary {
                 lower_level: *k,
+                zones,
                 paired: true,
                 error: None,
                 steps: p.steps,
@@ -183,6 +205,7 @@ fn summarise(name: &str, part: &TestPart, s: &GuideSettings, set: &GuideSet, sec
             },
             Err(e) => PairSummary {
                 lower_level: *k,
+                zones,
                 paired: false,
                 error: Some(e.to_string()),
                 steps: 0,
@@ -234,29 +257,41 @@ fn curves_csv(set: &GuideSet) -> String {
             }
         }
     }
-    for (n, pair) in &set.pairs {
+    for ((n, pair), zones) in set.pairs.iter().zip(&set.pair_zones) {
         if let Ok(p) = pair {
+            let zone = zones[0].unwrap_or(0);
             for (m, c) in p.path.iter().enumerate() {
-                put(*n, "pair_path", m, 0, c);
+                put(*n, "pair_path", m, zone, c);
             }
             for (m, c) in p.tilt.iter().enumerate() {
-                put(*n, "pair_tilt", m, 0, c);
+                put(*n, "pair_tilt", m, zone, c);
             }
         }
     }
     s
 }
 
-/// The part's inside with the limit curves (red) and path curves (blue).
+/// Colours of the degeneracy zones' path curves: zone 0 blue, then green,
+/// purple, teal, brown, olive.
+const ZONE_COLOURS: [[u8; 3]; 6] =
+    [[30, 60, 200], [20, 140, 60], [140, 40, 170], [0, 140, 150], [150, 90, 20], [110, 120, 0]];
+
+/// The part's inside with the limit curves (red) and path curves (blue,
+/// other colours for the degeneracy branches).
 fn picture(part: &TestPart, set: &GuideSet) -> String {
     let mut lines: Vec<(Vec<Point3>, bool, [u8; 3])> = Vec::new();
     for level in &set.levels {
-        for c in level.limit.loops.iter().chain(&level.limit.open) {
+        // Open chains closed by virtual flanks are drawn as their loops.
+        let open: &[Curve] = if level.limit.closed_by_virtual_flanks > 0 { &[] } else { &level.limit.open };
+        for c in level.limit.loops.iter().chain(open) {
             lines.push((c.line.points.clone(), c.line.closed, [200, 30, 30]));
         }
-        for step in &level.offsets {
-            for c in &step.curves {
-                lines.push((c.line.points.clone(), c.line.closed, [30, 60, 200]));
+        // Zone 0 in blue, each degeneracy branch in a colour of its own.
+        for (z, zone) in level.zones.iter().enumerate() {
+            let colour = ZONE_COLOURS[z % ZONE_COLOURS.len()];
+            let outer = (z > 0).then_some(&zone.outer);
+            for c in outer.into_iter().chain(zone.offsets.iter().flat_map(|s| &s.curves)) {
+                lines.push((c.line.points.clone(), c.line.closed, colour));
             }
         }
     }
@@ -273,8 +308,8 @@ fn report_html(summary: &GuidesSummary, picture: &str) -> String {
     for (k, l) in summary.levels.iter().enumerate() {
         let _ = write!(
             rows,
-            "<tr><td>{k}</td><td>{:.1}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
-            l.distance_mm, l.triangles, l.limit_loops, l.limit_open, l.path_curves
+            "<tr><td>{k}</td><td>{:.1}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+            l.distance_mm, l.triangles, l.limit_loops, l.limit_open, l.path_curves, l.zones
         );
     }
     let mut pairs = String::new();
@@ -282,17 +317,25 @@ fn report_html(summary: &GuidesSummary, picture: &str) -> String {
         let what = p.error.clone().unwrap_or_else(|| {
             format!("{} steps; spacing {:.2} / {:.2} mm", p.steps, p.path_spacing_mm, p.tilt_spacing_mm)
         });
-        let _ =
-            write!(pairs, "<tr><td>{} / {}</td><td>{}</td></tr>", p.lower_level, p.lower_level + 1, html_escape(&what));
+        let zone = |z: Option<usize>| z.map_or_else(|| "-".to_string(), |z| z.to_string());
+        let _ = write!(
+            pairs,
+            "<tr><td>{} / {}</td><td>{} / {}</td><td>{}</td></tr>",
+            p.lower_level,
+            p.lower_level + 1,
+            zone(p.zones[0]),
+            zone(p.zones[1]),
+            html_escape(&what)
+        );
     }
     format!(
         "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>scallop guides: {part}</title>\
          <style>body{{font-family:sans-serif;margin:2em}}table{{border-collapse:collapse}}td,th{{border:1px solid #bbb;padding:2px 8px}}</style>\
          </head><body><h1>Guide curves: {part}</h1>\
          <p>R {r} mm, flank allowance {sf} mm, a<sub>p</sub> {ap} mm, a<sub>e</sub> {ae} mm, voxel {h} mm; {t:.2} s. \
-         Limit curves in red, path curves in blue (docs/guides-curves.md).</p>{picture}\
-         <h2>Levels</h2><table><tr><th>level</th><th>mm above the bottom</th><th>triangles</th><th>limit loops</th><th>open chains</th><th>path curves</th></tr>{rows}</table>\
-         <h2>Tilt curves (pairs of levels)</h2><table><tr><th>levels</th><th>result</th></tr>{pairs}</table></body></html>\n",
+         Limit curves in red, path curves in blue, the path curves of each degeneracy branch in a colour of its own (docs/guides-curves.md).</p>{picture}\
+         <h2>Levels</h2><table><tr><th>level</th><th>mm above the bottom</th><th>triangles</th><th>limit loops</th><th>open chains</th><th>path curves</th><th>zones</th></tr>{rows}</table>\
+         <h2>Tilt curves (pairs of levels, per degeneracy zone)</h2><table><tr><th>levels</th><th>zones</th><th>result</th></tr>{pairs}</table></body></html>\n",
         part = html_escape(&summary.part),
         r = summary.settings[0],
         sf = summary.settings[1],

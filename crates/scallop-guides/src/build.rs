@@ -8,9 +8,9 @@
 use scallop_field::{FieldError, LevelOptions, Side, Surface, offset_levels};
 use scallop_mesh::TriMesh;
 
-use crate::{
-    GuideError, GuidePairs, Level, LimitCurves, OffsetStep, Support, limit_curves, offset_curves, pair_levels,
-};
+use crate::open::{OpenPocket, open_limit};
+use crate::zones::{Zone, degeneracy_zones, pair_zones};
+use crate::{GuideError, GuidePairs, LimitCurves, OffsetStep, Support, limit_curves, offset_curves};
 
 /// Settings of [`build_guides`] (mm).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -41,6 +41,13 @@ pub struct GuideLevel {
     /// The offsets of C_n (path curves), outermost first; empty when the
     /// level has no single closed limit loop.
     pub offsets: Vec<OffsetStep>,
+    /// The degeneracy zones of the offsets (Jousselin 2020, Ch. 2 §3.3):
+    /// zone 0 from C_n to the last unsplit offset, then one per branch;
+    /// empty when the level has no single closed limit loop.
+    pub zones: Vec<Zone>,
+    /// Why the level's open limit chains could not be closed by virtual
+    /// flanks, if they could not (Jousselin 2020, Ch. 4 §1.3.1).
+    pub closing: Option<GuideError>,
 }
 
 /// The guide curves of a pocket.
@@ -51,9 +58,14 @@ pub struct GuideSet {
     /// The levels, bottom up.
     pub levels: Vec<GuideLevel>,
     /// For each pair of neighbouring levels with one limit loop each (lower
-    /// level index), the paired path and tilt curves, or why they could not
-    /// be paired.
+    /// level index), the paired path and tilt curves of each pair of matched
+    /// degeneracy zones (zone 0 first), or why they could not be paired; a
+    /// zone without a partner gets an entry of its own
+    /// ([`GuideError::Unpaired`]).
     pub pairs: Vec<(usize, Result<GuidePairs, GuideError>)>,
+    /// For each entry of [`GuideSet::pairs`], the zone on the lower level and
+    /// the zone on the upper one (`None`: no partner).
+    pub pair_zones: Vec<[Option<usize>; 2]>,
 }
 
 fn field_error(what: &'static str, e: &FieldError) -> GuideError {
@@ -97,25 +109,53 @@ pub fn build_guides(bottom: &TriMesh, flanks: &TriMesh, settings: &GuideSettings
             .map_err(|e| field_error("flank offset", &e))?
             .pop()
             .ok_or(GuideError::Field { what: "flank offset", reason: "no sheet".into() })?;
-    let mut out = Vec::with_capacity(levels.len());
-    for (mesh, &distance) in levels.into_iter().zip(&distances) {
-        let support = Support::new(mesh);
-        let limit = limit_curves(&support, &flank_offset);
-        let offsets = if limit.loops.len() == 1 && limit.open.is_empty() {
-            offset_curves(&support, &limit.loops, settings.radial_step)?
-        } else {
-            Vec::new()
-        };
-        out.push(GuideLevel { distance, support, limit, offsets });
+    let open = OpenPocket::new(bottom, flanks, settings.tool_radius + settings.flank_allowance);
+    let out = levels
+        .into_iter()
+        .zip(&distances)
+        .map(|(mesh, &distance)| guide_level(Support::new(mesh), distance, &flank_offset, &open, settings))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut pairs = Vec::new();
+    let mut pair_zones = Vec::new();
+    for k in 0..out.len().saturating_sub(1) {
+        let (a, b) = (&out[k], &out[k + 1]);
+        for z in pair_zones_of(a, b, settings.radial_step) {
+            pairs.push((k, z.pairs));
+            pair_zones.push([z.lower, z.upper]);
+        }
     }
-    let pairs = (0..out.len().saturating_sub(1))
-        .filter(|&k| out[k].limit.loops.len() == 1 && out[k + 1].limit.loops.len() == 1)
-        .map(|k| (k, pair_levels(&level_of(&out[k]), &level_of(&out[k + 1]), settings.radial_step)))
-        .collect();
-    Ok(GuideSet { flank_offset, levels: out, pairs })
+    Ok(GuideSet { flank_offset, levels: out, pairs, pair_zones })
 }
 
-/// The curves of a level with one limit loop, for [`pair_levels`].
-fn level_of(g: &GuideLevel) -> Level<'_> {
-    Level { support: &g.support, limit: &g.limit.loops[0], offsets: &g.offsets }
+/// One level: its limit curves (an open pocket's closed by virtual flanks,
+/// [`crate::open`]), the offsets of a single limit loop and their degeneracy
+/// zones.
+fn guide_level(
+    support: Support,
+    distance: f64,
+    flank_offset: &TriMesh,
+    open: &OpenPocket,
+    settings: &GuideSettings,
+) -> Result<GuideLevel, GuideError> {
+    let mut limit = limit_curves(&support, flank_offset);
+    let mut closing = None;
+    if !limit.open.is_empty() {
+        let (loops, chains) = open_limit(&support, open);
+        if chains.is_empty() {
+            limit.closed_by_virtual_flanks = loops.len();
+            limit.loops = loops;
+            limit.nested = 0;
+        } else {
+            closing = Some(GuideError::OpenPocket { distance, reason: "the pocket region reaches the level's edge" });
+        }
+    }
+    let single = limit.loops.len() == 1 && closing.is_none();
+    let offsets = if single { offset_curves(&support, &limit.loops, settings.radial_step)? } else { Vec::new() };
+    let zones = if single { degeneracy_zones(&limit.loops[0], &offsets) } else { Vec::new() };
+    Ok(GuideLevel { distance, support, limit, offsets, zones, closing })
+}
+
+/// The zone pairs of two neighbouring levels (none unless both have zones).
+fn pair_zones_of(a: &GuideLevel, b: &GuideLevel, a_e: f64) -> Vec<crate::zones::ZonePair> {
+    pair_zones(&a.support, &a.zones, &b.support, &b.zones, a_e)
 }

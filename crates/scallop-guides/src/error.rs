@@ -55,6 +55,30 @@ pub enum GuideError {
         /// The field engine's message.
         reason: String,
     },
+    /// A degeneracy zone of one level has no partner on the neighbouring
+    /// level (Jousselin 2020, Fig. 4.7a: the two levels degenerate
+    /// differently).
+    #[error(
+        "zone {zone} of the {what} level has no partner on the other level: its offsets split differently; \
+         change a_p or a_e, or machine that zone separately"
+    )]
+    Unpaired {
+        /// `"lower"` or `"upper"`.
+        what: &'static str,
+        /// The zone index on that level.
+        zone: usize,
+    },
+    /// The open limit chains of a level could not be closed by virtual
+    /// flanks over the bottom's open edge.
+    #[error(
+        "level at {distance} mm: {reason}; the open pocket cannot be closed by virtual flanks over the bottom's open edge"
+    )]
+    OpenPocket {
+        /// Distance of the level from the bottom (mm).
+        distance: f64,
+        /// What failed.
+        reason: &'static str,
+    },
     /// The projection of the innermost curve onto the next level failed.
     #[error("the innermost curve could not be projected onto the next level: {reason}")]
     Projection {

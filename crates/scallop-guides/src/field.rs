@@ -10,6 +10,7 @@ use scallop_geom::{Point3, Vec3};
 use scallop_mesh::{Polyline3, PolylineFoot, PolylineQuery};
 
 use crate::support::Curve;
+use crate::tol;
 
 /// Signed distance to a set of curves.
 #[derive(Debug, Clone)]
@@ -23,6 +24,7 @@ impl CurveField {
     /// The field of `curves` (each with its surface normals).
     #[must_use]
     pub fn new(curves: &[Curve]) -> CurveField {
+        let curves: Vec<Curve> = curves.iter().map(merge_close_points).collect();
         let left = curves
             .iter()
             .map(|c| {
@@ -39,7 +41,7 @@ impl CurveField {
                     .collect()
             })
             .collect();
-        let lines: Vec<Polyline3> = curves.iter().map(|c| c.line.clone()).collect();
+        let lines: Vec<Polyline3> = curves.into_iter().map(|c| c.line).collect();
         CurveField { query: PolylineQuery::new(lines), left }
     }
 
@@ -93,4 +95,29 @@ impl CurveField {
         };
         if (p - f.point).dot(&l) >= 0.0 { f.distance } else { -f.distance }
     }
+}
+
+/// `c` without the points within [`tol::MERGE_DISTANCE`] of the point kept
+/// before them: a shorter segment has no reliable direction, and its left
+/// vector would decide the side of the points whose foot is its end.
+fn merge_close_points(c: &Curve) -> Curve {
+    if c.normals.len() != c.line.points.len() {
+        return c.clone();
+    }
+    let mut points: Vec<Point3> = Vec::with_capacity(c.line.points.len());
+    let mut normals = Vec::with_capacity(c.line.points.len());
+    for (p, n) in c.line.points.iter().zip(&c.normals) {
+        if points.last().is_none_or(|q: &Point3| (p - q).norm() > tol::MERGE_DISTANCE) {
+            points.push(*p);
+            normals.push(*n);
+        }
+    }
+    if c.line.closed && points.len() > 2 && (points[0] - points[points.len() - 1]).norm() <= tol::MERGE_DISTANCE {
+        points.pop();
+        normals.pop();
+    }
+    if points.len() < 2 {
+        return c.clone();
+    }
+    Curve { line: Polyline3::new(points, c.line.closed), normals }
 }

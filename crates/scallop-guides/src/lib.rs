@@ -12,7 +12,9 @@
 //! - [`morph_level`], [`pair_levels`]: tilt curves by scalar morphing on the
 //!   next level, the swap rule and the count rule (Ch. 2 §3.2.2);
 //! - [`build_guides`]: levels, flank offset, limit, path and tilt curves of
-//!   a pocket (module F);
+//!   a pocket (module F), with the degeneracy zones of non-convex limit
+//!   curves ([`degeneracy_zones`], [`pair_zones`], Ch. 2 §3.3) and open
+//!   pockets closed by virtual flanks along the level's edge (Ch. 4 §1.3.1);
 //! - [`vectorial_offset`]: the vectorial method (Eq. 2.8-2.10, Alg. 1-3), the
 //!   reference for the scalar one.
 //!
@@ -46,9 +48,11 @@ mod field;
 mod limit;
 mod morph;
 mod offset;
+mod open;
 mod support;
 pub mod tol;
 mod vectorial;
+mod zones;
 
 pub use build::{GuideLevel, GuideSet, GuideSettings, build_guides};
 pub use error::GuideError;
@@ -59,3 +63,4 @@ pub use morph::{GuidePairs, Level, morph_level, morph_vectorial, pair_levels, pr
 pub use offset::{OffsetStep, offset_curve, offset_curves};
 pub use support::{Curve, Support};
 pub use vectorial::{VectorialOffset, VectorialOptions, vectorial_offset};
+pub use zones::{Zone, ZonePair, degeneracy_zones, pair_zones};

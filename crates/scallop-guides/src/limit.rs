@@ -18,6 +18,11 @@ pub struct LimitCurves {
     /// Loops lying inside another loop (islands: outside the method's scope,
     /// reported, not processed).
     pub nested: usize,
+    /// How many of [`LimitCurves::loops`] were made by closing the open
+    /// chains along the level's edge (the virtual crossable flanks of an open
+    /// pocket, Jousselin 2020, Ch. 4 §1.3.1; the chains stay in
+    /// [`LimitCurves::open`]). Set by [`crate::build_guides`].
+    pub closed_by_virtual_flanks: usize,
 }
 
 /// The limit curves where `flank_offset` (the pocket-side sheet of the flank

@@ -29,7 +29,11 @@ pub struct OffsetStep {
 /// The successive inward offsets of `limit` (inside on the left of each
 /// curve, see [`Curve::inside_left`]) on `support`, `step` (the radial
 /// engagement a_e, mm) apart, until they vanish. The first entry is the first
-/// offset (C_n itself is not repeated).
+/// offset (C_n itself is not repeated). A loop narrower than
+/// [`tol::SLIVER_WIDTH_FACETS`] facets (mean width `2 area / length`) counts
+/// as vanished: it is the iso-line of a distance whose maximum barely passes
+/// the step, below the mesh's resolution, and where the region is a strip of
+/// about twice the step it breaks into a row of such slivers.
 ///
 /// # Errors
 /// [`GuideError::BadLength`] for a non-positive step, [`GuideError::BadCurve`]
@@ -48,7 +52,9 @@ pub fn offset_curves(support: &Support, limit: &[Curve], step: f64) -> Result<Ve
         if steps.len() >= guard {
             return Err(GuideError::NotVanishing { steps: steps.len() });
         }
-        let (iso, next) = offset_once(support, &current, step, band.as_ref());
+        let (mut iso, next) = offset_once(support, &current, step, band.as_ref());
+        let sliver = tol::SLIVER_WIDTH_FACETS * support.facet_size();
+        iso.curves.retain(|c| !c.line.closed || 2.0 * c.signed_area().abs() >= sliver * c.line.length());
         if iso.curves.is_empty() {
             break;
         }

@@ -27,18 +27,7 @@ impl Support {
     /// facet normals (by winding).
     #[must_use]
     pub fn new(mesh: TriMesh) -> Support {
-        let mut normals = vec![Vec3::zeros(); mesh.vertices().len()];
-        for (i, t) in mesh.triangles().iter().enumerate() {
-            let c = mesh.triangle(i);
-            let n = (c[1] - c[0]).cross(&(c[2] - c[0]));
-            for &v in t {
-                normals[v as usize] += n;
-            }
-        }
-        for n in &mut normals {
-            let len = n.norm();
-            *n = if len > 0.0 { *n / len } else { Vec3::z() };
-        }
+        let normals = area_weighted_normals(&mesh, Vec3::z());
         Support::assemble(mesh, normals)
     }
 
@@ -169,6 +158,24 @@ impl Curve {
     pub fn inside_left(self) -> Curve {
         if self.line.closed && self.signed_area() < 0.0 { self.reversed() } else { self }
     }
+}
+
+/// Unit vertex normals of `mesh`: area-weighted averages of the facet normals
+/// (by winding), `fallback` where they cancel.
+pub(crate) fn area_weighted_normals(mesh: &TriMesh, fallback: Vec3) -> Vec<Vec3> {
+    let mut normals = vec![Vec3::zeros(); mesh.vertices().len()];
+    for (i, t) in mesh.triangles().iter().enumerate() {
+        let c = mesh.triangle(i);
+        let n = (c[1] - c[0]).cross(&(c[2] - c[0]));
+        for &v in t {
+            normals[v as usize] += n;
+        }
+    }
+    for n in &mut normals {
+        let len = n.norm();
+        *n = if len > 0.0 { *n / len } else { fallback };
+    }
+    normals
 }
 
 /// Vertex adjacency in compressed rows.

@@ -26,3 +26,16 @@ pub const CORNER_TURN: f64 = 0.1;
 
 /// Most axial levels of one guide set (bounds the work on absurd settings).
 pub const MAX_LEVELS: usize = 1000;
+
+/// Consecutive curve points closer than this (mm) are merged in a distance
+/// field ([`crate::CurveField`]): the mesh intersection and Marching Facets
+/// can leave points a rounding error apart, whose segment has no reliable
+/// direction (coordinates of 1e2 mm carry 1e-14 mm of rounding, a direction
+/// error of 1e-7 rad at this length), so its left vector could flip the side
+/// of the points whose nearest point is its end.
+pub const MERGE_DISTANCE: f64 = 1e-7;
+
+/// An offset loop whose mean width (`2 area / length`) is under this many
+/// facet sizes has vanished ([`crate::offset_curves`]): its shape is below
+/// the mesh's resolution (docs/guides-curves.md, "Slivers").
+pub const SLIVER_WIDTH_FACETS: f64 = 0.5;
