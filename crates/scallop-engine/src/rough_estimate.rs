@@ -107,22 +107,44 @@ impl RoughModel {
         let ae = settings.stepover * 2.0 * r;
         let cell = self.cell;
         let zs = level_heights(index, stock, settings);
-        // Levels are independent (each reads the material the earlier operations left).
-        let cut: Vec<Option<(usize, usize, Vec<bool>)>> = zs
-            .par_iter()
-            .map(|&z| {
-                let region = self.region(z, r + settings.radial_allowance, settings.axial_allowance);
-                let region = if self.whole { region } else { self.limit_to_material(&region, z, r) };
-                let (count, cells) = offset_passes(&self.grid, &region, ae / cell);
-                // The offsets sweep the region grown by the tool radius down to z.
-                let swept = if later {
-                    distances(&self.grid, &region).iter().map(|d| d * cell <= r).collect()
-                } else {
-                    Vec::new()
-                };
-                (count > 0).then_some((count, cells, swept))
-            })
-            .collect();
+        // The part above a level is the cells of heights from the lowest one
+        // over the level (less the axial allowance): the levels between two
+        // heights share their region, computed once.
+        let key = |z: f64| {
+            let floor = z - settings.axial_allowance;
+            self.heights.iter().copied().filter(|&h| h > floor).fold(f64::INFINITY, f64::min)
+        };
+        let keys: Vec<f64> = zs.iter().map(|&z| key(z)).collect();
+        let mut distinct = keys.clone();
+        distinct.sort_by(f64::total_cmp);
+        distinct.dedup();
+        let regions: Vec<Vec<bool>> =
+            distinct.par_iter().map(|&h| self.region(h, r + settings.radial_allowance)).collect();
+        let region_of = |h: f64| &regions[distinct.partition_point(|&d| d < h)];
+        let level = |z: f64, region: &[bool]| {
+            let limited;
+            let region = if self.whole {
+                region
+            } else {
+                limited = self.limit_to_material(region, z, r);
+                &limited
+            };
+            let (count, cells) = offset_passes(&self.grid, region, ae / cell);
+            // The offsets sweep the region grown by the tool radius down to z.
+            let swept = if later { within(&self.grid, region, r / cell) } else { Vec::new() };
+            (count > 0).then_some((count, cells, swept))
+        };
+        // From the whole box a level's passes depend on its region only.
+        let shared: Vec<Option<(usize, usize, Vec<bool>)>> = if self.whole {
+            distinct.par_iter().zip(&regions).map(|(&h, region)| level(h, region)).collect()
+        } else {
+            Vec::new()
+        };
+        let cut: Vec<Option<(usize, usize, Vec<bool>)>> = if self.whole {
+            keys.iter().map(|&h| shared[distinct.partition_point(|&d| d < h)].clone()).collect()
+        } else {
+            zs.par_iter().zip(&keys).map(|(&z, &h)| level(z, region_of(h))).collect()
+        };
         let (mut passes, mut area, mut levels) = (0usize, 0.0, 0usize);
         for (z, level) in zs.iter().zip(cut) {
             let Some((count, cells, swept)) = level else { continue };
@@ -150,10 +172,10 @@ impl RoughModel {
         }
     }
 
-    /// The tool-centre region at tip height `z` (module docs): the cells
-    /// farther than `reach` from the part above `z - axial`.
-    fn region(&self, z: f64, reach: f64, axial: f64) -> Vec<bool> {
-        let part: Vec<bool> = self.heights.iter().map(|&p| p > z - axial).collect();
+    /// The tool-centre region of a level (module docs): the cells farther
+    /// than `reach` from the part's cells of heights `lowest` and up.
+    fn region(&self, lowest: f64, reach: f64) -> Vec<bool> {
+        let part: Vec<bool> = self.heights.iter().map(|&p| p >= lowest).collect();
         let clear = distances(&self.grid, &part);
         (0..self.grid.len()).map(|k| !self.grid.frame(k) && (clear[k] - 0.5) * self.cell > reach).collect()
     }
@@ -163,12 +185,10 @@ impl RoughModel {
     /// `r` less the margin of the region.
     fn limit_to_material(&self, region: &[bool], z: f64, r: f64) -> Vec<bool> {
         let cell = self.cell;
-        let near = distances(&self.grid, region);
-        let removable: Vec<bool> = (0..self.grid.len())
-            .map(|k| self.tops[k] > z + rtol::MIN_CHIP && near[k] * cell <= (r - self.margin).max(0.0))
-            .collect();
-        let to_material = distances(&self.grid, &removable);
-        region.iter().zip(&to_material).map(|(&inside, d)| inside && d * cell <= r).collect()
+        let near = within(&self.grid, region, (r - self.margin).max(0.0) / cell);
+        let removable: Vec<bool> = (0..self.grid.len()).map(|k| near[k] && self.tops[k] > z + rtol::MIN_CHIP).collect();
+        let to_material = within(&self.grid, &removable, r / cell);
+        region.iter().zip(&to_material).map(|(&inside, &near)| inside && near).collect()
     }
 }
 
@@ -281,6 +301,24 @@ impl Grid {
     fn loops(&self, set: &[bool]) -> usize {
         (2 * self.pieces(set).cast_signed() - self.euler(set)).max(0).cast_unsigned()
     }
+}
+
+/// The cells whose centre lies within `reach` cells of a `from` cell's
+/// centre: [`distances`] on the box of `from` grown by `reach`.
+fn within(grid: &Grid, from: &[bool], reach: f64) -> Vec<bool> {
+    let mut out = vec![false; grid.len()];
+    let Some((i0, j0, i1, j1)) = grid.bounds(from) else { return out };
+    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a grid's size at most")]
+    let grow = (reach.max(0.0).ceil() as usize).min(grid.nx + grid.ny) + 1;
+    let (a0, b0) = (i0.saturating_sub(grow), j0.saturating_sub(grow));
+    let (a1, b1) = ((i1 + grow).min(grid.nx - 1), (j1 + grow).min(grid.ny - 1));
+    let sub = Grid { nx: a1 - a0 + 1, ny: b1 - b0 + 1 };
+    let at = |k: usize| (k / sub.nx + b0) * grid.nx + k % sub.nx + a0;
+    let set: Vec<bool> = (0..sub.len()).map(|k| from[at(k)]).collect();
+    for (k, d) in distances(&sub, &set).into_iter().enumerate() {
+        out[at(k)] = d <= reach;
+    }
+    out
 }
 
 /// Euclidean distance (in cells) of every cell's centre to the nearest
@@ -444,5 +482,78 @@ mod tests {
                 assert!(*v == best || (v - best).abs() <= 1e-9 * best, "cell {k}: {v} vs {best}");
             }
         }
+    }
+
+    /// Two triangles over the rectangle `[x0, x1] x [y0, y1]` at height `z`.
+    fn quad(x0: f64, y0: f64, x1: f64, y1: f64, z: f64) -> [[scallop_geom::Point3; 3]; 2] {
+        let p = |x, y| scallop_geom::Point3::new(x, y, z);
+        [[p(x0, y0), p(x1, y0), p(x1, y1)], [p(x0, y0), p(x1, y1), p(x0, y1)]]
+    }
+
+    fn flat_job(radius: f64) -> FinishJob {
+        let shape = scallop_cutter::CutterShape::Flat { radius };
+        let cutter = scallop_cutter::Cutter::new(shape, 30.0).expect("a valid cutter");
+        FinishJob { cutter, ..FinishJob::choi_demo() }
+    }
+
+    fn settings(stepdown: f64, stepover: f64, allowance: f64) -> RoughSettings {
+        RoughSettings {
+            stepdown,
+            stepover,
+            radial_allowance: allowance,
+            axial_allowance: allowance,
+            pattern: scallop_rough::Pattern::Offset,
+            direction: scallop_rough::Direction::Climb,
+        }
+    }
+
+    /// Over a part below the stock (a floor at the stock's bottom), every
+    /// level's region is the stock grown by the tool radius, a W x H
+    /// rectangle: its offsets at ae are non-empty while k ae < H / 2, so each
+    /// level makes ceil(H / (2 ae)) passes (the grid may add or drop one).
+    #[test]
+    fn a_rectangle_level_makes_its_offsets_one_pass_each() {
+        let (mesh, _) = TriMesh::from_soup(&quad(0.0, 0.0, 40.0, 20.0, 0.0)).expect("a floor");
+        let stock =
+            Aabb3 { min: scallop_geom::Point3::new(0.0, 0.0, 0.0), max: scallop_geom::Point3::new(40.0, 20.0, 6.0) };
+        let (r, set) = (3.0, settings(2.0, 0.3, 0.0));
+        let ae = set.stepover * 2.0 * r;
+        let mut model = RoughModel::new(&mesh, &stock, r, (0.25 * ae, MAX_CELLS), 0.1);
+        let index = MeshIndex::build(&mesh);
+        let e = model.estimate(&flat_job(r), (&set, false), &stock, &index);
+        let levels = level_heights(&index, &stock, &set).len();
+        assert_eq!(e.levels, levels);
+        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a small count")]
+        let per_level = ((20.0 + 2.0 * r) / (2.0 * ae)).ceil() as usize;
+        assert!(e.passes.abs_diff(levels * per_level) <= levels, "{} passes, {levels} x {per_level}", e.passes);
+    }
+
+    /// A rest operation after a roughing operation finds less to cut than the
+    /// same operation from the whole box (metamorphic): on a block with a
+    /// square-cornered pocket, a 10 mm end mill leaves the corners, a 4 mm
+    /// one after it cuts only there.
+    #[test]
+    fn rest_after_roughing_estimates_fewer_passes_than_from_the_box() {
+        let soup = [
+            quad(0.0, 0.0, 60.0, 8.0, 15.0),
+            quad(0.0, 32.0, 60.0, 40.0, 15.0),
+            quad(0.0, 8.0, 10.0, 32.0, 15.0),
+            quad(50.0, 8.0, 60.0, 32.0, 15.0),
+            quad(10.0, 8.0, 50.0, 32.0, 5.0),
+        ]
+        .concat();
+        let (mesh, _) = TriMesh::from_soup(&soup).expect("a pocket");
+        let stock =
+            Aabb3 { min: scallop_geom::Point3::new(0.0, 0.0, 0.0), max: scallop_geom::Point3::new(60.0, 40.0, 16.0) };
+        let index = MeshIndex::build(&mesh);
+        let (rough, rest) = (settings(2.5, 0.3, 0.3), settings(1.5, 0.25, 0.3));
+        let model = || RoughModel::new(&mesh, &stock, 5.0, (0.1, MAX_REST_CELLS), 0.1);
+        let mut after = model();
+        let first = after.estimate(&flat_job(5.0), (&rough, true), &stock, &index);
+        let limited = after.estimate(&flat_job(2.0), (&rest, false), &stock, &index);
+        let whole = model().estimate(&flat_job(2.0), (&rest, false), &stock, &index);
+        assert!(first.passes > 0 && limited.passes > 0, "{first:?} {limited:?}");
+        assert!(limited.passes < whole.passes, "rest {} vs from the box {}", limited.passes, whole.passes);
+        assert!(limited.feed_length_mm < whole.feed_length_mm);
     }
 }

@@ -363,7 +363,8 @@ fn rule_step(
 /// measures each step and corrects it, within [`tol::ISO_FIT_ACCEPT`] of the
 /// target; on a curved surface its measure finds the curvature's share):
 /// isolines from the start of the cross range, each one rule step (on
-/// `samples` running parameters spread evenly) after the last, up to the end,
+/// `samples` running parameters spread evenly, the smaller of the steps read
+/// on the last isoline and on the one a step further) after the last, up to the end,
 /// for the scallop `target` (`sh` less the tessellation's chordal error).
 /// `scallop run --plan-only` estimates with this count.
 ///
@@ -391,6 +392,10 @@ pub fn iso_rule_passes(
         if !(step.is_finite() && step > 0.0) {
             break;
         }
+        // The gap must hold on the next isoline too (the cross speed and the
+        // curvature change across it).
+        let next = (iso + step).min(across[1]);
+        let step = step.min(rule_step(patch, direction, &model, (next, &running), target, true));
         iso = (iso + step).min(across[1]);
         passes += 1;
     }
