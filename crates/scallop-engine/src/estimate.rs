@@ -178,6 +178,7 @@ pub fn estimate_operation(job: &FinishJob) -> Result<Estimate, EngineError> {
 /// [`ISO_SAMPLES`] points of each isoline) for the scallop the planner aims
 /// at, `sh` less the chordal error of the tessellation it drops the cutter
 /// on; `e` keeps the parallel estimate's spacings and feed length.
+#[allow(clippy::result_large_err, reason = "the engine's one error type, as estimate_operation")]
 fn isoparametric(job: &FinishJob, direction: IsoDirection, mut e: Estimate) -> Result<Estimate, EngineError> {
     let Part::Surfaces(set) = &job.part else { return Ok(e) };
     let chordal = set.tessellate(planning_tolerances(job)?.tessellation())?.chordal_bound;
@@ -466,14 +467,17 @@ fn runs(section: &[Piece], gap: f64) -> Vec<[f64; 2]> {
 }
 
 /// Whether the planes of a band meet rest material (the steep-and-shallow
-/// planner's rest rule, `scallop_strategy::tol::REST_RESIDUAL_FACTOR`): in
-/// the band's section, the cutter's profile run along each run of shallow
-/// pieces (tip heights by the 2-D drop of the profile on the section, at
+/// planner's rest rule, `Planner::sweep` in `scallop_strategy`): in the
+/// band's section, the cutter's profile run along each run of shallow pieces
+/// (tip heights by the 2-D drop of the profile on the section, at
 /// [`REST_SAMPLES`] a cutter radius) leaves a residual, along the normal,
-/// over `REST_RESIDUAL_FACTOR` sh somewhere at least a cutter radius from
-/// the run's ends (where the planner measures: its zone end margin). A
-/// vertical wall inside a run (the pass steps down it) leaves the corner at
-/// its foot; no spacing removes that.
+/// over sh somewhere at least a cutter radius from the run's ends (where the
+/// planner measures: its zone end margin). No plane spacing lowers that
+/// residual, so the planner takes it for rest: at once when it is over
+/// `REST_RESIDUAL_FACTOR` sh, else when it keeps over half its height as
+/// the gap is more than halved. A vertical wall inside a run (the pass steps
+/// down it) leaves the corner at its foot, so does a concave edge tighter
+/// than the cutter.
 fn band_has_rest(section: &[Piece], runs: &[[f64; 2]], shape: &CutterShape, sh: f64) -> bool {
     let radius = shape.radius();
     let step = radius / REST_SAMPLES;
@@ -487,7 +491,6 @@ fn band_has_rest(section: &[Piece], runs: &[[f64; 2]], shape: &CutterShape, sh: 
             })
             .fold((f64::NEG_INFINITY, 1.0), |a, b| if b.0 > a.0 { b } else { a })
     };
-    let limit = stol::REST_RESIDUAL_FACTOR * sh;
     runs.iter().filter(|r| r[1] - r[0] > 2.0 * radius).any(|&[a, b]| {
         #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a bounded count")]
         let n = (((b - a) / step).ceil() as usize).min(MAX_REST_POINTS);
@@ -507,7 +510,7 @@ fn band_has_rest(section: &[Piece], runs: &[[f64; 2]], shape: &CutterShape, sh: 
             .collect();
         (0..=n).filter(|&i| us[i] >= a + radius && us[i] <= b - radius).any(|i| {
             let left = near(i).map(|j| tips[j] + shape.height_at((us[i] - us[j]).abs())).fold(f64::INFINITY, f64::min);
-            (left - zs[i].0) * zs[i].1.abs() > limit
+            (left - zs[i].0) * zs[i].1.abs() > sh
         })
     })
 }
@@ -699,5 +702,31 @@ mod tests {
         assert_eq!(count(apart), 2);
         let corner = [quad(p(0., 0., 0.), p(10., 0., 0.)), quad(p(10., 0., 0.), p(10., 10., 0.))].concat();
         assert_eq!(count(corner), 1);
+    }
+
+    /// The rest test on band sections: a floor, and a convex arc of radius
+    /// larger than the ball, leave no residual; a vertical step inside the
+    /// run leaves the corner at its foot (about the ball's radius high),
+    /// also when the run ends more than a radius from the step.
+    #[test]
+    fn a_step_leaves_rest_a_floor_and_a_convex_arc_none() {
+        let ball = CutterShape::Ball { radius: 2.0 };
+        let piece = |u0: f64, u1: f64, z0: f64, z1: f64| Piece { u: [u0, u1], z: [z0, z1], nz: 1.0, shallow: true };
+        let rest = |section: Vec<Piece>| {
+            let runs = runs(&section, 0.01);
+            band_has_rest(&section, &runs, &ball, 0.02)
+        };
+        assert!(!rest(vec![piece(0.0, 30.0, 5.0, 5.0)]));
+        // A circle of radius 20 through points 0.25 mm apart (chords sag 0.4 um).
+        let arc: Vec<Piece> = (0..80)
+            .map(|k| {
+                let (a, b) = (-1.0 + f64::from(k) / 40.0, -1.0 + f64::from(k + 1) / 40.0);
+                let z = |x: f64| (400.0 - 100.0 * x * x).sqrt();
+                piece(10.0 * a, 10.0 * b, z(a), z(b))
+            })
+            .collect();
+        assert!(!rest(arc));
+        assert!(rest(vec![piece(0.0, 10.0, 0.0, 0.0), piece(10.0, 20.0, 5.0, 5.0)]));
+        assert!(!rest(vec![piece(0.0, 3.0, 0.0, 0.0)]), "a run under two radii is not measured");
     }
 }
