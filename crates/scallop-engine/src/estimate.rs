@@ -369,11 +369,15 @@ fn steep_shallow(
         let is_shallow = |f: &Face| f.slope() < split.threshold + split.overlap;
         let sections = band_sections(mesh, faces, is_shallow, (lo, width), direction);
         let shape = job.cutter.shape();
+        let band_runs: Vec<Vec<[f64; 2]>> = sections.iter().map(|s| runs(s, job.tolerances.path)).collect();
+        let shallow_nz = (split.threshold + split.overlap).cos();
+        let across = across_rest(&sections, &band_runs, (width, shallow_nz), shape, job.scallop_height);
         let (runs, rest): (Vec<usize>, Vec<bool>) = sections
             .par_iter()
-            .map(|section| {
-                let runs = runs(section, job.tolerances.path);
-                (runs.len(), band_has_rest(section, &runs, shape, job.scallop_height))
+            .zip(&band_runs)
+            .zip(&across)
+            .map(|((section, runs), &across)| {
+                (runs.len(), across || band_has_rest(section, runs, shape, job.scallop_height))
             })
             .unzip();
         // Where a band meets rest material the planes go a share of the largest
@@ -480,39 +484,93 @@ fn runs(section: &[Piece], gap: f64) -> Vec<[f64; 2]> {
 /// than the cutter.
 fn band_has_rest(section: &[Piece], runs: &[[f64; 2]], shape: &CutterShape, sh: f64) -> bool {
     let radius = shape.radius();
-    let step = radius / REST_SAMPLES;
-    let profile = |u: f64| {
-        section
-            .iter()
-            .filter(|p| p.u[0] <= u && u <= p.u[1])
-            .map(|p| {
-                let w = if p.u[1] > p.u[0] { (u - p.u[0]) / (p.u[1] - p.u[0]) } else { 0.5 };
-                (p.z[0] + w * (p.z[1] - p.z[0]), p.nz)
-            })
-            .fold((f64::NEG_INFINITY, 1.0), |a, b| if b.0 > a.0 { b } else { a })
-    };
     runs.iter().filter(|r| r[1] - r[0] > 2.0 * radius).any(|&[a, b]| {
         #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a bounded count")]
-        let n = (((b - a) / step).ceil() as usize).min(MAX_REST_POINTS);
+        let n = (((b - a) * REST_SAMPLES / radius).ceil() as usize).clamp(1, MAX_REST_POINTS);
         #[allow(clippy::cast_precision_loss, reason = "a bounded count")]
         let us: Vec<f64> = (0..=n).map(|i| a + (b - a) * i as f64 / n as f64).collect();
-        let zs: Vec<(f64, f64)> = us.iter().map(|&u| profile(u)).collect();
-        #[allow(clippy::cast_precision_loss, reason = "a bounded count")]
-        let w = (radius / ((b - a) / n as f64)).floor();
-        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a bounded count")]
-        let w = w as usize;
-        let near = |i: usize| i.saturating_sub(w)..=(i + w).min(n);
-        // Tip heights along the run, then the surface they leave.
-        let tips: Vec<f64> = (0..=n)
-            .map(|i| {
-                near(i).map(|j| zs[j].0 - shape.height_at((us[i] - us[j]).abs())).fold(f64::NEG_INFINITY, f64::max)
-            })
-            .collect();
-        (0..=n).filter(|&i| us[i] >= a + radius && us[i] <= b - radius).any(|i| {
-            let left = near(i).map(|j| tips[j] + shape.height_at((us[i] - us[j]).abs())).fold(f64::INFINITY, f64::min);
-            (left - zs[i].0) * zs[i].1.abs() > sh
-        })
+        let zs: Vec<(f64, f64)> = us.iter().map(|&u| profile(section, u)).collect();
+        let left = residuals(&zs, (b - a) / us.len().saturating_sub(1).max(1) as f64, shape);
+        (0..=n).any(|i| us[i] >= a + radius && us[i] <= b - radius && left[i] > sh)
     })
+}
+
+/// The part's height (and normal z) on a band's centre line at feed
+/// abscissa `u`: the highest piece over it (`-inf` where none).
+fn profile(section: &[Piece], u: f64) -> (f64, f64) {
+    section
+        .iter()
+        .filter(|p| p.u[0] <= u && u <= p.u[1])
+        .map(|p| {
+            let w = if p.u[1] > p.u[0] { (u - p.u[0]) / (p.u[1] - p.u[0]) } else { 0.5 };
+            (p.z[0] + w * (p.z[1] - p.z[0]), p.nz)
+        })
+        .fold((f64::NEG_INFINITY, 1.0), |a, b| if b.0 > a.0 { b } else { a })
+}
+
+/// The residual, along the normal, that the cutter's profile run along a
+/// section sampled every `step` mm (heights and normal z `zs`) leaves at
+/// each sample: tip heights by the 2-D drop of the profile, then the lowest
+/// surface of the profile over each sample.
+fn residuals(zs: &[(f64, f64)], step: f64, shape: &CutterShape) -> Vec<f64> {
+    let n = zs.len();
+    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a bounded count")]
+    let w = ((shape.radius() / step).floor() as usize).min(n);
+    let near = |i: usize| i.saturating_sub(w)..(i + w + 1).min(n);
+    #[allow(clippy::cast_precision_loss, reason = "sample offsets")]
+    let h = |i: usize, j: usize| shape.height_at(step * i.abs_diff(j) as f64);
+    let tips: Vec<f64> = (0..n).map(|i| near(i).map(|j| zs[j].0 - h(i, j)).fold(f64::NEG_INFINITY, f64::max)).collect();
+    (0..n)
+        .map(|i| {
+            let left = near(i).map(|j| tips[j] + h(i, j)).fold(f64::INFINITY, f64::min);
+            (left - zs[i].0) * zs[i].1.abs()
+        })
+        .collect()
+}
+
+/// The bands whose planes meet rest material across the feed: the
+/// residual (as [`band_has_rest`]) of the cutter's profile run across the
+/// bands, on sections at every [`REST_SAMPLES`]-th of a cutter radius along
+/// the feed, over sh at a band's point on a shallow piece (normal z at
+/// least `shallow_nz`) that lies at least a cutter radius inside one of its
+/// runs and a cutter radius from the first and last band (the cutter beyond
+/// them is not sampled).
+fn across_rest(
+    sections: &[Vec<Piece>],
+    runs: &[Vec<[f64; 2]>],
+    (width, shallow_nz): (f64, f64),
+    shape: &CutterShape,
+    sh: f64,
+) -> Vec<bool> {
+    let radius = shape.radius();
+    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a bounded count")]
+    let margin = ((radius / width).ceil() as usize).min(sections.len());
+    let inside = |b: usize, u: f64| runs[b].iter().any(|r| u >= r[0] + radius && u <= r[1] - radius);
+    let lo = runs.iter().flatten().map(|r| r[0]).fold(f64::INFINITY, f64::min);
+    let hi = runs.iter().flatten().map(|r| r[1]).fold(f64::NEG_INFINITY, f64::max);
+    if hi.partial_cmp(&lo) != Some(std::cmp::Ordering::Greater) {
+        return vec![false; sections.len()];
+    }
+    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a bounded count")]
+    let n = (((hi - lo) * REST_SAMPLES / radius).ceil() as usize).clamp(1, MAX_REST_POINTS);
+    #[allow(clippy::cast_precision_loss, reason = "a bounded count")]
+    let us: Vec<f64> = (0..=n).map(|i| lo + (hi - lo) * i as f64 / n as f64).collect();
+    let hits: Vec<Vec<usize>> = us
+        .par_iter()
+        .map(|&u| {
+            let zs: Vec<(f64, f64)> = sections.iter().map(|s| profile(s, u)).collect();
+            let left = residuals(&zs, width, shape);
+            // A point of a shallow piece, with the bands a cutter radius around it.
+            (margin..sections.len().saturating_sub(margin))
+                .filter(|&b| left[b] > sh && zs[b].1 >= shallow_nz && inside(b, u))
+                .collect()
+        })
+        .collect();
+    let mut rest = vec![false; sections.len()];
+    for b in hits.into_iter().flatten() {
+        rest[b] = true;
+    }
+    rest
 }
 
 /// The waterline levels of the `steep` triangles stepped down as the planner
