@@ -646,14 +646,19 @@ fn run_machines_two_operations_on_one_stock() {
 }
 
 /// `--plan-only` on a roughing operation (a generated pyramid in a stock box)
-/// expects the planner's levels exactly and its passes within 10 %.
+/// expects the planner's levels exactly and its passes within 10 %; on a
+/// rest operation after it (a smaller end mill on what the first left), the
+/// planner's levels, and fewer passes than the same operation from the box.
 #[test]
 fn plan_only_estimates_the_levels_and_passes_of_roughing() {
     let dir = scratch("rough-estimate");
     std::fs::write(dir.join("pyramid.stl"), pyramid_stl()).expect("write");
-    let job = "[part]\nfile = \"pyramid.stl\"\n[stock]\nmargin = 4\ntop = 2\n\
-        [[operation]]\nkind = \"rough\"\n[operation.cutter]\nshape = \"flat\"\ndiameter = 4\nflute_length = 20\n\
-        [operation.roughing]\nstepdown = 1\nstepover = 0.3\nstock_to_leave = 0.3\n[verify]\nresolution = 0.1\n";
+    let head = "[part]\nfile = \"pyramid.stl\"\n[stock]\nmargin = 4\ntop = 2\n[verify]\nresolution = 0.1\n";
+    let rough = "[[operation]]\nkind = \"rough\"\n[operation.cutter]\nshape = \"flat\"\ndiameter = 4\nflute_length = 20\n\
+        [operation.roughing]\nstepdown = 1\nstepover = 0.3\nstock_to_leave = 0.3\n";
+    let rest = "[[operation]]\nkind = \"rest\"\n[operation.cutter]\nshape = \"flat\"\ndiameter = 2\nflute_length = 20\n\
+        [operation.roughing]\nstepdown = 0.5\nstepover = 0.3\nstock_to_leave = 0.3\n";
+    let job = format!("{head}{rough}{rest}");
     std::fs::write(dir.join("job.toml"), job).expect("write");
     let run = |extra: &[&str]| {
         let out = scallop()
@@ -669,12 +674,21 @@ fn plan_only_estimates_the_levels_and_passes_of_roughing() {
         serde_json::from_slice::<serde_json::Value>(&out.stdout).expect("json")
     };
     let estimate = run(&["--plan-only"]);
-    let e = &estimate[0]["estimate"];
-    assert_eq!(e["strategy"], "rough", "{estimate}");
-    let plan = &run(&[])["operations"][0]["plan"];
-    assert_eq!(e["levels"].as_u64(), plan["planes"].as_u64(), "levels: {estimate} {plan}");
+    let report = run(&[]);
+    for k in 0..2 {
+        let (e, plan) = (&estimate[k]["estimate"], &report["operations"][k]["plan"]);
+        assert_eq!(e["strategy"], "rough", "{estimate}");
+        assert_eq!(e["levels"].as_u64(), plan["planes"].as_u64(), "levels: {estimate} {plan}");
+    }
+    let (e, plan) = (&estimate[0]["estimate"], &report["operations"][0]["plan"]);
     let (expected, real) = (e["passes"].as_f64().unwrap(), plan["passes"].as_f64().unwrap());
     assert!((expected - real).abs() <= 0.1 * real, "estimated {expected} passes, planned {real}");
+    // The rest operation alone (from the whole box) has more to cut.
+    let alone = format!("{head}{}", rest.replace("kind = \"rest\"", "kind = \"rough\""));
+    std::fs::write(dir.join("job.toml"), alone).expect("write");
+    let whole = run(&["--plan-only"]);
+    let (after, from_box) = (&estimate[1]["estimate"]["passes"], &whole[0]["estimate"]["passes"]);
+    assert!(after.as_u64() < from_box.as_u64(), "rest {after} vs from the box {from_box}: {whole}");
 }
 
 /// The words of a G-code line without its comments: `(letter, number)` pairs.

@@ -25,16 +25,27 @@
 
 use std::collections::HashMap;
 
+use rayon::prelude::*;
 use scallop_analysis::{GridOptions, sample_mesh, sample_surface_set};
 use scallop_cutter::CutterShape;
-use scallop_geom::{Point3, Vec3};
-use scallop_mesh::TriMesh;
-use scallop_strategy::{SteepShallow, convex_factor, rule_spacing, tol as stol};
+use scallop_geom::{Aabb3, Point3, Vec3};
+use scallop_mesh::{MeshIndex, TriMesh};
+use scallop_strategy::{IsoDirection, SteepShallow, convex_factor, iso_rule_passes, rule_spacing, tol as stol};
 use serde::Serialize;
 
 use crate::finish::{analyse, planning_tolerances};
 use crate::job::job_stock;
+use crate::rough_estimate::RoughModel;
 use crate::{EngineError, FinishJob, Job, Part, Strategy};
+
+/// Profile samples per cutter radius of the rest test of steep and shallow.
+const REST_SAMPLES: f64 = 8.0;
+
+/// Profile samples of one run of the rest test, at most.
+const MAX_REST_POINTS: usize = 4_000;
+
+/// Points of each isoline where the isoparametric estimate reads the rule.
+const ISO_SAMPLES: usize = 128;
 
 /// Bands across the feed of the estimate.
 const BANDS: usize = 400;
@@ -155,9 +166,29 @@ pub fn estimate_operation(job: &FinishJob) -> Result<Estimate, EngineError> {
             }
             steep_shallow(job, mesh, &faces, &split, direction, estimate)
         }
+        (Strategy::Isoparametric(iso), _) => isoparametric(job, iso, parallel(job, &faces, direction, estimate))?,
         _ => parallel(job, &faces, direction, estimate),
     };
     e.time_at_feed_s = e.feed_length_mm / feed;
+    Ok(e)
+}
+
+/// Isoparametric passes on a parametric part: the planner's own spacing
+/// rule walked across each patch (`scallop_strategy::iso_rule_passes`, on
+/// [`ISO_SAMPLES`] points of each isoline) for the scallop the planner aims
+/// at, `sh` less the chordal error of the tessellation it drops the cutter
+/// on; `e` keeps the parallel estimate's spacings and feed length.
+#[allow(clippy::result_large_err, reason = "the engine's one error type, as estimate_operation")]
+fn isoparametric(job: &FinishJob, direction: IsoDirection, mut e: Estimate) -> Result<Estimate, EngineError> {
+    let Part::Surfaces(set) = &job.part else { return Ok(e) };
+    let chordal = set.tessellate(planning_tolerances(job)?.tessellation())?.chordal_bound;
+    let target = job.scallop_height - chordal.max(0.0);
+    let mut passes = 0;
+    for patch in set.patches() {
+        passes += iso_rule_passes(patch, &job.cutter, direction, target, ISO_SAMPLES).map_err(EngineError::Strategy)?;
+    }
+    e.planes = passes;
+    e.passes = passes;
     Ok(e)
 }
 
@@ -172,31 +203,55 @@ fn strategy_word(strategy: Strategy) -> &'static str {
 }
 
 /// Estimates every operation of `job`: finishing with [`estimate_operation`],
-/// roughing with [`crate::rough_estimate::estimate_rough`] on the job's stock
-/// (the part tessellated once for all roughing operations).
+/// roughing with one [`RoughModel`] of the job's stock (the part tessellated
+/// once for all roughing operations), each roughing operation on the
+/// material the earlier ones left in the model.
 #[must_use]
 pub fn estimate_job(job: &Job) -> Vec<Result<Estimate, EngineError>> {
-    let mut mesh: Option<TriMesh> = None;
+    let mut model: Option<(RoughModel, MeshIndex, Aabb3)> = None;
     let mut out = Vec::with_capacity(job.operations.len());
-    for op in &job.operations {
+    for (k, op) in job.operations.iter().enumerate() {
         let Some(settings) = &op.rough else {
             out.push(estimate_operation(&op.finish));
             continue;
         };
-        if mesh.is_none() {
+        let later = job.operations[k + 1..].iter().any(|o| o.rough.is_some());
+        if model.is_none() {
             match part_mesh(&op.finish) {
-                Ok(m) => mesh = Some(m),
+                Ok(m) => model = Some(rough_model(job, &m)),
                 Err(e) => {
                     out.push(Err(e));
                     continue;
                 }
             }
         }
-        if let Some(m) = &mesh {
-            out.push(Ok(crate::rough_estimate::estimate_rough(&op.finish, settings, &job_stock(job, m), m)));
+        if let Some((model, index, stock)) = &mut model {
+            out.push(Ok(model.estimate(&op.finish, (settings, later), stock, index)));
         }
     }
     out
+}
+
+/// The roughing model of `job` on its part `mesh` (`rough_estimate` module
+/// docs: cells of half the smallest stepover, or of the simulation's
+/// resolution when a roughing operation follows another operation), the
+/// part's index and the stock box.
+fn rough_model(job: &Job, mesh: &TriMesh) -> (RoughModel, MeshIndex, Aabb3) {
+    let stock = job_stock(job, mesh);
+    let radius = job.operations.iter().map(|o| o.finish.cutter.radius()).fold(0.0, f64::max);
+    let rest = job.operations.iter().skip(1).any(|o| o.rough.is_some());
+    let sim = job.operations.first().map_or(0.1, |o| o.finish.sim_resolution);
+    let cells = if rest {
+        (sim, crate::rough_estimate::MAX_REST_CELLS)
+    } else {
+        let half = job
+            .operations
+            .iter()
+            .filter_map(|o| o.rough.map(|s| s.stepover * o.finish.cutter.radius()))
+            .fold(f64::INFINITY, f64::min);
+        (half, crate::rough_estimate::MAX_CELLS)
+    };
+    (RoughModel::new(mesh, &stock, radius, cells, sim), MeshIndex::build(mesh), stock)
 }
 
 /// The part as the planner meshes it: the mesh, or the surfaces' tessellation.
@@ -311,10 +366,27 @@ fn steep_shallow(
     if !shallow.is_empty() {
         let (lo, width) = band_range(shallow.iter().copied());
         let (band, length) = band_spacings(job, shallow.iter().copied(), (lo, width), direction);
-        let runs = band_runs(mesh, &shallow, (lo, width), direction, job.tolerances.path);
+        let is_shallow = |f: &Face| f.slope() < split.threshold + split.overlap;
+        let sections = band_sections(mesh, faces, is_shallow, (lo, width), direction);
+        let shape = job.cutter.shape();
+        let band_runs: Vec<Vec<[f64; 2]>> = sections.iter().map(|s| runs(s, job.tolerances.path)).collect();
+        let shallow_nz = (split.threshold + split.overlap).cos();
+        let across = across_rest(&sections, &band_runs, (width, shallow_nz), shape, job.scallop_height);
+        let (runs, rest): (Vec<usize>, Vec<bool>) = sections
+            .par_iter()
+            .zip(&band_runs)
+            .zip(&across)
+            .map(|((section, runs), &across)| {
+                (runs.len(), across || band_has_rest(section, runs, shape, job.scallop_height))
+            })
+            .unzip();
+        // Where a band meets rest material the planes go a share of the largest
+        // step-over (the rule's spacing on a horizontal face) apart.
+        let rest_gap = stol::REST_SPACING_SHARE * rule_spacing(shape, job.scallop_height, &Vec3::z(), direction);
         let (mut planes, mut passes) = (0.0, 0.0);
-        for (s, &r) in band.iter().zip(&runs) {
+        for ((s, &r), &rest) in band.iter().zip(&runs).zip(&rest) {
             if s.is_finite() && r > 0 {
+                let s = if rest { s.min(rest_gap) } else { *s };
                 planes += width / s;
                 #[allow(clippy::cast_precision_loss, reason = "a small count")]
                 let r = r as f64;
@@ -334,15 +406,30 @@ fn steep_shallow(
     e
 }
 
-/// Per band, the runs of `faces` (mesh triangles) along the band's centre
-/// line: their intervals along the feed merged where they touch (within `gap`).
-fn band_runs(mesh: &TriMesh, faces: &[&Face], (lo, width): (f64, f64), direction: f64, gap: f64) -> Vec<usize> {
+/// A face's piece on a band's centre line: feed abscissae, heights, the
+/// face's normal z and whether it is shallow.
+struct Piece {
+    u: [f64; 2],
+    z: [f64; 2],
+    nz: f64,
+    shallow: bool,
+}
+
+/// Per band, the pieces of `faces` (mesh triangles) on the band's centre
+/// line, `shallow` telling which of them the planes finish.
+fn band_sections(
+    mesh: &TriMesh,
+    faces: &[Face],
+    shallow: impl Fn(&Face) -> bool,
+    (lo, width): (f64, f64),
+    direction: f64,
+) -> Vec<Vec<Piece>> {
     let (f, m) = (Vec3::new(direction.cos(), direction.sin(), 0.0), Vec3::new(-direction.sin(), direction.cos(), 0.0));
-    let mut intervals: Vec<Vec<[f64; 2]>> = vec![Vec::new(); BANDS];
+    let mut sections: Vec<Vec<Piece>> = (0..BANDS).map(|_| Vec::new()).collect();
     for face in faces {
         let Some(t) = face.triangle else { continue };
         let p = mesh.triangle(t);
-        for (k, band) in intervals
+        for (k, band) in sections
             .iter_mut()
             .enumerate()
             .take(band_index(face.across[1], lo, width) + 1)
@@ -350,35 +437,140 @@ fn band_runs(mesh: &TriMesh, faces: &[&Face], (lo, width): (f64, f64), direction
         {
             #[allow(clippy::cast_precision_loss, reason = "a band index")]
             let d = lo + (k as f64 + 0.5) * width;
-            let mut range = [f64::INFINITY, f64::NEG_INFINITY];
+            let mut ends: Vec<(f64, f64)> = Vec::with_capacity(2);
             for (a, b) in [(p[0], p[1]), (p[1], p[2]), (p[2], p[0])] {
                 let (da, db) = (a.coords.dot(&m) - d, b.coords.dot(&m) - d);
                 if da * db > 0.0 || (da - db).abs() < f64::MIN_POSITIVE {
                     continue;
                 }
-                let u = (a + (b - a) * (da / (da - db))).coords.dot(&f);
-                range = [range[0].min(u), range[1].max(u)];
+                let q = a + (b - a) * (da / (da - db));
+                ends.push((q.coords.dot(&f), q.z));
             }
-            if range[0] <= range[1] {
-                band.push(range);
+            ends.sort_by(|x, y| x.0.total_cmp(&y.0));
+            if let (Some(&(u0, z0)), Some(&(u1, z1))) = (ends.first(), ends.last()) {
+                band.push(Piece { u: [u0, u1], z: [z0, z1], nz: face.normal.z, shallow: shallow(face) });
             }
         }
     }
-    intervals
-        .into_iter()
-        .map(|mut list| {
-            list.sort_by(|a, b| a[0].total_cmp(&b[0]));
-            let mut runs = 0;
-            let mut end = f64::NEG_INFINITY;
-            for [a, b] in list {
-                if a > end + gap {
-                    runs += 1;
-                }
-                end = end.max(b);
-            }
-            runs
+    sections
+}
+
+/// The runs of the shallow pieces of a band: their intervals along the feed
+/// merged where they touch (within `gap`).
+fn runs(section: &[Piece], gap: f64) -> Vec<[f64; 2]> {
+    let mut list: Vec<[f64; 2]> = section.iter().filter(|p| p.shallow).map(|p| p.u).collect();
+    list.sort_by(|a, b| a[0].total_cmp(&b[0]));
+    let mut out: Vec<[f64; 2]> = Vec::new();
+    for [a, b] in list {
+        match out.last_mut() {
+            Some(last) if a <= last[1] + gap => last[1] = last[1].max(b),
+            _ => out.push([a, b]),
+        }
+    }
+    out
+}
+
+/// Whether the planes of a band meet rest material (the steep-and-shallow
+/// planner's rest rule, `Planner::sweep` in `scallop_strategy`): in the
+/// band's section, the cutter's profile run along each run of shallow pieces
+/// (tip heights by the 2-D drop of the profile on the section, at
+/// [`REST_SAMPLES`] a cutter radius) leaves a residual, along the normal,
+/// over sh somewhere at least a cutter radius from the run's ends (where the
+/// planner measures: its zone end margin). No plane spacing lowers that
+/// residual, so the planner takes it for rest: at once when it is over
+/// `REST_RESIDUAL_FACTOR` sh, else when it keeps over half its height as
+/// the gap is more than halved. A vertical wall inside a run (the pass steps
+/// down it) leaves the corner at its foot, so does a concave edge tighter
+/// than the cutter.
+fn band_has_rest(section: &[Piece], runs: &[[f64; 2]], shape: &CutterShape, sh: f64) -> bool {
+    let radius = shape.radius();
+    runs.iter().filter(|r| r[1] - r[0] > 2.0 * radius).any(|&[a, b]| {
+        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a bounded count")]
+        let n = (((b - a) * REST_SAMPLES / radius).ceil() as usize).clamp(1, MAX_REST_POINTS);
+        #[allow(clippy::cast_precision_loss, reason = "a bounded count")]
+        let us: Vec<f64> = (0..=n).map(|i| a + (b - a) * i as f64 / n as f64).collect();
+        let zs: Vec<(f64, f64)> = us.iter().map(|&u| profile(section, u)).collect();
+        let left = residuals(&zs, (b - a) / us.len().saturating_sub(1).max(1) as f64, shape);
+        (0..=n).any(|i| us[i] >= a + radius && us[i] <= b - radius && left[i] > sh)
+    })
+}
+
+/// The part's height (and normal z) on a band's centre line at feed
+/// abscissa `u`: the highest piece over it (`-inf` where none).
+fn profile(section: &[Piece], u: f64) -> (f64, f64) {
+    section
+        .iter()
+        .filter(|p| p.u[0] <= u && u <= p.u[1])
+        .map(|p| {
+            let w = if p.u[1] > p.u[0] { (u - p.u[0]) / (p.u[1] - p.u[0]) } else { 0.5 };
+            (p.z[0] + w * (p.z[1] - p.z[0]), p.nz)
+        })
+        .fold((f64::NEG_INFINITY, 1.0), |a, b| if b.0 > a.0 { b } else { a })
+}
+
+/// The residual, along the normal, that the cutter's profile run along a
+/// section sampled every `step` mm (heights and normal z `zs`) leaves at
+/// each sample: tip heights by the 2-D drop of the profile, then the lowest
+/// surface of the profile over each sample.
+fn residuals(zs: &[(f64, f64)], step: f64, shape: &CutterShape) -> Vec<f64> {
+    let n = zs.len();
+    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a bounded count")]
+    let w = ((shape.radius() / step).floor() as usize).min(n);
+    let near = |i: usize| i.saturating_sub(w)..(i + w + 1).min(n);
+    #[allow(clippy::cast_precision_loss, reason = "sample offsets")]
+    let h = |i: usize, j: usize| shape.height_at(step * i.abs_diff(j) as f64);
+    let tips: Vec<f64> = (0..n).map(|i| near(i).map(|j| zs[j].0 - h(i, j)).fold(f64::NEG_INFINITY, f64::max)).collect();
+    (0..n)
+        .map(|i| {
+            let left = near(i).map(|j| tips[j] + h(i, j)).fold(f64::INFINITY, f64::min);
+            (left - zs[i].0) * zs[i].1.abs()
         })
         .collect()
+}
+
+/// The bands whose planes meet rest material across the feed: the
+/// residual (as [`band_has_rest`]) of the cutter's profile run across the
+/// bands, on sections at every [`REST_SAMPLES`]-th of a cutter radius along
+/// the feed, over sh at a band's point on a shallow piece (normal z at
+/// least `shallow_nz`) that lies at least a cutter radius inside one of its
+/// runs and a cutter radius from the first and last band (the cutter beyond
+/// them is not sampled).
+fn across_rest(
+    sections: &[Vec<Piece>],
+    runs: &[Vec<[f64; 2]>],
+    (width, shallow_nz): (f64, f64),
+    shape: &CutterShape,
+    sh: f64,
+) -> Vec<bool> {
+    let radius = shape.radius();
+    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a bounded count")]
+    let margin = ((radius / width).ceil() as usize).min(sections.len());
+    let inside = |b: usize, u: f64| runs[b].iter().any(|r| u >= r[0] + radius && u <= r[1] - radius);
+    let lo = runs.iter().flatten().map(|r| r[0]).fold(f64::INFINITY, f64::min);
+    let hi = runs.iter().flatten().map(|r| r[1]).fold(f64::NEG_INFINITY, f64::max);
+    if hi.partial_cmp(&lo) != Some(std::cmp::Ordering::Greater) {
+        return vec![false; sections.len()];
+    }
+    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a bounded count")]
+    let n = (((hi - lo) * REST_SAMPLES / radius).ceil() as usize).clamp(1, MAX_REST_POINTS);
+    #[allow(clippy::cast_precision_loss, reason = "a bounded count")]
+    let us: Vec<f64> = (0..=n).map(|i| lo + (hi - lo) * i as f64 / n as f64).collect();
+    let hits: Vec<Vec<usize>> = us
+        .par_iter()
+        .map(|&u| {
+            let zs: Vec<(f64, f64)> = sections.iter().map(|s| profile(s, u)).collect();
+            let left = residuals(&zs, width, shape);
+            // A point of a shallow piece, with the bands a cutter radius around it.
+            (margin..sections.len().saturating_sub(margin))
+                .filter(|&b| left[b] > sh && zs[b].1 >= shallow_nz && inside(b, u))
+                .collect()
+        })
+        .collect();
+    let mut rest = vec![false; sections.len()];
+    for b in hits.into_iter().flatten() {
+        rest[b] = true;
+    }
+    rest
 }
 
 /// The waterline levels of the `steep` triangles stepped down as the planner
@@ -568,5 +760,31 @@ mod tests {
         assert_eq!(count(apart), 2);
         let corner = [quad(p(0., 0., 0.), p(10., 0., 0.)), quad(p(10., 0., 0.), p(10., 10., 0.))].concat();
         assert_eq!(count(corner), 1);
+    }
+
+    /// The rest test on band sections: a floor, and a convex arc of radius
+    /// larger than the ball, leave no residual; a vertical step inside the
+    /// run leaves the corner at its foot (about the ball's radius high),
+    /// also when the run ends more than a radius from the step.
+    #[test]
+    fn a_step_leaves_rest_a_floor_and_a_convex_arc_none() {
+        let ball = CutterShape::Ball { radius: 2.0 };
+        let piece = |u0: f64, u1: f64, z0: f64, z1: f64| Piece { u: [u0, u1], z: [z0, z1], nz: 1.0, shallow: true };
+        let rest = |section: Vec<Piece>| {
+            let runs = runs(&section, 0.01);
+            band_has_rest(&section, &runs, &ball, 0.02)
+        };
+        assert!(!rest(vec![piece(0.0, 30.0, 5.0, 5.0)]));
+        // A circle of radius 20 through points 0.25 mm apart (chords sag 0.4 um).
+        let arc: Vec<Piece> = (0..80)
+            .map(|k| {
+                let (a, b) = (-1.0 + f64::from(k) / 40.0, -1.0 + f64::from(k + 1) / 40.0);
+                let z = |x: f64| (400.0 - 100.0 * x * x).sqrt();
+                piece(10.0 * a, 10.0 * b, z(a), z(b))
+            })
+            .collect();
+        assert!(!rest(arc));
+        assert!(rest(vec![piece(0.0, 10.0, 0.0, 0.0), piece(10.0, 20.0, 5.0, 5.0)]));
+        assert!(!rest(vec![piece(0.0, 3.0, 0.0, 0.0)]), "a run under two radii is not measured");
     }
 }

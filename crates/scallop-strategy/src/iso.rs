@@ -281,27 +281,7 @@ impl Ctx<'_> {
 
     /// The spacing rule: the smallest parameter step over the pass.
     fn rule_step(&self, pass: &IsoPass, model: &Model, target: f64) -> f64 {
-        let mut step = f64::INFINITY;
-        for &a in &pass.samples {
-            let (f, x, n) = self.derivs(a, pass.iso);
-            let n = if n.z < 0.0 { -n } else { n };
-            let slope = n.z.clamp(-1.0, 1.0).acos();
-            let (nx, ny) = (n.x, n.y);
-            let alpha = if nx.hypot(ny) > tol::HORIZONTAL_XY && f.xy().norm() > tol::HORIZONTAL_XY {
-                (f.x * ny - f.y * nx).atan2(f.x * nx + f.y * ny)
-            } else {
-                0.0
-            };
-            let r_eff = model.effective_radius(slope, alpha);
-            let sod = scallop_analysis::step_over(target, r_eff).min(tol::ISO_MAX_STEP_OVER * model.radius());
-            // The part of S_cross across the feed direction on the surface.
-            let fu = f.try_normalize(1e-300).unwrap_or_else(Vec3::x);
-            let across = (x - fu * fu.dot(&x)).norm();
-            if across > 0.0 {
-                step = step.min(sod / across);
-            }
-        }
-        step
+        rule_step(self.patch, self.direction, model, (pass.iso, &pass.samples), target, false)
     }
 
     fn toolpath(&self, passes: &[IsoPass]) -> Toolpath {
@@ -321,6 +301,105 @@ impl Ctx<'_> {
         }
         path
     }
+}
+
+/// The spacing rule of [`plan_isoparametric`] on the isoline `iso` at the
+/// running parameters `samples`: the smallest parameter step over them.
+/// `curved`: the effective radius also takes the surface's normal curvature
+/// `k` across the feed (convex positive), `1 / (1 / R_eff + k)`: the cusp of
+/// two profile circles `w` apart on a surface so curved stands
+/// `w^2 (1 / R_eff + k) / 8` high (the curvature correction of
+/// `SteepShallow`'s `convex_factor`).
+fn rule_step(
+    patch: &Patch,
+    direction: IsoDirection,
+    model: &Model,
+    (iso, samples): (f64, &[f64]),
+    target: f64,
+    curved: bool,
+) -> f64 {
+    let mut step = f64::INFINITY;
+    for &a in samples {
+        let (u, v) = uv(direction, a, iso);
+        let d = patch.derivatives(u, v);
+        let (f, x) = match direction {
+            IsoDirection::U => (d.du, d.dv),
+            IsoDirection::V => (d.dv, d.du),
+        };
+        let n = patch.normal(u, v);
+        let n = if n.z < 0.0 { -n } else { n };
+        let slope = n.z.clamp(-1.0, 1.0).acos();
+        let (nx, ny) = (n.x, n.y);
+        let alpha = if nx.hypot(ny) > tol::HORIZONTAL_XY && f.xy().norm() > tol::HORIZONTAL_XY {
+            (f.x * ny - f.y * nx).atan2(f.x * nx + f.y * ny)
+        } else {
+            0.0
+        };
+        let mut r_eff = model.effective_radius(slope, alpha);
+        // The part of S_cross across the feed direction on the surface.
+        let fu = f.try_normalize(1e-300).unwrap_or_else(Vec3::x);
+        let across = (x - fu * fu.dot(&x)).norm();
+        if curved && across > 0.0 {
+            // The tangent across the feed, a S_along + S_cross, and its curvature.
+            let a = -fu.dot(&x) / f.norm().max(1e-300);
+            let (s_ff, s_fx, s_xx) = match direction {
+                IsoDirection::U => (d.duu, d.duv, d.dvv),
+                IsoDirection::V => (d.dvv, d.duv, d.duu),
+            };
+            let convex = -n.dot(&(s_ff * (a * a) + s_fx * (2.0 * a) + s_xx)) / (across * across);
+            let inverse = 1.0 / r_eff + convex;
+            r_eff = if inverse > 0.0 { 1.0 / inverse } else { f64::INFINITY };
+        }
+        let sod = scallop_analysis::step_over(target, r_eff).min(tol::ISO_MAX_STEP_OVER * model.radius());
+        if across > 0.0 {
+            step = step.min(sod / across);
+        }
+    }
+    step
+}
+
+/// The passes of [`plan_isoparametric`] on `patch` as its spacing rule
+/// places them, with the surface's curvature across the feed (the planner
+/// measures each step and corrects it, within [`tol::ISO_FIT_ACCEPT`] of the
+/// target; on a curved surface its measure finds the curvature's share):
+/// isolines from the start of the cross range, each one rule step (on
+/// `samples` running parameters spread evenly, the smaller of the steps read
+/// on the last isoline and on the one a step further) after the last, up to the end,
+/// for the scallop `target` (`sh` less the tessellation's chordal error).
+/// `scallop run --plan-only` estimates with this count.
+///
+/// # Errors
+/// A cone cutter ([`StrategyError::Unsupported`]).
+pub fn iso_rule_passes(
+    patch: &Patch,
+    cutter: &Cutter,
+    direction: IsoDirection,
+    target: f64,
+    samples: usize,
+) -> Result<usize, StrategyError> {
+    let model = model(cutter)?;
+    let domain = patch.domain();
+    let (along, across) = match direction {
+        IsoDirection::U => (domain.u, domain.v),
+        IsoDirection::V => (domain.v, domain.u),
+    };
+    let n = samples.max(2);
+    #[allow(clippy::cast_precision_loss, reason = "small counts")]
+    let running: Vec<f64> = (0..=n).map(|i| along[0] + (along[1] - along[0]) * i as f64 / n as f64).collect();
+    let (mut iso, mut passes) = (across[0], 1);
+    while iso < across[1] && passes <= tol::ISO_MAX_SAMPLES {
+        let step = rule_step(patch, direction, &model, (iso, &running), target, true);
+        if !(step.is_finite() && step > 0.0) {
+            break;
+        }
+        // The gap must hold on the next isoline too (the cross speed and the
+        // curvature change across it).
+        let next = (iso + step).min(across[1]);
+        let step = step.min(rule_step(patch, direction, &model, (next, &running), target, true));
+        iso = (iso + step).min(across[1]);
+        passes += 1;
+    }
+    Ok(passes)
 }
 
 /// `(R, r)` of the cutter body: ball `r = R`, flat `r = 0`.
