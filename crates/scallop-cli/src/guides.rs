@@ -146,7 +146,7 @@ pub fn run(args: &GuidesArgs) -> CliResult<()> {
     print_text(&text)
 }
 
-fn test_part(which: PartArg) -> CliResult<(&'static str, TestPart)> {
+pub(crate) fn test_part(which: PartArg) -> CliResult<(&'static str, TestPart)> {
     let made = match which {
         PartArg::Pocket => ("closed pocket", closed_pocket(&Default::default())),
         PartArg::Impeller => ("impeller channel", impeller_channel(&Default::default())),

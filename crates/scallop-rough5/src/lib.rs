@@ -33,9 +33,19 @@
 //! - A placed tool never penetrates the level mesh (the maximum over every
 //!   triangle's contacts); results do not depend on the thread count.
 
+mod collide;
 mod error;
+mod levels;
 pub mod place;
+mod plan;
+mod prove;
+mod sync;
 pub mod tol;
 
+pub use collide::BodyCheck;
 pub use error::Rough5Error;
+pub use levels::{LevelPasses, TiltMode, level_passes};
 pub use place::{Feature, Placement, Placer, tool_frame};
+pub use plan::{LevelReport, PassReport, Rough5Plan, Rough5Settings, plan_rough5};
+pub use prove::{Proof, prove};
+pub use sync::{SyncPoint, closest_vertex, limit_angular_step, pitch_angle, synchronise};

@@ -18,10 +18,10 @@ pub const MIN_AXIS_LENGTH: f64 = 1e-6;
 /// same to rounding).
 pub const ANGLE_EPS: f64 = 1e-12;
 
-/// Body samples of the flank collision check are this fraction of the
-/// tested radius apart along the axis; the check keeps a clearance of half
-/// the spacing, so it is conservative (see `collide.rs`).
-pub const BODY_SAMPLE_FRACTION: f64 = 0.25;
+/// Body samples of the flank collision check are this far apart along the
+/// axis (mm); the check keeps a clearance of half of it, so it is
+/// conservative (see `collide.rs`).
+pub const BODY_STEP: f64 = 0.25;
 
 /// Most passes (curves) of one level that the assembly accepts: a guard
 /// against absurd settings.
