@@ -13,7 +13,7 @@ use scallop_machine::Kinematics;
 use scallop_machine::program::{ProgramOptions, records_of, to_program};
 use scallop_parts::FaceTag;
 use scallop_post::{OutputMode, PostParams, check_replay, program_text, replay};
-use scallop_rough5::{Proof, Rough5Plan, Rough5Settings, TiltMode, plan_rough5, prove};
+use scallop_rough5::{Proof, ProofSettings, Rough5Plan, Rough5Settings, TiltMode, plan_rough5, prove};
 use serde::Serialize;
 
 use crate::guides::{PartArg, test_part};
@@ -73,12 +73,18 @@ pub struct Rough5Args {
     /// Largest tool-axis change between CL points (degrees).
     #[arg(long, default_value_t = 2.0)]
     max_angle_step: f64,
+    /// Largest change of the axis's azimuth about Z between CL points (degrees): the C table turns evenly.
+    #[arg(long, default_value_t = 5.0)]
+    max_azimuth_step: f64,
     /// Cutting feed (mm/min) and spindle speed (1/min): f_z 0.08, z 2, N 15000.
     #[arg(long, num_args = 2, default_values_t = [2400.0, 15000.0])]
     cutting: Vec<f64>,
     /// Tri-dexel resolution of the proof (mm).
     #[arg(long, default_value_t = 0.5)]
     resolution: f64,
+    /// Largest deviation of the simulated 5-axis sweeps from the true ones (mm).
+    #[arg(long, default_value_t = 0.05)]
+    sim_tolerance: f64,
     /// Machine (shipped name or .toml file) and its tool length (mm: stick-out plus holder).
     #[arg(long, default_value = "ucp710")]
     machine: String,
@@ -139,6 +145,8 @@ struct Report {
     tilt: String,
     machine: String,
     dialect: String,
+    /// Why the machine or the post refused the program (no `program.nc` then).
+    post_error: Option<String>,
     cl_points: usize,
     blocks: usize,
     replay_tip_deviation_mm: f64,
@@ -160,7 +168,9 @@ fn check_args(a: &Rough5Args) -> CliResult<()> {
         ("--stick-out", a.stick_out),
         ("--step", a.step),
         ("--max-angle-step", a.max_angle_step),
+        ("--max-azimuth-step", a.max_azimuth_step),
         ("--resolution", a.resolution),
+        ("--sim-tolerance", a.sim_tolerance),
         ("--tool-length", a.tool_length),
     ] {
         if !(v.is_finite() && v > 0.0) {
@@ -213,6 +223,7 @@ pub fn run(args: &Rough5Args) -> CliResult<()> {
         bottom_allowance: args.allowance[1],
         step: args.step,
         max_angle_step: args.max_angle_step.to_radians(),
+        max_azimuth_step: args.max_azimuth_step.to_radians(),
         ramp_angle: 5f64.to_radians(),
         clearance: 1.0,
         link_max: 2.0 * args.ae,
@@ -225,20 +236,28 @@ pub fn run(args: &Rough5Args) -> CliResult<()> {
     bar.finish_and_clear();
     let plan_seconds = clock.elapsed().as_secs_f64();
     let bar = progress_bar(0, "tri-dexel proof");
-    let proof = prove(&plan.toolpath, &tool, &part.stock, &part.mesh, args.resolution, &|d, t| {
+    let proof_settings = ProofSettings { resolution: args.resolution, axis_tolerance: args.sim_tolerance };
+    let proof = prove(&plan.toolpath, &tool, &part.stock, &part.mesh, &proof_settings, &|d, t| {
         crate::simulate::show(&bar, d, t);
     })
     .map_err(|e| Failure::rejected(format!("{name}: the program is not safe: {e}")))?;
     bar.finish_and_clear();
     let proof_seconds = clock.elapsed().as_secs_f64() - plan_seconds;
-    let (nc, post) = post_program(args, &plan)?;
-    let report = report(args, name, &plan, &proof, &post, [plan_seconds, proof_seconds]);
+    let posted = post_program(args, &plan);
+    let post = posted.as_ref().map(|(_, p)| p).map_err(|e| match e {
+        Failure::Rejected(e) | Failure::Io(e) => e.to_string(),
+    });
+    let report = report(args, name, &plan, &proof, post, [plan_seconds, proof_seconds]);
     let mut out = OutputSet::begin(&args.output, "rough5")?;
-    out.write("program.nc", nc.as_bytes())?;
+    if let Ok((nc, _)) = &posted {
+        out.write("program.nc", nc.as_bytes())?;
+    }
     out.write("toolpath.cl", scallop_io::cl::write_cl(&plan.toolpath).as_bytes())?;
     let json = serde_json::to_string_pretty(&report).map_err(|e| Failure::Io(e.into()))?;
     out.write("report.json", format!("{json}\n").as_bytes())?;
     let written = out.commit()?;
+    // The toolpath and the report are written for inspection; no program.
+    posted?;
     if args.json {
         return print_json(&with_written(&report, &written)?);
     }
@@ -247,8 +266,6 @@ pub fn run(args: &Rough5Args) -> CliResult<()> {
 
 /// What the post and the machine said.
 struct Posted {
-    machine: String,
-    dialect: String,
     blocks: usize,
     replay: f64,
     total: f64,
@@ -285,8 +302,6 @@ fn post_program(args: &Rough5Args, plan: &Rough5Plan) -> CliResult<(String, Post
     let trip = check_replay(&replayed, &records, &kin, &dialect, options.tol_pos, options.tol_ang)
         .map_err(|e| Failure::Io(anyhow::anyhow!("the program does not replay to the CL path: {e}")))?;
     let posted = Posted {
-        machine: machine.name().to_string(),
-        dialect: dialect.name.clone(),
         blocks: program.blocks.len(),
         replay: trip.max_tip_deviation,
         total: time.total,
@@ -296,8 +311,17 @@ fn post_program(args: &Rough5Args, plan: &Rough5Plan) -> CliResult<(String, Post
     Ok((nc, posted))
 }
 
-fn report(args: &Rough5Args, name: &str, plan: &Rough5Plan, proof: &Proof, post: &Posted, seconds: [f64; 2]) -> Report {
-    let t = post.total;
+fn report(
+    args: &Rough5Args,
+    name: &str,
+    plan: &Rough5Plan,
+    proof: &Proof,
+    post: Result<&Posted, String>,
+    seconds: [f64; 2],
+) -> Report {
+    // Without a machine program, the time at the programmed feeds.
+    let (t, feed, rapid) =
+        post.as_ref().map_or((plan.estimated_time, plan.estimated_time, 0.0), |p| (p.total, p.feed, p.rapid));
     let metrics = Metrics {
         volume_to_remove_mm3: proof.volume_to_remove,
         remaining_volume_mm3: proof.remaining_volume,
@@ -308,8 +332,8 @@ fn report(args: &Rough5Args, name: &str, plan: &Rough5Plan, proof: &Proof, post:
         path_length_dm: proof.cutting_length / 100.0,
         out_of_material_percent: proof.air_percent,
         machining_time_s: t,
-        feed_time_s: post.feed,
-        rapid_time_s: post.rapid,
+        feed_time_s: feed,
+        rapid_time_s: rapid,
         estimated_time_at_feed_s: plan.estimated_time,
         removal_rate_mm3_s: proof.removal_rate(t),
         removal_rate_percent_s: if t > 0.0 { (100.0 - proof.remaining_percent) / t } else { 0.0 },
@@ -319,11 +343,12 @@ fn report(args: &Rough5Args, name: &str, plan: &Rough5Plan, proof: &Proof, post:
         command: "rough5",
         part: name.to_string(),
         tilt: format!("{:?}", args.tilt).to_lowercase(),
-        machine: post.machine.clone(),
-        dialect: post.dialect.clone(),
+        machine: args.machine.clone(),
+        dialect: args.dialect.clone(),
         cl_points: plan.toolpath.moves().len(),
-        blocks: post.blocks,
-        replay_tip_deviation_mm: post.replay,
+        blocks: post.as_ref().map_or(0, |p| p.blocks),
+        replay_tip_deviation_mm: post.as_ref().map_or(f64::NAN, |p| p.replay),
+        post_error: post.err(),
         retracts: plan.retracts,
         links: plan.links,
         ramps: plan.ramps,

@@ -47,5 +47,5 @@ pub use error::Rough5Error;
 pub use levels::{LevelPasses, TiltMode, level_passes};
 pub use place::{Feature, Placement, Placer, tool_frame};
 pub use plan::{LevelReport, PassReport, Rough5Plan, Rough5Settings, plan_rough5};
-pub use prove::{Proof, prove};
-pub use sync::{SyncPoint, closest_vertex, limit_angular_step, pitch_angle, synchronise};
+pub use prove::{Proof, ProofSettings, prove};
+pub use sync::{SyncPoint, axis_steps, closest_vertex, interpolate_axis, limit_angular_step, pitch_angle, synchronise};

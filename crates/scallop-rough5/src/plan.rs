@@ -20,7 +20,7 @@ use scallop_toolpath::{Move, MoveKind, Toolpath};
 
 use crate::collide::BodyCheck;
 use crate::levels::{TiltMode, level_passes};
-use crate::sync::{SyncPoint, limit_angular_step, pitch_angle, synchronise};
+use crate::sync::{SyncPoint, axis_steps, interpolate_axis, limit_angular_step, pitch_angle, synchronise};
 use crate::{Placement, Placer, Rough5Error};
 
 /// Settings of [`plan_rough5`] (mm, rad, mm/min).
@@ -36,6 +36,9 @@ pub struct Rough5Settings {
     pub step: f64,
     /// Largest change of the tool axis between two CL points (rad).
     pub max_angle_step: f64,
+    /// Largest change of the tool axis's azimuth about +Z between two CL
+    /// points (rad): the C table of a table-table machine turns evenly.
+    pub max_azimuth_step: f64,
     /// Angle of the ramp entries (rad).
     pub ramp_angle: f64,
     /// Entry height above the level cut before, and the safe height above
@@ -111,6 +114,7 @@ fn check(settings: &Rough5Settings) -> Result<(), Rough5Error> {
     for (name, value) in [
         ("step", s.step),
         ("max_angle_step", s.max_angle_step),
+        ("max_azimuth_step", s.max_azimuth_step),
         ("ramp_angle", s.ramp_angle),
         ("clearance", s.clearance),
         ("link_max", s.link_max),
@@ -218,7 +222,11 @@ fn place_pass(
     cursor: &Point3,
     settings: &Rough5Settings,
 ) -> (Vec<Vec<Cl>>, PassReport) {
-    let pairs = limit_angular_step(&synchronise(path, tilt, cursor, settings.step), settings.max_angle_step);
+    let pairs = limit_angular_step(
+        &synchronise(path, tilt, cursor, settings.step),
+        settings.max_angle_step,
+        settings.max_azimuth_step,
+    );
     let placed: Vec<Option<Cl>> = pairs
         .par_iter()
         .map(|s| {
@@ -314,22 +322,23 @@ impl Emitter {
     /// the first run of a level), else entered from the safe height.
     fn cut_run(&mut self, run: &[Cl], entry_z: f64, first_of_level: bool, (placer, body): (&Placer, &BodyCheck)) {
         let linked = !first_of_level && self.last.is_some_and(|a| self.try_link(&a, &run[0], placer, body));
-        let from = if linked { 1 } else { self.enter(run, entry_z) };
-        let closed = (run[0].place.tip - run[run.len() - 1].place.tip).norm() < 1e-9;
+        // The tool is now at run[start].
+        let start = if linked { 0 } else { self.enter(run, entry_z) };
         let n = run.len();
-        if from == 0 || !closed {
-            for c in &run[from.min(n)..] {
-                self.push(MoveKind::Feed, c.place.tip, c.place.axis);
-            }
-        } else {
-            // A full lap from where the ramp ended.
+        let closed = n > 2 && (run[0].place.tip - run[n - 1].place.tip).norm() < 1e-9;
+        if closed {
+            // A full lap from where the tool reached the level.
             for k in 1..n {
-                let c = &run[(from + k) % (n - 1)];
+                let c = &run[(start + k) % (n - 1)];
                 self.push(MoveKind::Feed, c.place.tip, c.place.axis);
             }
+            self.last = Some(run[start % (n - 1)]);
+        } else {
+            for c in &run[(start + 1).min(n)..] {
+                self.push(MoveKind::Feed, c.place.tip, c.place.axis);
+            }
+            self.last = Some(run[n - 1]);
         }
-        let end = if closed && from > 0 && from < n { run[from % (n - 1)] } else { run[n - 1] };
-        self.last = Some(end);
     }
 
     /// Retracts along the axis, goes over at the safe height, plunges along
@@ -383,15 +392,14 @@ impl Emitter {
         if dist > self.settings.link_max {
             return false;
         }
-        let angle = a.place.axis.angle(&b.place.axis);
-        let n = ((dist / self.settings.step).ceil() as usize)
-            .max((angle / self.settings.max_angle_step).ceil() as usize)
-            .max(1);
+        let s = &self.settings;
+        let turns = axis_steps(&a.place.axis, &b.place.axis, s.max_angle_step, s.max_azimuth_step);
+        let n = ((dist / s.step).ceil() as usize).max(turns);
         let mut moves = Vec::with_capacity(n);
         for i in 1..=n {
             let w = i as f64 / n as f64;
             let guide = a.sync.path + (b.sync.path - a.sync.path) * w;
-            let axis = (a.place.axis * (1.0 - w) + b.place.axis * w).normalize();
+            let axis = interpolate_axis(&a.place.axis, &b.place.axis, w);
             let Some(p) = placer.place(&guide, &axis) else { return false };
             if body.collides(&p.tip, &p.axis) {
                 return false;

@@ -52,6 +52,16 @@ impl Proof {
     }
 }
 
+/// Settings of [`prove`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ProofSettings {
+    /// Spacing of the tri-dexel rays (mm).
+    pub resolution: f64,
+    /// Largest distance between the simulated and the true swept solid of a
+    /// 5-axis move (mm; [`DexelOptions::axis_tolerance`]).
+    pub axis_tolerance: f64,
+}
+
 /// Length of the interval pieces of `a` inside `b` (both sorted, disjoint).
 fn overlap(a: &[[f64; 2]], b: &[[f64; 2]]) -> f64 {
     let mut total = 0.0;
@@ -79,7 +89,7 @@ fn complement(a: &[[f64; 2]], lo: f64, hi: f64) -> Vec<[f64; 2]> {
     out
 }
 
-/// Cuts `path` with `cutter` on a tri-dexel stock of `stock` at `resolution`
+/// Cuts `path` with `cutter` on a tri-dexel stock of `stock` (`settings`)
 /// and measures it against `volume` (the volume to remove, closed, outward
 /// normals). `progress(done, total)` as [`DexelStock::cut_with_progress`].
 ///
@@ -91,13 +101,14 @@ pub fn prove(
     cutter: &Cutter,
     stock: &Aabb3,
     volume: &TriMesh,
-    resolution: f64,
+    settings: &ProofSettings,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<Proof, Rough5Error> {
     let sim = |e: scallop_sim::SimError| Rough5Error::Simulation(e.to_string());
-    let mut dexels = DexelStock::new(*stock, resolution).map_err(sim)?;
+    let mut dexels = DexelStock::new(*stock, settings.resolution).map_err(sim)?;
     let moves = ToolMove::from_toolpath(path);
-    let report = dexels.cut_with_progress(cutter, &moves, &DexelOptions::default(), progress).map_err(sim)?;
+    let options = DexelOptions { axis_tolerance: settings.axis_tolerance, check_collisions: true };
+    let report = dexels.cut_with_progress(cutter, &moves, &options, progress).map_err(sim)?;
     report.check().map_err(sim)?;
     let part = DexelPart::new(volume);
     let (nu, nv) = dexels.grid(2);

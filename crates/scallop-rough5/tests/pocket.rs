@@ -8,7 +8,7 @@
 use scallop_cutter::{Cutter, CutterShape, HolderSegment};
 use scallop_guides::GuideSettings;
 use scallop_parts::{FaceTag, closed_pocket};
-use scallop_rough5::{Rough5Settings, TiltMode, plan_rough5, prove};
+use scallop_rough5::{ProofSettings, Rough5Settings, TiltMode, plan_rough5, prove};
 use scallop_toolpath::MoveKind;
 
 fn settings(tilt: TiltMode, depth: f64) -> Rough5Settings {
@@ -25,6 +25,7 @@ fn settings(tilt: TiltMode, depth: f64) -> Rough5Settings {
         bottom_allowance: 0.5,
         step: 2.0,
         max_angle_step: 3f64.to_radians(),
+        max_azimuth_step: 10f64.to_radians(),
         ramp_angle: 5f64.to_radians(),
         clearance: 1.0,
         link_max: 9.0,
@@ -38,9 +39,9 @@ fn both_variants_prove_themselves_on_the_closed_pocket() {
     let part = closed_pocket(&Default::default()).unwrap();
     let bottom = part.faces(&[FaceTag::Bottom]).unwrap();
     let flanks = part.faces(&[FaceTag::Flank]).unwrap();
-    let tool = Cutter::new(CutterShape::Bull { radius: 5.0, corner: 1.5 }, 15.0)
+    let tool = Cutter::new(CutterShape::Bull { radius: 5.0, corner: 1.5 }, 30.0)
         .unwrap()
-        .with_shank(5.0, 26.0)
+        .with_shank(5.0, 11.0)
         .unwrap()
         .with_holder(vec![HolderSegment { length: 100.0, bottom_radius: 13.5, top_radius: 13.5 }])
         .unwrap();
@@ -65,7 +66,8 @@ fn both_variants_prove_themselves_on_the_closed_pocket() {
         let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
         let again = one.install(|| plan_rough5(&bottom, &flanks, &part.stock, &tool, &s, &|_, _| {}).unwrap());
         assert_eq!(again.toolpath, plan.toolpath);
-        let proof = prove(path, &tool, &part.stock, &part.mesh, 1.0, &|_, _| {}).unwrap();
+        let proof_settings = ProofSettings { resolution: 1.0, axis_tolerance: 0.05 };
+        let proof = prove(path, &tool, &part.stock, &part.mesh, &proof_settings, &|_, _| {}).unwrap();
         assert!(proof.gouge_depth <= 1.0, "{proof:?}");
         assert!(proof.remaining_percent < 100.0 && proof.removed_volume > 0.0, "{proof:?}");
         assert!((0.0..=100.0).contains(&proof.air_percent));
