@@ -131,6 +131,8 @@ struct Metrics {
     path_length_dm: f64,
     out_of_material_percent: f64,
     machining_time_s: f64,
+    /// Time lost to each axis's velocity, acceleration and jerk limits (s).
+    axis_time_lost_s: Vec<(String, f64)>,
     feed_time_s: f64,
     rapid_time_s: f64,
     estimated_time_at_feed_s: f64,
@@ -266,6 +268,8 @@ pub fn run(args: &Rough5Args) -> CliResult<()> {
 
 /// What the post and the machine said.
 struct Posted {
+    /// Time lost to each axis's limits (s), by axis name.
+    lost: Vec<(String, f64)>,
     blocks: usize,
     replay: f64,
     total: f64,
@@ -301,7 +305,9 @@ fn post_program(args: &Rough5Args, plan: &Rough5Plan) -> CliResult<(String, Post
         replay(&nc, &dialect, &kin).map_err(|e| Failure::Io(anyhow::anyhow!("our output does not read back: {e}")))?;
     let trip = check_replay(&replayed, &records, &kin, &dialect, options.tol_pos, options.tol_ang)
         .map_err(|e| Failure::Io(anyhow::anyhow!("the program does not replay to the CL path: {e}")))?;
+    let lost = machine.axes().iter().zip(time.lost).map(|(a, t)| (a.name.clone(), t)).collect();
     let posted = Posted {
+        lost,
         blocks: program.blocks.len(),
         replay: trip.max_tip_deviation,
         total: time.total,
@@ -332,6 +338,7 @@ fn report(
         path_length_dm: proof.cutting_length / 100.0,
         out_of_material_percent: proof.air_percent,
         machining_time_s: t,
+        axis_time_lost_s: post.as_ref().map_or_else(|_| Vec::new(), |p| p.lost.clone()),
         feed_time_s: feed,
         rapid_time_s: rapid,
         estimated_time_at_feed_s: plan.estimated_time,

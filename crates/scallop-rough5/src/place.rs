@@ -21,7 +21,7 @@
 
 use scallop_cutter::{ClPoint, Contact, Cutter, CutterShape, drop_triangle};
 use scallop_geom::{Aabb3, Point2, Point3, Vec3};
-use scallop_mesh::{Bvh, TriMesh};
+use scallop_mesh::{Bvh, MeshQuery, TriMesh};
 
 use crate::{Rough5Error, tol};
 
@@ -62,8 +62,9 @@ pub struct Placement {
 /// A level mesh indexed for placing one tool along any axis.
 #[derive(Debug, Clone)]
 pub struct Placer {
-    tris: Vec<[Point3; 3]>,
-    normals: Vec<Vec3>,
+    /// The triangles and their unit normals.
+    query: MeshQuery,
+    /// Over the triangles' boxes grown by the grown tool's radius.
     bvh: Bvh,
     /// The cutter grown by the allowance.
     grown: Cutter,
@@ -110,24 +111,16 @@ impl Placer {
         }
         let (grown, corner) = grow(cutter, allowance)?;
         let reach = grown.radius();
-        let tris: Vec<[Point3; 3]> = (0..mesh.triangles().len()).map(|i| mesh.triangle(i)).collect();
-        let normals = tris
-            .iter()
-            .map(|t| {
-                let n = (t[1] - t[0]).cross(&(t[2] - t[0]));
-                let len = n.norm();
-                if len > 0.0 { n / len } else { Vec3::zeros() }
-            })
-            .collect();
+        let query = MeshQuery::new(mesh);
         let grow_box = |t: &[Point3; 3]| {
             let b = scallop_mesh::triangle_box(t);
             let r = Vec3::repeat(reach);
             Aabb3 { min: b.min - r, max: b.max + r }
         };
-        let boxes: Vec<Aabb3> = tris.iter().map(grow_box).collect();
+        let boxes: Vec<Aabb3> = (0..query.len()).map(|i| grow_box(query.triangle(i))).collect();
         let bounds =
             boxes.iter().skip(1).fold(boxes[0], |a, b| Aabb3 { min: a.min.inf(&b.min), max: a.max.sup(&b.max) });
-        Ok(Placer { tris, normals, bvh: Bvh::build(&boxes), grown, allowance, corner, bounds })
+        Ok(Placer { query, bvh: Bvh::build(&boxes), grown, allowance, corner, bounds })
     }
 
     /// The allowance left on the mesh (mm).
@@ -155,8 +148,8 @@ impl Placer {
         let extent = (self.bounds.max - self.bounds.min).norm() + (point - centre).norm() + 1.0;
         let mut best = ClPoint::floor(Point2::origin(), -2.0 * extent);
         self.bvh.visit_ray(point, &u, -extent, extent, |i| {
-            let c = self.tris[i].map(|q| local(&q));
-            let n = self.normals[i];
+            let c = self.query.triangle(i).map(|q| local(&q));
+            let n = self.query.normal(i);
             let mut nl = Vec3::new(n.dot(&e1), n.dot(&e2), n.dot(&u));
             if nl.z < 0.0 {
                 nl = -nl;
@@ -191,7 +184,7 @@ impl Placer {
         f: (&Vec3, &Vec3, &Vec3),
     ) -> Vec3 {
         if feature == Feature::Facet {
-            let n = self.normals[triangle];
+            let n = self.query.normal(triangle);
             let nl = Vec3::new(n.dot(f.0), n.dot(f.1), n.dot(f.2));
             return if nl.z < 0.0 { -nl } else { nl };
         }
