@@ -16,7 +16,7 @@ use scallop_post::{OutputMode, PostParams, check_replay, program_text, replay};
 use scallop_rough5::{Proof, ProofSettings, Rough5Plan, Rough5Settings, TiltMode, plan_rough5, prove};
 use serde::Serialize;
 
-use crate::guides::{PartArg, test_part};
+use crate::guides::{LevelArgs, PartArg, test_part};
 use crate::output::{print_json, print_text, progress_bar, with_written};
 use crate::outset::OutputSet;
 use crate::post::{load_dialect, load_machine, program_time};
@@ -58,15 +58,8 @@ pub struct Rough5Args {
     /// Material left on the flanks and on the bottom (mm).
     #[arg(long, num_args = 2, default_values_t = [0.5, 0.5])]
     allowance: Vec<f64>,
-    /// Axial depth of cut a_p between levels (mm).
-    #[arg(long, default_value_t = 4.0)]
-    ap: f64,
-    /// Radial engagement a_e between passes (mm).
-    #[arg(long, default_value_t = 4.5)]
-    ae: f64,
-    /// Voxel size of the level fields (mm).
-    #[arg(long, default_value_t = 1.0)]
-    voxel: f64,
+    #[command(flatten)]
+    levels: LevelArgs,
     /// Spacing of the CL points along a pass (mm).
     #[arg(long, default_value_t = 1.0)]
     step: f64,
@@ -217,9 +210,9 @@ pub fn run(args: &Rough5Args) -> CliResult<()> {
         guides: GuideSettings {
             tool_radius: args.tool_radius,
             flank_allowance: args.allowance[0],
-            axial_step: args.ap,
-            radial_step: args.ae,
-            voxel: args.voxel,
+            axial_step: args.levels.ap,
+            radial_step: args.levels.ae,
+            voxel: args.levels.voxel,
             depth: part.stock.max.z - bottom.bounds().min.z,
         },
         bottom_allowance: args.allowance[1],
@@ -228,7 +221,7 @@ pub fn run(args: &Rough5Args) -> CliResult<()> {
         max_azimuth_step: args.max_azimuth_step.to_radians(),
         ramp_angle: 5f64.to_radians(),
         clearance: 1.0,
-        link_max: 2.0 * args.ae,
+        link_max: 2.0 * args.levels.ae,
         feed: args.cutting[0],
         rapid_rate: 20_000.0,
     };

@@ -149,6 +149,11 @@ pub fn plan_rough5(
 ) -> Result<Rough5Plan, Rough5Error> {
     check(settings)?;
     let levels = level_passes(bottom, flanks, &settings.guides, settings.tilt)?;
+    if levels.iter().all(|l| l.passes.is_empty()) {
+        let reason = "no level has a closed limit curve: open pockets (limit curves ending on the level's boundary) \
+                      are not handled yet";
+        return Err(Rough5Error::NoPass { reason: reason.into() });
+    }
     let body = BodyCheck::new(flanks, cutter, 0.0);
     let mut out = Emitter::new(stock.max.z, stock.max.z + settings.clearance + cutter.radius(), settings);
     let mut reports = Vec::new();
