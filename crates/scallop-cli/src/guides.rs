@@ -29,6 +29,20 @@ pub enum PartArg {
     Fitting,
 }
 
+/// The level and curve steps, shared by `scallop guides` and `scallop rough5`.
+#[derive(Args, Debug)]
+pub struct LevelArgs {
+    /// Axial depth of cut a_p between levels (mm).
+    #[arg(long, default_value_t = 4.0)]
+    pub ap: f64,
+    /// Radial engagement a_e between path curves (mm).
+    #[arg(long, default_value_t = 4.5)]
+    pub ae: f64,
+    /// Voxel size of the level fields (mm).
+    #[arg(long, default_value_t = 1.0)]
+    pub voxel: f64,
+}
+
 /// Arguments of `scallop guides`.
 #[derive(Args, Debug)]
 pub struct GuidesArgs {
@@ -41,15 +55,8 @@ pub struct GuidesArgs {
     /// Material left on the flanks (mm).
     #[arg(long, default_value_t = 0.5)]
     flank_allowance: f64,
-    /// Axial depth of cut a_p between levels (mm).
-    #[arg(long, default_value_t = 4.0)]
-    ap: f64,
-    /// Radial engagement a_e between path curves (mm).
-    #[arg(long, default_value_t = 4.5)]
-    ae: f64,
-    /// Voxel size of the level fields (mm).
-    #[arg(long, default_value_t = 1.0)]
-    voxel: f64,
+    #[command(flatten)]
+    levels: LevelArgs,
     /// Output folder.
     #[arg(short, long)]
     output: PathBuf,
@@ -111,9 +118,9 @@ pub fn run(args: &GuidesArgs) -> CliResult<()> {
     let settings = GuideSettings {
         tool_radius: args.tool_radius,
         flank_allowance: args.flank_allowance,
-        axial_step: args.ap,
-        radial_step: args.ae,
-        voxel: args.voxel,
+        axial_step: args.levels.ap,
+        radial_step: args.levels.ae,
+        voxel: args.levels.voxel,
         depth: pocket_depth(&bottom, &top),
     };
     let set = build_guides(&bottom, &flanks, &settings)
@@ -156,7 +163,7 @@ pub fn run(args: &GuidesArgs) -> CliResult<()> {
     print_text(&text)
 }
 
-fn test_part(which: PartArg) -> CliResult<(&'static str, TestPart)> {
+pub(crate) fn test_part(which: PartArg) -> CliResult<(&'static str, TestPart)> {
     let made = match which {
         PartArg::Pocket => ("closed pocket", closed_pocket(&Default::default())),
         PartArg::Impeller => ("impeller channel", impeller_channel(&Default::default())),

@@ -15,6 +15,7 @@ mod part;
 mod pocket;
 mod post;
 mod render;
+mod rough5;
 mod run;
 mod simulate;
 mod waterline;
@@ -71,6 +72,8 @@ enum Command {
     Waterline(waterline::WaterlineArgs),
     /// Guide curves of 5-axis roughing on a test part: levels, limit, path and tilt curves (docs/guides.md).
     Guides(guides::GuidesArgs),
+    /// 5-axis roughing of a test part by guide curves, proven and posted (docs/rough5.md).
+    Rough5(rough5::Rough5Args),
     /// Clear a 2D pocket (region JSON: outer boundary, then islands) and write G-code and CL.
     Pocket(pocket::PocketArgs),
     /// Load a part and report what was read (size, welding, open and non-manifold edges).
@@ -101,6 +104,7 @@ fn main() -> ExitCode {
         Command::Render(args) => render::run(&args),
         Command::Waterline(args) => waterline::run(&args),
         Command::Guides(args) => guides::run(&args),
+        Command::Rough5(args) => rough5::run(&args),
         Command::Engagement(args) => engagement::run(&args),
         Command::Pocket(args) => pocket::run(&args),
     };

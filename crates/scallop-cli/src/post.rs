@@ -133,7 +133,7 @@ pub(crate) fn load_machine(name: &str, folder: &Path, what: &str) -> CliResult<M
     crate::machine::load_five_axis(name, folder, what)
 }
 
-fn load_dialect(name: &str) -> CliResult<Dialect> {
+pub(crate) fn load_dialect(name: &str) -> CliResult<Dialect> {
     if name.ends_with(".toml") || Path::new(name).is_file() {
         let text = read_text(Path::new(name))?;
         Dialect::from_toml_str(&text).map_err(|e| Failure::rejected(format!("{name}: {e}")))
@@ -257,18 +257,18 @@ pub fn run(args: &PostArgs) -> CliResult<()> {
 }
 
 /// Times of a program.
-struct ProgramTime {
-    total: f64,
-    feed: f64,
-    floor: f64,
-    rapid: f64,
-    peak: [f64; 5],
-    lost: [f64; 5],
+pub(crate) struct ProgramTime {
+    pub(crate) total: f64,
+    pub(crate) feed: f64,
+    pub(crate) floor: f64,
+    pub(crate) rapid: f64,
+    pub(crate) peak: [f64; 5],
+    pub(crate) lost: [f64; 5],
 }
 
 /// Feed runs (maximal sequences of non-rapid blocks, with the block before as their
 /// start) by the look-ahead model; rapids per axis, stop to stop.
-fn program_time(
+pub(crate) fn program_time(
     kin: &Kinematics,
     blocks: &[(Motion, Joints, f64)],
 ) -> Result<ProgramTime, scallop_machine::MachineError> {

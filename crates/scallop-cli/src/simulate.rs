@@ -280,7 +280,7 @@ fn deviation(tops: &[f64], field: &PartField) -> (Vec<f64>, f64, f64) {
 
 /// Moves the progress bar to `done` of `total` bands (the library calls this
 /// from its worker threads, in any order: the bar only moves forward).
-fn show(bar: &indicatif::ProgressBar, done: usize, total: usize) {
+pub(crate) fn show(bar: &indicatif::ProgressBar, done: usize, total: usize) {
     // Counts far below 2^64: exact conversions.
     bar.set_length(total as u64);
     if done as u64 > bar.position() {
