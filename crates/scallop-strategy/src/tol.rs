@@ -283,3 +283,17 @@ pub const SHARP_EDGE_DEG: f64 = 30.0;
 /// keeps more than half its height when the gap is more than halved (a
 /// scallop would fall to a quarter).
 pub const REST_RESIDUAL_FACTOR: f64 = 20.0;
+
+/// Splits of a level spacing between the two walls of a concave crease at
+/// which `steep::crease_residual` evaluates the cusp (the worst is kept).
+pub const CREASE_SPLITS: usize = 16;
+
+/// Times a level spacing is shrunk until the residual across the concave
+/// creases between the two levels holds the scallop height.
+pub const CREASE_RETRIES: usize = 4;
+
+/// A point of a waterline level is paired with the nearest point of the level
+/// above within this many times the horizontal offset of two levels on the
+/// shallowest steep wall (`dz / tan(threshold - overlap)`) when looking for a
+/// concave crease between them (`Levels::crease`).
+pub const CREASE_REACH: f64 = 1.5;
