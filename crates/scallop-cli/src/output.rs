@@ -165,7 +165,11 @@ pub fn write_job(
         let what = match &spec.rough {
             Some(s) => format!("roughing, {} mm levels, stepover {} D", s.stepdown, s.stepover),
             None => {
-                format!("scallop height {} mm, feed at {:.2}° from X", op.scallop_height_mm, op.direction_deg + 0.0)
+                format!(
+                    "scallop height {} mm, feed at {:.2}° from X",
+                    op.scallop_height_mm,
+                    shown_deg(op.direction_deg)
+                )
             }
         };
         text.push_str(&format!(
@@ -281,7 +285,7 @@ pub fn write_finishing(
         part = r.part,
         slope = r.slope_deg,
         crit = r.critical_slope_deg,
-        dir = r.direction_deg + 0.0,
+        dir = shown_deg(r.direction_deg),
         rec = match r.recommendation {
             scallop_analysis::Recommendation::BallAlongPrincipal => "a ball along the principal direction is faster",
             scallop_analysis::Recommendation::ToroidalAlongSlope => "a bull-nose along the steepest slope is faster",
@@ -380,4 +384,9 @@ fn raster_demo(args: &DemoArgs) -> CliResult<()> {
         nc = nc.display(),
     );
     print_text(&text)
+}
+
+/// An angle as the summary prints it with two decimals: no "-0.00".
+fn shown_deg(deg: f64) -> f64 {
+    if deg.abs() < 0.005 { 0.0 } else { deg }
 }
