@@ -30,7 +30,7 @@ use scallop_analysis::{GridOptions, sample_mesh, sample_surface_set};
 use scallop_cutter::CutterShape;
 use scallop_geom::{Aabb3, Point3, Vec3};
 use scallop_mesh::{MeshIndex, TriMesh};
-use scallop_strategy::{IsoDirection, SteepShallow, convex_factor, iso_rule_passes, rule_spacing, tol as stol};
+use scallop_strategy::{IsoDirection, SteepShallow, convex_factor, iso_fitted_passes, rule_spacing, tol as stol};
 use serde::Serialize;
 
 use crate::finish::{analyse, planning_tolerances};
@@ -44,8 +44,9 @@ const REST_SAMPLES: f64 = 8.0;
 /// Profile samples of one run of the rest test, at most.
 const MAX_REST_POINTS: usize = 4_000;
 
-/// Points of each isoline where the isoparametric estimate reads the rule.
-const ISO_SAMPLES: usize = 128;
+/// Isolines of each patch where the isoparametric estimate runs the
+/// planner's step fit (`scallop_strategy::iso_fitted_passes`).
+const ISO_SAMPLES: usize = 8;
 
 /// Bands across the feed of the estimate.
 const BANDS: usize = 400;
@@ -173,19 +174,30 @@ pub fn estimate_operation(job: &FinishJob) -> Result<Estimate, EngineError> {
     Ok(e)
 }
 
-/// Isoparametric passes on a parametric part: the planner's own spacing
-/// rule walked across each patch (`scallop_strategy::iso_rule_passes`, on
-/// [`ISO_SAMPLES`] points of each isoline) for the scallop the planner aims
-/// at, `sh` less the chordal error of the tessellation it drops the cutter
-/// on; `e` keeps the parallel estimate's spacings and feed length.
+/// Isoparametric passes on a parametric part: the planner's own step fit
+/// (the rule's step measured on the tessellation and corrected) at
+/// [`ISO_SAMPLES`] isolines of each patch, the cross range walked with those
+/// steps (`scallop_strategy::iso_fitted_passes`); `e` keeps the parallel
+/// estimate's spacings and feed length.
 #[allow(clippy::result_large_err, reason = "the engine's one error type, as estimate_operation")]
 fn isoparametric(job: &FinishJob, direction: IsoDirection, mut e: Estimate) -> Result<Estimate, EngineError> {
     let Part::Surfaces(set) = &job.part else { return Ok(e) };
-    let chordal = set.tessellate(planning_tolerances(job)?.tessellation())?.chordal_bound;
-    let target = job.scallop_height - chordal.max(0.0);
+    let tolerances = planning_tolerances(job)?;
+    let prepared = crate::prepare_part(&job.part, &tolerances)?;
+    let params = job.timing_params();
     let mut passes = 0;
     for patch in set.patches() {
-        passes += iso_rule_passes(patch, &job.cutter, direction, target, ISO_SAMPLES).map_err(EngineError::Strategy)?;
+        passes += iso_fitted_passes(
+            patch,
+            &prepared.index,
+            &job.cutter,
+            &params,
+            direction,
+            &tolerances,
+            prepared.chordal_error,
+            ISO_SAMPLES,
+        )
+        .map_err(EngineError::Strategy)?;
     }
     e.planes = passes;
     e.passes = passes;

@@ -105,6 +105,86 @@ pub fn plan_isoparametric(
     tolerances: &Tolerances,
     chordal_error: f64,
 ) -> Result<IsoPlanned, StrategyError> {
+    let (model, target) = checked_target(cutter, params, tolerances, chordal_error)?;
+    let domain = patch.domain();
+    let (along, across) = match direction {
+        IsoDirection::U => (domain.u, domain.v),
+        IsoDirection::V => (domain.v, domain.u),
+    };
+    let ctx = Ctx { patch, index, cutter, direction, along, floor: index.bounds().min.z - 1.0, tolerances, params };
+    let mut passes = vec![ctx.pass(across[0])];
+    let mut heights: Vec<f64> = Vec::new();
+    let mut max_h = 0.0f64;
+    while passes.last().is_some_and(|p| p.iso < across[1]) {
+        let current = &passes[passes.len() - 1];
+        let (next, h, worst) = ctx.fit_next(current, &model, target, across[1])?;
+        max_h = max_h.max(worst);
+        heights.extend(h);
+        passes.push(next);
+    }
+    #[allow(clippy::cast_precision_loss, reason = "sample counts")]
+    let mean = if heights.is_empty() { 0.0 } else { heights.iter().sum::<f64>() / heights.len() as f64 };
+    let toolpath = ctx.toolpath(&passes);
+    Ok(IsoPlanned { toolpath, passes, max_scallop_mm: max_h + chordal_error.max(0.0), mean_scallop_mm: mean })
+}
+
+impl Ctx<'_> {
+    /// The pass after `current` as the planner places it: the rule's step for
+    /// `target`, then measured ([`iso_scallop`]) and corrected until the
+    /// worst scallop is within [`tol::ISO_FIT_ACCEPT`] of `target` (or the
+    /// isoline `end` is reached); the farthest measured pass that holds
+    /// `target`, with its scallop samples and their worst.
+    fn fit_next(
+        &self,
+        current: &IsoPass,
+        model: &Model,
+        target: f64,
+        end: f64,
+    ) -> Result<(IsoPass, Vec<f64>, f64), StrategyError> {
+        let (patch, index, cutter, direction) = (self.patch, self.index, self.cutter, self.direction);
+        let last = current.iso;
+        let mut step = self.rule_step(current, model, target);
+        let mut best: Option<(IsoPass, Vec<f64>, f64)> = None;
+        for _ in 0..tol::ISO_FIT_ITERATIONS {
+            let iso = (last + step).min(end);
+            let next = self.pass(iso);
+            let h = iso_scallop(patch, index, cutter, direction, current, &next);
+            let worst = h.iter().copied().fold(0.0, f64::max);
+            let reached_end = iso >= end;
+            if worst <= target {
+                let better = best.as_ref().is_none_or(|b| iso > b.0.iso);
+                if better {
+                    best = Some((next, h, worst));
+                }
+                if reached_end || worst >= tol::ISO_FIT_ACCEPT * target {
+                    break;
+                }
+            }
+            let factor = if worst > 0.0 { (target / worst).sqrt() * tol::SPACING_SAFETY } else { 2.0 };
+            let grown = step * factor.clamp(0.25, 2.0);
+            if worst <= target && grown <= step {
+                break;
+            }
+            step = if worst > target { step * factor.clamp(0.25, 0.95) } else { grown };
+            if step * self.cross_speed(current) < tol::MIN_SPACING {
+                break;
+            }
+        }
+        best.ok_or_else(|| {
+            let p = current.cl.first().copied().unwrap_or_else(Point3::origin);
+            StrategyError::Unreachable { x: p.x, y: p.y, spacing: step, scallop_height: self.params.scallop_height }
+        })
+    }
+}
+
+/// The planner's checks and its cutter model and target scallop: `sh` less
+/// the tessellation's `chordal_error`.
+fn checked_target(
+    cutter: &Cutter,
+    params: &FinishingParams,
+    tolerances: &Tolerances,
+    chordal_error: f64,
+) -> Result<(Model, f64), StrategyError> {
     params.validate()?;
     let model = model(cutter)?;
     let sh = params.scallop_height;
@@ -123,57 +203,68 @@ pub fn plan_isoparametric(
             fix: "the tessellation error exceeds the scallop height: use a smaller path tolerance",
         });
     }
+    Ok((model, target))
+}
+
+/// The number of passes [`plan_isoparametric`] makes on `patch`, estimated
+/// from the planner's own step fit (the rule's step, measured by
+/// [`iso_scallop`] and corrected, as the planner does) at `samples` isolines
+/// spread evenly across the patch: the cross range is walked with the fitted
+/// steps, linear between the sampled isolines. It costs about `samples` of
+/// the planner's passes; `scallop run --plan-only` estimates with it.
+///
+/// # Errors
+/// As [`plan_isoparametric`].
+#[allow(clippy::too_many_arguments, reason = "the planner's arguments plus the sample count")]
+pub fn iso_fitted_passes(
+    patch: &Patch,
+    index: &MeshIndex,
+    cutter: &Cutter,
+    params: &FinishingParams,
+    direction: IsoDirection,
+    tolerances: &Tolerances,
+    chordal_error: f64,
+    samples: usize,
+) -> Result<usize, StrategyError> {
+    use rayon::prelude::*;
+    let (model, target) = checked_target(cutter, params, tolerances, chordal_error)?;
     let domain = patch.domain();
     let (along, across) = match direction {
         IsoDirection::U => (domain.u, domain.v),
         IsoDirection::V => (domain.v, domain.u),
     };
     let ctx = Ctx { patch, index, cutter, direction, along, floor: index.bounds().min.z - 1.0, tolerances, params };
-    let mut passes = vec![ctx.pass(across[0])];
-    let mut heights: Vec<f64> = Vec::new();
-    let mut max_h = 0.0f64;
-    while passes.last().is_some_and(|p| p.iso < across[1]) {
-        let last = passes.last().map_or(across[0], |p| p.iso);
-        let current = &passes[passes.len() - 1];
-        let mut step = ctx.rule_step(current, &model, target);
-        let mut best: Option<(IsoPass, Vec<f64>, f64)> = None;
-        for _ in 0..tol::ISO_FIT_ITERATIONS {
-            let iso = (last + step).min(across[1]);
-            let next = ctx.pass(iso);
-            let h = iso_scallop(patch, index, cutter, direction, current, &next);
-            let worst = h.iter().copied().fold(0.0, f64::max);
-            let reached_end = iso >= across[1];
-            if worst <= target {
-                let better = best.as_ref().is_none_or(|b| iso > b.0.iso);
-                if better {
-                    best = Some((next, h, worst));
-                }
-                if reached_end || worst >= tol::ISO_FIT_ACCEPT * target {
-                    break;
-                }
-            }
-            let factor = if worst > 0.0 { (target / worst).sqrt() * tol::SPACING_SAFETY } else { 2.0 };
-            let grown = step * factor.clamp(0.25, 2.0);
-            if worst <= target && grown <= step {
-                break;
-            }
-            step = if worst > target { step * factor.clamp(0.25, 0.95) } else { grown };
-            if step * ctx.cross_speed(current) < tol::MIN_SPACING {
-                break;
+    let n = samples.max(2);
+    #[allow(clippy::cast_precision_loss, reason = "small counts")]
+    let fitted = (0..n)
+        .into_par_iter()
+        .map(|k| {
+            let c = across[0] + (across[1] - across[0]) * (k as f64 + 0.5) / n as f64;
+            let (next, _, _) = ctx.fit_next(&ctx.pass(c), &model, target, across[1])?;
+            Ok((c, next.iso - c))
+        })
+        .collect::<Result<Vec<(f64, f64)>, StrategyError>>()?;
+    let step_at = |c: f64| {
+        let k = fitted.partition_point(|&(ck, _)| ck <= c);
+        match k {
+            0 => fitted[0].1,
+            k if k == fitted.len() => fitted[k - 1].1,
+            k => {
+                let ((c0, s0), (c1, s1)) = (fitted[k - 1], fitted[k]);
+                s0 + (s1 - s0) * (c - c0) / (c1 - c0)
             }
         }
-        let Some((next, h, worst)) = best else {
-            let p = current.cl.first().copied().unwrap_or_else(Point3::origin);
-            return Err(StrategyError::Unreachable { x: p.x, y: p.y, spacing: step, scallop_height: sh });
-        };
-        max_h = max_h.max(worst);
-        heights.extend(h);
-        passes.push(next);
+    };
+    let (mut iso, mut passes) = (across[0], 1);
+    while iso < across[1] && passes <= tol::ISO_MAX_SAMPLES {
+        let step = step_at(iso);
+        if !(step.is_finite() && step > 0.0) {
+            break;
+        }
+        iso = (iso + step).min(across[1]);
+        passes += 1;
     }
-    #[allow(clippy::cast_precision_loss, reason = "sample counts")]
-    let mean = if heights.is_empty() { 0.0 } else { heights.iter().sum::<f64>() / heights.len() as f64 };
-    let toolpath = ctx.toolpath(&passes);
-    Ok(IsoPlanned { toolpath, passes, max_scallop_mm: max_h + chordal_error.max(0.0), mean_scallop_mm: mean })
+    Ok(passes)
 }
 
 fn model(cutter: &Cutter) -> Result<Model, StrategyError> {
@@ -281,7 +372,7 @@ impl Ctx<'_> {
 
     /// The spacing rule: the smallest parameter step over the pass.
     fn rule_step(&self, pass: &IsoPass, model: &Model, target: f64) -> f64 {
-        rule_step(self.patch, self.direction, model, (pass.iso, &pass.samples), target, false)
+        rule_step(self.patch, self.direction, model, (pass.iso, &pass.samples), target)
     }
 
     fn toolpath(&self, passes: &[IsoPass]) -> Toolpath {
@@ -305,19 +396,7 @@ impl Ctx<'_> {
 
 /// The spacing rule of [`plan_isoparametric`] on the isoline `iso` at the
 /// running parameters `samples`: the smallest parameter step over them.
-/// `curved`: the effective radius also takes the surface's normal curvature
-/// `k` across the feed (convex positive), `1 / (1 / R_eff + k)`: the cusp of
-/// two profile circles `w` apart on a surface so curved stands
-/// `w^2 (1 / R_eff + k) / 8` high (the curvature correction of
-/// `SteepShallow`'s `convex_factor`).
-fn rule_step(
-    patch: &Patch,
-    direction: IsoDirection,
-    model: &Model,
-    (iso, samples): (f64, &[f64]),
-    target: f64,
-    curved: bool,
-) -> f64 {
+fn rule_step(patch: &Patch, direction: IsoDirection, model: &Model, (iso, samples): (f64, &[f64]), target: f64) -> f64 {
     let mut step = f64::INFINITY;
     for &a in samples {
         let (u, v) = uv(direction, a, iso);
@@ -335,71 +414,16 @@ fn rule_step(
         } else {
             0.0
         };
-        let mut r_eff = model.effective_radius(slope, alpha);
+        let r_eff = model.effective_radius(slope, alpha);
         // The part of S_cross across the feed direction on the surface.
         let fu = f.try_normalize(1e-300).unwrap_or_else(Vec3::x);
         let across = (x - fu * fu.dot(&x)).norm();
-        if curved && across > 0.0 {
-            // The tangent across the feed, a S_along + S_cross, and its curvature.
-            let a = -fu.dot(&x) / f.norm().max(1e-300);
-            let (s_ff, s_fx, s_xx) = match direction {
-                IsoDirection::U => (d.duu, d.duv, d.dvv),
-                IsoDirection::V => (d.dvv, d.duv, d.duu),
-            };
-            let convex = -n.dot(&(s_ff * (a * a) + s_fx * (2.0 * a) + s_xx)) / (across * across);
-            let inverse = 1.0 / r_eff + convex;
-            r_eff = if inverse > 0.0 { 1.0 / inverse } else { f64::INFINITY };
-        }
         let sod = scallop_analysis::step_over(target, r_eff).min(tol::ISO_MAX_STEP_OVER * model.radius());
         if across > 0.0 {
             step = step.min(sod / across);
         }
     }
     step
-}
-
-/// The passes of [`plan_isoparametric`] on `patch` as its spacing rule
-/// places them, with the surface's curvature across the feed (the planner
-/// measures each step and corrects it, within [`tol::ISO_FIT_ACCEPT`] of the
-/// target; on a curved surface its measure finds the curvature's share):
-/// isolines from the start of the cross range, each one rule step (on
-/// `samples` running parameters spread evenly, the smaller of the steps read
-/// on the last isoline and on the one a step further) after the last, up to the end,
-/// for the scallop `target` (`sh` less the tessellation's chordal error).
-/// `scallop run --plan-only` estimates with this count.
-///
-/// # Errors
-/// A cone cutter ([`StrategyError::Unsupported`]).
-pub fn iso_rule_passes(
-    patch: &Patch,
-    cutter: &Cutter,
-    direction: IsoDirection,
-    target: f64,
-    samples: usize,
-) -> Result<usize, StrategyError> {
-    let model = model(cutter)?;
-    let domain = patch.domain();
-    let (along, across) = match direction {
-        IsoDirection::U => (domain.u, domain.v),
-        IsoDirection::V => (domain.v, domain.u),
-    };
-    let n = samples.max(2);
-    #[allow(clippy::cast_precision_loss, reason = "small counts")]
-    let running: Vec<f64> = (0..=n).map(|i| along[0] + (along[1] - along[0]) * i as f64 / n as f64).collect();
-    let (mut iso, mut passes) = (across[0], 1);
-    while iso < across[1] && passes <= tol::ISO_MAX_SAMPLES {
-        let step = rule_step(patch, direction, &model, (iso, &running), target, true);
-        if !(step.is_finite() && step > 0.0) {
-            break;
-        }
-        // The gap must hold on the next isoline too (the cross speed and the
-        // curvature change across it).
-        let next = (iso + step).min(across[1]);
-        let step = step.min(rule_step(patch, direction, &model, (next, &running), target, true));
-        iso = (iso + step).min(across[1]);
-        passes += 1;
-    }
-    Ok(passes)
 }
 
 /// `(R, r)` of the cutter body: ball `r = R`, flat `r = 0`.

@@ -184,7 +184,7 @@ pub mod trochoid;
 
 pub use error::StrategyError;
 pub use geometry::contact_to_tip;
-pub use iso::{IsoDirection, IsoPass, IsoPlanned, iso_rule_passes, iso_scallop, plan_isoparametric};
+pub use iso::{IsoDirection, IsoPass, IsoPlanned, iso_fitted_passes, iso_scallop, plan_isoparametric};
 pub use leads::{LeadFallback, LeadKind, LeadReport, apply_leads};
 pub use params::{Boundary, FinishingParams, Pattern};
 pub use plan::rule_spacing;

@@ -10,7 +10,7 @@ use proptest::prelude::*;
 use scallop_cutter::{Cutter, CutterShape, drop_cutter};
 use scallop_geom::{Point2, Point3, Tolerances};
 use scallop_mesh::MeshIndex;
-use scallop_strategy::{IsoDirection, Pattern, StrategyError, iso_scallop, plan_isoparametric};
+use scallop_strategy::{IsoDirection, Pattern, StrategyError, iso_fitted_passes, iso_scallop, plan_isoparametric};
 use scallop_surface::Patch;
 use scallop_toolpath::MoveKind;
 
@@ -129,5 +129,32 @@ fn iso_bull_in_a_tight_hollow_is_verified_or_refused() {
     match plan_isoparametric(&patch, &index, &bull(4.0, 1.5), &p, IsoDirection::U, &tol, t.chordal_bound) {
         Ok(_) => check(&patch, &bull(4.0, 1.5), IsoDirection::U, 0.01),
         Err(e) => assert!(matches!(e, StrategyError::Unreachable { .. }), "{e}"),
+    }
+}
+
+/// The estimate of `scallop run --plan-only` (the planner's step fit at 8
+/// isolines, the cross range walked with those steps) counts the planner's
+/// passes within 10 % on a plane, a dome and a saddle, both directions.
+#[test]
+fn the_fitted_estimate_counts_the_planners_passes() {
+    let tol = Tolerances { path: 0.01, gouge: 0.0 };
+    let dome = [0.0, 0.0, 0.0, 0.0, 0.0, 4.0, 4.0, 0.0, 0.0, 4.0, 4.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+    let saddle = [3.0, 0.0, 0.0, -3.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -3.0, 0.0, 0.0, 3.0];
+    for heights in [[0.0; 16], dome, saddle] {
+        let surface = patch(&heights);
+        let t = surface.tessellate(tol.tessellation()).expect("tessellates");
+        let index = MeshIndex::build(&t.mesh);
+        let p = params(0.0, Pattern::Zigzag, 0.01, 1.0);
+        for direction in [IsoDirection::U, IsoDirection::V] {
+            let planned = plan_isoparametric(&surface, &index, &ball(3.0), &p, direction, &tol, t.chordal_bound)
+                .expect("plans")
+                .passes
+                .len();
+            let estimated = iso_fitted_passes(&surface, &index, &ball(3.0), &p, direction, &tol, t.chordal_bound, 8)
+                .expect("estimates");
+            #[allow(clippy::cast_precision_loss, reason = "pass counts")]
+            let error = (estimated as f64 - planned as f64).abs() / planned as f64;
+            assert!(error <= 0.1, "{heights:?} {direction:?}: estimated {estimated}, planned {planned}");
+        }
     }
 }
