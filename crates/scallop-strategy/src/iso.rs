@@ -106,12 +106,7 @@ pub fn plan_isoparametric(
     chordal_error: f64,
 ) -> Result<IsoPlanned, StrategyError> {
     let (model, target) = checked_target(cutter, params, tolerances, chordal_error)?;
-    let domain = patch.domain();
-    let (along, across) = match direction {
-        IsoDirection::U => (domain.u, domain.v),
-        IsoDirection::V => (domain.v, domain.u),
-    };
-    let ctx = Ctx { patch, index, cutter, direction, along, floor: index.bounds().min.z - 1.0, tolerances, params };
+    let (ctx, across) = Ctx::new(patch, index, cutter, direction, tolerances, params);
     let mut passes = vec![ctx.pass(across[0])];
     let mut heights: Vec<f64> = Vec::new();
     let mut max_h = 0.0f64;
@@ -128,7 +123,25 @@ pub fn plan_isoparametric(
     Ok(IsoPlanned { toolpath, passes, max_scallop_mm: max_h + chordal_error.max(0.0), mean_scallop_mm: mean })
 }
 
-impl Ctx<'_> {
+impl<'a> Ctx<'a> {
+    /// The planner's context on `patch` and the cross range of its isolines.
+    fn new(
+        patch: &'a Patch,
+        index: &'a MeshIndex,
+        cutter: &'a Cutter,
+        direction: IsoDirection,
+        tolerances: &'a Tolerances,
+        params: &'a FinishingParams,
+    ) -> (Ctx<'a>, [f64; 2]) {
+        let domain = patch.domain();
+        let (along, across) = match direction {
+            IsoDirection::U => (domain.u, domain.v),
+            IsoDirection::V => (domain.v, domain.u),
+        };
+        let floor = index.bounds().min.z - 1.0;
+        (Ctx { patch, index, cutter, direction, along, floor, tolerances, params }, across)
+    }
+
     /// The pass after `current` as the planner places it: the rule's step for
     /// `target`, then measured ([`iso_scallop`]) and corrected until the
     /// worst scallop is within [`tol::ISO_FIT_ACCEPT`] of `target` (or the
@@ -228,12 +241,7 @@ pub fn iso_fitted_passes(
 ) -> Result<usize, StrategyError> {
     use rayon::prelude::*;
     let (model, target) = checked_target(cutter, params, tolerances, chordal_error)?;
-    let domain = patch.domain();
-    let (along, across) = match direction {
-        IsoDirection::U => (domain.u, domain.v),
-        IsoDirection::V => (domain.v, domain.u),
-    };
-    let ctx = Ctx { patch, index, cutter, direction, along, floor: index.bounds().min.z - 1.0, tolerances, params };
+    let (ctx, across) = Ctx::new(patch, index, cutter, direction, tolerances, params);
     let n = samples.max(2);
     #[allow(clippy::cast_precision_loss, reason = "small counts")]
     let fitted = (0..n)
