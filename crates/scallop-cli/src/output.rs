@@ -273,7 +273,7 @@ pub fn write_finishing(
         "finishing the {part}\n\
          \x20 analysis   PCA slope {slope:.2}°, critical slope {crit:.2}°: {rec}; feed at {dir:.2}° from X\n\
          \x20 cutter     {cutter}, scallop height {sh} mm, {chord}\n\
-         \x20 toolpath   {passes} passes on {planes} planes, {points} points, {links} links, {retracts} retracts\n\
+         \x20 toolpath   {passes} passes on {planes} planes, {points} points, {links} links, {retracts} retracts{refined}\n\
          \x20 scallop    verified max {smax:.5} mm (<= {sh} mm{by_sim}), mean material left {smean:.5} mm\n\
          \x20 time       {t1} stop-to-stop, {t2} look-ahead, + {tr} rapids\n\
          \x20 lengths    feed {feed:.0} mm, links {link:.0} mm, rapid {rapid:.0} mm\n\
@@ -297,6 +297,10 @@ pub fn write_finishing(
         } else {
             "a mesh, machined as given".to_string()
         },
+        refined = p.refinement.map_or(String::new(), |f| format!(
+            "\n\x20            refined in {} round(s): {} planes and {} levels added where the simulation of the first program found more than sh",
+            f.rounds, f.planes_added, f.levels_added
+        )),
         passes = p.passes,
         planes = p.planes,
         points = p.points,

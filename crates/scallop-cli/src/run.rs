@@ -430,6 +430,10 @@ fn run_one(job: &FinishJob) -> Result<scallop_engine::FinishOutput, scallop_engi
             bar.set_position(done as u64);
         }
         FinishStep::Verifying => bar.set_message("measuring the scallop and the material left"),
+        FinishStep::Refining { round } => {
+            bar.set_length(0);
+            bar.set_message(format!("planning again with passes where the scallop exceeded sh (round {round})"));
+        }
     };
     let out = scallop_engine::run_finishing_with_progress(job, &progress);
     bar.finish_and_clear();

@@ -18,12 +18,13 @@ use scallop_machine::{Kinematics, Machine};
 use scallop_mesh::{MeshIndex, TriMesh};
 use scallop_post::{Dialect, OutputMode, PostParams, ProgramInfo, program_text, write_fitted};
 use scallop_strategy::{
-    Boundary, FinishingParams, IsoDirection, LeadKind, LeadReport, Pattern, SteepShallow, apply_leads, lookahead_time,
-    plan_finishing, plan_isoparametric, plan_steep_shallow, stop_to_stop_time,
+    Boundary, FinishingParams, IsoDirection, LeadKind, LeadReport, Pattern, Refinement, SteepShallow, apply_leads,
+    lookahead_time, plan_finishing_refined, plan_isoparametric, plan_steep_shallow_refined, stop_to_stop_time,
 };
 use scallop_toolpath::{FittedPath, Move, MoveKind, Toolpath, fit_arcs};
 use serde::Serialize;
 
+use crate::refine::{Layout, MAX_ROUNDS, merged, refinement_for};
 use crate::{ARC_SHARE, EngineError, Part, PreparedPart, prepare_part};
 
 /// How the program is written.
@@ -257,6 +258,12 @@ pub enum FinishStep {
     },
     /// Measuring the scallop and the material left, writing the program.
     Verifying,
+    /// Planning again with planes or levels added where the simulation found
+    /// the scallop over sh (round 1, 2, ...; see docs/simulation.md, "Refinement").
+    Refining {
+        /// The refinement round.
+        round: usize,
+    },
 }
 
 /// [`run_finishing`], calling `progress` as it goes (planning, then the cut
@@ -275,24 +282,48 @@ pub fn run_finishing_with_progress(
         None => prepared,
     };
     let stock = stock_box(&prepared.mesh, job.cutter.radius());
-    progress(FinishStep::Planning(job.strategy));
-    let mut op = plan_operation(job, &prepared, &tolerances, None)?;
     let (gouge_tolerance, options) = verify_options(job, &prepared);
-    let sim = scallop_sim::simulate_with_progress(
-        stock,
-        job.sim_resolution,
-        &job.cutter,
-        &op.plan.toolpath,
-        &prepared.index,
-        &options,
-        &|done, total| progress(FinishStep::Cutting { done, total }),
-    )?;
-    progress(FinishStep::Verifying);
-    let rest = if job.strategy.simulation_verifies_scallop() {
-        network_scallop_from(&sim, job, &prepared, &options, &mut op.plan.report)?
-    } else {
-        RestReport::default()
+    let mut refine = Refinement::default();
+    let (mut round, mut first) = (0, (0, 0));
+    let (mut op, sim, rest) = loop {
+        progress(if round == 0 { FinishStep::Planning(job.strategy) } else { FinishStep::Refining { round } });
+        let mut op = plan_operation(job, &prepared, &tolerances, None, &refine)?;
+        if round == 0 {
+            first = (op.plan.layout.planes.len(), op.plan.layout.levels.len());
+        }
+        let sim = scallop_sim::simulate_with_progress(
+            stock,
+            job.sim_resolution,
+            &job.cutter,
+            &op.plan.toolpath,
+            &prepared.index,
+            &options,
+            &|done, total| progress(FinishStep::Cutting { done, total }),
+        )?;
+        progress(FinishStep::Verifying);
+        if !job.strategy.simulation_verifies_scallop() {
+            break (op, sim, RestReport::default());
+        }
+        let split = scallop_split(&sim, job, &prepared, &options);
+        let more =
+            if split.holds() || round == MAX_ROUNDS || op.plan.layout.planes.len() + op.plan.layout.levels.len() == 0 {
+                Refinement::default()
+            } else {
+                refinement_for(&op.plan.layout, &split.over, &job.cutter)
+            };
+        let all = merged(&refine, &more);
+        if more.is_empty() || all == refine {
+            let rest = accept_scallop(split, &sim, job, &mut op.plan.report)?;
+            break (op, sim, rest);
+        }
+        refine = all;
+        round += 1;
     };
+    op.plan.report.refinement = (round > 0).then_some(scallop_strategy::RefinementReport {
+        rounds: round,
+        planes_added: op.plan.layout.planes.len().saturating_sub(first.0),
+        levels_added: op.plan.layout.levels.len().saturating_sub(first.1),
+    });
     let (fitted, comments) = fit_and_comment(job, &op, &prepared, &tolerances);
     let text = match &job.setup {
         None => three_axis_program(job, &fitted, &comments)?,
@@ -367,6 +398,7 @@ pub(crate) fn plan_operation(
     prepared: &PreparedPart,
     tolerances: &Tolerances,
     clearance: Option<f64>,
+    refine: &Refinement,
 ) -> Result<PlannedOperation, EngineError> {
     let samples = match (&job.part, &job.setup) {
         (Part::Surfaces(set), None) => {
@@ -383,8 +415,13 @@ pub(crate) fn plan_operation(
     }
     let mut planned = match job.strategy {
         Strategy::ParallelPlanes => {
-            let p = plan_finishing(&prepared.index, &job.cutter, &params, tolerances)?;
-            Plan { toolpath: p.toolpath, report: p.report, scallop: Some(p.scallop) }
+            let p = plan_finishing_refined(&prepared.index, &job.cutter, &params, tolerances, refine)?;
+            let layout = Layout {
+                direction: params.direction,
+                planes: p.planes.iter().map(|q| q.offset).collect(),
+                ..Layout::default()
+            };
+            Plan { toolpath: p.toolpath, report: p.report, scallop: Some(p.scallop), layout }
         }
         Strategy::NetworkPlanes => {
             let set = parametric_only(job, "the network planner (finishing.strategy = \"network\")")?;
@@ -399,8 +436,23 @@ pub(crate) fn plan_operation(
             if let Some(t) = threshold_deg {
                 split.threshold = t.to_radians();
             }
-            let p = plan_steep_shallow(&prepared.mesh, &prepared.index, &job.cutter, &params, tolerances, &split)?;
-            Plan { toolpath: p.toolpath, report: p.report, scallop: None }
+            let p = plan_steep_shallow_refined(
+                &prepared.mesh,
+                &prepared.index,
+                &job.cutter,
+                &params,
+                tolerances,
+                &split,
+                refine,
+            )?;
+            let layout = Layout {
+                direction: params.direction,
+                planes: p.shallow.as_ref().map(|q| q.planes.iter().map(|q| q.offset).collect()).unwrap_or_default(),
+                levels: p.level_heights,
+                steep_min: split.threshold - split.overlap,
+                shallow_max: split.threshold + split.overlap,
+            };
+            Plan { toolpath: p.toolpath, report: p.report, scallop: None, layout }
         }
     };
     let (led, leads) =
@@ -500,16 +552,60 @@ pub(crate) fn network_scallop_from(
     options: &scallop_sim::VerifyOptions,
     report: &mut scallop_strategy::Report,
 ) -> Result<RestReport, EngineError> {
+    accept_scallop(scallop_split(sim, job, prepared, options), sim, job, report)
+}
+
+/// The scallop on the machined surface of a simulated program, told apart
+/// from the material the cutter cannot reach.
+pub(crate) struct ScallopSplit {
+    max: f64,
+    at: Option<scallop_geom::Point2>,
+    rest: RestReport,
+    /// The machined cells over the limit ([`scallop_sim::RestSplit::machined_over`]).
+    pub(crate) over: Vec<scallop_sim::OverCell>,
+    limit: f64,
+    bound: f64,
+}
+
+impl ScallopSplit {
+    /// Whether the scallop on the machined surface holds the limit.
+    pub(crate) fn holds(&self) -> bool {
+        self.max <= self.limit
+    }
+}
+
+/// Splits what the program left (see [`ScallopSplit`]); the split by reach
+/// runs only when the simulation's largest thickness exceeds the limit.
+pub(crate) fn scallop_split(
+    sim: &scallop_sim::Simulation,
+    job: &FinishJob,
+    prepared: &PreparedPart,
+    options: &scallop_sim::VerifyOptions,
+) -> ScallopSplit {
     let bound = sim.zmap.resolution_bound(job.cutter.shape());
     let limit = job.scallop_height + bound;
     let v = &sim.verification;
-    let (max, at, rest) = if v.max_thickness > limit {
+    if v.max_thickness > limit {
         let field = scallop_sim::PartField::new(&sim.zmap, &prepared.index);
         let split = scallop_sim::split_rest(&sim.zmap, &field, &prepared.index, &job.cutter, options, limit);
-        (split.machined_max, split.machined_at, RestReport::from_split(&split))
+        let rest = RestReport::from_split(&split);
+        ScallopSplit { max: split.machined_max, at: split.machined_at, rest, over: split.machined_over, limit, bound }
     } else {
-        (v.max_thickness, v.max_thickness_at, RestReport::default())
-    };
+        let (max, at) = (v.max_thickness, v.max_thickness_at);
+        ScallopSplit { max, at, rest: RestReport::default(), over: Vec::new(), limit, bound }
+    }
+}
+
+/// The rest report of a split that holds the limit, with the report's scallop
+/// figures filled; else [`EngineError::ScallopNotHeld`].
+pub(crate) fn accept_scallop(
+    split: ScallopSplit,
+    sim: &scallop_sim::Simulation,
+    job: &FinishJob,
+    report: &mut scallop_strategy::Report,
+) -> Result<RestReport, EngineError> {
+    let ScallopSplit { max, at, rest, limit, bound, .. } = split;
+    let v = &sim.verification;
     if max > limit {
         let at = at.unwrap_or_else(|| scallop_geom::Point2::new(f64::NAN, f64::NAN));
         return Err(EngineError::ScallopNotHeld { measured: max, x: at.x, y: at.y, limit: job.scallop_height, bound });
@@ -768,7 +864,7 @@ fn network_planes(
         cl_points_dropped: drops,
         ..scallop_strategy::Report::timed(&toolpath, params)
     };
-    Ok(Plan { toolpath, report, scallop: None })
+    Ok(Plan { toolpath, report, scallop: None, layout: Layout::default() })
 }
 
 /// A toolpath and its figures, whatever the strategy.
@@ -776,6 +872,9 @@ pub(crate) struct Plan {
     pub(crate) toolpath: Toolpath,
     pub(crate) report: scallop_strategy::Report,
     pub(crate) scallop: Option<scallop_strategy::ScallopReport>,
+    /// Where the planes and levels are, for a refinement (empty for the
+    /// strategies that are not refined).
+    pub(crate) layout: Layout,
 }
 
 /// Isoparametric passes patch after patch; the report's times and lengths are those
@@ -822,7 +921,7 @@ fn isoparametric(
         mean_scallop_mm: mean,
         ..scallop_strategy::Report::timed(&toolpath, params)
     };
-    Ok(Plan { toolpath, report, scallop: None })
+    Ok(Plan { toolpath, report, scallop: None, layout: Layout::default() })
 }
 
 /// The prepared part turned into the planning frame of a 3+2 setup.

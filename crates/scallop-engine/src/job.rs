@@ -260,7 +260,13 @@ pub fn run_job_with_progress(job: &Job, progress: &dyn Fn(JobStep)) -> Result<Jo
                     &tolerances,
                 )?))
             }
-            None => Planned::Finish(Box::new(plan_operation(f, &prepared, &tolerances, Some(clearance))?)),
+            None => Planned::Finish(Box::new(plan_operation(
+                f,
+                &prepared,
+                &tolerances,
+                Some(clearance),
+                &scallop_strategy::Refinement::default(),
+            )?)),
         };
         progress(JobStep { index, count, phase: JobPhase::Cutting });
         let volume_before = zmap.volume();

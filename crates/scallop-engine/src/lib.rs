@@ -24,6 +24,7 @@ mod estimate;
 mod finish;
 mod grid;
 mod job;
+mod refine;
 mod rough;
 mod rough_estimate;
 mod zones;

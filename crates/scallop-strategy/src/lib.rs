@@ -190,7 +190,9 @@ pub use params::{Boundary, FinishingParams, Pattern};
 pub use plan::rule_spacing;
 pub use region::ZoneRegion;
 pub use scallop::{PairScallop, ScallopReport, verify_scallop};
-pub use steep::{SteepPlanned, SteepShallow, convex_factor, crease_residual, plan_steep_shallow};
+pub use steep::{
+    SteepPlanned, SteepShallow, convex_factor, crease_residual, plan_steep_shallow, plan_steep_shallow_refined,
+};
 pub use time::{ClassTimes, MoveFeed, lookahead_profile, lookahead_time, stop_to_stop_time};
 
 use scallop_cutter::Cutter;
@@ -250,6 +252,21 @@ pub struct Report {
     pub cl_points_dropped: usize,
     /// Planning time (s): 0 from the library (no clocks); the caller measures it.
     pub planning_time_s: f64,
+    /// Planes and levels added where the stock simulation found the scallop
+    /// over sh (`None`: the first plan held it; see [`Refinement`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub refinement: Option<RefinementReport>,
+}
+
+/// What a refinement added to a plan ([`Report::refinement`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct RefinementReport {
+    /// Rounds of planning again.
+    pub rounds: usize,
+    /// Planes added.
+    pub planes_added: usize,
+    /// Waterline levels added.
+    pub levels_added: usize,
 }
 
 impl Report {
@@ -283,6 +300,7 @@ impl Report {
             points: toolpath.moves().len(),
             cl_points_dropped: 0,
             planning_time_s: 0.0,
+            refinement: None,
         }
     }
 }
@@ -319,7 +337,45 @@ pub fn plan_finishing(
     params: &FinishingParams,
     tol: &Tolerances,
 ) -> Result<Planned, StrategyError> {
-    plan(index, cutter, params, tol, None, false)
+    plan(index, cutter, params, tol, None, false, &[])
+}
+
+/// [`plan_finishing`] with the planes of `refine` added to the sweep's (see
+/// [`Refinement`]).
+///
+/// # Errors
+/// As [`plan_finishing`].
+pub fn plan_finishing_refined(
+    index: &MeshIndex,
+    cutter: &Cutter,
+    params: &FinishingParams,
+    tol: &Tolerances,
+    refine: &Refinement,
+) -> Result<Planned, StrategyError> {
+    plan(index, cutter, params, tol, None, false, &refine.planes)
+}
+
+/// Planes and waterline levels added to a plan where the stock simulation
+/// found more than `sh` on surface the cutter reaches (docs/simulation.md,
+/// "Refinement"): the planner measures the scallop between planes at its feed
+/// samples and between levels at their points, and a crease or a narrow
+/// feature between those samples can escape it; the simulation then names the
+/// places and the engine plans again with a plane or a level between the two
+/// that bracket each place.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Refinement {
+    /// Plane offsets `d = m . p` to add (mm).
+    pub planes: Vec<f64>,
+    /// Waterline levels (tip heights, mm) to add (steep and shallow).
+    pub levels: Vec<f64>,
+}
+
+impl Refinement {
+    /// Whether it adds nothing.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.planes.is_empty() && self.levels.is_empty()
+    }
 }
 
 /// [`plan_finishing`] restricted to one zone of a labelled part: a cutter
@@ -339,7 +395,7 @@ pub fn plan_zone_finishing(
     tol: &Tolerances,
     region: &ZoneRegion,
 ) -> Result<Planned, StrategyError> {
-    plan(index, cutter, params, tol, Some(region), false)
+    plan(index, cutter, params, tol, Some(region), false, &[])
 }
 
 /// Plans parallel planes (in `region` when given); with `tolerate_rest` the
@@ -354,10 +410,12 @@ fn plan(
     tol: &Tolerances,
     region: Option<&ZoneRegion>,
     tolerate_rest: bool,
+    extra: &[f64],
 ) -> Result<Planned, StrategyError> {
     let mut planner = plan::Planner::new(index, cutter, params, tol, region)?;
     planner.tolerate_rest = tolerate_rest;
     let planes = planner.sweep()?;
+    let planes = planner.with_planes(planes, extra);
     let (toolpath, links, retracts) = planner.toolpath(&planes);
     let planes: Vec<Plane> = planes.into_iter().map(|p| p.plane).collect();
     let feed_samples = planner.feed_samples.clone();

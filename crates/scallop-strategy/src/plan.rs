@@ -636,6 +636,24 @@ impl<'a> Planner<'a> {
         Ok(planes)
     }
 
+    /// `planes` (in increasing offset, as [`Self::sweep`] gives them) with a
+    /// plane at each offset of `extra` that has passes and is not already
+    /// within the boundary tolerance of one (see [`crate::Refinement`]).
+    pub(crate) fn with_planes(&mut self, mut planes: Vec<PlanePasses>, extra: &[f64]) -> Vec<PlanePasses> {
+        for &d in extra {
+            if !d.is_finite() || planes.iter().any(|p| (p.plane.offset - d).abs() <= self.boundary_tol) {
+                continue;
+            }
+            let plane = self.plane(d);
+            if plane.plane.passes.is_empty() {
+                continue;
+            }
+            let at = planes.partition_point(|p| p.plane.offset < d);
+            planes.insert(at, plane);
+        }
+        planes
+    }
+
     /// The planes from `previous` (the last plane of a range, returned first)
     /// up to the first plane `next` of the following range (excluded) such that
     /// every pair of neighbours holds `sh` by the refined measure. Between two

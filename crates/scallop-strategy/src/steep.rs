@@ -25,7 +25,7 @@ use scallop_toolpath::{Move, MoveKind, Toolpath};
 use scallop_waterline::{WaterlineGrid, WaterlineOptions};
 
 use crate::geometry::{contact_normal, slots_by_original};
-use crate::{FinishingParams, Planned, Report, StrategyError, ZoneRegion, tol};
+use crate::{FinishingParams, Planned, Refinement, Report, StrategyError, ZoneRegion, tol};
 
 /// How the part is split by slope.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -214,6 +214,8 @@ pub struct SteepPlanned {
     pub shallow: Option<Planned>,
     /// Waterline levels with at least one pass.
     pub levels: usize,
+    /// Tip heights of the levels with a pass, from the top down (mm).
+    pub level_heights: Vec<f64>,
     /// Passes on the levels (runs of steep contact).
     pub steep_passes: usize,
     /// Times, lengths and counts of the whole toolpath; the scallop is the
@@ -236,6 +238,23 @@ pub fn plan_steep_shallow(
     tol_: &Tolerances,
     split: &SteepShallow,
 ) -> Result<SteepPlanned, StrategyError> {
+    plan_steep_shallow_refined(mesh, index, cutter, params, tol_, split, &Refinement::default())
+}
+
+/// [`plan_steep_shallow`] with the planes and levels of `refine` added to
+/// those the planner places (see [`Refinement`]).
+///
+/// # Errors
+/// As [`plan_steep_shallow`].
+pub fn plan_steep_shallow_refined(
+    mesh: &TriMesh,
+    index: &MeshIndex,
+    cutter: &Cutter,
+    params: &FinishingParams,
+    tol_: &Tolerances,
+    split: &SteepShallow,
+    refine: &Refinement,
+) -> Result<SteepPlanned, StrategyError> {
     params.validate()?;
     split.check()?;
     if matches!(cutter.shape(), CutterShape::Cone { .. }) {
@@ -245,7 +264,7 @@ pub fn plan_steep_shallow(
     let labels: Vec<u32> = slopes.iter().map(|&s| u32::from(s >= split.threshold + split.overlap)).collect();
     let shallow = if labels.contains(&0) {
         let region = ZoneRegion::new(mesh, &labels, 0, 0.0)?;
-        match crate::plan(index, cutter, params, tol_, Some(&region), true) {
+        match crate::plan(index, cutter, params, tol_, Some(&region), true, &refine.planes) {
             Ok(p) => Some(p),
             Err(StrategyError::EmptyRegion { .. }) => None,
             Err(e) => return Err(e),
@@ -260,13 +279,14 @@ pub fn plan_steep_shallow(
         toolpath.extend_from(&p.toolpath);
     }
     let steep_z = steep_range(mesh, &slopes, steep_min);
-    let (levels, steep_passes) = match steep_z {
+    let (levels, steep_passes, level_heights) = match steep_z {
         Some(range) => {
             let mut levels = Levels::new(index, cutter, params, tol_, split, range)?;
             levels.flats = flat_heights(mesh, &slopes, tol_.path);
+            levels.extra.clone_from(&refine.levels);
             levels.append_to(&mut toolpath)?
         }
-        None => (0, 0),
+        None => (0, 0, Vec::new()),
     };
     if shallow.is_none() && steep_passes == 0 {
         return Err(StrategyError::EmptyRegion { direction_deg: params.direction.to_degrees() });
@@ -282,7 +302,7 @@ pub fn plan_steep_shallow(
     }
     report.passes += steep_passes;
     report.planes += levels;
-    Ok(SteepPlanned { toolpath, shallow, levels, steep_passes, report })
+    Ok(SteepPlanned { toolpath, shallow, levels, level_heights, steep_passes, report })
 }
 
 /// Slope of a triangle from the horizontal (rad, 0 to pi/2; facing down
@@ -343,6 +363,8 @@ struct Levels<'a> {
     flats: Vec<f64>,
     /// How far above a flat area its level runs (mm, `FLAT_LIFT_SHARE * path`).
     lift: f64,
+    /// Levels added to those the spacing rule places ([`Refinement::levels`]).
+    extra: Vec<f64>,
 }
 
 /// One level's passes and its smallest steep contact slope.
@@ -384,6 +406,7 @@ impl<'a> Levels<'a> {
             z_range: (bottom, top.max(bottom)),
             flats: Vec::new(),
             lift: tol::FLAT_LIFT_SHARE * tol_.path,
+            extra: Vec::new(),
         })
     }
 
@@ -515,7 +538,23 @@ impl<'a> Levels<'a> {
             }
             current = next;
         }
-        Ok(out)
+        self.with_extra(out)
+    }
+
+    /// `levels` (from the top down) with a level at each height of
+    /// [`Self::extra`] inside the levels' range and not within
+    /// [`tol::MIN_SPACING`] of one.
+    fn with_extra(&self, mut levels: Vec<Level>) -> Result<Vec<Level>, StrategyError> {
+        let (bottom, top) = self.z_range;
+        for &z in &self.extra {
+            if !(bottom..=top).contains(&z) || levels.iter().any(|l| (l.z - z).abs() <= tol::MIN_SPACING) {
+                continue;
+            }
+            let level = self.level(z)?;
+            let at = levels.partition_point(|l| l.z > z);
+            levels.insert(at, level);
+        }
+        Ok(levels)
     }
 
     /// The level `dz` below `z`, or the level just above a flat area between
@@ -529,16 +568,17 @@ impl<'a> Levels<'a> {
     /// Appends the levels to `path` (after what it holds), each pass entered
     /// from the clearance height or linked from the previous pass's end when the
     /// straight move between them stays above the CL surface; returns (levels
-    /// with a pass, passes).
-    fn append_to(&self, path: &mut Toolpath) -> Result<(usize, usize), StrategyError> {
+    /// with a pass, passes, the heights of those levels).
+    fn append_to(&self, path: &mut Toolpath) -> Result<(usize, usize, Vec<f64>), StrategyError> {
         let clear = self.index.bounds().max.z + self.params.clearance;
         let mut last: Option<Point3> = None;
-        let (mut levels, mut count) = (0, 0);
+        let (mut levels, mut count, mut heights) = (0, 0, Vec::new());
         for level in self.all()? {
             if level.passes.is_empty() {
                 continue;
             }
             levels += 1;
+            heights.push(level.z);
             for pass in order_from(level.passes, last.map(|p| p.xy())) {
                 let points: Vec<Point3> = pass.iter().map(|p| Point3::new(p.x, p.y, level.z)).collect();
                 let (Some(&start), Some(&end)) = (points.first(), points.last()) else { continue };
@@ -564,7 +604,7 @@ impl<'a> Levels<'a> {
         if let Some(end) = last {
             path.push(Move::new(MoveKind::Retract, Point3::new(end.x, end.y, clear)));
         }
-        Ok((levels, count))
+        Ok((levels, count, heights))
     }
 
     /// Whether the straight move from `a` to `b` stays on or above the
