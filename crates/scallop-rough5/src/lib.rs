@@ -34,18 +34,22 @@
 //!   triangle's contacts); results do not depend on the thread count.
 
 mod collide;
+mod cutting;
 mod error;
 mod levels;
 pub mod place;
 mod plan;
 mod prove;
+mod radius;
 mod sync;
 pub mod tol;
 
 pub use collide::BodyCheck;
+pub use cutting::CuttingData;
 pub use error::Rough5Error;
 pub use levels::{LevelPasses, TiltMode, level_passes};
 pub use place::{Feature, Placement, Placer, tool_frame};
 pub use plan::{LevelReport, PassReport, Rough5Plan, Rough5Settings, plan_rough5};
 pub use prove::{Proof, ProofSettings, prove};
+pub use radius::{apparent_contour_radius, effective_radius, exact_scallop, scallop_height, swept_profile};
 pub use sync::{SyncPoint, axis_steps, closest_vertex, interpolate_axis, limit_angular_step, pitch_angle, synchronise};
