@@ -31,6 +31,7 @@ fn settings(tilt: TiltMode, depth: f64) -> Rough5Settings {
         link_max: 9.0,
         feed: 2400.0,
         rapid_rate: 20_000.0,
+        orientation: None,
     }
 }
 
