@@ -9,7 +9,8 @@
 //! - [`plan_rough5`]: levels top-down, passes inside-out, ramp entries along
 //!   the innermost pass, links on the level or at a safe height, a maximum
 //!   angular step; the guide-curve variant and the zero-tilt baseline
-//!   (module J);
+//!   (module J); [`plan_single_pass`]: one pass alone (the orientation
+//!   cases of Ch. 3 §2.3);
 //! - [`prove`]: the program cut on a tri-dexel stock with shank and holder
 //!   collisions as errors, and the metrics of spec 10.1 (module L).
 //!
@@ -34,18 +35,28 @@
 //!   triangle's contacts); results do not depend on the thread count.
 
 mod collide;
+mod cutting;
 mod error;
 mod levels;
+mod orient;
 pub mod place;
 mod plan;
 mod prove;
+mod radius;
+pub mod sqp;
 mod sync;
 pub mod tol;
 
 pub use collide::BodyCheck;
+pub use cutting::CuttingData;
 pub use error::Rough5Error;
 pub use levels::{LevelPasses, TiltMode, level_passes};
+pub use orient::{
+    AngleUnit, BoundsPenalty, Coverage, OrientSettings, Orientation, Reparam, Weights, constraints, objective_terms,
+    optimise_pass, pitch_trace, synchronise_with,
+};
 pub use place::{Feature, Placement, Placer, tool_frame};
-pub use plan::{LevelReport, PassReport, Rough5Plan, Rough5Settings, plan_rough5};
+pub use plan::{LevelReport, PassReport, Rough5Plan, Rough5Settings, SinglePass, plan_rough5, plan_single_pass};
 pub use prove::{Proof, ProofSettings, prove};
+pub use radius::{apparent_contour_radius, effective_radius, exact_scallop, scallop_height, swept_profile};
 pub use sync::{SyncPoint, axis_steps, closest_vertex, interpolate_axis, limit_angular_step, pitch_angle, synchronise};

@@ -20,8 +20,9 @@ use scallop_toolpath::{Move, MoveKind, Toolpath};
 
 use crate::collide::BodyCheck;
 use crate::levels::{TiltMode, level_passes};
+use crate::orient::{OrientSettings, Orientation, optimise_pass, synchronise_with};
 use crate::sync::{SyncPoint, axis_steps, interpolate_axis, limit_angular_step, pitch_angle, synchronise};
-use crate::{Placement, Placer, Rough5Error};
+use crate::{LevelPasses, Placement, Placer, Rough5Error};
 
 /// Settings of [`plan_rough5`] (mm, rad, mm/min).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -50,6 +51,9 @@ pub struct Rough5Settings {
     pub feed: f64,
     /// Rapid rate of the time estimate (mm/min).
     pub rapid_rate: f64,
+    /// The optimised orientation of each paired pass (Jousselin 2020, Ch. 3
+    /// §2), or `None` for SPU.
+    pub orientation: Option<OrientSettings>,
 }
 
 /// What one pass became.
@@ -166,7 +170,8 @@ pub fn plan_rough5(
         let mut first = true;
         for (m, (path, tilt)) in level.passes.iter().enumerate() {
             let cursor = out.last.map_or_else(|| path.line.points[0], |c| c.sync.path);
-            let (runs, mut report) = place_pass(&placer, &body, (path, tilt.as_ref()), &cursor, settings);
+            let (pairs, _) = pass_pairs((path, tilt.as_ref()), &cursor, settings)?;
+            let (runs, mut report) = place_pass(&placer, &body, &pairs);
             report.level = j;
             report.pass = m;
             for run in &runs {
@@ -201,6 +206,68 @@ pub fn plan_rough5(
     })
 }
 
+/// One pass of a level as a program of its own (the orientation cases of
+/// Jousselin 2020, Ch. 3 §2.3).
+#[derive(Debug, Clone)]
+pub struct SinglePass {
+    /// The optimised orientation (`None` for SPU).
+    pub orientation: Option<Orientation>,
+    /// The program: a plunge along the first axis from the safe height, the
+    /// pass (a full lap of a closed pass), a retract.
+    pub toolpath: Toolpath,
+    /// (distance along the cut from its first CL point in mm, theta_t in rad)
+    /// at every CL point kept.
+    pub trace: Vec<(f64, f64)>,
+    /// The pass.
+    pub report: PassReport,
+    /// Time at the programmed feeds and the rapid rate (s).
+    pub estimated_time: f64,
+}
+
+/// Plans pass `pass` of `level` alone, from the path vertex closest to
+/// `entry`, with `cutter` checked against `flanks`; `bottom_allowance` of
+/// `settings` applies when `on_bottom`.
+///
+/// # Errors
+/// [`Rough5Error::NoPass`] when the pass does not exist or no CL point can
+/// be placed; the errors of the placer and of the orientation.
+pub fn plan_single_pass(
+    (level, pass, on_bottom): (&LevelPasses, usize, bool),
+    entry: &Point3,
+    (stock, flanks): (&Aabb3, &TriMesh),
+    cutter: &Cutter,
+    settings: &Rough5Settings,
+) -> Result<SinglePass, Rough5Error> {
+    check(settings)?;
+    let (path, tilt) = level.passes.get(pass).ok_or_else(|| Rough5Error::NoPass {
+        reason: format!("the level has {} passes, not {}", level.passes.len(), pass + 1),
+    })?;
+    let allowance = if on_bottom { settings.bottom_allowance } else { 0.0 };
+    let placer = Placer::new(level.support.mesh(), cutter, allowance)?;
+    let body = BodyCheck::new(flanks, cutter, 0.0);
+    let (pairs, orientation) = pass_pairs((path, tilt.as_ref()), entry, settings)?;
+    let (runs, mut report) = place_pass(&placer, &body, &pairs);
+    report.pass = pass;
+    if runs.is_empty() {
+        return Err(Rough5Error::NoPass { reason: "no CL point of the pass is clear of the flanks".into() });
+    }
+    let mut out = Emitter::new(stock.max.z, stock.max.z + settings.clearance + cutter.radius(), settings);
+    let mut trace = Vec::new();
+    let mut along = 0.0;
+    for (k, run) in runs.iter().enumerate() {
+        out.cut_run(run, f64::NEG_INFINITY, k == 0, (&placer, &body));
+        for (i, c) in run.iter().enumerate() {
+            if i > 0 {
+                along += (c.place.tip - run[i - 1].place.tip).norm();
+            }
+            trace.push((along, pitch_angle(&c.place.axis, &c.sync.tangent, &c.sync.normal)));
+        }
+    }
+    out.finish();
+    let estimated_time = estimate_time(&out.path, settings.rapid_rate);
+    Ok(SinglePass { orientation, toolpath: out.path, trace, report, estimated_time })
+}
+
 /// Time at the programmed feeds and the rapid rate (s).
 fn estimate_time(path: &Toolpath, rapid_rate: f64) -> f64 {
     let mut from: Option<Point3> = None;
@@ -218,20 +285,28 @@ fn estimate_time(path: &Toolpath, rapid_rate: f64) -> f64 {
     t
 }
 
-/// The synchronised, placed and checked CL points of one pass, split into
-/// runs where pairs were dropped.
-fn place_pass(
-    placer: &Placer,
-    body: &BodyCheck,
+/// The synchronised pairs of one pass: SPU, or the optimised
+/// reparameterisation when `settings.orientation` is given and the pass has
+/// a tilt curve; with the angular step limited.
+fn pass_pairs(
     (path, tilt): (&Curve, Option<&Curve>),
     cursor: &Point3,
     settings: &Rough5Settings,
-) -> (Vec<Vec<Cl>>, PassReport) {
-    let pairs = limit_angular_step(
-        &synchronise(path, tilt, cursor, settings.step),
-        settings.max_angle_step,
-        settings.max_azimuth_step,
-    );
+) -> Result<(Vec<SyncPoint>, Option<Orientation>), Rough5Error> {
+    let (pairs, orientation) = match (tilt, &settings.orientation) {
+        (Some(t), Some(o)) => {
+            let start = path.line.points[crate::closest_vertex(path, cursor)];
+            let found = optimise_pass(path, t, &start, o)?;
+            (synchronise_with(path, t, &start, settings.step, &found.reparam), Some(found))
+        }
+        _ => (synchronise(path, tilt, cursor, settings.step), None),
+    };
+    Ok((limit_angular_step(&pairs, settings.max_angle_step, settings.max_azimuth_step), orientation))
+}
+
+/// The placed and checked CL points of the pairs of one pass, split into
+/// runs where pairs were dropped.
+fn place_pass(placer: &Placer, body: &BodyCheck, pairs: &[SyncPoint]) -> (Vec<Vec<Cl>>, PassReport) {
     let placed: Vec<Option<Cl>> = pairs
         .par_iter()
         .map(|s| {

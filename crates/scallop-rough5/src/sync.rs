@@ -220,31 +220,64 @@ fn plan_turning(curve: &Curve) -> f64 {
         .sum()
 }
 
+/// The reference structure of one pass (Jousselin 2020, Fig. 3.15): the path
+/// curve started at P_T0 and the tilt curve turned the same way, with the
+/// arc length of P_D0 on it; immutable while the pass is reparameterised.
+pub(crate) struct PassCurves {
+    path: ArcCurve,
+    tilt: Option<(ArcCurve, f64)>,
+}
+
+impl PassCurves {
+    /// The curves of the pass `path` (started at its vertex closest to
+    /// `start`) and `tilt`; `None` for fewer than two path points.
+    pub(crate) fn new(path: &Curve, tilt: Option<&Curve>, start: &Point3) -> Option<PassCurves> {
+        if path.line.points.len() < 2 {
+            return None;
+        }
+        let cp = ArcCurve::new(path, closest_vertex(path, start));
+        let (p0, n0, _) = cp.at(0.0);
+        let ct = tilt.filter(|t| t.line.points.len() >= 2).map(|t| {
+            let same_way = plan_turning(t) * plan_turning(path) >= 0.0 || !path.line.closed;
+            let t = if same_way { t.clone() } else { t.reversed() };
+            let c = ArcCurve::new(&t, 0);
+            let s0 = c.closest_to_line(&p0, &n0);
+            (c, s0)
+        });
+        Some(PassCurves { path: cp, tilt: ct })
+    }
+
+    /// Length of the path curve (mm).
+    pub(crate) fn path_length(&self) -> f64 {
+        self.path.length()
+    }
+
+    /// The pair at the fractions `s_t` of the path curve and `s_d` of the
+    /// tilt curve from their start points (the path fraction taken modulo 1
+    /// outside [0, 1] on a closed curve, the tilt position modulo its length).
+    pub(crate) fn pair(&self, s_t: f64, s_d: f64) -> SyncPoint {
+        let s_t = if self.path.closed && !(0.0..=1.0).contains(&s_t) { s_t.rem_euclid(1.0) } else { s_t };
+        let (p, n, t) = self.path.at(s_t * self.path.length());
+        let d = self
+            .tilt
+            .as_ref()
+            .map(|(c, s0)| c.at((s0 + s_d * c.length()).rem_euclid(c.length().max(f64::MIN_POSITIVE))).0);
+        SyncPoint { path: p, tilt: d, normal: n, tangent: t, axis: pair_axis(&p, d.as_ref()) }
+    }
+}
+
 /// Synchronises `path` (started at its vertex closest to `start`) with
 /// `tilt` (or zero tilt when `None`) by SPU, `count + 1` pairs for `count`
 /// steps of about `step` mm along the path curve (the last pair closes a
 /// closed curve).
 #[must_use]
 pub fn synchronise(path: &Curve, tilt: Option<&Curve>, start: &Point3, step: f64) -> Vec<SyncPoint> {
-    if path.line.points.len() < 2 {
-        return Vec::new();
-    }
-    let cp = ArcCurve::new(path, closest_vertex(path, start));
-    let count = ((cp.length() / step).ceil() as usize).clamp(2, tol::MAX_PASS_POINTS);
-    let (p0, n0, _) = cp.at(0.0);
-    let ct = tilt.filter(|t| t.line.points.len() >= 2).map(|t| {
-        let same_way = plan_turning(t) * plan_turning(path) >= 0.0 || !path.line.closed;
-        let t = if same_way { t.clone() } else { t.reversed() };
-        let c = ArcCurve::new(&t, 0);
-        let s0 = c.closest_to_line(&p0, &n0);
-        (c, s0)
-    });
+    let Some(curves) = PassCurves::new(path, tilt, start) else { return Vec::new() };
+    let count = ((curves.path_length() / step).ceil() as usize).clamp(2, tol::MAX_PASS_POINTS);
     (0..=count)
         .map(|k| {
             let s = k as f64 / count as f64;
-            let (p, n, t) = cp.at(s * cp.length());
-            let d = ct.as_ref().map(|(c, s0)| c.at((s0 + s * c.length()) % c.length().max(f64::MIN_POSITIVE)).0);
-            SyncPoint { path: p, tilt: d, normal: n, tangent: t, axis: pair_axis(&p, d.as_ref()) }
+            curves.pair(s, s)
         })
         .collect()
 }

@@ -1,6 +1,8 @@
-//! The whole slice on the closed test pocket: both variants plan, place
-//! every CL point on or above its level, keep the angular step, do not
-//! depend on the thread count, and prove themselves on a tri-dexel stock (no
+//! The whole slice on the closed test pocket: the three variants (zero
+//! tilt, guide curves by SPU, guide curves with the optimised orientation)
+//! plan, place every CL point on or above its level, keep the angular step,
+//! do not depend on the thread count, and prove themselves on a tri-dexel
+//! stock (no
 //! rapid into stock, no shank or holder collision, nothing removed outside
 //! the volume to remove beyond the rays' rounding).
 #![allow(clippy::unwrap_used, reason = "tests: a panic is the failure report")]
@@ -8,7 +10,7 @@
 use scallop_cutter::{Cutter, CutterShape, HolderSegment};
 use scallop_guides::GuideSettings;
 use scallop_parts::{FaceTag, closed_pocket};
-use scallop_rough5::{ProofSettings, Rough5Settings, TiltMode, plan_rough5, prove};
+use scallop_rough5::{OrientSettings, ProofSettings, Rough5Settings, TiltMode, Weights, plan_rough5, prove};
 use scallop_toolpath::MoveKind;
 
 fn settings(tilt: TiltMode, depth: f64) -> Rough5Settings {
@@ -31,11 +33,12 @@ fn settings(tilt: TiltMode, depth: f64) -> Rough5Settings {
         link_max: 9.0,
         feed: 2400.0,
         rapid_rate: 20_000.0,
+        orientation: None,
     }
 }
 
 #[test]
-fn both_variants_prove_themselves_on_the_closed_pocket() {
+fn every_variant_proves_itself_on_the_closed_pocket() {
     let part = closed_pocket(&Default::default()).unwrap();
     let bottom = part.faces(&[FaceTag::Bottom]).unwrap();
     let flanks = part.faces(&[FaceTag::Flank]).unwrap();
@@ -47,8 +50,10 @@ fn both_variants_prove_themselves_on_the_closed_pocket() {
         .unwrap();
     let depth = part.stock.max.z - bottom.bounds().min.z;
     let mut remaining = Vec::new();
-    for tilt in [TiltMode::Zero, TiltMode::Guides] {
-        let s = settings(tilt, depth);
+    // The optimised orientation: the thesis's mixed weighting (Ch. 3 §2.3, case 2).
+    let mixed = OrientSettings::new(Weights { bounds: 15.0, fluidity: 1.2, pitch: 1.0 });
+    for (tilt, orientation) in [(TiltMode::Zero, None), (TiltMode::Guides, None), (TiltMode::Guides, Some(mixed))] {
+        let s = Rough5Settings { orientation, ..settings(tilt, depth) };
         let plan = plan_rough5(&bottom, &flanks, &part.stock, &tool, &s, &|_, _| {}).unwrap();
         let path = &plan.toolpath;
         assert!(plan.passes.iter().map(|p| p.points).sum::<usize>() > 100);
