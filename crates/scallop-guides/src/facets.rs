@@ -47,10 +47,29 @@ pub(crate) fn march(
     exact: &(impl Fn(&Point3) -> f64 + Sync),
     medial: &(impl Fn(usize) -> bool + Sync),
 ) -> Isolines {
+    march_facets(support, values, 0..support.mesh().triangles().len(), exact, medial)
+}
+
+/// As [`march`], looking only at `facets` (ascending): the caller vouches
+/// that every facet with vertices of both states is among them.
+pub(crate) fn march_facets(
+    support: &Support,
+    values: &[f64],
+    facets: impl Iterator<Item = usize>,
+    exact: &(impl Fn(&Point3) -> f64 + Sync),
+    medial: &(impl Fn(usize) -> bool + Sync),
+) -> Isolines {
     let mesh = support.mesh();
     let pos = |v: u32| values[v as usize] > 0.0;
-    let mut edges: Vec<(u32, u32)> = Vec::new();
-    for t in mesh.triangles() {
+    let mixed: Vec<usize> = facets
+        .filter(|&f| {
+            let n = mesh.triangles()[f].iter().filter(|&&v| pos(v)).count();
+            n == 1 || n == 2
+        })
+        .collect();
+    let mut edges: Vec<(u32, u32)> = Vec::with_capacity(2 * mixed.len());
+    for &f in &mixed {
+        let t = mesh.triangles()[f];
         for k in 0..3 {
             let (a, b) = (t[k], t[(k + 1) % 3]);
             if pos(a) != pos(b) {
@@ -65,13 +84,6 @@ pub(crate) fn march(
     for (i, &(a, b)) in edges.iter().enumerate() {
         index.insert(u64::from(a) << 32 | u64::from(b), u32::try_from(i).unwrap_or(u32::MAX));
     }
-    let mixed: Vec<usize> = (0..mesh.triangles().len())
-        .filter(|&f| {
-            let t = mesh.triangles()[f];
-            let n = t.iter().filter(|&&v| pos(v)).count();
-            n == 1 || n == 2
-        })
-        .collect();
     let built: Vec<(Segment, bool, bool)> =
         mixed.par_iter().map(|&f| facet_segment(support, values, &index, &crossings, f, exact, medial)).collect();
     let flagged = built.iter().filter(|b| b.1).count();
