@@ -47,16 +47,18 @@ pub(crate) fn march(
     exact: &(impl Fn(&Point3) -> f64 + Sync),
     medial: &(impl Fn(usize) -> bool + Sync),
 ) -> Isolines {
-    march_facets(support, values, 0..support.mesh().triangles().len(), exact, medial)
+    march_facets(support, values, 0..support.mesh().triangles().len(), &|p: &Point3, _| exact(p), medial)
 }
 
 /// As [`march`], looking only at `facets` (ascending): the caller vouches
-/// that every facet with vertices of both states is among them.
+/// that every facet with vertices of both states is among them. `exact(p, v)`
+/// is told a vertex `v` near `p` (an end of the edge, a corner of the facet),
+/// which it may use to search from, not to change the value.
 pub(crate) fn march_facets(
     support: &Support,
     values: &[f64],
     facets: impl Iterator<Item = usize>,
-    exact: &(impl Fn(&Point3) -> f64 + Sync),
+    exact: &(impl Fn(&Point3, u32) -> f64 + Sync),
     medial: &(impl Fn(usize) -> bool + Sync),
 ) -> Isolines {
     let mesh = support.mesh();
@@ -98,9 +100,15 @@ fn edge_key(a: u32, b: u32) -> u64 {
 }
 
 /// The crossing on edge `(a, b)` (states differ) by root finding.
-fn crossing(support: &Support, values: &[f64], exact: &(impl Fn(&Point3) -> f64 + Sync), a: u32, b: u32) -> Crossing {
+fn crossing(
+    support: &Support,
+    values: &[f64],
+    exact: &(impl Fn(&Point3, u32) -> f64 + Sync),
+    a: u32,
+    b: u32,
+) -> Crossing {
     let (pa, pb) = (support.mesh().vertices()[a as usize], support.mesh().vertices()[b as usize]);
-    let t = edge_root(|t| exact(&(pa + (pb - pa) * t)), values[a as usize], values[b as usize], (pb - pa).norm());
+    let t = edge_root(|t| exact(&(pa + (pb - pa) * t), a), values[a as usize], values[b as usize], (pb - pa).norm());
     let n = support.vertex_normal(a as usize) * (1.0 - t) + support.vertex_normal(b as usize) * t;
     let len = n.norm();
     Crossing { point: pa + (pb - pa) * t, normal: if len > 0.0 { n / len } else { support.vertex_normal(a as usize) } }
@@ -153,7 +161,7 @@ fn facet_segment(
     index: &FastMap<u64, u32>,
     crossings: &[Crossing],
     f: usize,
-    exact: &(impl Fn(&Point3) -> f64 + Sync),
+    exact: &(impl Fn(&Point3, u32) -> f64 + Sync),
     medial: &(impl Fn(usize) -> bool + Sync),
 ) -> (Segment, bool, bool) {
     let t = support.mesh().triangles()[f];
@@ -178,7 +186,9 @@ fn facet_segment(
     }
     let flagged = medial(f);
     let mid = if flagged {
-        repair(support, f, &crossings[ends[0] as usize].point, &crossings[ends[1] as usize].point, exact)
+        repair(support, f, &crossings[ends[0] as usize].point, &crossings[ends[1] as usize].point, &|p: &Point3| {
+            exact(p, t[0])
+        })
     } else {
         None
     };
@@ -189,13 +199,7 @@ fn facet_segment(
 /// The iso point across the middle of segment `[p, q]` within facet `f`, if
 /// the field changes state along the facet's in-plane normal to the segment
 /// and the point stays in the facet.
-fn repair(
-    support: &Support,
-    f: usize,
-    p: &Point3,
-    q: &Point3,
-    exact: &(impl Fn(&Point3) -> f64 + Sync),
-) -> Option<Point3> {
+fn repair(support: &Support, f: usize, p: &Point3, q: &Point3, exact: &impl Fn(&Point3) -> f64) -> Option<Point3> {
     let normal = support.query().normal(f);
     let w = normal.cross(&(q - p));
     let len = w.norm();

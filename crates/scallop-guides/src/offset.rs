@@ -7,6 +7,7 @@
 
 use rayon::prelude::*;
 use scallop_geom::Point3;
+use scallop_mesh::PolylineFoot;
 
 use crate::facets::{Isolines, march_facets};
 use crate::field::CurveField;
@@ -90,14 +91,14 @@ pub fn offset_curve(support: &Support, curves: &[Curve], distance: f64) -> Resul
 
 /// One Marching Facets extraction, measuring only the vertices near the
 /// iso-line (docs/guides-curves.md, "Only the vertices near the iso-line
-/// are measured"). The reach is `distance` plus two facets, the margin `m`
-/// two facets. A node of the vertex tree (centre `c`, radius `r`) whose
-/// centre is farther than the reach plus `r` from the curves holds only far
-/// vertices (value NaN, as a full scan leaves them); one nearer than
-/// `distance - m - r` only vertices nearer than `distance - m`, negative
+/// are measured"). Let `h` be the facet size and the reach `distance + 2h`.
+/// A node of the vertex tree (radius `r`) whose centre is farther than the
+/// reach plus `r` from the curves holds only vertices beyond the reach
+/// (value NaN, as a full scan leaves them); one whose centre is nearer than
+/// `distance - h - r` only vertices nearer than `distance - h`, negative
 /// whatever their side (`-inf`). The other leaves are measured vertex by
-/// vertex. A facet with both states then
-/// has a measured corner (an edge is shorter than `m`): only the facets of
+/// vertex. An edge is at most `h` long, so a facet with both states has a
+/// measured corner and no unmeasured near corner: only the facets of
 /// measured vertices are marched, after their far corners get their side
 /// ([`side_far_corners`]). The iso-line is the one of the full scan that
 /// measures every vertex within the reach.
@@ -109,7 +110,7 @@ fn offset_once(support: &Support, curves: &[Curve], distance: f64) -> Isolines {
     let verts = support.mesh().vertices();
     // The vertices of a leaf are neighbours in space: each query searches
     // from the last foot found (the same feet, fewer nodes visited).
-    let measured: Vec<Vec<(u32, f64, Option<Point3>)>> = leaves
+    let measured: Vec<Vec<(u32, f64, Option<PolylineFoot>)>> = leaves
         .par_iter()
         .map(|&l| {
             let mut hint = None;
@@ -120,7 +121,7 @@ fn offset_once(support: &Support, curves: &[Curve], distance: f64) -> Isolines {
                     match field.foot_near(p, reach, hint.as_ref()) {
                         Some(f) => {
                             hint = Some(f);
-                            (v, field.signed_at(p, &f) - distance, Some(f.point))
+                            (v, field.signed_at(p, &f) - distance, Some(f))
                         }
                         None => (v, f64::NAN, None),
                     }
@@ -135,35 +136,38 @@ fn offset_once(support: &Support, curves: &[Curve], distance: f64) -> Isolines {
         }
     }
     let mut slot = vec![u32::MAX; verts.len()];
-    let mut feet: Vec<Point3> = Vec::new();
+    let mut feet: Vec<PolylineFoot> = Vec::new();
+    let mut marked = vec![false; support.mesh().triangles().len()];
     for (v, value, foot) in measured.into_iter().flatten() {
         values[v as usize] = value;
         if let Some(f) = foot {
             slot[v as usize] = u32::try_from(feet.len()).unwrap_or(u32::MAX);
             feet.push(f);
+            for &f in support.vertex_facets(v as usize) {
+                marked[f as usize] = true;
+            }
         }
     }
-    let mut facets: Vec<u32> = (0..verts.len())
-        .filter(|&v| slot[v] != u32::MAX)
-        .flat_map(|v| support.vertex_facets(v).iter().copied())
-        .collect();
-    facets.sort_unstable();
-    facets.dedup();
+    let facets: Vec<u32> = (0..marked.len()).filter(|&f| marked[f]).map(|f| f as u32).collect();
     side_far_corners(support, &facets, &mut values);
-    let foot = |v: u32| feet.get(slot[v as usize] as usize).copied();
-    let exact = |p: &Point3| field.signed(p) - distance;
-    let medial = |f: usize| medial_facet(support, f, foot);
+    let foot = |v: u32| feet.get(slot[v as usize] as usize);
+    // Roots search from the foot of a nearby vertex: the same foot, found faster.
+    let exact = |p: &Point3, v: u32| {
+        let f = field.foot_near(p, f64::INFINITY, foot(v));
+        f.map_or(f64::NEG_INFINITY, |f| field.signed_at(p, &f)) - distance
+    };
+    let medial = |f: usize| medial_facet(support, f, |v| foot(v).map(|f| f.point));
     march_facets(support, &values, facets.iter().map(|&f| f as usize), &exact, &medial)
 }
 
 /// The nodes of the vertex tree whose vertices are all nearer than
-/// `distance - (reach - distance)` to the curves, and the leaves to measure,
+/// `distance` less a facet to the curves, and the leaves to measure,
 /// in tree order; the nodes left out hold only vertices farther than the
 /// reach.
 fn select_nodes(support: &Support, field: &CurveField, distance: f64, reach: f64) -> (Vec<u32>, Vec<u32>) {
     let mut out = (Vec::new(), Vec::new());
     if !support.vertex_tree().nodes.is_empty() {
-        let inner = distance - (reach - distance);
+        let inner = distance - support.facet_size() * (1.0 + tol::SELECTION_SLACK);
         select_under(support.vertex_tree(), field, 0, [inner, reach], &mut out);
     }
     out
@@ -249,7 +253,7 @@ mod tests {
     #![allow(clippy::unwrap_used, reason = "a test: a panic is the failure report")]
 
     use proptest::prelude::*;
-    use scallop_mesh::{Polyline3, PolylineFoot, TriMesh};
+    use scallop_mesh::{Polyline3, TriMesh};
 
     use super::*;
     use crate::facets::march;
