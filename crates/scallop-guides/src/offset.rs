@@ -91,44 +91,25 @@ pub fn offset_curve(support: &Support, curves: &[Curve], distance: f64) -> Resul
 
 /// One Marching Facets extraction, measuring only the vertices near the
 /// iso-line (docs/guides-curves.md, "Only the vertices near the iso-line
-/// are measured"). Let `h` be the facet size and the reach `distance + 2h`.
-/// A node of the vertex tree (radius `r`) whose centre is farther than the
-/// reach plus `r` from the curves holds only vertices beyond the reach
-/// (value NaN, as a full scan leaves them); one whose centre is nearer than
-/// `distance - h - r` only vertices nearer than `distance - h`, negative
-/// whatever their side (`-inf`). The other leaves are measured vertex by
-/// vertex. An edge is at most `h` long, so a facet with both states has a
-/// measured corner and no unmeasured near corner: only the facets of
-/// measured vertices are marched, after their far corners get their side
+/// are measured"). With `h` the facet size, the vertices nearer than
+/// `distance - h` to the curves ([`Limits`]) are negative whatever their side
+/// (`-inf`), those farther than `distance + h` take the side of a measured
+/// neighbour (NaN here), the others are measured within the reach
+/// `distance + 2h`. An edge is at most `h` long, so a facet with both states
+/// has only measured corners but for far ones: only the facets of measured
+/// vertices are marched, after their far corners get their side
 /// ([`side_far_corners`]). The iso-line is the one of the full scan that
 /// measures every vertex within the reach.
 fn offset_once(support: &Support, curves: &[Curve], distance: f64) -> Isolines {
     let field = CurveField::new(curves);
-    let reach = distance + 2.0 * support.facet_size();
-    let (near, leaves) = select_nodes(support, &field, distance, reach);
+    let h = support.facet_size() * (1.0 + tol::SELECTION_SLACK);
+    let lim =
+        Limits { distance, inner: distance - h, outer: distance + h, reach: distance + 2.0 * support.facet_size() };
+    let (near, leaves) = select_nodes(support, &field, lim);
     let tree = support.vertex_tree();
     let verts = support.mesh().vertices();
-    // The vertices of a leaf are neighbours in space: each query searches
-    // from the last foot found (the same feet, fewer nodes visited).
-    let measured: Vec<Vec<(u32, f64, Option<PolylineFoot>)>> = leaves
-        .par_iter()
-        .map(|&l| {
-            let mut hint = None;
-            tree.vertices(l as usize)
-                .iter()
-                .map(|&v| {
-                    let p = &verts[v as usize];
-                    match field.foot_near(p, reach, hint.as_ref()) {
-                        Some(f) => {
-                            hint = Some(f);
-                            (v, field.signed_at(p, &f) - distance, Some(f))
-                        }
-                        None => (v, f64::NAN, None),
-                    }
-                })
-                .collect()
-        })
-        .collect();
+    let measured: Vec<Vec<(u32, f64, Option<PolylineFoot>)>> =
+        leaves.par_iter().map(|&(l, dc)| measure_leaf(support, &field, l, dc, lim)).collect();
     let mut values = vec![f64::NAN; verts.len()];
     for &n in &near {
         for &v in tree.vertices(n as usize) {
@@ -160,47 +141,107 @@ fn offset_once(support: &Support, curves: &[Curve], distance: f64) -> Isolines {
     march_facets(support, &values, facets.iter().map(|&f| f as usize), &exact, &medial)
 }
 
+/// The distances that sort the vertices of one extraction (mm): the offset,
+/// the one below which a vertex is outside the new curve whatever its side,
+/// the one beyond which it takes its side from a neighbour, and the bound of
+/// a measurement.
+#[derive(Clone, Copy)]
+struct Limits {
+    distance: f64,
+    inner: f64,
+    outer: f64,
+    reach: f64,
+}
+
+/// The vertices of leaf `l`, whose centre is `dc` from the curves, with
+/// their values and feet. A vertex whose distance bounds (triangle inequality
+/// from the centre and from the last vertex measured) put it nearer than
+/// `inner` gets `-inf`, farther than `outer` NaN; the others a bounded query
+/// each, searching from the last foot found (the same foot, found faster).
+fn measure_leaf(
+    support: &Support,
+    field: &CurveField,
+    l: u32,
+    dc: f64,
+    lim: Limits,
+) -> Vec<(u32, f64, Option<PolylineFoot>)> {
+    let tree = support.vertex_tree();
+    let verts = support.mesh().vertices();
+    let c = tree.nodes[l as usize].center;
+    let slack = tol::SELECTION_SLACK * lim.reach;
+    let mut last: Option<(PolylineFoot, Point3)> = None;
+    tree.vertices(l as usize)
+        .iter()
+        .map(|&v| {
+            let p = verts[v as usize];
+            let e = (p - c).norm();
+            let (mut lo, mut hi) = (dc - e, dc + e);
+            if let Some((f, q)) = &last {
+                let e = (p - q).norm();
+                (lo, hi) = (lo.max(f.distance - e), hi.min(f.distance + e));
+            }
+            if hi + slack < lim.inner {
+                return (v, f64::NEG_INFINITY, None);
+            }
+            if lo - slack > lim.outer {
+                return (v, f64::NAN, None);
+            }
+            match field.foot_near(&p, lim.reach, last.as_ref().map(|l| &l.0)) {
+                Some(f) => {
+                    last = Some((f, p));
+                    (v, field.signed_at(&p, &f) - lim.distance, Some(f))
+                }
+                None => (v, f64::NAN, None),
+            }
+        })
+        .collect()
+}
+
 /// The nodes of the vertex tree whose vertices are all nearer than
-/// `distance` less a facet to the curves, and the leaves to measure,
-/// in tree order; the nodes left out hold only vertices farther than the
-/// reach.
-fn select_nodes(support: &Support, field: &CurveField, distance: f64, reach: f64) -> (Vec<u32>, Vec<u32>) {
+/// `lim.inner` to the curves, and the leaves to look into with their
+/// centre's distance, in tree order; the nodes left out hold only vertices
+/// farther than `lim.outer`.
+fn select_nodes(support: &Support, field: &CurveField, lim: Limits) -> (Vec<u32>, Vec<(u32, f64)>) {
     let mut out = (Vec::new(), Vec::new());
     if !support.vertex_tree().nodes.is_empty() {
-        let inner = distance - support.facet_size() * (1.0 + tol::SELECTION_SLACK);
-        select_under(support.vertex_tree(), field, 0, [inner, reach], &mut out);
+        select_under(support.vertex_tree(), field, 0, None, lim, &mut out);
     }
     out
 }
 
-/// [`select_nodes`] below node `i`, appending to `out` (near nodes, leaves);
-/// `limits` are the inner distance and the reach. Subtrees of more than
+/// [`select_nodes`] below node `i`, appending to `out`; the query searches
+/// from `hint`, the parent's foot. Subtrees of more than
 /// [`PARALLEL_VERTICES`] vertices are searched in parallel, their lists
 /// joined in tree order.
-fn select_under(tree: &VertexTree, field: &CurveField, i: u32, limits: [f64; 2], out: &mut (Vec<u32>, Vec<u32>)) {
-    let [inner, reach] = limits;
+fn select_under(
+    tree: &VertexTree,
+    field: &CurveField,
+    i: u32,
+    hint: Option<&PolylineFoot>,
+    lim: Limits,
+    out: &mut (Vec<u32>, Vec<(u32, f64)>),
+) {
     let n = &tree.nodes[i as usize];
-    let r = n.radius * (1.0 + tol::SELECTION_SLACK) + tol::SELECTION_SLACK * reach;
-    match field.foot_within(&n.center, reach + r) {
-        None => {}
-        Some(f) if f.distance + r < inner => out.0.push(i),
-        Some(_) if n.second == 0 => out.1.push(i),
-        Some(_) if (n.end - n.start) as usize > PARALLEL_VERTICES => {
-            let sub = |j: u32| {
-                let mut o = (Vec::new(), Vec::new());
-                select_under(tree, field, j, limits, &mut o);
-                o
-            };
-            let (a, b) = rayon::join(|| sub(i + 1), || sub(n.second));
-            for (near, leaves) in [a, b] {
-                out.0.extend(near);
-                out.1.extend(leaves);
-            }
+    let r = n.radius * (1.0 + tol::SELECTION_SLACK) + tol::SELECTION_SLACK * lim.reach;
+    let Some(f) = field.foot_near(&n.center, lim.outer + r, hint) else { return };
+    if f.distance + r < lim.inner {
+        out.0.push(i);
+    } else if n.second == 0 {
+        out.1.push((i, f.distance));
+    } else if (n.end - n.start) as usize > PARALLEL_VERTICES {
+        let sub = |j: u32| {
+            let mut o = (Vec::new(), Vec::new());
+            select_under(tree, field, j, Some(&f), lim, &mut o);
+            o
+        };
+        let (a, b) = rayon::join(|| sub(i + 1), || sub(n.second));
+        for (near, leaves) in [a, b] {
+            out.0.extend(near);
+            out.1.extend(leaves);
         }
-        Some(_) => {
-            select_under(tree, field, i + 1, limits, out);
-            select_under(tree, field, n.second, limits, out);
-        }
+    } else {
+        select_under(tree, field, i + 1, Some(&f), lim, out);
+        select_under(tree, field, n.second, Some(&f), lim, out);
     }
 }
 
