@@ -81,19 +81,27 @@ pub(crate) fn march_facets(
     }
     edges.sort_unstable();
     edges.dedup();
-    let crossings: Vec<Crossing> = edges.par_iter().map(|&(a, b)| crossing(support, values, exact, a, b)).collect();
+    let crossings: Vec<Crossing> =
+        edges.par_iter().with_min_len(ITEMS_PER_TASK).map(|&(a, b)| crossing(support, values, exact, a, b)).collect();
     let mut index: FastMap<u64, u32> = FastMap::default();
     for (i, &(a, b)) in edges.iter().enumerate() {
         index.insert(u64::from(a) << 32 | u64::from(b), u32::try_from(i).unwrap_or(u32::MAX));
     }
-    let built: Vec<(Segment, bool, bool)> =
-        mixed.par_iter().map(|&f| facet_segment(support, values, &index, &crossings, f, exact, medial)).collect();
+    let built: Vec<(Segment, bool, bool)> = mixed
+        .par_iter()
+        .with_min_len(ITEMS_PER_TASK)
+        .map(|&f| facet_segment(support, values, &index, &crossings, f, exact, medial))
+        .collect();
     let flagged = built.iter().filter(|b| b.1).count();
     let repaired = built.iter().filter(|b| b.2).count();
     let segments: Vec<Segment> = built.into_iter().map(|b| b.0).collect();
     let curves = chain(&segments, &crossings, &edges);
     Isolines { curves, flagged, repaired }
 }
+
+/// Fewest edges or facets per parallel task of [`march_facets`]: a crossing
+/// costs a few distance queries, too little to share finely.
+const ITEMS_PER_TASK: usize = 64;
 
 fn edge_key(a: u32, b: u32) -> u64 {
     u64::from(a.min(b)) << 32 | u64::from(a.max(b))

@@ -108,8 +108,11 @@ fn offset_once(support: &Support, curves: &[Curve], distance: f64) -> Isolines {
     let (near, leaves) = select_nodes(support, &field, lim);
     let tree = support.vertex_tree();
     let verts = support.mesh().vertices();
-    let measured: Vec<Vec<(u32, f64, Option<PolylineFoot>)>> =
-        leaves.par_iter().map(|&(l, dc)| measure_leaf(support, &field, l, dc, lim)).collect();
+    let measured: Vec<Vec<(u32, f64, Option<PolylineFoot>)>> = leaves
+        .par_iter()
+        .with_min_len(LEAVES_PER_TASK)
+        .map(|&(l, dc)| measure_leaf(support, &field, l, dc, lim))
+        .collect();
     let mut values = vec![f64::NAN; verts.len()];
     for &n in &near {
         for &v in tree.vertices(n as usize) {
@@ -246,7 +249,12 @@ fn select_under(
 }
 
 /// Subtrees of the vertex tree larger than this are searched in parallel.
-const PARALLEL_VERTICES: usize = 4096;
+/// Coarse parallel tasks: on a shared machine a thread may wait for a core,
+/// and a join waits for it.
+const PARALLEL_VERTICES: usize = 32_768;
+
+/// Fewest leaves measured by one parallel task (same reason).
+const LEAVES_PER_TASK: usize = 16;
 
 /// Gives the far corners (NaN) of `facets` the side of their lowest-numbered
 /// measured neighbour (the positive side gets `+inf`). This is what a flood
