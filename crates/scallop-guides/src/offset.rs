@@ -259,8 +259,8 @@ const LEAVES_PER_TASK: usize = 16;
 /// Gives the far corners (NaN) of `facets` the side of their lowest-numbered
 /// measured neighbour (the positive side gets `+inf`). This is what a flood
 /// from the measured vertices, taken in order, gives them: a far vertex is
-/// more than the reach from the curves, so no edge from it crosses the
-/// curves, and a connected set of far vertices lies on one side. Every
+/// more than a facet from the curves, so no edge from it crosses the curves,
+/// and a connected set of far vertices lies on one side. Every
 /// facet of `facets` has a measured corner, which is a neighbour of the
 /// others.
 fn side_far_corners(support: &Support, facets: &[u32], values: &mut [f64]) {
