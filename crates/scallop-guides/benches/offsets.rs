@@ -2,6 +2,15 @@
 //! (Marching Facets) and vectorial (Alg. 1-3): Jousselin 2020, Table 2.1.
 //! `cargo bench -p scallop-guides --bench offsets`; the 0.1 mm step (about
 //! 430k facets) only with `SCALLOP_BENCH_FINE=1`. Figures in docs/benchmarks.md.
+//!
+//! What is timed: `offsets/scalar` is one `offset_curves` call (every
+//! extraction until the offsets vanish, the curve fields included);
+//! `offsets/vectorial` is as many `vectorial_offset` calls (their curve
+//! indexes and resampling included). Both start from the same support and
+//! limit curve, built outside the timed closures; `support/new` times that
+//! set-up apart (`Support::new` on the welded mesh: the triangle BVH both
+//! methods query, the vertex adjacency and incidence, and the vertex tree
+//! only the scalar method uses).
 
 #![allow(clippy::unwrap_used, missing_docs, reason = "a bench: a panic is the failure report")]
 
@@ -11,7 +20,7 @@ mod common;
 use std::hint::black_box;
 
 use common::{grid_surface, p};
-use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use criterion::{BatchSize, BenchmarkId, Criterion, criterion_group, criterion_main};
 use scallop_guides::{Curve, Support, VectorialOptions, offset_curves, vectorial_offset};
 use scallop_mesh::Polyline3;
 
@@ -59,13 +68,9 @@ fn vectorial(s: &Support, c: &Curve, count: usize, step: f64) -> usize {
 }
 
 fn bench(c: &mut Criterion) {
-    let mut steps = vec![1.0, 0.5, 0.25];
-    if std::env::var_os("SCALLOP_BENCH_FINE").is_some() {
-        steps.push(0.1);
-    }
     let mut group = c.benchmark_group("offsets");
     group.sample_size(10);
-    for step in steps {
+    for step in steps_to_run() {
         let s = support(step);
         let lim = limit(&s);
         let facets = s.mesh().triangles().len();
@@ -78,6 +83,24 @@ fn bench(c: &mut Criterion) {
         });
     }
     group.finish();
+    let mut group = c.benchmark_group("support");
+    group.sample_size(10);
+    for step in steps_to_run() {
+        let mesh = support(step).mesh().clone();
+        group.bench_with_input(BenchmarkId::new("new", mesh.triangles().len()), &mesh, |b, m| {
+            b.iter_batched(|| m.clone(), Support::new, BatchSize::LargeInput);
+        });
+    }
+    group.finish();
+}
+
+/// The mesh steps (mm): 1, 0.5 and 0.25, and 0.1 with `SCALLOP_BENCH_FINE`.
+fn steps_to_run() -> Vec<f64> {
+    let mut steps = vec![1.0, 0.5, 0.25];
+    if std::env::var_os("SCALLOP_BENCH_FINE").is_some() {
+        steps.push(0.1);
+    }
+    steps
 }
 
 criterion_group!(benches, bench);

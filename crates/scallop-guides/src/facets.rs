@@ -47,10 +47,31 @@ pub(crate) fn march(
     exact: &(impl Fn(&Point3) -> f64 + Sync),
     medial: &(impl Fn(usize) -> bool + Sync),
 ) -> Isolines {
+    march_facets(support, values, 0..support.mesh().triangles().len(), &|p: &Point3, _| exact(p), medial)
+}
+
+/// As [`march`], looking only at `facets` (ascending): the caller vouches
+/// that every facet with vertices of both states is among them. `exact(p, v)`
+/// is told a vertex `v` near `p` (an end of the edge, a corner of the facet),
+/// which it may use to search from, not to change the value.
+pub(crate) fn march_facets(
+    support: &Support,
+    values: &[f64],
+    facets: impl Iterator<Item = usize>,
+    exact: &(impl Fn(&Point3, u32) -> f64 + Sync),
+    medial: &(impl Fn(usize) -> bool + Sync),
+) -> Isolines {
     let mesh = support.mesh();
     let pos = |v: u32| values[v as usize] > 0.0;
-    let mut edges: Vec<(u32, u32)> = Vec::new();
-    for t in mesh.triangles() {
+    let mixed: Vec<usize> = facets
+        .filter(|&f| {
+            let n = mesh.triangles()[f].iter().filter(|&&v| pos(v)).count();
+            n == 1 || n == 2
+        })
+        .collect();
+    let mut edges: Vec<(u32, u32)> = Vec::with_capacity(2 * mixed.len());
+    for &f in &mixed {
+        let t = mesh.triangles()[f];
         for k in 0..3 {
             let (a, b) = (t[k], t[(k + 1) % 3]);
             if pos(a) != pos(b) {
@@ -60,20 +81,17 @@ pub(crate) fn march(
     }
     edges.sort_unstable();
     edges.dedup();
-    let crossings: Vec<Crossing> = edges.par_iter().map(|&(a, b)| crossing(support, values, exact, a, b)).collect();
+    let crossings: Vec<Crossing> =
+        edges.par_iter().with_min_len(ITEMS_PER_TASK).map(|&(a, b)| crossing(support, values, exact, a, b)).collect();
     let mut index: FastMap<u64, u32> = FastMap::default();
     for (i, &(a, b)) in edges.iter().enumerate() {
         index.insert(u64::from(a) << 32 | u64::from(b), u32::try_from(i).unwrap_or(u32::MAX));
     }
-    let mixed: Vec<usize> = (0..mesh.triangles().len())
-        .filter(|&f| {
-            let t = mesh.triangles()[f];
-            let n = t.iter().filter(|&&v| pos(v)).count();
-            n == 1 || n == 2
-        })
+    let built: Vec<(Segment, bool, bool)> = mixed
+        .par_iter()
+        .with_min_len(ITEMS_PER_TASK)
+        .map(|&f| facet_segment(support, values, &index, &crossings, f, exact, medial))
         .collect();
-    let built: Vec<(Segment, bool, bool)> =
-        mixed.par_iter().map(|&f| facet_segment(support, values, &index, &crossings, f, exact, medial)).collect();
     let flagged = built.iter().filter(|b| b.1).count();
     let repaired = built.iter().filter(|b| b.2).count();
     let segments: Vec<Segment> = built.into_iter().map(|b| b.0).collect();
@@ -81,14 +99,24 @@ pub(crate) fn march(
     Isolines { curves, flagged, repaired }
 }
 
+/// Fewest edges or facets per parallel task of [`march_facets`]: a crossing
+/// costs a few distance queries, too little to share finely.
+const ITEMS_PER_TASK: usize = 64;
+
 fn edge_key(a: u32, b: u32) -> u64 {
     u64::from(a.min(b)) << 32 | u64::from(a.max(b))
 }
 
 /// The crossing on edge `(a, b)` (states differ) by root finding.
-fn crossing(support: &Support, values: &[f64], exact: &(impl Fn(&Point3) -> f64 + Sync), a: u32, b: u32) -> Crossing {
+fn crossing(
+    support: &Support,
+    values: &[f64],
+    exact: &(impl Fn(&Point3, u32) -> f64 + Sync),
+    a: u32,
+    b: u32,
+) -> Crossing {
     let (pa, pb) = (support.mesh().vertices()[a as usize], support.mesh().vertices()[b as usize]);
-    let t = edge_root(|t| exact(&(pa + (pb - pa) * t)), values[a as usize], values[b as usize], (pb - pa).norm());
+    let t = edge_root(|t| exact(&(pa + (pb - pa) * t), a), values[a as usize], values[b as usize], (pb - pa).norm());
     let n = support.vertex_normal(a as usize) * (1.0 - t) + support.vertex_normal(b as usize) * t;
     let len = n.norm();
     Crossing { point: pa + (pb - pa) * t, normal: if len > 0.0 { n / len } else { support.vertex_normal(a as usize) } }
@@ -141,7 +169,7 @@ fn facet_segment(
     index: &FastMap<u64, u32>,
     crossings: &[Crossing],
     f: usize,
-    exact: &(impl Fn(&Point3) -> f64 + Sync),
+    exact: &(impl Fn(&Point3, u32) -> f64 + Sync),
     medial: &(impl Fn(usize) -> bool + Sync),
 ) -> (Segment, bool, bool) {
     let t = support.mesh().triangles()[f];
@@ -166,7 +194,9 @@ fn facet_segment(
     }
     let flagged = medial(f);
     let mid = if flagged {
-        repair(support, f, &crossings[ends[0] as usize].point, &crossings[ends[1] as usize].point, exact)
+        repair(support, f, &crossings[ends[0] as usize].point, &crossings[ends[1] as usize].point, &|p: &Point3| {
+            exact(p, t[0])
+        })
     } else {
         None
     };
@@ -177,13 +207,7 @@ fn facet_segment(
 /// The iso point across the middle of segment `[p, q]` within facet `f`, if
 /// the field changes state along the facet's in-plane normal to the segment
 /// and the point stays in the facet.
-fn repair(
-    support: &Support,
-    f: usize,
-    p: &Point3,
-    q: &Point3,
-    exact: &(impl Fn(&Point3) -> f64 + Sync),
-) -> Option<Point3> {
+fn repair(support: &Support, f: usize, p: &Point3, q: &Point3, exact: &impl Fn(&Point3) -> f64) -> Option<Point3> {
     let normal = support.query().normal(f);
     let w = normal.cross(&(q - p));
     let len = w.norm();

@@ -16,10 +16,12 @@ pub struct Support {
     query: MeshQuery,
     vertex_normals: Vec<Vec3>,
     facet_size: f64,
-    /// Vertex neighbours (compressed rows): those of `v` are
-    /// `adjacency[offsets[v]..offsets[v + 1]]`, ascending.
-    offsets: Vec<u32>,
-    adjacency: Vec<u32>,
+    /// Per vertex, the vertices sharing an edge with it, ascending.
+    adjacency: Rows,
+    /// Per vertex, the facets using it, ascending.
+    incidence: Rows,
+    /// Bounding spheres over the vertices, to find those near a curve.
+    tree: VertexTree,
 }
 
 impl Support {
@@ -55,14 +57,26 @@ impl Support {
             })
             .fold(0.0, f64::max);
         let query = MeshQuery::new(&mesh);
-        let (offsets, adjacency) = neighbours(&mesh);
-        Support { mesh, query, vertex_normals, facet_size, offsets, adjacency }
+        let (adjacency, incidence) = (neighbours(&mesh), incidence(&mesh));
+        let tree = VertexTree::build(mesh.vertices());
+        Support { mesh, query, vertex_normals, facet_size, adjacency, incidence, tree }
     }
 
     /// The vertices sharing an edge with vertex `v`, ascending.
     #[must_use]
     pub fn neighbours(&self, v: usize) -> &[u32] {
-        &self.adjacency[self.offsets[v] as usize..self.offsets[v + 1] as usize]
+        self.adjacency.row(v)
+    }
+
+    /// The facets using vertex `v`, ascending.
+    #[must_use]
+    pub fn vertex_facets(&self, v: usize) -> &[u32] {
+        self.incidence.row(v)
+    }
+
+    /// The bounding-sphere hierarchy over the vertices.
+    pub(crate) fn vertex_tree(&self) -> &VertexTree {
+        &self.tree
     }
 
     /// The mesh.
@@ -178,8 +192,36 @@ pub(crate) fn area_weighted_normals(mesh: &TriMesh, fallback: Vec3) -> Vec<Vec3>
     normals
 }
 
-/// Vertex adjacency in compressed rows.
-fn neighbours(mesh: &TriMesh) -> (Vec<u32>, Vec<u32>) {
+/// Compressed rows: row `i` is `items[offsets[i]..offsets[i + 1]]`.
+#[derive(Debug, Clone, Default)]
+struct Rows {
+    offsets: Vec<u32>,
+    items: Vec<u32>,
+}
+
+impl Rows {
+    /// Rows `0..rows` from `(row, item)` pairs, each row ascending and
+    /// without repeats.
+    fn from_pairs(rows: usize, mut pairs: Vec<(u32, u32)>) -> Rows {
+        pairs.sort_unstable();
+        pairs.dedup();
+        let mut offsets = vec![0u32; rows + 1];
+        for &(a, _) in &pairs {
+            offsets[a as usize + 1] += 1;
+        }
+        for v in 0..rows {
+            offsets[v + 1] += offsets[v];
+        }
+        Rows { offsets, items: pairs.into_iter().map(|p| p.1).collect() }
+    }
+
+    fn row(&self, i: usize) -> &[u32] {
+        &self.items[self.offsets[i] as usize..self.offsets[i + 1] as usize]
+    }
+}
+
+/// Vertex adjacency.
+fn neighbours(mesh: &TriMesh) -> Rows {
     let mut pairs: Vec<(u32, u32)> = Vec::with_capacity(6 * mesh.triangles().len());
     for t in mesh.triangles() {
         for k in 0..3 {
@@ -188,16 +230,86 @@ fn neighbours(mesh: &TriMesh) -> (Vec<u32>, Vec<u32>) {
             pairs.push((b, a));
         }
     }
-    pairs.sort_unstable();
-    pairs.dedup();
-    let mut offsets = vec![0u32; mesh.vertices().len() + 1];
-    for &(a, _) in &pairs {
-        offsets[a as usize + 1] += 1;
+    Rows::from_pairs(mesh.vertices().len(), pairs)
+}
+
+/// The facets of each vertex.
+fn incidence(mesh: &TriMesh) -> Rows {
+    let pairs = (0..mesh.triangles().len())
+        .flat_map(|f| mesh.triangles()[f].map(|v| (v, u32::try_from(f).unwrap_or(u32::MAX))))
+        .collect();
+    Rows::from_pairs(mesh.vertices().len(), pairs)
+}
+
+/// Vertices per leaf of a [`VertexTree`]: a leaf is measured whole, so small
+/// leaves measure few vertices away from the iso-line, at the price of more
+/// node tests.
+const LEAF_VERTICES: usize = 16;
+
+/// A hierarchy of bounding spheres over the vertices, by median splits
+/// along the longest side of the box: node `i` holds the vertices
+/// `order[start..end]`; an inner node's children are node `i + 1` and node
+/// `second`.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct VertexTree {
+    pub(crate) nodes: Vec<VertexNode>,
+    pub(crate) order: Vec<u32>,
+}
+
+/// A node of a [`VertexTree`].
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct VertexNode {
+    /// Every vertex of the node is within `radius` of `center` (mm).
+    pub(crate) center: Point3,
+    pub(crate) radius: f64,
+    pub(crate) start: u32,
+    pub(crate) end: u32,
+    /// The second child; 0 for a leaf.
+    pub(crate) second: u32,
+}
+
+impl VertexTree {
+    /// The vertices of node `i`.
+    pub(crate) fn vertices(&self, i: usize) -> &[u32] {
+        let n = &self.nodes[i];
+        &self.order[n.start as usize..n.end as usize]
     }
-    for v in 0..mesh.vertices().len() {
-        offsets[v + 1] += offsets[v];
+
+    fn build(points: &[Point3]) -> VertexTree {
+        let mut tree = VertexTree { nodes: Vec::new(), order: (0..points.len()).map(|v| v as u32).collect() };
+        if !points.is_empty() {
+            tree.split(points, 0, points.len());
+        }
+        tree
     }
-    (offsets, pairs.into_iter().map(|p| p.1).collect())
+
+    /// Adds the node of `order[start..end]` and its subtree; its index.
+    fn split(&mut self, points: &[Point3], start: usize, end: usize) -> usize {
+        let slice = &mut self.order[start..end];
+        let at = |v: &u32| points[*v as usize];
+        let (lo, hi) =
+            slice.iter().fold((at(&slice[0]), at(&slice[0])), |(lo, hi), v| (lo.inf(&at(v)), hi.sup(&at(v))));
+        let center = Point3::from((lo.coords + hi.coords) * 0.5);
+        let radius = slice.iter().map(|v| (at(v) - center).norm()).fold(0.0, f64::max);
+        let id = self.nodes.len();
+        self.nodes.push(VertexNode { center, radius, start: start as u32, end: end as u32, second: 0 });
+        if end - start > LEAF_VERTICES {
+            let size = hi - lo;
+            let axis = if size.x >= size.y && size.x >= size.z {
+                0
+            } else if size.y >= size.z {
+                1
+            } else {
+                2
+            };
+            let mid = (end - start) / 2;
+            slice.select_nth_unstable_by(mid, |a, b| at(a)[axis].total_cmp(&at(b)[axis]).then(a.cmp(b)));
+            self.split(points, start, start + mid);
+            let second = self.split(points, start + mid, end);
+            self.nodes[id].second = second as u32;
+        }
+        id
+    }
 }
 
 /// [`check_line`] plus one normal per point.
