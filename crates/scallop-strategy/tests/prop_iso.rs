@@ -140,7 +140,13 @@ fn iso_bull_in_a_tight_hollow_is_verified_or_refused() {
     let t = patch.tessellate(tol.tessellation()).expect("tessellates");
     let index = MeshIndex::build(&t.mesh);
     let p = params(0.0, Pattern::Zigzag, 0.01, 1.0);
-    match plan_isoparametric(&patch, &index, &bull(4.0, 1.5), &p, IsoDirection::U, &tol, t.chordal_bound) {
+    match plan_isoparametric(
+        &IsoSurface { patch: &patch, index: &index, chordal_error: t.chordal_bound },
+        &bull(4.0, 1.5),
+        &p,
+        IsoDirection::U,
+        &tol,
+    ) {
         Ok(_) => check(&patch, &bull(4.0, 1.5), IsoDirection::U, 0.01),
         Err(e) => assert!(matches!(e, StrategyError::Unreachable { .. }), "{e}"),
     }
