@@ -17,7 +17,7 @@ use crate::{CliResult, Failure};
 pub(crate) fn load_described(name: &str, folder: &Path, what: &str) -> CliResult<Described> {
     let path = folder.join(name);
     if name.ends_with(".toml") || path.is_file() {
-        let text = crate::post::read_text(&path)?;
+        let text = crate::input::read_text(&path, "the file")?;
         Described::from_toml_str(&text).map_err(|e| Failure::rejected(format!("{} ({what}): {e}", path.display())))
     } else {
         Described::builtin(name).map_err(|_| {

@@ -7,6 +7,7 @@ mod choice;
 mod drop;
 mod engagement;
 mod guides;
+mod input;
 mod machine;
 mod optimize;
 mod output;

@@ -54,6 +54,11 @@ pub fn print_json(value: &impl Serialize) -> CliResult<()> {
     print_text(&format!("{text}\n"))
 }
 
+/// Prints `report` as JSON, or else the text `human` makes of it.
+pub fn print_report<T: Serialize>(report: &T, json: bool, human: impl FnOnce(&T) -> String) -> CliResult<()> {
+    if json { print_json(report) } else { print_text(&human(report)) }
+}
+
 /// Prints text on stdout; a closed pipe is not an error.
 pub fn print_text(text: &str) -> CliResult<()> {
     let mut out = std::io::stdout().lock();

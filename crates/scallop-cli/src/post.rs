@@ -13,6 +13,7 @@ use scallop_machine::{Joints, Kinematics, Machine};
 use scallop_post::{Dialect, OutputMode, PostParams, check_replay, program_text, replay};
 use serde::Serialize;
 
+use crate::input::read_text;
 use crate::output::{print_json, print_text, write_atomic};
 use crate::{CliResult, Failure};
 
@@ -118,14 +119,6 @@ pub struct PostReport {
     pub events: Vec<String>,
 }
 
-pub(crate) fn read_text(path: &Path) -> CliResult<String> {
-    let bytes = std::fs::read(path).map_err(|e| {
-        let err = anyhow::anyhow!("{}: cannot read: {e}", path.display());
-        if e.kind() == std::io::ErrorKind::NotFound { Failure::Rejected(err) } else { Failure::Io(err) }
-    })?;
-    scallop_io::utf8_text(&bytes).map(str::to_owned).map_err(|e| Failure::rejected(format!("{}: {e}", path.display())))
-}
-
 /// A 5-axis machine by shipped name or by TOML file (a relative path taken from
 /// `folder`: the job file's folder, or the working folder for `--machine`);
 /// `what` names the flag or key in messages.
@@ -135,7 +128,7 @@ pub(crate) fn load_machine(name: &str, folder: &Path, what: &str) -> CliResult<M
 
 pub(crate) fn load_dialect(name: &str) -> CliResult<Dialect> {
     if name.ends_with(".toml") || Path::new(name).is_file() {
-        let text = read_text(Path::new(name))?;
+        let text = read_text(Path::new(name), "the file")?;
         Dialect::from_toml_str(&text).map_err(|e| Failure::rejected(format!("{name}: {e}")))
     } else {
         Dialect::builtin(name).map_err(|e| Failure::rejected(format!("--dialect {name}: {e}")))
@@ -144,22 +137,18 @@ pub(crate) fn load_dialect(name: &str) -> CliResult<Dialect> {
 
 /// `scallop post`.
 pub fn run(args: &PostArgs) -> CliResult<()> {
-    for (flag, v) in [
+    crate::input::positive_flags(&[
         ("--feed", args.feed),
         ("--tolerance", args.tolerance),
         ("--spindle", args.spindle),
         ("--retract", args.retract),
-    ] {
-        if !(v.is_finite() && v > 0.0) {
-            return Err(Failure::rejected(format!("{flag} {v}: must be a finite number > 0")));
-        }
-    }
+    ])?;
     if !(args.tool_length.is_finite() && args.tool_length >= 0.0) {
         return Err(Failure::rejected(format!("--tool-length {}: must be a finite number >= 0", args.tool_length)));
     }
     let machine = load_machine(&args.machine, Path::new(""), "--machine")?;
     let dialect = load_dialect(&args.dialect)?;
-    let text = read_text(&args.cl_file)?;
+    let text = read_text(&args.cl_file, "the file")?;
     let path = read_cl(&text, args.feed).map_err(|e| Failure::rejected(format!("{}: {e}", args.cl_file.display())))?;
     let records = records_of(&path);
     let kin = Kinematics::new(&machine, args.tool_length);

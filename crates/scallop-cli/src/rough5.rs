@@ -180,7 +180,7 @@ struct Report {
 }
 
 fn check_args(a: &Rough5Args) -> CliResult<()> {
-    for (flag, v) in [
+    crate::input::positive_flags(&[
         ("--tool-radius", a.tool_radius),
         ("--corner", a.corner),
         ("--flutes", a.flutes),
@@ -191,11 +191,7 @@ fn check_args(a: &Rough5Args) -> CliResult<()> {
         ("--resolution", a.resolution),
         ("--sim-tolerance", a.sim_tolerance),
         ("--tool-length", a.tool_length),
-    ] {
-        if !(v.is_finite() && v > 0.0) {
-            return Err(Failure::rejected(format!("{flag} {v}: must be a finite number > 0")));
-        }
-    }
+    ])?;
     if a.stick_out < a.flutes {
         return Err(Failure::rejected(format!("--stick-out {} is shorter than --flutes {}", a.stick_out, a.flutes)));
     }

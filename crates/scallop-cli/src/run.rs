@@ -242,10 +242,7 @@ fn apply_finishing(job: &mut FinishJob, f: &scallop_io::job::FinishingSpec) {
 /// missing or non-UTF-8 file or a bad job is rejected naming the file.
 pub(crate) fn read_job(path: &Path) -> CliResult<(String, JobFile)> {
     let name = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| {
-        let err = anyhow::anyhow!("{name}: cannot read the job file: {e}");
-        if e.kind() == std::io::ErrorKind::NotFound { Failure::Rejected(err) } else { Failure::Io(err) }
-    })?;
+    let bytes = crate::input::read_bytes(path, &name, "the job file")?;
     let text = std::str::from_utf8(&bytes)
         .map_err(|e| Failure::rejected(format!("{name}: byte {}: the job file is not UTF-8 text", e.valid_up_to())))?;
     let library_file = tool_library_of(text);
@@ -276,13 +273,8 @@ pub(crate) fn read_job(path: &Path) -> CliResult<(String, JobFile)> {
 /// Reads a tool library (docs/job.md, "Tool library"); errors name the file,
 /// the line and the fix.
 pub(crate) fn read_tool_library(path: &Path) -> CliResult<scallop_io::tools::ToolLibrary> {
-    let name = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| {
-        let err = anyhow::anyhow!("{name}: cannot read the tool library (`tool_library` of the job): {e}");
-        if e.kind() == std::io::ErrorKind::NotFound { Failure::Rejected(err) } else { Failure::Io(err) }
-    })?;
-    let text = scallop_io::utf8_text(&bytes).map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
-    scallop_io::tools::parse_tool_library(text).map_err(|e| Failure::rejected(format!("{name}: {e}")))
+    let text = crate::input::read_text(path, "the tool library (`tool_library` of the job)")?;
+    scallop_io::tools::parse_tool_library(&text).map_err(|e| Failure::rejected(format!("{}: {e}", path.display())))
 }
 
 pub(crate) fn finish_job(spec: &JobFile, folder: &Path) -> CliResult<FinishJob> {

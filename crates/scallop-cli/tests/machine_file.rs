@@ -11,7 +11,7 @@ use scallop_machine::Described;
 
 mod common;
 
-use common::{scallop, scratch};
+use common::{rejected, run_job, scratch};
 
 fn repo(rel: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").join(rel)
@@ -35,11 +35,11 @@ fn run(dir: &Path, name: &str, text: &str) -> Result<String, String> {
     let file = dir.join(format!("{name}.toml"));
     std::fs::write(&file, text).expect("write job");
     let out_dir = dir.join(name);
-    let out = scallop().arg("run").arg(&file).arg("-o").arg(&out_dir).output().expect("run");
+    let out = run_job(&file, &out_dir, &[]);
     if !out.status.success() {
-        assert_eq!(out.status.code(), Some(1), "{}", String::from_utf8_lossy(&out.stderr));
+        let err = rejected(&out);
         assert!(!out_dir.join("program.nc").exists(), "a refused job wrote a program");
-        return Err(String::from_utf8_lossy(&out.stderr).into_owned());
+        return Err(err);
     }
     Ok(std::fs::read_to_string(out_dir.join("program.nc")).expect("program.nc"))
 }

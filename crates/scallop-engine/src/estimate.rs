@@ -30,7 +30,9 @@ use scallop_analysis::{GridOptions, sample_mesh, sample_surface_set};
 use scallop_cutter::CutterShape;
 use scallop_geom::{Aabb3, Point3, Vec3};
 use scallop_mesh::{MeshIndex, TriMesh};
-use scallop_strategy::{IsoDirection, SteepShallow, convex_factor, iso_fitted_passes, rule_spacing, tol as stol};
+use scallop_strategy::{
+    IsoDirection, IsoSurface, SteepShallow, convex_factor, iso_fitted_passes, rule_spacing, tol as stol,
+};
 use serde::Serialize;
 
 use crate::finish::{analyse, planning_tolerances};
@@ -187,17 +189,9 @@ fn isoparametric(job: &FinishJob, direction: IsoDirection, mut e: Estimate) -> R
     let params = job.timing_params();
     let mut passes = 0;
     for patch in set.patches() {
-        passes += iso_fitted_passes(
-            patch,
-            &prepared.index,
-            &job.cutter,
-            &params,
-            direction,
-            &tolerances,
-            prepared.chordal_error,
-            ISO_SAMPLES,
-        )
-        .map_err(EngineError::Strategy)?;
+        let surface = IsoSurface { patch, index: &prepared.index, chordal_error: prepared.chordal_error };
+        passes += iso_fitted_passes(&surface, &job.cutter, &params, direction, &tolerances, ISO_SAMPLES)
+            .map_err(EngineError::Strategy)?;
     }
     e.planes = passes;
     e.passes = passes;

@@ -18,8 +18,9 @@ use scallop_machine::{Kinematics, Machine};
 use scallop_mesh::{MeshIndex, TriMesh};
 use scallop_post::{Dialect, OutputMode, PostParams, ProgramInfo, program_text, write_fitted};
 use scallop_strategy::{
-    Boundary, FinishingParams, IsoDirection, LeadKind, LeadReport, Pattern, Refinement, SteepShallow, apply_leads,
-    lookahead_time, plan_finishing_refined, plan_isoparametric, plan_steep_shallow_refined, stop_to_stop_time,
+    Boundary, FinishingParams, IsoDirection, IsoSurface, LeadKind, LeadReport, Pattern, Refinement, SteepShallow,
+    apply_leads, lookahead_time, plan_finishing_refined, plan_isoparametric, plan_steep_shallow_refined,
+    stop_to_stop_time,
 };
 use scallop_toolpath::{FittedPath, Move, MoveKind, Toolpath, fit_arcs};
 use serde::Serialize;
@@ -891,15 +892,8 @@ fn isoparametric(
     toolpath.plunge_feed = params.plunge_feed * 60.0;
     let (mut passes, mut max_h, mut mean_sum) = (0, 0.0f64, 0.0);
     for patch in set.patches() {
-        let p = plan_isoparametric(
-            patch,
-            &prepared.index,
-            &job.cutter,
-            params,
-            direction,
-            tolerances,
-            prepared.chordal_error,
-        )?;
+        let surface = IsoSurface { patch, index: &prepared.index, chordal_error: prepared.chordal_error };
+        let p = plan_isoparametric(&surface, &job.cutter, params, direction, tolerances)?;
         passes += p.passes.len();
         max_h = max_h.max(p.max_scallop_mm);
         mean_sum += p.mean_scallop_mm;

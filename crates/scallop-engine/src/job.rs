@@ -276,7 +276,7 @@ pub fn run_job_with_progress(job: &Job, progress: &dyn Fn(JobStep)) -> Result<Jo
         }
         let collisions = zmap.part_collisions_in(&field, &f.cutter, p.toolpath(), cut.operation)?;
         if !collisions.is_empty() {
-            return Err(scallop_sim::SimError::PartCollision { count: collisions.len(), collisions }.into());
+            return Err(scallop_sim::SimError::PartCollision { collisions }.into());
         }
         cut.check()?;
         let figures = StockFigures {

@@ -1,41 +1,58 @@
 //! Small numeric routines shared across the workspace: fast exact rounding
 //! (bit-identical to the standard library's `round` and `floor`, for the machine
-//! layer and the post-processor) and the one golden-section search.
+//! layer and the post-processor), the one golden-section search and the one
+//! check of settings that must be finite and positive.
 
 /// `x.round()` (half away from zero, signed zero kept) without the library call for
 /// |x| < 2^52, where truncation and the fraction are exact.
 #[inline]
 #[must_use]
 pub fn round_fast(x: f64) -> f64 {
-    if x.abs() < 4_503_599_627_370_496.0 {
-        #[allow(clippy::cast_possible_truncation, clippy::cast_precision_loss, reason = "|x| < 2^52, exact")]
-        let t = x as i64 as f64;
-        let f = x - t;
-        let r = if f >= 0.5 {
-            t + 1.0
-        } else if f <= -0.5 {
-            t - 1.0
-        } else {
-            t
-        };
-        r.copysign(x)
+    let Some(t) = truncated(x) else { return x.round() };
+    let f = x - t;
+    let r = if f >= 0.5 {
+        t + 1.0
+    } else if f <= -0.5 {
+        t - 1.0
     } else {
-        x.round()
-    }
+        t
+    };
+    r.copysign(x)
 }
 
 /// `x.floor()` (signed zero kept) without the library call for |x| < 2^52.
 #[inline]
 #[must_use]
 pub fn floor_fast(x: f64) -> f64 {
+    let Some(t) = truncated(x) else { return x.floor() };
+    let r = if t > x { t - 1.0 } else { t };
+    r.copysign(x)
+}
+
+/// `x` truncated toward zero, for |x| < 2^52 (where the cast and the fraction
+/// `x - t` are exact); `None` beyond.
+#[inline]
+fn truncated(x: f64) -> Option<f64> {
     if x.abs() < 4_503_599_627_370_496.0 {
         #[allow(clippy::cast_possible_truncation, clippy::cast_precision_loss, reason = "|x| < 2^52, exact")]
         let t = x as i64 as f64;
-        let r = if t > x { t - 1.0 } else { t };
-        r.copysign(x)
+        Some(t)
     } else {
-        x.floor()
+        None
     }
+}
+
+/// The first setting of `settings` (name, value) that is not a finite number
+/// greater than zero: the check of lengths, steps and rates before any work.
+///
+/// ```
+/// use scallop_geom::num::first_not_positive;
+/// assert_eq!(first_not_positive(&[("step", 0.5), ("feed", 0.0), ("depth", f64::NAN)]), Some(("feed", 0.0)));
+/// assert_eq!(first_not_positive(&[("step", 0.5)]), None);
+/// ```
+#[must_use]
+pub fn first_not_positive<N: Copy>(settings: &[(N, f64)]) -> Option<(N, f64)> {
+    settings.iter().copied().find(|&(_, v)| !(v.is_finite() && v > 0.0))
 }
 
 /// `1 / phi = (sqrt(5) - 1) / 2`, the golden section's shrink factor.

@@ -6,6 +6,7 @@
 //! for each pair of neighbouring levels the paired path and tilt curves.
 
 use scallop_field::{FieldError, LevelOptions, Side, Surface, offset_levels};
+use scallop_geom::num::first_not_positive;
 use scallop_mesh::TriMesh;
 
 use crate::open::{OpenPocket, open_limit};
@@ -81,16 +82,14 @@ fn field_error(what: &'static str, e: &FieldError) -> GuideError {
 /// level or the flank offset cannot be extracted, and the errors of
 /// [`offset_curves`].
 pub fn build_guides(bottom: &TriMesh, flanks: &TriMesh, settings: &GuideSettings) -> Result<GuideSet, GuideError> {
-    for (name, value) in [
+    if let Some((name, value)) = first_not_positive(&[
         ("tool_radius", settings.tool_radius),
         ("axial_step", settings.axial_step),
         ("radial_step", settings.radial_step),
         ("voxel", settings.voxel),
         ("depth", settings.depth),
-    ] {
-        if !(value.is_finite() && value > 0.0) {
-            return Err(GuideError::BadLength { name, value });
-        }
+    ]) {
+        return Err(GuideError::BadLength { name, value });
     }
     if !(settings.flank_allowance.is_finite() && settings.flank_allowance >= 0.0) {
         return Err(GuideError::BadLength { name: "flank_allowance", value: settings.flank_allowance });

@@ -121,15 +121,20 @@ fn part_guides(part: &TestPart, settings: &GuideSettings) -> GuideSet {
     build_guides(&bottom, &flanks, settings).unwrap()
 }
 
+/// The guides of `part` for a tool of radius 5 from the stock top down to the
+/// bottom face's top.
+fn guides_to_the_floor(part: &TestPart) -> GuideSet {
+    let depth = part.stock.max.z - part.faces(&[FaceTag::Bottom]).unwrap().bounds().max.z;
+    part_guides(part, &settings(5.0, depth))
+}
+
 fn settings(tool_radius: f64, depth: f64) -> GuideSettings {
     GuideSettings { tool_radius, flank_allowance: 0.5, axial_step: 4.0, radial_step: 4.5, voxel: 1.0, depth }
 }
 
 #[test]
 fn the_closed_pocket_has_closed_guide_curves_on_every_level() {
-    let part = closed_pocket(&Default::default()).unwrap();
-    let depth = part.stock.max.z - part.faces(&[FaceTag::Bottom]).unwrap().bounds().max.z;
-    let set = part_guides(&part, &settings(5.0, depth));
+    let set = guides_to_the_floor(&closed_pocket(&Default::default()).unwrap());
     assert!(set.levels.len() >= 4, "{} levels", set.levels.len());
     for level in &set.levels {
         assert_eq!((level.limit.open.len(), level.limit.closed_by_virtual_flanks), (0, 0));
@@ -140,9 +145,7 @@ fn the_closed_pocket_has_closed_guide_curves_on_every_level() {
 
 #[test]
 fn the_fitting_splits_into_paired_degeneracy_zones_on_every_level() {
-    let part = fitting_pocket(&Default::default()).unwrap();
-    let depth = part.stock.max.z - part.faces(&[FaceTag::Bottom]).unwrap().bounds().max.z;
-    let set = part_guides(&part, &settings(5.0, depth));
+    let set = guides_to_the_floor(&fitting_pocket(&Default::default()).unwrap());
     assert!(set.levels.len() >= 4, "{} levels", set.levels.len());
     assert!(set.levels.iter().all(|l| l.zones.len() > 1), "the ribs split the offsets");
     assert!(set.levels.iter().all(|l| !l.offsets.is_empty()));

@@ -41,11 +41,16 @@ fn signed_volume(mesh: &TriMesh) -> f64 {
         .sum()
 }
 
-fn check_tags(part: &TestPart) {
+/// Every triangle tagged, every tag used, the mesh inside the stock.
+fn check_tags_and_stock(part: &TestPart) {
     assert_eq!(part.tags.len(), part.mesh.triangles().len());
     for tag in [FaceTag::Bottom, FaceTag::Flank, FaceTag::Top] {
         assert!(part.tags.contains(&tag), "{tag:?} missing");
         assert!(part.faces(&[tag]).is_ok());
+    }
+    let (b, s) = (part.mesh.bounds(), part.stock);
+    for k in 0..3 {
+        assert!(b.min[k] >= s.min[k] - 1e-9 && b.max[k] <= s.max[k] + 1e-9, "axis {k}: {b:?} outside {s:?}");
     }
 }
 
@@ -55,20 +60,12 @@ fn check_closed(part: &TestPart) {
     assert!(signed_volume(&part.mesh) > 0.0, "normals point inwards");
 }
 
-fn within_stock(part: &TestPart) {
-    let (b, s) = (part.mesh.bounds(), part.stock);
-    for k in 0..3 {
-        assert!(b.min[k] >= s.min[k] - 1e-9 && b.max[k] <= s.max[k] + 1e-9, "axis {k}: {b:?} outside {s:?}");
-    }
-}
-
 #[test]
 fn default_pocket_is_closed_tagged_and_fills_the_stock_top() {
     let params = PocketParams::default();
     let part = closed_pocket(&params).unwrap();
-    check_tags(&part);
+    check_tags_and_stock(&part);
     check_closed(&part);
-    within_stock(&part);
     assert!((part.mesh.bounds().max.z - params.stock[2]).abs() < 1e-9);
     assert_eq!(part.stock.max.coords, scallop_geom::Vec3::from(params.stock));
     // Undercut on +x: the bottom reaches farther out than the opening; draft on -x.
@@ -90,9 +87,8 @@ fn default_pocket_is_closed_tagged_and_fills_the_stock_top() {
 #[test]
 fn default_fitting_is_closed_non_convex_and_tagged() {
     let part = fitting_pocket(&FittingParams::default()).unwrap();
-    check_tags(&part);
+    check_tags_and_stock(&part);
     check_closed(&part);
-    within_stock(&part);
     // Non-convex: the volume is well below its convex box's.
     let b = part.mesh.bounds();
     let s = b.size();
@@ -103,8 +99,7 @@ fn default_fitting_is_closed_non_convex_and_tagged() {
 fn impeller_channel_is_open_only_at_inlet_and_outlet() {
     let params = ImpellerParams::default();
     let part = impeller_channel(&params).unwrap();
-    check_tags(&part);
-    within_stock(&part);
+    check_tags_and_stock(&part);
     let (open, bad) = edge_report(&part.mesh);
     assert_eq!(bad, 0);
     assert!(!open.is_empty());
@@ -145,9 +140,8 @@ proptest! {
     ) {
         let params = PocketParams { walls, tilt, dome, rings, side_points, corner_points, ..PocketParams::default() };
         let part = closed_pocket(&params).unwrap();
-        check_tags(&part);
+        check_tags_and_stock(&part);
         check_closed(&part);
-        within_stock(&part);
         let again = closed_pocket(&params).unwrap();
         prop_assert_eq!(part.mesh.triangles(), again.mesh.triangles());
         prop_assert_eq!(part.mesh.vertices(), again.mesh.vertices());
@@ -157,17 +151,15 @@ proptest! {
     fn fittings_stay_closed(rib in 1.0f64..8.0, reach in 0.2f64..0.8, draft in 0.0f64..0.1, rings in 1usize..6, step in 3.0f64..30.0) {
         let params = FittingParams { rib, rib_reach: reach, draft, rings, step, ..FittingParams::default() };
         let part = fitting_pocket(&params).unwrap();
-        check_tags(&part);
+        check_tags_and_stock(&part);
         check_closed(&part);
-        within_stock(&part);
     }
 
     #[test]
     fn impellers_stay_open_only_at_the_ends(blades in 5usize..20, wrap in -1.0f64..1.0, twist in -0.3f64..0.3) {
         let params = ImpellerParams { blades, wrap, twist, ..ImpellerParams::default() };
         let part = impeller_channel(&params).unwrap();
-        check_tags(&part);
-        within_stock(&part);
+        check_tags_and_stock(&part);
         let (_, bad) = edge_report(&part.mesh);
         prop_assert_eq!(bad, 0);
     }

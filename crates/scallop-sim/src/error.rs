@@ -73,13 +73,12 @@ pub enum SimError {
     #[error(
         "{count} moves drive the {what} into the stock; the first is {first}; \
          use longer flutes or a longer shank, or cut in more stepdowns",
+        count = collisions.len(),
         what = first_part(collisions),
         first = first_collision(collisions)
     )]
     HolderCollision {
-        /// Number of colliding moves.
-        count: usize,
-        /// The first ones, in program order.
+        /// The colliding moves, in program order.
         collisions: Vec<Collision>,
     },
     /// The shank or holder touched the design part itself.
@@ -87,13 +86,12 @@ pub enum SimError {
         "{count} moves drive the {what} into the part; the first is {first} \
          (part surface above the {what}'s lower face); use a tool with longer flutes or a longer reach, \
          or keep the passes farther from that wall",
+        count = collisions.len(),
         what = first_part(collisions),
         first = first_collision(collisions)
     )]
     PartCollision {
-        /// Number of colliding moves (per part of the tool).
-        count: usize,
-        /// The first ones, in program order.
+        /// The colliding moves, in program order.
         collisions: Vec<Collision>,
     },
     /// An uncut cell lies below the part: the stock box does not contain the part.
@@ -180,11 +178,10 @@ pub enum SimError {
     #[error(
         "{count} moves drive the shank or holder into the stock; the first: {first}; \
          use longer flutes or a longer shank, change the tool axis, or cut in more stepdowns",
+        count = collisions.len(),
         first = collisions.first().map_or_else(String::new, ToString::to_string)
     )]
     DexelCollision {
-        /// Number of colliding moves (per part of the tool).
-        count: usize,
         /// The collisions, in program order.
         collisions: Vec<DexelCollision>,
     },
@@ -193,11 +190,10 @@ pub enum SimError {
         "{count} moves drive the shank or holder into the part; the first: {first} (part material inside the \
          tool along a ray); use a tool with longer flutes or a longer reach, change the tool axis, or keep the \
          passes farther from that feature",
+        count = collisions.len(),
         first = collisions.first().map_or_else(String::new, |c| c.to_string().replace("into the stock", "into the part"))
     )]
     DexelPartCollision {
-        /// Number of colliding moves (per part of the tool).
-        count: usize,
         /// The collisions, in program order.
         collisions: Vec<DexelCollision>,
     },

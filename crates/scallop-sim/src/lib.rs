@@ -177,7 +177,7 @@ pub fn simulate_with_progress(
     let field = PartField::new(&zmap, part);
     let collisions = zmap.part_collisions_in(&field, cutter, toolpath, cut.operation)?;
     if !collisions.is_empty() {
-        return Err(SimError::PartCollision { count: collisions.len(), collisions });
+        return Err(SimError::PartCollision { collisions });
     }
     cut.check()?;
     let verification = verify_in(&zmap, &field, options)?;
@@ -243,7 +243,7 @@ pub fn simulate_dexel(
     if options.check_collisions {
         let collisions = dexels.part_collisions(part, cutter, moves, options, cut.operation)?;
         if !collisions.is_empty() {
-            return Err(SimError::DexelPartCollision { count: collisions.len(), collisions });
+            return Err(SimError::DexelPartCollision { collisions });
         }
     }
     cut.check()?;

@@ -161,10 +161,7 @@ impl CutReport {
     /// [`SimError::RapidIntoStock`] when a rapid or retract removed stock,
     /// [`SimError::HolderCollision`] when the shank or holder touched it.
     pub fn check(&self) -> Result<(), SimError> {
-        safety_verdict(&self.rapid_hits, &self.collisions, |count, collisions| SimError::HolderCollision {
-            count,
-            collisions,
-        })
+        safety_verdict(&self.rapid_hits, &self.collisions, |collisions| SimError::HolderCollision { collisions })
     }
 }
 
@@ -180,17 +177,17 @@ pub(crate) fn air_share(air: usize, feed: usize) -> f64 {
 }
 
 /// The safety verdict of a cut on either stock: rapid hits first, then the
-/// collisions as `collision_error(count, collisions)`.
+/// collisions as `collision_error(collisions)`.
 pub(crate) fn safety_verdict<C: Clone>(
     rapid_hits: &[RapidHit],
     collisions: &[C],
-    collision_error: impl FnOnce(usize, Vec<C>) -> SimError,
+    collision_error: impl FnOnce(Vec<C>) -> SimError,
 ) -> Result<(), SimError> {
     if !rapid_hits.is_empty() {
         return Err(SimError::RapidIntoStock { count: rapid_hits.len(), hits: rapid_hits.to_vec() });
     }
     if !collisions.is_empty() {
-        return Err(collision_error(collisions.len(), collisions.to_vec()));
+        return Err(collision_error(collisions.to_vec()));
     }
     Ok(())
 }

@@ -62,6 +62,19 @@ pub enum IsoDirection {
     V,
 }
 
+/// A patch as the isoparametric planner machines it: the patch, the index of
+/// its tessellation (what the cutter is dropped on) and that tessellation's
+/// chordal error (mm; the planner aims at `sh - chordal_error`).
+#[derive(Debug, Clone, Copy)]
+pub struct IsoSurface<'a> {
+    /// The patch.
+    pub patch: &'a Patch,
+    /// Its tessellation, indexed.
+    pub index: &'a MeshIndex,
+    /// Largest distance between the tessellation and the patch (mm).
+    pub chordal_error: f64,
+}
+
 /// One isoparametric pass.
 #[derive(Debug, Clone, PartialEq)]
 pub struct IsoPass {
@@ -88,8 +101,7 @@ pub struct IsoPlanned {
     pub mean_scallop_mm: f64,
 }
 
-/// Plans isoparametric passes over `patch` (its tessellation indexed by `index`,
-/// within `chordal_error` of it) with `cutter`. From `params` it uses
+/// Plans isoparametric passes over `surface` with `cutter`. From `params` it uses
 /// `scallop_height`, `max_step` and `clearance`; the feed is `params.machine.feed`.
 ///
 /// # Errors
@@ -97,16 +109,15 @@ pub struct IsoPlanned {
 /// spacing below [`tol::MIN_SPACING`] (in mm on the surface), or a measured scallop
 /// over `sh` (a bug).
 pub fn plan_isoparametric(
-    patch: &Patch,
-    index: &MeshIndex,
+    surface: &IsoSurface<'_>,
     cutter: &Cutter,
     params: &FinishingParams,
     direction: IsoDirection,
     tolerances: &Tolerances,
-    chordal_error: f64,
 ) -> Result<IsoPlanned, StrategyError> {
+    let chordal_error = surface.chordal_error;
     let (model, target) = checked_target(cutter, params, tolerances, chordal_error)?;
-    let (ctx, across) = Ctx::new(patch, index, cutter, direction, tolerances, params);
+    let (ctx, across) = Ctx::new(surface, cutter, direction, tolerances, params);
     let mut passes = vec![ctx.pass(across[0])];
     let mut heights: Vec<f64> = Vec::new();
     let mut max_h = 0.0f64;
@@ -124,15 +135,15 @@ pub fn plan_isoparametric(
 }
 
 impl<'a> Ctx<'a> {
-    /// The planner's context on `patch` and the cross range of its isolines.
+    /// The planner's context on `surface` and the cross range of its isolines.
     fn new(
-        patch: &'a Patch,
-        index: &'a MeshIndex,
+        surface: &IsoSurface<'a>,
         cutter: &'a Cutter,
         direction: IsoDirection,
         tolerances: &'a Tolerances,
         params: &'a FinishingParams,
     ) -> (Ctx<'a>, [f64; 2]) {
+        let (patch, index) = (surface.patch, surface.index);
         let domain = patch.domain();
         let (along, across) = match direction {
             IsoDirection::U => (domain.u, domain.v),
@@ -219,7 +230,7 @@ fn checked_target(
     Ok((model, target))
 }
 
-/// The number of passes [`plan_isoparametric`] makes on `patch`, estimated
+/// The number of passes [`plan_isoparametric`] makes on `surface`, estimated
 /// from the planner's own step fit (the rule's step, measured by
 /// [`iso_scallop`] and corrected, as the planner does) at `samples` isolines
 /// spread evenly across the patch: the cross range is walked with the fitted
@@ -228,20 +239,17 @@ fn checked_target(
 ///
 /// # Errors
 /// As [`plan_isoparametric`].
-#[allow(clippy::too_many_arguments, reason = "the planner's arguments plus the sample count")]
 pub fn iso_fitted_passes(
-    patch: &Patch,
-    index: &MeshIndex,
+    surface: &IsoSurface<'_>,
     cutter: &Cutter,
     params: &FinishingParams,
     direction: IsoDirection,
     tolerances: &Tolerances,
-    chordal_error: f64,
     samples: usize,
 ) -> Result<usize, StrategyError> {
     use rayon::prelude::*;
-    let (model, target) = checked_target(cutter, params, tolerances, chordal_error)?;
-    let (ctx, across) = Ctx::new(patch, index, cutter, direction, tolerances, params);
+    let (model, target) = checked_target(cutter, params, tolerances, surface.chordal_error)?;
+    let (ctx, across) = Ctx::new(surface, cutter, direction, tolerances, params);
     let n = samples.max(2);
     #[allow(clippy::cast_precision_loss, reason = "small counts")]
     let fitted = (0..n)

@@ -184,7 +184,7 @@ pub mod trochoid;
 
 pub use error::StrategyError;
 pub use geometry::contact_to_tip;
-pub use iso::{IsoDirection, IsoPass, IsoPlanned, iso_fitted_passes, iso_scallop, plan_isoparametric};
+pub use iso::{IsoDirection, IsoPass, IsoPlanned, IsoSurface, iso_fitted_passes, iso_scallop, plan_isoparametric};
 pub use leads::{LeadFallback, LeadKind, LeadReport, apply_leads};
 pub use params::{Boundary, FinishingParams, Pattern};
 pub use plan::rule_spacing;
@@ -419,16 +419,11 @@ fn plan(
     let (toolpath, links, retracts) = planner.toolpath(&planes);
     let planes: Vec<Plane> = planes.into_iter().map(|p| p.plane).collect();
     let feed_samples = planner.feed_samples.clone();
-    let scallop = scallop::verify_scallop_within(
-        index,
-        cutter,
-        &planes,
-        params.direction,
-        &feed_samples,
-        params.scallop_height,
-        plan::zone_end_margin(cutter, region),
-        !tolerate_rest,
-    )?;
+    let measure = scallop::Measure {
+        end_margin: plan::zone_end_margin(cutter, region),
+        ..scallop::Measure::new(index, cutter, params.direction, params.scallop_height)
+    };
+    let scallop = scallop::verify_measured(&measure, &planes, &feed_samples, !tolerate_rest)?;
     let report = Report {
         passes: planes.iter().map(|p| p.passes.len()).sum(),
         planes: planes.len(),

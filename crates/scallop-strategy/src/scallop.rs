@@ -426,28 +426,26 @@ pub fn verify_scallop(
     feed_samples: &[f64],
     scallop_height: f64,
 ) -> Result<ScallopReport, StrategyError> {
-    verify_scallop_within(index, cutter, planes, direction, feed_samples, scallop_height, 0.0, true)
+    verify_measured(&Measure::new(index, cutter, direction, scallop_height), planes, feed_samples, true)
 }
 
-/// [`verify_scallop`] leaving out the sections within `end_margin` of a pass end.
-pub(crate) fn verify_scallop_within(
-    index: &MeshIndex,
-    cutter: &Cutter,
+/// [`verify_scallop`] with `measure` (its limit the scallop height, its end
+/// margin left out); `strict: false` reports a scallop over the limit instead
+/// of refusing it.
+pub(crate) fn verify_measured(
+    measure: &Measure<'_>,
     planes: &[Plane],
-    direction: f64,
     feed_samples: &[f64],
-    scallop_height: f64,
-    end_margin: f64,
     strict: bool,
 ) -> Result<ScallopReport, StrategyError> {
-    let measure = Measure { end_margin, ..Measure::new(index, cutter, direction, scallop_height) };
+    let scallop_height = measure.limit;
     let frame = measure.frame;
     let curves: Vec<Vec<Curve>> =
         planes.iter().map(|pl| pl.passes.iter().map(|p| Curve::new(&frame, p)).collect()).collect();
     let pairs: Vec<(PairScallop, Vec<f64>)> = (0..planes.len().saturating_sub(1))
         .into_par_iter()
         .map(|k| {
-            let heights: Vec<Cusp> = pair_heights(&measure, &curves[k], &curves[k + 1], feed_samples);
+            let heights: Vec<Cusp> = pair_heights(measure, &curves[k], &curves[k + 1], feed_samples);
             let mut pair = PairScallop {
                 plane: k,
                 next: k + 1,
