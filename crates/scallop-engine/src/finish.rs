@@ -19,8 +19,7 @@ use scallop_mesh::{MeshIndex, TriMesh};
 use scallop_post::{Dialect, OutputMode, PostParams, ProgramInfo, program_text, write_fitted};
 use scallop_strategy::{
     Boundary, FinishingParams, IsoDirection, IsoSurface, LeadKind, LeadReport, Pattern, Refinement, SteepShallow,
-    apply_leads, lookahead_time, plan_finishing_refined, plan_isoparametric, plan_steep_shallow_refined,
-    stop_to_stop_time,
+    apply_leads, lookahead_time, plan_finishing_refined, plan_isoparametric, plan_steep_shallow, stop_to_stop_time,
 };
 use scallop_toolpath::{FittedPath, Move, MoveKind, Toolpath, fit_arcs};
 use serde::Serialize;
@@ -437,15 +436,8 @@ pub(crate) fn plan_operation(
             if let Some(t) = threshold_deg {
                 split.threshold = t.to_radians();
             }
-            let p = plan_steep_shallow_refined(
-                &prepared.mesh,
-                &prepared.index,
-                &job.cutter,
-                &params,
-                tolerances,
-                &split,
-                refine,
-            )?;
+            let p =
+                plan_steep_shallow(&prepared.mesh, &prepared.index, &job.cutter, &params, tolerances, &split, refine)?;
             let layout = Layout {
                 direction: params.direction,
                 planes: p.shallow.as_ref().map(|q| q.planes.iter().map(|q| q.offset).collect()).unwrap_or_default(),

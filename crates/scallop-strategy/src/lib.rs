@@ -190,9 +190,7 @@ pub use params::{Boundary, FinishingParams, Pattern};
 pub use plan::rule_spacing;
 pub use region::ZoneRegion;
 pub use scallop::{PairScallop, ScallopReport, verify_scallop};
-pub use steep::{
-    SteepPlanned, SteepShallow, convex_factor, crease_residual, plan_steep_shallow, plan_steep_shallow_refined,
-};
+pub use steep::{SteepPlanned, SteepShallow, convex_factor, crease_residual, plan_steep_shallow};
 pub use time::{ClassTimes, MoveFeed, lookahead_profile, lookahead_time, stop_to_stop_time};
 
 use scallop_cutter::Cutter;

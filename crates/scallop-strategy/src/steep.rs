@@ -224,29 +224,14 @@ pub struct SteepPlanned {
 }
 
 /// Plans steep-and-shallow finishing of `mesh` (indexed by `index`): see the
-/// module docs.
+/// module docs. The planes and levels of `refine` are added to those the
+/// planner places (see [`Refinement`]; `Refinement::default()` adds none).
 ///
 /// # Errors
 /// As [`crate::plan_finishing`] for the shallow planes; a bad split
 /// ([`StrategyError::BadParameter`]); a waterline failure
 /// ([`StrategyError::Waterline`]).
 pub fn plan_steep_shallow(
-    mesh: &TriMesh,
-    index: &MeshIndex,
-    cutter: &Cutter,
-    params: &FinishingParams,
-    tol_: &Tolerances,
-    split: &SteepShallow,
-) -> Result<SteepPlanned, StrategyError> {
-    plan_steep_shallow_refined(mesh, index, cutter, params, tol_, split, &Refinement::default())
-}
-
-/// [`plan_steep_shallow`] with the planes and levels of `refine` added to
-/// those the planner places (see [`Refinement`]).
-///
-/// # Errors
-/// As [`plan_steep_shallow`].
-pub fn plan_steep_shallow_refined(
     mesh: &TriMesh,
     index: &MeshIndex,
     cutter: &Cutter,

@@ -6,10 +6,7 @@ mod common;
 use common::{ball, inclined_plane, params};
 use scallop_geom::{Point3, Tolerances};
 use scallop_mesh::{MeshIndex, TriMesh};
-use scallop_strategy::{
-    Pattern, Refinement, SteepShallow, plan_finishing, plan_finishing_refined, plan_steep_shallow,
-    plan_steep_shallow_refined,
-};
+use scallop_strategy::{Pattern, Refinement, SteepShallow, plan_finishing, plan_finishing_refined, plan_steep_shallow};
 
 fn tolerances() -> Tolerances {
     Tolerances { path: 0.01, gouge: 0.0 }
@@ -63,13 +60,13 @@ fn a_level_between_two_levels_is_added_and_planned() {
     let p = params(0.0, Pattern::Zigzag, 0.05, 0.5);
     let tol = tolerances();
     let split = SteepShallow::default_for(&cutter, 0.05);
-    let base = plan_steep_shallow(&mesh, &index, &cutter, &p, &tol, &split).unwrap();
+    let base = plan_steep_shallow(&mesh, &index, &cutter, &p, &tol, &split, &Refinement::default()).unwrap();
     let z = &base.level_heights;
     assert!(z.len() >= 3, "{z:?}");
     assert!(z.windows(2).all(|w| w[0] > w[1]), "from the top down: {z:?}");
     let mid = 0.5 * (z[1] + z[2]);
     let refine = Refinement { planes: vec![], levels: vec![mid, z[0]] };
-    let refined = plan_steep_shallow_refined(&mesh, &index, &cutter, &p, &tol, &split, &refine).unwrap();
+    let refined = plan_steep_shallow(&mesh, &index, &cutter, &p, &tol, &split, &refine).unwrap();
     assert_eq!(refined.level_heights.len(), z.len() + 1, "{:?}", refined.level_heights);
     assert!(refined.level_heights.windows(2).all(|w| w[0] > w[1]));
     assert!(refined.level_heights.iter().any(|&h| (h - mid).abs() < 1e-12));
