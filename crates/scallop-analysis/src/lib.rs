@@ -58,7 +58,7 @@ mod pca;
 mod plane;
 mod plot;
 mod sample;
-pub mod tol;
+pub use scallop_geom::tol::analysis as tol;
 
 pub use advisor::{AnalysisReport, Note, PcaPlane, Recommendation, ToolOption, analyze};
 pub use cutter::{Cutter, effective_radius_for_step_over, fold_direction_angle, step_over};

@@ -65,7 +65,7 @@ mod kmeans;
 mod metric;
 mod partition;
 mod rpcl;
-pub mod tol;
+pub use scallop_geom::tol::cluster as tol;
 mod zone;
 
 pub use ccl::connected_components;

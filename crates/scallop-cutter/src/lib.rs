@@ -27,7 +27,7 @@
 
 mod drop;
 mod shape;
-pub mod tol;
+pub use scallop_geom::tol::cutter as tol;
 
 pub use drop::{
     ClPoint, Contact, drop_cutter, drop_cutter_brute_force, drop_grid, drop_path, drop_points, drop_triangle,

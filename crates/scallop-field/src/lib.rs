@@ -34,7 +34,7 @@ mod grid;
 mod level;
 mod surface;
 mod tet;
-pub mod tol;
+pub use scallop_geom::tol::field as tol;
 
 pub use field::{Field, distance_field, morph_field};
 pub use grid::Grid;

@@ -1,5 +1,8 @@
 //! Every numeric threshold of scallop. No other module of the workspace
-//! compares floats against a literal; they take a named value from here.
+//! compares floats against a literal; they take a named value from here. The
+//! thresholds of one crate are in the module named after it (`strategy` for
+//! `scallop-strategy`), which that crate re-exports as its own `tol`; the 2D
+//! contour crate, which depends on no scallop crate, keeps its own.
 
 /// User-facing machining tolerances in mm; part of every job.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -70,4 +73,1140 @@ impl Eps {
     pub fn for_bounds(b: &crate::Aabb3) -> Eps {
         Self::for_scale(b.max_abs_coord())
     }
+}
+
+pub mod analysis {
+    //! Thresholds of `scallop_analysis`, re-exported there as `scallop_analysis::tol`.
+    //!
+    //! Every numeric threshold and algorithm constant of this crate, in one place
+    //! (house rule: no float literal thresholds in algorithms). Values quoted from the
+    //! specification name the section of `finishing.md` they come from.
+
+    /// A normal whose XY projection is shorter than this is horizontal-plane normal
+    /// (`n = +-Z`): its steepest-slope direction theta is undefined and set to 0
+    /// (finishing.md 4.4 \[DECISION\]). The same rule folds the XY projections of the PCA
+    /// axes `S_I` and `S_III` into angles.
+    pub const HORIZONTAL_XY: f64 = 1e-12;
+
+    /// Below this `sin s`, Eq. 1.5 is treated as singular (horizontal plane) and the
+    /// toroidal step-over is the flat-bottom cap `sod_max` (finishing.md 5.3).
+    pub const SIN_SLOPE_HORIZONTAL: f64 = 1e-9;
+
+    /// Annex E (finishing.md 12.7): a PCA plane with `|X_III . Z|` below this is
+    /// vertical and its analytic time is `+inf` (not machinable by that model).
+    pub const VERTICAL_PLANE_NZ: f64 = 1e-6;
+
+    /// Annex E: a side region with fewer than this many (real) passes contributes
+    /// nothing (finishing.md 12.7 "if N < 1e-12 the side term is 0").
+    pub const ANNEX_E_MIN_SIDE_PASSES: f64 = 1e-12;
+
+    /// PCA canonical signs: when `|S_III . Z|` is at most this, the plane is vertical
+    /// and the sign of `S_II`, `S_III` is fixed by "largest-magnitude component of
+    /// `S_III` positive" instead of "`S_III` upward" (finishing.md 9.1).
+    pub const PCA_VERTICAL_NZ: f64 = 1e-12;
+
+    /// The samples are degenerate (on a line or at a point; the PCA rectangle has no
+    /// area) when `lambda_II <= DEGENERATE_EIGEN_REL * lambda_I`, or when `lambda_I`
+    /// is at most `DEGENERATE_EIGEN_REL` times the squared coordinate scale.
+    pub const DEGENERATE_EIGEN_REL: f64 = 1e-12;
+
+    /// Shape-factor limit of the decision aid (finishing.md 8.5, thesis footnote):
+    /// beyond `mu = 9` the model was not validated; the advisor still answers with the
+    /// `s_c` rule and adds a note.
+    pub const SHAPE_FACTOR_LIMIT: f64 = 9.0;
+
+    /// Samples per chunk in the fixed-order reductions (moments, orientation sums):
+    /// the chunking depends on this constant only, never on the thread count, so
+    /// results are bit-identical with any number of threads.
+    pub const REDUCTION_CHUNK: usize = 4096;
+
+    /// Number of points of the critical curve `s_c(mu)` drawn by `scallop_analysis::plot_svg`.
+    pub const PLOT_CURVE_POINTS: usize = 241;
+
+    /// Largest sampling grid of a patch (cells): 4 million, about 400 MB of samples and a few
+    /// seconds; the CLI's `--cells 2000` is the largest square grid under it.
+    pub const MAX_GRID_CELLS: usize = 4_000_000;
+}
+
+pub mod cluster {
+    //! Thresholds of `scallop_cluster`, re-exported there as `scallop_cluster::tol`.
+    //!
+    //! Every numeric threshold and algorithm constant of this crate, in one place
+    //! (house rule: no float literal thresholds in algorithms). Values quoted from the
+    //! specification name the section of `finishing.md` they come from.
+
+    /// Iteration cap of K-means and RPCL (finishing.md 11.6, 11.7, section 13): one
+    /// iteration is one full assignment sweep.
+    pub const MAX_ITERATIONS: usize = 300;
+
+    /// Incremental zone statistics are recomputed in batch every this many assignment
+    /// iterations (and at termination) so rounding cannot accumulate (finishing.md 11.5).
+    pub const BATCH_REFRESH_EVERY: usize = 10;
+
+    /// Per-cluster Mahalanobis and standard-deviation metrics fall back to the global
+    /// covariance for clusters with fewer cells than this (finishing.md 11.3, item 3).
+    pub const MIN_CELLS_PER_CLUSTER_COVARIANCE: usize = 5;
+
+    /// A symmetric covariance is singular when an eigenvalue is at most this times the
+    /// largest one. The global Mahalanobis metric then uses the pseudo-inverse (the
+    /// directions without spread, e.g. a constant slope on a plane, weigh 0); a
+    /// per-cluster covariance falls back to the global one (finishing.md 11.3).
+    pub const SINGULAR_EIGEN_REL: f64 = 1e-12;
+
+    /// A standard deviation (rad or parameter units) at or below this is zero: the
+    /// component is constant over the set and weighs 0 in the standard-deviation metric
+    /// (globally), or the per-cluster metric falls back to the global one.
+    pub const MIN_SIGMA: f64 = 1e-12;
+
+    /// The PCA metric's extra term is 0 for clusters with fewer cells than this
+    /// (finishing.md 11.3, item 6 \[DECISION\]).
+    pub const PCA_MIN_CELLS: usize = 3;
+
+    /// A vector whose XY projection is shorter than this (mm, or unit vectors) has no
+    /// direction angle; the PCA metric's corresponding `sin^2` term is then 0
+    /// (finishing.md 11.3, item 6 \[DECISION\]).
+    pub const XY_DEGENERATE: f64 = 1e-12;
+
+    /// Closed-form 3x3 eigenvectors: when the best cross product of two rows of
+    /// `A - lambda_I I` is at most this times the squared Frobenius norm of `A`, the top
+    /// eigenvalue is (nearly) repeated and the iterative solver is used instead.
+    pub const EIGEN_CROSS_REL: f64 = 1e-10;
+
+    /// RPCL winner learning rate at sweep 0 (finishing.md 11.7, section 13 \[DECISION\]).
+    pub const RPCL_ALPHA_WINNER: f64 = 0.05;
+
+    /// RPCL rival learning rate at sweep 0 (finishing.md 11.7, section 13 \[DECISION\]).
+    pub const RPCL_ALPHA_RIVAL: f64 = 0.005;
+
+    /// RPCL stops when both learning rates are below this (finishing.md 11.7).
+    pub const RPCL_TOL_ALPHA: f64 = 1e-4;
+
+    /// RPCL stops when fewer than this fraction of the cells changed cluster in a sweep
+    /// (finishing.md 11.7: "1 % move threshold").
+    pub const RPCL_TOL_MOVE: f64 = 0.01;
+
+    /// Assignment sweeps run on the rayon pool when `cells x clusters` is at least this
+    /// (the PCA metric always does); below, one thread is faster. Either way each cell's
+    /// label depends only on frozen statistics, so the result is the same.
+    pub const PARALLEL_MIN_PAIRS: usize = 1 << 17;
+
+    /// Relative slack of Hamerly's K-means bounds: a cell skips the scan only when its
+    /// upper bound times `1 + HAMERLY_SLACK` is below its lower bound, so rounding in
+    /// the accumulated bounds (about 1e-16 per update) can never keep a cell in the
+    /// wrong cluster.
+    pub const HAMERLY_SLACK: f64 = 1e-9;
+
+    /// Absolute margin (in the metric's units) added to the K-means scan's pruning
+    /// radius `2 u (1 + HAMERLY_SLACK)`, so that rounding near `u = 0` never prunes
+    /// a centre that could tie.
+    pub const HAMERLY_ABSOLUTE: f64 = 1e-12;
+
+    /// Cells per parallel assignment chunk.
+    pub const PARALLEL_CHUNK: usize = 1024;
+
+    /// Hierarchical clustering is O(n^2) in time (O(n) memory, nearest-neighbour
+    /// chain): grids with more kept cells than this are rejected (about 5 s here); coarsen
+    /// the clustering grid (the thesis recommends HAC only to suggest a K).
+    pub const HAC_MAX_CELLS: usize = 40_000;
+}
+
+pub mod cutter {
+    //! Thresholds of `scallop_cutter`, re-exported there as `scallop_cutter::tol`.
+    //!
+    //! The physical range of cutter sizes, named in one place.
+
+    /// Largest cutter radius R (mm): a 1 m face mill is beyond any catalogue; past it a
+    /// size is a typo (a diameter in microns, a missing decimal point), and the planning and
+    /// simulation work it implies has no bound.
+    pub const MAX_RADIUS: f64 = 500.0;
+
+    /// Smallest cutter radius R (mm): 1 micron, below the smallest micro end mills (5 microns
+    /// in diameter); a smaller radius makes scallop-driven spacings vanish.
+    pub const MIN_RADIUS: f64 = 1e-3;
+
+    /// Largest flute, shank or holder length and holder radius (mm): 2 m.
+    pub const MAX_LENGTH: f64 = 2000.0;
+}
+
+pub mod field {
+    //! Thresholds of `scallop_field`, re-exported there as `scallop_field::tol`.
+    //!
+    //! Every numeric threshold of the field engine, with its reason.
+
+    /// Samples per axis of one storage block of a `scallop_field::Field`. A block whose
+    /// centre is farther from the surface than the band cutoff plus its half-diagonal
+    /// holds no sample in the band and is not stored (cell binning of the band).
+    pub const BLOCK: usize = 8;
+
+    /// Default bound on the number of grid samples (2^25, at most 256 MiB of f64
+    /// per field). A grid over it is refused with `scallop_field::FieldError::GridTooLarge`,
+    /// which names the smallest voxel size that fits.
+    pub const DEFAULT_MAX_SAMPLES: usize = 1 << 25;
+
+    /// The band cutoff exceeds the largest iso-value by this many voxel sizes. The
+    /// longest edge of the Kuhn tetrahedra is `sqrt(3) h`, and the distance is
+    /// 1-Lipschitz, so every edge that crosses an iso-value has both ends computed
+    /// exactly when the cutoff is at least `iso + sqrt(3) h`; 2 leaves a margin. The
+    /// grid margin around the surface uses the same count (a sheet is never clipped
+    /// by the grid box).
+    pub const BAND_MARGIN_VOXELS: f64 = 2.0;
+
+    /// Relative clamp of the interpolation parameter on a crossed edge: the output
+    /// vertex stays at least this fraction of the edge length away from both grid
+    /// samples, so two vertices on different edges of one sample never coincide and
+    /// welding by edge never makes a zero-area triangle. The position error it adds
+    /// (`1e-4 h`) is far below the method's `h / 2` bound.
+    pub const INTERP_CLAMP: f64 = 1e-4;
+
+    /// Relative slack on the bound that a neighbouring sample's distance gives
+    /// (`d(q) + |p - q|`, the distance being 1-Lipschitz): rounding of the square
+    /// root and the sum can put the exact bound an ulp below the distance, which
+    /// would miss the closest triangle; 1e-9 covers it many times over and costs
+    /// no pruning worth measuring.
+    pub const LIPSCHITZ_SLACK: f64 = 1e-9;
+}
+
+pub mod guides {
+    //! Thresholds of `scallop_guides`, re-exported there as `scallop_guides::tol`.
+    //!
+    //! Thresholds of the guide-curve algorithms, each documented.
+
+    /// Root finding on a Marching Facets edge stops when the exact field is within
+    /// this of the iso-value, or the bracket is this short (mm). Far below the
+    /// 1e-6 mm asked of edge points (issue 17; docs/guides-curves.md).
+    pub const ROOT_TOLERANCE: f64 = 1e-10;
+
+    /// Iteration cap of the edge root finding (Illinois false position with
+    /// bisection steps); 2^-100 of an edge is far below [`ROOT_TOLERANCE`].
+    pub const MAX_ROOT_ITERATIONS: usize = 100;
+
+    /// A facet is flagged as crossed by the medial axis of the curve when the feet
+    /// of its corners on the curve are farther apart than this many times the
+    /// facet's longest edge (docs/guides-curves.md, "Medial-axis facets").
+    pub const MEDIAL_FOOT_FACTOR: f64 = 3.0;
+
+    /// Offsets stop after this many curves beyond `diagonal / a_e + 2` (a guard:
+    /// every step shrinks the region, so it is never reached on a valid mesh).
+    pub const EXTRA_STEPS: usize = 2;
+
+    /// A vertex of a curve is a corner to round in the vectorial offset (Alg. 3,
+    /// Jousselin 2020, Annex A) when the curve turns there by more than this
+    /// (radians): gaps on straight stretches are not filled, since the radial push
+    /// would bring the points closer than the offset distance to the curve.
+    pub const CORNER_TURN: f64 = 0.1;
+
+    /// Most axial levels of one guide set (bounds the work on absurd settings).
+    pub const MAX_LEVELS: usize = 1000;
+
+    /// Consecutive curve points closer than this (mm) are merged in a distance
+    /// field (`scallop_guides::CurveField`): the mesh intersection and Marching Facets
+    /// can leave points a rounding error apart, whose segment has no reliable
+    /// direction (coordinates of 1e2 mm carry 1e-14 mm of rounding, a direction
+    /// error of 1e-7 rad at this length), so its left vector could flip the side
+    /// of the points whose nearest point is its end.
+    pub const MERGE_DISTANCE: f64 = 1e-7;
+
+    /// An offset loop whose mean width (`2 area / length`) is under this many
+    /// facet sizes has vanished (`scallop_guides::offset_curves`): its shape is below
+    /// the mesh's resolution (docs/guides-curves.md, "Slivers").
+    pub const SLIVER_WIDTH_FACETS: f64 = 0.5;
+
+    /// Relative slack on the distance bounds by which Marching Facets decides,
+    /// without measuring them, that vertices are far from (or near to) the curves
+    /// (`scallop_guides::offset_curves`): it covers the rounding of the distances, so
+    /// that a vertex is left out only if a direct query would also place it
+    /// beyond the limit.
+    pub const SELECTION_SLACK: f64 = 1e-9;
+}
+
+pub mod machine {
+    //! Thresholds of `scallop_machine`, re-exported there as `scallop_machine::tol`.
+    //!
+    //! Thresholds specific to machine kinematics.
+
+    /// A declared axis direction (or tool axis) must have a norm within this of 1
+    /// before it is normalised (spec 2.3).
+    pub const DIRECTION_NORM: f64 = 1e-6;
+
+    /// Two unit directions count as parallel when `|u x v|` is below this (rotary axes of
+    /// one machine must not be parallel; a pivot direction is "along e_x" for the
+    /// closed-form families when it differs from it by less than this).
+    pub const PARALLEL: f64 = 1e-9;
+
+    /// Largest absolute coordinate (mm) of a point in a description (part-frame origin,
+    /// gauge point, pivot points): 100 m, beyond any machine; past it a value is a typo and
+    /// the kinematics would overflow.
+    pub const MAX_COORDINATE: f64 = 1e5;
+
+    /// The three linear axes must span space: `|det [d_1 d_2 d_3]|` above this.
+    pub const LINEAR_INDEPENDENCE: f64 = 1e-6;
+
+    /// Default pole threshold: `rho = |sin(tilt)|` below this means the tool axis is on
+    /// the pole and the free rotary axis is held (spec 2.3, `kinematics.pole_eps`).
+    pub const POLE_EPS_DEFAULT: f64 = 1e-7;
+
+    /// `mu3^2` of the two-rotary subproblem may be this far below zero from rounding and
+    /// still count as the boundary of the reachable orientation set (then `mu3 = 0`).
+    pub const SUBPROBLEM_ROUNDING: f64 = 1e-12;
+
+    /// Slack on axis limits in internal units (mm, rad): a value this far outside a stroke
+    /// is rounding, not a violation (the spec's MX330 vector puts A exactly at -125 deg).
+    pub const LIMIT_SLACK: f64 = 1e-9;
+
+    /// Acceptance of a numeric (Levenberg-Marquardt) inverse: the forward kinematics must
+    /// reproduce the tip to this (mm) and the tool axis to this (unit vector) (spec 3.2).
+    pub const NUMERIC_ACCEPT: f64 = 1e-9;
+
+    /// Maximum Levenberg-Marquardt iterations of the numeric inverse.
+    pub const NUMERIC_MAX_ITERATIONS: usize = 200;
+
+    /// Initial damping of the Levenberg-Marquardt iteration (relative to `diag(J^T J)`).
+    pub const NUMERIC_INITIAL_DAMPING: f64 = 1e-3;
+
+    /// Two branch candidates whose continuity costs (s) differ by less than this are a tie,
+    /// broken by the user preference (spec 3.5).
+    pub const COST_TIE: f64 = 1e-12;
+
+    /// Two rotary solutions closer than this (rad, after reduction modulo 2 pi) and two
+    /// linear solutions closer than this (mm) are the same joint vector.
+    pub const SAME_JOINTS: f64 = 1e-9;
+
+    /// The damping grows until this; beyond it no step reduces the residual and the
+    /// iteration stops.
+    pub const NUMERIC_MAX_DAMPING: f64 = 1e12;
+
+    /// Smallest damping (keeps the normal equations positive definite).
+    pub const NUMERIC_MIN_DAMPING: f64 = 1e-15;
+
+    /// Factor applied to the damping after a successful step.
+    pub const NUMERIC_DAMPING_DECREASE: f64 = 0.1;
+
+    /// Factor applied to the damping after a rejected step.
+    pub const NUMERIC_DAMPING_INCREASE: f64 = 10.0;
+
+    /// Marquardt scaling floor: a diagonal entry of `J^T J` counts as at least this times
+    /// the largest one (a joint with no effect near a pole still gets damped).
+    pub const NUMERIC_DIAGONAL_FLOOR: f64 = 1e-9;
+
+    /// The orientation iteration stops once `|O(q) - O|` is below `NUMERIC_ACCEPT` times
+    /// this (room for the rounding of the final linear solve).
+    pub const NUMERIC_ORIENTATION_MARGIN: f64 = 1e-2;
+
+    /// Default rotary jump (rad, 30 deg) above which a block counts as a flip or unwind
+    /// (spec 3.5 `flip_threshold`).
+    pub const FLIP_THRESHOLD_DEFAULT: f64 = std::f64::consts::PI / 6.0;
+
+    /// Default time charged for a retract, reorientation and approach around a jump on a
+    /// non-cutting move (s) [PLACEHOLDER until the time model provides it].
+    pub const REORIENT_PENALTY_DEFAULT: f64 = 5.0;
+
+    /// Candidate joint vectors kept per pose by the branch dynamic programme (spec 3.5: K <= 8).
+    pub const PLAN_BEAM: usize = 8;
+
+    /// Uniform samples per block when measuring the deviation of joint-linear motion
+    /// (spec 3.10), before golden-section refinement of the worst one.
+    pub const DEVIATION_SAMPLES: usize = 16;
+
+    /// Golden-section iterations refining the worst deviation sample (interval shrinks by
+    /// 0.618 per iteration: 40 iterations reach 1e-8 of the block).
+    pub const DEVIATION_REFINE_ITERATIONS: usize = 40;
+
+    /// Maximum bisection depth of the joint-space subdivision (spec 3.10).
+    pub const SUBDIVISION_MAX_DEPTH: usize = 16;
+
+    /// A G93 word within this relative distance of a multiple of the output step is that
+    /// multiple (rounding noise of `60/T` must not round an exact feed down a step).
+    pub const FEED_ROUNDING: f64 = 1e-12;
+
+    /// Turning angle (rad, 10 deg) up to which a junction belongs to a smooth curve sampled
+    /// by a polyline (spec 8.3 `theta_smooth`).
+    pub const SMOOTH_JUNCTION: f64 = std::f64::consts::PI / 18.0;
+
+    /// Bisection iterations of the time model's velocity searches (relative precision 2^-60).
+    pub const TIME_BISECTION_ITERATIONS: usize = 60;
+
+    /// A per-axis direction component below this (mm or rad per mm of path) does not
+    /// limit a block's acceleration or jerk (the axis does not move in that block).
+    pub const AXIS_DIRECTION_ZERO: f64 = 1e-12;
+
+    /// Default share of the path tolerance for joint-space interpolation (mm; spec 3.10
+    /// `tol_pos`).
+    pub const JOINT_INTERPOLATION_DEFAULT: f64 = 0.005;
+
+    /// Default angular tolerance of the tool axis under joint-space interpolation (rad,
+    /// 0.05 deg; spec 3.10 `tol_ang`).
+    pub const JOINT_ANGLE_DEFAULT: f64 = 0.05 * std::f64::consts::PI / 180.0;
+
+    /// Slack on the verification of emitted blocks (relative): rate and deviation checks
+    /// pass when within this fraction above their limit (rounding only).
+    pub const VERIFY_SLACK: f64 = 1e-9;
+
+    /// A pole-axis move above this (rad, 90 deg) marks a branch flip: the two branches of
+    /// the standard families differ by 180 deg on the pole axis, a continuous pole crossing
+    /// keeps it (used by the greedy planner's events and the subdivision's midpoint check).
+    pub const BRANCH_JUMP: f64 = std::f64::consts::FRAC_PI_2;
+
+    /// Factor applied to one axis's velocity, acceleration and jerk limits to measure the
+    /// time that axis costs (`TimeReport::axis_time_lost`): large enough that the axis never
+    /// binds, finite so the jerk-limited formulas stay defined.
+    pub const RELAXED_AXIS_FACTOR: f64 = 1e9;
+
+    /// Largest total rotation of one block (rad) for which `feed::deviation_bound` holds
+    /// (its distance bound needs `3 Omega < 1`); larger blocks are sampled.
+    pub const BOUND_MAX_ROTATION: f64 = 0.3;
+
+    /// Relative and absolute (mm) inflation of the trigonometry-free distance bound of
+    /// `feed::deviation_bound_relaxed`, so that it also bounds the rounded exact distance.
+    pub const BOUND_PRETEST_SLACK: f64 = 1e-9;
+
+    /// Relative inflation of the atan-free upper bound `r_ref tan(phi) / F` of the rotation
+    /// term of `feed::inverse_time_feed` (covers the rounding of the exact term, a few ulps).
+    pub const ROTATION_TERM_SLACK: f64 = 1e-12;
+
+    /// Largest rotary turn (rad, 5 deg) of one step of `plan::track`, which follows a CL move
+    /// continuously: well below the 180 deg between the two inverse branches on the pole
+    /// axis, so the nearest solution of each step is the continuation.
+    pub const TRACK_STEP: f64 = std::f64::consts::PI / 36.0;
+
+    /// First (and largest) step of `plan::track` as a fraction of the move.
+    pub const TRACK_FIRST_STEP: f64 = 1.0 / 8.0;
+
+    /// Smallest step of `plan::track` (fraction of the move): a turn above `TRACK_STEP` over
+    /// a step this small is a discontinuity (an exact singularity), not a motion.
+    pub const TRACK_MIN_STEP: f64 = 1.0 / 1_073_741_824.0;
+
+    /// Most inverse evaluations of one `plan::track` (a guard; a move turning several full
+    /// revolutions near the pole needs a few thousand).
+    pub const TRACK_MAX_EVALUATIONS: usize = 200_000;
+
+    /// An inverse solution is the end of `plan::track`'s continuous motion when its rotaries
+    /// equal the tracked ones within this (rad) modulo a turn; the tracked values are inverse
+    /// solutions of the same pose, so only rounding separates them.
+    pub const TRACK_MATCH: f64 = 1e-6;
+
+    /// Default retract distance (mm) along the tool axis of a link that changes branch or
+    /// unwinds (`program::ProgramOptions::retract`) [PLACEHOLDER: a job's clearance should
+    /// set it].
+    pub const LINK_RETRACT_DEFAULT: f64 = 10.0;
+}
+
+pub mod mesh {
+    //! Thresholds of `scallop_mesh`, re-exported there as `scallop_mesh::tol`.
+    //!
+    //! Thresholds of the mesh queries (each documented where it is decided).
+
+    /// Barycentric slack of the ray-triangle test (`scallop_mesh::ray_triangle`): a
+    /// relative margin of a few thousand ulps so that a ray through a shared edge
+    /// or vertex hits at least one of the triangles around it despite rounding.
+    pub const RAY_EDGE_SLACK: f64 = 1e-12;
+}
+
+pub mod optim {
+    //! Thresholds of `scallop_optim`, re-exported there as `scallop_optim::tol`.
+    //!
+    //! Named constants of the optimiser (finishing.md 12.9). Each is a setting of
+    //! the normative compact OrthoMADS, not a tuning knob.
+
+    /// Initial frame and mesh size `Delta_0` in scaled variables (`[0, 1]`).
+    pub const INITIAL_FRAME: f64 = 0.1;
+
+    /// Smallest mesh index `l` (`l >= -2`): the largest frame is `0.1 * 2^2 = 0.4`.
+    pub const MIN_MESH_INDEX: i32 = -2;
+
+    /// Stop when the mesh size `Delta^m` falls below this (scaled units).
+    pub const MIN_MESH_SIZE: f64 = 1e-9;
+
+    /// The mesh index at which `Delta^m = 0.1 * 4^-l < MIN_MESH_SIZE` first holds
+    /// (`0.1 * 4^-14 = 3.7e-10`); the finest mesh ever polled is `l = 13`.
+    pub const STOP_MESH_INDEX: i32 = 14;
+
+    /// Lattice resolution: every point the optimiser evaluates has scaled
+    /// coordinates `m / LATTICE` with an integer `m` in `[0, LATTICE]`.
+    /// `LATTICE = 10 * 4^14`, so `1 / LATTICE` is the mesh size at
+    /// [`STOP_MESH_INDEX`] and every coarser mesh size is an integer number of
+    /// lattice steps; cache keys are exact integers and periodic wraps are exact.
+    pub const LATTICE: i64 = 10 * (1 << 28);
+
+    /// `Delta_0` in lattice steps (`0.1 * LATTICE = 2^28`).
+    pub const INITIAL_FRAME_STEPS: i64 = 1 << 28;
+
+    /// The quadratic-model search uses cached points within this multiple of the
+    /// frame size `Delta^p` (infinity norm, scaled units) of the incumbent.
+    pub const MODEL_RADIUS_FRAMES: f64 = 2.0;
+
+    /// Relative weight of the constant and linear coefficients in the
+    /// minimum-norm model fit: small, so the norm minimised is (almost only) the
+    /// Frobenius norm of the Hessian, as in the minimum-Frobenius-norm models.
+    pub const MODEL_LINEAR_WEIGHT: f64 = 1e-3;
+
+    /// Singular values below this fraction of the largest are treated as zero in
+    /// the model fit's pseudo-inverse.
+    pub const MODEL_RANK_REL: f64 = 1e-10;
+
+    /// Projected-gradient iterations when minimising the model in the frame box.
+    pub const MODEL_DESCENT_STEPS: usize = 60;
+
+    /// Most cached points used by one model fit, as a multiple of the number of
+    /// coefficients of a full quadratic (beyond that the fit only gets slower).
+    pub const MODEL_POINTS_PER_COEFFICIENT: usize = 2;
+}
+
+pub mod post {
+    //! Thresholds of `scallop_post`, re-exported there as `scallop_post::tol`.
+    //!
+    //! Every numeric threshold of the crate, named.
+
+    /// Relative slack under which a value counts as exactly representable when rounding
+    /// feed words (binary floating point cannot hold 57.368 exactly).
+    pub const ROUNDING_SLACK: f64 = 1e-9;
+
+    /// Largest rotation (deg) of a modulo-360 rotary in one block: blocks turning this much
+    /// or more are split (spec 3.7: the control takes the shortest path).
+    pub const MODULO_HALF_TURN: f64 = 179.0;
+
+    /// Tilt words within this many degrees of zero satisfy either solution sign.
+    pub const ZERO_TILT_DEG: f64 = 1e-6;
+
+    /// Cost added to a tilted-plane solution whose tilt sign contradicts the direction word.
+    pub const WRONG_SOLUTION_PENALTY: f64 = 1e6;
+
+    /// Largest distance (mm) of the tool tip from a rotary axis assumed when turning the
+    /// rounding of rotary words into a tip allowance.
+    pub const REACH: f64 = 1000.0;
+
+    /// Number of rounded angles (two rotaries, or three plane angles with margin) in the
+    /// rounding allowance.
+    pub const ROUNDED_ANGLES: f64 = 4.0;
+
+    /// Relative slack on the path tolerance and the axis-rate ratio in `scallop_post::check_replay`.
+    pub const CHECK_SLACK: f64 = 1e-6;
+
+    /// Samples of each joint-space block in `scallop_post::check_replay`.
+    pub const CHECK_SAMPLES: u32 = 16;
+
+    /// Distance from a rounding tie (in units of the last digit) below which `fmt_number`
+    /// leaves its integer fast path for the exact formatter.
+    pub const FAST_FORMAT_TIE_MARGIN: f64 = 1e-6;
+}
+
+pub mod report {
+    //! Thresholds of `scallop_report`, re-exported there as `scallop_report::tol`.
+    //!
+    //! Every numeric threshold and constant of the report writers.
+
+    /// Above this many toolpath vertices the 3D display is decimated (every k-th
+    /// move, always keeping the moves where the kind changes); the figures and
+    /// plots always use the full toolpath. 200 000 vertices keep a 10^6-move
+    /// report far below 50 MB and draw smoothly in software WebGL.
+    pub const MAX_DISPLAY_VERTICES: usize = 200_000;
+
+    /// Points of a line plot: longer series are reduced to the minimum and the
+    /// maximum of this many buckets (dips stay visible).
+    pub const MAX_PLOT_BUCKETS: usize = 1_000;
+
+    /// Rapid rate for nominal times when no time model is given (mm/min).
+    pub const NOMINAL_RAPID_RATE: f64 = 10_000.0;
+
+    /// Margin around the fitted view of a render (share of the image side).
+    pub const RENDER_MARGIN: f64 = 0.05;
+
+    /// Ambient share of the Lambert shading of a render (the rest is diffuse).
+    pub const AMBIENT: f64 = 0.25;
+
+    /// Scale of the GLB scene: glTF is in metres, scallop in millimetres.
+    pub const GLB_SCALE: f64 = 0.001;
+
+    /// Above this many cells the deviation map is reduced for the 3D display
+    /// (square blocks of cells become one texel: the deepest gouge of the block
+    /// when it has one, else the most material left). 512 x 512 cells embed as
+    /// 1.4 MB of base64 and are about as fine as the screen on a fitted view.
+    pub const MAX_DISPLAY_DEVIATION_CELLS: usize = 512 * 512;
+
+    /// The viewer shows faces whose normal's Z component is below this (slopes
+    /// over about 84 degrees) in the wall colour: a height map seen from above
+    /// does not measure them (every point of a vertical face would take the
+    /// deviation of the surface above or beside it).
+    pub const WALL_NORMAL_Z: f64 = 0.1;
+}
+
+pub mod rough {
+    //! Thresholds of `scallop_rough`, re-exported there as `scallop_rough::tol`.
+    //!
+    //! Named tolerances and thresholds of the roughing planner (mm unless said).
+
+    /// Extra width, as a share of the stepover, allowed around the band a
+    /// tool-down link may cross: a link's radial engagement stays within about
+    /// one stepover (see `offset.rs`).
+    pub const LINK_MARGIN_SHARE: f64 = 0.05;
+
+    /// A facet whose unit normal has `z` above this is horizontal (a floor that
+    /// gets a level of its own): within 0.08 degrees of level.
+    pub const FLAT_NORMAL_Z: f64 = 1.0 - 1e-6;
+
+    /// Heights of flat facets closer than this are one floor.
+    pub const FLAT_MERGE: f64 = 1e-3;
+
+    /// Levels closer than this are one level (the higher is kept).
+    pub const LEVEL_MERGE: f64 = 1e-3;
+
+    /// A floor's level is this far above the floor plus the axial allowance, so
+    /// the waterline height is never exactly a facet's height (where every grid
+    /// sample would tie).
+    pub const FLAT_LIFT: f64 = 1e-5;
+
+    /// Rapids down into cleared area stop this far above the cleared level; a
+    /// plunge at the plunge feed does the rest.
+    pub const APPROACH: f64 = 1.0;
+
+    /// Largest sweep of one arc move (rad): longer arcs are split so that no
+    /// move reads as a full circle and the centre words stay well defined.
+    pub const MAX_ARC_SWEEP: f64 = std::f64::consts::FRAC_PI_2;
+
+    /// Most offset passes of one region (bounds the work on absurd inputs).
+    pub const MAX_PASSES: usize = 100_000;
+
+    /// Most levels of one plan.
+    pub const MAX_LEVELS: usize = 10_000;
+
+    /// A region is grown by this before testing whether a link stays in it, so
+    /// that passes on its contour count as inside (mm): the tool may go this far
+    /// into the allowance on a link.
+    pub const LINK_GROW: f64 = 1e-4;
+
+    /// Waterline loops are thinned by Douglas-Peucker at this before the region
+    /// booleans (mm): their points lie within the waterline's chord tolerance
+    /// (1e-4 mm) of each other's chords, far denser than a roughing region needs.
+    /// The region's boundary moves by at most this (into the allowance, and with
+    /// no allowance into the part: within the job's path tolerance).
+    pub const SIMPLIFY: f64 = 1e-3;
+
+    /// Helical entries: the tool centre's circle has this share of the tool
+    /// radius (the bore is 1.5 D wide, no core left in its middle).
+    pub const HELIX_RADIUS_SHARE: f64 = 0.5;
+
+    /// Helical entries descend this much per unit of length along the circle
+    /// (tan of about 3 degrees).
+    pub const HELIX_SLOPE: f64 = 0.05;
+
+    /// A point this far inside a ring (from a chord's midpoint, along its
+    /// normal) stands for the region in containment tests between levels (mm).
+    pub const INTERIOR_NUDGE: f64 = 1e-3;
+
+    /// Material less than this above a level (mm) is not worth a pass: the
+    /// in-process stock's cells that hold only this much over the level count
+    /// as cleared (see `material.rs`).
+    pub const MIN_CHIP: f64 = 0.05;
+
+    /// Most cells of an in-process stock map (bounds the memory of the outline
+    /// tracing on absurd inputs).
+    pub const MAX_MATERIAL_CELLS: usize = 64_000_000;
+}
+
+pub mod rough5 {
+    //! Thresholds of `scallop_rough5`, re-exported there as `scallop_rough5::tol`.
+    //!
+    //! Thresholds of 5-axis roughing, each documented.
+
+    /// A tool axis whose x component is below this (in absolute value) builds its
+    /// frame from +X, else from +Y (`scallop_rough5::place`): the frame is then never
+    /// built from a vector nearly parallel to the axis.
+    pub const FRAME_SWITCH: f64 = 0.9;
+
+    /// A contact closer to the tool axis than this (mm) is on the axis: its
+    /// normal is taken from the tool's centre point, not from the radial
+    /// direction (which is then undefined).
+    pub const ON_AXIS: f64 = 1e-12;
+
+    /// A tool axis shorter than this (mm, the distance between a path point and
+    /// its tilt point) is refused: the axis would be noise.
+    pub const MIN_AXIS_LENGTH: f64 = 1e-6;
+
+    /// Tool-axis steps below this (rad) are not subdivided (the axis is the
+    /// same to rounding).
+    pub const ANGLE_EPS: f64 = 1e-12;
+
+    /// Body samples of the flank collision check are this far apart along the
+    /// axis (mm); the check keeps a clearance of half of it, so it is
+    /// conservative (see `collide.rs`).
+    pub const BODY_STEP: f64 = 0.25;
+
+    /// Most passes (curves) of one level that the assembly accepts: a guard
+    /// against absurd settings.
+    pub const MAX_PASSES: usize = 10_000;
+
+    /// Most CL points of one pass (length over the step): a guard against
+    /// absurd settings.
+    pub const MAX_PASS_POINTS: usize = 1_000_000;
+
+    /// Relative finite-difference step of the SQP gradients (times 1 + |x_i|,
+    /// the polynomial coefficients being of order 1).
+    pub const SQP_FD_STEP: f64 = 1e-6;
+
+    /// A start whose constraint violation exceeds this is refused by the SQP.
+    pub const SQP_FEASIBLE: f64 = 1e-9;
+
+    /// The SQP stops when its step is below this in every coefficient.
+    pub const SQP_STEP: f64 = 1e-9;
+
+    /// The SQP stops when an iteration lowers the objective by less than this
+    /// times (1 + |objective|).
+    pub const SQP_REL_DECREASE: f64 = 1e-10;
+
+    /// Most iterations of one active-set QP.
+    pub const QP_MAX_ITER: usize = 500;
+
+    /// A working-set multiplier above -this counts as non-negative in the QP.
+    pub const QP_MULTIPLIER: f64 = 1e-10;
+
+    /// The smallest joint progress g_T' + g_D' of the two guide points (Eq.
+    /// 3.17 as corrected: never both stalled), per unit of s.
+    pub const MIN_PROGRESS: f64 = 1e-3;
+}
+
+pub mod sim {
+    //! Thresholds of `scallop_sim`, re-exported there as `scallop_sim::tol`.
+    //!
+    //! The simulator's named numeric thresholds (the workspace-wide ones are in
+    //! `scallop_geom::tol`).
+
+    /// A stock width within this relative distance of a whole number of cells is
+    /// that number of cells (not one more): `60 / 0.05` is 1200 cells even when the
+    /// division rounds to 1200.0000000000002.
+    pub const GRID_SNAP: f64 = 1e-9;
+
+    /// Default number of gouge cells listed in a `scallop_sim::SimError::Gouge`.
+    pub const WORST_REPORTED: usize = 20;
+
+    /// Cells of the machined surface over the scallop limit that
+    /// `scallop_sim::split_rest` lists for a refinement, at most (the thickest).
+    pub const OVER_REPORTED: usize = 20_000;
+
+    /// Slopes `|dz / L|` of a move above this are treated as vertical: the
+    /// horizontal travel is then below 1e-100 of the vertical one, far below
+    /// rounding, and the slope's square stays finite in the closed forms.
+    pub const VERTICAL_SLOPE: f64 = 1e100;
+
+    /// Largest distance (mm) between a circular or helical move of a tri-dexel
+    /// cut and the chords it is cut as (their vertices lie on the arc).
+    pub const ARC_SAGITTA: f64 = 1e-4;
+
+    /// Margin (mm) subtracted from the lower bounds of a swept floor that skip
+    /// the exact per-cell solve (`z_low + h(distance)`): far above the rounding of
+    /// both the bound and the solve (1e-14 mm at 100 mm), so that a skip never
+    /// happens where the solve would have lowered the cell, and results are the
+    /// same bits as without the bound.
+    pub const FLOOR_BOUND_MARGIN: f64 = 1e-9;
+
+    /// A probed point of the tool's periphery counts as cut by one of the tool's
+    /// recent moves only when it lies deeper than this (mm) inside the disc swept
+    /// by that move: the periphery of the current position is at exactly `R`
+    /// from the path's last point, and rounding must not count it as cut.
+    pub const ENGAGEMENT_CONTACT: f64 = 1e-6;
+
+    /// Samples per block of an engagement evaluation: a block reads the raster of
+    /// older cuts as it stood before the block, its samples run in parallel. A
+    /// fixed count, so the figures do not depend on the thread count.
+    pub const ENGAGEMENT_BLOCK: usize = 64;
+}
+
+pub mod strategy {
+    //! Thresholds of `scallop_strategy`, re-exported there as `scallop_strategy::tol`.
+    //!
+    //! Every numeric threshold and algorithm constant of this crate.
+    //!
+    //! Path-tolerance budget (style guide 2.6): the tessellation of parametric
+    //! surfaces takes [`crate::Tolerances::TESSELLATION_SHARE`] (0.25), the
+    //! forward sampling along a pass [`SAMPLING_SHARE`] (0.5) and the merging of
+    //! collinear points [`SIMPLIFY_SHARE`] (0.25): the total is `Tolerances::path`.
+    //!
+    //! Below the cutter-location surface (a gouge between cutter locations) only
+    //! the sampling share counts: a feed or link move never lies deeper than
+    //! `SAMPLING_SHARE * path` under the exact drop-cutter surface. The merging is
+    //! one-sided (`scallop_toolpath::simplify_above`: a kept chord passes on or
+    //! above every point it replaces), so its share is spent above the surface only.
+
+    /// Share of the path tolerance for the chordal deviation of the sampled CL
+    /// polyline (a step is bisected while the CL midpoint is farther than this
+    /// share of `path` above or below the chord).
+    pub const SAMPLING_SHARE: f64 = 0.5;
+
+    /// Share of the path tolerance for merging nearly collinear CL points
+    /// (`scallop_toolpath::simplify_above`: above the sampled polyline only).
+    pub const SIMPLIFY_SHARE: f64 = 0.25;
+
+    /// Share of the path tolerance for merging the CL points of parallel-planes
+    /// passes and links, one-sided (`simplify_above`): half of [`SIMPLIFY_SHARE`].
+    /// A kept chord passes above the valleys it smooths, and that material lies
+    /// between the feed samples where the planner measures the scallop: with the
+    /// full share the z-map simulation of the demo job (Choi, bull-nose R 5, r 2,
+    /// sh 0.01 mm) found 0.01035 mm, over sh plus its resolution bound (0.01031).
+    pub const PASS_SIMPLIFY_SHARE: f64 = 0.125;
+
+    /// The one-sided merging's tolerance is also at most this share of the
+    /// scallop height. A merged chord rides above the points it replaces, and the
+    /// material under it adds to the scallop between the feed samples where the
+    /// planner measures a pair of planes: the measure adds the larger lift of the
+    /// two planes (a small Choi zone study simulated 0.01157 mm for sh 0.01 mm
+    /// with the merging budgeted in the path tolerance only, docs/validation.md).
+    pub const MERGE_SCALLOP_SHARE: f64 = 0.02;
+
+    /// A forward step is split while the CL point at its middle, or at one of its
+    /// quarter points (an inflection inside the step can put the middle on the
+    /// chord), lies more than this fraction of the sampling share above the chord.
+    /// Where the CL surface is concave over the step (a crest, the top of a
+    /// descent), the chord's deepest point under it is at most twice the
+    /// midpoint's depth, so the chord stays within the sampling share. Jumps of the CL surface (walls) are
+    /// bisected down to `(GOUGE_MIDPOINT_SHARE * SAMPLING_SHARE * path)^2 / (2 R)`
+    /// (over which a circular arc of radius up to the cutter radius `R` rises by
+    /// at most that depth) and then stepped over vertically.
+    pub const GOUGE_MIDPOINT_SHARE: f64 = 0.5;
+
+    /// Pass ends are located by bisection of the region boundary until the bracket
+    /// is shorter than this share of the path tolerance (mm along the pass).
+    pub const BOUNDARY_SHARE: f64 = 0.5;
+
+    /// Forward steps are never bisected below this fraction of `max_step`.
+    pub const MIN_STEP_FRACTION: f64 = 1.0 / 4096.0;
+
+    /// The smallest horizontal plane spacing (mm) the planner accepts (finishing.md
+    /// 6.4 uses `Delta_min = 1e-6 m`); below it the scallop height cannot be met
+    /// with this cutter and direction and planning fails.
+    pub const MIN_SPACING: f64 = 1e-3;
+
+    /// When the measured scallop between a plane and its tentative successor
+    /// exceeds `sh`, the gap is multiplied by `sqrt(sh / h) * SPACING_SAFETY` (the
+    /// scallop grows about as the square of the gap) and measured again.
+    pub const SPACING_SAFETY: f64 = 1.0 - 1e-6;
+
+    /// Retries of the tentative next plane before giving up.
+    pub const MAX_SPACING_RETRIES: usize = 24;
+
+    /// Iterations of the first-plane fixed point (its offset is half its own spacing).
+    pub const FIRST_PLANE_ITERATIONS: usize = 4;
+
+    /// Relative measurement slack of the scallop check: a measured height up to
+    /// `sh * (1 + SCALLOP_REL_SLACK)` passes (rounding of the envelope search).
+    pub const SCALLOP_REL_SLACK: f64 = 1e-6;
+
+    /// Golden-section iterations of the envelope minimisation along one segment.
+    pub const GOLDEN_ITERATIONS: usize = 64;
+
+    /// Iterations of the cusp search (Illinois false position, then bisection).
+    pub const CUSP_ITERATIONS: usize = 80;
+
+    /// Relative convergence of the cusp search (times the plane gap).
+    pub const CUSP_REL_TOL: f64 = 1e-9;
+
+    /// Bins of the scallop histogram over `[0, sh]` (one more bin counts heights above `sh`).
+    pub const HISTOGRAM_BINS: usize = 10;
+
+    /// A normal whose XY projection is shorter than this is horizontal (slope 0).
+    pub const HORIZONTAL_XY: f64 = 1e-12;
+
+    /// A contact this far (relative to the cutter radius) outside the flat bottom
+    /// of a bull-nose lies on its torus, whose normal is then used.
+    pub const TORUS_CONTACT_REL: f64 = 1e-9;
+
+    /// Bisection iterations of the look-ahead velocity solver.
+    pub const VELOCITY_ITERATIONS: usize = 60;
+
+    /// Moves shorter than this (mm) are ignored by the time models (no direction).
+    pub const ZERO_LENGTH: f64 = 1e-12;
+
+    /// An envelope minimum within this fraction of the cutter radius of a pass end
+    /// comes from the end position (scallop samples there are skipped).
+    pub const PASS_END_REL: f64 = 1e-9;
+
+    /// A contact within this fraction of its triangle's longest edge from a vertex
+    /// or an edge lies on it (for the region's boundary test).
+    pub const ON_FEATURE_REL: f64 = 1e-9;
+
+    /// Virtual planes (plus one) of the dense-pass reference of a cusp over the limit.
+    pub const REFERENCE_PLANES: usize = 8;
+
+    /// Forward step of the dense-pass reference, as a fraction of the cutter radius.
+    pub const REFERENCE_STEP_FRACTION: f64 = 1.0 / 32.0;
+
+    /// From the second retry on, the gap shrinks at least by this factor.
+    pub const SPACING_MIN_SHRINK: f64 = 0.9;
+
+    /// Lateral samples of the residual between two passes when the envelopes do
+    /// not cross or the cutter is flat (its saw tooth need not peak at the crossing).
+    pub const CUSP_SPAN_SAMPLES: usize = 32;
+
+    /// The first retries of a plane measure the scallop against the part only;
+    /// later ones also subtract rest material (dense virtual passes, costly).
+    pub const RAW_RETRIES: usize = 3;
+
+    /// Relative convergence of the golden-section envelope search (times the cutter
+    /// radius): the envelope's value errs by the square of it (times the curvature).
+    pub const GOLDEN_REL_TOL: f64 = 1e-6;
+
+    /// Passes of the network planner shorter than this (mm) are dropped; their
+    /// vertices still count for the spacing (finishing.md 6.3: `eps_pass = 1e-6 m`).
+    pub const MIN_PASS_LENGTH: f64 = 1e-3;
+
+    /// Segments of the polylines that estimate isoline lengths for the network
+    /// resolution (finishing.md 6.3 \[DECISION\]).
+    pub const NETWORK_ISOLINE_SEGMENTS: usize = 200;
+
+    /// Parameters of the isolines whose longest length sets the network resolution
+    /// (finishing.md 6.3: `v in {0, 1/4, 1/2, 3/4, 1}`, likewise for u).
+    pub const NETWORK_ISOLINE_PARAMETERS: [f64; 5] = [0.0, 0.25, 0.5, 0.75, 1.0];
+
+    /// Largest number of network quads per direction (a 0.5 mm mesh of a 1 m part).
+    pub const MAX_NETWORK_QUADS: usize = 2048;
+
+    /// Relative slack of the spacing comparisons of the network sweep: a plane's
+    /// spacing within this fraction below the gap accepts the gap (rounding).
+    pub const LOOKAHEAD_REL: f64 = 1e-9;
+
+    /// Moves of a tentative next plane (look-ahead) before the sweep gives up.
+    pub const MAX_LOOKAHEAD_RETRIES: usize = 32;
+
+    /// A network plane closer than this fraction of the zone's extent (at least
+    /// 1 mm) to the lowest node is moved that far inside, so that a plane at
+    /// `d_min` yields the boundary (nodes on a plane count as above it).
+    pub const PLANE_NUDGE_REL: f64 = 1e-9;
+
+    /// A far strip wider than half a spacing by less than this fraction of the
+    /// spacing gets no further plane (rounding; ends the network sweep).
+    pub const END_STRIP_REL: f64 = 1e-6;
+
+    /// Look-ahead moves of the network sweep that go exactly to the spacing found;
+    /// later ones shrink by an extra `LOOKAHEAD_SHRINK * 2^k` (at most 1/2).
+    pub const LOOKAHEAD_PLAIN_RETRIES: usize = 4;
+
+    /// See [`LOOKAHEAD_PLAIN_RETRIES`].
+    pub const LOOKAHEAD_SHRINK: f64 = 1e-3;
+
+    /// Where the spacing shrinks from plane to plane, the network sweep steps by
+    /// `Delta_k - LOOKAHEAD_TREND (Delta_{k-1} - Delta_k)` instead of `Delta_k`, so
+    /// that the next plane's own spacing usually accepts the gap at once (a
+    /// slightly conservative step instead of a second plane).
+    pub const LOOKAHEAD_TREND: f64 = 1.25;
+    /// Measurements of the scallop per isoparametric pass pair while fitting the
+    /// spacing (each scales the step by `sqrt(sh / h)`).
+    pub const ISO_FIT_ITERATIONS: usize = 8;
+
+    /// Points across the gap between two isoparametric passes, plus one, at which the
+    /// scallop is measured (at every running sample).
+    pub const ISO_LATERAL_SAMPLES: usize = 6;
+
+    /// Most samples of one isoparametric pass.
+    pub const ISO_MAX_SAMPLES: usize = 20_000;
+
+    /// Largest isoparametric step-over, as a multiple of the cutter radius (where the
+    /// effective radius is infinite: a horizontal flat bottom).
+    pub const ISO_MAX_STEP_OVER: f64 = 1.8;
+
+    /// The isoparametric scallop check walks a pass's segments outwards from the
+    /// measured point's running parameter and stops after this many in a row that
+    /// cannot come closer (a segment left out only enlarges the measured scallop).
+    pub const ISO_WINDOW_MISSES: usize = 8;
+
+    /// An isoparametric step whose measured scallop lies between this fraction of
+    /// `sh` and `sh` is accepted without trying a larger one.
+    pub const ISO_FIT_ACCEPT: f64 = 0.8;
+
+    /// Budget of one plan in drop-cutter queries, checked before planning on a lower bound
+    /// (forward samples per pass at `max_step` times the passes at the flat-surface spacing):
+    /// 5e7 queries, a few minutes on 2 cores and about 1 GB of samples; a request over it is
+    /// refused with the estimate.
+    pub const MAX_PLAN_SAMPLES: f64 = 5e7;
+
+    /// Forward samples of one pass at `max_step` (the samples of a plane are held at once):
+    /// 1e7, 80 MB of abscissae and 0.6 GB of cutter locations.
+    pub const MAX_PASS_SAMPLES: f64 = 1e7;
+
+    /// The smallest path tolerance (mm) a plan accepts: a tenth of a micron, below the
+    /// resolution of machine axes and of the G-code's four decimals; a smaller tolerance
+    /// only multiplies samples, with forward steps bisected down to `MIN_STEP_FRACTION`.
+    pub const MIN_PATH_TOLERANCE: f64 = 1e-4;
+
+    /// Waterline levels of steep-and-shallow finishing stay this share of the path
+    /// tolerance inside the steep triangles' z range and the part's (mm): the
+    /// waterline exists strictly inside the part's height range.
+    pub const LEVEL_EDGE_SHARE: f64 = 1.0;
+
+    /// Most waterline levels of one steep-and-shallow plan (bounds the work before
+    /// it is spent: a wall 1 m tall at the smallest spacing of a 0.1 mm ball).
+    pub const MAX_LEVELS: usize = 20_000;
+
+    /// A pass of a waterline level is linked to the previous pass's end by a
+    /// straight feed move (when the move stays above the CL surface) only if they
+    /// are at most this many cutter radii apart; farther, it retracts.
+    pub const LEVEL_LINK_RADII: f64 = 2.0;
+
+    /// Chord tolerance of the waterline loops of steep-and-shallow finishing, as a
+    /// share of the path tolerance; the loops' points are pushed out by
+    /// [`LEVEL_PUSH_CHORDS`] of it, so no chord cuts into a convex wall, and the
+    /// level spacing holds the scallop height less the push.
+    pub const LEVEL_CHORD_SHARE: f64 = 0.1;
+
+    /// A triangle flatter than this slope (rad) is a floor: steep-and-shallow
+    /// finishing runs a waterline level just above it (at the levels' edge margin).
+    pub const FLAT_SLOPE: f64 = 1e-3;
+
+    /// The level of a flat area runs this share of the path tolerance above it:
+    /// the waterline there is the contour where a wall lifts the cutter off the
+    /// floor, and the floor is left with no more than this.
+    pub const FLAT_LIFT_SHARE: f64 = 0.01;
+
+    /// The contact of a waterline loop point is probed this many chord
+    /// tolerances inside the loop, where the part lifts the cutter above the level.
+    pub const LEVEL_PROBE_CHORDS: f64 = 4.0;
+
+    /// Waterline levels are spaced this fraction of the profile rule's spacing
+    /// (the rule assumes a wall of constant slope between two levels; the stock
+    /// simulation proves the result).
+    pub const LEVEL_SPACING_SAFETY: f64 = 0.9;
+
+    /// Waterline loop points are pushed out this many chord tolerances: the
+    /// kernel bounds a chord's deviation at its midpoint, and on a near-vertical
+    /// wall any inward step is a deep vertical gouge.
+    pub const LEVEL_PUSH_CHORDS: f64 = 2.0;
+
+    /// A link between two waterline passes is checked against the drop-cutter
+    /// every this many chord tolerances along it.
+    pub const LEVEL_LINK_SAMPLE_CHORDS: f64 = 10.0;
+
+    /// When the planner tolerates rest material (steep-and-shallow) and no
+    /// spacing holds sh (a crease's normal, the foot of a wall that the
+    /// waterline levels finish), the next plane is this share of the largest
+    /// step-over away (at most the rule's spacing) and the stock simulation
+    /// reports what is left.
+    pub const REST_SPACING_SHARE: f64 = 0.25;
+
+    /// Half-width (degrees) of the slope band that both parallel planes and
+    /// waterline levels finish in steep-and-shallow finishing.
+    pub const STEEP_OVERLAP_DEG: f64 = 10.0;
+
+    /// An edge or vertex contact whose cutter normal leans more than this
+    /// (degrees) from the contacted facet's normal is a sharp convex feature of
+    /// the part, not its tessellation: it does not set the pass spacing (see
+    /// `Planner::rides_sharp_edge`). Tessellations of smooth surfaces within the
+    /// usual chord tolerances bend by a few degrees between facets.
+    pub const SHARP_EDGE_DEG: f64 = 30.0;
+
+    /// With rest tolerated, a measured residual above this many times sh at the
+    /// spacing rule's gap is rest material, not a scallop (a scallop grows with
+    /// the square of the gap: the rule would be 4.5 times too wide), and the
+    /// next plane goes `REST_SPACING_SHARE` of the largest step-over away
+    /// instead of shrinking the gap (`Planner::sweep`). So is a residual that
+    /// keeps more than half its height when the gap is more than halved (a
+    /// scallop would fall to a quarter).
+    pub const REST_RESIDUAL_FACTOR: f64 = 20.0;
+
+    /// Splits of a level spacing between the two walls of a concave crease at
+    /// which `steep::crease_residual` evaluates the cusp (the worst is kept).
+    pub const CREASE_SPLITS: usize = 16;
+
+    /// Times a level spacing is shrunk until the residual across the concave
+    /// creases between the two levels holds the scallop height.
+    pub const CREASE_RETRIES: usize = 4;
+
+    /// A point of a waterline level is paired with the nearest point of the level
+    /// above within this many times the horizontal offset of two levels on the
+    /// shallowest steep wall (`dz / tan(threshold - overlap)`) when looking for a
+    /// concave crease between them (`Levels::crease`).
+    pub const CREASE_REACH: f64 = 1.5;
+}
+
+pub mod surface {
+    //! Thresholds of `scallop_surface`, re-exported there as `scallop_surface::tol`.
+    //!
+    //! Thresholds and algorithm constants specific to parametric surfaces.
+
+    /// A normal `Su x Sv` counts as degenerate when `|Su x Sv| <= NORMAL_DEGENERATE_REL * (|Su|^2 + |Sv|^2)`
+    /// (spec finishing.md 4.2: "< 1e-12 relative").
+    pub const NORMAL_DEGENERATE_REL: f64 = 1e-12;
+
+    /// Last-resort normal fallback: first step towards the domain centre, as a fraction
+    /// of the way there (doubled on each retry, see [`NORMAL_FALLBACK_STEPS`]).
+    pub const NORMAL_FALLBACK_FIRST_STEP: f64 = 1e-9;
+
+    /// Number of doublings of [`NORMAL_FALLBACK_FIRST_STEP`] tried before giving up and returning +Z.
+    pub const NORMAL_FALLBACK_STEPS: usize = 30;
+
+    /// Newton iterations stop when a step moves less than this fraction of the domain width.
+    pub const PARAM_STEP_REL: f64 = 1e-14;
+
+    /// Sufficient-decrease constant of the Armijo line search.
+    pub const ARMIJO: f64 = 1e-4;
+
+    /// Relative rounding of an objective evaluation (some tens of ulps times the
+    /// magnitudes that enter it): the line search accepts a step whose value rises by no
+    /// more than this uncertainty, so that Newton converges on its accurate gradient
+    /// instead of stalling on noise in the value.
+    pub const OBJECTIVE_ROUNDING_REL: f64 = 1e-14;
+
+    /// Maximum step halvings in one line search.
+    pub const LINE_SEARCH_HALVINGS: usize = 50;
+
+    /// A steepest-descent step (used where the Hessian is not positive definite) starts
+    /// at this fraction of the domain width.
+    pub const STEEPEST_FIRST_STEP: f64 = 0.25;
+
+    /// Safety factor applied to second-derivative maxima estimated by sampling (rational
+    /// patches only; polynomial patches use a guaranteed control-net bound).
+    pub const SAMPLED_BOUND_SAFETY: f64 = 1.5;
+
+    /// Sampling intervals per knot span and direction when estimating second-derivative
+    /// maxima of rational patches.
+    pub const SAMPLES_PER_SPAN: usize = 16;
+
+    /// Largest number of grid cells one patch may be tessellated into (two triangles each).
+    pub const MAX_TESSELLATION_CELLS: usize = 4_000_000;
+
+    /// Composite Gauss-Legendre area integration: sub-intervals per knot span and direction.
+    pub const AREA_SUBDIVISIONS_PER_SPAN: usize = 8;
+
+    /// Largest degree of a patch in either direction. CAD systems export degree 3 to 9
+    /// (some allow up to 25); past this a degree is a typo, and the control net and the
+    /// basis tables it implies are allocated only after this check.
+    pub const MAX_DEGREE: usize = 32;
+}
+
+pub mod waterline {
+    //! Thresholds of `scallop_waterline`, re-exported there as `scallop_waterline::tol`.
+    //!
+    //! Named thresholds of the waterline kernel (mm unless said otherwise).
+
+    /// Default distance, along the probe direction, between the last sample with
+    /// the cutter above the part and the last one with it cutting into the part
+    /// when a contour point is refined by bisection. The point returned is the
+    /// outside one, so the cutter placed there at height z never penetrates the part.
+    pub const CROSSING_TOLERANCE: f64 = 1e-7;
+
+    /// Default largest deviation, at a chord's midpoint, between a chord of a loop
+    /// and the true contour: longer chords are split (adaptive refinement).
+    pub const CHORD_TOLERANCE: f64 = 1e-4;
+
+    /// Default grid step as a fraction of the cutter radius R. Features of the
+    /// contour smaller than the step may be missed (see `docs/waterline.md`).
+    pub const STEP_PER_RADIUS: f64 = 0.25;
+
+    /// Most samples in the drop-cutter grid of one waterline computation
+    /// (8 bytes each, plus a bit per level): a larger grid is an input error.
+    pub const MAX_SAMPLES: usize = 50_000_000;
+
+    /// Grid cells of padding around the mesh footprint widened by the cutter
+    /// radius: every border sample is outside, so loops never reach the border.
+    pub const PAD_CELLS: f64 = 2.0;
+
+    /// Distance (mm) below the lowest contact used as the floor of the sampling grid,
+    /// so that "nothing under the cutter" is always below every waterline height.
+    pub const FLOOR_MARGIN: f64 = 1.0;
+
+    /// A chord shorter than this many crossing tolerances is never split.
+    pub const MIN_CHORD_PER_CROSSING: f64 = 16.0;
+
+    /// Deepest recursion of the adaptive chord refinement (a chord is halved at
+    /// most this many times).
+    pub const MAX_REFINE_DEPTH: u32 = 40;
+
+    /// Smallest tolerance accepted, relative to the model's largest |coordinate|:
+    /// below it the bisection would be deciding rounding noise.
+    pub const REL_MIN_TOLERANCE: f64 = 1e-13;
 }

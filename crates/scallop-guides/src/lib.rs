@@ -50,7 +50,7 @@ mod morph;
 mod offset;
 mod open;
 mod support;
-pub mod tol;
+pub use scallop_geom::tol::guides as tol;
 mod vectorial;
 mod zones;
 

@@ -54,7 +54,7 @@ pub mod mill;
 pub mod plan;
 pub mod program;
 pub mod time;
-pub mod tol;
+pub use scallop_geom::tol::machine as tol;
 
 pub use chain::{Class, Family, Jacobian6, Joints, Kinematics, Pose, Solver};
 pub use desc::{

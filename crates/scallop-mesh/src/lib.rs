@@ -29,7 +29,7 @@ mod index;
 mod intersect;
 mod polyline;
 mod query;
-pub mod tol;
+pub use scallop_geom::tol::mesh as tol;
 mod trimesh;
 
 pub use bvh::Bvh;

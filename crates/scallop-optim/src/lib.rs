@@ -28,7 +28,7 @@ mod plot;
 mod problem;
 pub mod study;
 pub mod surface;
-pub mod tol;
+pub use scallop_geom::tol::optim as tol;
 
 pub use error::OptimError;
 pub use mads::OrthoMads;

@@ -42,7 +42,7 @@ pub mod dialect;
 pub mod error;
 pub mod reader;
 pub mod three_axis;
-pub mod tol;
+pub use scallop_geom::tol::post as tol;
 pub mod writer;
 
 pub use dialect::{ArcWords, Dialect, FeedByTime, LineNumbers, ModuloWords, Syntax, TcpCodes, TiltedPlane};

@@ -44,7 +44,7 @@ mod job;
 pub mod png;
 pub mod render;
 pub mod svg;
-pub mod tol;
+pub use scallop_geom::tol::report as tol;
 
 use scallop_geom::{Aabb3, Point3};
 use scallop_mesh::TriMesh;

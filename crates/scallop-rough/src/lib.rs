@@ -22,7 +22,7 @@ use scallop_waterline::{WaterlineGrid, WaterlineOptions};
 
 mod material;
 mod offset;
-pub mod tol;
+pub use scallop_geom::tol::rough as tol;
 
 pub use material::{MaterialMap, limit_to_material};
 pub use offset::{Step, plan_offset};

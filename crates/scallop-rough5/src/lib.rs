@@ -45,7 +45,7 @@ mod prove;
 mod radius;
 pub mod sqp;
 mod sync;
-pub mod tol;
+pub use scallop_geom::tol::rough5 as tol;
 
 pub use collide::BodyCheck;
 pub use cutting::CuttingData;

@@ -82,7 +82,7 @@ mod error;
 mod rest;
 #[cfg(test)]
 mod test_support;
-pub mod tol;
+pub use scallop_geom::tol::sim as tol;
 mod verify;
 mod view;
 mod zmap;

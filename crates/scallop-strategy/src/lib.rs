@@ -179,7 +179,7 @@ mod region;
 mod scallop;
 mod steep;
 mod time;
-pub mod tol;
+pub use scallop_geom::tol::strategy as tol;
 pub mod trochoid;
 
 pub use error::StrategyError;

@@ -73,7 +73,7 @@ mod error;
 mod patch;
 mod set;
 pub mod tessellate;
-pub mod tol;
+pub use scallop_geom::tol::surface as tol;
 pub mod toml_format;
 
 pub use builtin::{BUILTIN_NAMES, builtin};

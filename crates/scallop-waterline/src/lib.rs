@@ -66,7 +66,7 @@
 
 mod contour;
 mod refine;
-pub mod tol;
+pub use scallop_geom::tol::waterline as tol;
 
 use rayon::prelude::*;
 use scallop_cutter::{Cutter, drop_grid};
