@@ -104,6 +104,12 @@ pub struct Rough5Args {
     /// Target pitch angle theta_tobj for `--tilt optimised` (degrees).
     #[arg(long, default_value_t = 10.0, allow_negative_numbers = true)]
     target: f64,
+    /// Turn the axis of a CL point whose tool collides with a flank in its correction plane (the
+    /// pitch kept) before dropping it: the collision correction of Jousselin 2020, Ch. 3 §3, step 1
+    /// (docs/rough5.md). Off by default: on the closed pocket it keeps V_r and costs time, and with
+    /// `--tilt optimised` the post's replay check refuses one block. Never applied with `--tilt zero`.
+    #[arg(long)]
+    correction: bool,
     /// Run the six orientation weightings of the thesis (Ch. 3 §2.3) on the last pass of one level
     /// instead of planning the pocket: writes `orientation.csv` (pitch traces) and `orientation.json`.
     #[arg(long)]
@@ -125,6 +131,7 @@ struct PassJson {
     pass: usize,
     points: usize,
     dropped: usize,
+    corrected: usize,
     runs: usize,
     pitch_deg: [f64; 3],
     max_tilt_deg: f64,
@@ -236,6 +243,7 @@ fn settings(args: &Rough5Args, part: &TestPart, bottom: &TriMesh) -> CliResult<R
         feed: cutting_feed(args)?,
         rapid_rate: 20_000.0,
         orientation: matches!(args.tilt, TiltArg::Optimised).then(|| orientation(args, weights)),
+        correct: args.correction && !matches!(args.tilt, TiltArg::Zero),
     })
 }
 
@@ -425,6 +433,7 @@ fn report(
                 pass: p.pass,
                 points: p.points,
                 dropped: p.dropped,
+                corrected: p.corrected,
                 runs: p.runs,
                 pitch_deg: p.pitch.map(deg),
                 max_tilt_deg: deg(p.max_tilt),
@@ -468,6 +477,10 @@ fn summary_text(r: &Report, output: &Path) -> String {
         m.removal_rate_percent_s,
         m.path_length_dm
     );
+    let corrected: usize = r.passes.iter().map(|p| p.corrected).sum();
+    let dropped: usize = r.passes.iter().map(|p| p.dropped).sum();
+    let _ =
+        writeln!(s, "  flank collisions: {corrected} CL points turned clear (collision correction), {dropped} dropped");
     let _ = writeln!(
         s,
         "  planned in {:.1} s, proven in {:.1} s; written to {}",

@@ -761,6 +761,29 @@ pub mod rough5 {
     /// The smallest joint progress g_T' + g_D' of the two guide points (Eq.
     /// 3.17 as corrected: never both stalled), per unit of s.
     pub const MIN_PROGRESS: f64 = 1e-3;
+
+    /// Angular step (rad, 0.5 degree: Jousselin 2020's cone sweep as the spec
+    /// fixes it) of the search for a collision-free axis in the correction plane
+    /// (`scallop_rough5::correct_planar`, Eq. 3.31).
+    pub const CONE_STEP: f64 = 0.5 * std::f64::consts::PI / 180.0;
+
+    /// The limit of the visibility cone is found by bisection to this (rad, 0.01
+    /// degree) once a free axis is found.
+    pub const CONE_BISECTION: f64 = 0.01 * std::f64::consts::PI / 180.0;
+
+    /// The correction plane is searched this far (rad) on each side of the
+    /// projection of the axis on the (feed, normal) plane: a quarter turn.
+    pub const CONE_HALF_ANGLE: f64 = std::f64::consts::FRAC_PI_2;
+
+    /// A corrected axis must have a z component above this (cos 60 degrees):
+    /// the correction never leans the tool more than 60 degrees from +Z, past
+    /// which the shank rather than the flutes would face the material.
+    pub const CONE_MIN_Z: f64 = 0.5;
+
+    /// Most rounds of collision correction of one pass (each corrects the pairs
+    /// the angular-step limit inserted next to the last round's corrections):
+    /// Jousselin 2020 caps its correction loop at 3 (Ch. 3 §3, Fig. 3.34).
+    pub const CORRECTION_ROUNDS: usize = 3;
 }
 
 pub mod sim {

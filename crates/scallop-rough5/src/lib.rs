@@ -11,6 +11,9 @@
 //!   angular step; the guide-curve variant and the zero-tilt baseline
 //!   (module J); [`plan_single_pass`]: one pass alone (the orientation
 //!   cases of Ch. 3 §2.3);
+//! - [`correct_planar`]: the collision correction that turns a colliding
+//!   tool axis in its correction plane, the pitch angle kept (Ch. 3 §3,
+//!   Eq. 3.31);
 //! - [`prove`]: the program cut on a tri-dexel stock with shank and holder
 //!   collisions as errors, and the metrics of spec 10.1 (module L).
 //!
@@ -35,6 +38,7 @@
 //!   triangle's contacts); results do not depend on the thread count.
 
 mod collide;
+mod correct;
 mod cutting;
 mod error;
 mod levels;
@@ -48,6 +52,7 @@ mod sync;
 pub use scallop_geom::tol::rough5 as tol;
 
 pub use collide::BodyCheck;
+pub use correct::{CorrectionCount, correct_pairs, correct_planar};
 pub use cutting::CuttingData;
 pub use error::Rough5Error;
 pub use levels::{LevelPasses, TiltMode, level_passes};

@@ -19,10 +19,11 @@ use scallop_mesh::TriMesh;
 use scallop_toolpath::{Move, MoveKind, Toolpath};
 
 use crate::collide::BodyCheck;
+use crate::correct::correct_pairs;
 use crate::levels::{TiltMode, level_passes};
 use crate::orient::{OrientSettings, Orientation, optimise_pass, synchronise_with};
 use crate::sync::{SyncPoint, axis_steps, interpolate_axis, limit_angular_step, pitch_angle, synchronise};
-use crate::{LevelPasses, Placement, Placer, Rough5Error};
+use crate::{LevelPasses, Placement, Placer, Rough5Error, tol};
 
 /// Settings of [`plan_rough5`] (mm, rad, mm/min).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -54,6 +55,10 @@ pub struct Rough5Settings {
     /// The optimised orientation of each paired pass (Jousselin 2020, Ch. 3
     /// §2), or `None` for SPU.
     pub orientation: Option<OrientSettings>,
+    /// Whether a pair whose tool collides with a flank is first turned in its
+    /// correction plane (Ch. 3 §3, step 1, [`crate::correct_planar`]) before
+    /// it is dropped.
+    pub correct: bool,
 }
 
 /// What one pass became.
@@ -67,6 +72,9 @@ pub struct PassReport {
     pub points: usize,
     /// Pairs dropped: tool not placed, or its body too close to a flank.
     pub dropped: usize,
+    /// Pairs whose axis the collision correction turned to clear the flanks
+    /// (kept, unless an angular-step insertion next to them collides).
+    pub corrected: usize,
     /// Runs the pass was split into.
     pub runs: usize,
     /// Pitch angle theta_t (Eq. 3.7) over the pass: min, max, mean (rad).
@@ -171,7 +179,9 @@ pub fn plan_rough5(
         for (m, (path, tilt)) in level.passes.iter().enumerate() {
             let cursor = out.last.map_or_else(|| path.line.points[0], |c| c.sync.path);
             let (pairs, _) = pass_pairs((path, tilt.as_ref()), &cursor, settings)?;
+            let (pairs, corrected) = corrected_pairs(&placer, &body, pairs, settings);
             let (runs, mut report) = place_pass(&placer, &body, &pairs);
+            report.corrected = corrected;
             report.level = j;
             report.pass = m;
             for run in &runs {
@@ -246,7 +256,9 @@ pub fn plan_single_pass(
     let placer = Placer::new(level.support.mesh(), cutter, allowance)?;
     let body = BodyCheck::new(flanks, cutter, 0.0);
     let (pairs, orientation) = pass_pairs((path, tilt.as_ref()), entry, settings)?;
+    let (pairs, corrected) = corrected_pairs(&placer, &body, pairs, settings);
     let (runs, mut report) = place_pass(&placer, &body, &pairs);
+    report.corrected = corrected;
     report.pass = pass;
     if runs.is_empty() {
         return Err(Rough5Error::NoPass { reason: "no CL point of the pass is clear of the flanks".into() });
@@ -304,6 +316,33 @@ fn pass_pairs(
     Ok((limit_angular_step(&pairs, settings.max_angle_step, settings.max_azimuth_step), orientation))
 }
 
+/// `pairs` with the colliding ones corrected when `settings.correct`, and how
+/// many pairs were corrected. Where a correction turned an axis the angular
+/// step is limited again; the pairs this inserts between a corrected axis and
+/// its neighbour may collide in turn, so the correction runs again on them,
+/// at most [`tol::CORRECTION_ROUNDS`] times (the thesis's cap on its
+/// correction loop, Jousselin 2020, Ch. 3 §3, Fig. 3.34).
+fn corrected_pairs(
+    placer: &Placer,
+    body: &BodyCheck,
+    mut pairs: Vec<SyncPoint>,
+    settings: &Rough5Settings,
+) -> (Vec<SyncPoint>, usize) {
+    let mut corrected = 0;
+    if !settings.correct {
+        return (pairs, corrected);
+    }
+    for _ in 0..tol::CORRECTION_ROUNDS {
+        let (turned, count) = correct_pairs(placer, body, &pairs, settings.max_angle_step);
+        if count.corrected == 0 {
+            break;
+        }
+        corrected += count.corrected;
+        pairs = limit_angular_step(&turned, settings.max_angle_step, settings.max_azimuth_step);
+    }
+    (pairs, corrected)
+}
+
 /// The placed and checked CL points of the pairs of one pass, split into
 /// runs where pairs were dropped.
 fn place_pass(placer: &Placer, body: &BodyCheck, pairs: &[SyncPoint]) -> (Vec<Vec<Cl>>, PassReport) {
@@ -340,6 +379,7 @@ fn place_pass(placer: &Placer, body: &BodyCheck, pairs: &[SyncPoint]) -> (Vec<Ve
         pass: 0,
         points: kept.len(),
         dropped: placed.len() - kept.len(),
+        corrected: 0,
         runs: runs.len(),
         pitch,
         max_tilt,

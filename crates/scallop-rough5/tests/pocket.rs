@@ -34,6 +34,7 @@ fn settings(tilt: TiltMode, depth: f64) -> Rough5Settings {
         feed: 2400.0,
         rapid_rate: 20_000.0,
         orientation: None,
+        correct: false,
     }
 }
 
@@ -52,8 +53,15 @@ fn every_variant_proves_itself_on_the_closed_pocket() {
     let mut remaining = Vec::new();
     // The optimised orientation: the thesis's mixed weighting (Ch. 3 §2.3, case 2).
     let mixed = OrientSettings::new(Weights { bounds: 15.0, fluidity: 1.2, pitch: 1.0 });
-    for (tilt, orientation) in [(TiltMode::Zero, None), (TiltMode::Guides, None), (TiltMode::Guides, Some(mixed))] {
-        let s = Rough5Settings { orientation, ..settings(tilt, depth) };
+    // And the guide curves with the collision correction (Ch. 3 §3, step 1).
+    let variants = [
+        (TiltMode::Zero, None, false),
+        (TiltMode::Guides, None, false),
+        (TiltMode::Guides, Some(mixed), false),
+        (TiltMode::Guides, None, true),
+    ];
+    for (tilt, orientation, correct) in variants {
+        let s = Rough5Settings { orientation, correct, ..settings(tilt, depth) };
         let plan = plan_rough5(&bottom, &flanks, &part.stock, &tool, &s, &|_, _| {}).unwrap();
         let path = &plan.toolpath;
         assert!(plan.passes.iter().map(|p| p.points).sum::<usize>() > 100);
