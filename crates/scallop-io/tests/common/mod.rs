@@ -1,7 +1,7 @@
 //! Writers for small test meshes in every format (test-only; the crate reads, never writes);
 //! the ASCII STL and 3MF object writers are the fuzzer's seed writers.
 
-#![allow(dead_code, reason = "each test file uses a different subset")]
+#![allow(dead_code, unused_imports, reason = "each test file uses a different subset")]
 
 use std::io::{Cursor, Write};
 
