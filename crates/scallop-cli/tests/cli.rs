@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 mod common;
 
-use common::{pyramid_stl, rejected, run_job, run_json, scallop, scratch};
+use common::{pyramid_stl, read_json, rejected, run_job, run_json, scallop, scratch, succeeded};
 
 #[test]
 fn demo_writes_a_program() {
@@ -278,8 +278,7 @@ fn optimize_writes_the_study_and_rejects_bad_settings() {
     let text = std::fs::read_to_string(dir.join("out/program.nc")).expect("program.nc");
     let path = scallop_io::gcode::read_gcode(&text, &scallop_io::gcode::GcodeOptions::default()).expect("parses");
     assert!(path.moves().len() > 100, "{}", path.moves().len());
-    let report: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(dir.join("out/report.json")).expect("report.json")).expect("json");
+    let report = read_json(&dir.join("out/report.json"));
     let program = &report["program"];
     let simulated = program["sim_max_scallop_mm"].as_f64().expect("simulated scallop");
     let limit = program["sim_scallop_limit_mm"].as_f64().expect("limit");
@@ -314,10 +313,8 @@ fn optimize_writes_the_study_and_rejects_bad_settings() {
         .replace("formulation = \"3axis\"", "formulation = \"3+2\"")
         .replace("flute_length = 50", "flute_length = 90");
     std::fs::write(dir.join("tilted.toml"), &tilted).expect("write");
-    let out = scallop().current_dir(&dir).args(["optimize", "tilted.toml", "-o", "out32"]).output().expect("run");
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let report: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(dir.join("out32/report.json")).expect("report.json")).expect("json");
+    succeeded(scallop().current_dir(&dir).args(["optimize", "tilted.toml", "-o", "out32"]));
+    let report = read_json(&dir.join("out32/report.json"));
     let program = &report["program"];
     let limit = program["sim_scallop_limit_mm"].as_f64().expect("limit");
     // A tilted zone plan is written as indexed setups; when a single zone is

@@ -6,20 +6,18 @@
 
 mod common;
 
-use common::{rejected, scallop, scratch};
+use common::{read_json, rejected, scallop, scratch, succeeded};
 
 #[test]
 fn rough5_writes_a_proven_program_and_its_metrics() {
     let dir = scratch("rough5");
-    let out = scallop()
-        .args(["rough5", "--part", "pocket", "--tilt", "zero", "--ap", "6", "--voxel", "1.5", "--step", "2"])
-        .args(["--resolution", "1", "--json", "-o"])
-        .arg(&dir)
-        .output()
-        .expect("run");
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let report: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(dir.join("report.json")).expect("report")).expect("json");
+    succeeded(
+        scallop()
+            .args(["rough5", "--part", "pocket", "--tilt", "zero", "--ap", "6", "--voxel", "1.5", "--step", "2"])
+            .args(["--resolution", "1", "--json", "-o"])
+            .arg(&dir),
+    );
+    let report = read_json(&dir.join("report.json"));
     let m = &report["metrics"];
     let num = |k: &str| m[k].as_f64().unwrap_or(f64::NAN);
     assert!(num("remaining_percent") > 0.0 && num("remaining_percent") < 100.0);
@@ -49,15 +47,13 @@ fn rough5_refuses_bad_settings() {
 #[test]
 fn rough5_orientation_cases_report_six_pitch_traces_and_times() {
     let dir = scratch("rough5-cases");
-    let out = scallop()
-        .args(["rough5", "--part", "pocket", "--orientation-cases", "--ap", "6", "--voxel", "1.5", "--step", "2"])
-        .args(["--json", "-o"])
-        .arg(&dir)
-        .output()
-        .expect("run");
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let summary: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(dir.join("orientation.json")).expect("summary")).expect("json");
+    succeeded(
+        scallop()
+            .args(["rough5", "--part", "pocket", "--orientation-cases", "--ap", "6", "--voxel", "1.5", "--step", "2"])
+            .args(["--json", "-o"])
+            .arg(&dir),
+    );
+    let summary = read_json(&dir.join("orientation.json"));
     let cases = summary["cases"].as_array().expect("cases");
     assert_eq!(cases.len(), 6);
     for c in cases {

@@ -5,18 +5,8 @@
 //! pseudonormal", IEEE TVCG 11(3), section 3).
 
 use scallop_geom::{Aabb3, Point3, Vec3};
-use scallop_mesh::{Bvh, FastMap, TriMesh, triangle_box};
-
-/// Where on its triangle a closest point lies.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Feature {
-    /// Inside the triangle.
-    Face,
-    /// On edge `k` (corner `k` to corner `k + 1`), not at a corner.
-    Edge(u8),
-    /// At corner `k`.
-    Vertex(u8),
-}
+pub use scallop_mesh::Feature;
+use scallop_mesh::{Bvh, FastMap, TriMesh, closest_feature_on_triangle, closest_on_triangle, triangle_box};
 
 /// The closest point of a surface to a query point.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -66,8 +56,8 @@ impl Surface {
         // Ties go to the lower triangle number (`Bvh::nearest`), so the
         // feature does not depend on the visiting order.
         let (t, dist2) =
-            self.bvh.nearest(p, bound, |t| (closest_on_triangle(p, &self.mesh.triangle(t)).0 - p).norm_squared())?;
-        let (point, feature) = closest_on_triangle(p, &self.mesh.triangle(t));
+            self.bvh.nearest(p, bound, |t| (closest_on_triangle(p, &self.mesh.triangle(t)) - p).norm_squared())?;
+        let (point, feature) = closest_feature_on_triangle(p, &self.mesh.triangle(t));
         Some(Closest { point, dist2, triangle: t, feature })
     }
 
@@ -99,45 +89,6 @@ impl Surface {
     pub fn side_within(&self, p: &Point3, max_dist: f64) -> f64 {
         self.closest(p, max_dist).map_or(0.0, |c| (p - c.point).dot(&self.pseudo_normal(&c)))
     }
-}
-
-/// Closest point of triangle `t` to `p` and its feature (Ericson 2005,
-/// "Real-Time Collision Detection", section 5.1.5: Voronoi regions in turn).
-fn closest_on_triangle(p: &Point3, t: &[Point3; 3]) -> (Point3, Feature) {
-    let [a, b, c] = *t;
-    let (ab, ac, ap) = (b - a, c - a, p - a);
-    let (d1, d2) = (ab.dot(&ap), ac.dot(&ap));
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return (a, Feature::Vertex(0));
-    }
-    let bp = p - b;
-    let (d3, d4) = (ab.dot(&bp), ac.dot(&bp));
-    if d3 >= 0.0 && d4 <= d3 {
-        return (b, Feature::Vertex(1));
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        let v = d1 / (d1 - d3);
-        return (a + ab * v, Feature::Edge(0));
-    }
-    let cp = p - c;
-    let (d5, d6) = (ab.dot(&cp), ac.dot(&cp));
-    if d6 >= 0.0 && d5 <= d6 {
-        return (c, Feature::Vertex(2));
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        let w = d2 / (d2 - d6);
-        return (a + ac * w, Feature::Edge(2));
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        return (b + (c - b) * w, Feature::Edge(1));
-    }
-    let denom = 1.0 / (va + vb + vc);
-    let (v, w) = (vb * denom, vc * denom);
-    (a + ab * v + ac * w, Feature::Face)
 }
 
 type Normals = (Vec<Vec3>, Vec<[Vec3; 3]>, Vec<Vec3>);

@@ -405,7 +405,9 @@ fn seed_mesh() -> (Vec<[f64; 3]>, Vec<[usize; 3]>) {
     (v, t)
 }
 
-fn stl_ascii(v: &[[f64; 3]], t: &[[usize; 3]]) -> Vec<u8> {
+/// An ASCII STL of the mesh `v`, `t` (a facet per triangle).
+#[must_use]
+pub fn stl_ascii(v: &[[f64; 3]], t: &[[usize; 3]]) -> Vec<u8> {
     let mut s = String::from("solid seed\n");
     for tri in t {
         s.push_str(" facet normal 0 0 1\n  outer loop\n");
@@ -477,16 +479,19 @@ fn ply(v: &[[f64; 3]], t: &[[usize; 3]], binary: bool) -> Vec<u8> {
     b
 }
 
-fn threemf_object(id: u32, v: &[[f64; 3]], t: &[[usize; 3]]) -> String {
-    let mut s = format!("<object id=\"{id}\" type=\"model\"><mesh><vertices>\n");
+/// `<object id=..><mesh>..</mesh></object>` of the mesh `v`, `t` for a 3MF
+/// model: an element a line, a vertex or a triangle a line.
+#[must_use]
+pub fn threemf_object(id: u32, v: &[[f64; 3]], t: &[[usize; 3]]) -> String {
+    let mut s = format!("  <object id=\"{id}\" type=\"model\">\n   <mesh>\n    <vertices>\n");
     for p in v {
-        s.push_str(&format!("<vertex x=\"{}\" y=\"{}\" z=\"{}\"/>\n", p[0], p[1], p[2]));
+        s.push_str(&format!("     <vertex x=\"{}\" y=\"{}\" z=\"{}\" />\n", p[0], p[1], p[2]));
     }
-    s.push_str("</vertices><triangles>\n");
+    s.push_str("    </vertices>\n    <triangles>\n");
     for tri in t {
-        s.push_str(&format!("<triangle v1=\"{}\" v2=\"{}\" v3=\"{}\"/>\n", tri[0], tri[1], tri[2]));
+        s.push_str(&format!("     <triangle v1=\"{}\" v2=\"{}\" v3=\"{}\" />\n", tri[0], tri[1], tri[2]));
     }
-    s.push_str("</triangles></mesh></object>\n");
+    s.push_str("    </triangles>\n   </mesh>\n  </object>\n");
     s
 }
 
@@ -518,10 +523,9 @@ pub fn threemf_model(resources: &str, build: &str) -> String {
     )
 }
 
-/// The model XML of [`threemf_instancing`].
-fn instancing_model(levels: u32, copies: u32) -> String {
-    let (v, t) = seed_mesh();
-    let mut resources = threemf_object(1, &v, &t);
+/// The model XML of [`threemf_instancing_of`].
+fn instancing_model(v: &[[f64; 3]], t: &[[usize; 3]], levels: u32, copies: u32) -> String {
+    let mut resources = threemf_object(1, v, t);
     for level in 0..levels {
         let id = level + 2;
         resources.push_str(&format!("<object id=\"{id}\" type=\"model\"><components>\n"));
@@ -541,7 +545,14 @@ fn instancing_model(levels: u32, copies: u32) -> String {
 /// file that places `triangles * copies^levels` triangles (the instancing case).
 #[must_use]
 pub fn threemf_instancing(levels: u32, copies: u32) -> Vec<u8> {
-    threemf(instancing_model(levels, copies).as_bytes())
+    let (v, t) = seed_mesh();
+    threemf_instancing_of(&v, &t, levels, copies)
+}
+
+/// [`threemf_instancing`] over the mesh `v`, `t`: `t.len() * copies^levels` triangles.
+#[must_use]
+pub fn threemf_instancing_of(v: &[[f64; 3]], t: &[[usize; 3]], levels: u32, copies: u32) -> Vec<u8> {
+    threemf(instancing_model(v, t, levels, copies).as_bytes())
 }
 
 /// The model XML documents the 3MF seeds are made of.
@@ -549,8 +560,8 @@ fn threemf_models() -> Vec<String> {
     let (v, t) = seed_mesh();
     vec![
         threemf_model(&threemf_object(1, &v, &t), "<item objectid=\"1\"/>\n"),
-        instancing_model(2, 4),
-        instancing_model(13, 4),
+        instancing_model(&v, &t, 2, 4),
+        instancing_model(&v, &t, 13, 4),
     ]
 }
 

@@ -21,15 +21,11 @@
 //! ```
 //! use scallop_geom::Point3;
 //! use scallop_guides::{Support, offset_curves};
-//! use scallop_mesh::{Polyline3, TriMesh};
+//! use scallop_mesh::{Polyline3, TriMesh, grid_triangles};
 //! // A 40 mm square plane in 1 mm cells, and a square loop of side 30 on it.
 //! let n = 40;
 //! let v: Vec<Point3> = (0..=n).flat_map(|j| (0..=n).map(move |i| Point3::new(i as f64 - 20.0, j as f64 - 20.0, 0.0))).collect();
-//! let t: Vec<[usize; 3]> = (0..n).flat_map(|j| (0..n).flat_map(move |i| {
-//!     let a = j * (n + 1) + i;
-//!     [[a, a + 1, a + n + 2], [a, a + n + 2, a + n + 1]]
-//! })).collect();
-//! let support = Support::new(TriMesh::from_indexed(&v, &t).unwrap().0);
+//! let support = Support::new(TriMesh::from_indexed(&v, &grid_triangles(n, n)).unwrap().0);
 //! let p = |x, y| Point3::new(x, y, 0.0);
 //! let square = Polyline3::new(vec![p(-15., -15.), p(15., -15.), p(15., 15.), p(-15., 15.)], true);
 //! let limit = support.curve(square).unwrap().inside_left();

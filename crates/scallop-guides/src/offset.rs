@@ -346,15 +346,7 @@ mod tests {
                 v.push(Point3::new(x, y, height(x, y)));
             }
         }
-        let t: Vec<[usize; 3]> = (0..n)
-            .flat_map(|j| {
-                (0..n).flat_map(move |i| {
-                    let a = j * (n + 1) + i;
-                    [[a, a + 1, a + n + 2], [a, a + n + 2, a + n + 1]]
-                })
-            })
-            .collect();
-        Support::new(TriMesh::from_indexed(&v, &t).unwrap().0)
+        Support::new(TriMesh::from_indexed(&v, &scallop_mesh::grid_triangles(n, n)).unwrap().0)
     }
 
     proptest! {

@@ -10,20 +10,7 @@ use scallop_io::{MeshFormat, MeshReadError, Units, read_mesh};
 
 /// `levels` objects each placing the one below `copies` times, over the tetrahedron.
 fn instancing(levels: u32, copies: u32) -> Vec<u8> {
-    let mut resources = threemf_object(1, &TETRA_VERTICES, &TETRA_TRIANGLES);
-    for level in 0..levels {
-        let id = level + 2;
-        resources.push_str(&format!("  <object id=\"{id}\" type=\"model\"><components>\n"));
-        for k in 0..copies {
-            resources.push_str(&format!(
-                "   <component objectid=\"{}\" transform=\"1 0 0 0 1 0 0 0 1 {} 0 0\" />\n",
-                id - 1,
-                f64::from(k) * 20.0
-            ));
-        }
-        resources.push_str("  </components></object>\n");
-    }
-    threemf(&threemf_model(None, &resources, &format!("  <item objectid=\"{}\" />\n", levels + 1)))
+    scallop_fuzz::threemf_instancing_of(&TETRA_VERTICES, &TETRA_TRIANGLES, levels, copies)
 }
 
 #[test]

@@ -37,5 +37,8 @@ pub use hash::{FastMap, WordHasher};
 pub use index::MeshIndex;
 pub use intersect::{KeyChain, MeshIntersection, chain_keys, intersect_meshes};
 pub use polyline::{Polyline3, PolylineFoot, PolylineQuery, segment_parameter};
-pub use query::{ClosestPoint, MeshQuery, RayHit, closest_on_triangle, ray_triangle, triangle_box};
-pub use trimesh::{MeshDiagnostics, MeshError, TriMesh};
+pub use query::{
+    ClosestPoint, Feature, MeshQuery, RayHit, closest_feature_on_triangle, closest_on_triangle, ray_triangle,
+    triangle_box,
+};
+pub use trimesh::{MeshDiagnostics, MeshError, TriMesh, grid_triangles};

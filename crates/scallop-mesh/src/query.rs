@@ -153,43 +153,61 @@ pub fn triangle_box(t: &[Point3; 3]) -> Aabb3 {
     Aabb3 { min: t[0].inf(&t[1]).inf(&t[2]), max: t[0].sup(&t[1]).sup(&t[2]) }
 }
 
+/// Where on its triangle a closest point lies.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Feature {
+    /// Inside the triangle.
+    Face,
+    /// On edge `k` (corner `k` to corner `k + 1`), not at a corner.
+    Edge(u8),
+    /// At corner `k`.
+    Vertex(u8),
+}
+
 /// The point of triangle `t` closest to `p` (Ericson 2005, "Real-Time
 /// Collision Detection", §5.1.5: Voronoi regions of the corners and edges).
 #[must_use]
 pub fn closest_on_triangle(p: &Point3, t: &[Point3; 3]) -> Point3 {
+    closest_feature_on_triangle(p, t).0
+}
+
+/// [`closest_on_triangle`] with the feature of `t` the point lies on (a
+/// degenerate triangle whose face case is undefined gives its first corner).
+#[must_use]
+pub fn closest_feature_on_triangle(p: &Point3, t: &[Point3; 3]) -> (Point3, Feature) {
     let [a, b, c] = *t;
     let (ab, ac, ap) = (b - a, c - a, p - a);
     let (d1, d2) = (ab.dot(&ap), ac.dot(&ap));
     if d1 <= 0.0 && d2 <= 0.0 {
-        return a;
+        return (a, Feature::Vertex(0));
     }
     let bp = p - b;
     let (d3, d4) = (ab.dot(&bp), ac.dot(&bp));
     if d3 >= 0.0 && d4 <= d3 {
-        return b;
+        return (b, Feature::Vertex(1));
     }
     let vc = d1 * d4 - d3 * d2;
     if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        return a + ab * (d1 / (d1 - d3));
+        return (a + ab * (d1 / (d1 - d3)), Feature::Edge(0));
     }
     let cp = p - c;
     let (d5, d6) = (ab.dot(&cp), ac.dot(&cp));
     if d6 >= 0.0 && d5 <= d6 {
-        return c;
+        return (c, Feature::Vertex(2));
     }
     let vb = d5 * d2 - d1 * d6;
     if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        return a + ac * (d2 / (d2 - d6));
+        return (a + ac * (d2 / (d2 - d6)), Feature::Edge(2));
     }
     let va = d3 * d6 - d5 * d4;
     if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+        return (b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6))), Feature::Edge(1));
     }
     let denom = va + vb + vc;
     if denom.is_nan() || denom == 0.0 {
-        return a;
+        return (a, Feature::Vertex(0));
     }
-    a + ab * (vb / denom) + ac * (vc / denom)
+    (a + ab * (vb / denom) + ac * (vc / denom), Feature::Face)
 }
 
 /// Parameter `t >= 0` where the half line `o + t d` meets triangle `tri`

@@ -397,6 +397,34 @@ fn edge_counts(triangles: &[[u32; 3]]) -> (usize, usize) {
     (boundary, non_manifold)
 }
 
+/// The triangles of a grid of `(nu + 1) x (nv + 1)` vertices stored row by
+/// row, vertex `(i, j)` at index `j (nu + 1) + i`: two per cell, cells in the
+/// same order, split along the diagonal from `(i, j)` to `(i + 1, j + 1)` and
+/// wound counter-clockwise in `(i, j)`.
+///
+/// ```
+/// use scallop_geom::Point3;
+/// use scallop_mesh::{TriMesh, grid_triangles};
+/// let n = 4;
+/// let v: Vec<Point3> = (0..=n).flat_map(|j| (0..=n).map(move |i| Point3::new(i as f64, j as f64, 0.0))).collect();
+/// let (mesh, _) = TriMesh::from_indexed(&v, &grid_triangles(n, n)).unwrap();
+/// assert_eq!(mesh.triangles().len(), 2 * n * n);
+/// let [a, b, c] = mesh.triangle(0);
+/// assert!((b - a).cross(&(c - a)).z > 0.0); // counter-clockwise seen from +z
+/// ```
+#[must_use]
+pub fn grid_triangles(nu: usize, nv: usize) -> Vec<[usize; 3]> {
+    let mut triangles = Vec::with_capacity(2 * nu * nv);
+    for j in 0..nv {
+        for i in 0..nu {
+            let a = j * (nu + 1) + i;
+            triangles.push([a, a + 1, a + nu + 2]);
+            triangles.push([a, a + nu + 2, a + nu + 1]);
+        }
+    }
+    triangles
+}
+
 #[cfg(test)]
 // `unwrap` is allowed in tests by clippy.toml.
 #[allow(clippy::float_cmp, reason = "tests: exact values are intended")]
@@ -455,14 +483,7 @@ mod tests {
             let (x, y) = (size * i as f64 / n as f64, size * j as f64 / n as f64);
             p(x, y, (x * 0.1).sin() + (y * 0.07).cos())
         };
-        let mut soup = Vec::new();
-        for i in 0..n {
-            for j in 0..n {
-                soup.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
-                soup.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
-            }
-        }
-        soup
+        grid_triangles(n, n).into_iter().map(|t| t.map(|k| at(k % (n + 1), k / (n + 1)))).collect()
     }
 
     #[test]

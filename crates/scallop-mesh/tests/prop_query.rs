@@ -10,7 +10,7 @@
 use proptest::prelude::*;
 use scallop_geom::{Point3, Vec3};
 use scallop_mesh::{
-    MeshQuery, Polyline3, PolylineQuery, TriMesh, closest_on_triangle, intersect_meshes, ray_triangle,
+    MeshQuery, Polyline3, PolylineQuery, TriMesh, closest_on_triangle, grid_triangles, intersect_meshes, ray_triangle,
     segment_parameter,
 };
 
@@ -28,15 +28,7 @@ fn grid(n: usize, half: f64, height: impl Fn(f64, f64) -> f64) -> TriMesh {
             v.push(p(x, y, height(x, y)));
         }
     }
-    let mut t = Vec::new();
-    for j in 0..n {
-        for i in 0..n {
-            let a = j * (n + 1) + i;
-            t.push([a, a + 1, a + n + 2]);
-            t.push([a, a + n + 2, a + n + 1]);
-        }
-    }
-    TriMesh::from_indexed(&v, &t).unwrap().0
+    TriMesh::from_indexed(&v, &grid_triangles(n, n)).unwrap().0
 }
 
 /// A closed UV sphere with `rings` latitude bands and `segs` longitudes.

@@ -26,29 +26,13 @@ pub fn plan_zone(
     zone: u32,
     params: &ZoneParams,
 ) -> Result<ZonePlan, StrategyError> {
-    let mut ws = Workspace::default();
-    plan_in(network, zoning, zone, params, &mut ws)
+    plan_zone_with(network, zoning, zone, params, &mut ZoneWorkspace::default())
 }
 
 /// Buffers of [`plan_zone_with`], reused from one zone to the next (their
 /// sizes follow the network: one value per node, one mark per edge).
 #[derive(Debug, Default)]
 pub struct ZoneWorkspace(Workspace);
-
-/// [`plan_zone`] with reused buffers: the same plan, without allocating and
-/// clearing per-node and per-edge buffers for every zone.
-///
-/// # Errors
-/// As [`plan_zone`].
-pub fn plan_zone_with(
-    network: &Network,
-    zoning: Option<&Zoning>,
-    zone: u32,
-    params: &ZoneParams,
-    workspace: &mut ZoneWorkspace,
-) -> Result<ZonePlan, StrategyError> {
-    plan_in(network, zoning, zone, params, &mut workspace.0)
-}
 
 /// PLANE_PASSES and NEXT_SPACING (finishing.md 6.3, 6.4) of one plane `m . P =
 /// offset` (`m = (-sin t, cos t, 0)`, `t = params.direction`): the passes of
@@ -98,12 +82,14 @@ pub fn plan_zones(
             fix: "give one feed direction per zone of the labelling (Zoning::zones)",
         });
     }
-    let mut ws = Workspace::default();
+    let mut ws = ZoneWorkspace::default();
     zoning
         .zones()
         .iter()
         .zip(directions)
-        .map(|(&zone, &direction)| plan_in(network, Some(zoning), zone, &ZoneParams { direction, ..*params }, &mut ws))
+        .map(|(&zone, &direction)| {
+            plan_zone_with(network, Some(zoning), zone, &ZoneParams { direction, ..*params }, &mut ws)
+        })
         .collect()
 }
 
@@ -147,14 +133,19 @@ fn validate(network: &Network, zoning: Option<&Zoning>, params: &ZoneParams) -> 
     Ok(())
 }
 
-/// [`plan_zone`] with caller-owned buffers.
-fn plan_in(
+/// [`plan_zone`] with reused buffers: the same plan, without allocating and
+/// clearing per-node and per-edge buffers for every zone.
+///
+/// # Errors
+/// As [`plan_zone`].
+pub fn plan_zone_with(
     network: &Network,
     zoning: Option<&Zoning>,
     zone: u32,
     params: &ZoneParams,
-    ws: &mut Workspace,
+    workspace: &mut ZoneWorkspace,
 ) -> Result<ZonePlan, StrategyError> {
+    let ws = &mut workspace.0;
     validate(network, zoning, params)?;
     let tool = ToolModel::new(&params.tool, params.scallop_height)?;
     let cos_sharp = params.sharp_corner.min(std::f64::consts::PI).cos();

@@ -48,7 +48,7 @@ pub mod writer;
 pub use dialect::{ArcWords, Dialect, FeedByTime, LineNumbers, ModuloWords, Syntax, TcpCodes, TiltedPlane};
 pub use error::PostError;
 pub use reader::{ReplayedBlock, RoundTrip, check_replay, replay};
-pub use three_axis::{NO_SPINDLE, ProgramInfo, Section, write_fitted, write_sections, write_toolpath};
+pub use three_axis::{NO_SPINDLE, ProgramInfo, Section, write_fitted, write_sections};
 pub use writer::{OutputMode, PostParams, cycle800_angles, program_text, write_program};
 
 /// Formats `v` with `decimals` digits, writing negative zero as zero.

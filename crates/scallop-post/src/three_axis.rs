@@ -1,10 +1,10 @@
-//! The 3-axis writer: a [`Toolpath`] or a [`FittedPath`] (lines and `G2`/`G3` arcs in
-//! the principal planes) in an ISO dialect, optionally after an indexed rotary
+//! The 3-axis writer: a [`FittedPath`] (lines and `G2`/`G3` arcs in the principal
+//! planes; [`FittedPath::lines`] for a toolpath without arcs) in an ISO dialect, optionally after an indexed rotary
 //! positioning (3+2: `G0 A.. C..` with the rotaries then held).
 
 use std::io::{self, Write};
 
-use scallop_toolpath::{ArcPlane, FittedPath, MoveKind, Segment, Toolpath};
+use scallop_toolpath::{ArcPlane, FittedPath, MoveKind, Segment};
 
 use crate::dialect::{ArcWords, Dialect};
 
@@ -266,18 +266,4 @@ fn write_section(path: &FittedPath, dialect: &Dialect, info: &ProgramInfo, out: 
         writeln!(out, "G17")?;
     }
     Ok(())
-}
-
-/// [`write_fitted`] of a toolpath without arcs.
-///
-/// # Errors
-/// Any error of `out`.
-pub fn write_toolpath(
-    path: &Toolpath,
-    dialect: &Dialect,
-    info: &ProgramInfo,
-    comments: &[&str],
-    out: &mut impl Write,
-) -> io::Result<()> {
-    write_fitted(&FittedPath::lines(path), dialect, info, comments, out)
 }

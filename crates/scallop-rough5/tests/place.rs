@@ -6,7 +6,7 @@
 use proptest::prelude::*;
 use scallop_cutter::{Cutter, CutterShape, drop_cutter};
 use scallop_geom::{Point2, Point3, Vec3};
-use scallop_mesh::{MeshIndex, TriMesh};
+use scallop_mesh::{MeshIndex, TriMesh, grid_triangles};
 use scallop_rough5::{Feature, Placer, tool_frame};
 
 fn p(x: f64, y: f64, z: f64) -> Point3 {
@@ -31,16 +31,7 @@ fn bumps(a: f64, b: f64, c: f64) -> TriMesh {
         .flat_map(|j| (0..=n).map(move |i| (f64::from(i) * 2.0 - 20.0, f64::from(j) * 2.0 - 20.0)))
         .map(|(x, y)| p(x, y, z(x, y)))
         .collect();
-    let n = n as usize;
-    let t: Vec<[usize; 3]> = (0..n)
-        .flat_map(|j| {
-            (0..n).flat_map(move |i| {
-                let a = j * (n + 1) + i;
-                [[a, a + 1, a + n + 2], [a, a + n + 2, a + n + 1]]
-            })
-        })
-        .collect();
-    TriMesh::from_indexed(&v, &t).unwrap().0
+    TriMesh::from_indexed(&v, &grid_triangles(n as usize, n as usize)).unwrap().0
 }
 
 fn cutter(kind: u8, radius: f64, corner: f64) -> Cutter {

@@ -47,6 +47,19 @@ pub fn rejected(out: &std::process::Output) -> String {
     err
 }
 
+/// A run that must succeed (the standard error shown when it did not).
+pub fn succeeded(command: &mut Command) -> Output {
+    let out = command.output().expect("run");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    out
+}
+
+/// The JSON file at `path` (a report a run wrote).
+pub fn read_json(path: &Path) -> serde_json::Value {
+    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    serde_json::from_slice(&bytes).expect("json")
+}
+
 /// `scallop run JOB -o OUT EXTRA...`.
 pub fn run_job(job: &Path, out: &Path, extra: &[&str]) -> Output {
     scallop().arg("run").arg(job).arg("-o").arg(out).args(extra).output().expect("run")

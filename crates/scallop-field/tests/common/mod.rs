@@ -3,7 +3,7 @@
 #![allow(clippy::unwrap_used, reason = "test geometry is valid by construction")]
 
 use scallop_geom::{Point3, Vec3};
-use scallop_mesh::{FastMap, TriMesh};
+use scallop_mesh::{FastMap, TriMesh, grid_triangles};
 
 pub fn p(x: f64, y: f64, z: f64) -> Point3 {
     Point3::new(x, y, z)
@@ -93,14 +93,7 @@ pub fn square(s: f64, z: f64, n: usize) -> TriMesh {
             v.push(p(s * i as f64 / n as f64, s * j as f64 / n as f64, z));
         }
     }
-    let mut f = Vec::new();
-    for j in 0..n {
-        for i in 0..n {
-            let a = j * (n + 1) + i;
-            f.extend([[a, a + 1, a + n + 2], [a, a + n + 2, a + n + 1]]);
-        }
-    }
-    TriMesh::from_indexed(&v, &f).unwrap().0
+    TriMesh::from_indexed(&v, &grid_triangles(n, n)).unwrap().0
 }
 
 fn segment_distance(q: &Point3, a: &Point3, b: &Point3) -> f64 {

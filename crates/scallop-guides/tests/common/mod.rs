@@ -7,7 +7,7 @@ use std::f64::consts::{PI, TAU};
 
 use scallop_geom::{Point3, Vec3};
 use scallop_guides::{Curve, Support};
-use scallop_mesh::{Polyline3, PolylineQuery, TriMesh};
+use scallop_mesh::{Polyline3, PolylineQuery, TriMesh, grid_triangles};
 
 pub fn p(x: f64, y: f64, z: f64) -> Point3 {
     Point3::new(x, y, z)
@@ -22,15 +22,7 @@ pub fn grid_surface(nu: usize, nv: usize, at: impl Fn(f64, f64) -> Point3) -> Tr
             v.push(at(i as f64 / nu as f64, j as f64 / nv as f64));
         }
     }
-    let mut t = Vec::with_capacity(2 * nu * nv);
-    for j in 0..nv {
-        for i in 0..nu {
-            let a = j * (nu + 1) + i;
-            t.push([a, a + 1, a + nu + 2]);
-            t.push([a, a + nu + 2, a + nu + 1]);
-        }
-    }
-    TriMesh::from_indexed(&v, &t).unwrap().0
+    TriMesh::from_indexed(&v, &grid_triangles(nu, nv)).unwrap().0
 }
 
 /// The plane through `origin` spanned by unit `e1`, `e2`, square of `half`

@@ -1,6 +1,7 @@
-//! Writers for small test meshes in every format (test-only; the crate reads, never writes).
+//! Writers for small test meshes in every format (test-only; the crate reads, never writes);
+//! the ASCII STL and 3MF object writers are the fuzzer's seed writers.
 
-#![allow(dead_code, reason = "each test file uses a different subset")]
+#![allow(dead_code, unused_imports, reason = "each test file uses a different subset")]
 
 use std::io::{Cursor, Write};
 
@@ -17,18 +18,7 @@ pub fn tetra_area() -> f64 {
     3.0 * 50.0 + 3.0_f64.sqrt() / 4.0 * 200.0
 }
 
-pub fn stl_ascii(v: &[[f64; 3]], t: &[[usize; 3]]) -> Vec<u8> {
-    let mut s = String::from("solid test\n");
-    for tri in t {
-        s.push_str("  facet normal 0 0 0\n    outer loop\n");
-        for &i in tri {
-            s.push_str(&format!("      vertex {} {} {}\n", v[i][0], v[i][1], v[i][2]));
-        }
-        s.push_str("    endloop\n  endfacet\n");
-    }
-    s.push_str("endsolid test\n");
-    s.into_bytes()
-}
+pub use scallop_fuzz::{stl_ascii, threemf_object};
 
 pub fn stl_binary(v: &[[f64; 3]], t: &[[usize; 3]], header: &[u8]) -> Vec<u8> {
     let mut b = vec![0u8; 80];
@@ -122,20 +112,6 @@ pub fn ply_binary(v: &[[f64; 3]], t: &[[usize; 3]], big_endian: bool) -> Vec<u8>
     put(&mut b, (-1i16).to_le_bytes().to_vec());
     put(&mut b, 5i16.to_le_bytes().to_vec());
     b
-}
-
-/// `<object id=..><mesh>..</mesh></object>` for a 3MF model.
-pub fn threemf_object(id: u32, v: &[[f64; 3]], t: &[[usize; 3]]) -> String {
-    let mut s = format!("  <object id=\"{id}\" type=\"model\">\n   <mesh>\n    <vertices>\n");
-    for p in v {
-        s.push_str(&format!("     <vertex x=\"{}\" y=\"{}\" z=\"{}\" />\n", p[0], p[1], p[2]));
-    }
-    s.push_str("    </vertices>\n    <triangles>\n");
-    for tri in t {
-        s.push_str(&format!("     <triangle v1=\"{}\" v2=\"{}\" v3=\"{}\" />\n", tri[0], tri[1], tri[2]));
-    }
-    s.push_str("    </triangles>\n   </mesh>\n  </object>\n");
-    s
 }
 
 /// A 3MF model document: `unit` attribute (or none), resources, and build items.
