@@ -299,7 +299,7 @@ impl Planner<'_> {
                 let Cut { phi, items, end, open } = self.cut_level(pieces, from, &mut undo);
                 let ratio = (1.0 - target.cos()) / (1.0 - phi.cos()).max(1e-12);
                 if phi <= self.accept || a <= a_min || trial >= tol::STEP_TRIALS || force {
-                    push_items(&mut steps, items, s);
+                    push_items(&mut steps, items, s, &self.holder, self.options.chord_tolerance);
                     pending = open;
                     pos = end;
                     t = level;
@@ -322,7 +322,7 @@ impl Planner<'_> {
         if let Some(ring) = pending {
             undo.clear();
             self.sweep(&ring, 0, &mut undo);
-            push_items(&mut steps, vec![(None, ring)], s);
+            push_items(&mut steps, vec![(None, ring)], s, &self.holder, self.options.chord_tolerance);
         }
         Ok(steps)
     }
@@ -357,7 +357,7 @@ impl Planner<'_> {
                     skip = lead;
                     (Some(self.link(pos, v[0], undo)), v)
                 }
-                Piece::Ring(v) if d <= r && single_ring => {
+                Piece::Ring(v) if d <= r && single_ring && self.spiral_fits(&v, j0, pos, level) => {
                     let (run, closing) = self.spiral(&v, j0, pos, level);
                     open = Some(closing);
                     (None, run)
@@ -372,6 +372,12 @@ impl Planner<'_> {
             items.push((link, run));
         }
         Cut { phi, items, end: pos, open }
+    }
+
+    /// Whether the spiral's first move, from `pos`, stays in the region.
+    fn spiral_fits(&self, v: &[P2], j: usize, pos: P2, level: Level<'_>) -> bool {
+        let (run, _) = self.spiral(v, j, pos, level);
+        run.get(1).is_some_and(|&p| self.holder.contains_segment(pos, p, self.options.chord_tolerance))
     }
 
     /// One turn of a spiral from the last front (level `t`) to the ring `v`
@@ -504,8 +510,10 @@ fn pieces(loops: Vec<Vec<IsoPoint>>, direction: Direction, gap: f64) -> Vec<Piec
 }
 
 /// Appends the cuts of a pass as steps: a link before each but the first
-/// of the plan (which starts at the entry `s`).
-fn push_items(steps: &mut Vec<Step>, items: Vec<Item>, s: P2) {
+/// of the plan (which starts at the entry `s`). A move of a cut that leaves
+/// `holder` (a chord of the grid across a wall's bend) is replaced by a
+/// retract: the cut goes on from the move's end.
+fn push_items(steps: &mut Vec<Step>, items: Vec<Item>, s: P2, holder: &Region, chord: f64) {
     for (link, mut run) in items {
         run.dedup_by(|a, b| dist(*a, *b) <= tol::LINK_GROW * 0.1);
         if steps.is_empty() {
@@ -515,11 +523,21 @@ fn push_items(steps: &mut Vec<Step>, items: Vec<Item>, s: P2) {
         } else if let Some(down) = link {
             steps.push(Step::Link { tool_down: down });
         }
-        if run.len() < 2 {
-            continue;
-        }
-        if let Ok(c) = Contour::from_points(&run, false, tol::ARC_FIT) {
-            steps.push(Step::Cut(c));
+        let mut from = 0;
+        for k in 1..=run.len() {
+            let split = k < run.len() && !holder.contains_segment(run[k - 1], run[k], chord);
+            if !split && k < run.len() {
+                continue;
+            }
+            if k - from >= 2 {
+                if let Ok(c) = Contour::from_points(&run[from..k], false, tol::ARC_FIT) {
+                    steps.push(Step::Cut(c));
+                }
+            }
+            if split {
+                steps.push(Step::Link { tool_down: false });
+            }
+            from = k;
         }
     }
 }
