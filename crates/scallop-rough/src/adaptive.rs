@@ -529,10 +529,10 @@ fn push_items(steps: &mut Vec<Step>, items: Vec<Item>, s: P2, holder: &Region, c
             if !split && k < run.len() {
                 continue;
             }
-            if k - from >= 2 {
-                if let Ok(c) = Contour::from_points(&run[from..k], false, tol::ARC_FIT) {
-                    steps.push(Step::Cut(c));
-                }
+            if k - from >= 2
+                && let Ok(c) = Contour::from_points(&run[from..k], false, tol::ARC_FIT)
+            {
+                steps.push(Step::Cut(c));
             }
             if split {
                 steps.push(Step::Link { tool_down: false });
