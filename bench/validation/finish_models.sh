@@ -5,7 +5,8 @@
 # table (markdown) of part, cutter, sh, exit code, passes, levels, predicted time, planning
 # time, simulated scallop, unreachable area.
 # Usage: bench/validation/finish_models.sh [OUT] [--reduced]   (reduced: sphere_on_plate and cone_on_side)
-# Env: SCALLOP (binary, default target/release/scallop, built when missing), TIMEOUT (s, 600).
+# Env: SCALLOP (binary, default target/release/scallop, built when missing), TIMEOUT (s, 600),
+# PARTS (comma-separated part names without extension, e.g. mount_rush,demo: only those; default all).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 OUT="${1:-target/finish-models}"
@@ -37,6 +38,9 @@ mech/idler_riser.STL in 6 10 2 30
 mech/octagonal_pocket.stl m 10 16 3 30"
 if [ "$REDUCED" = "--reduced" ]; then
     CASES="$(printf '%s\n' "$CASES" | grep -E 'sphere_on_plate|cone_on_side')"
+fi
+if [ -n "${PARTS:-}" ]; then
+    CASES="$(printf '%s\n' "$CASES" | grep -E "/($(printf '%s' "$PARTS" | tr ',' '|'))\.")"
 fi
 TABLE="$OUT/table.md"
 echo "| part | cutter | sh mm | exit | passes | levels | predicted time | planning s | simulated scallop mm | unreachable mm2 |" > "$TABLE"

@@ -7,7 +7,7 @@ mod common;
 
 use std::f64::consts::FRAC_PI_2;
 
-use common::{SplitMix, assert_abs, assert_rel, bilinear, builtin_samples, direction_diff_deg, plane_56x28};
+use common::{assert_abs, assert_rel, bilinear, builtin_samples, direction_diff_deg, plane_56x28};
 use scallop_analysis::{
     CrossPlane, Cutter, FeedDirection, GridOptions, KinematicModel, MachineLimits, Moments, Pca, Recommendation,
     Rectangle, ToolOptions, analyze, critical_shape_factor, critical_slope, plane_time, rectangle_time_at_angle,
@@ -15,6 +15,7 @@ use scallop_analysis::{
 };
 use scallop_geom::Point3;
 use scallop_geom::nalgebra::Matrix3;
+use scallop_geom::rng::SplitMix64;
 
 const SH: f64 = 0.01;
 
@@ -280,7 +281,7 @@ fn batch(points: &[(Point3, f64)]) -> (Point3, Matrix3<f64>) {
 #[test]
 fn a12_incremental_covariance() {
     for weighted in [false, true] {
-        let mut rng = SplitMix(if weighted { 7 } else { 3 });
+        let mut rng = SplitMix64::new(if weighted { 7 } else { 3 });
         let mut moments = Moments::new();
         let mut present: Vec<(Point3, f64)> = Vec::new();
         for op in 0..100_000 {
@@ -319,7 +320,7 @@ fn a12_thesis_forms_equal_stable_form() {
         let s1 = (s + e * e.transpose()) * (n / (n - 1.0)) - x * x.transpose() / (n - 1.0) - e1 * e1.transpose();
         (e1, s1)
     };
-    let mut rng = SplitMix(11);
+    let mut rng = SplitMix64::new(11);
     let mut moments = Moments::new();
     let (mut e, mut s) = (scallop_geom::Vec3::zeros(), Matrix3::zeros());
     let mut present: Vec<scallop_geom::Vec3> = Vec::new();

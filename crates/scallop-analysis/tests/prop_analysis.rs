@@ -6,13 +6,14 @@
 
 mod common;
 
-use common::{SplitMix, assert_rel, bilinear};
+use common::{assert_rel, bilinear};
 use proptest::prelude::*;
 use scallop_analysis::{
     FeedDirection, GridOptions, KinematicModel, MachineLimits, Moments, Pca, Rectangle, ToolOptions,
     critical_shape_factor, critical_slope, plane_time, sample_mesh, sample_patch,
 };
 use scallop_geom::nalgebra::{Rotation3, Vector3};
+use scallop_geom::rng::SplitMix64;
 use scallop_geom::{Point3, Vec3};
 use scallop_mesh::TriMesh;
 use scallop_surface::Patch;
@@ -120,7 +121,7 @@ proptest! {
     /// Incremental add/remove (stable form) equals batch statistics after 10^5 operations.
     #[test]
     fn incremental_equals_batch(seed in any::<u64>(), center in -1000.0f64..1000.0, spread in 0.1f64..100.0) {
-        let mut rng = SplitMix(seed);
+        let mut rng = SplitMix64::new(seed);
         let mut moments = Moments::new();
         let mut present: Vec<Point3> = Vec::new();
         for _ in 0..100_000 {

@@ -58,7 +58,7 @@ pub struct AnalyzeArgs {
 
 /// `scallop analyze`.
 pub fn run(args: &AnalyzeArgs) -> CliResult<()> {
-    for (flag, v) in [
+    crate::input::positive_flags(&[
         ("--ball-radius", args.ball_radius),
         ("--bull-radius", args.bull_radius),
         ("--corner-radius", args.corner_radius),
@@ -66,11 +66,7 @@ pub fn run(args: &AnalyzeArgs) -> CliResult<()> {
         ("--feed", args.feed),
         ("--acceleration", args.acceleration),
         ("--jerk", args.jerk),
-    ] {
-        if !(v.is_finite() && v > 0.0) {
-            return Err(Failure::rejected(format!("{flag} {v}: must be a finite number > 0")));
-        }
-    }
+    ])?;
     if args.cells == 0 {
         return Err(Failure::rejected("--cells 0: give at least 1"));
     }

@@ -9,7 +9,7 @@ use scallop_engine::{GridAxis, prepare_part};
 use scallop_geom::Tolerances;
 use serde::Serialize;
 
-use crate::output::{print_json, print_text, progress_bar, write_atomic};
+use crate::output::{print_report, progress_bar, write_atomic};
 use crate::part::{UnitsArg, load};
 use crate::{CliResult, Failure};
 
@@ -208,21 +208,20 @@ pub fn run(args: &DropArgs) -> CliResult<()> {
         contacts_facet: count(|c| matches!(c, Contact::Facet { .. })),
         output: args.output.display().to_string(),
     };
-    if args.json {
-        return print_json(&report);
-    }
-    print_text(&format!(
-        "{} points dropped in {:.3} s ({:.0} points/s, {} threads) on {}\n  cutter {}; contacts: {} facet, {} edge, {} vertex, {} floor\n  wrote {}\n",
-        report.points,
-        report.drop_seconds,
-        report.points_per_second,
-        report.threads,
-        report.part,
-        report.cutter,
-        report.contacts_facet,
-        report.contacts_edge,
-        report.contacts_vertex,
-        report.contacts_floor,
-        report.output
-    ))
+    print_report(&report, args.json, |r| {
+        format!(
+            "{} points dropped in {:.3} s ({:.0} points/s, {} threads) on {}\n  cutter {}; contacts: {} facet, {} edge, {} vertex, {} floor\n  wrote {}\n",
+            r.points,
+            r.drop_seconds,
+            r.points_per_second,
+            r.threads,
+            r.part,
+            r.cutter,
+            r.contacts_facet,
+            r.contacts_edge,
+            r.contacts_vertex,
+            r.contacts_floor,
+            r.output
+        )
+    })
 }

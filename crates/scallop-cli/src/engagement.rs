@@ -14,6 +14,7 @@ use scallop_strategy::{Boundary, FinishingParams, Pattern, lookahead_time};
 use scallop_toolpath::{MoveKind, Toolpath};
 use serde::{Deserialize, Serialize};
 
+use crate::input::read_text;
 use crate::output::{print_json, print_text};
 use crate::{CliResult, Failure};
 
@@ -102,18 +103,8 @@ struct Figures {
     seconds: f64,
 }
 
-fn read_text(path: &Path, what: &str) -> CliResult<String> {
-    let name = path.display();
-    let bytes = std::fs::read(path).map_err(|e| {
-        let err = anyhow::anyhow!("{name}: cannot read the {what}: {e}");
-        if e.kind() == std::io::ErrorKind::NotFound { Failure::Rejected(err) } else { Failure::Io(err) }
-    })?;
-    let text = scallop_io::utf8_text(&bytes).map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
-    Ok(text.to_owned())
-}
-
 fn read_pocket(path: &Path) -> CliResult<Pocket> {
-    let text = read_text(path, "pocket")?;
+    let text = read_text(path, "the pocket")?;
     let name = path.display();
     let file: PocketFile = serde_json::from_str(&text).map_err(|e| {
         Failure::rejected(format!("{name}: {e}; give {{\"units\":\"mm\",\"rings\":[[[x,y],...],...]}}"))
@@ -126,7 +117,7 @@ fn read_pocket(path: &Path) -> CliResult<Pocket> {
 }
 
 fn read_program(path: &Path) -> CliResult<Toolpath> {
-    let text = read_text(path, "program")?;
+    let text = read_text(path, "the program")?;
     let name = path.display();
     let csv = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("csv"));
     let read = if csv {

@@ -6,6 +6,9 @@ mod analyze;
 mod choice;
 mod drop;
 mod engagement;
+mod guides;
+mod input;
+mod machine;
 mod optimize;
 mod output;
 mod outset;
@@ -13,6 +16,7 @@ mod part;
 mod pocket;
 mod post;
 mod render;
+mod rough5;
 mod run;
 mod simulate;
 mod waterline;
@@ -67,6 +71,10 @@ enum Command {
     Render(render::RenderArgs),
     /// The closed contours where a cutter with its tip at height z touches a mesh (CSV or JSON loops).
     Waterline(waterline::WaterlineArgs),
+    /// Guide curves of 5-axis roughing on a test part: levels, limit, path and tilt curves (docs/guides.md).
+    Guides(guides::GuidesArgs),
+    /// 5-axis roughing of a test part by guide curves, proven and posted (docs/rough5.md).
+    Rough5(rough5::Rough5Args),
     /// Clear a 2D pocket (region JSON: outer boundary, then islands) and write G-code and CL.
     Pocket(pocket::PocketArgs),
     /// Load a part and report what was read (size, welding, open and non-manifold edges).
@@ -96,6 +104,8 @@ fn main() -> ExitCode {
         Command::Post(args) => post::run(&args),
         Command::Render(args) => render::run(&args),
         Command::Waterline(args) => waterline::run(&args),
+        Command::Guides(args) => guides::run(&args),
+        Command::Rough5(args) => rough5::run(&args),
         Command::Engagement(args) => engagement::run(&args),
         Command::Pocket(args) => pocket::run(&args),
     };

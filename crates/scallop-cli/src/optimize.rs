@@ -358,6 +358,7 @@ fn optimisation_report(
     }
     data.toolpath = Some(choice.output.toolpath.clone());
     data.zones = Some(Zones {
+        label: "zone".into(),
         of_move: choice.output.zone_of_move.iter().map(|&z| u16::try_from(z).unwrap_or(u16::MAX)).collect(),
         names: choice.plan.zones.iter().map(|z| format!("{} ({:.0} deg)", z.zone, z.theta_deg)).collect(),
         times_s: choice.plan.zones.iter().map(|z| z.time_s).collect(),

@@ -54,6 +54,11 @@ pub fn print_json(value: &impl Serialize) -> CliResult<()> {
     print_text(&format!("{text}\n"))
 }
 
+/// Prints `report` as JSON, or else the text `human` makes of it.
+pub fn print_report<T: Serialize>(report: &T, json: bool, human: impl FnOnce(&T) -> String) -> CliResult<()> {
+    if json { print_json(report) } else { print_text(&human(report)) }
+}
+
 /// Prints text on stdout; a closed pipe is not an error.
 pub fn print_text(text: &str) -> CliResult<()> {
     let mut out = std::io::stdout().lock();
@@ -110,24 +115,49 @@ pub fn demo(args: &DemoArgs) -> CliResult<()> {
     write_finishing(&job, &out, seconds, &args.output, args.json, "scallop demo")
 }
 
-/// Writes `program.nc`, `report.json` and `toolpath.csv` of a job of several
-/// operations into `folder` and prints the summary (or the report as JSON).
-pub fn write_job(out: &scallop_engine::JobOutput, seconds: f64, folder: &Path, json: bool) -> CliResult<()> {
-    // The three files replace the previous set in one step (`outset.rs`).
-    let mut set = OutputSet::begin(folder, "job")?;
+/// Writes `program.nc`, `report.json`, `toolpath.csv`, `report.html` and
+/// `scene.glb` into `folder`: staged, then replacing the previous set in one
+/// step (`outset.rs`). Returns the program's final path and the files written.
+fn write_program_set(
+    folder: &Path,
+    kind: &'static str,
+    gcode: &str,
+    report: &impl serde::Serialize,
+    toolpath: &scallop_toolpath::Toolpath,
+    data: &scallop_report::ReportData,
+) -> CliResult<(std::path::PathBuf, Vec<std::path::PathBuf>)> {
+    let mut set = OutputSet::begin(folder, kind)?;
     let nc = set.final_path("program.nc");
-    set.write("program.nc", out.gcode.as_bytes())?;
-    let text = serde_json::to_string_pretty(&out.report).map_err(|e| Failure::Io(e.into()))?;
+    set.write("program.nc", gcode.as_bytes())?;
+    let text = serde_json::to_string_pretty(report).map_err(|e| Failure::Io(e.into()))?;
     set.write("report.json", text.as_bytes())?;
-    set.write("toolpath.csv", scallop_io::cl::write_cl(&out.toolpath).as_bytes())?;
-    let written = set.commit()?;
+    set.write("toolpath.csv", scallop_io::cl::write_cl(toolpath).as_bytes())?;
+    set.write("report.html", scallop_report::html::report_html(data).as_bytes())?;
+    let glb = scallop_report::glb::scene_glb(data).map_err(|e| Failure::Io(anyhow::anyhow!("scene.glb: {e}")))?;
+    set.write("scene.glb", &glb)?;
+    Ok((nc, set.commit()?))
+}
+
+/// Writes the five files of a job of several operations into `folder` and
+/// prints the summary (or the report as JSON).
+pub fn write_job(
+    job: &scallop_engine::Job,
+    out: &scallop_engine::JobOutput,
+    seconds: f64,
+    folder: &Path,
+    json: bool,
+    command: &str,
+) -> CliResult<()> {
+    let data = scallop_report::ReportData::from_job(job, out, seconds, command);
+    let (nc, written) = write_program_set(folder, "job", &out.gcode, &out.report, &out.toolpath, &data)?;
     if json {
         return print_json(&with_written(&out.report, &written)?);
     }
     let r = &out.report;
     let mut text = format!(
-        "{} operations on one stock, {}\n  stock      [{:.2}, {:.2}, {:.2}] to [{:.2}, {:.2}, {:.2}] mm\n",
+        "{} operation{} on one stock, {}\n  stock      [{:.2}, {:.2}, {:.2}] to [{:.2}, {:.2}, {:.2}] mm\n",
         r.operations.len(),
+        if r.operations.len() == 1 { "" } else { "s" },
         r.part,
         r.stock_mm[0][0],
         r.stock_mm[0][1],
@@ -136,37 +166,54 @@ pub fn write_job(out: &scallop_engine::JobOutput, seconds: f64, folder: &Path, j
         r.stock_mm[1][1],
         r.stock_mm[1][2]
     );
-    for (k, op) in r.operations.iter().enumerate() {
+    for (k, (op, spec)) in r.operations.iter().zip(&job.operations).enumerate() {
+        let what = match &spec.rough {
+            Some(s) => format!("roughing, {} mm levels, stepover {} D", s.stepdown, s.stepover),
+            None => {
+                format!(
+                    "scallop height {} mm, feed at {:.2}° from X",
+                    op.scallop_height_mm,
+                    shown_deg(op.direction_deg)
+                )
+            }
+        };
         text.push_str(&format!(
-            "  {}. {} (T{}): {}, scallop height {} mm, feed at {:.2}° from X; {} passes, {} + {:.1} s rapids; \
-             removed {:.0} mm³ of the {:.0} mm³ it met, {:.0} % of its feed moves in air\n",
+            "  {}. {} (T{}): {}, {what}; {} passes, {} + {:.1} s rapids; \
+             removed {:.0} mm³ of the {:.0} mm³ it met, {:.0} % of its feed length in air; planned in {}\n",
             k + 1,
             op.name,
             op.tool,
             op.cutter,
-            op.scallop_height_mm,
-            op.direction_deg + 0.0,
             op.plan.passes,
             hms(op.plan.machining_time_s),
             op.plan.rapid_time_s,
             op.stock.removed_mm3,
             op.stock.volume_before_mm3,
-            100.0 * op.stock.air_cut_share
+            100.0 * op.stock.air_length_share,
+            hms(op.plan.planning_time_s)
         ));
     }
+    let left = if job.operations.last().is_some_and(|o| o.rough.is_some()) {
+        format!(
+            "most material left on the part {:.4} mm (the last operation roughs: its allowance and steps)",
+            r.sim_max_scallop_mm
+        )
+    } else {
+        format!(
+            "scallop on the machined surface {:.4} mm along the normal beyond R from the edge (last operation's limit: sh + {:.5} mm)",
+            r.sim_max_scallop_mm, r.sim_resolution_bound_mm
+        )
+    };
     text.push_str(&format!(
         "  time       {} in all (stop-to-stop, rapids included)\n\
-         \x20 simulated  no gouge on the final {} mm stock; deepest {:+.4} mm (tolerance {:.4} mm); \
-         scallop on the machined surface {:.4} mm along the normal beyond R from the edge (last operation's limit: sh + {:.5} mm)\n\
+         \x20 simulated  no gouge on the final {} mm stock; deepest {:+.4} mm (tolerance {:.4} mm); {left}\n\
          {}\
-         \x20 planned    in {}\n\
-         \x20 wrote      {}, report.json, toolpath.csv\n",
+         \x20 ran        in {} (planning, cutting, proof)\n\
+         \x20 wrote      {}, report.json, toolpath.csv, report.html, scene.glb\n",
         hms(r.total_time_s),
         r.sim_resolution_mm,
         r.sim_min_deviation_mm,
         r.sim_gouge_tolerance_mm,
-        r.sim_max_scallop_mm,
-        r.sim_resolution_bound_mm,
         rest_text(&r.rest),
         hms(seconds),
         nc.display()
@@ -221,18 +268,8 @@ pub fn write_finishing(
 ) -> CliResult<()> {
     let mut report = out.report.clone();
     report.plan.planning_time_s = seconds;
-    // All five files go into a staging folder and replace the previous set in one step.
-    let mut set = OutputSet::begin(folder, "finishing")?;
-    let nc = set.final_path("program.nc");
-    set.write("program.nc", out.gcode.as_bytes())?;
-    let text = serde_json::to_string_pretty(&report).map_err(|e| Failure::Io(e.into()))?;
-    set.write("report.json", text.as_bytes())?;
-    set.write("toolpath.csv", scallop_io::cl::write_cl(&out.toolpath).as_bytes())?;
     let data = scallop_report::ReportData::from_finishing(job, out, seconds, command);
-    set.write("report.html", scallop_report::html::report_html(&data).as_bytes())?;
-    let glb = scallop_report::glb::scene_glb(&data).map_err(|e| Failure::Io(anyhow::anyhow!("scene.glb: {e}")))?;
-    set.write("scene.glb", &glb)?;
-    let written = set.commit()?;
+    let (nc, written) = write_program_set(folder, "finishing", &out.gcode, &report, &out.toolpath, &data)?;
     if json {
         return print_json(&with_written(&report, &written)?);
     }
@@ -241,7 +278,7 @@ pub fn write_finishing(
         "finishing the {part}\n\
          \x20 analysis   PCA slope {slope:.2}°, critical slope {crit:.2}°: {rec}; feed at {dir:.2}° from X\n\
          \x20 cutter     {cutter}, scallop height {sh} mm, {chord}\n\
-         \x20 toolpath   {passes} passes on {planes} planes, {points} points, {links} links, {retracts} retracts\n\
+         \x20 toolpath   {passes} passes on {planes} planes, {points} points, {links} links, {retracts} retracts{refined}\n\
          \x20 scallop    verified max {smax:.5} mm (<= {sh} mm{by_sim}), mean material left {smean:.5} mm\n\
          \x20 time       {t1} stop-to-stop, {t2} look-ahead, + {tr} rapids\n\
          \x20 lengths    feed {feed:.0} mm, links {link:.0} mm, rapid {rapid:.0} mm\n\
@@ -253,7 +290,7 @@ pub fn write_finishing(
         part = r.part,
         slope = r.slope_deg,
         crit = r.critical_slope_deg,
-        dir = r.direction_deg + 0.0,
+        dir = shown_deg(r.direction_deg),
         rec = match r.recommendation {
             scallop_analysis::Recommendation::BallAlongPrincipal => "a ball along the principal direction is faster",
             scallop_analysis::Recommendation::ToroidalAlongSlope => "a bull-nose along the steepest slope is faster",
@@ -265,6 +302,10 @@ pub fn write_finishing(
         } else {
             "a mesh, machined as given".to_string()
         },
+        refined = p.refinement.map_or(String::new(), |f| format!(
+            "\n\x20            refined in {} round(s): {} planes and {} levels added where the simulation of the first program found more than sh",
+            f.rounds, f.planes_added, f.levels_added
+        )),
         passes = p.passes,
         planes = p.planes,
         points = p.points,
@@ -352,4 +393,9 @@ fn raster_demo(args: &DemoArgs) -> CliResult<()> {
         nc = nc.display(),
     );
     print_text(&text)
+}
+
+/// An angle as the summary prints it with two decimals: no "-0.00".
+fn shown_deg(deg: f64) -> f64 {
+    if deg.abs() < 0.005 { 0.0 } else { deg }
 }

@@ -71,10 +71,7 @@ pub fn load(spec: &str, units: UnitsArg) -> CliResult<LoadedPart> {
             scallop_surface::BUILTIN_NAMES.join(", ")
         )));
     }
-    let bytes = std::fs::read(path).map_err(|e| {
-        let err = anyhow::anyhow!("{spec}: cannot read the file: {e}");
-        if e.kind() == std::io::ErrorKind::NotFound { Failure::Rejected(err) } else { Failure::Io(err) }
-    })?;
+    let bytes = crate::input::read_bytes(path, spec, "the file")?;
     if is_toml {
         if units != UnitsArg::Mm {
             return Err(Failure::rejected(format!(

@@ -16,7 +16,7 @@ use scallop_rough::{ClearOptions, Direction, Motion, Pattern, pocket_toolpath};
 use scallop_toolpath::{FittedPath, MoveKind};
 use serde::{Deserialize, Serialize};
 
-use crate::output::{print_json, print_text, write_atomic};
+use crate::output::{print_report, write_atomic};
 use crate::{CliResult, Failure};
 
 /// Clearing patterns of `scallop pocket`.
@@ -178,19 +178,18 @@ pub fn run(args: &PocketArgs) -> CliResult<()> {
         planning_seconds,
         written: vec![program.display().to_string(), cl.display().to_string()],
     };
-    if args.json {
-        return print_json(&report);
-    }
-    print_text(&format!(
-        "{} passes, {} tool-down links, {} retracts, {} helical entries, {} arcs; feed {:.1} mm, links {:.1} mm; planned in {:.3} s\n  wrote {}\n",
-        report.passes,
-        report.links,
-        report.retracts,
-        report.helical_entries,
-        report.arcs,
-        report.feed_length_mm,
-        report.link_length_mm,
-        report.planning_seconds,
-        report.written.join(", ")
-    ))
+    print_report(&report, args.json, |r| {
+        format!(
+            "{} passes, {} tool-down links, {} retracts, {} helical entries, {} arcs; feed {:.1} mm, links {:.1} mm; planned in {:.3} s\n  wrote {}\n",
+            r.passes,
+            r.links,
+            r.retracts,
+            r.helical_entries,
+            r.arcs,
+            r.feed_length_mm,
+            r.link_length_mm,
+            r.planning_seconds,
+            r.written.join(", ")
+        )
+    })
 }

@@ -13,6 +13,7 @@ use scallop_machine::{Joints, Kinematics, Machine};
 use scallop_post::{Dialect, OutputMode, PostParams, check_replay, program_text, replay};
 use serde::Serialize;
 
+use crate::input::read_text;
 use crate::output::{print_json, print_text, write_atomic};
 use crate::{CliResult, Failure};
 
@@ -32,7 +33,8 @@ pub enum ModeArg {
 pub struct PostArgs {
     /// Cutter-location CSV: header `kind,x,y,z[,i,j,k][,feed]` (part frame, mm, mm/min).
     cl_file: PathBuf,
-    /// Machine: a shipped name (see `machines/`, e.g. ucp710, mx330, linuxcnc-xyzac-trt) or a TOML file.
+    /// 5-axis machine: a shipped name (see `machines/`, e.g. ucp710, mx330, linuxcnc-xyzac-trt) or a TOML
+    /// file (a 3-axis machine is refused: jobs name those, docs/job.md).
     #[arg(long)]
     machine: String,
     /// Dialect: linuxcnc, fanuc, siemens840d, heidenhain, heidenhain-iso, grbl, plain, or a TOML file.
@@ -117,35 +119,16 @@ pub struct PostReport {
     pub events: Vec<String>,
 }
 
-fn read_text(path: &Path) -> CliResult<String> {
-    let bytes = std::fs::read(path).map_err(|e| {
-        let err = anyhow::anyhow!("{}: cannot read: {e}", path.display());
-        if e.kind() == std::io::ErrorKind::NotFound { Failure::Rejected(err) } else { Failure::Io(err) }
-    })?;
-    scallop_io::utf8_text(&bytes).map(str::to_owned).map_err(|e| Failure::rejected(format!("{}: {e}", path.display())))
-}
-
-/// A machine by shipped name or by TOML file (a relative path taken from
+/// A 5-axis machine by shipped name or by TOML file (a relative path taken from
 /// `folder`: the job file's folder, or the working folder for `--machine`);
 /// `what` names the flag or key in messages.
 pub(crate) fn load_machine(name: &str, folder: &Path, what: &str) -> CliResult<Machine> {
-    let path = folder.join(name);
-    if name.ends_with(".toml") || path.is_file() {
-        let text = read_text(&path)?;
-        Machine::from_toml_str(&text).map_err(|e| Failure::rejected(format!("{}: {e}", path.display())))
-    } else {
-        Machine::builtin(name).map_err(|e| {
-            Failure::rejected(format!(
-                "{what} = \"{name}\": {e}; give a shipped name ({}) or a machine file (.toml)",
-                Machine::builtin_names().join(", ")
-            ))
-        })
-    }
+    crate::machine::load_five_axis(name, folder, what)
 }
 
-fn load_dialect(name: &str) -> CliResult<Dialect> {
+pub(crate) fn load_dialect(name: &str) -> CliResult<Dialect> {
     if name.ends_with(".toml") || Path::new(name).is_file() {
-        let text = read_text(Path::new(name))?;
+        let text = read_text(Path::new(name), "the file")?;
         Dialect::from_toml_str(&text).map_err(|e| Failure::rejected(format!("{name}: {e}")))
     } else {
         Dialect::builtin(name).map_err(|e| Failure::rejected(format!("--dialect {name}: {e}")))
@@ -154,22 +137,18 @@ fn load_dialect(name: &str) -> CliResult<Dialect> {
 
 /// `scallop post`.
 pub fn run(args: &PostArgs) -> CliResult<()> {
-    for (flag, v) in [
+    crate::input::positive_flags(&[
         ("--feed", args.feed),
         ("--tolerance", args.tolerance),
         ("--spindle", args.spindle),
         ("--retract", args.retract),
-    ] {
-        if !(v.is_finite() && v > 0.0) {
-            return Err(Failure::rejected(format!("{flag} {v}: must be a finite number > 0")));
-        }
-    }
+    ])?;
     if !(args.tool_length.is_finite() && args.tool_length >= 0.0) {
         return Err(Failure::rejected(format!("--tool-length {}: must be a finite number >= 0", args.tool_length)));
     }
     let machine = load_machine(&args.machine, Path::new(""), "--machine")?;
     let dialect = load_dialect(&args.dialect)?;
-    let text = read_text(&args.cl_file)?;
+    let text = read_text(&args.cl_file, "the file")?;
     let path = read_cl(&text, args.feed).map_err(|e| Failure::rejected(format!("{}: {e}", args.cl_file.display())))?;
     let records = records_of(&path);
     let kin = Kinematics::new(&machine, args.tool_length);
@@ -267,18 +246,18 @@ pub fn run(args: &PostArgs) -> CliResult<()> {
 }
 
 /// Times of a program.
-struct ProgramTime {
-    total: f64,
-    feed: f64,
-    floor: f64,
-    rapid: f64,
-    peak: [f64; 5],
-    lost: [f64; 5],
+pub(crate) struct ProgramTime {
+    pub(crate) total: f64,
+    pub(crate) feed: f64,
+    pub(crate) floor: f64,
+    pub(crate) rapid: f64,
+    pub(crate) peak: [f64; 5],
+    pub(crate) lost: [f64; 5],
 }
 
 /// Feed runs (maximal sequences of non-rapid blocks, with the block before as their
 /// start) by the look-ahead model; rapids per axis, stop to stop.
-fn program_time(
+pub(crate) fn program_time(
     kin: &Kinematics,
     blocks: &[(Motion, Joints, f64)],
 ) -> Result<ProgramTime, scallop_machine::MachineError> {

@@ -83,11 +83,8 @@ fn parse_csv(name: &str, text: &str) -> CliResult<Toolpath> {
 }
 
 fn read_text(path: &Path) -> CliResult<String> {
-    let name = path.display();
-    let bytes = std::fs::read(path).map_err(|e| {
-        let err = anyhow::anyhow!("{name}: cannot read the file: {e}");
-        if e.kind() == std::io::ErrorKind::NotFound { Failure::Rejected(err) } else { Failure::Io(err) }
-    })?;
+    let name = path.display().to_string();
+    let bytes = crate::input::read_bytes(path, &name, "the file")?;
     String::from_utf8(bytes)
         .map_err(|e| Failure::rejected(format!("{name}: byte {}: not UTF-8 text", e.utf8_error().valid_up_to())))
 }

@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use scallop_cutter::{Cutter, CutterShape};
-use scallop_engine::{FinishJob, Job, Operation, OutputOptions, Setup, StockShape, Strategy, run_finishing, run_job};
+use scallop_engine::{FinishJob, Job, Operation, OutputOptions, Setup, StockShape, Strategy};
 use scallop_geom::Aabb3;
 use scallop_geom::Tolerances;
 use scallop_geom::nalgebra::Rotation3;
@@ -43,40 +43,52 @@ pub fn run(args: &RunArgs) -> CliResult<()> {
         other => other,
     })?;
     if args.plan_only {
-        let operations = if spec.operation_list {
-            operations_job(&spec, job)?.operations
+        let job = if spec.operation_list {
+            operations_job(&spec, job)?
         } else {
-            vec![Operation { name: "finish".into(), finish: job, rough: None }]
+            Job { stock: None, operations: vec![Operation { name: "finish".into(), finish: job, rough: None }] }
         };
-        return plan_only(&name, &operations, args.json);
+        return plan_only(&name, &job, args.json);
     }
     if spec.operation_list {
         let engine_job = operations_job(&spec, job).map_err(|e| match e {
             Failure::Rejected(e) => Failure::Rejected(anyhow::anyhow!("{name}: {e:#}")),
             other => other,
         })?;
-        let spinner = progress_bar(0, "planning, cutting and verifying the operations");
-        spinner.enable_steady_tick(std::time::Duration::from_millis(120));
         let start = std::time::Instant::now();
-        let out = run_job(&engine_job).map_err(|e| Failure::rejected(format!("{name}: {e}{}", job_keys(&e))))?;
-        spinner.finish_and_clear();
-        return write_job(&out, start.elapsed().as_secs_f64(), &args.output, args.json);
+        let out = run_operations(&engine_job).map_err(|e| Failure::rejected(format!("{name}: {e}{}", job_keys(&e))))?;
+        check_travel(&spec, &args.job, &name, &out.toolpath)?;
+        let command = format!("scallop run {name}");
+        return write_job(&engine_job, &out, start.elapsed().as_secs_f64(), &args.output, args.json, &command);
     }
-    let spinner = progress_bar(0, "planning and verifying");
-    spinner.enable_steady_tick(std::time::Duration::from_millis(120));
     let start = std::time::Instant::now();
-    let out = run_finishing(&job).map_err(|e| Failure::rejected(format!("{name}: {e}{}", job_keys(&e))))?;
-    spinner.finish_and_clear();
+    let out = run_one(&job).map_err(|e| Failure::rejected(format!("{name}: {e}{}", job_keys(&e))))?;
+    check_travel(&spec, &args.job, &name, &out.toolpath)?;
     let command = format!("scallop run {name}");
     write_finishing(&job, &out, start.elapsed().as_secs_f64(), &args.output, args.json, &command)
 }
 
+/// Checks a 3-axis program against the travel of the machine the job names (a
+/// 3+2 program is checked by the kinematics of its setup's machine); nothing is
+/// written when it leaves the travel.
+fn check_travel(spec: &JobFile, job: &Path, name: &str, path: &scallop_toolpath::Toolpath) -> CliResult<()> {
+    if spec.setup.is_some() {
+        return Ok(());
+    }
+    let Some(machine) = crate::machine::job_machine(spec, job.parent().unwrap_or(Path::new(".")))? else {
+        return Ok(());
+    };
+    crate::machine::check_travel(&machine, path.moves().iter().map(|m| m.to)).map_err(|e| match e {
+        Failure::Rejected(e) => Failure::Rejected(anyhow::anyhow!("{name}: {e:#}")),
+        other => other,
+    })
+}
+
 /// `scallop run --plan-only`: the estimate of every operation (docs/job.md).
-fn plan_only(name: &str, operations: &[Operation], json: bool) -> CliResult<()> {
-    let mut estimates = Vec::with_capacity(operations.len());
-    for op in operations {
-        let e = scallop_engine::estimate_operation(&op.finish)
-            .map_err(|e| Failure::rejected(format!("{name}: operation `{}`: {e}", op.name)))?;
+fn plan_only(name: &str, job: &Job, json: bool) -> CliResult<()> {
+    let mut estimates = Vec::with_capacity(job.operations.len());
+    for (op, e) in job.operations.iter().zip(scallop_engine::estimate_job(job)) {
+        let e = e.map_err(|e| Failure::rejected(format!("{name}: operation `{}`: {e}", op.name)))?;
         estimates.push((op.name.clone(), e));
     }
     if json {
@@ -86,13 +98,28 @@ fn plan_only(name: &str, operations: &[Operation], json: bool) -> CliResult<()> 
     }
     let mut text = format!("{name}: estimate before planning (no drop-cutter, no simulation)\n");
     for (k, (n, e)) in estimates.iter().enumerate() {
+        if e.strategy == "rough" {
+            text.push_str(&format!(
+                "  {}. {n}: rough, ~{} passes on {} levels, {:.3} mm stepover; ~{:.0} mm of feed, >= {} at the \
+                 programmed feed\n",
+                k + 1,
+                e.passes,
+                e.levels,
+                e.spacing_mm[0],
+                e.feed_length_mm,
+                crate::output::hms(e.time_at_feed_s)
+            ));
+            continue;
+        }
+        let levels = if e.levels > 0 { format!(" and {} waterline levels", e.levels) } else { String::new() };
         text.push_str(&format!(
-            "  {}. {n}: {}, feed at {:.2}° from X ({}); ~{} planes at {:.3} to {:.3} mm; ~{:.0} mm of feed, \
-             >= {} at the programmed feed\n",
+            "  {}. {n}: {}, feed at {:.2}° from X ({}); ~{} passes on ~{} planes{levels}, planes {:.3} to {:.3} mm \
+             apart; ~{:.0} mm of feed, >= {} at the programmed feed\n",
             k + 1,
             e.strategy,
             e.direction_deg,
             if e.direction_given { "given" } else { "from the analysis" },
+            e.passes,
             e.planes,
             e.spacing_mm[0],
             e.spacing_mm[1],
@@ -216,10 +243,7 @@ fn apply_finishing(job: &mut FinishJob, f: &scallop_io::job::FinishingSpec) {
 /// missing or non-UTF-8 file or a bad job is rejected naming the file.
 pub(crate) fn read_job(path: &Path) -> CliResult<(String, JobFile)> {
     let name = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| {
-        let err = anyhow::anyhow!("{name}: cannot read the job file: {e}");
-        if e.kind() == std::io::ErrorKind::NotFound { Failure::Rejected(err) } else { Failure::Io(err) }
-    })?;
+    let bytes = crate::input::read_bytes(path, &name, "the job file")?;
     let text = std::str::from_utf8(&bytes)
         .map_err(|e| Failure::rejected(format!("{name}: byte {}: the job file is not UTF-8 text", e.valid_up_to())))?;
     let library_file = tool_library_of(text);
@@ -227,25 +251,31 @@ pub(crate) fn read_job(path: &Path) -> CliResult<(String, JobFile)> {
         Some(file) => Some(read_tool_library(&path.parent().unwrap_or(Path::new(".")).join(file))?),
         None => None,
     };
-    let spec = parse_job_with_tools(text, library.as_ref()).map_err(|e| match (&e, &library_file) {
+    let mut spec = parse_job_with_tools(text, library.as_ref()).map_err(|e| match (&e, &library_file) {
         (scallop_io::job::JobError::UnknownTool { .. }, Some(lib)) => {
             Failure::rejected(format!("{name}: {e} (tool library {lib})"))
         }
         _ => Failure::rejected(format!("{name}: {e}")),
     })?;
+    let in_job = |e: Failure| match e {
+        Failure::Rejected(e) => Failure::Rejected(anyhow::anyhow!("{name}: {e:#}")),
+        other => other,
+    };
+    if let Some(machine) =
+        crate::machine::job_machine(&spec, path.parent().unwrap_or(Path::new("."))).map_err(in_job)?
+    {
+        for note in crate::machine::apply(&mut spec, &machine).map_err(in_job)? {
+            eprintln!("note: {name}: {note}");
+        }
+    }
     Ok((name, spec))
 }
 
 /// Reads a tool library (docs/job.md, "Tool library"); errors name the file,
 /// the line and the fix.
 pub(crate) fn read_tool_library(path: &Path) -> CliResult<scallop_io::tools::ToolLibrary> {
-    let name = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| {
-        let err = anyhow::anyhow!("{name}: cannot read the tool library (`tool_library` of the job): {e}");
-        if e.kind() == std::io::ErrorKind::NotFound { Failure::Rejected(err) } else { Failure::Io(err) }
-    })?;
-    let text = scallop_io::utf8_text(&bytes).map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
-    scallop_io::tools::parse_tool_library(text).map_err(|e| Failure::rejected(format!("{name}: {e}")))
+    let text = crate::input::read_text(path, "the tool library (`tool_library` of the job)")?;
+    scallop_io::tools::parse_tool_library(&text).map_err(|e| Failure::rejected(format!("{}: {e}", path.display())))
 }
 
 pub(crate) fn finish_job(spec: &JobFile, folder: &Path) -> CliResult<FinishJob> {
@@ -267,16 +297,19 @@ pub(crate) fn finish_job(spec: &JobFile, folder: &Path) -> CliResult<FinishJob> 
     let cutter = cutter_of(&spec.cutter)?;
     let first = &spec.operations[0];
     let o = &spec.output;
-    let dialect = scallop_post::Dialect::builtin(&o.dialect).map_err(|_| {
+    let dialect_name = o.dialect_or(None);
+    let mut dialect = scallop_post::Dialect::builtin(dialect_name).map_err(|_| {
         Failure::rejected(format!(
-            "`output.dialect` = \"{}\": no such dialect; use one of {:?}",
-            o.dialect,
+            "`output.dialect` = \"{dialect_name}\": no such dialect; use one of {:?}",
             scallop_post::Dialect::builtin_names()
         ))
     })?;
+    if let Some(machine) = crate::machine::job_machine(spec, folder)? {
+        crate::machine::manual_tool_change(&mut dialect, &machine);
+    }
     let dialect = match o.units {
         scallop_io::job::UnitsWord::In => dialect.in_inches().map_err(|e| {
-            Failure::rejected(format!("`output.units` = \"in\" with `output.dialect` = \"{}\": {e}", o.dialect))
+            Failure::rejected(format!("`output.units` = \"in\" with `output.dialect` = \"{dialect_name}\": {e}"))
         })?,
         _ => dialect,
     };
@@ -335,5 +368,77 @@ fn job_keys(e: &scallop_engine::EngineError) -> &'static str {
         E::Output { .. } => " (job keys: [output], [setup])",
         E::Rough(_) => " (job keys: [operation.roughing], [operation.cutter], [stock])",
         _ => "",
+    }
+}
+
+/// Runs a job of several operations with a progress line per operation and
+/// phase; each operation's `planning_time_s` is the wall time from its
+/// planning step to its cutting step.
+fn run_operations(job: &Job) -> Result<scallop_engine::JobOutput, scallop_engine::EngineError> {
+    use scallop_engine::{JobPhase, JobStep};
+    let spinner = progress_bar(0, "planning the first operation");
+    spinner.enable_steady_tick(std::time::Duration::from_millis(120));
+    let steps: std::cell::RefCell<Vec<(JobStep, std::time::Instant)>> = std::cell::RefCell::new(Vec::new());
+    let progress = |step: JobStep| {
+        steps.borrow_mut().push((step, std::time::Instant::now()));
+        let message = match (step.phase, job.operations.get(step.index)) {
+            (JobPhase::Planning, Some(op)) => {
+                format!("operation {}/{} `{}`: planning", step.index + 1, step.count, op.name)
+            }
+            (JobPhase::Cutting, Some(op)) => {
+                format!("operation {}/{} `{}`: cutting the simulated stock", step.index + 1, step.count, op.name)
+            }
+            _ => "proving the stock all operations left, writing the program".to_string(),
+        };
+        spinner.set_message(message);
+    };
+    let mut out = scallop_engine::run_job_with_progress(job, &progress)?;
+    spinner.finish_and_clear();
+    let steps = steps.into_inner();
+    for (planning, cutting) in steps.iter().zip(steps.iter().skip(1)) {
+        if planning.0.phase == JobPhase::Planning
+            && cutting.0.phase == JobPhase::Cutting
+            && let Some(op) = out.report.operations.get_mut(planning.0.index)
+        {
+            op.plan.planning_time_s = cutting.1.duration_since(planning.1).as_secs_f64();
+        }
+    }
+    Ok(out)
+}
+
+/// Runs a finishing job with a progress line: the strategy while planning,
+/// a bar of the stock's bands cut (with the time left) while simulating, then the
+/// proof.
+fn run_one(job: &FinishJob) -> Result<scallop_engine::FinishOutput, scallop_engine::EngineError> {
+    use scallop_engine::FinishStep;
+    let bar = progress_bar(0, "preparing the part");
+    bar.enable_steady_tick(std::time::Duration::from_millis(120));
+    let progress = |step: FinishStep| match step {
+        FinishStep::Planning(strategy) => bar.set_message(format!("planning ({})", strategy_name(strategy))),
+        FinishStep::Cutting { done, total } => {
+            if bar.length() != Some(total as u64) {
+                bar.set_length(total as u64);
+                bar.set_message("cutting the simulated stock (bands of rows)");
+            }
+            bar.set_position(done as u64);
+        }
+        FinishStep::Verifying => bar.set_message("measuring the scallop and the material left"),
+        FinishStep::Refining { round } => {
+            bar.set_length(0);
+            bar.set_message(format!("planning again with passes where the scallop exceeded sh (round {round})"));
+        }
+    };
+    let out = scallop_engine::run_finishing_with_progress(job, &progress);
+    bar.finish_and_clear();
+    out
+}
+
+/// How the progress line names a strategy.
+fn strategy_name(strategy: Strategy) -> &'static str {
+    match strategy {
+        Strategy::ParallelPlanes => "parallel planes",
+        Strategy::Isoparametric(_) => "isoparametric passes",
+        Strategy::NetworkPlanes => "network planes",
+        Strategy::SteepShallow { .. } => "steep and shallow: planes and waterline levels",
     }
 }

@@ -16,6 +16,7 @@ use scallop_toolpath::Toolpath;
 use serde::Serialize;
 
 use crate::drop::CutterArgs;
+use crate::input::read_text;
 use crate::output::{print_json, print_text, progress_bar, write_atomic};
 use crate::part::{UnitsArg, load};
 use crate::{CliResult, Failure};
@@ -157,11 +158,7 @@ fn read_program(args: &SimulateArgs) -> CliResult<Program> {
         Failure::rejected("give the program with --program FILE.nc (G-code) or --toolpath FILE.csv (cutter locations)")
     })?;
     let name = file.display().to_string();
-    let bytes = std::fs::read(file).map_err(|e| {
-        let err = anyhow::anyhow!("{name}: cannot read the program: {e}");
-        if e.kind() == std::io::ErrorKind::NotFound { Failure::Rejected(err) } else { Failure::Io(err) }
-    })?;
-    let text = scallop_io::utf8_text(&bytes).map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
+    let text = &read_text(file, "the program")?;
     if args.program.is_some() {
         // Arcs stay arcs: the z-map cuts them exactly.
         let path =
@@ -222,11 +219,17 @@ pub fn run(args: &SimulateArgs) -> CliResult<()> {
     };
     let options =
         VerifyOptions { gouge_tolerance: budget.gouge_allowance(prepared.chordal_error), ..VerifyOptions::default() };
-    let (report, zmap, dev, max_dev) = if dexel {
-        simulate_dexel(args, &program, &cutter, &cutter_text, stock, &prepared, &options, &loaded.description)?
-    } else {
-        simulate_zmap(args, &program, &cutter, &cutter_text, stock, &prepared, &options, &loaded.description)?
+    let run = Run {
+        args,
+        program: &program,
+        cutter: &cutter,
+        cutter_text: &cutter_text,
+        stock,
+        prepared: &prepared,
+        options: &options,
+        part_name: &loaded.description,
     };
+    let (report, zmap, dev, max_dev) = if dexel { simulate_dexel(&run)? } else { simulate_zmap(&run)? };
     let verdict = if report.verdict == ["ok"] { Vec::new() } else { report.verdict.clone() };
     let program = program.path;
     let json = serde_json::to_string_pretty(&report).map_err(|e| Failure::Io(e.into()))?;
@@ -280,7 +283,7 @@ fn deviation(tops: &[f64], field: &PartField) -> (Vec<f64>, f64, f64) {
 
 /// Moves the progress bar to `done` of `total` bands (the library calls this
 /// from its worker threads, in any order: the bar only moves forward).
-fn show(bar: &indicatif::ProgressBar, done: usize, total: usize) {
+pub(crate) fn show(bar: &indicatif::ProgressBar, done: usize, total: usize) {
     // Counts far below 2^64: exact conversions.
     bar.set_length(total as u64);
     if done as u64 > bar.position() {
@@ -288,145 +291,149 @@ fn show(bar: &indicatif::ProgressBar, done: usize, total: usize) {
     }
 }
 
-/// The 3-axis simulation on a z-map.
-#[allow(clippy::too_many_arguments)] // private; the pieces of one command.
-fn simulate_zmap(
-    args: &SimulateArgs,
-    program: &Program,
-    cutter: &scallop_cutter::Cutter,
-    cutter_text: &str,
+/// The pieces of one simulation, whichever the stock model.
+struct Run<'a> {
+    args: &'a SimulateArgs,
+    program: &'a Program,
+    cutter: &'a scallop_cutter::Cutter,
+    cutter_text: &'a str,
     stock: Aabb3,
-    prepared: &scallop_engine::PreparedPart,
-    options: &VerifyOptions,
-    part_name: &str,
-) -> CliResult<Outcome> {
-    let name = &program.name;
-    let mut zmap = ZMap::new(stock, args.resolution).map_err(|e| Failure::rejected(format!("stock: {e}")))?;
+    prepared: &'a scallop_engine::PreparedPart,
+    options: &'a VerifyOptions,
+    part_name: &'a str,
+}
+
+/// What a cut measured, whichever the stock model: moves, volumes, and the
+/// largest scallop (mm, XY) and deepest deviation (mm) of the verification,
+/// else of the deviation map.
+struct Measured {
+    stock_model: &'static str,
+    cells: [usize; 2],
+    feed_moves: usize,
+    air_cut_share: f64,
+    volumes_mm3: [f64; 2],
+    scallop: (f64, Option<[f64; 2]>, f64),
+}
+
+impl Run<'_> {
+    /// Maps a library error to a rejection naming the program.
+    fn rejected(&self, e: impl std::fmt::Display) -> Failure {
+        Failure::rejected(format!("{}: {e}", self.program.name))
+    }
+
+    /// The report of a cut; the tri-dexel stock's own figures are left out.
+    fn report(&self, m: Measured, verdict: &[String]) -> SimReport {
+        let (max_scallop_mm, max_scallop_at, min_deviation_mm) = m.scallop;
+        SimReport {
+            stock_model: m.stock_model,
+            part: self.part_name.to_string(),
+            program: self.program.name.clone(),
+            cutter: self.cutter_text.to_string(),
+            resolution_mm: self.args.resolution,
+            cells: m.cells,
+            moves: self.program.path.moves().len(),
+            feed_moves: m.feed_moves,
+            air_cut_share: m.air_cut_share,
+            removed_volume_mm3: m.volumes_mm3[0],
+            remaining_volume_mm3: m.volumes_mm3[1],
+            max_scallop_mm,
+            max_scallop_at,
+            min_deviation_mm,
+            gouge_tolerance_mm: self.options.gouge_tolerance,
+            rays: None,
+            max_thickness_mm: None,
+            axis_tolerance_mm: None,
+            sweeps: None,
+            verdict: if verdict.is_empty() {
+                vec!["ok".into()]
+            } else {
+                verdict.iter().map(|v| self.program.with_lines(v)).collect()
+            },
+        }
+    }
+}
+
+/// `result`'s value, or `None` with its error added to the verdict.
+fn noted<T, E: std::fmt::Display>(result: Result<T, E>, verdict: &mut Vec<String>) -> Option<T> {
+    result.map_err(|e| verdict.push(e.to_string())).ok()
+}
+
+/// The 3-axis simulation on a z-map.
+fn simulate_zmap(run: &Run) -> CliResult<Outcome> {
+    let (program, cutter) = (run.program, run.cutter);
+    let mut zmap = ZMap::new(run.stock, run.args.resolution).map_err(|e| Failure::rejected(format!("stock: {e}")))?;
     let bar = progress_bar(0, "cutting the z-map stock");
     let cut = zmap
         .cut_with_progress(cutter, &program.path, &|done, total| show(&bar, done, total))
-        .map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
+        .map_err(|e| run.rejected(e))?;
     bar.finish_and_clear();
     let mut verdict = Vec::new();
-    if let Err(e) = cut.check() {
-        verdict.push(e.to_string());
-    }
+    noted(cut.check(), &mut verdict);
     // The part rasterised once: collisions, verification and the picture.
-    let field = PartField::new(&zmap, &prepared.index);
-    let collisions = zmap
-        .part_collisions_in(&field, cutter, &program.path, cut.operation)
-        .map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
+    let field = PartField::new(&zmap, &run.prepared.index);
+    let collisions =
+        zmap.part_collisions_in(&field, cutter, &program.path, cut.operation).map_err(|e| run.rejected(e))?;
     if !collisions.is_empty() {
-        verdict.push(scallop_sim::SimError::PartCollision { count: collisions.len(), collisions }.to_string());
+        verdict.push(scallop_sim::SimError::PartCollision { collisions }.to_string());
     }
-    let verification = match verify_in(&zmap, &field, options) {
-        Ok(v) => Some(v),
-        Err(e) => {
-            verdict.push(e.to_string());
-            None
-        }
-    };
+    let verification = noted(verify_in(&zmap, &field, run.options), &mut verdict);
     let (dev, max_dev, min_dev) = deviation(zmap.heights(), &field);
-    let report = SimReport {
+    let verified = verification.map(|v| (v.max_scallop, v.max_scallop_at.map(|p| [p.x, p.y]), v.min_deviation));
+    let measured = Measured {
         stock_model: "z-map",
-        part: part_name.to_string(),
-        program: name.clone(),
-        cutter: cutter_text.to_string(),
-        resolution_mm: args.resolution,
         cells: [zmap.nx(), zmap.ny()],
-        moves: program.path.moves().len(),
         feed_moves: cut.feed_moves,
         air_cut_share: cut.air_cut_share(),
-        removed_volume_mm3: cut.removed_volume,
-        remaining_volume_mm3: zmap.volume(),
-        max_scallop_mm: verification.as_ref().map_or(max_dev, |v| v.max_scallop),
-        max_scallop_at: verification.as_ref().and_then(|v| v.max_scallop_at).map(|p| [p.x, p.y]),
-        min_deviation_mm: verification.as_ref().map_or(min_dev, |v| v.min_deviation),
-        gouge_tolerance_mm: options.gouge_tolerance,
-        rays: None,
-        max_thickness_mm: None,
-        axis_tolerance_mm: None,
-        sweeps: None,
-        verdict: if verdict.is_empty() {
-            vec!["ok".into()]
-        } else {
-            verdict.iter().map(|v| program.with_lines(v)).collect()
-        },
+        volumes_mm3: [cut.removed_volume, zmap.volume()],
+        scallop: verified.unwrap_or((max_dev, None, min_dev)),
     };
-    Ok((report, zmap, dev, max_dev))
+    Ok((run.report(measured, &verdict), zmap, dev, max_dev))
 }
 
 /// The multi-axis simulation on a tri-dexel stock.
-#[allow(clippy::too_many_arguments)] // private; the pieces of one command.
-fn simulate_dexel(
-    args: &SimulateArgs,
-    program: &Program,
-    cutter: &scallop_cutter::Cutter,
-    cutter_text: &str,
-    stock: Aabb3,
-    prepared: &scallop_engine::PreparedPart,
-    options: &VerifyOptions,
-    part_name: &str,
-) -> CliResult<Outcome> {
-    let name = &program.name;
-    let mut dexels = DexelStock::new(stock, args.resolution).map_err(|e| Failure::rejected(format!("stock: {e}")))?;
+fn simulate_dexel(run: &Run) -> CliResult<Outcome> {
+    let (program, cutter, args) = (run.program, run.cutter, run.args);
+    let mut dexels =
+        DexelStock::new(run.stock, args.resolution).map_err(|e| Failure::rejected(format!("stock: {e}")))?;
     let dexel_options = DexelOptions { axis_tolerance: args.axis_tolerance, ..DexelOptions::default() };
     let bar = progress_bar(0, "cutting the tri-dexel stock");
     let cut = dexels
         .cut_with_progress(cutter, &program.moves, &dexel_options, &|done, total| show(&bar, done, total))
-        .map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
+        .map_err(|e| run.rejected(e))?;
     bar.finish_and_clear();
     let mut verdict = Vec::new();
-    if let Err(e) = cut.check() {
-        verdict.push(e.to_string());
-    }
-    let part = DexelPart::new(&prepared.mesh);
+    noted(cut.check(), &mut verdict);
+    let part = DexelPart::new(&run.prepared.mesh);
     let collisions = dexels
         .part_collisions(&part, cutter, &program.moves, &dexel_options, cut.operation)
-        .map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
+        .map_err(|e| run.rejected(e))?;
     if !collisions.is_empty() {
-        verdict.push(scallop_sim::SimError::DexelPartCollision { count: collisions.len(), collisions }.to_string());
+        verdict.push(scallop_sim::SimError::DexelPartCollision { collisions }.to_string());
     }
-    let verification = match verify_dexel(&dexels, &part, options) {
-        Ok(v) => Some(v),
-        Err(e) => {
-            verdict.push(e.to_string());
-            None
-        }
-    };
+    let verification = noted(verify_dexel(&dexels, &part, run.options), &mut verdict);
     // An uncut z-map on the Z rays' grid: the same cells, for the picture.
-    let grid = ZMap::new(stock, args.resolution).map_err(|e| Failure::rejected(format!("stock: {e}")))?;
-    let (dev, max_dev, min_dev) = deviation(&dexels.top_heights(), &PartField::new(&grid, &prepared.index));
+    let grid = ZMap::new(run.stock, args.resolution).map_err(|e| Failure::rejected(format!("stock: {e}")))?;
+    let (dev, max_dev, min_dev) = deviation(&dexels.top_heights(), &PartField::new(&grid, &run.prepared.index));
     let counts = dexels.counts();
     let rays = [0, 1, 2].map(|k| {
         let (nu, nv) = dexels.grid(k);
         nu * nv
     });
-    let report = SimReport {
+    let verified = verification.map(|v| (v.max_scallop, v.max_scallop_at.map(|p| [p.x, p.y]), v.min_deviation));
+    let measured = Measured {
         stock_model: "tri-dexel",
-        part: part_name.to_string(),
-        program: name.clone(),
-        cutter: cutter_text.to_string(),
-        resolution_mm: args.resolution,
         cells: [counts[0], counts[1]],
-        moves: program.path.moves().len(),
         feed_moves: cut.feed_moves,
         air_cut_share: cut.air_cut_share(),
-        removed_volume_mm3: cut.removed_volume,
-        remaining_volume_mm3: dexels.volume(),
-        max_scallop_mm: verification.as_ref().map_or(max_dev, |v| v.max_scallop),
-        max_scallop_at: verification.as_ref().and_then(|v| v.max_scallop_at).map(|p| [p.x, p.y]),
-        min_deviation_mm: verification.as_ref().map_or(min_dev, |v| v.min_deviation),
-        gouge_tolerance_mm: options.gouge_tolerance,
+        volumes_mm3: [cut.removed_volume, dexels.volume()],
+        scallop: verified.unwrap_or((max_dev, None, min_dev)),
+    };
+    let report = SimReport {
         rays: Some(rays),
-        max_thickness_mm: verification.as_ref().map(|v| v.max_thickness),
+        max_thickness_mm: verification.map(|v| v.max_thickness),
         axis_tolerance_mm: Some(args.axis_tolerance),
         sweeps: Some(cut.sweeps),
-        verdict: if verdict.is_empty() {
-            vec!["ok".into()]
-        } else {
-            verdict.iter().map(|v| program.with_lines(v)).collect()
-        },
+        ..run.report(measured, &verdict)
     };
     Ok((report, grid, dev, max_dev))
 }

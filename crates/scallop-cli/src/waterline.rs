@@ -11,7 +11,7 @@ use scallop_waterline::{Loop, WaterlineError, WaterlineGrid, WaterlineOptions, t
 use serde::Serialize;
 
 use crate::drop::CutterArgs;
-use crate::output::{print_json, print_text, progress_bar, write_atomic};
+use crate::output::{print_report, progress_bar, write_atomic};
 use crate::part::{UnitsArg, load};
 use crate::{CliResult, Failure};
 
@@ -213,22 +213,21 @@ pub fn run(args: &WaterlineArgs) -> CliResult<()> {
         seconds,
         output: args.output.display().to_string(),
     };
-    if args.json {
-        return print_json(&report);
-    }
-    print_text(&format!(
-        "{} loops ({} points) at {} levels in {:.3} s (grid {}x{} step {} mm: {:.3} s; {} threads) on {}\n  cutter {}\n  wrote {}\n",
-        report.loops,
-        report.points,
-        report.levels.len(),
-        report.seconds,
-        nx,
-        ny,
-        report.step_mm,
-        report.grid_seconds,
-        report.threads,
-        report.part,
-        report.cutter,
-        report.output
-    ))
+    print_report(&report, args.json, |r| {
+        format!(
+            "{} loops ({} points) at {} levels in {:.3} s (grid {}x{} step {} mm: {:.3} s; {} threads) on {}\n  cutter {}\n  wrote {}\n",
+            r.loops,
+            r.points,
+            r.levels.len(),
+            r.seconds,
+            nx,
+            ny,
+            r.step_mm,
+            r.grid_seconds,
+            r.threads,
+            r.part,
+            r.cutter,
+            r.output
+        )
+    })
 }

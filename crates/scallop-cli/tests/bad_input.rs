@@ -5,24 +5,16 @@
 
 #![allow(clippy::unwrap_used, reason = "tests fail loudly by design")]
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::Path;
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("scallop-bad-input-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+mod common;
+
+use common::{rejected, scallop, scratch};
 
 /// Runs `scallop ARGS` in `dir`; asserts exit code 1, no panic, and that stderr names
 /// every string of `expect`. Returns stderr.
 fn refused(dir: &Path, args: &[&str], expect: &[&str]) -> String {
-    let out =
-        Command::new(env!("CARGO_BIN_EXE_scallop")).current_dir(dir).env("CI", "true").args(args).output().unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert_eq!(out.status.code(), Some(1), "scallop {args:?}: {stderr}");
-    assert!(!stderr.contains("panicked"), "scallop {args:?}: {stderr}");
+    let stderr = rejected(&scallop().current_dir(dir).args(args).output().unwrap());
     for e in expect {
         assert!(stderr.contains(e), "scallop {args:?}: `{e}` not in: {stderr}");
     }

@@ -64,7 +64,6 @@ mod hac;
 mod kmeans;
 mod metric;
 mod partition;
-mod rng;
 mod rpcl;
 pub mod tol;
 mod zone;

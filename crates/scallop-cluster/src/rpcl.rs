@@ -4,8 +4,8 @@
 use crate::engine::{Frozen, Setup, Stats, circle_centres, compact};
 use crate::features::{ThetaMode, delta, fold_direction};
 use crate::partition::{Clustering, RpclParams};
-use crate::rng::SplitMix64;
 use crate::tol;
+use scallop_geom::rng::SplitMix64;
 
 /// RPCL with `k` centres, at most `max_sweeps` sweeps, the seeded permutation of
 /// `seed`.

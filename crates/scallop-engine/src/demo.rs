@@ -11,7 +11,7 @@ use scallop_post::{Dialect, write_gcode};
 use scallop_toolpath::{Move, MoveKind, Toolpath, simplify_above};
 use serde::Serialize;
 
-use crate::{EngineError, Part, prepare_part};
+use crate::{EngineError, Part, PreparedPart, prepare_part};
 
 /// Share of the path tolerance given to merging nearly collinear CL points
 /// (the tessellation takes `Tolerances::TESSELLATION_SHARE`; the rest is left
@@ -159,10 +159,48 @@ pub fn run_demo(settings: &DemoSettings, progress: &(dyn Fn(usize, usize) + Sync
     let grid = drop_grid(&cutter, &prepared.index, &xs, &ys, floor, &|done| progress(done, total));
     let mut dropped = grid.len();
 
-    // Runs of contact along each raster line, zigzag order.
-    let simplify_tol = SIMPLIFY_SHARE * s.tolerances.path;
+    let runs = zigzag_runs(&grid, xs.len());
+
+    // Refine every run where the straight move between two samples would leave
+    // the CL surface: below it at all (a gouge) or above it by more than the
+    // sampling share of the path tolerance.
+    let sampling_tol = SAMPLING_SHARE * s.tolerances.path;
+    let runs: Vec<Vec<Point3>> =
+        runs.par_iter().map(|run| refine(&cutter, &prepared.index, run, floor, sampling_tol, &mut 0)).collect();
+    dropped += runs.iter().map(Vec::len).sum::<usize>();
+
+    let clearance = bounds.max.z + s.clearance;
+    let surface = Surface { cutter: &cutter, index: &prepared.index, floor, sampling_tol };
+    let (path, linked) = link_runs(&surface, &runs, s, clearance);
+    dropped += linked;
+
+    // Verify the program on a simulated stock: the part's box from 1 mm below to
+    // 1 mm above. A gouge beyond the gouge tolerance plus the tessellation's
+    // chordal error (the program follows the mesh, which lies that close to the
+    // surface) plus the sampling share (what remains between refined samples is
+    // of second order, bounded here by the share) is an error.
+    let stock = scallop_geom::Aabb3 {
+        min: Point3::new(bounds.min.x, bounds.min.y, bounds.min.z - 1.0),
+        max: Point3::new(bounds.max.x, bounds.max.y, bounds.max.z + 1.0),
+    };
+    let options = scallop_sim::VerifyOptions {
+        gouge_tolerance: s.tolerances.gouge + prepared.chordal_error + sampling_tol,
+        ..scallop_sim::VerifyOptions::default()
+    };
+    let sim = scallop_sim::simulate(stock, s.sim_resolution, &cutter, &path, &prepared.index, &options)?;
+
+    let cutter_text = format!("ball D{} mm", s.cutter_diameter);
+    let gcode = demo_gcode(&path, s, &cutter_text, prepared.chordal_error)?;
+    let summary = summarise(&path, s, cutter_text, &prepared, (runs.len(), dropped), &sim);
+    Ok(DemoOutput { toolpath: path, gcode, summary })
+}
+
+/// Runs of contact along each raster line of `grid` (rows of `width`
+/// points), in zigzag order: points where the cutter touches nothing split
+/// the passes, and runs of one point are dropped.
+fn zigzag_runs(grid: &[ClPoint], width: usize) -> Vec<Vec<Point3>> {
     let mut runs: Vec<Vec<Point3>> = Vec::new();
-    for (row, line) in grid.chunks(xs.len()).enumerate() {
+    for (row, line) in grid.chunks(width).enumerate() {
         let ordered: Vec<&ClPoint> = if row % 2 == 0 { line.iter().collect() } else { line.iter().rev().collect() };
         let mut run: Vec<Point3> = Vec::new();
         for cl in ordered {
@@ -179,23 +217,32 @@ pub fn run_demo(settings: &DemoSettings, progress: &(dyn Fn(usize, usize) + Sync
             runs.push(run);
         }
     }
+    runs
+}
 
-    // Refine every run where the straight move between two samples would leave
-    // the CL surface: below it at all (a gouge) or above it by more than the
-    // sampling share of the path tolerance.
-    let sampling_tol = SAMPLING_SHARE * s.tolerances.path;
-    let runs: Vec<Vec<Point3>> =
-        runs.par_iter().map(|run| refine(&cutter, &prepared.index, run, floor, sampling_tol, &mut 0)).collect();
-    dropped += runs.iter().map(Vec::len).sum::<usize>();
+/// What the cutter is dropped on: the part's index above `floor`, refined to
+/// `sampling_tol`.
+struct Surface<'a> {
+    cutter: &'a Cutter,
+    index: &'a scallop_mesh::MeshIndex,
+    floor: f64,
+    sampling_tol: f64,
+}
 
-    let clearance = bounds.max.z + s.clearance;
+/// The program through the refined `runs`: each linked to the next on the CL
+/// surface where a link stays on it, else by a retract to `clearance`, a rapid
+/// and a plunge. Returns the path and the drop-cutter queries of the links.
+fn link_runs(surface: &Surface, runs: &[Vec<Point3>], s: &DemoSettings, clearance: f64) -> (Toolpath, usize) {
+    let Surface { cutter, index, floor, sampling_tol } = *surface;
+    let simplify_tol = SIMPLIFY_SHARE * s.tolerances.path;
+    let mut dropped = 0;
     let mut path = Toolpath::new(s.feed);
     let mut last: Option<Point3> = None;
-    for run in &runs {
+    for run in runs {
         let start = run[0];
         let link = last.and_then(|p| {
-            let cl = link_on_surface(&cutter, &prepared.index, p, start, s.sample_step, floor)
-                .map(|points| refine(&cutter, &prepared.index, &points, floor, sampling_tol, &mut 0));
+            let cl = link_on_surface(cutter, index, p, start, s.sample_step, floor)
+                .map(|points| refine(cutter, index, &points, floor, sampling_tol, &mut 0));
             dropped += cl.as_ref().map_or(0, Vec::len);
             cl
         });
@@ -221,35 +268,35 @@ pub fn run_demo(settings: &DemoSettings, progress: &(dyn Fn(usize, usize) + Sync
     if let Some(p) = last {
         path.push(Move::new(MoveKind::Retract, Point3::new(p.x, p.y, clearance)));
     }
+    (path, dropped)
+}
 
-    // Verify the program on a simulated stock: the part's box from 1 mm below to
-    // 1 mm above. A gouge beyond the gouge tolerance plus the tessellation's
-    // chordal error (the program follows the mesh, which lies that close to the
-    // surface) plus the sampling share (what remains between refined samples is
-    // of second order, bounded here by the share) is an error.
-    let stock = scallop_geom::Aabb3 {
-        min: Point3::new(bounds.min.x, bounds.min.y, bounds.min.z - 1.0),
-        max: Point3::new(bounds.max.x, bounds.max.y, bounds.max.z + 1.0),
-    };
-    let options = scallop_sim::VerifyOptions {
-        gouge_tolerance: s.tolerances.gouge + prepared.chordal_error + sampling_tol,
-        ..scallop_sim::VerifyOptions::default()
-    };
-    let sim = scallop_sim::simulate(stock, s.sim_resolution, &cutter, &path, &prepared.index, &options)?;
-
-    let cutter_text = format!("ball D{} mm", s.cutter_diameter);
+/// The demo's program as plain G-code, with a header naming the part, the
+/// cutter and the tolerances.
+fn demo_gcode(path: &Toolpath, s: &DemoSettings, cutter_text: &str, chordal_error: f64) -> Result<String, EngineError> {
     let mut gcode = Vec::new();
     let comments = [
-        format!("part: built-in {} surface, tessellated within {:.5} mm", s.part, prepared.chordal_error),
+        format!("part: built-in {} surface, tessellated within {:.5} mm", s.part, chordal_error),
         format!("cutter: {cutter_text}; stepover {} mm; feed {} mm/min", s.stepover, s.feed),
         format!("path tolerance {} mm; gouge tolerance {} mm", s.tolerances.path, s.tolerances.gouge),
     ];
     let comment_refs: Vec<&str> = comments.iter().map(String::as_str).collect();
     // INVARIANT: writing into a Vec cannot fail.
-    write_gcode(&path, &Dialect::plain(), &comment_refs, &mut gcode)
-        .map_err(|_| EngineError::BadTolerance(f64::NAN))?;
-    let gcode = String::from_utf8_lossy(&gcode).into_owned();
+    write_gcode(path, &Dialect::plain(), &comment_refs, &mut gcode).map_err(|_| EngineError::BadTolerance(f64::NAN))?;
+    Ok(String::from_utf8_lossy(&gcode).into_owned())
+}
 
+/// The summary of the demo's `path` on `prepared`, from its `(passes,
+/// drop-cutter queries)` and its simulation.
+fn summarise(
+    path: &Toolpath,
+    s: &DemoSettings,
+    cutter: String,
+    prepared: &PreparedPart,
+    (passes, dropped): (usize, usize),
+    sim: &scallop_sim::Simulation,
+) -> DemoSummary {
+    let radius = 0.5 * s.cutter_diameter;
     let (zmin, zmax) = path
         .moves()
         .iter()
@@ -260,14 +307,14 @@ pub fn run_demo(settings: &DemoSettings, progress: &(dyn Fn(usize, usize) + Sync
     let plunge_len = path.length(MoveKind::Plunge);
     let rapid_len = path.length(MoveKind::Rapid) + path.length(MoveKind::Retract);
     let half = 0.5 * s.stepover;
-    let summary = DemoSummary {
+    DemoSummary {
         part: s.part.clone(),
         triangles: prepared.mesh.triangles().len(),
         chordal_error_mm: prepared.chordal_error,
-        cutter: cutter_text,
+        cutter,
         stepover_mm: s.stepover,
         flat_scallop_mm: radius - (radius * radius - half * half).max(0.0).sqrt(),
-        passes: runs.len(),
+        passes,
         cl_points_dropped: dropped,
         moves: path.moves().len(),
         feed_length_mm: feed_len,
@@ -277,14 +324,13 @@ pub fn run_demo(settings: &DemoSettings, progress: &(dyn Fn(usize, usize) + Sync
         naive_time_s: 60.0
             * ((feed_len + link_len) / s.feed + plunge_len / path.plunge_feed + rapid_len / s.rapid_rate),
         tip_z_range_mm: [zmin, zmax],
-        simplify_tolerance_mm: simplify_tol,
+        simplify_tolerance_mm: SIMPLIFY_SHARE * s.tolerances.path,
         sim_resolution_mm: s.sim_resolution,
         verified_max_scallop_mm: sim.verification.max_scallop,
         verified_max_scallop_at: sim.verification.max_scallop_at.map(|p| [p.x, p.y]),
         verified_min_deviation_mm: sim.verification.min_deviation,
         air_cut_share: sim.cut.air_cut_share(),
-    };
-    Ok(DemoOutput { toolpath: path, gcode, summary })
+    }
 }
 
 /// Inserts drop-cutter points between consecutive CL points `run` until the

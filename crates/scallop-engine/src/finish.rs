@@ -13,17 +13,18 @@ use scallop_cutter::{Cutter, CutterShape};
 use scallop_geom::nalgebra::Rotation3;
 use scallop_geom::{Aabb3, Point3, Tolerances, Vec3};
 use scallop_machine::frame::SetupFrame;
-use scallop_machine::program::{ProgramOptions, records_from_toolpath, to_program};
+use scallop_machine::program::{MachineProgram, ProgramOptions, records_from_toolpath, to_program};
 use scallop_machine::{Kinematics, Machine};
 use scallop_mesh::{MeshIndex, TriMesh};
 use scallop_post::{Dialect, OutputMode, PostParams, ProgramInfo, program_text, write_fitted};
 use scallop_strategy::{
-    Boundary, FinishingParams, IsoDirection, LeadKind, LeadReport, Pattern, SteepShallow, apply_leads, lookahead_time,
-    plan_finishing, plan_isoparametric, plan_steep_shallow, stop_to_stop_time,
+    Boundary, FinishingParams, IsoDirection, IsoSurface, LeadKind, LeadReport, Pattern, Refinement, SteepShallow,
+    apply_leads, lookahead_time, plan_finishing_refined, plan_isoparametric, plan_steep_shallow, stop_to_stop_time,
 };
 use scallop_toolpath::{FittedPath, Move, MoveKind, Toolpath, fit_arcs};
 use serde::Serialize;
 
+use crate::refine::{Layout, MAX_ROUNDS, merged, refinement_for};
 use crate::{ARC_SHARE, EngineError, Part, PreparedPart, prepare_part};
 
 /// How the program is written.
@@ -111,6 +112,13 @@ pub struct FinishJob {
 }
 
 impl FinishJob {
+    /// The machine and feed parameters the planners time this job's moves
+    /// with (the feed direction left at 0: timing does not use it).
+    #[must_use]
+    pub fn timing_params(&self) -> FinishingParams {
+        finishing_params(self, 0.0)
+    }
+
     /// The spec's main job: the Choi surface, bull-nose R 5 r 2, sh 0.01 mm,
     /// V 5 m/min, A 6 m/s², J 40 m/s³, along the PCA steepest slope.
     ///
@@ -232,6 +240,41 @@ pub struct FinishDetails {
 /// Bad settings, an unknown part, a plan that cannot hold the scallop height,
 /// or a safety problem found by the stock simulation.
 pub fn run_finishing(job: &FinishJob) -> Result<FinishOutput, EngineError> {
+    run_finishing_with_progress(job, &|_| {})
+}
+
+/// What [`run_finishing_with_progress`] is doing.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum FinishStep {
+    /// Planning the toolpath with this strategy.
+    Planning(Strategy),
+    /// Cutting the simulated stock: `done` of `total` bands of rows
+    /// ([`scallop_sim::ZMap::cut_with_progress`]).
+    Cutting {
+        /// Bands cut.
+        done: usize,
+        /// All bands.
+        total: usize,
+    },
+    /// Measuring the scallop and the material left, writing the program.
+    Verifying,
+    /// Planning again with planes or levels added where the simulation found
+    /// the scallop over sh (round 1, 2, ...; see docs/simulation.md, "Refinement").
+    Refining {
+        /// The refinement round.
+        round: usize,
+    },
+}
+
+/// [`run_finishing`], calling `progress` as it goes (planning, then the cut
+/// with its count of bands, then the proof).
+///
+/// # Errors
+/// As [`run_finishing`].
+pub fn run_finishing_with_progress(
+    job: &FinishJob,
+    progress: &(dyn Fn(FinishStep) + Sync),
+) -> Result<FinishOutput, EngineError> {
     let tolerances = planning_tolerances(job)?;
     let prepared = prepare_part(&job.part, &tolerances)?;
     let prepared = match &job.setup {
@@ -239,15 +282,48 @@ pub fn run_finishing(job: &FinishJob) -> Result<FinishOutput, EngineError> {
         None => prepared,
     };
     let stock = stock_box(&prepared.mesh, job.cutter.radius());
-    let mut op = plan_operation(job, &prepared, &tolerances, None)?;
     let (gouge_tolerance, options) = verify_options(job, &prepared);
-    let sim =
-        scallop_sim::simulate(stock, job.sim_resolution, &job.cutter, &op.plan.toolpath, &prepared.index, &options)?;
-    let rest = if job.strategy.simulation_verifies_scallop() {
-        network_scallop_from(&sim, job, &prepared, &options, &mut op.plan.report)?
-    } else {
-        RestReport::default()
+    let mut refine = Refinement::default();
+    let (mut round, mut first) = (0, (0, 0));
+    let (mut op, sim, rest) = loop {
+        progress(if round == 0 { FinishStep::Planning(job.strategy) } else { FinishStep::Refining { round } });
+        let mut op = plan_operation(job, &prepared, &tolerances, None, &refine)?;
+        if round == 0 {
+            first = (op.plan.layout.planes.len(), op.plan.layout.levels.len());
+        }
+        let sim = scallop_sim::simulate_with_progress(
+            stock,
+            job.sim_resolution,
+            &job.cutter,
+            &op.plan.toolpath,
+            &prepared.index,
+            &options,
+            &|done, total| progress(FinishStep::Cutting { done, total }),
+        )?;
+        progress(FinishStep::Verifying);
+        if !job.strategy.simulation_verifies_scallop() {
+            break (op, sim, RestReport::default());
+        }
+        let split = scallop_split(&sim, job, &prepared, &options);
+        let more =
+            if split.holds() || round == MAX_ROUNDS || op.plan.layout.planes.len() + op.plan.layout.levels.len() == 0 {
+                Refinement::default()
+            } else {
+                refinement_for(&op.plan.layout, &split.over, &job.cutter)
+            };
+        let all = merged(&refine, &more);
+        if more.is_empty() || all == refine {
+            let rest = accept_scallop(split, &sim, job, &mut op.plan.report)?;
+            break (op, sim, rest);
+        }
+        refine = all;
+        round += 1;
     };
+    op.plan.report.refinement = (round > 0).then_some(scallop_strategy::RefinementReport {
+        rounds: round,
+        planes_added: op.plan.layout.planes.len().saturating_sub(first.0),
+        levels_added: op.plan.layout.levels.len().saturating_sub(first.1),
+    });
     let (fitted, comments) = fit_and_comment(job, &op, &prepared, &tolerances);
     let text = match &job.setup {
         None => three_axis_program(job, &fitted, &comments)?,
@@ -322,6 +398,7 @@ pub(crate) fn plan_operation(
     prepared: &PreparedPart,
     tolerances: &Tolerances,
     clearance: Option<f64>,
+    refine: &Refinement,
 ) -> Result<PlannedOperation, EngineError> {
     let samples = match (&job.part, &job.setup) {
         (Part::Surfaces(set), None) => {
@@ -338,8 +415,13 @@ pub(crate) fn plan_operation(
     }
     let mut planned = match job.strategy {
         Strategy::ParallelPlanes => {
-            let p = plan_finishing(&prepared.index, &job.cutter, &params, tolerances)?;
-            Plan { toolpath: p.toolpath, report: p.report, scallop: Some(p.scallop) }
+            let p = plan_finishing_refined(&prepared.index, &job.cutter, &params, tolerances, refine)?;
+            let layout = Layout {
+                direction: params.direction,
+                planes: p.planes.iter().map(|q| q.offset).collect(),
+                ..Layout::default()
+            };
+            Plan { toolpath: p.toolpath, report: p.report, scallop: Some(p.scallop), layout }
         }
         Strategy::NetworkPlanes => {
             let set = parametric_only(job, "the network planner (finishing.strategy = \"network\")")?;
@@ -354,8 +436,16 @@ pub(crate) fn plan_operation(
             if let Some(t) = threshold_deg {
                 split.threshold = t.to_radians();
             }
-            let p = plan_steep_shallow(&prepared.mesh, &prepared.index, &job.cutter, &params, tolerances, &split)?;
-            Plan { toolpath: p.toolpath, report: p.report, scallop: None }
+            let p =
+                plan_steep_shallow(&prepared.mesh, &prepared.index, &job.cutter, &params, tolerances, &split, refine)?;
+            let layout = Layout {
+                direction: params.direction,
+                planes: p.shallow.as_ref().map(|q| q.planes.iter().map(|q| q.offset).collect()).unwrap_or_default(),
+                levels: p.level_heights,
+                steep_min: split.threshold - split.overlap,
+                shallow_max: split.threshold + split.overlap,
+            };
+            Plan { toolpath: p.toolpath, report: p.report, scallop: None, layout }
         }
     };
     let (led, leads) =
@@ -455,16 +545,60 @@ pub(crate) fn network_scallop_from(
     options: &scallop_sim::VerifyOptions,
     report: &mut scallop_strategy::Report,
 ) -> Result<RestReport, EngineError> {
+    accept_scallop(scallop_split(sim, job, prepared, options), sim, job, report)
+}
+
+/// The scallop on the machined surface of a simulated program, told apart
+/// from the material the cutter cannot reach.
+pub(crate) struct ScallopSplit {
+    max: f64,
+    at: Option<scallop_geom::Point2>,
+    rest: RestReport,
+    /// The machined cells over the limit ([`scallop_sim::RestSplit::machined_over`]).
+    pub(crate) over: Vec<scallop_sim::OverCell>,
+    limit: f64,
+    bound: f64,
+}
+
+impl ScallopSplit {
+    /// Whether the scallop on the machined surface holds the limit.
+    pub(crate) fn holds(&self) -> bool {
+        self.max <= self.limit
+    }
+}
+
+/// Splits what the program left (see [`ScallopSplit`]); the split by reach
+/// runs only when the simulation's largest thickness exceeds the limit.
+pub(crate) fn scallop_split(
+    sim: &scallop_sim::Simulation,
+    job: &FinishJob,
+    prepared: &PreparedPart,
+    options: &scallop_sim::VerifyOptions,
+) -> ScallopSplit {
     let bound = sim.zmap.resolution_bound(job.cutter.shape());
     let limit = job.scallop_height + bound;
     let v = &sim.verification;
-    let (max, at, rest) = if v.max_thickness > limit {
+    if v.max_thickness > limit {
         let field = scallop_sim::PartField::new(&sim.zmap, &prepared.index);
         let split = scallop_sim::split_rest(&sim.zmap, &field, &prepared.index, &job.cutter, options, limit);
-        (split.machined_max, split.machined_at, RestReport::from_split(&split))
+        let rest = RestReport::from_split(&split);
+        ScallopSplit { max: split.machined_max, at: split.machined_at, rest, over: split.machined_over, limit, bound }
     } else {
-        (v.max_thickness, v.max_thickness_at, RestReport::default())
-    };
+        let (max, at) = (v.max_thickness, v.max_thickness_at);
+        ScallopSplit { max, at, rest: RestReport::default(), over: Vec::new(), limit, bound }
+    }
+}
+
+/// The rest report of a split that holds the limit, with the report's scallop
+/// figures filled; else [`EngineError::ScallopNotHeld`].
+pub(crate) fn accept_scallop(
+    split: ScallopSplit,
+    sim: &scallop_sim::Simulation,
+    job: &FinishJob,
+    report: &mut scallop_strategy::Report,
+) -> Result<RestReport, EngineError> {
+    let ScallopSplit { max, at, rest, limit, bound, .. } = split;
+    let v = &sim.verification;
     if max > limit {
         let at = at.unwrap_or_else(|| scallop_geom::Point2::new(f64::NAN, f64::NAN));
         return Err(EngineError::ScallopNotHeld { measured: max, x: at.x, y: at.y, limit: job.scallop_height, bound });
@@ -723,7 +857,7 @@ fn network_planes(
         cl_points_dropped: drops,
         ..scallop_strategy::Report::timed(&toolpath, params)
     };
-    Ok(Plan { toolpath, report, scallop: None })
+    Ok(Plan { toolpath, report, scallop: None, layout: Layout::default() })
 }
 
 /// A toolpath and its figures, whatever the strategy.
@@ -731,6 +865,9 @@ pub(crate) struct Plan {
     pub(crate) toolpath: Toolpath,
     pub(crate) report: scallop_strategy::Report,
     pub(crate) scallop: Option<scallop_strategy::ScallopReport>,
+    /// Where the planes and levels are, for a refinement (empty for the
+    /// strategies that are not refined).
+    pub(crate) layout: Layout,
 }
 
 /// Isoparametric passes patch after patch; the report's times and lengths are those
@@ -747,15 +884,8 @@ fn isoparametric(
     toolpath.plunge_feed = params.plunge_feed * 60.0;
     let (mut passes, mut max_h, mut mean_sum) = (0, 0.0f64, 0.0);
     for patch in set.patches() {
-        let p = plan_isoparametric(
-            patch,
-            &prepared.index,
-            &job.cutter,
-            params,
-            direction,
-            tolerances,
-            prepared.chordal_error,
-        )?;
+        let surface = IsoSurface { patch, index: &prepared.index, chordal_error: prepared.chordal_error };
+        let p = plan_isoparametric(&surface, &job.cutter, params, direction, tolerances)?;
         passes += p.passes.len();
         max_h = max_h.max(p.max_scallop_mm);
         mean_sum += p.mean_scallop_mm;
@@ -777,7 +907,7 @@ fn isoparametric(
         mean_scallop_mm: mean,
         ..scallop_strategy::Report::timed(&toolpath, params)
     };
-    Ok(Plan { toolpath, report, scallop: None })
+    Ok(Plan { toolpath, report, scallop: None, layout: Layout::default() })
 }
 
 /// The prepared part turned into the planning frame of a 3+2 setup.
@@ -810,17 +940,30 @@ fn indexed_program(job: &FinishJob, setup: &Setup, path: &Toolpath, time: f64) -
         what: format!("the indexed tool axis on machine `{}`: {e}", setup.machine.name()),
         fix: "choose a setup rotation the machine can reach, or another machine".into(),
     })?;
+    tilted_plane_text(job, &program, (&kin, setup.tool_length), &options, time)
+}
+
+/// A 3+2 machine program written in tilted work planes (joint space with the
+/// rotaries held where the dialect has no plane code), for the kinematics `kin`
+/// with its tool length, predicted to take `time` seconds.
+pub(crate) fn tilted_plane_text(
+    job: &FinishJob,
+    program: &MachineProgram,
+    (kin, tool_length): (&Kinematics, f64),
+    options: &ProgramOptions,
+    time: f64,
+) -> Result<String, EngineError> {
     let params = PostParams {
         program: job.output.program.clone(),
         mode: OutputMode::TiltedPlane,
         tool: job.output.tool.max(1),
-        tool_length: setup.tool_length,
+        tool_length,
         spindle: job.output.spindle,
         tol_pos: options.tol_pos,
         tol_ang: options.tol_ang,
         predicted_time: Some(time),
     };
-    program_text(&program, &kin, &job.output.dialect, &params).map_err(|e| EngineError::Output {
+    program_text(program, kin, &job.output.dialect, &params).map_err(|e| EngineError::Output {
         what: e.to_string(),
         fix: "use a 5-axis dialect (linuxcnc, fanuc, siemens840d, heidenhain)".into(),
     })

@@ -6,6 +6,7 @@
 //! operation.
 
 use scallop_geom::{Aabb3, Tolerances};
+use scallop_mesh::TriMesh;
 use scallop_post::{ProgramInfo, Section, write_sections};
 use scallop_sim::{PartField, StockView, ZMap, verify_in};
 use scallop_toolpath::{FittedPath, Toolpath};
@@ -105,6 +106,8 @@ pub struct StockFigures {
     pub removed_mm3: f64,
     /// Share of its feed moves that removed nothing (air), in [0, 1].
     pub air_cut_share: f64,
+    /// Share of its feed length that removed nothing (air), in [0, 1].
+    pub air_length_share: f64,
     /// The clearance above the part's top its rapids ran at (mm): the job's,
     /// raised to clear the stock by [`STOCK_CLEARANCE_MM`].
     pub clearance_mm: f64,
@@ -172,6 +175,21 @@ pub struct JobOutput {
     pub simulation: scallop_sim::Simulation,
 }
 
+/// The stock box of `job` around its (prepared) part `mesh`.
+pub(crate) fn job_stock(job: &Job, mesh: &TriMesh) -> Aabb3 {
+    let radius = job.operations.iter().map(|o| o.finish.cutter.radius()).fold(0.0, f64::max);
+    match job.stock {
+        None => stock_box(mesh, radius),
+        Some(StockShape::Box(b)) => b,
+        Some(StockShape::AroundPart { margin, top, bottom }) => {
+            let mut b = stock_box(mesh, margin.unwrap_or(radius));
+            b.max.z += top - 1.0;
+            b.min.z -= bottom - 1.0;
+            b
+        }
+    }
+}
+
 /// Runs the operations of `job` in order on one simulated stock and proves
 /// the result (see the module documentation).
 ///
@@ -181,32 +199,76 @@ pub struct JobOutput {
 /// [`crate::run_finishing`] (planning, safety problems found by the
 /// simulation of each operation on the stock the others left).
 pub fn run_job(job: &Job) -> Result<JobOutput, EngineError> {
+    run_job_with_progress(job, &|_| {})
+}
+
+/// Where [`run_job_with_progress`] is: operation `index` (0-based) of
+/// `count` enters `phase`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct JobStep {
+    /// The operation (0-based); `count` for the final proof and the program.
+    pub index: usize,
+    /// Number of operations.
+    pub count: usize,
+    /// What starts now.
+    pub phase: JobPhase,
+}
+
+/// The phases of a job that [`run_job_with_progress`] announces.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum JobPhase {
+    /// Planning an operation's toolpath.
+    Planning,
+    /// Cutting the operation from the simulated stock and checking it.
+    Cutting,
+    /// Proving the stock all operations left, and writing the program.
+    Proving,
+}
+
+/// [`run_job`], calling `progress` as each operation enters a phase (in
+/// order: planning then cutting per operation, then proving once). The
+/// caller may time the phases: the planning time of operation `k` is the
+/// time between its `Planning` and `Cutting` steps.
+///
+/// # Errors
+/// As [`run_job`].
+pub fn run_job_with_progress(job: &Job, progress: &dyn Fn(JobStep)) -> Result<JobOutput, EngineError> {
+    let count = job.operations.len();
     let first = &check_operations(job)?.finish;
     let tolerances = planning_tolerances(first)?;
     let prepared = prepare_part(&first.part, &tolerances)?;
-    let radius = job.operations.iter().map(|o| o.finish.cutter.radius()).fold(0.0, f64::max);
-    let stock = match job.stock {
-        None => stock_box(&prepared.mesh, radius),
-        Some(StockShape::Box(b)) => b,
-        Some(StockShape::AroundPart { margin, top, bottom }) => {
-            let mut b = stock_box(&prepared.mesh, margin.unwrap_or(radius));
-            b.max.z += top - 1.0;
-            b.min.z -= bottom - 1.0;
-            b
-        }
-    };
+    let stock = job_stock(job, &prepared.mesh);
     let mut zmap = ZMap::new(stock, first.sim_resolution)?;
     let field = PartField::new(&zmap, &prepared.index);
     let part_top = prepared.mesh.bounds().max.z;
     let mut planned: Vec<(Planned, StockFigures)> = Vec::with_capacity(job.operations.len());
-    for op in &job.operations {
+    for (index, op) in job.operations.iter().enumerate() {
+        progress(JobStep { index, count, phase: JobPhase::Planning });
         let f = &op.finish;
         let top_before = zmap.max_top().unwrap_or(stock.min.z);
         let clearance = f.clearance.max(top_before + STOCK_CLEARANCE_MM - part_top);
         let p = match &op.rough {
-            Some(r) => Planned::Rough(Box::new(plan_rough_operation(f, r, &prepared, &stock, clearance, &tolerances)?)),
-            None => Planned::Finish(Box::new(plan_operation(f, &prepared, &tolerances, Some(clearance))?)),
+            Some(r) => {
+                let material = crate::rough::material_of(&zmap)?;
+                Planned::Rough(Box::new(plan_rough_operation(
+                    f,
+                    r,
+                    &prepared,
+                    &stock,
+                    material.as_ref(),
+                    clearance,
+                    &tolerances,
+                )?))
+            }
+            None => Planned::Finish(Box::new(plan_operation(
+                f,
+                &prepared,
+                &tolerances,
+                Some(clearance),
+                &scallop_strategy::Refinement::default(),
+            )?)),
         };
+        progress(JobStep { index, count, phase: JobPhase::Cutting });
         let volume_before = zmap.volume();
         let cut = zmap.cut(&f.cutter, p.toolpath())?;
         if !cut.rapid_hits.is_empty() {
@@ -214,7 +276,7 @@ pub fn run_job(job: &Job) -> Result<JobOutput, EngineError> {
         }
         let collisions = zmap.part_collisions_in(&field, &f.cutter, p.toolpath(), cut.operation)?;
         if !collisions.is_empty() {
-            return Err(scallop_sim::SimError::PartCollision { count: collisions.len(), collisions }.into());
+            return Err(scallop_sim::SimError::PartCollision { collisions }.into());
         }
         cut.check()?;
         let figures = StockFigures {
@@ -222,6 +284,7 @@ pub fn run_job(job: &Job) -> Result<JobOutput, EngineError> {
             volume_before_mm3: volume_before,
             removed_mm3: cut.removed_volume,
             air_cut_share: cut.air_cut_share(),
+            air_length_share: cut.air_length_share(),
             clearance_mm: clearance,
         };
         planned.push((p, figures));
@@ -229,6 +292,7 @@ pub fn run_job(job: &Job) -> Result<JobOutput, EngineError> {
     let Some(last) = job.operations.last().map(|o| &o.finish) else {
         return Err(no_operation());
     };
+    progress(JobStep { index: count, count, phase: JobPhase::Proving });
     let (gouge_tolerance, options) = verify_options(last, &prepared);
     let verification = verify_in(&zmap, &field, &options)?;
     let simulation = scallop_sim::Simulation { zmap, cut: empty_cut(), verification };
@@ -319,6 +383,8 @@ fn empty_cut() -> scallop_sim::CutReport {
         removed_volume: 0.0,
         feed_moves: 0,
         air_feed_moves: 0,
+        feed_length_mm: 0.0,
+        air_feed_length_mm: 0.0,
         rapid_hits: Vec::new(),
         collisions: Vec::new(),
     }

@@ -24,7 +24,9 @@ mod estimate;
 mod finish;
 mod grid;
 mod job;
+mod refine;
 mod rough;
+mod rough_estimate;
 mod zones;
 
 use scallop_geom::Tolerances;
@@ -33,14 +35,15 @@ use scallop_surface::SurfaceSet;
 
 pub use budget::{ARC_SHARE, Budget};
 pub use demo::{DemoOutput, DemoSettings, DemoSummary, run_demo};
-pub use estimate::{Estimate, estimate_operation};
+pub use estimate::{Estimate, estimate_job, estimate_operation};
 pub use finish::{
-    FinishDetails, FinishJob, FinishOutput, FinishReport, OutputOptions, RestPlaceReport, RestReport, Setup, Strategy,
-    auto_direction_deg, run_finishing, stock_box,
+    FinishDetails, FinishJob, FinishOutput, FinishReport, FinishStep, OutputOptions, RestPlaceReport, RestReport,
+    Setup, Strategy, auto_direction_deg, run_finishing, run_finishing_with_progress, stock_box,
 };
 pub use grid::{GridAxis, GridError, MAX_GRID_POINTS};
 pub use job::{
-    Job, JobOutput, JobReport, Operation, OperationReport, STOCK_CLEARANCE_MM, StockFigures, StockShape, run_job,
+    Job, JobOutput, JobPhase, JobReport, JobStep, Operation, OperationReport, STOCK_CLEARANCE_MM, StockFigures,
+    StockShape, run_job, run_job_with_progress,
 };
 pub use zones::{
     ProgramCandidate, ZONE_MARGIN_PER_RADIUS, ZONE_MARGIN_PER_SPACING, ZONE_MARGIN_ROUNDS, ZoneFigures,

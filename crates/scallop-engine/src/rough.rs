@@ -3,7 +3,7 @@
 //! the job's one stock like every other operation.
 
 use scallop_geom::{Aabb3, Tolerances};
-use scallop_rough::{Motion, RoughSettings, plan_rough};
+use scallop_rough::{MaterialMap, Motion, RoughSettings, plan_rough_from};
 use scallop_strategy::Report;
 use scallop_toolpath::FittedPath;
 
@@ -23,7 +23,8 @@ pub(crate) struct PlannedRough {
 }
 
 /// Plans the roughing of the prepared part from `stock` with the cutter,
-/// feeds and clearance of `job` (`clearance` above the part's top).
+/// feeds and clearance of `job` (`clearance` above the part's top), limited
+/// to the material the earlier operations left when `material` is given.
 ///
 /// # Errors
 /// [`EngineError::Rough`].
@@ -32,6 +33,7 @@ pub(crate) fn plan_rough_operation(
     settings: &RoughSettings,
     prepared: &PreparedPart,
     stock: &Aabb3,
+    material: Option<&MaterialMap>,
     clearance: f64,
     tolerances: &Tolerances,
 ) -> Result<PlannedRough, EngineError> {
@@ -39,7 +41,7 @@ pub(crate) fn plan_rough_operation(
     params.clearance = clearance;
     let part_top = prepared.mesh.bounds().max.z;
     let motion = Motion { clearance_z: part_top + clearance, feed: job.machine[0] * 1000.0 };
-    let plan = plan_rough(&prepared.index, &job.cutter, stock, settings, &motion, tolerances.path)?;
+    let plan = plan_rough_from(&prepared.index, &job.cutter, stock, material, settings, &motion, tolerances.path)?;
     let mut toolpath = plan.toolpath;
     toolpath.plunge_feed = params.plunge_feed * 60.0;
     let mut report = Report::timed(&toolpath, &params);
@@ -70,4 +72,22 @@ pub(crate) fn fit_and_comment(job: &FinishJob, op: &PlannedRough) -> (FittedPath
         ),
     ];
     (FittedPath::with_xy_arcs(&op.toolpath), comments)
+}
+
+/// The in-process stock of `zmap` as the roughing planner reads it, `None`
+/// while the stock is whole (the first cut plans from the box).
+///
+/// # Errors
+/// [`EngineError::Rough`] when the grid is refused (never for a z-map the
+/// simulator built).
+pub(crate) fn material_of(zmap: &scallop_sim::ZMap) -> Result<Option<MaterialMap>, EngineError> {
+    let b = zmap.stock();
+    let full = b.max.z - zmap.eps();
+    if zmap.heights().iter().all(|&h| h >= full) {
+        return Ok(None);
+    }
+    let empty = b.min.z + zmap.eps();
+    let tops = zmap.heights().iter().map(|&h| if h > empty { h } else { f64::NEG_INFINITY }).collect();
+    let (cx, cy) = zmap.cell_size();
+    Ok(Some(MaterialMap::new([b.min.x, b.min.y], [cx, cy], zmap.nx(), zmap.ny(), tops)?))
 }

@@ -43,7 +43,6 @@ use scallop_machine::Kinematics;
 use scallop_machine::program::{ProgramOptions, records_from_toolpath, to_program};
 use scallop_mesh::{MeshIndex, TriMesh};
 use scallop_network::{CellLabels, Orientation, Transitions};
-use scallop_post::{OutputMode, PostParams, program_text};
 use scallop_strategy::{FinishingParams, StrategyError, ZoneRegion, plan_zone_finishing};
 use scallop_surface::{Direction, Patch};
 use scallop_toolpath::{FittedPath, MoveKind, Toolpath, fit_arcs};
@@ -347,24 +346,7 @@ pub fn finish_zones(job: &FinishJob, spec: &ZonePlanSpec) -> Result<ZoneFinishOu
 
 /// [`finish_zones`] with the start margin `share` times the cutter radius.
 fn finish_zones_with(job: &FinishJob, spec: &ZonePlanSpec, share: f64) -> Result<ZoneFinishOutput, EngineError> {
-    let Part::Surfaces(set) = &job.part else {
-        return Err(EngineError::Output {
-            what: "zone finishing of a mesh part".into(),
-            fix: "give one parametric patch (builtin or a surface file)".into(),
-        });
-    };
-    let [patch] = set.patches() else {
-        return Err(EngineError::Output {
-            what: format!("zone finishing of {} patches", set.patches().len()),
-            fix: "give one parametric patch".into(),
-        });
-    };
-    if job.setup.is_some() || job.strategy != Strategy::ParallelPlanes {
-        return Err(EngineError::Output {
-            what: "zone finishing with a [setup] or isoparametric passes".into(),
-            fix: "remove [setup] and use finishing.strategy = \"parallel\"".into(),
-        });
-    }
+    let patch = zone_patch(job)?;
     let tolerances = crate::Budget::new(job.tolerances, job.output.arc_fitting)?.planning();
     let (prepared, uv) = labelled_mesh(patch, &tolerances)?;
     let labels: Vec<u32> = uv.iter().map(|&[u, v]| spec.labels.label_at(u, v)).collect();
@@ -380,13 +362,6 @@ fn finish_zones_with(job: &FinishJob, spec: &ZonePlanSpec, share: f64) -> Result
         scallop_sim::VerifyOptions { gouge_tolerance, scallop_margin: radius, ..scallop_sim::VerifyOptions::default() };
     let open_edge = open_edge_vertices(&prepared.mesh);
 
-    let mut toolpath = Toolpath::new(machine.feed * 60.0);
-    toolpath.plunge_feed = base.plunge_feed * 60.0;
-    let mut zone_of_move = Vec::new();
-    let mut records = Vec::new();
-    let mut zone_sims: Vec<(f64, f64, f64)> = Vec::new(); // (scallop, min deviation, bound) per tilted zone
-    let mut figures = Vec::with_capacity(spec.zones.len());
-    let mut ends: Vec<(Point3, Point3)> = Vec::new();
     let ctx = ZoneContext {
         job,
         spec,
@@ -400,26 +375,7 @@ fn finish_zones_with(job: &FinishJob, spec: &ZonePlanSpec, share: f64) -> Result
         open_edge: &open_edge,
         tilted,
     };
-    for zone in &spec.zones {
-        let planned = plan_zone_of(&ctx, zone)?;
-        if let Some((zone_path, axis, sim)) = planned.path {
-            zone_sims.extend(sim);
-            records.extend(records_from_toolpath(&zone_path, &axis));
-            let first = zone_path.moves().iter().find(|m| m.kind == MoveKind::Plunge).map(|m| m.to);
-            let last = zone_path.moves().iter().rev().find(|m| m.kind != MoveKind::Retract).map(|m| m.to);
-            if let (Some(a), Some(b)) = (first, last) {
-                ends.push((a, b));
-            }
-            for m in zone_path.moves() {
-                toolpath.push_with_axis(*m, axis);
-                zone_of_move.push(zone.label);
-            }
-        }
-        figures.push(planned.figure);
-    }
-    if toolpath.moves().is_empty() {
-        return Err(StrategyError::EmptyRegion { direction_deg: 0.0 }.into());
-    }
+    let JoinedZones { toolpath, zone_of_move, records, zone_sims, figures, ends } = join_zones(&ctx)?;
 
     // Times and lengths of the joined program.
     let transitions = ends.len().saturating_sub(1);
@@ -435,20 +391,8 @@ fn finish_zones_with(job: &FinishJob, spec: &ZonePlanSpec, share: f64) -> Result
 
     // The proof: the whole 3-axis program on a stock box (as `run_finishing`); 3+2
     // zones were proven one by one above, each in its own frame.
-    let (sim, bound, max_scallop, max_at, edge, min_deviation) = if tilted {
-        let bound = zone_sims.iter().map(|z| z.2).fold(0.0, f64::max);
-        let height = zone_sims.iter().map(|z| z.0).fold(0.0, f64::max);
-        let deepest = zone_sims.iter().map(|z| z.1).fold(f64::INFINITY, f64::min);
-        (None, bound, height, None, 0.0, deepest)
-    } else {
-        let stock = crate::stock_box(&prepared.mesh, radius);
-        let sim = scallop_sim::simulate(stock, job.sim_resolution, &job.cutter, &toolpath, &prepared.index, &options)?;
-        let bound = sim.zmap.resolution_bound(job.cutter.shape());
-        let v = &sim.verification;
-        let (height, at, edge, deepest) =
-            (v.max_thickness, v.max_thickness_at.map(|p| [p.x, p.y]), v.margin_max_thickness, v.min_deviation);
-        (Some(sim), bound, height, at, edge, deepest)
-    };
+    let (sim, bound, max_scallop, max_at, edge, min_deviation) =
+        if tilted { proof_of_zones(&zone_sims) } else { prove_three_axis(job, &prepared, &toolpath, &options)? };
     let limit = job.scallop_height + bound;
     if max_scallop > limit {
         let at = max_at.unwrap_or([f64::NAN; 2]);
@@ -501,6 +445,109 @@ fn finish_zones_with(job: &FinishJob, spec: &ZonePlanSpec, share: f64) -> Result
         sim_gouge_tolerance_mm: gouge_tolerance,
     };
     Ok(ZoneFinishOutput { toolpath, zone_of_move, gcode: text, report, prepared, simulation: sim })
+}
+
+/// The one parametric patch a zone finish runs on, or why the job cannot be
+/// zone-finished (a mesh part, several patches, a [setup] or isoparametric
+/// passes).
+fn zone_patch(job: &FinishJob) -> Result<&Patch, EngineError> {
+    let Part::Surfaces(set) = &job.part else {
+        return Err(EngineError::Output {
+            what: "zone finishing of a mesh part".into(),
+            fix: "give one parametric patch (builtin or a surface file)".into(),
+        });
+    };
+    let [patch] = set.patches() else {
+        return Err(EngineError::Output {
+            what: format!("zone finishing of {} patches", set.patches().len()),
+            fix: "give one parametric patch".into(),
+        });
+    };
+    if job.setup.is_some() || job.strategy != Strategy::ParallelPlanes {
+        return Err(EngineError::Output {
+            what: "zone finishing with a [setup] or isoparametric passes".into(),
+            fix: "remove [setup] and use finishing.strategy = \"parallel\"".into(),
+        });
+    }
+    Ok(patch)
+}
+
+/// The zones' paths joined in the order of the spec.
+struct JoinedZones {
+    toolpath: Toolpath,
+    /// The zone label of every move of `toolpath`.
+    zone_of_move: Vec<u32>,
+    /// The joined program's records (with each zone's tool axis).
+    records: Vec<scallop_machine::program::ClRecord>,
+    /// (scallop, min deviation, bound) of every tilted zone's own proof.
+    zone_sims: Vec<(f64, f64, f64)>,
+    figures: Vec<ZoneFigures>,
+    /// First plunge and last cutting point of every zone with passes.
+    ends: Vec<(Point3, Point3)>,
+}
+
+/// Plans every zone of `ctx` and joins their paths, in the spec's order.
+fn join_zones(ctx: &ZoneContext<'_>) -> Result<JoinedZones, EngineError> {
+    let (spec, base) = (ctx.spec, &ctx.base);
+    let mut toolpath = Toolpath::new(base.machine.feed * 60.0);
+    toolpath.plunge_feed = base.plunge_feed * 60.0;
+    let mut zone_of_move = Vec::new();
+    let mut records = Vec::new();
+    let mut zone_sims: Vec<(f64, f64, f64)> = Vec::new();
+    let mut figures = Vec::with_capacity(spec.zones.len());
+    let mut ends: Vec<(Point3, Point3)> = Vec::new();
+    for zone in &spec.zones {
+        let planned = plan_zone_of(ctx, zone)?;
+        if let Some((zone_path, axis, sim)) = planned.path {
+            zone_sims.extend(sim);
+            records.extend(records_from_toolpath(&zone_path, &axis));
+            let first = zone_path.moves().iter().find(|m| m.kind == MoveKind::Plunge).map(|m| m.to);
+            let last = zone_path.moves().iter().rev().find(|m| m.kind != MoveKind::Retract).map(|m| m.to);
+            if let (Some(a), Some(b)) = (first, last) {
+                ends.push((a, b));
+            }
+            for m in zone_path.moves() {
+                toolpath.push_with_axis(*m, axis);
+                zone_of_move.push(zone.label);
+            }
+        }
+        figures.push(planned.figure);
+    }
+    if toolpath.moves().is_empty() {
+        return Err(StrategyError::EmptyRegion { direction_deg: 0.0 }.into());
+    }
+    Ok(JoinedZones { toolpath, zone_of_move, records, zone_sims, figures, ends })
+}
+
+/// What the proof of a zone finish found: the simulation (3-axis only), the
+/// resolution bound, the largest scallop and where, the largest at the open
+/// edges, the smallest deviation.
+type ZoneProof = (Option<scallop_sim::Simulation>, f64, f64, Option<[f64; 2]>, f64, f64);
+
+/// The proof of 3+2 zones from each zone's own proof: the largest bound and
+/// scallop, the smallest deviation.
+fn proof_of_zones(zone_sims: &[(f64, f64, f64)]) -> ZoneProof {
+    let bound = zone_sims.iter().map(|z| z.2).fold(0.0, f64::max);
+    let height = zone_sims.iter().map(|z| z.0).fold(0.0, f64::max);
+    let deepest = zone_sims.iter().map(|z| z.1).fold(f64::INFINITY, f64::min);
+    (None, bound, height, None, 0.0, deepest)
+}
+
+/// The proof of a 3-axis zone program: the whole program on a stock box (as
+/// `run_finishing`).
+fn prove_three_axis(
+    job: &FinishJob,
+    prepared: &PreparedPart,
+    toolpath: &Toolpath,
+    options: &scallop_sim::VerifyOptions,
+) -> Result<ZoneProof, EngineError> {
+    let stock = crate::stock_box(&prepared.mesh, job.cutter.radius());
+    let sim = scallop_sim::simulate(stock, job.sim_resolution, &job.cutter, toolpath, &prepared.index, options)?;
+    let bound = sim.zmap.resolution_bound(job.cutter.shape());
+    let v = &sim.verification;
+    let (height, at, edge, deepest) =
+        (v.max_thickness, v.max_thickness_at.map(|p| [p.x, p.y]), v.margin_max_thickness, v.min_deviation);
+    Ok((Some(sim), bound, height, at, edge, deepest))
 }
 
 /// What every zone of one [`finish_zones_with`] run shares.
@@ -788,20 +835,7 @@ fn indexed_zones(
         what: format!("the zones' tool axes on machine `{}`: {e}", machine.name()),
         fix: "choose a machine whose rotaries reach every zone's orientation".into(),
     })?;
-    let params = PostParams {
-        program: job.output.program.clone(),
-        mode: OutputMode::TiltedPlane,
-        tool: job.output.tool.max(1),
-        tool_length: 0.0,
-        spindle: job.output.spindle,
-        tol_pos: options.tol_pos,
-        tol_ang: options.tol_ang,
-        predicted_time: Some(time),
-    };
-    program_text(&program, &kin, &job.output.dialect, &params).map_err(|e| EngineError::Output {
-        what: e.to_string(),
-        fix: "use a 5-axis dialect (linuxcnc, fanuc, siemens840d, heidenhain)".into(),
-    })
+    crate::finish::tilted_plane_text(job, &program, (&kin, 0.0), &options, time)
 }
 
 /// The part's patch tessellated on the grid `Patch::tessellate` picks within

@@ -10,19 +10,12 @@ use scallop_geom::{Aabb3, Point3};
 use scallop_mesh::TriMesh;
 use scallop_rough::{Direction, Pattern, RoughSettings};
 
-/// A block `[-6, 6] x [-5, 5] x [0, 6]` with a step on half of it up to 8,
-/// on a plate at z = 0 that spans the stock (closed boxes).
-fn part() -> TriMesh {
-    // Boxes as (min, max) corners: the plate and the two blocks; each box's
-    // 12 triangles from its 8 corners (corner bit i: x, y, z high).
-    let boxes = [
-        ([-15.0, -15.0, -0.5], [15.0, 15.0, 0.0]),
-        ([-6.0, -5.0, 0.0], [6.0, 5.0, 6.0]),
-        ([-6.0, -5.0, 6.0], [6.0, 0.0, 8.0]),
-    ];
+/// Closed boxes given by their (min, max) corners, as one mesh: each box's
+/// 12 triangles from its 8 corners (corner bit i: x, y, z high).
+fn boxes_mesh(boxes: &[([f64; 3], [f64; 3])]) -> TriMesh {
     const FACES: [[usize; 4]; 6] = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
     let mut soup = Vec::new();
-    for (lo, hi) in boxes {
+    for &(lo, hi) in boxes {
         let corner = |i: usize| {
             let pick = |k: usize| if i >> k & 1 == 1 { hi[k] } else { lo[k] };
             Point3::new(pick(0), pick(1), pick(2))
@@ -33,6 +26,16 @@ fn part() -> TriMesh {
         }
     }
     TriMesh::from_soup(&soup).unwrap().0
+}
+
+/// A block `[-6, 6] x [-5, 5] x [0, 6]` with a step on half of it up to 8,
+/// on a plate at z = 0 that spans the stock.
+fn part() -> TriMesh {
+    boxes_mesh(&[
+        ([-15.0, -15.0, -0.5], [15.0, 15.0, 0.0]),
+        ([-6.0, -5.0, 0.0], [6.0, 5.0, 6.0]),
+        ([-6.0, -5.0, 6.0], [6.0, 0.0, 8.0]),
+    ])
 }
 
 fn rough_job(allowance: f64) -> Job {
@@ -106,4 +109,59 @@ fn finishing_after_roughing() {
     let r = &out.report;
     assert!(r.sim_max_scallop_mm <= 0.05 + r.sim_resolution_bound_mm, "{r:?}");
     assert!(out.gcode.contains("T2 M6"));
+}
+
+/// An L of two walls 8 mm high on a plate: the inside corner at
+/// `(-6, -6)` keeps a fillet of the roughing tool's radius.
+fn l_part() -> TriMesh {
+    boxes_mesh(&[
+        ([-15.0, -15.0, -0.5], [15.0, 15.0, 0.0]),
+        ([-10.0, -10.0, 0.0], [10.0, -6.0, 8.0]),
+        ([-10.0, -6.0, 0.0], [-6.0, 10.0, 8.0]),
+    ])
+}
+
+/// An operation roughing the L part with a flat end mill of `radius`.
+fn l_operation(name: &str, radius: f64) -> Operation {
+    let mut finish = FinishJob::choi_demo();
+    finish.part = Part::Mesh(l_part());
+    finish.part_name = "L walls".into();
+    finish.cutter = Cutter::new(CutterShape::Flat { radius }, 30.0).unwrap();
+    finish.sim_resolution = 0.2;
+    let settings = RoughSettings {
+        stepdown: 2.0,
+        stepover: 0.3,
+        radial_allowance: 0.2,
+        axial_allowance: 0.2,
+        pattern: Pattern::Offset,
+        direction: Direction::Climb,
+    };
+    Operation { name: name.into(), finish, rough: Some(settings) }
+}
+
+fn l_job(operations: Vec<Operation>) -> Job {
+    let stock = Aabb3 { min: Point3::new(-12.0, -12.0, -1.0), max: Point3::new(12.0, 12.0, 9.0) };
+    Job { stock: Some(StockShape::Box(stock)), operations }
+}
+
+/// Rest roughing: a 4 mm tool after a 12 mm one machines only what the large
+/// one left (the inside corner's fillet), in a fraction of the feed length
+/// the 4 mm tool needs from the box, and leaves no more material than that
+/// 4 mm roughing alone (within the simulation's cells along the walls).
+#[test]
+fn rest_roughing_machines_only_what_the_larger_tool_left() {
+    let both = run_job(&l_job(vec![l_operation("rough", 6.0), l_operation("rest", 2.0)])).unwrap();
+    let alone = run_job(&l_job(vec![l_operation("rough small", 2.0)])).unwrap();
+    let [big, rest] = [&both.report.operations[0], &both.report.operations[1]];
+    let small = &alone.report.operations[0];
+    // The corner fillet of radius 6 less the one of radius 2, 8 mm high: about 55 mm^3.
+    assert!(rest.stock.removed_mm3 > 20.0, "{:?}", rest.stock);
+    assert!(rest.stock.removed_mm3 < 0.1 * big.stock.removed_mm3, "{:?} {:?}", big.stock, rest.stock);
+    assert!(rest.plan.feed_length_mm < 0.5 * small.plan.feed_length_mm, "{:?} {:?}", rest.plan, small.plan);
+    let left_both = both.simulation.zmap.volume();
+    let left_alone = alone.simulation.zmap.volume();
+    assert!(
+        left_both <= left_alone + 5.0,
+        "left {left_both} mm^3 after rest, {left_alone} mm^3 by the small tool alone"
+    );
 }

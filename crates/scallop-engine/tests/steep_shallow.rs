@@ -107,3 +107,36 @@ fn inclined_wall_is_finished_with_a_bull_nose() {
     let cutter = Cutter::new(CutterShape::Bull { radius: 3.0, corner: 1.0 }, 30.0).unwrap();
     finish_and_check(&job(mesh, cutter, 0.02));
 }
+
+/// A terrace: a wall of `wall_deg` falling `width` mm (in XY) from a plateau
+/// onto a face of `face_deg`, then a floor. With both slopes above the planes'
+/// band (55 degrees for a ball) the waterline levels alone finish the concave
+/// crease between the wall and the face, which runs along the levels; the cusp
+/// of the two levels either side of it stands higher above the cutter's reach
+/// (the profile circle sitting in the crease) than the spacing rule's scallop,
+/// about linearly in the level spacing. The simulation measures it against the
+/// reach.
+fn terrace(wall_deg: f64, width: f64, face_deg: f64) -> TriMesh {
+    let (kw, kf) = (wall_deg.to_radians().tan(), face_deg.to_radians().tan());
+    let (top, crest) = (6.0, 8.0);
+    height_field(20.0, 0.25, move |_, y| {
+        if y <= crest {
+            top
+        } else if y <= crest + width {
+            top - kw * (y - crest)
+        } else {
+            (top - kw * width - kf * (y - crest - width)).max(0.0)
+        }
+    })
+}
+
+#[test]
+fn concave_crease_between_steep_walls_holds_the_scallop() {
+    finish_and_check(&job(terrace(85.0, 0.25, 58.0), ball(1.5), 0.05));
+}
+
+#[test]
+fn concave_crease_between_steep_walls_holds_the_scallop_with_a_bull_nose() {
+    let cutter = Cutter::new(CutterShape::Bull { radius: 3.0, corner: 1.0 }, 30.0).unwrap();
+    finish_and_check(&job(terrace(85.0, 0.25, 62.0), cutter, 0.05));
+}

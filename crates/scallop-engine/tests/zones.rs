@@ -50,6 +50,64 @@ fn labels() -> CellLabels {
     CellLabels { cells_u: n, cells_v: n, labels }
 }
 
+/// A zone of the hill planned in the part's frame (no tilt), feeding along
+/// `direction_deg`.
+fn zone(label: u32, direction_deg: f64, predicted_time_s: Option<f64>) -> ZoneSpec {
+    ZoneSpec { label, direction_deg, tilt_deg: 0.0, azimuth_deg: 0.0, predicted_time_s }
+}
+
+/// The spec of `zones` over [`labels`], default transitions and no fixed margin.
+fn spec(
+    zones: Vec<ZoneSpec>,
+    predicted_time_s: Option<f64>,
+    machine: Option<scallop_machine::Machine>,
+) -> ZonePlanSpec {
+    ZonePlanSpec {
+        labels: labels(),
+        zones,
+        transitions: Transitions::default(),
+        predicted_time_s,
+        fixed_margin_mm: None,
+        machine,
+    }
+}
+
+/// Zigzag finishing parameters along `direction` (radians) for scallop height `sh`.
+fn zigzag(direction: f64, sh: f64) -> FinishingParams {
+    FinishingParams {
+        direction,
+        pattern: Pattern::Zigzag,
+        scallop_height: sh,
+        boundary: scallop_strategy::Boundary::ContactInside,
+        max_step: 0.5,
+        clearance: 5.0,
+        machine: scallop_analysis::MachineLimits::default(),
+        plunge_feed: 20.0,
+        rapid_rate: 500.0,
+        sharp_corner: 30f64.to_radians(),
+        blend_tolerance: 0.01,
+    }
+}
+
+/// The contact point of every pass point of `planned`, found by dropping the
+/// cutter again onto `index` from `floor`.
+fn pass_contacts(planned: &scallop_strategy::Planned, index: &MeshIndex, floor: f64) -> Vec<Point3> {
+    let mut contacts = Vec::new();
+    for plane in &planned.planes {
+        for pass in &plane.passes {
+            for p in pass {
+                let cl = drop_cutter(&cutter(), index, Point2::new(p.x, p.y), floor);
+                if let Contact::Facet { point, .. } | Contact::Edge { point, .. } | Contact::Vertex { point, .. } =
+                    cl.contact
+                {
+                    contacts.push(point);
+                }
+            }
+        }
+    }
+    contacts
+}
+
 fn job(sh: f64) -> FinishJob {
     FinishJob {
         part: Part::Surfaces(SurfaceSet::new(vec![hill()]).unwrap()),
@@ -64,17 +122,7 @@ fn job(sh: f64) -> FinishJob {
 #[test]
 fn two_zones_cover_the_hill_within_the_scallop_and_stay_in_their_regions() {
     let sh = 0.02;
-    let spec = ZonePlanSpec {
-        labels: labels(),
-        zones: vec![
-            ZoneSpec { label: 0, direction_deg: 0.0, tilt_deg: 0.0, azimuth_deg: 0.0, predicted_time_s: None },
-            ZoneSpec { label: 1, direction_deg: 70.0, tilt_deg: 0.0, azimuth_deg: 0.0, predicted_time_s: None },
-        ],
-        transitions: Transitions::default(),
-        predicted_time_s: None,
-        fixed_margin_mm: None,
-        machine: None,
-    };
+    let spec = spec(vec![zone(0, 0.0, None), zone(1, 70.0, None)], None, None);
     // finish_zones fails on a gouge, a rapid into stock or a simulated scallop over the limit.
     let out = finish_zones(&job(sh), &spec).unwrap();
     let r = &out.report;
@@ -139,17 +187,7 @@ fn two_zones_cover_the_hill_within_the_scallop_and_stay_in_their_regions() {
 #[test]
 fn candidates_are_the_programs_they_name_in_order() {
     let sh = 0.02;
-    let spec = ZonePlanSpec {
-        labels: labels(),
-        zones: vec![
-            ZoneSpec { label: 0, direction_deg: 0.0, tilt_deg: 0.0, azimuth_deg: 0.0, predicted_time_s: Some(10.0) },
-            ZoneSpec { label: 1, direction_deg: 70.0, tilt_deg: 0.0, azimuth_deg: 0.0, predicted_time_s: Some(10.0) },
-        ],
-        transitions: Transitions::default(),
-        predicted_time_s: Some(20.0),
-        fixed_margin_mm: None,
-        machine: None,
-    };
+    let spec = spec(vec![zone(0, 0.0, Some(10.0)), zone(1, 70.0, Some(10.0))], Some(20.0), None);
     let candidates = [
         ProgramCandidate::SingleZone { direction_deg: 70.0, predicted_time_s: Some(20.0) },
         ProgramCandidate::Zones(spec.clone()),
@@ -197,33 +235,12 @@ fn one_zone_alone_leaves_the_other_uncut() {
         })
         .collect();
     let region = ZoneRegion::new(&mesh, &labels, 0, 2.0).unwrap();
-    let params = FinishingParams {
-        direction: 0.3,
-        pattern: Pattern::Zigzag,
-        scallop_height: sh,
-        boundary: scallop_strategy::Boundary::ContactInside,
-        max_step: 0.5,
-        clearance: 5.0,
-        machine: scallop_analysis::MachineLimits::default(),
-        plunge_feed: 20.0,
-        rapid_rate: 500.0,
-        sharp_corner: 30f64.to_radians(),
-        blend_tolerance: 0.01,
-    };
+    let params = zigzag(0.3, sh);
     let planned = plan_zone_finishing(&index, &cutter(), &params, &tolerances, &region).unwrap();
     assert!(planned.scallop.max_mm <= sh * (1.0 + 1e-6));
     // Every pass point's contact lies at x < 20 + margin + a triangle.
-    for plane in &planned.planes {
-        for pass in &plane.passes {
-            for p in pass {
-                let cl = drop_cutter(&cutter(), &index, Point2::new(p.x, p.y), mesh.bounds().min.z - 100.0);
-                if let Contact::Facet { point, .. } | Contact::Edge { point, .. } | Contact::Vertex { point, .. } =
-                    cl.contact
-                {
-                    assert!(point.x <= 20.0 + 2.0 + 1.5, "{point:?}");
-                }
-            }
-        }
+    for point in pass_contacts(&planned, &index, mesh.bounds().min.z - 100.0) {
+        assert!(point.x <= 20.0 + 2.0 + 1.5, "{point:?}");
     }
     let b = mesh.bounds();
     let stock = Aabb3 {
@@ -254,17 +271,9 @@ fn triangle_labels(mesh: &TriMesh, labels: &CellLabels) -> Vec<u32> {
 #[test]
 fn a_tilted_zone_is_an_indexed_setup_proven_in_its_own_frame() {
     let sh = 0.02;
-    let spec = ZonePlanSpec {
-        labels: labels(),
-        zones: vec![
-            ZoneSpec { label: 0, direction_deg: 0.0, tilt_deg: 0.0, azimuth_deg: 0.0, predicted_time_s: None },
-            ZoneSpec { label: 1, direction_deg: 30.0, tilt_deg: 20.0, azimuth_deg: 150.0, predicted_time_s: None },
-        ],
-        transitions: Transitions::default(),
-        predicted_time_s: None,
-        fixed_margin_mm: None,
-        machine: Some(scallop_machine::Machine::builtin("linuxcnc-xyzac-trt").unwrap()),
-    };
+    let tilted = ZoneSpec { tilt_deg: 20.0, azimuth_deg: 150.0, ..zone(1, 30.0, None) };
+    let machine = scallop_machine::Machine::builtin("linuxcnc-xyzac-trt").unwrap();
+    let spec = spec(vec![zone(0, 0.0, None), tilted], None, Some(machine));
     let job =
         FinishJob { cutter: Cutter::new(CutterShape::Bull { radius: 3.0, corner: 1.0 }, 60.0).unwrap(), ..job(sh) };
     // finish_zones fails on a gouge or collision in either frame, or a zone that
@@ -330,37 +339,15 @@ fn a_non_convex_zone_splits_its_planes_into_several_passes() {
         .collect();
     let margin = 1.0;
     let region = ZoneRegion::new(&mesh, &labels, 0, margin).unwrap();
-    let params = FinishingParams {
-        direction: 0.0,
-        pattern: Pattern::Zigzag,
-        scallop_height: sh,
-        boundary: scallop_strategy::Boundary::ContactInside,
-        max_step: 0.5,
-        clearance: 5.0,
-        machine: scallop_analysis::MachineLimits::default(),
-        plunge_feed: 20.0,
-        rapid_rate: 500.0,
-        sharp_corner: 30f64.to_radians(),
-        blend_tolerance: 0.01,
-    };
+    let params = zigzag(0.0, sh);
     let planned = plan_zone_finishing(&index, &cutter(), &params, &tolerances, &region).unwrap();
     let split = planned.planes.iter().filter(|p| p.passes.len() >= 2).count();
     assert!(split > 10, "{split} planes cross both arms");
     // The gap between the arms (x in [12 + margin + a triangle, 28 - margin - a triangle],
     // y > 8 + margin + a triangle) has no contact of the zone's passes.
     let floor = mesh.bounds().min.z - 100.0;
-    for plane in &planned.planes {
-        for pass in &plane.passes {
-            for p in pass {
-                let cl = drop_cutter(&cutter(), &index, Point2::new(p.x, p.y), floor);
-                if let Contact::Facet { point, .. } | Contact::Edge { point, .. } | Contact::Vertex { point, .. } =
-                    cl.contact
-                {
-                    let deep =
-                        point.x > 12.0 + margin + 1.0 && point.x < 28.0 - margin - 1.0 && point.y > 8.0 + margin + 1.0;
-                    assert!(!deep, "{point:?}");
-                }
-            }
-        }
+    for point in pass_contacts(&planned, &index, floor) {
+        let deep = point.x > 12.0 + margin + 1.0 && point.x < 28.0 - margin - 1.0 && point.y > 8.0 + margin + 1.0;
+        assert!(!deep, "{point:?}");
     }
 }

@@ -18,6 +18,7 @@ use std::io::{Cursor, Write};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::time::{Duration, Instant};
 
+use scallop_geom::rng::SplitMix64;
 use scallop_io::{MeshFormat, Units};
 
 /// One parser or entry point.
@@ -39,7 +40,7 @@ pub enum Target {
     Job,
     /// The surface TOML: `parse_surfaces`.
     Surface,
-    /// The machine description: `Machine::from_toml_str`.
+    /// The machine description: `Described::from_toml_str` (3-axis mills and 5-axis machines).
     Machine,
 }
 
@@ -80,24 +81,20 @@ impl Target {
     }
 }
 
-/// SplitMix64: a small deterministic generator.
+/// The fuzzer's generator: SplitMix64 ([`SplitMix64`]) with its own pick.
 #[derive(Debug, Clone)]
-pub struct Rng(u64);
+pub struct Rng(SplitMix64);
 
 impl Rng {
     /// A generator from a seed.
     #[must_use]
     pub fn new(seed: u64) -> Rng {
-        Rng(seed)
+        Rng(SplitMix64::new(seed))
     }
 
     /// The next 64 random bits.
     pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
+        self.0.next_u64()
     }
 
     /// Uniform in `0..n` (`n > 0`).
@@ -331,7 +328,15 @@ fn check(target: Target, bytes: &[u8]) -> Result<bool, String> {
         }
         Target::Machine => {
             let Some(text) = text() else { return Ok(false) };
-            let Ok(m) = scallop_machine::Machine::from_toml_str(text) else { return Ok(false) };
+            let Ok(d) = scallop_machine::Described::from_toml_str(text) else { return Ok(false) };
+            // A 3-axis mill: its dynamics and the travel check of a point stay finite.
+            let words = d.linear_words(scallop_geom::Point3::new(1.0, -2.0, 3.0));
+            let _ = d.check_travel([scallop_geom::Point3::origin()]);
+            let dynamics = d.linear_dynamics();
+            if !(words.iter().chain(&[dynamics.vmax, dynamics.amax, dynamics.jmax]).all(|c| c.is_finite())) {
+                return Err("a machine with non-finite travel words or dynamics was accepted".into());
+            }
+            let scallop_machine::Described::FiveAxis(m) = d else { return Ok(true) };
             let g = m.gauge_point();
             let frame = m.part_frame().to_homogeneous();
             if !(g.coords.iter().chain(frame.iter()).all(|c| c.is_finite())) {
@@ -602,6 +607,8 @@ pub fn seeds(target: Target) -> Vec<Vec<u8>> {
             include_str!("../../../machines/generic-head-head-ca.toml"),
             include_str!("../../../machines/generic-head-table-bc.toml"),
             include_str!("../../../machines/linuxcnc-xyzac-trt.toml"),
+            include_str!("../../../machines/grbl-3axis.toml"),
+            include_str!("../../../machines/fanuc-3axis.toml"),
         ]
         .map(text)
         .to_vec(),

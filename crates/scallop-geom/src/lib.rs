@@ -14,6 +14,7 @@
 
 pub mod num;
 pub mod predicates;
+pub mod rng;
 pub mod tol;
 
 pub use nalgebra;

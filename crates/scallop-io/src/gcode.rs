@@ -190,137 +190,51 @@ fn read(text: &str, options: &GcodeOptions, keep_arcs: bool) -> Result<(Toolpath
     let mut lines: Vec<usize> = Vec::new();
     for (k, raw) in text.lines().enumerate() {
         let line = k + 1;
-        let words = words(raw, line)?;
-        let mut target = [None::<f64>; 3];
-        let (mut i, mut j, mut kk, mut r) = (None, None, None, None);
-        let mut m6 = false;
-        for (letter, value) in words {
-            match letter {
-                'G' => state.g_code(value, line)?,
-                'X' => target[0] = Some(value),
-                'Y' => target[1] = Some(value),
-                'Z' => target[2] = Some(value),
-                'I' => i = Some(value),
-                'J' => j = Some(value),
-                'K' => kk = Some(value),
-                'R' => r = Some(value),
-                'F' => {
-                    if !(value.is_finite() && value > 0.0) {
-                        return Err(GcodeError::Syntax { line, word: format!("F{value}") });
-                    }
-                    state.feed = Some(value);
-                }
-                'T' => tool.selected = Some(value),
-                'M' if (value - 6.0).abs() < 1e-9 => m6 = true,
-                'N' | 'S' | 'M' | 'O' | 'P' | 'H' | 'D' => {}
-                'A' | 'B' | 'C' | 'U' | 'V' | 'W' => {
-                    return Err(GcodeError::Unsupported {
-                        line,
-                        code: letter.to_string(),
-                        why: "rotary or extra axes: this reader is 3-axis",
-                    });
-                }
-                other => return Err(GcodeError::Syntax { line, word: other.to_string() }),
-            }
-        }
-        if m6 {
-            // After the block's T word, whatever their order (as controllers do).
-            tool.change(line)?;
-        }
+        let block = state.block(&mut tool, raw, line)?;
+        let target = block.target;
         if target.iter().all(Option::is_none) {
             continue;
         }
         let Some(motion) = state.motion else {
             return Err(GcodeError::State { line, why: "coordinates without a motion mode (G0/G1/G2/G3)" });
         };
-        if state.pos.is_none() && target.iter().any(Option::is_none) {
-            // Unknown start, as on a controller after homing: rapids may give the axes one
-            // at a time (`G0 Z50` then `G0 X0 Y0`); the tool is placed once all are known.
-            if motion != 0 {
-                return Err(GcodeError::State {
-                    line,
-                    why: "a feed move before X, Y and Z are all known; start with G0 moves that give every axis",
-                });
-            }
-            if !state.absolute {
-                return Err(GcodeError::State {
-                    line,
-                    why: "an incremental (G91) move from an unknown position; give absolute X, Y and Z first",
-                });
-            }
-            for (axis, name) in ["X", "Y", "Z"].into_iter().enumerate() {
-                if let Some(v) = target[axis] {
-                    state.partial[axis] = Some(in_range(line, name, v * state.scale)?);
+        let placed = if state.pos.is_none() && target.iter().any(Option::is_none) {
+            state.place_partial(target, motion, line)?
+        } else {
+            let to = state.resolve(target, line)?;
+            match state.pos {
+                Some(from) => {
+                    if motion != 0 {
+                        let feed =
+                            state.feed.ok_or(GcodeError::State { line, why: "a feed move before any F word" })?;
+                        tool.cut = true;
+                        feeds.push(feed * state.scale);
+                    }
+                    match motion {
+                        0 => path.push(Move::new(MoveKind::Rapid, to)),
+                        1 => {
+                            let plunge = (to.x - from.x).abs() + (to.y - from.y).abs() == 0.0 && to.z < from.z;
+                            path.push(Move::new(if plunge { MoveKind::Plunge } else { MoveKind::Feed }, to));
+                        }
+                        2 | 3 => {
+                            let arc = ArcMove { from, to, clockwise: motion == 2, keep: keep_arcs };
+                            push_arc(&mut path, &state, &block, &arc, options.arc_tolerance, line)?;
+                        }
+                        _ => unreachable!("motion modes are 0..=3"),
+                    }
+                    state.pos = Some(to);
+                    lines.resize(path.moves().len(), line);
+                    None
                 }
-                state.partial_line = line;
+                // Unknown start: place the tool.
+                None => Some(to),
             }
-            if let [Some(x), Some(y), Some(z)] = state.partial {
-                let to = Point3::new(x, y, z);
-                path.push(Move::new(MoveKind::Rapid, to));
-                state.pos = Some(to);
-                lines.push(line);
-            }
-            continue;
-        }
-        let to = state.resolve(target, line)?;
-        let Some(from) = state.pos else {
-            // Unknown start: place the tool.
+        };
+        if let Some(to) = placed {
             path.push(Move::new(MoveKind::Rapid, to));
             state.pos = Some(to);
             lines.push(line);
-            continue;
-        };
-        match motion {
-            0 => path.push(Move::new(MoveKind::Rapid, to)),
-            1..=3 => {
-                let feed = state.feed.ok_or(GcodeError::State { line, why: "a feed move before any F word" })?;
-                tool.cut = true;
-                feeds.push(feed * state.scale);
-                let kind = if (to.x - from.x).abs() + (to.y - from.y).abs() == 0.0 && to.z < from.z {
-                    MoveKind::Plunge
-                } else {
-                    MoveKind::Feed
-                };
-                if motion == 1 {
-                    path.push(Move::new(kind, to));
-                } else {
-                    let (u, v, _) = state.plane;
-                    let offsets = [i, j, kk].map(|o| o.map(|x| x * state.scale));
-                    for (o, name) in offsets.iter().zip(["I", "J", "K"]) {
-                        if let Some(o) = o {
-                            in_range(line, name, *o)?;
-                        }
-                    }
-                    if let Some(r) = r {
-                        in_range(line, "R", r * state.scale)?;
-                    }
-                    let centre = arc_centre(
-                        (from[u], from[v]),
-                        (to[u], to[v]),
-                        (offsets[u], offsets[v]),
-                        r.map(|x| x * state.scale),
-                        motion == 2,
-                        line,
-                    )?;
-                    // The whole circle stays in range (an arc may sweep most of it).
-                    let radius = (from[u] - centre.0).hypot(from[v] - centre.1);
-                    in_range(line, "arc extent (|centre| + radius)", centre.0.abs() + radius)?;
-                    in_range(line, "arc extent (|centre| + radius)", centre.1.abs() + radius)?;
-                    if keep_arcs && state.plane == (0, 1, 2) {
-                        let (_, sweep) = arc_sweep(from, to, centre, (0, 1), motion == 2);
-                        let arc = ArcXY { center: Point2::new(centre.0, centre.1), sweep };
-                        path.push_arc(Move::new(MoveKind::Feed, to), arc);
-                    } else {
-                        for p in arc_points(from, to, centre, state.plane, motion == 2, options.arc_tolerance) {
-                            path.push(Move::new(MoveKind::Feed, p));
-                        }
-                    }
-                }
-            }
-            _ => unreachable!("motion modes are 0..=3"),
         }
-        state.pos = Some(to);
-        lines.resize(path.moves().len(), line);
     }
     if path.moves().is_empty() {
         if state.partial.iter().any(Option::is_some) {
@@ -337,6 +251,67 @@ fn read(text: &str, options: &GcodeOptions, keep_arcs: bool) -> Result<(Toolpath
     path.plunge_feed = path.feed;
     debug_assert_eq!(lines.len(), path.moves().len());
     Ok((path, lines))
+}
+
+/// One block's coordinate words: the axes it gives (X, Y, Z), the arc
+/// centre offsets (I, J, K) and the arc radius (R), as written.
+struct Block {
+    target: [Option<f64>; 3],
+    offsets: [Option<f64>; 3],
+    radius: Option<f64>,
+}
+
+/// The ends and sense of one G2/G3 move; `keep` keeps XY arcs as arcs.
+struct ArcMove {
+    from: Point3,
+    to: Point3,
+    clockwise: bool,
+    keep: bool,
+}
+
+/// Pushes a G2/G3 move onto `path`: one arc move (G17 with `keep`), else
+/// chords within `tolerance` of the circle.
+fn push_arc(
+    path: &mut Toolpath,
+    state: &State,
+    block: &Block,
+    arc: &ArcMove,
+    tolerance: f64,
+    line: usize,
+) -> Result<(), GcodeError> {
+    let (from, to) = (arc.from, arc.to);
+    let (u, v, _) = state.plane;
+    let offsets = block.offsets.map(|o| o.map(|x| x * state.scale));
+    for (o, name) in offsets.iter().zip(["I", "J", "K"]) {
+        if let Some(o) = o {
+            in_range(line, name, *o)?;
+        }
+    }
+    if let Some(r) = block.radius {
+        in_range(line, "R", r * state.scale)?;
+    }
+    let centre = arc_centre(
+        (from[u], from[v]),
+        (to[u], to[v]),
+        (offsets[u], offsets[v]),
+        block.radius.map(|x| x * state.scale),
+        arc.clockwise,
+        line,
+    )?;
+    // The whole circle stays in range (an arc may sweep most of it).
+    let radius = (from[u] - centre.0).hypot(from[v] - centre.1);
+    in_range(line, "arc extent (|centre| + radius)", centre.0.abs() + radius)?;
+    in_range(line, "arc extent (|centre| + radius)", centre.1.abs() + radius)?;
+    if arc.keep && state.plane == (0, 1, 2) {
+        let (_, sweep) = arc_sweep(from, to, centre, (0, 1), arc.clockwise);
+        let xy = ArcXY { center: Point2::new(centre.0, centre.1), sweep };
+        path.push_arc(Move::new(MoveKind::Feed, to), xy);
+    } else {
+        for p in arc_points(from, to, centre, state.plane, arc.clockwise, tolerance) {
+            path.push(Move::new(MoveKind::Feed, p));
+        }
+    }
+    Ok(())
 }
 
 /// Tool words: the program is simulated with one cutter, so a tool change (`M6`) to
@@ -405,6 +380,81 @@ impl State {
             }
         }
         Ok(())
+    }
+
+    /// Reads one block: modal codes and the feed into the state, tool words
+    /// into `tool` (an `M6` after the block's `T` word, whatever their order,
+    /// as controllers do), coordinates and arc words into the result.
+    fn block(&mut self, tool: &mut Tools, raw: &str, line: usize) -> Result<Block, GcodeError> {
+        let mut block = Block { target: [None; 3], offsets: [None; 3], radius: None };
+        let mut m6 = false;
+        for (letter, value) in words(raw, line)? {
+            match letter {
+                'G' => self.g_code(value, line)?,
+                'X' => block.target[0] = Some(value),
+                'Y' => block.target[1] = Some(value),
+                'Z' => block.target[2] = Some(value),
+                'I' => block.offsets[0] = Some(value),
+                'J' => block.offsets[1] = Some(value),
+                'K' => block.offsets[2] = Some(value),
+                'R' => block.radius = Some(value),
+                'F' => {
+                    if !(value.is_finite() && value > 0.0) {
+                        return Err(GcodeError::Syntax { line, word: format!("F{value}") });
+                    }
+                    self.feed = Some(value);
+                }
+                'T' => tool.selected = Some(value),
+                'M' if (value - 6.0).abs() < 1e-9 => m6 = true,
+                'N' | 'S' | 'M' | 'O' | 'P' | 'H' | 'D' => {}
+                'A' | 'B' | 'C' | 'U' | 'V' | 'W' => {
+                    return Err(GcodeError::Unsupported {
+                        line,
+                        code: letter.to_string(),
+                        why: "rotary or extra axes: this reader is 3-axis",
+                    });
+                }
+                other => return Err(GcodeError::Syntax { line, word: other.to_string() }),
+            }
+        }
+        if m6 {
+            tool.change(line)?;
+        }
+        Ok(block)
+    }
+
+    /// Takes the axes a block gives while the start is unknown, as on a
+    /// controller after homing: rapids may give the axes one at a time
+    /// (`G0 Z50` then `G0 X0 Y0`). Returns where to place the tool once all
+    /// three are known.
+    fn place_partial(
+        &mut self,
+        target: [Option<f64>; 3],
+        motion: u8,
+        line: usize,
+    ) -> Result<Option<Point3>, GcodeError> {
+        if motion != 0 {
+            return Err(GcodeError::State {
+                line,
+                why: "a feed move before X, Y and Z are all known; start with G0 moves that give every axis",
+            });
+        }
+        if !self.absolute {
+            return Err(GcodeError::State {
+                line,
+                why: "an incremental (G91) move from an unknown position; give absolute X, Y and Z first",
+            });
+        }
+        for (axis, name) in ["X", "Y", "Z"].into_iter().enumerate() {
+            if let Some(v) = target[axis] {
+                self.partial[axis] = Some(in_range(line, name, v * self.scale)?);
+            }
+            self.partial_line = line;
+        }
+        Ok(match self.partial {
+            [Some(x), Some(y), Some(z)] => Some(Point3::new(x, y, z)),
+            _ => None,
+        })
     }
 
     fn resolve(&self, target: [Option<f64>; 3], line: usize) -> Result<Point3, GcodeError> {

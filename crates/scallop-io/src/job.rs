@@ -43,7 +43,7 @@ pub struct JobFile {
     pub operation_list: bool,
     /// Tolerances (mm).
     pub tolerances: TolerancesSpec,
-    /// Machine limits.
+    /// Machine limits, and the machine description the job names, if any.
     pub machine: MachineSpec,
     /// Stock simulation that proves the program.
     pub verify: VerifySpec,
@@ -68,7 +68,7 @@ struct RawJob {
     operation: Vec<OperationSpec>,
     #[serde(default)]
     tolerances: TolerancesSpec,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "machine_field")]
     machine: MachineSpec,
     #[serde(default)]
     verify: VerifySpec,
@@ -104,6 +104,10 @@ pub enum OperationKind {
     Finish,
     /// Z-level roughing from the stock (`[operation.roughing]`).
     Rough,
+    /// Rest roughing (`[operation.roughing]`): z-level roughing of only the
+    /// material the earlier operations left (docs/roughing.md); never the
+    /// first operation.
+    Rest,
 }
 
 /// `[[operation]]`: one operation with its own cutter, tool and spindle.
@@ -118,6 +122,12 @@ pub struct OperationSpec {
     pub tool: Option<u32>,
     /// Spindle speed (1/min; default `output.spindle`).
     pub spindle: Option<f64>,
+    /// Whether `spindle` comes from the tool library's cutting data (not the job).
+    #[serde(skip)]
+    pub spindle_from_library: bool,
+    /// Whether `feed` comes from the tool library's cutting data (not the job).
+    #[serde(skip)]
+    pub feed_from_library: bool,
     /// `[operation.cutter]`; left out when `tool` names a tool of the job's
     /// tool library, which gives it ([`CutterSpec::unset`] until then).
     #[serde(default = "CutterSpec::unset")]
@@ -163,10 +173,11 @@ fn default_milling() -> MillingWord {
 /// `[output]`.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 pub struct OutputSpec {
-    /// Controller dialect: `linuxcnc` (default), `plain`, `fanuc`, `grbl`, `siemens840d`,
-    /// `heidenhain-iso` (checked by the caller against the shipped dialects).
-    #[serde(default = "default_dialect")]
-    pub dialect: String,
+    /// Controller dialect: `linuxcnc`, `plain`, `fanuc`, `grbl`, `siemens840d`,
+    /// `heidenhain-iso` (checked by the caller against the shipped dialects); `None`: the
+    /// named machine's (`nc.dialect`), else `linuxcnc` ([`OutputSpec::dialect_or`]).
+    #[serde(default)]
+    pub dialect: Option<String>,
     /// `G2`/`G3` arcs within a quarter of the path tolerance (default false).
     #[serde(default)]
     pub arc_fitting: bool,
@@ -184,8 +195,17 @@ pub struct OutputSpec {
     pub units: UnitsWord,
 }
 
-fn default_dialect() -> String {
-    "linuxcnc".into()
+impl OutputSpec {
+    /// The dialect the job gives, else `machine` (the named machine's), else `linuxcnc`.
+    ///
+    /// ```
+    /// let o = scallop_io::job::OutputSpec::default();
+    /// assert_eq!((o.dialect_or(Some("grbl")), o.dialect_or(None)), ("grbl", "linuxcnc"));
+    /// ```
+    #[must_use]
+    pub fn dialect_or<'a>(&'a self, machine: Option<&'a str>) -> &'a str {
+        self.dialect.as_deref().or(machine).unwrap_or("linuxcnc")
+    }
 }
 fn default_program() -> String {
     "1".into()
@@ -194,7 +214,7 @@ fn default_program() -> String {
 impl Default for OutputSpec {
     fn default() -> Self {
         OutputSpec {
-            dialect: default_dialect(),
+            dialect: None,
             arc_fitting: false,
             program: default_program(),
             tool: 0,
@@ -517,9 +537,16 @@ impl Default for TolerancesSpec {
     }
 }
 
-/// `[machine]`: the spec's units (m/min, m/s², m/s³) and mm.
+/// `[machine]`: the spec's units (m/min, m/s², m/s³) and mm; or `machine = "NAME"`
+/// (a shipped machine or a machine file relative to the job file), the same as
+/// `[machine]` with `description = "NAME"` and the other keys at their defaults.
+/// With a description, the machine file gives acceleration, jerk and rapid (giving
+/// them here too is an error); `feed` and `clearance` stay the job's.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 pub struct MachineSpec {
+    /// The machine description (shipped name or file), if named.
+    #[serde(default)]
+    pub description: Option<String>,
     /// Feed V (m/min).
     #[serde(default = "default_feed")]
     pub feed: f64,
@@ -556,6 +583,7 @@ fn default_clearance() -> f64 {
 impl Default for MachineSpec {
     fn default() -> Self {
         MachineSpec {
+            description: None,
             feed: default_feed(),
             acceleration: default_acceleration(),
             jerk: default_jerk(),
@@ -563,6 +591,54 @@ impl Default for MachineSpec {
             clearance: default_clearance(),
         }
     }
+}
+
+/// `machine = "NAME"` or a `[machine]` table (read through the job's unknown-key
+/// tracking, so a misspelt key inside the table is still reported).
+fn machine_field<'de, D: serde::Deserializer<'de>>(de: D) -> Result<MachineSpec, D::Error> {
+    struct Field;
+    impl<'de> serde::de::Visitor<'de> for Field {
+        type Value = MachineSpec;
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            f.write_str("a machine name or file (`machine = \"linuxcnc-3axis\"`) or a [machine] table")
+        }
+        fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<MachineSpec, E> {
+            Ok(MachineSpec { description: Some(v.to_string()), ..MachineSpec::default() })
+        }
+        fn visit_map<A: serde::de::MapAccess<'de>>(self, map: A) -> Result<MachineSpec, A::Error> {
+            let raw = RawMachineTable::deserialize(serde::de::value::MapAccessDeserializer::new(map))?;
+            if let Some(name) = &raw.description {
+                for (key, v) in [("acceleration", raw.acceleration), ("jerk", raw.jerk), ("rapid", raw.rapid)] {
+                    if let Some(v) = v {
+                        return Err(serde::de::Error::custom(format!(
+                            "[machine] gives {key} = {v} and description = \"{name}\": the machine file gives \
+                             acceleration, jerk and rapid; remove {key} (or remove description to use [machine] alone)"
+                        )));
+                    }
+                }
+            }
+            let d = MachineSpec::default();
+            Ok(MachineSpec {
+                description: raw.description,
+                feed: raw.feed.unwrap_or(d.feed),
+                acceleration: raw.acceleration.unwrap_or(d.acceleration),
+                jerk: raw.jerk.unwrap_or(d.jerk),
+                rapid: raw.rapid.unwrap_or(d.rapid),
+                clearance: raw.clearance.unwrap_or(d.clearance),
+            })
+        }
+    }
+    /// `[machine]` as written.
+    #[derive(Deserialize)]
+    struct RawMachineTable {
+        description: Option<String>,
+        feed: Option<f64>,
+        acceleration: Option<f64>,
+        jerk: Option<f64>,
+        rapid: Option<f64>,
+        clearance: Option<f64>,
+    }
+    de.deserialize_any(Field)
 }
 
 /// `[verify]`.
@@ -836,6 +912,8 @@ fn normalise(raw: RawJob, text: &str, library: Option<&ToolLibrary>) -> Result<J
             name: "finish".into(),
             tool: (library.is_some() && raw.output.tool > 0).then_some(raw.output.tool),
             spindle: None,
+            spindle_from_library: false,
+            feed_from_library: false,
             cutter,
             feed: None,
             finishing,
@@ -895,6 +973,8 @@ fn resolve_tools(
             return Err(JobError::UnknownTool { number, line, known: library.numbers() });
         };
         op.cutter = tool.cutter();
+        op.spindle_from_library = op.spindle.is_none() && tool.spindle_speed().is_some();
+        op.feed_from_library = op.feed.is_none() && tool.feed().is_some();
         op.spindle = op.spindle.or(tool.spindle_speed());
         op.feed = op.feed.or(tool.feed());
     }
@@ -1015,6 +1095,12 @@ pub fn parse_job_with_tools(text: &str, library: Option<&ToolLibrary>) -> Result
         let checked = match op.kind {
             OperationKind::Finish => check_finish_kind(op).and_then(|()| check_cutting(&op.cutter, &op.finishing)),
             OperationKind::Rough => check_rough(op),
+            OperationKind::Rest if k == 0 => Err(JobError::Value {
+                key: "kind",
+                value: "rest".into(),
+                fix: "rest roughing machines what earlier operations left: put a kind = \"rough\" operation before it",
+            }),
+            OperationKind::Rest => check_rough(op),
         };
         checked.map_err(|e| {
             if job.operation_list {
@@ -1113,7 +1199,7 @@ fn check_finish_kind(op: &OperationSpec) -> Result<(), JobError> {
         return Err(JobError::Value {
             key: "roughing",
             value: "given".into(),
-            fix: "[operation.roughing] belongs to kind = \"rough\" operations",
+            fix: "[operation.roughing] belongs to kind = \"rough\" and \"rest\" operations",
         });
     }
     if op.finishing.scallop_height.is_nan() {
@@ -1412,6 +1498,28 @@ mod tests {
     }
 
     #[test]
+    fn a_machine_is_named_by_string_or_table_and_the_file_wins_over_its_dynamics() {
+        let job = parse_job(&format!("machine = \"grbl-3axis\"\n{BASE}")).unwrap();
+        assert_eq!(job.machine.description.as_deref(), Some("grbl-3axis"));
+        assert_eq!(job.machine.clearance, MachineSpec::default().clearance);
+        let job = parse_job(&format!("{BASE}[machine]\ndescription = \"m.toml\"\nclearance = 9\nfeed = 2\n")).unwrap();
+        assert_eq!(
+            (job.machine.description.as_deref(), job.machine.clearance, job.machine.feed),
+            (Some("m.toml"), 9.0, 2.0)
+        );
+        assert_eq!(parse_job(BASE).unwrap().machine.description, None);
+        for key in ["acceleration", "jerk", "rapid"] {
+            let text = format!("{BASE}[machine]\ndescription = \"grbl-3axis\"\n{key} = 6\n");
+            let err = parse_job(&text).unwrap_err().to_string();
+            assert!(err.contains(key) && err.contains("remove"), "{err}");
+        }
+        let err = parse_job(&format!("{BASE}[machine]\ndescription = \"m\"\nfeeed = 2\n")).unwrap_err().to_string();
+        assert!(err.contains("machine.feeed"), "{err}");
+        let err = parse_job(&format!("machine = 3\n{BASE}")).unwrap_err().to_string();
+        assert!(err.contains("machine"), "{err}");
+    }
+
+    #[test]
     fn every_unknown_key_is_reported_with_its_line() {
         let text = format!("{BASE}colour = 3\n[machine]\njerks = 40\nfeeed = 5\n");
         let err = parse_job(&text).unwrap_err();
@@ -1488,5 +1596,17 @@ mod tests {
         let err =
             parse_job(&rough.replace("[operation.finishing]\nscallop_height = 0.01\n", "")).unwrap_err().to_string();
         assert!(err.contains("operation 2") && err.contains("finishing"), "{err}");
+        // Rest roughing reads as roughing, after an earlier operation only.
+        let rest = rough.replace(
+            "[[operation]]\nkind = \"finish\"",
+            "[[operation]]\nkind = \"rest\"\n[operation.cutter]\nshape = \"flat\"\ndiameter = 2\n\
+             [operation.roughing]\nstepdown = 1\nstepover = 0.2\nstock_to_leave = 0.3\n[[operation]]\nkind = \"finish\"",
+        );
+        let job = parse_job(&rest).unwrap();
+        assert_eq!(job.operations[1].kind, OperationKind::Rest);
+        assert!(job.operations[1].roughing.is_some());
+        let first = rest.replacen("kind = \"rough\"", "kind = \"rest\"", 1);
+        let err = parse_job(&first).unwrap_err().to_string();
+        assert!(err.contains("operation 1") && err.contains("kind = \"rough\" operation before it"), "{err}");
     }
 }

@@ -12,6 +12,8 @@
 //! weights start uniform in +-0.5 (seeded); training runs a fixed number of epochs and
 //! keeps the weights of the epoch with the lowest validation error.
 
+use scallop_geom::rng::SplitMix64;
+
 use crate::chain::{Joints, Kinematics};
 
 /// One network of Table V.3.
@@ -50,36 +52,10 @@ fn sigmoid(x: f64) -> f64 {
     1.0 / (1.0 + (-x).exp())
 }
 
-/// SplitMix64: a small, fixed, portable generator (determinism across platforms).
-#[derive(Debug, Clone)]
-pub struct SplitMix(u64);
-
-impl SplitMix {
-    /// A generator from a seed.
-    #[must_use]
-    pub fn new(seed: u64) -> SplitMix {
-        SplitMix(seed)
-    }
-
-    /// Next 64 random bits.
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in [0, 1).
-    pub fn unit(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
-
 impl Mlp {
     /// A network with layer sizes `sizes` (inputs first), weights uniform in +-0.5.
     #[must_use]
-    pub fn new(sizes: &[usize], rng: &mut SplitMix) -> Mlp {
+    pub fn new(sizes: &[usize], rng: &mut SplitMix64) -> Mlp {
         let weights = sizes.windows(2).map(|w| (0..w[1] * (w[0] + 1)).map(|_| rng.unit() - 0.5).collect()).collect();
         Mlp { sizes: sizes.to_vec(), weights }
     }
@@ -235,7 +211,7 @@ pub struct NetResult {
 pub fn train_all(data: &DataSet, epochs: usize, seed: u64) -> Vec<NetResult> {
     let n = data.joints.len();
     let mut order: Vec<usize> = (0..n).collect();
-    let mut rng = SplitMix::new(seed);
+    let mut rng = SplitMix64::new(seed);
     for i in (1..n).rev() {
         let j = (rng.next_u64() % (i as u64 + 1)) as usize;
         order.swap(i, j);
@@ -250,12 +226,12 @@ pub fn train_all(data: &DataSet, epochs: usize, seed: u64) -> Vec<NetResult> {
             let inputs = &data.inputs[j];
             let target = |k: usize| scale(data.joints[k][j], data.target_range[j]);
             let sizes = [inputs[0].len(), spec.hidden[0], spec.hidden[1], 1];
-            let mut net = Mlp::new(&sizes, &mut SplitMix::new(seed ^ (j as u64 + 1)));
+            let mut net = Mlp::new(&sizes, &mut SplitMix64::new(seed ^ (j as u64 + 1)));
             let mut velocity: Vec<Vec<f64>> = net.weights.iter().map(|w| vec![0.0; w.len()]).collect();
             let mse = |net: &Mlp, set: &[usize]| {
                 set.iter().map(|&k| (net.predict(&inputs[k]) - target(k)).powi(2)).sum::<f64>() / set.len() as f64
             };
-            let mut shuffle = SplitMix::new(seed.wrapping_add(0x5eed) ^ j as u64);
+            let mut shuffle = SplitMix64::new(seed.wrapping_add(0x5eed) ^ j as u64);
             let mut sequence = train.to_vec();
             let (mut best, mut best_epoch, mut best_net) = (f64::MAX, 0, net.clone());
             for epoch in 1..=epochs {
@@ -298,7 +274,7 @@ mod tests {
     fn back_propagation_follows_the_error_gradient() {
         // With no momentum, one step changes each weight by -rate * dE/dw,
         // E = (target - y)^2 / 2; compare with central differences.
-        let mut rng = SplitMix::new(7);
+        let mut rng = SplitMix64::new(7);
         let net = Mlp::new(&[3, 4, 5, 1], &mut rng);
         let (input, target, rate) = ([0.2, 0.7, 0.4], 0.9, 1e-3);
         let error = |n: &Mlp| 0.5 * (target - n.predict(&input)).powi(2);
@@ -324,7 +300,7 @@ mod tests {
 
     #[test]
     fn momentum_adds_the_previous_change() {
-        let mut rng = SplitMix::new(3);
+        let mut rng = SplitMix64::new(3);
         let mut net = Mlp::new(&[2, 3, 1], &mut rng);
         let mut velocity: Vec<Vec<f64>> = net.weights.iter().map(|w| vec![0.5; w.len()]).collect();
         let mut plain = net.clone();

@@ -118,6 +118,8 @@ pub enum Dialect {
     Siemens840d,
     /// Heidenhain (ISO mode or conversational).
     Heidenhain,
+    /// grbl 1.1 (3-axis hobby controllers).
+    Grbl,
 }
 
 /// How a controller measures F in G94 (spec 3.9).
@@ -169,6 +171,9 @@ pub struct Nc {
     pub corner_tolerance: f64,
     /// Reference radius for pure reorientation feeds (mm).
     pub r_ref: f64,
+    /// The machine changes tools by program (`T.. M6`); `false`: by hand (the program
+    /// names the tool in a comment and pauses with `M0`).
+    pub tool_changer: bool,
 }
 
 impl Default for Nc {
@@ -182,6 +187,7 @@ impl Default for Nc {
             decimals: Decimals::default(),
             corner_tolerance: 0.0,
             r_ref: 50.0,
+            tool_changer: true,
         }
     }
 }
@@ -202,29 +208,30 @@ pub struct Tcp {
 
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-struct RawFrame {
+pub(crate) struct RawFrame {
     origin: [f64; 3],
     rotation: [[f64; 3]; 3],
 }
 
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
-struct RawSpindle {
-    gauge_point: [f64; 3],
-    tool_axis: [f64; 3],
+pub(crate) struct RawSpindle {
+    gauge_point: Option<[f64; 3]>,
+    tool_axis: Option<[f64; 3]>,
+    max_speed: Option<f64>,
 }
 
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
-struct RawChains {
+pub(crate) struct RawChains {
     part: Vec<String>,
     tool: Vec<String>,
 }
 
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-struct RawAxis {
-    kind: AxisKind,
+pub(crate) struct RawAxis {
+    pub(crate) kind: AxisKind,
     direction: [f64; 3],
     point: Option<[f64; 3]>,
     nc_sign: Option<i32>,
@@ -237,14 +244,14 @@ struct RawAxis {
 
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-struct RawPreferred {
+pub(crate) struct RawPreferred {
     axis: String,
     sign: i32,
 }
 
 #[derive(Clone, Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields, default)]
-struct RawKinematics {
+pub(crate) struct RawKinematics {
     family: FamilyChoice,
     preferred_branch: Option<RawPreferred>,
     pole_eps: Option<f64>,
@@ -252,29 +259,41 @@ struct RawKinematics {
 
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-struct RawMachine {
-    schema: String,
-    name: String,
+pub(crate) struct RawMachine {
+    pub(crate) schema: String,
+    pub(crate) name: String,
     #[serde(default)]
-    source: String,
+    pub(crate) source: String,
     #[serde(default)]
     controlled_point: ControlledPoint,
     #[serde(default)]
     tool_length_mode: ToolLengthMode,
-    part_frame: Option<RawFrame>,
-    spindle: RawSpindle,
-    chains: RawChains,
-    axes: BTreeMap<String, RawAxis>,
+    pub(crate) part_frame: Option<RawFrame>,
     #[serde(default)]
-    dynamics: BTreeMap<String, [f64; 3]>,
+    pub(crate) spindle: RawSpindle,
+    /// Absent: every axis on the tool side (3-axis machines only).
+    pub(crate) chains: Option<RawChains>,
+    pub(crate) axes: BTreeMap<String, RawAxis>,
     #[serde(default)]
-    rapid: BTreeMap<String, f64>,
+    pub(crate) dynamics: BTreeMap<String, [f64; 3]>,
     #[serde(default)]
-    kinematics: RawKinematics,
+    pub(crate) rapid: BTreeMap<String, f64>,
     #[serde(default)]
-    tcp: Tcp,
+    pub(crate) kinematics: RawKinematics,
     #[serde(default)]
-    nc: Nc,
+    pub(crate) tcp: Tcp,
+    #[serde(default)]
+    pub(crate) nc: Nc,
+}
+
+impl RawMachine {
+    pub(crate) fn spindle_tool_axis(&self) -> Option<[f64; 3]> {
+        self.spindle.tool_axis
+    }
+
+    pub(crate) fn spindle_gauge_point(&self) -> Option<[f64; 3]> {
+        self.spindle.gauge_point
+    }
 }
 
 /// Feed-motion limits of one axis, internal units (mm or rad per s, s^2, s^3).
@@ -418,10 +437,11 @@ pub struct Machine {
     pub(crate) pole_eps: f64,
     pub(crate) tcp: Tcp,
     pub(crate) nc: Nc,
+    pub(crate) max_spindle_speed: Option<f64>,
 }
 
 /// The machine descriptions shipped in `machines/`, by short name.
-const BUILTIN: &[(&str, &str)] = &[
+pub(crate) const BUILTIN: &[(&str, &str)] = &[
     ("mx330", include_str!("../../../machines/matsuura-mx330.toml")),
     ("ucp710", include_str!("../../../machines/mikron-ucp710.toml")),
     ("generic-tt-bc", include_str!("../../../machines/generic-table-table-bc.toml")),
@@ -440,7 +460,7 @@ fn vec3(a: [f64; 3]) -> Vec3 {
 /// and chain side.
 /// The part frame of a machine file (identity when absent), checked: a proper
 /// rotation and an origin in range.
-fn part_frame_of(frame: Option<&RawFrame>) -> Result<Isometry3<f64>, MachineError> {
+pub(crate) fn part_frame_of(frame: Option<&RawFrame>) -> Result<Isometry3<f64>, MachineError> {
     Ok(match frame {
         None => Isometry3::identity(),
         Some(f) => {
@@ -463,7 +483,7 @@ fn part_frame_of(frame: Option<&RawFrame>) -> Result<Isometry3<f64>, MachineErro
 
 /// The controller settings of a machine file: block time and corner tolerance
 /// >= 0, a positive reference radius, known TCP forms.
-fn check_controller(nc: &Nc, tcp: &Tcp) -> Result<(), MachineError> {
+pub(crate) fn check_controller(nc: &Nc, tcp: &Tcp) -> Result<(), MachineError> {
     for (place, v) in [("nc.min_block_time", nc.min_block_time), ("nc.corner_tolerance", nc.corner_tolerance)] {
         if !(v.is_finite() && v >= 0.0) {
             return Err(MachineError::invalid(place, format!("{v} must be >= 0"), "give a non-negative value"));
@@ -488,7 +508,7 @@ fn check_controller(nc: &Nc, tcp: &Tcp) -> Result<(), MachineError> {
     Ok(())
 }
 
-fn axis_of(raw: &RawMachine, name: &String) -> Result<Axis, MachineError> {
+pub(crate) fn axis_of(raw: &RawMachine, name: &String) -> Result<Axis, MachineError> {
     let a = &raw.axes[name];
     let place = format!("axes.{name}");
     let direction = unit_direction(a.direction, &format!("{place}.direction"))?;
@@ -575,10 +595,10 @@ fn axis_of(raw: &RawMachine, name: &String) -> Result<Axis, MachineError> {
         Some(r) => *r,
         None => d[0],
     };
-    let side = match (raw.chains.part.contains(name), raw.chains.tool.contains(name)) {
-        (true, false) => ChainSide::Part,
-        (false, true) => ChainSide::Tool,
-        _ => {
+    let side = match raw.chains.as_ref().map(|c| (c.part.contains(name), c.tool.contains(name))) {
+        None | Some((false, true)) => ChainSide::Tool,
+        Some((true, false)) => ChainSide::Part,
+        Some(_) => {
             return Err(MachineError::invalid(
                 "chains",
                 format!("axis {name} must be in exactly one of chains.part and chains.tool"),
@@ -600,7 +620,7 @@ fn axis_of(raw: &RawMachine, name: &String) -> Result<Axis, MachineError> {
     })
 }
 
-fn unit_direction(a: [f64; 3], place: &str) -> Result<Vec3, MachineError> {
+pub(crate) fn unit_direction(a: [f64; 3], place: &str) -> Result<Vec3, MachineError> {
     let v = vec3(a);
     let n = v.norm();
     if !n.is_finite() || (n - 1.0).abs() > tol::DIRECTION_NORM {
@@ -614,7 +634,7 @@ fn unit_direction(a: [f64; 3], place: &str) -> Result<Vec3, MachineError> {
 }
 
 /// A point of the description: finite and within [`tol::MAX_COORDINATE`] of the origin.
-fn point_in_range(a: [f64; 3], place: &str) -> Result<Point3, MachineError> {
+pub(crate) fn point_in_range(a: [f64; 3], place: &str) -> Result<Point3, MachineError> {
     if a.iter().all(|v| v.is_finite() && v.abs() <= tol::MAX_COORDINATE) {
         return Ok(Point3::new(a[0], a[1], a[2]));
     }
@@ -623,6 +643,60 @@ fn point_in_range(a: [f64; 3], place: &str) -> Result<Point3, MachineError> {
         format!("point [{:?}, {:?}, {:?}] is not finite or outside +-{:e} mm", a[0], a[1], a[2], tol::MAX_COORDINATE),
         "give finite coordinates in mm (machine frame at q = 0)",
     ))
+}
+
+/// Every `[dynamics]` and `[rapid]` entry names a declared axis.
+pub(crate) fn check_dynamics_keys(raw: &RawMachine) -> Result<(), MachineError> {
+    for key in raw.dynamics.keys().chain(raw.rapid.keys()) {
+        if !raw.axes.contains_key(key) {
+            return Err(MachineError::invalid(
+                format!("dynamics.{key}"),
+                format!("no axis named {key}"),
+                "remove the entry or declare the axis under [axes]",
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The first three axes (the linear ones) span space.
+pub(crate) fn check_linear_independence(axes: &[Axis]) -> Result<(), MachineError> {
+    let lin = Matrix3::from_columns(&[axes[0].direction, axes[1].direction, axes[2].direction]);
+    if lin.determinant().abs() < tol::LINEAR_INDEPENDENCE {
+        return Err(MachineError::invalid(
+            "axes",
+            "the three linear axis directions are not independent",
+            "give linear directions that span space (normally e_x, e_y, e_z)",
+        ));
+    }
+    Ok(())
+}
+
+/// The description as written (TOML errors with their line and column).
+pub(crate) fn parse_raw(text: &str) -> Result<RawMachine, MachineError> {
+    toml::from_str(text).map_err(|e| {
+        let (line, column) = e.span().map_or((1, 1), |s| line_column(text, s.start));
+        MachineError::Parse { line, column, message: e.message().trim().to_string() }
+    })
+}
+
+/// The schema id and the largest spindle speed of a description, checked.
+pub(crate) fn check_schema_and_spindle(raw: &RawMachine) -> Result<Option<f64>, MachineError> {
+    if raw.schema != SCHEMA {
+        return Err(MachineError::invalid(
+            "schema",
+            format!("unknown schema `{}`", raw.schema),
+            format!("write schema = \"{SCHEMA}\""),
+        ));
+    }
+    match raw.spindle.max_speed {
+        Some(n) if !(n.is_finite() && n > 0.0) => Err(MachineError::invalid(
+            "spindle.max_speed",
+            format!("{n} is not a positive speed"),
+            "give the largest spindle speed in 1/min (> 0), or remove it (no limit)",
+        )),
+        n => Ok(n),
+    }
 }
 
 fn line_column(text: &str, offset: usize) -> (usize, usize) {
@@ -646,11 +720,7 @@ impl Machine {
     /// fields; [`MachineError::Invalid`] naming the field for a bad value;
     /// [`MachineError::Unsupported`] for machines other than 3 linear + 2 rotary.
     pub fn from_toml_str(text: &str) -> Result<Machine, MachineError> {
-        let raw: RawMachine = toml::from_str(text).map_err(|e| {
-            let (line, column) = e.span().map_or((1, 1), |s| line_column(text, s.start));
-            MachineError::Parse { line, column, message: e.message().trim().to_string() }
-        })?;
-        Self::validate(raw)
+        Self::validate(parse_raw(text)?)
     }
 
     /// One of the shipped descriptions of `machines/` by short name: `mx330`, `ucp710`,
@@ -686,18 +756,20 @@ impl Machine {
 
     #[allow(clippy::too_many_lines, reason = "one linear validation pass, field by field")]
     fn validate(raw: RawMachine) -> Result<Machine, MachineError> {
-        if raw.schema != SCHEMA {
-            return Err(MachineError::invalid(
-                "schema",
-                format!("unknown schema `{}`", raw.schema),
-                format!("write schema = \"{SCHEMA}\""),
-            ));
-        }
+        let max_spindle_speed = check_schema_and_spindle(&raw)?;
         // Axis order: linear first, then rotary, each sorted by name (BTreeMap order).
         let mut names: Vec<&String> =
             raw.axes.iter().filter(|(_, a)| a.kind == AxisKind::Linear).map(|(n, _)| n).collect();
         let n_linear = names.len();
         names.extend(raw.axes.iter().filter(|(_, a)| a.kind == AxisKind::Rotary).map(|(n, _)| n));
+        if n_linear == 3 && names.len() == 3 {
+            return Err(MachineError::Unsupported {
+                place: "axes".into(),
+                what: format!("the 3-axis machine `{}` in 5-axis or 3+2 output", raw.name),
+                fix: "name a 5-axis machine here; a 3-axis machine is named by a job's `machine` key (docs/job.md)"
+                    .into(),
+            });
+        }
         if n_linear != 3 || names.len() != 5 {
             return Err(MachineError::Unsupported {
                 place: "axes".into(),
@@ -705,19 +777,18 @@ impl Machine {
                 fix: "describe 3 linear and 2 rotary axes (3- and 4-axis machines come later)".into(),
             });
         }
+        let Some(chains) = raw.chains.as_ref() else {
+            return Err(MachineError::invalid(
+                "chains",
+                "missing",
+                "add [chains] with part = [...] and tool = [...] (the axes that carry the part and the tool)",
+            ));
+        };
         let mut axes = Vec::with_capacity(5);
         for name in &names {
             axes.push(axis_of(&raw, name)?);
         }
-        for key in raw.dynamics.keys().chain(raw.rapid.keys()) {
-            if !raw.axes.contains_key(key) {
-                return Err(MachineError::invalid(
-                    format!("dynamics.{key}"),
-                    format!("no axis named {key}"),
-                    "remove the entry or declare the axis under [axes]",
-                ));
-            }
-        }
+        check_dynamics_keys(&raw)?;
         let index_of = |n: &String| names.iter().position(|m| *m == n);
         let chain = |list: &[String], which: &str| -> Result<Vec<usize>, MachineError> {
             let mut out = Vec::new();
@@ -740,16 +811,9 @@ impl Machine {
             }
             Ok(out)
         };
-        let part_chain = chain(&raw.chains.part, "part")?;
-        let tool_chain = chain(&raw.chains.tool, "tool")?;
-        let lin = Matrix3::from_columns(&[axes[0].direction, axes[1].direction, axes[2].direction]);
-        if lin.determinant().abs() < tol::LINEAR_INDEPENDENCE {
-            return Err(MachineError::invalid(
-                "axes",
-                "the three linear axis directions are not independent",
-                "give linear directions that span space (normally e_x, e_y, e_z)",
-            ));
-        }
+        let part_chain = chain(&chains.part, "part")?;
+        let tool_chain = chain(&chains.tool, "tool")?;
+        check_linear_independence(&axes)?;
         if axes[3].direction.cross(&axes[4].direction).norm() < tol::PARALLEL {
             return Err(MachineError::invalid(
                 format!("axes.{}.direction", axes[4].name),
@@ -757,8 +821,15 @@ impl Machine {
                 "a 5-axis machine needs two non-parallel rotary axes",
             ));
         }
-        let tool_axis = unit_direction(raw.spindle.tool_axis, "spindle.tool_axis")?;
-        let gauge_point = point_in_range(raw.spindle.gauge_point, "spindle.gauge_point")?;
+        let (Some(tool_axis), Some(gauge_point)) = (raw.spindle.tool_axis, raw.spindle.gauge_point) else {
+            return Err(MachineError::invalid(
+                "spindle",
+                "missing gauge_point or tool_axis",
+                "add spindle = { gauge_point = [x, y, z], tool_axis = [0, 0, 1] } (mm, machine frame at q = 0)",
+            ));
+        };
+        let tool_axis = unit_direction(tool_axis, "spindle.tool_axis")?;
+        let gauge_point = point_in_range(gauge_point, "spindle.gauge_point")?;
         let part_frame = part_frame_of(raw.part_frame.as_ref())?;
         let preferred_branch = match raw.kinematics.preferred_branch {
             None => None,
@@ -810,6 +881,7 @@ impl Machine {
             pole_eps,
             tcp: raw.tcp,
             nc,
+            max_spindle_speed,
         })
     }
 
@@ -976,6 +1048,17 @@ impl Machine {
     #[must_use]
     pub fn tcp(&self) -> &Tcp {
         &self.tcp
+    }
+
+    /// The largest spindle speed (1/min), when the description gives it
+    /// (`spindle.max_speed`).
+    ///
+    /// ```
+    /// assert_eq!(scallop_machine::Machine::builtin("ucp710").unwrap().max_spindle_speed(), None);
+    /// ```
+    #[must_use]
+    pub fn max_spindle_speed(&self) -> Option<f64> {
+        self.max_spindle_speed
     }
 
     /// Controller conventions.

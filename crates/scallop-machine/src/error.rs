@@ -68,6 +68,20 @@ pub enum MachineError {
         /// `mm` or `deg`.
         unit: &'static str,
     },
+    /// A program leaves the travel of a linear axis (3-axis work, [`crate::Described::check_travel`]).
+    #[error("the program moves axis {axis} to {value:.3} mm, outside its travel [{min}, {max}] mm; fix: {fix}")]
+    OutOfTravel {
+        /// The axis name as declared (e.g. `Z`).
+        axis: String,
+        /// The NC word outside the travel (mm).
+        value: f64,
+        /// Lower end of the travel (mm).
+        min: f64,
+        /// Upper end of the travel (mm).
+        max: f64,
+        /// How to repair it (the program's extent on the axis and what to move).
+        fix: String,
+    },
     /// The numeric inverse (for chains without a closed form) did not converge.
     #[error("block {}: the numeric inverse did not reproduce the pose (residual {residual:.3e}); fix: check that the pose is reachable, or give a closer previous joint vector", fmt_block(*.block))]
     NoConvergence {

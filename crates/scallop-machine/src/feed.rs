@@ -3,6 +3,7 @@
 //! (G93) feeds bounded by every axis's velocity limit (spec 3.9).
 
 use scallop_geom::nalgebra::UnitQuaternion;
+use scallop_geom::num::golden_section;
 use scallop_geom::{Point3, Vec3};
 
 use crate::chain::{Joints, Kinematics, Pose};
@@ -87,12 +88,7 @@ pub fn deviation(kin: &Kinematics, pose_a: &Pose, pose_b: &Pose, qa: &Joints, qb
 /// ```
 #[must_use]
 pub fn deviation_bound(kin: &Kinematics, qa: &Joints, qb: &Joints) -> Option<(f64, f64)> {
-    let (omega, b) = match rotation_and_translation(kin, qa, qb) {
-        Rates::Translation => return Some((0.0, 0.0)),
-        Rates::TooFar => return None,
-        Rates::Screw(omega, b) => (omega, b),
-    };
-    Some(bound_from(exact_d0(kin, qa), omega, b))
+    screw_bound(kin, qa, qb, exact_d0)
 }
 
 /// [`deviation_bound`] with the distance `D0` replaced by a cheaper upper bound (no
@@ -112,12 +108,7 @@ pub fn deviation_bound(kin: &Kinematics, qa: &Joints, qb: &Joints) -> Option<(f6
 /// ```
 #[must_use]
 pub fn deviation_bound_relaxed(kin: &Kinematics, qa: &Joints, qb: &Joints) -> Option<(f64, f64)> {
-    let (omega, b) = match rotation_and_translation(kin, qa, qb) {
-        Rates::Translation => return Some((0.0, 0.0)),
-        Rates::TooFar => return None,
-        Rates::Screw(omega, b) => (omega, b),
-    };
-    Some(bound_from(relaxed_d0(kin, qa), omega, b))
+    screw_bound(kin, qa, qb, relaxed_d0)
 }
 
 enum Rates {
@@ -127,6 +118,16 @@ enum Rates {
     TooFar,
     /// `(Omega, B)`.
     Screw(f64, f64),
+}
+
+/// The bound of a block from its screw motion, with `d0` giving D0 at `qa` (the
+/// tip's largest distance to a rotary line: [`exact_d0`] or [`relaxed_d0`]).
+fn screw_bound(kin: &Kinematics, qa: &Joints, qb: &Joints, d0: fn(&Kinematics, &Joints) -> f64) -> Option<(f64, f64)> {
+    match rotation_and_translation(kin, qa, qb) {
+        Rates::Translation => Some((0.0, 0.0)),
+        Rates::TooFar => None,
+        Rates::Screw(omega, b) => Some(bound_from(d0(kin, qa), omega, b)),
+    }
 }
 
 fn rotation_and_translation(kin: &Kinematics, qa: &Joints, qb: &Joints) -> Rates {
@@ -248,26 +249,9 @@ fn maximise(f: impl Fn(f64) -> f64) -> f64 {
             best_s = s;
         }
     }
-    let (mut lo, mut hi) = ((best_s - step).max(0.0), (best_s + step).min(1.0));
-    let g = (5f64.sqrt() - 1.0) / 2.0;
-    let (mut x1, mut x2) = (hi - g * (hi - lo), lo + g * (hi - lo));
-    let (mut f1, mut f2) = (f(x1), f(x2));
-    for _ in 0..tol::DEVIATION_REFINE_ITERATIONS {
-        if f1 > f2 {
-            hi = x2;
-            x2 = x1;
-            f2 = f1;
-            x1 = hi - g * (hi - lo);
-            f1 = f(x1);
-        } else {
-            lo = x1;
-            x1 = x2;
-            f1 = f2;
-            x2 = lo + g * (hi - lo);
-            f2 = f(x2);
-        }
-    }
-    best.max(f1).max(f2)
+    let (lo, hi) = ((best_s - step).max(0.0), (best_s + step).min(1.0));
+    let end = golden_section(f, (lo, hi), tol::DEVIATION_REFINE_ITERATIONS, None, |f1, f2| f1 > f2);
+    best.max(end.inner[0].1).max(end.inner[1].1)
 }
 
 /// One sub-block end: the part-frame pose and its joints.

@@ -14,7 +14,8 @@
 //!
 //! Modules: [`desc`] (descriptions), [`chain`] (forward kinematics, Jacobian), [`ik`]
 //! (inverse), [`plan`] (selection, unwrapping, limits), [`feed`] (subdivision, G93),
-//! [`program`] (CL records to a joint-space program), [`time`] (time model), [`tol`].
+//! [`program`] (CL records to a joint-space program), [`time`] (time model), [`mill`]
+//! (3-axis mills and [`Described`], a machine of either kind as a job names it), [`tol`].
 //!
 //! ```
 //! use scallop_geom::{Point3, Vec3};
@@ -49,6 +50,7 @@ pub mod error;
 pub mod feed;
 pub mod frame;
 pub mod ik;
+pub mod mill;
 pub mod plan;
 pub mod program;
 pub mod time;
@@ -61,3 +63,4 @@ pub use desc::{
 };
 pub use error::MachineError;
 pub use ik::{Branch, IkSolution, IkSolutions};
+pub use mill::{Described, Mill};

@@ -289,13 +289,8 @@ fn vectors_linuxcnc_forward_random_against_rederivation() {
     // Independent forms: the published xyzac forward map (conventional-directions = false),
     // and P = Rz(-g)(R_t(-t)(j - p_t) + p_t - p_c) + p_c for both modules.
     let (xr, yr, zr, off, zo, to) = (10.0, -5.0, 20.0, 15.0, -30.0, 40.0);
-    let mut state = 0x2545_f491_4f6c_dd1d_u64;
-    let mut rnd = |lo: f64, hi: f64| {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        lo + (hi - lo) * (state >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut rng = scallop_geom::rng::SplitMix64::new(0x2545_f491_4f6c_dd1d);
+    let mut rnd = |lo: f64, hi: f64| rng.uniform(lo, hi);
     for ac in [true, false] {
         for conventional in [true, false] {
             let k = trt(ac, conventional);

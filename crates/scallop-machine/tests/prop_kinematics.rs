@@ -226,13 +226,8 @@ proptest! {
 fn poses_sampled_in_pose_space_mx330() {
     // Reachable poses drawn directly (tip anywhere near the table, tilt <= 120 deg).
     let k = Kinematics::new(&Machine::builtin("mx330").expect("shipped"), 100.0);
-    let mut state = 0x9e37_79b9_7f4a_7c15_u64;
-    let mut rnd = || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut rng = scallop_geom::rng::SplitMix64::new(0x9e37_79b9_7f4a_7c15);
+    let mut rnd = || rng.unit();
     for _ in 0..2000 {
         let tilt = 120f64.to_radians() * rnd();
         let az = std::f64::consts::TAU * rnd();

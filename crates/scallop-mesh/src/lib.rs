@@ -1,7 +1,9 @@
 //! Triangle meshes for scallop: one validated f64 indexed mesh ([`TriMesh`]),
 //! vertex welding scaled to the model, degenerate-triangle removal with
 //! diagnostics, and an XY bounding-volume hierarchy ([`MeshIndex`]) for
-//! drop-cutter queries.
+//! drop-cutter queries; a 3D hierarchy ([`Bvh`]) for closest points and rays
+//! ([`MeshQuery`]), polylines and the distance to them ([`PolylineQuery`]),
+//! and mesh-mesh intersection chained into polylines ([`intersect_meshes`]).
 //!
 //! ```
 //! use scallop_geom::Point3;
@@ -21,10 +23,19 @@
 //!   indices and no degenerate (exactly collinear) triangle. Nothing re-validates it.
 //! - Never performs I/O.
 
+mod bvh;
 mod hash;
 mod index;
+mod intersect;
+mod polyline;
+mod query;
+pub mod tol;
 mod trimesh;
 
+pub use bvh::Bvh;
 pub use hash::{FastMap, WordHasher};
 pub use index::MeshIndex;
+pub use intersect::{KeyChain, MeshIntersection, chain_keys, intersect_meshes};
+pub use polyline::{Polyline3, PolylineFoot, PolylineQuery, segment_parameter};
+pub use query::{ClosestPoint, MeshQuery, RayHit, closest_on_triangle, ray_triangle, triangle_box};
 pub use trimesh::{MeshDiagnostics, MeshError, TriMesh};

@@ -306,7 +306,9 @@ fn weld(points: &[Point3], dist: f64) -> (Vec<Point3>, Vec<u32>) {
         for dx in span[0].0..=span[0].1 {
             for dy in span[1].0..=span[1].1 {
                 for dz in span[2].0..=span[2].1 {
-                    if let Some(list) = grid.get(&[k[0] + dx, k[1] + dy, k[2] + dz]) {
+                    // Saturating: a coordinate whose cell saturated the cast shares the edge cell.
+                    let key = [k[0].saturating_add(dx), k[1].saturating_add(dy), k[2].saturating_add(dz)];
+                    if let Some(list) = grid.get(&key) {
                         for &i in list {
                             if (kept[i as usize] - p).norm_squared() <= d2 {
                                 found = Some(found.map_or(i, |f| f.min(i)));
@@ -403,6 +405,15 @@ mod tests {
 
     fn p(x: f64, y: f64, z: f64) -> Point3 {
         Point3::new(x, y, z)
+    }
+
+    #[test]
+    fn huge_coordinates_share_the_weld_grid_edge_cell_without_overflow() {
+        // A cell index saturated by the float-to-int cast, then looked at from its neighbours.
+        let far = Point3::new(-9.0e17, 0.0, 0.0);
+        let (kept, remap) = weld(&[far, far, Point3::new(1.0, 0.0, 0.0)], 1e-9);
+        assert_eq!(kept.len(), 2);
+        assert_eq!(remap, vec![0, 0, 1]);
     }
 
     #[test]

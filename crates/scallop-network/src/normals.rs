@@ -147,6 +147,49 @@ fn tangent(a: &Homogeneous, da: &Homogeneous) -> Vec3 {
     Vec3::new(a[3] * da[0] - da[3] * a[0], a[3] * da[1] - da[3] * a[1], a[3] * da[2] - da[3] * a[2])
 }
 
+/// The control net collapsed along one parameter (of degree `n`) at the
+/// `stations + 1` even values `k / stations`: for each station, then each of
+/// the `lines + 1` control lines across it, the homogeneous point and its
+/// derivative along the collapsed parameter. `at(line, m)` indexes `control`.
+fn collapse(
+    control: &[Homogeneous],
+    n: usize,
+    lines: usize,
+    stations: usize,
+    at: impl Fn(usize, usize) -> usize,
+) -> (Vec<Homogeneous>, Vec<Homogeneous>) {
+    let (mut values, mut derivatives) = ([0.0; MAX_DEGREE + 1], [0.0; MAX_DEGREE + 1]);
+    let mut points = Vec::with_capacity((stations + 1) * (lines + 1));
+    let mut slopes = Vec::with_capacity(points.capacity());
+    for k in 0..=stations {
+        bernstein(n, k as f64 / stations as f64, &mut values, &mut derivatives);
+        for line in 0..=lines {
+            let (mut c, mut dc) = ([0.0; 4], [0.0; 4]);
+            for m in 0..=n {
+                axpy(&mut c, values[m], &control[at(line, m)]);
+                axpy(&mut dc, derivatives[m], &control[at(line, m)]);
+            }
+            points.push(c);
+            slopes.push(dc);
+        }
+    }
+    (points, slopes)
+}
+
+/// [`along`] on line `line` of collapsed tables (lines of `n + 1` entries, as
+/// [`collapse`] lays them out).
+#[inline]
+fn along_line(
+    n: usize,
+    line: usize,
+    t: f64,
+    points: &[Homogeneous],
+    slopes: &[Homogeneous],
+) -> (Homogeneous, Homogeneous, Homogeneous) {
+    let range = line * (n + 1)..(line + 1) * (n + 1);
+    along(n, t, &points[range.clone()], &slopes[range])
+}
+
 impl EdgeNormals {
     /// Tables for `patch` on a network of `quads` quads, `None` for NURBS or
     /// degrees above the tabulated limit.
@@ -163,53 +206,22 @@ impl EdgeNormals {
                 control.push([c.x * w, c.y * w, c.z * w, w]);
             }
         }
-        let (mut values, mut derivatives) = ([0.0; MAX_DEGREE + 1], [0.0; MAX_DEGREE + 1]);
-        let mut rows = Vec::with_capacity((quads[1] + 1) * (p + 1));
-        let mut rows_dv = Vec::with_capacity(rows.capacity());
-        for b in 0..=quads[1] {
-            bernstein(q, b as f64 / quads[1] as f64, &mut values, &mut derivatives);
-            for i in 0..=p {
-                let (mut r, mut r_dv) = ([0.0; 4], [0.0; 4]);
-                for j in 0..=q {
-                    axpy(&mut r, values[j], &control[i * (q + 1) + j]);
-                    axpy(&mut r_dv, derivatives[j], &control[i * (q + 1) + j]);
-                }
-                rows.push(r);
-                rows_dv.push(r_dv);
-            }
-        }
-        let mut columns = Vec::with_capacity((quads[0] + 1) * (q + 1));
-        let mut columns_du = Vec::with_capacity(columns.capacity());
-        for a in 0..=quads[0] {
-            bernstein(p, a as f64 / quads[0] as f64, &mut values, &mut derivatives);
-            for j in 0..=q {
-                let (mut c, mut c_du) = ([0.0; 4], [0.0; 4]);
-                for i in 0..=p {
-                    axpy(&mut c, values[i], &control[i * (q + 1) + j]);
-                    axpy(&mut c_du, derivatives[i], &control[i * (q + 1) + j]);
-                }
-                columns.push(c);
-                columns_du.push(c_du);
-            }
-        }
+        let (rows, rows_dv) = collapse(&control, q, p, quads[1], |i, j| i * (q + 1) + j);
+        let (columns, columns_du) = collapse(&control, p, q, quads[0], |j, i| i * (q + 1) + j);
         Some(EdgeNormals { degree: [p, q], control, rows, rows_dv, columns, columns_du })
     }
 
     /// `(S_u, S_v)` up to a common positive factor on the u-edge row `b` at `u`.
     #[inline]
     pub(crate) fn on_row(&self, b: usize, u: f64) -> (Vec3, Vec3) {
-        let p = self.degree[0];
-        let range = b * (p + 1)..(b + 1) * (p + 1);
-        let (a, a_u, a_v) = along(p, u, &self.rows[range.clone()], &self.rows_dv[range]);
+        let (a, a_u, a_v) = along_line(self.degree[0], b, u, &self.rows, &self.rows_dv);
         (tangent(&a, &a_u), tangent(&a, &a_v))
     }
 
     /// `(S_u, S_v)` up to a common positive factor on the v-edge column `a` at `v`.
     #[inline]
     pub(crate) fn on_column(&self, column: usize, v: f64) -> (Vec3, Vec3) {
-        let q = self.degree[1];
-        let range = column * (q + 1)..(column + 1) * (q + 1);
-        let (a, a_v, a_u) = along(q, v, &self.columns[range.clone()], &self.columns_du[range]);
+        let (a, a_v, a_u) = along_line(self.degree[1], column, v, &self.columns, &self.columns_du);
         (tangent(&a, &a_u), tangent(&a, &a_v))
     }
 

@@ -173,13 +173,8 @@ mod tests {
             Cutter::Ball { radius: 3.0 },
             Cutter::Toroidal { radius: 4.0, corner: 0.0 },
         ];
-        let mut seed = 0x2545_f491_4f6c_dd1du64;
-        let mut random = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = scallop_geom::rng::SplitMix64::new(0x2545_f491_4f6c_dd1d);
+        let mut random = || rng.unit();
         let sin_h = scallop_analysis::tol::SIN_SLOPE_HORIZONTAL;
         for tool in tools {
             let model = ToolModel::new(&tool, 0.01).unwrap_or_else(|e| panic!("{e}"));

@@ -361,6 +361,7 @@ impl Dialect {
             D::Linuxcnc => "linuxcnc",
             D::Siemens840d => "siemens840d",
             D::Heidenhain => "heidenhain",
+            D::Grbl => "grbl",
         };
         // INVARIANT: every shipped dialect file parses (tested).
         Self::builtin(name).unwrap_or_else(|_| Dialect::plain())

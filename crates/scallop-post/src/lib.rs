@@ -300,22 +300,12 @@ pub fn write_gcode(path: &Toolpath, dialect: &Dialect, comments: &[&str], out: &
 mod tests {
     use super::{floor_fast, fmt_number, push_key, push_token_key, round_fast, scaled_key};
 
-    /// A deterministic xorshift sequence of 64-bit words from `state`.
-    fn xorshift(mut state: u64) -> impl FnMut() -> u64 {
-        move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        }
-    }
-
     #[test]
     fn keys_format_as_the_exact_formatter_and_the_fast_roundings_equal_the_library() {
-        let mut next = xorshift(0x2545_f491_4f6c_dd1d);
+        let mut rng = scallop_geom::rng::SplitMix64::new(0x2545_f491_4f6c_dd1d);
         for _ in 0..100_000 {
-            let magnitude = 10f64.powi(i32::try_from(next() % 16).unwrap_or(0) - 6);
-            let v = ((next() >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 2.0 * magnitude;
+            let magnitude = 10f64.powi(i32::try_from(rng.next_u64() % 16).unwrap_or(0) - 6);
+            let v = (rng.unit() - 0.5) * 2.0 * magnitude;
             for d in [0, 1, 3, 4, 6, 9] {
                 if let Some(key) = scaled_key(v, d) {
                     let exact = fmt_number(v, d);
@@ -347,11 +337,11 @@ mod tests {
     #[test]
     fn the_fast_path_equals_the_exact_formatter() {
         // A deterministic sweep of magnitudes, signs, ties and near-ties.
-        let mut next = xorshift(0x9e37_79b9_7f4a_7c15);
+        let mut rng = scallop_geom::rng::SplitMix64::new(0x9e37_79b9_7f4a_7c15);
         for _ in 0..200_000 {
-            let bits = next();
+            let bits = rng.next_u64();
             let magnitude = 10f64.powi(i32::try_from(bits % 14).unwrap_or(0) - 6);
-            let v = ((next() >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 2.0 * magnitude;
+            let v = (rng.unit() - 0.5) * 2.0 * magnitude;
             for d in [0, 1, 3, 4, 6] {
                 assert_eq!(fmt_number(v, d), exact(v, d), "{v:e} at {d}");
             }

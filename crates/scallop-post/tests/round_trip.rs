@@ -6,7 +6,7 @@
 use scallop_geom::{Point3, Vec3};
 use scallop_machine::program::{ClRecord, Motion, ProgramOptions, to_program};
 use scallop_machine::{Kinematics, Machine, Pose};
-use scallop_post::{Dialect, OutputMode, PostError, PostParams, check_replay, program_text, replay};
+use scallop_post::{Dialect, OutputMode, PostError, PostParams, RoundTrip, check_replay, program_text, replay};
 
 const DIALECTS: [&str; 6] = ["linuxcnc", "fanuc", "siemens840d", "heidenhain", "heidenhain-iso", "plain"];
 
@@ -136,6 +136,21 @@ fn text_for(
     program_text(&program, &kin, &Dialect::builtin(dialect).expect("shipped"), &params(mode, length, &opts))
 }
 
+/// Replays `text` in `dialect` on `machine` and checks it against the records of
+/// `make` (as [`text_for`] posted them).
+fn replay_check(
+    machine: &str,
+    dialect: &str,
+    text: &str,
+    make: fn(f64) -> Vec<ClRecord>,
+) -> Result<RoundTrip, PostError> {
+    let (kin, _, z) = setup(machine);
+    let dialect = Dialect::builtin(dialect).expect("shipped");
+    let opts = ProgramOptions::default();
+    let blocks = replay(text, &dialect, &kin).expect("reads");
+    check_replay(&blocks, &make(z), &kin, &dialect, opts.tol_pos, opts.tol_ang)
+}
+
 #[test]
 fn tilted_plane_codes_per_dialect() {
     let fanuc = text_for("ucp710", "fanuc", OutputMode::TiltedPlane, indexed).expect("fanuc");
@@ -216,32 +231,20 @@ fn grbl_takes_three_axis_work_only() {
         r.push(rec(Point3::new(30.0, 5.0, z), Vec3::z(), Motion::Feed));
         r
     };
-    let (kin, length, z) = setup("generic-hh-ca");
-    let opts = ProgramOptions::default();
-    let records = flat(z);
-    let program = to_program(&kin, &records, None, &opts).expect("plans");
-    let grbl = Dialect::builtin("grbl").expect("shipped");
-    let text = program_text(&program, &kin, &grbl, &params(OutputMode::Joint, length, &opts)).expect("3-axis");
+    let text = text_for("generic-hh-ca", "grbl", OutputMode::Joint, flat).expect("3-axis");
     assert!(!text.contains(" A") && !text.contains(" C") && !text.contains("G93") && !text.contains("M6"), "{text}");
-    let blocks = replay(&text, &grbl, &kin).expect("reads");
-    check_replay(&blocks, &records, &kin, &grbl, opts.tol_pos, opts.tol_ang).expect("round trip");
+    replay_check("generic-hh-ca", "grbl", &text, flat).expect("round trip");
 }
 
 #[test]
 fn a_corrupted_word_is_caught_by_the_replay() {
-    let (kin, length, z) = setup("ucp710");
-    let opts = ProgramOptions::default();
-    let records = tilted_circle(z);
-    let program = to_program(&kin, &records, None, &opts).expect("plans");
-    let d = Dialect::builtin("fanuc").expect("shipped");
-    let text = program_text(&program, &kin, &d, &params(OutputMode::Joint, length, &opts)).expect("writes");
+    let text = text_for("ucp710", "fanuc", OutputMode::Joint, tilted_circle).expect("writes");
     // Change one A word by 0.01 deg.
     let line = text.lines().filter(|l| l.contains(" A")).nth(20).expect("a line with A");
     let word = line.split_whitespace().find(|w| w.starts_with('A')).expect("A word");
     let value: f64 = word[1..].parse().expect("number");
     let bad = text.replacen(line, &line.replace(word, &format!("A{:.4}", value + 0.01)), 1);
-    let blocks = replay(&bad, &d, &kin).expect("reads");
-    let err = check_replay(&blocks, &records, &kin, &d, opts.tol_pos, opts.tol_ang);
+    let err = replay_check("ucp710", "fanuc", &bad, tilted_circle);
     assert!(matches!(err, Err(PostError::Deviation { .. })), "{err:?}");
 }
 

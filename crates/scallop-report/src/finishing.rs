@@ -1,7 +1,7 @@
 //! The report of a finishing job (`scallop run`, `scallop demo`).
 
 use scallop_engine::{FinishJob, FinishOutput};
-use scallop_sim::part_heights;
+use scallop_sim::{ZMap, part_heights};
 use scallop_strategy::lookahead_profile;
 
 use crate::{DeviationMap, Figure, Histogram, PathTiming, ReportData, commanded_feed};
@@ -23,19 +23,7 @@ impl ReportData {
             commanded: path.moves().iter().map(|m| commanded_feed(path, m.kind, rapid_rate)).collect(),
             achieved: profile.iter().map(|m| m.peak * 60.0).collect(),
         };
-        let zmap = &d.simulation.zmap;
-        let top = part_heights(zmap, &d.prepared.index);
-        let values: Vec<f64> =
-            zmap.heights().iter().zip(&top).map(|(s, t)| if t.is_finite() { s - t } else { f64::NAN }).collect();
-        let c0 = zmap.cell_center(0, 0);
-        let deviation = DeviationMap {
-            origin: [c0.x, c0.y],
-            cell: [zmap.cell_size().0, zmap.cell_size().1],
-            nx: zmap.nx(),
-            ny: zmap.ny(),
-            values,
-            gouge_tolerance: r.sim_gouge_tolerance_mm,
-        };
+        let deviation = DeviationMap::of_stock(&d.simulation.zmap, &d.prepared.index, r.sim_gouge_tolerance_mm);
         let sc = d.scallop.as_ref();
         let mut figures = vec![
             Figure::number("machining time, stop-to-stop model (a)", p.machining_time_s, 1, "s"),
@@ -109,6 +97,26 @@ impl ReportData {
                 unit: "mm".into(),
             }),
             convergence: Vec::new(),
+        }
+    }
+}
+
+impl DeviationMap {
+    /// The simulated stock's height minus the part's (`index`) at every cell
+    /// of `zmap` (NaN off the part).
+    #[must_use]
+    pub fn of_stock(zmap: &ZMap, index: &scallop_mesh::MeshIndex, gouge_tolerance: f64) -> DeviationMap {
+        let top = part_heights(zmap, index);
+        let values: Vec<f64> =
+            zmap.heights().iter().zip(&top).map(|(s, t)| if t.is_finite() { s - t } else { f64::NAN }).collect();
+        let c0 = zmap.cell_center(0, 0);
+        DeviationMap {
+            origin: [c0.x, c0.y],
+            cell: [zmap.cell_size().0, zmap.cell_size().1],
+            nx: zmap.nx(),
+            ny: zmap.ny(),
+            values,
+            gouge_tolerance,
         }
     }
 }

@@ -20,7 +20,7 @@ use scallop_toolpath::MoveKind;
 use serde_json::{Value, json};
 
 use crate::svg::{Series, bar_chart, escape, line_chart};
-use crate::{Figure, FigureValue, KIND_COLOURS, KIND_NAMES, ReportData, kind_index, tol};
+use crate::{DeviationMap, Figure, FigureValue, KIND_COLOURS, KIND_NAMES, ReportData, kind_index, tol};
 
 /// The viewer's script.
 const VIEWER_JS: &str = include_str!("viewer.js");
@@ -67,6 +67,29 @@ pub fn display_indices(kinds: &[MoveKind], max: usize) -> Vec<usize> {
     (0..n).filter(|&i| i % stride == 0 || i + 1 == n || (keep_boundaries && boundary(i))).collect()
 }
 
+/// The deviation map as the viewer's texture: the map reduced to at most
+/// [`tol::MAX_DISPLAY_DEVIATION_CELLS`] cells, its first cell's centre
+/// relative to the scene centre `c`, its range and the gouge tolerance. The
+/// viewer colours each fragment of the part by the cell under it (so a large
+/// facet shows every cell it covers), faces steeper than
+/// [`tol::WALL_NORMAL_Z`] in the wall colour.
+#[allow(clippy::cast_possible_truncation, reason = "f32 is the display precision")]
+fn deviation_json(d: &DeviationMap, c: [f64; 2]) -> Value {
+    let shown = d.reduced(tol::MAX_DISPLAY_DEVIATION_CELLS);
+    let finite = || shown.values.iter().copied().filter(|v| v.is_finite());
+    json!({
+        "origin": [shown.origin[0] - c[0], shown.origin[1] - c[1]],
+        "cell": shown.cell,
+        "nx": shown.nx,
+        "ny": shown.ny,
+        "values": b64_f32(shown.values.iter().map(|&v| v as f32)),
+        "min": finite().fold(0.0, f64::min),
+        "max": finite().fold(0.0, f64::max),
+        "gougeTolerance": d.gouge_tolerance,
+        "wallNormalZ": tol::WALL_NORMAL_Z,
+    })
+}
+
 /// The scene block of the page (JSON).
 #[allow(clippy::cast_possible_truncation, reason = "f32 is the display precision")]
 fn scene_json(data: &ReportData) -> Value {
@@ -74,26 +97,14 @@ fn scene_json(data: &ReportData) -> Value {
     let c = scallop_geom::Point3::from((bounds.min.coords + bounds.max.coords) * 0.5);
     let radius = (0.5 * (bounds.max - bounds.min).norm()).max(1e-6);
     let rel = |p: &scallop_geom::Point3| [(p.x - c.x) as f32, (p.y - c.y) as f32, (p.z - c.z) as f32];
-    let mut dev_range = json!(null);
     let part = data.part.as_ref().map(|mesh| {
-        let deviation = data.deviation.as_ref().map(|d| {
-            let values: Vec<f32> =
-                mesh.vertices().iter().map(|p| d.at(p.x, p.y).map_or(f32::NAN, |v| v as f32)).collect();
-            let finite = || values.iter().copied().filter(|v| v.is_finite());
-            dev_range = json!({
-                "min": finite().fold(0.0f32, f32::min),
-                "max": finite().fold(0.0f32, f32::max),
-                "gougeTolerance": d.gouge_tolerance,
-            });
-            b64_f32(values.into_iter())
-        });
         json!({
             "positions": b64_f32(mesh.vertices().iter().flat_map(rel)),
             "indices": base64(&mesh.triangles().iter().flatten().flat_map(|i| i.to_le_bytes()).collect::<Vec<u8>>()),
-            "deviation": deviation,
             "triangles": mesh.triangles().len(),
         })
     });
+    let deviation = data.deviation.as_ref().filter(|_| data.part.is_some()).map(|d| deviation_json(d, [c.x, c.y]));
     let path = data.toolpath.as_ref().map(|path| {
         let moves = path.moves();
         let kinds: Vec<MoveKind> = moves.iter().map(|m| m.kind).collect();
@@ -147,8 +158,9 @@ fn scene_json(data: &ReportData) -> Value {
         "part": part,
         "stock": stock,
         "path": path,
-        "deviation": dev_range,
+        "deviation": deviation,
         "zoneNames": data.zones.as_ref().map(|z| z.names.clone()),
+        "zoneLabel": data.zones.as_ref().map(|z| z.label.clone()),
         "kindNames": KIND_NAMES,
         "kindColours": KIND_COLOURS,
     })
@@ -211,7 +223,8 @@ pub fn plots(data: &ReportData) -> Vec<String> {
     if let Some(z) = &data.zones
         && !z.times_s.is_empty()
     {
-        out.push(bar_chart("Machining time per zone", "zone", "time (s)", &z.names, &z.times_s));
+        let title = format!("Machining time per {}", z.label);
+        out.push(bar_chart(&title, &z.label, "time (s)", &z.names, &z.times_s));
     }
     for c in &data.convergence {
         let series: Vec<Series> =

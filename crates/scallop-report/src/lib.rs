@@ -4,8 +4,9 @@
 //! the part, the stock and the toolpath.
 //!
 //! Everything starts from a [`ReportData`]: the commands fill it
-//! ([`ReportData::from_finishing`] for `scallop run` and `scallop demo`, the
-//! CLI for `scallop simulate`), and each writer turns it into bytes.
+//! ([`ReportData::from_finishing`] for `scallop run` and `scallop demo`,
+//! [`ReportData::from_job`] for jobs of several operations, the CLI for
+//! `scallop simulate`), and each writer turns it into bytes.
 //!
 //! ```
 //! use scallop_geom::Point3;
@@ -39,6 +40,7 @@
 mod finishing;
 pub mod glb;
 pub mod html;
+mod job;
 pub mod png;
 pub mod render;
 pub mod svg;
@@ -143,10 +145,13 @@ pub struct PathTiming {
     pub achieved: Vec<f64>,
 }
 
-/// Zones of a toolpath (filled by `scallop optimize`): a zone per move, the
-/// zones' names and machining times.
+/// Zones of a toolpath (filled by `scallop optimize`, and by jobs of several
+/// operations with an operation per zone): a zone per move, the zones' names
+/// and machining times.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Zones {
+    /// What a zone is, for legends and titles ("zone", "operation").
+    pub label: String,
     /// Zone index of each move (into `names`).
     pub of_move: Vec<u16>,
     /// Name of each zone.
@@ -223,6 +228,50 @@ impl DeviationMap {
         #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "checked in range above")]
         let (i, j) = (fx as usize, fy as usize);
         self.values.get(j * self.nx + i).copied().filter(|v| v.is_finite())
+    }
+
+    /// The map with at most `max_cells` cells: square blocks of `k x k`
+    /// cells (the smallest `k` that fits) become one cell centred on the
+    /// block, holding the deepest value of the block when it is a gouge
+    /// (below `-gouge_tolerance`), else the most material left; NaN only
+    /// where no cell of the block lies over the part. Gouges and the largest
+    /// material left thus survive the reduction.
+    #[must_use]
+    pub fn reduced(&self, max_cells: usize) -> DeviationMap {
+        let mut k = 1usize;
+        while self.nx.div_ceil(k) * self.ny.div_ceil(k) > max_cells.max(1) && k < self.nx.max(self.ny) {
+            k += 1;
+        }
+        if k == 1 {
+            return self.clone();
+        }
+        let (nx, ny) = (self.nx.div_ceil(k), self.ny.div_ceil(k));
+        let mut values = vec![f64::NAN; nx * ny];
+        for (j, row) in self.values.chunks(self.nx).enumerate() {
+            for (i, &v) in row.iter().enumerate().filter(|(_, v)| v.is_finite()) {
+                let out = &mut values[(j / k) * nx + i / k];
+                let gouge = |x: f64| x < -self.gouge_tolerance;
+                *out = if out.is_nan() {
+                    v
+                } else if gouge(v) || gouge(*out) {
+                    out.min(v)
+                } else {
+                    out.max(v)
+                };
+            }
+        }
+        #[allow(clippy::cast_precision_loss, reason = "block sizes far below 2^52")]
+        let half = 0.5 * (k - 1) as f64;
+        #[allow(clippy::cast_precision_loss, reason = "block sizes far below 2^52")]
+        let kf = k as f64;
+        DeviationMap {
+            origin: [self.origin[0] + half * self.cell[0], self.origin[1] + half * self.cell[1]],
+            cell: [kf * self.cell[0], kf * self.cell[1]],
+            nx,
+            ny,
+            values,
+            gouge_tolerance: self.gouge_tolerance,
+        }
     }
 }
 

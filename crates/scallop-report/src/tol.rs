@@ -21,3 +21,15 @@ pub const AMBIENT: f64 = 0.25;
 
 /// Scale of the GLB scene: glTF is in metres, scallop in millimetres.
 pub const GLB_SCALE: f64 = 0.001;
+
+/// Above this many cells the deviation map is reduced for the 3D display
+/// (square blocks of cells become one texel: the deepest gouge of the block
+/// when it has one, else the most material left). 512 x 512 cells embed as
+/// 1.4 MB of base64 and are about as fine as the screen on a fitted view.
+pub const MAX_DISPLAY_DEVIATION_CELLS: usize = 512 * 512;
+
+/// The viewer shows faces whose normal's Z component is below this (slopes
+/// over about 84 degrees) in the wall colour: a height map seen from above
+/// does not measure them (every point of a vertical face would take the
+/// deviation of the surface above or beside it).
+pub const WALL_NORMAL_Z: f64 = 0.1;

@@ -24,6 +24,9 @@
     var i = Math.min(3, Math.floor(t)), f = t - i;
     for (var c = 0; c < 3; c++) out[k + c] = (STOPS[i][c] + (STOPS[i + 1][c] - STOPS[i][c]) * f) / 255;
   }
+  // Deviation view: gouges, cells with no part under them, walls (not measured from above).
+  var GOUGE = [230, 0, 230], NO_PART = [77, 77, 77], WALL = [205, 205, 190];
+  function rgb(c) { return "vec3(" + c.map(function (v) { return (v / 255).toFixed(4); }).join(", ") + ")"; }
   var ZONE_COLOURS = [[31, 119, 180], [255, 127, 14], [44, 160, 44], [214, 39, 40], [148, 103, 189],
     [140, 86, 75], [227, 119, 194], [127, 127, 127], [188, 189, 34], [23, 190, 207]];
 
@@ -62,10 +65,21 @@
   var VS_MESH = "attribute vec3 aPos; attribute vec3 aNormal; attribute vec3 aColour; uniform mat4 uMvp;" +
     "varying vec3 vPos; varying vec3 vNormal; varying vec3 vColour;" +
     "void main() { vPos = aPos; vNormal = aNormal; vColour = aColour; gl_Position = uMvp * vec4(aPos, 1.0); }";
-  var FS_MESH = "precision mediump float; uniform vec4 uPlane; uniform vec3 uLight;" +
-    "varying vec3 vPos; varying vec3 vNormal; varying vec3 vColour;" +
+  // Deviation colouring per fragment: the cell of the deviation map under the
+  // fragment (a texture, nearest cell), so a large facet shows every cell it
+  // covers; faces steeper than wallNormalZ take the wall colour (a height map
+  // seen from above does not measure them), cells with no part the grey.
+  var FS_MESH = "#ifdef GL_FRAGMENT_PRECISION_HIGH\nprecision highp float;\n#else\nprecision mediump float;\n#endif\n" +
+    "uniform vec4 uPlane; uniform vec3 uLight; uniform float uDevMode; uniform vec4 uDevRect; uniform float uWallZ;" +
+    "uniform sampler2D uDev; varying vec3 vPos; varying vec3 vNormal; varying vec3 vColour;" +
     "void main() { if (dot(uPlane.xyz, vPos) > uPlane.w) discard;" +
-    " float l = 0.3 + 0.7 * abs(dot(normalize(vNormal), uLight)); gl_FragColor = vec4(vColour * l, 1.0); }";
+    " vec3 n = normalize(vNormal); vec3 c = vColour;" +
+    " if (uDevMode > 0.5) {" +
+    "  vec2 uv = (vPos.xy - uDevRect.xy) * uDevRect.zw;" +
+    "  vec4 t = texture2D(uDev, clamp(uv, 0.0, 1.0));" +
+    "  bool inside = uv.x >= 0.0 && uv.y >= 0.0 && uv.x <= 1.0 && uv.y <= 1.0 && t.a > 0.5;" +
+    "  c = abs(n.z) < uWallZ ? " + rgb(WALL) + " : inside ? t.rgb : " + rgb(NO_PART) + "; }" +
+    " float l = 0.3 + 0.7 * abs(dot(n, uLight)); gl_FragColor = vec4(c * l, 1.0); }";
   var VS_LINE = "attribute vec3 aPos; attribute vec3 aColour; attribute float aTime; uniform mat4 uMvp;" +
     "uniform float uPointSize; varying vec3 vPos; varying vec3 vColour; varying float vTime;" +
     "void main() { vPos = aPos; vColour = aColour; vTime = aTime; gl_PointSize = uPointSize;" +
@@ -88,7 +102,7 @@
     gl.linkProgram(p);
     if (!gl.getProgramParameter(p, gl.LINK_STATUS)) throw new Error("link: " + gl.getProgramInfoLog(p));
     p.u = {};
-    ["uMvp", "uPlane", "uLight", "uTime", "uPointSize"].forEach(function (n) { p.u[n] = gl.getUniformLocation(p, n); });
+    ["uMvp", "uPlane", "uLight", "uTime", "uPointSize", "uDevMode", "uDevRect", "uWallZ", "uDev"].forEach(function (n) { p.u[n] = gl.getUniformLocation(p, n); });
     return p;
   }
   function buffer(array) {
@@ -113,7 +127,6 @@
   function buildPart() {
     if (!data.part) return;
     var pos = decode(data.part.positions, Float32Array), idx = decode(data.part.indices, Uint32Array);
-    var dev = decode(data.part.deviation, Float32Array);
     var n = idx.length, p = new Float32Array(3 * n), nn = new Float32Array(3 * n);
     for (var t = 0; t < n; t += 3) {
       var a = 3 * idx[t], b = 3 * idx[t + 1], c = 3 * idx[t + 2];
@@ -125,7 +138,32 @@
         for (var d = 0; d < 3; d++) { p[3 * (t + k) + d] = pos[v + d]; nn[3 * (t + k) + d] = fn[d]; }
       }
     }
-    part = { count: n, pos: buffer(p), normal: buffer(nn), colour: gl.createBuffer(), idx: idx, dev: dev };
+    var c = new Float32Array(3 * n);
+    for (t = 0; t < 3 * n; t += 3) { c[t] = 0.67; c[t + 1] = 0.73; c[t + 2] = 0.8; }
+    part = { count: n, pos: buffer(p), normal: buffer(nn), colour: buffer(c) };
+  }
+  // The deviation map as an RGBA texture (one texel per cell, alpha 0 where no part lies).
+  var devTexture = null;
+  function buildDeviation() {
+    var d = data.deviation;
+    if (!d || !part || d.nx < 1 || d.ny < 1) return;
+    var limit = gl.getParameter(gl.MAX_TEXTURE_SIZE);
+    if (d.nx > limit || d.ny > limit) { ui.pathNote.textContent += " (the deviation map is larger than this browser's textures)"; return; }
+    var v = decode(d.values, Float32Array), px = new Uint8Array(4 * d.nx * d.ny), c = [0, 0, 0];
+    for (var i = 0; i < v.length; i++) {
+      if (!isFinite(v[i])) continue;
+      if (v[i] < -d.gougeTolerance) c = GOUGE.map(function (x) { return x / 255; });
+      else ramp(d.max > 0 ? Math.max(0, v[i]) / d.max : 0, c, 0);
+      for (var k = 0; k < 3; k++) px[4 * i + k] = Math.round(255 * c[k]);
+      px[4 * i + 3] = 255;
+    }
+    devTexture = gl.createTexture();
+    gl.bindTexture(gl.TEXTURE_2D, devTexture);
+    gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
+    gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA, d.nx, d.ny, 0, gl.RGBA, gl.UNSIGNED_BYTE, px);
+    [gl.TEXTURE_MIN_FILTER, gl.TEXTURE_MAG_FILTER].forEach(function (f) { gl.texParameteri(gl.TEXTURE_2D, f, gl.NEAREST); });
+    [gl.TEXTURE_WRAP_S, gl.TEXTURE_WRAP_T].forEach(function (w) { gl.texParameteri(gl.TEXTURE_2D, w, gl.CLAMP_TO_EDGE); });
+    devTexture.rect = [d.origin[0] - 0.5 * d.cell[0], d.origin[1] - 0.5 * d.cell[1], 1 / (d.cell[0] * d.nx), 1 / (d.cell[1] * d.ny)];
   }
   function buildStock() {
     if (!data.stock) return;
@@ -162,19 +200,6 @@
   }
   function colourise() {
     var mode = ui.colour.value, legend = "", i, k;
-    if (part) {
-      var c = new Float32Array(3 * part.count), dv = data.deviation;
-      for (i = 0; i < part.count; i++) {
-        if (mode === "deviation" && part.dev) {
-          var v = part.dev[part.idx[i]];
-          if (!isFinite(v)) { c[3 * i] = c[3 * i + 1] = c[3 * i + 2] = 0.3; }
-          else if (v < -dv.gougeTolerance) { c[3 * i] = 0.9; c[3 * i + 1] = 0; c[3 * i + 2] = 0.9; }
-          else ramp(dv.max > 0 ? Math.max(0, v) / dv.max : 0, c, 3 * i);
-        } else { c[3 * i] = 0.67; c[3 * i + 1] = 0.73; c[3 * i + 2] = 0.8; }
-      }
-      gl.bindBuffer(gl.ARRAY_BUFFER, part.colour);
-      gl.bufferData(gl.ARRAY_BUFFER, c, gl.STATIC_DRAW);
-    }
     if (path) {
       var pc = new Float32Array(3 * path.count), maxFeed = data.path.maxFeed || 1;
       for (i = 0; i < path.count; i++) {
@@ -193,14 +218,15 @@
       Math.round(data.path.maxFeed) + " mm/min</span>";
     if (mode === "zone") legend = (data.zoneNames || []).map(function (n, j) { return swatch(ZONE_COLOURS[j % ZONE_COLOURS.length], n); }).join("");
     if (mode === "deviation") legend = "<span>material left: 0 <span class=\"ramp\"></span> " + data.deviation.max.toFixed(4) +
-      " mm</span>" + swatch([230, 0, 230], "gouge (below -" + data.deviation.gougeTolerance.toFixed(4) + " mm)") + swatch([77, 77, 77], "no part");
+      " mm</span>" + swatch(GOUGE, "gouge (below -" + data.deviation.gougeTolerance.toFixed(4) + " mm)") + swatch(NO_PART, "no part") +
+      swatch(WALL, "wall (steeper than " + Math.round(Math.acos(data.deviation.wallNormalZ) * 180 / Math.PI) + "°: not measured from above)");
     ui.legend.innerHTML = legend;
   }
   function colourModes() {
     var modes = [["kind", "move type"]];
     if (data.path && data.path.feeds) modes.push(["feed", "achieved feed"]);
-    if (data.path && data.path.zones) modes.push(["zone", "zone"]);
-    if (data.part && data.part.deviation) modes.push(["deviation", "simulated deviation"]);
+    if (data.path && data.path.zones) modes.push(["zone", data.zoneLabel || "zone"]);
+    if (devTexture) modes.push(["deviation", "simulated deviation"]);
     ui.colour.innerHTML = modes.map(function (m) { return "<option value=\"" + m[0] + "\">" + m[1] + "</option>"; }).join("");
   }
 
@@ -252,6 +278,15 @@
         gl.uniformMatrix4fv(meshProg.u.uMvp, false, mvp);
         gl.uniform4fv(meshProg.u.uPlane, pl);
         gl.uniform3fv(meshProg.u.uLight, light);
+        var dev = devTexture && ui.colour.value === "deviation";
+        gl.uniform1f(meshProg.u.uDevMode, dev ? 1 : 0);
+        if (dev) {
+          gl.activeTexture(gl.TEXTURE0);
+          gl.bindTexture(gl.TEXTURE_2D, devTexture);
+          gl.uniform1i(meshProg.u.uDev, 0);
+          gl.uniform4fv(meshProg.u.uDevRect, devTexture.rect);
+          gl.uniform1f(meshProg.u.uWallZ, data.deviation.wallNormalZ);
+        }
         attrib(meshProg, "aPos", part.pos, 3); attrib(meshProg, "aNormal", part.normal, 3); attrib(meshProg, "aColour", part.colour, 3);
         gl.enable(gl.POLYGON_OFFSET_FILL); gl.polygonOffset(1, 1);
         gl.drawArrays(gl.TRIANGLES, 0, part.count);
@@ -361,12 +396,15 @@
     meshProg = program(VS_MESH, FS_MESH);
     lineProg = program(VS_LINE, FS_LINE);
     gl.enable(gl.DEPTH_TEST);
-    buildPart(); buildStock(); buildPath();
+    buildPart(); buildStock(); buildPath(); buildDeviation();
     if (!data.path) document.getElementById("player").style.display = "none";
     colourModes();
     // report.html#colour=feed opens with that colouring (for links and screenshots).
     var asked = /colour=(\w+)/.exec(window.location.hash);
     if (asked && ui.colour.querySelector("option[value=\"" + asked[1] + "\"]")) ui.colour.value = asked[1];
+    // ...and report.html#hide=path,stock starts with those layers hidden.
+    var hide = /hide=([\w,]+)/.exec(window.location.hash), layers = { part: "showPart", stock: "showStock", path: "showPath", rapids: "showRapids" };
+    if (hide) hide[1].split(",").forEach(function (h) { if (layers[h]) ui[layers[h]].checked = false; });
     colourise(); controls(); fit();
   } catch (ex) {
     report("viewer: " + (ex && ex.message ? ex.message : ex));

@@ -8,7 +8,7 @@ use scallop_engine::{FinishJob, Part, run_finishing};
 use scallop_geom::Point3;
 use scallop_mesh::TriMesh;
 use scallop_report::html::{base64, display_indices, report_html};
-use scallop_report::{Figure, PathTiming, ReportData, Zones, tol};
+use scallop_report::{DeviationMap, Figure, PathTiming, ReportData, Zones, tol};
 use scallop_toolpath::{Move, MoveKind, Toolpath};
 use serde_json::Value;
 
@@ -83,8 +83,12 @@ fn the_page_is_self_contained_and_carries_its_scene() {
     let mut data = ReportData::new("a <small> & \"quoted\" job");
     data.part = Some(mesh.clone());
     data.toolpath = Some(raster(2000));
-    data.zones =
-        Some(Zones { of_move: vec![1; 2000], names: vec!["flat".into(), "steep".into()], times_s: vec![2.0, 3.0] });
+    data.zones = Some(Zones {
+        label: "zone".into(),
+        of_move: vec![1; 2000],
+        names: vec!["flat".into(), "steep".into()],
+        times_s: vec![2.0, 3.0],
+    });
     data.figures = vec![Figure::count("moves", 2000), Figure::text("script", "</script><script>alert(1)</script>")];
     let page = report_html(&data);
     for bad in ["http://", "https://", " src=", " href=", "<link", "@import", "url(", "<iframe", "<img"] {
@@ -204,8 +208,12 @@ fn the_figures_table_holds_the_reports_numbers() {
     // Plots: feed along the path and the scallop histogram; deviation colouring.
     assert!(page.contains("Feed along the cutting path") && page.contains("Measured scallop heights"));
     let s = scene(&page);
-    assert!(s["part"]["deviation"].is_string() && s["path"]["feeds"].is_string());
+    assert!(s["deviation"]["values"].is_string() && s["path"]["feeds"].is_string());
     assert!(s["deviation"]["max"].as_f64().unwrap() >= 0.0);
+    // The viewer's texture is the simulated map itself (small enough not to be reduced).
+    let d = data.deviation.as_ref().unwrap();
+    assert!(d.nx * d.ny <= tol::MAX_DISPLAY_DEVIATION_CELLS);
+    assert_eq!((s["deviation"]["nx"].as_u64(), s["deviation"]["ny"].as_u64()), (Some(d.nx as u64), Some(d.ny as u64)));
 }
 
 proptest! {
@@ -226,6 +234,45 @@ proptest! {
         if 2 * changes.len() <= max / 2 {
             for i in changes {
                 prop_assert!(keep.binary_search(&i).is_ok() && keep.binary_search(&(i - 1)).is_ok());
+            }
+        }
+    }
+}
+
+proptest! {
+    /// The display reduction of a deviation map fits the budget, and every
+    /// cell of the map finds its block by position (`at`): a cell over the
+    /// part lies in a block over the part, a gouge in a block at least as deep,
+    /// a cell's material left in a block with at least as much (or a gouge).
+    #[test]
+    fn reduced_deviation_keeps_gouges_and_the_most_material_left(
+        nx in 1usize..60, ny in 1usize..60, max_cells in 1usize..400,
+        seed in proptest::collection::vec((0u8..4, -1.0f64..1.0), 3600),
+        origin in (-50.0f64..50.0, -50.0f64..50.0), cell in (0.05f64..2.0, 0.05f64..2.0),
+    ) {
+        let values: Vec<f64> = seed[..nx * ny]
+            .iter()
+            .map(|&(kind, v)| match kind { 0 => f64::NAN, 1 => -0.1 - v.abs(), _ => v.abs() })
+            .collect();
+        let map = DeviationMap {
+            origin: [origin.0, origin.1], cell: [cell.0, cell.1], nx, ny, values, gouge_tolerance: 0.05,
+        };
+        let shown = map.reduced(max_cells);
+        prop_assert!(shown.nx * shown.ny <= max_cells);
+        for j in 0..ny {
+            for i in 0..nx {
+                let v = map.values[j * nx + i];
+                let (x, y) = (origin.0 + i as f64 * cell.0, origin.1 + j as f64 * cell.1);
+                let block = shown.at(x, y);
+                if v.is_nan() {
+                    continue;
+                }
+                let b = block.expect("a cell over the part lies in a block over the part");
+                if v < -map.gouge_tolerance {
+                    prop_assert!(b <= v, "gouge {v} in a block of {b}");
+                } else {
+                    prop_assert!(b >= v || b < -map.gouge_tolerance, "material {v} in a block of {b}");
+                }
             }
         }
     }

@@ -22,10 +22,12 @@ use scallop_waterline::{WaterlineGrid, WaterlineOptions};
 
 mod adaptive;
 mod grid;
+mod material;
 mod offset;
 pub mod tol;
 
 pub use adaptive::plan_adaptive;
+pub use material::{MaterialMap, limit_to_material};
 pub use offset::{Step, plan_offset};
 
 /// Why a roughing plan could not be made; each variant names the setting and the fix.
@@ -271,6 +273,10 @@ pub fn level_regions(
 /// One connected part of one level, with its clearing plan.
 struct Node {
     z: f64,
+    /// The top of the material above the node before it is cut: its
+    /// parent's level, else the stock's top (or the material's, see
+    /// [`plan_rough_from`]).
+    top: f64,
     region: Region,
     parent: Option<usize>,
     steps: Vec<Step>,
@@ -290,9 +296,38 @@ pub fn plan_rough(
     motion: &Motion,
     tolerance: f64,
 ) -> Result<RoughPlan, RoughError> {
+    plan_rough_from(index, cutter, stock, None, settings, motion, tolerance)
+}
+
+/// As [`plan_rough`], from the in-process stock `material` when given (the
+/// stock the earlier operations left, inside the box `stock`): each level's
+/// region is cut down to the centres that reach material to remove
+/// ([`limit_to_material`]), so a smaller tool after a larger one machines
+/// only what the larger one left (rest roughing), and entries start from
+/// the material's top rather than the box's.
+///
+/// # Errors
+/// As [`plan_rough`].
+pub fn plan_rough_from(
+    index: &MeshIndex,
+    cutter: &Cutter,
+    stock: &Aabb3,
+    material: Option<&MaterialMap>,
+    settings: &RoughSettings,
+    motion: &Motion,
+    tolerance: f64,
+) -> Result<RoughPlan, RoughError> {
     settings.validate()?;
     let zs = level_heights(index, stock, settings);
-    let levels = level_regions(index, cutter, stock, settings, &zs, tolerance)?;
+    let mut levels = level_regions(index, cutter, stock, settings, &zs, tolerance)?;
+    if let Some(m) = material {
+        let r = cutter.radius();
+        levels = levels
+            .into_par_iter()
+            .map(|l| Level { region: limit_to_material(&l.region, m, l.z, r, tolerance), z: l.z })
+            .filter(|l| !l.region.is_empty())
+            .collect();
+    }
     let options = ClearOptions {
         tool_radius: cutter.radius(),
         stepover: settings.stepover * 2.0 * cutter.radius(),
@@ -300,7 +335,20 @@ pub fn plan_rough(
         chord_tolerance: tolerance,
         pattern: settings.pattern,
     };
-    let nodes = build_tree(&levels, &options)?;
+    let mut nodes = build_tree(&levels, &options)?;
+    if let Some(m) = material {
+        // A node with no parent is entered from the material's top over its
+        // region grown by the tool radius (not the box's top).
+        let r = cutter.radius();
+        for n in nodes.iter_mut().filter(|n| n.parent.is_none()) {
+            if let Some((lo, hi)) = n.region.bounds() {
+                n.top = m
+                    .top_in([lo[0] - r, lo[1] - r], [hi[0] + r, hi[1] + r])
+                    .map_or(n.z, |t| t.max(n.z))
+                    .min(stock.max.z);
+            }
+        }
+    }
     let mut out = Emitter::new(motion, stock.max.z, &options);
     let roots: Vec<usize> = (0..nodes.len()).filter(|&k| nodes[k].parent.is_none()).collect();
     visit_all(&nodes, &roots, &mut out);
@@ -334,7 +382,8 @@ fn build_tree(levels: &[Level], options: &ClearOptions) -> Result<Vec<Node>, Rou
         } else {
             (first_of_level[k - 1]..first_of_level[k]).find(|&p| contains_part(&out[p].region, &region))
         };
-        out.push(Node { z: levels[k].z, region, parent, steps });
+        let top = parent.map_or(f64::INFINITY, |p| out[p].z);
+        out.push(Node { z: levels[k].z, top, region, parent, steps });
     }
     Ok(out)
 }
@@ -441,7 +490,7 @@ impl Emitter {
     /// The moves of node `k`: the way there, then its passes and links.
     fn node(&mut self, nodes: &[Node], k: usize) {
         let node = &nodes[k];
-        let above = node.parent.map_or(self.stock_top, |p| nodes[p].z);
+        let above = node.top.min(self.stock_top);
         let mut first = true;
         for step in &node.steps {
             match step {
@@ -475,7 +524,7 @@ impl Emitter {
     /// levels above `k` and a plunge.
     fn enter(&mut self, nodes: &[Node], k: usize, s: P2) {
         let node = &nodes[k];
-        let above = node.parent.map_or(self.stock_top, |p| nodes[p].z);
+        let above = node.top.min(self.stock_top);
         let (Some(here), Some(last)) = (self.at(), self.last) else {
             self.path.push(Move::new(MoveKind::Rapid, Point3::new(s[0], s[1], self.clearance)));
             self.plunge(s, above, node.z, &node.region);
@@ -639,7 +688,7 @@ pub fn pocket_toolpath(
     let mut nodes = Vec::new();
     for part in region.components() {
         let steps = plan_region(&part, options)?;
-        nodes.push(Node { z, region: part, parent: None, steps });
+        nodes.push(Node { z, top, region: part, parent: None, steps });
     }
     let roots: Vec<usize> = (0..nodes.len()).collect();
     visit_all(&nodes, &roots, &mut out);

@@ -58,6 +58,17 @@ pub const HELIX_SLOPE: f64 = 0.05;
 /// normal) stands for the region in containment tests between levels (mm).
 pub const INTERIOR_NUDGE: f64 = 1e-3;
 
+/// Material less than this above a level (mm) is not worth a pass: the
+/// in-process stock's cells that hold only this much over the level count
+/// as cleared (see `material.rs`).
+pub const MIN_CHIP: f64 = 0.05;
+
+/// Most cells of an in-process stock map (bounds the memory of the outline
+/// tracing on absurd inputs).
+pub const MAX_MATERIAL_CELLS: usize = 64_000_000;
+
+// ---- Adaptive clearing (branch adaptive; issue 16) ----
+
 /// Adaptive clearing: the grid's cell side as a share of the tool radius
 /// (R / 16: 0.19 mm for a 6 mm tool).
 pub const GRID_SHARE: f64 = 1.0 / 16.0;
@@ -96,3 +107,4 @@ pub const ARC_FIT: f64 = 0.01;
 /// geometry, not the step, sets the engagement there, and the larger step
 /// is kept.
 pub const STEP_STALL: f64 = 0.035;
+// ---- end of adaptive clearing ----

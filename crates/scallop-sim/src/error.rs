@@ -45,12 +45,9 @@ pub enum SimError {
     },
     /// The stock was cut below the part by more than the gouge tolerance.
     #[error(
-        "gouge: {count} cells lie below the part by more than {tolerance} mm; the worst is {depth:.4} mm deep at \
-         ({x:.3}, {y:.3}), cut by {cut_by}; fix the toolpath there (drop-cutter contact, stepdown or linking)",
-        depth = worst.first().map_or(0.0, |g| g.depth),
-        x = worst.first().map_or(0.0, |g| g.at.x),
-        y = worst.first().map_or(0.0, |g| g.at.y),
-        cut_by = worst.first().and_then(|g| g.cut_by).map_or_else(|| "no move".to_string(), |m| m.to_string())
+        "gouge: {count} cells lie below the part by more than {tolerance} mm; the worst is {deepest}; \
+         fix the toolpath there (drop-cutter contact, stepdown or linking)",
+        deepest = Deepest(worst.first().map(|g| (g.depth, [g.at.x, g.at.y], g.cut_by)))
     )]
     Gouge {
         /// Number of gouged cells.
@@ -76,13 +73,12 @@ pub enum SimError {
     #[error(
         "{count} moves drive the {what} into the stock; the first is {first}; \
          use longer flutes or a longer shank, or cut in more stepdowns",
+        count = collisions.len(),
         what = first_part(collisions),
         first = first_collision(collisions)
     )]
     HolderCollision {
-        /// Number of colliding moves.
-        count: usize,
-        /// The first ones, in program order.
+        /// The colliding moves, in program order.
         collisions: Vec<Collision>,
     },
     /// The shank or holder touched the design part itself.
@@ -90,13 +86,12 @@ pub enum SimError {
         "{count} moves drive the {what} into the part; the first is {first} \
          (part surface above the {what}'s lower face); use a tool with longer flutes or a longer reach, \
          or keep the passes farther from that wall",
+        count = collisions.len(),
         what = first_part(collisions),
         first = first_collision(collisions)
     )]
     PartCollision {
-        /// Number of colliding moves (per part of the tool).
-        count: usize,
-        /// The first ones, in program order.
+        /// The colliding moves, in program order.
         collisions: Vec<Collision>,
     },
     /// An uncut cell lies below the part: the stock box does not contain the part.
@@ -167,13 +162,9 @@ pub enum SimError {
     },
     /// Part material was removed beyond the gouge tolerance (tri-dexel stock).
     #[error(
-        "gouge: {count} ray pieces of the part were cut deeper than {tolerance} mm; the worst is {depth:.4} mm deep \
-         at ({x:.3}, {y:.3}, {z:.3}), cut by {cut_by}; fix the toolpath there (contact point, tool axis or linking)",
-        depth = worst.first().map_or(0.0, |g| g.depth),
-        x = worst.first().map_or(0.0, |g| g.at.x),
-        y = worst.first().map_or(0.0, |g| g.at.y),
-        z = worst.first().map_or(0.0, |g| g.at.z),
-        cut_by = worst.first().and_then(|g| g.cut_by).map_or_else(|| "no move".to_string(), |m| m.to_string())
+        "gouge: {count} ray pieces of the part were cut deeper than {tolerance} mm; the worst is {deepest}; \
+         fix the toolpath there (contact point, tool axis or linking)",
+        deepest = Deepest(worst.first().map(|g| (g.depth, [g.at.x, g.at.y, g.at.z], g.cut_by)))
     )]
     DexelGouge {
         /// Number of gouged ray pieces.
@@ -187,11 +178,10 @@ pub enum SimError {
     #[error(
         "{count} moves drive the shank or holder into the stock; the first: {first}; \
          use longer flutes or a longer shank, change the tool axis, or cut in more stepdowns",
+        count = collisions.len(),
         first = collisions.first().map_or_else(String::new, ToString::to_string)
     )]
     DexelCollision {
-        /// Number of colliding moves (per part of the tool).
-        count: usize,
         /// The collisions, in program order.
         collisions: Vec<DexelCollision>,
     },
@@ -200,11 +190,10 @@ pub enum SimError {
         "{count} moves drive the shank or holder into the part; the first: {first} (part material inside the \
          tool along a ray); use a tool with longer flutes or a longer reach, change the tool axis, or keep the \
          passes farther from that feature",
+        count = collisions.len(),
         first = collisions.first().map_or_else(String::new, |c| c.to_string().replace("into the stock", "into the part"))
     )]
     DexelPartCollision {
-        /// Number of colliding moves (per part of the tool).
-        count: usize,
         /// The collisions, in program order.
         collisions: Vec<DexelCollision>,
     },
@@ -255,6 +244,22 @@ impl std::fmt::Display for FirstPlace {
     }
 }
 
+/// The deepest gouge, shown as `DEPTH mm deep at (x, y[, z]), cut by MOVE`
+/// (zeros and "no move" for an empty list, which the verifiers never report).
+struct Deepest<const N: usize>(Option<(f64, [f64; N], Option<MoveId>)>);
+
+impl<const N: usize> std::fmt::Display for Deepest<N> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let (depth, at, cut_by) = self.0.unwrap_or((0.0, [0.0; N], None));
+        let at: Vec<String> = at.iter().map(|c| format!("{c:.3}")).collect();
+        write!(f, "{depth:.4} mm deep at ({}), cut by ", at.join(", "))?;
+        match cut_by {
+            Some(id) => write!(f, "{id}"),
+            None => f.write_str("no move"),
+        }
+    }
+}
+
 fn first_collision(collisions: &[Collision]) -> FirstPlace {
     FirstPlace(collisions.first().map(|c| (c.id, c.at, c.depth)))
 }
@@ -262,4 +267,30 @@ fn first_collision(collisions: &[Collision]) -> FirstPlace {
 /// The part of the tool of the first collision ("shank" for an empty list).
 fn first_part(collisions: &[Collision]) -> &'static str {
     collisions.first().map_or("shank", |c| c.part.name())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{Deepest, SimError};
+    use crate::{GougeCell, MoveId};
+    use scallop_geom::Point2;
+
+    #[test]
+    fn a_gouge_names_its_deepest_cell_and_the_move() {
+        let cell = GougeCell {
+            cell: (3, 4),
+            at: Point2::new(1.25, -2.5),
+            stock_z: 0.9,
+            part_z: 1.0,
+            depth: 0.1,
+            cut_by: Some(MoveId { operation: 1, index: 7 }),
+        };
+        let text = SimError::Gouge { count: 1, tolerance: 0.01, worst: vec![cell] }.to_string();
+        assert!(
+            text.contains("the worst is 0.1000 mm deep at (1.250, -2.500), cut by move 7 of operation 1;"),
+            "{text}"
+        );
+        let none = Deepest::<3>(None).to_string();
+        assert_eq!(none, "0.0000 mm deep at (0.000, 0.000, 0.000), cut by no move");
+    }
 }

@@ -99,7 +99,7 @@ pub use dexel::{
 pub use engagement::{EngagementOptions, EngagementReport, Pocket, engagement_angle, pocket_engagement};
 pub use envelope::swept_floor;
 pub use error::SimError;
-pub use rest::{RestPlace, RestSplit, split_rest};
+pub use rest::{OverCell, RestPlace, RestSplit, split_rest};
 pub use verify::{GougeCell, PartField, Verification, VerifyOptions, part_heights, verify, verify_in};
 pub use view::StockView;
 pub use zmap::{Collision, CutReport, MAX_CELLS, MoveId, RapidHit, ToolPart, ZMap};
@@ -149,8 +149,25 @@ pub fn simulate(
     part: &MeshIndex,
     options: &VerifyOptions,
 ) -> Result<Simulation, SimError> {
+    simulate_with_progress(stock, resolution, cutter, toolpath, part, options, &|_, _| {})
+}
+
+/// [`simulate`], calling `progress(done, total)` as the cut proceeds (bands
+/// of rows cut, of all bands; see [`ZMap::cut_with_progress`]).
+///
+/// # Errors
+/// As [`simulate`].
+pub fn simulate_with_progress(
+    stock: Aabb3,
+    resolution: f64,
+    cutter: &Cutter,
+    toolpath: &Toolpath,
+    part: &MeshIndex,
+    options: &VerifyOptions,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<Simulation, SimError> {
     let mut zmap = ZMap::new(stock, resolution)?;
-    let cut = zmap.cut(cutter, toolpath)?;
+    let cut = zmap.cut_with_progress(cutter, toolpath, progress)?;
     if !cut.rapid_hits.is_empty() {
         cut.check()?;
     }
@@ -160,7 +177,7 @@ pub fn simulate(
     let field = PartField::new(&zmap, part);
     let collisions = zmap.part_collisions_in(&field, cutter, toolpath, cut.operation)?;
     if !collisions.is_empty() {
-        return Err(SimError::PartCollision { count: collisions.len(), collisions });
+        return Err(SimError::PartCollision { collisions });
     }
     cut.check()?;
     let verification = verify_in(&zmap, &field, options)?;
@@ -226,7 +243,7 @@ pub fn simulate_dexel(
     if options.check_collisions {
         let collisions = dexels.part_collisions(part, cutter, moves, options, cut.operation)?;
         if !collisions.is_empty() {
-            return Err(SimError::DexelPartCollision { count: collisions.len(), collisions });
+            return Err(SimError::DexelPartCollision { collisions });
         }
     }
     cut.check()?;

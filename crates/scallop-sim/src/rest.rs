@@ -20,7 +20,7 @@
 
 use rayon::prelude::*;
 use scallop_cutter::{Cutter, drop_cutter};
-use scallop_geom::Point2;
+use scallop_geom::{Point2, Point3};
 use scallop_mesh::MeshIndex;
 
 use crate::verify::{PartField, edge_distance2};
@@ -52,6 +52,21 @@ pub struct RestSplit {
     pub unreachable_depth: f64,
     /// The places, largest first (at most [`crate::tol::WORST_REPORTED`]).
     pub places: Vec<RestPlace>,
+    /// The cells of the machined surface whose scallop exceeds the limit,
+    /// thickest first (at most [`crate::tol::OVER_REPORTED`]): the places a
+    /// planner has to refine.
+    pub machined_over: Vec<OverCell>,
+}
+
+/// A cell of the machined surface with more than the limit left on it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OverCell {
+    /// The part's surface point under the cell's centre (mm).
+    pub at: Point3,
+    /// The vertical component of the part's normal there.
+    pub nz: f64,
+    /// The scallop there, along the normal (mm).
+    pub thickness: f64,
 }
 
 /// Splits the material the program left on `zmap` over the part (`field`,
@@ -104,6 +119,19 @@ pub fn split_rest(
         }
         rest[k] = r;
     }
+    let mut machined_over: Vec<OverCell> = candidates
+        .iter()
+        .zip(&split)
+        .filter(|&(_, &(m, _))| m > limit)
+        .map(|(&k, &(m, _))| {
+            let c = zmap.cell_center(k % nx, k / nx);
+            OverCell { at: Point3::new(c.x, c.y, top[k].0), nz: top[k].1, thickness: m }
+        })
+        .collect();
+    machined_over.sort_by(|a, b| {
+        b.thickness.total_cmp(&a.thickness).then(a.at.x.total_cmp(&b.at.x)).then(a.at.y.total_cmp(&b.at.y))
+    });
+    machined_over.truncate(crate::tol::OVER_REPORTED);
     let places = places(&rest, zmap);
     let area = cx * cy;
     #[allow(clippy::cast_precision_loss, reason = "cell counts")]
@@ -114,6 +142,7 @@ pub fn split_rest(
         unreachable_area,
         unreachable_depth: rest.iter().copied().fold(0.0, f64::max),
         places,
+        machined_over,
     }
 }
 

@@ -9,6 +9,10 @@ pub const GRID_SNAP: f64 = 1e-9;
 /// Default number of gouge cells listed in a [`crate::SimError::Gouge`].
 pub const WORST_REPORTED: usize = 20;
 
+/// Cells of the machined surface over the scallop limit that
+/// [`crate::split_rest`] lists for a refinement, at most (the thickest).
+pub const OVER_REPORTED: usize = 20_000;
+
 /// Slopes `|dz / L|` of a move above this are treated as vertical: the
 /// horizontal travel is then below 1e-100 of the vertical one, far below
 /// rounding, and the slope's square stays finite in the closed forms.

@@ -7,7 +7,7 @@ use rayon::prelude::*;
 use scallop_cutter::{Cutter, CutterShape};
 use scallop_geom::{Aabb3, Eps, Point2, Point3};
 use scallop_mesh::MeshIndex;
-use scallop_toolpath::{MoveKind, Toolpath};
+use scallop_toolpath::{Move, MoveKind, Toolpath};
 
 use crate::SimError;
 use crate::envelope::SweptMove;
@@ -111,6 +111,10 @@ pub struct CutReport {
     pub feed_moves: usize,
     /// Feed moves that lowered no cell by more than the stock's rounding epsilon.
     pub air_feed_moves: usize,
+    /// Length of the feed moves (mm).
+    pub feed_length_mm: f64,
+    /// Length of the feed moves that cut air (mm).
+    pub air_feed_length_mm: f64,
     /// Rapid and retract moves that removed stock, in program order (errors).
     pub rapid_hits: Vec<RapidHit>,
     /// Shank and holder collisions with the in-process stock, in program order (errors).
@@ -135,11 +139,20 @@ impl CutReport {
     /// let report = zmap.cut(&flat, &path).unwrap();
     /// assert_eq!((report.feed_moves, report.air_feed_moves), (2, 1));
     /// assert_eq!(report.air_cut_share(), 0.5);
+    /// assert!((report.air_length_share() - 0.5).abs() < 1e-12);
     /// assert!(report.check().is_ok());
     /// ```
     #[must_use]
     pub fn air_cut_share(&self) -> f64 {
         air_share(self.air_feed_moves, self.feed_moves)
+    }
+
+    /// Share of the feed length that cut air, in [0, 1] (0 with no feed):
+    /// a few long passes in material weigh more than many short moves of a
+    /// helix in air, unlike [`CutReport::air_cut_share`].
+    #[must_use]
+    pub fn air_length_share(&self) -> f64 {
+        if self.feed_length_mm > 0.0 { self.air_feed_length_mm / self.feed_length_mm } else { 0.0 }
     }
 
     /// The safety verdict of the cut: rapid hits first, then collisions.
@@ -148,10 +161,7 @@ impl CutReport {
     /// [`SimError::RapidIntoStock`] when a rapid or retract removed stock,
     /// [`SimError::HolderCollision`] when the shank or holder touched it.
     pub fn check(&self) -> Result<(), SimError> {
-        safety_verdict(&self.rapid_hits, &self.collisions, |count, collisions| SimError::HolderCollision {
-            count,
-            collisions,
-        })
+        safety_verdict(&self.rapid_hits, &self.collisions, |collisions| SimError::HolderCollision { collisions })
     }
 }
 
@@ -167,17 +177,17 @@ pub(crate) fn air_share(air: usize, feed: usize) -> f64 {
 }
 
 /// The safety verdict of a cut on either stock: rapid hits first, then the
-/// collisions as `collision_error(count, collisions)`.
+/// collisions as `collision_error(collisions)`.
 pub(crate) fn safety_verdict<C: Clone>(
     rapid_hits: &[RapidHit],
     collisions: &[C],
-    collision_error: impl FnOnce(usize, Vec<C>) -> SimError,
+    collision_error: impl FnOnce(Vec<C>) -> SimError,
 ) -> Result<(), SimError> {
     if !rapid_hits.is_empty() {
         return Err(SimError::RapidIntoStock { count: rapid_hits.len(), hits: rapid_hits.to_vec() });
     }
     if !collisions.is_empty() {
-        return Err(collision_error(collisions.len(), collisions.to_vec()));
+        return Err(collision_error(collisions.to_vec()));
     }
     Ok(())
 }
@@ -650,99 +660,11 @@ impl ZMap {
         progress: &(dyn Fn(usize, usize) + Sync),
     ) -> Result<CutReport, SimError> {
         let moves = toolpath.moves();
-        let n = u32::try_from(moves.len()).map_err(|_| SimError::TooManyMoves { moves: moves.len() })?;
-
-        // Non-cutting parts as flat discs: (radius, lift above the tip, part).
-        let mut parts = vec![(cutter.radius().max(cutter.shank_radius()), cutter.flute_length(), ToolPart::Shank)];
-        let mut lift = cutter.flute_length() + cutter.shank_length();
-        for (k, s) in cutter.holder().iter().enumerate() {
-            parts.push((s.bottom_radius.max(s.top_radius), lift, ToolPart::Holder(k)));
-            lift += s.length;
-        }
-        let mut discs = Vec::with_capacity(moves.len() * parts.len());
-        let mut plans: Vec<Plan> = Vec::with_capacity(moves.len());
-        for (k, m) in moves.iter().enumerate() {
-            let from = if k == 0 { m.to } else { moves[k - 1].to };
-            // k < n <= u32::MAX (checked above).
-            let id = k as u32;
-            let rapid = matches!(m.kind, MoveKind::Rapid | MoveKind::Retract);
-            let arc = if k == 0 { None } else { toolpath.arc(k) };
-            match arc {
-                // A planar arc (z constant within the stock's epsilon): exact (SweptMove::arc).
-                Some(arc) if (from.z - m.to.z).abs() <= self.eps => {
-                    let first = discs.len();
-                    for &(radius, lift, _) in &parts {
-                        discs.push(SweptMove::arc(None, (radius, lift), &from, &m.to, arc.center, arc.sweep));
-                    }
-                    let cut = SweptMove::arc(Some(cutter.shape()), (0.0, 0.0), &from, &m.to, arc.center, arc.sweep);
-                    plans.push(Plan::new(id, cut, &discs, first, &parts, &from, &m.to, rapid));
-                }
-                // A helix: straight chords within `HELIX_SAGITTA` of it.
-                Some(arc) => {
-                    let c = arc.center;
-                    let r = (from.x - c.x).hypot(from.y - c.y);
-                    let start = (from.y - c.y).atan2(from.x - c.x);
-                    let step =
-                        if r > HELIX_SAGITTA { 2.0 * (1.0 - HELIX_SAGITTA / r).acos() } else { std::f64::consts::PI };
-                    // Bounded by MAX_HELIX_CHORDS: exact conversions.
-                    let chords = (arc.sweep.abs() / step).ceil().clamp(1.0, MAX_HELIX_CHORDS);
-                    let mut a = from;
-                    for q in 1..=chords as u32 {
-                        let t = f64::from(q) / chords;
-                        let b = if q == chords as u32 {
-                            m.to
-                        } else {
-                            let theta = start + arc.sweep * t;
-                            Point3::new(c.x + r * theta.cos(), c.y + r * theta.sin(), from.z + (m.to.z - from.z) * t)
-                        };
-                        let first = discs.len();
-                        for &(radius, lift, _) in &parts {
-                            discs.push(SweptMove::disc(radius, lift, &a, &b));
-                        }
-                        let cut = SweptMove::new(cutter.shape(), &a, &b);
-                        plans.push(Plan::new(id, cut, &discs, first, &parts, &a, &b, rapid));
-                        a = b;
-                    }
-                }
-                None => {
-                    let first = discs.len();
-                    for &(radius, lift, _) in &parts {
-                        discs.push(SweptMove::disc(radius, lift, &from, &m.to));
-                    }
-                    let cut = SweptMove::new(cutter.shape(), &from, &m.to);
-                    plans.push(Plan::new(id, cut, &discs, first, &parts, &from, &m.to, rapid));
-                }
-            }
-        }
-
-        // Moves per band (compressed rows), in program order.
-        let bands = self.ny.div_ceil(BAND_ROWS);
-        let band_range = |p: &Plan| {
-            let (lo, hi) = (p.box_lo.y - p.reach, p.box_hi.y + p.reach);
-            self.row_range(lo, hi).map(|(a, b)| (a / BAND_ROWS, b / BAND_ROWS))
-        };
-        let mut start = vec![0usize; bands + 1];
-        for p in &plans {
-            if let Some((a, b)) = band_range(p) {
-                for s in &mut start[a + 1..=b + 1] {
-                    *s += 1;
-                }
-            }
-        }
-        for b in 0..bands {
-            start[b + 1] += start[b];
-        }
-        let mut fill = start.clone();
-        let mut members = vec![0u32; start[bands]];
-        for (k, p) in plans.iter().enumerate() {
-            if let Some((a, b)) = band_range(p) {
-                for f in &mut fill[a..=b] {
-                    // k < n <= u32::MAX (checked above).
-                    members[*f] = k as u32;
-                    *f += 1;
-                }
-            }
-        }
+        u32::try_from(moves.len()).map_err(|_| SimError::TooManyMoves { moves: moves.len() })?;
+        let parts = tool_parts(cutter);
+        let (plans, discs) = self.plan_moves(cutter, toolpath, &parts);
+        let (start, members) = self.band_members(&plans);
+        let bands = start.len() - 1;
 
         let grid = Grid {
             nx: self.nx,
@@ -768,14 +690,93 @@ impl ZMap {
                 out
             })
             .collect();
+        Ok(self.merge_bands(&outputs, moves, operation))
+    }
 
-        // Merge in band order: deterministic sums and tie-breaks.
+    /// Every move of `toolpath` prepared for the per-cell solve (helices as
+    /// chords), with the shank and holder discs the plans index into.
+    /// The caller has checked that the move count fits in `u32`.
+    fn plan_moves(
+        &self,
+        cutter: &Cutter,
+        toolpath: &Toolpath,
+        parts: &[(f64, f64, ToolPart)],
+    ) -> (Vec<Plan>, Vec<SweptMove>) {
+        let moves = toolpath.moves();
+        let mut discs = Vec::with_capacity(moves.len() * parts.len());
+        let mut plans: Vec<Plan> = Vec::with_capacity(moves.len());
+        for (k, m) in moves.iter().enumerate() {
+            let from = if k == 0 { m.to } else { moves[k - 1].to };
+            // k < moves.len() <= u32::MAX (checked by the caller).
+            let id = k as u32;
+            let rapid = matches!(m.kind, MoveKind::Rapid | MoveKind::Retract);
+            let arc = if k == 0 { None } else { toolpath.arc(k) };
+            match arc {
+                // A planar arc (z constant within the stock's epsilon): exact (SweptMove::arc).
+                Some(arc) if (from.z - m.to.z).abs() <= self.eps => {
+                    let first = discs.len();
+                    for &(radius, lift, _) in parts {
+                        discs.push(SweptMove::arc(None, (radius, lift), &from, &m.to, arc.center, arc.sweep));
+                    }
+                    let cut = SweptMove::arc(Some(cutter.shape()), (0.0, 0.0), &from, &m.to, arc.center, arc.sweep);
+                    plans.push(Plan::new(id, cut, &discs, first, parts, &from, &m.to, rapid));
+                }
+                // A helix: straight chords within `HELIX_SAGITTA` of it.
+                Some(arc) => {
+                    let mut a = from;
+                    for b in helix_chords(&from, &m.to, arc.center, arc.sweep) {
+                        plan_segment(&mut plans, &mut discs, (id, rapid), cutter, parts, &a, &b);
+                        a = b;
+                    }
+                }
+                None => plan_segment(&mut plans, &mut discs, (id, rapid), cutter, parts, &from, &m.to),
+            }
+        }
+        (plans, discs)
+    }
+
+    /// The plans reaching each band (compressed rows, in program order):
+    /// band `b`'s plans are `members[start[b]..start[b + 1]]`.
+    fn band_members(&self, plans: &[Plan]) -> (Vec<usize>, Vec<u32>) {
+        let bands = self.ny.div_ceil(BAND_ROWS);
+        let band_range = |p: &Plan| {
+            let (lo, hi) = (p.box_lo.y - p.reach, p.box_hi.y + p.reach);
+            self.row_range(lo, hi).map(|(a, b)| (a / BAND_ROWS, b / BAND_ROWS))
+        };
+        let mut start = vec![0usize; bands + 1];
+        for p in plans {
+            if let Some((a, b)) = band_range(p) {
+                for s in &mut start[a + 1..=b + 1] {
+                    *s += 1;
+                }
+            }
+        }
+        for b in 0..bands {
+            start[b + 1] += start[b];
+        }
+        let mut fill = start.clone();
+        let mut members = vec![0u32; start[bands]];
+        for (k, p) in plans.iter().enumerate() {
+            if let Some((a, b)) = band_range(p) {
+                for f in &mut fill[a..=b] {
+                    // The plan's index: one plan a move, MAX_HELIX_CHORDS at most a helix.
+                    members[*f] = k as u32;
+                    *f += 1;
+                }
+            }
+        }
+        (start, members)
+    }
+
+    /// The report of one sweep from its bands' outputs, merged in band order:
+    /// deterministic sums and tie-breaks.
+    fn merge_bands(&self, outputs: &[BandOutput], moves: &[Move], operation: u32) -> CutReport {
         let count = moves.len();
         let mut removed_by_move = vec![0.0; count];
         let mut lowered = vec![0.0f64; count];
         let mut rapid: Vec<Option<(f64, usize)>> = vec![None; count];
         let mut collided: Vec<Vec<(ToolPart, f64, usize)>> = vec![Vec::new(); count];
-        for out in &outputs {
+        for out in outputs {
             for &(k, volume, lower) in &out.removed {
                 removed_by_move[k as usize] += volume;
                 lowered[k as usize] = lowered[k as usize].max(lower);
@@ -795,11 +796,21 @@ impl ZMap {
                 }
             }
         }
+        let nx = self.nx;
         let cell_point = |cell: usize| self.cell_center(cell % nx, cell / nx);
+        // k < moves.len() <= u32::MAX (checked by the sweep).
         let id = |k: usize| MoveId { operation, index: k as u32 };
         let feed_moves = moves.iter().filter(|m| m.kind == MoveKind::Feed).count();
         let air_feed_moves =
             moves.iter().zip(&lowered).filter(|(m, l)| m.kind == MoveKind::Feed && **l <= self.eps).count();
+        let (mut feed_length_mm, mut air_feed_length_mm) = (0.0, 0.0);
+        for (k, m) in moves.iter().enumerate().skip(1).filter(|(_, m)| m.kind == MoveKind::Feed) {
+            let len = (m.to - moves[k - 1].to).norm();
+            feed_length_mm += len;
+            if lowered[k] <= self.eps {
+                air_feed_length_mm += len;
+            }
+        }
         let rapid_hits = rapid
             .iter()
             .enumerate()
@@ -812,14 +823,74 @@ impl ZMap {
             .map(|(k, part, depth, cell)| Collision { id: id(k), part, at: cell_point(cell), depth })
             .collect();
         let removed_volume = removed_by_move.iter().sum();
-        debug_assert_eq!(n as usize, count);
-        Ok(CutReport { operation, removed_by_move, removed_volume, feed_moves, air_feed_moves, rapid_hits, collisions })
+        CutReport {
+            operation,
+            removed_by_move,
+            removed_volume,
+            feed_moves,
+            air_feed_moves,
+            feed_length_mm,
+            air_feed_length_mm,
+            rapid_hits,
+            collisions,
+        }
     }
 
     /// Rows whose centres may lie in [lo, hi] (one row of margin each side), or None.
     fn row_range(&self, lo: f64, hi: f64) -> Option<(usize, usize)> {
         index_range(lo, hi, self.stock.min.y, self.cell_y, self.ny)
     }
+}
+
+/// The shank and holder as flat discs: (radius, lift above the tip, part).
+fn tool_parts(cutter: &Cutter) -> Vec<(f64, f64, ToolPart)> {
+    let mut parts = vec![(cutter.radius().max(cutter.shank_radius()), cutter.flute_length(), ToolPart::Shank)];
+    let mut lift = cutter.flute_length() + cutter.shank_length();
+    for (k, s) in cutter.holder().iter().enumerate() {
+        parts.push((s.bottom_radius.max(s.top_radius), lift, ToolPart::Holder(k)));
+        lift += s.length;
+    }
+    parts
+}
+
+/// The ends of the straight chords, within `HELIX_SAGITTA` of a helix from
+/// `from` to `to` about `center` turning by `sweep` (the last is `to` exactly).
+fn helix_chords(from: &Point3, to: &Point3, center: Point2, sweep: f64) -> Vec<Point3> {
+    let c = center;
+    let r = (from.x - c.x).hypot(from.y - c.y);
+    let start = (from.y - c.y).atan2(from.x - c.x);
+    let step = if r > HELIX_SAGITTA { 2.0 * (1.0 - HELIX_SAGITTA / r).acos() } else { std::f64::consts::PI };
+    // Bounded by MAX_HELIX_CHORDS: exact conversions.
+    let chords = (sweep.abs() / step).ceil().clamp(1.0, MAX_HELIX_CHORDS);
+    (1..=chords as u32)
+        .map(|q| {
+            let t = f64::from(q) / chords;
+            if q == chords as u32 {
+                *to
+            } else {
+                let theta = start + sweep * t;
+                Point3::new(c.x + r * theta.cos(), c.y + r * theta.sin(), from.z + (to.z - from.z) * t)
+            }
+        })
+        .collect()
+}
+
+/// Plans the straight segment `a`-`b` of move `id` (its discs first).
+fn plan_segment(
+    plans: &mut Vec<Plan>,
+    discs: &mut Vec<SweptMove>,
+    (id, rapid): (u32, bool),
+    cutter: &Cutter,
+    parts: &[(f64, f64, ToolPart)],
+    a: &Point3,
+    b: &Point3,
+) {
+    let first = discs.len();
+    for &(radius, lift, _) in parts {
+        discs.push(SweptMove::disc(radius, lift, a, b));
+    }
+    let cut = SweptMove::new(cutter.shape(), a, b);
+    plans.push(Plan::new(id, cut, discs, first, parts, a, b, rapid));
 }
 
 /// Cell indices whose centres `min + (i + 0.5) cell` may lie in [lo, hi], with

@@ -43,6 +43,7 @@
 
 use scallop_analysis::Cutter as Model;
 use scallop_cutter::{Cutter, CutterShape, drop_cutter};
+use scallop_geom::num::golden_section;
 use scallop_geom::{Point2, Point3, Tolerances, Vec3};
 use scallop_mesh::MeshIndex;
 use scallop_surface::Patch;
@@ -59,6 +60,19 @@ pub enum IsoDirection {
     U,
     /// Passes along `v` (isolines `u = const`).
     V,
+}
+
+/// A patch as the isoparametric planner machines it: the patch, the index of
+/// its tessellation (what the cutter is dropped on) and that tessellation's
+/// chordal error (mm; the planner aims at `sh - chordal_error`).
+#[derive(Debug, Clone, Copy)]
+pub struct IsoSurface<'a> {
+    /// The patch.
+    pub patch: &'a Patch,
+    /// Its tessellation, indexed.
+    pub index: &'a MeshIndex,
+    /// Largest distance between the tessellation and the patch (mm).
+    pub chordal_error: f64,
 }
 
 /// One isoparametric pass.
@@ -87,8 +101,7 @@ pub struct IsoPlanned {
     pub mean_scallop_mm: f64,
 }
 
-/// Plans isoparametric passes over `patch` (its tessellation indexed by `index`,
-/// within `chordal_error` of it) with `cutter`. From `params` it uses
+/// Plans isoparametric passes over `surface` with `cutter`. From `params` it uses
 /// `scallop_height`, `max_step` and `clearance`; the feed is `params.machine.feed`.
 ///
 /// # Errors
@@ -96,14 +109,106 @@ pub struct IsoPlanned {
 /// spacing below [`tol::MIN_SPACING`] (in mm on the surface), or a measured scallop
 /// over `sh` (a bug).
 pub fn plan_isoparametric(
-    patch: &Patch,
-    index: &MeshIndex,
+    surface: &IsoSurface<'_>,
     cutter: &Cutter,
     params: &FinishingParams,
     direction: IsoDirection,
     tolerances: &Tolerances,
-    chordal_error: f64,
 ) -> Result<IsoPlanned, StrategyError> {
+    let chordal_error = surface.chordal_error;
+    let (model, target) = checked_target(cutter, params, tolerances, chordal_error)?;
+    let (ctx, across) = Ctx::new(surface, cutter, direction, tolerances, params);
+    let mut passes = vec![ctx.pass(across[0])];
+    let mut heights: Vec<f64> = Vec::new();
+    let mut max_h = 0.0f64;
+    while passes.last().is_some_and(|p| p.iso < across[1]) {
+        let current = &passes[passes.len() - 1];
+        let (next, h, worst) = ctx.fit_next(current, &model, target, across[1])?;
+        max_h = max_h.max(worst);
+        heights.extend(h);
+        passes.push(next);
+    }
+    #[allow(clippy::cast_precision_loss, reason = "sample counts")]
+    let mean = if heights.is_empty() { 0.0 } else { heights.iter().sum::<f64>() / heights.len() as f64 };
+    let toolpath = ctx.toolpath(&passes);
+    Ok(IsoPlanned { toolpath, passes, max_scallop_mm: max_h + chordal_error.max(0.0), mean_scallop_mm: mean })
+}
+
+impl<'a> Ctx<'a> {
+    /// The planner's context on `surface` and the cross range of its isolines.
+    fn new(
+        surface: &IsoSurface<'a>,
+        cutter: &'a Cutter,
+        direction: IsoDirection,
+        tolerances: &'a Tolerances,
+        params: &'a FinishingParams,
+    ) -> (Ctx<'a>, [f64; 2]) {
+        let (patch, index) = (surface.patch, surface.index);
+        let domain = patch.domain();
+        let (along, across) = match direction {
+            IsoDirection::U => (domain.u, domain.v),
+            IsoDirection::V => (domain.v, domain.u),
+        };
+        let floor = index.bounds().min.z - 1.0;
+        (Ctx { patch, index, cutter, direction, along, floor, tolerances, params }, across)
+    }
+
+    /// The pass after `current` as the planner places it: the rule's step for
+    /// `target`, then measured ([`iso_scallop`]) and corrected until the
+    /// worst scallop is within [`tol::ISO_FIT_ACCEPT`] of `target` (or the
+    /// isoline `end` is reached); the farthest measured pass that holds
+    /// `target`, with its scallop samples and their worst.
+    fn fit_next(
+        &self,
+        current: &IsoPass,
+        model: &Model,
+        target: f64,
+        end: f64,
+    ) -> Result<(IsoPass, Vec<f64>, f64), StrategyError> {
+        let (patch, index, cutter, direction) = (self.patch, self.index, self.cutter, self.direction);
+        let last = current.iso;
+        let mut step = self.rule_step(current, model, target);
+        let mut best: Option<(IsoPass, Vec<f64>, f64)> = None;
+        for _ in 0..tol::ISO_FIT_ITERATIONS {
+            let iso = (last + step).min(end);
+            let next = self.pass(iso);
+            let h = iso_scallop(patch, index, cutter, direction, current, &next);
+            let worst = h.iter().copied().fold(0.0, f64::max);
+            let reached_end = iso >= end;
+            if worst <= target {
+                let better = best.as_ref().is_none_or(|b| iso > b.0.iso);
+                if better {
+                    best = Some((next, h, worst));
+                }
+                if reached_end || worst >= tol::ISO_FIT_ACCEPT * target {
+                    break;
+                }
+            }
+            let factor = if worst > 0.0 { (target / worst).sqrt() * tol::SPACING_SAFETY } else { 2.0 };
+            let grown = step * factor.clamp(0.25, 2.0);
+            if worst <= target && grown <= step {
+                break;
+            }
+            step = if worst > target { step * factor.clamp(0.25, 0.95) } else { grown };
+            if step * self.cross_speed(current) < tol::MIN_SPACING {
+                break;
+            }
+        }
+        best.ok_or_else(|| {
+            let p = current.cl.first().copied().unwrap_or_else(Point3::origin);
+            StrategyError::Unreachable { x: p.x, y: p.y, spacing: step, scallop_height: self.params.scallop_height }
+        })
+    }
+}
+
+/// The planner's checks and its cutter model and target scallop: `sh` less
+/// the tessellation's `chordal_error`.
+fn checked_target(
+    cutter: &Cutter,
+    params: &FinishingParams,
+    tolerances: &Tolerances,
+    chordal_error: f64,
+) -> Result<(Model, f64), StrategyError> {
     params.validate()?;
     let model = model(cutter)?;
     let sh = params.scallop_height;
@@ -122,57 +227,60 @@ pub fn plan_isoparametric(
             fix: "the tessellation error exceeds the scallop height: use a smaller path tolerance",
         });
     }
-    let domain = patch.domain();
-    let (along, across) = match direction {
-        IsoDirection::U => (domain.u, domain.v),
-        IsoDirection::V => (domain.v, domain.u),
-    };
-    let ctx = Ctx { patch, index, cutter, direction, along, floor: index.bounds().min.z - 1.0, tolerances, params };
-    let mut passes = vec![ctx.pass(across[0])];
-    let mut heights: Vec<f64> = Vec::new();
-    let mut max_h = 0.0f64;
-    while passes.last().is_some_and(|p| p.iso < across[1]) {
-        let last = passes.last().map_or(across[0], |p| p.iso);
-        let current = &passes[passes.len() - 1];
-        let mut step = ctx.rule_step(current, &model, target);
-        let mut best: Option<(IsoPass, Vec<f64>, f64)> = None;
-        for _ in 0..tol::ISO_FIT_ITERATIONS {
-            let iso = (last + step).min(across[1]);
-            let next = ctx.pass(iso);
-            let h = iso_scallop(patch, index, cutter, direction, current, &next);
-            let worst = h.iter().copied().fold(0.0, f64::max);
-            let reached_end = iso >= across[1];
-            if worst <= target {
-                let better = best.as_ref().is_none_or(|b| iso > b.0.iso);
-                if better {
-                    best = Some((next, h, worst));
-                }
-                if reached_end || worst >= tol::ISO_FIT_ACCEPT * target {
-                    break;
-                }
-            }
-            let factor = if worst > 0.0 { (target / worst).sqrt() * tol::SPACING_SAFETY } else { 2.0 };
-            let grown = step * factor.clamp(0.25, 2.0);
-            if worst <= target && grown <= step {
-                break;
-            }
-            step = if worst > target { step * factor.clamp(0.25, 0.95) } else { grown };
-            if step * ctx.cross_speed(current) < tol::MIN_SPACING {
-                break;
+    Ok((model, target))
+}
+
+/// The number of passes [`plan_isoparametric`] makes on `surface`, estimated
+/// from the planner's own step fit (the rule's step, measured by
+/// [`iso_scallop`] and corrected, as the planner does) at `samples` isolines
+/// spread evenly across the patch: the cross range is walked with the fitted
+/// steps, linear between the sampled isolines. It costs about `samples` of
+/// the planner's passes; `scallop run --plan-only` estimates with it.
+///
+/// # Errors
+/// As [`plan_isoparametric`].
+pub fn iso_fitted_passes(
+    surface: &IsoSurface<'_>,
+    cutter: &Cutter,
+    params: &FinishingParams,
+    direction: IsoDirection,
+    tolerances: &Tolerances,
+    samples: usize,
+) -> Result<usize, StrategyError> {
+    use rayon::prelude::*;
+    let (model, target) = checked_target(cutter, params, tolerances, surface.chordal_error)?;
+    let (ctx, across) = Ctx::new(surface, cutter, direction, tolerances, params);
+    let n = samples.max(2);
+    #[allow(clippy::cast_precision_loss, reason = "small counts")]
+    let fitted = (0..n)
+        .into_par_iter()
+        .map(|k| {
+            let c = across[0] + (across[1] - across[0]) * (k as f64 + 0.5) / n as f64;
+            let (next, _, _) = ctx.fit_next(&ctx.pass(c), &model, target, across[1])?;
+            Ok((c, next.iso - c))
+        })
+        .collect::<Result<Vec<(f64, f64)>, StrategyError>>()?;
+    let step_at = |c: f64| {
+        let k = fitted.partition_point(|&(ck, _)| ck <= c);
+        match k {
+            0 => fitted[0].1,
+            k if k == fitted.len() => fitted[k - 1].1,
+            k => {
+                let ((c0, s0), (c1, s1)) = (fitted[k - 1], fitted[k]);
+                s0 + (s1 - s0) * (c - c0) / (c1 - c0)
             }
         }
-        let Some((next, h, worst)) = best else {
-            let p = current.cl.first().copied().unwrap_or_else(Point3::origin);
-            return Err(StrategyError::Unreachable { x: p.x, y: p.y, spacing: step, scallop_height: sh });
-        };
-        max_h = max_h.max(worst);
-        heights.extend(h);
-        passes.push(next);
+    };
+    let (mut iso, mut passes) = (across[0], 1);
+    while iso < across[1] && passes <= tol::ISO_MAX_SAMPLES {
+        let step = step_at(iso);
+        if !(step.is_finite() && step > 0.0) {
+            break;
+        }
+        iso = (iso + step).min(across[1]);
+        passes += 1;
     }
-    #[allow(clippy::cast_precision_loss, reason = "sample counts")]
-    let mean = if heights.is_empty() { 0.0 } else { heights.iter().sum::<f64>() / heights.len() as f64 };
-    let toolpath = ctx.toolpath(&passes);
-    Ok(IsoPlanned { toolpath, passes, max_scallop_mm: max_h + chordal_error.max(0.0), mean_scallop_mm: mean })
+    Ok(passes)
 }
 
 fn model(cutter: &Cutter) -> Result<Model, StrategyError> {
@@ -280,27 +388,7 @@ impl Ctx<'_> {
 
     /// The spacing rule: the smallest parameter step over the pass.
     fn rule_step(&self, pass: &IsoPass, model: &Model, target: f64) -> f64 {
-        let mut step = f64::INFINITY;
-        for &a in &pass.samples {
-            let (f, x, n) = self.derivs(a, pass.iso);
-            let n = if n.z < 0.0 { -n } else { n };
-            let slope = n.z.clamp(-1.0, 1.0).acos();
-            let (nx, ny) = (n.x, n.y);
-            let alpha = if nx.hypot(ny) > tol::HORIZONTAL_XY && f.xy().norm() > tol::HORIZONTAL_XY {
-                (f.x * ny - f.y * nx).atan2(f.x * nx + f.y * ny)
-            } else {
-                0.0
-            };
-            let r_eff = model.effective_radius(slope, alpha);
-            let sod = scallop_analysis::step_over(target, r_eff).min(tol::ISO_MAX_STEP_OVER * model.radius());
-            // The part of S_cross across the feed direction on the surface.
-            let fu = f.try_normalize(1e-300).unwrap_or_else(Vec3::x);
-            let across = (x - fu * fu.dot(&x)).norm();
-            if across > 0.0 {
-                step = step.min(sod / across);
-            }
-        }
-        step
+        rule_step(self.patch, self.direction, model, (pass.iso, &pass.samples), target)
     }
 
     fn toolpath(&self, passes: &[IsoPass]) -> Toolpath {
@@ -320,6 +408,38 @@ impl Ctx<'_> {
         }
         path
     }
+}
+
+/// The spacing rule of [`plan_isoparametric`] on the isoline `iso` at the
+/// running parameters `samples`: the smallest parameter step over them.
+fn rule_step(patch: &Patch, direction: IsoDirection, model: &Model, (iso, samples): (f64, &[f64]), target: f64) -> f64 {
+    let mut step = f64::INFINITY;
+    for &a in samples {
+        let (u, v) = uv(direction, a, iso);
+        let d = patch.derivatives(u, v);
+        let (f, x) = match direction {
+            IsoDirection::U => (d.du, d.dv),
+            IsoDirection::V => (d.dv, d.du),
+        };
+        let n = patch.normal(u, v);
+        let n = if n.z < 0.0 { -n } else { n };
+        let slope = n.z.clamp(-1.0, 1.0).acos();
+        let (nx, ny) = (n.x, n.y);
+        let alpha = if nx.hypot(ny) > tol::HORIZONTAL_XY && f.xy().norm() > tol::HORIZONTAL_XY {
+            (f.x * ny - f.y * nx).atan2(f.x * nx + f.y * ny)
+        } else {
+            0.0
+        };
+        let r_eff = model.effective_radius(slope, alpha);
+        // The part of S_cross across the feed direction on the surface.
+        let fu = f.try_normalize(1e-300).unwrap_or_else(Vec3::x);
+        let across = (x - fu * fu.dot(&x)).norm();
+        let sod = scallop_analysis::step_over(target, r_eff).min(tol::ISO_MAX_STEP_OVER * model.radius());
+        if across > 0.0 {
+            step = step.min(sod / across);
+        }
+    }
+    step
 }
 
 /// `(R, r)` of the cutter body: ball `r = R`, flat `r = 0`.
@@ -373,25 +493,8 @@ fn swept_distance(p: &Point3, pass: &IsoPass, s: f64, radius: f64, corner: f64) 
             return false;
         }
         let f = |s: f64| body_distance(p, &(a + (b - a) * s), radius, corner);
-        let (mut lo, mut hi) = (0.0f64, 1.0f64);
-        let g = 0.5 * (5f64.sqrt() - 1.0);
-        let (mut x1, mut x2) = (hi - g * (hi - lo), lo + g * (hi - lo));
-        let (mut f1, mut f2) = (f(x1), f(x2));
-        for _ in 0..tol::GOLDEN_ITERATIONS {
-            if f1 <= f2 {
-                hi = x2;
-                x2 = x1;
-                f2 = f1;
-                x1 = hi - g * (hi - lo);
-                f1 = f(x1);
-            } else {
-                lo = x1;
-                x1 = x2;
-                f1 = f2;
-                x2 = lo + g * (hi - lo);
-                f2 = f(x2);
-            }
-        }
+        let end = golden_section(f, (0.0, 1.0), tol::GOLDEN_ITERATIONS, None, |f1, f2| f1 <= f2);
+        let [(_, f1), (_, f2)] = end.inner;
         *best = best.min(f1.min(f2)).min(f(0.0)).min(f(1.0));
         true
     };

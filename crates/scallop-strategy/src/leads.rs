@@ -108,79 +108,54 @@ pub fn apply_leads(
     }
     let mut out: Vec<Move> = Vec::with_capacity(moves.len());
     let floor = index_floor(index);
-    let mut i = 0;
-    while i < moves.len() {
-        let m = moves[i];
+    for (i, &m) in moves.iter().enumerate() {
         let prev = if i > 0 { Some(moves[i - 1]) } else { None };
         let next = moves.get(i + 1).copied();
-        // Lead-in: a plunge from a height onto the start of a pass.
-        if let (MoveKind::Plunge, Some(p), Some(n)) = (m.kind, prev, next)
-            && n.kind == MoveKind::Feed
-        {
-            let top = p.to.z;
-            match lead_points(m.to, n.to - m.to, kind, chord_tolerance, false)
-                .and_then(|pts| checked(&pts, top, index, cutter, floor, gouge))
-            {
-                Ok(pts) => {
-                    // The rapid at the safe height goes above the lead's top instead of
-                    // above p0 (any XY is safe there), straight down to the top, then
-                    // along the lead onto p0.
-                    if let Some(last) = out.last_mut()
-                        && last.kind == MoveKind::Rapid
-                    {
-                        last.to = Point3::new(pts[0].x, pts[0].y, last.to.z);
-                    }
-                    for q in &pts {
-                        out.push(Move::new(MoveKind::Plunge, *q));
-                    }
-                    report.applied += 1;
-                }
-                Err(why) => {
-                    report.fallbacks.push(LeadFallback {
-                        move_index: i,
-                        which: "lead-in",
-                        at: m.to.coords.into(),
-                        why,
-                    });
-                    out.push(m);
-                }
+        let lead = match (m.kind, prev, next) {
+            // Lead-in: a plunge from a height onto the start of a pass.
+            (MoveKind::Plunge, Some(p), Some(n)) if n.kind == MoveKind::Feed => {
+                let points = lead_points(m.to, n.to - m.to, kind, chord_tolerance, false)
+                    .and_then(|pts| checked(&pts, p.to.z, index, cutter, floor, gouge));
+                Some(("lead-in", m.to, points))
             }
-            i += 1;
-            continue;
-        }
-        // Lead-out: a retract from the end of a pass.
-        if let (MoveKind::Retract, Some(p)) = (m.kind, prev)
-            && p.kind == MoveKind::Feed
-            && i >= 2
-        {
-            let dir = p.to - moves[i - 2].to;
-            match lead_points(p.to, dir, kind, chord_tolerance, true)
-                .and_then(|pts| checked(&pts, m.to.z, index, cutter, floor, gouge))
-            {
-                Ok(pts) => {
-                    // pts run from the lead's top down to the pass end: walk them
-                    // backwards, then retract straight up from the top.
-                    for q in pts.iter().rev().skip(1) {
-                        out.push(Move::new(MoveKind::Plunge, *q));
-                    }
-                    out.push(Move::new(m.kind, Point3::new(pts[0].x, pts[0].y, m.to.z)));
-                    report.applied += 1;
-                }
-                Err(why) => {
-                    report.fallbacks.push(LeadFallback {
-                        move_index: i,
-                        which: "lead-out",
-                        at: p.to.coords.into(),
-                        why,
-                    });
-                    out.push(m);
-                }
+            // Lead-out: a retract from the end of a pass.
+            (MoveKind::Retract, Some(p), _) if p.kind == MoveKind::Feed && i >= 2 => {
+                let points = lead_points(p.to, p.to - moves[i - 2].to, kind, chord_tolerance, true)
+                    .and_then(|pts| checked(&pts, m.to.z, index, cutter, floor, gouge));
+                Some(("lead-out", p.to, points))
             }
-            i += 1;
-            continue;
+            _ => None,
+        };
+        match lead {
+            Some(("lead-in", _, Ok(pts))) => {
+                // The rapid at the safe height goes above the lead's top instead of
+                // above p0 (any XY is safe there), straight down to the top, then
+                // along the lead onto p0.
+                if let Some(last) = out.last_mut()
+                    && last.kind == MoveKind::Rapid
+                {
+                    last.to = Point3::new(pts[0].x, pts[0].y, last.to.z);
+                }
+                for q in &pts {
+                    out.push(Move::new(MoveKind::Plunge, *q));
+                }
+                report.applied += 1;
+            }
+            Some((_, _, Ok(pts))) => {
+                // pts run from the lead's top down to the pass end: walk them
+                // backwards, then retract straight up from the top.
+                for q in pts.iter().rev().skip(1) {
+                    out.push(Move::new(MoveKind::Plunge, *q));
+                }
+                out.push(Move::new(m.kind, Point3::new(pts[0].x, pts[0].y, m.to.z)));
+                report.applied += 1;
+            }
+            Some((which, at, Err(why))) => {
+                report.fallbacks.push(LeadFallback { move_index: i, which, at: at.coords.into(), why });
+                out.push(m);
+            }
+            None => out.push(m),
         }
-        out.push(m);
-        i += 1;
     }
     let mut led = Toolpath::new(path.feed);
     led.plunge_feed = path.plunge_feed;

@@ -184,13 +184,13 @@ pub mod trochoid;
 
 pub use error::StrategyError;
 pub use geometry::contact_to_tip;
-pub use iso::{IsoDirection, IsoPass, IsoPlanned, iso_scallop, plan_isoparametric};
+pub use iso::{IsoDirection, IsoPass, IsoPlanned, IsoSurface, iso_fitted_passes, iso_scallop, plan_isoparametric};
 pub use leads::{LeadFallback, LeadKind, LeadReport, apply_leads};
 pub use params::{Boundary, FinishingParams, Pattern};
 pub use plan::rule_spacing;
 pub use region::ZoneRegion;
 pub use scallop::{PairScallop, ScallopReport, verify_scallop};
-pub use steep::{SteepPlanned, SteepShallow, plan_steep_shallow};
+pub use steep::{SteepPlanned, SteepShallow, convex_factor, crease_residual, plan_steep_shallow};
 pub use time::{ClassTimes, MoveFeed, lookahead_profile, lookahead_time, stop_to_stop_time};
 
 use scallop_cutter::Cutter;
@@ -250,6 +250,21 @@ pub struct Report {
     pub cl_points_dropped: usize,
     /// Planning time (s): 0 from the library (no clocks); the caller measures it.
     pub planning_time_s: f64,
+    /// Planes and levels added where the stock simulation found the scallop
+    /// over sh (`None`: the first plan held it; see [`Refinement`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub refinement: Option<RefinementReport>,
+}
+
+/// What a refinement added to a plan ([`Report::refinement`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct RefinementReport {
+    /// Rounds of planning again.
+    pub rounds: usize,
+    /// Planes added.
+    pub planes_added: usize,
+    /// Waterline levels added.
+    pub levels_added: usize,
 }
 
 impl Report {
@@ -283,6 +298,7 @@ impl Report {
             points: toolpath.moves().len(),
             cl_points_dropped: 0,
             planning_time_s: 0.0,
+            refinement: None,
         }
     }
 }
@@ -319,7 +335,45 @@ pub fn plan_finishing(
     params: &FinishingParams,
     tol: &Tolerances,
 ) -> Result<Planned, StrategyError> {
-    plan(index, cutter, params, tol, None, false)
+    plan(index, cutter, params, tol, None, false, &[])
+}
+
+/// [`plan_finishing`] with the planes of `refine` added to the sweep's (see
+/// [`Refinement`]).
+///
+/// # Errors
+/// As [`plan_finishing`].
+pub fn plan_finishing_refined(
+    index: &MeshIndex,
+    cutter: &Cutter,
+    params: &FinishingParams,
+    tol: &Tolerances,
+    refine: &Refinement,
+) -> Result<Planned, StrategyError> {
+    plan(index, cutter, params, tol, None, false, &refine.planes)
+}
+
+/// Planes and waterline levels added to a plan where the stock simulation
+/// found more than `sh` on surface the cutter reaches (docs/simulation.md,
+/// "Refinement"): the planner measures the scallop between planes at its feed
+/// samples and between levels at their points, and a crease or a narrow
+/// feature between those samples can escape it; the simulation then names the
+/// places and the engine plans again with a plane or a level between the two
+/// that bracket each place.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Refinement {
+    /// Plane offsets `d = m . p` to add (mm).
+    pub planes: Vec<f64>,
+    /// Waterline levels (tip heights, mm) to add (steep and shallow).
+    pub levels: Vec<f64>,
+}
+
+impl Refinement {
+    /// Whether it adds nothing.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.planes.is_empty() && self.levels.is_empty()
+    }
 }
 
 /// [`plan_finishing`] restricted to one zone of a labelled part: a cutter
@@ -339,7 +393,7 @@ pub fn plan_zone_finishing(
     tol: &Tolerances,
     region: &ZoneRegion,
 ) -> Result<Planned, StrategyError> {
-    plan(index, cutter, params, tol, Some(region), false)
+    plan(index, cutter, params, tol, Some(region), false, &[])
 }
 
 /// Plans parallel planes (in `region` when given); with `tolerate_rest` the
@@ -354,23 +408,20 @@ fn plan(
     tol: &Tolerances,
     region: Option<&ZoneRegion>,
     tolerate_rest: bool,
+    extra: &[f64],
 ) -> Result<Planned, StrategyError> {
     let mut planner = plan::Planner::new(index, cutter, params, tol, region)?;
     planner.tolerate_rest = tolerate_rest;
     let planes = planner.sweep()?;
+    let planes = planner.with_planes(planes, extra);
     let (toolpath, links, retracts) = planner.toolpath(&planes);
     let planes: Vec<Plane> = planes.into_iter().map(|p| p.plane).collect();
     let feed_samples = planner.feed_samples.clone();
-    let scallop = scallop::verify_scallop_within(
-        index,
-        cutter,
-        &planes,
-        params.direction,
-        &feed_samples,
-        params.scallop_height,
-        plan::zone_end_margin(cutter, region),
-        !tolerate_rest,
-    )?;
+    let measure = scallop::Measure {
+        end_margin: plan::zone_end_margin(cutter, region),
+        ..scallop::Measure::new(index, cutter, params.direction, params.scallop_height)
+    };
+    let scallop = scallop::verify_measured(&measure, &planes, &feed_samples, !tolerate_rest)?;
     let report = Report {
         passes: planes.iter().map(|p| p.passes.len()).sum(),
         planes: planes.len(),

@@ -440,12 +440,31 @@ impl<'a> Planner<'a> {
         let mut best: Option<(f64, Point2)> = None;
         for cl in &plane.samples {
             let n = contact_normal(&self.shape, self.index, &self.slots, cl);
+            if self.rides_sharp_edge(cl, &n) {
+                continue;
+            }
             let delta = spacing_at(&self.shape, &self.model, sh, &n, self.params.direction, &m);
             if best.is_none_or(|(b, _)| delta < b) {
                 best = Some((delta, Point2::new(cl.tip.x, cl.tip.y)));
             }
         }
         best
+    }
+
+    /// Whether the cutter at `cl` rolls over a sharp convex edge or vertex of
+    /// the mesh: an edge or vertex contact whose cutter normal `n` leans more
+    /// than [`tol::SHARP_EDGE_DEG`] from the contacted facet's normal. There
+    /// the part has no surface between passes to leave a scallop on (every
+    /// pass touches the same edge), so the contact does not set the spacing;
+    /// the measured scallop still checks the pair.
+    fn rides_sharp_edge(&self, cl: &ClPoint, n: &Vec3) -> bool {
+        let triangle = match cl.contact {
+            Contact::Vertex { triangle, .. } | Contact::Edge { triangle, .. } => triangle,
+            Contact::Floor | Contact::Facet { .. } => return false,
+        };
+        self.slots
+            .get(triangle)
+            .is_some_and(|&slot| self.index.normal(slot as usize).dot(n) < tol::SHARP_EDGE_DEG.to_radians().cos())
     }
 
     /// Largest measured scallop between two planes at the feed samples.
@@ -545,6 +564,13 @@ impl<'a> Planner<'a> {
                     _ if self.tolerate_rest => tol::REST_SPACING_SHARE * cap,
                     s => return Err(self.unreachable(s, at)),
                 };
+                // With rest tolerated, a residual many times sh at the rule's
+                // spacing is rest material between the passes (the foot of a
+                // wall that the waterline levels finish, a corner), not a
+                // scallop: creeping on at tiny spacings would multiply the
+                // planes, so the next plane goes a share of the largest
+                // step-over away and the simulation reports what is left.
+                let rest_gap = (tol::REST_SPACING_SHARE * cap).min(spacing);
                 delta = spacing;
                 let mut gap = spacing;
                 let mut next = self.plane(d + gap);
@@ -564,7 +590,7 @@ impl<'a> Planner<'a> {
                     }
                 }
                 let mut accepted = false;
-                let rule_gap = gap;
+                let mut last_try: Option<(f64, f64)> = None;
                 for retry in 0..tol::MAX_SPACING_RETRIES {
                     // INVARIANT: as above.
                     let current = planes.last().expect("a plane of this range");
@@ -573,6 +599,12 @@ impl<'a> Planner<'a> {
                         accepted = true;
                         break;
                     }
+                    // A residual that does not fall as the gap shrinks is rest too.
+                    let stalled = last_try.is_some_and(|(g, hp)| gap < 0.5 * g && h > 0.5 * hp);
+                    if self.tolerate_rest && ((retry == 0 && h > tol::REST_RESIDUAL_FACTOR * sh) || stalled) {
+                        break;
+                    }
+                    last_try = Some((gap, h));
                     // Scallop ~ gap^2; after a first exact-ratio try, shrink by at
                     // least SPACING_MIN_SHRINK per retry (curvature, rest material).
                     let ratio = if h.is_finite() { (sh / h).sqrt() * tol::SPACING_SAFETY } else { 0.5 };
@@ -589,9 +621,9 @@ impl<'a> Planner<'a> {
                     if !self.tolerate_rest {
                         return Err(self.unreachable(gap, at));
                     }
-                    next = self.plane(d + rule_gap);
+                    next = self.plane(d + rest_gap);
                     if next.plane.passes.is_empty() {
-                        empty = d + rule_gap;
+                        empty = d + rest_gap;
                         continue 'ranges;
                     }
                 }
@@ -602,6 +634,24 @@ impl<'a> Planner<'a> {
             return Err(StrategyError::EmptyRegion { direction_deg: self.params.direction.to_degrees() });
         }
         Ok(planes)
+    }
+
+    /// `planes` (in increasing offset, as [`Self::sweep`] gives them) with a
+    /// plane at each offset of `extra` that has passes and is not already
+    /// within the boundary tolerance of one (see [`crate::Refinement`]).
+    pub(crate) fn with_planes(&mut self, mut planes: Vec<PlanePasses>, extra: &[f64]) -> Vec<PlanePasses> {
+        for &d in extra {
+            if !d.is_finite() || planes.iter().any(|p| (p.plane.offset - d).abs() <= self.boundary_tol) {
+                continue;
+            }
+            let plane = self.plane(d);
+            if plane.plane.passes.is_empty() {
+                continue;
+            }
+            let at = planes.partition_point(|p| p.plane.offset < d);
+            planes.insert(at, plane);
+        }
+        planes
     }
 
     /// The planes from `previous` (the last plane of a range, returned first)

@@ -28,6 +28,7 @@
 
 use rayon::prelude::*;
 use scallop_cutter::{Cutter, CutterShape};
+use scallop_geom::num::golden_section;
 use scallop_geom::{Point2, Point3};
 use scallop_mesh::MeshIndex;
 use serde::{Deserialize, Serialize};
@@ -164,31 +165,11 @@ impl Curve {
 }
 
 /// Minimum of a convex function on `[a, b]` by golden section: `(argmin, min)`.
-fn golden_min(g: &impl Fn(f64) -> f64, mut a: f64, mut b: f64, scale: f64) -> (f64, f64) {
-    const INV_PHI: f64 = 0.618_033_988_749_894_9;
-    let stop = tol::GOLDEN_REL_TOL * scale;
-    let mut x1 = b - INV_PHI * (b - a);
-    let mut x2 = a + INV_PHI * (b - a);
-    let (mut g1, mut g2) = (g(x1), g(x2));
-    for _ in 0..tol::GOLDEN_ITERATIONS {
-        if b - a <= stop {
-            break;
-        }
-        if g1 <= g2 {
-            b = x2;
-            x2 = x1;
-            g2 = g1;
-            x1 = b - INV_PHI * (b - a);
-            g1 = g(x1);
-        } else {
-            a = x1;
-            x1 = x2;
-            g1 = g2;
-            x2 = a + INV_PHI * (b - a);
-            g2 = g(x2);
-        }
-    }
-    [(x1, g1), (x2, g2), (a, g(a)), (b, g(b))]
+fn golden_min(g: &impl Fn(f64) -> f64, a: f64, b: f64, scale: f64) -> (f64, f64) {
+    let stop = Some(tol::GOLDEN_REL_TOL * scale);
+    let end = golden_section(g, (a, b), tol::GOLDEN_ITERATIONS, stop, |g1, g2| g1 <= g2);
+    let (a, b) = (end.lo, end.hi);
+    [end.inner[0], end.inner[1], (a, g(a)), (b, g(b))]
         .into_iter()
         .fold((a, f64::INFINITY), |m, c| if c.1 < m.1 { c } else { m })
 }
@@ -445,28 +426,26 @@ pub fn verify_scallop(
     feed_samples: &[f64],
     scallop_height: f64,
 ) -> Result<ScallopReport, StrategyError> {
-    verify_scallop_within(index, cutter, planes, direction, feed_samples, scallop_height, 0.0, true)
+    verify_measured(&Measure::new(index, cutter, direction, scallop_height), planes, feed_samples, true)
 }
 
-/// [`verify_scallop`] leaving out the sections within `end_margin` of a pass end.
-pub(crate) fn verify_scallop_within(
-    index: &MeshIndex,
-    cutter: &Cutter,
+/// [`verify_scallop`] with `measure` (its limit the scallop height, its end
+/// margin left out); `strict: false` reports a scallop over the limit instead
+/// of refusing it.
+pub(crate) fn verify_measured(
+    measure: &Measure<'_>,
     planes: &[Plane],
-    direction: f64,
     feed_samples: &[f64],
-    scallop_height: f64,
-    end_margin: f64,
     strict: bool,
 ) -> Result<ScallopReport, StrategyError> {
-    let measure = Measure { end_margin, ..Measure::new(index, cutter, direction, scallop_height) };
+    let scallop_height = measure.limit;
     let frame = measure.frame;
     let curves: Vec<Vec<Curve>> =
         planes.iter().map(|pl| pl.passes.iter().map(|p| Curve::new(&frame, p)).collect()).collect();
     let pairs: Vec<(PairScallop, Vec<f64>)> = (0..planes.len().saturating_sub(1))
         .into_par_iter()
         .map(|k| {
-            let heights: Vec<Cusp> = pair_heights(&measure, &curves[k], &curves[k + 1], feed_samples);
+            let heights: Vec<Cusp> = pair_heights(measure, &curves[k], &curves[k + 1], feed_samples);
             let mut pair = PairScallop {
                 plane: k,
                 next: k + 1,

@@ -16,14 +16,16 @@
 //! and never more than the cutter radius. The stock simulation of the program
 //! proves the result (`scallop_engine`).
 
+use std::collections::HashMap;
+
 use scallop_cutter::{ClPoint, Cutter, CutterShape, drop_cutter};
-use scallop_geom::{Point2, Point3, Tolerances};
+use scallop_geom::{Point2, Point3, Tolerances, Vec2};
 use scallop_mesh::{MeshIndex, TriMesh};
 use scallop_toolpath::{Move, MoveKind, Toolpath};
 use scallop_waterline::{WaterlineGrid, WaterlineOptions};
 
 use crate::geometry::{contact_normal, slots_by_original};
-use crate::{FinishingParams, Planned, Report, StrategyError, ZoneRegion, tol};
+use crate::{FinishingParams, Planned, Refinement, Report, StrategyError, ZoneRegion, tol};
 
 /// How the part is split by slope.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -71,6 +73,19 @@ impl SteepShallow {
         SteepShallow { threshold: 0.5 * (a + b), overlap: tol::STEEP_OVERLAP_DEG.to_radians(), climb: true }
     }
 
+    /// The spacing (mm) of two waterline levels on a wall of `slope` (rad;
+    /// not finite: the steep range's lowest slope) for `cutter`, scallop
+    /// height `sh` and path tolerance `path` (module docs; before the
+    /// convexity factor of a wall that grows steeper downwards). The planner
+    /// spaces its levels so; `scallop run --plan-only` estimates with it.
+    #[must_use]
+    pub fn level_spacing(&self, cutter: &Cutter, sh: f64, path: f64, slope: f64) -> f64 {
+        let s = if slope.is_finite() { slope } else { self.threshold - self.overlap };
+        // The push-out adds its width to the material left on the wall.
+        let sh = sh - tol::LEVEL_PUSH_CHORDS * (tol::LEVEL_CHORD_SHARE * path);
+        (tol::LEVEL_SPACING_SAFETY * level_dz(cutter.shape(), sh, s)).max(tol::MIN_SPACING)
+    }
+
     fn check(&self) -> Result<(), StrategyError> {
         let ok = self.threshold.is_finite()
             && self.overlap.is_finite()
@@ -87,6 +102,81 @@ impl SteepShallow {
             })
         }
     }
+}
+
+/// On a wall that grows steeper downwards (convex in its vertical section,
+/// curvature `k` from the slopes `s0` at the upper level `z0` and `s1` at the
+/// lower `z1`), the profile circles leave a higher cusp than on a plane:
+/// `d^2 (1 / rho + k) / 8` instead of `d^2 / (8 rho)`, so the level spacing
+/// shrinks by `1 / sqrt(1 + rho k)`; `None` when it would change by less than
+/// 1 % (or for a flat end or a cone). The planner applies it between two
+/// levels; `scallop run --plan-only` estimates with it.
+#[must_use]
+pub fn convex_factor(shape: &CutterShape, (z0, s0): (f64, f64), (z1, s1): (f64, f64)) -> Option<f64> {
+    let rho = match *shape {
+        CutterShape::Ball { radius } => radius,
+        CutterShape::Bull { corner, .. } => corner,
+        CutterShape::Flat { .. } | CutterShape::Cone { .. } => return None,
+    };
+    if !(s0.is_finite() && s1.is_finite() && s1 > s0) {
+        return None;
+    }
+    let along = (z0 - z1) / (0.5 * (s0 + s1)).sin().max(1e-9);
+    let factor = 1.0 / (1.0 + rho * (s1 - s0) / along).sqrt();
+    (factor < 0.99).then_some(factor)
+}
+
+/// The largest residual (mm, from the lowest surface the cutter can reach)
+/// that two levels `dz` apart leave across a concave crease where a wall of
+/// slope `upper` (rad, above the crease) meets one of slope `lower` (below;
+/// `lower < upper`): in the vertical section across a horizontal crease, the
+/// profile circles' centres (radius `rho`: the ball radius, the corner radius
+/// of a bull-nose) run on two lines meeting at the centre `C` of the circle
+/// that touches both walls; the reach there is that circle, and the cusp of
+/// the two levels' circles (one on each line, `dz` apart in height, at every
+/// split of `dz` between the lines) stands `rho - dist(cusp, centre lines)`
+/// above it. On a straight wall (`upper == lower`) this is the scallop of the
+/// circles `dz / sin s` apart; a crease adds about `dz sin(deflection / 2)`,
+/// linear in `dz`, where the spacing rule assumes the quadratic law.
+/// 0 for a flat end or a cone (no profile circle), `f64::INFINITY` where the
+/// circles do not meet.
+#[must_use]
+pub fn crease_residual(shape: &CutterShape, upper: f64, lower: f64, dz: f64) -> f64 {
+    let rho = match *shape {
+        CutterShape::Ball { radius } => radius,
+        CutterShape::Bull { corner, .. } => corner,
+        CutterShape::Flat { .. } | CutterShape::Cone { .. } => return 0.0,
+    };
+    if !(dz > 0.0 && upper > lower && lower > 0.0) {
+        return 0.0;
+    }
+    let (u1, u2) = (Vec2::new(-upper.cos(), upper.sin()), Vec2::new(lower.cos(), -lower.sin()));
+    // The part lies on the side away from the walls' mean normal.
+    let normal = Vec2::new(upper.sin() + lower.sin(), upper.cos() + lower.cos());
+    let to_lines = |x: Vec2| {
+        [u1, u2]
+            .iter()
+            .map(|u| if x.dot(u) <= 0.0 { x.norm() } else { (x - u * x.dot(u)).norm() })
+            .fold(f64::INFINITY, f64::min)
+    };
+    let top = dz / upper.sin();
+    let mut worst = 0.0_f64;
+    for k in 0..=tol::CREASE_SPLITS {
+        #[allow(clippy::cast_precision_loss, reason = "a small count")]
+        let a = top * (k as f64 / tol::CREASE_SPLITS as f64);
+        let b = (dz - a * upper.sin()) / lower.sin();
+        let (c1, c2) = (u1 * a, u2 * b);
+        let chord = c2 - c1;
+        let half = 0.5 * chord.norm();
+        if half >= rho {
+            return f64::INFINITY;
+        }
+        let across = Vec2::new(-chord.y, chord.x) / (2.0 * half).max(f64::MIN_POSITIVE);
+        let side = if across.dot(&normal) > 0.0 { -1.0 } else { 1.0 };
+        let cusp = (c1 + c2) * 0.5 + across * (side * (rho * rho - half * half).sqrt());
+        worst = worst.max(rho - to_lines(cusp));
+    }
+    worst
 }
 
 /// The plane step-over (along the wall's horizontal projection) of parallel
@@ -124,6 +214,8 @@ pub struct SteepPlanned {
     pub shallow: Option<Planned>,
     /// Waterline levels with at least one pass.
     pub levels: usize,
+    /// Tip heights of the levels with a pass, from the top down (mm).
+    pub level_heights: Vec<f64>,
     /// Passes on the levels (runs of steep contact).
     pub steep_passes: usize,
     /// Times, lengths and counts of the whole toolpath; the scallop is the
@@ -132,7 +224,8 @@ pub struct SteepPlanned {
 }
 
 /// Plans steep-and-shallow finishing of `mesh` (indexed by `index`): see the
-/// module docs.
+/// module docs. The planes and levels of `refine` are added to those the
+/// planner places (see [`Refinement`]; `Refinement::default()` adds none).
 ///
 /// # Errors
 /// As [`crate::plan_finishing`] for the shallow planes; a bad split
@@ -145,6 +238,7 @@ pub fn plan_steep_shallow(
     params: &FinishingParams,
     tol_: &Tolerances,
     split: &SteepShallow,
+    refine: &Refinement,
 ) -> Result<SteepPlanned, StrategyError> {
     params.validate()?;
     split.check()?;
@@ -155,7 +249,7 @@ pub fn plan_steep_shallow(
     let labels: Vec<u32> = slopes.iter().map(|&s| u32::from(s >= split.threshold + split.overlap)).collect();
     let shallow = if labels.contains(&0) {
         let region = ZoneRegion::new(mesh, &labels, 0, 0.0)?;
-        match crate::plan(index, cutter, params, tol_, Some(&region), true) {
+        match crate::plan(index, cutter, params, tol_, Some(&region), true, &refine.planes) {
             Ok(p) => Some(p),
             Err(StrategyError::EmptyRegion { .. }) => None,
             Err(e) => return Err(e),
@@ -170,13 +264,14 @@ pub fn plan_steep_shallow(
         toolpath.extend_from(&p.toolpath);
     }
     let steep_z = steep_range(mesh, &slopes, steep_min);
-    let (levels, steep_passes) = match steep_z {
+    let (levels, steep_passes, level_heights) = match steep_z {
         Some(range) => {
             let mut levels = Levels::new(index, cutter, params, tol_, split, range)?;
             levels.flats = flat_heights(mesh, &slopes, tol_.path);
+            levels.extra.clone_from(&refine.levels);
             levels.append_to(&mut toolpath)?
         }
-        None => (0, 0),
+        None => (0, 0, Vec::new()),
     };
     if shallow.is_none() && steep_passes == 0 {
         return Err(StrategyError::EmptyRegion { direction_deg: params.direction.to_degrees() });
@@ -192,7 +287,7 @@ pub fn plan_steep_shallow(
     }
     report.passes += steep_passes;
     report.planes += levels;
-    Ok(SteepPlanned { toolpath, shallow, levels, steep_passes, report })
+    Ok(SteepPlanned { toolpath, shallow, levels, level_heights, steep_passes, report })
 }
 
 /// Slope of a triangle from the horizontal (rad, 0 to pi/2; facing down
@@ -242,6 +337,8 @@ struct Levels<'a> {
     /// (mm): a chord of a convex contour lies inside it by up to this much,
     /// and on a steep wall any inward step is a deep vertical gouge.
     chord: f64,
+    /// The path tolerance (mm).
+    path: f64,
     slots: Vec<u32>,
     floor: f64,
     /// Lowest and highest level (tip heights, mm).
@@ -251,12 +348,16 @@ struct Levels<'a> {
     flats: Vec<f64>,
     /// How far above a flat area its level runs (mm, `FLAT_LIFT_SHARE * path`).
     lift: f64,
+    /// Levels added to those the spacing rule places ([`Refinement::levels`]).
+    extra: Vec<f64>,
 }
 
 /// One level's passes and its smallest steep contact slope.
 struct Level {
     z: f64,
     passes: Vec<Vec<Point2>>,
+    /// The contact slope at each point of `passes` (rad).
+    slopes: Vec<Vec<f64>>,
     min_slope: f64,
 }
 
@@ -284,11 +385,13 @@ impl<'a> Levels<'a> {
             split,
             grid,
             chord,
+            path: tol_.path,
             slots: slots_by_original(index),
             floor: bounds.min.z - bounds.diagonal() - 1.0,
             z_range: (bottom, top.max(bottom)),
             flats: Vec::new(),
             lift: tol::FLAT_LIFT_SHARE * tol_.path,
+            extra: Vec::new(),
         })
     }
 
@@ -297,7 +400,7 @@ impl<'a> Levels<'a> {
     fn level(&self, z: f64) -> Result<Level, StrategyError> {
         let loops = self.grid.loops(z).map_err(|e| StrategyError::Waterline(e.to_string()))?;
         let steep_min = self.split.threshold - self.split.overlap;
-        let mut passes = Vec::new();
+        let (mut passes, mut pass_slopes) = (Vec::new(), Vec::new());
         let mut min_slope = f64::INFINITY;
         for l in loops {
             let mut points = pushed_out(&l.points, tol::LEVEL_PUSH_CHORDS * self.chord);
@@ -316,9 +419,12 @@ impl<'a> Levels<'a> {
             for &s in slopes.iter().filter(|&&s| s >= steep_min) {
                 min_slope = min_slope.min(s);
             }
-            passes.extend(steep_runs(&points, &slopes, steep_min));
+            for run in steep_runs(&slopes, steep_min) {
+                passes.push(run.iter().map(|&i| points[i]).collect());
+                pass_slopes.push(run.iter().map(|&i| slopes[i]).collect());
+            }
         }
-        Ok(Level { z, passes, min_slope })
+        Ok(Level { z, passes, slopes: pass_slopes, min_slope })
     }
 
     fn contact_slope(&self, p: Point2) -> f64 {
@@ -328,30 +434,57 @@ impl<'a> Levels<'a> {
     }
 
     fn dz(&self, slope: f64) -> f64 {
-        let s = if slope.is_finite() { slope } else { self.split.threshold - self.split.overlap };
-        // The push-out adds its width to the material left on the wall.
-        let sh = self.params.scallop_height - tol::LEVEL_PUSH_CHORDS * self.chord;
-        (tol::LEVEL_SPACING_SAFETY * level_dz(self.cutter.shape(), sh, s)).max(tol::MIN_SPACING)
+        self.split.level_spacing(self.cutter, self.params.scallop_height, self.path, slope)
     }
 
-    /// On a wall that grows steeper downwards (convex in its vertical section,
-    /// curvature `k` from the two levels' slopes), the profile circles leave a
-    /// higher cusp than on a plane: `d^2 (1 / rho + k) / 8` instead of
-    /// `d^2 / (8 rho)`, so the spacing shrinks by `1 / sqrt(1 + rho k)`;
-    /// `None` when it would change by less than 1 %.
     fn convex_factor(&self, upper: &Level, lower: &Level) -> Option<f64> {
-        let rho = match *self.cutter.shape() {
-            CutterShape::Ball { radius } => radius,
-            CutterShape::Bull { corner, .. } => corner,
-            CutterShape::Flat { .. } | CutterShape::Cone { .. } => return None,
-        };
-        let (s0, s1) = (upper.min_slope, lower.min_slope);
-        if !(s0.is_finite() && s1.is_finite() && s1 > s0) {
-            return None;
+        convex_factor(self.cutter.shape(), (upper.z, upper.min_slope), (lower.z, lower.min_slope))
+    }
+
+    /// The scallop height the levels hold: `sh` less the push-out (see
+    /// [`SteepShallow::level_spacing`]).
+    fn level_sh(&self) -> f64 {
+        self.params.scallop_height - tol::LEVEL_PUSH_CHORDS * self.chord
+    }
+
+    /// The largest [`crease_residual`] between two levels: each point of
+    /// `lower` is paired with the nearest point of `upper` within
+    /// `CREASE_REACH` times `dz / tan(threshold - overlap)` in XY (two levels
+    /// on walls steeper than that lie closer); where the upper contact is
+    /// steeper, a concave crease may lie between them.
+    fn crease(&self, upper: &Level, lower: &Level) -> f64 {
+        let dz = upper.z - lower.z;
+        let steep_min = self.split.threshold - self.split.overlap;
+        let radius = (tol::CREASE_REACH * dz / steep_min.tan()).max(tol::MIN_SPACING);
+        #[allow(clippy::cast_possible_truncation, reason = "cell indices of a bounded part")]
+        let key = |p: &Point2| ((p.x / radius).floor() as i64, (p.y / radius).floor() as i64);
+        let mut cells: HashMap<(i64, i64), Vec<(Point2, f64)>> = HashMap::new();
+        for (pass, slopes) in upper.passes.iter().zip(&upper.slopes) {
+            for (p, &s) in pass.iter().zip(slopes) {
+                cells.entry(key(p)).or_default().push((*p, s));
+            }
         }
-        let along = (upper.z - lower.z) / (0.5 * (s0 + s1)).sin().max(1e-9);
-        let factor = 1.0 / (1.0 + rho * (s1 - s0) / along).sqrt();
-        (factor < 0.99).then_some(factor)
+        let mut worst = 0.0_f64;
+        for (pass, slopes) in lower.passes.iter().zip(&lower.slopes) {
+            for (q, &s_lo) in pass.iter().zip(slopes) {
+                let (i, j) = key(q);
+                let mut nearest: Option<(f64, f64)> = None;
+                for di in -1..=1 {
+                    for dj in -1..=1 {
+                        for (p, s) in cells.get(&(i + di, j + dj)).into_iter().flatten() {
+                            let d = (p - q).norm();
+                            if d <= radius && nearest.is_none_or(|(best, _)| d < best) {
+                                nearest = Some((d, *s));
+                            }
+                        }
+                    }
+                }
+                if let Some((_, s_up)) = nearest.filter(|&(_, s_up)| s_up > s_lo) {
+                    worst = worst.max(crease_residual(self.cutter.shape(), s_up, s_lo, dz));
+                }
+            }
+        }
+        worst
     }
 
     /// The levels from the top down (module docs), each spaced by the smaller
@@ -374,13 +507,39 @@ impl<'a> Levels<'a> {
                 dz *= factor;
                 next = self.level(self.next_z(current.z, dz))?;
             }
+            for _ in 0..tol::CREASE_RETRIES {
+                let residual = self.crease(&current, &next);
+                if residual <= self.level_sh() || dz <= tol::MIN_SPACING {
+                    break;
+                }
+                // The crease's residual grows about linearly with dz.
+                let ratio = if residual.is_finite() { self.level_sh() / residual } else { 0.5 };
+                dz = (dz * ratio * tol::LEVEL_SPACING_SAFETY).max(tol::MIN_SPACING);
+                next = self.level(self.next_z(current.z, dz))?;
+            }
             out.push(current);
             if out.len() > tol::MAX_LEVELS {
                 return Err(StrategyError::TooManyLevels { levels: out.len(), dz, max: tol::MAX_LEVELS });
             }
             current = next;
         }
-        Ok(out)
+        self.with_extra(out)
+    }
+
+    /// `levels` (from the top down) with a level at each height of
+    /// [`Self::extra`] inside the levels' range and not within
+    /// [`tol::MIN_SPACING`] of one.
+    fn with_extra(&self, mut levels: Vec<Level>) -> Result<Vec<Level>, StrategyError> {
+        let (bottom, top) = self.z_range;
+        for &z in &self.extra {
+            if !(bottom..=top).contains(&z) || levels.iter().any(|l| (l.z - z).abs() <= tol::MIN_SPACING) {
+                continue;
+            }
+            let level = self.level(z)?;
+            let at = levels.partition_point(|l| l.z > z);
+            levels.insert(at, level);
+        }
+        Ok(levels)
     }
 
     /// The level `dz` below `z`, or the level just above a flat area between
@@ -394,16 +553,17 @@ impl<'a> Levels<'a> {
     /// Appends the levels to `path` (after what it holds), each pass entered
     /// from the clearance height or linked from the previous pass's end when the
     /// straight move between them stays above the CL surface; returns (levels
-    /// with a pass, passes).
-    fn append_to(&self, path: &mut Toolpath) -> Result<(usize, usize), StrategyError> {
+    /// with a pass, passes, the heights of those levels).
+    fn append_to(&self, path: &mut Toolpath) -> Result<(usize, usize, Vec<f64>), StrategyError> {
         let clear = self.index.bounds().max.z + self.params.clearance;
         let mut last: Option<Point3> = None;
-        let (mut levels, mut count) = (0, 0);
+        let (mut levels, mut count, mut heights) = (0, 0, Vec::new());
         for level in self.all()? {
             if level.passes.is_empty() {
                 continue;
             }
             levels += 1;
+            heights.push(level.z);
             for pass in order_from(level.passes, last.map(|p| p.xy())) {
                 let points: Vec<Point3> = pass.iter().map(|p| Point3::new(p.x, p.y, level.z)).collect();
                 let (Some(&start), Some(&end)) = (points.first(), points.last()) else { continue };
@@ -429,7 +589,7 @@ impl<'a> Levels<'a> {
         if let Some(end) = last {
             path.push(Move::new(MoveKind::Retract, Point3::new(end.x, end.y, clear)));
         }
-        Ok((levels, count))
+        Ok((levels, count, heights))
     }
 
     /// Whether the straight move from `a` to `b` stays on or above the
@@ -473,25 +633,25 @@ fn pushed_out(points: &[Point2], by: f64) -> Vec<Point2> {
 
 /// Maximal runs of `points` (a closed loop) whose `slopes` reach `steep_min`;
 /// a loop steep all around comes back closed (its first point again at the end).
-fn steep_runs(points: &[Point2], slopes: &[f64], steep_min: f64) -> Vec<Vec<Point2>> {
-    let n = points.len();
+fn steep_runs(slopes: &[f64], steep_min: f64) -> Vec<Vec<usize>> {
+    let n = slopes.len();
     let keep: Vec<bool> = slopes.iter().map(|&s| s >= steep_min).collect();
     if n < 2 || !keep.contains(&true) {
         return Vec::new();
     }
     if keep.iter().all(|&k| k) {
-        let mut closed = points.to_vec();
-        closed.push(points[0]);
+        let mut closed: Vec<usize> = (0..n).collect();
+        closed.push(0);
         return vec![closed];
     }
     // Start right after a dropped point so no run wraps around the start.
     let start = (0..n).find(|&i| !keep[i]).map_or(0, |i| (i + 1) % n);
     let mut runs = Vec::new();
-    let mut run: Vec<Point2> = Vec::new();
+    let mut run: Vec<usize> = Vec::new();
     for k in 0..n {
         let i = (start + k) % n;
         if keep[i] {
-            run.push(points[i]);
+            run.push(i);
         } else if !run.is_empty() {
             let done = std::mem::take(&mut run);
             if done.len() >= 2 {
@@ -539,14 +699,67 @@ mod tests {
 
     #[test]
     fn runs_split_a_loop_at_shallow_points_without_wrapping() {
-        let pts: Vec<Point2> = (0..6).map(|i| Point2::new(f64::from(i), 0.0)).collect();
         let slopes = [1.0, 1.0, 0.0, 1.0, 1.0, 1.0];
-        let runs = steep_runs(&pts, &slopes, 0.5);
+        let runs = steep_runs(&slopes, 0.5);
         // After the dropped point 2: 3, 4, 5, then 0, 1 (one run across the loop's start).
-        assert_eq!(runs, vec![vec![pts[3], pts[4], pts[5], pts[0], pts[1]]]);
-        let all = steep_runs(&pts, &[1.0; 6], 0.5);
+        assert_eq!(runs, vec![vec![3, 4, 5, 0, 1]]);
+        let all = steep_runs(&[1.0; 6], 0.5);
         assert_eq!(all[0].len(), 7);
         assert_eq!(all[0].first(), all[0].last());
+    }
+
+    #[test]
+    fn crease_residual_is_the_straight_scallop_without_a_crease_and_grows_with_it() {
+        let ball = CutterShape::Ball { radius: 1.5 };
+        let (s, dz) = (50f64.to_radians(), 0.4);
+        // Nearly equal slopes: the circles dz / sin s apart on a straight line.
+        let half = 0.5 * dz / s.sin();
+        let straight = 1.5 - (1.5 * 1.5 - half * half).sqrt();
+        let nearly = crease_residual(&ball, s + 1e-9, s, dz);
+        assert!((nearly - straight).abs() < 1e-6, "{nearly} {straight}");
+        // A sharper crease leaves more; halving dz leaves much more than a
+        // quarter (the linear term of the crease).
+        let sharp = crease_residual(&ball, 80f64.to_radians(), 40f64.to_radians(), dz);
+        let milder = crease_residual(&ball, 60f64.to_radians(), 40f64.to_radians(), dz);
+        assert!(sharp > milder && milder > crease_residual(&ball, 41f64.to_radians(), 40f64.to_radians(), dz));
+        let half_dz = crease_residual(&ball, 80f64.to_radians(), 40f64.to_radians(), 0.5 * dz);
+        assert!(half_dz > 0.4 * sharp, "{half_dz} {sharp}");
+        // No crease (convex or equal slopes) and no profile circle: nothing to add.
+        assert!(crease_residual(&ball, s, s, dz).abs() < f64::EPSILON);
+        assert!(crease_residual(&CutterShape::Flat { radius: 1.5 }, 1.2, 0.7, dz).abs() < f64::EPSILON);
+    }
+
+    /// Brute force in the section: the cusp of the two levels' circles,
+    /// measured to the lowest circle over a dense family of centres on the two
+    /// centre lines (the reach), agrees with `crease_residual`.
+    #[test]
+    fn crease_residual_matches_a_dense_family_of_circles() {
+        let rho = 1.0;
+        let ball = CutterShape::Ball { radius: rho };
+        let (upper, lower, dz) = (75f64.to_radians(), 38f64.to_radians(), 0.3);
+        let (u1, u2) = (Vec2::new(-upper.cos(), upper.sin()), Vec2::new(lower.cos(), -lower.sin()));
+        let mut worst = 0.0_f64;
+        for k in 0..=400 {
+            let a = dz / upper.sin() * (f64::from(k) / 400.0);
+            let b = (dz - a * upper.sin()) / lower.sin();
+            let (c1, c2) = (u1 * a, u2 * b);
+            // The lower intersection of the two circles, by bisection on the
+            // bisector of the chord, below the chord.
+            let mid = (c1 + c2) * 0.5;
+            let chord = c2 - c1;
+            let across = Vec2::new(chord.y, -chord.x) / chord.norm();
+            let across = if across.y < 0.0 { across } else { -across };
+            let cusp = mid + across * (rho * rho - 0.25 * chord.norm_squared()).sqrt();
+            // Distance to the family of centres (both lines, densely).
+            let mut nearest = f64::INFINITY;
+            for j in 0..=4000 {
+                let t = 3.0 * f64::from(j) / 4000.0;
+                nearest = nearest.min((cusp - u1 * t).norm()).min((cusp - u2 * t).norm());
+            }
+            worst = worst.max(rho - nearest);
+        }
+        let r = crease_residual(&ball, upper, lower, dz);
+        assert!((r - worst).abs() < 2e-3 * worst.max(1e-3) + 1e-6, "{r} {worst}");
     }
 
     #[test]

@@ -257,11 +257,43 @@ pub const LEVEL_PUSH_CHORDS: f64 = 2.0;
 /// every this many chord tolerances along it.
 pub const LEVEL_LINK_SAMPLE_CHORDS: f64 = 10.0;
 
-/// Where the spacing rule gives no usable spacing (a crease's normal) and the
-/// planner tolerates rest material, the next plane is this share of the
-/// largest step-over away (then measured as usual).
+/// When the planner tolerates rest material (steep-and-shallow) and no
+/// spacing holds sh (a crease's normal, the foot of a wall that the
+/// waterline levels finish), the next plane is this share of the largest
+/// step-over away (at most the rule's spacing) and the stock simulation
+/// reports what is left.
 pub const REST_SPACING_SHARE: f64 = 0.25;
 
 /// Half-width (degrees) of the slope band that both parallel planes and
 /// waterline levels finish in steep-and-shallow finishing.
 pub const STEEP_OVERLAP_DEG: f64 = 10.0;
+
+/// An edge or vertex contact whose cutter normal leans more than this
+/// (degrees) from the contacted facet's normal is a sharp convex feature of
+/// the part, not its tessellation: it does not set the pass spacing (see
+/// `Planner::rides_sharp_edge`). Tessellations of smooth surfaces within the
+/// usual chord tolerances bend by a few degrees between facets.
+pub const SHARP_EDGE_DEG: f64 = 30.0;
+
+/// With rest tolerated, a measured residual above this many times sh at the
+/// spacing rule's gap is rest material, not a scallop (a scallop grows with
+/// the square of the gap: the rule would be 4.5 times too wide), and the
+/// next plane goes `REST_SPACING_SHARE` of the largest step-over away
+/// instead of shrinking the gap (`Planner::sweep`). So is a residual that
+/// keeps more than half its height when the gap is more than halved (a
+/// scallop would fall to a quarter).
+pub const REST_RESIDUAL_FACTOR: f64 = 20.0;
+
+/// Splits of a level spacing between the two walls of a concave crease at
+/// which `steep::crease_residual` evaluates the cusp (the worst is kept).
+pub const CREASE_SPLITS: usize = 16;
+
+/// Times a level spacing is shrunk until the residual across the concave
+/// creases between the two levels holds the scallop height.
+pub const CREASE_RETRIES: usize = 4;
+
+/// A point of a waterline level is paired with the nearest point of the level
+/// above within this many times the horizontal offset of two levels on the
+/// shallowest steep wall (`dz / tan(threshold - overlap)`) when looking for a
+/// concave crease between them (`Levels::crease`).
+pub const CREASE_REACH: f64 = 1.5;

@@ -5,20 +5,15 @@
 
 mod common;
 
-use common::{bull, params};
-use scallop_analysis::{GridOptions, MachineLimits, Recommendation, ToolOptions, analyze, sample_patch};
+use common::{bull, choi_analysed, params};
+use scallop_analysis::Recommendation;
 use scallop_geom::Tolerances;
-use scallop_mesh::MeshIndex;
 use scallop_strategy::{Pattern, plan_finishing};
 
 #[test]
 fn choi_bull_nose_along_the_steepest_slope() {
-    let set = scallop_surface::builtin("choi").unwrap();
     let tol = Tolerances { path: 0.01, gouge: 0.0 };
-    let index = MeshIndex::build(&set.tessellate(tol.tessellation()).unwrap().mesh);
-    let samples = sample_patch(&set.patches()[0], &GridOptions::default()).unwrap();
-    let machine = MachineLimits::from_thesis_units(5.0, 6.0, 40.0);
-    let analysis = analyze(&samples, &ToolOptions::default(), &machine, 0.01).unwrap();
+    let (index, analysis) = choi_analysed(&tol);
     assert_eq!(analysis.recommendation, Recommendation::ToroidalAlongSlope);
     let p = params(analysis.slope_direction_deg.to_radians(), Pattern::Zigzag, 0.01, 0.5);
     let planned = plan_finishing(&index, &bull(5.0, 2.0), &p, &tol).unwrap();

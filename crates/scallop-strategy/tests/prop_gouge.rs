@@ -143,13 +143,8 @@ proptest! {
 /// sampling share.
 #[test]
 fn choi_demo_moves_stay_above_the_cl_surface() {
-    use scallop_analysis::{GridOptions, MachineLimits, ToolOptions, analyze, sample_patch};
-    let set = scallop_surface::builtin("choi").unwrap();
     let tolerances = Tolerances { path: 0.01, gouge: 0.0 };
-    let index = MeshIndex::build(&set.tessellate(tolerances.tessellation()).unwrap().mesh);
-    let samples = sample_patch(&set.patches()[0], &GridOptions::default()).unwrap();
-    let machine = MachineLimits::from_thesis_units(5.0, 6.0, 40.0);
-    let analysis = analyze(&samples, &ToolOptions::default(), &machine, 0.01).unwrap();
+    let (index, analysis) = common::choi_analysed(&tolerances);
     let p = params(analysis.slope_direction_deg.to_radians(), Pattern::Zigzag, 0.01, 0.5);
     let cutter = bull(5.0, 2.0);
     let planned = plan_finishing(&index, &cutter, &p, &tolerances).unwrap();

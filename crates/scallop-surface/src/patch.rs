@@ -355,7 +355,8 @@ impl Patch {
         let basis_u = self.basis(Direction::U, u);
         let basis_v = self.basis(Direction::V, v);
         let columns = self.shape[1];
-        // Homogeneous sums, order: (0,0), (1,0), (0,1), (2,0), (1,1), (0,2) derivatives.
+        // Homogeneous sums of the derivatives of orders (in u, in v), in this order.
+        const ORDERS: [(usize, usize); 6] = [(0, 0), (1, 0), (0, 1), (2, 0), (1, 1), (0, 2)];
         let mut a = [Vec3::zeros(); 6];
         let mut w = [0.0; 6];
         let count_u = basis_u.values[0].len();
@@ -373,19 +374,11 @@ impl Patch {
                     weight_v[l] += weight * basis_v.values[l][s];
                 }
             }
-            let [n0, n1, n2] = [basis_u.values[0][r], basis_u.values[1][r], basis_u.values[2][r]];
-            a[0] += along_v[0] * n0;
-            a[1] += along_v[0] * n1;
-            a[2] += along_v[1] * n0;
-            a[3] += along_v[0] * n2;
-            a[4] += along_v[1] * n1;
-            a[5] += along_v[2] * n0;
-            w[0] += weight_v[0] * n0;
-            w[1] += weight_v[0] * n1;
-            w[2] += weight_v[1] * n0;
-            w[3] += weight_v[0] * n2;
-            w[4] += weight_v[1] * n1;
-            w[5] += weight_v[2] * n0;
+            let n = [basis_u.values[0][r], basis_u.values[1][r], basis_u.values[2][r]];
+            for (k, &(du, dv)) in ORDERS.iter().enumerate() {
+                a[k] += along_v[dv] * n[du];
+                w[k] += weight_v[dv] * n[du];
+            }
         }
         if self.weights.is_none() {
             // Polynomial: W = 1 exactly (partition of unity), all its derivatives 0.

@@ -3,8 +3,9 @@
 
 mod common;
 
-use common::{Rng, builtin_patch, p, quarter_cylinder, rational_nurbs};
+use common::{builtin_patch, p, quarter_cylinder, rational_nurbs};
 use proptest::prelude::*;
+use scallop_geom::rng::SplitMix64;
 use scallop_geom::{Point3, assert_near};
 use scallop_surface::Patch;
 
@@ -81,7 +82,7 @@ fn points_beyond_edges_and_corners_project_onto_them() {
 /// conditions: (S - P) . Su = 0 unless u is on a bound (then the gradient points out).
 #[test]
 fn closest_point_beats_dense_sampling_and_is_stationary() {
-    let mut rng = Rng::new(7);
+    let mut rng = SplitMix64::new(7);
     for patch in [builtin_patch("choi"), builtin_patch("rubio"), rational_nurbs()] {
         let bounds = patch.bounds();
         let n = 120;
@@ -95,9 +96,9 @@ fn closest_point_beats_dense_sampling_and_is_stationary() {
             .collect();
         for _ in 0..40 {
             let q = p(
-                rng.range(bounds.min.x - 15.0, bounds.max.x + 15.0),
-                rng.range(bounds.min.y - 15.0, bounds.max.y + 15.0),
-                rng.range(bounds.min.z - 15.0, bounds.max.z + 15.0),
+                rng.uniform(bounds.min.x - 15.0, bounds.max.x + 15.0),
+                rng.uniform(bounds.min.y - 15.0, bounds.max.y + 15.0),
+                rng.uniform(bounds.min.z - 15.0, bounds.max.z + 15.0),
             );
             let c = patch.closest_point(&q);
             let brute = samples.iter().map(|s| (s - q).norm()).fold(f64::INFINITY, f64::min);

@@ -3,9 +3,10 @@
 mod common;
 
 use common::{
-    Rng, builtin_patch, p, point_triangle_distance, quarter_cylinder, rational_nurbs, rubio_split_as_nurbs, set_of,
+    builtin_patch, p, point_triangle_distance, quarter_cylinder, rational_nurbs, rubio_split_as_nurbs, set_of,
 };
 use scallop_geom::Point3;
+use scallop_geom::rng::SplitMix64;
 use scallop_mesh::TriMesh;
 use scallop_surface::{Direction, Patch, SurfaceError, Tessellation};
 
@@ -13,10 +14,10 @@ use scallop_surface::{Direction, Patch, SurfaceError, Tessellation};
 /// random points, plus (for Bezier patches, whose grid is uniform) the centre of
 /// every cell, the midpoint of the diagonal, where the bound's maximum sits.
 fn max_deviation(patch: &Patch, mesh: &TriMesh, cells: Option<[usize; 2]>, samples: usize, seed: u64) -> f64 {
-    let mut rng = Rng::new(seed);
+    let mut rng = SplitMix64::new(seed);
     let soup = mesh.soup();
     let domain = patch.domain();
-    let mut params: Vec<(f64, f64)> = (0..samples).map(|_| domain.lerp(rng.next_f64(), rng.next_f64())).collect();
+    let mut params: Vec<(f64, f64)> = (0..samples).map(|_| domain.lerp(rng.unit(), rng.unit())).collect();
     if let (true, Some([nu, nv])) = (patch.is_bezier(), cells) {
         for i in 0..nu {
             for j in 0..nv {

@@ -38,21 +38,3 @@ pub fn builtin_samples(name: &str, n: usize) -> Samples {
     let set = scallop_surface::builtin(name).unwrap();
     sample_patch(&set.patches()[0], &GridOptions { cells_u: n, cells_v: n }).unwrap()
 }
-
-/// SplitMix64: a tiny deterministic generator for test data.
-pub struct SplitMix(pub u64);
-
-impl SplitMix {
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in [lo, hi).
-    pub fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * ((self.next_u64() >> 11) as f64 / (1u64 << 53) as f64)
-    }
-}

@@ -3,8 +3,8 @@
 
 #![allow(dead_code, reason = "each test binary uses a subset")]
 
-use std::path::PathBuf;
-use std::process::Command;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
 
 /// The `scallop` binary, as under CI (no progress bars).
 pub fn scallop() -> Command {
@@ -37,4 +37,24 @@ pub fn pyramid_stl() -> Vec<u8> {
         out.extend_from_slice(&[0u8; 2]);
     }
     out
+}
+
+/// The standard error of a run the binary rejected: exit code 1, no panic.
+pub fn rejected(out: &std::process::Output) -> String {
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    err
+}
+
+/// `scallop run JOB -o OUT EXTRA...`.
+pub fn run_job(job: &Path, out: &Path, extra: &[&str]) -> Output {
+    scallop().arg("run").arg(job).arg("-o").arg(out).args(extra).output().expect("run")
+}
+
+/// [`run_job`] with `--json`, which must succeed: the report it prints.
+pub fn run_json(job: &Path, out: &Path, extra: &[&str]) -> serde_json::Value {
+    let done = run_job(job, out, &[&["--json"], extra].concat());
+    assert!(done.status.success(), "{}", String::from_utf8_lossy(&done.stderr));
+    serde_json::from_slice(&done.stdout).expect("json")
 }

@@ -158,8 +158,7 @@ impl DexelReport {
     /// # Errors
     /// [`SimError::RapidIntoStock`], then [`SimError::DexelCollision`].
     pub fn check(&self) -> Result<(), SimError> {
-        crate::zmap::safety_verdict(&self.rapid_hits, &self.collisions, |count, collisions| SimError::DexelCollision {
-            count,
+        crate::zmap::safety_verdict(&self.rapid_hits, &self.collisions, |collisions| SimError::DexelCollision {
             collisions,
         })
     }

@@ -45,3 +45,15 @@ pub fn ball(radius: f64) -> Cutter {
 pub fn flat(radius: f64) -> Cutter {
     Cutter::new(CutterShape::Flat { radius }, 30.0).unwrap()
 }
+
+/// The demo's job (finishing.md 14.3): the Choi surface indexed at the path
+/// tolerance `tol`, and its analysis for the machine (V = 5 m/min,
+/// A = 6 m/s^2, J = 40 m/s^3) at sh = 0.01 mm.
+pub fn choi_analysed(tol: &scallop_geom::Tolerances) -> (MeshIndex, scallop_analysis::AnalysisReport) {
+    use scallop_analysis::{GridOptions, ToolOptions, analyze, sample_patch};
+    let set = scallop_surface::builtin("choi").unwrap();
+    let index = MeshIndex::build(&set.tessellate(tol.tessellation()).unwrap().mesh);
+    let samples = sample_patch(&set.patches()[0], &GridOptions::default()).unwrap();
+    let machine = MachineLimits::from_thesis_units(5.0, 6.0, 40.0);
+    (index, analyze(&samples, &ToolOptions::default(), &machine, 0.01).unwrap())
+}

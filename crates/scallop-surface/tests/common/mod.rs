@@ -75,69 +75,9 @@ pub fn set_of(patches: Vec<Patch>) -> SurfaceSet {
     SurfaceSet::new(patches).expect("valid set")
 }
 
-/// Deterministic pseudo-random numbers in [0, 1) (SplitMix64).
-pub struct Rng(u64);
-
-impl Rng {
-    pub fn new(seed: u64) -> Self {
-        Rng(seed)
-    }
-
-    pub fn next_f64(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        (z >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    pub fn range(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.next_f64()
-    }
-}
-
-/// Distance from `q` to triangle `abc` (Ericson, Real-Time Collision Detection 5.1.5).
-pub fn point_triangle_distance(q: &Point3, [a, b, c]: [Point3; 3]) -> f64 {
-    let ab = b - a;
-    let ac = c - a;
-    let ap = q - a;
-    let d1 = ab.dot(&ap);
-    let d2 = ac.dot(&ap);
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return (q - a).norm();
-    }
-    let bp = q - b;
-    let d3 = ab.dot(&bp);
-    let d4 = ac.dot(&bp);
-    if d3 >= 0.0 && d4 <= d3 {
-        return (q - b).norm();
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        let v = d1 / (d1 - d3);
-        return (q - (a + ab * v)).norm();
-    }
-    let cp = q - c;
-    let d5 = ab.dot(&cp);
-    let d6 = ac.dot(&cp);
-    if d6 >= 0.0 && d5 <= d6 {
-        return (q - c).norm();
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        let w = d2 / (d2 - d6);
-        return (q - (a + ac * w)).norm();
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        return (q - (b + (c - b) * w)).norm();
-    }
-    let denom = 1.0 / (va + vb + vc);
-    let v = vb * denom;
-    let w = vc * denom;
-    (q - (a + ab * v + ac * w)).norm()
+/// Distance from `q` to triangle `abc`.
+pub fn point_triangle_distance(q: &Point3, t: [Point3; 3]) -> f64 {
+    (q - scallop_mesh::closest_on_triangle(q, &t)).norm()
 }
 
 /// `|a - b| <= tol * max(1, |b|)`, with a message naming `what`.

@@ -1,0 +1,662 @@
+//! `scallop rough5`: 5-axis roughing of a test part by guide curves (or the
+//! zero-tilt baseline), proven on a tri-dexel stock and posted for a 5-axis
+//! machine (docs/rough5.md): `program.nc`, `toolpath.cl` and `report.json`.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use clap::{Args, ValueEnum};
+use scallop_cutter::{Cutter, CutterShape, HolderSegment};
+use scallop_guides::GuideSettings;
+use scallop_machine::Kinematics;
+use scallop_machine::program::{ClRecord, MachineProgram, ProgramOptions, records_of, to_program};
+use scallop_mesh::TriMesh;
+use scallop_parts::FaceTag;
+use scallop_parts::TestPart;
+use scallop_post::{OutputMode, PostParams, check_replay, program_text, replay};
+use scallop_rough5::{
+    CuttingData, OrientSettings, Proof, ProofSettings, Rough5Plan, Rough5Settings, TiltMode, Weights, plan_rough5,
+    prove,
+};
+use scallop_toolpath::Toolpath;
+use serde::Serialize;
+
+use crate::guides::{LevelArgs, PartArg, test_part};
+use crate::output::{print_json, print_text, progress_bar, with_written};
+use crate::outset::OutputSet;
+use crate::post::{ProgramTime, load_dialect, load_machine, program_time};
+use crate::{CliResult, Failure};
+
+/// The tool-axis variant.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum TiltArg {
+    /// Tool axis +Z on every offset level (the zero-tilt baseline).
+    Zero,
+    /// Tool axis from the path curve to the tilt curve on the level above (SPU).
+    Guides,
+    /// Guide curves with the optimised reparameterisation of each pass (`--weights`, `--interval`, `--target`).
+    Optimised,
+}
+
+/// Arguments of `scallop rough5`.
+#[derive(Args, Debug)]
+pub struct Rough5Args {
+    /// Test part.
+    #[arg(long, value_enum, default_value = "pocket")]
+    part: PartArg,
+    /// Tool-axis variant.
+    #[arg(long, value_enum, default_value = "guides")]
+    tilt: TiltArg,
+    /// Torus radius R (mm; the thesis's FRAISA torus R 5 r 1.5).
+    #[arg(long, default_value_t = 5.0)]
+    tool_radius: f64,
+    /// Corner radius r (mm).
+    #[arg(long, default_value_t = 1.5)]
+    corner: f64,
+    /// Flute length (mm; not given in the thesis: 30 mm keeps the shank above the 35 mm block).
+    #[arg(long, default_value_t = 30.0)]
+    flutes: f64,
+    /// Stick-out from the holder (mm).
+    #[arg(long, default_value_t = 41.0)]
+    stick_out: f64,
+    /// Holder diameter and length (mm; the thesis's slender collet chuck).
+    #[arg(long, num_args = 2, default_values_t = [27.0, 192.0])]
+    holder: Vec<f64>,
+    /// Material left on the flanks and on the bottom (mm).
+    #[arg(long, num_args = 2, default_values_t = [0.5, 0.5])]
+    allowance: Vec<f64>,
+    #[command(flatten)]
+    levels: LevelArgs,
+    /// Spacing of the CL points along a pass (mm).
+    #[arg(long, default_value_t = 1.0)]
+    step: f64,
+    /// Largest tool-axis change between CL points (degrees).
+    #[arg(long, default_value_t = 2.0)]
+    max_angle_step: f64,
+    /// Largest change of the axis's azimuth about Z between CL points (degrees): the C table turns evenly.
+    #[arg(long, default_value_t = 5.0)]
+    max_azimuth_step: f64,
+    /// Teeth z, feed per tooth f_z (mm) and spindle speed N (1/min): the feed is z f_z N (2400 mm/min).
+    #[arg(long, num_args = 3, default_values_t = [2.0, 0.08, 15000.0])]
+    cutting: Vec<f64>,
+    /// Tri-dexel resolution of the proof (mm).
+    #[arg(long, default_value_t = 0.5)]
+    resolution: f64,
+    /// Largest deviation of the simulated 5-axis sweeps from the true ones (mm).
+    #[arg(long, default_value_t = 0.05)]
+    sim_tolerance: f64,
+    /// Machine (shipped name or .toml file) and its tool length (mm: stick-out plus holder).
+    #[arg(long, default_value = "ucp710")]
+    machine: String,
+    /// Tool length used by the kinematics (mm).
+    #[arg(long, default_value_t = 233.0)]
+    tool_length: f64,
+    /// Post dialect (shipped name or .toml file).
+    #[arg(long, default_value = "siemens840d")]
+    dialect: String,
+    /// Weights (beta, phi, tau) of the bounds, fluidity and pitch-target objectives of `--tilt optimised`.
+    #[arg(long, num_args = 3, default_values_t = [15.0, 1.2, 1.0])]
+    weights: Vec<f64>,
+    /// Interval [theta_tmin, theta_tmax] of the pitch angle for `--tilt optimised` (degrees).
+    #[arg(long, num_args = 2, default_values_t = [0.0, 30.0], allow_negative_numbers = true)]
+    interval: Vec<f64>,
+    /// Target pitch angle theta_tobj for `--tilt optimised` (degrees).
+    #[arg(long, default_value_t = 10.0, allow_negative_numbers = true)]
+    target: f64,
+    /// Run the six orientation weightings of the thesis (Ch. 3 §2.3) on the last pass of one level
+    /// instead of planning the pocket: writes `orientation.csv` (pitch traces) and `orientation.json`.
+    #[arg(long)]
+    orientation_cases: bool,
+    /// Level of the orientation cases (0 = bottom; default: the lowest level with tilt curves).
+    #[arg(long)]
+    case_level: Option<usize>,
+    /// Output folder.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Print the report as JSON on stdout.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Serialize)]
+struct PassJson {
+    level: usize,
+    pass: usize,
+    points: usize,
+    dropped: usize,
+    runs: usize,
+    pitch_deg: [f64; 3],
+    max_tilt_deg: f64,
+}
+
+#[derive(Serialize)]
+struct LevelJson {
+    distance_mm: f64,
+    passes: usize,
+    untilted: Option<String>,
+}
+
+#[derive(Serialize)]
+struct Metrics {
+    volume_to_remove_mm3: f64,
+    remaining_volume_mm3: f64,
+    remaining_percent: f64,
+    removed_volume_mm3: f64,
+    gouge_volume_mm3: f64,
+    gouge_depth_mm: f64,
+    path_length_dm: f64,
+    out_of_material_percent: f64,
+    machining_time_s: f64,
+    /// Time lost to each axis's velocity, acceleration and jerk limits (s).
+    axis_time_lost_s: Vec<(String, f64)>,
+    feed_time_s: f64,
+    rapid_time_s: f64,
+    estimated_time_at_feed_s: f64,
+    removal_rate_mm3_s: f64,
+    removal_rate_percent_s: f64,
+}
+
+#[derive(Serialize)]
+struct Report {
+    command: &'static str,
+    part: String,
+    tilt: String,
+    machine: String,
+    dialect: String,
+    /// Why the machine or the post refused the program (no `program.nc` then).
+    post_error: Option<String>,
+    cl_points: usize,
+    blocks: usize,
+    replay_tip_deviation_mm: f64,
+    retracts: usize,
+    links: usize,
+    ramps: usize,
+    metrics: Metrics,
+    levels: Vec<LevelJson>,
+    passes: Vec<PassJson>,
+    plan_seconds: f64,
+    proof_seconds: f64,
+}
+
+fn check_args(a: &Rough5Args) -> CliResult<()> {
+    crate::input::positive_flags(&[
+        ("--tool-radius", a.tool_radius),
+        ("--corner", a.corner),
+        ("--flutes", a.flutes),
+        ("--stick-out", a.stick_out),
+        ("--step", a.step),
+        ("--max-angle-step", a.max_angle_step),
+        ("--max-azimuth-step", a.max_azimuth_step),
+        ("--resolution", a.resolution),
+        ("--sim-tolerance", a.sim_tolerance),
+        ("--tool-length", a.tool_length),
+    ])?;
+    if a.stick_out < a.flutes {
+        return Err(Failure::rejected(format!("--stick-out {} is shorter than --flutes {}", a.stick_out, a.flutes)));
+    }
+    Ok(())
+}
+
+fn cutter(a: &Rough5Args) -> CliResult<Cutter> {
+    let bad = |e: scallop_cutter::CutterError| {
+        Failure::rejected(format!("the tool: {e} (--tool-radius, --corner, --flutes, --holder)"))
+    };
+    let shape = CutterShape::Bull { radius: a.tool_radius, corner: a.corner };
+    let holder = HolderSegment { length: a.holder[1], bottom_radius: a.holder[0] / 2.0, top_radius: a.holder[0] / 2.0 };
+    Cutter::new(shape, a.flutes)
+        .and_then(|c| c.with_shank(a.tool_radius, a.stick_out - a.flutes))
+        .and_then(|c| c.with_holder(vec![holder]))
+        .map_err(bad)
+}
+
+/// The planning settings of the arguments.
+fn settings(args: &Rough5Args, part: &TestPart, bottom: &TriMesh) -> CliResult<Rough5Settings> {
+    let weights = Weights { bounds: args.weights[0], fluidity: args.weights[1], pitch: args.weights[2] };
+    Ok(Rough5Settings {
+        tilt: match args.tilt {
+            TiltArg::Zero => TiltMode::Zero,
+            TiltArg::Guides | TiltArg::Optimised => TiltMode::Guides,
+        },
+        guides: GuideSettings {
+            tool_radius: args.tool_radius,
+            flank_allowance: args.allowance[0],
+            axial_step: args.levels.ap,
+            radial_step: args.levels.ae,
+            voxel: args.levels.voxel,
+            depth: part.stock.max.z - bottom.bounds().min.z,
+        },
+        bottom_allowance: args.allowance[1],
+        step: args.step,
+        max_angle_step: args.max_angle_step.to_radians(),
+        max_azimuth_step: args.max_azimuth_step.to_radians(),
+        ramp_angle: 5f64.to_radians(),
+        clearance: 1.0,
+        link_max: 2.0 * args.levels.ae,
+        feed: cutting_feed(args)?,
+        rapid_rate: 20_000.0,
+        orientation: matches!(args.tilt, TiltArg::Optimised).then(|| orientation(args, weights)),
+    })
+}
+
+/// The orientation settings of `--weights`, `--interval` and `--target`.
+fn orientation(args: &Rough5Args, weights: Weights) -> OrientSettings {
+    OrientSettings {
+        interval: [args.interval[0].to_radians(), args.interval[1].to_radians()],
+        target: args.target.to_radians(),
+        ..OrientSettings::new(weights)
+    }
+}
+
+/// The feed z f_z N of `--cutting` (mm/min).
+fn cutting_feed(a: &Rough5Args) -> CliResult<f64> {
+    let teeth = a.cutting[0];
+    if !(teeth.fract() == 0.0 && (1.0..=64.0).contains(&teeth)) {
+        return Err(Failure::rejected(format!("--cutting: {teeth} teeth: give a whole number of teeth (1 to 64)")));
+    }
+    let data = CuttingData { teeth: teeth as u32, feed_per_tooth: a.cutting[1], spindle: a.cutting[2] };
+    data.feed().map_err(|e| Failure::rejected(format!("--cutting: {e}")))
+}
+
+/// Runs `scallop rough5`.
+///
+/// # Errors
+/// Bad settings, a part without passes, an unsafe program or one the machine
+/// cannot run (exit 1); I/O.
+pub fn run(args: &Rough5Args) -> CliResult<()> {
+    check_args(args)?;
+    let clock = Instant::now();
+    let (name, part) = test_part(args.part)?;
+    let faces = |tags: &[FaceTag]| part.faces(tags).map_err(|e| Failure::rejected(format!("{name}: {e}")));
+    let (bottom, flanks) = (faces(&[FaceTag::Bottom])?, faces(&[FaceTag::Flank])?);
+    let tool = cutter(args)?;
+    let settings = settings(args, &part, &bottom)?;
+    if args.orientation_cases {
+        return cases::run(args, name, &part, (&bottom, &flanks), &tool, &settings);
+    }
+    let bar = progress_bar(0, "levels");
+    let plan = plan_rough5(&bottom, &flanks, &part.stock, &tool, &settings, &|d, t| crate::simulate::show(&bar, d, t))
+        .map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
+    bar.finish_and_clear();
+    let plan_seconds = clock.elapsed().as_secs_f64();
+    let bar = progress_bar(0, "tri-dexel proof");
+    let proof_settings = ProofSettings { resolution: args.resolution, axis_tolerance: args.sim_tolerance };
+    let proof = prove(&plan.toolpath, &tool, &part.stock, &part.mesh, &proof_settings, &|d, t| {
+        crate::simulate::show(&bar, d, t);
+    })
+    .map_err(|e| Failure::rejected(format!("{name}: the program is not safe: {e}")))?;
+    bar.finish_and_clear();
+    let proof_seconds = clock.elapsed().as_secs_f64() - plan_seconds;
+    let posted = post_program(args, &plan);
+    let post = posted.as_ref().map(|(_, p)| p).map_err(|e| match e {
+        Failure::Rejected(e) | Failure::Io(e) => e.to_string(),
+    });
+    let report = report(args, name, &plan, &proof, post, [plan_seconds, proof_seconds]);
+    let mut out = OutputSet::begin(&args.output, "rough5")?;
+    if let Ok((nc, _)) = &posted {
+        out.write("program.nc", nc.as_bytes())?;
+    }
+    out.write("toolpath.cl", scallop_io::cl::write_cl(&plan.toolpath).as_bytes())?;
+    let json = serde_json::to_string_pretty(&report).map_err(|e| Failure::Io(e.into()))?;
+    out.write("report.json", format!("{json}\n").as_bytes())?;
+    let written = out.commit()?;
+    // The toolpath and the report are written for inspection; no program.
+    posted?;
+    if args.json {
+        return print_json(&with_written(&report, &written)?);
+    }
+    print_text(&summary_text(&report, &args.output))
+}
+
+/// The toolpath through the machine's kinematics (joint limits checked) and
+/// its time model.
+fn on_machine(
+    args: &Rough5Args,
+    path: &Toolpath,
+) -> CliResult<(Kinematics, Vec<ClRecord>, MachineProgram, ProgramTime)> {
+    let machine = load_machine(&args.machine, Path::new(""), "--machine")?;
+    let kin = Kinematics::new(&machine, args.tool_length);
+    let records = records_of(path);
+    let program = to_program(&kin, &records, None, &ProgramOptions::default())
+        .map_err(|e| Failure::rejected(format!("the program on {}: {e}", machine.name())))?;
+    let blocks: Vec<_> = program.blocks.iter().map(|b| (b.motion, b.joints, b.feed)).collect();
+    let time = program_time(&kin, &blocks).map_err(|e| Failure::rejected(format!("time model: {e}")))?;
+    Ok((kin, records, program, time))
+}
+
+/// What the post and the machine said.
+struct Posted {
+    /// Time lost to each axis's limits (s), by axis name.
+    lost: Vec<(String, f64)>,
+    blocks: usize,
+    replay: f64,
+    total: f64,
+    feed: f64,
+    rapid: f64,
+}
+
+/// The program through the machine's kinematics (joint limits checked) and
+/// the dialect in TCP form (TRAORI on the 840D), replayed against the CL path.
+fn post_program(args: &Rough5Args, plan: &Rough5Plan) -> CliResult<(String, Posted)> {
+    let (kin, records, program, time) = on_machine(args, &plan.toolpath)?;
+    let options = ProgramOptions::default();
+    let dialect = load_dialect(&args.dialect)?;
+    let params = PostParams {
+        program: "1000".into(),
+        mode: OutputMode::Tcp,
+        tool: 1,
+        tool_length: args.tool_length,
+        spindle: args.cutting[2],
+        tol_pos: options.tol_pos,
+        tol_ang: options.tol_ang,
+        predicted_time: Some(time.total),
+    };
+    let nc = program_text(&program, &kin, &dialect, &params)
+        .map_err(|e| Failure::rejected(format!("{}: {e}", dialect.name)))?;
+    let replayed =
+        replay(&nc, &dialect, &kin).map_err(|e| Failure::Io(anyhow::anyhow!("our output does not read back: {e}")))?;
+    let trip = check_replay(&replayed, &records, &kin, &dialect, options.tol_pos, options.tol_ang)
+        .map_err(|e| Failure::Io(anyhow::anyhow!("the program does not replay to the CL path: {e}")))?;
+    let lost = kin.machine().axes().iter().zip(time.lost).map(|(a, t)| (a.name.clone(), t)).collect();
+    let posted = Posted {
+        lost,
+        blocks: program.blocks.len(),
+        replay: trip.max_tip_deviation,
+        total: time.total,
+        feed: time.feed,
+        rapid: time.rapid,
+    };
+    Ok((nc, posted))
+}
+
+fn report(
+    args: &Rough5Args,
+    name: &str,
+    plan: &Rough5Plan,
+    proof: &Proof,
+    post: Result<&Posted, String>,
+    seconds: [f64; 2],
+) -> Report {
+    // Without a machine program, the time at the programmed feeds.
+    let (t, feed, rapid) =
+        post.as_ref().map_or((plan.estimated_time, plan.estimated_time, 0.0), |p| (p.total, p.feed, p.rapid));
+    let metrics = Metrics {
+        volume_to_remove_mm3: proof.volume_to_remove,
+        remaining_volume_mm3: proof.remaining_volume,
+        remaining_percent: proof.remaining_percent,
+        removed_volume_mm3: proof.removed_volume,
+        gouge_volume_mm3: proof.gouge_volume,
+        gouge_depth_mm: proof.gouge_depth,
+        path_length_dm: proof.cutting_length / 100.0,
+        out_of_material_percent: proof.air_percent,
+        machining_time_s: t,
+        axis_time_lost_s: post.as_ref().map_or_else(|_| Vec::new(), |p| p.lost.clone()),
+        feed_time_s: feed,
+        rapid_time_s: rapid,
+        estimated_time_at_feed_s: plan.estimated_time,
+        removal_rate_mm3_s: proof.removal_rate(t),
+        removal_rate_percent_s: if t > 0.0 { (100.0 - proof.remaining_percent) / t } else { 0.0 },
+    };
+    let deg = f64::to_degrees;
+    Report {
+        command: "rough5",
+        part: name.to_string(),
+        tilt: format!("{:?}", args.tilt).to_lowercase(),
+        machine: args.machine.clone(),
+        dialect: args.dialect.clone(),
+        cl_points: plan.toolpath.moves().len(),
+        blocks: post.as_ref().map_or(0, |p| p.blocks),
+        replay_tip_deviation_mm: post.as_ref().map_or(f64::NAN, |p| p.replay),
+        post_error: post.err(),
+        retracts: plan.retracts,
+        links: plan.links,
+        ramps: plan.ramps,
+        metrics,
+        levels: plan
+            .levels
+            .iter()
+            .map(|l| LevelJson { distance_mm: l.distance, passes: l.passes, untilted: l.untilted.clone() })
+            .collect(),
+        passes: plan
+            .passes
+            .iter()
+            .map(|p| PassJson {
+                level: p.level,
+                pass: p.pass,
+                points: p.points,
+                dropped: p.dropped,
+                runs: p.runs,
+                pitch_deg: p.pitch.map(deg),
+                max_tilt_deg: deg(p.max_tilt),
+            })
+            .collect(),
+        plan_seconds: seconds[0],
+        proof_seconds: seconds[1],
+    }
+}
+
+fn summary_text(r: &Report, output: &Path) -> String {
+    let m = &r.metrics;
+    let mut s = format!(
+        "{} ({} tilt): {} levels, {} passes, {} CL points, {} blocks on {} ({})\n",
+        r.part,
+        r.tilt,
+        r.levels.len(),
+        r.passes.len(),
+        r.cl_points,
+        r.blocks,
+        r.machine,
+        r.dialect
+    );
+    let _ = writeln!(
+        s,
+        "  V_r {:.2} % ({:.0} of {:.0} mm3), gouge {:.3} mm3 (deepest {:.3} mm), L_HM {:.1} %",
+        m.remaining_percent,
+        m.remaining_volume_mm3,
+        m.volume_to_remove_mm3,
+        m.gouge_volume_mm3,
+        m.gouge_depth_mm,
+        m.out_of_material_percent
+    );
+    let _ = writeln!(
+        s,
+        "  time {} (feed {}, rapid {}), removal rate {:.1} mm3/s ({:.3} %/s), path {:.1} dm",
+        crate::output::hms(m.machining_time_s),
+        crate::output::hms(m.feed_time_s),
+        crate::output::hms(m.rapid_time_s),
+        m.removal_rate_mm3_s,
+        m.removal_rate_percent_s,
+        m.path_length_dm
+    );
+    let _ = writeln!(
+        s,
+        "  planned in {:.1} s, proven in {:.1} s; written to {}",
+        r.plan_seconds,
+        r.proof_seconds,
+        output.display()
+    );
+    s
+}
+
+/// `scallop rough5 --orientation-cases`: the six weightings of the thesis
+/// (Jousselin 2020, Ch. 3 §2.3, Tables 3.3-3.4) on the last pass of one
+/// level, each with its pitch trace and its machining time (docs/rough5.md).
+mod cases {
+    use std::fmt::Write as _;
+
+    use scallop_geom::Point3;
+    use scallop_mesh::TriMesh;
+    use scallop_parts::TestPart;
+    use scallop_rough5::{
+        OrientSettings, Rough5Settings, SinglePass, TiltMode, Weights, level_passes, plan_single_pass,
+    };
+    use serde::Serialize;
+
+    use super::{Rough5Args, on_machine};
+    use crate::output::{print_json, print_text, with_written};
+    use crate::outset::OutputSet;
+    use crate::{CliResult, Failure};
+
+    /// (name, (beta, phi, tau), interval, target) in degrees.
+    const CASES: [(&str, [f64; 3], [f64; 2], f64); 6] = [
+        ("SPU", [0.0, 0.0, 0.0], [0.0, 30.0], 10.0),
+        ("mixed", [15.0, 1.2, 1.0], [0.0, 30.0], 10.0),
+        ("fluidity", [0.0, 1.0, 0.0], [0.0, 30.0], 10.0),
+        ("positive bounds", [1.0, 0.0, 0.0], [0.0, 30.0], 10.0),
+        ("negative bounds", [1.0, 0.0, 0.0], [-30.0, 0.0], 10.0),
+        ("compromise", [5.0, 10.0, 0.0], [-45.0, 0.0], 10.0),
+    ];
+
+    #[derive(Serialize)]
+    struct CaseJson {
+        case: usize,
+        name: &'static str,
+        weights: [f64; 3],
+        interval_deg: [f64; 2],
+        target_deg: f64,
+        objective: f64,
+        spu_objective: f64,
+        iterations: usize,
+        constraint_violation: f64,
+        coefficients: [f64; 8],
+        points: usize,
+        dropped: usize,
+        runs: usize,
+        pitch_deg: [f64; 3],
+        max_tilt_deg: f64,
+        machining_time_s: f64,
+        estimated_time_at_feed_s: f64,
+        time_gain_percent: f64,
+    }
+
+    #[derive(Serialize)]
+    struct Summary {
+        command: &'static str,
+        part: String,
+        level: usize,
+        level_distance_mm: f64,
+        pass: usize,
+        machine: String,
+        cases: Vec<CaseJson>,
+    }
+
+    /// Runs the six cases.
+    pub(super) fn run(
+        args: &Rough5Args,
+        name: &str,
+        part: &TestPart,
+        (bottom, flanks): (&TriMesh, &TriMesh),
+        tool: &scallop_cutter::Cutter,
+        settings: &Rough5Settings,
+    ) -> CliResult<()> {
+        let fail = |e: scallop_rough5::Rough5Error| Failure::rejected(format!("{name}: {e}"));
+        let levels = level_passes(bottom, flanks, &settings.guides, TiltMode::Guides).map_err(fail)?;
+        let paired = |j: &usize| levels[*j].untilted.is_none() && !levels[*j].passes.is_empty();
+        let j = match args.case_level {
+            Some(j) if j < levels.len() && paired(&j) => j,
+            Some(j) => return Err(Failure::rejected(format!("--case-level {j}: that level has no tilt curves"))),
+            None => (0..levels.len())
+                .find(paired)
+                .ok_or_else(|| Failure::rejected(format!("{name}: no level has tilt curves")))?,
+        };
+        let level = &levels[j];
+        let pass = level.passes.len() - 1;
+        let path = &level.passes[pass].0;
+        // The entry point: the middle of the front (-y) side of the stock.
+        let entry = Point3::new(part.stock.center().x, part.stock.min.y, path.line.points[0].z);
+        let mut csv = String::from("case,name,point,distance_mm,theta_t_deg\n");
+        let mut cases = Vec::new();
+        for (k, (label, w, interval, target)) in CASES.iter().enumerate() {
+            let orient = OrientSettings {
+                interval: interval.map(f64::to_radians),
+                target: target.to_radians(),
+                ..OrientSettings::new(Weights { bounds: w[0], fluidity: w[1], pitch: w[2] })
+            };
+            let s = Rough5Settings { orientation: Some(orient), ..*settings };
+            let single =
+                plan_single_pass((level, pass, j == 0), &entry, (&part.stock, flanks), tool, &s).map_err(fail)?;
+            for (i, (d, t)) in single.trace.iter().enumerate() {
+                let _ = writeln!(csv, "{},{label},{i},{d:.4},{:.5}", k + 1, t.to_degrees());
+            }
+            let (_, _, _, time) = on_machine(args, &single.toolpath)?;
+            cases.push(case_json(k + 1, label, (w, interval, *target), &single, time.total));
+        }
+        let spu_time = cases[0].machining_time_s;
+        for c in &mut cases {
+            c.time_gain_percent = 100.0 * (spu_time - c.machining_time_s) / spu_time;
+        }
+        let summary = Summary {
+            command: "rough5 --orientation-cases",
+            part: name.to_string(),
+            level: j,
+            level_distance_mm: level.distance,
+            pass,
+            machine: args.machine.clone(),
+            cases,
+        };
+        let mut out = OutputSet::begin(&args.output, "rough5")?;
+        out.write("orientation.csv", csv.as_bytes())?;
+        let json = serde_json::to_string_pretty(&summary).map_err(|e| Failure::Io(e.into()))?;
+        out.write("orientation.json", format!("{json}\n").as_bytes())?;
+        let written = out.commit()?;
+        if args.json {
+            return print_json(&with_written(&summary, &written)?);
+        }
+        print_text(&text(&summary))
+    }
+
+    fn case_json(
+        case: usize,
+        name: &'static str,
+        (w, interval, target): (&[f64; 3], &[f64; 2], f64),
+        single: &SinglePass,
+        machining_time_s: f64,
+    ) -> CaseJson {
+        let o = single.orientation;
+        CaseJson {
+            case,
+            name,
+            weights: *w,
+            interval_deg: *interval,
+            target_deg: target,
+            objective: o.map_or(0.0, |o| o.objective),
+            spu_objective: o.map_or(0.0, |o| o.spu_objective),
+            iterations: o.map_or(0, |o| o.iterations),
+            constraint_violation: o.map_or(0.0, |o| o.violation),
+            coefficients: o.map_or(scallop_rough5::Reparam::SPU.x, |o| o.reparam.x),
+            points: single.report.points,
+            dropped: single.report.dropped,
+            runs: single.report.runs,
+            pitch_deg: single.report.pitch.map(f64::to_degrees),
+            max_tilt_deg: single.report.max_tilt.to_degrees(),
+            machining_time_s,
+            estimated_time_at_feed_s: single.estimated_time,
+            time_gain_percent: 0.0,
+        }
+    }
+
+    fn text(s: &Summary) -> String {
+        let mut t = format!(
+            "{}: orientation cases on level {} ({:.2} mm), pass {} (the last), on {}\n",
+            s.part, s.level, s.level_distance_mm, s.pass, s.machine
+        );
+        let _ =
+            writeln!(t, "  case  name              theta_t min/max/mean (deg)   time (s)  gain vs SPU  points dropped");
+        for c in &s.cases {
+            let _ = writeln!(
+                t,
+                "  {:>4}  {:<16}  {:>7.2} {:>7.2} {:>7.2}       {:>8.1}  {:>10.1} %  {:>6} {:>7}",
+                c.case,
+                c.name,
+                c.pitch_deg[0],
+                c.pitch_deg[1],
+                c.pitch_deg[2],
+                c.machining_time_s,
+                c.time_gain_percent,
+                c.points,
+                c.dropped
+            );
+        }
+        t
+    }
+}

@@ -1,0 +1,150 @@
+//! Refinement of a finishing plan by its simulation (docs/simulation.md,
+//! "Refinement"). The planners hold `sh` by what they measure: between two
+//! planes at the feed samples, between two waterline levels at their points.
+//! A concave crease or a narrow feature between those samples can leave more
+//! than `sh` on surface the cutter does reach, which only the stock
+//! simulation sees. Rather than refuse the part, the engine takes the cells
+//! the simulation names ([`scallop_sim::RestSplit::machined_over`]), finds the
+//! two planes (or levels) that bracket each, and plans again with one more
+//! plane (or level) half-way between them; the new program is simulated and
+//! proven like the first. After [`MAX_ROUNDS`] rounds a scallop still over
+//! the limit is refused as before.
+
+use std::collections::BTreeSet;
+
+use scallop_cutter::{Cutter, CutterShape};
+use scallop_sim::OverCell;
+use scallop_strategy::Refinement;
+
+/// Rounds of refinement before a scallop over the limit is refused.
+pub const MAX_ROUNDS: usize = 2;
+
+/// Offsets closer than this are one (mm): two cells bracketed by the same
+/// pair give the same mid-plane.
+const SAME_OFFSET: f64 = 1e-6;
+
+/// Where a plan put its passes: what a refinement needs to bracket a place.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub(crate) struct Layout {
+    /// Feed direction (rad from +X).
+    pub(crate) direction: f64,
+    /// Plane offsets `d = m . p`, increasing (mm).
+    pub(crate) planes: Vec<f64>,
+    /// Waterline tip heights, decreasing (mm).
+    pub(crate) levels: Vec<f64>,
+    /// Slopes (rad): a cell at least `steep_min` steep is bracketed by levels,
+    /// one under `shallow_max` by planes (both in the steep-and-shallow
+    /// overlap band; planes alone when there are no levels).
+    pub(crate) steep_min: f64,
+    pub(crate) shallow_max: f64,
+}
+
+/// The planes and levels to add to `layout` for the cells `over`: one half-way
+/// between the two that bracket each cell, one through a cell beyond the
+/// first or last (the planner drops those without passes).
+pub(crate) fn refinement_for(layout: &Layout, over: &[OverCell], cutter: &Cutter) -> Refinement {
+    let m = (-layout.direction.sin(), layout.direction.cos());
+    // The tip of a cutter touching the part at the cell lies this much below
+    // the contact per unit of (1 - n_z): the corner radius.
+    let corner = match *cutter.shape() {
+        CutterShape::Ball { radius } => radius,
+        CutterShape::Bull { corner, .. } => corner,
+        _ => 0.0,
+    };
+    let key = |v: f64| {
+        #[allow(clippy::cast_possible_truncation, reason = "offsets of a bounded part in units of SAME_OFFSET")]
+        let k = (v / SAME_OFFSET).round() as i64;
+        k
+    };
+    let (mut planes, mut levels) = (BTreeSet::new(), BTreeSet::new());
+    for cell in over {
+        let slope = cell.nz.abs().min(1.0).acos();
+        let by_levels = !layout.levels.is_empty() && slope >= layout.steep_min;
+        let by_planes = layout.levels.is_empty() || slope < layout.shallow_max;
+        if by_planes {
+            let d = m.0 * cell.at.x + m.1 * cell.at.y;
+            let i = layout.planes.partition_point(|&p| p < d);
+            if i > 0 && i < layout.planes.len() {
+                planes.insert(key(0.5 * (layout.planes[i - 1] + layout.planes[i])));
+            } else if !layout.planes.is_empty() {
+                // Beyond the first or last plane: a plane through the cell.
+                planes.insert(key(d));
+            }
+        }
+        if by_levels {
+            let tip = cell.at.z - corner * (1.0 - cell.nz.abs().min(1.0));
+            let j = layout.levels.partition_point(|&z| z > tip);
+            if j > 0 && j < layout.levels.len() {
+                levels.insert(key(0.5 * (layout.levels[j - 1] + layout.levels[j])));
+            } else {
+                // Above the top level or below the lowest: a level at the tip.
+                levels.insert(key(tip));
+            }
+        }
+    }
+    #[allow(clippy::cast_precision_loss, reason = "keys of bounded offsets")]
+    let value = |k: i64| k as f64 * SAME_OFFSET;
+    Refinement { planes: planes.into_iter().map(value).collect(), levels: levels.into_iter().map(value).collect() }
+}
+
+/// `a` with the planes and levels of `b` added.
+pub(crate) fn merged(a: &Refinement, b: &Refinement) -> Refinement {
+    let join = |x: &[f64], y: &[f64]| {
+        let mut v: Vec<f64> = x.iter().chain(y).copied().collect();
+        v.sort_by(f64::total_cmp);
+        v.dedup_by(|p, q| (*p - *q).abs() <= SAME_OFFSET);
+        v
+    };
+    Refinement { planes: join(&a.planes, &b.planes), levels: join(&a.levels, &b.levels) }
+}
+
+#[cfg(test)]
+mod tests {
+    use scallop_geom::Point3;
+
+    use super::*;
+
+    fn cell(x: f64, y: f64, z: f64, nz: f64) -> OverCell {
+        OverCell { at: Point3::new(x, y, z), nz, thickness: 0.1 }
+    }
+
+    #[test]
+    fn a_cell_between_two_planes_gets_the_mid_plane_and_one_beyond_them_a_plane_through_it() {
+        // Direction 0: planes along +X, offsets are y.
+        let layout = Layout { planes: vec![0.0, 1.0, 3.0], ..Layout::default() };
+        let cutter = Cutter::new(CutterShape::Ball { radius: 3.0 }, 20.0).expect("a ball");
+        let r = refinement_for(
+            &layout,
+            &[cell(5.0, 2.5, 0.0, 1.0), cell(7.0, 2.9, 0.0, 1.0), cell(0.0, 4.0, 0.0, 1.0)],
+            &cutter,
+        );
+        assert_eq!(r.planes, vec![2.0, 4.0]);
+        assert!(r.levels.is_empty());
+    }
+
+    #[test]
+    fn a_steep_cell_gets_the_level_between_those_bracketing_its_tip() {
+        let layout = Layout {
+            planes: vec![0.0, 2.0],
+            levels: vec![10.0, 8.0, 6.0],
+            steep_min: 40_f64.to_radians(),
+            shallow_max: 50_f64.to_radians(),
+            ..Layout::default()
+        };
+        let cutter = Cutter::new(CutterShape::Ball { radius: 2.0 }, 20.0).expect("a ball");
+        // A vertical wall point at z = 9: the ball's tip touching it is R = 2
+        // below, at 7, between the levels 8 and 6.
+        let r = refinement_for(&layout, &[cell(0.0, 1.0, 9.0, 0.0)], &cutter);
+        assert_eq!(r.levels, vec![7.0]);
+        assert!(r.planes.is_empty(), "a vertical cell is not the planes'");
+    }
+
+    #[test]
+    fn merging_keeps_each_offset_once_in_order() {
+        let a = Refinement { planes: vec![2.0, 1.0], levels: vec![] };
+        let b = Refinement { planes: vec![1.0, 3.0], levels: vec![5.0] };
+        let m = merged(&a, &b);
+        assert_eq!(m.planes, vec![1.0, 2.0, 3.0]);
+        assert_eq!(m.levels, vec![5.0]);
+    }
+}

@@ -1,0 +1,75 @@
+//! The tool's body (flutes above the corner, shank, holder) against the
+//! flank faces of the finished part: a placed tool whose body comes closer
+//! to a flank than its radius would gouge the flank or collide with it.
+//!
+//! The body is a stack of solids of revolution of radius at most `rho` over
+//! heights `[h0, h1]` above the tip. Points of the axis are sampled every
+//! `delta` mm and each must be at least `rho + delta / 2` from the flank
+//! mesh: the distance to a mesh is 1-Lipschitz and every axis point is within
+//! `delta / 2` of a sample, so the check is conservative. The lower end of the
+//! tool (below the corner height) lies inside the ball of radius R around the
+//! axis point at the corner height, which the flute check covers.
+
+use scallop_cutter::{Cutter, CutterShape};
+use scallop_geom::{Point3, Vec3};
+use scallop_mesh::{MeshQuery, TriMesh};
+
+use crate::tol;
+
+/// The flank check of one tool.
+#[derive(Debug, Clone)]
+pub struct BodyCheck {
+    query: MeshQuery,
+    /// (h0, h1, radius) above the tip.
+    pieces: Vec<(f64, f64, f64)>,
+    /// Highest z of the flanks: samples whose ball is above it are skipped.
+    top: f64,
+    delta: f64,
+}
+
+impl BodyCheck {
+    /// The check of `cutter`'s body against `flanks`, keeping `clearance`
+    /// (mm) between the flutes and the flanks.
+    #[must_use]
+    pub fn new(flanks: &TriMesh, cutter: &Cutter, clearance: f64) -> BodyCheck {
+        let corner = match *cutter.shape() {
+            CutterShape::Ball { radius } => radius,
+            CutterShape::Bull { corner, .. } => corner,
+            _ => 0.0,
+        };
+        let flutes = cutter.flute_length();
+        let mut pieces = vec![(corner.min(flutes), flutes, cutter.radius() + clearance)];
+        let shank_top = flutes + cutter.shank_length();
+        pieces.push((flutes, shank_top, cutter.shank_radius()));
+        let mut h = shank_top;
+        for s in cutter.holder() {
+            pieces.push((h, h + s.length, s.bottom_radius.max(s.top_radius)));
+            h += s.length;
+        }
+        BodyCheck { query: MeshQuery::new(flanks), pieces, top: flanks.bounds().max.z, delta: tol::BODY_STEP }
+    }
+
+    /// Whether the tool with its tip at `tip` and unit axis `axis` comes
+    /// closer to the flanks than its radius (plus the clearance on the flutes).
+    #[must_use]
+    pub fn collides(&self, tip: &Point3, axis: &Vec3) -> bool {
+        for &(h0, h1, rho) in &self.pieces {
+            let n = ((h1 - h0) / self.delta).ceil().max(1.0) as usize;
+            let need = rho + 0.5 * self.delta;
+            for k in 0..=n {
+                let h = h0 + (h1 - h0) * (k as f64 / n as f64);
+                let p = tip + axis * h;
+                if p.z - need > self.top {
+                    if axis.z > 0.0 {
+                        break;
+                    }
+                    continue;
+                }
+                if self.query.closest_within(&p, need).is_some() {
+                    return true;
+                }
+            }
+        }
+        false
+    }
+}

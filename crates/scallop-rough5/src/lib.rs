@@ -1,0 +1,62 @@
+//! 5-axis roughing by guide curves, part 2 (Jousselin 2020, PhD thesis,
+//! Université Paris-Saclay, Ch. 2 §1.2.3 and Ch. 3; docs/rough5.md): from the
+//! guide curves of `scallop-guides` to a proven 5-axis roughing program.
+//!
+//! - [`Placer`]: the tool (flat, ball, torus) dropped along any axis to
+//!   tangent contact with a level mesh (module G; C_C to C_L by Eq. 1.1);
+//! - [`synchronise`], [`pitch_angle`]: SPU synchronisation of a path curve
+//!   with its tilt curve (Eq. 3.10) and the pitch angle theta_t (Eq. 3.7);
+//! - [`plan_rough5`]: levels top-down, passes inside-out, ramp entries along
+//!   the innermost pass, links on the level or at a safe height, a maximum
+//!   angular step; the guide-curve variant and the zero-tilt baseline
+//!   (module J); [`plan_single_pass`]: one pass alone (the orientation
+//!   cases of Ch. 3 §2.3);
+//! - [`prove`]: the program cut on a tri-dexel stock with shank and holder
+//!   collisions as errors, and the metrics of spec 10.1 (module L).
+//!
+//! ```
+//! use scallop_cutter::{Cutter, CutterShape};
+//! use scallop_geom::{Point3, Vec3};
+//! use scallop_mesh::TriMesh;
+//! use scallop_rough5::Placer;
+//! let p = |x, y, z| Point3::new(x, y, z);
+//! let (plane, _) = TriMesh::from_soup(&[[p(-50., -50., 0.), p(50., -50., 0.), p(0., 50., 0.)]]).unwrap();
+//! let torus = Cutter::new(CutterShape::Bull { radius: 5.0, corner: 1.5 }, 20.0).unwrap();
+//! let placer = Placer::new(&plane, &torus, 0.0).unwrap();
+//! // Tilted by 10 degrees: C_L height r + (R - r) sin 10 deg (spec 12.1 item 2).
+//! let t = 10f64.to_radians();
+//! let placed = placer.place(&p(0., 0., 30.), &Vec3::new(t.sin(), 0.0, t.cos())).unwrap();
+//! assert!((placed.cl.z - (1.5 + 3.5 * t.sin())).abs() < 1e-9);
+//! ```
+//!
+//! # Invariants
+//! - Never performs I/O; never prints; errors are [`Rough5Error`].
+//! - A placed tool never penetrates the level mesh (the maximum over every
+//!   triangle's contacts); results do not depend on the thread count.
+
+mod collide;
+mod cutting;
+mod error;
+mod levels;
+mod orient;
+pub mod place;
+mod plan;
+mod prove;
+mod radius;
+pub mod sqp;
+mod sync;
+pub mod tol;
+
+pub use collide::BodyCheck;
+pub use cutting::CuttingData;
+pub use error::Rough5Error;
+pub use levels::{LevelPasses, TiltMode, level_passes};
+pub use orient::{
+    AngleUnit, BoundsPenalty, Coverage, OrientSettings, Orientation, Reparam, Weights, constraints, objective_terms,
+    optimise_pass, pitch_trace, synchronise_with,
+};
+pub use place::{Feature, Placement, Placer, tool_frame};
+pub use plan::{LevelReport, PassReport, Rough5Plan, Rough5Settings, SinglePass, plan_rough5, plan_single_pass};
+pub use prove::{Proof, ProofSettings, prove};
+pub use radius::{apparent_contour_radius, effective_radius, exact_scallop, scallop_height, swept_profile};
+pub use sync::{SyncPoint, axis_steps, closest_vertex, interpolate_axis, limit_angular_step, pitch_angle, synchronise};

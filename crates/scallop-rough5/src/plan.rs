@@ -1,0 +1,501 @@
+//! Assembly of the roughing program (module J; Jousselin 2020, Ch. 2 §1.2,
+//! Ch. 4 §1; spec 5.12): levels top-down, each emptying the volume between
+//! it and the level above; passes inside-out (m = 0 first), one milling mode
+//! (the curves' own orientation, inside on the left: climb milling with a
+//! clockwise spindle); the tool placed along its axis at every synchronised
+//! pair ([`crate::Placer`]), no more than a maximum angular step between
+//! neighbouring orientations; pairs whose tool body would meet a flank
+//! dropped (the pass is split there); the first run of a level entered by a
+//! ramp along its closed pass from just above the level cut before, later
+//! runs linked on the level when the link is short, placed and collision
+//! free, else through a retract along the tool axis to a safe height, a
+//! rapid, and a plunge back along the axis.
+
+use rayon::prelude::*;
+use scallop_cutter::Cutter;
+use scallop_geom::{Aabb3, Point3, Vec3};
+use scallop_guides::{Curve, GuideSettings};
+use scallop_mesh::TriMesh;
+use scallop_toolpath::{Move, MoveKind, Toolpath};
+
+use crate::collide::BodyCheck;
+use crate::levels::{TiltMode, level_passes};
+use crate::orient::{OrientSettings, Orientation, optimise_pass, synchronise_with};
+use crate::sync::{SyncPoint, axis_steps, interpolate_axis, limit_angular_step, pitch_angle, synchronise};
+use crate::{LevelPasses, Placement, Placer, Rough5Error};
+
+/// Settings of [`plan_rough5`] (mm, rad, mm/min).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Rough5Settings {
+    /// The tool-axis variant.
+    pub tilt: TiltMode,
+    /// Levels and curves: tool radius, flank allowance, a_p, a_e, voxel, depth.
+    pub guides: GuideSettings,
+    /// Material left on the bottom (mm).
+    pub bottom_allowance: f64,
+    /// Spacing of the synchronised pairs along a pass (mm).
+    pub step: f64,
+    /// Largest change of the tool axis between two CL points (rad).
+    pub max_angle_step: f64,
+    /// Largest change of the tool axis's azimuth about +Z between two CL
+    /// points (rad): the C table of a table-table machine turns evenly.
+    pub max_azimuth_step: f64,
+    /// Angle of the ramp entries (rad).
+    pub ramp_angle: f64,
+    /// Entry height above the level cut before, and the safe height above
+    /// the stock (plus the tool radius), mm.
+    pub clearance: f64,
+    /// Longest link kept on the level between two runs (mm).
+    pub link_max: f64,
+    /// Cutting feed (mm/min).
+    pub feed: f64,
+    /// Rapid rate of the time estimate (mm/min).
+    pub rapid_rate: f64,
+    /// The optimised orientation of each paired pass (Jousselin 2020, Ch. 3
+    /// §2), or `None` for SPU.
+    pub orientation: Option<OrientSettings>,
+}
+
+/// What one pass became.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PassReport {
+    /// Level number (0 = bottom).
+    pub level: usize,
+    /// Pass number in the level (0 = innermost).
+    pub pass: usize,
+    /// CL points cut.
+    pub points: usize,
+    /// Pairs dropped: tool not placed, or its body too close to a flank.
+    pub dropped: usize,
+    /// Runs the pass was split into.
+    pub runs: usize,
+    /// Pitch angle theta_t (Eq. 3.7) over the pass: min, max, mean (rad).
+    pub pitch: [f64; 3],
+    /// Largest angle between the tool axis and +Z (rad).
+    pub max_tilt: f64,
+}
+
+/// One level of the plan.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LevelReport {
+    /// Distance from the bottom (mm).
+    pub distance: f64,
+    /// Passes.
+    pub passes: usize,
+    /// Why the level was cut with the axis +Z in the guide-curve variant.
+    pub untilted: Option<String>,
+}
+
+/// The roughing program and what it is made of.
+#[derive(Debug, Clone)]
+pub struct Rough5Plan {
+    /// The program: tool tips in the part frame with their tool axes.
+    pub toolpath: Toolpath,
+    /// The levels, bottom up.
+    pub levels: Vec<LevelReport>,
+    /// The passes in cutting order.
+    pub passes: Vec<PassReport>,
+    /// Entries through the safe height.
+    pub retracts: usize,
+    /// Links kept on the level.
+    pub links: usize,
+    /// Ramp entries.
+    pub ramps: usize,
+    /// Time at the programmed feeds and the rapid rate (s), without the
+    /// machine's dynamics.
+    pub estimated_time: f64,
+}
+
+/// A CL point and the pair it was placed from.
+#[derive(Debug, Clone, Copy)]
+struct Cl {
+    place: Placement,
+    sync: SyncPoint,
+}
+
+fn check(settings: &Rough5Settings) -> Result<(), Rough5Error> {
+    let s = settings;
+    for (name, value) in [
+        ("step", s.step),
+        ("max_angle_step", s.max_angle_step),
+        ("max_azimuth_step", s.max_azimuth_step),
+        ("ramp_angle", s.ramp_angle),
+        ("clearance", s.clearance),
+        ("link_max", s.link_max),
+        ("feed", s.feed),
+        ("rapid_rate", s.rapid_rate),
+    ] {
+        if !(value.is_finite() && value > 0.0) {
+            return Err(Rough5Error::BadSetting { name, value });
+        }
+    }
+    if !(s.bottom_allowance.is_finite() && s.bottom_allowance >= 0.0) {
+        return Err(Rough5Error::BadSetting { name: "bottom_allowance", value: s.bottom_allowance });
+    }
+    Ok(())
+}
+
+/// Plans the roughing of the pocket with bottom faces `bottom` and flank
+/// faces `flanks` (normals out of the volume to remove) in `stock`, with
+/// `cutter` (its shank and holder checked against the flanks).
+/// `progress(done, total)` is called after each level.
+///
+/// # Errors
+/// [`Rough5Error::BadSetting`], the errors of the guide curves and of the
+/// placer, [`Rough5Error::NoPass`] when nothing can be cut.
+pub fn plan_rough5(
+    bottom: &TriMesh,
+    flanks: &TriMesh,
+    stock: &Aabb3,
+    cutter: &Cutter,
+    settings: &Rough5Settings,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<Rough5Plan, Rough5Error> {
+    check(settings)?;
+    let levels = level_passes(bottom, flanks, &settings.guides, settings.tilt)?;
+    if levels.iter().all(|l| l.passes.is_empty()) {
+        let reason = "no level has a closed limit curve: open pockets (limit curves ending on the level's boundary) \
+                      are not handled yet";
+        return Err(Rough5Error::NoPass { reason: reason.into() });
+    }
+    let body = BodyCheck::new(flanks, cutter, 0.0);
+    let mut out = Emitter::new(stock.max.z, stock.max.z + settings.clearance + cutter.radius(), settings);
+    let mut reports = Vec::new();
+    let mut entry_z = stock.max.z + settings.clearance;
+    for (done, j) in (0..levels.len()).rev().enumerate() {
+        let level = &levels[j];
+        let allowance = if j == 0 { settings.bottom_allowance } else { 0.0 };
+        let placer = Placer::new(level.support.mesh(), cutter, allowance)?;
+        let mut top = f64::NEG_INFINITY;
+        let mut first = true;
+        for (m, (path, tilt)) in level.passes.iter().enumerate() {
+            let cursor = out.last.map_or_else(|| path.line.points[0], |c| c.sync.path);
+            let (pairs, _) = pass_pairs((path, tilt.as_ref()), &cursor, settings)?;
+            let (runs, mut report) = place_pass(&placer, &body, &pairs);
+            report.level = j;
+            report.pass = m;
+            for run in &runs {
+                top = run.iter().fold(top, |t, c| t.max(c.place.tip.z));
+                out.cut_run(run, entry_z, first, (&placer, &body));
+                first = false;
+            }
+            reports.push(report);
+        }
+        if top.is_finite() {
+            entry_z = top + settings.clearance;
+        }
+        progress(done + 1, levels.len());
+    }
+    if out.path.moves().is_empty() {
+        return Err(Rough5Error::NoPass { reason: "no pass could be placed clear of the flanks".into() });
+    }
+    out.finish();
+    let levels = levels
+        .iter()
+        .map(|l| LevelReport { distance: l.distance, passes: l.passes.len(), untilted: l.untilted.clone() })
+        .collect();
+    let estimated_time = estimate_time(&out.path, settings.rapid_rate);
+    Ok(Rough5Plan {
+        toolpath: out.path,
+        levels,
+        passes: reports,
+        retracts: out.retracts,
+        links: out.links,
+        ramps: out.ramps,
+        estimated_time,
+    })
+}
+
+/// One pass of a level as a program of its own (the orientation cases of
+/// Jousselin 2020, Ch. 3 §2.3).
+#[derive(Debug, Clone)]
+pub struct SinglePass {
+    /// The optimised orientation (`None` for SPU).
+    pub orientation: Option<Orientation>,
+    /// The program: a plunge along the first axis from the safe height, the
+    /// pass (a full lap of a closed pass), a retract.
+    pub toolpath: Toolpath,
+    /// (distance along the cut from its first CL point in mm, theta_t in rad)
+    /// at every CL point kept.
+    pub trace: Vec<(f64, f64)>,
+    /// The pass.
+    pub report: PassReport,
+    /// Time at the programmed feeds and the rapid rate (s).
+    pub estimated_time: f64,
+}
+
+/// Plans pass `pass` of `level` alone, from the path vertex closest to
+/// `entry`, with `cutter` checked against `flanks`; `bottom_allowance` of
+/// `settings` applies when `on_bottom`.
+///
+/// # Errors
+/// [`Rough5Error::NoPass`] when the pass does not exist or no CL point can
+/// be placed; the errors of the placer and of the orientation.
+pub fn plan_single_pass(
+    (level, pass, on_bottom): (&LevelPasses, usize, bool),
+    entry: &Point3,
+    (stock, flanks): (&Aabb3, &TriMesh),
+    cutter: &Cutter,
+    settings: &Rough5Settings,
+) -> Result<SinglePass, Rough5Error> {
+    check(settings)?;
+    let (path, tilt) = level.passes.get(pass).ok_or_else(|| Rough5Error::NoPass {
+        reason: format!("the level has {} passes, not {}", level.passes.len(), pass + 1),
+    })?;
+    let allowance = if on_bottom { settings.bottom_allowance } else { 0.0 };
+    let placer = Placer::new(level.support.mesh(), cutter, allowance)?;
+    let body = BodyCheck::new(flanks, cutter, 0.0);
+    let (pairs, orientation) = pass_pairs((path, tilt.as_ref()), entry, settings)?;
+    let (runs, mut report) = place_pass(&placer, &body, &pairs);
+    report.pass = pass;
+    if runs.is_empty() {
+        return Err(Rough5Error::NoPass { reason: "no CL point of the pass is clear of the flanks".into() });
+    }
+    let mut out = Emitter::new(stock.max.z, stock.max.z + settings.clearance + cutter.radius(), settings);
+    let mut trace = Vec::new();
+    let mut along = 0.0;
+    for (k, run) in runs.iter().enumerate() {
+        out.cut_run(run, f64::NEG_INFINITY, k == 0, (&placer, &body));
+        for (i, c) in run.iter().enumerate() {
+            if i > 0 {
+                along += (c.place.tip - run[i - 1].place.tip).norm();
+            }
+            trace.push((along, pitch_angle(&c.place.axis, &c.sync.tangent, &c.sync.normal)));
+        }
+    }
+    out.finish();
+    let estimated_time = estimate_time(&out.path, settings.rapid_rate);
+    Ok(SinglePass { orientation, toolpath: out.path, trace, report, estimated_time })
+}
+
+/// Time at the programmed feeds and the rapid rate (s).
+fn estimate_time(path: &Toolpath, rapid_rate: f64) -> f64 {
+    let mut from: Option<Point3> = None;
+    let mut t = 0.0;
+    for (i, m) in path.moves().iter().enumerate() {
+        if let Some(a) = from {
+            let rate = match m.kind {
+                MoveKind::Rapid | MoveKind::Retract => rapid_rate,
+                _ => path.feed_of(i),
+            };
+            t += (m.to - a).norm() / rate * 60.0;
+        }
+        from = Some(m.to);
+    }
+    t
+}
+
+/// The synchronised pairs of one pass: SPU, or the optimised
+/// reparameterisation when `settings.orientation` is given and the pass has
+/// a tilt curve; with the angular step limited.
+fn pass_pairs(
+    (path, tilt): (&Curve, Option<&Curve>),
+    cursor: &Point3,
+    settings: &Rough5Settings,
+) -> Result<(Vec<SyncPoint>, Option<Orientation>), Rough5Error> {
+    let (pairs, orientation) = match (tilt, &settings.orientation) {
+        (Some(t), Some(o)) => {
+            let start = path.line.points[crate::closest_vertex(path, cursor)];
+            let found = optimise_pass(path, t, &start, o)?;
+            (synchronise_with(path, t, &start, settings.step, &found.reparam), Some(found))
+        }
+        _ => (synchronise(path, tilt, cursor, settings.step), None),
+    };
+    Ok((limit_angular_step(&pairs, settings.max_angle_step, settings.max_azimuth_step), orientation))
+}
+
+/// The placed and checked CL points of the pairs of one pass, split into
+/// runs where pairs were dropped.
+fn place_pass(placer: &Placer, body: &BodyCheck, pairs: &[SyncPoint]) -> (Vec<Vec<Cl>>, PassReport) {
+    let placed: Vec<Option<Cl>> = pairs
+        .par_iter()
+        .map(|s| {
+            let p = placer.place(&s.path, &s.axis())?;
+            (!body.collides(&p.tip, &p.axis)).then_some(Cl { place: p, sync: *s })
+        })
+        .collect();
+    let mut runs: Vec<Vec<Cl>> = Vec::new();
+    let mut current: Vec<Cl> = Vec::new();
+    for c in &placed {
+        match c {
+            Some(c) => current.push(*c),
+            None if current.len() >= 2 => runs.push(std::mem::take(&mut current)),
+            None => current.clear(),
+        }
+    }
+    if current.len() >= 2 {
+        runs.push(current);
+    }
+    let kept: Vec<&Cl> = runs.iter().flatten().collect();
+    let pitches: Vec<f64> = kept.iter().map(|c| pitch_angle(&c.place.axis, &c.sync.tangent, &c.sync.normal)).collect();
+    let n = pitches.len().max(1) as f64;
+    let pitch = [
+        pitches.iter().copied().fold(f64::INFINITY, f64::min),
+        pitches.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        pitches.iter().sum::<f64>() / n,
+    ];
+    let max_tilt = kept.iter().map(|c| c.place.axis.angle(&Vec3::z())).fold(0.0, f64::max);
+    let report = PassReport {
+        level: 0,
+        pass: 0,
+        points: kept.len(),
+        dropped: placed.len() - kept.len(),
+        runs: runs.len(),
+        pitch,
+        max_tilt,
+    };
+    (runs, report)
+}
+
+/// Writes the runs as moves.
+struct Emitter {
+    path: Toolpath,
+    safe_z: f64,
+    stock_top: f64,
+    last: Option<Cl>,
+    settings: Rough5Settings,
+    retracts: usize,
+    links: usize,
+    ramps: usize,
+}
+
+impl Emitter {
+    fn new(stock_top: f64, safe_z: f64, settings: &Rough5Settings) -> Emitter {
+        Emitter {
+            path: Toolpath::new(settings.feed),
+            safe_z,
+            stock_top: stock_top + settings.clearance,
+            last: None,
+            settings: *settings,
+            retracts: 0,
+            links: 0,
+            ramps: 0,
+        }
+    }
+
+    fn push(&mut self, kind: MoveKind, to: Point3, axis: Vec3) {
+        self.path.push_with_axis(Move::new(kind, to), axis);
+    }
+
+    /// The point of the axis through `tip` at height `z`.
+    fn above_at(tip: &Point3, axis: &Vec3, z: f64) -> Point3 {
+        let lift = if axis.z > 0.0 { ((z - tip.z) / axis.z).max(0.0) } else { 0.0 };
+        tip + axis * lift
+    }
+
+    /// The point of the axis through `tip` at the safe height.
+    fn above(&self, tip: &Point3, axis: &Vec3) -> Point3 {
+        Emitter::above_at(tip, axis, self.safe_z)
+    }
+
+    /// Leaves the material along the axis at the cutting feed up to the
+    /// stock top (material the levels above could not reach may be left
+    /// over the tool), then retracts to the safe height.
+    fn retract(&mut self, a: &Placement) {
+        let out = Emitter::above_at(&a.tip, &a.axis, self.stock_top);
+        self.push(MoveKind::Link, out, a.axis);
+        let up = self.above(&a.tip, &a.axis);
+        self.push(MoveKind::Retract, up, a.axis);
+    }
+
+    /// Cuts `run`: linked from the previous run when possible (never for
+    /// the first run of a level), else entered from the safe height.
+    fn cut_run(&mut self, run: &[Cl], entry_z: f64, first_of_level: bool, (placer, body): (&Placer, &BodyCheck)) {
+        let linked = !first_of_level && self.last.is_some_and(|a| self.try_link(&a, &run[0], placer, body));
+        // The tool is now at run[start].
+        let start = if linked { 0 } else { self.enter(run, entry_z) };
+        let n = run.len();
+        let closed = n > 2 && (run[0].place.tip - run[n - 1].place.tip).norm() < 1e-9;
+        if closed {
+            // A full lap from where the tool reached the level.
+            for k in 1..n {
+                let c = &run[(start + k) % (n - 1)];
+                self.push(MoveKind::Feed, c.place.tip, c.place.axis);
+            }
+            self.last = Some(run[start % (n - 1)]);
+        } else {
+            for c in &run[(start + 1).min(n)..] {
+                self.push(MoveKind::Feed, c.place.tip, c.place.axis);
+            }
+            self.last = Some(run[n - 1]);
+        }
+    }
+
+    /// Retracts along the axis, goes over at the safe height, plunges along
+    /// the new axis to above the level and ramps down along a closed run.
+    /// Returns the index of the run where the tool reached the level.
+    fn enter(&mut self, run: &[Cl], entry_z: f64) -> usize {
+        if let Some(a) = self.last {
+            self.retract(&a.place);
+            self.retracts += 1;
+        }
+        let s = run[0].place;
+        let lift = if s.axis.z > 0.0 { ((entry_z - s.tip.z) / s.axis.z).max(0.0) } else { 0.0 };
+        let start = s.tip + s.axis * lift;
+        self.push(MoveKind::Rapid, self.above(&start, &s.axis), s.axis);
+        self.push(MoveKind::Plunge, start, s.axis);
+        let closed = run.len() > 2 && (s.tip - run[run.len() - 1].place.tip).norm() < 1e-9;
+        if lift <= 0.0 {
+            return 0;
+        }
+        if !closed {
+            self.push(MoveKind::Plunge, s.tip, s.axis);
+            return 0;
+        }
+        self.ramps += 1;
+        self.ramp(run, lift)
+    }
+
+    /// Ramps down along a closed run from `lift` above it; returns the index
+    /// where the lift reaches zero.
+    fn ramp(&mut self, run: &[Cl], lift: f64) -> usize {
+        let ramp_len = lift / self.settings.ramp_angle.tan();
+        let n = run.len() - 1;
+        let (mut s, mut k) = (0.0, 0usize);
+        loop {
+            let (a, b) = (&run[k % n].place, &run[(k + 1) % n].place);
+            s += (b.tip - a.tip).norm();
+            k += 1;
+            let h = lift * (1.0 - s / ramp_len);
+            if h <= 0.0 {
+                self.push(MoveKind::Feed, b.tip, b.axis);
+                return k % n;
+            }
+            self.push(MoveKind::Feed, b.tip + b.axis * h, b.axis);
+        }
+    }
+
+    /// Links `a` to `b` on the level when the link is short, every point of
+    /// it placed and clear of the flanks; pushes the link moves.
+    fn try_link(&mut self, a: &Cl, b: &Cl, placer: &Placer, body: &BodyCheck) -> bool {
+        let dist = (b.place.tip - a.place.tip).norm();
+        if dist > self.settings.link_max {
+            return false;
+        }
+        let s = &self.settings;
+        let turns = axis_steps(&a.place.axis, &b.place.axis, s.max_angle_step, s.max_azimuth_step);
+        let n = ((dist / s.step).ceil() as usize).max(turns);
+        let mut moves = Vec::with_capacity(n);
+        for i in 1..=n {
+            let w = i as f64 / n as f64;
+            let guide = a.sync.path + (b.sync.path - a.sync.path) * w;
+            let axis = interpolate_axis(&a.place.axis, &b.place.axis, w);
+            let Some(p) = placer.place(&guide, &axis) else { return false };
+            if body.collides(&p.tip, &p.axis) {
+                return false;
+            }
+            moves.push(p);
+        }
+        for p in moves {
+            self.push(MoveKind::Link, p.tip, p.axis);
+        }
+        self.links += 1;
+        true
+    }
+
+    fn finish(&mut self) {
+        if let Some(a) = self.last {
+            self.retract(&a.place);
+        }
+    }
+}

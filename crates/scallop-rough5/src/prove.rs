@@ -1,0 +1,168 @@
+//! The proof of a roughing program and its metrics (module L; spec 10.1):
+//! the program cut on a tri-dexel stock of the block ([`DexelStock`], the
+//! shank and holder checked against the in-process stock, rapids into stock
+//! and collisions as errors), then along every Z ray of the stock, against
+//! the volume to remove (a closed mesh):
+//!
+//! - V_r: the stock left inside the volume to remove, in % of its volume;
+//! - the stock removed outside it (a gouge of the finished part, beyond the
+//!   rounding of the rays), its volume and its longest piece along a ray;
+//! - the removal rate (removed volume over the time given);
+//! - L_HM: the share of the cutting path length that removed nothing.
+
+use rayon::prelude::*;
+use scallop_cutter::Cutter;
+use scallop_geom::Aabb3;
+use scallop_mesh::TriMesh;
+use scallop_sim::{DexelOptions, DexelPart, DexelStock, ToolMove};
+use scallop_toolpath::{MoveKind, Toolpath};
+
+use crate::Rough5Error;
+
+/// The metrics of a proven program.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Proof {
+    /// Volume to remove, measured on the rays (mm^3).
+    pub volume_to_remove: f64,
+    /// Stock left inside the volume to remove (mm^3).
+    pub remaining_volume: f64,
+    /// V_r: `remaining_volume` in % of `volume_to_remove`.
+    pub remaining_percent: f64,
+    /// Stock removed (mm^3).
+    pub removed_volume: f64,
+    /// Stock removed outside the volume to remove (mm^3).
+    pub gouge_volume: f64,
+    /// Longest piece removed outside it along one Z ray (mm).
+    pub gouge_depth: f64,
+    /// Total length of the cutting moves (feeds, links, plunges), mm.
+    pub cutting_length: f64,
+    /// L_HM: % of the cutting length that removed nothing.
+    pub air_percent: f64,
+    /// Fixed-axis sweeps the simulation cut.
+    pub sweeps: usize,
+    /// Rays per family of the stock.
+    pub rays: [usize; 3],
+}
+
+impl Proof {
+    /// Removal rate (mm^3/s) over `seconds`.
+    #[must_use]
+    pub fn removal_rate(&self, seconds: f64) -> f64 {
+        if seconds > 0.0 { self.removed_volume / seconds } else { 0.0 }
+    }
+}
+
+/// Settings of [`prove`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ProofSettings {
+    /// Spacing of the tri-dexel rays (mm).
+    pub resolution: f64,
+    /// Largest distance between the simulated and the true swept solid of a
+    /// 5-axis move (mm; [`DexelOptions::axis_tolerance`]).
+    pub axis_tolerance: f64,
+}
+
+/// Length of the interval pieces of `a` inside `b` (both sorted, disjoint).
+fn overlap(a: &[[f64; 2]], b: &[[f64; 2]]) -> f64 {
+    let mut total = 0.0;
+    for x in a {
+        for y in b {
+            total += (x[1].min(y[1]) - x[0].max(y[0])).max(0.0);
+        }
+    }
+    total
+}
+
+/// `[lo, hi]` minus the sorted disjoint `a`.
+fn complement(a: &[[f64; 2]], lo: f64, hi: f64) -> Vec<[f64; 2]> {
+    let mut out = Vec::new();
+    let mut from = lo;
+    for x in a {
+        if x[0] > from {
+            out.push([from, x[0].min(hi)]);
+        }
+        from = from.max(x[1]);
+    }
+    if hi > from {
+        out.push([from, hi]);
+    }
+    out
+}
+
+/// Cuts `path` with `cutter` on a tri-dexel stock of `stock` (`settings`)
+/// and measures it against `volume` (the volume to remove, closed, outward
+/// normals). `progress(done, total)` as [`DexelStock::cut_with_progress`].
+///
+/// # Errors
+/// [`Rough5Error::Simulation`] for a refused stock, a rapid into the stock
+/// or a shank or holder collision.
+pub fn prove(
+    path: &Toolpath,
+    cutter: &Cutter,
+    stock: &Aabb3,
+    volume: &TriMesh,
+    settings: &ProofSettings,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<Proof, Rough5Error> {
+    let sim = |e: scallop_sim::SimError| Rough5Error::Simulation(e.to_string());
+    let mut dexels = DexelStock::new(*stock, settings.resolution).map_err(sim)?;
+    let moves = ToolMove::from_toolpath(path);
+    let options = DexelOptions { axis_tolerance: settings.axis_tolerance, check_collisions: true };
+    let report = dexels.cut_with_progress(cutter, &moves, &options, progress).map_err(sim)?;
+    report.check().map_err(sim)?;
+    let part = DexelPart::new(volume);
+    let (nu, nv) = dexels.grid(2);
+    let cell = dexels.cell_size();
+    let area = cell[0] * cell[1];
+    let eps = dexels.eps();
+    let (lo, hi) = (stock.min.z, stock.max.z);
+    // Per row of rays: (volume to remove, left in it, removed outside, deepest).
+    let rows: Vec<[f64; 4]> = (0..nv)
+        .into_par_iter()
+        .map(|iv| {
+            let mut acc = [0.0; 4];
+            for iu in 0..nu {
+                let o = dexels.ray_origin(2, iu, iv);
+                let pocket: Vec<[f64; 2]> =
+                    part.intervals(&o, 2).iter().map(|s| [s.0.max(lo), s.1.min(hi)]).filter(|s| s[1] > s[0]).collect();
+                let material = dexels.intervals(2, iu, iv);
+                let removed = complement(&material, lo, hi);
+                acc[0] += pocket.iter().map(|s| s[1] - s[0]).sum::<f64>();
+                acc[1] += overlap(&material, &pocket);
+                for piece in complement(&pocket, lo, hi) {
+                    let out = overlap(&removed, &[piece]);
+                    if out > eps {
+                        acc[2] += out;
+                        acc[3] = f64::max(acc[3], out);
+                    }
+                }
+            }
+            acc
+        })
+        .collect();
+    let sum = |k: usize| rows.iter().map(|r| r[k]).sum::<f64>() * area;
+    let (to_remove, left) = (sum(0), sum(1));
+    let (mut cutting, mut air) = (0.0, 0.0);
+    let moves = path.moves();
+    for (i, m) in moves.iter().enumerate().skip(1) {
+        if matches!(m.kind, MoveKind::Feed | MoveKind::Link | MoveKind::Plunge) {
+            let len = (m.to - moves[i - 1].to).norm();
+            cutting += len;
+            if report.removed_by_move[i] <= eps * area {
+                air += len;
+            }
+        }
+    }
+    Ok(Proof {
+        volume_to_remove: to_remove,
+        remaining_volume: left,
+        remaining_percent: if to_remove > 0.0 { 100.0 * left / to_remove } else { 0.0 },
+        removed_volume: report.removed_volume,
+        gouge_volume: sum(2),
+        gouge_depth: rows.iter().map(|r| r[3]).fold(0.0, f64::max),
+        cutting_length: cutting,
+        air_percent: if cutting > 0.0 { 100.0 * air / cutting } else { 0.0 },
+        sweeps: report.sweeps,
+        rays: [dexels.grid(0).0 * dexels.grid(0).1, dexels.grid(1).0 * dexels.grid(1).1, nu * nv],
+    })
+}
