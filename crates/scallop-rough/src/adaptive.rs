@@ -12,6 +12,13 @@
 //! material within R of `F(t)` is cut and a pass meets at most a band about
 //! `a` wide.
 //!
+//! The front is slowed near the walls (fast marching with a speed of
+//! [`tol::WALL_SPEED`] on a wall, rising to 1 at [`tol::WALL_BAND`] R from
+//! it): it bends to meet a wall nearly parallel, with passes closer together
+//! there. A pass's points on a wall are moved onto the wall itself and the
+//! wall's vertices between them put back (`walls.rs`), so a pass along a wall
+//! follows it exactly and reaches into its corners.
+//!
 //! The step `a` is chosen per pass from the engagement itself: a grid keeps
 //! the distance from every point to the tool centres swept so far (the
 //! cleared material is where it is at most R), the candidate pass is swept
@@ -41,6 +48,7 @@ use scallop_contour::{Contour, P2, Region};
 
 use crate::grid::{BIG, Grid, IsoPoint, iso_lines};
 use crate::offset::Step;
+use crate::walls::Walls;
 use crate::{ClearOptions, Direction, RoughError, tol};
 
 /// One piece of a front's boundary to cut.
@@ -88,6 +96,8 @@ struct Planner<'a> {
     swept: Vec<f64>,
     /// The region grown a hair: links must stay in it.
     holder: Region,
+    /// The region's walls, onto which the passes' wall points are moved.
+    walls: Walls,
     options: &'a ClearOptions,
     /// The largest accepted engagement (rad).
     accept: f64,
@@ -116,7 +126,7 @@ pub fn plan_adaptive(region: &Region, options: &ClearOptions) -> Result<Vec<Step
         .filter(|&k| inside[k] && [k - 1, k + 1, k - grid.nx, k + grid.nx].iter().any(|&n| !inside[n]))
         .map(|k| (k, 0.5 * h))
         .collect();
-    let depth = grid.march(&inside, &walls);
+    let depth = grid.march(&inside, &walls, None);
     let Some(seed) = (0..grid.len())
         .filter(|&k| depth[k] < 0.5 * BIG)
         .max_by(|&a, &b| depth[a].total_cmp(&depth[b]).then(b.cmp(&a)))
@@ -130,6 +140,7 @@ pub fn plan_adaptive(region: &Region, options: &ClearOptions) -> Result<Vec<Step
         swept: vec![BIG; grid.len()],
         reach,
         holder: region.offset(-tol::LINK_GROW),
+        walls: Walls::new(region, 2.0 * h),
         options,
         accept: tol::ENGAGE_ACCEPT * (1.0 - (options.stepover / r).min(1.0)).acos(),
         grid,
@@ -140,7 +151,10 @@ pub fn plan_adaptive(region: &Region, options: &ClearOptions) -> Result<Vec<Step
         .map(|k| (k, dist(planner.grid.centre(k), s)))
         .filter(|&(k, d)| d <= near && inside[k])
         .collect();
-    let g = planner.grid.march(&inside, &sources);
+    // The front slows down near the walls: it meets them nearly parallel,
+    // with passes closer together there (see the module documentation).
+    let slow: Vec<f64> = depth.iter().map(|&d| 1.0 / wall_speed(d, r)).collect();
+    let g = planner.grid.march(&inside, &sources, Some(&slow));
     let mut steps = planner.fronts(&g, s, r0)?;
     let pos = steps.iter().rev().find_map(|st| match st {
         Step::Cut(c) => c.vertices().last().map(|v| [v.x, v.y]),
@@ -149,6 +163,14 @@ pub fn plan_adaptive(region: &Region, options: &ClearOptions) -> Result<Vec<Step
     let mut rest = planner.finish(region, pos.unwrap_or(s));
     steps.append(&mut rest);
     Ok(steps)
+}
+
+/// The front's speed at `depth` mm from the region's walls (tool radius
+/// `r`): [`tol::WALL_SPEED`] on the wall, rising linearly to 1 at
+/// [`tol::WALL_BAND`] x `r` from it.
+fn wall_speed(depth: f64, r: f64) -> f64 {
+    let f = (depth / (tol::WALL_BAND * r)).clamp(0.0, 1.0);
+    tol::WALL_SPEED + (1.0 - tol::WALL_SPEED) * f
 }
 
 fn dist(a: P2, b: P2) -> f64 {
@@ -292,8 +314,8 @@ impl Planner<'_> {
             loop {
                 trial += 1;
                 let level = t + a;
-                let pieces =
-                    pieces(iso_lines(&self.grid, g, level, t), self.options.direction, 2.0 * self.options.tool_radius);
+                let loops = iso_lines(&self.grid, g, level, t).iter().map(|lp| self.walls.snap(lp)).collect();
+                let pieces = pieces(loops, self.options.direction, 2.0 * self.options.tool_radius);
                 undo.clear();
                 let from = Level { g, a, pos, pending: pending.as_ref() };
                 let Cut { phi, items, end, open } = self.cut_level(pieces, from, &mut undo);

@@ -152,8 +152,10 @@ impl Grid {
     }
 
     /// Distances from the sources `seeds` (cell, value) through the cells
-    /// where `open` holds, by fast marching ([`BIG`] where not reached).
-    pub fn march(&self, open: &[bool], seeds: &[(usize, f64)]) -> Vec<f64> {
+    /// where `open` holds, by fast marching ([`BIG`] where not reached); with
+    /// `slowness`, arrival times of a front whose speed at a cell is the
+    /// inverse of its slowness (mm per unit of time).
+    pub fn march(&self, open: &[bool], seeds: &[(usize, f64)], slowness: Option<&[f64]>) -> Vec<f64> {
         let mut t = vec![BIG; self.len()];
         let mut known = vec![false; self.len()];
         let mut heap = BinaryHeap::new();
@@ -176,6 +178,7 @@ impl Grid {
                 let a = t[n - 1].min(t[n + 1]);
                 let b = t[n - self.nx].min(t[n + self.nx]);
                 let (a, b) = if a <= b { (a, b) } else { (b, a) };
+                let h = slowness.map_or(h, |w| h * w[n]);
                 let v = if b - a >= h { a + h } else { 0.5 * (a + b + (2.0 * h * h - (b - a) * (b - a)).sqrt()) };
                 if v < t[n] {
                     t[n] = v;

@@ -25,6 +25,7 @@ mod grid;
 mod material;
 mod offset;
 pub mod tol;
+mod walls;
 
 pub use adaptive::plan_adaptive;
 pub use material::{MaterialMap, limit_to_material};

@@ -107,4 +107,23 @@ pub const ARC_FIT: f64 = 0.01;
 /// geometry, not the step, sets the engagement there, and the larger step
 /// is kept.
 pub const STEP_STALL: f64 = 0.035;
+/// Adaptive clearing: the front's speed on a wall of the region, as a share
+/// of its speed inside (a front slowed near the walls meets them nearly
+/// parallel, with passes closer there: a front meeting a straight wall at an
+/// angle theta engages the tool going along the wall by up to theta more
+/// than the target, docs/roughing.md).
+pub const WALL_SPEED: f64 = 0.3;
+
+/// Adaptive clearing: the band along the walls where the front slows down,
+/// as a share of the tool radius.
+pub const WALL_BAND: f64 = 1.0;
+
+/// Adaptive clearing: the walls' chords (mm) onto which passes along a wall
+/// are moved (see `walls.rs`); a chord of a wall bending into the region
+/// lies this much outside it.
+pub const WALL_CHORD: f64 = 1e-5;
+
+/// Adaptive clearing: most wall vertices put back between two wall points
+/// of a pass (the chords of a wall's arc between two cells).
+pub const WALL_CORNERS: usize = 256;
 // ---- end of adaptive clearing ----

@@ -136,7 +136,9 @@ fn pockets_stay_within_the_bound_without_slots() {
         .iter()
         .enumerate()
         .filter(|(_, r)| r.slot_length > 0.0 || r.max > bound)
-        .map(|(kind, r)| format!("shape {kind}: max {:.1} deg, slot {:.2} mm", r.max.to_degrees(), r.slot_length))
+        .map(|(kind, r)| {
+            format!("shape {kind}: max {:.1} deg at {:?}, slot {:.2} mm", r.max.to_degrees(), r.max_at, r.slot_length)
+        })
         .collect();
     assert!(over.is_empty(), "bound {:.1} deg: {over:?}", bound.to_degrees());
 }
