@@ -531,6 +531,21 @@ fn pieces(loops: Vec<Vec<IsoPoint>>, direction: Direction, gap: f64) -> Vec<Piec
     out
 }
 
+/// `c` with its arcs of radius over [`tol::MAX_ARC_RADIUS`] made lines (the
+/// fit of nearly collinear points along a wall: a G-code reader refuses their
+/// far centres).
+fn flat_arcs(c: &Contour) -> Result<Contour, scallop_contour::ContourError> {
+    let mut v = c.vertices();
+    for k in 0..v.len().saturating_sub(1) {
+        let chord = (v[k + 1].x - v[k].x).hypot(v[k + 1].y - v[k].y);
+        let b = v[k].bulge.abs();
+        if b > 0.0 && chord * (1.0 + b * b) / (4.0 * b) > tol::MAX_ARC_RADIUS {
+            v[k].bulge = 0.0;
+        }
+    }
+    Contour::new(&v, false)
+}
+
 /// Appends the cuts of a pass as steps: a link before each but the first
 /// of the plan (which starts at the entry `s`). A move of a cut that leaves
 /// `holder` (a chord of the grid across a wall's bend) is replaced by a
@@ -552,7 +567,7 @@ fn push_items(steps: &mut Vec<Step>, items: Vec<Item>, s: P2, holder: &Region, c
                 continue;
             }
             if k - from >= 2
-                && let Ok(c) = Contour::from_points(&run[from..k], false, tol::ARC_FIT)
+                && let Ok(c) = Contour::from_points(&run[from..k], false, tol::ARC_FIT).and_then(|c| flat_arcs(&c))
             {
                 steps.push(Step::Cut(c));
             }

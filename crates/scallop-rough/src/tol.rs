@@ -126,4 +126,9 @@ pub const WALL_CHORD: f64 = 1e-5;
 /// Adaptive clearing: most wall vertices put back between two wall points
 /// of a pass (the chords of a wall's arc between two cells).
 pub const WALL_CORNERS: usize = 256;
+
+/// Adaptive clearing: a fitted arc of a larger radius (mm) becomes a line
+/// (it deviates from its chord by at most chord^2 / 8000 mm: 1 um for a
+/// 2.8 mm chord).
+pub const MAX_ARC_RADIUS: f64 = 1000.0;
 // ---- end of adaptive clearing ----
