@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Side by side: FreeCAD 0.20.2 Adaptive clearing vs `scallop pocket --pattern adaptive`,
+# Side by side: FreeCAD 0.20.2 Adaptive clearing vs `scallop pocket` (--pattern offset or adaptive),
 # both evaluated by the same independent measure, `scallop engagement`.
 #
 #   bash bench/freecad/run.sh [--reduced] [--workdir DIR] [--scallop BIN] [--planner BIN] [--pattern NAME] [--markdown FILE]
@@ -10,7 +10,7 @@
 # accuracy 0.1 mm. FreeCAD (LGPL) runs as an external program (`freecadcmd`); when it is
 # missing and apt has `freecad-python3`, it is installed (about 1.3 GB, 5 minutes).
 # scallop's side runs when `scallop pocket` exists, else it is skipped with a message;
-# --pattern gives its clearing pattern (default adaptive); --planner another scallop binary
+# --pattern gives its clearing pattern (default offset: adaptive is experimental, docs/roughing.md); --planner another scallop binary
 # that plans (`scallop pocket`) while --scallop evaluates (`scallop engagement`).
 # Outputs (pockets, G-code, JSON figures) go to the work directory, never to the repository.
 # Exit status: 0 done, 2 setup or run error.
@@ -23,7 +23,7 @@ workdir="$repo_root/target/freecad-bench"
 scallop=""
 reduced=()
 markdown=""
-pattern=adaptive
+pattern=offset
 planner=""
 while [ $# -gt 0 ]; do
     case "$1" in

@@ -12,7 +12,7 @@ use std::path::PathBuf;
 use clap::{Args, ValueEnum};
 use scallop_contour::{Contour, Region};
 use scallop_post::{Dialect, ProgramInfo, write_fitted};
-use scallop_rough::{ClearOptions, Direction, Motion, pocket_toolpath};
+use scallop_rough::{ClearOptions, Direction, Motion, Pattern, pocket_toolpath};
 use scallop_toolpath::{FittedPath, MoveKind};
 use serde::{Deserialize, Serialize};
 
@@ -24,7 +24,7 @@ use crate::{CliResult, Failure};
 pub enum PatternArg {
     /// Contour-parallel offsets, inside-out, then the wall contour.
     Offset,
-    /// Engagement-controlled clearing (not available yet: rejected).
+    /// Engagement-controlled clearing: a front grown from the deepest point.
     Adaptive,
 }
 
@@ -117,9 +117,6 @@ fn tool_centre_region(text: &str, r: f64) -> CliResult<Region> {
 
 /// `scallop pocket`.
 pub fn run(args: &PocketArgs) -> CliResult<()> {
-    if args.pattern == PatternArg::Adaptive {
-        return Err(Failure::rejected("--pattern adaptive is not available yet; use --pattern offset"));
-    }
     let d = args.tool_diameter;
     let positive = |v: f64| v.is_finite() && v > 0.0;
     if !(positive(d) && positive(args.stepover) && args.stepover <= 0.5 && positive(args.depth)) {
@@ -141,16 +138,26 @@ pub fn run(args: &PocketArgs) -> CliResult<()> {
         )));
     }
     let direction = if args.conventional { Direction::Conventional } else { Direction::Climb };
-    let options =
-        ClearOptions { tool_radius: d / 2.0, stepover: args.stepover * d, direction, chord_tolerance: args.tolerance };
+    let pattern = match args.pattern {
+        PatternArg::Offset => Pattern::Offset,
+        PatternArg::Adaptive => Pattern::Adaptive,
+    };
+    let options = ClearOptions {
+        tool_radius: d / 2.0,
+        stepover: args.stepover * d,
+        direction,
+        chord_tolerance: args.tolerance,
+        pattern,
+    };
     let motion = Motion { clearance_z: args.clearance, feed: args.feed };
     let plan = pocket_toolpath(&region, &options, -args.depth, 0.0, &motion)
         .map_err(|e| Failure::rejected(format!("{}: {e}", args.region.display())))?;
     let planning_seconds = start.elapsed().as_secs_f64();
     let fitted = FittedPath::with_xy_arcs(&plan.toolpath);
     let (program, cl) = (args.output.join("program.nc"), args.output.join("toolpath.csv"));
+    let name = if pattern == Pattern::Adaptive { "adaptive" } else { "offset" };
     let comments =
-        [format!("pocket {}: flat D{d} mm, stepover {} D, offset clearing", args.region.display(), args.stepover)];
+        [format!("pocket {}: flat D{d} mm, stepover {} D, {name} clearing", args.region.display(), args.stepover)];
     let refs: Vec<&str> = comments.iter().map(String::as_str).collect();
     let info = ProgramInfo { program: "1".into(), tool: 1, spindle: 0.0, indexed_rotaries: Vec::new() };
     let dialect = Dialect::builtin("linuxcnc").map_err(|e| Failure::Io(anyhow::anyhow!("{e}")))?;

@@ -51,7 +51,7 @@ fn pocket_rejects_bad_input_with_exit_code_1() {
     for args in [
         vec!["--tool-diameter", "0"],
         vec!["--tool-diameter", "6", "--stepover", "0.9"],
-        vec!["--tool-diameter", "6", "--pattern", "adaptive"],
+        vec!["--tool-diameter", "6", "--pattern", "spiral"],
         vec!["--tool-diameter", "50"],
     ] {
         let out = scallop()

@@ -700,6 +700,70 @@ pub mod rough {
     /// Most cells of an in-process stock map (bounds the memory of the outline
     /// tracing on absurd inputs).
     pub const MAX_MATERIAL_CELLS: usize = 64_000_000;
+
+    /// Adaptive clearing: the grid's cell side as a share of the tool radius
+    /// (R / 16: 0.19 mm for a 6 mm tool).
+    pub const GRID_SHARE: f64 = 1.0 / 16.0;
+
+    /// Adaptive clearing: most cells of one region's grid; larger regions get
+    /// coarser cells.
+    pub const MAX_GRID_CELLS: usize = 8_000_000;
+
+    /// Adaptive clearing: a pass is kept when its largest engagement, measured
+    /// on the grid every cell side with the periphery probed every
+    /// [`ENGAGE_PROBES`]th of a turn, is at most this times the target (the
+    /// planner's margin under the 1.1 bound of docs/roughing.md).
+    pub const ENGAGE_ACCEPT: f64 = 1.03;
+
+    /// Adaptive clearing: points probed on the tool's periphery.
+    pub const ENGAGE_PROBES: usize = 180;
+
+    /// Adaptive clearing: the next pass tries at most this times the last
+    /// pass's step (never more than the stepover).
+    pub const STEP_GROW: f64 = 1.3;
+
+    /// Adaptive clearing: the smallest step between passes, as a share of the
+    /// grid's cell side (a pass that still exceeds the bound there is kept).
+    pub const STEP_MIN_SHARE: f64 = 0.25;
+
+    /// Adaptive clearing: trials of one pass's step before the smallest is kept.
+    pub const STEP_TRIALS: usize = 12;
+
+    /// Adaptive clearing: the passes (grid iso-lines) are replaced by arcs and
+    /// lines within this (mm): fewer, smoother moves; the tool may go this much
+    /// deeper into the material or towards a wall.
+    pub const ARC_FIT: f64 = 0.01;
+
+    /// Adaptive clearing: a smaller step that lowers a pass's largest
+    /// engagement by less than this (rad, 2 degrees) is not worth it: the
+    /// geometry, not the step, sets the engagement there, and the larger step
+    /// is kept.
+    pub const STEP_STALL: f64 = 0.035;
+
+    /// Adaptive clearing: the front's speed on a wall of the region, as a share
+    /// of its speed inside (a front slowed near the walls meets them nearly
+    /// parallel, with passes closer there: a front meeting a straight wall at an
+    /// angle theta engages the tool going along the wall by up to theta more
+    /// than the target, docs/roughing.md).
+    pub const WALL_SPEED: f64 = 0.3;
+
+    /// Adaptive clearing: the band along the walls where the front slows down,
+    /// as a share of the tool radius.
+    pub const WALL_BAND: f64 = 1.0;
+
+    /// Adaptive clearing: the walls' chords (mm) onto which passes along a wall
+    /// are moved (see `walls.rs`); a chord of a wall bending into the region
+    /// lies this much outside it.
+    pub const WALL_CHORD: f64 = 1e-5;
+
+    /// Adaptive clearing: most wall vertices put back between two wall points
+    /// of a pass (the chords of a wall's arc between two cells).
+    pub const WALL_CORNERS: usize = 256;
+
+    /// Adaptive clearing: a fitted arc of a larger radius (mm) becomes a line
+    /// (it deviates from its chord by at most chord^2 / 8000 mm: 1 um for a
+    /// 2.8 mm chord).
+    pub const MAX_ARC_RADIUS: f64 = 1000.0;
 }
 
 pub mod rough5 {

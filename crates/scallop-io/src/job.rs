@@ -154,7 +154,7 @@ pub struct RoughingSpec {
     pub stock_to_leave: f64,
     /// Material left on the floors (mm; default `stock_to_leave`).
     pub stock_to_leave_axial: Option<f64>,
-    /// Clearing pattern (`offset`).
+    /// Clearing pattern (`offset` or `adaptive`).
     #[serde(default = "default_rough_pattern")]
     pub pattern: RoughPatternWord,
     /// `climb` (default) or `conventional`.
@@ -297,7 +297,8 @@ word_enum! {
 word_enum! {
     /// `roughing.pattern`.
     RoughPatternWord { /// Contour-parallel offsets.
-        Offset = "offset" }
+        Offset = "offset", /// Engagement-controlled (adaptive) clearing.
+        Adaptive = "adaptive" }
 }
 word_enum! {
     /// `roughing.direction`.

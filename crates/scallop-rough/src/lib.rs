@@ -20,10 +20,14 @@ use scallop_mesh::MeshIndex;
 use scallop_toolpath::{ArcXY, Move, MoveKind, Toolpath};
 use scallop_waterline::{WaterlineGrid, WaterlineOptions};
 
+mod adaptive;
+mod grid;
 mod material;
 mod offset;
 pub use scallop_geom::tol::rough as tol;
+mod walls;
 
+pub use adaptive::plan_adaptive;
 pub use material::{MaterialMap, limit_to_material};
 pub use offset::{Step, plan_offset};
 
@@ -73,6 +77,20 @@ pub enum Pattern {
     /// Contour-parallel offsets at the stepover, inside-out, then the region's contour.
     #[default]
     Offset,
+    /// A front grown from the deepest point with the engagement held at the
+    /// stepover's angle, then the region's contour (docs/roughing.md).
+    Adaptive,
+}
+
+/// The clearing of one connected tool-centre region by `options.pattern`.
+///
+/// # Errors
+/// [`RoughError::TooMuchWork`] beyond the planners' bounds.
+pub fn plan_region(region: &Region, options: &ClearOptions) -> Result<Vec<Step>, RoughError> {
+    match options.pattern {
+        Pattern::Offset => plan_offset(region, options),
+        Pattern::Adaptive => plan_adaptive(region, options),
+    }
 }
 
 /// Settings of the clearing of one region in the plane.
@@ -86,6 +104,8 @@ pub struct ClearOptions {
     pub direction: Direction,
     /// Chords stand for arcs within this in link checks (mm).
     pub chord_tolerance: f64,
+    /// Clearing pattern.
+    pub pattern: Pattern,
 }
 
 /// The settings of a roughing operation.
@@ -314,6 +334,7 @@ pub fn plan_rough_from(
         stepover: settings.stepover * 2.0 * cutter.radius(),
         direction: settings.direction,
         chord_tolerance: tolerance,
+        pattern: settings.pattern,
     };
     let mut nodes = build_tree(&levels, &options)?;
     if let Some(m) = material {
@@ -352,7 +373,7 @@ fn build_tree(levels: &[Level], options: &ClearOptions) -> Result<Vec<Node>, Rou
     let first_of_level: Vec<usize> =
         (0..=levels.len()).map(|k| shells.iter().position(|s| s.0 >= k).unwrap_or(shells.len())).collect();
     let planned: Result<Vec<Vec<Step>>, RoughError> =
-        shells.par_iter().map(|(_, region)| plan_offset(region, options)).collect();
+        shells.par_iter().map(|(_, region)| plan_region(region, options)).collect();
     let planned = planned?;
     // Parents are found among the previous level's nodes by containment.
     let mut out: Vec<Node> = Vec::with_capacity(shells.len());
@@ -651,12 +672,12 @@ pub fn push_contour(path: &mut Toolpath, c: &Contour, z: f64) {
     }
 }
 
-/// The offset clearing of one 2D pocket at height `z` from the height
+/// The clearing of one 2D pocket at height `z` from the height
 /// `top` (the material's top): a plunge at the first pass, links and
-/// retracts as planned (see [`plan_offset`]).
+/// retracts as planned (see [`plan_region`]).
 ///
 /// # Errors
-/// As [`plan_offset`].
+/// As [`plan_region`].
 pub fn pocket_toolpath(
     region: &Region,
     options: &ClearOptions,
@@ -667,7 +688,7 @@ pub fn pocket_toolpath(
     let mut out = Emitter::new(motion, top, options);
     let mut nodes = Vec::new();
     for part in region.components() {
-        let steps = plan_offset(&part, options)?;
+        let steps = plan_region(&part, options)?;
         nodes.push(Node { z, top, region: part, parent: None, steps });
     }
     let roots: Vec<usize> = (0..nodes.len()).collect();

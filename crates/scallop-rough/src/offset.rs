@@ -23,7 +23,8 @@ use crate::{ClearOptions, Direction, RoughError, tol};
 /// One step of a clearing plan in the plane.
 #[derive(Debug, Clone)]
 pub enum Step {
-    /// A closed pass along the contour, from its first vertex back to it.
+    /// A pass along the contour from its first vertex (a closed one back to
+    /// it; adaptive clearing's open runs end at their last vertex).
     Cut(Contour),
     /// The move to the next cut's start: at the cutting depth through
     /// cleared area when `tool_down`, else by a retract.

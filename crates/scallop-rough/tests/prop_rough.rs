@@ -147,7 +147,7 @@ proptest! {
             vec![Contour::circle([w / 2.0, h / 2.0], isl).unwrap()],
         ).unwrap();
         let region = wall.offset(r);
-        let options = ClearOptions { tool_radius: r, stepover: f * 2.0 * r, direction: Direction::Climb, chord_tolerance: 1e-3 };
+        let options = ClearOptions { tool_radius: r, stepover: f * 2.0 * r, direction: Direction::Climb, chord_tolerance: 1e-3, pattern: Pattern::Offset };
         // Climb: the last (largest) pass runs counter-clockwise along the wall,
         // the passes around the island clockwise; conventional: the reverse.
         for (direction, sign) in [(Direction::Climb, 1.0), (Direction::Conventional, -1.0)] {

@@ -1,0 +1,283 @@
+//! A square grid of samples over a tool-centre region for adaptive clearing:
+//! the region's inside (a scanline fill), distance fields kept by stamping
+//! (minimum of distances to stamped points and segments, read by bilinear
+//! interpolation), the first-order fast marching method for distances
+//! measured inside the region (Sethian 1996, "A fast marching level set
+//! method for monotonically advancing fronts", PNAS 93(4), equation 3), and
+//! oriented iso-lines (marching squares, Lorensen and Cline 1987, in 2D).
+//!
+//! Samples sit at the cells' centres; `BIG` stands for "far" (unreached,
+//! outside the stamping radius) and keeps the arithmetic finite.
+
+use std::cmp::Reverse;
+use std::collections::{BinaryHeap, HashMap};
+
+use scallop_contour::{P2, Region};
+
+use crate::{RoughError, tol};
+
+/// A value beyond every distance of a grid (mm).
+pub(crate) const BIG: f64 = 1e12;
+
+/// The grid: `nx * ny` cells of side `h` from `(x0, y0)` (the lower-left corner).
+#[derive(Debug, Clone)]
+pub(crate) struct Grid {
+    pub x0: f64,
+    pub y0: f64,
+    pub h: f64,
+    pub nx: usize,
+    pub ny: usize,
+}
+
+impl Grid {
+    /// A grid covering `lo..hi` with a margin of `margin`, cells of side `h`
+    /// (grown when more than [`tol::MAX_GRID_CELLS`] cells would be needed).
+    pub fn new(lo: P2, hi: P2, margin: f64, h: f64) -> Result<Grid, RoughError> {
+        let (w, ht) = (hi[0] - lo[0] + 2.0 * margin, hi[1] - lo[1] + 2.0 * margin);
+        if !(w.is_finite() && ht.is_finite() && h > 0.0) {
+            return Err(RoughError::TooMuchWork { what: "grid cells", limit: tol::MAX_GRID_CELLS });
+        }
+        #[allow(clippy::cast_precision_loss, reason = "a bound well below 2^52")]
+        let area_cells = w * ht / (h * h);
+        #[allow(clippy::cast_precision_loss, reason = "a bound well below 2^52")]
+        let h = if area_cells > tol::MAX_GRID_CELLS as f64 { (w * ht / tol::MAX_GRID_CELLS as f64).sqrt() } else { h };
+        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "bounded positive counts")]
+        let (nx, ny) = ((w / h).ceil() as usize + 2, (ht / h).ceil() as usize + 2);
+        Ok(Grid { x0: lo[0] - margin - h, y0: lo[1] - margin - h, h, nx, ny })
+    }
+
+    pub fn len(&self) -> usize {
+        self.nx * self.ny
+    }
+
+    /// The centre of cell `k`.
+    pub fn centre(&self, k: usize) -> P2 {
+        let (i, j) = (k % self.nx, k / self.nx);
+        #[allow(clippy::cast_precision_loss, reason = "grid indices")]
+        let p = [self.x0 + (i as f64 + 0.5) * self.h, self.y0 + (j as f64 + 0.5) * self.h];
+        p
+    }
+
+    /// The cell index range (inclusive) of the centres within `r` of the box `lo..hi`.
+    fn range(&self, lo: P2, hi: P2, r: f64) -> (usize, usize, usize, usize) {
+        let clamp = |v: f64, n: usize| {
+            #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, clippy::cast_precision_loss)]
+            let c = v.clamp(0.0, (n - 1) as f64) as usize;
+            c
+        };
+        let i0 = clamp(((lo[0] - r - self.x0) / self.h - 0.5).floor(), self.nx);
+        let i1 = clamp(((hi[0] + r - self.x0) / self.h - 0.5).ceil(), self.nx);
+        let j0 = clamp(((lo[1] - r - self.y0) / self.h - 0.5).floor(), self.ny);
+        let j1 = clamp(((hi[1] + r - self.y0) / self.h - 0.5).ceil(), self.ny);
+        (i0, i1, j0, j1)
+    }
+
+    /// The field `f` at `p`, bilinear between the four nearest centres
+    /// ([`BIG`] off the grid).
+    pub fn sample(&self, f: &[f64], p: P2) -> f64 {
+        let u = (p[0] - self.x0) / self.h - 0.5;
+        let v = (p[1] - self.y0) / self.h - 0.5;
+        #[allow(clippy::cast_precision_loss, reason = "grid sizes")]
+        let inside = u >= 0.0 && v >= 0.0 && u < (self.nx - 1) as f64 && v < (self.ny - 1) as f64;
+        if !inside {
+            return BIG;
+        }
+        let (fu, fv) = (u.floor(), v.floor());
+        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "checked above")]
+        let k = fv as usize * self.nx + fu as usize;
+        let (a, b) = (u - fu, v - fv);
+        let (f00, f10, f01, f11) = (f[k], f[k + 1], f[k + self.nx], f[k + self.nx + 1]);
+        (f00 * (1.0 - a) + f10 * a) * (1.0 - b) + (f01 * (1.0 - a) + f11 * a) * b
+    }
+
+    /// Cells whose centre lies inside `region` (non-zero winding of its
+    /// rings as chords within `tolerance`), row by row.
+    pub fn fill(&self, region: &Region, tolerance: f64) -> Vec<bool> {
+        let rings: Vec<Vec<P2>> = region.rings().iter().map(|c| c.to_points(tolerance)).collect();
+        let mut inside = vec![false; self.len()];
+        let mut cross: Vec<(f64, i32)> = Vec::new();
+        for j in 0..self.ny {
+            let y = self.centre(j * self.nx)[1];
+            cross.clear();
+            for ring in &rings {
+                for (k, a) in ring.iter().enumerate() {
+                    let b = ring[(k + 1) % ring.len()];
+                    if (a[1] <= y) != (b[1] <= y) {
+                        let x = a[0] + (y - a[1]) / (b[1] - a[1]) * (b[0] - a[0]);
+                        cross.push((x, if b[1] > a[1] { 1 } else { -1 }));
+                    }
+                }
+            }
+            cross.sort_by(|p, q| p.0.total_cmp(&q.0));
+            let mut wind = 0;
+            for w in 0..cross.len() {
+                wind += cross[w].1;
+                if wind != 0 && w + 1 < cross.len() {
+                    let (lo, hi) = (cross[w].0, cross[w + 1].0);
+                    let (i0, i1, _, _) = self.range([lo, y], [hi, y], 0.0);
+                    for i in i0..=i1 {
+                        let x = self.centre(i)[0];
+                        if x > lo && x <= hi {
+                            inside[j * self.nx + i] = true;
+                        }
+                    }
+                }
+            }
+        }
+        inside
+    }
+
+    /// `f = min(f, distance to the segment a-b)` within `r` of it; the old
+    /// values go to `undo` when given.
+    pub fn stamp_segment(&self, f: &mut [f64], a: P2, b: P2, r: f64, mut undo: Option<&mut Vec<(usize, f64)>>) {
+        let lo = [a[0].min(b[0]), a[1].min(b[1])];
+        let hi = [a[0].max(b[0]), a[1].max(b[1])];
+        let (i0, i1, j0, j1) = self.range(lo, hi, r);
+        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+        let l2 = dx * dx + dy * dy;
+        for j in j0..=j1 {
+            for i in i0..=i1 {
+                let k = j * self.nx + i;
+                let c = self.centre(k);
+                let t = if l2 > 0.0 { (((c[0] - a[0]) * dx + (c[1] - a[1]) * dy) / l2).clamp(0.0, 1.0) } else { 0.0 };
+                let d = (c[0] - a[0] - t * dx).hypot(c[1] - a[1] - t * dy);
+                if d <= r && d < f[k] {
+                    if let Some(u) = undo.as_deref_mut() {
+                        u.push((k, f[k]));
+                    }
+                    f[k] = d;
+                }
+            }
+        }
+    }
+
+    /// Distances from the sources `seeds` (cell, value) through the cells
+    /// where `open` holds, by fast marching ([`BIG`] where not reached); with
+    /// `slowness`, arrival times of a front whose speed at a cell is the
+    /// inverse of its slowness (mm per unit of time).
+    pub fn march(&self, open: &[bool], seeds: &[(usize, f64)], slowness: Option<&[f64]>) -> Vec<f64> {
+        let mut t = vec![BIG; self.len()];
+        let mut known = vec![false; self.len()];
+        let mut heap = BinaryHeap::new();
+        for &(k, v) in seeds {
+            if open[k] && v < t[k] {
+                t[k] = v;
+                heap.push(Reverse((v.to_bits(), k)));
+            }
+        }
+        let h = self.h;
+        while let Some(Reverse((bits, k))) = heap.pop() {
+            if known[k] || f64::from_bits(bits) > t[k] {
+                continue;
+            }
+            known[k] = true;
+            for n in self.neighbours(k) {
+                if known[n] || !open[n] {
+                    continue;
+                }
+                let a = t[n - 1].min(t[n + 1]);
+                let b = t[n - self.nx].min(t[n + self.nx]);
+                let (a, b) = if a <= b { (a, b) } else { (b, a) };
+                let h = slowness.map_or(h, |w| h * w[n]);
+                let v = if b - a >= h { a + h } else { 0.5 * (a + b + (2.0 * h * h - (b - a) * (b - a)).sqrt()) };
+                if v < t[n] {
+                    t[n] = v;
+                    heap.push(Reverse((v.to_bits(), n)));
+                }
+            }
+        }
+        t
+    }
+
+    /// The 4-neighbours of `k` that are not on the grid's border.
+    fn neighbours(&self, k: usize) -> impl Iterator<Item = usize> + '_ {
+        let (i, j) = (k % self.nx, k / self.nx);
+        let cand = [
+            (i > 1).then(|| k - 1),
+            (i + 2 < self.nx).then(|| k + 1),
+            (j > 1).then(|| k - self.nx),
+            (j + 2 < self.ny).then(|| k + self.nx),
+        ];
+        cand.into_iter().flatten()
+    }
+}
+
+/// A point of an iso-line, whether it is new: beyond the level `prev` (a
+/// point on a wall whose inner sample is at or below `prev` was on the
+/// iso-line of `prev` already), and whether it lies on a wall.
+pub(crate) type IsoPoint = (P2, bool, bool);
+
+/// The closed iso-lines `f = level` with `{f <= level}` on their left
+/// (counter-clockwise around it); values at or above `BIG / 2` are walls.
+pub(crate) fn iso_lines(grid: &Grid, f: &[f64], level: f64, prev: f64) -> Vec<Vec<IsoPoint>> {
+    let nx = grid.nx;
+    let inside = |k: usize| f[k] <= level;
+    let h_edge = |i: usize, j: usize| 2 * (j * nx + i);
+    let v_edge = |i: usize, j: usize| 2 * (j * nx + i) + 1;
+    let mut next: HashMap<usize, usize> = HashMap::new();
+    let mut order: Vec<usize> = Vec::new();
+    let mut point: HashMap<usize, IsoPoint> = HashMap::new();
+    let crossing = |e: usize, a: usize, b: usize, point: &mut HashMap<usize, IsoPoint>| {
+        point.entry(e).or_insert_with(|| {
+            let (ka, kb) = if inside(a) { (a, b) } else { (b, a) };
+            let (pa, pb) = (grid.centre(ka), grid.centre(kb));
+            let wall = f[kb] >= 0.5 * BIG;
+            let s = if wall { 0.0 } else { ((level - f[ka]) / (f[kb] - f[ka])).clamp(0.0, 1.0) };
+            let p = [pa[0] + s * (pb[0] - pa[0]), pa[1] + s * (pb[1] - pa[1])];
+            (p, !wall || f[ka] > prev, wall)
+        });
+    };
+    for j in 0..grid.ny - 1 {
+        for i in 0..nx - 1 {
+            let c = [j * nx + i, j * nx + i + 1, (j + 1) * nx + i + 1, (j + 1) * nx + i];
+            let ins = c.map(inside);
+            if ins.iter().all(|&x| x) || ins.iter().all(|&x| !x) {
+                continue;
+            }
+            // The square's edges counter-clockwise, with their corners in that order.
+            let edges =
+                [(h_edge(i, j), 0, 1), (v_edge(i + 1, j), 1, 2), (h_edge(i, j + 1), 2, 3), (v_edge(i, j), 3, 0)];
+            let mut xs: Vec<(usize, bool)> = Vec::with_capacity(4);
+            for &(e, p, q) in &edges {
+                if ins[p] != ins[q] {
+                    crossing(e, c[p], c[q], &mut point);
+                    xs.push((e, ins[p]));
+                }
+            }
+            let centre_in = c.iter().map(|&k| f[k].min(BIG)).sum::<f64>() * 0.25 <= level;
+            let n = xs.len();
+            for a in 0..n {
+                if !xs[a].1 {
+                    continue;
+                }
+                // Exit `a` joins the next entry counter-clockwise (centre
+                // inside, or only two crossings), else the previous one.
+                let b = if centre_in || n == 2 { (a + 1) % n } else { (a + n - 1) % n };
+                next.insert(xs[a].0, xs[b].0);
+                order.push(xs[a].0);
+            }
+        }
+    }
+    let mut done: HashMap<usize, ()> = HashMap::new();
+    let mut loops = Vec::new();
+    for &start in &order {
+        if done.contains_key(&start) {
+            continue;
+        }
+        let mut ring = Vec::new();
+        let mut e = start;
+        while done.insert(e, ()).is_none() {
+            if let Some(p) = point.get(&e) {
+                ring.push(*p);
+            }
+            match next.get(&e) {
+                Some(&n) => e = n,
+                None => break,
+            }
+        }
+        if ring.len() >= 2 {
+            loops.push(ring);
+        }
+    }
+    loops
+}

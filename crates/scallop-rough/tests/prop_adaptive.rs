@@ -1,0 +1,164 @@
+//! Adaptive clearing of generated pockets (disc, rectangle, rectangle with
+//! a round island, L), judged by the simulator's engagement evaluation
+//! (`scallop_sim::pocket_engagement`): the tool never reaches beyond a wall,
+//! no reachable material is left, and the plan is the same on one and two
+//! threads. The simulator takes every move as a straight line, so arcs are
+//! measured as chords within 1 um, as `scallop engagement` reads G2/G3. The
+//! engagement bound (1.1 x the stepover's angle outside the entry) and no
+//! full slot are not met yet on these small pockets: that test is ignored
+//! (docs/roughing.md, "Adaptive clearing").
+#![allow(clippy::unwrap_used, reason = "tests: a panic is the failure report")]
+
+use proptest::prelude::*;
+use scallop_contour::{Contour, Region};
+use scallop_geom::{Point2, Point3};
+use scallop_rough::{ClearOptions, Direction, Motion, Pattern, RoughPlan, pocket_toolpath};
+use scallop_sim::{EngagementOptions, EngagementReport, Pocket, engagement_angle, pocket_engagement};
+use scallop_toolpath::{Move, Toolpath};
+
+const R: f64 = 1.5;
+const AE: f64 = 0.4 * R;
+
+fn circle(cx: f64, cy: f64, r: f64, n: usize, clockwise: bool) -> Vec<[f64; 2]> {
+    #[allow(clippy::cast_precision_loss, reason = "small counts")]
+    let mut v: Vec<[f64; 2]> = (0..n)
+        .map(|k| {
+            let a = std::f64::consts::TAU * k as f64 / n as f64;
+            [cx + r * a.cos(), cy + r * a.sin()]
+        })
+        .collect();
+    if clockwise {
+        v.reverse();
+    }
+    v
+}
+
+fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> Vec<[f64; 2]> {
+    vec![[x0, y0], [x1, y0], [x1, y1], [x0, y1]]
+}
+
+/// The pocket's rings (wall first, then islands) and its plan.
+fn plan(rings: &[Vec<[f64; 2]>]) -> (Pocket, RoughPlan) {
+    let mut it = rings.iter().map(|r| Contour::polygon(r, true).unwrap());
+    let outer = it.next().unwrap();
+    let wall = Region::with_holes(outer, it.collect()).unwrap();
+    let region = wall.offset(R);
+    let options = ClearOptions {
+        tool_radius: R,
+        stepover: AE,
+        direction: Direction::Climb,
+        chord_tolerance: 1e-3,
+        pattern: Pattern::Adaptive,
+    };
+    let motion = Motion { clearance_z: 5.0, feed: 1000.0 };
+    let plan = pocket_toolpath(&region, &options, -1.0, 0.0, &motion).unwrap();
+    let pocket =
+        Pocket::new(rings.iter().map(|r| r.iter().map(|p| Point2::new(p[0], p[1])).collect()).collect()).unwrap();
+    (pocket, plan)
+}
+
+/// The path with every XY arc replaced by chords within `SAGITTA` (as
+/// `scallop engagement` reads a program's G2/G3): the simulator's engagement
+/// takes each move as a straight line.
+fn chords(path: &Toolpath) -> Toolpath {
+    const SAGITTA: f64 = 1e-3;
+    let mut out = Toolpath::new(path.feed);
+    let moves = path.moves();
+    for (k, m) in moves.iter().enumerate() {
+        let Some(arc) = path.arc(k).filter(|_| k > 0) else {
+            out.push(*m);
+            continue;
+        };
+        let from = moves[k - 1].to;
+        let (c, radius) = (arc.center, (from.x - arc.center.x).hypot(from.y - arc.center.y));
+        let step = 2.0 * (1.0 - SAGITTA / radius.max(SAGITTA)).acos();
+        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a small positive count")]
+        let n = (arc.sweep.abs() / step.max(1e-3)).ceil().max(1.0) as usize;
+        let a0 = (from.y - c.y).atan2(from.x - c.x);
+        for i in 1..n {
+            #[allow(clippy::cast_precision_loss, reason = "small counts")]
+            let f = i as f64 / n as f64;
+            let a = a0 + arc.sweep * f;
+            let to = Point3::new(c.x + radius * a.cos(), c.y + radius * a.sin(), from.z + (m.to.z - from.z) * f);
+            out.push(Move::new(m.kind, to));
+        }
+        out.push(*m);
+    }
+    out
+}
+
+fn judge(pocket: &Pocket, plan: &RoughPlan) -> EngagementReport {
+    let options = EngagementOptions { gouge_tolerance: 0.03, ..EngagementOptions::default() };
+    // A reach beyond a wall fails here (`PocketGouge`).
+    pocket_engagement(pocket, R, &chords(&plan.toolpath), engagement_angle(AE, R), &options).unwrap()
+}
+
+/// Nothing reachable left, no gouge (in `judge`).
+fn check_cleared(report: &EngagementReport) {
+    assert!(report.uncut_area <= 0.05, "uncut {} mm2", report.uncut_area);
+}
+
+fn shape(w: f64, h: f64, kind: usize) -> Vec<Vec<[f64; 2]>> {
+    match kind {
+        0 => vec![rect(0.0, 0.0, w, h)],
+        1 => vec![rect(0.0, 0.0, w, h), circle(0.5 * w, 0.5 * h, 1.5, 48, true)],
+        2 => vec![vec![[0.0, 0.0], [w, 0.0], [w, 0.5 * h], [0.5 * w, 0.5 * h], [0.5 * w, h], [0.0, h]]],
+        _ => vec![circle(0.5 * w, 0.5 * h, 0.5 * h, 96, false)],
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(4))]
+
+    #[test]
+    fn pockets_are_cleared_inside_their_walls(w in 12.0..18.0f64, h in 9.0..12.0f64, kind in 0..4usize) {
+        // Rectangles, with an island, Ls, discs.
+        let (pocket, plan) = plan(&shape(w, h, kind));
+        check_cleared(&judge(&pocket, &plan));
+    }
+}
+
+#[test]
+fn ls_are_cleared_inside_their_walls() {
+    // The L's inner corner is cut by an arc of radius R about the corner:
+    // measured as its chord it read 0.11 mm beyond the wall.
+    let (pocket, plan) = plan(&shape(12.0, 9.0, 2));
+    assert!(plan.toolpath.arc_count() > 0);
+    check_cleared(&judge(&pocket, &plan));
+}
+
+#[test]
+#[ignore = "issue 16: the bound and no slot are not met yet (docs/roughing.md, Adaptive clearing)"]
+fn pockets_stay_within_the_bound_without_slots() {
+    let bound = 1.1 * engagement_angle(AE, R);
+    let reports: Vec<EngagementReport> = (0..4).map(|kind| judge_shape(&shape(16.0, 12.0, kind))).collect();
+    let over: Vec<String> = reports
+        .iter()
+        .enumerate()
+        .filter(|(_, r)| r.slot_length > 0.0 || r.max > bound)
+        .map(|(kind, r)| {
+            format!("shape {kind}: max {:.1} deg at {:?}, slot {:.2} mm", r.max.to_degrees(), r.max_at, r.slot_length)
+        })
+        .collect();
+    assert!(over.is_empty(), "bound {:.1} deg: {over:?}", bound.to_degrees());
+}
+
+fn judge_shape(rings: &[Vec<[f64; 2]>]) -> EngagementReport {
+    let (pocket, plan) = plan(rings);
+    judge(&pocket, &plan)
+}
+
+#[test]
+fn the_same_plan_on_one_and_two_threads() {
+    let rings = vec![rect(0.0, 0.0, 14.0, 10.0), circle(7.0, 5.0, 1.5, 48, true)];
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| {
+            plan(&rings).1.toolpath.moves().iter().map(|m| (m.kind, m.to.x, m.to.y, m.to.z)).collect::<Vec<_>>()
+        })
+    };
+    let one = run(1);
+    assert!(!one.is_empty());
+    assert_eq!(one, run(2));
+    assert_eq!(one, run(1));
+}
