@@ -36,3 +36,8 @@ pub const MAX_REFINE_DEPTH: u32 = 40;
 /// Smallest tolerance accepted, relative to the model's largest |coordinate|:
 /// below it the bisection would be deciding rounding noise.
 pub const REL_MIN_TOLERANCE: f64 = 1e-13;
+
+/// How many times finer a block of 3 x 3 grid cells is sampled again where a
+/// mesh vertex above z lies with every sample of the block outside: a small
+/// island of the contour (see `docs/waterline.md`).
+pub const ISLAND_REFINE: f64 = 16.0;
