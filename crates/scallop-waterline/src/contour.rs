@@ -19,36 +19,25 @@
 //! narrower than the step): where no single triangle certifies it
 //! (`WaterlineGrid::cover_of`), it is walked (`refine::Local::gaps`) and holds
 //! two crossings per gap. A cell then has several exits: walking its boundary
-//! the crossings alternate exit, entry, and each exit links to the next entry
-//! (the inside joined across the cell) or to the previous one (the outside
-//! joined). A plain saddle decides by its centre as above; a cell with a gap
-//! and two exits joins the outside: the gap is taken as a thin channel of
-//! outside running through the cell (a slot barely wider than the cutter),
-//! not as a notch that ends inside it next to another outside stretch.
+//! the crossings alternate exit, entry. A cell with one exit links it to its
+//! entry; a cell with more (a saddle, a gap next to another outside stretch)
+//! is linked by subdivision (`cell.rs`), so that no link runs across a thin
+//! feature inside the cell.
 
 use rayon::prelude::*;
 use scallop_geom::Point2;
 
 use crate::WaterlineGrid;
+use crate::cell::{Cell, Resolver};
 use crate::refine::Probe;
 
 /// The crossings of one grid edge, in increasing x (horizontal) or y
-/// (vertical), and whether the edge's first end is inside.
+/// (vertical).
 struct EdgeCrossings {
     id: usize,
-    first_inside: bool,
     points: Vec<Point2>,
     /// Number of the first crossing in the flat list of all crossings.
     offset: usize,
-}
-
-/// A crossing met walking a cell's boundary counter-clockwise.
-#[derive(Clone, Copy)]
-struct Met {
-    id: usize,
-    exit: bool,
-    /// Walk edge (0 bottom, 1 right, 2 top, 3 left) it lies on.
-    side: usize,
 }
 
 /// Grid edge numbering: horizontal edges first, then vertical ones.
@@ -140,9 +129,9 @@ fn edge_crossings(grid: &WaterlineGrid<'_>, probe: &Probe<'_>, inside: &[bool]) 
         .collect();
     let mut offset = 0;
     let mut out = Vec::new();
-    for (&(id, first_inside, _), points) in todo.iter().zip(found) {
+    for (&(id, _, _), points) in todo.iter().zip(found) {
         if !points.is_empty() {
-            out.push(EdgeCrossings { id, first_inside, offset, points: points.clone() });
+            out.push(EdgeCrossings { id, offset, points: points.clone() });
             offset += points.len();
         }
     }
@@ -164,59 +153,42 @@ pub(crate) fn trace(grid: &WaterlineGrid<'_>, probe: &Probe<'_>) -> Vec<Vec<Poin
     cells.sort_unstable_by_key(|c| (c[1], c[0]));
     cells.dedup();
     let find = |id: usize| edges.binary_search_by_key(&id, |e| e.id).ok().map(|k| &edges[k]);
-    let links: Vec<Vec<(usize, usize)>> = cells
+    let points: Vec<Point2> = edges.iter().flat_map(|e| e.points.iter().copied()).collect();
+    // Per cell: its links, and the crossings it adds (numbered from `total`).
+    let linked: Vec<(Vec<(usize, usize)>, Vec<Point2>)> = cells
         .par_iter()
         .with_min_len(16)
         .map(|&[i, j]| {
             let walk = [(num.h(i, j), true), (num.v(i + 1, j), true), (num.h(i, j + 1), false), (num.v(i, j), false)];
-            let mut met = Vec::new();
+            let mut sides: [Vec<usize>; 4] = Default::default();
             for (side, &(id, forward)) in walk.iter().enumerate() {
                 let Some(e) = find(id) else { continue };
                 let n = e.points.len();
-                for s in 0..n {
-                    let k = if forward { s } else { n - 1 - s };
-                    // Inside before crossing k, along the edge's own direction.
-                    let before_in = e.first_inside ^ (k % 2 == 1);
-                    met.push(Met { id: e.offset + k, exit: before_in == forward, side });
-                }
+                sides[side].extend((0..n).map(|s| e.offset + if forward { s } else { n - 1 - s }));
             }
-            link_cell(grid, probe, [i, j], &met)
+            let corners = [grid.point(i, j), grid.point(i + 1, j), grid.point(i + 1, j + 1), grid.point(i, j + 1)];
+            let at = |[a, b]: [usize; 2]| inside[b * nx + a];
+            let cell =
+                Cell { corners, inside: [at([i, j]), at([i + 1, j]), at([i + 1, j + 1]), at([i, j + 1])], sides };
+            let local = probe.local(corners[0], corners[2]);
+            let mut resolver = Resolver::new(&local, total);
+            let links = resolver.link(&cell, &|id| points[id], 0);
+            (links, resolver.into_new_nodes())
         })
         .collect();
+    let mut points = points;
     let mut next = vec![usize::MAX; total];
-    for (from, to) in links.into_iter().flatten() {
-        next[from] = to;
+    for (links, added) in linked {
+        // Renumber the cell's new crossings after those already placed.
+        let shift = points.len() - total;
+        let renumber = |id: usize| if id >= total { id + shift } else { id };
+        next.resize(points.len() + added.len(), usize::MAX);
+        points.extend(added);
+        for (from, to) in links {
+            next[renumber(from)] = renumber(to);
+        }
     }
-    let points: Vec<Point2> = edges.iter().flat_map(|e| e.points.iter().copied()).collect();
     chains(&next, &points)
-}
-
-/// The links (exit, entry) of one cell, given its crossings in walk order.
-fn link_cell(grid: &WaterlineGrid<'_>, probe: &Probe<'_>, [i, j]: [usize; 2], met: &[Met]) -> Vec<(usize, usize)> {
-    let n = met.len();
-    let exits = met.iter().filter(|m| m.exit).count();
-    if exits == 0 {
-        return Vec::new();
-    }
-    let plain = exits == 2 && met.iter().map(|m| m.side).collect::<std::collections::BTreeSet<_>>().len() == 4;
-    let join_inside = if exits == 1 {
-        true // one exit, one entry: either rule links them
-    } else if plain || exits > 2 {
-        let (a, b) = (grid.point(i, j), grid.point(i + 1, j + 1));
-        probe.is_inside(Point2::new(0.5 * (a.x + b.x), 0.5 * (a.y + b.y)))
-    } else {
-        // A gap and one more outside stretch: the gap is taken as a channel of
-        // outside that joins it (a thin slot running through the cell).
-        false
-    };
-    (0..n)
-        .filter(|&k| met[k].exit)
-        .map(|k| {
-            let to = if join_inside { met[(k + 1) % n] } else { met[(k + n - 1) % n] };
-            debug_assert!(!to.exit, "cell ({i}, {j}): crossings do not alternate");
-            (met[k].id, to.id)
-        })
-        .collect()
 }
 
 /// Closed chains of the permutation `next`, each from its smallest crossing.

@@ -64,6 +64,7 @@
 //!   not depend on the number of threads (parallel work uses indexed collects).
 //! - Never performs I/O; never prints.
 
+mod cell;
 mod contour;
 mod refine;
 pub mod tol;

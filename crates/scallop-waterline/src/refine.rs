@@ -38,11 +38,6 @@ impl<'a> Probe<'a> {
         best.tip.z - self.z
     }
 
-    /// Exact: the cutter with its tip at z cuts into the part at `p`.
-    pub(crate) fn is_inside(&self, p: Point2) -> bool {
-        self.height(p) > 0.0
-    }
-
     /// The probe restricted to points of the box `[lo, hi]`: the triangles
     /// within the cutter's reach of the box, sorted by decreasing top, so that
     /// each evaluation scans a short list instead of searching the index.
@@ -96,7 +91,7 @@ impl Local<'_> {
 
     /// [`Local::height`] and the slot of the triangle that gives it (`None` on
     /// the floor, or for a point outside the box).
-    fn height_slot(&self, p: Point2) -> (f64, Option<usize>) {
+    pub(crate) fn height_slot(&self, p: Point2) -> (f64, Option<usize>) {
         let probe = self.probe;
         if !(p.x >= self.lo.x && p.x <= self.hi.x && p.y >= self.lo.y && p.y <= self.hi.y) {
             return (probe.height(p), None);
@@ -303,7 +298,7 @@ enum Near {
 const CHORD_MARGIN: f64 = 1.5;
 
 /// Growth of the probe distance from one probe to the next.
-const PROBE_GROWTH: f64 = 8.0;
+const PROBE_GROWTH: f64 = 2.0;
 
 /// Probe offset either side of a secant guess, in crossing tolerances: just
 /// under a half, so that two probes that straddle the contour close the bracket.

@@ -41,3 +41,11 @@ pub const REL_MIN_TOLERANCE: f64 = 1e-13;
 /// mesh vertex above z lies with every sample of the block outside: a small
 /// island of the contour (see `docs/waterline.md`).
 pub const ISLAND_REFINE: f64 = 16.0;
+
+// --- Issue 15, waterline linking (branch wline2): new thresholds below. ---
+
+/// Most halvings of an ambiguous grid cell (two or more exits) when its
+/// crossings are linked by subdivision: features of the contour down to
+/// `step / 2^6` are followed through the cell; below, the inside is joined
+/// (see `cell.rs`).
+pub const MAX_SUBDIVISION_DEPTH: u32 = 6;

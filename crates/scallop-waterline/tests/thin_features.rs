@@ -128,3 +128,50 @@ proptest! {
         }
     }
 }
+
+mod common;
+
+/// A wedge ridge along x over `[x0, x1]`, its crest at height `top` on the
+/// line y = `y` and its flanks `half` wide at height 0, rotated.
+fn ridge_soup(angle: f64, x0: f64, x1: f64, y: f64, half: f64, top: f64) -> Vec<[Point3; 3]> {
+    let p = |x, yy, z| rotated(angle, x, yy, z);
+    let (a0, a1) = (p(x0, y - half, 0.), p(x1, y - half, 0.));
+    let (c0, c1) = (p(x0, y, top), p(x1, y, top));
+    let (b0, b1) = (p(x0, y + half, 0.), p(x1, y + half, 0.));
+    vec![[a0, a1, c1], [a0, c1, c0], [c0, c1, b1], [c0, b1, b0]]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 48, .. ProptestConfig::default() })]
+
+    /// The slot between two boxes (barely wider than the cutter) is crossed by
+    /// a low ridge whose crest is just above z: the channel of outside is cut
+    /// in two by a thin band of inside. No chord may run along the channel
+    /// across the band (it would cut the ridge): every vertex and chord is on
+    /// the contact surface.
+    #[test]
+    fn a_ridge_across_a_thin_slot_is_never_cut(
+        kind in 0u8..4,
+        radius in 0.8..2.5f64,
+        gap in 2e-6..2e-2f64,
+        angle in 0.0..std::f64::consts::TAU,
+        wall in 0.0..1.0f64,
+        ridge_y in 2.0..8.0f64,
+        above in 1e-3..0.05f64,
+    ) {
+        let x1 = BOX_LENGTH + wall;
+        let x2 = x1 + 2.0 * radius + gap;
+        let z = 0.5 * BOX_HEIGHT;
+        let mut soup = box_soup(angle, 0.0, x1, BOX_LENGTH, BOX_HEIGHT);
+        soup.extend(box_soup(angle, x2, x2 + BOX_LENGTH, BOX_LENGTH, BOX_HEIGHT));
+        soup.extend(ridge_soup(angle, x1 - 1.0, x2 + 1.0, ridge_y, 0.5, z + above));
+        let mesh = TriMesh::from_soup(&soup).expect("boxes and ridge").0;
+        let index = MeshIndex::build(&mesh);
+        let cutter = Cutter::new(shape_of(kind, radius), 40.0).expect("cutter");
+        let options = WaterlineOptions::default();
+        let loops = WaterlineGrid::new(&cutter, &index, &options).expect("grid").loops(z).expect("level");
+        let reach = options.chord_tolerance * (1.0 + 1e-6) + options.crossing_tolerance;
+        let checked = common::check_on_contact(&cutter, &index, &loops, z, 1e-5, reach);
+        prop_assert!(checked.is_ok(), "{}", checked.unwrap_err());
+    }
+}
