@@ -40,6 +40,9 @@ struct EdgeCrossings {
     offset: usize,
 }
 
+/// The links (exit, entry) of one cell and the crossings it adds inside.
+type CellLinks = (Vec<(usize, usize)>, Vec<Point2>);
+
 /// Grid edge numbering: horizontal edges first, then vertical ones.
 struct Numbering {
     nx: usize,
@@ -155,7 +158,7 @@ pub(crate) fn trace(grid: &WaterlineGrid<'_>, probe: &Probe<'_>) -> Vec<Vec<Poin
     let find = |id: usize| edges.binary_search_by_key(&id, |e| e.id).ok().map(|k| &edges[k]);
     let points: Vec<Point2> = edges.iter().flat_map(|e| e.points.iter().copied()).collect();
     // Per cell: its links, and the crossings it adds (numbered from `total`).
-    let linked: Vec<(Vec<(usize, usize)>, Vec<Point2>)> = cells
+    let linked: Vec<CellLinks> = cells
         .par_iter()
         .with_min_len(16)
         .map(|&[i, j]| {

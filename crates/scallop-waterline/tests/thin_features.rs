@@ -169,9 +169,10 @@ proptest! {
         let index = MeshIndex::build(&mesh);
         let cutter = Cutter::new(shape_of(kind, radius), 40.0).expect("cutter");
         let options = WaterlineOptions::default();
-        let loops = WaterlineGrid::new(&cutter, &index, &options).expect("grid").loops(z).expect("level");
+        let grid = WaterlineGrid::new(&cutter, &index, &options).expect("grid");
+        let loops = grid.loops(z).expect("level");
         let reach = options.chord_tolerance * (1.0 + 1e-6) + options.crossing_tolerance;
-        let checked = common::check_on_contact(&cutter, &index, &loops, z, 1e-5, reach);
+        let checked = common::check_on_contact(&cutter, &index, &loops, z, 1e-5, reach, grid.step());
         prop_assert!(checked.is_ok(), "{}", checked.unwrap_err());
     }
 }
