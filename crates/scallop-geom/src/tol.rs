@@ -1296,4 +1296,15 @@ pub mod waterline {
     /// Smallest tolerance accepted, relative to the model's largest |coordinate|:
     /// below it the bisection would be deciding rounding noise.
     pub const REL_MIN_TOLERANCE: f64 = 1e-13;
+
+    /// How many times finer a block of 3 x 3 grid cells is sampled again where a
+    /// mesh vertex above z lies with every sample of the block outside: a small
+    /// island of the contour (see `docs/waterline.md`).
+    pub const ISLAND_REFINE: f64 = 16.0;
+
+    /// Most halvings of an ambiguous grid cell (two or more exits) when its
+    /// crossings are linked by subdivision: features of the contour down to
+    /// `step / 2^6` are followed through the cell; below, the inside is joined
+    /// (see `cell.rs`).
+    pub const MAX_SUBDIVISION_DEPTH: u32 = 6;
 }

@@ -14,109 +14,191 @@
 //! Every crossing edge is an exit of one of its two cells and an entry of the
 //! other (the two cells walk it in opposite directions), so the links form a
 //! permutation of the crossings: disjoint closed chains.
+//!
+//! An edge with both ends inside may still hold a gap (a sliver of outside
+//! narrower than the step): where no single triangle certifies it
+//! (`WaterlineGrid::cover_of`), it is walked (`refine::Local::gaps`) and holds
+//! two crossings per gap. A cell then has several exits: walking its boundary
+//! the crossings alternate exit, entry. A cell with one exit links it to its
+//! entry; a cell with more (a saddle, a gap next to another outside stretch)
+//! is linked by subdivision (`cell.rs`), so that no link runs across a thin
+//! feature inside the cell.
 
 use rayon::prelude::*;
 use scallop_geom::Point2;
 
 use crate::WaterlineGrid;
+use crate::cell::{Cell, Resolver};
 use crate::refine::Probe;
 
-/// The chains of crossing points of `grid` at the probe's height, each
-/// starting at its smallest edge number, listed in that order.
-pub(crate) fn trace(grid: &WaterlineGrid<'_>, probe: &Probe<'_>) -> Vec<Vec<Point2>> {
+/// The crossings of one grid edge, in increasing x (horizontal) or y
+/// (vertical).
+struct EdgeCrossings {
+    id: usize,
+    points: Vec<Point2>,
+    /// Number of the first crossing in the flat list of all crossings.
+    offset: usize,
+}
+
+/// The links (exit, entry) of one cell and the crossings it adds inside.
+type CellLinks = (Vec<(usize, usize)>, Vec<Point2>);
+
+/// Grid edge numbering: horizontal edges first, then vertical ones.
+struct Numbering {
+    nx: usize,
+    ny: usize,
+}
+
+impl Numbering {
+    fn h(&self, i: usize, j: usize) -> usize {
+        j * (self.nx - 1) + i
+    }
+    fn v(&self, i: usize, j: usize) -> usize {
+        (self.nx - 1) * self.ny + j * self.nx + i
+    }
+    /// The two ends (sample indices) of an edge.
+    fn ends(&self, id: usize) -> ([usize; 2], [usize; 2]) {
+        let horizontal = (self.nx - 1) * self.ny;
+        if id < horizontal {
+            let (i, j) = (id % (self.nx - 1), id / (self.nx - 1));
+            ([i, j], [i + 1, j])
+        } else {
+            let k = id - horizontal;
+            let (i, j) = (k % self.nx, k / self.nx);
+            ([i, j], [i, j + 1])
+        }
+    }
+    /// The cells on either side of an edge that lie in the grid.
+    fn cells(&self, id: usize) -> impl Iterator<Item = [usize; 2]> {
+        let horizontal = (self.nx - 1) * self.ny;
+        let ([i, j], _) = self.ends(id);
+        let (nx, ny) = (self.nx, self.ny);
+        let pair = if id < horizontal {
+            [Some([i, j]).filter(|_| j + 1 < ny), j.checked_sub(1).map(|jm| [i, jm])]
+        } else {
+            [Some([i, j]).filter(|_| i + 1 < nx), i.checked_sub(1).map(|im| [im, j])]
+        };
+        pair.into_iter().flatten()
+    }
+}
+
+/// The crossings of every edge that holds some, in increasing edge number:
+/// one per edge with ends on different sides, two per gap on an edge with
+/// both ends inside that no triangle certifies.
+fn edge_crossings(grid: &WaterlineGrid<'_>, probe: &Probe<'_>, inside: &[bool]) -> Vec<EdgeCrossings> {
     let (nx, ny) = (grid.nx, grid.ny);
     let z = probe.z;
-    let inside: Vec<bool> = grid.heights.par_iter().map(|&h| h > z).collect();
-    let is_in = |i: usize, j: usize| inside[j * nx + i];
-    let horizontal = (nx - 1) * ny;
-    let edge_h = |i: usize, j: usize| j * (nx - 1) + i;
-    let edge_v = |i: usize, j: usize| horizontal + j * nx + i;
-
-    // Crossing edges in increasing edge number, with their inside and outside ends.
-    let mut edges: Vec<(usize, [usize; 2], [usize; 2])> = Vec::new();
+    let num = Numbering { nx, ny };
+    // (edge, first end inside, crossing edge (else a gap candidate)).
+    let mut todo: Vec<(usize, bool, bool)> = Vec::new();
+    let mut look = |id: usize, ka: usize, kb: usize, dir: usize| {
+        let (a, b) = (inside[ka], inside[kb]);
+        if a != b {
+            todo.push((id, a, true));
+        } else if a && grid.cover[ka][dir] <= z {
+            todo.push((id, true, false));
+        }
+    };
     for j in 0..ny {
         for i in 0..nx - 1 {
-            let (a, b) = (is_in(i, j), is_in(i + 1, j));
-            if a != b {
-                let (pin, pout) = if a { ([i, j], [i + 1, j]) } else { ([i + 1, j], [i, j]) };
-                edges.push((edge_h(i, j), pin, pout));
-            }
+            look(num.h(i, j), j * nx + i, j * nx + i + 1, 0);
         }
     }
     for j in 0..ny - 1 {
         for i in 0..nx {
-            let (a, b) = (is_in(i, j), is_in(i, j + 1));
-            if a != b {
-                let (pin, pout) = if a { ([i, j], [i, j + 1]) } else { ([i, j + 1], [i, j]) };
-                edges.push((edge_v(i, j), pin, pout));
-            }
+            look(num.v(i, j), j * nx + i, (j + 1) * nx + i, 1);
         }
     }
-    if edges.is_empty() {
-        return Vec::new();
-    }
-    let points: Vec<Point2> = edges
+    let floored = |k: usize| (grid.heights[k] - z).max(-grid.step);
+    let found: Vec<Vec<Point2>> = todo
         .par_iter()
         .with_min_len(16)
-        .map(|&(_, [ia, ja], [ib, jb])| {
-            // Floored as `Probe::height` floors them, so the secant sees one function.
-            let (h_in, h_out) = (grid.heights[ja * nx + ia] - z, (grid.heights[jb * nx + ib] - z).max(-grid.step));
+        .map(|&(id, first_inside, crossing)| {
+            let ([ia, ja], [ib, jb]) = num.ends(id);
+            let (ka, kb) = (ja * nx + ia, jb * nx + ib);
             let (a, b) = (grid.point(ia, ja), grid.point(ib, jb));
             let local = probe.local(Point2::new(a.x.min(b.x), a.y.min(b.y)), Point2::new(a.x.max(b.x), a.y.max(b.y)));
-            local.bisect_heights(a, h_in, b, h_out)
-        })
-        .collect();
-    let slot = |id: usize| {
-        // INVARIANT: only called with the number of a crossing edge, which is in `edges`.
-        edges.binary_search_by_key(&id, |e| e.0).unwrap_or_else(|_| unreachable!("edge {id} is not a crossing"))
-    };
-
-    // Mixed cells, and which saddles have their centre inside.
-    let mut cells: Vec<(usize, usize, u8)> = Vec::new();
-    for j in 0..ny - 1 {
-        for i in 0..nx - 1 {
-            let mask = u8::from(is_in(i, j))
-                | u8::from(is_in(i + 1, j)) << 1
-                | u8::from(is_in(i + 1, j + 1)) << 2
-                | u8::from(is_in(i, j + 1)) << 3;
-            if mask != 0 && mask != 0b1111 {
-                cells.push((i, j, mask));
+            if !crossing {
+                return local.gaps(a, grid.slots[ka] as usize, b, floored(kb));
             }
-        }
-    }
-    let saddle_inside: Vec<bool> = cells
-        .par_iter()
-        .map(|&(i, j, mask)| {
-            (mask == 0b0101 || mask == 0b1010) && {
-                let (a, b) = (grid.point(i, j), grid.point(i + 1, j + 1));
-                probe.is_inside(Point2::new(0.5 * (a.x + b.x), 0.5 * (a.y + b.y)))
-            }
-        })
-        .collect();
-
-    let mut next = vec![usize::MAX; edges.len()];
-    for (&(i, j, mask), &centre_in) in cells.iter().zip(&saddle_inside) {
-        let cell_edges = [edge_h(i, j), edge_v(i + 1, j), edge_h(i, j + 1), edge_v(i, j)];
-        let corner_in = |k: usize| mask >> (k % 4) & 1 == 1;
-        let saddle = mask == 0b0101 || mask == 0b1010;
-        for k in 0..4 {
-            if !(corner_in(k) && !corner_in(k + 1)) {
-                continue; // not an exit
-            }
-            let entry = if saddle {
-                if centre_in { (k + 1) % 4 } else { (k + 3) % 4 }
+            // Floored as `Probe::height` floors them, so the secant sees one function.
+            let p = if first_inside {
+                local.bisect_heights(a, floored(ka), b, floored(kb))
             } else {
-                // The only entry of the cell.
-                (1..4).map(|s| (k + s) % 4).find(|&e| !corner_in(e) && corner_in(e + 1)).unwrap_or(k)
+                local.bisect_heights(b, floored(kb), a, floored(ka))
             };
-            debug_assert!(!corner_in(entry) && corner_in(entry + 1), "cell ({i}, {j}) mask {mask:04b}");
-            next[slot(cell_edges[k])] = slot(cell_edges[entry]);
+            vec![p]
+        })
+        .collect();
+    let mut offset = 0;
+    let mut out = Vec::new();
+    for (&(id, _, _), points) in todo.iter().zip(found) {
+        if !points.is_empty() {
+            out.push(EdgeCrossings { id, offset, points: points.clone() });
+            offset += points.len();
         }
     }
+    out
+}
 
-    let mut seen = vec![false; edges.len()];
-    let mut chains = Vec::new();
-    for start in 0..edges.len() {
+/// The chains of crossing points of `grid` at the probe's height, each
+/// starting at its smallest crossing (edge number, then along the edge),
+/// listed in that order.
+pub(crate) fn trace(grid: &WaterlineGrid<'_>, probe: &Probe<'_>) -> Vec<Vec<Point2>> {
+    let (nx, ny) = (grid.nx, grid.ny);
+    let z = probe.z;
+    let inside: Vec<bool> = grid.heights.par_iter().map(|&h| h > z).collect();
+    let edges = edge_crossings(grid, probe, &inside);
+    let Some(last) = edges.last() else { return Vec::new() };
+    let total = last.offset + last.points.len();
+    let num = Numbering { nx, ny };
+    let mut cells: Vec<[usize; 2]> = edges.iter().flat_map(|e| num.cells(e.id)).collect();
+    cells.sort_unstable_by_key(|c| (c[1], c[0]));
+    cells.dedup();
+    let find = |id: usize| edges.binary_search_by_key(&id, |e| e.id).ok().map(|k| &edges[k]);
+    let points: Vec<Point2> = edges.iter().flat_map(|e| e.points.iter().copied()).collect();
+    // Per cell: its links, and the crossings it adds (numbered from `total`).
+    let linked: Vec<CellLinks> = cells
+        .par_iter()
+        .with_min_len(16)
+        .map(|&[i, j]| {
+            let walk = [(num.h(i, j), true), (num.v(i + 1, j), true), (num.h(i, j + 1), false), (num.v(i, j), false)];
+            let mut sides: [Vec<usize>; 4] = Default::default();
+            for (side, &(id, forward)) in walk.iter().enumerate() {
+                let Some(e) = find(id) else { continue };
+                let n = e.points.len();
+                sides[side].extend((0..n).map(|s| e.offset + if forward { s } else { n - 1 - s }));
+            }
+            let corners = [grid.point(i, j), grid.point(i + 1, j), grid.point(i + 1, j + 1), grid.point(i, j + 1)];
+            let at = |[a, b]: [usize; 2]| inside[b * nx + a];
+            let cell =
+                Cell { corners, inside: [at([i, j]), at([i + 1, j]), at([i + 1, j + 1]), at([i, j + 1])], sides };
+            let local = probe.local(corners[0], corners[2]);
+            let mut resolver = Resolver::new(&local, total);
+            let links = resolver.link(&cell, &|id| points[id], 0);
+            (links, resolver.into_new_nodes())
+        })
+        .collect();
+    let mut points = points;
+    let mut next = vec![usize::MAX; total];
+    for (links, added) in linked {
+        // Renumber the cell's new crossings after those already placed.
+        let shift = points.len() - total;
+        let renumber = |id: usize| if id >= total { id + shift } else { id };
+        next.resize(points.len() + added.len(), usize::MAX);
+        points.extend(added);
+        for (from, to) in links {
+            next[renumber(from)] = renumber(to);
+        }
+    }
+    chains(&next, &points)
+}
+
+/// Closed chains of the permutation `next`, each from its smallest crossing.
+fn chains(next: &[usize], points: &[Point2]) -> Vec<Vec<Point2>> {
+    let mut seen = vec![false; next.len()];
+    let mut out = Vec::new();
+    for start in 0..next.len() {
         if seen[start] {
             continue;
         }
@@ -127,13 +209,13 @@ pub(crate) fn trace(grid: &WaterlineGrid<'_>, probe: &Probe<'_>) -> Vec<Vec<Poin
             chain.push(points[at]);
             at = next[at];
             // INVARIANT: the border samples are outside (padding), so every crossing
-            // edge lies between two cells and has a successor.
+            // lies between two cells and has a successor.
             debug_assert!(at != usize::MAX, "open chain");
             if at == usize::MAX {
                 break;
             }
         }
-        chains.push(chain);
+        out.push(chain);
     }
-    chains
+    out
 }

@@ -64,12 +64,13 @@
 //!   not depend on the number of threads (parallel work uses indexed collects).
 //! - Never performs I/O; never prints.
 
+mod cell;
 mod contour;
 mod refine;
 pub use scallop_geom::tol::waterline as tol;
 
 use rayon::prelude::*;
-use scallop_cutter::{Cutter, drop_grid};
+use scallop_cutter::{ClPoint, Contact, Cutter, drop_grid, drop_triangle};
 use scallop_geom::{Point2, predicates::orient2d};
 use scallop_mesh::MeshIndex;
 
@@ -284,6 +285,11 @@ pub struct WaterlineGrid<'a> {
     ny: usize,
     /// Drop-cutter tip heights, row-major, x fastest.
     heights: Vec<f64>,
+    /// Index slot of the triangle giving each height (`u32::MAX`: the floor).
+    slots: Vec<u32>,
+    /// Per sample, for the edges to its +x and +y neighbours: the height above
+    /// which the edge is certainly inside when both ends are (see `cover_of`).
+    cover: Vec<[f64; 2]>,
 }
 
 /// Rows of the grid sampled per `drop_grid` call (bounds the 64-byte cutter
@@ -372,12 +378,30 @@ impl<'a> WaterlineGrid<'a> {
         }
         #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)] // checked above: 1 <= n <= MAX_SAMPLES
         let (nx, ny) = (nx_f as usize, ny_f as usize);
+        Ok(Self::sample(cutter, index, options, origin, step, [nx, ny], progress))
+    }
+
+    /// Samples the drop-cutter on `n[0] x n[1]` points from `origin` at `step`.
+    fn sample(
+        cutter: &'a Cutter,
+        index: &'a MeshIndex,
+        options: &WaterlineOptions,
+        origin: Point2,
+        step: f64,
+        [nx, ny]: [usize; 2],
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> Self {
         #[allow(clippy::cast_precision_loss)]
         let xs: Vec<f64> = (0..nx).map(|i| origin.x + i as f64 * step).collect();
         #[allow(clippy::cast_precision_loss)]
         let ys: Vec<f64> = (0..ny).map(|j| origin.y + j as f64 * step).collect();
-        let floor = bounds.min.z - cutter.shape().profile_height() - tol::FLOOR_MARGIN;
+        let floor = index.bounds().min.z - cutter.shape().profile_height() - tol::FLOOR_MARGIN;
+        let mut slot_of = vec![u32::MAX; index.len()];
+        for slot in 0..index.len() {
+            slot_of[index.original_index(slot)] = u32::try_from(slot).unwrap_or(u32::MAX);
+        }
         let mut heights = Vec::with_capacity(nx * ny);
+        let mut slots = Vec::with_capacity(nx * ny);
         let done = std::sync::atomic::AtomicUsize::new(0);
         for rows in ys.chunks(ROWS_PER_BATCH) {
             let cl = drop_grid(cutter, index, &xs, rows, floor, &|_| {
@@ -385,8 +409,53 @@ impl<'a> WaterlineGrid<'a> {
                 progress(d, ny);
             });
             heights.par_extend(cl.par_iter().map(|c| c.tip.z));
+            slots.par_extend(cl.par_iter().map(|c| match c.contact {
+                Contact::Floor => u32::MAX,
+                Contact::Vertex { triangle, .. } | Contact::Edge { triangle, .. } | Contact::Facet { triangle, .. } => {
+                    slot_of[triangle]
+                }
+            }));
         }
-        Ok(WaterlineGrid { cutter, index, options: *options, origin, step, nx, ny, heights })
+        let mut grid =
+            WaterlineGrid { cutter, index, options: *options, origin, step, nx, ny, heights, slots, cover: Vec::new() };
+        grid.cover = (0..nx * ny)
+            .into_par_iter()
+            .with_min_len(256)
+            .map(|k| {
+                let (i, j) = (k % nx, k / nx);
+                [
+                    if i + 1 < nx { grid.cover_of([i, j], [i + 1, j]) } else { f64::NEG_INFINITY },
+                    if j + 1 < ny { grid.cover_of([i, j], [i, j + 1]) } else { f64::NEG_INFINITY },
+                ]
+            })
+            .collect();
+        grid
+    }
+
+    /// The height below which the grid edge from sample `a` to sample `b` is
+    /// entirely inside whenever both ends are: the larger of the height of
+    /// `a`'s triangle at `b` and of `b`'s triangle at `a`. The cutter at z cuts
+    /// one triangle on a convex set of positions (the cutter and the triangle
+    /// are convex), so a triangle above z at both ends is above z along the
+    /// whole edge. Where neither is, a gap may hide between the samples: the
+    /// edge is walked at that level (`refine::Local::gaps`).
+    fn cover_of(&self, a: [usize; 2], b: [usize; 2]) -> f64 {
+        let (ka, kb) = (a[1] * self.nx + a[0], b[1] * self.nx + b[0]);
+        let (sa, sb) = (self.slots[ka], self.slots[kb]);
+        if sa == u32::MAX || sb == u32::MAX {
+            return f64::NEG_INFINITY; // an end on the floor is never inside
+        }
+        if sa == sb {
+            return f64::INFINITY;
+        }
+        let at = |slot: u32, p: Point2| {
+            let slot = slot as usize;
+            let mut best = ClPoint::floor(p, f64::NEG_INFINITY);
+            let ix = self.index;
+            drop_triangle(self.cutter, ix.corners(slot), ix.normal(slot), ix.original_index(slot), &mut best);
+            best.tip.z
+        };
+        at(sa, self.point(b[0], b[1])).max(at(sb, self.point(a[0], a[1])))
     }
 
     /// Samples along X and Y.
@@ -430,7 +499,72 @@ impl<'a> WaterlineGrid<'a> {
             step: self.step,
         };
         let chains = contour::trace(self, &probe);
-        Ok(refine::refine_loops(&probe, &chains, self.options.chord_tolerance, z))
+        let mut loops = refine::refine_loops(&probe, &chains, self.options.chord_tolerance, z);
+        loops.extend(self.islands(z));
+        Ok(loops)
+    }
+
+    /// Islands of inside that no grid sample sees: each contains the top
+    /// vertex of a triangle above z (the cutter cuts a triangle on a convex
+    /// set that holds the part of the triangle above z), so a vertex above z
+    /// in a cell whose block of 3 x 3 cells has every sample outside marks
+    /// one. A square 3 cells wide centred on the vertex is sampled again
+    /// [`tol::ISLAND_REFINE`] times finer, the vertex itself a sample (inside,
+    /// so an island of any size is seen), and contoured; the loops found there
+    /// (whose finer border is outside) are added, each once. An island that reaches past its block, or a thin
+    /// arm of a larger region, is not looked for (the sampling limit).
+    fn islands(&self, z: f64) -> Vec<Loop> {
+        let (nx, ny) = (self.nx, self.ny);
+        let outside = |i: usize, j: usize| self.heights[j * nx + i] <= z;
+        let mut peaks: Vec<Point2> = Vec::new();
+        for slot in 0..self.index.len() {
+            for v in self.index.corners(slot) {
+                if v.z <= z {
+                    continue;
+                }
+                let (fx, fy) = ((v.x - self.origin.x) / self.step, (v.y - self.origin.y) / self.step);
+                #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)] // the padded grid holds the part
+                let (i, j) = (fx.floor().max(1.0) as usize, fy.floor().max(1.0) as usize);
+                if i + 2 < nx && j + 2 < ny && (j - 1..j + 3).all(|jj| (i - 1..i + 3).all(|ii| outside(ii, jj))) {
+                    peaks.push(Point2::new(v.x, v.y));
+                }
+            }
+        }
+        peaks.sort_unstable_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+        peaks.dedup();
+        let mut found: Vec<Loop> = Vec::new();
+        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+        let half = (1.5 * tol::ISLAND_REFINE) as usize;
+        let fine = self.step / tol::ISLAND_REFINE;
+        for v in peaks {
+            if found.iter().any(|f| f.winding_number(v) != 0) {
+                continue;
+            }
+            // The vertex is a sample of the finer grid: it is inside, so its island is seen.
+            #[allow(clippy::cast_precision_loss)]
+            let origin = Point2::new(v.x - half as f64 * fine, v.y - half as f64 * fine);
+            let n = 2 * half + 1;
+            let patch = Self::sample(self.cutter, self.index, &self.options, origin, fine, [n, n], &|_, _| {});
+            let border_in = (0..n)
+                .any(|k| [(k, 0), (k, n - 1), (0, k), (n - 1, k)].iter().any(|&(a, b)| patch.heights[b * n + a] > z));
+            if border_in {
+                continue;
+            }
+            let probe = refine::Probe {
+                cutter: self.cutter,
+                index: self.index,
+                z,
+                tolerance: self.options.crossing_tolerance,
+                step: fine,
+            };
+            let chains = contour::trace(&patch, &probe);
+            for l in refine::refine_loops(&probe, &chains, self.options.chord_tolerance, z) {
+                if !found.iter().any(|f| f.winding_number(l.points[0]) != 0 || l.winding_number(f.points[0]) != 0) {
+                    found.push(l);
+                }
+            }
+        }
+        found
     }
 
     fn point(&self, i: usize, j: usize) -> Point2 {

@@ -27,9 +27,15 @@ impl<'a> Probe<'a> {
         drop_cutter(self.cutter, self.index, p, self.z - self.step).tip.z - self.z
     }
 
-    /// Exact: the cutter with its tip at z cuts into the part at `p`.
-    pub(crate) fn is_inside(&self, p: Point2) -> bool {
-        self.height(p) > 0.0
+    /// Tip height of the drop-cutter on the one triangle in `slot` at `p`,
+    /// minus z, floored as [`Probe::height`]: the full height is the maximum of
+    /// these over all triangles. The set where it is > 0 is convex (the cutter
+    /// and the triangle are convex), so it meets a segment in one interval.
+    pub(crate) fn triangle_height(&self, slot: usize, p: Point2) -> f64 {
+        let mut best = ClPoint::floor(p, self.z - self.step);
+        let index = self.index;
+        drop_triangle(self.cutter, index.corners(slot), index.normal(slot), index.original_index(slot), &mut best);
+        best.tip.z - self.z
     }
 
     /// The probe restricted to points of the box `[lo, hi]`: the triangles
@@ -80,13 +86,20 @@ pub(crate) struct Local<'a> {
 impl Local<'_> {
     /// [`Probe::height`] through the candidate list.
     fn height(&self, p: Point2) -> f64 {
+        self.height_slot(p).0
+    }
+
+    /// [`Local::height`] and the slot of the triangle that gives it (`None` on
+    /// the floor, or for a point outside the box).
+    pub(crate) fn height_slot(&self, p: Point2) -> (f64, Option<usize>) {
         let probe = self.probe;
         if !(p.x >= self.lo.x && p.x <= self.hi.x && p.y >= self.lo.y && p.y <= self.hi.y) {
-            return probe.height(p);
+            return (probe.height(p), None);
         }
         let radius = probe.cutter.radius();
         let shape = probe.cutter.shape();
         let mut best = ClPoint::floor(p, probe.z - probe.step);
+        let mut best_slot = None;
         // The index's rounding slack on its bounds, as `drop_cutter` prunes.
         let slack = probe.index.slack();
         for c in &self.candidates {
@@ -100,6 +113,7 @@ impl Local<'_> {
                 continue;
             }
             let slot = c.slot;
+            let before = best.tip.z;
             drop_triangle(
                 probe.cutter,
                 probe.index.corners(slot),
@@ -107,8 +121,11 @@ impl Local<'_> {
                 probe.index.original_index(slot),
                 &mut best,
             );
+            if best.tip.z > before {
+                best_slot = Some(slot);
+            }
         }
-        best.tip.z - probe.z
+        (best.tip.z - probe.z, best_slot)
     }
 
     /// Shrinks the bracket from `inside` (height `h_in > 0`) to `outside`
@@ -120,18 +137,18 @@ impl Local<'_> {
     /// two probes half a tolerance either side of it close the bracket; where it
     /// is not (vertical walls, creases), a step that did not halve the bracket
     /// is followed by a bisection, so the worst case is twice plain bisection.
-    pub(crate) fn bisect_heights(
-        &self,
-        mut inside: Point2,
-        mut h_in: f64,
-        mut outside: Point2,
-        mut h_out: f64,
-    ) -> Point2 {
+    pub(crate) fn bisect_heights(&self, inside: Point2, h_in: f64, outside: Point2, h_out: f64) -> Point2 {
+        self.bracket(inside, h_in, outside, h_out).1
+    }
+
+    /// As [`Local::bisect_heights`], returning both ends of the final bracket
+    /// (inside, outside).
+    fn bracket(&self, mut inside: Point2, mut h_in: f64, mut outside: Point2, mut h_out: f64) -> (Point2, Point2) {
         let mut bisect_next = false;
         loop {
             let width = (outside - inside).norm();
             if width <= self.probe.tolerance {
-                return outside;
+                return (inside, outside);
             }
             let secant = h_in - h_out;
             let use_secant = !bisect_next && secant.is_finite() && secant > 0.0;
@@ -159,7 +176,7 @@ impl Local<'_> {
             let after = (outside - inside).norm();
             if after >= width {
                 // Down to adjacent floats (or a guess on an end): stop on the outside.
-                return outside;
+                return (inside, outside);
             }
             // A secant step that did not halve the bracket: the height is not
             // smooth here (a wall, a crease): plain bisection from now on.
@@ -197,6 +214,76 @@ impl Local<'_> {
     }
 }
 
+impl Local<'_> {
+    /// The contour crossings on the segment from `a` to `b`, both inside (the
+    /// cutter at z cuts there), in order from `a`: the ends of the gaps
+    /// (outside intervals) between them, each an outside point within the
+    /// crossing tolerance of an inside one. `slot_a` is the triangle that
+    /// gives the height at `a`.
+    ///
+    /// A cover walk: the triangle that lifts the cutter above z at the current
+    /// point does so on one interval of the segment (convexity, see
+    /// [`Probe::triangle_height`]); its end is bisected on that triangle alone,
+    /// and the full drop-cutter there either finds the next triangle (no gap)
+    /// or starts a gap, whose far end is bisected on the full drop-cutter. A
+    /// gap of any width above the crossing tolerance is found, however far it
+    /// is from the grid samples (the fibres of OpenCAMLib's push-cutter find
+    /// the same intervals); an inside sliver within a gap is not looked for.
+    pub(crate) fn gaps(&self, a: Point2, slot_a: usize, b: Point2, h_b: f64) -> Vec<Point2> {
+        let probe = self.probe;
+        let mut out = Vec::new();
+        let (mut at, mut slot) = (a, slot_a);
+        for _ in 0..MAX_COVER_STEPS {
+            if probe.triangle_height(slot, b) > 0.0 {
+                break; // this triangle covers the rest of the segment
+            }
+            let end = self.triangle_end(slot, at, b);
+            let (h, next) = self.height_slot(end);
+            if h > 0.0 {
+                match next {
+                    Some(next) if end != at => (at, slot) = (end, next),
+                    _ => break,
+                }
+                continue;
+            }
+            // A gap starts at `end`: its far end, towards the inside end `b`.
+            let (inside, outside) = self.bracket(b, h_b, end, h);
+            out.push(end);
+            out.push(outside);
+            let (h_in, next) = self.height_slot(inside);
+            match next {
+                Some(next) if h_in > 0.0 && inside != at => (at, slot) = (inside, next),
+                _ => break,
+            }
+        }
+        out
+    }
+
+    /// The first point from `inside` towards `outside` (the triangle in `slot`
+    /// lifting the cutter above z at the first, not at the second) where that
+    /// triangle no longer does, within the crossing tolerance: bisection on the
+    /// one triangle.
+    fn triangle_end(&self, slot: usize, mut inside: Point2, mut outside: Point2) -> Point2 {
+        let probe = self.probe;
+        while (outside - inside).norm() > probe.tolerance {
+            let mid = Point2::new(0.5 * (inside.x + outside.x), 0.5 * (inside.y + outside.y));
+            if mid == inside || mid == outside {
+                break;
+            }
+            if probe.triangle_height(slot, mid) > 0.0 {
+                inside = mid;
+            } else {
+                outside = mid;
+            }
+        }
+        outside
+    }
+}
+
+/// Most triangles a cover walk along one grid edge steps through before it
+/// gives up (the walk usually takes one to three).
+const MAX_COVER_STEPS: usize = 256;
+
 /// What [`Local::contour_near`] found.
 enum Near {
     /// The contour is within the accepted distance.
@@ -211,7 +298,7 @@ enum Near {
 const CHORD_MARGIN: f64 = 1.5;
 
 /// Growth of the probe distance from one probe to the next.
-const PROBE_GROWTH: f64 = 8.0;
+const PROBE_GROWTH: f64 = 2.0;
 
 /// Probe offset either side of a secant guess, in crossing tolerances: just
 /// under a half, so that two probes that straddle the contour close the bracket.

@@ -1,0 +1,113 @@
+//! The contact check shared by the waterline tests: every loop vertex and
+//! every chord's midpoint lies on the cutter's contact surface at z, so that a
+//! cutter moving along a chord never cuts into the part. The oracle is the
+//! brute-force drop-cutter `d(x, y)`; the cutter at tip height z cuts into the
+//! part exactly where `d > z`.
+
+use scallop_cutter::{Contact, Cutter, drop_cutter_brute_force};
+use scallop_geom::{Point2, Vec2};
+use scallop_mesh::MeshIndex;
+use scallop_waterline::Loop;
+
+/// Directions tried around a point when looking for the other side.
+const RING: u32 = 32;
+
+/// Points tried along the chord's normal when looking for the other side.
+const LINE_STEPS: u32 = 64;
+
+/// Height slack for the brute force against the indexed drop-cutter, relative
+/// to the part's size.
+const HEIGHT_SLACK: f64 = 1e-10;
+
+/// Relative rounding at which the brute-force and the indexed drop-cutter may
+/// disagree about a contact exactly on the cutter's rim (horizontal distance R).
+const RIM_ROUNDING: f64 = 1e-12;
+
+/// Checks, with the brute-force drop-cutter:
+/// - every vertex is safe (`d <= z`) and within `vertex_reach` of a point
+///   where the cutter cuts (`d > z`): it is on the contour;
+/// - every chord's midpoint is on the contact surface: if it cuts (`d > z`),
+///   a point within `chord_reach` does not (the chord enters the part by at
+///   most `chord_reach` horizontally); if it is safe, a point within
+///   `off_reach` cuts (the chord stays near the contour: material left, never
+///   a gouge, so a looser bound).
+///
+/// Only the midpoint is checked, as the kernel's chord refinement checks it:
+/// elsewhere on a long chord the contour may bulge farther (open item of
+/// `docs/waterline.md`).
+///
+/// Returns the first violation found, described.
+pub fn check_on_contact(
+    cutter: &Cutter,
+    index: &MeshIndex,
+    loops: &[Loop],
+    z: f64,
+    vertex_reach: f64,
+    chord_reach: f64,
+    off_reach: f64,
+) -> Result<(), String> {
+    let b = index.bounds();
+    let floor = b.min.z - 100.0;
+    let slack = HEIGHT_SLACK * (1.0 + b.max.z.abs().max(b.min.z.abs()));
+    // The brute-force height at q, and whether its contact is on the cutter's
+    // rim (where rounding may decide either way).
+    let d = |q: Point2| {
+        let cl = drop_cutter_brute_force(cutter, index, q, floor);
+        let rim = match cl.contact {
+            Contact::Floor => false,
+            Contact::Vertex { point, .. } | Contact::Edge { point, .. } | Contact::Facet { point, .. } => {
+                (point.x - q.x).hypot(point.y - q.y) >= cutter.radius() * (1.0 - RIM_ROUNDING)
+            }
+        };
+        (cl.tip.z, rim)
+    };
+    let cuts_at = |q: Point2| d(q).0 > z;
+    let safe_at = |q: Point2| {
+        let (h, rim) = d(q);
+        h <= z + slack || rim
+    };
+    // Is some point within r of q on the given side? Searched along the hinted
+    // direction in fine steps (a thin channel of the other side is found), then
+    // on a ring of radius r.
+    let side_near = |q: Point2, hint: Vec2, r: f64, want_cut: bool| {
+        let on = |p: Point2| if want_cut { cuts_at(p) } else { safe_at(p) };
+        (1..=LINE_STEPS).any(|k| on(q + hint * (r * f64::from(k) / f64::from(LINE_STEPS))))
+            || (0..RING).any(|a| {
+                let t = std::f64::consts::TAU * f64::from(a) / f64::from(RING);
+                on(Point2::new(q.x + r * t.cos(), q.y + r * t.sin()))
+            })
+    };
+    for l in loops {
+        let n = l.points.len();
+        for i in 0..n {
+            let (a, c) = (l.points[i], l.points[(i + 1) % n]);
+            let dv = d(a).0;
+            if !safe_at(a) {
+                return Err(format!("vertex {a:?} cuts into the part: d = {dv}, z = {z}"));
+            }
+            let chord = c - a;
+            let len = chord.norm();
+            let left = if len > 0.0 { Vec2::new(-chord.y, chord.x) / len } else { Vec2::new(0.0, 0.0) };
+            if !side_near(a, left, vertex_reach, true) {
+                return Err(format!(
+                    "vertex {a:?} is farther than {vertex_reach} from the contour (d = {dv}, z = {z})"
+                ));
+            }
+            if len == 0.0 {
+                continue;
+            }
+            let mid = a + chord * 0.5;
+            let dm = d(mid).0;
+            let cuts = !safe_at(mid);
+            let hint = if cuts { -left } else { left };
+            let reach = if cuts { chord_reach } else { off_reach };
+            if !side_near(mid, hint, reach, !cuts) {
+                let what = if cuts { "cuts into the part" } else { "is off the contour" };
+                return Err(format!(
+                    "midpoint {mid:?} of chord {a:?} -> {c:?} {what} by more than {reach} (d = {dm}, z = {z})"
+                ));
+            }
+        }
+    }
+    Ok(())
+}
