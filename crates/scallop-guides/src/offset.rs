@@ -337,31 +337,64 @@ mod tests {
         Support::new(TriMesh::from_indexed(&v, &t).unwrap().0)
     }
 
+    /// A closed loop of 240 points `r(t)` about `(cx, cy)` lifted onto `support`.
+    fn polar_loop(
+        support: &Support,
+        height: impl Fn(f64, f64) -> f64,
+        cx: f64,
+        cy: f64,
+        r: impl Fn(f64) -> f64,
+    ) -> Curve {
+        let pts: Vec<Point3> = (0..240)
+            .map(|i| {
+                let t = std::f64::consts::TAU * f64::from(i) / 240.0;
+                let (x, y) = (cx + r(t) * t.cos(), cy + r(t) * t.sin());
+                support.query().closest_point(&Point3::new(x, y, height(x, y))).point
+            })
+            .collect();
+        support.curve(Polyline3::new(pts, true)).unwrap().inside_left()
+    }
+
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(24))]
-        /// The vertices picked by the tree give the offsets of the full scan
-        /// on random terrains and random star-shaped loops (peanuts split).
+        /// Following the iso-line from the seeds gives, bit for bit, the
+        /// offsets of the full scan on random terrains and random star-shaped
+        /// loops (peanuts split).
         #[test]
-        fn tree_selection_gives_the_full_scan_offsets(
+        fn following_gives_the_full_scan_offsets(
             n in 24usize..64, amp in 0.0..6.0f64, wx in 6.0..30.0f64, wy in 6.0..30.0f64,
             r0 in 8.0..17.0f64, wobble in 0.0..0.45f64, lobes in 1u32..5, phase in 0.0..6.3f64,
             cx in -3.0..3.0f64, a_e in 1.0..6.0f64,
         ) {
             let height = move |x: f64, y: f64| amp * (x / wx).sin() * (y / wy).cos();
             let support = terrain(n, 20.0, height);
-            let pts: Vec<Point3> = (0..200)
-                .map(|i| {
-                    let t = std::f64::consts::TAU * f64::from(i) / 200.0;
-                    let r = r0 * (1.0 + wobble * (f64::from(lobes) * t + phase).sin());
-                    let (x, y) = (cx + r * t.cos(), r * t.sin());
-                    support.query().closest_point(&Point3::new(x, y, height(x, y))).point
-                })
-                .collect();
-            let limit = support.curve(Polyline3::new(pts, true)).unwrap().inside_left();
+            let limit = polar_loop(&support, height, cx, 0.0, |t| r0 * (1.0 + wobble * (f64::from(lobes) * t + phase).sin()));
             let fast = iterate(&support, std::slice::from_ref(&limit), a_e, offset_once).unwrap();
             let scan = iterate(&support, std::slice::from_ref(&limit), a_e, offset_once_scan).unwrap();
             prop_assert!(!fast.is_empty());
             prop_assert_eq!(fast, scan);
+        }
+
+        /// A dumbbell whose neck closes before its lobes: the offsets split
+        /// into two loops, each found, as by the full scan; likewise two
+        /// separate limit loops of different sizes offset together.
+        #[test]
+        fn every_loop_is_found_when_offsets_split(
+            n in 40usize..72, amp in 0.0..4.0f64, neck in 0.45..0.65f64, a_e in 1.0..2.0f64, phase in 0.0..0.3f64,
+        ) {
+            let height = move |x: f64, y: f64| amp * (x / 11.0).sin() * (y / 13.0).cos();
+            let support = terrain(n, 20.0, height);
+            let dumbbell = polar_loop(&support, height, 0.0, 0.0, |t| 10.0 * (1.0 + neck * (2.0 * (t + phase)).cos()));
+            let fast = iterate(&support, std::slice::from_ref(&dumbbell), a_e, offset_once).unwrap();
+            prop_assert!(fast.iter().any(|s| s.split && s.curves.len() == 2));
+            prop_assert_eq!(&fast, &iterate(&support, std::slice::from_ref(&dumbbell), a_e, offset_once_scan).unwrap());
+            let pair = [
+                polar_loop(&support, height, -9.0, -6.0, |_| 8.0),
+                polar_loop(&support, height, 10.0, 8.0, |t| 6.0 + 0.5 * (3.0 * t).sin()),
+            ];
+            let fast = iterate(&support, &pair, a_e, offset_once).unwrap();
+            prop_assert_eq!(fast[0].curves.len(), 2);
+            prop_assert_eq!(fast, iterate(&support, &pair, a_e, offset_once_scan).unwrap());
         }
     }
 }
