@@ -192,12 +192,10 @@ impl<'a> Follow<'a> {
             let mut s = [a.segment, b.segment, c.segment];
             s.sort_unstable();
             let n = line.segment_count();
-            // The arcs from each foot's segment forward to the one before it.
-            let arcs = if line.closed {
-                vec![(s[0], s[2] - s[0]), (s[1], s[0] + n - s[1]), (s[2], s[1] + n - s[2])]
-            } else {
-                vec![(s[0], s[2] - s[0])]
-            };
+            // The arcs from each foot's segment forward to the one before it
+            // (only the first on an open curve).
+            let arcs = [(s[0], s[2] - s[0]), (s[1], s[0] + n - s[1]), (s[2], s[1] + n - s[2])];
+            let arcs = if line.closed { &arcs[..] } else { &arcs[..1] };
             let Some(&(start, len)) = arcs.iter().min_by_key(|a| a.1) else { continue };
             let seg = |k: usize| (start + k) % n;
             let length: f64 = (1..len)
