@@ -310,13 +310,6 @@ pub mod guides {
     /// facet sizes has vanished (`scallop_guides::offset_curves`): its shape is below
     /// the mesh's resolution (docs/guides-curves.md, "Slivers").
     pub const SLIVER_WIDTH_FACETS: f64 = 0.5;
-
-    /// Relative slack on the distance bounds by which Marching Facets decides,
-    /// without measuring them, that vertices are far from (or near to) the curves
-    /// (`scallop_guides::offset_curves`): it covers the rounding of the distances, so
-    /// that a vertex is left out only if a direct query would also place it
-    /// beyond the limit.
-    pub const SELECTION_SLACK: f64 = 1e-9;
 }
 
 pub mod machine {

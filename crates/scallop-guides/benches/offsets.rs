@@ -9,8 +9,8 @@
 //! indexes and resampling included). Both start from the same support and
 //! limit curve, built outside the timed closures; `support/new` times that
 //! set-up apart (`Support::new` on the welded mesh: the triangle BVH both
-//! methods query, the vertex adjacency and incidence, and the vertex tree
-//! only the scalar method uses).
+//! methods query, and the vertex adjacency and incidence the scalar method
+//! walks over).
 
 #![allow(clippy::unwrap_used, missing_docs, reason = "a bench: a panic is the failure report")]
 

@@ -72,6 +72,12 @@ impl CurveField {
         }
     }
 
+    /// The unit left vector of segment `segment` of curve `curve` (tangent
+    /// to the support, toward the inside; zero for a degenerate segment).
+    pub(crate) fn left(&self, curve: usize, segment: usize) -> Vec3 {
+        self.left[curve][segment]
+    }
+
     /// Signed distance from `p`: `+d` on the inside (left), `-d` outside.
     #[must_use]
     pub fn signed(&self, p: &Point3) -> f64 {

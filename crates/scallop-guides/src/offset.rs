@@ -5,13 +5,12 @@
 //! curved supports), until no facet is crossed. Several loops at a step mean
 //! the offset split (Ch. 2 §3.3, Fig. 2.39b).
 
-use rayon::prelude::*;
 use scallop_geom::Point3;
-use scallop_mesh::PolylineFoot;
+use scallop_mesh::{FastMap, PolylineFoot};
 
 use crate::facets::{Isolines, march_facets};
 use crate::field::CurveField;
-use crate::support::{Curve, Support, VertexTree, check_curve};
+use crate::support::{Curve, Support, check_curve};
 use crate::{GuideError, tol};
 
 /// One offset step.
@@ -89,52 +88,35 @@ pub fn offset_curve(support: &Support, curves: &[Curve], distance: f64) -> Resul
     Ok(offset_once(support, curves, distance))
 }
 
-/// One Marching Facets extraction, measuring only the vertices near the
-/// iso-line (docs/guides-curves.md, "Only the vertices near the iso-line
-/// are measured"). With `h` the facet size, the vertices nearer than
-/// `distance - h` to the curves ([`Limits`]) are negative whatever their side
-/// (`-inf`), those farther than `distance + h` take the side of a measured
-/// neighbour (NaN here), the others are measured within the reach
-/// `distance + 2h`. An edge is at most `h` long, so a facet with both states
-/// has only measured corners but for far ones: only the facets of measured
-/// vertices are marched, after their far corners get their side
-/// ([`side_far_corners`]). The iso-line is the one of the full scan that
-/// measures every vertex within the reach.
+/// One Marching Facets extraction that follows the iso-line from facet to
+/// facet (docs/guides-curves.md, "The iso-line is followed"): the distance
+/// is measured only at the corners of the facets it crosses, and at the few
+/// vertices a seed walk passes over. Each segment of the curves that no loop
+/// found so far covers ([`Follow::cover`]) gives a seed: the facet nearest to
+/// its middle moved `distance` along its left vector (tangent to the
+/// support, inward), where the segment's offset lies if no other part of the
+/// curves is nearer. From there a walk toward the iso-line finds a crossed
+/// edge ([`Follow::seed`]), and the loop through it is followed
+/// ([`Follow::follow`]). Values, feet and crossings are those of a full scan
+/// that measures every vertex within `distance` + two facets.
 fn offset_once(support: &Support, curves: &[Curve], distance: f64) -> Isolines {
     let field = CurveField::new(curves);
-    let h = support.facet_size() * (1.0 + tol::SELECTION_SLACK);
-    let lim =
-        Limits { distance, inner: distance - h, outer: distance + h, reach: distance + 2.0 * support.facet_size() };
-    let (near, leaves) = select_nodes(support, &field, lim);
-    let tree = support.vertex_tree();
-    let verts = support.mesh().vertices();
-    let measured: Vec<Vec<(u32, f64, Option<PolylineFoot>)>> = leaves
-        .par_iter()
-        .with_min_len(LEAVES_PER_TASK)
-        .map(|&(l, dc)| measure_leaf(support, &field, l, dc, lim))
-        .collect();
-    let mut values = vec![f64::NAN; verts.len()];
-    for &n in &near {
-        for &v in tree.vertices(n as usize) {
-            values[v as usize] = f64::NEG_INFINITY;
-        }
-    }
-    let mut slot = vec![u32::MAX; verts.len()];
-    let mut feet: Vec<PolylineFoot> = Vec::new();
-    let mut marked = vec![false; support.mesh().triangles().len()];
-    for (v, value, foot) in measured.into_iter().flatten() {
-        values[v as usize] = value;
-        if let Some(f) = foot {
-            slot[v as usize] = u32::try_from(feet.len()).unwrap_or(u32::MAX);
-            feet.push(f);
-            for &f in support.vertex_facets(v as usize) {
-                marked[f as usize] = true;
+    let mut follow = Follow::new(support, &field, distance);
+    for (c, line) in field.curves().iter().enumerate() {
+        for s in 0..line.segment_count() {
+            if follow.covered[c][s] {
+                continue;
             }
+            let (a, b) = line.segment(s);
+            let target = Point3::from((a.coords + b.coords) * 0.5) + field.left(c, s) * distance;
+            let found = follow.facets.len();
+            follow.seed(support.query().closest_point(&target).triangle);
+            follow.cover(found);
         }
     }
-    let facets: Vec<u32> = (0..marked.len()).filter(|&f| marked[f]).map(|f| f as u32).collect();
-    side_far_corners(support, &facets, &mut values);
-    let foot = |v: u32| feet.get(slot[v as usize] as usize);
+    let Follow { values, feet, mut facets, .. } = follow;
+    facets.sort_unstable();
+    let foot = |v: u32| feet.get(&v);
     // Roots search from the foot of a nearby vertex: the same foot, found faster.
     let exact = |p: &Point3, v: u32| {
         let f = field.foot_near(p, f64::INFINITY, foot(v));
@@ -144,140 +126,171 @@ fn offset_once(support: &Support, curves: &[Curve], distance: f64) -> Isolines {
     march_facets(support, &values, facets.iter().map(|&f| f as usize), &exact, &medial)
 }
 
-/// The distances that sort the vertices of one extraction (mm): the offset,
-/// the one below which a vertex is outside the new curve whatever its side,
-/// the one beyond which it takes its side from a neighbour, and the bound of
-/// a measurement.
-#[derive(Clone, Copy)]
-struct Limits {
+/// A facet never seeded nor followed.
+const UNSEEN: u8 = 0;
+/// A facet a seed walk started from.
+const SEEDED: u8 = 1;
+/// A facet the iso-line crosses, found by following it.
+const CROSSED: u8 = 2;
+
+/// The state of one extraction: the vertices measured so far and the facets
+/// found crossed.
+struct Follow<'a> {
+    support: &'a Support,
+    field: &'a CurveField,
     distance: f64,
-    inner: f64,
-    outer: f64,
+    /// The bound of a measurement: `distance` + two facets.
     reach: f64,
+    /// Per vertex, the signed distance minus `distance`; NaN where not
+    /// measured, infinite for a corner beyond the reach given its side.
+    values: Vec<f64>,
+    /// The feet of the measured vertices.
+    feet: FastMap<u32, PolylineFoot>,
+    /// Per facet, [`UNSEEN`], [`SEEDED`] or [`CROSSED`].
+    marks: Vec<u8>,
+    /// The facets found crossed, in the order found.
+    facets: Vec<u32>,
+    /// Per curve of the field, per segment: whether a loop found is its
+    /// offset.
+    covered: Vec<Vec<bool>>,
 }
 
-/// The vertices of leaf `l`, whose centre is `dc` from the curves, with
-/// their values and feet. A vertex whose distance bounds (triangle inequality
-/// from the centre and from the last vertex measured) put it nearer than
-/// `inner` gets `-inf`, farther than `outer` NaN; the others a bounded query
-/// each, searching from the last foot found (the same foot, found faster).
-fn measure_leaf(
-    support: &Support,
-    field: &CurveField,
-    l: u32,
-    dc: f64,
-    lim: Limits,
-) -> Vec<(u32, f64, Option<PolylineFoot>)> {
-    let tree = support.vertex_tree();
-    let verts = support.mesh().vertices();
-    let c = tree.nodes[l as usize].center;
-    let slack = tol::SELECTION_SLACK * lim.reach;
-    let mut last: Option<(PolylineFoot, Point3)> = None;
-    tree.vertices(l as usize)
-        .iter()
-        .map(|&v| {
-            let p = verts[v as usize];
-            let e = (p - c).norm();
-            let (mut lo, mut hi) = (dc - e, dc + e);
-            if let Some((f, q)) = &last {
-                let e = (p - q).norm();
-                (lo, hi) = (lo.max(f.distance - e), hi.min(f.distance + e));
-            }
-            if hi + slack < lim.inner {
-                return (v, f64::NEG_INFINITY, None);
-            }
-            if lo - slack > lim.outer {
-                return (v, f64::NAN, None);
-            }
-            match field.foot_near(&p, lim.reach, last.as_ref().map(|l| &l.0)) {
-                Some(f) => {
-                    last = Some((f, p));
-                    (v, field.signed_at(&p, &f) - lim.distance, Some(f))
-                }
-                None => (v, f64::NAN, None),
-            }
-        })
-        .collect()
-}
-
-/// The nodes of the vertex tree whose vertices are all nearer than
-/// `lim.inner` to the curves, and the leaves to look into with their
-/// centre's distance, in tree order; the nodes left out hold only vertices
-/// farther than `lim.outer`.
-fn select_nodes(support: &Support, field: &CurveField, lim: Limits) -> (Vec<u32>, Vec<(u32, f64)>) {
-    let mut out = (Vec::new(), Vec::new());
-    if !support.vertex_tree().nodes.is_empty() {
-        select_under(support.vertex_tree(), field, 0, None, lim, &mut out);
-    }
-    out
-}
-
-/// [`select_nodes`] below node `i`, appending to `out`; the query searches
-/// from `hint`, the parent's foot. Subtrees of more than
-/// [`PARALLEL_VERTICES`] vertices are searched in parallel, their lists
-/// joined in tree order.
-fn select_under(
-    tree: &VertexTree,
-    field: &CurveField,
-    i: u32,
-    hint: Option<&PolylineFoot>,
-    lim: Limits,
-    out: &mut (Vec<u32>, Vec<(u32, f64)>),
-) {
-    let n = &tree.nodes[i as usize];
-    let r = n.radius * (1.0 + tol::SELECTION_SLACK) + tol::SELECTION_SLACK * lim.reach;
-    let Some(f) = field.foot_near(&n.center, lim.outer + r, hint) else { return };
-    if f.distance + r < lim.inner {
-        out.0.push(i);
-    } else if n.second == 0 {
-        out.1.push((i, f.distance));
-    } else if (n.end - n.start) as usize > PARALLEL_VERTICES {
-        let sub = |j: u32| {
-            let mut o = (Vec::new(), Vec::new());
-            select_under(tree, field, j, Some(&f), lim, &mut o);
-            o
-        };
-        let (a, b) = rayon::join(|| sub(i + 1), || sub(n.second));
-        for (near, leaves) in [a, b] {
-            out.0.extend(near);
-            out.1.extend(leaves);
+impl<'a> Follow<'a> {
+    fn new(support: &'a Support, field: &'a CurveField, distance: f64) -> Follow<'a> {
+        Follow {
+            support,
+            field,
+            distance,
+            reach: distance + 2.0 * support.facet_size(),
+            values: vec![f64::NAN; support.mesh().vertices().len()],
+            feet: FastMap::default(),
+            marks: vec![UNSEEN; support.mesh().triangles().len()],
+            facets: Vec::new(),
+            covered: field.curves().iter().map(|c| vec![false; c.segment_count()]).collect(),
         }
-    } else {
-        select_under(tree, field, i + 1, Some(&f), lim, out);
-        select_under(tree, field, n.second, Some(&f), lim, out);
     }
-}
 
-/// Subtrees of the vertex tree larger than this are searched in parallel.
-/// Coarse parallel tasks: on a shared machine a thread may wait for a core,
-/// and a join waits for it.
-const PARALLEL_VERTICES: usize = 32_768;
+    /// Marks as covered the segments of the curves whose offset passes
+    /// through the crossed facets `facets[from..]`: per facet not crossed by
+    /// the medial axis ([`medial_facet`]), the segments of its corners' feet
+    /// and those between them along the shorter way, if not longer than
+    /// twice [`tol::MEDIAL_FOOT_FACTOR`] facet sizes (a longer way means the
+    /// feet are near each other across a gap, not along the curve).
+    fn cover(&mut self, from: usize) {
+        let tris = self.support.mesh().triangles();
+        let bound = 2.0 * tol::MEDIAL_FOOT_FACTOR * self.support.facet_size();
+        for &f in &self.facets[from..] {
+            let t = tris[f as usize];
+            let [Some(a), Some(b), Some(c)] = t.map(|v| self.feet.get(&v)) else { continue };
+            if a.curve != b.curve
+                || a.curve != c.curve
+                || medial_facet(self.support, f as usize, |v| self.feet.get(&v).map(|f| f.point))
+            {
+                continue;
+            }
+            let line = &self.field.curves()[a.curve];
+            let mut s = [a.segment, b.segment, c.segment];
+            s.sort_unstable();
+            let n = line.segment_count();
+            // The arcs from each foot's segment forward to the one before it
+            // (only the first on an open curve).
+            let arcs = [(s[0], s[2] - s[0]), (s[1], s[0] + n - s[1]), (s[2], s[1] + n - s[2])];
+            let arcs = if line.closed { &arcs[..] } else { &arcs[..1] };
+            let Some(&(start, len)) = arcs.iter().min_by_key(|a| a.1) else { continue };
+            let seg = |k: usize| (start + k) % n;
+            let length: f64 = (1..len)
+                .map(|k| {
+                    let (p, q) = line.segment(seg(k));
+                    (q - p).norm()
+                })
+                .sum();
+            if length <= bound {
+                for k in 0..=len {
+                    self.covered[a.curve][seg(k)] = true;
+                }
+            }
+        }
+    }
 
-/// Fewest leaves measured by one parallel task (same reason).
-const LEAVES_PER_TASK: usize = 16;
+    /// The value of vertex `v` (NaN beyond the reach), measured once,
+    /// searching from the foot of vertex `near` if measured (the same foot,
+    /// found faster).
+    fn measure(&mut self, v: u32, near: Option<u32>) -> f64 {
+        let known = self.values[v as usize];
+        if !known.is_nan() {
+            return known;
+        }
+        let p = self.support.mesh().vertices()[v as usize];
+        let hint = near.and_then(|n| self.feet.get(&n));
+        let Some(f) = self.field.foot_near(&p, self.reach, hint) else { return f64::NAN };
+        let g = self.field.signed_at(&p, &f) - self.distance;
+        self.values[v as usize] = g;
+        self.feet.insert(v, f);
+        g
+    }
 
-/// Gives the far corners (NaN) of `facets` the side of their lowest-numbered
-/// measured neighbour (the positive side gets `+inf`). This is what a flood
-/// from the measured vertices, taken in order, gives them: a far vertex is
-/// more than a facet from the curves, so no edge from it crosses the curves,
-/// and a connected set of far vertices lies on one side. Every
-/// facet of `facets` has a measured corner, which is a neighbour of the
-/// others.
-fn side_far_corners(support: &Support, facets: &[u32], values: &mut [f64]) {
-    let tris = support.mesh().triangles();
-    let mut far: Vec<u32> =
-        facets.iter().flat_map(|&f| tris[f as usize]).filter(|&v| values[v as usize].is_nan()).collect();
-    far.sort_unstable();
-    far.dedup();
-    let sides: Vec<f64> = far
-        .iter()
-        .map(|&v| {
-            let measured = support.neighbours(v as usize).iter().find(|&&w| values[w as usize].is_finite());
-            if measured.is_some_and(|&w| values[w as usize] > 0.0) { f64::INFINITY } else { f64::NEG_INFINITY }
-        })
-        .collect();
-    for (&v, side) in far.iter().zip(sides) {
-        values[v as usize] = side;
+    /// A walk from a corner of facet `f` to the iso-line: from vertex to
+    /// neighbour, up the values while negative, down while positive, until
+    /// an edge changes state (whose loop is then followed) or no neighbour
+    /// is nearer the iso-line (no loop passes there: the offset vanished or
+    /// another part of the curves is nearer).
+    fn seed(&mut self, f: usize) {
+        if self.marks[f] != UNSEEN {
+            return;
+        }
+        self.marks[f] = SEEDED;
+        let support = self.support;
+        let mut v = support.mesh().triangles()[f][0];
+        let mut gv = self.measure(v, None);
+        while gv.is_finite() {
+            let mut best = (v, gv);
+            for &w in support.neighbours(v as usize) {
+                let gw = self.measure(w, Some(v));
+                if !gw.is_finite() {
+                    continue;
+                }
+                if (gw > 0.0) != (gv > 0.0) {
+                    self.follow(v, w);
+                    return;
+                }
+                if (gv > 0.0 && gw < best.1) || (gv <= 0.0 && gw > best.1) {
+                    best = (w, gw);
+                }
+            }
+            if best.0 == v {
+                return;
+            }
+            (v, gv) = best;
+        }
+    }
+
+    /// Marks every facet reachable from the crossed edge `(a, b)` through
+    /// crossed edges, measuring the third corner of each. A corner beyond
+    /// the reach takes the side of the lower-numbered end of the edge it
+    /// was reached from: it is more than a facet from the curves, so no
+    /// edge from it crosses them.
+    fn follow(&mut self, a: u32, b: u32) {
+        let support = self.support;
+        let tris = support.mesh().triangles();
+        let mut stack = vec![(a, b)];
+        while let Some((a, b)) = stack.pop() {
+            for &f in support.vertex_facets(a as usize) {
+                let t = tris[f as usize];
+                if self.marks[f as usize] == CROSSED || !t.contains(&b) {
+                    continue;
+                }
+                self.marks[f as usize] = CROSSED;
+                self.facets.push(f);
+                let Some(c) = t.into_iter().find(|&x| x != a && x != b) else { continue };
+                if self.measure(c, Some(a)).is_nan() {
+                    let side = self.values[a.min(b) as usize] > 0.0;
+                    self.values[c as usize] = if side { f64::INFINITY } else { f64::NEG_INFINITY };
+                }
+                let pos = |v: u32| self.values[v as usize] > 0.0;
+                let next = if pos(a) == pos(c) { (b, c) } else { (a, c) };
+                stack.push(next);
+            }
+        }
     }
 }
 
@@ -349,31 +362,65 @@ mod tests {
         Support::new(TriMesh::from_indexed(&v, &scallop_mesh::grid_triangles(n, n)).unwrap().0)
     }
 
+    /// A closed loop of 240 points `r(t)` about `(cx, cy)` lifted onto `support`.
+    fn polar_loop(
+        support: &Support,
+        height: impl Fn(f64, f64) -> f64,
+        cx: f64,
+        cy: f64,
+        r: impl Fn(f64) -> f64,
+    ) -> Curve {
+        let pts: Vec<Point3> = (0..240)
+            .map(|i| {
+                let t = std::f64::consts::TAU * f64::from(i) / 240.0;
+                let (x, y) = (cx + r(t) * t.cos(), cy + r(t) * t.sin());
+                support.query().closest_point(&Point3::new(x, y, height(x, y))).point
+            })
+            .collect();
+        support.curve(Polyline3::new(pts, true)).unwrap().inside_left()
+    }
+
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(24))]
-        /// The vertices picked by the tree give the offsets of the full scan
-        /// on random terrains and random star-shaped loops (peanuts split).
+        /// Following the iso-line from the seeds gives, bit for bit, the
+        /// offsets of the full scan on random terrains and random star-shaped
+        /// loops (peanuts split).
         #[test]
-        fn tree_selection_gives_the_full_scan_offsets(
+        fn following_gives_the_full_scan_offsets(
             n in 24usize..64, amp in 0.0..6.0f64, wx in 6.0..30.0f64, wy in 6.0..30.0f64,
             r0 in 8.0..17.0f64, wobble in 0.0..0.45f64, lobes in 1u32..5, phase in 0.0..6.3f64,
             cx in -3.0..3.0f64, a_e in 1.0..6.0f64,
         ) {
             let height = move |x: f64, y: f64| amp * (x / wx).sin() * (y / wy).cos();
             let support = terrain(n, 20.0, height);
-            let pts: Vec<Point3> = (0..200)
-                .map(|i| {
-                    let t = std::f64::consts::TAU * f64::from(i) / 200.0;
-                    let r = r0 * (1.0 + wobble * (f64::from(lobes) * t + phase).sin());
-                    let (x, y) = (cx + r * t.cos(), r * t.sin());
-                    support.query().closest_point(&Point3::new(x, y, height(x, y))).point
-                })
-                .collect();
-            let limit = support.curve(Polyline3::new(pts, true)).unwrap().inside_left();
+            let limit = polar_loop(&support, height, cx, 0.0, |t| r0 * (1.0 + wobble * (f64::from(lobes) * t + phase).sin()));
             let fast = iterate(&support, std::slice::from_ref(&limit), a_e, offset_once).unwrap();
             let scan = iterate(&support, std::slice::from_ref(&limit), a_e, offset_once_scan).unwrap();
-            prop_assert!(!fast.is_empty());
+            // The loop holds a disc of radius r0 (1 - wobble): a_e under half of it leaves an offset.
+            prop_assert!(!fast.is_empty() || 2.0 * a_e > r0 * (1.0 - wobble));
             prop_assert_eq!(fast, scan);
+        }
+
+        /// A dumbbell whose neck closes before its lobes: the offsets split
+        /// into two loops, each found, as by the full scan; likewise two
+        /// separate limit loops of different sizes offset together.
+        #[test]
+        fn every_loop_is_found_when_offsets_split(
+            n in 40usize..72, amp in 0.0..4.0f64, neck in 0.58..0.65f64, a_e in 0.8..1.6f64, phase in 0.0..0.3f64,
+        ) {
+            let height = move |x: f64, y: f64| amp * (x / 11.0).sin() * (y / 13.0).cos();
+            let support = terrain(n, 20.0, height);
+            let dumbbell = polar_loop(&support, height, 0.0, 0.0, |t| 10.0 * (1.0 + neck * (2.0 * (t + phase)).cos()));
+            let fast = iterate(&support, std::slice::from_ref(&dumbbell), a_e, offset_once).unwrap();
+            prop_assert!(fast.iter().any(|s| s.split && s.curves.len() == 2));
+            prop_assert_eq!(&fast, &iterate(&support, std::slice::from_ref(&dumbbell), a_e, offset_once_scan).unwrap());
+            let pair = [
+                polar_loop(&support, height, -9.0, -6.0, |_| 8.0),
+                polar_loop(&support, height, 10.0, 8.0, |t| 6.0 + 0.5 * (3.0 * t).sin()),
+            ];
+            let fast = iterate(&support, &pair, a_e, offset_once).unwrap();
+            prop_assert_eq!(fast[0].curves.len(), 2);
+            prop_assert_eq!(fast, iterate(&support, &pair, a_e, offset_once_scan).unwrap());
         }
     }
 }

@@ -20,8 +20,6 @@ pub struct Support {
     adjacency: Rows,
     /// Per vertex, the facets using it, ascending.
     incidence: Rows,
-    /// Bounding spheres over the vertices, to find those near a curve.
-    tree: VertexTree,
 }
 
 impl Support {
@@ -58,8 +56,7 @@ impl Support {
             .fold(0.0, f64::max);
         let query = MeshQuery::new(&mesh);
         let (adjacency, incidence) = (neighbours(&mesh), incidence(&mesh));
-        let tree = VertexTree::build(mesh.vertices());
-        Support { mesh, query, vertex_normals, facet_size, adjacency, incidence, tree }
+        Support { mesh, query, vertex_normals, facet_size, adjacency, incidence }
     }
 
     /// The vertices sharing an edge with vertex `v`, ascending.
@@ -72,11 +69,6 @@ impl Support {
     #[must_use]
     pub fn vertex_facets(&self, v: usize) -> &[u32] {
         self.incidence.row(v)
-    }
-
-    /// The bounding-sphere hierarchy over the vertices.
-    pub(crate) fn vertex_tree(&self) -> &VertexTree {
-        &self.tree
     }
 
     /// The mesh.
@@ -239,77 +231,6 @@ fn incidence(mesh: &TriMesh) -> Rows {
         .flat_map(|f| mesh.triangles()[f].map(|v| (v, u32::try_from(f).unwrap_or(u32::MAX))))
         .collect();
     Rows::from_pairs(mesh.vertices().len(), pairs)
-}
-
-/// Vertices per leaf of a [`VertexTree`]: a leaf is measured whole, so small
-/// leaves measure few vertices away from the iso-line, at the price of more
-/// node tests.
-const LEAF_VERTICES: usize = 16;
-
-/// A hierarchy of bounding spheres over the vertices, by median splits
-/// along the longest side of the box: node `i` holds the vertices
-/// `order[start..end]`; an inner node's children are node `i + 1` and node
-/// `second`.
-#[derive(Debug, Clone, Default)]
-pub(crate) struct VertexTree {
-    pub(crate) nodes: Vec<VertexNode>,
-    pub(crate) order: Vec<u32>,
-}
-
-/// A node of a [`VertexTree`].
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct VertexNode {
-    /// Every vertex of the node is within `radius` of `center` (mm).
-    pub(crate) center: Point3,
-    pub(crate) radius: f64,
-    pub(crate) start: u32,
-    pub(crate) end: u32,
-    /// The second child; 0 for a leaf.
-    pub(crate) second: u32,
-}
-
-impl VertexTree {
-    /// The vertices of node `i`.
-    pub(crate) fn vertices(&self, i: usize) -> &[u32] {
-        let n = &self.nodes[i];
-        &self.order[n.start as usize..n.end as usize]
-    }
-
-    fn build(points: &[Point3]) -> VertexTree {
-        let mut tree = VertexTree { nodes: Vec::new(), order: (0..points.len()).map(|v| v as u32).collect() };
-        if !points.is_empty() {
-            tree.split(points, 0, points.len());
-        }
-        tree
-    }
-
-    /// Adds the node of `order[start..end]` and its subtree; its index.
-    fn split(&mut self, points: &[Point3], start: usize, end: usize) -> usize {
-        let slice = &mut self.order[start..end];
-        let at = |v: &u32| points[*v as usize];
-        let (lo, hi) =
-            slice.iter().fold((at(&slice[0]), at(&slice[0])), |(lo, hi), v| (lo.inf(&at(v)), hi.sup(&at(v))));
-        let center = Point3::from((lo.coords + hi.coords) * 0.5);
-        let radius = slice.iter().map(|v| (at(v) - center).norm()).fold(0.0, f64::max);
-        let id = self.nodes.len();
-        self.nodes.push(VertexNode { center, radius, start: start as u32, end: end as u32, second: 0 });
-        if end - start > LEAF_VERTICES {
-            let size = hi - lo;
-            let axis = if size.x >= size.y && size.x >= size.z {
-                0
-            } else if size.y >= size.z {
-                1
-            } else {
-                2
-            };
-            let mid = (end - start) / 2;
-            slice.select_nth_unstable_by(mid, |a, b| at(a)[axis].total_cmp(&at(b)[axis]).then(a.cmp(b)));
-            self.split(points, start, start + mid);
-            let second = self.split(points, start + mid, end);
-            self.nodes[id].second = second as u32;
-        }
-        id
-    }
 }
 
 /// [`check_line`] plus one normal per point.
