@@ -887,6 +887,10 @@ pub mod sim {
     /// older cuts as it stood before the block, its samples run in parallel. A
     /// fixed count, so the figures do not depend on the thread count.
     pub const ENGAGEMENT_BLOCK: usize = 64;
+
+    /// The engagement follows an arc move (G2/G3) along chords whose sagitta is
+    /// at most this (mm, 1 um): as `scallop engagement` reads a program's arcs.
+    pub const ENGAGEMENT_ARC_SAGITTA: f64 = 1e-3;
 }
 
 pub mod strategy {

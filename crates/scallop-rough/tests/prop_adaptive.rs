@@ -2,19 +2,17 @@
 //! a round island, L), judged by the simulator's engagement evaluation
 //! (`scallop_sim::pocket_engagement`): the tool never reaches beyond a wall,
 //! no reachable material is left, and the plan is the same on one and two
-//! threads. The simulator takes every move as a straight line, so arcs are
-//! measured as chords within 1 um, as `scallop engagement` reads G2/G3. The
-//! engagement bound (1.1 x the stepover's angle outside the entry) and no
+//! threads. The simulator follows arc moves along chords within 1 um, as
+//! `scallop engagement` reads G2/G3. The engagement bound (1.1 x the stepover's angle outside the entry) and no
 //! full slot are not met yet on these small pockets: that test is ignored
 //! (docs/roughing.md, "Adaptive clearing").
 #![allow(clippy::unwrap_used, reason = "tests: a panic is the failure report")]
 
 use proptest::prelude::*;
 use scallop_contour::{Contour, Region};
-use scallop_geom::{Point2, Point3};
+use scallop_geom::Point2;
 use scallop_rough::{ClearOptions, Direction, Motion, Pattern, RoughPlan, pocket_toolpath};
 use scallop_sim::{EngagementOptions, EngagementReport, Pocket, engagement_angle, pocket_engagement};
-use scallop_toolpath::{Move, Toolpath};
 
 const R: f64 = 1.5;
 const AE: f64 = 0.4 * R;
@@ -57,40 +55,10 @@ fn plan(rings: &[Vec<[f64; 2]>]) -> (Pocket, RoughPlan) {
     (pocket, plan)
 }
 
-/// The path with every XY arc replaced by chords within `SAGITTA` (as
-/// `scallop engagement` reads a program's G2/G3): the simulator's engagement
-/// takes each move as a straight line.
-fn chords(path: &Toolpath) -> Toolpath {
-    const SAGITTA: f64 = 1e-3;
-    let mut out = Toolpath::new(path.feed);
-    let moves = path.moves();
-    for (k, m) in moves.iter().enumerate() {
-        let Some(arc) = path.arc(k).filter(|_| k > 0) else {
-            out.push(*m);
-            continue;
-        };
-        let from = moves[k - 1].to;
-        let (c, radius) = (arc.center, (from.x - arc.center.x).hypot(from.y - arc.center.y));
-        let step = 2.0 * (1.0 - SAGITTA / radius.max(SAGITTA)).acos();
-        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a small positive count")]
-        let n = (arc.sweep.abs() / step.max(1e-3)).ceil().max(1.0) as usize;
-        let a0 = (from.y - c.y).atan2(from.x - c.x);
-        for i in 1..n {
-            #[allow(clippy::cast_precision_loss, reason = "small counts")]
-            let f = i as f64 / n as f64;
-            let a = a0 + arc.sweep * f;
-            let to = Point3::new(c.x + radius * a.cos(), c.y + radius * a.sin(), from.z + (m.to.z - from.z) * f);
-            out.push(Move::new(m.kind, to));
-        }
-        out.push(*m);
-    }
-    out
-}
-
 fn judge(pocket: &Pocket, plan: &RoughPlan) -> EngagementReport {
     let options = EngagementOptions { gouge_tolerance: 0.03, ..EngagementOptions::default() };
     // A reach beyond a wall fails here (`PocketGouge`).
-    pocket_engagement(pocket, R, &chords(&plan.toolpath), engagement_angle(AE, R), &options).unwrap()
+    pocket_engagement(pocket, R, &plan.toolpath, engagement_angle(AE, R), &options).unwrap()
 }
 
 /// Nothing reachable left, no gouge (in `judge`).
@@ -121,7 +89,8 @@ proptest! {
 #[test]
 fn ls_are_cleared_inside_their_walls() {
     // The L's inner corner is cut by an arc of radius R about the corner:
-    // measured as its chord it read 0.11 mm beyond the wall.
+    // measured as its chord (before the simulator followed arcs) it read
+    // 0.11 mm beyond the wall.
     let (pocket, plan) = plan(&shape(12.0, 9.0, 2));
     assert!(plan.toolpath.arc_count() > 0);
     check_cleared(&judge(&pocket, &plan));

@@ -234,3 +234,54 @@ proptest! {
         }
     }
 }
+
+/// A pass around the inner corner of an L by an arc of radius R about the
+/// corner touches the corner and never reaches beyond it; the same move read
+/// as its chord would cut R (1 - cos 45 deg) into the corner. So the
+/// evaluation follows the arc: no gouge, and the move's figures are those of
+/// the arc.
+#[test]
+fn an_arc_around_an_inner_corner_is_followed_not_its_chord() {
+    use scallop_toolpath::ArcXY;
+    // The L: [0, 20]^2 without [10, 20]^2; its inner corner is (10, 10).
+    let l = vec![
+        Point2::new(0.0, 0.0),
+        Point2::new(20.0, 0.0),
+        Point2::new(20.0, 10.0),
+        Point2::new(10.0, 10.0),
+        Point2::new(10.0, 20.0),
+        Point2::new(0.0, 20.0),
+    ];
+    let pocket = Pocket::new(vec![l]).unwrap();
+    let radius = 2.0;
+    let corner_pass = |arc: bool| {
+        let mut path = Toolpath::new(1000.0);
+        path.push(Move::new(MoveKind::Rapid, Point3::new(8.0, 18.0, 5.0)));
+        path.push(Move::new(MoveKind::Plunge, Point3::new(8.0, 18.0, -1.0)));
+        path.push(Move::new(MoveKind::Feed, Point3::new(8.0, 10.0, -1.0)));
+        let end = Move::new(MoveKind::Feed, Point3::new(10.0, 8.0, -1.0));
+        if arc {
+            path.push_arc(end, ArcXY { center: Point2::new(10.0, 10.0), sweep: std::f64::consts::FRAC_PI_2 });
+        } else {
+            path.push(end);
+        }
+        path.push(Move::new(MoveKind::Feed, Point3::new(18.0, 8.0, -1.0)));
+        path.push(Move::new(MoveKind::Retract, Point3::new(18.0, 8.0, 5.0)));
+        path
+    };
+    let opts = options(0.1);
+    let target = engagement_angle(1.0, radius);
+    let report = pocket_engagement(&pocket, radius, &corner_pass(true), target, &opts).unwrap();
+    assert_eq!(report.move_phi.len(), 6);
+    assert!(report.move_phi[3] > 0.0, "the arc cuts the corner's material");
+    match pocket_engagement(&pocket, radius, &corner_pass(false), target, &opts) {
+        Err(SimError::PocketGouge { depth, index, .. }) => {
+            assert_eq!(index, 3);
+            // The chord's middle is R (1 - cos 45 deg) inside the corner; the
+            // samples come within a sample step of it.
+            let chord = radius * (1.0 - std::f64::consts::FRAC_1_SQRT_2);
+            assert!(depth <= chord + 1e-9 && depth > 0.9 * chord, "depth {depth}, chord {chord}");
+        }
+        other => panic!("the chord should gouge the corner: {other:?}"),
+    }
+}

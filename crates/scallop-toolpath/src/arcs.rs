@@ -34,6 +34,10 @@ pub const MIN_RADIUS: f64 = 0.05;
 /// Most toolpath vertices one arc may replace (bounds the quadratic check).
 pub const MAX_ARC_POINTS: usize = 512;
 
+/// Most chords [`crate::ArcXY::chords`] cuts one arc into (bounds the work and
+/// memory of a tiny sagitta on a large arc).
+pub const MAX_CHORDS_PER_ARC: usize = 65_536;
+
 /// A principal plane of circular interpolation.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum ArcPlane {

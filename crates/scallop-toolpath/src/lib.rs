@@ -22,7 +22,10 @@ use scallop_geom::{Point2, Point3, Vec3};
 
 mod arcs;
 
-pub use arcs::{ArcMove, ArcPlane, FittedPath, MAX_ARC_POINTS, MAX_RADIUS, MAX_SWEEP, MIN_RADIUS, Segment, fit_arcs};
+pub use arcs::{
+    ArcMove, ArcPlane, FittedPath, MAX_ARC_POINTS, MAX_CHORDS_PER_ARC, MAX_RADIUS, MAX_SWEEP, MIN_RADIUS, Segment,
+    fit_arcs,
+};
 
 /// What a move is for; decides how it is emitted and coloured.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -68,6 +71,50 @@ pub struct ArcXY {
     /// Signed swept angle (rad): positive counter-clockwise (G3), negative
     /// clockwise (G2); a full circle is +-2 pi.
     pub sweep: f64,
+}
+
+impl ArcXY {
+    /// The points of the arc from `from` to `to` as chords whose sagitta is at
+    /// most `sagitta` (mm), `from` excluded and `to` the last one; z linear in
+    /// the angle. At most [`MAX_CHORDS_PER_ARC`] chords (a larger count is
+    /// capped: its sagitta is then larger); one chord when the radius is within
+    /// `sagitta`.
+    ///
+    /// ```
+    /// use scallop_geom::{Point2, Point3};
+    /// use scallop_toolpath::ArcXY;
+    /// let half = ArcXY { center: Point2::origin(), sweep: std::f64::consts::PI };
+    /// let (from, to) = (Point3::new(10.0, 0.0, 0.0), Point3::new(-10.0, 0.0, 1.0));
+    /// let points = half.chords(&from, &to, 0.01);
+    /// assert_eq!(points.last(), Some(&to));
+    /// assert!(points.iter().all(|p| (p.x.hypot(p.y) - 10.0).abs() < 1e-9));
+    /// // Each chord of a 10 mm circle within 0.01 mm sagitta spans at most 2 acos(0.999).
+    /// assert!(points.len() as f64 >= std::f64::consts::PI / (2.0 * 0.999f64.acos()));
+    /// ```
+    #[must_use]
+    pub fn chords(&self, from: &Point3, to: &Point3, sagitta: f64) -> Vec<Point3> {
+        let c = self.center;
+        let radius = (from.x - c.x).hypot(from.y - c.y);
+        let n = if radius > sagitta && sagitta > 0.0 {
+            let step = 2.0 * (1.0 - sagitta / radius).acos();
+            // A whole number of chords, capped.
+            #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+            let n = (self.sweep.abs() / step).ceil().min(MAX_CHORDS_PER_ARC as f64) as usize;
+            n.max(1)
+        } else {
+            1
+        };
+        let a0 = (from.y - c.y).atan2(from.x - c.x);
+        let mut points: Vec<Point3> = (1..n)
+            .map(|i| {
+                let f = i as f64 / n as f64;
+                let a = a0 + self.sweep * f;
+                Point3::new(c.x + radius * a.cos(), c.y + radius * a.sin(), from.z + (to.z - from.z) * f)
+            })
+            .collect();
+        points.push(*to);
+        points
+    }
 }
 
 /// A sequence of moves from an unspecified start (the first move is a rapid in practice).

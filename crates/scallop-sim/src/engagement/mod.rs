@@ -35,7 +35,7 @@ use scallop_geom::Point2;
 use scallop_toolpath::{MoveKind, Toolpath};
 
 use crate::SimError;
-use crate::tol::{ENGAGEMENT_BLOCK, ENGAGEMENT_CONTACT};
+use crate::tol::{ENGAGEMENT_ARC_SAGITTA as ARC_SAGITTA, ENGAGEMENT_BLOCK, ENGAGEMENT_CONTACT};
 pub use pocket::Pocket;
 pub(crate) use pocket::segment_distance;
 use raster::Raster;
@@ -255,27 +255,35 @@ fn track(path: &Toolpath, radius: f64, options: &EngagementOptions) -> Track {
             t.retracts += usize::from(before);
             continue;
         }
-        let (a, b) = (xy(i - 1), xy(i));
         if !before {
             t.entries += 1;
-            entry_point = Some(a);
+            entry_point = Some(xy(i - 1));
         }
-        let length = (b - a).norm();
-        t.segments.push(Segment { a, b, s1: s + length, index: i });
-        // Whole numbers of steps (at most a path length over a positive step).
-        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
-        let n = (length / options.sample_step).ceil() as usize;
-        for k in 1..=n {
-            let f = k as f64 / n as f64;
-            let at = a + (b - a) * f;
-            let entry = entry_point.is_some_and(|e| (at - e).norm() <= entry_radius);
-            if !entry {
-                entry_point = None;
+        // An arc move (G2/G3) is followed along its chords within
+        // `ARC_SAGITTA`, each a segment of the same move.
+        let (from, to) = (path.moves()[i - 1].to, path.moves()[i].to);
+        let ends = path.arc(i).map_or_else(|| vec![to], |arc| arc.chords(&from, &to, ARC_SAGITTA));
+        let mut a = xy(i - 1);
+        for end in ends {
+            let b = Point2::new(end.x, end.y);
+            let length = (b - a).norm();
+            t.segments.push(Segment { a, b, s1: s + length, index: i });
+            // Whole numbers of steps (at most a path length over a positive step).
+            #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+            let n = (length / options.sample_step).ceil() as usize;
+            for k in 1..=n {
+                let f = k as f64 / n as f64;
+                let at = a + (b - a) * f;
+                let entry = entry_point.is_some_and(|e| (at - e).norm() <= entry_radius);
+                if !entry {
+                    entry_point = None;
+                }
+                let segment = t.segments.len() - 1;
+                t.samples.push(Sample { at, s: s + length * f, segment, weight: length / n as f64, entry });
             }
-            let segment = t.segments.len() - 1;
-            t.samples.push(Sample { at, s: s + length * f, segment, weight: length / n as f64, entry });
+            s += length;
+            a = b;
         }
-        s += length;
     }
     t
 }
