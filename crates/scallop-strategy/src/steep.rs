@@ -501,7 +501,7 @@ impl<'a> Levels<'a> {
         ok
     }
 
-    /// The contour point on the ray from `inside` (where the cutter at `z`
+    /// The contour point on the ray from `start` (where the cutter at `z`
     /// cuts into the part) along `outward`: probes at doubling distances up
     /// to `reach`, then bisects to `tol::LEVEL_CHORD_BRACKET` chord
     /// tolerances and returns the outside end (the cutter there clears the
