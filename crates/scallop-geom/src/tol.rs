@@ -1195,6 +1195,22 @@ pub mod strategy {
     /// shallowest steep wall (`dz / tan(threshold - overlap)`) when looking for a
     /// concave crease between them (`Levels::crease`).
     pub const CREASE_REACH: f64 = 1.5;
+
+    /// Each chord of a waterline level, pushed out by [`LEVEL_PUSH_CHORDS`]
+    /// chord tolerances, is probed with the drop-cutter at the `k /
+    /// LEVEL_CHORD_SAMPLES` points of its length (`0 < k < LEVEL_CHORD_SAMPLES`):
+    /// the kernel bounds a chord's deviation at its midpoint only, and a contour
+    /// that crosses the chord there (an S bend) leaves it inside the part on
+    /// both sides; on a near-vertical wall that is a deep vertical gouge.
+    pub const LEVEL_CHORD_SAMPLES: usize = 4;
+
+    /// Deepest recursion of the split of a waterline chord whose samples cut
+    /// into the part (a chord is split at most this many times along one path).
+    pub const LEVEL_CHORD_DEPTH: u32 = 16;
+
+    /// Width of the bracket (in chord tolerances) to which the contour point
+    /// added in a waterline chord is bisected; its outside end is kept.
+    pub const LEVEL_CHORD_BRACKET: f64 = 0.01;
 }
 
 pub mod surface {

@@ -18,6 +18,8 @@
 
 use std::collections::HashMap;
 
+use rayon::prelude::*;
+
 use scallop_cutter::{ClPoint, Cutter, CutterShape, drop_cutter};
 use scallop_geom::{Point2, Point3, Tolerances, Vec2};
 use scallop_mesh::{MeshIndex, TriMesh};
@@ -403,11 +405,12 @@ impl<'a> Levels<'a> {
         let (mut passes, mut pass_slopes) = (Vec::new(), Vec::new());
         let mut min_slope = f64::INFINITY;
         for l in loops {
-            let mut points = pushed_out(&l.points, tol::LEVEL_PUSH_CHORDS * self.chord);
+            let contour = self.tightened(z, &l.points);
+            let mut points = pushed_out(&contour, tol::LEVEL_PUSH_CHORDS * self.chord);
             // The contact that lifts the cutter above z: a little inside the
             // loop (its points are where the cutter just clears the part, on a
             // floor level the floor itself).
-            let mut slopes: Vec<f64> = pushed_out(&l.points, -tol::LEVEL_PROBE_CHORDS * self.chord)
+            let mut slopes: Vec<f64> = pushed_out(&contour, -tol::LEVEL_PROBE_CHORDS * self.chord)
                 .iter()
                 .map(|p| self.contact_slope(*p))
                 .collect();
@@ -425,6 +428,111 @@ impl<'a> Levels<'a> {
             }
         }
         Ok(Level { z, passes, slopes: pass_slopes, min_slope })
+    }
+
+    /// The closed contour `points` (tip height `z`, inside on the left) with
+    /// a contour point added wherever a chord, moved out by the push-out,
+    /// has a sample (`tol::LEVEL_CHORD_SAMPLES`) where the cutter at `z`
+    /// cuts into the part: the kernel checks a chord at its midpoint only.
+    /// Chords in parallel; the result does not depend on the thread count.
+    fn tightened(&self, z: f64, points: &[Point2]) -> Vec<Point2> {
+        let n = points.len();
+        let inserted: Vec<Vec<Point2>> = (0..n)
+            .into_par_iter()
+            .with_min_len(16)
+            .map(|i| {
+                let mut out = Vec::new();
+                self.tighten_chord(z, points[i], points[(i + 1) % n], 0, &mut out);
+                out
+            })
+            .collect();
+        let mut out = Vec::with_capacity(n + inserted.iter().map(Vec::len).sum::<usize>());
+        for (p, extra) in points.iter().zip(inserted) {
+            out.push(*p);
+            out.extend(extra);
+        }
+        out
+    }
+
+    /// Tip height of the drop-cutter at `p` above `z` (0 where nothing
+    /// reaches above `z`).
+    fn above(&self, z: f64, p: Point2) -> f64 {
+        drop_cutter(self.cutter, self.index, p, z).tip.z - z
+    }
+
+    /// The contour points to add strictly between `a` and `b` (see
+    /// [`Self::tightened`]), in order from `a` to `b`, appended to `out`;
+    /// `false` (and nothing added) when the chord cuts into the part and no
+    /// polyline within reach clears it: the chord is then kept as the kernel
+    /// gave it, never replaced by a detour the samples have not cleared.
+    fn tighten_chord(&self, z: f64, a: Point2, b: Point2, depth: u32, out: &mut Vec<Point2>) -> bool {
+        let push = tol::LEVEL_PUSH_CHORDS * self.chord;
+        let d = b - a;
+        let length = d.norm();
+        if length <= push {
+            return true;
+        }
+        let outward = Vec2::new(d.y, -d.x) / length; // right of a -> b: away from the material
+        // The deepest sample that cuts into the part, if any.
+        let mut worst: Option<(f64, Point2)> = None;
+        for k in 1..tol::LEVEL_CHORD_SAMPLES {
+            #[allow(clippy::cast_precision_loss, reason = "a small count")]
+            let t = k as f64 / tol::LEVEL_CHORD_SAMPLES as f64;
+            let p = a + d * t + outward * push;
+            let h = self.above(z, p);
+            if h > 0.0 && worst.is_none_or(|(w, _)| h > w) {
+                worst = Some((h, p));
+            }
+        }
+        let Some((_, p)) = worst else { return true };
+        if depth >= tol::LEVEL_CHORD_DEPTH {
+            return false;
+        }
+        // The bend of this chord lies within about its length of it.
+        let Some(on) = self.contour_outward(z, p, outward, length) else { return false };
+        let at = out.len();
+        let ok = self.tighten_chord(z, a, on, depth + 1, out) && {
+            out.push(on);
+            self.tighten_chord(z, on, b, depth + 1, out)
+        };
+        if !ok {
+            out.truncate(at);
+        }
+        ok
+    }
+
+    /// The contour point on the ray from `start` (where the cutter at `z`
+    /// cuts into the part) along `outward`: probes at doubling distances up
+    /// to `reach`, then bisects to `tol::LEVEL_CHORD_BRACKET` chord
+    /// tolerances and returns the outside end (the cutter there clears the
+    /// part); `None` if no probe is clear.
+    fn contour_outward(&self, z: f64, start: Point2, outward: Vec2, reach: f64) -> Option<Point2> {
+        let mut inside = start;
+        let mut r = tol::LEVEL_PUSH_CHORDS * self.chord;
+        let mut outside = loop {
+            let q = start + outward * r;
+            if self.above(z, q) <= 0.0 {
+                break q;
+            }
+            if r >= reach {
+                return None;
+            }
+            inside = q;
+            r = (2.0 * r).min(reach);
+        };
+        let bracket = tol::LEVEL_CHORD_BRACKET * self.chord;
+        while (outside - inside).norm() > bracket {
+            let m = Point2::new(0.5 * (inside.x + outside.x), 0.5 * (inside.y + outside.y));
+            if m == inside || m == outside {
+                break;
+            }
+            if self.above(z, m) > 0.0 {
+                inside = m;
+            } else {
+                outside = m;
+            }
+        }
+        Some(outside)
     }
 
     fn contact_slope(&self, p: Point2) -> f64 {
@@ -760,6 +868,88 @@ mod tests {
         }
         let r = crease_residual(&ball, upper, lower, dz);
         assert!((r - worst).abs() < 2e-3 * worst.max(1e-3) + 1e-6, "{r} {worst}");
+    }
+
+    /// Two boxes with vertical walls, the second's front wall `stagger` mm
+    /// in front of the first's and `gap` mm beyond its end: at mid-height the
+    /// waterline runs along the first wall, arcs into a notch and runs along
+    /// the second, so a chord from one wall to the other has the contour on
+    /// its outside near one end and inside near the other (an S bend, as on
+    /// mount_rush at z = -13.525, bull R3 r1: docs/validation.md). The
+    /// kernel checks a chord at its midpoint only.
+    fn staggered_boxes(shift: f64, stagger: f64, gap: f64) -> TriMesh {
+        let mut soup = Vec::new();
+        let mut cuboid = |lo: Point3, hi: Point3| {
+            let c = |i: usize| {
+                Point3::new(
+                    if i & 1 == 0 { lo.x } else { hi.x },
+                    if i & 2 == 0 { lo.y } else { hi.y },
+                    if i & 4 == 0 { lo.z } else { hi.z },
+                )
+            };
+            for [a, b, cc, d] in [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]] {
+                soup.push([c(a), c(b), c(cc)]);
+                soup.push([c(a), c(cc), c(d)]);
+            }
+        };
+        cuboid(Point3::new(0.0, 0.0, 0.0), Point3::new(10.0 + shift, 10.0, 10.0));
+        cuboid(Point3::new(10.0 + shift + gap, -stagger, 0.0), Point3::new(20.0, 10.0, 10.0));
+        TriMesh::from_soup(&soup).expect("two boxes").0
+    }
+
+    /// The largest height (mm) by which the cutter at a level's height cuts
+    /// into the part along the level's passes, sampled every `step` mm.
+    fn deepest_cut(levels: &Levels<'_>, level: &Level, step: f64) -> f64 {
+        let mut worst = 0.0_f64;
+        for pass in &level.passes {
+            for w in pass.windows(2) {
+                let d = w[1] - w[0];
+                #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a small count")]
+                let n = (d.norm() / step).ceil().max(1.0) as usize;
+                for k in 0..=n {
+                    #[allow(clippy::cast_precision_loss, reason = "a small count")]
+                    let p = w[0] + d * (k as f64 / n as f64);
+                    worst = worst.max(levels.above(level.z, p));
+                }
+            }
+        }
+        worst
+    }
+
+    /// Regression (mount_rush bull R3 r1 sh 0.05 gouged 0.045 mm): whatever
+    /// the notch's place on the waterline grid, the level's passes never cut
+    /// into the part between their points, with a ball and a bull-nose.
+    #[test]
+    fn level_chords_never_cut_into_the_part_across_an_s_bend() {
+        let params = FinishingParams {
+            direction: 0.0,
+            pattern: crate::Pattern::Zigzag,
+            scallop_height: 0.05,
+            boundary: crate::Boundary::ContactInside,
+            max_step: 0.5,
+            clearance: 5.0,
+            machine: scallop_analysis::MachineLimits::default(),
+            plunge_feed: 20.0,
+            rapid_rate: 500.0,
+            sharp_corner: 30f64.to_radians(),
+            blend_tolerance: 0.01,
+        };
+        let tolerances = Tolerances { path: 0.01, gouge: 0.0 };
+        let mut cuts = Vec::new();
+        for shape in [CutterShape::Ball { radius: 3.0 }, CutterShape::Bull { radius: 3.0, corner: 1.0 }] {
+            let cutter = Cutter::new(shape, 30.0).expect("cutter");
+            let split = SteepShallow::default_for(&cutter, params.scallop_height);
+            for k in 0..64 {
+                let mesh = staggered_boxes(f64::from(k) * 0.75 / 64.0, 0.05, 0.15);
+                let index = MeshIndex::build(&mesh);
+                let levels = Levels::new(&index, &cutter, &params, &tolerances, &split, (0.0, 10.0)).expect("levels");
+                let level = levels.level(5.0).expect("level");
+                assert!(!level.passes.is_empty());
+                cuts.push(deepest_cut(&levels, &level, 1e-3));
+            }
+        }
+        let worst = cuts.iter().copied().fold(0.0, f64::max);
+        assert!(worst <= tolerances.path * tol::LEVEL_CHORD_SHARE, "{worst} {cuts:?}");
     }
 
     #[test]
