@@ -280,6 +280,14 @@ pub mod guides {
     /// bisection steps); 2^-100 of an edge is far below [`ROOT_TOLERANCE`].
     pub const MAX_ROOT_ITERATIONS: usize = 100;
 
+    /// Most segments of the stretch of the curves under a Marching Facets edge
+    /// whose distance gives the first guess of its crossing (the two feet's
+    /// segments, those between and one more at each end). A cost bound only:
+    /// a guess is kept when the exact field confirms it within
+    /// [`ROOT_TOLERANCE`], so results are within that tolerance either way
+    /// (docs/guides-curves.md, "A first guess from the stretch under the edge").
+    pub const ROOT_GUESS_SEGMENTS: usize = 16;
+
     /// A facet is flagged as crossed by the medial axis of the curve when the feet
     /// of its corners on the curve are farther apart than this many times the
     /// facet's longest edge (docs/guides-curves.md, "Medial-axis facets").

@@ -47,18 +47,24 @@ pub(crate) fn march(
     exact: &(impl Fn(&Point3) -> f64 + Sync),
     medial: &(impl Fn(usize) -> bool + Sync),
 ) -> Isolines {
-    march_facets(support, values, 0..support.mesh().triangles().len(), &|p: &Point3, _| exact(p), medial)
+    let facets = 0..support.mesh().triangles().len();
+    march_facets(support, values, facets, &|p: &Point3, _| exact(p), &|_, _, _, _| None, medial)
 }
 
 /// As [`march`], looking only at `facets` (ascending): the caller vouches
 /// that every facet with vertices of both states is among them. `exact(p, v)`
 /// is told a vertex `v` near `p` (an end of the edge, a corner of the facet),
 /// which it may use to search from, not to change the value.
+/// `guess(a, b, ga, gb)` may give a first guess in `(0, 1)` of the root on
+/// edge `(a, b)` (`ga`, `gb` the values of its ends): when the exact field is
+/// within [`tol::ROOT_TOLERANCE`] of the iso-value there, one evaluation
+/// settles the crossing; otherwise it narrows the bracket.
 pub(crate) fn march_facets(
     support: &Support,
     values: &[f64],
     facets: impl Iterator<Item = usize>,
     exact: &(impl Fn(&Point3, u32) -> f64 + Sync),
+    guess: &(impl Fn(u32, u32, f64, f64) -> Option<f64> + Sync),
     medial: &(impl Fn(usize) -> bool + Sync),
 ) -> Isolines {
     let mesh = support.mesh();
@@ -81,8 +87,11 @@ pub(crate) fn march_facets(
     }
     edges.sort_unstable();
     edges.dedup();
-    let crossings: Vec<Crossing> =
-        edges.par_iter().with_min_len(ITEMS_PER_TASK).map(|&(a, b)| crossing(support, values, exact, a, b)).collect();
+    let crossings: Vec<Crossing> = edges
+        .par_iter()
+        .with_min_len(ITEMS_PER_TASK)
+        .map(|&(a, b)| crossing(support, values, exact, guess, a, b))
+        .collect();
     let mut index: FastMap<u64, u32> = FastMap::default();
     for (i, &(a, b)) in edges.iter().enumerate() {
         index.insert(u64::from(a) << 32 | u64::from(b), u32::try_from(i).unwrap_or(u32::MAX));
@@ -107,16 +116,32 @@ fn edge_key(a: u32, b: u32) -> u64 {
     u64::from(a.min(b)) << 32 | u64::from(a.max(b))
 }
 
-/// The crossing on edge `(a, b)` (states differ) by root finding.
+/// The crossing on edge `(a, b)` (states differ) by root finding, from the
+/// first guess of `guess` if any (see [`march_facets`]).
 fn crossing(
     support: &Support,
     values: &[f64],
     exact: &(impl Fn(&Point3, u32) -> f64 + Sync),
+    guess: &(impl Fn(u32, u32, f64, f64) -> Option<f64> + Sync),
     a: u32,
     b: u32,
 ) -> Crossing {
     let (pa, pb) = (support.mesh().vertices()[a as usize], support.mesh().vertices()[b as usize]);
-    let t = edge_root(|t| exact(&(pa + (pb - pa) * t), a), values[a as usize], values[b as usize], (pb - pa).norm());
+    let g = |t: f64| exact(&(pa + (pb - pa) * t), a);
+    let (ga, gb, len) = (values[a as usize], values[b as usize], (pb - pa).norm());
+    let t = match guess(a, b, ga, gb).filter(|&t| t > 0.0 && t < 1.0) {
+        None => edge_root(g, ga, gb, len),
+        Some(t0) => {
+            let g0 = g(t0);
+            if g0.abs() <= tol::ROOT_TOLERANCE {
+                t0
+            } else if (g0 > 0.0) == (gb > 0.0) {
+                root_between(g, (0.0, ga), (t0, g0), len)
+            } else {
+                root_between(g, (t0, g0), (1.0, gb), len)
+            }
+        }
+    };
     let n = support.vertex_normal(a as usize) * (1.0 - t) + support.vertex_normal(b as usize) * t;
     let len = n.norm();
     Crossing { point: pa + (pb - pa) * t, normal: if len > 0.0 { n / len } else { support.vertex_normal(a as usize) } }
@@ -127,7 +152,13 @@ fn crossing(
 /// is not finite; stops within [`tol::ROOT_TOLERANCE`] of the root value or
 /// of bracket length (`len` is the edge length in mm).
 pub(crate) fn edge_root(g: impl Fn(f64) -> f64, ga: f64, gb: f64, len: f64) -> f64 {
-    let (mut a, mut b, mut fa, mut fb) = (0.0, 1.0, ga, gb);
+    root_between(g, (0.0, ga), (1.0, gb), len)
+}
+
+/// As [`edge_root`] within the bracket `[lo.0, hi.0]` of `[0, 1]`, where
+/// `g` has the values `lo.1` and `hi.1` of different states.
+fn root_between(g: impl Fn(f64) -> f64, lo: (f64, f64), hi: (f64, f64), len: f64) -> f64 {
+    let ((mut a, mut fa), (mut b, mut fb)) = (lo, hi);
     let mut last_side = 0i8;
     for _ in 0..tol::MAX_ROOT_ITERATIONS {
         if (b - a) * len <= tol::ROOT_TOLERANCE {

@@ -7,7 +7,7 @@
 //! pseudo-normal rule, Bærentzen & Aanæs 2005, applied to polylines).
 
 use scallop_geom::{Point3, Vec3};
-use scallop_mesh::{Polyline3, PolylineFoot, PolylineQuery};
+use scallop_mesh::{Polyline3, PolylineFoot, PolylineQuery, segment_parameter};
 
 use crate::support::Curve;
 use crate::tol;
@@ -100,6 +100,59 @@ impl CurveField {
             left[f.segment]
         };
         if (p - f.point).dot(&l) >= 0.0 { f.distance } else { -f.distance }
+    }
+}
+
+/// `count` consecutive segments of curve `curve` from segment `first`
+/// (round the end of a closed curve).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Stretch {
+    curve: usize,
+    first: usize,
+    count: usize,
+}
+
+impl CurveField {
+    /// The segments of the feet `a` and `b` and those between them (the
+    /// shorter way round a closed curve), with one more at each end, if the
+    /// feet are on one curve and these are at most `max` segments.
+    pub(crate) fn stretch(&self, a: &PolylineFoot, b: &PolylineFoot, max: usize) -> Option<Stretch> {
+        let line = self.curves().get(a.curve).filter(|_| a.curve == b.curve)?;
+        let n = line.segment_count();
+        let (lo, hi) = (a.segment.min(b.segment), a.segment.max(b.segment));
+        if hi >= n {
+            return None;
+        }
+        let (first, count) = if !line.closed {
+            let first = lo.saturating_sub(1);
+            (first, (hi + 1).min(n - 1) - first + 1)
+        } else if lo + n - hi < hi - lo {
+            ((hi + n - 1) % n, (lo + n - hi + 3).min(n))
+        } else {
+            ((lo + n - 1) % n, (hi - lo + 3).min(n))
+        };
+        (count <= max).then_some(Stretch { curve: a.curve, first, count })
+    }
+
+    /// The signed distance from `p` to the segments of `stretch` only, the
+    /// side read as in [`CurveField::signed_at`]: the same value as
+    /// [`CurveField::signed`] wherever the foot of `p` is on the stretch.
+    pub(crate) fn signed_on(&self, p: &Point3, stretch: &Stretch) -> f64 {
+        let line = &self.curves()[stretch.curve];
+        let n = line.segment_count();
+        let mut best = (f64::INFINITY, stretch.first, 0.0, *p);
+        for k in 0..stretch.count {
+            let segment = (stretch.first + k) % n;
+            let (a, b) = line.segment(segment);
+            let t = segment_parameter(p, &a, &b);
+            let q = a + (b - a) * t;
+            let d2 = (q - p).norm_squared();
+            if d2 < best.0 {
+                best = (d2, segment, t, q);
+            }
+        }
+        let (d2, segment, t, point) = best;
+        self.signed_at(p, &PolylineFoot { curve: stretch.curve, segment, t, point, distance: d2.sqrt() })
     }
 }
 

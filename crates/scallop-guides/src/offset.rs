@@ -8,7 +8,7 @@
 use scallop_geom::Point3;
 use scallop_mesh::{FastMap, PolylineFoot};
 
-use crate::facets::{Isolines, march_facets};
+use crate::facets::{Isolines, edge_root, march_facets};
 use crate::field::CurveField;
 use crate::support::{Curve, Support, check_curve};
 use crate::{GuideError, tol};
@@ -122,8 +122,30 @@ fn offset_once(support: &Support, curves: &[Curve], distance: f64) -> Isolines {
         let f = field.foot_near(p, f64::INFINITY, foot(v));
         f.map_or(f64::NEG_INFINITY, |f| field.signed_at(p, &f)) - distance
     };
+    let verts = support.mesh().vertices();
+    let guess = |a: u32, b: u32, ga: f64, gb: f64| {
+        stretch_root(&field, distance, [(verts[a as usize], foot(a)?, ga), (verts[b as usize], foot(b)?, gb)])
+    };
     let medial = |f: usize| medial_facet(support, f, |v| foot(v).map(|f| f.point));
-    march_facets(support, &values, facets.iter().map(|&f| f as usize), &exact, &medial)
+    march_facets(support, &values, facets.iter().map(|&f| f as usize), &exact, &guess, &medial)
+}
+
+/// The first guess of a crossing (docs/guides-curves.md, "A first guess from
+/// the stretch under the edge"): on the edge between `ends` (each its
+/// point, its foot on the curves and its value), the root of the signed
+/// distance to the stretch of the curves between the two feet
+/// ([`CurveField::stretch`], at most [`tol::ROOT_GUESS_SEGMENTS`]
+/// segments) minus `distance`. A few segments and no tree: far cheaper than
+/// the exact field, and equal to it wherever the crossing's foot is on that
+/// stretch, so the exact field usually confirms it in one evaluation.
+fn stretch_root(field: &CurveField, distance: f64, ends: [(Point3, &PolylineFoot, f64); 2]) -> Option<f64> {
+    let [(pa, fa, ga), (pb, fb, gb)] = ends;
+    if !ga.is_finite() || !gb.is_finite() {
+        return None;
+    }
+    let stretch = field.stretch(fa, fb, tol::ROOT_GUESS_SEGMENTS)?;
+    let g = |t: f64| field.signed_on(&(pa + (pb - pa) * t), &stretch) - distance;
+    Some(edge_root(g, ga, gb, (pb - pa).norm()))
 }
 
 /// A facet never seeded nor followed.
@@ -318,11 +340,13 @@ mod tests {
     use scallop_mesh::{Polyline3, TriMesh};
 
     use super::*;
-    use crate::facets::march;
 
     /// The brute-force oracle of [`offset_once`]: every vertex within the
     /// reach measured, the others given their side by a flood over the vertex
     /// adjacency from the measured ones (taken in order), every facet marched.
+    /// The crossings start from the same first guesses ([`stretch_root`] on
+    /// the feet of the edge's ends), so the comparison is of the following;
+    /// `every_point_is_on_the_iso_line` checks the roots.
     fn offset_once_scan(support: &Support, curves: &[Curve], distance: f64) -> Isolines {
         let field = CurveField::new(curves);
         let reach = distance + 2.0 * support.facet_size();
@@ -345,9 +369,14 @@ mod tests {
             values[v] = if field.signed(&verts[v]) > 0.0 { f64::INFINITY } else { f64::NEG_INFINITY };
             queue.push_back(v);
         }
-        let exact = |p: &Point3| field.signed(p) - distance;
+        let exact = |p: &Point3, _| field.signed(p) - distance;
+        let guess = |a: u32, b: u32, ga: f64, gb: f64| {
+            let end = |v: u32| Some((verts[v as usize], feet[v as usize].as_ref()?));
+            let ((pa, fa), (pb, fb)) = (end(a)?, end(b)?);
+            stretch_root(&field, distance, [(pa, fa, ga), (pb, fb, gb)])
+        };
         let medial = |f: usize| medial_facet(support, f, |v| feet[v as usize].map(|f| f.point));
-        march(support, &values, &exact, &medial)
+        march_facets(support, &values, 0..support.mesh().triangles().len(), &exact, &guess, &medial)
     }
 
     /// `z = height(x, y)` over `[-half, half]^2` in `n x n` cells.
@@ -399,6 +428,29 @@ mod tests {
             // The loop holds a disc of radius r0 (1 - wobble): a_e under half of it leaves an offset.
             prop_assert!(!fast.is_empty() || 2.0 * a_e > r0 * (1.0 - wobble));
             prop_assert_eq!(fast, scan);
+        }
+
+        /// Every point of every offset, found from a first guess or not, is
+        /// within the root tolerance of the iso-value of the field of the
+        /// curves before it.
+        #[test]
+        fn every_point_is_on_the_iso_line(
+            n in 24usize..64, amp in 0.0..6.0f64, r0 in 8.0..17.0f64, wobble in 0.0..0.45f64, lobes in 1u32..5,
+            a_e in 1.0..6.0f64,
+        ) {
+            let height = move |x: f64, y: f64| amp * (x / 9.0).sin() * (y / 13.0).cos();
+            let support = terrain(n, 20.0, height);
+            let limit = polar_loop(&support, height, 0.0, 0.0, |t| r0 * (1.0 + wobble * (f64::from(lobes) * t).sin()));
+            let steps = iterate(&support, std::slice::from_ref(&limit), a_e, offset_once).unwrap();
+            let mut previous = vec![limit];
+            for step in steps {
+                let field = CurveField::new(&previous);
+                for p in step.curves.iter().flat_map(|c| c.line.points.iter()) {
+                    let g = field.signed(p) - a_e;
+                    prop_assert!(g.abs() <= tol::ROOT_TOLERANCE, "{p} is {g} mm off the iso-line");
+                }
+                previous = step.curves;
+            }
         }
 
         /// A dumbbell whose neck closes before its lobes: the offsets split
