@@ -3,9 +3,9 @@
 //! (`scallop_sim::pocket_engagement`): the tool never reaches beyond a wall,
 //! no reachable material is left, and the plan is the same on one and two
 //! threads. The simulator follows arc moves along chords within 1 um, as
-//! `scallop engagement` reads G2/G3. The engagement bound (1.1 x the stepover's angle outside the entry) and no
-//! full slot are not met yet on these small pockets: that test is ignored
-//! (docs/roughing.md, "Adaptive clearing").
+//! `scallop engagement` reads G2/G3. The engagement bound (1.1 x the
+//! stepover's angle outside the entry) holds on discs, not yet at the sharp
+//! corners of straight walls (docs/roughing.md, "Adaptive clearing").
 #![allow(clippy::unwrap_used, reason = "tests: a panic is the failure report")]
 
 use proptest::prelude::*;
@@ -97,19 +97,25 @@ fn ls_are_cleared_inside_their_walls() {
 }
 
 #[test]
-#[ignore = "issue 16: the bound and no slot are not met yet (docs/roughing.md, Adaptive clearing)"]
-fn pockets_stay_within_the_bound_without_slots() {
+fn discs_stay_within_the_bound_and_no_pocket_has_a_slot() {
+    // The bound (1.1 x the stepover's angle) holds on a disc; the straight-
+    // walled pockets (rectangle, with an island, L) exceed it at their sharp
+    // corners, which this pattern does not handle yet (issue 16,
+    // docs/roughing.md "Adaptive clearing"), so only their slots are judged.
     let bound = 1.1 * engagement_angle(AE, R);
-    let reports: Vec<EngagementReport> = (0..4).map(|kind| judge_shape(&shape(16.0, 12.0, kind))).collect();
-    let over: Vec<String> = reports
-        .iter()
-        .enumerate()
-        .filter(|(_, r)| r.slot_length > 0.0 || r.max > bound)
-        .map(|(kind, r)| {
-            format!("shape {kind}: max {:.1} deg at {:?}, slot {:.2} mm", r.max.to_degrees(), r.max_at, r.slot_length)
-        })
-        .collect();
-    assert!(over.is_empty(), "bound {:.1} deg: {over:?}", bound.to_degrees());
+    for kind in 0..4 {
+        let r = judge_shape(&shape(16.0, 12.0, kind));
+        assert!(r.slot_length <= 0.0, "shape {kind}: slot {:.2} mm", r.slot_length);
+        if kind == 3 {
+            assert!(
+                r.max <= bound,
+                "disc: max {:.1} deg at {:?}, bound {:.1} deg",
+                r.max.to_degrees(),
+                r.max_at,
+                bound.to_degrees()
+            );
+        }
+    }
 }
 
 fn judge_shape(rings: &[Vec<[f64; 2]>]) -> EngagementReport {
