@@ -4,7 +4,7 @@
 //! drop-cutter), translation, thread-count invariance.
 
 use proptest::prelude::*;
-use scallop_cutter::{Contact, Cutter, CutterShape, drop_cutter_brute_force};
+use scallop_cutter::{Contact, Cutter, drop_cutter_brute_force};
 use scallop_geom::{Point2, Point3, Vec3};
 use scallop_mesh::{MeshIndex, TriMesh};
 use scallop_waterline::{Loop, WaterlineGrid, WaterlineOptions};
@@ -21,15 +21,6 @@ fn terrain(n: usize, cell: f64, h: &[f64]) -> TriMesh {
         }
     }
     TriMesh::from_soup(&soup).expect("valid terrain").0
-}
-
-fn shape_of(kind: u8, radius: f64) -> CutterShape {
-    match kind % 4 {
-        0 => CutterShape::Flat { radius },
-        1 => CutterShape::Ball { radius },
-        2 => CutterShape::Bull { radius, corner: 0.4 * radius },
-        _ => CutterShape::Cone { radius, half_angle: 0.6 },
-    }
 }
 
 /// Relative rounding at which the brute-force and the indexed drop-cutter may
@@ -92,7 +83,7 @@ proptest! {
     ) {
         let mesh = terrain(6, 4.0, &h);
         let index = MeshIndex::build(&mesh);
-        let cutter = Cutter::new(shape_of(kind, radius), 40.0).expect("cutter");
+        let cutter = Cutter::new(common::shape_of(kind, radius), 40.0).expect("cutter");
         let b = mesh.bounds();
         let z = b.min.z + z_frac * (b.max.z - b.min.z);
         let options = WaterlineOptions::default();
@@ -156,7 +147,7 @@ proptest! {
         let mesh = terrain(6, 4.0, &h);
         let moved = mesh.translated(&Vec3::new(dx, dy, dz));
         let (index, moved_index) = (MeshIndex::build(&mesh), MeshIndex::build(&moved));
-        let cutter = Cutter::new(shape_of(kind, 1.5), 40.0).expect("cutter");
+        let cutter = Cutter::new(common::shape_of(kind, 1.5), 40.0).expect("cutter");
         let b = mesh.bounds();
         let z = b.min.z + z_frac * (b.max.z - b.min.z);
         let options = WaterlineOptions::default();
@@ -189,7 +180,7 @@ fn one_and_two_threads_give_identical_loops() {
     let mesh = terrain(6, 4.0, &h);
     let index = MeshIndex::build(&mesh);
     for kind in 0..4 {
-        let cutter = Cutter::new(shape_of(kind, 1.2), 40.0).expect("cutter");
+        let cutter = Cutter::new(common::shape_of(kind, 1.2), 40.0).expect("cutter");
         let run = |threads: usize| {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("pool");
             pool.install(|| {
@@ -226,7 +217,7 @@ proptest! {
     ) {
         let mesh = terrain(6, 4.0, &h);
         let index = MeshIndex::build(&mesh);
-        let cutter = Cutter::new(shape_of(kind, radius), 40.0).expect("cutter");
+        let cutter = Cutter::new(common::shape_of(kind, radius), 40.0).expect("cutter");
         let b = mesh.bounds();
         let z = b.min.z + z_frac * (b.max.z - b.min.z);
         let options = WaterlineOptions::default();

@@ -4,7 +4,7 @@
 //! generated here; the oracle is the brute-force drop-cutter.
 
 use proptest::prelude::*;
-use scallop_cutter::{Cutter, CutterShape, drop_cutter_brute_force};
+use scallop_cutter::{Cutter, drop_cutter_brute_force};
 use scallop_geom::{Point2, Point3};
 use scallop_mesh::{MeshIndex, TriMesh};
 use scallop_waterline::{Loop, WaterlineGrid, WaterlineOptions};
@@ -32,15 +32,6 @@ fn box_soup(angle: f64, x0: f64, x1: f64, b: f64, h: f64) -> Vec<[Point3; 3]> {
         [b3, b0, t0],
         [b3, t0, t3],
     ]
-}
-
-fn shape_of(kind: u8, radius: f64) -> CutterShape {
-    match kind % 4 {
-        0 => CutterShape::Flat { radius },
-        1 => CutterShape::Ball { radius },
-        2 => CutterShape::Bull { radius, corner: 0.4 * radius },
-        _ => CutterShape::Cone { radius, half_angle: 0.6 },
-    }
 }
 
 fn winding(loops: &[Loop], q: Point2) -> i32 {
@@ -72,7 +63,7 @@ proptest! {
         soup.extend(box_soup(angle, x2, x2 + BOX_LENGTH, BOX_LENGTH, BOX_HEIGHT));
         let mesh = TriMesh::from_soup(&soup).expect("two boxes").0;
         let index = MeshIndex::build(&mesh);
-        let cutter = Cutter::new(shape_of(kind, radius), 40.0).expect("cutter");
+        let cutter = Cutter::new(common::shape_of(kind, radius), 40.0).expect("cutter");
         let z = 0.5 * BOX_HEIGHT;
         let loops = WaterlineGrid::new(&cutter, &index, &WaterlineOptions::default()).expect("grid").loops(z).expect("level");
         prop_assert_eq!(loops.len(), 2, "one loop around each box");
@@ -115,7 +106,7 @@ proptest! {
     ) {
         let mesh = pyramid(ax, ay);
         let index = MeshIndex::build(&mesh);
-        let cutter = Cutter::new(shape_of(kind, radius), 40.0).expect("cutter");
+        let cutter = Cutter::new(common::shape_of(kind, radius), 40.0).expect("cutter");
         let z = BOX_HEIGHT - below;
         let loops = WaterlineGrid::new(&cutter, &index, &WaterlineOptions::default()).expect("grid").loops(z).expect("level");
         let apex = Point2::new(ax, ay);
@@ -170,7 +161,7 @@ proptest! {
         soup.extend(ridge_soup(angle, x1 - 1.0, x2 + 1.0, ridge_y, 0.5, z + above));
         let mesh = TriMesh::from_soup(&soup).expect("boxes and ridge").0;
         let index = MeshIndex::build(&mesh);
-        let cutter = Cutter::new(shape_of(kind, radius), 40.0).expect("cutter");
+        let cutter = Cutter::new(common::shape_of(kind, radius), 40.0).expect("cutter");
         let options = WaterlineOptions::default();
         let grid = WaterlineGrid::new(&cutter, &index, &options).expect("grid");
         let loops = grid.loops(z).expect("level");

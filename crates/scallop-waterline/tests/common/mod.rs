@@ -4,7 +4,7 @@
 //! brute-force drop-cutter `d(x, y)`; the cutter at tip height z cuts into the
 //! part exactly where `d > z`.
 
-use scallop_cutter::{Contact, Cutter, drop_cutter_brute_force};
+use scallop_cutter::{Contact, Cutter, CutterShape, drop_cutter_brute_force};
 use scallop_geom::{Point2, Vec2};
 use scallop_mesh::MeshIndex;
 use scallop_waterline::Loop;
@@ -110,4 +110,15 @@ pub fn check_on_contact(
         }
     }
     Ok(())
+}
+
+/// The cutter of shape `kind` (flat, ball, bull-nose with corner 0.4 R, cone
+/// of half-angle 0.6 rad, cycling) and `radius`.
+pub fn shape_of(kind: u8, radius: f64) -> CutterShape {
+    match kind % 4 {
+        0 => CutterShape::Flat { radius },
+        1 => CutterShape::Ball { radius },
+        2 => CutterShape::Bull { radius, corner: 0.4 * radius },
+        _ => CutterShape::Cone { radius, half_angle: 0.6 },
+    }
 }
