@@ -314,7 +314,9 @@ pub fn run(args: &Rough5Args) -> CliResult<()> {
         return cases::run(args, name, &part, (&bottom, &flanks), &tool, &settings);
     }
     let (plan, setups) = if let Some(which) = args.baseline {
-        baseline(args, which, &part, &tool, &settings).map_err(|e| Failure::rejected(format!("{name}: {e}")))?
+        let max_tilt = machine_tilt(args)?;
+        baseline(args, (which, max_tilt), &part, &tool, &settings)
+            .map_err(|e| Failure::rejected(format!("{name}: {e}")))?
     } else {
         let bar = progress_bar(0, "levels");
         let plan =
@@ -505,7 +507,7 @@ fn machine_tilt(args: &Rough5Args) -> CliResult<f64> {
 /// program, as a plan the rest of the command proves, posts and reports.
 fn baseline(
     args: &Rough5Args,
-    which: BaselineArg,
+    (which, max_tilt): (BaselineArg, f64),
     part: &scallop_parts::TestPart,
     tool: &Cutter,
     settings: &Rough5Settings,
@@ -523,7 +525,7 @@ fn baseline(
         feed: settings.feed,
         rapid_rate: settings.rapid_rate,
         clearance: settings.clearance,
-        max_tilt: machine_tilt(args).map_err(|e| e.to_string())?,
+        max_tilt,
         resolution: args.resolution,
         axis_tolerance: args.sim_tolerance,
     };
