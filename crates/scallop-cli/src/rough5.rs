@@ -1,5 +1,6 @@
 //! `scallop rough5`: 5-axis roughing of a test part by guide curves (or the
-//! zero-tilt baseline), proven on a tri-dexel stock and posted for a 5-axis
+//! zero-tilt baseline, or the 3-axis z-level and 3+2 baselines of
+//! `--baseline`), proven on a tri-dexel stock and posted for a 5-axis
 //! machine (docs/rough5.md): `program.nc`, `toolpath.cl` and `report.json`.
 
 use std::fmt::Write as _;
@@ -16,8 +17,8 @@ use scallop_parts::FaceTag;
 use scallop_parts::TestPart;
 use scallop_post::{OutputMode, PostParams, check_replay, program_text, replay};
 use scallop_rough5::{
-    CuttingData, OrientSettings, Proof, ProofSettings, Rough5Plan, Rough5Settings, TiltMode, Weights, plan_rough5,
-    prove,
+    BaselinePlan, BaselineSettings, CuttingData, OrientSettings, Pocket, Proof, ProofSettings, Rough5Plan,
+    Rough5Settings, TiltMode, Weights, plan_rough5, plan_three_plus_two, plan_zlevel, prove,
 };
 use scallop_toolpath::Toolpath;
 use serde::Serialize;
@@ -39,6 +40,16 @@ pub enum TiltArg {
     Optimised,
 }
 
+/// A 3-axis baseline on the same part, tool and cutting data.
+#[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
+pub enum BaselineArg {
+    /// Z-level roughing in one setup, the tool axis +Z.
+    Zlevel,
+    /// The z-level program, then rest roughing in fixed orientations chosen from the undercuts.
+    #[value(name = "3+2")]
+    ThreePlusTwo,
+}
+
 /// Arguments of `scallop rough5`.
 #[derive(Args, Debug)]
 pub struct Rough5Args {
@@ -48,6 +59,11 @@ pub struct Rough5Args {
     /// Tool-axis variant.
     #[arg(long, value_enum, default_value = "guides")]
     tilt: TiltArg,
+    /// Plan a 3-axis baseline instead of the 5-axis program (same part, tool, a_p, a_e, allowances,
+    /// feed, proof and machine): `zlevel` in one setup, or `3+2` (zlevel, then rest roughing in
+    /// setups chosen from the undercut flanks). `--tilt` is then ignored.
+    #[arg(long, value_enum)]
+    baseline: Option<BaselineArg>,
     /// Torus radius R (mm; the thesis's FRAISA torus R 5 r 1.5).
     #[arg(long, default_value_t = 5.0)]
     tool_radius: f64,
@@ -164,6 +180,19 @@ struct Metrics {
     removal_rate_percent_s: f64,
 }
 
+/// One fixed orientation of a baseline.
+#[derive(Serialize)]
+struct SetupJson {
+    axis: [f64; 3],
+    tilt_deg: f64,
+    undercut_area_mm2: f64,
+    levels: usize,
+    passes: usize,
+    links: usize,
+    retracts: usize,
+    helices: usize,
+}
+
 #[derive(Serialize)]
 struct Report {
     command: &'static str,
@@ -182,6 +211,8 @@ struct Report {
     metrics: Metrics,
     levels: Vec<LevelJson>,
     passes: Vec<PassJson>,
+    /// The setups of a 3-axis baseline (empty for the 5-axis programs).
+    setups: Vec<SetupJson>,
     plan_seconds: f64,
     proof_seconds: f64,
 }
@@ -282,10 +313,18 @@ pub fn run(args: &Rough5Args) -> CliResult<()> {
     if args.orientation_cases {
         return cases::run(args, name, &part, (&bottom, &flanks), &tool, &settings);
     }
-    let bar = progress_bar(0, "levels");
-    let plan = plan_rough5(&bottom, &flanks, &part.stock, &tool, &settings, &|d, t| crate::simulate::show(&bar, d, t))
-        .map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
-    bar.finish_and_clear();
+    let (plan, setups) = if let Some(which) = args.baseline {
+        let max_tilt = machine_tilt(args)?;
+        baseline(args, (which, max_tilt), &part, &tool, &settings)
+            .map_err(|e| Failure::rejected(format!("{name}: {e}")))?
+    } else {
+        let bar = progress_bar(0, "levels");
+        let plan =
+            plan_rough5(&bottom, &flanks, &part.stock, &tool, &settings, &|d, t| crate::simulate::show(&bar, d, t))
+                .map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
+        bar.finish_and_clear();
+        (plan, Vec::new())
+    };
     let plan_seconds = clock.elapsed().as_secs_f64();
     let bar = progress_bar(0, "tri-dexel proof");
     let proof_settings = ProofSettings { resolution: args.resolution, axis_tolerance: args.sim_tolerance };
@@ -299,7 +338,8 @@ pub fn run(args: &Rough5Args) -> CliResult<()> {
     let post = posted.as_ref().map(|(_, p)| p).map_err(|e| match e {
         Failure::Rejected(e) | Failure::Io(e) => e.to_string(),
     });
-    let report = report(args, name, &plan, &proof, post, [plan_seconds, proof_seconds]);
+    let mut report = report(args, name, &plan, &proof, post, [plan_seconds, proof_seconds]);
+    report.setups = setups;
     let mut out = OutputSet::begin(&args.output, "rough5")?;
     if let Ok((nc, _)) = &posted {
         out.write("program.nc", nc.as_bytes())?;
@@ -409,7 +449,11 @@ fn report(
     Report {
         command: "rough5",
         part: name.to_string(),
-        tilt: format!("{:?}", args.tilt).to_lowercase(),
+        tilt: match args.baseline {
+            Some(BaselineArg::Zlevel) => "zlevel (3-axis baseline)".into(),
+            Some(BaselineArg::ThreePlusTwo) => "3+2 (3-axis baseline)".into(),
+            None => format!("{:?}", args.tilt).to_lowercase(),
+        },
         machine: args.machine.clone(),
         dialect: args.dialect.clone(),
         cl_points: plan.toolpath.moves().len(),
@@ -439,9 +483,82 @@ fn report(
                 max_tilt_deg: deg(p.max_tilt),
             })
             .collect(),
+        setups: Vec::new(),
         plan_seconds: seconds[0],
         proof_seconds: seconds[1],
     }
+}
+
+/// The largest tilt of the tool axis from +Z the machine allows: the largest
+/// stop of its rotary axes that are not vertical (a quarter turn without
+/// stops).
+fn machine_tilt(args: &Rough5Args) -> CliResult<f64> {
+    let machine = load_machine(&args.machine, Path::new(""), "--machine")?;
+    let tilt = machine
+        .axes()
+        .iter()
+        .filter(|a| matches!(a.kind, scallop_machine::AxisKind::Rotary) && a.direction.z.abs() < 0.5)
+        .map(|a| a.limits.map_or(std::f64::consts::FRAC_PI_2, |(lo, hi)| lo.abs().max(hi.abs())))
+        .fold(0.0, f64::max);
+    Ok(tilt.min(std::f64::consts::FRAC_PI_2))
+}
+
+/// Plans a 3-axis baseline (`--baseline`) with the settings of the 5-axis
+/// program, as a plan the rest of the command proves, posts and reports.
+fn baseline(
+    args: &Rough5Args,
+    (which, max_tilt): (BaselineArg, f64),
+    part: &scallop_parts::TestPart,
+    tool: &Cutter,
+    settings: &Rough5Settings,
+) -> Result<(Rough5Plan, Vec<SetupJson>), String> {
+    let faces = |tags: &[FaceTag]| part.faces(tags).map_err(|e| e.to_string());
+    let (surface, opening) = (faces(&[FaceTag::Bottom, FaceTag::Flank])?, faces(&[FaceTag::Top])?);
+    let flanks = faces(&[FaceTag::Flank])?;
+    let pocket =
+        Pocket { surface: &surface, opening: &opening, flanks: &flanks, volume: &part.mesh, stock: part.stock };
+    let s = BaselineSettings {
+        stepdown: settings.guides.axial_step,
+        stepover: settings.guides.radial_step,
+        flank_allowance: settings.guides.flank_allowance,
+        bottom_allowance: settings.bottom_allowance,
+        feed: settings.feed,
+        rapid_rate: settings.rapid_rate,
+        clearance: settings.clearance,
+        max_tilt,
+        resolution: args.resolution,
+        axis_tolerance: args.sim_tolerance,
+    };
+    let plan: BaselinePlan = match which {
+        BaselineArg::Zlevel => plan_zlevel(&pocket, tool, &s),
+        BaselineArg::ThreePlusTwo => plan_three_plus_two(&pocket, tool, &s),
+    }
+    .map_err(|e| e.to_string())?;
+    let setups = plan
+        .setups
+        .iter()
+        .map(|u| SetupJson {
+            axis: [u.axis.x, u.axis.y, u.axis.z],
+            tilt_deg: u.axis.angle(&scallop_geom::Vec3::z()).to_degrees(),
+            undercut_area_mm2: u.undercut_area,
+            levels: u.levels,
+            passes: u.passes,
+            links: u.links,
+            retracts: u.retracts,
+            helices: u.helices,
+        })
+        .collect();
+    let sum = |f: fn(&scallop_rough5::SetupReport) -> usize| plan.setups.iter().map(f).sum();
+    let as_plan = Rough5Plan {
+        retracts: sum(|u| u.retracts),
+        links: sum(|u| u.links),
+        ramps: sum(|u| u.helices),
+        toolpath: plan.toolpath,
+        levels: Vec::new(),
+        passes: Vec::new(),
+        estimated_time: plan.estimated_time,
+    };
+    Ok((as_plan, setups))
 }
 
 fn summary_text(r: &Report, output: &Path) -> String {
@@ -457,6 +574,19 @@ fn summary_text(r: &Report, output: &Path) -> String {
         r.machine,
         r.dialect
     );
+    for (k, u) in r.setups.iter().enumerate() {
+        let _ = writeln!(
+            s,
+            "  setup {}: axis ({:.3}, {:.3}, {:.3}) tilted {:.1} deg, {} levels, {} passes",
+            k + 1,
+            u.axis[0],
+            u.axis[1],
+            u.axis[2],
+            u.tilt_deg,
+            u.levels,
+            u.passes
+        );
+    }
     let _ = writeln!(
         s,
         "  V_r {:.2} % ({:.0} of {:.0} mm3), gouge {:.3} mm3 (deepest {:.3} mm), L_HM {:.1} %",

@@ -2,6 +2,7 @@
 //! pocket is proven, posted for the UCP 710 (840D, TRAORI) and reported with
 //! consistent metrics (spec 12.1 item 6); the six orientation cases of the
 //! thesis (Ch. 3 §2.3) run on one pass with their pitch traces and times;
+//! the 3+2 baseline (`--baseline 3+2`) is proven and posted with its setups;
 //! bad settings exit 1.
 
 mod common;
@@ -29,6 +30,30 @@ fn rough5_writes_a_proven_program_and_its_metrics() {
     let nc = std::fs::read_to_string(dir.join("program.nc")).expect("program");
     assert!(nc.contains("TRAORI"));
     assert!(report["post_error"].is_null());
+}
+
+#[test]
+fn rough5_baseline_3plus2_is_proven_posted_and_reports_its_setups() {
+    let dir = scratch("rough5-3plus2");
+    succeeded(
+        scallop()
+            .args(["rough5", "--part", "pocket", "--baseline", "3+2", "--ap", "6", "--resolution", "1", "--json"])
+            .arg("-o")
+            .arg(&dir),
+    );
+    let report = read_json(&dir.join("report.json"));
+    let num = |k: &str| report["metrics"][k].as_f64().unwrap_or(f64::NAN);
+    assert!(num("remaining_percent") > 0.0 && num("remaining_percent") < 100.0);
+    assert!(num("gouge_depth_mm") <= 1.0);
+    assert!(num("machining_time_s") > 0.0);
+    let setups = report["setups"].as_array().expect("setups");
+    // The z-level setup (axis +Z) first, then at least one tilted rest setup.
+    assert!(setups.len() >= 2, "{setups:?}");
+    assert!(setups[0]["tilt_deg"].as_f64().unwrap_or(f64::NAN).abs() < 1e-9);
+    assert!(setups[1..].iter().all(|u| u["tilt_deg"].as_f64().unwrap_or(0.0) > 1.0));
+    assert!(std::fs::read_to_string(dir.join("program.nc")).expect("program").contains("TRAORI"));
+    let out = scallop().args(["rough5", "--baseline", "4+1", "-o"]).arg(&dir).output().expect("run");
+    assert!(!out.status.success());
 }
 
 #[test]

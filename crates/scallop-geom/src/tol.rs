@@ -849,6 +849,40 @@ pub mod rough5 {
     /// the angular-step limit inserted next to the last round's corrections):
     /// Jousselin 2020 caps its correction loop at 3 (Ch. 3 §3, Fig. 3.34).
     pub const CORRECTION_ROUNDS: usize = 3;
+
+    /// A flank triangle whose outward normal (out of the volume to remove)
+    /// rises above the horizontal by more than this sine (1 degree) is an
+    /// undercut: the 3+2 baseline looks for setups that reach under it
+    /// (`scallop_rough5::setup_axes`).
+    pub const UNDERCUT_SIN: f64 = 0.017_452_406_437_283_5;
+
+    /// A 3+2 setup's axis leans this much (rad, 3 degrees) beyond the mean
+    /// undercut of its flanks, so the flutes clear the overhang it reaches
+    /// under.
+    pub const SETUP_MARGIN: f64 = 3.0 * std::f64::consts::PI / 180.0;
+
+    /// The undercut flanks are grouped by the azimuth of their normals in
+    /// this many equal sectors (the first centred on +X); each sector is one
+    /// candidate 3+2 setup.
+    pub const SETUP_SECTORS: usize = 4;
+
+    /// A sector whose undercut area is below this share of the whole undercut
+    /// area gets no setup of its own.
+    pub const SETUP_MIN_SHARE: f64 = 0.05;
+
+    /// Between two 3+2 setups the tool leaves along the old axis and comes
+    /// back along the new one from this height above the stock (mm).
+    pub const SETUP_CHANGE_LIFT: f64 = 50.0;
+
+    /// Chord tolerance (mm) of the 3-axis baselines: the booleans of the level
+    /// regions and the arcs of the z-level passes written as lines (a tilted
+    /// setup has no XY arcs in the part frame).
+    pub const BASELINE_CHORD: f64 = 0.005;
+
+    /// The material map of a rest setup (the in-process stock seen along the
+    /// setup's axis) has cells this many times the tri-dexel spacing, so that
+    /// every cell holds a sample of the tilted rays.
+    pub const MATERIAL_CELL_FACTOR: f64 = 2.0;
 }
 
 pub mod sim {

@@ -320,7 +320,28 @@ pub fn plan_rough_from(
 ) -> Result<RoughPlan, RoughError> {
     settings.validate()?;
     let zs = level_heights(index, stock, settings);
-    let mut levels = level_regions(index, cutter, stock, settings, &zs, tolerance)?;
+    let levels = level_regions(index, cutter, stock, settings, &zs, tolerance)?;
+    plan_levels(levels, cutter, stock, material, settings, motion, tolerance)
+}
+
+/// The second half of [`plan_rough_from`]: clears the given `levels` (top
+/// down, each a tool-tip height and its tool-centre region), from the
+/// in-process stock `material` when given. A caller that restricts the
+/// regions of [`level_regions`] further (5-axis roughing's 3-axis baselines
+/// in a tilted setup, `scallop-rough5`) plans them here.
+///
+/// # Errors
+/// As [`plan_rough`].
+pub fn plan_levels(
+    mut levels: Vec<Level>,
+    cutter: &Cutter,
+    stock: &Aabb3,
+    material: Option<&MaterialMap>,
+    settings: &RoughSettings,
+    motion: &Motion,
+    tolerance: f64,
+) -> Result<RoughPlan, RoughError> {
+    settings.validate()?;
     if let Some(m) = material {
         let r = cutter.radius();
         levels = levels

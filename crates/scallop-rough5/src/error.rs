@@ -37,6 +37,9 @@ pub enum Rough5Error {
         /// Why.
         reason: String,
     },
+    /// The 3-axis roughing of a baseline failed.
+    #[error("3-axis roughing: {0}")]
+    Rough(String),
     /// The stock simulation refused the program or found it unsafe.
     #[error("stock simulation: {0}")]
     Simulation(String),

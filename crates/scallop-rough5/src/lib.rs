@@ -14,6 +14,9 @@
 //! - [`correct_planar`]: the collision correction that turns a colliding
 //!   tool axis in its correction plane, the pitch angle kept (Ch. 3 §3,
 //!   Eq. 3.31);
+//! - [`plan_zlevel`], [`plan_three_plus_two`]: the 3-axis baselines on the
+//!   same part, tool and cutting data (z-level roughing in one setup, then
+//!   rest roughing in fixed orientations chosen from the undercuts);
 //! - [`prove`]: the program cut on a tri-dexel stock with shank and holder
 //!   collisions as errors, and the metrics of spec 10.1 (module L).
 //!
@@ -37,6 +40,7 @@
 //! - A placed tool never penetrates the level mesh (the maximum over every
 //!   triangle's contacts); results do not depend on the thread count.
 
+mod baseline;
 mod collide;
 mod correct;
 mod cutting;
@@ -51,6 +55,7 @@ pub mod sqp;
 mod sync;
 pub use scallop_geom::tol::rough5 as tol;
 
+pub use baseline::{BaselinePlan, BaselineSettings, Pocket, SetupReport, plan_three_plus_two, plan_zlevel, setup_axes};
 pub use collide::BodyCheck;
 pub use correct::{CorrectionCount, correct_pairs, correct_planar};
 pub use cutting::CuttingData;

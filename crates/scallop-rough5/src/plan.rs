@@ -281,7 +281,7 @@ pub fn plan_single_pass(
 }
 
 /// Time at the programmed feeds and the rapid rate (s).
-fn estimate_time(path: &Toolpath, rapid_rate: f64) -> f64 {
+pub(crate) fn estimate_time(path: &Toolpath, rapid_rate: f64) -> f64 {
     let mut from: Option<Point3> = None;
     let mut t = 0.0;
     for (i, m) in path.moves().iter().enumerate() {
