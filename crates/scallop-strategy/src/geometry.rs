@@ -95,18 +95,12 @@ pub(crate) fn contact_normal(shape: &CutterShape, index: &MeshIndex, slots: &[u3
     let tip = cl.tip;
     let from_cutter = match *shape {
         CutterShape::Ball { radius } => Some(Point3::new(tip.x, tip.y, tip.z + radius) - point),
-        CutterShape::Bull { radius, corner } => {
+        CutterShape::Bull { radius, corner } if !on_flat_bottom(shape, cl) => {
             let radial = Vec2::new(point.x - tip.x, point.y - tip.y);
-            let rho = radial.norm();
-            let flat = radius - corner;
-            if rho > flat + tol::TORUS_CONTACT_REL * radius {
-                let ring = radial * (flat / rho);
-                Some(Point3::new(tip.x + ring.x, tip.y + ring.y, tip.z + corner) - point)
-            } else {
-                None
-            }
+            let ring = radial * ((radius - corner) / radial.norm());
+            Some(Point3::new(tip.x + ring.x, tip.y + ring.y, tip.z + corner) - point)
         }
-        CutterShape::Flat { .. } | CutterShape::Cone { .. } => None,
+        CutterShape::Bull { .. } | CutterShape::Flat { .. } | CutterShape::Cone { .. } => None,
     };
     if let Some(n) = from_cutter {
         let len = n.norm();
@@ -115,6 +109,22 @@ pub(crate) fn contact_normal(shape: &CutterShape, index: &MeshIndex, slots: &[u3
         }
     }
     slots.get(triangle).map_or_else(Vec3::z, |&slot| *index.normal(slot as usize))
+}
+
+/// Whether the contact of `cl` lies under the flat bottom of a bull-nose
+/// (within `tol::TORUS_CONTACT_REL` of the radius from the torus), where the
+/// cutter's own normal is +Z. `false` for every other shape and for `Floor`.
+pub(crate) fn on_flat_bottom(shape: &CutterShape, cl: &ClPoint) -> bool {
+    let (CutterShape::Bull { radius, corner }, Some(point)) = (*shape, contact_point(cl)) else { return false };
+    let rho = Vec2::new(point.x - cl.tip.x, point.y - cl.tip.y).norm();
+    rho <= radius - corner + tol::TORUS_CONTACT_REL * radius
+}
+
+fn contact_point(cl: &ClPoint) -> Option<Point3> {
+    match cl.contact {
+        Contact::Floor => None,
+        Contact::Vertex { point, .. } | Contact::Edge { point, .. } | Contact::Facet { point, .. } => Some(point),
+    }
 }
 
 /// Bit pattern of a point: welded meshes share exact vertex coordinates.

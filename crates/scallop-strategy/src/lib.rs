@@ -312,7 +312,9 @@ pub struct Planned {
     pub planes: Vec<Plane>,
     /// Feed coordinates `t` at which the scallop was measured.
     pub feed_samples: Vec<f64>,
-    /// The verified scallop.
+    /// The verified scallop; for the shallow planes of steep-and-shallow
+    /// (rest tolerated) the raw measure, rest material included
+    /// (`rest_material_mm` 0), which the stock simulation replaces.
     pub scallop: ScallopReport,
     /// Times, lengths and counts.
     pub report: Report,
@@ -417,8 +419,13 @@ fn plan(
     let (toolpath, links, retracts) = planner.toolpath(&planes);
     let planes: Vec<Plane> = planes.into_iter().map(|p| p.plane).collect();
     let feed_samples = planner.feed_samples.clone();
+    // With rest tolerated the measure is a report, not a proof (the stock
+    // simulation proves the program): the heights are raw, rest material
+    // included, without the dense-pass reference of every cusp over sh, whose
+    // drops along every wall's foot cost more than the plan itself.
     let measure = scallop::Measure {
         end_margin: plan::zone_end_margin(cutter, region),
+        refine: !tolerate_rest,
         ..scallop::Measure::new(index, cutter, params.direction, params.scallop_height)
     };
     let scallop = scallop::verify_measured(&measure, &planes, &feed_samples, !tolerate_rest)?;

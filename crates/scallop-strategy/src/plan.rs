@@ -8,7 +8,7 @@ use scallop_geom::{Point2, Point3, Tolerances, Vec2, Vec3};
 use scallop_mesh::MeshIndex;
 use scallop_toolpath::{Move, MoveKind, Toolpath, simplify_above};
 
-use crate::geometry::{Frame, PartBoundary, contact_normal, slots_by_original};
+use crate::geometry::{Frame, PartBoundary, contact_normal, on_flat_bottom, slots_by_original};
 use crate::scallop::{Curve, Measure, pair_heights};
 use crate::{Boundary, FinishingParams, Pattern, Plane, StrategyError, ZoneRegion, tol};
 
@@ -456,15 +456,19 @@ impl<'a> Planner<'a> {
     /// than [`tol::SHARP_EDGE_DEG`] from the contacted facet's normal. There
     /// the part has no surface between passes to leave a scallop on (every
     /// pass touches the same edge), so the contact does not set the spacing;
-    /// the measured scallop still checks the pair.
+    /// the measured scallop still checks the pair. A flat bottom resting on
+    /// the edge or vertex has the normal +Z whatever triangle owns the feature
+    /// (the top corner of a vertical wall: the wall's normal would otherwise
+    /// set a spacing near zero, [`on_flat_bottom`]).
     fn rides_sharp_edge(&self, cl: &ClPoint, n: &Vec3) -> bool {
         let triangle = match cl.contact {
             Contact::Vertex { triangle, .. } | Contact::Edge { triangle, .. } => triangle,
             Contact::Floor | Contact::Facet { .. } => return false,
         };
+        let n = if on_flat_bottom(&self.shape, cl) { Vec3::z() } else { *n };
         self.slots
             .get(triangle)
-            .is_some_and(|&slot| self.index.normal(slot as usize).dot(n) < tol::SHARP_EDGE_DEG.to_radians().cos())
+            .is_some_and(|&slot| self.index.normal(slot as usize).dot(&n) < tol::SHARP_EDGE_DEG.to_radians().cos())
     }
 
     /// Largest measured scallop between two planes at the feed samples.
@@ -621,7 +625,11 @@ impl<'a> Planner<'a> {
                     if !self.tolerate_rest {
                         return Err(self.unreachable(gap, at));
                     }
-                    next = self.plane(d + rest_gap);
+                    // At the rule's own gap (a residual called rest on the
+                    // first try) `next` is that plane already.
+                    if rest_gap.to_bits() != gap.to_bits() {
+                        next = self.plane(d + rest_gap);
+                    }
                     if next.plane.passes.is_empty() {
                         empty = d + rest_gap;
                         continue 'ranges;
@@ -958,5 +966,70 @@ mod cone_tests {
         let a = 45f64.to_radians();
         assert!((cone_step(0.05, 0.2, a) - cone_step(0.05, -0.2, a)).abs() < 1e-12);
         assert!(cone_step(0.05, 0.3, a) > cone_step(0.05, 0.1, a));
+    }
+}
+
+#[cfg(test)]
+mod sharp_edge_tests {
+    use scallop_cutter::{ClPoint, Contact, Cutter, CutterShape};
+    use scallop_geom::{Point3, Tolerances};
+    use scallop_mesh::{MeshIndex, TriMesh};
+
+    use super::Planner;
+    use crate::geometry::contact_normal;
+
+    /// A block 20 x 20 x 10 mm with vertical walls.
+    fn block() -> TriMesh {
+        let c = |i: usize| {
+            let pick = |bit: usize, hi: f64| if i & bit == 0 { 0.0 } else { hi };
+            Point3::new(pick(1, 20.0), pick(2, 20.0), pick(4, 10.0))
+        };
+        let mut soup = Vec::new();
+        for [a, b, cc, d] in [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]] {
+            soup.push([c(a), c(b), c(cc)]);
+            soup.push([c(a), c(cc), c(d)]);
+        }
+        TriMesh::from_soup(&soup).expect("block").0
+    }
+
+    /// A bull-nose whose flat bottom rests on the block's top corner touches a
+    /// horizontal surface, whichever triangle owns the corner: a vertical
+    /// wall's normal there would set a spacing near zero (issue 15,
+    /// octagonal_pocket), so the contact counts as a sharp edge exactly when
+    /// the owner is a wall; a contact on the torus keeps the torus normal.
+    #[test]
+    fn a_flat_bottom_on_the_top_corner_of_a_wall_rides_a_sharp_edge() {
+        let params = crate::steep::tests::test_params();
+        let mesh = block();
+        let index = MeshIndex::build(&mesh);
+        let corner = Point3::new(0.0, 0.0, 10.0);
+        let (mut walls, mut tops) = (0, 0);
+        for shape in [CutterShape::Bull { radius: 8.0, corner: 3.0 }, CutterShape::Ball { radius: 5.0 }] {
+            let cutter = Cutter::new(shape, 30.0).expect("cutter");
+            let planner =
+                Planner::new(&index, &cutter, &params, &Tolerances { path: 0.01, gouge: 0.0 }, None).expect("planner");
+            for slot in 0..index.len() {
+                let triangle = index.original_index(slot);
+                if !mesh.triangle(triangle).contains(&corner) {
+                    continue;
+                }
+                // The tip 3.6 mm inside the corner over the top face, at its height.
+                let cl =
+                    ClPoint { tip: Point3::new(2.0, 3.0, 10.0), contact: Contact::Vertex { triangle, point: corner } };
+                let n = contact_normal(&shape, &index, &planner.slots, &cl);
+                let wall = index.normal(slot).z.abs() < 1e-12;
+                let sharp = planner.rides_sharp_edge(&cl, &n);
+                if matches!(shape, CutterShape::Bull { .. }) {
+                    assert_eq!(sharp, wall, "triangle {triangle}: normal {n:?}");
+                    walls += usize::from(wall);
+                    tops += usize::from(!wall);
+                } else {
+                    // The ball's own normal at this tip points from its centre.
+                    let expect = (Point3::new(2.0, 3.0, 15.0) - corner).normalize();
+                    assert!((n - expect).norm() < 1e-12);
+                }
+            }
+        }
+        assert!(walls > 0 && tops > 0, "the corner is shared by walls ({walls}) and the top ({tops})");
     }
 }

@@ -802,8 +802,25 @@ fn order_from(mut passes: Vec<Vec<Point2>>, from: Option<Point2>) -> Vec<Vec<Poi
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
+
+    /// Finishing settings of the crate's unit tests: direction 0, sh 0.05 mm.
+    pub(crate) fn test_params() -> FinishingParams {
+        FinishingParams {
+            direction: 0.0,
+            pattern: crate::Pattern::Zigzag,
+            scallop_height: 0.05,
+            boundary: crate::Boundary::ContactInside,
+            max_step: 0.5,
+            clearance: 5.0,
+            machine: scallop_analysis::MachineLimits::default(),
+            plunge_feed: 20.0,
+            rapid_rate: 500.0,
+            sharp_corner: 30f64.to_radians(),
+            blend_tolerance: 0.01,
+        }
+    }
 
     #[test]
     fn runs_split_a_loop_at_shallow_points_without_wrapping() {
@@ -921,19 +938,7 @@ mod tests {
     /// into the part between their points, with a ball and a bull-nose.
     #[test]
     fn level_chords_never_cut_into_the_part_across_an_s_bend() {
-        let params = FinishingParams {
-            direction: 0.0,
-            pattern: crate::Pattern::Zigzag,
-            scallop_height: 0.05,
-            boundary: crate::Boundary::ContactInside,
-            max_step: 0.5,
-            clearance: 5.0,
-            machine: scallop_analysis::MachineLimits::default(),
-            plunge_feed: 20.0,
-            rapid_rate: 500.0,
-            sharp_corner: 30f64.to_radians(),
-            blend_tolerance: 0.01,
-        };
+        let params = test_params();
         let tolerances = Tolerances { path: 0.01, gouge: 0.0 };
         let mut cuts = Vec::new();
         for shape in [CutterShape::Ball { radius: 3.0 }, CutterShape::Bull { radius: 3.0, corner: 1.0 }] {
@@ -950,6 +955,24 @@ mod tests {
         }
         let worst = cuts.iter().copied().fold(0.0, f64::max);
         assert!(worst <= tolerances.path * tol::LEVEL_CHORD_SHARE, "{worst} {cuts:?}");
+    }
+
+    /// The shallow planes' measure is a report where rest is tolerated: raw
+    /// heights, no dense-pass reference (so no rest material subtracted).
+    #[test]
+    fn the_shallow_report_of_steep_and_shallow_is_the_raw_measure() {
+        let params = test_params();
+        let tolerances = Tolerances { path: 0.01, gouge: 0.0 };
+        let mesh = staggered_boxes(0.0, 0.05, 4.0);
+        let index = MeshIndex::build(&mesh);
+        let cutter = Cutter::new(CutterShape::Bull { radius: 3.0, corner: 1.0 }, 30.0).expect("cutter");
+        let split = SteepShallow::default_for(&cutter, params.scallop_height);
+        let p = plan_steep_shallow(&mesh, &index, &cutter, &params, &tolerances, &split, &Refinement::default())
+            .expect("plan");
+        let shallow = p.shallow.expect("the boxes' tops are shallow");
+        assert!(shallow.scallop.samples > 0);
+        assert_eq!(shallow.scallop.rest_material_mm, 0.0);
+        assert!(shallow.scallop.max_mm.is_finite());
     }
 
     #[test]
