@@ -522,9 +522,8 @@ impl<'a> Planner<'a> {
     /// that is not rest material. With rest tolerated, a sample is rest when
     /// its residual at the first try exceeds [`tol::REST_RESIDUAL_FACTOR`]
     /// `sh`, or does not fall to half when the gap is more than halved (the
-    /// foot of a wall, a corner: no spacing removes it); on new rest the gap
-    /// goes back to `rest_gap` (at most the first gap) and shrinks again for
-    /// the samples left. The other samples of the pair still hold `sh`: a
+    /// foot of a wall, a corner: no spacing removes it); near rest the gap is
+    /// at most `rest_gap`. The other samples of the pair still hold `sh`: a
     /// rest place on one section does not leave the rest of the pair to the
     /// spacing rule, whose model of a plane is optimistic on convex or
     /// faceted surface, most for a bull-nose whose contact lies far from its
@@ -543,7 +542,7 @@ impl<'a> Planner<'a> {
         mut next: PlanePasses,
         rest_gap: f64,
     ) -> Result<(bool, f64, PlanePasses), StrategyError> {
-        let (sh, start) = (self.sh, gap);
+        let sh = self.sh;
         let mut rest = vec![false; self.feed_samples.len()];
         let mut last_try: Option<(f64, Vec<(f64, Point2)>)> = None;
         for retry in 0..tol::MAX_SPACING_RETRIES {
@@ -561,10 +560,9 @@ impl<'a> Planner<'a> {
                     }
                 }
             }
-            // New rest: the other sections may hold at a wider gap than the
-            // one the rest sections shrank it to, up to `rest_gap`.
-            if found_rest && (gap - rest_gap.min(start)).abs() > self.boundary_tol {
-                gap = rest_gap.min(start);
+            // Near rest the planes keep at most the rest gap.
+            if found_rest && gap > rest_gap {
+                gap = rest_gap;
                 next = self.plane(d + gap);
                 if next.plane.passes.is_empty() {
                     return Ok((false, gap, next));
