@@ -309,7 +309,7 @@ pub fn run_finishing_with_progress(
             if split.holds() || round == MAX_ROUNDS || op.plan.layout.planes.len() + op.plan.layout.levels.len() == 0 {
                 Refinement::default()
             } else {
-                refinement_for(&op.plan.layout, &split.over, &job.cutter)
+                refinement_for(&op.plan.layout, &split.over, &job.cutter, &prepared.index)
             };
         let all = merged(&refine, &more);
         if more.is_empty() || all == refine {

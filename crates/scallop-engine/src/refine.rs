@@ -7,12 +7,18 @@
 //! the simulation names ([`scallop_sim::RestSplit::machined_over`]), finds the
 //! two planes (or levels) that bracket each, and plans again with one more
 //! plane (or level) half-way between them; the new program is simulated and
-//! proven like the first. After [`MAX_ROUNDS`] rounds a scallop still over
+//! proven like the first. A plane's passes leave their scallop where the
+//! cutter touches the part, beside the plane on a slope (by `R sin s` for a
+//! ball, `R - r + r sin s` for a bull-nose, towards the uphill side): a cell
+//! is bracketed by the planes of the cutter locations that touch it. After [`MAX_ROUNDS`] rounds a scallop still over
 //! the limit is refused as before.
 
 use std::collections::BTreeSet;
 
 use scallop_cutter::{Cutter, CutterShape};
+use scallop_geom::predicates::in_triangle;
+use scallop_geom::{Aabb2, Point2, Vec3};
+use scallop_mesh::MeshIndex;
 use scallop_sim::OverCell;
 use scallop_strategy::Refinement;
 
@@ -42,7 +48,7 @@ pub(crate) struct Layout {
 /// The planes and levels to add to `layout` for the cells `over`: one half-way
 /// between the two that bracket each cell, one through a cell beyond the
 /// first or last (the planner drops those without passes).
-pub(crate) fn refinement_for(layout: &Layout, over: &[OverCell], cutter: &Cutter) -> Refinement {
+pub(crate) fn refinement_for(layout: &Layout, over: &[OverCell], cutter: &Cutter, index: &MeshIndex) -> Refinement {
     let m = (-layout.direction.sin(), layout.direction.cos());
     // The tip of a cutter touching the part at the cell lies this much below
     // the contact per unit of (1 - n_z): the corner radius.
@@ -57,12 +63,14 @@ pub(crate) fn refinement_for(layout: &Layout, over: &[OverCell], cutter: &Cutter
         k
     };
     let (mut planes, mut levels) = (BTreeSet::new(), BTreeSet::new());
+    let mut scratch = Vec::new();
     for cell in over {
         let slope = cell.nz.abs().min(1.0).acos();
         let by_levels = !layout.levels.is_empty() && slope >= layout.steep_min;
         let by_planes = layout.levels.is_empty() || slope < layout.shallow_max;
         if by_planes {
-            let d = m.0 * cell.at.x + m.1 * cell.at.y;
+            let axis = touching_axis(cutter, index, cell, &mut scratch);
+            let d = m.0 * axis.x + m.1 * axis.y;
             let i = layout.planes.partition_point(|&p| p < d);
             if i > 0 && i < layout.planes.len() {
                 planes.insert(key(0.5 * (layout.planes[i - 1] + layout.planes[i])));
@@ -87,6 +95,48 @@ pub(crate) fn refinement_for(layout: &Layout, over: &[OverCell], cutter: &Cutter
     Refinement { planes: planes.into_iter().map(value).collect(), levels: levels.into_iter().map(value).collect() }
 }
 
+/// The XY place of the axis of `cutter` touching the part at `cell`: the
+/// contact lies on the cutter's side towards the uphill direction `-n_h`, at
+/// `R |n_h|` from the axis for a ball, `R - r + r |n_h|` for a bull-nose and
+/// `R` for a flat end (`n` the part's unit normal under the cell). The cell
+/// itself on a flat place or where no facet lies under it.
+fn touching_axis(cutter: &Cutter, index: &MeshIndex, cell: &OverCell, scratch: &mut Vec<u32>) -> Point2 {
+    let at = Point2::new(cell.at.x, cell.at.y);
+    let Some(n) = normal_under(index, at, cell.at.z, scratch) else { return at };
+    let horizontal = n.x.hypot(n.y);
+    if horizontal <= 0.0 {
+        return at;
+    }
+    let offset = match *cutter.shape() {
+        CutterShape::Ball { radius } => radius * horizontal,
+        CutterShape::Bull { radius, corner } => radius - corner + corner * horizontal,
+        CutterShape::Flat { radius } => radius,
+        CutterShape::Cone { .. } => 0.0,
+    };
+    at + scallop_geom::Vec2::new(n.x, n.y) * (offset / horizontal)
+}
+
+/// The unit upward normal of the facet under `at` whose height there is
+/// nearest `z` (a cell's part point), `None` without one.
+fn normal_under(index: &MeshIndex, at: Point2, z: f64, scratch: &mut Vec<u32>) -> Option<Vec3> {
+    scratch.clear();
+    index.collect_box(&Aabb2::around(at, 0.0), scratch);
+    let mut best: Option<(f64, Vec3)> = None;
+    for &slot in scratch.iter() {
+        let c = index.corners(slot as usize);
+        let n = *index.normal(slot as usize);
+        if n.z == 0.0 || !in_triangle(&at, &c[0].xy(), &c[1].xy(), &c[2].xy()) {
+            continue;
+        }
+        // The facet's plane through its first corner, at `at`.
+        let height = c[0].z - (n.x * (at.x - c[0].x) + n.y * (at.y - c[0].y)) / n.z;
+        if best.is_none_or(|(d, _)| (height - z).abs() < d) {
+            best = Some(((height - z).abs(), if n.z < 0.0 { -n } else { n }));
+        }
+    }
+    best.map(|(_, n)| n)
+}
+
 /// `a` with the planes and levels of `b` added.
 pub(crate) fn merged(a: &Refinement, b: &Refinement) -> Refinement {
     let join = |x: &[f64], y: &[f64]| {
@@ -108,6 +158,14 @@ mod tests {
         OverCell { at: Point3::new(x, y, z), nz, thickness: 0.1 }
     }
 
+    /// The plane `z = y tan(slope)` over `[-20, 20]^2`, rising towards +Y.
+    fn ramp(slope: f64) -> MeshIndex {
+        let p = |x: f64, y: f64| Point3::new(x, y, y * slope.tan());
+        let (a, b, c, d) = (p(-20.0, -20.0), p(20.0, -20.0), p(20.0, 20.0), p(-20.0, 20.0));
+        let (mesh, _) = scallop_mesh::TriMesh::from_soup(&[[a, b, c], [a, c, d]]).expect("two triangles");
+        MeshIndex::build(&mesh)
+    }
+
     #[test]
     fn a_cell_between_two_planes_gets_the_mid_plane_and_one_beyond_them_a_plane_through_it() {
         // Direction 0: planes along +X, offsets are y.
@@ -117,6 +175,7 @@ mod tests {
             &layout,
             &[cell(5.0, 2.5, 0.0, 1.0), cell(7.0, 2.9, 0.0, 1.0), cell(0.0, 4.0, 0.0, 1.0)],
             &cutter,
+            &ramp(0.0),
         );
         assert_eq!(r.planes, vec![2.0, 4.0]);
         assert!(r.levels.is_empty());
@@ -134,9 +193,33 @@ mod tests {
         let cutter = Cutter::new(CutterShape::Ball { radius: 2.0 }, 20.0).expect("a ball");
         // A vertical wall point at z = 9: the ball's tip touching it is R = 2
         // below, at 7, between the levels 8 and 6.
-        let r = refinement_for(&layout, &[cell(0.0, 1.0, 9.0, 0.0)], &cutter);
+        let r = refinement_for(&layout, &[cell(0.0, 1.0, 9.0, 0.0)], &cutter, &ramp(0.0));
         assert_eq!(r.levels, vec![7.0]);
         assert!(r.planes.is_empty(), "a vertical cell is not the planes'");
+    }
+
+    #[test]
+    fn a_cell_on_a_slope_is_bracketed_by_the_planes_of_the_cutters_that_touch_it() {
+        // Planes along +X every 0.5 mm on a 20-degree ramp rising towards +Y: a
+        // cutter touches the ramp on its uphill side, so the passes that leave
+        // a scallop at the cell have their axes below it (smaller y).
+        let slope = 20_f64.to_radians();
+        let layout = Layout { planes: (0..40).map(|i| -10.0 + 0.5 * f64::from(i)).collect(), ..Layout::default() };
+        let index = ramp(slope);
+        let cells = |y: f64| [cell(0.0, y, y * slope.tan(), slope.cos())];
+        for (shape, offset) in [
+            (CutterShape::Ball { radius: 3.0 }, 3.0 * slope.sin()),
+            (CutterShape::Bull { radius: 3.0, corner: 1.0 }, 2.0 + slope.sin()),
+        ] {
+            let cutter = Cutter::new(shape, 20.0).expect("a cutter");
+            for y in [0.1, 0.3, 0.45] {
+                let r = refinement_for(&layout, &cells(y), &cutter, &index);
+                let axis = y - offset;
+                let mid = 0.5 * ((axis / 0.5).floor() + (axis / 0.5).ceil()) * 0.5;
+                assert_eq!(r.planes.len(), 1, "{shape:?} at {y}");
+                assert!((r.planes[0] - mid).abs() < 1e-5, "{shape:?} at {y}: {:?}, axis {axis}", r.planes);
+            }
+        }
     }
 
     #[test]

@@ -140,3 +140,60 @@ fn concave_crease_between_steep_walls_holds_the_scallop_with_a_bull_nose() {
     let cutter = Cutter::new(CutterShape::Bull { radius: 3.0, corner: 1.0 }, 30.0).unwrap();
     finish_and_check(&job(terrace(85.0, 0.25, 62.0), cutter, 0.05));
 }
+
+/// A ridge along X (a cylinder of radius 5 at its crest, flanks of 30
+/// degrees, down to a floor at 0) cut across by a slot 1 mm wide and 3 mm
+/// deep at x = 15: the slot is rest material on every plane pair that
+/// crosses it, the ridge is a convex surface where the spacing rule (a
+/// model of planes) is optimistic.
+fn ridge_with_a_slot(x: f64, y: f64) -> f64 {
+    let (radius, flank) = (5.0_f64, 30_f64.to_radians());
+    let u = (y - 15.0).abs();
+    let edge = radius * flank.sin();
+    let crest =
+        if u <= edge { (radius * radius - u * u).sqrt() } else { radius * flank.cos() - (u - edge) * flank.tan() };
+    let slot = if (x - 15.0).abs() < 0.5 { 3.0 } else { 0.0 };
+    crest.max(0.0) + 2.0 - slot
+}
+
+#[test]
+fn rest_on_one_section_does_not_leave_the_rest_of_the_plane_pair_unchecked() {
+    // Steep-and-shallow's planes alone (no refinement by the simulation): the
+    // stock simulation of the program holds sh plus its resolution bound on
+    // the machined surface, for a bull-nose and a ball.
+    let mesh = height_field(30.0, 0.25, ridge_with_a_slot);
+    let bull = Cutter::new(CutterShape::Bull { radius: 3.0, corner: 1.0 }, 30.0).unwrap();
+    for cutter in [bull, ball(1.5)] {
+        let job = job(mesh.clone(), cutter.clone(), 0.05);
+        let index = scallop_mesh::MeshIndex::build(&mesh);
+        let split = scallop_strategy::SteepShallow::default_for(&cutter, job.scallop_height);
+        let params = job.timing_params();
+        let plan = scallop_strategy::plan_steep_shallow(
+            &mesh,
+            &index,
+            &cutter,
+            &params,
+            &job.tolerances,
+            &split,
+            &scallop_strategy::Refinement::default(),
+        )
+        .unwrap();
+        let stock = scallop_engine::stock_box(&mesh, cutter.radius());
+        // The engine's allowance on a mesh part (no chordal error).
+        let gouge_tolerance = job.tolerances.gouge + job.tolerances.path;
+        let options =
+            scallop_sim::VerifyOptions { gouge_tolerance, scallop_margin: cutter.radius(), ..Default::default() };
+        let sim = scallop_sim::simulate(stock, job.sim_resolution, &cutter, &plan.toolpath, &index, &options).unwrap();
+        let limit = job.scallop_height + sim.zmap.resolution_bound(cutter.shape());
+        let field = scallop_sim::PartField::new(&sim.zmap, &index);
+        let rest = scallop_sim::split_rest(&sim.zmap, &field, &index, &cutter, &options, limit);
+        assert!(
+            rest.machined_max <= limit,
+            "{:?}: scallop {} at {:?} over {limit}",
+            cutter.shape(),
+            rest.machined_max,
+            rest.machined_at
+        );
+        assert!(rest.unreachable_area > 0.0, "the slot is not reported");
+    }
+}

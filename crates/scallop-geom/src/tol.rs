@@ -1197,10 +1197,11 @@ pub mod strategy {
     /// every this many chord tolerances along it.
     pub const LEVEL_LINK_SAMPLE_CHORDS: f64 = 10.0;
 
-    /// When the planner tolerates rest material (steep-and-shallow) and no
-    /// spacing holds sh (a crease's normal, the foot of a wall that the
-    /// waterline levels finish), the next plane is this share of the largest
-    /// step-over away (at most the rule's spacing) and the stock simulation
+    /// When the planner tolerates rest material (steep-and-shallow) and a
+    /// section of a plane pair has rest (a crease's normal, the foot of a wall
+    /// that the waterline levels finish), the next plane is at most this share
+    /// of the largest step-over away (and at most the rule's spacing); the
+    /// other sections of the pair still hold sh, and the stock simulation
     /// reports what is left.
     pub const REST_SPACING_SHARE: f64 = 0.25;
 
@@ -1215,13 +1216,14 @@ pub mod strategy {
     /// usual chord tolerances bend by a few degrees between facets.
     pub const SHARP_EDGE_DEG: f64 = 30.0;
 
-    /// With rest tolerated, a measured residual above this many times sh at the
-    /// spacing rule's gap is rest material, not a scallop (a scallop grows with
-    /// the square of the gap: the rule would be 4.5 times too wide), and the
-    /// next plane goes `REST_SPACING_SHARE` of the largest step-over away
-    /// instead of shrinking the gap (`Planner::sweep`). So is a residual that
-    /// keeps more than half its height when the gap is more than halved (a
-    /// scallop would fall to a quarter).
+    /// With rest tolerated, a residual measured on one section (feed sample)
+    /// above this many times sh at the spacing rule's gap is rest material,
+    /// not a scallop (a scallop grows with the square of the gap: the rule
+    /// would be 4.5 times too wide): that section no longer sets the gap, which
+    /// is at most `REST_SPACING_SHARE` of the largest step-over
+    /// (`Planner::hold`). So is a section whose residual keeps more than half
+    /// its height when the gap is more than halved (a scallop would fall to a
+    /// quarter).
     pub const REST_RESIDUAL_FACTOR: f64 = 20.0;
 
     /// Splits of a level spacing between the two walls of a concave crease at

@@ -487,6 +487,119 @@ impl<'a> Planner<'a> {
         (h + a.lift.max(b.lift), at)
     }
 
+    /// Per feed sample, the largest measured scallop between two planes
+    /// (0 where none, or where `skip` is set: rest) with its place, and the
+    /// merged chords' lift of the pair (added to every sample's height).
+    fn measured_samples(
+        &self,
+        a: &PlanePasses,
+        b: &PlanePasses,
+        refine: bool,
+        skip: &[bool],
+    ) -> (Vec<(f64, Point2)>, f64) {
+        let measure = if refine { &self.measure } else { &self.raw_measure };
+        let heights = self
+            .feed_samples
+            .par_chunks(16)
+            .zip(skip.par_chunks(16))
+            .flat_map_iter(|(ts, skip)| {
+                ts.iter()
+                    .zip(skip)
+                    .map(|(t, &skip)| {
+                        let cusps = if skip {
+                            Vec::new()
+                        } else {
+                            pair_heights(measure, &a.curves, &b.curves, std::slice::from_ref(t))
+                        };
+                        cusps
+                            .into_iter()
+                            .fold((0.0, Point2::origin()), |m, c| if c.height > m.0 { (c.height, c.at) } else { m })
+                    })
+                    .collect::<Vec<_>>()
+            })
+            .collect();
+        (heights, a.lift.max(b.lift))
+    }
+
+    /// The next plane after the last one at `d`: from `next` at `gap`, the gap
+    /// shrinks until the measured scallop holds `sh` at every feed sample
+    /// that is not rest material. With rest tolerated, a sample is rest when
+    /// its residual at the first try exceeds [`tol::REST_RESIDUAL_FACTOR`]
+    /// `sh`, or does not fall to half when the gap is more than halved (the
+    /// foot of a wall, a corner: no spacing removes it); near rest the gap is
+    /// at most `rest_gap`. The other samples of the pair still hold `sh`: a
+    /// rest place on one section does not leave the rest of the pair to the
+    /// spacing rule, whose model of a plane is optimistic on convex or
+    /// faceted surface, most for a bull-nose whose contact lies far from its
+    /// axis (docs/validation.md, issue 15, "Rest on one section").
+    /// `current` is the plane at `d`. Returns whether it holds, the gap and
+    /// the plane there.
+    ///
+    /// # Errors
+    /// [`StrategyError::Unreachable`] when the gap falls under
+    /// [`tol::MIN_SPACING`] without rest tolerated.
+    fn hold(
+        &mut self,
+        current: &PlanePasses,
+        d: f64,
+        mut gap: f64,
+        mut next: PlanePasses,
+        rest_gap: f64,
+    ) -> Result<(bool, f64, PlanePasses), StrategyError> {
+        let sh = self.sh;
+        let mut rest = vec![false; self.feed_samples.len()];
+        let mut last_try: Option<(f64, Vec<(f64, Point2)>)> = None;
+        for retry in 0..tol::MAX_SPACING_RETRIES {
+            let (heights, lift) = self.measured_samples(current, &next, retry >= tol::RAW_RETRIES, &rest);
+            let mut found_rest = false;
+            if self.tolerate_rest {
+                for (i, &(h, _)) in heights.iter().enumerate() {
+                    // A residual that does not fall as the gap shrinks is rest too.
+                    let stalled = last_try
+                        .as_ref()
+                        .is_some_and(|(g, hp)| gap < 0.5 * g && hp[i].0 + lift > sh && h > 0.5 * hp[i].0);
+                    if !rest[i] && h + lift > sh && ((retry == 0 && h > tol::REST_RESIDUAL_FACTOR * sh) || stalled) {
+                        rest[i] = true;
+                        found_rest = true;
+                    }
+                }
+            }
+            // Near rest the planes keep at most the rest gap.
+            if found_rest && gap > rest_gap {
+                gap = rest_gap;
+                next = self.plane(d + gap);
+                if next.plane.passes.is_empty() {
+                    return Ok((false, gap, next));
+                }
+                last_try = None;
+                continue;
+            }
+            let (h, place) = heights
+                .iter()
+                .zip(&rest)
+                .filter(|&(_, &r)| !r)
+                .fold((0.0, Point2::origin()), |m, (&(h, at), _)| if h > m.0 { (h, at) } else { m });
+            let h = h + lift;
+            if h <= sh {
+                return Ok((true, gap, next));
+            }
+            // Scallop ~ gap^2; after a first exact-ratio try, shrink by at
+            // least SPACING_MIN_SHRINK per retry (curvature, rest material).
+            let ratio = if h.is_finite() { (sh / h).sqrt() * tol::SPACING_SAFETY } else { 0.5 };
+            let first = last_try.is_none();
+            last_try = Some((gap, heights));
+            gap *= if first { ratio } else { ratio.min(tol::SPACING_MIN_SHRINK) };
+            if gap < tol::MIN_SPACING {
+                if self.tolerate_rest {
+                    break;
+                }
+                return Err(self.unreachable(gap, place));
+            }
+            next = self.plane(d + gap);
+        }
+        Ok((false, gap, next))
+    }
+
     fn unreachable(&self, spacing: f64, at: Point2) -> StrategyError {
         StrategyError::Unreachable { x: at.x, y: at.y, spacing, scallop_height: self.params.scallop_height }
     }
@@ -572,8 +685,10 @@ impl<'a> Planner<'a> {
                 // spacing is rest material between the passes (the foot of a
                 // wall that the waterline levels finish, a corner), not a
                 // scallop: creeping on at tiny spacings would multiply the
-                // planes, so the next plane goes a share of the largest
-                // step-over away and the simulation reports what is left.
+                // planes, so near rest the next plane goes at most a share of
+                // the largest step-over away (the other sections of the pair
+                // still hold sh, see `hold`) and the simulation reports what
+                // is left.
                 let rest_gap = (tol::REST_SPACING_SHARE * cap).min(spacing);
                 delta = spacing;
                 let mut gap = spacing;
@@ -593,34 +708,10 @@ impl<'a> Planner<'a> {
                         continue 'ranges;
                     }
                 }
-                let mut accepted = false;
-                let mut last_try: Option<(f64, f64)> = None;
-                for retry in 0..tol::MAX_SPACING_RETRIES {
-                    // INVARIANT: as above.
-                    let current = planes.last().expect("a plane of this range");
-                    let (h, place) = self.measured(current, &next, retry >= tol::RAW_RETRIES);
-                    if h <= sh {
-                        accepted = true;
-                        break;
-                    }
-                    // A residual that does not fall as the gap shrinks is rest too.
-                    let stalled = last_try.is_some_and(|(g, hp)| gap < 0.5 * g && h > 0.5 * hp);
-                    if self.tolerate_rest && ((retry == 0 && h > tol::REST_RESIDUAL_FACTOR * sh) || stalled) {
-                        break;
-                    }
-                    last_try = Some((gap, h));
-                    // Scallop ~ gap^2; after a first exact-ratio try, shrink by at
-                    // least SPACING_MIN_SHRINK per retry (curvature, rest material).
-                    let ratio = if h.is_finite() { (sh / h).sqrt() * tol::SPACING_SAFETY } else { 0.5 };
-                    gap *= if retry == 0 { ratio } else { ratio.min(tol::SPACING_MIN_SHRINK) };
-                    if gap < tol::MIN_SPACING {
-                        if self.tolerate_rest {
-                            break;
-                        }
-                        return Err(self.unreachable(gap, place));
-                    }
-                    next = self.plane(d + gap);
-                }
+                // INVARIANT: as above.
+                let current = planes.last().expect("a plane of this range");
+                let (accepted, held_gap, held) = self.hold(current, d, gap, next, rest_gap)?;
+                (gap, next) = (held_gap, held);
                 if !accepted {
                     if !self.tolerate_rest {
                         return Err(self.unreachable(gap, at));
