@@ -18,7 +18,7 @@ use scallop_parts::TestPart;
 use scallop_post::{OutputMode, PostParams, check_replay, program_text, replay};
 use scallop_rough5::{
     BaselinePlan, BaselineSettings, CuttingData, OrientSettings, Pocket, Proof, ProofSettings, Rough5Plan,
-    Rough5Settings, TiltMode, Weights, plan_rough5, plan_three_plus_two, plan_zlevel, prove,
+    Rough5Settings, TiltMode, Weights, plan_rough5, plan_three_plus_two, plan_zlevel, prove_from_blank,
 };
 use scallop_toolpath::Toolpath;
 use serde::Serialize;
@@ -328,11 +328,27 @@ pub fn run(args: &Rough5Args) -> CliResult<()> {
     let plan_seconds = clock.elapsed().as_secs_f64();
     let bar = progress_bar(0, "tri-dexel proof");
     let proof_settings = ProofSettings { resolution: args.resolution, axis_tolerance: args.sim_tolerance };
-    let proof = prove(&plan.toolpath, &tool, &part.stock, &part.mesh, &proof_settings, &|d, t| {
-        crate::simulate::show(&bar, d, t);
-    })
+    let proof = prove_from_blank(
+        &plan.toolpath,
+        &tool,
+        &part.stock,
+        part.blank.as_ref(),
+        &part.mesh,
+        &proof_settings,
+        &|d, t| {
+            crate::simulate::show(&bar, d, t);
+        },
+    )
     .map_err(|e| Failure::rejected(format!("{name}: the program is not safe: {e}")))?;
     bar.finish_and_clear();
+    if proof.gouge_depth > args.sim_tolerance {
+        let [x, y, z] = proof.gouge_at.unwrap_or_default();
+        return Err(Failure::rejected(format!(
+            "{name}: the program is not safe: it removes {:.1} mm3 outside the volume to remove, {:.3} mm deep along Z \
+             near ({x:.3}, {y:.3}, {z:.3}) (tolerance --sim-tolerance {} mm); nothing was written",
+            proof.gouge_volume, proof.gouge_depth, args.sim_tolerance
+        )));
+    }
     let proof_seconds = clock.elapsed().as_secs_f64() - plan_seconds;
     let posted = post_program(args, &plan);
     let post = posted.as_ref().map(|(_, p)| p).map_err(|e| match e {

@@ -120,6 +120,6 @@ impl Builder {
         if lost > 0 {
             return Err(PartError::Degenerate { lost });
         }
-        Ok(TestPart { mesh, tags: self.tags, stock })
+        Ok(TestPart { mesh, tags: self.tags, stock, blank: None })
     }
 }

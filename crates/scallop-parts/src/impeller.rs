@@ -85,6 +85,12 @@ impl ImpellerParams {
         Point3::new(r * theta.cos(), r * theta.sin(), hub + t * span)
     }
 
+    /// Height of the blade tips at `u` along the channel (the same across it).
+    fn tip_z(&self, u: f64) -> f64 {
+        let hub = self.hub_z[1] + (self.hub_z[0] - self.hub_z[1]) * (1.0 - u) * (1.0 - u);
+        hub + self.span[0] + u * (self.span[1] - self.span[0])
+    }
+
     /// The closed cross-section at `u`: across the hub, up blade b, back across
     /// the tip, down blade a; with the tag of the segment starting at each point.
     fn section(&self, u: f64) -> (Vec<Point3>, Vec<FaceTag>) {
@@ -120,8 +126,9 @@ impl ImpellerParams {
 /// The channel between two blades: cross-sections lofted from the inlet to
 /// the outlet, the hub tagged bottom, the blades flank, the tip surface top;
 /// open at the inlet and the outlet (crossable faces left out: an open pocket,
-/// to be closed by virtual surfaces). The stock is the box of the turned blank
-/// around the whole impeller, 2 mm over the blades.
+/// to be closed by virtual surfaces). The stock is the box around the whole
+/// impeller, 2 mm over the blades; the blank inside it ([`TestPart::blank`])
+/// is turned to the envelope of the blade tips.
 ///
 /// # Errors
 /// [`PartError::BadParameter`] naming the parameter and its range.
@@ -149,8 +156,70 @@ pub fn impeller_channel(params: &ImpellerParams) -> Result<TestPart, PartError> 
             part.mesh.triangles().iter().map(|t| [t[0] as usize, t[2] as usize, t[1] as usize]).collect();
         part.mesh = scallop_mesh::TriMesh::from_indexed(part.mesh.vertices(), &flipped)?.0;
     }
-    let rmax = params.radii[1] + 2.0;
-    let zmax = part.mesh.bounds().max.z + 2.0;
+    let rmax = params.radii[1] + BLANK_MARGIN;
+    let zmax = part.mesh.bounds().max.z + BLANK_MARGIN;
     part.stock = Aabb3 { min: Point3::new(-rmax, -rmax, 0.0), max: Point3::new(rmax, rmax, zmax) };
+    part.blank = Some(turned_blank(params, zmax)?);
     Ok(part)
+}
+
+/// Room of the stock box over the blade tips and beyond the outlet (mm).
+const BLANK_MARGIN: f64 = 2.0;
+
+/// Segments of the blank's revolution (its chords lie within 0.003 mm of the
+/// true surface at the outlet radius).
+const BLANK_SEGMENTS: usize = 360;
+
+/// The turned blank: the revolution about z of the blade tips' profile (at
+/// most `top`) down to z = 0, and inside the inlet radius the nose at the
+/// hub's inlet height (the impeller is turned to the envelope of its blade
+/// tips and its nose before the channels are roughed, so nothing stands above
+/// the channels' tops). Its outer radius is that of the outlet section's
+/// chords and its nose's radius that of the inlet beyond the blank's own
+/// chords, so that no sliver between two tessellations lies outside the
+/// channel at its open ends: a tool leaving the channel there cuts air, not a
+/// gouge.
+fn turned_blank(params: &ImpellerParams, top: f64) -> Result<scallop_mesh::TriMesh, PartError> {
+    let [r0, r1] = params.radii;
+    let u_of = |r: f64| (r - r0) / (r1 - r0);
+    #[allow(clippy::cast_precision_loss, reason = "small counts")]
+    let outer = r1 * (std::f64::consts::PI / (params.blades * params.samples[1]) as f64).cos();
+    #[allow(clippy::cast_precision_loss, reason = "small counts")]
+    let nose = r0 / (std::f64::consts::PI / BLANK_SEGMENTS as f64).cos();
+    let n = params.samples[0];
+    // The profile (r, z) counter-clockwise in the half-plane r > 0, without its two points on the axis.
+    let mut profile = vec![(outer, 0.0), (outer, params.tip_z(u_of(outer)).min(top))];
+    for k in 1..n {
+        #[allow(clippy::cast_precision_loss, reason = "small counts")]
+        let u = 1.0 - k as f64 / n as f64;
+        let r = r0 + u * (r1 - r0);
+        if r > nose && r < outer {
+            profile.push((r, params.tip_z(u).min(top)));
+        }
+    }
+    profile.push((nose, params.tip_z(u_of(nose)).min(top)));
+    profile.push((nose, params.hub_z[0]));
+    let mut b = Builder::default();
+    let rings: Vec<Vec<usize>> = profile
+        .iter()
+        .map(|&(r, z)| {
+            b.ring((0..BLANK_SEGMENTS).map(|i| {
+                #[allow(clippy::cast_precision_loss, reason = "small counts")]
+                let a = TAU * i as f64 / BLANK_SEGMENTS as f64;
+                Point3::new(r * a.cos(), r * a.sin(), z)
+            }))
+        })
+        .collect();
+    b.fan(Point3::origin(), &rings[0], FaceTag::Top, &-Vec3::z());
+    for (w, seg) in rings.windows(2).zip(profile.windows(2)) {
+        // Outward normal of a counter-clockwise profile segment: (dz, -dr).
+        let (dr, dz) = (seg[1].0 - seg[0].0, seg[1].1 - seg[0].1);
+        b.band_towards(&w[0], &w[1], FaceTag::Top, |c| {
+            let radial = Vec3::new(c.x, c.y, 0.0).normalize();
+            dz * radial - dr * Vec3::z()
+        });
+    }
+    let last = rings.last().map_or(&[][..], |r| &r[..]);
+    b.fan(Point3::new(0.0, 0.0, params.hub_z[0]), last, FaceTag::Top, &Vec3::z());
+    Ok(b.finish(Aabb3 { min: Point3::origin(), max: Point3::origin() })?.mesh)
 }

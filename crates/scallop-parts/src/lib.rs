@@ -49,6 +49,10 @@ pub struct TestPart {
     pub tags: Vec<FaceTag>,
     /// The stock box (mm).
     pub stock: Aabb3,
+    /// The blank inside the stock box when the stock is not the whole box (a
+    /// turned or cast blank: a closed mesh, outward normals); `None` when the
+    /// box is the stock.
+    pub blank: Option<TriMesh>,
 }
 
 impl TestPart {

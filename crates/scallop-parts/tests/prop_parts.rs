@@ -116,6 +116,43 @@ fn impeller_channel_is_open_only_at_inlet_and_outlet() {
     assert!((b - a).cross(&(c - a)).z < 0.0);
 }
 
+/// The impeller's turned blank is a closed, outward solid inside the stock
+/// box, turned to the blade tips: its vertices lie on or under the tips'
+/// profile (the nose at the hub's inlet height), the channel's vertices under
+/// it and inside its outer radius; the other parts have no blank (the box is
+/// their stock).
+#[test]
+fn the_impeller_blank_holds_the_channel() {
+    let params = ImpellerParams::default();
+    let part = impeller_channel(&params).unwrap();
+    let blank = part.blank.as_ref().unwrap();
+    let (open, bad) = edge_report(blank);
+    assert!(open.is_empty() && bad == 0, "open {} bad {bad}", open.len());
+    assert!(signed_volume(blank) > 0.0);
+    let b = blank.bounds();
+    assert!(part.stock.min.x <= b.min.x && b.max.x <= part.stock.max.x + 1e-9);
+    assert!(part.stock.min.z <= b.min.z && b.max.z <= part.stock.max.z + 1e-9);
+    let [r0, r1] = params.radii;
+    let top_at = |r: f64| {
+        let u = ((r - r0) / (r1 - r0)).clamp(0.0, 1.0);
+        let hub = params.hub_z[1] + (params.hub_z[0] - params.hub_z[1]) * (1.0 - u) * (1.0 - u);
+        hub + params.span[0] + u * (params.span[1] - params.span[0])
+    };
+    // The blank's vertices lie on or under that profile, and on the nose (the hub's inlet height)
+    // inside the inlet radius.
+    for p in blank.vertices() {
+        let r = p.x.hypot(p.y);
+        let top = if r < r0 - 1e-9 { params.hub_z[0] } else { top_at(r) };
+        assert!(r <= r1 + 1e-9 && p.z <= top + 1e-9, "blank vertex {p:?}");
+    }
+    for p in part.mesh.vertices() {
+        let r = p.x.hypot(p.y);
+        assert!(r <= r1 + 1e-9 && p.z <= top_at(r) + 1e-9, "channel vertex {p:?} outside the blank");
+    }
+    assert!(closed_pocket(&PocketParams::default()).unwrap().blank.is_none());
+    assert!(fitting_pocket(&FittingParams::default()).unwrap().blank.is_none());
+}
+
 #[test]
 fn bad_parameters_name_themselves() {
     let err = closed_pocket(&PocketParams { wall: -1.0, ..PocketParams::default() }).unwrap_err();

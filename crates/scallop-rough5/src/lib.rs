@@ -67,6 +67,6 @@ pub use orient::{
 };
 pub use place::{Feature, Placement, Placer, tool_frame};
 pub use plan::{LevelReport, PassReport, Rough5Plan, Rough5Settings, SinglePass, plan_rough5, plan_single_pass};
-pub use prove::{Proof, ProofSettings, prove};
+pub use prove::{Proof, ProofSettings, prove, prove_from_blank};
 pub use radius::{apparent_contour_radius, effective_radius, exact_scallop, scallop_height, swept_profile};
 pub use sync::{SyncPoint, axis_steps, closest_vertex, interpolate_axis, limit_angular_step, pitch_angle, synchronise};

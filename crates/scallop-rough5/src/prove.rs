@@ -34,6 +34,9 @@ pub struct Proof {
     pub gouge_volume: f64,
     /// Longest piece removed outside it along one Z ray (mm).
     pub gouge_depth: f64,
+    /// Where that piece is: its ray's x, y and the middle height of the
+    /// piece of the ray outside the volume to remove that holds it (mm).
+    pub gouge_at: Option<[f64; 3]>,
     /// Total length of the cutting moves (feeds, links, plunges), mm.
     pub cutting_length: f64,
     /// L_HM: % of the cutting length that removed nothing.
@@ -73,6 +76,20 @@ fn overlap(a: &[[f64; 2]], b: &[[f64; 2]]) -> f64 {
     total
 }
 
+/// The pieces of `a` inside `b` (both sorted, disjoint), sorted.
+fn intersection(a: &[[f64; 2]], b: &[[f64; 2]]) -> Vec<[f64; 2]> {
+    let mut out = Vec::new();
+    for x in a {
+        for y in b {
+            let (s, e) = (x[0].max(y[0]), x[1].min(y[1]));
+            if e > s {
+                out.push([s, e]);
+            }
+        }
+    }
+    out
+}
+
 /// `[lo, hi]` minus the sorted disjoint `a`.
 fn complement(a: &[[f64; 2]], lo: f64, hi: f64) -> Vec<[f64; 2]> {
     let mut out = Vec::new();
@@ -104,8 +121,32 @@ pub fn prove(
     settings: &ProofSettings,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<Proof, Rough5Error> {
+    prove_from_blank(path, cutter, stock, None, volume, settings, progress)
+}
+
+/// As [`prove`], the stock being the closed `blank` inside the box `stock`
+/// when one is given ([`DexelStock::from_solid`]: a turned blank), the whole
+/// box otherwise; material removed outside the blank is no gouge (there was
+/// none).
+///
+/// # Errors
+/// As [`prove`]; an open blank is a refused stock.
+pub fn prove_from_blank(
+    path: &Toolpath,
+    cutter: &Cutter,
+    stock: &Aabb3,
+    blank: Option<&TriMesh>,
+    volume: &TriMesh,
+    settings: &ProofSettings,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<Proof, Rough5Error> {
     let sim = |e: scallop_sim::SimError| Rough5Error::Simulation(e.to_string());
-    let mut dexels = DexelStock::new(*stock, settings.resolution).map_err(sim)?;
+    let blank = blank.map(DexelPart::new);
+    let mut dexels = match &blank {
+        Some(b) => DexelStock::from_solid(*stock, settings.resolution, b),
+        None => DexelStock::new(*stock, settings.resolution),
+    }
+    .map_err(sim)?;
     let moves = ToolMove::from_toolpath(path);
     let options = DexelOptions { axis_tolerance: settings.axis_tolerance, check_collisions: true };
     let report = dexels.cut_with_progress(cutter, &moves, &options, progress).map_err(sim)?;
@@ -116,24 +157,31 @@ pub fn prove(
     let area = cell[0] * cell[1];
     let eps = dexels.eps();
     let (lo, hi) = (stock.min.z, stock.max.z);
-    // Per row of rays: (volume to remove, left in it, removed outside, deepest).
-    let rows: Vec<[f64; 4]> = (0..nv)
+    // Per row of rays: (volume to remove, left in it, removed outside, deepest, its x, y, z).
+    let rows: Vec<[f64; 7]> = (0..nv)
         .into_par_iter()
         .map(|iv| {
-            let mut acc = [0.0; 4];
+            let mut acc = [0.0; 7];
             for iu in 0..nu {
                 let o = dexels.ray_origin(2, iu, iv);
                 let pocket: Vec<[f64; 2]> =
                     part.intervals(&o, 2).iter().map(|s| [s.0.max(lo), s.1.min(hi)]).filter(|s| s[1] > s[0]).collect();
                 let material = dexels.intervals(2, iu, iv);
-                let removed = complement(&material, lo, hi);
+                let mut removed = complement(&material, lo, hi);
+                if let Some(b) = &blank {
+                    let start: Vec<[f64; 2]> = b.intervals(&o, 2).iter().map(|s| [s.0, s.1]).collect();
+                    removed = intersection(&removed, &start);
+                }
                 acc[0] += pocket.iter().map(|s| s[1] - s[0]).sum::<f64>();
                 acc[1] += overlap(&material, &pocket);
                 for piece in complement(&pocket, lo, hi) {
                     let out = overlap(&removed, &[piece]);
                     if out > eps {
                         acc[2] += out;
-                        acc[3] = f64::max(acc[3], out);
+                        if out > acc[3] {
+                            acc[3] = out;
+                            [acc[4], acc[5], acc[6]] = [o.x, o.y, 0.5 * (piece[0] + piece[1])];
+                        }
                     }
                 }
             }
@@ -160,6 +208,7 @@ pub fn prove(
         removed_volume: report.removed_volume,
         gouge_volume: sum(2),
         gouge_depth: rows.iter().map(|r| r[3]).fold(0.0, f64::max),
+        gouge_at: rows.iter().filter(|r| r[3] > 0.0).max_by(|a, b| a[3].total_cmp(&b[3])).map(|r| [r[4], r[5], r[6]]),
         cutting_length: cutting,
         air_percent: if cutting > 0.0 { 100.0 * air / cutting } else { 0.0 },
         sweeps: report.sweeps,

@@ -213,6 +213,11 @@ pub enum SimError {
         /// The value given.
         value: f64,
     },
+    /// A blank given as the starting stock is not a closed solid.
+    #[error(
+        "the blank is not a closed mesh (some edge has an odd number of triangles); give a closed solid as the starting stock"
+    )]
+    OpenBlank,
     /// The tool at cutting depth reaches beyond a wall of the pocket or an island.
     #[error(
         "gouge: the tool reaches {depth:.4} mm beyond a pocket wall (tolerance {tolerance} mm) with its centre at \

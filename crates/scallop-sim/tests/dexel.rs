@@ -674,3 +674,56 @@ fn rays_through_edges_and_vertices_of_a_closed_part() {
         }
     }
 }
+
+/// A stock started from a closed blank holds exactly the blank: its volume on
+/// every ray family is the blank's, a slot through the box removes only the
+/// part of the slot inside the blank, and a shank passing over the box but
+/// outside the blank collides with nothing.
+#[test]
+fn a_blank_is_the_starting_stock() {
+    let stock = Aabb3 { min: p(0.0, 0.0, -10.0), max: p(40.0, 20.0, 0.0) };
+    // A step: the blank fills x < 20 to z = 0 and x >= 20 to z = -6 (cell-aligned at 0.25 mm).
+    let low = block(p(20.0, 0.0, -10.0), p(40.0, 20.0, -6.0));
+    let high = block(p(0.0, 0.0, -10.0), p(20.0, 20.0, 0.0));
+    let mut soup: Vec<[Point3; 3]> = Vec::new();
+    for m in [&low, &high] {
+        soup.extend((0..m.triangles().len()).map(|t| m.triangle(t)));
+    }
+    let blank = TriMesh::from_soup(&soup).unwrap().0;
+    let mut dexels = DexelStock::from_solid(stock, 0.25, &DexelPart::new(&blank)).unwrap();
+    let expected = 20.0 * 20.0 * 10.0 + 20.0 * 20.0 * 4.0;
+    for axis in 0..3 {
+        assert!((dexels.volume_along(axis) - expected).abs() < 1e-6, "axis {axis}: {}", dexels.volume_along(axis));
+    }
+    assert!((dexels.initial_volume() - expected).abs() < 1e-6);
+    // A flat D4 slot 1 mm deep along x at y = 10 from above the box: 4 x 1 x 40 inside the box, half
+    // of it over the low side, where the blank stops at z = -6: only the high half is cut.
+    let flat = Cutter::new(CutterShape::Flat { radius: 2.0 }, 10.0).unwrap();
+    let path = [
+        mv(MoveKind::Rapid, p(-3.0, 10.0, 5.0), Vec3::z()),
+        mv(MoveKind::Plunge, p(-3.0, 10.0, -1.0), Vec3::z()),
+        mv(MoveKind::Feed, p(43.0, 10.0, -1.0), Vec3::z()),
+    ];
+    let report = dexels.cut(&flat, &path, &DexelOptions::default()).unwrap();
+    report.check().unwrap();
+    assert!((report.removed_volume - 80.0).abs() < 1e-6, "{}", report.removed_volume);
+    assert!((dexels.initial_volume() - dexels.volume() - 80.0).abs() < 1e-6);
+    // Flutes 4 mm long under a shank of radius 3: a slot at z = -7 on the low side puts the shank
+    // (above z = -3) inside the box but over the blank's top (z = -6): no collision from the blank,
+    // one from the full box.
+    let short = Cutter::new(CutterShape::Flat { radius: 2.0 }, 4.0).unwrap().with_shank(3.0, 20.0).unwrap();
+    let low_slot = [
+        mv(MoveKind::Rapid, p(30.0, -3.0, 5.0), Vec3::z()),
+        mv(MoveKind::Plunge, p(30.0, -3.0, -7.0), Vec3::z()),
+        mv(MoveKind::Feed, p(30.0, 23.0, -7.0), Vec3::z()),
+    ];
+    let options = DexelOptions::default();
+    assert!(options.check_collisions);
+    let mut from_blank = DexelStock::from_solid(stock, 0.25, &DexelPart::new(&blank)).unwrap();
+    assert!(from_blank.cut(&short, &low_slot, &options).unwrap().collisions.is_empty());
+    let mut full = DexelStock::new(stock, 0.25).unwrap();
+    assert!(!full.cut(&short, &low_slot, &options).unwrap().collisions.is_empty());
+    // An open surface is no blank.
+    let open = TriMesh::from_soup(&soup[..soup.len() - 1]).unwrap().0;
+    assert!(matches!(DexelStock::from_solid(stock, 0.25, &DexelPart::new(&open)), Err(SimError::OpenBlank)));
+}

@@ -322,6 +322,8 @@ pub struct DexelStock {
     /// naming the move behind a gouge).
     history: Vec<Step>,
     bodies: Vec<Body>,
+    /// Volume of the stock before any cut (mm^3), in the sum of [`DexelStock::volume`].
+    initial: f64,
 }
 
 impl DexelStock {
@@ -343,7 +345,7 @@ impl DexelStock {
         let n = [f[0] as usize, f[1] as usize, f[2] as usize];
         let cell = [size.x / f[0], size.y / f[1], size.z / f[2]];
         let rays = [0, 1, 2].map(|k| vec![Ray::Full; n[(k + 1) % 3] * n[(k + 2) % 3]]);
-        Ok(DexelStock {
+        let mut dexels = DexelStock {
             stock,
             n,
             cell,
@@ -352,7 +354,45 @@ impl DexelStock {
             operations: 0,
             history: Vec::new(),
             bodies: Vec::new(),
-        })
+            initial: 0.0,
+        };
+        let area = cell[0] * cell[1];
+        let column = stock.max.z - stock.min.z;
+        dexels.initial = (0..n[1]).map(|_| (0..n[0]).map(|_| column).sum::<f64>() * area).sum();
+        Ok(dexels)
+    }
+
+    /// A stock that is the material of a closed `solid` (a turned or cast
+    /// blank) inside the box `stock`, with rays `resolution` (mm) apart or
+    /// closer: each ray holds the solid's intervals along it, clipped to the
+    /// box (exact crossings, see [`DexelPart`]).
+    ///
+    /// # Errors
+    /// As [`DexelStock::new`], and [`SimError::OpenBlank`] when `solid` is not
+    /// closed (a height field has no inside to start from).
+    pub fn from_solid(stock: Aabb3, resolution: f64, solid: &DexelPart) -> Result<DexelStock, SimError> {
+        if !solid.is_closed() {
+            return Err(SimError::OpenBlank);
+        }
+        let mut dexels = DexelStock::new(stock, resolution)?;
+        for axis in 0..3 {
+            let material = solid.family_material(&dexels, axis);
+            dexels.rays[axis] = material
+                .into_iter()
+                .map(|spans| {
+                    let mut merged: Vec<[f64; 2]> = Vec::with_capacity(spans.len());
+                    for s in spans {
+                        match merged.last_mut() {
+                            Some(last) if s[0] <= last[1] => last[1] = last[1].max(s[1]),
+                            _ => merged.push(s),
+                        }
+                    }
+                    Ray::Cut(merged)
+                })
+                .collect();
+        }
+        dexels.initial = dexels.volume();
+        Ok(dexels)
     }
 
     /// Cells along X, Y and Z.
@@ -447,12 +487,11 @@ impl DexelStock {
         self.volume_along(2)
     }
 
-    /// Volume of the full stock box (mm^3), in the same sum as [`DexelStock::volume`].
+    /// Volume of the stock before any cut (mm^3; the full box, or the blank of
+    /// [`DexelStock::from_solid`]), in the same sum as [`DexelStock::volume`].
     #[must_use]
     pub fn initial_volume(&self) -> f64 {
-        let area = self.cell[0] * self.cell[1];
-        let column = self.stock.max.z - self.stock.min.z;
-        (0..self.n[1]).map(|_| (0..self.n[0]).map(|_| column).sum::<f64>() * area).sum()
+        self.initial
     }
 
     /// Splits the moves into fixed-axis sweeps.
