@@ -180,6 +180,13 @@ impl<'a> Resolver<'a> {
     }
 }
 
+/// The links of a cell with at most one exit (an exit and its entry, which
+/// need no drop-cutter), or `None` if the cell must be resolved.
+pub(crate) fn simple_links(cell: &Cell) -> Option<Vec<(usize, usize)>> {
+    let met = walk(cell);
+    (met.iter().filter(|m| m.1).count() <= 1).then(|| join(&met, true))
+}
+
 /// The crossings of `cell` in walk order, each with whether it is an exit
 /// (the walk leaves the inside there).
 fn walk(cell: &Cell) -> Vec<(usize, bool)> {
