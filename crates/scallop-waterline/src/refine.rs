@@ -149,15 +149,25 @@ impl Local<'_> {
     /// the contour from the last two probes, a little beyond (where the height
     /// is smooth the next probe crosses the contour), kept between
     /// [`PROBE_GROWTH`] and [`PROBE_GROWTH_MAX`] times the last distance.
+    ///
+    /// A step between two inside probes is checked whole (the secant may jump
+    /// over a band of outside to another inside region): the contact triangle
+    /// of either end lifting the cutter above z at the other end certifies the
+    /// step (convexity, see [`Local::triangle_height`]); otherwise the step is
+    /// walked as a grid edge ([`Local::gaps`]) and its first gap is the
+    /// contour. A gap of any width above the crossing tolerance is found, so
+    /// the contour found from an inside midpoint is the nearest one along the
+    /// line up to that tolerance. Between two outside probes an inside sliver
+    /// is not looked for (the midpoint is safe there).
     fn contour_near(&self, mid: Point2, normal: Vec2, accept: f64, reach: f64) -> Near {
-        let h_mid = self.height(mid);
+        let (h_mid, slot_mid) = self.height_slot(mid);
         let mid_in = h_mid > 0.0;
         let towards = if mid_in { -normal } else { normal };
-        let (mut last, mut h_last, mut r_last) = (mid, h_mid, 0.0);
+        let (mut last, mut h_last, mut r_last, mut slot_last) = (mid, h_mid, 0.0, slot_mid);
         let mut r = accept;
         loop {
             let p = mid + towards * r;
-            let h = self.height(p);
+            let (h, slot) = self.height_slot(p);
             if (h > 0.0) != mid_in {
                 if r <= accept {
                     return Near::Within;
@@ -168,6 +178,9 @@ impl Local<'_> {
                     self.bisect_heights(p, h, last, h_last)
                 });
             }
+            if mid_in && let Some(gap) = self.first_gap(last, slot_last, p, h, slot) {
+                return if r <= accept { Near::Within } else { Near::Found(gap) };
+            }
             if r >= reach {
                 return Near::Missing;
             }
@@ -175,7 +188,7 @@ impl Local<'_> {
             let slope = (h - h_last) / (r - r_last);
             let root = r - h / slope;
             let guess = if root.is_finite() && root > r { SECANT_OVERSHOOT * root } else { 0.0 };
-            (last, h_last, r_last) = (p, h, r);
+            (last, h_last, r_last, slot_last) = (p, h, r, slot);
             r = guess.clamp(PROBE_GROWTH * r, PROBE_GROWTH_MAX * r).min(reach);
         }
     }
@@ -223,6 +236,29 @@ impl Local<'_> {
             }
         }
         out
+    }
+
+    /// The start of the first gap (an outside point within the crossing
+    /// tolerance of an inside one) on the segment from `a` to `b`, both inside
+    /// with contact triangles `slot_a` and `slot_b`; `None` if the segment is
+    /// inside throughout (up to gaps under the crossing tolerance). One
+    /// triangle evaluation when a contact triangle covers the segment, else
+    /// the cover walk of [`Local::gaps`].
+    fn first_gap(
+        &self,
+        a: Point2,
+        slot_a: Option<usize>,
+        b: Point2,
+        h_b: f64,
+        slot_b: Option<usize>,
+    ) -> Option<Point2> {
+        if slot_a.is_some_and(|s| self.triangle_height(s, b) > 0.0)
+            || slot_b.is_some_and(|s| self.triangle_height(s, a) > 0.0)
+        {
+            return None;
+        }
+        // An inside point always has a contact triangle (the floor is below z).
+        slot_a.and_then(|s| self.gaps(a, s, b, h_b).first().copied())
     }
 
     /// The first point from `inside` towards `outside` (the triangle in `slot`
