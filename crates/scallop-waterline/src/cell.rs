@@ -172,8 +172,8 @@ impl<'a> Resolver<'a> {
     /// `None` if `a` is inside without a contact triangle (outside the box).
     fn crossings(&self, a: Point2, (ha, slot_a): (f64, Option<usize>), b: Point2, hb: f64) -> Option<Vec<Point2>> {
         Some(match (ha > 0.0, hb > 0.0) {
-            (true, false) => vec![self.local.bisect_heights(a, ha, b, hb)],
-            (false, true) => vec![self.local.bisect_heights(b, hb, a, ha)],
+            (true, false) => vec![self.local.bisect_heights(a, ha, slot_a, b, hb)],
+            (false, true) => vec![self.local.bisect_heights(b, hb, None, a, ha)],
             (true, true) => self.local.gaps(a, slot_a?, b, hb),
             (false, false) => Vec::new(),
         })

@@ -122,10 +122,11 @@ fn edge_crossings(grid: &WaterlineGrid<'_>, probe: &Probe<'_>, inside: &[bool]) 
                 return local.gaps(a, grid.slots[ka] as usize, b, floored(kb));
             }
             // Floored as `Probe::height` floors them, so the secant sees one function.
+            let slot = |k: usize| (grid.slots[k] != u32::MAX).then_some(grid.slots[k] as usize);
             let p = if first_inside {
-                local.bisect_heights(a, floored(ka), b, floored(kb))
+                local.bisect_heights(a, floored(ka), slot(ka), b, floored(kb))
             } else {
-                local.bisect_heights(b, floored(kb), a, floored(ka))
+                local.bisect_heights(b, floored(kb), slot(kb), a, floored(ka))
             };
             vec![p]
         })

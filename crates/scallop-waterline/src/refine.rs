@@ -89,13 +89,72 @@ impl Local<'_> {
     /// is followed by [`BISECTIONS_AFTER_SECANT`] bisections before the secant
     /// is tried again (a crease is one point: the bracket soon lies on one
     /// smooth piece), so the worst case is about twice plain bisection.
-    pub(crate) fn bisect_heights(&self, inside: Point2, h_in: f64, outside: Point2, h_out: f64) -> Point2 {
-        self.bracket(inside, h_in, outside, h_out).1
+    ///
+    /// With `slot_in`, the contact triangle at `inside`, the crossing is first
+    /// looked for by [`Local::walk_bracket`] (a few full evaluations where the
+    /// height has creases between triangles).
+    pub(crate) fn bisect_heights(
+        &self,
+        inside: Point2,
+        h_in: f64,
+        slot_in: Option<usize>,
+        outside: Point2,
+        h_out: f64,
+    ) -> Point2 {
+        slot_in
+            .and_then(|slot| self.walk_bracket(inside, slot, outside))
+            .unwrap_or_else(|| self.bracket(inside, h_in, outside, h_out))
+            .1
     }
 
-    /// As [`Local::bisect_heights`], returning both ends of the final bracket
-    /// (inside, outside).
-    fn bracket(&self, mut inside: Point2, mut h_in: f64, mut outside: Point2, mut h_out: f64) -> (Point2, Point2) {
+    /// The first crossing from `inside` (contact triangle `slot`) towards
+    /// `outside` (the cutter at z cuts at the first, not at the second) as a
+    /// bracket (inside, outside) no wider than the tolerance, found triangle by
+    /// triangle: the interval where the current triangle lifts the cutter above
+    /// z ends within the segment (convexity; that triangle alone is below the
+    /// full height at `outside`); its end is bracketed on that one triangle
+    /// (a smooth height: secant steps, a few cheap evaluations), and one full
+    /// evaluation at the outer end of that bracket either ends the walk
+    /// (outside: its inner end is inside, lifted by the triangle) or names the
+    /// next triangle. `None` after [`MAX_WALK_STEPS`] triangles or on a step
+    /// that does not advance (rounding): the caller brackets on the full
+    /// drop-cutter instead.
+    fn walk_bracket(&self, inside: Point2, slot: usize, outside: Point2) -> Option<(Point2, Point2)> {
+        let (mut at, mut slot) = (inside, slot);
+        for _ in 0..MAX_WALK_STEPS {
+            let h_at = self.triangle_height(slot, at);
+            let h_end = self.triangle_height(slot, outside);
+            if !(h_at > 0.0 && h_end <= 0.0) {
+                return None;
+            }
+            let (tin, tout) = self.bracket_with(&|p| self.triangle_height(slot, p), at, h_at, outside, h_end);
+            let (h, next) = self.height_slot(tout);
+            if h <= 0.0 {
+                return (tin != tout).then_some((tin, tout));
+            }
+            match next {
+                Some(next) if tout != at => (at, slot) = (tout, next),
+                _ => return None,
+            }
+        }
+        None
+    }
+
+    /// As [`Local::bisect_heights`] without a contact triangle, returning both
+    /// ends of the final bracket (inside, outside).
+    fn bracket(&self, inside: Point2, h_in: f64, outside: Point2, h_out: f64) -> (Point2, Point2) {
+        self.bracket_with(&|p| self.height(p), inside, h_in, outside, h_out)
+    }
+
+    /// The bracket of [`Local::bracket`] on the height function `height`.
+    fn bracket_with(
+        &self,
+        height: &dyn Fn(Point2) -> f64,
+        mut inside: Point2,
+        mut h_in: f64,
+        mut outside: Point2,
+        mut h_out: f64,
+    ) -> (Point2, Point2) {
         let mut bisections = 0;
         loop {
             let width = (outside - inside).norm();
@@ -117,7 +176,7 @@ impl Local<'_> {
                 if p == inside || p == outside {
                     continue;
                 }
-                let h = self.height(p);
+                let h = height(p);
                 if h > 0.0 {
                     (inside, h_in) = (p, h);
                 } else {
@@ -173,9 +232,9 @@ impl Local<'_> {
                     return Near::Within;
                 }
                 return Near::Found(if mid_in {
-                    self.bisect_heights(last, h_last, p, h)
+                    self.bisect_heights(last, h_last, slot_last, p, h)
                 } else {
-                    self.bisect_heights(p, h, last, h_last)
+                    self.bisect_heights(p, h, slot, last, h_last)
                 });
             }
             if mid_in && let Some(gap) = self.first_gap(last, slot_last, p, h, slot) {
@@ -281,6 +340,10 @@ impl Local<'_> {
         outside
     }
 }
+
+/// Most triangles [`Local::walk_bracket`] steps through before the plain
+/// bracket takes over.
+const MAX_WALK_STEPS: usize = 8;
 
 /// Bisection steps after a secant step that failed to halve the bracket,
 /// before the secant is tried again.
