@@ -457,6 +457,9 @@ fn drop_candidates(
         if c.ub + slack <= best.tip.z {
             break; // sorted: nothing after this can rise above the best
         }
+        if seed == Some(c.slot) {
+            continue; // already tested whole, every corner and edge
+        }
         let dx = (c.min[0] - xy.x).max(0.0).max(xy.x - c.max[0]);
         let dy = (c.min[1] - xy.y).max(0.0).max(xy.y - c.max[1]);
         let d2 = dx * dx + dy * dy;
