@@ -69,7 +69,7 @@ pub(crate) fn refinement_for(layout: &Layout, over: &[OverCell], cutter: &Cutter
         let by_levels = !layout.levels.is_empty() && slope >= layout.steep_min;
         let by_planes = layout.levels.is_empty() || slope < layout.shallow_max;
         if by_planes {
-            let axis = touching_axis(cutter, index, cell, &mut scratch);
+            let axis = cell.reached_from.map_or_else(|| touching_axis(cutter, index, cell, &mut scratch), |c| c.xy());
             let d = m.0 * axis.x + m.1 * axis.y;
             let i = layout.planes.partition_point(|&p| p < d);
             if i > 0 && i < layout.planes.len() {
@@ -80,7 +80,7 @@ pub(crate) fn refinement_for(layout: &Layout, over: &[OverCell], cutter: &Cutter
             }
         }
         if by_levels {
-            let tip = cell.at.z - corner * (1.0 - cell.nz.abs().min(1.0));
+            let tip = cell.reached_from.map_or(cell.at.z - corner * (1.0 - cell.nz.abs().min(1.0)), |c| c.z);
             let j = layout.levels.partition_point(|&z| z > tip);
             if j > 0 && j < layout.levels.len() {
                 levels.insert(key(0.5 * (layout.levels[j - 1] + layout.levels[j])));
@@ -95,8 +95,9 @@ pub(crate) fn refinement_for(layout: &Layout, over: &[OverCell], cutter: &Cutter
     Refinement { planes: planes.into_iter().map(value).collect(), levels: levels.into_iter().map(value).collect() }
 }
 
-/// The XY place of the axis of `cutter` touching the part at `cell`: the
-/// contact lies on the cutter's side towards the uphill direction `-n_h`, at
+/// The XY place of the axis of `cutter` touching the part at `cell` when the
+/// simulation did not say where the cutter that reaches it stands
+/// ([`OverCell::reached_from`]), by the cell's facet alone: the contact lies on the cutter's side towards the uphill direction `-n_h`, at
 /// `R |n_h|` from the axis for a ball, `R - r + r |n_h|` for a bull-nose and
 /// `R` for a flat end (`n` the part's unit normal under the cell). The cell
 /// itself on a flat place or where no facet lies under it.
@@ -155,7 +156,7 @@ mod tests {
     use super::*;
 
     fn cell(x: f64, y: f64, z: f64, nz: f64) -> OverCell {
-        OverCell { at: Point3::new(x, y, z), nz, thickness: 0.1 }
+        OverCell { at: Point3::new(x, y, z), nz, thickness: 0.1, reached_from: None }
     }
 
     /// The plane `z = y tan(slope)` over `[-20, 20]^2`, rising towards +Y.
@@ -220,6 +221,79 @@ mod tests {
                 assert!((r.planes[0] - mid).abs() < 1e-5, "{shape:?} at {y}: {:?}, axis {axis}", r.planes);
             }
         }
+    }
+
+    /// A groove along X: a 43-degree flank rising towards -Y, a 70-degree
+    /// wall towards +Y, flat beyond.
+    fn groove() -> (scallop_mesh::TriMesh, f64, f64) {
+        let (a, b) = (43_f64.to_radians().tan(), 70_f64.to_radians().tan());
+        let depth = 5.0;
+        let (ya, yb) = (-depth / a, depth / b);
+        let p = |x: f64, y: f64| Point3::new(x, y, if y < 0.0 { -a * y } else { b * y }.min(depth));
+        let ys = [-9.0, ya, 0.0, yb, 5.0];
+        let mut soup = Vec::new();
+        for w in ys.windows(2) {
+            let (q0, q1, q2, q3) = (p(-6.0, w[0]), p(6.0, w[0]), p(6.0, w[1]), p(-6.0, w[1]));
+            soup.push([q0, q1, q2]);
+            soup.push([q0, q2, q3]);
+        }
+        (scallop_mesh::TriMesh::from_soup(&soup).expect("a groove").0, a, b)
+    }
+
+    /// Where a cell of the machined surface lies on a facet that other faces
+    /// keep the cutter off (a hollow narrower than the cutter: here the foot
+    /// of a 43-degree flank in a groove whose far wall holds a bull-nose R3
+    /// r1 up), the cutter that reaches it stands where it touches both faces,
+    /// not where it would rest on the flank alone (`R - r + r sin s` downhill
+    /// of the cell, inside the wall). The planes around that cutter are the
+    /// ones that leave the cell's scallop (mount_rush, docs/validation.md,
+    /// "mount_rush with the bull-nose"): the cell is bracketed by them.
+    #[test]
+    fn a_cell_the_cutter_reaches_wedged_in_a_hollow_is_bracketed_around_the_wedged_cutter() {
+        let (mesh, ta, tb) = groove();
+        let index = MeshIndex::build(&mesh);
+        let (radius, corner) = (3.0, 1.0);
+        let cutter = Cutter::new(CutterShape::Bull { radius, corner }, 20.0).expect("a bull-nose");
+        // The axis touching both faces with the two corner arcs (a section across the groove).
+        let (ca, cb) = (43_f64.to_radians().cos(), 70_f64.to_radians().cos());
+        let flat = radius - corner;
+        let wedged = (flat * (ta - tb) + corner / ca - corner / cb) / (ta + tb);
+        // Passes along X: every 0.1 mm up the flank from 0.2 mm off the wedged
+        // axis, every 0.05 mm up the wall from 0.03 mm off it.
+        let mut planes: Vec<f64> = (2..80).map(|k| wedged - 0.1 * f64::from(k)).collect();
+        planes.extend((0..40).map(|k| wedged + 0.03 + 0.05 * f64::from(k)));
+        planes.sort_by(f64::total_cmp);
+        let mut path = scallop_toolpath::Toolpath::new(1000.0);
+        for &y in &planes {
+            for k in 0..=150 {
+                let x = -7.5 + 0.1 * f64::from(k);
+                let cl = scallop_cutter::drop_cutter(&cutter, &index, Point2::new(x, y), -10.0);
+                if k == 0 {
+                    let above = Point3::new(cl.tip.x, cl.tip.y, 10.0);
+                    path.push(scallop_toolpath::Move::new(scallop_toolpath::MoveKind::Rapid, above));
+                    path.push(scallop_toolpath::Move::new(scallop_toolpath::MoveKind::Plunge, cl.tip));
+                } else {
+                    path.push(scallop_toolpath::Move::new(scallop_toolpath::MoveKind::Feed, cl.tip));
+                }
+            }
+            path.push(scallop_toolpath::Move::new(scallop_toolpath::MoveKind::Retract, Point3::new(7.5, y, 10.0)));
+        }
+        let stock = scallop_geom::Aabb3 { min: Point3::new(-9.0, -12.0, -1.0), max: Point3::new(9.0, 8.0, 5.0 + 1e-3) };
+        let options =
+            scallop_sim::VerifyOptions { gouge_tolerance: 0.01, scallop_margin: radius, ..Default::default() };
+        let sim = scallop_sim::simulate(stock, 0.1, &cutter, &path, &index, &options).expect("simulated");
+        let field = scallop_sim::PartField::new(&sim.zmap, &index);
+        let limit = 0.01 + sim.zmap.resolution_bound(cutter.shape());
+        let split = scallop_sim::split_rest(&sim.zmap, &field, &index, &cutter, &options, limit);
+        // The cells on the flank within a cutter's reach of the groove's foot.
+        let flank: Vec<OverCell> =
+            split.machined_over.iter().filter(|c| (c.nz - ca).abs() < 1e-6 && c.at.y > -6.0).copied().collect();
+        let layout = Layout { planes: planes.clone(), ..Layout::default() };
+        let r = refinement_for(&layout, &flank, &cutter, &index);
+        assert!(!flank.is_empty(), "the program leaves the flank's foot over the limit");
+        // The mid-plane of the pair around the wedged axis, and no other.
+        assert_eq!(r.planes.len(), 1, "{:?}", r.planes);
+        assert!((r.planes[0] - (wedged - 0.085)).abs() < 1e-5, "{:?}, wedged axis {wedged}", r.planes);
     }
 
     #[test]

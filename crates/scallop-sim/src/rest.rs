@@ -67,6 +67,13 @@ pub struct OverCell {
     pub nz: f64,
     /// The scallop there, along the normal (mm).
     pub thickness: f64,
+    /// The tip of the sampled cutter location whose cutter comes lowest over
+    /// the cell (the one that defines the reach there): the cutter that
+    /// touches the part at the cell. Where other faces hold the cutter off
+    /// (a hollow of the drop-cutter surface) it is not where a cutter resting
+    /// on the cell's facet alone would stand. `None` where no location was
+    /// sampled within the cutter radius.
+    pub reached_from: Option<Point3>,
 }
 
 /// Splits the material the program left on `zmap` over the part (`field`,
@@ -97,12 +104,17 @@ pub fn split_rest(
     let reach = Reach::new(zmap, part, cutter, &candidates);
     // Per candidate: (machined thickness, rest thickness): a cell whose surface
     // the cutter cannot reach within the limit is rest, all its material counted.
-    let split: Vec<(f64, f64)> = candidates
+    let split: Vec<(f64, f64, Option<Point3>)> = candidates
         .par_iter()
         .map(|&k| {
             let (part_z, nz) = top[k];
-            let r = reach.at(k).max(part_z);
-            if (r - part_z) * nz > limit { (0.0, thickness(k)) } else { ((zmap.heights()[k] - r) * nz, 0.0) }
+            let (r, from) = reach.at(k);
+            let r = r.max(part_z);
+            if (r - part_z) * nz > limit {
+                (0.0, thickness(k), from)
+            } else {
+                ((zmap.heights()[k] - r) * nz, 0.0, from)
+            }
         })
         .collect();
     let mut machined: Option<(f64, usize)> = None;
@@ -113,7 +125,7 @@ pub fn split_rest(
         }
     }
     let mut rest = vec![0.0; nx * ny];
-    for (&k, &(m, r)) in candidates.iter().zip(&split) {
+    for (&k, &(m, r, _)) in candidates.iter().zip(&split) {
         if machined.is_none_or(|(best, _)| m > best) {
             machined = Some((m, k));
         }
@@ -122,10 +134,10 @@ pub fn split_rest(
     let mut machined_over: Vec<OverCell> = candidates
         .iter()
         .zip(&split)
-        .filter(|&(_, &(m, _))| m > limit)
-        .map(|(&k, &(m, _))| {
+        .filter(|&(_, &(m, _, _))| m > limit)
+        .map(|(&k, &(m, _, reached_from))| {
             let c = zmap.cell_center(k % nx, k / nx);
-            OverCell { at: Point3::new(c.x, c.y, top[k].0), nz: top[k].1, thickness: m }
+            OverCell { at: Point3::new(c.x, c.y, top[k].0), nz: top[k].1, thickness: m, reached_from }
         })
         .collect();
     machined_over.sort_by(|a, b| {
@@ -188,24 +200,27 @@ impl<'a> Reach<'a> {
         ((cutter.radius() / cx).ceil() as usize, (cutter.radius() / cy).ceil() as usize)
     }
 
-    /// `reach` at cell `k` (module docs), over the sampled locations.
-    fn at(&self, k: usize) -> f64 {
+    /// `reach` at cell `k` (module docs), over the sampled locations, and the
+    /// tip of the location it comes from.
+    fn at(&self, k: usize) -> (f64, Option<Point3>) {
         let (nx, ny) = (self.zmap.nx(), self.zmap.ny());
         let (ri, rj) = Self::radius_cells(self.zmap, self.cutter);
         let (i, j) = (k % nx, k / nx);
         let p = self.zmap.cell_center(i, j);
         let (radius, shape) = (self.cutter.radius(), self.cutter.shape());
-        let mut best = f64::INFINITY;
+        let (mut best, mut from) = (f64::INFINITY, None);
         for jj in j.saturating_sub(rj)..=(j + rj).min(ny - 1) {
             for ii in i.saturating_sub(ri)..=(i + ri).min(nx - 1) {
                 let c = self.cl[jj * nx + ii];
-                let d = (self.zmap.cell_center(ii, jj) - p).norm();
-                if d <= radius && c.is_finite() {
-                    best = best.min(c + shape.height_at(d));
+                let q = self.zmap.cell_center(ii, jj);
+                let d = (q - p).norm();
+                if d <= radius && c.is_finite() && c + shape.height_at(d) < best {
+                    best = c + shape.height_at(d);
+                    from = Some(Point3::new(q.x, q.y, c));
                 }
             }
         }
-        best
+        (best, from)
     }
 }
 
