@@ -346,7 +346,8 @@ struct Levels<'a> {
     /// Lowest and highest level (tip heights, mm).
     z_range: (f64, f64),
     /// Heights of the part's flat areas, highest first: a level runs just
-    /// above each, so the foot of a wall standing on a floor is finished.
+    /// above each, so the foot of a wall standing on a floor is finished, and
+    /// looks for the floor's wells its grid misses ([`Levels::wells`]).
     flats: Vec<f64>,
     /// How far above a flat area its level runs (mm, `FLAT_LIFT_SHARE * path`).
     lift: f64,
@@ -451,11 +452,11 @@ impl<'a> Levels<'a> {
     /// it, which a flat bottom reaches from there alone, is left uncut (issue
     /// 15, octagonal_pocket: docs/validation.md). Such a well lies at the
     /// bottom of a valley of the drop-cutter surface, where the cutter hangs
-    /// between the pocket's walls: from every sample of the grid above `z`,
-    /// none of whose eight neighbours is lower and one higher, a descent (steps halved down to the
-    /// chord tolerance) looks for a point where the cutter at `z` clears the
-    /// part; one that `loops` count inside the part is a missed well, whose
-    /// contour is traced by rays from it.
+    /// between the pocket's walls: from every sample of the grid above `z`
+    /// none of whose eight neighbours is lower (and one higher), a descent
+    /// (steps halved down to the chord tolerance) looks for a point where the
+    /// cutter at `z` clears the part; one that `loops` count inside the part
+    /// is a missed well, whose contour is traced by rays from it.
     fn wells(&self, z: f64, loops: &[Loop]) -> Vec<Loop> {
         let (nx, ny) = self.grid.shape();
         let mut seeds = Vec::new();
