@@ -1179,6 +1179,24 @@ pub mod strategy {
     /// floor, and the floor is left with no more than this.
     pub const FLAT_LIFT_SHARE: f64 = 0.01;
 
+    /// A well of a flat area's level (the only place where the cutter reaches
+    /// the floor of a pocket just wider than it, narrower than the waterline
+    /// grid step) is looked for within this many grid steps of a valley bottom
+    /// of the grid, and its contour within this many grid steps of the point found.
+    pub const WELL_REACH_STEPS: f64 = 2.0;
+
+    /// Most probes (moves and halvings of the step) of the descent from a
+    /// valley bottom of the waterline grid towards a well.
+    pub const WELL_DESCENT_MOVES: usize = 64;
+
+    /// Rays of the first pass of a well's contour; each gap between two is
+    /// halved while the contour leaves the chord by more than the chord
+    /// tolerance, at most [`WELL_RAY_DEPTH`] times.
+    pub const WELL_RAYS: usize = 32;
+
+    /// Most halvings of a gap between two rays of a well's contour.
+    pub const WELL_RAY_DEPTH: u32 = 6;
+
     /// The contact of a waterline loop point is probed this many chord
     /// tolerances inside the loop, where the part lifts the cutter above the level.
     pub const LEVEL_PROBE_CHORDS: f64 = 4.0;

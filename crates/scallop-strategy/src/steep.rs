@@ -24,7 +24,7 @@ use scallop_cutter::{ClPoint, Cutter, CutterShape, drop_cutter};
 use scallop_geom::{Point2, Point3, Tolerances, Vec2};
 use scallop_mesh::{MeshIndex, TriMesh};
 use scallop_toolpath::{Move, MoveKind, Toolpath};
-use scallop_waterline::{WaterlineGrid, WaterlineOptions};
+use scallop_waterline::{Loop, WaterlineGrid, WaterlineOptions};
 
 use crate::geometry::{contact_normal, slots_by_original};
 use crate::{FinishingParams, Planned, Refinement, Report, StrategyError, ZoneRegion, tol};
@@ -346,7 +346,8 @@ struct Levels<'a> {
     /// Lowest and highest level (tip heights, mm).
     z_range: (f64, f64),
     /// Heights of the part's flat areas, highest first: a level runs just
-    /// above each, so the foot of a wall standing on a floor is finished.
+    /// above each, so the foot of a wall standing on a floor is finished, and
+    /// looks for the floor's wells its grid misses ([`Levels::wells`]).
     flats: Vec<f64>,
     /// How far above a flat area its level runs (mm, `FLAT_LIFT_SHARE * path`).
     lift: f64,
@@ -400,7 +401,11 @@ impl<'a> Levels<'a> {
     /// The passes of the level at tip height `z`: runs of loop points whose
     /// contact is at least `threshold - overlap` steep, in cutting order.
     fn level(&self, z: f64) -> Result<Level, StrategyError> {
-        let loops = self.grid.loops(z).map_err(|e| StrategyError::Waterline(e.to_string()))?;
+        let mut loops = self.grid.loops(z).map_err(|e| StrategyError::Waterline(e.to_string()))?;
+        if self.above_flat(z) {
+            let wells = self.wells(z, &loops);
+            loops.extend(wells);
+        }
         let steep_min = self.split.threshold - self.split.overlap;
         let (mut passes, mut pass_slopes) = (Vec::new(), Vec::new());
         let mut min_slope = f64::INFINITY;
@@ -428,6 +433,175 @@ impl<'a> Levels<'a> {
             }
         }
         Ok(Level { z, passes, slopes: pass_slopes, min_slope })
+    }
+
+    /// Whether `z` runs just above a flat area (within the levels' edge margin,
+    /// and the lift for rounding): a floor's level, or the lowest level on the
+    /// lowest floor.
+    fn above_flat(&self, z: f64) -> bool {
+        let margin = tol::LEVEL_EDGE_SHARE * self.path + self.lift;
+        self.flats.iter().any(|&f| z > f && z - f <= margin)
+    }
+
+    /// The wells of a floor's level at `z` that the waterline grid misses, as
+    /// loops (inside on the left) to add to `loops`. In a pocket just wider
+    /// than the cutter (a triangle whose inscribed circle is a little larger
+    /// than the cutter's), the cutter reaches the floor only in a small region
+    /// (the pocket offset inwards by the cutter), which may lie between the
+    /// grid's samples: the kernel sees no contour there, and the floor around
+    /// it, which a flat bottom reaches from there alone, is left uncut (issue
+    /// 15, octagonal_pocket: docs/validation.md). Such a well lies at the
+    /// bottom of a valley of the drop-cutter surface, where the cutter hangs
+    /// between the pocket's walls: from every sample of the grid above `z`
+    /// none of whose eight neighbours is lower (and one higher), a descent
+    /// (steps halved down to the chord tolerance) looks for a point where the
+    /// cutter at `z` clears the part; one that `loops` count inside the part
+    /// is a missed well, whose contour is traced by rays from it.
+    fn wells(&self, z: f64, loops: &[Loop]) -> Vec<Loop> {
+        let (nx, ny) = self.grid.shape();
+        let mut seeds = Vec::new();
+        for j in 1..ny.saturating_sub(1) {
+            for i in 1..nx.saturating_sub(1) {
+                let h = self.grid.height(i, j);
+                let around = (j - 1..=j + 1)
+                    .flat_map(|jj| (i - 1..=i + 1).map(move |ii| (ii, jj)))
+                    .filter(|&at| at != (i, j))
+                    .map(|(ii, jj)| self.grid.height(ii, jj));
+                let (lowest, higher) = around.fold((true, false), |(l, m), n| (l && n >= h, m || n > h));
+                if h > z && lowest && higher {
+                    #[allow(clippy::cast_precision_loss, reason = "grid indices")]
+                    let at = self.grid.origin() + Vec2::new(i as f64, j as f64) * self.grid.step();
+                    seeds.push(at);
+                }
+            }
+        }
+        let found: Vec<Option<Point2>> = seeds.par_iter().map(|&at| self.descend(z, at)).collect();
+        let mut out: Vec<Loop> = Vec::new();
+        for p in found.into_iter().flatten() {
+            if loops.iter().chain(&out).map(|l| l.winding_number(p)).sum::<i32>() == 0 {
+                continue; // outside already: a contour the grid found
+            }
+            if let Some(well) = self.well_contour(z, p) {
+                out.push(well);
+            }
+        }
+        out
+    }
+
+    /// From `start` (where the cutter at `z` cuts into the part), the pattern
+    /// search down the drop-cutter surface (eight directions, the step halved
+    /// where none is lower) to a point where the cutter at `z` clears the part,
+    /// within [`tol::WELL_REACH_STEPS`] grid steps; `None` if there is none.
+    fn descend(&self, z: f64, start: Point2) -> Option<Point2> {
+        let reach = tol::WELL_REACH_STEPS * self.grid.step();
+        let diagonal = std::f64::consts::FRAC_1_SQRT_2;
+        let directions = [
+            Vec2::new(1.0, 0.0),
+            Vec2::new(diagonal, diagonal),
+            Vec2::new(0.0, 1.0),
+            Vec2::new(-diagonal, diagonal),
+            Vec2::new(-1.0, 0.0),
+            Vec2::new(-diagonal, -diagonal),
+            Vec2::new(0.0, -1.0),
+            Vec2::new(diagonal, -diagonal),
+        ];
+        let (mut p, mut h) = (start, self.above(z, start));
+        let mut step = 0.5 * self.grid.step();
+        for _ in 0..tol::WELL_DESCENT_MOVES {
+            if h <= 0.0 {
+                return Some(p);
+            }
+            if step < self.chord {
+                return None;
+            }
+            let lower = directions
+                .iter()
+                .map(|d| p + d * step)
+                .filter(|q| (q - start).norm() <= reach)
+                .map(|q| (self.above(z, q), q))
+                .min_by(|a, b| a.0.total_cmp(&b.0));
+            match lower {
+                Some((hq, q)) if hq < h => (p, h) = (q, hq),
+                _ => step *= 0.5,
+            }
+        }
+        None
+    }
+
+    /// The contour at `z` of the well around `inside` (where the cutter at `z`
+    /// clears the part), inside (the part) on the left: along rays from
+    /// `inside`, the first place where the cutter cuts into the part, bisected
+    /// to `tol::LEVEL_CHORD_BRACKET` chord tolerances and kept at its clear
+    /// end; rays are added between two whose chord leaves the contour by more
+    /// than the chord tolerance. `None` when a ray finds no contour within
+    /// [`tol::WELL_REACH_STEPS`] grid steps (no small well).
+    fn well_contour(&self, z: f64, inside: Point2) -> Option<Loop> {
+        let reach = tol::WELL_REACH_STEPS * self.grid.step();
+        let ray = |angle: f64| -> Option<Point2> {
+            let u = Vec2::new(angle.cos(), angle.sin());
+            let (mut clear, mut r) = (0.0, self.chord);
+            let mut cut = loop {
+                if self.above(z, inside + u * r) > 0.0 {
+                    break r;
+                }
+                if r >= reach {
+                    return None;
+                }
+                clear = r;
+                r = (2.0 * r).min(reach);
+            };
+            let bracket = tol::LEVEL_CHORD_BRACKET * self.chord;
+            while cut - clear > bracket {
+                let m = 0.5 * (clear + cut);
+                if self.above(z, inside + u * m) > 0.0 {
+                    cut = m;
+                } else {
+                    clear = m;
+                }
+            }
+            Some(inside + u * clear)
+        };
+        let tau = std::f64::consts::TAU;
+        #[allow(clippy::cast_precision_loss, reason = "a small count")]
+        let first: Vec<f64> = (0..=tol::WELL_RAYS).map(|k| tau * k as f64 / tol::WELL_RAYS as f64).collect();
+        let mut points: Vec<(f64, Point2)> = Vec::new();
+        for w in first.windows(2) {
+            let (a, b) = ((w[0], ray(w[0])?), (w[1], ray(w[1])?));
+            self.well_arc(&ray, a, b, 0, &mut points)?;
+        }
+        // Counter-clockwise around the well: reversed, the part is on the left.
+        let mut loop_points: Vec<Point2> = points.into_iter().map(|(_, p)| p).collect();
+        loop_points.reverse();
+        (loop_points.len() >= 3).then_some(Loop { z, points: loop_points })
+    }
+
+    /// The contour points from ray `a` (included) towards ray `b` (excluded),
+    /// rays added half-way while the middle one leaves the chord by more than
+    /// the chord tolerance (see [`Self::well_contour`]).
+    fn well_arc(
+        &self,
+        ray: &dyn Fn(f64) -> Option<Point2>,
+        a: (f64, Point2),
+        b: (f64, Point2),
+        depth: u32,
+        out: &mut Vec<(f64, Point2)>,
+    ) -> Option<()> {
+        if depth < tol::WELL_RAY_DEPTH {
+            let angle = 0.5 * (a.0 + b.0);
+            let m = ray(angle)?;
+            let chord = b.1 - a.1;
+            let off = if chord.norm() > 0.0 {
+                (chord.x * (m.y - a.1.y) - chord.y * (m.x - a.1.x)).abs() / chord.norm()
+            } else {
+                (m - a.1).norm()
+            };
+            if off > self.chord {
+                self.well_arc(ray, a, (angle, m), depth + 1, out)?;
+                return self.well_arc(ray, (angle, m), b, depth + 1, out);
+            }
+        }
+        out.push(a);
+        Some(())
     }
 
     /// The closed contour `points` (tip height `z`, inside on the left) with
@@ -955,6 +1129,82 @@ pub(crate) mod tests {
         }
         let worst = cuts.iter().copied().fold(0.0, f64::max);
         assert!(worst <= tolerances.path * tol::LEVEL_CHORD_SHARE, "{worst} {cuts:?}");
+    }
+
+    /// A triangular plate (circumradius 30 mm, 5 mm thick) with an
+    /// equilateral triangular pocket 4 mm deep whose inscribed circle has the
+    /// radius `inradius`, its centre at `centre`.
+    fn triangle_pocket(centre: Point2, inradius: f64) -> TriMesh {
+        let corner = |k: usize, size: f64, at: Point2, z: f64| {
+            #[allow(clippy::cast_precision_loss, reason = "a small count")]
+            let a = std::f64::consts::FRAC_PI_2 + std::f64::consts::TAU * k as f64 / 3.0;
+            Point3::new(at.x + size * a.cos(), at.y + size * a.sin(), z)
+        };
+        let origin = Point2::origin();
+        let (o, t) =
+            (|k: usize, z| corner(k % 3, 30.0, origin, z), |k: usize, z| corner(k % 3, 2.0 * inradius, centre, z));
+        let mut soup = Vec::new();
+        let mut quad = |a: Point3, b: Point3, c: Point3, d: Point3| {
+            soup.push([a, b, c]);
+            soup.push([a, c, d]);
+        };
+        for k in 0..3 {
+            quad(o(k, 5.0), o(k + 1, 5.0), t(k + 1, 5.0), t(k, 5.0)); // the top around the pocket
+            quad(t(k, 1.0), t(k, 5.0), t(k + 1, 5.0), t(k + 1, 1.0)); // the pocket's walls
+            quad(o(k, 0.0), o(k + 1, 0.0), o(k + 1, 5.0), o(k, 5.0)); // the outer walls
+        }
+        soup.push([t(0, 1.0), t(1, 1.0), t(2, 1.0)]);
+        soup.push([o(0, 0.0), o(2, 0.0), o(1, 0.0)]);
+        TriMesh::from_soup(&soup).expect("a triangular pocket").0
+    }
+
+    /// Regression (octagonal_pocket, bull-nose R8 r3 at sh 0.05, 0.0534 mm
+    /// over sh: docs/validation.md): in a pocket whose inscribed circle is
+    /// 0.1 mm larger than a bull-nose R3 r1, the cutter reaches the floor
+    /// only in a triangle 0.35 mm wide, here in the middle of a cell of the
+    /// waterline grid (step 0.75 mm), where no sample sees it. The floor's
+    /// level runs around that well, with the cutter clear of the part at
+    /// every point, wherever in the cell the well lies.
+    #[test]
+    fn the_floor_level_runs_around_a_well_narrower_than_the_waterline_grid() {
+        let params = test_params();
+        let tolerances = Tolerances { path: 0.01, gouge: 0.0 };
+        let cutter = Cutter::new(CutterShape::Bull { radius: 3.0, corner: 1.0 }, 30.0).expect("cutter");
+        let split = SteepShallow::default_for(&cutter, params.scallop_height);
+        // The grid's origin depends on the plate only: place the well in its cells.
+        let plate = MeshIndex::build(&triangle_pocket(Point2::origin(), 3.1));
+        let grid = Levels::new(&plate, &cutter, &params, &tolerances, &split, (0.0, 5.0)).expect("levels");
+        let (origin, step) = (grid.grid.origin(), grid.grid.step());
+        let mut missing = Vec::new();
+        for (fx, fy) in [(0.5, 0.5), (0.3, 0.6), (0.7, 0.35)] {
+            let cell = Vec2::new((-origin.x / step).floor() + fx, (-origin.y / step).floor() + fy);
+            let centre = origin + cell * step;
+            let mesh = triangle_pocket(centre, 3.1);
+            let index = MeshIndex::build(&mesh);
+            let mut levels = Levels::new(&index, &cutter, &params, &tolerances, &split, (0.0, 5.0)).expect("levels");
+            levels.flats = flat_heights(
+                &mesh,
+                &mesh
+                    .triangles()
+                    .iter()
+                    .enumerate()
+                    .map(|(t, _)| triangle_slope(&mesh.triangle(t)))
+                    .collect::<Vec<_>>(),
+                tolerances.path,
+            );
+            let z = 1.0 + levels.lift;
+            assert!(levels.above(z, centre) <= 0.0, "the cutter reaches the floor at the pocket's centre");
+            let level = levels.level(z).expect("level");
+            let around = level.passes.iter().any(|pass| {
+                let closed = Loop { z, points: pass.clone() };
+                closed.winding_number(centre) != 0
+                    && pass.iter().all(|p| (p - centre).norm() < 0.5 && levels.above(z, *p) <= 0.0)
+            });
+            if !around {
+                missing.push((fx, fy));
+            }
+        }
+        assert!(missing.is_empty(), "no pass around the well at {missing:?}");
     }
 
     /// The shallow planes' measure is a report where rest is tolerated: raw

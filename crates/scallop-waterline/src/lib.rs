@@ -477,6 +477,13 @@ impl<'a> WaterlineGrid<'a> {
         self.step
     }
 
+    /// The drop-cutter tip height at sample `(i, j)` (mm; `i` below the first
+    /// and `j` below the second number of [`WaterlineGrid::shape`]).
+    #[must_use]
+    pub fn height(&self, i: usize, j: usize) -> f64 {
+        self.heights[j * self.nx + i]
+    }
+
     /// The part's height range `[zmin, zmax)` where waterlines exist.
     #[must_use]
     pub fn z_range(&self) -> (f64, f64) {
