@@ -540,28 +540,7 @@ fn flat_arcs(c: &Contour) -> Result<Contour, scallop_contour::ContourError> {
     Contour::new(&v, false)
 }
 
-/// Appends the runs of a chain as cuts (the link before the first is the
-/// caller's; each run starts where the one before ended). A move of a run
-/// that leaves `holder` (a chord of the grid across a wall's bend) is
-/// replaced by a retract: the cut goes on from the move's end.
-fn push_runs(steps: &mut Vec<Step>, runs: Vec<Vec<P2>>, holder: &Region, chord: f64) {
-    for mut run in runs {
-        run.dedup_by(|a, b| dist(*a, *b) <= tol::LINK_GROW * 0.1);
-        let mut from = 0;
-        for k in 1..=run.len() {
-            let split = k < run.len() && !holder.contains_segment(run[k - 1], run[k], chord);
-            if !split && k < run.len() {
-                continue;
-            }
-            if k - from >= 2
-                && let Ok(c) = Contour::from_points(&run[from..k], false, tol::ARC_FIT).and_then(|c| flat_arcs(&c))
-            {
-                steps.push(Step::Cut(c));
-            }
-            if split {
-                steps.push(Step::Link { tool_down: false, via: Vec::new(), cleared: false });
-            }
-            from = k;
-        }
-    }
+/// The points as lines and arcs within [`tol::ARC_FIT`], far arcs made lines.
+fn fit(points: &[P2]) -> Option<Contour> {
+    Contour::from_points(points, false, tol::ARC_FIT).and_then(|c| flat_arcs(&c)).ok()
 }

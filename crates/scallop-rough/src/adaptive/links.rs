@@ -121,7 +121,12 @@ impl Planner<'_> {
     /// The lattice cell nearest `p`, and its (i, j).
     fn lattice_near(&self, p: P2) -> (usize, usize) {
         let g = &self.grid;
-        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, clippy::cast_precision_loss, reason = "clamped")]
+        #[allow(
+            clippy::cast_possible_truncation,
+            clippy::cast_sign_loss,
+            clippy::cast_precision_loss,
+            reason = "clamped"
+        )]
         let snap = |v: f64, n: usize| {
             let c = (v / LATTICE as f64).round().clamp(0.0, ((n - 1) / LATTICE) as f64) as usize;
             c * LATTICE
@@ -182,8 +187,7 @@ impl Planner<'_> {
             let c = self.grid.centre(k);
             let g = best.get(&k).map_or(BIG, |b| b.0);
             // An end across a wall does not count as a try.
-            if dist(c, to) <= near.max(2.0 * step)
-                && self.holder.contains_segment(c, to, self.options.chord_tolerance)
+            if dist(c, to) <= near.max(2.0 * step) && self.holder.contains_segment(c, to, self.options.chord_tolerance)
             {
                 goals += 1;
                 if self.link_ok(c, to, to) {
@@ -316,11 +320,8 @@ impl Planner<'_> {
                 let step = self.link_step(pos, to);
                 steps.push(step);
             }
-            for run in &runs {
-                self.stamp(run);
-            }
             pos = runs.last().and_then(|v| v.last()).copied().unwrap_or(pos);
-            super::push_runs(&mut steps, runs, &self.holder, self.options.chord_tolerance);
+            self.emit_runs(&mut steps, runs);
             for &n in &after[j] {
                 waiting[n] -= 1;
                 if waiting[n] == 0 {
@@ -329,6 +330,36 @@ impl Planner<'_> {
             }
         }
         (steps, pos)
+    }
+
+    /// Appends the runs of a chain as cuts, stamped (the link before the
+    /// first is the caller's; each run starts where the one before ended).
+    /// A move of a run that leaves the region (a chord of the grid across a
+    /// wall's bend) is not cut: the tool goes on from the move's end by a
+    /// link.
+    fn emit_runs(&mut self, steps: &mut Vec<Step>, runs: Vec<Vec<P2>>) {
+        let chord = self.options.chord_tolerance;
+        for mut run in runs {
+            run.dedup_by(|a, b| dist(*a, *b) <= super::tol::LINK_GROW * 0.1);
+            let mut from = 0;
+            for k in 1..=run.len() {
+                let split = k < run.len() && !self.holder.contains_segment(run[k - 1], run[k], chord);
+                if !split && k < run.len() {
+                    continue;
+                }
+                if k - from >= 2 {
+                    self.stamp(&run[from..k]);
+                    if let Some(c) = super::fit(&run[from..k]) {
+                        steps.push(Step::Cut(c));
+                    }
+                }
+                if split {
+                    let link = self.link_step(run[k - 1], run[k]);
+                    steps.push(link);
+                }
+                from = k;
+            }
+        }
     }
 
     /// The link from `from` to `to` as a step; a tool-down link's path is
