@@ -196,10 +196,10 @@ fn comb(w: &[f64]) -> Vec<Vec<[f64; 2]>> {
     vec![pts]
 }
 
-/// The moves of kind `Link` (tool down at cutting depth): every one but the
-/// last of a link (the approach to a cut's start, which may enter a front at
-/// a new point) cuts nothing by the simulator's reading, and that last one
-/// no more than the bound. "Nothing" is within the simulator's raster: older
+/// The moves of kind `Link` (tool down at cutting depth): a move ending
+/// within 2 R of the link's end (the approach to a cut's start, which may
+/// enter a front at a new point) engages no more than the bound, every other
+/// cuts nothing by the simulator's reading. "Nothing" is within the simulator's raster: older
 /// cuts and the walls are cells of `resolution`, so a tool centre at R from
 /// an older one or from a wall may read a sliver up to a cell deep (plus the
 /// planner's 5 um slack), 2 arccos(1 - d / R) of periphery (31 degrees here;
@@ -213,7 +213,10 @@ fn check_links(plan: &RoughPlan, report: &EngagementReport) {
         if m.kind != scallop_toolpath::MoveKind::Link || m.to.z > -0.5 {
             continue;
         }
-        let approach = moves.get(i + 1).is_none_or(|n| n.kind != scallop_toolpath::MoveKind::Link);
+        let end = moves[i..].iter().find(|n| n.kind != scallop_toolpath::MoveKind::Link).map_or(m.to, |_| {
+            moves[i..].iter().take_while(|n| n.kind == scallop_toolpath::MoveKind::Link).last().map_or(m.to, |n| n.to)
+        });
+        let approach = (m.to.x - end.x).hypot(m.to.y - end.y) <= 2.0 * R;
         let phi = report.move_phi[i];
         let limit = if approach { bound } else { air };
         assert!(phi <= limit, "link move {i} to {:?}: {:.1} deg", m.to, phi.to_degrees());
