@@ -35,12 +35,12 @@
 //! speed machining of pockets", CAD 37(2): a bounded engagement from the
 //! medial axis outwards), done by measurement instead of a closed form.
 //!
-//! Passes are joined in order nearest first. A closed front (not touching a
-//! wall) is entered by a straight ramp from the current point to its point
-//! R further along it; a pass that starts on a wall starts where the wall
-//! was reached before (cleared), and the link to it stays at cutting depth
-//! when it lies in the region and engages no more than a pass, else it is a
-//! retract. Last, the region's own rings are cut (the contour at the
+//! A closed front (not touching a wall) is entered by a spiral turn from
+//! the current point; a pass that starts on a wall starts where the wall
+//! was reached before (cleared). Once every pass is planned, the cuts are
+//! put in an order that clears a branch before moving on, and joined by
+//! tool-down links through cleared area, retracts only when none is found
+//! (`links.rs`). Last, the region's own rings are cut (the contour at the
 //! allowance, exact and with arcs): the grid's iso-lines stay within a cell
 //! side of the walls.
 
@@ -50,6 +50,9 @@ use crate::grid::{BIG, Grid, IsoPoint, iso_lines};
 use crate::offset::Step;
 use crate::walls::Walls;
 use crate::{ClearOptions, Direction, RoughError, tol};
+
+mod links;
+use links::Planned;
 
 /// One piece of a front's boundary to cut.
 enum Piece {
@@ -78,14 +81,10 @@ struct Level<'g> {
 /// its spiral turn leaves open.
 struct Cut {
     phi: f64,
-    items: Vec<Item>,
+    items: Vec<Planned>,
     end: P2,
     open: Option<Vec<P2>>,
 }
-
-/// A cut of a pass: how the tool gets there (`None`: it is there, the cut
-/// starts with a ramp from the current point) and the points.
-type Item = (Option<bool>, Vec<P2>);
 
 /// The state of the planner of one region.
 struct Planner<'a> {
@@ -101,6 +100,12 @@ struct Planner<'a> {
     options: &'a ClearOptions,
     /// The largest accepted engagement (rad).
     accept: f64,
+    /// Cells whose centre lies in the region.
+    inside: Vec<bool>,
+    /// The link search's cache per cell (`links.rs`).
+    lattice: Vec<u32>,
+    /// Chains cut so far (the cache's clock).
+    epoch: u32,
 }
 
 /// The adaptive clearing of `region` (one connected tool-centre region):
@@ -143,9 +148,13 @@ pub fn plan_adaptive(region: &Region, options: &ClearOptions) -> Result<Vec<Step
         walls: Walls::new(region, 2.0 * h),
         options,
         accept: tol::ENGAGE_ACCEPT * (1.0 - (options.stepover / r).min(1.0)).acos(),
+        lattice: vec![0; grid.len()],
+        epoch: 1,
+        inside: inside.clone(),
         grid,
     };
     planner.bore(s, r0);
+    let bored = planner.swept.clone();
     let near = r0 + 2.0 * h;
     let sources: Vec<(usize, f64)> = (0..planner.grid.len())
         .map(|k| (k, dist(planner.grid.centre(k), s)))
@@ -155,12 +164,11 @@ pub fn plan_adaptive(region: &Region, options: &ClearOptions) -> Result<Vec<Step
     // with passes closer together there (see the module documentation).
     let slow: Vec<f64> = depth.iter().map(|&d| 1.0 / wall_speed(d, r)).collect();
     let g = planner.grid.march(&inside, &sources, Some(&slow));
-    let mut steps = planner.fronts(&g, s, r0)?;
-    let pos = steps.iter().rev().find_map(|st| match st {
-        Step::Cut(c) => c.vertices().last().map(|v| [v.x, v.y]),
-        Step::Link { .. } => None,
-    });
-    let mut rest = planner.finish(region, pos.unwrap_or(s));
+    let cuts = planner.fronts(&g, s, r0)?;
+    // The cuts again in their own order (`links.rs`), from the bore.
+    planner.swept = bored;
+    let (mut steps, pos) = planner.schedule(cuts, s);
+    let mut rest = planner.finish(region, pos);
     steps.append(&mut rest);
     Ok(steps)
 }
@@ -182,7 +190,7 @@ fn rings_only(region: &Region, options: &ClearOptions) -> Vec<Step> {
     let mut steps = Vec::new();
     for ring in region.rings() {
         if !steps.is_empty() {
-            steps.push(Step::Link { tool_down: false });
+            steps.push(Step::Link { tool_down: false, via: Vec::new(), cleared: false });
         }
         steps.push(Step::Cut(orient(ring, options.direction)));
     }
@@ -277,29 +285,15 @@ impl Planner<'_> {
         }
     }
 
-    /// Whether the link from `a` to `b` stays at cutting depth: inside the
-    /// region and engaging no more than a pass (then it is swept).
-    fn link(&mut self, a: P2, b: P2, undo: &mut Vec<(usize, f64)>) -> bool {
-        if !self.holder.contains_segment(a, b, self.options.chord_tolerance) {
-            return false;
-        }
-        let mark = undo.len();
-        if self.sweep(&[a, b], 0, undo) > self.accept {
-            self.revert(undo, mark);
-            return false;
-        }
-        true
-    }
-
     /// The passes of the growing front from the bore of radius `r0` about `s`
     /// until the front has reached every point of the distance field `g`.
-    fn fronts(&mut self, g: &[f64], s: P2, r0: f64) -> Result<Vec<Step>, RoughError> {
+    fn fronts(&mut self, g: &[f64], s: P2, r0: f64) -> Result<Vec<Planned>, RoughError> {
         let gmax = g.iter().copied().filter(|&v| v < 0.5 * BIG).fold(0.0f64, f64::max);
         let ae = self.options.stepover;
         let target = self.accept / tol::ENGAGE_ACCEPT;
         let a_min = tol::STEP_MIN_SHARE * self.grid.h;
         let (mut t, mut a, mut pos) = (r0, ae, s);
-        let mut steps: Vec<Step> = Vec::new();
+        let mut steps: Vec<Planned> = Vec::new();
         let mut undo = Vec::new();
         let mut passes = 0usize;
         let mut pending: Option<Vec<P2>> = None;
@@ -321,7 +315,7 @@ impl Planner<'_> {
                 let Cut { phi, items, end, open } = self.cut_level(pieces, from, &mut undo);
                 let ratio = (1.0 - target.cos()) / (1.0 - phi.cos()).max(1e-12);
                 if phi <= self.accept || a <= a_min || trial >= tol::STEP_TRIALS || force {
-                    push_items(&mut steps, items, s, &self.holder, self.options.chord_tolerance);
+                    steps.extend(items);
                     pending = open;
                     pos = end;
                     t = level;
@@ -342,9 +336,8 @@ impl Planner<'_> {
             }
         }
         if let Some(ring) = pending {
-            undo.clear();
-            self.sweep(&ring, 0, &mut undo);
-            push_items(&mut steps, vec![(None, ring)], s, &self.holder, self.options.chord_tolerance);
+            self.stamp(&ring);
+            steps.push((true, ring));
         }
         Ok(steps)
     }
@@ -364,7 +357,7 @@ impl Planner<'_> {
         if let Some(ring) = level.pending.filter(|_| !single_ring) {
             phi = phi.max(self.sweep(ring, 0, undo));
             pos = *ring.last().unwrap_or(&pos);
-            items.push((None, ring.clone()));
+            items.push((true, ring.clone()));
         }
         while !pieces.is_empty() {
             let near = |p: &Piece| match p {
@@ -374,24 +367,26 @@ impl Planner<'_> {
             let i = (0..pieces.len()).min_by(|&x, &y| near(&pieces[x]).0.total_cmp(&near(&pieces[y]).0)).unwrap_or(0);
             let (d, j0) = near(&pieces[i]);
             let mut skip = 0;
-            let (link, run) = match pieces.remove(i) {
+            // Links are planned later (`links.rs`) and cut nothing but
+            // their approach, which no cut of this plan relies on.
+            let (glued, run) = match pieces.remove(i) {
                 Piece::Open(v, lead) => {
                     skip = lead;
-                    (Some(self.link(pos, v[0], undo)), v)
+                    (false, v)
                 }
                 Piece::Ring(v) if d <= r && single_ring && self.spiral_fits(&v, j0, pos, level) => {
                     let (run, closing) = self.spiral(&v, j0, pos, level);
                     open = Some(closing);
-                    (None, run)
+                    (true, run)
                 }
                 Piece::Ring(v) => {
                     let run: Vec<P2> = v[j0..].iter().chain(v[..=j0].iter()).copied().collect();
-                    (Some(self.link(pos, run[0], undo)), run)
+                    (false, run)
                 }
             };
             phi = phi.max(self.sweep(&run, skip, undo));
             pos = *run.last().unwrap_or(&pos);
-            items.push((link, run));
+            items.push((glued, run));
         }
         Cut { phi, items, end: pos, open }
     }
@@ -431,7 +426,6 @@ impl Planner<'_> {
     fn finish(&mut self, region: &Region, mut pos: P2) -> Vec<Step> {
         let mut rings: Vec<Contour> = region.rings().iter().map(|c| orient(c, self.options.direction)).collect();
         let mut steps = Vec::new();
-        let mut undo = Vec::new();
         while !rings.is_empty() {
             let started: Vec<Contour> = rings.iter().map(|c| c.starting_near(pos)).collect();
             let d = |c: &Contour| c.start().map_or(f64::INFINITY, |p| dist(p, pos));
@@ -439,11 +433,11 @@ impl Planner<'_> {
             let ring = started[i].clone();
             rings.remove(i);
             let Some(start) = ring.start() else { continue };
-            let down = self.link(pos, start, &mut undo);
-            steps.push(Step::Link { tool_down: down });
+            let link = self.link_step(pos, start);
+            steps.push(link);
             let mut pts = ring.to_points(0.25 * self.grid.h);
             pts.push(start);
-            self.sweep(&pts, 0, &mut undo);
+            self.stamp(&pts);
             pos = start;
             steps.push(Step::Cut(ring));
         }
@@ -546,35 +540,7 @@ fn flat_arcs(c: &Contour) -> Result<Contour, scallop_contour::ContourError> {
     Contour::new(&v, false)
 }
 
-/// Appends the cuts of a pass as steps: a link before each but the first
-/// of the plan (which starts at the entry `s`). A move of a cut that leaves
-/// `holder` (a chord of the grid across a wall's bend) is replaced by a
-/// retract: the cut goes on from the move's end.
-fn push_items(steps: &mut Vec<Step>, items: Vec<Item>, s: P2, holder: &Region, chord: f64) {
-    for (link, mut run) in items {
-        run.dedup_by(|a, b| dist(*a, *b) <= tol::LINK_GROW * 0.1);
-        if steps.is_empty() {
-            if run.first().is_some_and(|p| dist(*p, s) > 0.0) {
-                run.insert(0, s);
-            }
-        } else if let Some(down) = link {
-            steps.push(Step::Link { tool_down: down });
-        }
-        let mut from = 0;
-        for k in 1..=run.len() {
-            let split = k < run.len() && !holder.contains_segment(run[k - 1], run[k], chord);
-            if !split && k < run.len() {
-                continue;
-            }
-            if k - from >= 2
-                && let Ok(c) = Contour::from_points(&run[from..k], false, tol::ARC_FIT).and_then(|c| flat_arcs(&c))
-            {
-                steps.push(Step::Cut(c));
-            }
-            if split {
-                steps.push(Step::Link { tool_down: false });
-            }
-            from = k;
-        }
-    }
+/// The points as lines and arcs within [`tol::ARC_FIT`], far arcs made lines.
+fn fit(points: &[P2]) -> Option<Contour> {
+    Contour::from_points(points, false, tol::ARC_FIT).and_then(|c| flat_arcs(&c)).ok()
 }

@@ -524,14 +524,17 @@ impl Emitter {
                     }
                     self.cut(c, node.z);
                 }
-                Step::Link { tool_down } => {
+                Step::Link { tool_down, via, cleared } => {
                     let next = next_start(&node.steps, step);
                     if let Some(s) = next {
                         if *tool_down {
+                            for p in via {
+                                self.path.push(Move::new(MoveKind::Link, Point3::new(p[0], p[1], node.z)));
+                            }
                             self.path.push(Move::new(MoveKind::Link, Point3::new(s[0], s[1], node.z)));
                             self.links += 1;
                         } else {
-                            self.retract_to(s, above, node.z, &node.region);
+                            self.retract_to(s, above, node.z, &node.region, *cleared);
                         }
                     }
                 }
@@ -625,13 +628,19 @@ impl Emitter {
         self.helices += 1;
     }
 
-    /// A retract within a level: up to the clearance, over, and down.
-    fn retract_to(&mut self, s: P2, above: f64, z: f64, region: &Region) {
+    /// A retract within a level: up to the clearance, over, and down (a
+    /// straight plunge when the tool cuts nothing at `s`: `cleared`).
+    fn retract_to(&mut self, s: P2, above: f64, z: f64, region: &Region, cleared: bool) {
         let Some(here) = self.at() else { return };
         self.retracts += 1;
         self.path.push(Move::new(MoveKind::Retract, Point3::new(here.x, here.y, self.clearance)));
         self.path.push(Move::new(MoveKind::Rapid, Point3::new(s[0], s[1], self.clearance)));
-        self.plunge(s, above, z, region);
+        if cleared {
+            self.path.push(Move::new(MoveKind::Rapid, Point3::new(s[0], s[1], above + tol::APPROACH)));
+            self.path.push(Move::new(MoveKind::Plunge, Point3::new(s[0], s[1], z)));
+        } else {
+            self.plunge(s, above, z, region);
+        }
     }
 
     /// The last retract to the clearance height.

@@ -31,6 +31,12 @@ pub enum Step {
     Link {
         /// Stays at the cutting depth.
         tool_down: bool,
+        /// A tool-down link's points between the last cut's end and the next
+        /// cut's start (empty: a straight move).
+        via: Vec<P2>,
+        /// The next cut starts where the tool cuts nothing: after a retract,
+        /// a straight plunge there is enough (no helix).
+        cleared: bool,
     },
 }
 
@@ -71,7 +77,7 @@ pub fn plan_offset(region: &Region, options: &ClearOptions) -> Result<Vec<Step>,
                     band.contains_segment(p, start, options.chord_tolerance)
                         && holder.contains_segment(p, start, options.chord_tolerance)
                 });
-                steps.push(Step::Link { tool_down: down });
+                steps.push(Step::Link { tool_down: down, via: Vec::new(), cleared: false });
             }
             pos = Some(start);
             steps.push(Step::Cut(ring));

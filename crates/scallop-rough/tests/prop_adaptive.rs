@@ -137,3 +137,118 @@ fn the_same_plan_on_one_and_two_threads() {
     assert_eq!(one, run(2));
     assert_eq!(one, run(1));
 }
+
+/// A "#" of bars `bar` wide over `side` x `side`, its middle square an island
+/// (the bench's glyph, `bench/freecad/pockets.py`, at any scale).
+fn hash(side: f64, bar: f64) -> Vec<Vec<[f64; 2]>> {
+    let (a, b) = (0.25 * side, 0.25 * side + bar);
+    let (c, d) = (0.75 * side - bar, 0.75 * side);
+    let outer = vec![
+        [a, 0.0],
+        [b, 0.0],
+        [b, a],
+        [c, a],
+        [c, 0.0],
+        [d, 0.0],
+        [d, a],
+        [side, a],
+        [side, b],
+        [d, b],
+        [d, c],
+        [side, c],
+        [side, d],
+        [d, d],
+        [d, side],
+        [c, side],
+        [c, d],
+        [b, d],
+        [b, side],
+        [a, side],
+        [a, d],
+        [0.0, d],
+        [0.0, c],
+        [a, c],
+        [a, b],
+        [0.0, b],
+        [0.0, a],
+        [a, a],
+    ];
+    vec![outer, rect(b, b, c, c).into_iter().rev().collect()]
+}
+
+/// A channel along the bottom with fingers up from it (the bench's narrow
+/// branching pocket, straight fingers only): widths `w` of the fingers.
+fn comb(w: &[f64]) -> Vec<Vec<[f64; 2]>> {
+    let width = 4.0 * R + 1.0;
+    let mut pts = vec![[0.0, 0.0]];
+    let mut x = 2.0 * R;
+    let mut top = Vec::new();
+    for &fw in w {
+        top.push((x, fw));
+        x += fw + 3.0 * R;
+    }
+    pts.push([x, 0.0]);
+    pts.push([x, width]);
+    for &(x0, fw) in top.iter().rev() {
+        pts.extend([[x0 + fw, width], [x0 + fw, width + 6.0 * fw], [x0, width + 6.0 * fw], [x0, width]]);
+    }
+    pts.push([0.0, width]);
+    vec![pts]
+}
+
+/// The moves of kind `Link` (tool down at cutting depth): a move ending
+/// within 2 R of the link's end (the approach to a cut's start, which may
+/// enter a front at a new point) engages no more than the bound, every other
+/// cuts nothing by the simulator's reading. "Nothing" is within the simulator's raster: older
+/// cuts and the walls are cells of `resolution`, so a tool centre at R from
+/// an older one or from a wall may read a sliver up to a cell deep (plus the
+/// planner's 5 um slack), 2 arccos(1 - d / R) of periphery (31 degrees here;
+/// a pass reads 53).
+fn check_links(plan: &RoughPlan, report: &EngagementReport) {
+    let depth = EngagementOptions::default().resolution + 0.005;
+    let air = 2.0 * (1.0 - depth / R).acos();
+    let bound = 1.1 * engagement_angle(AE, R);
+    let moves = plan.toolpath.moves();
+    for (i, m) in moves.iter().enumerate() {
+        if m.kind != scallop_toolpath::MoveKind::Link || m.to.z > -0.5 {
+            continue;
+        }
+        let end = moves[i..].iter().find(|n| n.kind != scallop_toolpath::MoveKind::Link).map_or(m.to, |_| {
+            moves[i..].iter().take_while(|n| n.kind == scallop_toolpath::MoveKind::Link).last().map_or(m.to, |n| n.to)
+        });
+        let approach = (m.to.x - end.x).hypot(m.to.y - end.y) <= 2.0 * R;
+        let phi = report.move_phi[i];
+        let limit = if approach { bound } else { air };
+        assert!(phi <= limit, "link move {i} to {:?}: {:.1} deg", m.to, phi.to_degrees());
+    }
+}
+
+#[test]
+fn a_hash_is_cleared_with_its_pieces_joined_tool_down() {
+    // The front splits at the "#"'s crossings: its pieces were joined by
+    // hundreds of retracts on the bench's glyph; they are joined through
+    // cleared area now, by links that cut nothing.
+    let (pocket, plan) = plan(&hash(40.0, 4.0 * R + 1.0));
+    let report = judge(&pocket, &plan);
+    check_cleared(&report);
+    assert!(report.slot_length <= 0.0, "slot {:.2} mm", report.slot_length);
+    check_links(&plan, &report);
+    // A join is a retract only where no cleared path is found (at most 2 %).
+    assert!(50 * plan.retracts <= plan.links, "{} retracts, {} links", plan.retracts, plan.links);
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(3))]
+
+    #[test]
+    fn combs_are_cleared_with_links_that_cut_nothing(
+        w in proptest::collection::vec(2.0 * R + 0.5..4.0 * R, 2..4)
+    ) {
+        // Fingers a little wider than the tool: fronts split into one piece per finger.
+        let (pocket, plan) = plan(&comb(&w));
+        let report = judge(&pocket, &plan);
+        check_cleared(&report);
+        check_links(&plan, &report);
+        prop_assert!(plan.retracts <= 1, "{} retracts, {} links", plan.retracts, plan.links);
+    }
+}

@@ -1,0 +1,451 @@
+//! The order of an adaptive plan's cuts and the tool-down links between
+//! them (docs/roughing.md, "Adaptive clearing", "Order and links").
+//!
+//! The fronts give the cuts level by level over the whole region: in a
+//! branching region (a "#", fingers) every pass visits every branch. The
+//! cuts are grouped into chains (a cut that starts where the one before it
+//! ended, a spiral's turns, belongs to the same chain) and a chain depends
+//! on every earlier chain whose tool centres come within 2 R of its own
+//! (their sweeps overlap): cut after its dependencies, a chain meets no
+//! more material than when it was planned (material only goes away), so
+//! its measured engagement still bounds it. Chains are then cut nearest
+//! first among those whose dependencies are cut: a branch is cleared before
+//! the tool moves on.
+//!
+//! A link from the end of a chain to the start of the next stays at the
+//! cutting depth through cleared area: a shortest path on a lattice of the
+//! grid (every [`LATTICE`]th cell) through the tool centres that cut
+//! nothing (no probe of the periphery in material, checked on the grid's
+//! swept field as it is when the link runs), shortened by straight
+//! segments that cut nothing either, the last [`APPROACH_SHARE`] R to the
+//! start allowed to engage up to the accepted bound (a closed front is
+//! entered at a new point). It is a retract only when no such path exists
+//! within [`DETOUR`] times the straight distance plus [`DETOUR_EXTRA`] R.
+
+use std::cmp::Reverse;
+use std::collections::{BinaryHeap, HashMap};
+
+use scallop_contour::P2;
+
+use super::{Planner, dist};
+use crate::grid::BIG;
+use crate::offset::Step;
+
+/// Lattice of the link search: every this-many grid cells (R / 8 for the
+/// default grid of R / 16).
+const LATTICE: usize = 2;
+
+/// Probes on the tool's periphery when checking that a centre cuts nothing.
+const LINK_PROBES: usize = 128;
+
+/// A probe counts as in material when the swept field there exceeds R by
+/// more than this (mm): the bilinear reading of the distance to the swept
+/// centres is within about 2 um of the distance at R from them with cells of
+/// R / 16, so a link may touch material at most this deep.
+const LINK_SLACK: f64 = 0.005;
+
+/// The last this-many R of a link may engage material up to the accepted
+/// bound (the start of a closed front lies in material by the step).
+const APPROACH_SHARE: f64 = 2.0;
+
+/// A link path longer than this times the straight distance (plus
+/// [`DETOUR_EXTRA`] R) is a retract instead.
+const DETOUR: f64 = 3.0;
+
+/// See [`DETOUR`].
+const DETOUR_EXTRA: f64 = 10.0;
+
+/// Most lattice nodes one link search expands.
+const MAX_EXPAND: usize = 60_000;
+
+/// Most candidate ends (lattice nodes near the target) one link search tries.
+const MAX_GOALS: usize = 64;
+
+/// One cut as planned: whether it starts where the cut before it ended
+/// (glued, no link), and its tool-centre points.
+pub(super) type Planned = (bool, Vec<P2>);
+
+/// A lattice node's state in the cache of [`Planner::node_clear`].
+const CLEAR: u32 = u32::MAX;
+
+impl Planner<'_> {
+    /// Whether the tool centred at `p` cuts nothing: inside the region's
+    /// grid and no probe of its periphery in material.
+    pub(super) fn clear_at(&self, p: P2) -> bool {
+        let r = self.options.tool_radius;
+        for i in 0..LINK_PROBES {
+            #[allow(clippy::cast_precision_loss, reason = "a small count")]
+            let a = std::f64::consts::TAU * i as f64 / LINK_PROBES as f64;
+            let q = [p[0] + r * a.cos(), p[1] + r * a.sin()];
+            if self.grid.sample(&self.reach, q) < r && self.grid.sample(&self.swept, q) > r + LINK_SLACK {
+                return false;
+            }
+        }
+        true
+    }
+
+    /// Whether the straight move `a` to `b` may be part of a link towards
+    /// `target`: in the region, and every sample cuts nothing, or, within
+    /// [`APPROACH_SHARE`] R of `target`, engages no more than a pass.
+    fn link_ok(&self, a: P2, b: P2, target: P2) -> bool {
+        if !self.holder.contains_segment(a, b, self.options.chord_tolerance) {
+            return false;
+        }
+        let near = APPROACH_SHARE * self.options.tool_radius;
+        let step = 0.5 * self.grid.h;
+        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a small positive count")]
+        let n = ((dist(a, b) / step).ceil() as usize).max(1);
+        (1..=n).all(|i| {
+            #[allow(clippy::cast_precision_loss, reason = "a small count")]
+            let f = i as f64 / n as f64;
+            let p = [a[0] + f * (b[0] - a[0]), a[1] + f * (b[1] - a[1])];
+            self.clear_at(p) || (dist(p, target) <= near && self.engagement(p) <= self.accept)
+        })
+    }
+
+    /// Whether lattice cell `k` is a centre that cuts nothing, cached: a
+    /// clear centre stays clear (material only goes away), a blocked one is
+    /// checked again once a chain has been cut since.
+    fn node_clear(&mut self, k: usize) -> bool {
+        match self.lattice[k] {
+            CLEAR => true,
+            e if e == self.epoch => false,
+            _ => {
+                let ok = self.inside[k] && self.clear_at(self.grid.centre(k));
+                self.lattice[k] = if ok { CLEAR } else { self.epoch };
+                ok
+            }
+        }
+    }
+
+    /// The lattice cell nearest `p`, and its (i, j).
+    fn lattice_near(&self, p: P2) -> (usize, usize) {
+        let g = &self.grid;
+        #[allow(
+            clippy::cast_possible_truncation,
+            clippy::cast_sign_loss,
+            clippy::cast_precision_loss,
+            reason = "clamped"
+        )]
+        let snap = |v: f64, n: usize| {
+            let c = (v / LATTICE as f64).round().clamp(0.0, ((n - 1) / LATTICE) as f64) as usize;
+            c * LATTICE
+        };
+        (snap((p[0] - g.x0) / g.h - 0.5, g.nx), snap((p[1] - g.y0) / g.h - 0.5, g.ny))
+    }
+
+    /// A tool-down link from `from` (where the tool is, its disc cleared) to
+    /// `to`: the points between them, or `None` when the link must be a
+    /// retract (see the module documentation).
+    pub(super) fn link_path(&mut self, from: P2, to: P2) -> Option<Vec<P2>> {
+        if dist(from, to) <= 1e-9 {
+            return Some(Vec::new());
+        }
+        if self.link_ok(from, to, to) {
+            return Some(Vec::new());
+        }
+        let (nx, ny) = (self.grid.nx, self.grid.ny);
+        let l = LATTICE;
+        let step = self.grid.h * l as f64;
+        let r = self.options.tool_radius;
+        let limit = DETOUR * dist(from, to) + DETOUR_EXTRA * r;
+        let near = APPROACH_SHARE * r;
+        let mut best: HashMap<usize, (f64, usize)> = HashMap::new();
+        let mut heap: BinaryHeap<Reverse<(u64, usize)>> = BinaryHeap::new();
+        let push = |heap: &mut BinaryHeap<Reverse<(u64, usize)>>, k: usize, g: f64, p: P2| {
+            heap.push(Reverse(((g + dist(p, to)).to_bits(), k)));
+        };
+        // Seeds: the lattice cells around `from` reached by a clear move.
+        let (ci, cj) = self.lattice_near(from);
+        for dj in -2i64..=2 {
+            for di in -2i64..=2 {
+                let (i, j) = (ci as i64 + di * l as i64, cj as i64 + dj * l as i64);
+                if i < 1 || j < 1 || i as usize >= nx - 1 || j as usize >= ny - 1 {
+                    continue;
+                }
+                #[allow(clippy::cast_sign_loss, reason = "checked above")]
+                let k = j as usize * nx + i as usize;
+                let c = self.grid.centre(k);
+                if self.node_clear(k) && self.link_ok(from, c, to) {
+                    let g = dist(from, c);
+                    best.insert(k, (g, usize::MAX));
+                    push(&mut heap, k, g, c);
+                }
+            }
+        }
+        let mut expanded = 0usize;
+        let mut goals = 0usize;
+        let mut done: HashMap<usize, ()> = HashMap::new();
+        while let Some(Reverse((bits, k))) = heap.pop() {
+            if f64::from_bits(bits) > limit || expanded >= MAX_EXPAND || goals >= MAX_GOALS {
+                return None;
+            }
+            if done.insert(k, ()).is_some() {
+                continue;
+            }
+            expanded += 1;
+            let c = self.grid.centre(k);
+            let g = best.get(&k).map_or(BIG, |b| b.0);
+            // An end across a wall does not count as a try.
+            if dist(c, to) <= near.max(2.0 * step) && self.holder.contains_segment(c, to, self.options.chord_tolerance)
+            {
+                goals += 1;
+                if self.link_ok(c, to, to) {
+                    let mut nodes = vec![c];
+                    let mut at = k;
+                    while let Some(&(_, prev)) = best.get(&at) {
+                        if prev == usize::MAX {
+                            break;
+                        }
+                        nodes.push(self.grid.centre(prev));
+                        at = prev;
+                    }
+                    nodes.push(from);
+                    nodes.reverse();
+                    nodes.push(to);
+                    return self.shorten(&nodes, to);
+                }
+            }
+            let (i, j) = (k % nx, k / nx);
+            for (di, dj) in [(1i64, 0i64), (-1, 0), (0, 1), (0, -1), (1, 1), (1, -1), (-1, 1), (-1, -1)] {
+                let (a, b) = (i as i64 + di * l as i64, j as i64 + dj * l as i64);
+                if a < 1 || b < 1 || a as usize >= nx - 1 || b as usize >= ny - 1 {
+                    continue;
+                }
+                #[allow(clippy::cast_sign_loss, reason = "checked above")]
+                let n = b as usize * nx + a as usize;
+                if done.contains_key(&n) || !self.node_clear(n) {
+                    continue;
+                }
+                // A diagonal move needs both cells beside it clear (no
+                // corner of a wall or of material cut across).
+                if di != 0 && dj != 0 {
+                    #[allow(clippy::cast_sign_loss, reason = "checked above")]
+                    let (s1, s2) = (j * nx + a as usize, b as usize * nx + i);
+                    if !self.node_clear(s1) || !self.node_clear(s2) {
+                        continue;
+                    }
+                }
+                let d = if di != 0 && dj != 0 { step * std::f64::consts::SQRT_2 } else { step };
+                let gn = g + d;
+                if best.get(&n).is_none_or(|b| gn < b.0) {
+                    best.insert(n, (gn, k));
+                    push(&mut heap, n, gn, self.grid.centre(n));
+                }
+            }
+        }
+        None
+    }
+
+    /// The lattice path `nodes` (from the tool's position to `to`) as few
+    /// straight moves that each pass [`Planner::link_ok`]: the points
+    /// between the ends, or `None` when a lattice move itself fails.
+    fn shorten(&self, nodes: &[P2], to: P2) -> Option<Vec<P2>> {
+        let last = nodes.len() - 1;
+        let mut out = Vec::new();
+        let mut i = 0;
+        while i < last {
+            let mut j = i + 1;
+            if !self.link_ok(nodes[i], nodes[j], to) {
+                return None;
+            }
+            // Longest reach first by doubling, then back to the last good.
+            let mut span = 1;
+            let mut good = j;
+            loop {
+                let cand = (i + 2 * span).min(last);
+                if cand == good || !self.link_ok(nodes[i], nodes[cand], to) {
+                    break;
+                }
+                good = cand;
+                span *= 2;
+            }
+            while good < last && self.link_ok(nodes[i], nodes[good + 1], to) {
+                good += 1;
+            }
+            j = good;
+            if j < last {
+                out.push(nodes[j]);
+            }
+            i = j;
+        }
+        Some(out)
+    }
+
+    /// Stamps the polyline `run` on the swept field (no engagement measured).
+    pub(super) fn stamp(&mut self, run: &[P2]) {
+        let w = self.options.tool_radius + 2.0 * self.grid.h;
+        if let Some(&p) = run.first() {
+            self.grid.stamp_segment(&mut self.swept, p, p, w, None);
+        }
+        for pair in run.windows(2) {
+            self.grid.stamp_segment(&mut self.swept, pair[0], pair[1], w, None);
+        }
+        self.epoch = self.epoch.wrapping_add(1).min(CLEAR - 1);
+    }
+
+    /// The planned cuts in the order of the module documentation, with
+    /// their links, from the entry `s` (the swept field is back to the
+    /// bore's): the steps, and where the tool ends.
+    pub(super) fn schedule(&mut self, cuts: Vec<Planned>, s: P2) -> (Vec<Step>, P2) {
+        let chains = chains(cuts);
+        let r = self.options.tool_radius;
+        let spacing = 0.25 * r;
+        let reach = 2.0 * r + spacing + 2.0 * self.grid.h;
+        let deps = dependencies(&chains, spacing, reach);
+        let mut waiting: Vec<usize> = deps.iter().map(Vec::len).collect();
+        let mut after: Vec<Vec<usize>> = vec![Vec::new(); chains.len()];
+        for (j, d) in deps.iter().enumerate() {
+            for &i in d {
+                after[i].push(j);
+            }
+        }
+        let mut ready: Vec<usize> = (0..chains.len()).filter(|&j| waiting[j] == 0).collect();
+        let mut steps: Vec<Step> = Vec::new();
+        let mut pos = s;
+        while !ready.is_empty() {
+            let start = |j: usize| chains[j][0].first().copied().unwrap_or(pos);
+            let i = (0..ready.len())
+                .min_by(|&a, &b| {
+                    dist(start(ready[a]), pos).total_cmp(&dist(start(ready[b]), pos)).then(ready[a].cmp(&ready[b]))
+                })
+                .unwrap_or(0);
+            let j = ready.swap_remove(i);
+            let mut runs = chains[j].clone();
+            if steps.is_empty() {
+                if runs[0].first().is_some_and(|p| dist(*p, s) > 0.0) {
+                    runs[0].insert(0, s);
+                }
+            } else if let Some(&to) = runs[0].first() {
+                let step = self.link_step(pos, to);
+                steps.push(step);
+            }
+            pos = runs.last().and_then(|v| v.last()).copied().unwrap_or(pos);
+            self.emit_runs(&mut steps, runs);
+            for &n in &after[j] {
+                waiting[n] -= 1;
+                if waiting[n] == 0 {
+                    ready.push(n);
+                }
+            }
+        }
+        (steps, pos)
+    }
+
+    /// Appends the runs of a chain as cuts, stamped (the link before the
+    /// first is the caller's; each run starts where the one before ended).
+    /// A move of a run that leaves the region (a chord of the grid across a
+    /// wall's bend) is not cut: the tool goes on from the move's end by a
+    /// link.
+    fn emit_runs(&mut self, steps: &mut Vec<Step>, runs: Vec<Vec<P2>>) {
+        let chord = self.options.chord_tolerance;
+        for mut run in runs {
+            run.dedup_by(|a, b| dist(*a, *b) <= super::tol::LINK_GROW * 0.1);
+            let mut from = 0;
+            for k in 1..=run.len() {
+                let split = k < run.len() && !self.holder.contains_segment(run[k - 1], run[k], chord);
+                if !split && k < run.len() {
+                    continue;
+                }
+                if k - from >= 2 {
+                    self.stamp(&run[from..k]);
+                    if let Some(c) = super::fit(&run[from..k]) {
+                        steps.push(Step::Cut(c));
+                    }
+                }
+                if split {
+                    let link = self.link_step(run[k - 1], run[k]);
+                    steps.push(link);
+                }
+                from = k;
+            }
+        }
+    }
+
+    /// The link from `from` to `to` as a step; a tool-down link's path is
+    /// stamped.
+    pub(super) fn link_step(&mut self, from: P2, to: P2) -> Step {
+        match self.link_path(from, to) {
+            Some(via) => {
+                let mut line = vec![from];
+                line.extend_from_slice(&via);
+                line.push(to);
+                self.stamp(&line);
+                Step::Link { tool_down: true, via, cleared: true }
+            }
+            None => Step::Link { tool_down: false, via: Vec::new(), cleared: self.clear_at(to) },
+        }
+    }
+}
+
+/// The planned cuts grouped into chains: a glued cut joins the chain before it.
+fn chains(cuts: Vec<Planned>) -> Vec<Vec<Vec<P2>>> {
+    let mut out: Vec<Vec<Vec<P2>>> = Vec::new();
+    for (glued, run) in cuts {
+        if run.is_empty() {
+            continue;
+        }
+        match out.last_mut() {
+            Some(c) if glued => c.push(run),
+            _ => out.push(vec![run]),
+        }
+    }
+    out
+}
+
+/// For each chain, the earlier chains that have a point within `reach` of
+/// one of its points, the chains' polylines sampled every `spacing` or less.
+fn dependencies(chains: &[Vec<Vec<P2>>], spacing: f64, reach: f64) -> Vec<Vec<usize>> {
+    let side = reach.max(1e-9);
+    let key = |p: P2| {
+        #[allow(clippy::cast_possible_truncation, reason = "bucket indices of finite coordinates")]
+        let k = ((p[0] / side).floor() as i64, (p[1] / side).floor() as i64);
+        k
+    };
+    let mut buckets: HashMap<(i64, i64), Vec<(usize, P2)>> = HashMap::new();
+    let mut mark = vec![usize::MAX; chains.len()];
+    let mut out = Vec::with_capacity(chains.len());
+    for (j, chain) in chains.iter().enumerate() {
+        let pts = samples(chain, spacing);
+        let mut deps = Vec::new();
+        for &p in &pts {
+            let (bi, bj) = key(p);
+            for dj in -1..=1 {
+                for di in -1..=1 {
+                    let Some(list) = buckets.get(&(bi + di, bj + dj)) else { continue };
+                    for &(i, q) in list {
+                        if mark[i] != j && dist(p, q) < reach {
+                            mark[i] = j;
+                            deps.push(i);
+                        }
+                    }
+                }
+            }
+        }
+        for &p in &pts {
+            buckets.entry(key(p)).or_default().push((j, p));
+        }
+        out.push(deps);
+    }
+    out
+}
+
+/// The points of the runs of a chain, with points added so that consecutive
+/// ones are at most `spacing` apart.
+fn samples(chain: &[Vec<P2>], spacing: f64) -> Vec<P2> {
+    let mut out = Vec::new();
+    for run in chain {
+        let Some(&first) = run.first() else { continue };
+        out.push(first);
+        for w in run.windows(2) {
+            #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a small positive count")]
+            let n = ((dist(w[0], w[1]) / spacing).ceil() as usize).max(1);
+            for i in 1..=n {
+                #[allow(clippy::cast_precision_loss, reason = "a small count")]
+                let f = i as f64 / n as f64;
+                out.push([w[0][0] + f * (w[1][0] - w[0][0]), w[0][1] + f * (w[1][1] - w[0][1])]);
+            }
+        }
+    }
+    out
+}
