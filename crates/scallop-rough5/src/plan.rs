@@ -578,6 +578,11 @@ const POLE_TILT: f64 = 1e-6;
 /// table axis (0.001 mm at 100 mm).
 const POLE_DEPARTURE: f64 = 0.5 * std::f64::consts::PI / 180.0;
 
+/// The tilt (rad) at which the axis turns its azimuth before leaving the
+/// pole ([`Emitter::pole_turn`]): half a degree, the tool body within 0.4 mm
+/// of the vertical one over its 41 mm stick-out.
+const POLE_TURN_TILT: f64 = 0.5 * std::f64::consts::PI / 180.0;
+
 /// The azimuth of a tilted axis about +Z, `None` on the pole.
 fn azimuth(axis: &Vec3) -> Option<f64> {
     (axis.angle(&Vec3::z()) > POLE_TILT).then(|| axis.y.atan2(axis.x))
@@ -696,16 +701,53 @@ impl Emitter {
         if closed {
             // A full lap from where the tool reached the level.
             for k in 1..n {
-                let c = &run[(start + k) % (n - 1)];
+                let (b, c) = (&run[(start + k - 1) % (n - 1)], &run[(start + k) % (n - 1)]);
+                self.turn_if_leaving(b, c, (placer, body));
                 self.feed_to(c.place.tip, c.place.axis);
             }
             self.last = Some(run[start % (n - 1)]);
         } else {
-            for c in &run[(start + 1).min(n)..] {
-                self.feed_to(c.place.tip, c.place.axis);
+            for k in (start + 1).min(n)..n {
+                self.turn_if_leaving(&run[k - 1], &run[k], (placer, body));
+                self.feed_to(run[k].place.tip, run[k].place.axis);
             }
             self.last = Some(run[n - 1]);
         }
+    }
+
+    /// Where the move from `a` (the tool is there, on the pole) to `b` would
+    /// leave the pole in another azimuth than the one held, turns the axis to
+    /// `b`'s azimuth first at a small tilt ([`Emitter::pole_turn`]), when it
+    /// can; else the move is left to [`Emitter::feed_to`] (a retract).
+    fn turn_if_leaving(&mut self, a: &Cl, b: &Cl, checks: (&Placer, &BodyCheck)) {
+        if self.departs(&a.place.axis, &b.place.axis)
+            && let Some(turn) = self.pole_turn(a, &b.place.axis, checks)
+        {
+            for p in turn {
+                self.push(MoveKind::Feed, p.tip, p.axis);
+            }
+        }
+    }
+
+    /// The turn of the axis at `a` (on the pole) from the azimuth held to
+    /// that of `to`, at the tilt [`POLE_TURN_TILT`]: the axis leaves the pole
+    /// in the held azimuth, then its azimuth turns by at most the azimuth
+    /// step per move, each axis placed on the level from `a`'s guide point
+    /// and checked against the flanks; `None` when no azimuth is held or a
+    /// turned tool meets a flank.
+    fn pole_turn(&self, a: &Cl, to: &Vec3, (placer, body): (&Placer, &BodyCheck)) -> Option<Vec<Placement>> {
+        let (held, target) = (self.held?, azimuth(to)?);
+        let d = (target - held + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
+        let n = (d.abs() / self.settings.max_azimuth_step).ceil().max(1.0) as usize;
+        let t = POLE_TURN_TILT.min(self.settings.max_angle_step);
+        (0..=n)
+            .map(|k| {
+                let f = held + d * (k as f64 / n as f64);
+                let axis = Vec3::new(t.sin() * f.cos(), t.sin() * f.sin(), t.cos());
+                let p = placer.place(&a.sync.path, &axis)?;
+                (!body.collides(&p.tip, &p.axis)).then_some(p)
+            })
+            .collect()
     }
 
     /// Retracts along the axis, goes over at the safe height, plunges along
@@ -756,9 +798,16 @@ impl Emitter {
     /// it placed and clear of the flanks; pushes the link moves.
     fn try_link(&mut self, a: &Cl, b: &Cl, placer: &Placer, body: &BodyCheck) -> bool {
         let dist = (b.place.tip - a.place.tip).norm();
-        if dist > self.settings.link_max || self.departs(&a.place.axis, &b.place.axis) {
+        if dist > self.settings.link_max {
             return false;
         }
+        // Leaving the pole in another azimuth: the turn at `a` first.
+        let turn = if self.departs(&a.place.axis, &b.place.axis) {
+            let Some(turn) = self.pole_turn(a, &b.place.axis, (placer, body)) else { return false };
+            turn
+        } else {
+            Vec::new()
+        };
         let s = &self.settings;
         let turns = axis_steps(&a.place.axis, &b.place.axis, s.max_angle_step, s.max_azimuth_step);
         let n = ((dist / s.step).ceil() as usize).max(turns);
@@ -772,6 +821,9 @@ impl Emitter {
                 return false;
             }
             moves.push(p);
+        }
+        for p in turn {
+            self.push(MoveKind::Feed, p.tip, p.axis);
         }
         for p in moves {
             self.push(MoveKind::Link, p.tip, p.axis);
