@@ -54,7 +54,8 @@ impl BodyCheck {
     /// than needed its worst axis sample is (mm, positive), and the unit
     /// direction from the flank point closest to that sample to the sample
     /// (the flank normal N_f seen from the tool, Jousselin 2020, Ch. 3 §3,
-    /// step 3; zero when the sample is on the flank); `None` exactly when
+    /// step 3, for a tool on the open side of the flank; zero when the sample
+    /// is on the flank); `None` exactly when
     /// [`BodyCheck::collides`] is false.
     #[must_use]
     pub fn intrusion(&self, tip: &Point3, axis: &Vec3) -> Option<(f64, Vec3)> {
