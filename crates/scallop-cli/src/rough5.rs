@@ -17,8 +17,8 @@ use scallop_parts::FaceTag;
 use scallop_parts::TestPart;
 use scallop_post::{OutputMode, PostParams, check_replay, program_text, replay};
 use scallop_rough5::{
-    BaselinePlan, BaselineSettings, CuttingData, OrientSettings, Pocket, Proof, ProofSettings, Rough5Plan,
-    Rough5Settings, TiltMode, Weights, plan_rough5, plan_three_plus_two, plan_zlevel, prove_from_blank,
+    BaselinePlan, BaselineSettings, CuttingData, LevelOptions, OrientSettings, Pocket, Proof, ProofSettings,
+    Rough5Plan, Rough5Settings, TiltMode, Weights, plan_rough5, plan_three_plus_two, plan_zlevel, prove_from_blank,
 };
 use scallop_toolpath::Toolpath;
 use serde::Serialize;
@@ -38,6 +38,22 @@ pub enum TiltArg {
     Guides,
     /// Guide curves with the optimised reparameterisation of each pass (`--weights`, `--interval`, `--target`).
     Optimised,
+}
+
+/// A refinement of the 5-axis programs that `--without` leaves out (docs/rough5.md, "Where the remaining
+/// volume was").
+#[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
+pub enum RefineArg {
+    /// The bottom's inner offsets that the sliver rule drops on its coarse facets.
+    CentreOffsets,
+    /// Where the guide curves of two levels do not pair, pair their own curves by rank from the limit.
+    PairByRank,
+    /// Inner passes with the axis +Z wherever the vertical tool clears the flanks.
+    VerticalInside,
+    /// Colliding CL points translated away from the flank (thesis Ch. 3 §3, step 3) before they are dropped.
+    Translation,
+    /// All of them: the program of 28 Nov 2026.
+    All,
 }
 
 /// A 3-axis baseline on the same part, tool and cutting data.
@@ -126,6 +142,9 @@ pub struct Rough5Args {
     /// `--tilt optimised` the post's replay check refuses one block. Never applied with `--tilt zero`.
     #[arg(long)]
     correction: bool,
+    /// Leave out refinements of the 5-axis programs, comma-separated (default: all of them are on).
+    #[arg(long, value_enum, value_delimiter = ',')]
+    without: Vec<RefineArg>,
     /// Run the six orientation weightings of the thesis (Ch. 3 §2.3) on the last pass of one level
     /// instead of planning the pocket: writes `orientation.csv` (pitch traces) and `orientation.json`.
     #[arg(long)]
@@ -158,6 +177,8 @@ struct LevelJson {
     distance_mm: f64,
     passes: usize,
     untilted: Option<String>,
+    /// Why the guide curves did not pair, when the passes were paired by rank instead.
+    paired_by_rank: Option<String>,
 }
 
 #[derive(Serialize)]
@@ -251,6 +272,7 @@ fn cutter(a: &Rough5Args) -> CliResult<Cutter> {
 /// The planning settings of the arguments.
 fn settings(args: &Rough5Args, part: &TestPart, bottom: &TriMesh) -> CliResult<Rough5Settings> {
     let weights = Weights { bounds: args.weights[0], fluidity: args.weights[1], pitch: args.weights[2] };
+    let on = |r: RefineArg| !args.without.iter().any(|w| *w == r || *w == RefineArg::All);
     Ok(Rough5Settings {
         tilt: match args.tilt {
             TiltArg::Zero => TiltMode::Zero,
@@ -275,6 +297,9 @@ fn settings(args: &Rough5Args, part: &TestPart, bottom: &TriMesh) -> CliResult<R
         rapid_rate: 20_000.0,
         orientation: matches!(args.tilt, TiltArg::Optimised).then(|| orientation(args, weights)),
         correct: args.correction && !matches!(args.tilt, TiltArg::Zero),
+        levels: LevelOptions { centre_offsets: on(RefineArg::CentreOffsets), pair_by_rank: on(RefineArg::PairByRank) },
+        vertical_inside: on(RefineArg::VerticalInside),
+        translate: on(RefineArg::Translation),
     })
 }
 
@@ -483,7 +508,12 @@ fn report(
         levels: plan
             .levels
             .iter()
-            .map(|l| LevelJson { distance_mm: l.distance, passes: l.passes, untilted: l.untilted.clone() })
+            .map(|l| LevelJson {
+                distance_mm: l.distance,
+                passes: l.passes,
+                untilted: l.untilted.clone(),
+                paired_by_rank: l.paired_by_rank.clone(),
+            })
             .collect(),
         passes: plan
             .passes

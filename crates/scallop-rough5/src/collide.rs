@@ -49,6 +49,42 @@ impl BodyCheck {
         BodyCheck { query: MeshQuery::new(flanks), pieces, top: flanks.bounds().max.z, delta: tol::BODY_STEP }
     }
 
+    /// The deepest intrusion of the tool with its tip at `tip` and unit axis
+    /// `axis` into the distance it must keep from the flanks: how much closer
+    /// than needed its worst axis sample is (mm, positive), and the unit
+    /// direction from the flank point closest to that sample to the sample
+    /// (the flank normal N_f seen from the tool, Jousselin 2020, Ch. 3 §3,
+    /// step 3, for a tool on the open side of the flank; zero when the sample
+    /// is on the flank); `None` exactly when
+    /// [`BodyCheck::collides`] is false.
+    #[must_use]
+    pub fn intrusion(&self, tip: &Point3, axis: &Vec3) -> Option<(f64, Vec3)> {
+        let mut worst: Option<(f64, Vec3)> = None;
+        for &(h0, h1, rho) in &self.pieces {
+            let n = ((h1 - h0) / self.delta).ceil().max(1.0) as usize;
+            let need = rho + 0.5 * self.delta;
+            for k in 0..=n {
+                let h = h0 + (h1 - h0) * (k as f64 / n as f64);
+                let p = tip + axis * h;
+                if p.z - need > self.top {
+                    if axis.z > 0.0 {
+                        break;
+                    }
+                    continue;
+                }
+                let Some(c) = self.query.closest_within(&p, need) else { continue };
+                let deficit = need - c.distance;
+                if worst.is_none_or(|w| deficit > w.0) {
+                    // A sample on the flank has no direction: zero.
+                    let away = p - c.point;
+                    let len = away.norm();
+                    worst = Some((deficit, if len > 0.0 { away / len } else { Vec3::zeros() }));
+                }
+            }
+        }
+        worst
+    }
+
     /// Whether the tool with its tip at `tip` and unit axis `axis` comes
     /// closer to the flanks than its radius (plus the clearance on the flutes).
     #[must_use]

@@ -6,10 +6,17 @@
 //! one whose pairing failed) and every level of the zero-tilt variant get
 //! their own path curves, innermost first, then the limit curve, with the
 //! tool axis +Z.
+//!
+//! [`level_passes_with`] adds two repairs ([`LevelOptions`]): the bottom's
+//! innermost offsets that `offset_curves` drops as slivers of its coarse
+//! facets, and, where `pair_levels` fails (the bottom of the closed pocket),
+//! a pairing of the level's own curves with the own curves of the level above
+//! by rank from the limit (limit with limit, first offset with first offset,
+//! ...), so that the outer passes of such a level lean along the flanks too.
 
 use scallop_guides::{
-    Curve, GuideError, GuideSet, GuideSettings, Level, OffsetStep, Support, build_guides, limit_curves, offset_curves,
-    pair_levels,
+    Curve, GuideError, GuideSet, GuideSettings, Level, OffsetStep, Support, build_guides, limit_curves, offset_curve,
+    offset_curves, pair_levels,
 };
 use scallop_mesh::TriMesh;
 
@@ -38,6 +45,24 @@ pub struct LevelPasses {
     /// Why the level has no tilt curves, when it has none in the guide-curve
     /// variant.
     pub untilted: Option<String>,
+    /// How many of the last passes follow the level's limit curves (the
+    /// outermost passes, along the flanks).
+    pub outer: usize,
+    /// Why `pair_levels` failed when the passes were paired by rank instead.
+    pub paired_by_rank: Option<String>,
+}
+
+/// Options of [`level_passes_with`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct LevelOptions {
+    /// Add the bottom's inner offsets that `offset_curves` drops as slivers
+    /// of the bottom's coarse facets (its sliver width is relative to the
+    /// longest facet edge): while the innermost closed loop has a closed
+    /// offset at a_e inside it, that offset is a pass too.
+    pub centre_offsets: bool,
+    /// Where `pair_levels` fails, pair the level's own curves with the own
+    /// curves of the level above by rank from the limit.
+    pub pair_by_rank: bool,
 }
 
 /// One level's own curves: limit loops and offsets.
@@ -61,17 +86,47 @@ impl Own {
 }
 
 /// The bottom as level 0: its limit curves on the flank offset and their
-/// offsets (none when the limit is not one closed loop).
-fn bottom_level(bottom: &TriMesh, set: &GuideSet, a_e: f64) -> Result<Own, GuideError> {
+/// offsets (none when the limit is not one closed loop); with `centre`, the
+/// inner offsets dropped as slivers added back ([`LevelOptions`]).
+fn bottom_level(bottom: &TriMesh, set: &GuideSet, a_e: f64, centre: bool) -> Result<Own, GuideError> {
     let support = Support::new(bottom.clone());
     let limit = limit_curves(&support, &set.flank_offset);
-    let offsets = if limit.loops.len() == 1 && limit.open.is_empty() {
+    let mut offsets = if limit.loops.len() == 1 && limit.open.is_empty() {
         offset_curves(&support, &limit.loops, a_e)?
     } else {
         Vec::new()
     };
+    if centre && !offsets.is_empty() {
+        centre_offsets(&support, &mut offsets, a_e)?;
+    }
     Ok(Own { distance: 0.0, support, loops: limit.loops, offsets })
 }
+
+/// Appends the closed offsets at `a_e` inside the innermost offset while it
+/// is one closed loop with one closed loop inside it, at most
+/// [`CENTRE_OFFSETS`] of them.
+fn centre_offsets(support: &Support, offsets: &mut Vec<OffsetStep>, a_e: f64) -> Result<(), GuideError> {
+    for _ in 0..CENTRE_OFFSETS {
+        let Some(last) = offsets.last() else { return Ok(()) };
+        if last.curves.len() != 1 || !last.curves[0].line.closed {
+            return Ok(());
+        }
+        let iso = offset_curve(support, &last.curves, a_e)?;
+        // Only a single closed loop that is not a point: an inside of at least
+        // one step of its own (2 area / length is the half-width of a strip).
+        let mut inner: Vec<Curve> =
+            iso.curves.into_iter().filter(|c| c.line.closed && c.line.points.len() >= 3).collect();
+        if inner.len() != 1 || inner[0].line.length() < 4.0 * support.facet_size().min(a_e) {
+            return Ok(());
+        }
+        let curves = vec![inner.swap_remove(0).inside_left()];
+        offsets.push(OffsetStep { curves, split: false, flagged: iso.flagged, repaired: iso.repaired });
+    }
+    Ok(())
+}
+
+/// The bottom's sliver offsets added back at most this many times.
+const CENTRE_OFFSETS: usize = 3;
 
 /// The levels of the pocket with bottom `bottom` and flanks `flanks`, bottom
 /// up, with their passes.
@@ -84,8 +139,22 @@ pub fn level_passes(
     guides: &GuideSettings,
     mode: TiltMode,
 ) -> Result<Vec<LevelPasses>, Rough5Error> {
+    level_passes_with(bottom, flanks, guides, mode, &LevelOptions::default())
+}
+
+/// [`level_passes`] with the repairs of `options`.
+///
+/// # Errors
+/// Those of [`build_guides`] and of the bottom level's offsets.
+pub fn level_passes_with(
+    bottom: &TriMesh,
+    flanks: &TriMesh,
+    guides: &GuideSettings,
+    mode: TiltMode,
+    options: &LevelOptions,
+) -> Result<Vec<LevelPasses>, Rough5Error> {
     let set = build_guides(bottom, flanks, guides)?;
-    let mut own = vec![bottom_level(bottom, &set, guides.radial_step)?];
+    let mut own = vec![bottom_level(bottom, &set, guides.radial_step, options.centre_offsets)?];
     for l in set.levels {
         own.push(Own { distance: l.distance, support: l.support, loops: l.limit.loops, offsets: l.offsets });
     }
@@ -99,11 +168,41 @@ pub fn level_passes(
                 _ => Err("a level without one closed limit loop".to_string()),
             },
         };
-        let (passes, untilted) = match paired {
-            Ok(p) => (p.path.into_iter().zip(p.tilt.into_iter().map(Some)).collect(), None),
-            Err(why) => (own[j].passes(), Some(why)),
+        let mut paired_by_rank = None;
+        let (passes, untilted, outer) = match paired {
+            Ok(p) => (p.path.into_iter().zip(p.tilt.into_iter().map(Some)).collect(), None, 1),
+            Err(why) => match own.get(j + 1) {
+                Some(above) if options.pair_by_rank && mode == TiltMode::Guides => {
+                    paired_by_rank = Some(why);
+                    (by_rank(&own[j].passes(), &above.passes()), None, own[j].loops.len())
+                }
+                _ => (own[j].passes(), Some(why), own[j].loops.len()),
+            },
         };
-        out.push(LevelPasses { distance: own[j].distance, support: own[j].support.clone(), passes, untilted });
+        out.push(LevelPasses {
+            distance: own[j].distance,
+            support: own[j].support.clone(),
+            passes,
+            untilted,
+            outer,
+            paired_by_rank,
+        });
     }
     Ok(out)
+}
+
+/// The passes `below` (innermost first, no tilt) with the curves `above`
+/// (the same order) as tilt curves by rank from the last (the limit): the
+/// last with the last, and so on; the inner passes left over have none.
+fn by_rank(below: &[(Curve, Option<Curve>)], above: &[(Curve, Option<Curve>)]) -> Vec<(Curve, Option<Curve>)> {
+    let (n, m) = (below.len(), above.len());
+    below
+        .iter()
+        .enumerate()
+        .map(|(i, (c, _))| {
+            let from_last = n - 1 - i;
+            let tilt = (from_last < m).then(|| above[m - 1 - from_last].0.clone());
+            (c.clone(), tilt)
+        })
+        .collect()
 }

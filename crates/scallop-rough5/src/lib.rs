@@ -60,13 +60,16 @@ pub use collide::BodyCheck;
 pub use correct::{CorrectionCount, correct_pairs, correct_planar};
 pub use cutting::CuttingData;
 pub use error::Rough5Error;
-pub use levels::{LevelPasses, TiltMode, level_passes};
+pub use levels::{LevelOptions, LevelPasses, TiltMode, level_passes, level_passes_with};
 pub use orient::{
     AngleUnit, BoundsPenalty, Coverage, OrientSettings, Orientation, Reparam, Weights, constraints, objective_terms,
     optimise_pass, pitch_trace, synchronise_with,
 };
 pub use place::{Feature, Placement, Placer, tool_frame};
-pub use plan::{LevelReport, PassReport, Rough5Plan, Rough5Settings, SinglePass, plan_rough5, plan_single_pass};
+pub use plan::{
+    LevelReport, PassReport, Rough5Plan, Rough5Settings, SinglePass, TRANSLATION_MAX, TRANSLATION_SLOPE, plan_rough5,
+    plan_single_pass,
+};
 pub use prove::{Proof, ProofSettings, prove, prove_from_blank};
 pub use radius::{apparent_contour_radius, effective_radius, exact_scallop, scallop_height, swept_profile};
 pub use sync::{SyncPoint, axis_steps, closest_vertex, interpolate_axis, limit_angular_step, pitch_angle, synchronise};

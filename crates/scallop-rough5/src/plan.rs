@@ -10,6 +10,14 @@
 //! runs linked on the level when the link is short, placed and collision
 //! free, else through a retract along the tool axis to a safe height, a
 //! rapid, and a plunge back along the axis.
+//!
+//! Three refinements of the guide-curve program (docs/rough5.md, "Where the
+//! remaining volume was"), each a setting: the passes inside a level's
+//! outermost ones cut with the axis +Z wherever the vertical tool clears the
+//! flanks (the tilt kept where it does not, the neighbours leaning in);
+//! a pair whose tool still comes too close to a flank translated away from it
+//! (the axis translation of Jousselin 2020, Ch. 3 §3, step 3) before it is
+//! dropped; and the level repairs of [`LevelOptions`].
 
 use rayon::prelude::*;
 use scallop_cutter::Cutter;
@@ -20,7 +28,7 @@ use scallop_toolpath::{Move, MoveKind, Toolpath};
 
 use crate::collide::BodyCheck;
 use crate::correct::correct_pairs;
-use crate::levels::{TiltMode, level_passes};
+use crate::levels::{LevelOptions, TiltMode, level_passes_with};
 use crate::orient::{OrientSettings, Orientation, optimise_pass, synchronise_with};
 use crate::sync::{SyncPoint, axis_steps, interpolate_axis, limit_angular_step, pitch_angle, synchronise};
 use crate::{LevelPasses, Placement, Placer, Rough5Error, tol};
@@ -59,7 +67,31 @@ pub struct Rough5Settings {
     /// correction plane (Ch. 3 §3, step 1, [`crate::correct_planar`]) before
     /// it is dropped.
     pub correct: bool,
+    /// The repairs of the levels' passes (bottom centre offsets, pairing by
+    /// rank where `pair_levels` fails).
+    pub levels: LevelOptions,
+    /// Whether the passes inside a level's outermost ones (those along its
+    /// limit curves) are cut with the axis +Z wherever the vertical tool is
+    /// placed clear of the flanks: the tilt is kept where it is not, and the
+    /// pairs around such a pair lean in by one angular step per pair, in its
+    /// azimuth, so the rotary axes stay still on the inner loops.
+    pub vertical_inside: bool,
+    /// Whether a pair whose tool still comes closer to a flank than its
+    /// radius is translated away from the flank (Ch. 3 §3, step 3, the axis
+    /// kept; at most [`TRANSLATION_MAX`]) before it is dropped, its
+    /// neighbours following by [`TRANSLATION_SLOPE`] per mm along the pass.
+    pub translate: bool,
 }
+
+/// Largest axis translation of a colliding pair (mm).
+pub const TRANSLATION_MAX: f64 = 2.5;
+/// A translated pair's neighbours are moved by its translation less this much
+/// per mm along the pass (mm/mm).
+pub const TRANSLATION_SLOPE: f64 = 0.25;
+/// Distance kept beyond the intrusion when translating (mm).
+const TRANSLATION_MARGIN: f64 = 0.05;
+/// Translations tried per pair (each re-placed and checked again).
+const TRANSLATION_TRIES: usize = 4;
 
 /// What one pass became.
 #[derive(Debug, Clone, PartialEq)]
@@ -92,6 +124,9 @@ pub struct LevelReport {
     pub passes: usize,
     /// Why the level was cut with the axis +Z in the guide-curve variant.
     pub untilted: Option<String>,
+    /// Why `pair_levels` failed when the level's passes were paired with the
+    /// level above by rank instead ([`LevelOptions::pair_by_rank`]).
+    pub paired_by_rank: Option<String>,
 }
 
 /// The roughing program and what it is made of.
@@ -160,7 +195,7 @@ pub fn plan_rough5(
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<Rough5Plan, Rough5Error> {
     check(settings)?;
-    let levels = level_passes(bottom, flanks, &settings.guides, settings.tilt)?;
+    let levels = level_passes_with(bottom, flanks, &settings.guides, settings.tilt, &settings.levels)?;
     if levels.iter().all(|l| l.passes.is_empty()) {
         let reason = "no level has a closed limit curve: open pockets (limit curves ending on the level's boundary) \
                       are not handled yet";
@@ -179,7 +214,14 @@ pub fn plan_rough5(
         for (m, (path, tilt)) in level.passes.iter().enumerate() {
             let cursor = out.last.map_or_else(|| path.line.points[0], |c| c.sync.path);
             let (pairs, _) = pass_pairs((path, tilt.as_ref()), &cursor, settings)?;
-            let (pairs, corrected) = corrected_pairs(&placer, &body, pairs, settings);
+            let (mut pairs, corrected) = corrected_pairs(&placer, &body, pairs, settings);
+            let outer = m + level.outer >= level.passes.len();
+            if settings.vertical_inside && !outer && tilt.is_some() {
+                pairs = vertical_where_clear(&placer, &body, &pairs, settings);
+            }
+            if settings.translate {
+                pairs = translated(&placer, &body, pairs);
+            }
             let (runs, mut report) = place_pass(&placer, &body, &pairs);
             report.corrected = corrected;
             report.level = j;
@@ -202,7 +244,12 @@ pub fn plan_rough5(
     out.finish();
     let levels = levels
         .iter()
-        .map(|l| LevelReport { distance: l.distance, passes: l.passes.len(), untilted: l.untilted.clone() })
+        .map(|l| LevelReport {
+            distance: l.distance,
+            passes: l.passes.len(),
+            untilted: l.untilted.clone(),
+            paired_by_rank: l.paired_by_rank.clone(),
+        })
         .collect();
     let estimated_time = estimate_time(&out.path, settings.rapid_rate);
     Ok(Rough5Plan {
@@ -343,6 +390,141 @@ fn corrected_pairs(
     (pairs, corrected)
 }
 
+/// Whether a pass's pairs close on themselves (the last repeats the first).
+fn is_closed(pairs: &[SyncPoint]) -> bool {
+    let n = pairs.len();
+    n > 2 && (pairs[0].path - pairs[n - 1].path).norm() < 1e-9
+}
+
+/// Distance along the pass from pair `i` to pair `j` (`at`: the cumulative
+/// length at each pair; `lap` the length of a closed pass, else infinite).
+fn along(at: &[f64], lap: f64, i: usize, j: usize) -> f64 {
+    let d = (at[i] - at[j]).abs();
+    d.min(lap - d)
+}
+
+/// Cumulative length along the guide points of `pairs`, and the lap length
+/// when the pass is closed (infinite otherwise).
+fn arc_positions(pairs: &[SyncPoint]) -> (Vec<f64>, f64) {
+    let mut at = Vec::with_capacity(pairs.len());
+    let mut s = 0.0;
+    for (i, p) in pairs.iter().enumerate() {
+        if i > 0 {
+            s += (p.path - pairs[i - 1].path).norm();
+        }
+        at.push(s);
+    }
+    let lap = if is_closed(pairs) { s } else { f64::INFINITY };
+    (at, lap)
+}
+
+/// `pairs` with the axis +Z wherever the vertical tool is placed clear of
+/// the flanks ([`Rough5Settings::vertical_inside`]). A pair where it is not
+/// keeps its axis; the pairs around it lean in, in its azimuth, by its tilt
+/// less one angular step per `step` mm along the pass (the largest over such
+/// pairs), so the axis turns by at most the angular step between pairs. The
+/// angular step is limited again afterwards.
+fn vertical_where_clear(
+    placer: &Placer,
+    body: &BodyCheck,
+    pairs: &[SyncPoint],
+    settings: &Rough5Settings,
+) -> Vec<SyncPoint> {
+    let blocked: Vec<bool> = pairs
+        .par_iter()
+        .map(|s| placer.place(&s.path, &Vec3::z()).is_none_or(|p| body.collides(&p.tip, &p.axis)))
+        .collect();
+    let (at, lap) = arc_positions(pairs);
+    let per_mm = settings.max_angle_step / settings.step;
+    // (tilt needed, the blocked pair that needs it) at every pair.
+    let mut need: Vec<(f64, Option<usize>)> = vec![(0.0, None); pairs.len()];
+    for j in (0..pairs.len()).filter(|&j| blocked[j]) {
+        let tilt = pairs[j].axis.angle(&Vec3::z());
+        for (i, n) in need.iter_mut().enumerate() {
+            let t = tilt - per_mm * along(&at, lap, i, j);
+            if t > n.0 {
+                *n = (t, Some(j));
+            }
+        }
+    }
+    let out: Vec<SyncPoint> = pairs
+        .iter()
+        .zip(&need)
+        .enumerate()
+        .map(|(i, (s, &(t, from)))| {
+            let axis = match from {
+                _ if blocked[i] => s.axis,
+                None => Vec3::z(),
+                Some(j) => {
+                    let u = pairs[j].axis;
+                    let f = u.y.atan2(u.x);
+                    Vec3::new(t.sin() * f.cos(), t.sin() * f.sin(), t.cos())
+                }
+            };
+            SyncPoint { axis, ..*s }
+        })
+        .collect();
+    limit_angular_step(&out, settings.max_angle_step, settings.max_azimuth_step)
+}
+
+/// The translation of the guide point of a pair whose tool comes too close
+/// to a flank that clears it, the axis kept (Jousselin 2020, Ch. 3 §3,
+/// step 3, Eq. 3.33 as corrected: the axis moved along the flank normal N_f
+/// by what it lacks): the part of N_f across the axis, by the intrusion plus
+/// a margin, the tool placed again, at most [`TRANSLATION_TRIES`] times and
+/// [`TRANSLATION_MAX`] in all. Zero for a clear pair and for one that cannot
+/// be cleared.
+fn translation(placer: &Placer, body: &BodyCheck, s: &SyncPoint) -> Vec3 {
+    let mut shift = Vec3::zeros();
+    for _ in 0..=TRANSLATION_TRIES {
+        let Some(p) = placer.place(&(s.path + shift), &s.axis) else { return Vec3::zeros() };
+        let Some((deficit, normal)) = body.intrusion(&p.tip, &p.axis) else { return shift };
+        let across = normal - p.axis * normal.dot(&p.axis);
+        let len = across.norm();
+        if len < 1e-6 {
+            return Vec3::zeros();
+        }
+        shift += across / len * (deficit + TRANSLATION_MARGIN);
+        if shift.norm() > TRANSLATION_MAX {
+            return Vec3::zeros();
+        }
+    }
+    Vec3::zeros()
+}
+
+/// `pairs` with the colliding ones translated clear of the flanks
+/// ([`translation`]) and their neighbours moved the same way by the
+/// translation less [`TRANSLATION_SLOPE`] per mm along the pass (the largest
+/// such move), so the pass bends away from the flank instead of jumping.
+fn translated(placer: &Placer, body: &BodyCheck, pairs: Vec<SyncPoint>) -> Vec<SyncPoint> {
+    let shifts: Vec<Vec3> = pairs
+        .par_iter()
+        .map(|s| {
+            let clear = placer.place(&s.path, &s.axis).is_some_and(|p| !body.collides(&p.tip, &p.axis));
+            if clear { Vec3::zeros() } else { translation(placer, body, s) }
+        })
+        .collect();
+    let moved: Vec<usize> = (0..pairs.len()).filter(|&j| shifts[j].norm() > 0.0).collect();
+    if moved.is_empty() {
+        return pairs;
+    }
+    let (at, lap) = arc_positions(&pairs);
+    pairs
+        .into_iter()
+        .enumerate()
+        .map(|(i, s)| {
+            let mut best = shifts[i];
+            for &j in &moved {
+                let len = shifts[j].norm() - TRANSLATION_SLOPE * along(&at, lap, i, j);
+                if len > best.norm() {
+                    best = shifts[j] * (len / shifts[j].norm());
+                }
+            }
+            SyncPoint { path: s.path + best, ..s }
+        })
+        .collect()
+}
+
 /// The placed and checked CL points of the pairs of one pass, split into
 /// runs where pairs were dropped.
 fn place_pass(placer: &Placer, body: &BodyCheck, pairs: &[SyncPoint]) -> (Vec<Vec<Cl>>, PassReport) {
@@ -387,6 +569,25 @@ fn place_pass(placer: &Placer, body: &BodyCheck, pairs: &[SyncPoint]) -> (Vec<Ve
     (runs, report)
 }
 
+/// A tool axis within this of +Z (rad, its tilt) is on the pole of a
+/// table-table machine, where the machine holds its C table.
+const POLE_TILT: f64 = 1e-6;
+/// Largest azimuth change (rad) allowed where a cutting move leaves the pole:
+/// the C table turns by it within the first instant of the move, which the
+/// tip follows by a chord of at most `r (1 - cos(d / 2))` at `r` mm from the
+/// table axis (0.001 mm at 100 mm).
+const POLE_DEPARTURE: f64 = 0.5 * std::f64::consts::PI / 180.0;
+
+/// The tilt (rad) at which the axis turns its azimuth before leaving the
+/// pole ([`Emitter::pole_turn`]): half a degree, the tool body within 0.4 mm
+/// of the vertical one over its 41 mm stick-out.
+const POLE_TURN_TILT: f64 = 0.5 * std::f64::consts::PI / 180.0;
+
+/// The azimuth of a tilted axis about +Z, `None` on the pole.
+fn azimuth(axis: &Vec3) -> Option<f64> {
+    (axis.angle(&Vec3::z()) > POLE_TILT).then(|| axis.y.atan2(axis.x))
+}
+
 /// Writes the runs as moves.
 struct Emitter {
     path: Toolpath,
@@ -397,6 +598,9 @@ struct Emitter {
     retracts: usize,
     links: usize,
     ramps: usize,
+    /// The azimuth of the last tilted axis written: where a table-table
+    /// machine holds its C table while the axis is on the pole.
+    held: Option<f64>,
 }
 
 impl Emitter {
@@ -410,11 +614,59 @@ impl Emitter {
             retracts: 0,
             links: 0,
             ramps: 0,
+            held: None,
         }
     }
 
     fn push(&mut self, kind: MoveKind, to: Point3, axis: Vec3) {
+        if let Some(a) = azimuth(&axis) {
+            self.held = Some(a);
+        }
         self.path.push_with_axis(Move::new(kind, to), axis);
+    }
+
+    /// Whether a cutting move from the pose `from_axis` to `axis` leaves the
+    /// pole in another azimuth than the one the machine holds: a table-table
+    /// machine would turn its C table within the first instant of the move
+    /// (the machine layer refuses it: "joint-space interpolation still
+    /// deviates"). Such a move is made through a retract and a rapid, where
+    /// the table turns freely.
+    fn departs(&self, from_axis: &Vec3, axis: &Vec3) -> bool {
+        if azimuth(from_axis).is_some() {
+            return false;
+        }
+        match (azimuth(axis), self.held) {
+            (None, _) => false,
+            (Some(_), None) => true,
+            (Some(a), Some(h)) => {
+                let d = (a - h).rem_euclid(std::f64::consts::TAU);
+                d.min(std::f64::consts::TAU - d) > POLE_DEPARTURE
+            }
+        }
+    }
+
+    /// The tip and axis of the last move written.
+    fn current(&self) -> Option<(Point3, Vec3)> {
+        let n = self.path.moves().len();
+        (n > 0).then(|| (self.path.moves()[n - 1].to, self.path.axis(n - 1)))
+    }
+
+    /// A cutting move to `to` along `axis`: a feed, or, where it would leave
+    /// the pole in another azimuth ([`Emitter::departs`]), a retract along
+    /// the current axis, a rapid to above `to` along `axis` and a plunge.
+    fn feed_to(&mut self, to: Point3, axis: Vec3) {
+        match self.current() {
+            Some((tip, from_axis)) if self.departs(&from_axis, &axis) => {
+                let out = Emitter::above_at(&tip, &from_axis, self.stock_top);
+                self.push(MoveKind::Link, out, from_axis);
+                let up = self.above(&tip, &from_axis);
+                self.push(MoveKind::Retract, up, from_axis);
+                self.retracts += 1;
+                self.push(MoveKind::Rapid, self.above(&to, &axis), axis);
+                self.push(MoveKind::Plunge, to, axis);
+            }
+            _ => self.push(MoveKind::Feed, to, axis),
+        }
     }
 
     /// The point of the axis through `tip` at height `z`.
@@ -449,16 +701,53 @@ impl Emitter {
         if closed {
             // A full lap from where the tool reached the level.
             for k in 1..n {
-                let c = &run[(start + k) % (n - 1)];
-                self.push(MoveKind::Feed, c.place.tip, c.place.axis);
+                let (b, c) = (&run[(start + k - 1) % (n - 1)], &run[(start + k) % (n - 1)]);
+                self.turn_if_leaving(b, c, (placer, body));
+                self.feed_to(c.place.tip, c.place.axis);
             }
             self.last = Some(run[start % (n - 1)]);
         } else {
-            for c in &run[(start + 1).min(n)..] {
-                self.push(MoveKind::Feed, c.place.tip, c.place.axis);
+            for k in (start + 1).min(n)..n {
+                self.turn_if_leaving(&run[k - 1], &run[k], (placer, body));
+                self.feed_to(run[k].place.tip, run[k].place.axis);
             }
             self.last = Some(run[n - 1]);
         }
+    }
+
+    /// Where the move from `a` (the tool is there, on the pole) to `b` would
+    /// leave the pole in another azimuth than the one held, turns the axis to
+    /// `b`'s azimuth first at a small tilt ([`Emitter::pole_turn`]), when it
+    /// can; else the move is left to [`Emitter::feed_to`] (a retract).
+    fn turn_if_leaving(&mut self, a: &Cl, b: &Cl, checks: (&Placer, &BodyCheck)) {
+        if self.departs(&a.place.axis, &b.place.axis)
+            && let Some(turn) = self.pole_turn(a, &b.place.axis, checks)
+        {
+            for p in turn {
+                self.push(MoveKind::Feed, p.tip, p.axis);
+            }
+        }
+    }
+
+    /// The turn of the axis at `a` (on the pole) from the azimuth held to
+    /// that of `to`, at the tilt [`POLE_TURN_TILT`]: the axis leaves the pole
+    /// in the held azimuth, then its azimuth turns by at most the azimuth
+    /// step per move, each axis placed on the level from `a`'s guide point
+    /// and checked against the flanks; `None` when no azimuth is held or a
+    /// turned tool meets a flank.
+    fn pole_turn(&self, a: &Cl, to: &Vec3, (placer, body): (&Placer, &BodyCheck)) -> Option<Vec<Placement>> {
+        let (held, target) = (self.held?, azimuth(to)?);
+        let d = (target - held + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
+        let n = (d.abs() / self.settings.max_azimuth_step).ceil().max(1.0) as usize;
+        let t = POLE_TURN_TILT.min(self.settings.max_angle_step);
+        (0..=n)
+            .map(|k| {
+                let f = held + d * (k as f64 / n as f64);
+                let axis = Vec3::new(t.sin() * f.cos(), t.sin() * f.sin(), t.cos());
+                let p = placer.place(&a.sync.path, &axis)?;
+                (!body.collides(&p.tip, &p.axis)).then_some(p)
+            })
+            .collect()
     }
 
     /// Retracts along the axis, goes over at the safe height, plunges along
@@ -498,10 +787,10 @@ impl Emitter {
             k += 1;
             let h = lift * (1.0 - s / ramp_len);
             if h <= 0.0 {
-                self.push(MoveKind::Feed, b.tip, b.axis);
+                self.feed_to(b.tip, b.axis);
                 return k % n;
             }
-            self.push(MoveKind::Feed, b.tip + b.axis * h, b.axis);
+            self.feed_to(b.tip + b.axis * h, b.axis);
         }
     }
 
@@ -512,6 +801,13 @@ impl Emitter {
         if dist > self.settings.link_max {
             return false;
         }
+        // Leaving the pole in another azimuth: the turn at `a` first.
+        let turn = if self.departs(&a.place.axis, &b.place.axis) {
+            let Some(turn) = self.pole_turn(a, &b.place.axis, (placer, body)) else { return false };
+            turn
+        } else {
+            Vec::new()
+        };
         let s = &self.settings;
         let turns = axis_steps(&a.place.axis, &b.place.axis, s.max_angle_step, s.max_azimuth_step);
         let n = ((dist / s.step).ceil() as usize).max(turns);
@@ -525,6 +821,9 @@ impl Emitter {
                 return false;
             }
             moves.push(p);
+        }
+        for p in turn {
+            self.push(MoveKind::Feed, p.tip, p.axis);
         }
         for p in moves {
             self.push(MoveKind::Link, p.tip, p.axis);

@@ -10,7 +10,9 @@
 use scallop_cutter::{Cutter, CutterShape, HolderSegment};
 use scallop_guides::GuideSettings;
 use scallop_parts::{FaceTag, closed_pocket};
-use scallop_rough5::{OrientSettings, ProofSettings, Rough5Settings, TiltMode, Weights, plan_rough5, prove};
+use scallop_rough5::{
+    LevelOptions, OrientSettings, ProofSettings, Rough5Settings, TiltMode, Weights, plan_rough5, prove,
+};
 use scallop_toolpath::MoveKind;
 
 fn settings(tilt: TiltMode, depth: f64) -> Rough5Settings {
@@ -35,6 +37,9 @@ fn settings(tilt: TiltMode, depth: f64) -> Rough5Settings {
         rapid_rate: 20_000.0,
         orientation: None,
         correct: false,
+        levels: LevelOptions::default(),
+        vertical_inside: false,
+        translate: false,
     }
 }
 

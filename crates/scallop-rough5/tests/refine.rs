@@ -1,0 +1,195 @@
+//! The refinements of the guide-curve program (docs/rough5.md, "Where the
+//! remaining volume was"): the intrusion the axis translation reads is that
+//! of the flank (a planar wall: its normal, and moving the tool by it clears
+//! it); on a small closed pocket the refined program leaves less of the volume
+//! to remove than the plain one, is proven (no gouge, no shank or holder
+//! collision), keeps every CL point clear of the flanks, keeps the angular
+//! step, never leaves the pole in another azimuth than the one held, and
+//! does not depend on the thread count; the bottom's centre offsets leave no
+//! island wider than the tool inside the innermost pass.
+#![allow(clippy::unwrap_used, reason = "tests: a panic is the failure report")]
+
+use proptest::prelude::*;
+use scallop_cutter::{Cutter, CutterShape, HolderSegment};
+use scallop_geom::{Point3, Vec3};
+use scallop_guides::GuideSettings;
+use scallop_mesh::TriMesh;
+use scallop_parts::{FaceTag, PocketParams, closed_pocket};
+use scallop_rough5::{
+    BodyCheck, LevelOptions, ProofSettings, Rough5Settings, TiltMode, level_passes_with, plan_rough5, prove,
+};
+use scallop_toolpath::MoveKind;
+
+fn tool() -> Cutter {
+    Cutter::new(CutterShape::Bull { radius: 5.0, corner: 1.5 }, 20.0)
+        .unwrap()
+        .with_shank(5.0, 11.0)
+        .unwrap()
+        .with_holder(vec![HolderSegment { length: 100.0, bottom_radius: 13.5, top_radius: 13.5 }])
+        .unwrap()
+}
+
+/// The wall through the origin with unit normal `n` (horizontal part along
+/// +x), 600 mm wide and high around the origin: every closest point of the
+/// tool's axis is inside it.
+fn wall(lean: f64) -> (TriMesh, Vec3) {
+    let n = Vec3::new(lean.cos(), 0.0, lean.sin());
+    let up = Vec3::new(-lean.sin(), 0.0, lean.cos());
+    let side = Vec3::y() * 300.0;
+    let (a, b) = (Point3::origin() - up * 300.0, Point3::origin() + up * 300.0);
+    let m = TriMesh::from_soup(&[[a - side, a + side, b + side], [a - side, b + side, b - side]]).unwrap().0;
+    (m, n)
+}
+
+proptest! {
+    /// Against a planar wall, with the tool's axis on the wall's open side,
+    /// the intrusion is reported exactly when the tool collides, its
+    /// direction is the wall's normal, and the tool moved along it by the
+    /// intrusion (and a hair) is clear.
+    #[test]
+    fn the_intrusion_is_the_walls(
+        lean in -0.25f64..0.25,
+        gap in 0.0f64..8.0,
+        tilt in 0.0f64..0.35,
+        azimuth in 0.0f64..std::f64::consts::TAU,
+        z in -20.0f64..-5.0,
+    ) {
+        let (flank, n) = wall(lean);
+        let body = BodyCheck::new(&flank, &tool(), 0.0);
+        let axis = Vec3::new(tilt.sin() * azimuth.cos(), tilt.sin() * azimuth.sin(), tilt.cos());
+        let tip = Point3::origin() + n * gap + Vec3::z() * z;
+        // The axis from the tip to the holder's top (131 mm) on the open side.
+        prop_assume!(tip.coords.dot(&n) > 0.0 && (tip + axis * 131.0).coords.dot(&n) > 0.0);
+        let found = body.intrusion(&tip, &axis);
+        prop_assert_eq!(found.is_some(), body.collides(&tip, &axis));
+        if let Some((deficit, dir)) = found {
+            prop_assert!(deficit > 0.0);
+            prop_assert!((dir - n).norm() < 1e-9, "{dir:?} {n:?}");
+            prop_assert!(!body.collides(&(tip + n * (deficit + 1e-6)), &axis));
+        }
+    }
+}
+
+fn settings(depth: f64, refined: bool) -> Rough5Settings {
+    Rough5Settings {
+        tilt: TiltMode::Guides,
+        guides: GuideSettings {
+            tool_radius: 5.0,
+            flank_allowance: 0.5,
+            axial_step: 4.0,
+            radial_step: 4.5,
+            voxel: 1.0,
+            depth,
+        },
+        bottom_allowance: 0.5,
+        step: 1.0,
+        max_angle_step: 2f64.to_radians(),
+        max_azimuth_step: 5f64.to_radians(),
+        ramp_angle: 5f64.to_radians(),
+        clearance: 1.0,
+        link_max: 9.0,
+        feed: 2400.0,
+        rapid_rate: 20_000.0,
+        orientation: None,
+        correct: false,
+        levels: LevelOptions { centre_offsets: refined, pair_by_rank: refined },
+        vertical_inside: refined,
+        translate: refined,
+    }
+}
+
+/// A 60 x 60 x 20 mm block with the closed pocket's drafts and undercuts.
+fn small_pocket() -> scallop_parts::TestPart {
+    closed_pocket(&PocketParams {
+        stock: [60.0, 60.0, 20.0],
+        bottom_z: 6.0,
+        wall: 8.0,
+        corner_radius: 6.0,
+        dome: 1.0,
+        ..Default::default()
+    })
+    .unwrap()
+}
+
+/// The azimuth of a tilted axis, `None` on the pole.
+fn azimuth(u: &Vec3) -> Option<f64> {
+    (u.angle(&Vec3::z()) > 1e-6).then(|| u.y.atan2(u.x))
+}
+
+#[test]
+fn the_refined_program_leaves_less_and_stays_safe() {
+    let part = small_pocket();
+    let bottom = part.faces(&[FaceTag::Bottom]).unwrap();
+    let flanks = part.faces(&[FaceTag::Flank]).unwrap();
+    let depth = part.stock.max.z - bottom.bounds().min.z;
+    let tool = tool();
+    let body = BodyCheck::new(&flanks, &tool, 0.0);
+    let proof_settings = ProofSettings { resolution: 0.5, axis_tolerance: 0.05 };
+    let mut remaining = Vec::new();
+    for refined in [false, true] {
+        let s = settings(depth, refined);
+        let plan = plan_rough5(&bottom, &flanks, &part.stock, &tool, &s, &|_, _| {}).unwrap();
+        let path = &plan.toolpath;
+        let mut held: Option<f64> = None;
+        for (i, m) in path.moves().iter().enumerate().skip(1) {
+            let (a, b) = (path.axis(i - 1), path.axis(i));
+            if matches!(m.kind, MoveKind::Feed | MoveKind::Link | MoveKind::Plunge) {
+                assert!(!body.collides(&m.to, &b), "move {i} meets a flank");
+            }
+            if matches!(m.kind, MoveKind::Feed | MoveKind::Link) {
+                assert!(a.angle(&b) <= s.max_angle_step + 1e-9, "move {i}: {}", a.angle(&b));
+            }
+            // Leaving the pole while cutting only in the azimuth held (refined
+            // program: the plain one does not guarantee it).
+            if refined
+                && m.kind != MoveKind::Rapid
+                && azimuth(&a).is_none()
+                && let Some(f) = azimuth(&b)
+            {
+                let h = held.unwrap();
+                let d = (f - h).rem_euclid(std::f64::consts::TAU);
+                assert!(d.min(std::f64::consts::TAU - d) <= 0.5f64.to_radians() + 1e-12, "move {i}");
+            }
+            if let Some(f) = azimuth(&b) {
+                held = Some(f);
+            }
+        }
+        let proof = prove(path, &tool, &part.stock, &part.mesh, &proof_settings, &|_, _| {}).unwrap();
+        assert!(proof.gouge_depth <= proof_settings.resolution, "{proof:?}");
+        if refined {
+            let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
+            let again = one.install(|| plan_rough5(&bottom, &flanks, &part.stock, &tool, &s, &|_, _| {}).unwrap());
+            assert_eq!(again.toolpath, plan.toolpath);
+        }
+        remaining.push(proof.remaining_percent);
+    }
+    assert!(remaining[1] < remaining[0], "{remaining:?}");
+}
+
+/// Half the mean width (area over length) of a closed curve's inside: the
+/// half-width of a strip, the inradius of a square.
+fn half_width(c: &scallop_guides::Curve) -> f64 {
+    c.signed_area().abs() / c.line.length() * 2.0
+}
+
+#[test]
+fn the_bottom_centre_is_reached() {
+    let part = closed_pocket(&PocketParams::default()).unwrap();
+    let bottom = part.faces(&[FaceTag::Bottom]).unwrap();
+    let flanks = part.faces(&[FaceTag::Flank]).unwrap();
+    let depth = part.stock.max.z - bottom.bounds().min.z;
+    let g = settings(depth, true).guides;
+    let widths: Vec<f64> = [false, true]
+        .iter()
+        .map(|&centre| {
+            let options = LevelOptions { centre_offsets: centre, pair_by_rank: false };
+            let levels = level_passes_with(&bottom, &flanks, &g, TiltMode::Zero, &options).unwrap();
+            half_width(&levels[0].passes[0].0)
+        })
+        .collect();
+    // Without the centre offsets the innermost bottom pass leaves an island
+    // beyond the tool's reach; with them it is within one step of the centre.
+    assert!(widths[0] > g.tool_radius + 1.0, "{widths:?}");
+    assert!(widths[1] < g.tool_radius + 1.0, "{widths:?}");
+    assert!(widths[1] < widths[0] - 0.5 * g.radial_step, "{widths:?}");
+}
