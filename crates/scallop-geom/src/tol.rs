@@ -765,6 +765,38 @@ pub mod rough {
     /// (it deviates from its chord by at most chord^2 / 8000 mm: 1 um for a
     /// 2.8 mm chord).
     pub const MAX_ARC_RADIUS: f64 = 1000.0;
+
+    // Tool-down links of the adaptive pattern (`adaptive/links.rs`).
+
+    /// Lattice of the link search: every this-many grid cells (R / 8 for the
+    /// default grid of R / 16).
+    pub const LATTICE: usize = 2;
+
+    /// Probes on the tool's periphery when checking that a centre cuts nothing.
+    pub const LINK_PROBES: usize = 128;
+
+    /// A probe counts as in material when the swept field there exceeds R by
+    /// more than this (mm): the bilinear reading of the distance to the swept
+    /// centres is within about 2 um of the distance at R from them with cells of
+    /// R / 16, so a link may touch material at most this deep.
+    pub const LINK_SLACK: f64 = 0.005;
+
+    /// The last this-many R of a link may engage material up to the accepted
+    /// bound (the start of a closed front lies in material by the step).
+    pub const APPROACH_SHARE: f64 = 2.0;
+
+    /// A link path longer than this times the straight distance (plus
+    /// [`DETOUR_EXTRA`] R) is a retract instead.
+    pub const DETOUR: f64 = 3.0;
+
+    /// See [`DETOUR`].
+    pub const DETOUR_EXTRA: f64 = 10.0;
+
+    /// Most lattice nodes one link search expands.
+    pub const MAX_EXPAND: usize = 60_000;
+
+    /// Most candidate ends (lattice nodes near the target) one link search tries.
+    pub const MAX_GOALS: usize = 64;
 }
 
 pub mod rough5 {

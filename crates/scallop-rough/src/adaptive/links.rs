@@ -30,36 +30,7 @@ use scallop_contour::P2;
 use super::{Planner, dist};
 use crate::grid::BIG;
 use crate::offset::Step;
-
-/// Lattice of the link search: every this-many grid cells (R / 8 for the
-/// default grid of R / 16).
-const LATTICE: usize = 2;
-
-/// Probes on the tool's periphery when checking that a centre cuts nothing.
-const LINK_PROBES: usize = 128;
-
-/// A probe counts as in material when the swept field there exceeds R by
-/// more than this (mm): the bilinear reading of the distance to the swept
-/// centres is within about 2 um of the distance at R from them with cells of
-/// R / 16, so a link may touch material at most this deep.
-const LINK_SLACK: f64 = 0.005;
-
-/// The last this-many R of a link may engage material up to the accepted
-/// bound (the start of a closed front lies in material by the step).
-const APPROACH_SHARE: f64 = 2.0;
-
-/// A link path longer than this times the straight distance (plus
-/// [`DETOUR_EXTRA`] R) is a retract instead.
-const DETOUR: f64 = 3.0;
-
-/// See [`DETOUR`].
-const DETOUR_EXTRA: f64 = 10.0;
-
-/// Most lattice nodes one link search expands.
-const MAX_EXPAND: usize = 60_000;
-
-/// Most candidate ends (lattice nodes near the target) one link search tries.
-const MAX_GOALS: usize = 64;
+use crate::tol::{APPROACH_SHARE, DETOUR, DETOUR_EXTRA, LATTICE, LINK_PROBES, LINK_SLACK, MAX_EXPAND, MAX_GOALS};
 
 /// One cut as planned: whether it starts where the cut before it ended
 /// (glued, no link), and its tool-centre points.
