@@ -92,8 +92,13 @@ pub struct DemoArgs {
     #[arg(short, long, default_value = "out/demo")]
     output: PathBuf,
     /// Run the first, simpler job instead: a ball cutter on a fixed-stepover raster.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "rough")]
     raster: bool,
+    /// Run the roughing demo instead: a block with a pocket roughed, rest-roughed in its
+    /// corners and finished on one stock (three tools, one program; the job of
+    /// `examples/jobs/pocket-rest.toml`, embedded).
+    #[arg(long)]
+    rough: bool,
     /// Print the summary as JSON.
     #[arg(long)]
     json: bool,
@@ -103,6 +108,9 @@ pub struct DemoArgs {
 pub fn demo(args: &DemoArgs) -> CliResult<()> {
     if args.raster {
         return raster_demo(args);
+    }
+    if args.rough {
+        return crate::run::rough_demo(&args.output, args.json);
     }
     let job = scallop_engine::FinishJob::choi_demo();
     let spinner = progress_bar(0, "planning and verifying the finishing of the Choi surface");

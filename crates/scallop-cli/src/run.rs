@@ -68,6 +68,30 @@ pub fn run(args: &RunArgs) -> CliResult<()> {
     write_finishing(&job, &out, start.elapsed().as_secs_f64(), &args.output, args.json, &command)
 }
 
+/// The job of `scallop demo --rough`: `examples/jobs/pocket-rest.toml` with its
+/// part, `examples/parts/pocket.stl`, both embedded in the binary (a block
+/// with a pocket roughed by a 10 mm end mill, rest-roughed in its corners by a
+/// 4 mm one, finished by a 4 mm ball; docs/roughing.md).
+const ROUGH_DEMO_JOB: &str = include_str!("../../../examples/jobs/pocket-rest.toml");
+const ROUGH_DEMO_PART: &[u8] = include_bytes!("../../../examples/parts/pocket.stl");
+
+/// `scallop demo --rough`: roughing, rest roughing and finishing of the
+/// embedded pocket on one stock, written like `scallop run` writes a job.
+pub(crate) fn rough_demo(output: &Path, json: bool) -> CliResult<()> {
+    let name = "the built-in roughing demo";
+    let spec = scallop_io::job::parse_job(ROUGH_DEMO_JOB).map_err(|e| Failure::Io(anyhow::anyhow!("{name}: {e}")))?;
+    let loaded = scallop_io::read_mesh(ROUGH_DEMO_PART, scallop_io::MeshFormat::Stl, scallop_io::Units::Millimetres)
+        .map_err(|e| Failure::Io(anyhow::anyhow!("{name}: {e}")))?;
+    let n = loaded.mesh.triangles().len();
+    let part = scallop_engine::Part::Mesh(loaded.mesh);
+    let description = format!("built-in pocket block (examples/parts/pocket.stl, {n} triangles)");
+    let first = finish_job_with_part(&spec, Path::new("."), part, description)?;
+    let job = operations_job(&spec, first)?;
+    let start = std::time::Instant::now();
+    let out = run_operations(&job).map_err(|e| Failure::Io(anyhow::anyhow!("{name} failed: {e}")))?;
+    write_job(&job, &out, start.elapsed().as_secs_f64(), output, json, "scallop demo --rough")
+}
+
 /// Checks a 3-axis program against the travel of the machine the job names (a
 /// 3+2 program is checked by the kinematics of its setup's machine); nothing is
 /// written when it leaves the travel.
@@ -294,6 +318,17 @@ pub(crate) fn finish_job(spec: &JobFile, folder: &Path) -> CliResult<FinishJob> 
         }
         (None, None) => return Err(Failure::rejected("part: give `file` or `builtin`")),
     };
+    finish_job_with_part(spec, folder, part, part_name)
+}
+
+/// The finishing job of `spec` on a part already loaded (`scallop demo --rough`
+/// gives its embedded part this way); `folder` resolves the job's other files.
+pub(crate) fn finish_job_with_part(
+    spec: &JobFile,
+    folder: &Path,
+    part: scallop_engine::Part,
+    part_name: String,
+) -> CliResult<FinishJob> {
     let cutter = cutter_of(&spec.cutter)?;
     let first = &spec.operations[0];
     let o = &spec.output;
