@@ -200,6 +200,21 @@ pub fn write_job(
             100.0 * op.stock.air_length_share,
             hms(op.plan.planning_time_s)
         ));
+        if let Some(e) = &op.engagement {
+            text.push_str(&format!(
+                "     engagement (simulated) median {:.0}°, p95 {:.0}°, max {:.0}° (target {:.0}°; entries apart, \
+                 up to {:.0}°); {:.0} mm above 1.2 x target, {:.0} mm full slot; {:.0} % of the length at depth \
+                 in links\n",
+                e.p50_deg,
+                e.p95_deg,
+                e.max_deg,
+                e.target_deg,
+                e.entry_max_deg,
+                e.over_length_mm,
+                e.slot_length_mm,
+                100.0 * e.link_share
+            ));
+        }
     }
     let left = if job.operations.last().is_some_and(|o| o.rough.is_some()) {
         format!(

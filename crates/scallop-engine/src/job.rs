@@ -113,6 +113,70 @@ pub struct StockFigures {
     pub clearance_mm: f64,
 }
 
+/// The engagement of a roughing operation, read by the simulator on the stock
+/// the operation received, cut move by move (`scallop_sim::stock_engagement`;
+/// docs/simulation.md, "Engagement on the in-process stock"). Angles in
+/// degrees, lengths in mm; entries (within 2 R of where the tool reached
+/// cutting depth) are reported apart and not counted in the percentiles.
+#[derive(Debug, Clone, Serialize)]
+pub struct EngagementFigures {
+    /// The target, `arccos(1 - stepover D / R)`.
+    pub target_deg: f64,
+    /// Median engagement of the samples that cut.
+    pub p50_deg: f64,
+    /// 95th percentile.
+    pub p95_deg: f64,
+    /// 99th percentile.
+    pub p99_deg: f64,
+    /// Largest engagement outside entries.
+    pub max_deg: f64,
+    /// Where it is: tool centre x, y (mm) and the move's index in the
+    /// operation's toolpath.
+    pub max_at: Option<([f64; 2], usize)>,
+    /// Largest engagement inside entries.
+    pub entry_max_deg: f64,
+    /// Length above 1.2 x the target.
+    pub over_length_mm: f64,
+    /// Length at or above 170 degrees (a full slot).
+    pub slot_length_mm: f64,
+    /// Length of the moves that cut.
+    pub cutting_length_mm: f64,
+    /// Share of the cutting moves' length below 2 degrees.
+    pub air_share: f64,
+    /// Share of the feed length at cutting depth in moves that cut nothing.
+    pub link_share: f64,
+    /// Times the tool reached cutting depth, and left it.
+    pub entries: usize,
+    /// Times it left.
+    pub retracts: usize,
+    /// The largest engagement of each move of the operation (degrees; 0 where
+    /// it cuts nothing): the report's colouring.
+    #[serde(skip)]
+    pub move_deg: Vec<f64>,
+}
+
+impl EngagementFigures {
+    fn of(r: &scallop_sim::EngagementReport) -> EngagementFigures {
+        EngagementFigures {
+            target_deg: r.target.to_degrees(),
+            p50_deg: r.p50.to_degrees(),
+            p95_deg: r.p95.to_degrees(),
+            p99_deg: r.p99.to_degrees(),
+            max_deg: r.max.to_degrees(),
+            max_at: r.max_at.map(|(p, i)| ([p.x, p.y], i)),
+            entry_max_deg: r.entry_max.to_degrees(),
+            over_length_mm: r.over_length,
+            slot_length_mm: r.slot_length,
+            cutting_length_mm: r.cutting_length,
+            air_share: r.air_share(),
+            link_share: r.link_share(),
+            entries: r.entries,
+            retracts: r.retracts,
+            move_deg: r.move_phi.iter().map(|p| p.to_degrees()).collect(),
+        }
+    }
+}
+
 /// The report of one operation.
 #[derive(Debug, Clone, Serialize)]
 pub struct OperationReport {
@@ -130,6 +194,9 @@ pub struct OperationReport {
     pub plan: scallop_strategy::Report,
     /// What it met on the stock.
     pub stock: StockFigures,
+    /// A roughing operation's engagement as the simulator read it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub engagement: Option<EngagementFigures>,
 }
 
 /// The report of a job (`report.json`).
@@ -241,7 +308,7 @@ pub fn run_job_with_progress(job: &Job, progress: &dyn Fn(JobStep)) -> Result<Jo
     let mut zmap = ZMap::new(stock, first.sim_resolution)?;
     let field = PartField::new(&zmap, &prepared.index);
     let part_top = prepared.mesh.bounds().max.z;
-    let mut planned: Vec<(Planned, StockFigures)> = Vec::with_capacity(job.operations.len());
+    let mut planned: Vec<(Planned, StockFigures, Option<EngagementFigures>)> = Vec::with_capacity(job.operations.len());
     for (index, op) in job.operations.iter().enumerate() {
         progress(JobStep { index, count, phase: JobPhase::Planning });
         let f = &op.finish;
@@ -269,6 +336,16 @@ pub fn run_job_with_progress(job: &Job, progress: &dyn Fn(JobStep)) -> Result<Jo
             )?)),
         };
         progress(JobStep { index, count, phase: JobPhase::Cutting });
+        let engagement = match &op.rough {
+            Some(r) => {
+                let radius = f.cutter.shape().radius();
+                let target = scallop_sim::engagement_angle(2.0 * radius * r.stepover, radius);
+                let options = scallop_sim::EngagementOptions::default();
+                let read = scallop_sim::stock_engagement(&zmap, &f.cutter, p.toolpath(), target, &options)?;
+                Some(EngagementFigures::of(&read))
+            }
+            None => None,
+        };
         let volume_before = zmap.volume();
         let cut = zmap.cut(&f.cutter, p.toolpath())?;
         if !cut.rapid_hits.is_empty() {
@@ -287,7 +364,7 @@ pub fn run_job_with_progress(job: &Job, progress: &dyn Fn(JobStep)) -> Result<Jo
             air_length_share: cut.air_length_share(),
             clearance_mm: clearance,
         };
-        planned.push((p, figures));
+        planned.push((p, figures, engagement));
     }
     let Some(last) = job.operations.last().map(|o| &o.finish) else {
         return Err(no_operation());
@@ -298,7 +375,7 @@ pub fn run_job_with_progress(job: &Job, progress: &dyn Fn(JobStep)) -> Result<Jo
     let simulation = scallop_sim::Simulation { zmap, cut: empty_cut(), verification };
     let mut rest = crate::RestReport::default();
     if last.strategy.simulation_verifies_scallop()
-        && let Some((Planned::Finish(p), _)) = planned.last_mut()
+        && let Some((Planned::Finish(p), _, _)) = planned.last_mut()
     {
         rest = network_scallop_from(&simulation, last, &prepared, &options, &mut p.plan.report)?;
     }
@@ -306,7 +383,7 @@ pub fn run_job_with_progress(job: &Job, progress: &dyn Fn(JobStep)) -> Result<Jo
     let mut toolpath = Toolpath::new(first.machine[0] * 1000.0);
     let mut reports = Vec::with_capacity(planned.len());
     let mut total_time = 0.0;
-    for ((p, figures), (k, op)) in planned.iter().zip(job.operations.iter().enumerate()) {
+    for ((p, figures, engagement), (k, op)) in planned.iter().zip(job.operations.iter().enumerate()) {
         toolpath.extend_from(p.toolpath());
         total_time += p.report().total_time_s;
         reports.push(OperationReport {
@@ -317,6 +394,7 @@ pub fn run_job_with_progress(job: &Job, progress: &dyn Fn(JobStep)) -> Result<Jo
             direction_deg: p.direction_deg(),
             plan: p.report().clone(),
             stock: figures.clone(),
+            engagement: engagement.clone(),
         });
     }
     let v = &simulation.verification;
@@ -332,7 +410,7 @@ pub fn run_job_with_progress(job: &Job, progress: &dyn Fn(JobStep)) -> Result<Jo
         sim_gouge_tolerance_mm: gouge_tolerance,
         rest,
     };
-    let toolpaths = planned.iter().map(|(p, _)| p.toolpath().clone()).collect();
+    let toolpaths = planned.iter().map(|(p, _, _)| p.toolpath().clone()).collect();
     Ok(JobOutput { toolpaths, toolpath, gcode, report, prepared, simulation })
 }
 
@@ -393,13 +471,13 @@ fn empty_cut() -> scallop_sim::CutReport {
 /// One program: the job's header comments, then each operation's section.
 fn program(
     job: &Job,
-    planned: &[(Planned, StockFigures)],
+    planned: &[(Planned, StockFigures, Option<EngagementFigures>)],
     prepared: &PreparedPart,
     tolerances: &Tolerances,
 ) -> Result<String, EngineError> {
     let mut fitted: Vec<(FittedPath, Vec<String>)> = Vec::with_capacity(planned.len());
     let mut header: Vec<String> = Vec::new();
-    for (k, ((p, _), op)) in planned.iter().zip(&job.operations).enumerate() {
+    for (k, ((p, _, _), op)) in planned.iter().zip(&job.operations).enumerate() {
         let (f, comments) = match p {
             Planned::Finish(p) => fit_and_comment(&op.finish, p, prepared, tolerances),
             Planned::Rough(r) => crate::rough::fit_and_comment(&op.finish, r),

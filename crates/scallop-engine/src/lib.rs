@@ -42,8 +42,8 @@ pub use finish::{
 };
 pub use grid::{GridAxis, GridError, MAX_GRID_POINTS};
 pub use job::{
-    Job, JobOutput, JobPhase, JobReport, JobStep, Operation, OperationReport, STOCK_CLEARANCE_MM, StockFigures,
-    StockShape, run_job, run_job_with_progress,
+    EngagementFigures, Job, JobOutput, JobPhase, JobReport, JobStep, Operation, OperationReport, STOCK_CLEARANCE_MM,
+    StockFigures, StockShape, run_job, run_job_with_progress,
 };
 pub use zones::{
     ProgramCandidate, ZONE_MARGIN_PER_RADIUS, ZONE_MARGIN_PER_SPACING, ZONE_MARGIN_ROUNDS, ZoneFigures,

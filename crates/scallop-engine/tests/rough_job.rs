@@ -105,6 +105,7 @@ fn finishing_after_roughing() {
     };
     let out = run_job(&job).unwrap();
     let [a, b] = [&out.report.operations[0], &out.report.operations[1]];
+    assert!(a.engagement.is_some() && b.engagement.is_none());
     assert!(b.stock.removed_mm3 < 0.2 * a.stock.removed_mm3, "{a:?} {b:?}");
     let r = &out.report;
     assert!(r.sim_max_scallop_mm <= 0.05 + r.sim_resolution_bound_mm, "{r:?}");
@@ -164,4 +165,28 @@ fn rest_roughing_machines_only_what_the_larger_tool_left() {
         left_both <= left_alone + 5.0,
         "left {left_both} mm^3 after rest, {left_alone} mm^3 by the small tool alone"
     );
+}
+
+/// A roughing operation reports the engagement the simulator read on the
+/// stock it received: its target from the stepover (0.2 D: 53.13 degrees),
+/// one figure per move of its toolpath (rapids and retracts cut nothing),
+/// the offset pattern's passes at the target (the median within the
+/// stock's reading, docs/simulation.md) and its slots where the offsets
+/// start at 180 (a finishing operation reports none: `finishing_after_roughing`).
+#[test]
+fn a_roughing_operation_reports_its_simulated_engagement() {
+    let out = run_job(&rough_job(0.3)).unwrap();
+    let e = out.report.operations[0].engagement.as_ref().unwrap();
+    assert!((e.target_deg - 53.13).abs() < 0.01, "{}", e.target_deg);
+    let path = &out.toolpaths[0];
+    assert_eq!(e.move_deg.len(), path.moves().len());
+    for (m, d) in path.moves().iter().zip(&e.move_deg) {
+        if matches!(m.kind, scallop_toolpath::MoveKind::Rapid | scallop_toolpath::MoveKind::Retract) {
+            assert_eq!(*d, 0.0);
+        }
+    }
+    assert!(e.p50_deg <= e.p95_deg && e.p95_deg <= e.max_deg && e.max_deg <= 180.0, "{e:?}");
+    assert!((e.p50_deg - e.target_deg).abs() < 6.0, "{e:?}");
+    assert!(e.slot_length_mm > 0.0 && e.cutting_length_mm > e.slot_length_mm, "{e:?}");
+    assert!(e.entries > 0 && e.entries == e.retracts, "{e:?}");
 }

@@ -965,6 +965,13 @@ pub mod sim {
     /// The engagement follows an arc move (G2/G3) along chords whose sagitta is
     /// at most this (mm, 1 um): as `scallop engagement` reads a program's arcs.
     pub const ENGAGEMENT_ARC_SAGITTA: f64 = 1e-3;
+
+    /// On the in-process stock (`scallop_sim::stock_engagement`), a probe of the
+    /// periphery is in material when the stock there rises more than this (mm)
+    /// above the height where the tool's profile reaches its radius: thinner
+    /// material (the floor a pass at the same level left, up to the z-map's
+    /// rounding) is not engagement.
+    pub const ENGAGEMENT_FLOOR: f64 = 0.01;
 }
 
 pub mod strategy {

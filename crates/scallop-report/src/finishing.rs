@@ -97,6 +97,7 @@ impl ReportData {
                 unit: "mm".into(),
             }),
             convergence: Vec::new(),
+            engagement: None,
         }
     }
 }

@@ -139,12 +139,22 @@ fn scene_json(data: &ReportData) -> Value {
             .as_ref()
             .filter(|z| z.of_move.len() == moves.len())
             .map(|z| base64(&keep.iter().flat_map(|&i| z.of_move[i].to_le_bytes()).collect::<Vec<u8>>()));
+        let engagement = data.engagement.as_ref().filter(|e| e.len() == moves.len()).map(|e| {
+            // The highest ratio of the moves merged into each shown vertex; -1: not measured.
+            let mut prev = 0usize;
+            b64_f32(keep.iter().map(|&i| {
+                let hi = e[(prev + 1).min(i)..=i].iter().flatten().copied().fold(f64::NEG_INFINITY, f64::max);
+                prev = i;
+                if hi.is_finite() { hi as f32 } else { -1.0 }
+            }))
+        });
         json!({
             "positions": b64_f32(keep.iter().flat_map(|&i| rel(&moves[i].to))),
             "kinds": base64(&keep.iter().map(|&i| kind_index(kinds[i])).collect::<Vec<u8>>()),
             "times": times,
             "feeds": feeds,
             "zones": zones,
+            "engagement": engagement,
             "moves": moves.len(),
             "shown": keep.len(),
             "totalTime": t,

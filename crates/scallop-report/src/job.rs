@@ -4,6 +4,7 @@
 //! and the figures of each operation.
 
 use scallop_engine::{Job, JobOutput};
+use scallop_toolpath::MoveKind;
 
 use scallop_strategy::lookahead_profile;
 
@@ -62,6 +63,18 @@ impl ReportData {
             figures.push(Figure::number(&label("removed"), o.stock.removed_mm3, 0, "mm³"));
             figures.push(Figure::number(&label("feed length in air"), 100.0 * o.stock.air_length_share, 0, "%"));
             figures.push(Figure::number(&label("planning time"), p.planning_time_s, 2, "s"));
+            if let Some(e) = &o.engagement {
+                figures.push(Figure::text(
+                    &label("engagement, simulated (median / p95 / max, target)"),
+                    format!(
+                        "{:.0}° / {:.0}° / {:.0}°, target {:.0}° (entries apart: up to {:.0}°)",
+                        e.p50_deg, e.p95_deg, e.max_deg, e.target_deg, e.entry_max_deg
+                    ),
+                ));
+                figures.push(Figure::number(&label("length above 1.2 x target"), e.over_length_mm, 0, "mm"));
+                figures.push(Figure::number(&label("full-slot length"), e.slot_length_mm, 0, "mm"));
+                figures.push(Figure::number(&label("tool-down links"), 100.0 * e.link_share, 0, "%"));
+            }
         }
         let settings = job
             .operations
@@ -108,6 +121,32 @@ impl ReportData {
             settings,
             histogram: None,
             convergence: Vec::new(),
+            engagement: engagement_ratios(r, &out.toolpaths),
         }
     }
+}
+
+/// Each move's simulated engagement over its operation's target, for the
+/// operations that report one (`None` elsewhere); `None` when no operation does.
+fn engagement_ratios(
+    r: &scallop_engine::JobReport,
+    toolpaths: &[scallop_toolpath::Toolpath],
+) -> Option<Vec<Option<f64>>> {
+    if r.operations.iter().all(|o| o.engagement.is_none()) {
+        return None;
+    }
+    let mut ratios = Vec::new();
+    for (o, path) in r.operations.iter().zip(toolpaths) {
+        let n = path.moves().len();
+        match &o.engagement {
+            Some(e) if e.move_deg.len() == n && e.target_deg > 0.0 => {
+                let moves = path.moves().iter();
+                ratios.extend(e.move_deg.iter().zip(moves).map(|(&d, m)| {
+                    (!matches!(m.kind, MoveKind::Rapid | MoveKind::Retract)).then_some(d / e.target_deg)
+                }));
+            }
+            _ => ratios.extend(std::iter::repeat_n(None, n)),
+        }
+    }
+    Some(ratios)
 }

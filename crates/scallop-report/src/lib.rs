@@ -304,6 +304,10 @@ pub struct ReportData {
     pub histogram: Option<Histogram>,
     /// Convergence plots (filled by `scallop optimize`).
     pub convergence: Vec<Convergence>,
+    /// The simulated engagement of each move over its operation's target
+    /// (`None` for a move not measured: rapids, finishing operations); the
+    /// toolpath's "engagement" colouring.
+    pub engagement: Option<Vec<Option<f64>>>,
 }
 
 impl ReportData {

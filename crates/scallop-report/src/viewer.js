@@ -26,6 +26,8 @@
   }
   // Deviation view: gouges, cells with no part under them, walls (not measured from above).
   var GOUGE = [230, 0, 230], NO_PART = [77, 77, 77], WALL = [205, 205, 190];
+  // The engagement colouring's top: 1.5 x the target and above are red.
+  var ENGAGEMENT_TOP = 1.5;
   function rgb(c) { return "vec3(" + c.map(function (v) { return (v / 255).toFixed(4); }).join(", ") + ")"; }
   var ZONE_COLOURS = [[31, 119, 180], [255, 127, 14], [44, 160, 44], [214, 39, 40], [148, 103, 189],
     [140, 86, 75], [227, 119, 194], [127, 127, 127], [188, 189, 34], [23, 190, 207]];
@@ -183,7 +185,8 @@
     var d = data.path;
     path = {
       count: d.shown, posArray: decode(d.positions, Float32Array), kinds: decode(d.kinds, Uint8Array),
-      times: decode(d.times, Float32Array), feeds: decode(d.feeds, Float32Array), zones: decode(d.zones, Uint16Array)
+      times: decode(d.times, Float32Array), feeds: decode(d.feeds, Float32Array), zones: decode(d.zones, Uint16Array),
+      engagement: decode(d.engagement, Float32Array)
     };
     path.pos = buffer(path.posArray);
     path.time = buffer(path.times);
@@ -205,6 +208,9 @@
       for (i = 0; i < path.count; i++) {
         var kind = path.kinds[i], rgb;
         if (mode === "feed" && path.feeds && (kind === 2 || kind === 3)) { ramp(path.feeds[i] / maxFeed, pc, 3 * i); continue; }
+        if (mode === "engagement" && path.engagement && path.engagement[i] >= 0) {
+          ramp(Math.min(path.engagement[i], ENGAGEMENT_TOP) / ENGAGEMENT_TOP, pc, 3 * i); continue;
+        }
         if (mode === "zone" && path.zones) rgb = ZONE_COLOURS[path.zones[i] % ZONE_COLOURS.length];
         else if (mode === "kind") rgb = data.kindColours[kind];
         else rgb = kind === 2 || kind === 3 ? [60, 60, 60] : [190, 190, 190];
@@ -216,6 +222,8 @@
     if (mode === "kind") legend = data.kindNames.map(function (n, j) { return swatch(data.kindColours[j], n); }).join("");
     if (mode === "feed") legend = "<span>achieved feed (look-ahead): 0 <span class=\"ramp\"></span> " +
       Math.round(data.path.maxFeed) + " mm/min</span>";
+    if (mode === "engagement") legend = "<span>simulated engagement / target: 0 <span class=\"ramp\"></span> " +
+      ENGAGEMENT_TOP + " and above (1 = the target; grey: not measured)</span>";
     if (mode === "zone") legend = (data.zoneNames || []).map(function (n, j) { return swatch(ZONE_COLOURS[j % ZONE_COLOURS.length], n); }).join("");
     if (mode === "deviation") legend = "<span>material left: 0 <span class=\"ramp\"></span> " + data.deviation.max.toFixed(4) +
       " mm</span>" + swatch(GOUGE, "gouge (below -" + data.deviation.gougeTolerance.toFixed(4) + " mm)") + swatch(NO_PART, "no part") +
@@ -226,6 +234,7 @@
     var modes = [["kind", "move type"]];
     if (data.path && data.path.feeds) modes.push(["feed", "achieved feed"]);
     if (data.path && data.path.zones) modes.push(["zone", data.zoneLabel || "zone"]);
+    if (data.path && data.path.engagement) modes.push(["engagement", "simulated engagement"]);
     if (devTexture) modes.push(["deviation", "simulated deviation"]);
     ui.colour.innerHTML = modes.map(function (m) { return "<option value=\"" + m[0] + "\">" + m[1] + "</option>"; }).join("");
   }

@@ -96,7 +96,9 @@ pub use dexel::{
     DexelCollision, DexelGouge, DexelOptions, DexelPart, DexelReport, DexelStock, DexelVerification, MAX_RAYS,
     MAX_SUBSTEPS, ToolMove, verify_dexel,
 };
-pub use engagement::{EngagementOptions, EngagementReport, Pocket, engagement_angle, pocket_engagement};
+pub use engagement::{
+    EngagementOptions, EngagementReport, Pocket, engagement_angle, pocket_engagement, stock_engagement,
+};
 pub use envelope::swept_floor;
 pub use error::SimError;
 pub use rest::{OverCell, RestPlace, RestSplit, split_rest};

@@ -29,6 +29,7 @@
 
 mod pocket;
 mod raster;
+mod stock;
 
 use rayon::prelude::*;
 use scallop_geom::Point2;
@@ -39,6 +40,7 @@ use crate::tol::{ENGAGEMENT_ARC_SAGITTA as ARC_SAGITTA, ENGAGEMENT_BLOCK, ENGAGE
 pub use pocket::Pocket;
 pub(crate) use pocket::segment_distance;
 use raster::Raster;
+pub use stock::stock_engagement;
 
 /// The engagement angle (rad) of a straight cut at radial depth `ae` (mm) by a
 /// tool of `radius` (mm): `arccos(1 - ae / R)` (`ae` clamped to `0..=2R`).
@@ -223,6 +225,8 @@ struct Segment {
 #[derive(Debug, Clone, Copy)]
 struct Sample {
     at: Point2,
+    /// The tool tip's height.
+    z: f64,
     s: f64,
     segment: usize,
     weight: f64,
@@ -264,6 +268,7 @@ fn track(path: &Toolpath, radius: f64, options: &EngagementOptions) -> Track {
         let (from, to) = (path.moves()[i - 1].to, path.moves()[i].to);
         let ends = path.arc(i).map_or_else(|| vec![to], |arc| arc.chords(&from, &to, ARC_SAGITTA));
         let mut a = xy(i - 1);
+        let mut za = from.z;
         for end in ends {
             let b = Point2::new(end.x, end.y);
             let length = (b - a).norm();
@@ -279,10 +284,12 @@ fn track(path: &Toolpath, radius: f64, options: &EngagementOptions) -> Track {
                     entry_point = None;
                 }
                 let segment = t.segments.len() - 1;
-                t.samples.push(Sample { at, s: s + length * f, segment, weight: length / n as f64, entry });
+                let z = za + (end.z - za) * f;
+                t.samples.push(Sample { at, z, s: s + length * f, segment, weight: length / n as f64, entry });
             }
             s += length;
             a = b;
+            za = end.z;
         }
     }
     t
