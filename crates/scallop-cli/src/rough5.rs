@@ -9,8 +9,8 @@ use std::time::Instant;
 
 use clap::{Args, ValueEnum};
 use scallop_cutter::{Cutter, CutterShape, HolderSegment};
-use scallop_guides::GuideSettings;
 use scallop_engine::{OnMachine, Posted, Rough5Metrics, TcpWords, post_tcp, rough5_metrics, rough5_settings};
+use scallop_guides::GuideSettings;
 use scallop_machine::Kinematics;
 use scallop_parts::FaceTag;
 use scallop_parts::TestPart;
@@ -179,7 +179,6 @@ struct LevelJson {
     paired_by_rank: Option<String>,
 }
 
-
 /// One fixed orientation of a baseline.
 #[derive(Serialize)]
 struct SetupJson {
@@ -259,11 +258,7 @@ fn settings(args: &Rough5Args, part: &TestPart) -> CliResult<Rough5Settings> {
             TiltArg::Zero => TiltMode::Zero,
             TiltArg::Guides | TiltArg::Optimised => TiltMode::Guides,
         },
-        guides: GuideSettings {
-            flank_allowance: args.allowance[0],
-            voxel: args.levels.voxel,
-            ..base.guides
-        },
+        guides: GuideSettings { flank_allowance: args.allowance[0], voxel: args.levels.voxel, ..base.guides },
         bottom_allowance: args.allowance[1],
         step: args.step,
         max_angle_step: args.max_angle_step.to_radians(),

@@ -272,6 +272,15 @@ fn summary(r: &JobReport, out: &Rough5Output, folder: &Path) -> String {
         "     replayed within {:.4} mm; {} retracts, {} ramps, {} CL points dropped at flanks",
         out.posted.replay_tip_deviation, op.retracts, op.ramps, op.dropped_pairs
     );
+    for f in &m.faces {
+        let q = f.deviation_quartiles_outside_corners_mm;
+        let _ = writeln!(
+            s,
+            "     {}: crests max {:.3}, mean {:.3}, sigma {:.3} mm (corners excluded); deviation from the allowance \
+             {:.3} / {:.3} / {:.3} / {:.3} / {:.3} mm (min, quartiles, max, outside corners)",
+            f.face, f.crest_max_mm, f.crest_mean_mm, f.crest_sigma_mm, q[0], q[1], q[2], q[3], q[4]
+        );
+    }
     let _ = writeln!(
         s,
         "  planned in {:.1} s, proven in {:.1} s; written to {}",

@@ -43,6 +43,17 @@ fn a_rough5_job_plans_proves_and_posts() {
     assert!(t > 0.0 && t >= num("feed_time_s") && num("feed_time_s") >= 0.999 * num("estimated_time_at_feed_s") - 1.0);
     assert!((num("removal_rate_mm3_s") * t - num("removed_volume_mm3")).abs() <= 1e-6 * num("removed_volume_mm3"));
     assert_eq!(report["total_time_s"].as_f64(), Some(t));
+    // Spec 10.1 per face: quartiles in order, crests from the allowance up.
+    let faces = m["faces"].as_array().expect("faces");
+    assert_eq!(faces.len(), 2, "{m}");
+    for f in faces {
+        let q: Vec<f64> =
+            f["deviation_quartiles_mm"].as_array().expect("q").iter().filter_map(|v| v.as_f64()).collect();
+        assert!(q.len() == 5 && q.windows(2).all(|w| w[0] <= w[1]), "{f}");
+        let crest = |k: &str| f[k].as_f64().unwrap_or(f64::NAN);
+        assert!(crest("crest_mean_mm") >= 0.0 && crest("crest_mean_mm") <= crest("crest_max_mm"), "{f}");
+        assert!(f["samples"].as_u64().unwrap_or(0) > f["corner_samples"].as_u64().unwrap_or(u64::MAX), "{f}");
+    }
     let nc = std::fs::read_to_string(out.join("program.nc")).expect("program");
     assert!(nc.contains("TRAORI") && nc.contains("T3"), "{}", &nc[..nc.len().min(2000)]);
     assert!(op["replay_tip_deviation_mm"].as_f64().unwrap_or(f64::NAN) < 0.01);
@@ -67,7 +78,7 @@ fn bad_rough5_jobs_exit_1_naming_the_key() {
         ("resolution = 1", "resolution = inf", "rough5.resolution"),
         ("shape = \"bull\"", "shape = \"cone\"", "cutter.shape"),
         ("test_part = \"pocket\"", "builtin = \"choi\"", "part.test_part"),
-        ("machine = \"ucp710\"", "machine = \"linuxcnc-3axis\"", "5-axis"),
+        ("machine = \"ucp710\"", "machine = \"grbl-3axis\"", "5-axis"),
     ];
     for (k, (from, to, needle)) in cases.iter().enumerate() {
         let job = write_job(&dir.join(k.to_string()), &JOB.replace(from, to));
@@ -80,7 +91,8 @@ fn bad_rough5_jobs_exit_1_naming_the_key() {
     // No machine named, and a rough5 operation next to a finishing one.
     let job = write_job(&dir.join("nomachine"), &JOB.replace("machine = \"ucp710\"\n", ""));
     assert!(rejected(&run_job(&job, &dir.join("o1"), &[])).contains("5-axis machine"));
-    let two = JOB.to_string() + "[[operation]]\nkind = \"finish\"\n[operation.cutter]\nshape = \"ball\"\ndiameter = 4\n\
+    let two = JOB.to_string()
+        + "[[operation]]\nkind = \"finish\"\n[operation.cutter]\nshape = \"ball\"\ndiameter = 4\n\
         [operation.finishing]\nscallop_height = 0.01\n";
     let job = write_job(&dir.join("two"), &two);
     assert!(rejected(&run_job(&job, &dir.join("o2"), &[])).contains("exactly one [[operation]]"));

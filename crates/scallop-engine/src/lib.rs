@@ -49,8 +49,8 @@ pub use job::{
     StockShape, run_job, run_job_with_progress,
 };
 pub use rough5::{
-    OnMachine, Posted, ProgramTime, Rough5Job, Rough5Metrics, Rough5Output, Rough5Step, TcpWords, on_machine,
-    post_tcp, program_time, rough5_metrics, rough5_settings, run_rough5,
+    FaceReport, OnMachine, Posted, ProgramTime, Rough5Job, Rough5Metrics, Rough5Output, Rough5Step, TcpWords,
+    on_machine, post_tcp, program_time, rough5_metrics, rough5_settings, run_rough5,
 };
 pub use zones::{
     ProgramCandidate, ZONE_MARGIN_PER_RADIUS, ZONE_MARGIN_PER_SPACING, ZONE_MARGIN_ROUNDS, ZoneFigures,

@@ -15,7 +15,7 @@ use scallop_machine::{Joints, Kinematics, Machine};
 use scallop_parts::{FaceTag, TestPart};
 use scallop_post::{Dialect, OutputMode, PostParams, check_replay, program_text, replay};
 use scallop_rough5::{
-    LevelOptions, Proof, ProofSettings, Rough5Plan, Rough5Settings, TiltMode, plan_rough5, prove_from_blank,
+    LevelOptions, Proof, ProofFace, ProofSettings, Rough5Plan, Rough5Settings, TiltMode, plan_rough5, prove_with_faces,
 };
 use scallop_toolpath::Toolpath;
 use serde::Serialize;
@@ -154,7 +154,8 @@ pub fn post_tcp(kin: &Kinematics, path: &Toolpath, dialect: &Dialect, words: &Tc
         predicted_time: Some(run.time.total),
     };
     let output = |what: String| EngineError::Output { what, fix: "another dialect (output.dialect)".into() };
-    let text = program_text(&run.program, kin, dialect, &params).map_err(|e| output(format!("{}: {e}", dialect.name)))?;
+    let text =
+        program_text(&run.program, kin, dialect, &params).map_err(|e| output(format!("{}: {e}", dialect.name)))?;
     let replayed = replay(&text, dialect, kin).map_err(|e| output(format!("our output does not read back: {e}")))?;
     let trip = check_replay(&replayed, &run.records, kin, dialect, options.tol_pos, options.tol_ang)
         .map_err(|e| output(format!("the program does not replay to the CL path: {e}")))?;
@@ -201,6 +202,37 @@ pub struct Rough5Metrics {
     pub removal_rate_mm3_s: f64,
     /// Removal rate in % of the volume to remove per second.
     pub removal_rate_percent_s: f64,
+    /// The finished faces' deviation from the allowance and crest heights
+    /// (measured by [`run_rough5`]; empty otherwise).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub faces: Vec<FaceReport>,
+}
+
+/// The metrics of one finished face (spec 10.1): the thickness left measured
+/// along the face's normal on the proof's tri-dexel stock, at one sample per
+/// sub-triangle of at most the ray spacing (`scallop_rough5::face_metrics`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FaceReport {
+    /// `bottom` or `flanks`.
+    pub face: &'static str,
+    /// Its area (mm^2).
+    pub area_mm2: f64,
+    /// Samples measured.
+    pub samples: usize,
+    /// Samples within a tool radius of the other face (corners).
+    pub corner_samples: usize,
+    /// Deviation from the allowance (thickness left less the allowance, mm),
+    /// the whole face: minimum, first quartile, median, third quartile, maximum.
+    pub deviation_quartiles_mm: [f64; 5],
+    /// The same outside the corners (within a tool radius of the other face, a
+    /// ray along the normal may run through that face's allowance shell).
+    pub deviation_quartiles_outside_corners_mm: [f64; 5],
+    /// Crest height (thickness above the allowance, mm), corners excluded: maximum.
+    pub crest_max_mm: f64,
+    /// Area-weighted mean.
+    pub crest_mean_mm: f64,
+    /// Area-weighted standard deviation.
+    pub crest_sigma_mm: f64,
 }
 
 /// The metrics of a plan, its proof and, when the machine took it, its posted
@@ -225,6 +257,21 @@ pub fn rough5_metrics(plan: &Rough5Plan, proof: &Proof, posted: Option<&Posted>)
         estimated_time_at_feed_s: plan.estimated_time,
         removal_rate_mm3_s: proof.removal_rate(t),
         removal_rate_percent_s: if t > 0.0 { (100.0 - proof.remaining_percent) / t } else { 0.0 },
+        faces: proof
+            .faces
+            .iter()
+            .map(|f| FaceReport {
+                face: f.name,
+                area_mm2: f.area,
+                samples: f.samples,
+                corner_samples: f.corner_samples,
+                deviation_quartiles_mm: f.deviation_quartiles,
+                deviation_quartiles_outside_corners_mm: f.deviation_quartiles_outside_corners,
+                crest_max_mm: f.crest_max,
+                crest_mean_mm: f.crest_mean,
+                crest_sigma_mm: f.crest_sigma,
+            })
+            .collect(),
     }
 }
 
@@ -339,12 +386,23 @@ pub fn run_rough5(job: &Rough5Job, progress: &(dyn Fn(Rough5Step) + Sync)) -> Re
     let plan = plan_rough5(&bottom, &flanks, &part.stock, &job.tool, &job.settings, &|done, total| {
         progress(Rough5Step::Planning { done, total });
     })?;
-    let proof = prove_from_blank(
+    let corner = job.settings.guides.tool_radius;
+    let faces = [
+        ProofFace { name: "bottom", mesh: &bottom, others: &flanks, allowance: job.settings.bottom_allowance, corner },
+        ProofFace {
+            name: "flanks",
+            mesh: &flanks,
+            others: &bottom,
+            allowance: job.settings.guides.flank_allowance,
+            corner,
+        },
+    ];
+    let proof = prove_with_faces(
         &plan.toolpath,
         &job.tool,
-        &part.stock,
-        part.blank.as_ref(),
+        (&part.stock, part.blank.as_ref()),
         &part.mesh,
+        &faces,
         &job.proof,
         &|done, total| progress(Rough5Step::Proving { done, total }),
     )?;

@@ -1345,11 +1345,11 @@ fn check_rough5_job(job: &JobFile) -> Result<(), JobError> {
 /// with finite, positive steps, a_e within the tool's diameter and a_p within
 /// its flutes, and no finishing or roughing table.
 fn check_rough5(op: &OperationSpec) -> Result<(), JobError> {
-    check_cutter(&op.cutter)?;
     let bad = |key, value: String, fix| Err(JobError::Value { key, value, fix });
     if op.cutter.shape == ShapeWord::Cone {
         return bad("cutter.shape", "cone".into(), "a rough5 tool is a torus (\"bull\"), \"flat\" or \"ball\"");
     }
+    check_cutter(&op.cutter)?;
     let Some(r) = &op.rough5 else {
         return bad("rough5", "missing".into(), "give [operation.rough5] with ap and ae");
     };
