@@ -1817,4 +1817,31 @@ mod tests {
         let err = parse_job(&first).unwrap_err().to_string();
         assert!(err.contains("operation 1") && err.contains("kind = \"rough\" operation before it"), "{err}");
     }
+
+    #[test]
+    fn rough5_operations_read_with_defaults_and_their_limits() {
+        let job = "[part]\ntest_part = \"pocket\"\n[[operation]]\nkind = \"rough5\"\n\
+            [operation.cutter]\nshape = \"bull\"\ndiameter = 10\ncorner_radius = 1.5\nflute_length = 30\n\
+            [operation.rough5]\nap = 4\nae = 4.5\n";
+        let parsed = parse_job(job).unwrap();
+        assert_eq!(parsed.part.test_part, Some(TestPartWord::Pocket));
+        let r = parsed.operations[0].rough5.as_ref().unwrap();
+        assert_eq!((r.tilt, r.stock_to_leave, r.stock_to_leave_axial, r.voxel), (TiltWord::Guides, 0.5, None, 1.0));
+        for (from, to, key) in [
+            ("ap = 4", "ap = 31", "rough5.ap"),
+            ("ap = 4", "ap = nan", "rough5.ap"),
+            ("ae = 4.5", "ae = 0", "rough5.ae"),
+            ("ae = 4.5", "ae = 11", "rough5.ae"),
+            ("ae = 4.5", "ae = 4.5\nstock_to_leave = -1", "rough5.stock_to_leave"),
+            ("ae = 4.5", "ae = 4.5\nteeth = 2", "rough5.teeth"),
+            ("ae = 4.5", "ae = 4.5\nmax_angle_step_deg = 120", "rough5.max_angle_step_deg"),
+            ("test_part = \"pocket\"", "test_part = \"gear\"", "unknown variant `gear`"),
+            ("test_part = \"pocket\"", "file = \"a.stl\"", "part.test_part"),
+            ("test_part = \"pocket\"", "test_part = \"pocket\"\nbuiltin = \"choi\"", "exactly one of"),
+            ("kind = \"rough5\"", "kind = \"rough\"", "z-map stock"),
+        ] {
+            let err = parse_job(&job.replace(from, to)).unwrap_err().to_string();
+            assert!(err.contains(key), "{to}: {err}");
+        }
+    }
 }
