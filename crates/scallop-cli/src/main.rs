@@ -17,6 +17,7 @@ mod pocket;
 mod post;
 mod render;
 mod rough5;
+mod rough5_job;
 mod run;
 mod simulate;
 mod waterline;

@@ -7,9 +7,8 @@ use std::path::{Path, PathBuf};
 
 use clap::{Args, ValueEnum};
 use scallop_io::cl::read_cl;
-use scallop_machine::program::{Motion, ProgramOptions, records_of, to_program};
-use scallop_machine::time::{path_time, rapid_time};
-use scallop_machine::{Joints, Kinematics, Machine};
+use scallop_machine::program::{ProgramOptions, records_of, to_program};
+use scallop_machine::{Kinematics, Machine};
 use scallop_post::{Dialect, OutputMode, PostParams, check_replay, program_text, replay};
 use serde::Serialize;
 
@@ -245,44 +244,4 @@ pub fn run(args: &PostArgs) -> CliResult<()> {
     }
 }
 
-/// Times of a program.
-pub(crate) struct ProgramTime {
-    pub(crate) total: f64,
-    pub(crate) feed: f64,
-    pub(crate) floor: f64,
-    pub(crate) rapid: f64,
-    pub(crate) peak: [f64; 5],
-    pub(crate) lost: [f64; 5],
-}
-
-/// Feed runs (maximal sequences of non-rapid blocks, with the block before as their
-/// start) by the look-ahead model; rapids per axis, stop to stop.
-pub(crate) fn program_time(
-    kin: &Kinematics,
-    blocks: &[(Motion, Joints, f64)],
-) -> Result<ProgramTime, scallop_machine::MachineError> {
-    let mut t = ProgramTime { total: 0.0, feed: 0.0, floor: 0.0, rapid: 0.0, peak: [0.0; 5], lost: [0.0; 5] };
-    let mut k = 1;
-    while k < blocks.len() {
-        if blocks[k].0 == Motion::Rapid {
-            t.rapid += rapid_time(kin.machine(), &blocks[k - 1].1, &blocks[k].1);
-            k += 1;
-            continue;
-        }
-        let start = k - 1;
-        while k < blocks.len() && blocks[k].0 != Motion::Rapid {
-            k += 1;
-        }
-        let joints: Vec<Joints> = blocks[start..k].iter().map(|b| b.1).collect();
-        let feeds: Vec<f64> = blocks[start + 1..k].iter().map(|b| b.2).collect();
-        let r = path_time(kin, &joints, &feeds)?;
-        t.feed += r.total;
-        t.floor += r.feed_time;
-        for i in 0..5 {
-            t.peak[i] = t.peak[i].max(r.axis_peak_speed[i]);
-            t.lost[i] += r.axis_time_lost[i];
-        }
-    }
-    t.total = t.feed + t.rapid;
-    Ok(t)
-}
+use scallop_engine::program_time;

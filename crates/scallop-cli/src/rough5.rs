@@ -9,13 +9,11 @@ use std::time::Instant;
 
 use clap::{Args, ValueEnum};
 use scallop_cutter::{Cutter, CutterShape, HolderSegment};
+use scallop_engine::{OnMachine, Posted, Rough5Metrics, TcpWords, post_tcp, rough5_metrics, rough5_settings};
 use scallop_guides::GuideSettings;
 use scallop_machine::Kinematics;
-use scallop_machine::program::{ClRecord, MachineProgram, ProgramOptions, records_of, to_program};
-use scallop_mesh::TriMesh;
 use scallop_parts::FaceTag;
 use scallop_parts::TestPart;
-use scallop_post::{OutputMode, PostParams, check_replay, program_text, replay};
 use scallop_rough5::{
     BaselinePlan, BaselineSettings, CuttingData, LevelOptions, OrientSettings, Pocket, Proof, ProofSettings,
     Rough5Plan, Rough5Settings, TiltMode, Weights, plan_rough5, plan_three_plus_two, plan_zlevel, prove_from_blank,
@@ -26,7 +24,7 @@ use serde::Serialize;
 use crate::guides::{LevelArgs, PartArg, test_part};
 use crate::output::{print_json, print_text, progress_bar, with_written};
 use crate::outset::OutputSet;
-use crate::post::{ProgramTime, load_dialect, load_machine, program_time};
+use crate::post::{load_dialect, load_machine};
 use crate::{CliResult, Failure};
 
 /// The tool-axis variant.
@@ -181,26 +179,6 @@ struct LevelJson {
     paired_by_rank: Option<String>,
 }
 
-#[derive(Serialize)]
-struct Metrics {
-    volume_to_remove_mm3: f64,
-    remaining_volume_mm3: f64,
-    remaining_percent: f64,
-    removed_volume_mm3: f64,
-    gouge_volume_mm3: f64,
-    gouge_depth_mm: f64,
-    path_length_dm: f64,
-    out_of_material_percent: f64,
-    machining_time_s: f64,
-    /// Time lost to each axis's velocity, acceleration and jerk limits (s).
-    axis_time_lost_s: Vec<(String, f64)>,
-    feed_time_s: f64,
-    rapid_time_s: f64,
-    estimated_time_at_feed_s: f64,
-    removal_rate_mm3_s: f64,
-    removal_rate_percent_s: f64,
-}
-
 /// One fixed orientation of a baseline.
 #[derive(Serialize)]
 struct SetupJson {
@@ -229,7 +207,7 @@ struct Report {
     retracts: usize,
     links: usize,
     ramps: usize,
-    metrics: Metrics,
+    metrics: Rough5Metrics,
     levels: Vec<LevelJson>,
     passes: Vec<PassJson>,
     /// The setups of a 3-axis baseline (empty for the 5-axis programs).
@@ -270,36 +248,27 @@ fn cutter(a: &Rough5Args) -> CliResult<Cutter> {
 }
 
 /// The planning settings of the arguments.
-fn settings(args: &Rough5Args, part: &TestPart, bottom: &TriMesh) -> CliResult<Rough5Settings> {
+fn settings(args: &Rough5Args, part: &TestPart) -> CliResult<Rough5Settings> {
     let weights = Weights { bounds: args.weights[0], fluidity: args.weights[1], pitch: args.weights[2] };
     let on = |r: RefineArg| !args.without.iter().any(|w| *w == r || *w == RefineArg::All);
+    let base = rough5_settings(part, args.tool_radius, (args.levels.ap, args.levels.ae), cutting_feed(args)?)
+        .map_err(|e| Failure::rejected(e.to_string()))?;
     Ok(Rough5Settings {
         tilt: match args.tilt {
             TiltArg::Zero => TiltMode::Zero,
             TiltArg::Guides | TiltArg::Optimised => TiltMode::Guides,
         },
-        guides: GuideSettings {
-            tool_radius: args.tool_radius,
-            flank_allowance: args.allowance[0],
-            axial_step: args.levels.ap,
-            radial_step: args.levels.ae,
-            voxel: args.levels.voxel,
-            depth: part.stock.max.z - bottom.bounds().min.z,
-        },
+        guides: GuideSettings { flank_allowance: args.allowance[0], voxel: args.levels.voxel, ..base.guides },
         bottom_allowance: args.allowance[1],
         step: args.step,
         max_angle_step: args.max_angle_step.to_radians(),
         max_azimuth_step: args.max_azimuth_step.to_radians(),
-        ramp_angle: 5f64.to_radians(),
-        clearance: 1.0,
-        link_max: 2.0 * args.levels.ae,
-        feed: cutting_feed(args)?,
-        rapid_rate: 20_000.0,
         orientation: matches!(args.tilt, TiltArg::Optimised).then(|| orientation(args, weights)),
         correct: args.correction && !matches!(args.tilt, TiltArg::Zero),
         levels: LevelOptions { centre_offsets: on(RefineArg::CentreOffsets), pair_by_rank: on(RefineArg::PairByRank) },
         vertical_inside: on(RefineArg::VerticalInside),
         translate: on(RefineArg::Translation),
+        ..base
     })
 }
 
@@ -334,7 +303,7 @@ pub fn run(args: &Rough5Args) -> CliResult<()> {
     let faces = |tags: &[FaceTag]| part.faces(tags).map_err(|e| Failure::rejected(format!("{name}: {e}")));
     let (bottom, flanks) = (faces(&[FaceTag::Bottom])?, faces(&[FaceTag::Flank])?);
     let tool = cutter(args)?;
-    let settings = settings(args, &part, &bottom)?;
+    let settings = settings(args, &part)?;
     if args.orientation_cases {
         return cases::run(args, name, &part, (&bottom, &flanks), &tool, &settings);
     }
@@ -376,14 +345,14 @@ pub fn run(args: &Rough5Args) -> CliResult<()> {
     }
     let proof_seconds = clock.elapsed().as_secs_f64() - plan_seconds;
     let posted = post_program(args, &plan);
-    let post = posted.as_ref().map(|(_, p)| p).map_err(|e| match e {
+    let post = posted.as_ref().map_err(|e| match e {
         Failure::Rejected(e) | Failure::Io(e) => e.to_string(),
     });
     let mut report = report(args, name, &plan, &proof, post, [plan_seconds, proof_seconds]);
     report.setups = setups;
     let mut out = OutputSet::begin(&args.output, "rough5")?;
-    if let Ok((nc, _)) = &posted {
-        out.write("program.nc", nc.as_bytes())?;
+    if let Ok(p) = &posted {
+        out.write("program.nc", p.text.as_bytes())?;
     }
     out.write("toolpath.cl", scallop_io::cl::write_cl(&plan.toolpath).as_bytes())?;
     let json = serde_json::to_string_pretty(&report).map_err(|e| Failure::Io(e.into()))?;
@@ -399,63 +368,20 @@ pub fn run(args: &Rough5Args) -> CliResult<()> {
 
 /// The toolpath through the machine's kinematics (joint limits checked) and
 /// its time model.
-fn on_machine(
-    args: &Rough5Args,
-    path: &Toolpath,
-) -> CliResult<(Kinematics, Vec<ClRecord>, MachineProgram, ProgramTime)> {
+fn on_machine(args: &Rough5Args, path: &Toolpath) -> CliResult<OnMachine> {
     let machine = load_machine(&args.machine, Path::new(""), "--machine")?;
     let kin = Kinematics::new(&machine, args.tool_length);
-    let records = records_of(path);
-    let program = to_program(&kin, &records, None, &ProgramOptions::default())
-        .map_err(|e| Failure::rejected(format!("the program on {}: {e}", machine.name())))?;
-    let blocks: Vec<_> = program.blocks.iter().map(|b| (b.motion, b.joints, b.feed)).collect();
-    let time = program_time(&kin, &blocks).map_err(|e| Failure::rejected(format!("time model: {e}")))?;
-    Ok((kin, records, program, time))
-}
-
-/// What the post and the machine said.
-struct Posted {
-    /// Time lost to each axis's limits (s), by axis name.
-    lost: Vec<(String, f64)>,
-    blocks: usize,
-    replay: f64,
-    total: f64,
-    feed: f64,
-    rapid: f64,
+    scallop_engine::on_machine(&kin, path).map_err(|e| Failure::rejected(e.to_string()))
 }
 
 /// The program through the machine's kinematics (joint limits checked) and
 /// the dialect in TCP form (TRAORI on the 840D), replayed against the CL path.
-fn post_program(args: &Rough5Args, plan: &Rough5Plan) -> CliResult<(String, Posted)> {
-    let (kin, records, program, time) = on_machine(args, &plan.toolpath)?;
-    let options = ProgramOptions::default();
+fn post_program(args: &Rough5Args, plan: &Rough5Plan) -> CliResult<Posted> {
+    let machine = load_machine(&args.machine, Path::new(""), "--machine")?;
+    let kin = Kinematics::new(&machine, args.tool_length);
     let dialect = load_dialect(&args.dialect)?;
-    let params = PostParams {
-        program: "1000".into(),
-        mode: OutputMode::Tcp,
-        tool: 1,
-        tool_length: args.tool_length,
-        spindle: args.cutting[2],
-        tol_pos: options.tol_pos,
-        tol_ang: options.tol_ang,
-        predicted_time: Some(time.total),
-    };
-    let nc = program_text(&program, &kin, &dialect, &params)
-        .map_err(|e| Failure::rejected(format!("{}: {e}", dialect.name)))?;
-    let replayed =
-        replay(&nc, &dialect, &kin).map_err(|e| Failure::Io(anyhow::anyhow!("our output does not read back: {e}")))?;
-    let trip = check_replay(&replayed, &records, &kin, &dialect, options.tol_pos, options.tol_ang)
-        .map_err(|e| Failure::Io(anyhow::anyhow!("the program does not replay to the CL path: {e}")))?;
-    let lost = kin.machine().axes().iter().zip(time.lost).map(|(a, t)| (a.name.clone(), t)).collect();
-    let posted = Posted {
-        lost,
-        blocks: program.blocks.len(),
-        replay: trip.max_tip_deviation,
-        total: time.total,
-        feed: time.feed,
-        rapid: time.rapid,
-    };
-    Ok((nc, posted))
+    let words = TcpWords { program: "1000".into(), tool: 1, tool_length: args.tool_length, spindle: args.cutting[2] };
+    post_tcp(&kin, &plan.toolpath, &dialect, &words).map_err(|e| Failure::rejected(e.to_string()))
 }
 
 fn report(
@@ -466,26 +392,7 @@ fn report(
     post: Result<&Posted, String>,
     seconds: [f64; 2],
 ) -> Report {
-    // Without a machine program, the time at the programmed feeds.
-    let (t, feed, rapid) =
-        post.as_ref().map_or((plan.estimated_time, plan.estimated_time, 0.0), |p| (p.total, p.feed, p.rapid));
-    let metrics = Metrics {
-        volume_to_remove_mm3: proof.volume_to_remove,
-        remaining_volume_mm3: proof.remaining_volume,
-        remaining_percent: proof.remaining_percent,
-        removed_volume_mm3: proof.removed_volume,
-        gouge_volume_mm3: proof.gouge_volume,
-        gouge_depth_mm: proof.gouge_depth,
-        path_length_dm: proof.cutting_length / 100.0,
-        out_of_material_percent: proof.air_percent,
-        machining_time_s: t,
-        axis_time_lost_s: post.as_ref().map_or_else(|_| Vec::new(), |p| p.lost.clone()),
-        feed_time_s: feed,
-        rapid_time_s: rapid,
-        estimated_time_at_feed_s: plan.estimated_time,
-        removal_rate_mm3_s: proof.removal_rate(t),
-        removal_rate_percent_s: if t > 0.0 { (100.0 - proof.remaining_percent) / t } else { 0.0 },
-    };
+    let metrics = rough5_metrics(plan, proof, post.as_ref().ok().copied());
     let deg = f64::to_degrees;
     Report {
         command: "rough5",
@@ -499,7 +406,7 @@ fn report(
         dialect: args.dialect.clone(),
         cl_points: plan.toolpath.moves().len(),
         blocks: post.as_ref().map_or(0, |p| p.blocks),
-        replay_tip_deviation_mm: post.as_ref().map_or(f64::NAN, |p| p.replay),
+        replay_tip_deviation_mm: post.as_ref().map_or(f64::NAN, |p| p.replay_tip_deviation),
         post_error: post.err(),
         retracts: plan.retracts,
         links: plan.links,
@@ -767,8 +674,8 @@ mod cases {
             for (i, (d, t)) in single.trace.iter().enumerate() {
                 let _ = writeln!(csv, "{},{label},{i},{d:.4},{:.5}", k + 1, t.to_degrees());
             }
-            let (_, _, _, time) = on_machine(args, &single.toolpath)?;
-            cases.push(case_json(k + 1, label, (w, interval, *target), &single, time.total));
+            let run = on_machine(args, &single.toolpath)?;
+            cases.push(case_json(k + 1, label, (w, interval, *target), &single, run.time.total));
         }
         let spu_time = cases[0].machining_time_s;
         for c in &mut cases {

@@ -38,6 +38,14 @@ pub struct RunArgs {
 /// `scallop run`.
 pub fn run(args: &RunArgs) -> CliResult<()> {
     let (name, spec) = read_job(&args.job)?;
+    if spec.part.test_part.is_some() {
+        if args.plan_only {
+            return Err(Failure::rejected(format!(
+                "{name}: --plan-only has no estimate for kind = \"rough5\" operations yet; run the job without it"
+            )));
+        }
+        return crate::rough5_job::run(&spec, &args.job, &name, &args.output, args.json);
+    }
     let job = finish_job(&spec, args.job.parent().unwrap_or(Path::new("."))).map_err(|e| match e {
         Failure::Rejected(e) => Failure::Rejected(anyhow::anyhow!("{name}: {e:#}")),
         other => other,
@@ -203,7 +211,7 @@ fn rough_settings(r: &scallop_io::job::RoughingSpec) -> scallop_rough::RoughSett
 
 /// The cutter of a `[cutter]` table (or a library tool): profile, flutes
 /// (default 4 D, or the cone's height if longer), shank and holder stack.
-fn cutter_of(spec: &scallop_io::job::CutterSpec) -> CliResult<Cutter> {
+pub(crate) fn cutter_of(spec: &scallop_io::job::CutterSpec) -> CliResult<Cutter> {
     let radius = spec.diameter / 2.0;
     let shape = match spec.shape {
         ShapeWord::Ball => CutterShape::Ball { radius },

@@ -4,7 +4,9 @@
 //! [`run_finishing`] machines a part in one direction or 3+2 setup;
 //! [`run_job`] runs a job's operations in order on one simulated stock;
 //! [`finish_zones`] machines a zone plan of the optimiser zone by zone (each in
-//! its direction or 3+2 orientation) and proves it on the simulated stock.
+//! its direction or 3+2 orientation) and proves it on the simulated stock;
+//! [`run_rough5`] plans, proves and posts a 5-axis roughing operation of a
+//! test part (`kind = "rough5"`).
 //!
 //! ```
 //! use scallop_engine::{Part, prepare_part};
@@ -26,6 +28,7 @@ mod grid;
 mod job;
 mod refine;
 mod rough;
+mod rough5;
 mod rough_estimate;
 mod zones;
 
@@ -44,6 +47,10 @@ pub use grid::{GridAxis, GridError, MAX_GRID_POINTS};
 pub use job::{
     EngagementFigures, Job, JobOutput, JobPhase, JobReport, JobStep, Operation, OperationReport, STOCK_CLEARANCE_MM,
     StockFigures, StockShape, run_job, run_job_with_progress,
+};
+pub use rough5::{
+    FaceReport, OnMachine, Posted, ProgramTime, Rough5Job, Rough5Metrics, Rough5Output, Rough5Step, TcpWords,
+    on_machine, post_tcp, program_time, rough5_metrics, rough5_settings, run_rough5,
 };
 pub use zones::{
     ProgramCandidate, ZONE_MARGIN_PER_RADIUS, ZONE_MARGIN_PER_SPACING, ZONE_MARGIN_ROUNDS, ZoneFigures,
@@ -127,6 +134,32 @@ pub enum EngineError {
         x: f64,
         /// Place (mm).
         y: f64,
+    },
+    /// A test part without the faces a 5-axis roughing operation needs.
+    #[error("the test part: {0}")]
+    TestPart(#[from] scallop_parts::PartError),
+    /// The 5-axis roughing planner refused, or its tri-dexel proof found a
+    /// rapid into stock or a shank or holder collision.
+    #[error("5-axis roughing: {0}")]
+    Rough5(#[from] scallop_rough5::Rough5Error),
+    /// The 5-axis roughing program removes stock outside the volume to remove.
+    #[error(
+        "the program is not safe: it removes {volume:.1} mm3 outside the volume to remove, {depth:.3} mm deep along Z \
+         near ({x:.3}, {y:.3}, {z:.3}) (tolerance {tolerance} mm, rough5.sim_tolerance)"
+    )]
+    Rough5Gouge {
+        /// Volume removed outside (mm^3).
+        volume: f64,
+        /// Its longest piece along one Z ray (mm).
+        depth: f64,
+        /// Where (mm).
+        x: f64,
+        /// Where (mm).
+        y: f64,
+        /// Where (mm).
+        z: f64,
+        /// The depth allowed (mm).
+        tolerance: f64,
     },
     /// The program cannot be written as asked (dialect, machine, 3+2 setup).
     #[error("output: {what}; fix: {fix}")]

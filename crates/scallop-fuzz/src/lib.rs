@@ -597,6 +597,7 @@ pub fn seeds(target: Target) -> Vec<Vec<u8>> {
             include_str!("../../../examples/jobs/choi-3plus2.toml"),
             include_str!("../../../examples/jobs/choi-network.toml"),
             include_str!("../../../examples/jobs/optimize-choi-3axis.toml"),
+            include_str!("../../../examples/jobs/pocket-rough5.toml"),
             "[part]\nbuiltin = \"choi\"\n\n[cutter]\nshape = \"bull\"\ndiameter = 1e308\ncorner_radius = 1\n\
              flute_length = 30\n\n[finishing]\nscallop_height = 0.05\nmax_step = 1e-6\n\n[verify]\nresolution = 0.0085\n",
         ]

@@ -108,6 +108,9 @@ pub enum OperationKind {
     /// material the earlier operations left (docs/roughing.md); never the
     /// first operation.
     Rest,
+    /// 5-axis roughing by guide curves of a test part (`[operation.rough5]`,
+    /// docs/rough5.md), proven on a tri-dexel stock.
+    Rough5,
 }
 
 /// `[[operation]]`: one operation with its own cutter, tool and spindle.
@@ -140,6 +143,75 @@ pub struct OperationSpec {
     pub finishing: FinishingSpec,
     /// `[operation.roughing]` (rough operations only).
     pub roughing: Option<RoughingSpec>,
+    /// `[operation.rough5]` (rough5 operations only).
+    pub rough5: Option<Rough5Spec>,
+}
+
+/// `[operation.rough5]`: 5-axis roughing by guide curves (docs/rough5.md).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+pub struct Rough5Spec {
+    /// Axial depth of cut a_p between levels (mm).
+    pub ap: f64,
+    /// Radial engagement a_e between passes (mm).
+    pub ae: f64,
+    /// Material left on the flanks (mm, default 0.5).
+    #[serde(default = "default_rough5_allowance")]
+    pub stock_to_leave: f64,
+    /// Material left on the bottom (mm; default `stock_to_leave`).
+    pub stock_to_leave_axial: Option<f64>,
+    /// Tool-axis variant: `guides` (default), `zero` or `optimised`.
+    #[serde(default = "default_tilt")]
+    pub tilt: TiltWord,
+    /// Voxel size of the level fields (mm, default 1).
+    #[serde(default = "default_one")]
+    pub voxel: f64,
+    /// Spacing of the CL points along a pass (mm, default 1).
+    #[serde(default = "default_one")]
+    pub step: f64,
+    /// Largest tool-axis change between CL points (degrees, default 2).
+    #[serde(default = "default_angle_step")]
+    pub max_angle_step_deg: f64,
+    /// Largest change of the axis's azimuth about Z between CL points (degrees, default 5).
+    #[serde(default = "default_azimuth_step")]
+    pub max_azimuth_step_deg: f64,
+    /// Teeth z of the tool: with `feed_per_tooth` and the spindle speed, the
+    /// feed z f_z N when the operation gives no `feed`.
+    pub teeth: Option<u32>,
+    /// Feed per tooth f_z (mm).
+    pub feed_per_tooth: Option<f64>,
+    /// Tool length the kinematics use (mm; default: flutes, shank and holder).
+    pub tool_length: Option<f64>,
+    /// Tri-dexel ray spacing of the proof (mm, default 0.5).
+    #[serde(default = "default_dexel_resolution")]
+    pub resolution: f64,
+    /// Largest deviation of the simulated 5-axis sweeps from the true ones (mm, default 0.05).
+    #[serde(default = "default_sim_tolerance")]
+    pub sim_tolerance: f64,
+    /// Collision correction of Ch. 3 §3, step 1 (default false; docs/rough5.md).
+    #[serde(default)]
+    pub correction: bool,
+}
+
+fn default_rough5_allowance() -> f64 {
+    0.5
+}
+fn default_tilt() -> TiltWord {
+    TiltWord::Guides
+}
+fn default_one() -> f64 {
+    1.0
+}
+fn default_angle_step() -> f64 {
+    2.0
+}
+fn default_azimuth_step() -> f64 {
+    5.0
+}
+fn default_dexel_resolution() -> f64 {
+    0.5
+}
+fn default_sim_tolerance() -> f64 {
+    0.05
 }
 
 /// `[operation.roughing]`.
@@ -237,13 +309,18 @@ pub struct SetupSpec {
     pub tool_length: f64,
 }
 
-/// `[part]`: one of `file` (mesh or surface file, relative to the job file) or `builtin`.
+/// `[part]`: one of `file` (mesh or surface file, relative to the job file),
+/// `builtin` or `test_part`.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 pub struct PartSpec {
     /// Mesh (.stl .obj .ply .3mf) or surface (.toml) file.
     pub file: Option<String>,
     /// Built-in surface name (`choi`, `rubio`).
     pub builtin: Option<String>,
+    /// A test part of 5-axis roughing (`pocket`, `impeller`, `fitting`): the
+    /// volume to remove with its bottom, flank and top faces, its stock box
+    /// and blank (`scallop-parts`); for `kind = "rough5"` operations.
+    pub test_part: Option<TestPartWord>,
     /// Unit of mesh coordinates: `mm` (default) or `in`.
     #[serde(default = "default_units")]
     pub units: UnitsWord,
@@ -287,6 +364,20 @@ word_enum! {
         Flat = "flat", /// Bull-nose (toroidal).
         Bull = "bull", /// Cone (V) cutter.
         Cone = "cone" }
+}
+word_enum! {
+    /// `part.test_part`.
+    TestPartWord { /// The closed pocket (100 x 100 x 35 mm, drafts and undercuts).
+        Pocket = "pocket", /// The impeller channel between two blades.
+        Impeller = "impeller", /// The fitting pocket with two ribs.
+        Fitting = "fitting" }
+}
+word_enum! {
+    /// `rough5.tilt`.
+    TiltWord { /// Tool axis +Z on every level (the zero-tilt baseline).
+        Zero = "zero", /// From the path curve to the tilt curve on the level above (SPU).
+        Guides = "guides", /// Guide curves with the optimised reparameterisation of each pass.
+        Optimised = "optimised" }
 }
 word_enum! {
     /// `finishing.pattern`.
@@ -918,6 +1009,7 @@ fn normalise(raw: RawJob, text: &str, library: Option<&ToolLibrary>) -> Result<J
             feed: None,
             finishing,
             roughing: None,
+            rough5: None,
         }]
     };
     let mut operations = operations;
@@ -1079,16 +1171,16 @@ pub fn parse_job_with_tools(text: &str, library: Option<&ToolLibrary>) -> Result
     }
     let job = normalise(raw, text, library)?;
     let bad = |key, value: f64, fix| Err(JobError::Value { key, value: value.to_string(), fix });
-    match (&job.part.file, &job.part.builtin) {
-        (Some(_), Some(_)) | (None, None) => {
-            return Err(JobError::Value {
-                key: "part",
-                value: "file and builtin".into(),
-                fix: "give exactly one of `file` and `builtin`",
-            });
-        }
-        _ => {}
+    let given = [job.part.file.is_some(), job.part.builtin.is_some(), job.part.test_part.is_some()];
+    if given.iter().filter(|g| **g).count() != 1 {
+        return Err(JobError::Value {
+            key: "part",
+            value: if given.contains(&true) { "more than one of file, builtin and test_part" } else { "missing" }
+                .into(),
+            fix: "give exactly one of `file`, `builtin` and `test_part`",
+        });
     }
+    check_rough5_job(&job)?;
     let positive = |v: f64| v.is_finite() && v > 0.0;
     let operations = job.operations.clone();
     for (k, op) in operations.iter().enumerate() {
@@ -1101,6 +1193,7 @@ pub fn parse_job_with_tools(text: &str, library: Option<&ToolLibrary>) -> Result
                 fix: "rest roughing machines what earlier operations left: put a kind = \"rough\" operation before it",
             }),
             OperationKind::Rest => check_rough(op),
+            OperationKind::Rough5 => check_rough5(op),
         };
         checked.map_err(|e| {
             if job.operation_list {
@@ -1195,6 +1288,13 @@ pub fn parse_job_with_tools(text: &str, library: Option<&ToolLibrary>) -> Result
 /// single-operation job).
 /// A finish operation has a finishing table and no roughing table.
 fn check_finish_kind(op: &OperationSpec) -> Result<(), JobError> {
+    if op.rough5.is_some() {
+        return Err(JobError::Value {
+            key: "rough5",
+            value: "given".into(),
+            fix: "[operation.rough5] belongs to kind = \"rough5\" operations",
+        });
+    }
     if op.roughing.is_some() {
         return Err(JobError::Value {
             key: "roughing",
@@ -1212,9 +1312,117 @@ fn check_finish_kind(op: &OperationSpec) -> Result<(), JobError> {
     Ok(())
 }
 
+/// A job with a test part has one operation, of kind rough5 (the tri-dexel
+/// proof starts from the part's blank; the z-map stock of the other kinds holds
+/// no undercut), and a rough5 operation needs a test part (its guide curves
+/// need the bottom and flank faces, which a mesh file does not tag).
+fn check_rough5_job(job: &JobFile) -> Result<(), JobError> {
+    let rough5 = job.operations.iter().filter(|o| o.kind == OperationKind::Rough5).count();
+    let bad = |key, value: &str, fix| Err(JobError::Value { key, value: value.into(), fix });
+    if rough5 > 0 && job.part.test_part.is_none() {
+        return bad(
+            "part",
+            "not a test part",
+            "kind = \"rough5\" needs `part.test_part` (pocket, impeller or fitting): its guide curves need the \
+             pocket's bottom and flank faces, which a mesh or surface file does not tag",
+        );
+    }
+    if job.part.test_part.is_some() && (rough5 != 1 || job.operations.len() != 1) {
+        return bad(
+            "operation",
+            "not one rough5 operation",
+            "a job of a test part has exactly one [[operation]], of kind = \"rough5\" (the other kinds run on a \
+             z-map stock, which holds no undercut)",
+        );
+    }
+    if rough5 > 0 && job.setup.is_some() {
+        return bad("setup", "given", "a rough5 operation sets its own tool axes: remove [setup]");
+    }
+    Ok(())
+}
+
+/// A rough5 operation: a torus, flat or ball cutter, `[operation.rough5]`
+/// with finite, positive steps, a_e within the tool's diameter and a_p within
+/// its flutes, and no finishing or roughing table.
+fn check_rough5(op: &OperationSpec) -> Result<(), JobError> {
+    let bad = |key, value: String, fix| Err(JobError::Value { key, value, fix });
+    if op.cutter.shape == ShapeWord::Cone {
+        return bad("cutter.shape", "cone".into(), "a rough5 tool is a torus (\"bull\"), \"flat\" or \"ball\"");
+    }
+    check_cutter(&op.cutter)?;
+    let Some(r) = &op.rough5 else {
+        return bad("rough5", "missing".into(), "give [operation.rough5] with ap and ae");
+    };
+    if !op.finishing.scallop_height.is_nan() || op.roughing.is_some() {
+        return bad(
+            "finishing, roughing",
+            "given".into(),
+            "a rough5 operation takes [operation.rough5], not [operation.finishing] or [operation.roughing]",
+        );
+    }
+    for (key, v) in [
+        ("rough5.ap", r.ap),
+        ("rough5.ae", r.ae),
+        ("rough5.voxel", r.voxel),
+        ("rough5.step", r.step),
+        ("rough5.max_angle_step_deg", r.max_angle_step_deg),
+        ("rough5.max_azimuth_step_deg", r.max_azimuth_step_deg),
+        ("rough5.resolution", r.resolution),
+        ("rough5.sim_tolerance", r.sim_tolerance),
+        ("rough5.feed_per_tooth", r.feed_per_tooth.unwrap_or(1.0)),
+        ("rough5.tool_length", r.tool_length.unwrap_or(1.0)),
+    ] {
+        if !(v.is_finite() && v > 0.0) {
+            return bad(key, v.to_string(), "must be a finite number > 0");
+        }
+    }
+    for (key, v) in [
+        ("rough5.stock_to_leave", r.stock_to_leave),
+        ("rough5.stock_to_leave_axial", r.stock_to_leave_axial.unwrap_or(0.0)),
+    ] {
+        if !(v.is_finite() && v >= 0.0) {
+            return bad(key, v.to_string(), "give the allowance in mm, >= 0");
+        }
+    }
+    if r.ae > op.cutter.diameter {
+        return bad("rough5.ae", r.ae.to_string(), "give a radial engagement of at most the cutter diameter");
+    }
+    let flutes = op.cutter.flute_length.unwrap_or(4.0 * op.cutter.diameter);
+    if r.ap > flutes {
+        return bad(
+            "rough5.ap",
+            r.ap.to_string(),
+            "give an axial depth of cut of at most the flute length (cutter.flute_length, default 4 D)",
+        );
+    }
+    if r.max_angle_step_deg > 90.0 || r.max_azimuth_step_deg > 180.0 {
+        return bad(
+            "rough5.max_angle_step_deg",
+            format!("{} (azimuth {})", r.max_angle_step_deg, r.max_azimuth_step_deg),
+            "give an angular step of at most 90 deg and an azimuth step of at most 180 deg",
+        );
+    }
+    if let Some(z) = r.teeth
+        && !(1..=64).contains(&z)
+    {
+        return bad("rough5.teeth", z.to_string(), "give a whole number of teeth, 1 to 64");
+    }
+    if r.teeth.is_some() != r.feed_per_tooth.is_some() {
+        return bad("rough5.teeth", format!("{:?}", r.teeth), "give both teeth and feed_per_tooth, or neither");
+    }
+    Ok(())
+}
+
 /// A rough operation: its cutter and `[operation.roughing]`, and no finishing table.
 fn check_rough(op: &OperationSpec) -> Result<(), JobError> {
     check_cutter(&op.cutter)?;
+    if op.rough5.is_some() {
+        return Err(JobError::Value {
+            key: "rough5",
+            value: "given".into(),
+            fix: "[operation.rough5] belongs to kind = \"rough5\" operations",
+        });
+    }
     let Some(r) = &op.roughing else {
         return Err(JobError::Value {
             key: "roughing",
@@ -1608,5 +1816,32 @@ mod tests {
         let first = rest.replacen("kind = \"rough\"", "kind = \"rest\"", 1);
         let err = parse_job(&first).unwrap_err().to_string();
         assert!(err.contains("operation 1") && err.contains("kind = \"rough\" operation before it"), "{err}");
+    }
+
+    #[test]
+    fn rough5_operations_read_with_defaults_and_their_limits() {
+        let job = "[part]\ntest_part = \"pocket\"\n[[operation]]\nkind = \"rough5\"\n\
+            [operation.cutter]\nshape = \"bull\"\ndiameter = 10\ncorner_radius = 1.5\nflute_length = 30\n\
+            [operation.rough5]\nap = 4\nae = 4.5\n";
+        let parsed = parse_job(job).unwrap();
+        assert_eq!(parsed.part.test_part, Some(TestPartWord::Pocket));
+        let r = parsed.operations[0].rough5.as_ref().unwrap();
+        assert_eq!((r.tilt, r.stock_to_leave, r.stock_to_leave_axial, r.voxel), (TiltWord::Guides, 0.5, None, 1.0));
+        for (from, to, key) in [
+            ("ap = 4", "ap = 31", "rough5.ap"),
+            ("ap = 4", "ap = nan", "rough5.ap"),
+            ("ae = 4.5", "ae = 0", "rough5.ae"),
+            ("ae = 4.5", "ae = 11", "rough5.ae"),
+            ("ae = 4.5", "ae = 4.5\nstock_to_leave = -1", "rough5.stock_to_leave"),
+            ("ae = 4.5", "ae = 4.5\nteeth = 2", "rough5.teeth"),
+            ("ae = 4.5", "ae = 4.5\nmax_angle_step_deg = 120", "rough5.max_angle_step_deg"),
+            ("test_part = \"pocket\"", "test_part = \"gear\"", "unknown variant `gear`"),
+            ("test_part = \"pocket\"", "file = \"a.stl\"", "part.test_part"),
+            ("test_part = \"pocket\"", "test_part = \"pocket\"\nbuiltin = \"choi\"", "exactly one of"),
+            ("kind = \"rough5\"", "kind = \"rough\"", "z-map stock"),
+        ] {
+            let err = parse_job(&job.replace(from, to)).unwrap_err().to_string();
+            assert!(err.contains(key), "{to}: {err}");
+        }
     }
 }

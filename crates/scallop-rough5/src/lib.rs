@@ -18,7 +18,9 @@
 //!   same part, tool and cutting data (z-level roughing in one setup, then
 //!   rest roughing in fixed orientations chosen from the undercuts);
 //! - [`prove`]: the program cut on a tri-dexel stock with shank and holder
-//!   collisions as errors, and the metrics of spec 10.1 (module L).
+//!   collisions as errors, and the metrics of spec 10.1 (module L);
+//!   [`prove_with_faces`] adds those of the finished faces ([`face_metrics`]:
+//!   deviation from the allowance, crest heights).
 //!
 //! ```
 //! use scallop_cutter::{Cutter, CutterShape};
@@ -45,6 +47,7 @@ mod collide;
 mod correct;
 mod cutting;
 mod error;
+mod faces;
 mod levels;
 mod orient;
 pub mod place;
@@ -60,6 +63,7 @@ pub use collide::BodyCheck;
 pub use correct::{CorrectionCount, correct_pairs, correct_planar};
 pub use cutting::CuttingData;
 pub use error::Rough5Error;
+pub use faces::{FaceMetrics, ProofFace, face_metrics};
 pub use levels::{LevelOptions, LevelPasses, TiltMode, level_passes, level_passes_with};
 pub use orient::{
     AngleUnit, BoundsPenalty, Coverage, OrientSettings, Orientation, Reparam, Weights, constraints, objective_terms,
@@ -70,6 +74,6 @@ pub use plan::{
     LevelReport, PassReport, Rough5Plan, Rough5Settings, SinglePass, TRANSLATION_MAX, TRANSLATION_SLOPE, plan_rough5,
     plan_single_pass,
 };
-pub use prove::{Proof, ProofSettings, prove, prove_from_blank};
+pub use prove::{Proof, ProofSettings, prove, prove_from_blank, prove_with_faces};
 pub use radius::{apparent_contour_radius, effective_radius, exact_scallop, scallop_height, swept_profile};
 pub use sync::{SyncPoint, axis_steps, closest_vertex, interpolate_axis, limit_angular_step, pitch_angle, synchronise};

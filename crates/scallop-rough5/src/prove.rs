@@ -18,6 +18,7 @@ use scallop_sim::{DexelOptions, DexelPart, DexelStock, ToolMove};
 use scallop_toolpath::{MoveKind, Toolpath};
 
 use crate::Rough5Error;
+use crate::faces::{FaceMetrics, ProofFace, face_metrics};
 
 /// The metrics of a proven program.
 #[derive(Debug, Clone, PartialEq)]
@@ -45,6 +46,8 @@ pub struct Proof {
     pub sweeps: usize,
     /// Rays per family of the stock.
     pub rays: [usize; 3],
+    /// The metrics of the finished faces asked for ([`prove_with_faces`]).
+    pub faces: Vec<FaceMetrics>,
 }
 
 impl Proof {
@@ -140,6 +143,25 @@ pub fn prove_from_blank(
     settings: &ProofSettings,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<Proof, Rough5Error> {
+    prove_with_faces(path, cutter, (stock, blank), volume, &[], settings, progress)
+}
+
+/// As [`prove_from_blank`] (the stock box and the blank as a pair), with the
+/// metrics of the finished `faces` measured on the stock left
+/// ([`face_metrics`](crate::face_metrics): the deviation from the allowance
+/// and the crest heights; spec 10.1).
+///
+/// # Errors
+/// As [`prove`]; an open blank is a refused stock.
+pub fn prove_with_faces(
+    path: &Toolpath,
+    cutter: &Cutter,
+    (stock, blank): (&Aabb3, Option<&TriMesh>),
+    volume: &TriMesh,
+    faces: &[ProofFace<'_>],
+    settings: &ProofSettings,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<Proof, Rough5Error> {
     let sim = |e: scallop_sim::SimError| Rough5Error::Simulation(e.to_string());
     let blank = blank.map(DexelPart::new);
     let mut dexels = match &blank {
@@ -213,5 +235,6 @@ pub fn prove_from_blank(
         air_percent: if cutting > 0.0 { 100.0 * air / cutting } else { 0.0 },
         sweeps: report.sweeps,
         rays: [dexels.grid(0).0 * dexels.grid(0).1, dexels.grid(1).0 * dexels.grid(1).1, nu * nv],
+        faces: faces.iter().map(|f| face_metrics(&dexels, &part, f, settings.resolution)).collect(),
     })
 }

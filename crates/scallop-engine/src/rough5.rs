@@ -1,0 +1,425 @@
+//! `kind = "rough5"` job operations (docs/job.md, docs/rough5.md): 5-axis
+//! roughing of a test part by guide curves, planned by `scallop-rough5`,
+//! proven on a tri-dexel stock (gouges, rapids into stock, shank and holder
+//! collisions are errors), put through the machine's kinematics (joint limits
+//! checked) and posted in TCP form (Siemens 840D `TRAORI`, Fanuc `G43.4`,
+//! Heidenhain `M128`/`TCPM`, ...), read back and replayed against the CL path,
+//! with the machine's time model. The `scallop rough5` command and `scallop run`
+//! share these functions.
+
+use scallop_cutter::Cutter;
+use scallop_guides::GuideSettings;
+use scallop_machine::program::{ClRecord, MachineProgram, Motion, ProgramOptions, records_of, to_program};
+use scallop_machine::time::{path_time, rapid_time};
+use scallop_machine::{Joints, Kinematics, Machine};
+use scallop_parts::{FaceTag, TestPart};
+use scallop_post::{Dialect, OutputMode, PostParams, check_replay, program_text, replay};
+use scallop_rough5::{
+    LevelOptions, Proof, ProofFace, ProofSettings, Rough5Plan, Rough5Settings, TiltMode, plan_rough5, prove_with_faces,
+};
+use scallop_toolpath::Toolpath;
+use serde::Serialize;
+
+use crate::EngineError;
+
+/// Times of a machine program (s).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ProgramTime {
+    /// Feed and rapid time.
+    pub total: f64,
+    /// Feed runs by the look-ahead model.
+    pub feed: f64,
+    /// Feed runs at the programmed feeds alone.
+    pub floor: f64,
+    /// Rapids, per axis stop to stop.
+    pub rapid: f64,
+    /// Peak speed of each joint over the feed runs (mm/s or deg/s).
+    pub peak: [f64; 5],
+    /// Time lost to each joint's velocity, acceleration and jerk limits.
+    pub lost: [f64; 5],
+}
+
+/// The machine-aware time of a program's blocks `(motion, joints, feed)`: feed
+/// runs (maximal sequences of non-rapid blocks, with the block before as their
+/// start) by the look-ahead model; rapids per axis, stop to stop.
+///
+/// # Errors
+/// The time model refuses a run (a feed that is not positive).
+pub fn program_time(
+    kin: &Kinematics,
+    blocks: &[(Motion, Joints, f64)],
+) -> Result<ProgramTime, scallop_machine::MachineError> {
+    let mut t = ProgramTime { total: 0.0, feed: 0.0, floor: 0.0, rapid: 0.0, peak: [0.0; 5], lost: [0.0; 5] };
+    let mut k = 1;
+    while k < blocks.len() {
+        if blocks[k].0 == Motion::Rapid {
+            t.rapid += rapid_time(kin.machine(), &blocks[k - 1].1, &blocks[k].1);
+            k += 1;
+            continue;
+        }
+        let start = k - 1;
+        while k < blocks.len() && blocks[k].0 != Motion::Rapid {
+            k += 1;
+        }
+        let joints: Vec<Joints> = blocks[start..k].iter().map(|b| b.1).collect();
+        let feeds: Vec<f64> = blocks[start + 1..k].iter().map(|b| b.2).collect();
+        let r = path_time(kin, &joints, &feeds)?;
+        t.feed += r.total;
+        t.floor += r.feed_time;
+        for i in 0..5 {
+            t.peak[i] = t.peak[i].max(r.axis_peak_speed[i]);
+            t.lost[i] += r.axis_time_lost[i];
+        }
+    }
+    t.total = t.feed + t.rapid;
+    Ok(t)
+}
+
+/// A toolpath on a 5-axis machine: its CL records, the joint-space program
+/// (joint limits checked, branches and poles handled) and its time.
+#[derive(Debug, Clone)]
+pub struct OnMachine {
+    /// The CL records of the toolpath.
+    pub records: Vec<ClRecord>,
+    /// The joint-space program.
+    pub program: MachineProgram,
+    /// Its machine-aware time.
+    pub time: ProgramTime,
+}
+
+/// The toolpath through the machine's kinematics and its time model.
+///
+/// # Errors
+/// [`EngineError::Output`] when the machine cannot run the program (a joint
+/// limit, an interpolation that leaves the path), naming the block.
+pub fn on_machine(kin: &Kinematics, path: &Toolpath) -> Result<OnMachine, EngineError> {
+    let name = kin.machine().name().to_string();
+    let records = records_of(path);
+    let program = to_program(kin, &records, None, &ProgramOptions::default()).map_err(|e| EngineError::Output {
+        what: format!("the program on {name}: {e}"),
+        fix: "another machine, or a smaller angular step (rough5.max_angle_step_deg, rough5.max_azimuth_step_deg)"
+            .into(),
+    })?;
+    let blocks: Vec<_> = program.blocks.iter().map(|b| (b.motion, b.joints, b.feed)).collect();
+    let time = program_time(kin, &blocks)
+        .map_err(|e| EngineError::Output { what: format!("time model on {name}: {e}"), fix: "report it".into() })?;
+    Ok(OnMachine { records, program, time })
+}
+
+/// The words of a TCP program.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TcpWords {
+    /// Program name or number.
+    pub program: String,
+    /// Tool number.
+    pub tool: u32,
+    /// Tool length the kinematics use (mm).
+    pub tool_length: f64,
+    /// Spindle speed (1/min).
+    pub spindle: f64,
+}
+
+/// A posted 5-axis program.
+#[derive(Debug, Clone)]
+pub struct Posted {
+    /// The program text.
+    pub text: String,
+    /// Its blocks (after subdivision).
+    pub blocks: usize,
+    /// Largest tip deviation of the replayed program from the CL path (mm).
+    pub replay_tip_deviation: f64,
+    /// Its machine-aware time.
+    pub time: ProgramTime,
+    /// Time lost to each axis's limits (s), by axis name.
+    pub axis_time_lost: Vec<(String, f64)>,
+}
+
+/// The toolpath through the machine (joint limits checked) and the dialect in
+/// TCP form (`TRAORI` on the 840D), read back and replayed against the CL path.
+///
+/// # Errors
+/// [`EngineError::Output`]: the machine refuses the program, the dialect has
+/// no TCP form (grbl), or the program read back leaves the CL path.
+pub fn post_tcp(kin: &Kinematics, path: &Toolpath, dialect: &Dialect, words: &TcpWords) -> Result<Posted, EngineError> {
+    let run = on_machine(kin, path)?;
+    let options = ProgramOptions::default();
+    let params = PostParams {
+        program: words.program.clone(),
+        mode: OutputMode::Tcp,
+        tool: words.tool,
+        tool_length: words.tool_length,
+        spindle: words.spindle,
+        tol_pos: options.tol_pos,
+        tol_ang: options.tol_ang,
+        predicted_time: Some(run.time.total),
+    };
+    let output = |what: String| EngineError::Output { what, fix: "another dialect (output.dialect)".into() };
+    let text =
+        program_text(&run.program, kin, dialect, &params).map_err(|e| output(format!("{}: {e}", dialect.name)))?;
+    let replayed = replay(&text, dialect, kin).map_err(|e| output(format!("our output does not read back: {e}")))?;
+    let trip = check_replay(&replayed, &run.records, kin, dialect, options.tol_pos, options.tol_ang)
+        .map_err(|e| output(format!("the program does not replay to the CL path: {e}")))?;
+    let axis_time_lost = kin.machine().axes().iter().zip(run.time.lost).map(|(a, t)| (a.name.clone(), t)).collect();
+    Ok(Posted {
+        text,
+        blocks: run.program.blocks.len(),
+        replay_tip_deviation: trip.max_tip_deviation,
+        time: run.time,
+        axis_time_lost,
+    })
+}
+
+/// The metrics of a 5-axis roughing program (spec 10.1, docs/rough5.md).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Rough5Metrics {
+    /// Volume to remove, on the proof's rays (mm^3).
+    pub volume_to_remove_mm3: f64,
+    /// Stock left inside it (mm^3).
+    pub remaining_volume_mm3: f64,
+    /// V_r (% of the volume to remove).
+    pub remaining_percent: f64,
+    /// Stock removed (mm^3).
+    pub removed_volume_mm3: f64,
+    /// Stock removed outside the volume to remove (mm^3).
+    pub gouge_volume_mm3: f64,
+    /// Its longest piece along one Z ray (mm).
+    pub gouge_depth_mm: f64,
+    /// Cutting length (dm).
+    pub path_length_dm: f64,
+    /// L_HM: % of the cutting length that removed nothing.
+    pub out_of_material_percent: f64,
+    /// Machine time (s); the time at the programmed feeds without a machine program.
+    pub machining_time_s: f64,
+    /// Time lost to each axis's velocity, acceleration and jerk limits (s).
+    pub axis_time_lost_s: Vec<(String, f64)>,
+    /// Feed time (s).
+    pub feed_time_s: f64,
+    /// Rapid time (s).
+    pub rapid_time_s: f64,
+    /// Time at the programmed feeds (s).
+    pub estimated_time_at_feed_s: f64,
+    /// Removal rate (mm^3/s) over the machining time.
+    pub removal_rate_mm3_s: f64,
+    /// Removal rate in % of the volume to remove per second.
+    pub removal_rate_percent_s: f64,
+    /// The finished faces' deviation from the allowance and crest heights
+    /// (measured by [`run_rough5`]; empty otherwise).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub faces: Vec<FaceReport>,
+}
+
+/// The metrics of one finished face (spec 10.1): the thickness left measured
+/// along the face's normal on the proof's tri-dexel stock, at one sample per
+/// sub-triangle of at most the ray spacing (`scallop_rough5::face_metrics`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FaceReport {
+    /// `bottom` or `flanks`.
+    pub face: &'static str,
+    /// Its area (mm^2).
+    pub area_mm2: f64,
+    /// Samples measured.
+    pub samples: usize,
+    /// Samples within a tool radius of the other face (corners).
+    pub corner_samples: usize,
+    /// Deviation from the allowance (thickness left less the allowance, mm),
+    /// the whole face: minimum, first quartile, median, third quartile, maximum.
+    pub deviation_quartiles_mm: [f64; 5],
+    /// The same outside the corners (within a tool radius of the other face, a
+    /// ray along the normal may run through that face's allowance shell).
+    pub deviation_quartiles_outside_corners_mm: [f64; 5],
+    /// Crest height (thickness above the allowance, mm), corners excluded: maximum.
+    pub crest_max_mm: f64,
+    /// Area-weighted mean.
+    pub crest_mean_mm: f64,
+    /// Area-weighted standard deviation.
+    pub crest_sigma_mm: f64,
+}
+
+/// The metrics of a plan, its proof and, when the machine took it, its posted
+/// program (without one, the time at the programmed feeds).
+#[must_use]
+pub fn rough5_metrics(plan: &Rough5Plan, proof: &Proof, posted: Option<&Posted>) -> Rough5Metrics {
+    let (t, feed, rapid) =
+        posted.map_or((plan.estimated_time, plan.estimated_time, 0.0), |p| (p.time.total, p.time.feed, p.time.rapid));
+    Rough5Metrics {
+        volume_to_remove_mm3: proof.volume_to_remove,
+        remaining_volume_mm3: proof.remaining_volume,
+        remaining_percent: proof.remaining_percent,
+        removed_volume_mm3: proof.removed_volume,
+        gouge_volume_mm3: proof.gouge_volume,
+        gouge_depth_mm: proof.gouge_depth,
+        path_length_dm: proof.cutting_length / 100.0,
+        out_of_material_percent: proof.air_percent,
+        machining_time_s: t,
+        axis_time_lost_s: posted.map_or_else(Vec::new, |p| p.axis_time_lost.clone()),
+        feed_time_s: feed,
+        rapid_time_s: rapid,
+        estimated_time_at_feed_s: plan.estimated_time,
+        removal_rate_mm3_s: proof.removal_rate(t),
+        removal_rate_percent_s: if t > 0.0 { (100.0 - proof.remaining_percent) / t } else { 0.0 },
+        faces: proof
+            .faces
+            .iter()
+            .map(|f| FaceReport {
+                face: f.name,
+                area_mm2: f.area,
+                samples: f.samples,
+                corner_samples: f.corner_samples,
+                deviation_quartiles_mm: f.deviation_quartiles,
+                deviation_quartiles_outside_corners_mm: f.deviation_quartiles_outside_corners,
+                crest_max_mm: f.crest_max,
+                crest_mean_mm: f.crest_mean,
+                crest_sigma_mm: f.crest_sigma,
+            })
+            .collect(),
+    }
+}
+
+/// The settings of `scallop rough5` (docs/rough5.md) for a part, a tool
+/// radius, a_p, a_e and a feed (mm/min): guide curves (SPU), voxel 1 mm, CL
+/// points every 1 mm, angular steps of 2 deg (axis) and 5 deg (azimuth), 0.5 mm
+/// allowances, ramps of 5 deg, links on the level up to 2 a_e, every
+/// refinement of "Where the remaining volume was" on, no collision correction.
+///
+/// # Errors
+/// The part has no bottom faces.
+pub fn rough5_settings(
+    part: &TestPart,
+    tool_radius: f64,
+    (ap, ae): (f64, f64),
+    feed: f64,
+) -> Result<Rough5Settings, EngineError> {
+    let bottom = part.faces(&[FaceTag::Bottom])?;
+    Ok(Rough5Settings {
+        tilt: TiltMode::Guides,
+        guides: GuideSettings {
+            tool_radius,
+            flank_allowance: 0.5,
+            axial_step: ap,
+            radial_step: ae,
+            voxel: 1.0,
+            depth: part.stock.max.z - bottom.bounds().min.z,
+        },
+        bottom_allowance: 0.5,
+        step: 1.0,
+        max_angle_step: 2f64.to_radians(),
+        max_azimuth_step: 5f64.to_radians(),
+        ramp_angle: 5f64.to_radians(),
+        clearance: 1.0,
+        link_max: 2.0 * ae,
+        feed,
+        rapid_rate: 20_000.0,
+        orientation: None,
+        correct: false,
+        levels: LevelOptions { centre_offsets: true, pair_by_rank: true },
+        vertical_inside: true,
+        translate: true,
+    })
+}
+
+/// A 5-axis roughing operation of a job.
+#[derive(Debug, Clone)]
+pub struct Rough5Job {
+    /// How messages name the part.
+    pub part_name: String,
+    /// The part: the volume to remove with its faces, the stock box and blank.
+    pub part: TestPart,
+    /// The tool, with its shank and holder.
+    pub tool: Cutter,
+    /// The planning settings.
+    pub settings: Rough5Settings,
+    /// The proof's settings; its `axis_tolerance` is also the gouge allowed.
+    pub proof: ProofSettings,
+    /// The 5-axis machine.
+    pub machine: Machine,
+    /// The dialect.
+    pub dialect: Dialect,
+    /// The program's words.
+    pub words: TcpWords,
+}
+
+/// Where [`run_rough5`] is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Rough5Step {
+    /// Planning: levels done of all.
+    Planning {
+        /// Done.
+        done: usize,
+        /// All.
+        total: usize,
+    },
+    /// Proving: bands of the tri-dexel stock done of all.
+    Proving {
+        /// Done.
+        done: usize,
+        /// All.
+        total: usize,
+    },
+    /// Through the machine and the post.
+    Posting,
+}
+
+/// A planned, proven and posted 5-axis roughing operation.
+#[derive(Debug, Clone)]
+pub struct Rough5Output {
+    /// The plan (toolpath, levels, passes).
+    pub plan: Rough5Plan,
+    /// The tri-dexel proof.
+    pub proof: Proof,
+    /// The posted program.
+    pub posted: Posted,
+    /// Its metrics.
+    pub metrics: Rough5Metrics,
+}
+
+/// Plans, proves and posts a 5-axis roughing operation.
+///
+/// # Errors
+/// The planner refuses (settings, a part without passes); the proof finds a
+/// rapid into stock, a shank or holder collision
+/// ([`EngineError::Rough5`]) or stock removed outside the volume to remove
+/// deeper than the proof's tolerance ([`EngineError::Rough5Gouge`], with its
+/// place); the machine or the post refuses the program ([`EngineError::Output`]).
+pub fn run_rough5(job: &Rough5Job, progress: &(dyn Fn(Rough5Step) + Sync)) -> Result<Rough5Output, EngineError> {
+    let part = &job.part;
+    let (bottom, flanks) = (part.faces(&[FaceTag::Bottom])?, part.faces(&[FaceTag::Flank])?);
+    let plan = plan_rough5(&bottom, &flanks, &part.stock, &job.tool, &job.settings, &|done, total| {
+        progress(Rough5Step::Planning { done, total });
+    })?;
+    let corner = job.settings.guides.tool_radius;
+    let faces = [
+        ProofFace { name: "bottom", mesh: &bottom, others: &flanks, allowance: job.settings.bottom_allowance, corner },
+        ProofFace {
+            name: "flanks",
+            mesh: &flanks,
+            others: &bottom,
+            allowance: job.settings.guides.flank_allowance,
+            corner,
+        },
+    ];
+    let proof = prove_with_faces(
+        &plan.toolpath,
+        &job.tool,
+        (&part.stock, part.blank.as_ref()),
+        &part.mesh,
+        &faces,
+        &job.proof,
+        &|done, total| progress(Rough5Step::Proving { done, total }),
+    )?;
+    if proof.gouge_depth > job.proof.axis_tolerance {
+        let [x, y, z] = proof.gouge_at.unwrap_or_default();
+        return Err(EngineError::Rough5Gouge {
+            volume: proof.gouge_volume,
+            depth: proof.gouge_depth,
+            x,
+            y,
+            z,
+            tolerance: job.proof.axis_tolerance,
+        });
+    }
+    progress(Rough5Step::Posting);
+    let kin = Kinematics::new(&job.machine, job.words.tool_length);
+    let posted = post_tcp(&kin, &plan.toolpath, &job.dialect, &job.words)?;
+    let metrics = rough5_metrics(&plan, &proof, Some(&posted));
+    Ok(Rough5Output { plan, proof, posted, metrics })
+}
