@@ -52,6 +52,8 @@ pub enum RefineArg {
     VerticalInside,
     /// Colliding CL points translated away from the flank (thesis Ch. 3 §3, step 3) before they are dropped.
     Translation,
+    /// An open pocket's bottom extended across its open edge and cut as a level (its limit closed there).
+    OpenBottom,
     /// All of them: the program of 28 Nov 2026.
     All,
 }
@@ -297,7 +299,11 @@ fn settings(args: &Rough5Args, part: &TestPart, bottom: &TriMesh) -> CliResult<R
         rapid_rate: 20_000.0,
         orientation: matches!(args.tilt, TiltArg::Optimised).then(|| orientation(args, weights)),
         correct: args.correction && !matches!(args.tilt, TiltArg::Zero),
-        levels: LevelOptions { centre_offsets: on(RefineArg::CentreOffsets), pair_by_rank: on(RefineArg::PairByRank) },
+        levels: LevelOptions {
+            centre_offsets: on(RefineArg::CentreOffsets),
+            pair_by_rank: on(RefineArg::PairByRank),
+            open_bottom: on(RefineArg::OpenBottom),
+        },
         vertical_inside: on(RefineArg::VerticalInside),
         translate: on(RefineArg::Translation),
     })

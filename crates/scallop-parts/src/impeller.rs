@@ -185,15 +185,20 @@ const BLANK_SEGMENTS: usize = 360;
 /// hub's inlet height (the impeller is turned to the envelope of its blade
 /// tips and its nose before the channels are roughed, so nothing stands above
 /// the channels' tops). Its outer radius is that of the outlet section's
-/// chords and its nose's radius that of the inlet beyond the blank's own
+/// deepest chords (across the hub and up the twisted blades) and its nose's radius that of the inlet beyond the blank's own
 /// chords, so that no sliver between two tessellations lies outside the
 /// channel at its open ends: a tool leaving the channel there cuts air, not a
 /// gouge.
 fn turned_blank(params: &ImpellerParams, top: f64) -> Result<scallop_mesh::TriMesh, PartError> {
     let [r0, r1] = params.radii;
     let u_of = |r: f64| (r - r0) / (r1 - r0);
+    // The outlet section's triangles span at most one step across the hub
+    // and one step of the twist up the blades; their chords dip to r1 times
+    // the cosine of half that angle.
     #[allow(clippy::cast_precision_loss, reason = "small counts")]
-    let outer = r1 * (std::f64::consts::PI / (params.blades * params.samples[1]) as f64).cos();
+    let span = (TAU / params.blades as f64 - params.thickness / r1) / params.samples[1] as f64
+        + (0.5 * params.twist).abs() / params.samples[2] as f64;
+    let outer = r1 * (0.5 * span).cos();
     #[allow(clippy::cast_precision_loss, reason = "small counts")]
     let nose = r0 / (std::f64::consts::PI / BLANK_SEGMENTS as f64).cos();
     let n = params.samples[0];

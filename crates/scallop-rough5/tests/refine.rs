@@ -92,7 +92,7 @@ fn settings(depth: f64, refined: bool) -> Rough5Settings {
         rapid_rate: 20_000.0,
         orientation: None,
         correct: false,
-        levels: LevelOptions { centre_offsets: refined, pair_by_rank: refined },
+        levels: LevelOptions { centre_offsets: refined, pair_by_rank: refined, open_bottom: refined },
         vertical_inside: refined,
         translate: refined,
     }
@@ -182,7 +182,7 @@ fn the_bottom_centre_is_reached() {
     let widths: Vec<f64> = [false, true]
         .iter()
         .map(|&centre| {
-            let options = LevelOptions { centre_offsets: centre, pair_by_rank: false };
+            let options = LevelOptions { centre_offsets: centre, pair_by_rank: false, open_bottom: false };
             let levels = level_passes_with(&bottom, &flanks, &g, TiltMode::Zero, &options).unwrap();
             half_width(&levels[0].passes[0].0)
         })
