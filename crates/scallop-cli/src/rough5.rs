@@ -18,7 +18,7 @@ use scallop_parts::TestPart;
 use scallop_post::{OutputMode, PostParams, check_replay, program_text, replay};
 use scallop_rough5::{
     BaselinePlan, BaselineSettings, CuttingData, LevelOptions, OrientSettings, Pocket, Proof, ProofSettings,
-    Rough5Plan, Rough5Settings, TiltMode, Weights, plan_rough5, plan_three_plus_two, plan_zlevel, prove_from_blank,
+    Rough5Plan, Rough5Settings, TiltMode, Weights, plan_rough5_in, plan_three_plus_two, plan_zlevel, prove_from_blank,
 };
 use scallop_toolpath::Toolpath;
 use serde::Serialize;
@@ -54,6 +54,8 @@ pub enum RefineArg {
     Translation,
     /// An open pocket's bottom extended across its open edge and cut as a level (its limit closed there).
     OpenBottom,
+    /// CL points whose tool lies above the part's blank (the impeller's turned blank) left out as air.
+    AirTrim,
     /// All of them: the program of 28 Nov 2026.
     All,
 }
@@ -350,9 +352,14 @@ pub fn run(args: &Rough5Args) -> CliResult<()> {
             .map_err(|e| Failure::rejected(format!("{name}: {e}")))?
     } else {
         let bar = progress_bar(0, "levels");
-        let plan =
-            plan_rough5(&bottom, &flanks, &part.stock, &tool, &settings, &|d, t| crate::simulate::show(&bar, d, t))
-                .map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
+        let blank = part
+            .blank
+            .as_ref()
+            .filter(|_| !args.without.iter().any(|w| matches!(w, RefineArg::AirTrim | RefineArg::All)));
+        let plan = plan_rough5_in(&bottom, &flanks, (&part.stock, blank), &tool, &settings, &|d, t| {
+            crate::simulate::show(&bar, d, t);
+        })
+        .map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
         bar.finish_and_clear();
         (plan, Vec::new())
     };
