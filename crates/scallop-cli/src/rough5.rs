@@ -16,7 +16,7 @@ use scallop_parts::FaceTag;
 use scallop_parts::TestPart;
 use scallop_rough5::{
     BaselinePlan, BaselineSettings, CuttingData, LevelOptions, OrientSettings, Pocket, Proof, ProofSettings,
-    Rough5Plan, Rough5Settings, TiltMode, Weights, plan_rough5, plan_three_plus_two, plan_zlevel, prove_from_blank,
+    Rough5Plan, Rough5Settings, TiltMode, Weights, plan_rough5_in, plan_three_plus_two, plan_zlevel, prove_from_blank,
 };
 use scallop_toolpath::Toolpath;
 use serde::Serialize;
@@ -50,6 +50,10 @@ pub enum RefineArg {
     VerticalInside,
     /// Colliding CL points translated away from the flank (thesis Ch. 3 §3, step 3) before they are dropped.
     Translation,
+    /// An open pocket's bottom extended across its open edge and cut as a level (its limit closed there).
+    OpenBottom,
+    /// CL points whose tool lies above the part's blank (the impeller's turned blank) left out as air.
+    AirTrim,
     /// All of them: the program of 28 Nov 2026.
     All,
 }
@@ -265,7 +269,11 @@ fn settings(args: &Rough5Args, part: &TestPart) -> CliResult<Rough5Settings> {
         max_azimuth_step: args.max_azimuth_step.to_radians(),
         orientation: matches!(args.tilt, TiltArg::Optimised).then(|| orientation(args, weights)),
         correct: args.correction && !matches!(args.tilt, TiltArg::Zero),
-        levels: LevelOptions { centre_offsets: on(RefineArg::CentreOffsets), pair_by_rank: on(RefineArg::PairByRank) },
+        levels: LevelOptions {
+            centre_offsets: on(RefineArg::CentreOffsets),
+            pair_by_rank: on(RefineArg::PairByRank),
+            open_bottom: on(RefineArg::OpenBottom),
+        },
         vertical_inside: on(RefineArg::VerticalInside),
         translate: on(RefineArg::Translation),
         ..base
@@ -313,9 +321,14 @@ pub fn run(args: &Rough5Args) -> CliResult<()> {
             .map_err(|e| Failure::rejected(format!("{name}: {e}")))?
     } else {
         let bar = progress_bar(0, "levels");
-        let plan =
-            plan_rough5(&bottom, &flanks, &part.stock, &tool, &settings, &|d, t| crate::simulate::show(&bar, d, t))
-                .map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
+        let blank = part
+            .blank
+            .as_ref()
+            .filter(|_| !args.without.iter().any(|w| matches!(w, RefineArg::AirTrim | RefineArg::All)));
+        let plan = plan_rough5_in(&bottom, &flanks, (&part.stock, blank), &tool, &settings, &|d, t| {
+            crate::simulate::show(&bar, d, t);
+        })
+        .map_err(|e| Failure::rejected(format!("{name}: {e}")))?;
         bar.finish_and_clear();
         (plan, Vec::new())
     };

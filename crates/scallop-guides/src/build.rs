@@ -9,7 +9,7 @@ use scallop_field::{FieldError, LevelOptions, Side, Surface, offset_levels};
 use scallop_geom::num::first_not_positive;
 use scallop_mesh::TriMesh;
 
-use crate::open::{OpenPocket, open_limit};
+use crate::open::{OpenPocket, extended_bottom, open_limit};
 use crate::zones::{Zone, degeneracy_zones, pair_zones};
 use crate::{GuideError, GuidePairs, LimitCurves, OffsetStep, Support, limit_curves, offset_curves};
 
@@ -124,6 +124,33 @@ pub fn build_guides(bottom: &TriMesh, flanks: &TriMesh, settings: &GuideSettings
         }
     }
     Ok(GuideSet { flank_offset, levels: out, pairs, pair_zones })
+}
+
+/// The bottom S_0 itself as the lowest level of the pocket with bottom faces
+/// `bottom` and flank faces `flanks`: its limit curves where it meets
+/// `flank_offset` (the [`GuideSet::flank_offset`] of the same settings), and
+/// their offsets. Where those are open chains (an open pocket), the bottom is
+/// extended across its open edge by a strip R + s_f wide and the chains are
+/// closed by the virtual flanks there, as on the offset levels (Jousselin
+/// 2020, Ch. 4 §1.3.1): the level's support is then the extended bottom.
+///
+/// # Errors
+/// Those of [`offset_curves`].
+pub fn bottom_level(
+    bottom: &TriMesh,
+    flanks: &TriMesh,
+    flank_offset: &TriMesh,
+    settings: &GuideSettings,
+) -> Result<GuideLevel, GuideError> {
+    let clearance = settings.tool_radius + settings.flank_allowance;
+    let open = OpenPocket::new(bottom, flanks, clearance);
+    let support = Support::new(bottom.clone());
+    let own = limit_curves(&support, flank_offset);
+    let support = match extended_bottom(bottom, flanks, clearance, settings.voxel) {
+        Some(mesh) if !own.open.is_empty() => Support::new(mesh),
+        _ => support,
+    };
+    guide_level(support, 0.0, flank_offset, &open, settings)
 }
 
 /// One level: its limit curves (an open pocket's closed by virtual flanks,

@@ -50,7 +50,7 @@ pub use scallop_geom::tol::guides as tol;
 mod vectorial;
 mod zones;
 
-pub use build::{GuideLevel, GuideSet, GuideSettings, build_guides};
+pub use build::{GuideLevel, GuideSet, GuideSettings, bottom_level, build_guides};
 pub use error::GuideError;
 pub use facets::Isolines;
 pub use field::CurveField;

@@ -116,6 +116,80 @@ impl OpenBottom {
     }
 }
 
+/// The bottom extended across its open edge (the edges used by one bottom
+/// triangle and by no flank triangle) by a strip `width` wide, so that the
+/// bottom itself, as the lowest level, holds the virtual flank and a closed
+/// limit loop. The strip runs along the horizontal part of the virtual
+/// flank's outward normal (the normal itself where that is vertical): a
+/// crossable end meets the stock beyond it, and a turned or cast blank is
+/// level there, not on the bottom's tangent plane, which rises steeply where
+/// the bottom does (the impeller's hub at its inlet). `None` when the bottom
+/// has no open edge or the strip does not make a valid mesh. Its facets are
+/// split in four until their edges are at most `edge` long (at most
+/// [`MAX_SPLITS`] times): the curves on it are extracted facet by facet.
+pub(crate) fn extended_bottom(bottom: &TriMesh, flanks: &TriMesh, width: f64, edge: f64) -> Option<TriMesh> {
+    let open = OpenBottom::new(bottom, flanks);
+    if open.edges.is_empty() {
+        return None;
+    }
+    let mut vertices = bottom.vertices().to_vec();
+    let mut triangles: Vec<[usize; 3]> = bottom.triangles().iter().map(|t| t.map(|v| v as usize)).collect();
+    let mut moved: FastMap<u32, usize> = FastMap::default();
+    let mut strip_vertex = |v: u32, vertices: &mut Vec<Point3>| -> usize {
+        *moved.entry(v).or_insert_with(|| {
+            let out = open.tangent[v as usize].cross(&open.normals[v as usize]);
+            let level = Vec3::new(out.x, out.y, 0.0);
+            let dir = if level.norm() > 0.5 * out.norm() { level.normalize() } else { out.normalize() };
+            vertices.push(vertices[v as usize] + dir * width);
+            vertices.len() - 1
+        })
+    };
+    let mut edges: Vec<(u32, u32)> = open.edges.values().copied().collect();
+    edges.sort_unstable();
+    for (a, b) in edges {
+        let (a2, b2) = (strip_vertex(a, &mut vertices), strip_vertex(b, &mut vertices));
+        let (a, b) = (a as usize, b as usize);
+        triangles.push([b, a, a2]);
+        triangles.push([b, a2, b2]);
+    }
+    for _ in 0..MAX_SPLITS {
+        if longest_edge(&vertices, &triangles) <= edge {
+            break;
+        }
+        triangles = split_in_four(&mut vertices, &triangles);
+    }
+    let (mesh, _) = TriMesh::from_indexed(&vertices, &triangles).ok()?;
+    (mesh.triangles().len() == triangles.len()).then_some(mesh)
+}
+
+/// Splits halving the facets of an extended bottom at most this many times.
+const MAX_SPLITS: usize = 3;
+
+fn longest_edge(vertices: &[Point3], triangles: &[[usize; 3]]) -> f64 {
+    triangles
+        .iter()
+        .flat_map(|t| (0..3).map(move |k| (vertices[t[k]] - vertices[t[(k + 1) % 3]]).norm()))
+        .fold(0.0, f64::max)
+}
+
+/// Every triangle split in four at its edges' midpoints (shared between
+/// neighbours, so the mesh stays connected; the surface is unchanged).
+fn split_in_four(vertices: &mut Vec<Point3>, triangles: &[[usize; 3]]) -> Vec<[usize; 3]> {
+    let mut mid: FastMap<(usize, usize), usize> = FastMap::default();
+    let mut out = Vec::with_capacity(4 * triangles.len());
+    for t in triangles {
+        let m = [0, 1, 2].map(|k| {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                vertices.push(Point3::from((vertices[a].coords + vertices[b].coords) * 0.5));
+                vertices.len() - 1
+            })
+        });
+        out.extend([[t[0], m[0], m[2]], [m[0], t[1], m[1]], [m[2], m[1], t[2]], [m[0], m[1], m[2]]]);
+    }
+    out
+}
+
 /// The bottom and flanks of an open pocket, prepared for [`open_limit`].
 pub(crate) struct OpenPocket {
     bottom: OpenBottom,

@@ -13,7 +13,7 @@
 use std::f64::consts::PI;
 
 use scallop_geom::{Point3, Vec3};
-use scallop_guides::{Curve, GuideSet, GuideSettings, build_guides};
+use scallop_guides::{Curve, GuideSet, GuideSettings, Support, bottom_level, build_guides, limit_curves};
 use scallop_mesh::TriMesh;
 use scallop_parts::{FaceTag, TestPart, closed_pocket, fitting_pocket, impeller_channel};
 
@@ -162,6 +162,37 @@ fn the_impeller_channel_is_closed_by_virtual_flanks_on_every_level() {
         assert!(!level.limit.open.is_empty() && level.limit.closed_by_virtual_flanks == 1);
     }
     check_guides(&set, 4.5, 1.0, false);
+}
+
+/// The impeller's hub itself (the bottom level) is an open pocket too: on
+/// the hub alone its limit curves are chains that end on the hub's inlet and
+/// outlet edges; extended across those edges, the hub holds one closed loop,
+/// closed by the virtual flanks, that reaches both ends of the channel, with
+/// offsets inside it. A closed pocket's bottom is not extended.
+#[test]
+fn the_impeller_hub_is_closed_by_virtual_flanks() {
+    let part = impeller_channel(&Default::default()).unwrap();
+    let (bottom, flanks) = (part.faces(&[FaceTag::Bottom]).unwrap(), part.faces(&[FaceTag::Flank]).unwrap());
+    let s = settings(5.0, 14.0);
+    let set = build_guides(&bottom, &flanks, &s).unwrap();
+    let own = limit_curves(&Support::new(bottom.clone()), &set.flank_offset);
+    assert!(own.loops.is_empty() && !own.open.is_empty());
+    let level = bottom_level(&bottom, &flanks, &set.flank_offset, &s).unwrap();
+    assert!(level.closing.is_none());
+    assert_eq!((level.limit.loops.len(), level.limit.closed_by_virtual_flanks), (1, 1));
+    assert!(!level.offsets.is_empty());
+    let radii: Vec<f64> = level.limit.loops[0].line.points.iter().map(|p| p.x.hypot(p.y)).collect();
+    let (lo, hi) = radii.iter().fold((f64::INFINITY, 0.0f64), |(a, b), &r| (a.min(r), b.max(r)));
+    assert!(lo < 25.0 + 1.0 && hi > 75.0 - 1.0, "the loop spans r {lo:.2} to {hi:.2}");
+    for p in level.support.mesh().vertices() {
+        assert!(p.z >= bottom.bounds().min.z - 1e-9, "the extended hub dips to {p:?}");
+    }
+    let pocket = closed_pocket(&Default::default()).unwrap();
+    let (bottom, flanks) = (pocket.faces(&[FaceTag::Bottom]).unwrap(), pocket.faces(&[FaceTag::Flank]).unwrap());
+    let set = build_guides(&bottom, &flanks, &settings(5.0, 4.0)).unwrap();
+    let level = bottom_level(&bottom, &flanks, &set.flank_offset, &settings(5.0, 4.0)).unwrap();
+    assert_eq!(level.support.mesh().triangles().len(), bottom.triangles().len());
+    assert_eq!((level.limit.loops.len(), level.limit.closed_by_virtual_flanks), (1, 0));
 }
 
 /// The closed polygon of a dumbbell: lobes of radius `r` centred at

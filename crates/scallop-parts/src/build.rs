@@ -105,6 +105,53 @@ impl Builder {
         self.tri_towards(t, tag, &hint);
     }
 
+    /// The unit normal of the first triangle tagged `tag` (by winding).
+    pub(crate) fn first_normal(&self, tag: FaceTag) -> Option<Vec3> {
+        let i = self.tags.iter().position(|&t| t == tag)?;
+        let [a, b, c] = self.triangles[i].map(|k| self.vertices[k]);
+        Some((b - a).cross(&(c - a)).normalize())
+    }
+
+    /// Caps the closed cross-section `ring` of [`crate::ImpellerParams`]'s
+    /// layout (`samples = [_, nw, nt]`: `nw` points across the hub, `nt` up
+    /// blade b, `nw` back across the tip, `nt` down blade a) by the grid of
+    /// `point(w, t)` over `w, t` in `[0, 1]` whose boundary is the ring, each
+    /// triangle tagged top and turned towards `side` times its radial
+    /// direction from the z axis.
+    pub(crate) fn section_cap(
+        &mut self,
+        ring: &[usize],
+        point: impl Fn(f64, f64) -> Point3,
+        samples: [usize; 3],
+        side: f64,
+    ) {
+        let [_, nw, nt] = samples;
+        #[allow(clippy::cast_precision_loss, reason = "small counts")]
+        let grid: Vec<Vec<usize>> = (0..=nt)
+            .map(|j| {
+                (0..=nw)
+                    .map(|i| match (i, j) {
+                        (i, 0) if i < nw => ring[i],
+                        (i, j) if i == nw && j < nt => ring[nw + j],
+                        (i, j) if j == nt && i > 0 => ring[nw + nt + (nw - i)],
+                        (0, j) => ring[2 * nw + nt + (nt - j)],
+                        (i, j) => self.ring([point(i as f64 / nw as f64, j as f64 / nt as f64)])[0],
+                    })
+                    .collect()
+            })
+            .collect();
+        for j in 0..nt {
+            for i in 0..nw {
+                let (a, b, c, d) = (grid[j][i], grid[j][i + 1], grid[j + 1][i + 1], grid[j + 1][i]);
+                for t in [[a, b, c], [a, c, d]] {
+                    let m = t.iter().map(|&k| self.vertices[k].coords).sum::<Vec3>() / 3.0;
+                    let radial = Vec3::new(m.x, m.y, 0.0);
+                    self.tri_towards(t, FaceTag::Top, &(radial * side));
+                }
+            }
+        }
+    }
+
     /// A fan from a new centre vertex to a closed ring, normals along `hint`.
     pub(crate) fn fan(&mut self, centre: Point3, ring: &[usize], tag: FaceTag, hint: &Vec3) {
         let c = self.ring([centre])[0];

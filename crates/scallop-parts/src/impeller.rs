@@ -124,9 +124,11 @@ impl ImpellerParams {
 }
 
 /// The channel between two blades: cross-sections lofted from the inlet to
-/// the outlet, the hub tagged bottom, the blades flank, the tip surface top;
-/// open at the inlet and the outlet (crossable faces left out: an open pocket,
-/// to be closed by virtual surfaces). The stock is the box around the whole
+/// the outlet, the hub tagged bottom, the blades flank, the tip surface top,
+/// and the inlet and outlet sections (pieces of the cylinders at the inlet
+/// and outlet radii) top too: the volume to remove is a closed solid, but its
+/// bottom and flanks are an open pocket, open at the inlet and the outlet
+/// (the planners close it by virtual surfaces). The stock is the box around the whole
 /// impeller, 2 mm over the blades; the blank inside it ([`TestPart::blank`])
 /// is turned to the envelope of the blade tips.
 ///
@@ -147,6 +149,14 @@ pub fn impeller_channel(params: &ImpellerParams) -> Result<TestPart, PartError> 
     for w in sections.windows(2) {
         b.band(&w[0], &w[1], true, |i| tags[i]);
     }
+    // The inlet and outlet sections close the volume to remove (crossable, so
+    // tagged top: the planners build their virtual flanks from the bottom and
+    // the flanks alone), outward as the bands are: the hub faces down when
+    // they are outward, and the whole mesh is flipped below when they are not.
+    let outward = b.first_normal(FaceTag::Bottom).is_some_and(|n| n.z < 0.0);
+    let sign = if outward { 1.0 } else { -1.0 };
+    b.section_cap(&sections[0], |w, t| params.point(0.0, w, t), params.samples, -sign);
+    b.section_cap(&sections[n], |w, t| params.point(1.0, w, t), params.samples, sign);
     let mut part = b.finish(Aabb3 { min: Point3::origin(), max: Point3::origin() })?;
     // Sections run counter-clockwise about the outflow: flip if the hub faces up.
     let hub = part.tags.iter().position(|&t| t == FaceTag::Bottom).unwrap_or(0);
@@ -175,15 +185,20 @@ const BLANK_SEGMENTS: usize = 360;
 /// hub's inlet height (the impeller is turned to the envelope of its blade
 /// tips and its nose before the channels are roughed, so nothing stands above
 /// the channels' tops). Its outer radius is that of the outlet section's
-/// chords and its nose's radius that of the inlet beyond the blank's own
+/// deepest chords (across the hub and up the twisted blades) and its nose's radius that of the inlet beyond the blank's own
 /// chords, so that no sliver between two tessellations lies outside the
 /// channel at its open ends: a tool leaving the channel there cuts air, not a
 /// gouge.
 fn turned_blank(params: &ImpellerParams, top: f64) -> Result<scallop_mesh::TriMesh, PartError> {
     let [r0, r1] = params.radii;
     let u_of = |r: f64| (r - r0) / (r1 - r0);
+    // The outlet section's triangles span at most one step across the hub
+    // and one step of the twist up the blades; their chords dip to r1 times
+    // the cosine of half that angle.
     #[allow(clippy::cast_precision_loss, reason = "small counts")]
-    let outer = r1 * (std::f64::consts::PI / (params.blades * params.samples[1]) as f64).cos();
+    let span = (TAU / params.blades as f64 - params.thickness / r1) / params.samples[1] as f64
+        + (0.5 * params.twist).abs() / params.samples[2] as f64;
+    let outer = r1 * (0.5 * span).cos();
     #[allow(clippy::cast_precision_loss, reason = "small counts")]
     let nose = r0 / (std::f64::consts::PI / BLANK_SEGMENTS as f64).cos();
     let n = params.samples[0];

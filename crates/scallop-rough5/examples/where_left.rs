@@ -5,7 +5,14 @@
 //! ```sh
 //! scallop rough5 --part pocket --tilt guides -o out/guides
 //! cargo run -p scallop-rough5 --profile fast --example where_left -- out/guides/toolpath.cl [left.csv]
+//! scallop rough5 --part impeller -o out/impeller
+//! cargo run -p scallop-rough5 --profile fast --example where_left -- out/impeller/toolpath.cl --part impeller
 //! ```
+//!
+//! With `--part impeller` the program is cut on the channel's turned blank
+//! and every remaining sample is classed by its distance to the hub (4 mm
+//! bands: the levels), to the blades and to the tip surface, and by where it
+//! lies along the channel (tenths from the inlet to the outlet).
 //!
 //! The program (`toolpath.cl` of `scallop rough5`, the default tool and
 //! cutting data of the command) is cut on the tri-dexel stock of the proof
@@ -28,7 +35,7 @@ use scallop_machine::program::{Motion, ProgramOptions, records_of, to_program};
 use scallop_machine::time::{path_time, rapid_time};
 use scallop_machine::{Joints, Kinematics, Machine};
 use scallop_mesh::MeshQuery;
-use scallop_parts::{FaceTag, closed_pocket};
+use scallop_parts::{FaceTag, ImpellerParams, closed_pocket, impeller_channel};
 use scallop_sim::{DexelOptions, DexelPart, DexelStock, ToolMove};
 use scallop_toolpath::MoveKind;
 
@@ -36,20 +43,139 @@ const ALLOWANCE: f64 = 0.5;
 const DZ: f64 = 0.05;
 
 fn main() {
-    let file = std::env::args().nth(1).expect("give a toolpath.cl of `scallop rough5 --part pocket`");
-    let text = std::fs::read_to_string(&file).unwrap();
+    let mut args: Vec<String> = std::env::args().skip(1).collect();
+    let impeller = match args.iter().position(|a| a == "--part") {
+        Some(i) => {
+            let name = args.remove(i + 1);
+            args.remove(i);
+            name == "impeller"
+        }
+        None => false,
+    };
+    let file = args.first().expect("give a toolpath.cl of `scallop rough5 --part pocket`");
+    let text = std::fs::read_to_string(file).unwrap();
     let path = scallop_io::cl::read_cl(&text, 2400.0).unwrap();
-    let part = closed_pocket(&Default::default()).unwrap();
-    let bottom = part.faces(&[FaceTag::Bottom]).unwrap();
-    let flanks = part.faces(&[FaceTag::Flank]).unwrap();
     let tool = Cutter::new(CutterShape::Bull { radius: 5.0, corner: 1.5 }, 30.0)
         .unwrap()
         .with_shank(5.0, 11.0)
         .unwrap()
         .with_holder(vec![HolderSegment { length: 192.0, bottom_radius: 13.5, top_radius: 13.5 }])
         .unwrap();
-    remaining(&path, &tool, &part, (&bottom, &flanks));
+    if impeller {
+        let part = impeller_channel(&ImpellerParams::default()).unwrap();
+        remaining_impeller(&path, &tool, &part, args.get(1));
+    } else {
+        let part = closed_pocket(&Default::default()).unwrap();
+        let bottom = part.faces(&[FaceTag::Bottom]).unwrap();
+        let flanks = part.faces(&[FaceTag::Flank]).unwrap();
+        remaining(&path, &tool, &part, (&bottom, &flanks), args.get(1));
+    }
     timing(&path);
+}
+
+/// The remaining volume of a program of the impeller channel, cut on its
+/// turned blank: by distance to the hub (4 mm bands), the class of
+/// [`class`] with the tip surface as a third face, and the tenth of the
+/// channel (by radius, 25 mm at the inlet to 75 mm at the outlet).
+fn remaining_impeller(
+    path: &scallop_toolpath::Toolpath,
+    tool: &Cutter,
+    part: &scallop_parts::TestPart,
+    csv: Option<&String>,
+) {
+    let blank = DexelPart::new(part.blank.as_ref().unwrap());
+    let mut dexels = DexelStock::from_solid(part.stock, 0.5, &blank).unwrap();
+    let moves = ToolMove::from_toolpath(path);
+    let options = DexelOptions { axis_tolerance: 0.05, check_collisions: true };
+    dexels.cut_with_progress(tool, &moves, &options, &|_, _| {}).unwrap().check().unwrap();
+    let volume = DexelPart::new(&part.mesh);
+    let face = |t| MeshQuery::new(&part.faces(&[t]).unwrap());
+    let (qb, qf, qt) = (face(FaceTag::Bottom), face(FaceTag::Flank), face(FaceTag::Top));
+    let (nu, nv) = dexels.grid(2);
+    let cell = dexels.cell_size();
+    let area = cell[0] * cell[1];
+    let (lo, hi) = (part.stock.min.z, part.stock.max.z);
+    type Row = (BTreeMap<(String, i64, i64), f64>, f64, Vec<[f64; 5]>);
+    let rows: Vec<Row> = (0..nv)
+        .into_par_iter()
+        .map(|iv| {
+            let mut acc = BTreeMap::new();
+            let mut total = 0.0;
+            let mut samples = Vec::new();
+            for iu in 0..nu {
+                let o = dexels.ray_origin(2, iu, iv);
+                let pocket: Vec<[f64; 2]> = volume
+                    .intervals(&o, 2)
+                    .iter()
+                    .map(|s| [s.0.max(lo), s.1.min(hi)])
+                    .filter(|s| s[1] > s[0])
+                    .collect();
+                total += pocket.iter().map(|s| s[1] - s[0]).sum::<f64>() * area;
+                for m in dexels.intervals(2, iu, iv) {
+                    for s in &pocket {
+                        let (a, b) = (m[0].max(s[0]), m[1].min(s[1]));
+                        if b <= a {
+                            continue;
+                        }
+                        let n = ((b - a) / DZ).ceil().max(1.0) as usize;
+                        let w = (b - a) / n as f64 * area;
+                        for k in 0..n {
+                            let p = Point3::new(o.x, o.y, a + (k as f64 + 0.5) * (b - a) / n as f64);
+                            let d = |q: &MeshQuery| (q.closest_point(&p).point - p).norm();
+                            let (d_b, d_f, d_t) = (d(&qb), d(&qf), d(&qt));
+                            let c = if d_t <= 3.0 && d_b > ALLOWANCE + 1e-3 && d_f > 3.0 {
+                                "under the tip surface (within 3 mm)"
+                            } else {
+                                class(d_b, d_f)
+                            };
+                            let tenth = ((p.x.hypot(p.y) - 25.0) / 5.0).floor().clamp(-1.0, 10.0) as i64;
+                            *acc.entry((c.to_string(), (d_b / 4.0).floor() as i64, tenth)).or_insert(0.0) += w;
+                            samples.push([p.x, p.y, p.z, w, d_b]);
+                        }
+                    }
+                }
+            }
+            (acc, total, samples)
+        })
+        .collect();
+    let total: f64 = rows.iter().map(|r| r.1).sum();
+    if let Some(csv) = csv {
+        let mut text = String::from("x,y,z,mm3,hub_distance\n");
+        for r in rows.iter().flat_map(|r| &r.2) {
+            text.push_str(&format!("{},{},{:.3},{:.5},{:.3}\n", r[0], r[1], r[2], r[3], r[4]));
+        }
+        std::fs::write(csv, text).unwrap();
+    }
+    let mut all: BTreeMap<(String, i64, i64), f64> = BTreeMap::new();
+    for (m, _, _) in rows {
+        for (k, v) in m {
+            *all.entry(k).or_insert(0.0) += v;
+        }
+    }
+    let left: f64 = all.values().sum();
+    println!("volume to remove {total:.0} mm3, left {left:.0} mm3, V_r {:.2} %", 100.0 * left / total);
+    let pct = |v: f64| 100.0 * v / total;
+    let by = |f: &dyn Fn(&(String, i64, i64)) -> String, title: &str| {
+        let mut m: BTreeMap<String, f64> = BTreeMap::new();
+        for (k, v) in &all {
+            *m.entry(f(k)).or_insert(0.0) += v;
+        }
+        println!("\n{title}:");
+        for (k, v) in m {
+            println!("  {k:<50} {v:>8.0} mm3  {:>6.2} %", pct(v));
+        }
+    };
+    by(&|k| k.0.clone(), "by class");
+    by(&|k| format!("{:>2}: {:>2}-{:>2} mm from the hub", k.1, 4 * k.1, 4 * k.1 + 4), "by distance to the hub");
+    by(&|k| format!("{:>2}: r {:>2}-{:>2} mm", k.2, 25 + 5 * k.2, 30 + 5 * k.2), "by tenth of the channel (radius)");
+    by(
+        &|k| if k.0.starts_with("allowance") { k.0.clone() } else { format!("{:>2} band | {}", k.1, k.0) },
+        "by band and class (beyond the allowance)",
+    );
+    by(
+        &|k| if k.0.starts_with("allowance") { k.0.clone() } else { format!("{:>2} tenth | {:>2} band", k.2, k.1) },
+        "by tenth and band (beyond the allowance)",
+    );
 }
 
 /// The class of a remaining sample.
@@ -94,6 +220,7 @@ fn remaining(
     tool: &Cutter,
     part: &scallop_parts::TestPart,
     (bottom, flanks): (&scallop_mesh::TriMesh, &scallop_mesh::TriMesh),
+    csv: Option<&String>,
 ) {
     let mut dexels = DexelStock::new(part.stock, 0.5).unwrap();
     let moves = ToolMove::from_toolpath(path);
@@ -164,12 +291,12 @@ fn remaining(
         .collect();
     let total: f64 = rows.iter().map(|r| r.1).sum();
     let mut all: BTreeMap<(String, String, i64), f64> = BTreeMap::new();
-    if let Some(csv) = std::env::args().nth(2) {
+    if let Some(csv) = csv {
         let mut text = String::from("x,y,left_mm,z_lo,z_hi\n");
         for r in rows.iter().flat_map(|r| &r.2) {
             text.push_str(&format!("{},{},{:.3},{:.3},{:.3}\n", r[0], r[1], r[2], r[3], r[4]));
         }
-        std::fs::write(&csv, text).unwrap();
+        std::fs::write(csv, text).unwrap();
         let mut text = String::from("x,y,z,mm3\n");
         for r in rows.iter().flat_map(|r| &r.3) {
             text.push_str(&format!("{},{},{:.3},{:.5}\n", r[0], r[1], r[2], r[3]));

@@ -63,6 +63,11 @@ pub struct LevelOptions {
     /// Where `pair_levels` fails, pair the level's own curves with the own
     /// curves of the level above by rank from the limit.
     pub pair_by_rank: bool,
+    /// Where the bottom's limit curves are open chains (an open pocket),
+    /// extend the bottom across its open edge and close them by the virtual
+    /// flanks there, so that the bottom is cut too
+    /// ([`scallop_guides::bottom_level`]).
+    pub open_bottom: bool,
 }
 
 /// One level's own curves: limit loops and offsets.
@@ -86,20 +91,34 @@ impl Own {
 }
 
 /// The bottom as level 0: its limit curves on the flank offset and their
-/// offsets (none when the limit is not one closed loop); with `centre`, the
-/// inner offsets dropped as slivers added back ([`LevelOptions`]).
-fn bottom_level(bottom: &TriMesh, set: &GuideSet, a_e: f64, centre: bool) -> Result<Own, GuideError> {
-    let support = Support::new(bottom.clone());
-    let limit = limit_curves(&support, &set.flank_offset);
-    let mut offsets = if limit.loops.len() == 1 && limit.open.is_empty() {
-        offset_curves(&support, &limit.loops, a_e)?
+/// offsets (none when the limit is not one closed loop); with `open`, an open
+/// pocket's bottom extended across its open edge and its limit chains closed
+/// by the virtual flanks there ([`scallop_guides::bottom_level`]); with
+/// `centre`, the inner offsets dropped as slivers added back
+/// ([`LevelOptions`]).
+fn bottom_level(
+    (bottom, flanks): (&TriMesh, &TriMesh),
+    set: &GuideSet,
+    guides: &GuideSettings,
+    options: &LevelOptions,
+) -> Result<Own, GuideError> {
+    let (support, loops, mut offsets) = if options.open_bottom {
+        let level = scallop_guides::bottom_level(bottom, flanks, &set.flank_offset, guides)?;
+        (level.support, level.limit.loops, level.offsets)
     } else {
-        Vec::new()
+        let support = Support::new(bottom.clone());
+        let limit = limit_curves(&support, &set.flank_offset);
+        let offsets = if limit.loops.len() == 1 && limit.open.is_empty() {
+            offset_curves(&support, &limit.loops, guides.radial_step)?
+        } else {
+            Vec::new()
+        };
+        (support, limit.loops, offsets)
     };
-    if centre && !offsets.is_empty() {
-        centre_offsets(&support, &mut offsets, a_e)?;
+    if options.centre_offsets && !offsets.is_empty() {
+        centre_offsets(&support, &mut offsets, guides.radial_step)?;
     }
-    Ok(Own { distance: 0.0, support, loops: limit.loops, offsets })
+    Ok(Own { distance: 0.0, support, loops, offsets })
 }
 
 /// Appends the closed offsets at `a_e` inside the innermost offset while it
@@ -154,7 +173,7 @@ pub fn level_passes_with(
     options: &LevelOptions,
 ) -> Result<Vec<LevelPasses>, Rough5Error> {
     let set = build_guides(bottom, flanks, guides)?;
-    let mut own = vec![bottom_level(bottom, &set, guides.radial_step, options.centre_offsets)?];
+    let mut own = vec![bottom_level((bottom, flanks), &set, guides, options)?];
     for l in set.levels {
         own.push(Own { distance: l.distance, support: l.support, loops: l.limit.loops, offsets: l.offsets });
     }

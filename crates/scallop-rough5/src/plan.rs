@@ -24,6 +24,7 @@ use scallop_cutter::Cutter;
 use scallop_geom::{Aabb3, Point3, Vec3};
 use scallop_guides::{Curve, GuideSettings};
 use scallop_mesh::TriMesh;
+use scallop_sim::DexelPart;
 use scallop_toolpath::{Move, MoveKind, Toolpath};
 
 use crate::collide::BodyCheck;
@@ -104,6 +105,9 @@ pub struct PassReport {
     pub points: usize,
     /// Pairs dropped: tool not placed, or its body too close to a flank.
     pub dropped: usize,
+    /// Pairs left out because the tool lies above the blank
+    /// ([`plan_rough5_in`]).
+    pub air: usize,
     /// Pairs whose axis the collision correction turned to clear the flanks
     /// (kept, unless an angular-step insertion next to them collides).
     pub corrected: usize,
@@ -194,7 +198,27 @@ pub fn plan_rough5(
     settings: &Rough5Settings,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<Rough5Plan, Rough5Error> {
+    plan_rough5_in(bottom, flanks, (stock, None), cutter, settings, progress)
+}
+
+/// [`plan_rough5`] in a blank inside the stock box (a turned or cast blank,
+/// a closed mesh): a CL point whose tool lies above the blank everywhere
+/// within its radius (by [`AIR_MARGIN`]) cuts air and is left out, its
+/// pass split there (the levels that run over an impeller's blade tips are
+/// cut where they are below the blank's envelope: the crossable top).
+///
+/// # Errors
+/// Those of [`plan_rough5`].
+pub fn plan_rough5_in(
+    bottom: &TriMesh,
+    flanks: &TriMesh,
+    (stock, blank): (&Aabb3, Option<&TriMesh>),
+    cutter: &Cutter,
+    settings: &Rough5Settings,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<Rough5Plan, Rough5Error> {
     check(settings)?;
+    let air = blank.map(|b| Air { blank: DexelPart::new(b), radius: cutter.radius() });
     let levels = level_passes_with(bottom, flanks, &settings.guides, settings.tilt, &settings.levels)?;
     if levels.iter().all(|l| l.passes.is_empty()) {
         let reason = "no level has a closed limit curve: open pockets (limit curves ending on the level's boundary) \
@@ -204,7 +228,9 @@ pub fn plan_rough5(
     let body = BodyCheck::new(flanks, cutter, 0.0);
     let mut out = Emitter::new(stock.max.z, stock.max.z + settings.clearance + cutter.radius(), settings);
     let mut reports = Vec::new();
-    let mut entry_z = stock.max.z + settings.clearance;
+    // The first level is entered from above the stock: the box's top, or the blank's.
+    let stock_top = blank.map_or(stock.max.z, |b| b.bounds().max.z.min(stock.max.z));
+    let mut entry_z = stock_top + settings.clearance;
     for (done, j) in (0..levels.len()).rev().enumerate() {
         let level = &levels[j];
         let allowance = if j == 0 { settings.bottom_allowance } else { 0.0 };
@@ -222,7 +248,7 @@ pub fn plan_rough5(
             if settings.translate {
                 pairs = translated(&placer, &body, pairs);
             }
-            let (runs, mut report) = place_pass(&placer, &body, &pairs);
+            let (runs, mut report) = place_pass_in(&placer, &body, air.as_ref(), &pairs);
             report.corrected = corrected;
             report.level = j;
             report.pass = m;
@@ -525,16 +551,63 @@ fn translated(placer: &Placer, body: &BodyCheck, pairs: Vec<SyncPoint>) -> Vec<S
         .collect()
 }
 
+/// How far above the blank (mm) a tool's lowest point must be, everywhere
+/// within its radius, for its CL point to be left out as air.
+pub const AIR_MARGIN: f64 = 1.0;
+
+/// The blank a program cuts in, for [`plan_rough5_in`].
+struct Air {
+    blank: DexelPart,
+    radius: f64,
+}
+
+impl Air {
+    /// The blank's top along the vertical through `(x, y)` (`-inf` off it).
+    fn top(&self, x: f64, y: f64) -> f64 {
+        let spans = self.blank.intervals(&Point3::new(x, y, 0.0), 2);
+        spans.iter().map(|s| s.1).fold(f64::NEG_INFINITY, f64::max)
+    }
+
+    /// Whether the tool at `p` lies above the blank by [`AIR_MARGIN`] at its
+    /// axis and at 16 points on the circles of its radius and half of it
+    /// (the blank is a smooth envelope); its lowest point is taken `R sin
+    /// tilt` under the tip.
+    fn holds(&self, p: &Placement) -> bool {
+        let low = p.tip.z - self.radius * p.axis.angle(&Vec3::z()).sin() - AIR_MARGIN;
+        let ring = (0..8).flat_map(|k| {
+            let a = std::f64::consts::FRAC_PI_4 * f64::from(k);
+            [1.0, 0.5].map(|f| (p.tip.x + f * self.radius * a.cos(), p.tip.y + f * self.radius * a.sin()))
+        });
+        std::iter::once((p.tip.x, p.tip.y)).chain(ring).all(|(x, y)| self.top(x, y) < low)
+    }
+}
+
 /// The placed and checked CL points of the pairs of one pass, split into
 /// runs where pairs were dropped.
 fn place_pass(placer: &Placer, body: &BodyCheck, pairs: &[SyncPoint]) -> (Vec<Vec<Cl>>, PassReport) {
+    place_pass_in(placer, body, None, pairs)
+}
+
+/// [`place_pass`], leaving out the CL points in `air` too.
+fn place_pass_in(
+    placer: &Placer,
+    body: &BodyCheck,
+    air: Option<&Air>,
+    pairs: &[SyncPoint],
+) -> (Vec<Vec<Cl>>, PassReport) {
+    let in_air = std::sync::atomic::AtomicUsize::new(0);
     let placed: Vec<Option<Cl>> = pairs
         .par_iter()
         .map(|s| {
             let p = placer.place(&s.path, &s.axis())?;
+            if air.is_some_and(|a| a.holds(&p)) {
+                in_air.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                return None;
+            }
             (!body.collides(&p.tip, &p.axis)).then_some(Cl { place: p, sync: *s })
         })
         .collect();
+    let in_air = in_air.into_inner();
     let mut runs: Vec<Vec<Cl>> = Vec::new();
     let mut current: Vec<Cl> = Vec::new();
     for c in &placed {
@@ -560,7 +633,8 @@ fn place_pass(placer: &Placer, body: &BodyCheck, pairs: &[SyncPoint]) -> (Vec<Ve
         level: 0,
         pass: 0,
         points: kept.len(),
-        dropped: placed.len() - kept.len(),
+        dropped: placed.len() - kept.len() - in_air,
+        air: in_air,
         corrected: 0,
         runs: runs.len(),
         pitch,

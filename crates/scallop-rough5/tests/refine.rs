@@ -16,7 +16,8 @@ use scallop_guides::GuideSettings;
 use scallop_mesh::TriMesh;
 use scallop_parts::{FaceTag, PocketParams, closed_pocket};
 use scallop_rough5::{
-    BodyCheck, LevelOptions, ProofSettings, Rough5Settings, TiltMode, level_passes_with, plan_rough5, prove,
+    AIR_MARGIN, BodyCheck, LevelOptions, ProofSettings, Rough5Settings, TiltMode, level_passes_with, plan_rough5,
+    plan_rough5_in, prove, prove_from_blank,
 };
 use scallop_toolpath::MoveKind;
 
@@ -92,7 +93,7 @@ fn settings(depth: f64, refined: bool) -> Rough5Settings {
         rapid_rate: 20_000.0,
         orientation: None,
         correct: false,
-        levels: LevelOptions { centre_offsets: refined, pair_by_rank: refined },
+        levels: LevelOptions { centre_offsets: refined, pair_by_rank: refined, open_bottom: refined },
         vertical_inside: refined,
         translate: refined,
     }
@@ -182,7 +183,7 @@ fn the_bottom_centre_is_reached() {
     let widths: Vec<f64> = [false, true]
         .iter()
         .map(|&centre| {
-            let options = LevelOptions { centre_offsets: centre, pair_by_rank: false };
+            let options = LevelOptions { centre_offsets: centre, pair_by_rank: false, open_bottom: false };
             let levels = level_passes_with(&bottom, &flanks, &g, TiltMode::Zero, &options).unwrap();
             half_width(&levels[0].passes[0].0)
         })
@@ -192,4 +193,46 @@ fn the_bottom_centre_is_reached() {
     assert!(widths[0] > g.tool_radius + 1.0, "{widths:?}");
     assert!(widths[1] < g.tool_radius + 1.0, "{widths:?}");
     assert!(widths[1] < widths[0] - 0.5 * g.radial_step, "{widths:?}");
+}
+
+/// A closed box mesh between `lo` and `hi`.
+fn box_mesh(lo: Point3, hi: Point3) -> TriMesh {
+    let p = |i: usize| Point3::new([lo.x, hi.x][i & 1], [lo.y, hi.y][(i >> 1) & 1], [lo.z, hi.z][i >> 2]);
+    let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+    let soup: Vec<[Point3; 3]> =
+        quads.iter().flat_map(|q| [[p(q[0]), p(q[1]), p(q[2])], [p(q[0]), p(q[2]), p(q[3])]]).collect();
+    TriMesh::from_soup(&soup).unwrap().0
+}
+
+/// In a blank 8 mm under the stock top, the CL points whose tool lies above
+/// the blank are left out: no cutting move runs higher than the blank's top
+/// plus the tool radius, the margin and the entry clearance, where the plan
+/// in the whole box has such moves; the program is shorter and proven from
+/// the blank. The plan in no blank is the plan in the box.
+#[test]
+fn a_low_blank_trims_the_levels_above_it() {
+    let part = small_pocket();
+    let bottom = part.faces(&[FaceTag::Bottom]).unwrap();
+    let flanks = part.faces(&[FaceTag::Flank]).unwrap();
+    let depth = part.stock.max.z - bottom.bounds().min.z;
+    let (tool, s) = (tool(), settings(depth, true));
+    let top = part.stock.max.z - 8.0;
+    let blank = box_mesh(part.stock.min, Point3::new(part.stock.max.x, part.stock.max.y, top));
+    let boxed = plan_rough5(&bottom, &flanks, &part.stock, &tool, &s, &|_, _| {}).unwrap();
+    let none = plan_rough5_in(&bottom, &flanks, (&part.stock, None), &tool, &s, &|_, _| {}).unwrap();
+    assert_eq!(none.toolpath, boxed.toolpath);
+    let trimmed = plan_rough5_in(&bottom, &flanks, (&part.stock, Some(&blank)), &tool, &s, &|_, _| {}).unwrap();
+    let ceiling = top + tool.radius() + AIR_MARGIN + s.clearance + 1e-9;
+    let high = |p: &scallop_toolpath::Toolpath| {
+        p.moves().iter().filter(|m| m.kind == MoveKind::Feed && m.to.z > ceiling).count()
+    };
+    assert!(high(&boxed.toolpath) > 0);
+    assert_eq!(high(&trimmed.toolpath), 0);
+    assert!(trimmed.passes.iter().map(|p| p.air).sum::<usize>() > 0);
+    assert!(trimmed.toolpath.moves().len() < boxed.toolpath.moves().len());
+    let proof_settings = ProofSettings { resolution: 0.5, axis_tolerance: 0.05 };
+    let proof =
+        prove_from_blank(&trimmed.toolpath, &tool, &part.stock, Some(&blank), &part.mesh, &proof_settings, &|_, _| {})
+            .unwrap();
+    assert!(proof.gouge_depth <= proof_settings.resolution, "{proof:?}");
 }
