@@ -15,7 +15,8 @@ use scallop_machine::{Joints, Kinematics, Machine};
 use scallop_parts::{FaceTag, TestPart};
 use scallop_post::{Dialect, OutputMode, PostParams, check_replay, program_text, replay};
 use scallop_rough5::{
-    LevelOptions, Proof, ProofFace, ProofSettings, Rough5Plan, Rough5Settings, TiltMode, plan_rough5, prove_with_faces,
+    LevelOptions, Proof, ProofFace, ProofSettings, Rough5Plan, Rough5Settings, TiltMode, plan_rough5_in,
+    prove_with_faces,
 };
 use scallop_toolpath::Toolpath;
 use serde::Serialize;
@@ -311,7 +312,7 @@ pub fn rough5_settings(
         rapid_rate: 20_000.0,
         orientation: None,
         correct: false,
-        levels: LevelOptions { centre_offsets: true, pair_by_rank: true },
+        levels: LevelOptions { centre_offsets: true, pair_by_rank: true, open_bottom: true },
         vertical_inside: true,
         translate: true,
     })
@@ -383,9 +384,16 @@ pub struct Rough5Output {
 pub fn run_rough5(job: &Rough5Job, progress: &(dyn Fn(Rough5Step) + Sync)) -> Result<Rough5Output, EngineError> {
     let part = &job.part;
     let (bottom, flanks) = (part.faces(&[FaceTag::Bottom])?, part.faces(&[FaceTag::Flank])?);
-    let plan = plan_rough5(&bottom, &flanks, &part.stock, &job.tool, &job.settings, &|done, total| {
-        progress(Rough5Step::Planning { done, total });
-    })?;
+    let plan = plan_rough5_in(
+        &bottom,
+        &flanks,
+        (&part.stock, part.blank.as_ref()),
+        &job.tool,
+        &job.settings,
+        &|done, total| {
+            progress(Rough5Step::Planning { done, total });
+        },
+    )?;
     let corner = job.settings.guides.tool_radius;
     let faces = [
         ProofFace { name: "bottom", mesh: &bottom, others: &flanks, allowance: job.settings.bottom_allowance, corner },
