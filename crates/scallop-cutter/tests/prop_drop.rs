@@ -7,7 +7,8 @@
 
 use proptest::prelude::*;
 use scallop_cutter::{
-    ClPoint, Contact, Cutter, CutterShape, drop_cutter, drop_cutter_brute_force, drop_grid, drop_path,
+    BoxDrop, ClPoint, Contact, Cutter, CutterShape, drop_cutter, drop_cutter_brute_force, drop_grid, drop_path,
+    drop_triangle,
 };
 use scallop_geom::{Point2, Point3, Vec3, assert_near};
 use scallop_mesh::{MeshIndex, TriMesh};
@@ -102,6 +103,33 @@ proptest! {
             let xy = Point2::new(xs[k % xs.len()], ys[k / xs.len()]);
             let slow = drop_cutter_brute_force(&c, &index, xy, FLOOR);
             prop_assert_eq!(cl.tip.z.to_bits(), slow.tip.z.to_bits(), "at {:?}: {:?} vs {:?}", xy, cl, slow);
+        }
+    }
+
+    /// The candidate list of a box gives the brute-force heights bit for bit,
+    /// at points inside the box (any seed) and outside it (the index), and its
+    /// one-triangle drop equals `drop_triangle`.
+    #[test]
+    fn box_drop_equals_brute_force(soup in soup_strategy(80), shape in shape_strategy(),
+                                   lo in (-3.0f64..10.0, -3.0f64..10.0), size in (0.0f64..3.0, 0.0f64..3.0),
+                                   pts in prop::collection::vec((-0.5f64..1.5, -0.5f64..1.5, 0usize..200), 1..40)) {
+        let Some((_, index)) = build(&soup) else { return Ok(()) };
+        let c = cutter(shape);
+        let (lo, hi) = (Point2::new(lo.0, lo.1), Point2::new(lo.0 + size.0, lo.1 + size.1));
+        let local = BoxDrop::new(&c, &index, lo, hi);
+        for (u, v, seed) in pts {
+            let xy = Point2::new(lo.x + u * size.0, lo.y + v * size.1);
+            let seed = (seed < index.len()).then_some(seed);
+            let (cl, slot) = local.drop(xy, FLOOR, seed);
+            let slow = drop_cutter_brute_force(&c, &index, xy, FLOOR);
+            prop_assert_eq!(cl.tip.z.to_bits(), slow.tip.z.to_bits(), "at {:?}: {:?} vs {:?}", xy, cl, slow);
+            if let Some(slot) = slot {
+                let one = local.drop_one(slot, xy, FLOOR);
+                let mut best = ClPoint::floor(xy, FLOOR);
+                drop_triangle(&c, index.corners(slot), index.normal(slot), index.original_index(slot), &mut best);
+                prop_assert_eq!(one.tip.z.to_bits(), best.tip.z.to_bits());
+                prop_assert_eq!(one.tip.z.to_bits(), cl.tip.z.to_bits(), "the slot gives the height");
+            }
         }
     }
 
