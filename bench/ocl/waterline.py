@@ -16,6 +16,9 @@ waterline loops at the same tip height, single-threaded:
 - loop counts per level;
 - speed: OpenCAMLib `Waterline.run()` summed over the levels vs scallop's whole
   command time for all levels (grid + contours, from `--json`), both on one thread;
+  also as CPU time (OpenCAMLib's `run()` calls by `time.process_time`, scallop's whole
+  process by the children's `getrusage`), which the load of a shared machine inflates
+  far less than wall time;
   scallop runs twice, both with chord tolerance CHORD_TOLERANCE (--chord-tolerance):
   with its grid step equal to OpenCAMLib's fibre spacing (the same feature resolution;
   this run decides the exit status), and with its default step R/4 (2.5 times coarser;
@@ -29,6 +32,7 @@ import argparse
 import json
 import math
 import os
+import resource
 import subprocess
 import sys
 import time
@@ -91,11 +95,11 @@ def run_ocl(surf, cutter, z, sampling):
     w.setCutter(cutter)
     w.setZ(z)
     w.setSampling(sampling)
-    t = time.perf_counter()
+    t, c = time.perf_counter(), time.process_time()
     w.run()
-    dt = time.perf_counter() - t
+    dt, dc = time.perf_counter() - t, time.process_time() - c
     loops = [np.array([(p.x, p.y) for p in lp], dtype=np.float64) for lp in w.getLoops()]
-    return [lp for lp in loops if len(lp)], dt
+    return [lp for lp in loops if len(lp)], dt, dc
 
 
 def run_scallop(exe, mesh, cname, d, zs, out_csv, chord, step):
@@ -111,10 +115,15 @@ def run_scallop(exe, mesh, cname, d, zs, out_csv, chord, step):
     if step is not None:
         cmd += ["--step", fmt(step)]
     cmd += ["--threads", "1", "-o", out_csv, "--json"]
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     r = subprocess.run(cmd, capture_output=True, text=True)
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
     if r.returncode != 0:
         raise RuntimeError(f"scallop failed ({r.returncode}): {' '.join(cmd)}\n{r.stderr.strip()}")
     info = json.loads(r.stdout)
+    # CPU time of the whole process (reading the mesh and writing the loops included):
+    # unlike the wall time, it does not grow with the load of the machine.
+    info["cpu_seconds"] = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
     data = np.loadtxt(out_csv, delimiter=",", skiprows=1, ndmin=2)
     loops = {}
     for k in np.unique(data[:, 0]).astype(int):
@@ -207,7 +216,8 @@ def main():
     head = ["mesh", "triangles", "cutter", "levels", "loops OCL/scallop", "OCL points", "max OCL->scallop (mm)",
             "mean OCL->scallop (mm)", "over tol", "max scallop->OCL polyline (mm)", "OCL s 1 thr",
             f"scallop s 1 thr (step = OCL sampling, chord {a.chord_tolerance:g})", "OCL/scallop",
-            "scallop s 1 thr (step R/4)", "OCL/scallop (step R/4)", "over tol (step R/4)"]
+            "scallop s 1 thr (step R/4)", "OCL/scallop (step R/4)", "over tol (step R/4)",
+            "OCL CPU s", "scallop CPU s (step = OCL sampling, whole process)", "OCL/scallop CPU"]
     print(f"# OpenCAMLib {ocl.version()} Waterline; mode {'reduced' if a.reduced else 'full'}; tolerance {TOLERANCE:g} mm "
           f"(OCL point to scallop loop); scallop chord tolerance {a.chord_tolerance:g} mm; OCL sampling "
           f"{SAMPLING_PER_DIAMETER:g} D", flush=True)
@@ -241,11 +251,12 @@ def main():
                 return 2
             if not a.keep_csv:
                 os.remove(stem)
-            t_ocl, n_ocl, n_ours, npts, over_coarse = 0.0, 0, 0, 0, 0
+            t_ocl, c_ocl, n_ocl, n_ours, npts, over_coarse = 0.0, 0.0, 0, 0, 0, 0
             d_o2s, d_s2o, far_ocl, far_ours = [], [], [], []
             for z in zs:
-                theirs, dt = run_ocl(surf, cutter, z, sampling)
+                theirs, dt, dc = run_ocl(surf, cutter, z, sampling)
                 t_ocl += dt
+                c_ocl += dc
                 mine = ours.get(float(z), [])
                 n_ocl += len(theirs)
                 n_ours += len(mine)
@@ -267,16 +278,18 @@ def main():
             ratio = t_ocl / t_ours if t_ours > 0 else math.inf
             t_default = info_default["seconds"]
             ratio_default = t_ocl / t_default if t_default > 0 else math.inf
+            c_ours = info["cpu_seconds"]
+            ratio_cpu = c_ocl / c_ours if c_ours > 0 else math.inf
             fin = d_s2o[np.isfinite(d_s2o)]
             row = [base, str(len(tris)), cname, str(len(zs)), f"{n_ocl}/{n_ours}", str(npts),
                    f"{d_o2s.max() if len(d_o2s) else 0:.2e}", f"{d_o2s.mean() if len(d_o2s) else 0:.2e}", str(over),
                    f"{fin.max() if len(fin) else 0:.2e}" + ("" if len(fin) == len(d_s2o) else f" ({len(d_s2o) - len(fin)} far)"),
                    f"{t_ocl:.3f}", f"{t_ours:.3f}", f"{ratio:.1f}", f"{t_default:.3f}", f"{ratio_default:.1f}",
-                   str(over_coarse)]
+                   str(over_coarse), f"{c_ocl:.3f}", f"{c_ours:.3f}", f"{ratio_cpu:.1f}"]
             rows.append(row)
             print(" | ".join(row), flush=True)
             if cname not in known:
-                ratios.append((ratio, ratio_default))
+                ratios.append((ratio, ratio_default, ratio_cpu))
             # OpenCAMLib sometimes splits one contour into several loops (or adds
             # one-point loops): the loop counts are informational. A failure is an
             # OpenCAMLib point away from scallop's loops, or a scallop point with no
@@ -325,6 +338,10 @@ def main():
         notes.append(f"speed ratio OCL/scallop, single thread, all levels of a case: scallop at OCL's sampling and "
                      f"chord tolerance {a.chord_tolerance:g} mm min {min(r1):.1f}, median {float(np.median(r1)):.1f}; "
                      f"scallop with step R/4 (same chord tolerance) min {min(r2):.1f}, median {float(np.median(r2)):.1f}")
+        r3 = [r[2] for r in ratios]
+        notes.append(f"CPU-time ratio OCL/scallop at OCL's sampling (OCL's run() calls vs scallop's whole process): "
+                     f"min {min(r3):.1f}, median {float(np.median(r3)):.1f}, at least 20 on {sum(r >= 20 for r in r3)} "
+                     f"of {len(r3)} cases")
     notes.append(f"load average (1/5/15 min) at start {load0[0]:.2f}/{load0[1]:.2f}/{load0[2]:.2f}, at end "
                  "{:.2f}/{:.2f}/{:.2f} on {} CPUs".format(*os.getloadavg(), os.cpu_count()))
     print("\nNotes:")

@@ -7,7 +7,8 @@
 
 use proptest::prelude::*;
 use scallop_cutter::{
-    ClPoint, Contact, Cutter, CutterShape, drop_cutter, drop_cutter_brute_force, drop_grid, drop_path,
+    BoxDrop, ClPoint, Contact, Cutter, CutterShape, drop_cutter, drop_cutter_brute_force, drop_grid, drop_path,
+    drop_triangle,
 };
 use scallop_geom::{Point2, Point3, Vec3, assert_near};
 use scallop_mesh::{MeshIndex, TriMesh};
@@ -105,6 +106,33 @@ proptest! {
         }
     }
 
+    /// The candidate list of a box gives the brute-force heights bit for bit,
+    /// at points inside the box (any seed) and outside it (the index), and its
+    /// one-triangle drop equals `drop_triangle`.
+    #[test]
+    fn box_drop_equals_brute_force(soup in soup_strategy(80), shape in shape_strategy(),
+                                   lo in (-3.0f64..10.0, -3.0f64..10.0), size in (0.0f64..3.0, 0.0f64..3.0),
+                                   pts in prop::collection::vec((-0.5f64..1.5, -0.5f64..1.5, 0usize..200), 1..40)) {
+        let Some((_, index)) = build(&soup) else { return Ok(()) };
+        let c = cutter(shape);
+        let (lo, hi) = (Point2::new(lo.0, lo.1), Point2::new(lo.0 + size.0, lo.1 + size.1));
+        let local = BoxDrop::new(&c, &index, lo, hi);
+        for (u, v, seed) in pts {
+            let xy = Point2::new(lo.x + u * size.0, lo.y + v * size.1);
+            let seed = (seed < index.len()).then_some(seed);
+            let (cl, slot) = local.drop(xy, FLOOR, seed);
+            let slow = drop_cutter_brute_force(&c, &index, xy, FLOOR);
+            prop_assert_eq!(cl.tip.z.to_bits(), slow.tip.z.to_bits(), "at {:?}: {:?} vs {:?}", xy, cl, slow);
+            if let Some(slot) = slot {
+                let one = local.drop_one(slot, xy, FLOOR);
+                let mut best = ClPoint::floor(xy, FLOOR);
+                drop_triangle(&c, index.corners(slot), index.normal(slot), index.original_index(slot), &mut best);
+                prop_assert_eq!(one.tip.z.to_bits(), best.tip.z.to_bits());
+                prop_assert_eq!(one.tip.z.to_bits(), cl.tip.z.to_bits(), "the slot gives the height");
+            }
+        }
+    }
+
     /// A wandering path (small steps with occasional jumps, so blocks of many
     /// points and blocks of one) gives the brute-force heights bit for bit.
     #[test]
@@ -152,6 +180,38 @@ proptest! {
             } else {
                 prop_assert_eq!(cl.tip.z, FLOOR);
             }
+        }
+    }
+
+    /// A wall whose vertical edge leans by a rounding-level offset (its ends
+    /// 1e-18 to 1e-14 mm apart in XY, as a CAD export writes -0.0 as -1e-17)
+    /// gives the heights of the same wall exactly vertical, up to rounding:
+    /// the edge's parameter there is all rounding, and its slope must not carry
+    /// it past the wall's top (on `idler_riser.STL`, docs/validation.md, the
+    /// bull-nose was lifted 6.6 mm above the part, in spikes that split the
+    /// waterline passes).
+    #[test]
+    fn a_wall_leaning_by_rounding_gives_the_vertical_walls_heights(
+        shape in shape_strategy(), base in (0.0f64..10.0, 0.0f64..10.0), lean in (-18.0f64..-14.0, 0.0f64..6.3),
+        heights in (0.0f64..3.0, 3.0f64..6.0, 0.0f64..6.0), side in (1.0f64..8.0, 0.0f64..6.3),
+        pts in prop::collection::vec((0.0f64..1.2, 0.0f64..6.3), 1..20)) {
+        let (x0, y0) = base;
+        let e = 10f64.powf(lean.0);
+        let (lo, hi, zc) = heights;
+        let far = Point3::new(x0 + side.0 * side.1.cos(), y0 + side.0 * side.1.sin(), zc);
+        let top = Point3::new(x0, y0, hi);
+        let leaning = Point3::new(x0 + e * lean.1.cos(), y0 + e * lean.1.sin(), lo);
+        let upright = Point3::new(x0, y0, lo);
+        let Some((_, bent)) = build(&[[leaning, top, far]]) else { return Ok(()) };
+        let Some((_, straight)) = build(&[[upright, top, far]]) else { return Ok(()) };
+        let c = cutter(shape);
+        for (rho, angle) in pts {
+            let r = rho * shape.radius();
+            let xy = Point2::new(x0 + r * angle.cos(), y0 + r * angle.sin());
+            let a = drop_cutter(&c, &bent, xy, FLOOR);
+            let b = drop_cutter(&c, &straight, xy, FLOOR);
+            prop_assert!(a.tip.z <= hi.max(zc) + EPS, "above the wall at {:?}: {:?}", xy, a);
+            prop_assert!((a.tip.z - b.tip.z).abs() <= EPS, "at {:?}: {:?} vs {:?}", xy, a, b);
         }
     }
 
@@ -272,4 +332,26 @@ fn grid_is_row_major_and_thread_independent() {
         assert_eq!(pa.tip.x, xs[k % xs.len()]);
         assert_eq!(pa.tip.y, ys[k / xs.len()]);
     }
+}
+
+/// The wall of `idler_riser.STL` (inches, scaled to mm) whose vertical edge
+/// from (0, 0, 0.79375) to (0, 0, 12.7) leans 3.6e-17 mm in x: the bull-nose
+/// R5 r2 at (-0.4, -4.5) rests on the edge's top corner, at distance 4.518,
+/// not 6.6 mm higher on the edge produced past its top (the bug this pins).
+#[test]
+fn the_idler_risers_leaning_edge_holds_the_bull_nose_at_its_top_corner() {
+    let p = |x: f64, y: f64, z: f64| Point3::new(x, y, z);
+    let wall = [
+        p(-6.938_893_956_846_787_6e-15, 5.080_000_075_697_899, 11.906_250_756_978_988),
+        p(3.577_140_604_771_371e-17, 0.0, 0.79375),
+        p(0.0, 0.0, 12.7),
+    ];
+    let (_, index) = build(&[wall]).expect("mesh");
+    let c = cutter(CutterShape::Bull { radius: 5.0, corner: 2.0 });
+    let xy = Point2::new(-0.4, -4.5);
+    let cl = drop_cutter(&c, &index, xy, FLOOR);
+    // The corner contact: the torus at horizontal distance 4.518 from the axis.
+    let rho = xy.coords.norm();
+    let corner = 12.7 - (2.0 - (4.0 - (rho - 3.0) * (rho - 3.0)).sqrt());
+    assert_near!(cl.tip.z, corner, EPS);
 }

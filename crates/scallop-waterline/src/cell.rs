@@ -172,12 +172,19 @@ impl<'a> Resolver<'a> {
     /// `None` if `a` is inside without a contact triangle (outside the box).
     fn crossings(&self, a: Point2, (ha, slot_a): (f64, Option<usize>), b: Point2, hb: f64) -> Option<Vec<Point2>> {
         Some(match (ha > 0.0, hb > 0.0) {
-            (true, false) => vec![self.local.bisect_heights(a, ha, b, hb)],
-            (false, true) => vec![self.local.bisect_heights(b, hb, a, ha)],
+            (true, false) => vec![self.local.bisect_heights(a, ha, slot_a, b, hb)],
+            (false, true) => vec![self.local.bisect_heights(b, hb, None, a, ha)],
             (true, true) => self.local.gaps(a, slot_a?, b, hb),
             (false, false) => Vec::new(),
         })
     }
+}
+
+/// The links of a cell with at most one exit (an exit and its entry, which
+/// need no drop-cutter), or `None` if the cell must be resolved.
+pub(crate) fn simple_links(cell: &Cell) -> Option<Vec<(usize, usize)>> {
+    let met = walk(cell);
+    (met.iter().filter(|m| m.1).count() <= 1).then(|| join(&met, true))
 }
 
 /// The crossings of `cell` in walk order, each with whether it is an exit

@@ -28,7 +28,7 @@ use rayon::prelude::*;
 use scallop_geom::Point2;
 
 use crate::WaterlineGrid;
-use crate::cell::{Cell, Resolver};
+use crate::cell::{Cell, Resolver, simple_links};
 use crate::refine::Probe;
 
 /// The crossings of one grid edge, in increasing x (horizontal) or y
@@ -122,10 +122,11 @@ fn edge_crossings(grid: &WaterlineGrid<'_>, probe: &Probe<'_>, inside: &[bool]) 
                 return local.gaps(a, grid.slots[ka] as usize, b, floored(kb));
             }
             // Floored as `Probe::height` floors them, so the secant sees one function.
+            let slot = |k: usize| (grid.slots[k] != u32::MAX).then_some(grid.slots[k] as usize);
             let p = if first_inside {
-                local.bisect_heights(a, floored(ka), b, floored(kb))
+                local.bisect_heights(a, floored(ka), slot(ka), b, floored(kb))
             } else {
-                local.bisect_heights(b, floored(kb), a, floored(ka))
+                local.bisect_heights(b, floored(kb), slot(kb), a, floored(ka))
             };
             vec![p]
         })
@@ -173,6 +174,9 @@ pub(crate) fn trace(grid: &WaterlineGrid<'_>, probe: &Probe<'_>) -> Vec<Vec<Poin
             let at = |[a, b]: [usize; 2]| inside[b * nx + a];
             let cell =
                 Cell { corners, inside: [at([i, j]), at([i + 1, j]), at([i + 1, j + 1]), at([i, j + 1])], sides };
+            if let Some(links) = simple_links(&cell) {
+                return (links, Vec::new()); // no index query for a plain cell
+            }
             let local = probe.local(corners[0], corners[2]);
             let mut resolver = Resolver::new(&local, total);
             let links = resolver.link(&cell, &|id| points[id], 0);

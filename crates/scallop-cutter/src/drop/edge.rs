@@ -54,7 +54,20 @@ pub(super) fn drop_edge(profile: &Profile, a: &Point3, b: &Point3, triangle: usi
         return;
     }
     let m = (b.z - a.z) / len;
-    let z_at = |x: f64| a.z + m * (x - xa);
+    // The edge's height at x, kept between its ends' heights: on a nearly
+    // vertical edge (its XY length at the rounding level of `xa`, as a wall's
+    // edge whose ends differ by 1e-17 mm in XY) `x - xa` is off by a rounding
+    // unit of `xa`, which the slope `m` would magnify past the edge's top.
+    let z_at = |x: f64| {
+        let t = (x - xa) / len;
+        if t >= 1.0 {
+            b.z
+        } else if t <= 0.0 {
+            a.z
+        } else {
+            a.z + m * (x - xa)
+        }
+    };
     // Upper bound: the highest point of the chord, lifted by the profile at the
     // smallest distance d (h is non-decreasing).
     if z_at(lo).max(z_at(hi)) - profile.height(d) <= best.tip.z {
@@ -63,7 +76,8 @@ pub(super) fn drop_edge(profile: &Profile, a: &Point3, b: &Point3, triangle: usi
     let x = if matches!(profile.shape, CutterShape::Bull { .. }) && m != 0.0 {
         // Mirror so that the edge rises with x, solve, mirror back.
         let (l, h) = if m > 0.0 { (lo, hi) } else { (-hi, -lo) };
-        match bull_edge(profile, m.abs(), d, l, h, z_at(0.0), best.tip.z) {
+        // The line's height at x = 0 (the bound of `bull_edge` adds m x to it).
+        match bull_edge(profile, m.abs(), d, l, h, a.z - m * xa, best.tip.z) {
             Some(x) => {
                 if m > 0.0 {
                     x
@@ -80,7 +94,7 @@ pub(super) fn drop_edge(profile: &Profile, a: &Point3, b: &Point3, triangle: usi
     let zc = z_at(x);
     let tip = zc - profile.height((x * x + d * d).sqrt());
     if tip > best.tip.z {
-        let t = (x - xa) / len;
+        let t = ((x - xa) / len).clamp(0.0, 1.0);
         best.tip.z = tip;
         best.contact = Contact::Edge { triangle, point: Point3::new(a.x + t * ex, a.y + t * ey, zc) };
     }

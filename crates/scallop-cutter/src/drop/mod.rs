@@ -147,28 +147,28 @@ fn drop_seeded(
             best_slot = Some(slot);
         }
     }
+    drop_search(&profile, index, &mut best, &mut best_slot);
+    (best, best_slot)
+}
+
+/// The index search of [`drop_seeded`] from `best` (its tip's XY is the point).
+fn drop_search(profile: &Profile, index: &MeshIndex, best: &mut ClPoint, best_slot: &mut Option<usize>) {
     let mut bound = best.tip.z;
+    let xy = Point2::new(best.tip.x, best.tip.y);
     index.visit_disk(
         xy,
-        cutter.radius(),
+        profile.radius,
         |d2| profile.height(d2.sqrt()),
         &mut bound,
         |slot, bound| {
             let before = best.tip.z;
-            drop_triangle_profile(
-                &profile,
-                index.corners(slot),
-                index.normal(slot),
-                index.original_index(slot),
-                &mut best,
-            );
+            drop_triangle_profile(profile, index.corners(slot), index.normal(slot), index.original_index(slot), best);
             if best.tip.z > before {
-                best_slot = Some(slot);
+                *best_slot = Some(slot);
             }
             *bound = best.tip.z;
         },
     );
-    (best, best_slot)
 }
 
 /// The test oracle: every triangle, no index, no pruning.
@@ -299,6 +299,74 @@ pub fn drop_path(cutter: &Cutter, index: &MeshIndex, points: &[Point2], floor: f
     out
 }
 
+/// The drop-cutter restricted to the points of one box: the triangles within
+/// the cutter's reach of the box, sorted by decreasing upper bound (as the
+/// blocks of [`drop_grid`]), so that many evaluations near each other (a
+/// bisection, a cell's subdivision) share one index query. Every height is
+/// [`drop_cutter`]'s up to rounding: the same contacts, each mesh corner and
+/// edge tested once, by the triangle that owns it (as [`drop_grid`]), where
+/// the index tests a shared edge from both triangles (in opposite directions,
+/// which can differ in the last bit); on a triangle soup, bit for bit. Points
+/// outside the box fall back to the index.
+#[derive(Debug, Clone)]
+pub struct BoxDrop<'a> {
+    profile: Profile,
+    index: &'a MeshIndex,
+    lo: Point2,
+    hi: Point2,
+    candidates: Vec<Candidate>,
+}
+
+impl<'a> BoxDrop<'a> {
+    /// The candidate list of `cutter` on `index` for points of the box `[lo, hi]`.
+    ///
+    /// ```
+    /// use scallop_cutter::{BoxDrop, Cutter, CutterShape, drop_cutter};
+    /// use scallop_geom::{Point2, Point3};
+    /// use scallop_mesh::{MeshIndex, TriMesh};
+    /// let p = |x, y, z| Point3::new(x, y, z);
+    /// let (mesh, _) = TriMesh::from_soup(&[[p(0., 0., 0.), p(4., 0., 0.), p(0., 4., 3.)]]).unwrap();
+    /// let index = MeshIndex::build(&mesh);
+    /// let ball = Cutter::new(CutterShape::Ball { radius: 1.0 }, 10.0).unwrap();
+    /// let local = BoxDrop::new(&ball, &index, Point2::new(0., 0.), Point2::new(1., 1.));
+    /// let q = Point2::new(0.5, 0.7);
+    /// assert_eq!(local.drop(q, -5.0, None).0, drop_cutter(&ball, &index, q, -5.0));
+    /// ```
+    #[must_use]
+    pub fn new(cutter: &Cutter, index: &'a MeshIndex, lo: Point2, hi: Point2) -> Self {
+        let profile = Profile::new(cutter.shape());
+        let mut scratch = BlockScratch::default();
+        scratch.fill(index, &profile, [lo.x, lo.y], [hi.x, hi.y]);
+        BoxDrop { profile, index, lo, hi, candidates: scratch.sorted }
+    }
+
+    /// Drop-cutter at `xy` with the tip floored at `floor`, first trying the
+    /// triangle in `seed` (a valid lower bound: same result), and the slot of
+    /// the triangle that gives the height (`None` on the floor).
+    #[must_use]
+    pub fn drop(&self, xy: Point2, floor: f64, seed: Option<usize>) -> (ClPoint, Option<usize>) {
+        let inside = xy.x >= self.lo.x && xy.x <= self.hi.x && xy.y >= self.lo.y && xy.y <= self.hi.y;
+        if inside {
+            drop_candidates(&self.profile, self.index, &self.candidates, xy, floor, seed)
+        } else {
+            let mut best = ClPoint::floor(xy, floor);
+            let mut best_slot = None;
+            drop_search(&self.profile, self.index, &mut best, &mut best_slot);
+            (best, best_slot)
+        }
+    }
+
+    /// The drop-cutter on the one triangle in `slot` at `xy` (all its corners
+    /// and edges), floored at `floor`, as [`drop_triangle`].
+    #[must_use]
+    pub fn drop_one(&self, slot: usize, xy: Point2, floor: f64) -> ClPoint {
+        let mut best = ClPoint::floor(xy, floor);
+        let ix = self.index;
+        drop_triangle_profile(&self.profile, ix.corners(slot), ix.normal(slot), ix.original_index(slot), &mut best);
+        best
+    }
+}
+
 /// Reusable buffers of one worker: the candidates of the current block.
 #[derive(Default)]
 struct BlockScratch {
@@ -388,6 +456,9 @@ fn drop_candidates(
     for c in candidates {
         if c.ub + slack <= best.tip.z {
             break; // sorted: nothing after this can rise above the best
+        }
+        if seed == Some(c.slot) {
+            continue; // already tested whole, every corner and edge
         }
         let dx = (c.min[0] - xy.x).max(0.0).max(xy.x - c.max[0]);
         let dy = (c.min[1] - xy.y).max(0.0).max(xy.y - c.max[1]);
