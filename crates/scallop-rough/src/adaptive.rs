@@ -190,7 +190,7 @@ fn rings_only(region: &Region, options: &ClearOptions) -> Vec<Step> {
     let mut steps = Vec::new();
     for ring in region.rings() {
         if !steps.is_empty() {
-            steps.push(Step::Link { tool_down: false, via: Vec::new(), cleared: false });
+            steps.push(Step::Link { tool_down: false, via: Vec::new(), cleared: false, to: None });
         }
         steps.push(Step::Cut(orient(ring, options.direction)));
     }

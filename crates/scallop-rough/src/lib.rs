@@ -524,8 +524,8 @@ impl Emitter {
                     }
                     self.cut(c, node.z);
                 }
-                Step::Link { tool_down, via, cleared } => {
-                    let next = next_start(&node.steps, step);
+                Step::Link { tool_down, via, cleared, to } => {
+                    let next = to.or_else(|| next_start(&node.steps, step));
                     if let Some(s) = next {
                         if *tool_down {
                             for p in via {
@@ -733,4 +733,41 @@ pub fn pocket_toolpath(
         retracts: out.retracts,
         helices: out.helices,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Two links in a row (an adaptive run split at two moves in a row, no
+    /// cut between them): the first ends where it was planned to end, where
+    /// the second was planned from, not at the next cut's start (a move
+    /// never checked, which cut into a wall of mount_rush).
+    #[test]
+    fn a_link_ends_where_it_was_planned_to_end() {
+        let square = |x0: f64, y0: f64, s: f64| {
+            Contour::polygon(&[[x0, y0], [x0 + s, y0], [x0 + s, y0 + s], [x0, y0 + s]], true).unwrap()
+        };
+        let options = ClearOptions {
+            tool_radius: 1.0,
+            stepover: 0.4,
+            direction: Direction::Climb,
+            chord_tolerance: 0.01,
+            pattern: Pattern::Adaptive,
+        };
+        let (q, r) = ([5.0, 1.0], [9.0, 9.0]);
+        let steps = vec![
+            Step::Cut(square(1.0, 1.0, 2.0)),
+            Step::Link { tool_down: true, via: vec![[4.0, 1.0]], cleared: true, to: Some(q) },
+            Step::Link { tool_down: true, via: vec![[9.0, 1.0]], cleared: true, to: Some(r) },
+            Step::Cut(square(9.0, 9.0, 0.5)),
+        ];
+        let region = Region::from_polygons(&[vec![[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [0.0, 10.0]]], false);
+        let nodes = vec![Node { z: -1.0, top: 0.0, region, parent: None, steps }];
+        let mut out = Emitter::new(&Motion { clearance_z: 5.0, feed: 1000.0 }, 0.0, &options);
+        visit_all(&nodes, &[0], &mut out);
+        let links: Vec<[f64; 2]> =
+            out.path.moves().iter().filter(|m| m.kind == MoveKind::Link).map(|m| [m.to.x, m.to.y]).collect();
+        assert_eq!(links, vec![[4.0, 1.0], q, [9.0, 1.0], r]);
+    }
 }

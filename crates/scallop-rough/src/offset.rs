@@ -37,6 +37,11 @@ pub enum Step {
         /// The next cut starts where the tool cuts nothing: after a retract,
         /// a straight plunge there is enough (no helix).
         cleared: bool,
+        /// Where the link was planned to end, when that is not the next
+        /// cut's start: a run of adaptive clearing split at two moves in a
+        /// row gives two links with no cut between them, the first ending
+        /// where the second was planned from. `None`: the next cut's start.
+        to: Option<P2>,
     },
 }
 
@@ -77,7 +82,7 @@ pub fn plan_offset(region: &Region, options: &ClearOptions) -> Result<Vec<Step>,
                     band.contains_segment(p, start, options.chord_tolerance)
                         && holder.contains_segment(p, start, options.chord_tolerance)
                 });
-                steps.push(Step::Link { tool_down: down, via: Vec::new(), cleared: false });
+                steps.push(Step::Link { tool_down: down, via: Vec::new(), cleared: false, to: None });
             }
             pos = Some(start);
             steps.push(Step::Cut(ring));

@@ -342,9 +342,9 @@ impl Planner<'_> {
                 line.extend_from_slice(&via);
                 line.push(to);
                 self.stamp(&line);
-                Step::Link { tool_down: true, via, cleared: true }
+                Step::Link { tool_down: true, via, cleared: true, to: Some(to) }
             }
-            None => Step::Link { tool_down: false, via: Vec::new(), cleared: self.clear_at(to) },
+            None => Step::Link { tool_down: false, via: Vec::new(), cleared: self.clear_at(to), to: Some(to) },
         }
     }
 }
