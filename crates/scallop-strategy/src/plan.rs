@@ -549,6 +549,7 @@ impl<'a> Planner<'a> {
         let sh = self.sh;
         let mut rest = vec![false; self.feed_samples.len()];
         let mut last_try: Option<(f64, Vec<(f64, Point2)>)> = None;
+        let widest = gap.min(rest_gap);
         for retry in 0..tol::MAX_SPACING_RETRIES {
             let (heights, lift) = self.measured_samples(current, &next, retry >= tol::RAW_RETRIES, &rest);
             let mut found_rest = false;
@@ -561,9 +562,10 @@ impl<'a> Planner<'a> {
                     }
                 }
             }
-            // Near rest the planes keep at most the rest gap.
-            if found_rest && gap > rest_gap {
-                gap = rest_gap;
+            // Near rest the planes keep at most the rest gap; a gap shrunk
+            // for sections now found to be rest goes back up to it.
+            if found_rest && gap.to_bits() != widest.to_bits() {
+                gap = widest;
                 next = self.plane(d + gap);
                 if next.plane.passes.is_empty() {
                     return Ok((false, gap, next));
