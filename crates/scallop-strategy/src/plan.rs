@@ -527,7 +527,8 @@ impl<'a> Planner<'a> {
     /// its residual at any try exceeds [`tol::REST_RESIDUAL_FACTOR`] `sh`, or
     /// does not fall as the gap shrinks ([`is_rest`]: the foot of a wall, a
     /// corner: no spacing removes it); near rest the gap is
-    /// at most `rest_gap`. The other samples of the pair still hold `sh`: a
+    /// at most `rest_gap`, and a gap shrunk for samples found rest later goes
+    /// back up to it (at most the first gap). The other samples of the pair still hold `sh`: a
     /// rest place on one section does not leave the rest of the pair to the
     /// spacing rule, whose model of a plane is optimistic on convex or
     /// faceted surface, most for a bull-nose whose contact lies far from its
