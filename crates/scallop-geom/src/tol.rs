@@ -1274,13 +1274,14 @@ pub mod strategy {
     pub const SHARP_EDGE_DEG: f64 = 30.0;
 
     /// With rest tolerated, a residual measured on one section (feed sample)
-    /// above this many times sh at the spacing rule's gap is rest material,
+    /// above this many times sh at the spacing rule's gap, or at any smaller
+    /// gap the planner tries, is rest material,
     /// not a scallop (a scallop grows with the square of the gap: the rule
     /// would be 4.5 times too wide): that section no longer sets the gap, which
     /// is at most `REST_SPACING_SHARE` of the largest step-over
-    /// (`Planner::hold`). So is a section whose residual keeps more than half
-    /// its height when the gap is more than halved (a scallop would fall to a
-    /// quarter).
+    /// (`Planner::hold`). So is a section whose residual grows as the gap
+    /// shrinks, or keeps more than half its height when the gap is more than
+    /// halved (a scallop would fall to a quarter).
     pub const REST_RESIDUAL_FACTOR: f64 = 20.0;
 
     /// Splits of a level spacing between the two walls of a concave crease at

@@ -524,10 +524,11 @@ impl<'a> Planner<'a> {
     /// The next plane after the last one at `d`: from `next` at `gap`, the gap
     /// shrinks until the measured scallop holds `sh` at every feed sample
     /// that is not rest material. With rest tolerated, a sample is rest when
-    /// its residual at the first try exceeds [`tol::REST_RESIDUAL_FACTOR`]
-    /// `sh`, or does not fall to half when the gap is more than halved (the
-    /// foot of a wall, a corner: no spacing removes it); near rest the gap is
-    /// at most `rest_gap`. The other samples of the pair still hold `sh`: a
+    /// its residual at any try exceeds [`tol::REST_RESIDUAL_FACTOR`] `sh`, or
+    /// does not fall as the gap shrinks ([`is_rest`]: the foot of a wall, a
+    /// corner: no spacing removes it); near rest the gap is
+    /// at most `rest_gap`, and a gap shrunk for samples found rest later goes
+    /// back up to it (at most the first gap). The other samples of the pair still hold `sh`: a
     /// rest place on one section does not leave the rest of the pair to the
     /// spacing rule, whose model of a plane is optimistic on convex or
     /// faceted surface, most for a bull-nose whose contact lies far from its
@@ -549,24 +550,23 @@ impl<'a> Planner<'a> {
         let sh = self.sh;
         let mut rest = vec![false; self.feed_samples.len()];
         let mut last_try: Option<(f64, Vec<(f64, Point2)>)> = None;
+        let widest = gap.min(rest_gap);
         for retry in 0..tol::MAX_SPACING_RETRIES {
             let (heights, lift) = self.measured_samples(current, &next, retry >= tol::RAW_RETRIES, &rest);
             let mut found_rest = false;
             if self.tolerate_rest {
                 for (i, &(h, _)) in heights.iter().enumerate() {
-                    // A residual that does not fall as the gap shrinks is rest too.
-                    let stalled = last_try
-                        .as_ref()
-                        .is_some_and(|(g, hp)| gap < 0.5 * g && hp[i].0 + lift > sh && h > 0.5 * hp[i].0);
-                    if !rest[i] && h + lift > sh && ((retry == 0 && h > tol::REST_RESIDUAL_FACTOR * sh) || stalled) {
+                    let before = last_try.as_ref().map(|(g, hp)| (*g, hp[i].0));
+                    if !rest[i] && is_rest(h, lift, sh, gap, before) {
                         rest[i] = true;
                         found_rest = true;
                     }
                 }
             }
-            // Near rest the planes keep at most the rest gap.
-            if found_rest && gap > rest_gap {
-                gap = rest_gap;
+            // Near rest the planes keep at most the rest gap; a gap shrunk
+            // for sections now found to be rest goes back up to it.
+            if found_rest && gap.to_bits() != widest.to_bits() {
+                gap = widest;
                 next = self.plane(d + gap);
                 if next.plane.passes.is_empty() {
                     return Ok((false, gap, next));
@@ -926,6 +926,25 @@ pub(crate) fn zone_end_margin(cutter: &Cutter, region: Option<&ZoneRegion>) -> f
     region.map_or(0.0, |_| cutter.radius())
 }
 
+/// Whether a section's residual `h` (mm, plus the pair's chord `lift`)
+/// measured at `gap` is rest material rather than a scallop, with rest
+/// tolerated; `before` is the gap and residual of the previous try (the gap
+/// only shrinks from the spacing rule's). A scallop grows with the square of
+/// the gap, so a residual above [`tol::REST_RESIDUAL_FACTOR`] `sh` at any try
+/// is rest; so is one that does not fall as the gap shrinks: one that grows
+/// (it held, or was lower, at the wider gap: its cusp lies on other material
+/// than between the passes), or keeps more than half its height when the gap
+/// is more than halved (a scallop would fall to a quarter). Without the
+/// first two a section could shrink the gap until the passes nearly
+/// coincided (docs/validation.md, "idler_riser regressions traced").
+fn is_rest(h: f64, lift: f64, sh: f64, gap: f64, before: Option<(f64, f64)>) -> bool {
+    if h + lift <= sh {
+        return false;
+    }
+    let not_falling = before.is_some_and(|(g, hp)| h > hp || (gap < 0.5 * g && hp + lift > sh && h > 0.5 * hp));
+    h > tol::REST_RESIDUAL_FACTOR * sh || not_falling
+}
+
 /// Vertical distance of the CL point `mid`, dropped at the XY midpoint of `a`
 /// and `b`, from their chord. Gouges are heights (the stock simulation measures
 /// stock below part vertically), and on a steep pass the vertical gap is the
@@ -1122,5 +1141,50 @@ mod sharp_edge_tests {
             }
         }
         assert!(walls > 0 && tops > 0, "the corner is shared by walls ({walls}) and the top ({tops})");
+    }
+}
+
+#[cfg(test)]
+mod rest_tests {
+    use super::is_rest;
+    use crate::tol;
+
+    const SH: f64 = 0.01;
+
+    /// A section that held at the wider gap and shows a residual many times
+    /// sh once the gap shrank (its cusp moved onto other material) is rest:
+    /// shrinking on for it left planes a few um apart (idler_riser with the
+    /// bull-nose, docs/validation.md, "idler_riser regressions traced").
+    #[test]
+    fn a_residual_that_grows_as_the_gap_shrinks_is_rest() {
+        assert!(is_rest(0.3 * tol::REST_RESIDUAL_FACTOR * SH, 0.0, SH, 0.06, Some((0.23, 0.8 * SH))));
+        // Just over sh and growing a little while the gap shrank by 10 %.
+        assert!(is_rest(1.2 * SH, 0.0, SH, 0.9 * 0.2, Some((0.2, 1.1 * SH))));
+    }
+
+    /// The residual factor holds at every try, not only at the spacing rule's
+    /// gap: the gap only shrinks from it, so a scallop could only be lower.
+    #[test]
+    fn a_residual_many_times_sh_is_rest_at_any_try() {
+        let h = 1.25 * tol::REST_RESIDUAL_FACTOR * SH;
+        // Falling, but the gap shrank by less than half: not stalled.
+        assert!(is_rest(h, 0.0, SH, 0.15, Some((0.2, 1.5 * tol::REST_RESIDUAL_FACTOR * SH))));
+        assert!(is_rest(h, 0.0, SH, 0.2, None));
+    }
+
+    /// A scallop falls with the square of the gap: never rest, at any gap,
+    /// from a first residual under the factor; nor a residual that holds sh.
+    #[test]
+    fn a_scallop_falling_with_the_square_of_the_gap_is_not_rest() {
+        let (g0, h0) = (0.4, 0.9 * tol::REST_RESIDUAL_FACTOR * SH);
+        assert!(!is_rest(h0, 0.0, SH, g0, None));
+        let mut before = (g0, h0);
+        for shrink in [0.9, 0.5, 0.3, 0.1] {
+            let gap = before.0 * shrink;
+            let h = before.1 * shrink * shrink;
+            assert!(!is_rest(h, 0.0, SH, gap, Some(before)), "{gap} {h}");
+            before = (gap, h);
+        }
+        assert!(!is_rest(0.5 * SH, 0.0, SH, 0.1, Some((0.2, 0.1 * SH))));
     }
 }
