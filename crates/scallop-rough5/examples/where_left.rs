@@ -1,12 +1,15 @@
-//! Where a roughing program of the closed test pocket leaves its remaining
-//! volume V_r, and where its machine time goes (docs/validation.md, "5-axis
-//! roughing: where the remaining volume is").
+//! Where a roughing program of the closed test pocket (or of the fitting
+//! pocket, `--part fitting`) leaves its remaining volume V_r, and where its
+//! machine time goes (docs/validation.md, "5-axis roughing: where the
+//! remaining volume is").
 //!
 //! ```sh
 //! scallop rough5 --part pocket --tilt guides -o out/guides
 //! cargo run -p scallop-rough5 --profile fast --example where_left -- out/guides/toolpath.cl [left.csv]
 //! scallop rough5 --part impeller -o out/impeller
 //! cargo run -p scallop-rough5 --profile fast --example where_left -- out/impeller/toolpath.cl --part impeller
+//! scallop rough5 --part fitting -o out/fitting
+//! cargo run -p scallop-rough5 --profile fast --example where_left -- out/fitting/toolpath.cl --part fitting
 //! ```
 //!
 //! With `--part impeller` the program is cut on the channel's turned blank
@@ -35,7 +38,7 @@ use scallop_machine::program::{Motion, ProgramOptions, records_of, to_program};
 use scallop_machine::time::{path_time, rapid_time};
 use scallop_machine::{Joints, Kinematics, Machine};
 use scallop_mesh::MeshQuery;
-use scallop_parts::{FaceTag, ImpellerParams, closed_pocket, impeller_channel};
+use scallop_parts::{FaceTag, ImpellerParams, closed_pocket, fitting_pocket, impeller_channel};
 use scallop_sim::{DexelOptions, DexelPart, DexelStock, ToolMove};
 use scallop_toolpath::MoveKind;
 
@@ -44,13 +47,13 @@ const DZ: f64 = 0.05;
 
 fn main() {
     let mut args: Vec<String> = std::env::args().skip(1).collect();
-    let impeller = match args.iter().position(|a| a == "--part") {
+    let part_name = match args.iter().position(|a| a == "--part") {
         Some(i) => {
             let name = args.remove(i + 1);
             args.remove(i);
-            name == "impeller"
+            name
         }
-        None => false,
+        None => "pocket".to_string(),
     };
     let file = args.first().expect("give a toolpath.cl of `scallop rough5 --part pocket`");
     let text = std::fs::read_to_string(file).unwrap();
@@ -61,14 +64,17 @@ fn main() {
         .unwrap()
         .with_holder(vec![HolderSegment { length: 192.0, bottom_radius: 13.5, top_radius: 13.5 }])
         .unwrap();
-    if impeller {
+    if part_name == "impeller" {
         let part = impeller_channel(&ImpellerParams::default()).unwrap();
         remaining_impeller(&path, &tool, &part, args.get(1));
     } else {
-        let part = closed_pocket(&Default::default()).unwrap();
+        let fitting = part_name == "fitting";
+        let part = if fitting { fitting_pocket(&Default::default()) } else { closed_pocket(&Default::default()) };
+        let part = part.unwrap();
         let bottom = part.faces(&[FaceTag::Bottom]).unwrap();
         let flanks = part.faces(&[FaceTag::Flank]).unwrap();
-        remaining(&path, &tool, &part, (&bottom, &flanks), args.get(1));
+        let side = if fitting { fitting_side } else { side };
+        remaining(&path, &tool, &part, (&bottom, &flanks, side), args.get(1));
     }
     timing(&path);
 }
@@ -215,11 +221,36 @@ fn side(p: &Point3) -> &'static str {
     }
 }
 
+/// The side of the fitting pocket (`FittingParams::default()`: outline 10 mm
+/// inside the 140 x 100 mm block, 4 mm ribs at x 50 from -y and x 90 from +y,
+/// reaching 48 mm) a flank point is on.
+fn fitting_side(p: &Point3) -> &'static str {
+    let rib = |x: f64| (p.x - x).abs() < 6.0;
+    if rib(50.0) && p.y < 62.0 {
+        return "rib x 50 (from -y)";
+    }
+    if rib(90.0) && p.y > 38.0 {
+        return "rib x 90 (from +y)";
+    }
+    let (dx, dy) = (p.x - 70.0, p.y - 50.0);
+    if dx.abs() > 55.0 && dy.abs() > 35.0 {
+        "corner"
+    } else if dx.abs() - 60.0 > dy.abs() - 40.0 {
+        if dx > 0.0 { "+x" } else { "-x" }
+    } else if dy > 0.0 {
+        "+y"
+    } else {
+        "-y"
+    }
+}
+
+type Side = fn(&Point3) -> &'static str;
+
 fn remaining(
     path: &scallop_toolpath::Toolpath,
     tool: &Cutter,
     part: &scallop_parts::TestPart,
-    (bottom, flanks): (&scallop_mesh::TriMesh, &scallop_mesh::TriMesh),
+    (bottom, flanks, side): (&scallop_mesh::TriMesh, &scallop_mesh::TriMesh, Side),
     csv: Option<&String>,
 ) {
     let mut dexels = DexelStock::new(part.stock, 0.5).unwrap();

@@ -18,6 +18,9 @@ use scallop_guides::{
     Curve, GuideError, GuideSet, GuideSettings, Level, OffsetStep, Support, build_guides, limit_curves, offset_curve,
     offset_curves, pair_levels,
 };
+use std::collections::{BinaryHeap, HashMap};
+
+use scallop_geom::Point3;
 use scallop_mesh::TriMesh;
 
 use crate::Rough5Error;
@@ -101,7 +104,17 @@ fn bottom_level(
     set: &GuideSet,
     guides: &GuideSettings,
     options: &LevelOptions,
-) -> Result<Own, GuideError> {
+) -> Result<Own, Rough5Error> {
+    // The part's own bottom faces can be long slivers (an ear-clipped flat
+    // floor): refined to the level fields' voxel, its offsets are not
+    // dropped as slivers of its facets.
+    let refined;
+    let bottom = if options.centre_offsets {
+        refined = refine_facets(bottom, guides.voxel)?;
+        &refined
+    } else {
+        bottom
+    };
     let (support, loops, mut offsets) = if options.open_bottom {
         let level = scallop_guides::bottom_level(bottom, flanks, &set.flank_offset, guides)?;
         (level.support, level.limit.loops, level.offsets)
@@ -142,6 +155,79 @@ fn centre_offsets(support: &Support, offsets: &mut Vec<OffsetStep>, a_e: f64) ->
         offsets.push(OffsetStep { curves, split: false, flagged: iso.flagged, repaired: iso.repaired });
     }
     Ok(())
+}
+
+/// `mesh` with every edge longer than `longest` split at its midpoint,
+/// longest first, in every facet that has it (each such facet bisected
+/// through its opposite corner), until no edge is longer: a conforming
+/// refinement on the same facets' planes (longest-edge bisection, Rivara
+/// 1984). The offsets of `offset_curves` are linear in each facet and a
+/// loop narrower than half the longest facet edge counts as vanished
+/// ([`scallop_guides::offset_curves`]), so a floor triangulated into long
+/// slivers loses every offset without it.
+///
+/// # Errors
+/// [`Rough5Error::BadSetting`] for a `longest` that is not finite and
+/// positive.
+pub fn refine_facets(mesh: &TriMesh, longest: f64) -> Result<TriMesh, Rough5Error> {
+    if !(longest.is_finite() && longest > 0.0) {
+        return Err(Rough5Error::BadSetting { name: "longest facet edge", value: longest });
+    }
+    let mut verts: Vec<Point3> = mesh.vertices().to_vec();
+    let mut tris: Vec<[usize; 3]> = mesh.triangles().iter().map(|t| t.map(|i| i as usize)).collect();
+    let key = |a: usize, b: usize| if a < b { (a, b) } else { (b, a) };
+    let mut edges: HashMap<(usize, usize), Vec<usize>> = HashMap::new();
+    // Lengths are positive and finite: their bit patterns order as they do.
+    let mut heap: BinaryHeap<(u64, usize, usize)> = BinaryHeap::new();
+    let push = |heap: &mut BinaryHeap<(u64, usize, usize)>, verts: &[Point3], (a, b): (usize, usize)| {
+        let len = (verts[a] - verts[b]).norm();
+        if len > longest {
+            heap.push((len.to_bits(), a, b));
+        }
+    };
+    for (t, tri) in tris.iter().enumerate() {
+        for k in 0..3 {
+            let e = key(tri[k], tri[(k + 1) % 3]);
+            let list = edges.entry(e).or_default();
+            if list.is_empty() {
+                push(&mut heap, &verts, e);
+            }
+            list.push(t);
+        }
+    }
+    while let Some((_, a, b)) = heap.pop() {
+        let Some(faces) = edges.remove(&(a, b)) else { continue };
+        let m = verts.len();
+        verts.push(Point3::from((verts[a].coords + verts[b].coords) * 0.5));
+        for t in faces {
+            let tri = tris[t];
+            // The corner where the edge starts in the facet's winding.
+            let Some(k) = (0..3).find(|&k| key(tri[k], tri[(k + 1) % 3]) == (a, b)) else { continue };
+            let (p, q, c) = (tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]);
+            let child = tris.len();
+            tris[t] = [p, m, c];
+            tris.push([m, q, c]);
+            // The facet `t` keeps (p, m), (m, c), (c, p); the child takes (m, q), (q, c), (c, m).
+            if let Some(list) = edges.get_mut(&key(q, c)) {
+                for f in list.iter_mut().filter(|f| **f == t) {
+                    *f = child;
+                }
+            }
+            for (e, f) in [(key(p, m), t), (key(m, q), child)] {
+                let list = edges.entry(e).or_default();
+                if list.is_empty() {
+                    push(&mut heap, &verts, e);
+                }
+                list.push(f);
+            }
+            let list = edges.entry(key(m, c)).or_default();
+            if list.is_empty() {
+                push(&mut heap, &verts, key(m, c));
+            }
+            list.extend([t, child]);
+        }
+    }
+    Ok(TriMesh::from_indexed(&verts, &tris).map_or_else(|_| mesh.clone(), |(m, _)| m))
 }
 
 /// The bottom's sliver offsets added back at most this many times.

@@ -64,7 +64,7 @@ pub use correct::{CorrectionCount, correct_pairs, correct_planar};
 pub use cutting::CuttingData;
 pub use error::Rough5Error;
 pub use faces::{FaceMetrics, ProofFace, face_metrics};
-pub use levels::{LevelOptions, LevelPasses, TiltMode, level_passes, level_passes_with};
+pub use levels::{LevelOptions, LevelPasses, TiltMode, level_passes, level_passes_with, refine_facets};
 pub use orient::{
     AngleUnit, BoundsPenalty, Coverage, OrientSettings, Orientation, Reparam, Weights, constraints, objective_terms,
     optimise_pass, pitch_trace, synchronise_with,
