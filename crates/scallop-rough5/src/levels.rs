@@ -107,9 +107,11 @@ fn bottom_level(
 ) -> Result<Own, Rough5Error> {
     // The part's own bottom faces can be long slivers (an ear-clipped flat
     // floor): refined to the level fields' voxel, its offsets are not
-    // dropped as slivers of its facets.
+    // dropped as slivers of its facets. An open pocket's bottom (the
+    // impeller's hub) is extended across its open edge instead.
     let refined;
-    let bottom = if options.centre_offsets {
+    let closed = || limit_curves(&Support::new(bottom.clone()), &set.flank_offset).open.is_empty();
+    let bottom = if options.centre_offsets && closed() {
         refined = refine_facets(bottom, guides.voxel)?;
         &refined
     } else {

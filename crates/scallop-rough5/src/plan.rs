@@ -227,6 +227,7 @@ pub fn plan_rough5_in(
     }
     let body = BodyCheck::new(flanks, cutter, 0.0);
     let mut out = Emitter::new(stock.max.z, stock.max.z + settings.clearance + cutter.radius(), settings);
+    out.flat = Emitter::flat_radius(cutter);
     let mut reports = Vec::new();
     // The first level is entered from above the stock: the box's top, or the blank's.
     let stock_top = blank.map_or(stock.max.z, |b| b.bounds().max.z.min(stock.max.z));
@@ -669,6 +670,8 @@ struct Emitter {
     stock_top: f64,
     last: Option<Cl>,
     settings: Rough5Settings,
+    /// The radius of the flat of the tool's end (0: no ramp is shortened).
+    flat: f64,
     retracts: usize,
     links: usize,
     ramps: usize,
@@ -685,6 +688,7 @@ impl Emitter {
             stock_top: stock_top + settings.clearance,
             last: None,
             settings: *settings,
+            flat: 0.0,
             retracts: 0,
             links: 0,
             ramps: 0,
@@ -849,11 +853,30 @@ impl Emitter {
         self.ramp(run, lift)
     }
 
-    /// Ramps down along a closed run from `lift` above it; returns the index
+    /// The radius of the flat of `cutter`'s end: R for a flat end mill, R - r
+/// for a torus, 0 otherwise.
+fn flat_radius(cutter: &Cutter) -> f64 {
+    match *cutter.shape() {
+        scallop_cutter::CutterShape::Flat { radius } => radius,
+        scallop_cutter::CutterShape::Bull { radius, corner } => radius - corner,
+        _ => 0.0,
+    }
+}
+
+/// Ramps down along a closed run from `lift` above it; returns the index
     /// where the lift reaches zero.
     fn ramp(&mut self, run: &[Cl], lift: f64) -> usize {
-        let ramp_len = lift / self.settings.ramp_angle.tan();
         let n = run.len() - 1;
+        // At most one lap on a loop within the flat of the tool's end round
+        // its centre (the fitting's smallest inner loops, 15 mm long): there
+        // the ramp circled it up to 4 times, the flat covering the loop
+        // whatever the ramp; it is steeper instead.
+        let full = lift / self.settings.ramp_angle.tan();
+        let tips = || run[..n].iter().map(|c| c.place.tip.coords);
+        let centre = tips().sum::<Vec3>() / n as f64;
+        let lap: f64 = (0..n).map(|k| (run[k + 1].place.tip - run[k].place.tip).norm()).sum();
+        let within = tips().all(|p| (p - centre).norm() <= self.flat);
+        let ramp_len = if within && lap > 0.0 { full.min(lap) } else { full };
         let (mut s, mut k) = (0.0, 0usize);
         loop {
             let (a, b) = (&run[k % n].place, &run[(k + 1) % n].place);
