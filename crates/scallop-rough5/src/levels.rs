@@ -58,10 +58,12 @@ pub struct LevelPasses {
 /// Options of [`level_passes_with`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct LevelOptions {
-    /// Add the bottom's inner offsets that `offset_curves` drops as slivers
-    /// of the bottom's coarse facets (its sliver width is relative to the
-    /// longest facet edge): while the innermost closed loop has a closed
-    /// offset at a_e inside it, that offset is a pass too.
+    /// Keep the bottom's offsets that `offset_curves` drops as slivers of
+    /// the bottom's coarse facets (its sliver width is relative to the
+    /// longest facet edge): a closed pocket's bottom is refined to facets
+    /// no longer than the voxel ([`refine_facets`]), and while the innermost
+    /// closed loop has a closed offset at a_e inside it, that offset is a
+    /// pass too.
     pub centre_offsets: bool,
     /// Where `pair_levels` fails, pair the level's own curves with the own
     /// curves of the level above by rank from the limit.

@@ -854,16 +854,16 @@ impl Emitter {
     }
 
     /// The radius of the flat of `cutter`'s end: R for a flat end mill, R - r
-/// for a torus, 0 otherwise.
-fn flat_radius(cutter: &Cutter) -> f64 {
-    match *cutter.shape() {
-        scallop_cutter::CutterShape::Flat { radius } => radius,
-        scallop_cutter::CutterShape::Bull { radius, corner } => radius - corner,
-        _ => 0.0,
+    /// for a torus, 0 otherwise.
+    fn flat_radius(cutter: &Cutter) -> f64 {
+        match *cutter.shape() {
+            scallop_cutter::CutterShape::Flat { radius } => radius,
+            scallop_cutter::CutterShape::Bull { radius, corner } => radius - corner,
+            _ => 0.0,
+        }
     }
-}
 
-/// Ramps down along a closed run from `lift` above it; returns the index
+    /// Ramps down along a closed run from `lift` above it; returns the index
     /// where the lift reaches zero.
     fn ramp(&mut self, run: &[Cl], lift: f64) -> usize {
         let n = run.len() - 1;
