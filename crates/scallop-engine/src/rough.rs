@@ -100,8 +100,9 @@ const LEFT_PLACES: usize = 10;
 /// under their centre are not measured).
 ///
 /// Per cell p: the floor `F(p)` is the part's height grown sideways by the
-/// radial allowance (the highest part cell within `s` plus a cell of p: a
-/// wall lies anywhere between two centres) plus the axial allowance; the
+/// radial allowance (the highest part cell within `s` plus a cell's diagonal
+/// of p: a wall lies anywhere between two centres, and a wall across the grid
+/// steps by a diagonal) plus the axial allowance; the
 /// material left is `h(p) - F(p)` where above [`LeftFigures::limit_mm`].
 /// The lowest the operation's cutter can take the stock at p is
 /// `reach(p) = min over centres c within R of p of CL(c) + a + h_R(|p - c|)`,
@@ -147,7 +148,7 @@ pub(crate) fn left_above_allowance(
         let (ii, jj) = (i.checked_add_signed(o.0)?, j.checked_add_signed(o.1)?);
         (ii < nx && jj < ny).then_some(jj * nx + ii)
     };
-    let grow = disc(settings.radial_allowance + cx.max(cy));
+    let grow = disc(settings.radial_allowance + cx.hypot(cy));
     let floor: Vec<f64> = (0..nx * ny)
         .into_par_iter()
         .map(|k| {

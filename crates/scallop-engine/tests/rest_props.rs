@@ -171,6 +171,16 @@ proptest! {
         prop_assert!(steps.len() > 20, "the 12 mm tool left only {} cells the 4 mm one reaches", steps.len());
         let volume = |cells: &[(f64, f64, f64)]| cells.iter().map(|c| c.2).sum::<f64>() * 0.04;
         prop_assert!(volume(&left_both) < 0.5 * volume(&left_first), "{} mm3 after rest, {} mm3 before", volume(&left_both), volume(&left_first));
+        // The engine's own report of what each roughing left (docs/roughing.md,
+        // "Material left above the allowance"): the 12 mm tool leaves material it
+        // cannot reach, the rest pass takes most of it, and on a part of boxes
+        // (no slopes, so no steps) nothing thicker than a chip is left where
+        // the 4 mm tool reaches.
+        let l0 = first.report.operations[0].left.as_ref().unwrap();
+        let l1 = both.report.operations[1].left.as_ref().unwrap();
+        prop_assert!(l0.unreachable_volume_mm3 > 0.0 && !l0.places.is_empty(), "{l0:?}");
+        prop_assert!(l1.unreachable_volume_mm3 < 0.5 * l0.unreachable_volume_mm3, "{l0:?} {l1:?}");
+        prop_assert!(l1.reached_max_mm < 0.2, "{l1:?}");
         // Each of the two corners is worked by the rest pass.
         for x in [-0.5 * w, 0.5 * w] {
             let corner = |cells: &[(f64, f64, f64)]| cells.iter().filter(|c| (c.0 - x).abs() < 6.0 && (c.1 + 10.0 - t).abs() < 6.0).count();
