@@ -215,6 +215,22 @@ pub fn write_job(
                 100.0 * e.link_share
             ));
         }
+        if let Some(l) = &op.left {
+            let place = l.places.first().map_or(String::new(), |p| {
+                format!(", the largest {:.0} mm² at ({:.1}, {:.1}) mm", p.area_mm2, p.at[0], p.at[1])
+            });
+            text.push_str(&format!(
+                "     left above {:.2} mm: {:.0} mm³ (the most {:.2} mm thick where the tool reaches); \
+                 {:.0} mm³ on {:.0} mm² where it cannot reach, up to {:.2} mm, in {} places{place}\n",
+                l.limit_mm,
+                l.volume_mm3,
+                l.reached_max_mm,
+                l.unreachable_volume_mm3,
+                l.unreachable_area_mm2,
+                l.unreachable_depth_mm,
+                l.places.len()
+            ));
+        }
     }
     let left = if job.operations.last().is_some_and(|o| o.rough.is_some()) {
         format!(

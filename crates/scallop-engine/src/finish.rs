@@ -639,7 +639,7 @@ pub struct RestPlaceReport {
 }
 
 impl RestReport {
-    fn from_split(split: &scallop_sim::RestSplit) -> RestReport {
+    pub(crate) fn from_split(split: &scallop_sim::RestSplit) -> RestReport {
         RestReport {
             area_mm2: split.unreachable_area,
             depth_mm: split.unreachable_depth,

@@ -177,6 +177,36 @@ impl EngagementFigures {
     }
 }
 
+/// What a roughing operation left above its allowance, read on the stock it
+/// left (docs/roughing.md, "Material left above the allowance"): the material
+/// above the part grown by the allowances, split into the steps the levels
+/// leave where the cutter reaches and the places it cannot reach (a corner
+/// sharper than it, a slot narrower than it), which a smaller tool or the
+/// finishing must take.
+#[derive(Debug, Clone, Serialize)]
+pub struct LeftFigures {
+    /// Material thinner than this above the part grown by the allowances is
+    /// not counted (mm): the minimum chip of rest roughing
+    /// (`scallop_geom::tol::rough::MIN_CHIP`) and the stock's rounding.
+    pub limit_mm: f64,
+    /// Volume above the part grown by the allowances (mm^3), reachable or not.
+    pub volume_mm3: f64,
+    /// Largest height of material above the part grown by the allowances
+    /// where the cutter reaches (mm): the steps between levels on slopes.
+    pub reached_max_mm: f64,
+    /// Where it is, `[x, y]` (mm).
+    pub reached_at: Option<[f64; 2]>,
+    /// Area where the cutter cannot take the stock down to the part grown by
+    /// the allowances (mm^2).
+    pub unreachable_area_mm2: f64,
+    /// The part of `volume_mm3` there (mm^3).
+    pub unreachable_volume_mm3: f64,
+    /// Largest height of material there above the part grown by the allowances (mm).
+    pub unreachable_depth_mm: f64,
+    /// The unreachable places, largest first (at most ten).
+    pub places: Vec<crate::RestPlaceReport>,
+}
+
 /// The report of one operation.
 #[derive(Debug, Clone, Serialize)]
 pub struct OperationReport {
@@ -197,6 +227,9 @@ pub struct OperationReport {
     /// A roughing operation's engagement as the simulator read it.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub engagement: Option<EngagementFigures>,
+    /// What a roughing operation left above its allowance.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub left: Option<LeftFigures>,
 }
 
 /// The report of a job (`report.json`).
@@ -309,6 +342,7 @@ pub fn run_job_with_progress(job: &Job, progress: &dyn Fn(JobStep)) -> Result<Jo
     let field = PartField::new(&zmap, &prepared.index);
     let part_top = prepared.mesh.bounds().max.z;
     let mut planned: Vec<(Planned, StockFigures, Option<EngagementFigures>)> = Vec::with_capacity(job.operations.len());
+    let mut lefts: Vec<Option<LeftFigures>> = Vec::with_capacity(job.operations.len());
     for (index, op) in job.operations.iter().enumerate() {
         progress(JobStep { index, count, phase: JobPhase::Planning });
         let f = &op.finish;
@@ -365,6 +399,10 @@ pub fn run_job_with_progress(job: &Job, progress: &dyn Fn(JobStep)) -> Result<Jo
             clearance_mm: clearance,
         };
         planned.push((p, figures, engagement));
+        lefts.push(match &op.rough {
+            Some(r) => Some(crate::rough::left_above_allowance(&zmap, &field, &prepared, &f.cutter, r)?),
+            None => None,
+        });
     }
     let Some(last) = job.operations.last().map(|o| &o.finish) else {
         return Err(no_operation());
@@ -383,7 +421,8 @@ pub fn run_job_with_progress(job: &Job, progress: &dyn Fn(JobStep)) -> Result<Jo
     let mut toolpath = Toolpath::new(first.machine[0] * 1000.0);
     let mut reports = Vec::with_capacity(planned.len());
     let mut total_time = 0.0;
-    for ((p, figures, engagement), (k, op)) in planned.iter().zip(job.operations.iter().enumerate()) {
+    for (((p, figures, engagement), left), (k, op)) in planned.iter().zip(lefts).zip(job.operations.iter().enumerate())
+    {
         toolpath.extend_from(p.toolpath());
         total_time += p.report().total_time_s;
         reports.push(OperationReport {
@@ -395,6 +434,7 @@ pub fn run_job_with_progress(job: &Job, progress: &dyn Fn(JobStep)) -> Result<Jo
             plan: p.report().clone(),
             stock: figures.clone(),
             engagement: engagement.clone(),
+            left,
         });
     }
     let v = &simulation.verification;

@@ -45,8 +45,8 @@ pub use finish::{
 };
 pub use grid::{GridAxis, GridError, MAX_GRID_POINTS};
 pub use job::{
-    EngagementFigures, Job, JobOutput, JobPhase, JobReport, JobStep, Operation, OperationReport, STOCK_CLEARANCE_MM,
-    StockFigures, StockShape, run_job, run_job_with_progress,
+    EngagementFigures, Job, JobOutput, JobPhase, JobReport, JobStep, LeftFigures, Operation, OperationReport,
+    STOCK_CLEARANCE_MM, StockFigures, StockShape, run_job, run_job_with_progress,
 };
 pub use rough5::{
     FaceReport, OnMachine, Posted, ProgramTime, Rough5Job, Rough5Metrics, Rough5Output, Rough5Step, TcpWords,

@@ -91,3 +91,181 @@ pub(crate) fn material_of(zmap: &scallop_sim::ZMap) -> Result<Option<MaterialMap
     let (cx, cy) = zmap.cell_size();
     Ok(Some(MaterialMap::new([b.min.x, b.min.y], [cx, cy], zmap.nx(), zmap.ny(), tops)?))
 }
+
+/// Places of unreachable material reported.
+const LEFT_PLACES: usize = 10;
+
+/// What a roughing operation with `settings` and `cutter` left above its
+/// allowance on the stock `zmap`, over the part `field` (cells with no part
+/// under their centre are not measured).
+///
+/// Per cell p: the floor `F(p)` is the part's height grown sideways by the
+/// radial allowance (the highest part cell within `s` plus a cell's diagonal
+/// of p: a wall lies anywhere between two centres, and a wall across the grid
+/// steps by a diagonal) plus the axial allowance; the
+/// material left is `h(p) - F(p)` where above [`LeftFigures::limit_mm`].
+/// The lowest the operation's cutter can take the stock at p is
+/// `reach(p) = min over centres c within R of p of CL(c) + a + h_R(|p - c|)`,
+/// with CL the drop-cutter of the cutter grown by the radial allowance (the
+/// tool the planner keeps off the part) and `h_R` the real cutter's profile
+/// (docs/roughing.md): where `reach(p)` stands above `F(p)` plus the limit,
+/// the cutter cannot reach. CL is sampled at the cell centres, so `reach` is
+/// known within the grid's sampling.
+///
+/// # Errors
+/// [`EngineError::Rough`] for a cone (no grown cutter).
+pub(crate) fn left_above_allowance(
+    zmap: &scallop_sim::ZMap,
+    field: &scallop_sim::PartField,
+    prepared: &PreparedPart,
+    cutter: &scallop_cutter::Cutter,
+    settings: &RoughSettings,
+) -> Result<crate::LeftFigures, EngineError> {
+    use rayon::prelude::*;
+    let (nx, ny) = (zmap.nx(), zmap.ny());
+    let (cx, cy) = zmap.cell_size();
+    let area = cx * cy;
+    let part: Vec<f64> = field.heights().collect();
+    let heights = zmap.heights();
+    let limit = scallop_rough::tol::MIN_CHIP + zmap.eps();
+    // Cell offsets within `d` (centre to centre).
+    let disc = |d: f64| -> Vec<(isize, isize, f64)> {
+        #[allow(clippy::cast_possible_truncation, reason = "a small count")]
+        let (ri, rj) = ((d / cx).floor() as isize, (d / cy).floor() as isize);
+        let mut out = Vec::new();
+        for dj in -rj..=rj {
+            for di in -ri..=ri {
+                #[allow(clippy::cast_precision_loss, reason = "small counts")]
+                let r = (di as f64 * cx).hypot(dj as f64 * cy);
+                if r <= d {
+                    out.push((di, dj, r));
+                }
+            }
+        }
+        out
+    };
+    let at = |i: usize, j: usize, o: &(isize, isize, f64)| -> Option<usize> {
+        let (ii, jj) = (i.checked_add_signed(o.0)?, j.checked_add_signed(o.1)?);
+        (ii < nx && jj < ny).then_some(jj * nx + ii)
+    };
+    let grow = disc(settings.radial_allowance + cx.hypot(cy));
+    let floor: Vec<f64> = (0..nx * ny)
+        .into_par_iter()
+        .map(|k| {
+            if part[k] == f64::NEG_INFINITY {
+                return f64::NEG_INFINITY;
+            }
+            let (i, j) = (k % nx, k / nx);
+            grow.iter().filter_map(|o| at(i, j, o)).map(|n| part[n]).fold(f64::NEG_INFINITY, f64::max)
+                + settings.axial_allowance
+        })
+        .collect();
+    let left: Vec<usize> =
+        (0..nx * ny).filter(|&k| floor[k] != f64::NEG_INFINITY && heights[k] - floor[k] > limit).collect();
+    // The grown cutter's drop-cutter at the centres within R of a cell left.
+    let reach_disc = disc(cutter.radius());
+    let mut need = vec![false; nx * ny];
+    for &k in &left {
+        for o in &reach_disc {
+            if let Some(n) = at(k % nx, k / nx, o) {
+                need[n] = true;
+            }
+        }
+    }
+    let grown = scallop_rough::grown_cutter(cutter, settings.radial_allowance)?;
+    let bottom = zmap.stock().min.z - prepared.mesh.bounds().diagonal() - 1.0;
+    let cl: Vec<f64> = (0..nx * ny)
+        .into_par_iter()
+        .map(|k| {
+            if need[k] {
+                scallop_cutter::drop_cutter(&grown, &prepared.index, zmap.cell_center(k % nx, k / nx), bottom).tip.z
+            } else {
+                f64::INFINITY
+            }
+        })
+        .collect();
+    let shape = cutter.shape();
+    let unreachable: Vec<bool> = left
+        .par_iter()
+        .map(|&k| {
+            let (i, j) = (k % nx, k / nx);
+            let reach = reach_disc
+                .iter()
+                .filter_map(|o| at(i, j, o).map(|n| cl[n] + shape.height_at(o.2)))
+                .fold(f64::INFINITY, f64::min)
+                + settings.axial_allowance;
+            reach > floor[k] + limit
+        })
+        .collect();
+    let mut figures = crate::LeftFigures {
+        limit_mm: limit,
+        volume_mm3: 0.0,
+        reached_max_mm: 0.0,
+        reached_at: None,
+        unreachable_area_mm2: 0.0,
+        unreachable_volume_mm3: 0.0,
+        unreachable_depth_mm: 0.0,
+        places: Vec::new(),
+    };
+    let mut rest = vec![0.0; nx * ny];
+    for (&k, &out) in left.iter().zip(&unreachable) {
+        let excess = heights[k] - floor[k];
+        figures.volume_mm3 += excess * area;
+        if out {
+            figures.unreachable_area_mm2 += area;
+            figures.unreachable_volume_mm3 += excess * area;
+            figures.unreachable_depth_mm = figures.unreachable_depth_mm.max(excess);
+            rest[k] = excess;
+        } else if excess > figures.reached_max_mm {
+            figures.reached_max_mm = excess;
+            let c = zmap.cell_center(k % nx, k / nx);
+            figures.reached_at = Some([c.x, c.y]);
+        }
+    }
+    figures.places = places(&rest, zmap);
+    Ok(figures)
+}
+
+/// The connected places (4-neighbours) of cells with `rest > 0`, largest
+/// first, at most [`LEFT_PLACES`].
+fn places(rest: &[f64], zmap: &scallop_sim::ZMap) -> Vec<crate::RestPlaceReport> {
+    let nx = zmap.nx();
+    let (cx, cy) = zmap.cell_size();
+    let mut seen = vec![false; rest.len()];
+    let mut out = Vec::new();
+    let mut stack = Vec::new();
+    for start in 0..rest.len() {
+        if seen[start] || rest[start] <= 0.0 {
+            continue;
+        }
+        seen[start] = true;
+        stack.push(start);
+        let (mut cells, mut deepest) = (0usize, (0.0, start));
+        while let Some(k) = stack.pop() {
+            cells += 1;
+            if rest[k] > deepest.0 {
+                deepest = (rest[k], k);
+            }
+            let (i, j) = (k % nx, k / nx);
+            let neighbours = [
+                (i > 0).then(|| k - 1),
+                (i + 1 < nx).then_some(k + 1),
+                (j > 0).then(|| k - nx),
+                (k + nx < rest.len()).then_some(k + nx),
+            ];
+            for n in neighbours.into_iter().flatten() {
+                if !seen[n] && rest[n] > 0.0 {
+                    seen[n] = true;
+                    stack.push(n);
+                }
+            }
+        }
+        #[allow(clippy::cast_precision_loss, reason = "cell counts")]
+        let area_mm2 = cells as f64 * cx * cy;
+        let c = zmap.cell_center(deepest.1 % nx, deepest.1 / nx);
+        out.push(crate::RestPlaceReport { at: [c.x, c.y], area_mm2, depth_mm: deepest.0 });
+    }
+    out.sort_by(|a, b| b.area_mm2.total_cmp(&a.area_mm2).then(b.depth_mm.total_cmp(&a.depth_mm)));
+    out.truncate(LEFT_PLACES);
+    out
+}

@@ -659,6 +659,14 @@ pub mod rough {
     /// plunge at the plunge feed does the rest.
     pub const APPROACH: f64 = 1.0;
 
+    /// Such a rapid stops above a cleared level only where the tool centre lies
+    /// this far inside the level's region (mm), else above the level over it
+    /// that does: the level's passes sweep its region's boundary within their
+    /// chords, so a centre on that boundary may graze the step a sloped wall
+    /// keeps above the level (on `octagonal_pocket` a rapid 1 mm above a level
+    /// met 2 mm of stock at the tool's rim, 1.7 um out of the swept area).
+    pub const ENTRY_MARGIN: f64 = 0.05;
+
     /// Largest sweep of one arc move (rad): longer arcs are split so that no
     /// move reads as a full circle and the centre words stay well defined.
     pub const MAX_ARC_SWEEP: f64 = std::f64::consts::FRAC_PI_2;

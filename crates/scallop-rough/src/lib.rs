@@ -512,7 +512,6 @@ impl Emitter {
     /// The moves of node `k`: the way there, then its passes and links.
     fn node(&mut self, nodes: &[Node], k: usize) {
         let node = &nodes[k];
-        let above = node.top.min(self.stock_top);
         let mut first = true;
         for step in &node.steps {
             match step {
@@ -534,6 +533,7 @@ impl Emitter {
                             self.path.push(Move::new(MoveKind::Link, Point3::new(s[0], s[1], node.z)));
                             self.links += 1;
                         } else {
+                            let above = self.cleared_top(nodes, k, s);
                             self.retract_to(s, above, node.z, &node.region, *cleared);
                         }
                     }
@@ -549,7 +549,7 @@ impl Emitter {
     /// levels above `k` and a plunge.
     fn enter(&mut self, nodes: &[Node], k: usize, s: P2) {
         let node = &nodes[k];
-        let above = node.top.min(self.stock_top);
+        let above = self.cleared_top(nodes, k, s);
         let (Some(here), Some(last)) = (self.at(), self.last) else {
             self.path.push(Move::new(MoveKind::Rapid, Point3::new(s[0], s[1], self.clearance)));
             self.plunge(s, above, node.z, &node.region);
@@ -584,6 +584,23 @@ impl Emitter {
                 self.plunge(s, above, node.z, &node.region);
             }
         }
+    }
+
+    /// The height down to which the material over the tool centre `s` of node
+    /// `k` and over the start of a helix about it is cleared: the level of its
+    /// parent when both lie [`tol::ENTRY_MARGIN`] inside the parent's region
+    /// (the parent's passes swept every point within R of it), else the same
+    /// for the parent, up to a root's top; never above the stock's top.
+    fn cleared_top(&self, nodes: &[Node], k: usize, s: P2) -> f64 {
+        let points = [s, [s[0] + self.helix_radius, s[1]]];
+        let mut c = k;
+        while let Some(p) = nodes[c].parent {
+            if points.iter().all(|&q| inside_by(&nodes[p].region, q, tol::ENTRY_MARGIN)) {
+                break;
+            }
+            c = p;
+        }
+        nodes[c].top.min(self.stock_top)
     }
 
     /// Down from the cleared height `above` to `z` at `s`: a rapid to
@@ -654,6 +671,16 @@ impl Emitter {
         push_contour(&mut self.path, c, z);
         self.passes += 1;
     }
+}
+
+/// Whether `p` and the points at distance `d` from it in 16 directions lie in
+/// `region`.
+fn inside_by(region: &Region, p: P2, d: f64) -> bool {
+    region.contains(p)
+        && (0..16).all(|i| {
+            let a = std::f64::consts::PI * f64::from(i) / 8.0;
+            region.contains([p[0] + d * a.cos(), p[1] + d * a.sin()])
+        })
 }
 
 /// The node and its ancestors.

@@ -10,8 +10,8 @@ use scallop_cutter::{Cutter, CutterShape, drop_cutter};
 use scallop_geom::{Aabb3, Point2, Point3};
 use scallop_mesh::{MeshIndex, TriMesh};
 use scallop_rough::{
-    ClearOptions, Direction, Motion, Pattern, RoughSettings, Step, grown_cutter, plan_offset, plan_rough,
-    pocket_toolpath,
+    ClearOptions, Direction, MaterialMap, Motion, Pattern, RoughSettings, Step, grown_cutter, plan_offset, plan_rough,
+    plan_rough_from, pocket_toolpath,
 };
 use scallop_toolpath::{MoveKind, Toolpath};
 
@@ -207,5 +207,102 @@ fn links_and_threads() {
         if moves[k].kind == MoveKind::Link {
             assert!((moves[k].to.z - moves[k - 1].to.z).abs() < 1e-12);
         }
+    }
+}
+
+/// A material map of 0.5 mm cells over `stock` holding the stock's top in
+/// `blocks` (`[x0, y0, x1, y1, top]`, material from the stock's bottom up to
+/// `top`) and nothing elsewhere: what earlier operations might have left.
+fn material(stock: &Aabb3, blocks: &[[f64; 5]]) -> MaterialMap {
+    let cell = 0.5;
+    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "small positive counts")]
+    let (nx, ny) =
+        (((stock.max.x - stock.min.x) / cell).ceil() as usize, ((stock.max.y - stock.min.y) / cell).ceil() as usize);
+    let mut tops = vec![f64::NEG_INFINITY; nx * ny];
+    for j in 0..ny {
+        for i in 0..nx {
+            let (x, y) = (stock.min.x + (i as f64 + 0.5) * cell, stock.min.y + (j as f64 + 0.5) * cell);
+            for b in blocks {
+                if x >= b[0] && x <= b[2] && y >= b[1] && y <= b[3] {
+                    tops[j * nx + i] = tops[j * nx + i].max(b[4]);
+                }
+            }
+        }
+    }
+    MaterialMap::new([stock.min.x, stock.min.y], [cell, cell], nx, ny, tops).unwrap()
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(6))]
+
+    /// Roughing from an in-process stock (rest roughing): every level's
+    /// region lies in the region of the same level planned from the box
+    /// (so outside the part grown by the allowances), every centre of it is
+    /// within R of material above the level, and every centre of the box's
+    /// region within `R - margin` of such material is kept (brute force over
+    /// the material's cells, not the planner's outlines).
+    #[test]
+    fn rest_regions_reach_the_material_and_only_it(
+        w in 8.0..16.0_f64, d in 8.0..16.0_f64, h in 3.0..7.0_f64,
+        bx in -10.0..6.0_f64, by in -10.0..6.0_f64, bw in 1.0..6.0_f64, top in 1.0..9.0_f64,
+    ) {
+        let mesh = stepped_part(-w / 2.0, w / 2.0, -d / 2.0, d / 2.0, h, 1.5);
+        let index = MeshIndex::build(&mesh);
+        let r = 2.0;
+        let cutter = Cutter::new(CutterShape::Flat { radius: r }, 40.0).unwrap();
+        let stock = Aabb3 { min: Point3::new(-w / 2.0 - 5.0, -d / 2.0 - 5.0, 0.0), max: Point3::new(w / 2.0 + 5.0, d / 2.0 + 5.0, h + 3.0) };
+        // Two blocks of material left: one placed at random, one in a corner of the stock.
+        let blocks = [[bx, by, bx + bw, by + bw, top], [stock.min.x, stock.min.y, stock.min.x + 3.0, stock.min.y + 2.0, h + 2.0]];
+        let map = material(&stock, &blocks);
+        let set = settings(1.0, 0.3, 0.2);
+        let motion = Motion { clearance_z: h + 10.0, feed: 1000.0 };
+        let from_box = plan_rough(&index, &cutter, &stock, &set, &motion, 1e-3).unwrap();
+        let rest = plan_rough_from(&index, &cutter, &stock, Some(&map), &set, &motion, 1e-3).unwrap();
+        let cell = 0.5;
+        // Cells with material more than the minimum chip above z, as squares.
+        let above = |z: f64| -> Vec<[f64; 2]> {
+            let mut out = Vec::new();
+            let (nx, ny) = (((stock.max.x - stock.min.x) / cell).ceil() as usize, ((stock.max.y - stock.min.y) / cell).ceil() as usize);
+            for j in 0..ny { for i in 0..nx {
+                let c = [stock.min.x + (i as f64 + 0.5) * cell, stock.min.y + (j as f64 + 0.5) * cell];
+                if blocks.iter().any(|b| c[0] >= b[0] && c[0] <= b[2] && c[1] >= b[1] && c[1] <= b[3] && b[4] > z + scallop_rough::tol::MIN_CHIP) {
+                    out.push(c);
+                }
+            }}
+            out
+        };
+        // Distance from p to a cell's square.
+        let to_cell = |p: [f64; 2], c: [f64; 2]| ((p[0] - c[0]).abs() - cell / 2.0).max(0.0).hypot(((p[1] - c[1]).abs() - cell / 2.0).max(0.0));
+        let margin = cell * 2f64.sqrt() + scallop_rough::tol::MIN_CHIP;
+        let mut kept = 0;
+        for level in &from_box.levels {
+            let cells = above(level.z);
+            let limited = rest.levels.iter().find(|l| (l.z - level.z).abs() < 1e-9);
+            // Sample the box's region on a 0.25 mm grid.
+            let (lo, hi) = (level.region.bounds().unwrap().0, level.region.bounds().unwrap().1);
+            let mut y = lo[1];
+            while y <= hi[1] {
+                let mut x = lo[0];
+                while x <= hi[0] {
+                    let p = [x, y];
+                    let near = cells.iter().map(|&c| to_cell(p, c)).fold(f64::INFINITY, f64::min);
+                    let inside_rest = limited.is_some_and(|l| l.region.contains(p));
+                    if inside_rest {
+                        kept += 1;
+                        // Within the region planned from the box (away from its boundary by the chords).
+                        let boundary = [[1e-2, 0.0], [-1e-2, 0.0], [0.0, 1e-2], [0.0, -1e-2]].iter().any(|o| !level.region.contains([x + o[0], y + o[1]]));
+                        prop_assert!(level.region.contains(p) || boundary, "{p:?} at {} outside the box's region", level.z);
+                        prop_assert!(near <= r + 0.3, "{p:?} at {} is {near} mm from material", level.z);
+                    } else if level.region.contains(p) && near < r - margin - 0.35 {
+                        // Near the rest region's boundary the booleans' chords decide.
+                        let edge = limited.is_some_and(|l| [[0.1, 0.0], [-0.1, 0.0], [0.0, 0.1], [0.0, -0.1]].iter().any(|o| l.region.contains([x + o[0], y + o[1]])));
+                        prop_assert!(edge, "{p:?} at {} reaches material {near} mm away but is not kept", level.z);
+                    }
+                    x += 0.25;
+                }
+                y += 0.25;
+            }
+        }
+        prop_assert!(kept > 0, "no centre kept");
     }
 }
