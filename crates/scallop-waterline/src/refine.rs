@@ -246,10 +246,10 @@ impl Local<'_> {
         let mut r = accept;
         loop {
             let p = mid + towards * r;
-            // The first probe inwards may be known already (the same point).
-            let (h, slot) = match first.take() {
-                Some(known) if mid_in && r == accept => known,
-                _ => self.height_slot(p),
+            // The first probe (taken on the first pass) may be known already: the same point.
+            let (h, slot) = match first.take().filter(|_| mid_in) {
+                Some(known) => known,
+                None => self.height_slot(p),
             };
             if (h > 0.0) != mid_in {
                 if r <= accept {

@@ -25,7 +25,8 @@ use scallop_geom::{Point3, tol};
 pub(super) fn ball_clear_of(corners: &[Point3; 3], radius: f64, cx: f64, cy: f64, tip: f64) -> bool {
     let oz = tip + radius;
     let [a, b, c] = corners;
-    if !(a.z.max(b.z).max(c.z) <= oz) {
+    let top = a.z.max(b.z).max(c.z);
+    if top > oz || top.is_nan() || oz.is_nan() {
         return false; // a point above the centre's height may be in the cylinder
     }
     let o = [cx, cy, oz];
@@ -100,7 +101,41 @@ fn finite(v: f64) -> Option<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::CutterShape;
+    use crate::drop::{ALL_FEATURES, ClPoint, drop_features};
+    use crate::shape::Profile;
     use scallop_geom::rng::SplitMix64;
+    use scallop_geom::{Point2, Vec3};
+
+    /// A triangle the ball is clear of at a tip height never gives a contact
+    /// above that height: random triangles and points, tips just below, at and
+    /// above the triangle's own contact.
+    #[test]
+    fn a_clear_triangle_never_raises_the_ball() {
+        let profile = Profile::new(&CutterShape::Ball { radius: 1.0 });
+        let mut rng = SplitMix64::new(20_261_206);
+        let mut cleared = 0;
+        for _ in 0..20_000 {
+            let mut q = || Point3::new(rng.uniform(-1.5, 1.5), rng.uniform(-1.5, 1.5), rng.uniform(-1.0, 1.0));
+            let t = [q(), q(), q()];
+            let n = (t[1] - t[0]).cross(&(t[2] - t[0]));
+            if n.norm() == 0.0 {
+                continue;
+            }
+            let n: Vec3 = if n.z < 0.0 { -n / n.norm() } else { n / n.norm() };
+            let c = Point2::new(rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0));
+            let mut own = ClPoint::floor(c, -100.0);
+            drop_features(&profile, &t, &n, 0, ALL_FEATURES, &mut own);
+            for offset in [-0.3, -1e-6, -1e-12, 0.0, 1e-12, 1e-6, 0.2, 1.5] {
+                let tip = own.tip.z + offset;
+                if ball_clear_of(&t, 1.0, c.x, c.y, tip) {
+                    cleared += 1;
+                    assert!(own.tip.z <= tip, "{t:?} at {c:?}: contact {} above the clear tip {tip}", own.tip.z);
+                }
+            }
+        }
+        assert!(cleared > 10_000, "the test clears triangles ({cleared})");
+    }
 
     /// The region test against dense sampling of the triangle: never above
     /// the sampled minimum, and close to it.

@@ -35,7 +35,6 @@ const MAX_ITERATIONS: usize = 200;
 
 pub(super) fn drop_edge(profile: &Profile, a: &Point3, b: &Point3, triangle: usize, c: Point2, best: &mut ClPoint) {
     let (ex, ey) = (b.x - a.x, b.y - a.y);
-    let radius = profile.radius;
     let len2 = ex * ex + ey * ey;
     if len2 == 0.0 {
         return; // vertical edge: its upper corner is the highest contact
@@ -44,6 +43,19 @@ pub(super) fn drop_edge(profile: &Profile, a: &Point3, b: &Point3, triangle: usi
     if edge_below(profile, [px, py, a.z], [ex, ey, b.z - a.z], len2, best.tip.z) {
         return;
     }
+    drop_edge_exact(profile, a, b, triangle, c, best);
+}
+
+/// [`drop_edge`] without the bounds of [`edge_below`]: the edge frame and the
+/// contact.
+fn drop_edge_exact(profile: &Profile, a: &Point3, b: &Point3, triangle: usize, c: Point2, best: &mut ClPoint) {
+    let (ex, ey) = (b.x - a.x, b.y - a.y);
+    let radius = profile.radius;
+    let len2 = ex * ex + ey * ey;
+    if len2 == 0.0 {
+        return;
+    }
+    let (px, py) = (a.x - c.x, a.y - c.y);
     let len = len2.sqrt();
     let (ux, uy) = (ex / len, ey / len);
     let xa = px * ux + py * uy;
@@ -282,6 +294,47 @@ mod tests {
                 m * x - shape.height_at((x * x + d * d).sqrt())
             })
             .fold(f64::NEG_INFINITY, f64::max)
+    }
+
+    /// The bounds of `edge_below` never skip an edge whose exact contact
+    /// would raise the best height: random edges, tips and best heights around
+    /// the exact contact (just below, at and above it), every shape.
+    #[test]
+    fn edge_below_never_skips_a_raising_edge() {
+        use scallop_geom::rng::SplitMix64;
+        let shapes = [
+            CutterShape::Flat { radius: 1.0 },
+            CutterShape::Ball { radius: 1.0 },
+            CutterShape::Bull { radius: 1.0, corner: 0.3 },
+            CutterShape::Cone { radius: 1.0, half_angle: 0.6 },
+        ];
+        let mut rng = SplitMix64::new(20_261_206);
+        let mut skipped = 0;
+        for shape in shapes {
+            let profile = Profile::new(&shape);
+            for _ in 0..20_000 {
+                let mut q = || Point3::new(rng.uniform(-1.5, 1.5), rng.uniform(-1.5, 1.5), rng.uniform(-1.0, 1.0));
+                let (a, b) = (q(), q());
+                let c = Point2::new(0.0, 0.0);
+                let mut exact = ClPoint::floor(c, -100.0);
+                drop_edge_exact(&profile, &a, &b, 0, c, &mut exact);
+                for offset in [-0.3, -1e-6, -1e-12, 0.0, 1e-12, 0.2] {
+                    let start = ClPoint::floor(c, exact.tip.z + offset);
+                    let (mut pruned, mut full) = (start, start);
+                    drop_edge(&profile, &a, &b, 0, c, &mut pruned);
+                    drop_edge_exact(&profile, &a, &b, 0, c, &mut full);
+                    assert_eq!(pruned, full, "{shape:?} {a:?} {b:?} offset {offset}");
+                    let ends = [a.x - c.x, a.y - c.y, a.z];
+                    let (ex, ey) = (b.x - a.x, b.y - a.y);
+                    if ex * ex + ey * ey > 0.0
+                        && edge_below(&profile, ends, [ex, ey, b.z - a.z], ex * ex + ey * ey, start.tip.z)
+                    {
+                        skipped += 1;
+                    }
+                }
+            }
+        }
+        assert!(skipped > 10_000, "the bounds skip edges ({skipped})");
     }
 
     #[test]
