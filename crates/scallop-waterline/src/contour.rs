@@ -29,7 +29,7 @@ use scallop_geom::Point2;
 
 use crate::WaterlineGrid;
 use crate::cell::{Cell, Resolver, simple_links};
-use crate::refine::{Probe, chord_groups};
+use crate::refine::Probe;
 
 /// The crossings of one grid edge, in increasing x (horizontal) or y
 /// (vertical).
@@ -110,43 +110,25 @@ fn edge_crossings(grid: &WaterlineGrid<'_>, probe: &Probe<'_>, inside: &[bool]) 
         }
     }
     let floored = |k: usize| (grid.heights[k] - z).max(-grid.step);
-    let segments: Vec<(Point2, Point2)> = todo
-        .iter()
-        .map(|&(id, _, _)| {
-            let ([ia, ja], [ib, jb]) = num.ends(id);
-            (grid.point(ia, ja), grid.point(ib, jb))
-        })
-        .collect();
-    // Nearby edges (consecutive in edge order: along a row) share one
-    // candidate list, as runs of chords do: the same heights, fewer index queries.
-    let groups = chord_groups(&segments, grid.step);
-    let found: Vec<Vec<Point2>> = groups
+    let found: Vec<Vec<Point2>> = todo
         .par_iter()
-        .flat_map_iter(|&(start, end)| {
-            let (mut lo, mut hi) = (segments[start].0, segments[start].0);
-            for p in segments[start..end].iter().flat_map(|(a, b)| [a, b]) {
-                (lo, hi) = (Point2::new(lo.x.min(p.x), lo.y.min(p.y)), Point2::new(hi.x.max(p.x), hi.y.max(p.y)));
+        .with_min_len(16)
+        .map(|&(id, first_inside, crossing)| {
+            let ([ia, ja], [ib, jb]) = num.ends(id);
+            let (ka, kb) = (ja * nx + ia, jb * nx + ib);
+            let (a, b) = (grid.point(ia, ja), grid.point(ib, jb));
+            let local = probe.local(Point2::new(a.x.min(b.x), a.y.min(b.y)), Point2::new(a.x.max(b.x), a.y.max(b.y)));
+            if !crossing {
+                return local.gaps(a, grid.slots[ka] as usize, b, floored(kb));
             }
-            let local = probe.local(lo, hi);
-            (start..end)
-                .map(|e| {
-                    let (id, first_inside, crossing) = todo[e];
-                    let ([ia, ja], [ib, jb]) = num.ends(id);
-                    let (ka, kb) = (ja * nx + ia, jb * nx + ib);
-                    let (a, b) = segments[e];
-                    if !crossing {
-                        return local.gaps(a, grid.slots[ka] as usize, b, floored(kb));
-                    }
-                    // Floored as `Probe::height` floors them, so the secant sees one function.
-                    let slot = |k: usize| (grid.slots[k] != u32::MAX).then_some(grid.slots[k] as usize);
-                    let p = if first_inside {
-                        local.bisect_heights(a, floored(ka), slot(ka), b, floored(kb))
-                    } else {
-                        local.bisect_heights(b, floored(kb), slot(kb), a, floored(ka))
-                    };
-                    vec![p]
-                })
-                .collect::<Vec<_>>()
+            // Floored as `Probe::height` floors them, so the secant sees one function.
+            let slot = |k: usize| (grid.slots[k] != u32::MAX).then_some(grid.slots[k] as usize);
+            let p = if first_inside {
+                local.bisect_heights(a, floored(ka), slot(ka), b, floored(kb))
+            } else {
+                local.bisect_heights(b, floored(kb), slot(kb), a, floored(ka))
+            };
+            vec![p]
         })
         .collect();
     let mut offset = 0;

@@ -432,7 +432,7 @@ fn refine_chord(local: &Local<'_>, a: Point2, b: Point2, chord_tolerance: f64, d
 /// at most [`CHORDS_PER_GROUP`] chords whose ends stay within a box of
 /// [`GROUP_SPAN`] grid steps (one index query instead of one per chord; the
 /// heights are the same).
-pub(crate) fn chord_groups(chords: &[(Point2, Point2)], step: f64) -> Vec<(usize, usize)> {
+fn chord_groups(chords: &[(Point2, Point2)], step: f64) -> Vec<(usize, usize)> {
     let span = GROUP_SPAN * step;
     let mut groups = Vec::new();
     let mut start = 0;
