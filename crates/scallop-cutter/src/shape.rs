@@ -211,8 +211,20 @@ impl Profile {
         Profile { shape: *shape, radius, flat_radius, corner, tan, cot }
     }
 
+    /// [`Profile::height`] at the horizontal distance `sqrt(rho2)`, for bounds:
+    /// without the square root of `rho2` where the profile does not need it
+    /// (flat, ball), so equal to `height(rho2.sqrt())` up to rounding only.
+    #[inline(always)]
+    pub(crate) fn height_sq(&self, rho2: f64) -> f64 {
+        match self.shape {
+            CutterShape::Flat { .. } => 0.0,
+            CutterShape::Ball { .. } => self.corner - (self.corner * self.corner - rho2).max(0.0).sqrt(),
+            CutterShape::Bull { .. } | CutterShape::Cone { .. } => self.height(rho2.sqrt()),
+        }
+    }
+
     /// Same as [`CutterShape::height_at`], without trigonometry.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn height(&self, rho: f64) -> f64 {
         match self.shape {
             CutterShape::Flat { .. } => 0.0,

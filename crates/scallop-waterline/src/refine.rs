@@ -218,15 +218,39 @@ impl Local<'_> {
     /// the contour found from an inside midpoint is the nearest one along the
     /// line up to that tolerance. Between two outside probes an inside sliver
     /// is not looked for (the midpoint is safe there).
+    ///
+    /// The first probe pair needs one full evaluation where a single triangle
+    /// settles the other side (the full height is the maximum over the
+    /// triangles, so one triangle lifting the cutter above z proves inside):
+    /// the last contact triangle at `mid` before the full evaluation at the
+    /// first outside probe; the midpoint's contact triangle at the first
+    /// inside probe. The outcome is the same as with full evaluations.
     fn contour_near(&self, mid: Point2, normal: Vec2, accept: f64, reach: f64) -> Near {
+        let mut first: Option<(f64, Option<usize>)> = None;
+        if let Some(seed) = self.seed.get()
+            && self.triangle_height(seed, mid) > 0.0
+        {
+            let (h, slot) = self.height_slot(mid - normal * accept);
+            if h <= 0.0 {
+                return Near::Within; // inside at the midpoint, outside within `accept`
+            }
+            first = Some((h, slot));
+        }
         let (h_mid, slot_mid) = self.height_slot(mid);
         let mid_in = h_mid > 0.0;
+        if !mid_in && slot_mid.is_some_and(|s| self.triangle_height(s, mid + normal * accept) > 0.0) {
+            return Near::Within; // outside at the midpoint, inside within `accept`
+        }
         let towards = if mid_in { -normal } else { normal };
         let (mut last, mut h_last, mut r_last, mut slot_last) = (mid, h_mid, 0.0, slot_mid);
         let mut r = accept;
         loop {
             let p = mid + towards * r;
-            let (h, slot) = self.height_slot(p);
+            // The first probe (taken on the first pass) may be known already: the same point.
+            let (h, slot) = match first.take().filter(|_| mid_in) {
+                Some(known) => known,
+                None => self.height_slot(p),
+            };
             if (h > 0.0) != mid_in {
                 if r <= accept {
                     return Near::Within;

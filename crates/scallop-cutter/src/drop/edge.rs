@@ -35,13 +35,29 @@ const MAX_ITERATIONS: usize = 200;
 
 pub(super) fn drop_edge(profile: &Profile, a: &Point3, b: &Point3, triangle: usize, c: Point2, best: &mut ClPoint) {
     let (ex, ey) = (b.x - a.x, b.y - a.y);
-    let radius = profile.radius;
-    let len = (ex * ex + ey * ey).sqrt();
-    if len == 0.0 {
+    let len2 = ex * ex + ey * ey;
+    if len2 == 0.0 {
         return; // vertical edge: its upper corner is the highest contact
     }
-    let (ux, uy) = (ex / len, ey / len);
     let (px, py) = (a.x - c.x, a.y - c.y);
+    if edge_below(profile, [px, py, a.z], [ex, ey, b.z - a.z], len2, best.tip.z) {
+        return;
+    }
+    drop_edge_exact(profile, a, b, triangle, c, best);
+}
+
+/// [`drop_edge`] without the bounds of [`edge_below`]: the edge frame and the
+/// contact.
+fn drop_edge_exact(profile: &Profile, a: &Point3, b: &Point3, triangle: usize, c: Point2, best: &mut ClPoint) {
+    let (ex, ey) = (b.x - a.x, b.y - a.y);
+    let radius = profile.radius;
+    let len2 = ex * ex + ey * ey;
+    if len2 == 0.0 {
+        return;
+    }
+    let (px, py) = (a.x - c.x, a.y - c.y);
+    let len = len2.sqrt();
+    let (ux, uy) = (ex / len, ey / len);
     let xa = px * ux + py * uy;
     let d = (px * uy - py * ux).abs();
     if d > radius {
@@ -98,6 +114,45 @@ pub(super) fn drop_edge(profile: &Profile, a: &Point3, b: &Point3, triangle: usi
         best.tip.z = tip;
         best.contact = Contact::Edge { triangle, point: Point3::new(a.x + t * ex, a.y + t * ey, zc) };
     }
+}
+
+/// Whether no contact on the edge from `p` (its first corner, XY relative to
+/// the tip's XY, z absolute) along `e` (`len2 = |e_xy|^2 > 0`) can hold the
+/// tip above `best`. Two bounds, before the edge frame (two square roots, four
+/// divisions) is built:
+/// - the edge's line farther than R, or its highest corner lifted by the
+///   profile at the line's distance d (h is non-decreasing) not above `best`;
+/// - for the ball, the highest contact with the whole line: with the line's
+///   height `z0` at its point nearest the tip's XY and slope `m`, the maximum of
+///   `z0 + m x - h(sqrt(x^2 + d^2))` over |x| <= x_R is
+///   `z0 + x_R sqrt(1 + m^2) - R` (at `x = m x_R / sqrt(1 + m^2)`, see the
+///   module's table), no lower than the contact on the edge itself.
+///
+/// Conservative: d is lowered past its rounding (the cross product may
+/// cancel) and each bound carries the prune slack of its terms, so where the
+/// exact test of [`drop_edge`] would raise `best` this is false and no height
+/// changes. False on NaN.
+#[inline]
+fn edge_below(profile: &Profile, [px, py, za]: [f64; 3], [ex, ey, dz]: [f64; 3], len2: f64, best: f64) -> bool {
+    let cross = px * ey - py * ex;
+    let d2 = cross * cross / len2 - tol::REL_ROUNDING * (px * px + py * py + len2);
+    let (radius, d2) = (profile.radius, d2.max(0.0));
+    let r2 = radius * radius;
+    if d2 > r2 {
+        return true;
+    }
+    let z_top = za.max(za + dz);
+    let slack = tol::REL_PRUNE_SLACK * (z_top.abs() + best.abs() + radius + 1.0);
+    if z_top - profile.height_sq(d2) + slack <= best {
+        return true;
+    }
+    if let CutterShape::Ball { .. } = profile.shape {
+        let rise = dz * (px * ex + py * ey) / len2; // m x_a: the line's height at the foot is za - rise
+        let lift = ((r2 - d2) * (1.0 + dz * dz / len2)).sqrt(); // x_R sqrt(1 + m^2)
+        let slack = tol::REL_PRUNE_SLACK * (za.abs() + rise.abs() + lift + best.abs() + radius + 1.0);
+        return za - rise + lift - radius + slack <= best;
+    }
+    false
 }
 
 /// The x >= 0 that maximises `m x - h(sqrt(x^2 + d^2))` on [0, x_r], for m >= 0.
@@ -239,6 +294,47 @@ mod tests {
                 m * x - shape.height_at((x * x + d * d).sqrt())
             })
             .fold(f64::NEG_INFINITY, f64::max)
+    }
+
+    /// The bounds of `edge_below` never skip an edge whose exact contact
+    /// would raise the best height: random edges, tips and best heights around
+    /// the exact contact (just below, at and above it), every shape.
+    #[test]
+    fn edge_below_never_skips_a_raising_edge() {
+        use scallop_geom::rng::SplitMix64;
+        let shapes = [
+            CutterShape::Flat { radius: 1.0 },
+            CutterShape::Ball { radius: 1.0 },
+            CutterShape::Bull { radius: 1.0, corner: 0.3 },
+            CutterShape::Cone { radius: 1.0, half_angle: 0.6 },
+        ];
+        let mut rng = SplitMix64::new(20_261_206);
+        let mut skipped = 0;
+        for shape in shapes {
+            let profile = Profile::new(&shape);
+            for _ in 0..20_000 {
+                let mut q = || Point3::new(rng.uniform(-1.5, 1.5), rng.uniform(-1.5, 1.5), rng.uniform(-1.0, 1.0));
+                let (a, b) = (q(), q());
+                let c = Point2::new(0.0, 0.0);
+                let mut exact = ClPoint::floor(c, -100.0);
+                drop_edge_exact(&profile, &a, &b, 0, c, &mut exact);
+                for offset in [-0.3, -1e-6, -1e-12, 0.0, 1e-12, 0.2] {
+                    let start = ClPoint::floor(c, exact.tip.z + offset);
+                    let (mut pruned, mut full) = (start, start);
+                    drop_edge(&profile, &a, &b, 0, c, &mut pruned);
+                    drop_edge_exact(&profile, &a, &b, 0, c, &mut full);
+                    assert_eq!(pruned, full, "{shape:?} {a:?} {b:?} offset {offset}");
+                    let ends = [a.x - c.x, a.y - c.y, a.z];
+                    let (ex, ey) = (b.x - a.x, b.y - a.y);
+                    if ex * ex + ey * ey > 0.0
+                        && edge_below(&profile, ends, [ex, ey, b.z - a.z], ex * ex + ey * ey, start.tip.z)
+                    {
+                        skipped += 1;
+                    }
+                }
+            }
+        }
+        assert!(skipped > 10_000, "the bounds skip edges ({skipped})");
     }
 
     #[test]

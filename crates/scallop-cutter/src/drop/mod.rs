@@ -16,6 +16,7 @@
 //! exceed the best height found so far is skipped. Skipping cannot change the
 //! maximum, so the indexed result equals [`drop_cutter_brute_force`] exactly.
 
+mod clear;
 mod edge;
 mod facet;
 mod vertex;
@@ -453,6 +454,7 @@ fn drop_candidates(
     }
     let slack = index.slack();
     let r2 = profile.radius * profile.radius;
+    let ball = matches!(profile.shape, crate::CutterShape::Ball { .. });
     for c in candidates {
         if c.ub + slack <= best.tip.z {
             break; // sorted: nothing after this can rise above the best
@@ -463,8 +465,12 @@ fn drop_candidates(
         let dx = (c.min[0] - xy.x).max(0.0).max(xy.x - c.max[0]);
         let dy = (c.min[1] - xy.y).max(0.0).max(xy.y - c.max[1]);
         let d2 = dx * dx + dy * dy;
-        if d2 > r2 || c.zmax - profile.height(d2.sqrt()) + slack <= best.tip.z {
+        // A bound (up to rounding, which the slack covers): skipping cannot change the height.
+        if d2 > r2 || c.zmax - profile.height_sq(d2) + slack <= best.tip.z {
             continue;
+        }
+        if ball && clear::ball_clear_of(index.corners(c.slot), profile.radius, xy.x, xy.y, best.tip.z) {
+            continue; // the ball at the best height is clear of the whole triangle
         }
         let before = best.tip.z;
         let (slot, features) = (c.slot, index.owned_features(c.slot));
