@@ -736,7 +736,7 @@ pub mod rough {
     pub const WALK_WALL_TURN: f64 = 0.0873;
 
     /// Adaptive clearing: bisections of a step's turn.
-    pub const WALK_BISECTIONS: usize = 12;
+    pub const WALK_BISECTIONS: usize = 8;
 
     /// Adaptive clearing: headings tried all round at a pass's start.
     pub const WALK_START_HEADINGS: usize = 72;

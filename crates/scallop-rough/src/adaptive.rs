@@ -70,6 +70,8 @@ struct Planner<'a> {
     /// Tool centres of earlier passes, where a pass may start: the point,
     /// whether material may still lie next to it, and its pass (0: the bore).
     starts: Vec<(P2, bool, u32)>,
+    /// Unit directions of the front half's probes about the heading +x.
+    probes: Vec<P2>,
 }
 
 /// One step of a walk: where the tool goes, its heading (rad) and engagement (rad).
@@ -129,6 +131,7 @@ pub fn plan_adaptive(region: &Region, options: &ClearOptions) -> Result<Vec<Step
         inside,
         grid,
         starts: Vec::new(),
+        probes: front_probes(tol::ENGAGE_PROBES / 2),
     };
     if !planner.edges.contains(s) {
         return Ok(rings_only(region, options));
@@ -138,6 +141,18 @@ pub fn plan_adaptive(region: &Region, options: &ClearOptions) -> Result<Vec<Step
     let mut rest = planner.finish(region, end);
     steps.append(&mut rest);
     Ok(steps)
+}
+
+/// `n` unit directions evenly over the front half about +x (from -90 to
+/// +90 degrees, at the middles of `n` equal arcs).
+fn front_probes(n: usize) -> Vec<P2> {
+    (0..n)
+        .map(|i| {
+            #[allow(clippy::cast_precision_loss, reason = "a small count")]
+            let a = -std::f64::consts::FRAC_PI_2 + std::f64::consts::PI * (i as f64 + 0.5) / n as f64;
+            [a.cos(), a.sin()]
+        })
+        .collect()
 }
 
 fn dist(a: P2, b: P2) -> f64 {
@@ -193,7 +208,7 @@ impl Planner<'_> {
     /// pocket) and farther than R from every swept centre.
     fn material(&self, q: P2) -> bool {
         let r = self.options.tool_radius;
-        self.grid.sample(&self.reach, q) < r && self.grid.sample(&self.swept, q) > r
+        self.grid.sample(&self.swept, q) > r && self.grid.sample(&self.reach, q) < r
     }
 
     /// The engagement (rad) of the tool centred at `p`: the share of its
@@ -219,12 +234,13 @@ impl Planner<'_> {
     /// back half lies in what the tool has just cut).
     fn front(&self, p: P2, heading: f64) -> f64 {
         let r = self.options.tool_radius;
-        let n = tol::ENGAGE_PROBES / 2;
+        let n = self.probes.len();
+        let (s, c) = heading.sin_cos();
         let mut count = 0usize;
-        for i in 0..n {
-            #[allow(clippy::cast_precision_loss, reason = "a small count")]
-            let a = heading - std::f64::consts::FRAC_PI_2 + std::f64::consts::PI * (i as f64 + 0.5) / n as f64;
-            if self.material([p[0] + r * a.cos(), p[1] + r * a.sin()]) {
+        for &[u, v] in &self.probes {
+            // The probe's direction (u, v) about the heading, rotated onto it.
+            let q = [p[0] + r * (u * c - v * s), p[1] + r * (u * s + v * c)];
+            if self.material(q) {
                 count += 1;
             }
         }

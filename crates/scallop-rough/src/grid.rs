@@ -81,10 +81,12 @@ impl Grid {
         if !inside {
             return BIG;
         }
-        let (fu, fv) = (u.floor(), v.floor());
+        // Non-negative: truncation is the floor.
         #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "checked above")]
-        let k = fv as usize * self.nx + fu as usize;
-        let (a, b) = (u - fu, v - fv);
+        let (iu, iv) = (u as usize, v as usize);
+        let k = iv * self.nx + iu;
+        #[allow(clippy::cast_precision_loss, reason = "grid indices")]
+        let (a, b) = (u - iu as f64, v - iv as f64);
         let (f00, f10, f01, f11) = (f[k], f[k + 1], f[k + self.nx], f[k + self.nx + 1]);
         (f00 * (1.0 - a) + f10 * a) * (1.0 - b) + (f01 * (1.0 - a) + f11 * a) * b
     }
@@ -139,12 +141,16 @@ impl Grid {
                 let k = j * self.nx + i;
                 let c = self.centre(k);
                 let t = if l2 > 0.0 { (((c[0] - a[0]) * dx + (c[1] - a[1]) * dy) / l2).clamp(0.0, 1.0) } else { 0.0 };
-                let d = (c[0] - a[0] - t * dx).hypot(c[1] - a[1] - t * dy);
-                if d <= r && d < f[k] {
-                    if let Some(u) = undo.as_deref_mut() {
-                        u.push((k, f[k]));
+                let (ex, ey) = (c[0] - a[0] - t * dx, c[1] - a[1] - t * dy);
+                let d2 = ex * ex + ey * ey;
+                if d2 <= r * r && d2 < f[k] * f[k] {
+                    let d = d2.sqrt();
+                    if d < f[k] {
+                        if let Some(u) = undo.as_deref_mut() {
+                            u.push((k, f[k]));
+                        }
+                        f[k] = d;
                     }
-                    f[k] = d;
                 }
             }
         }
