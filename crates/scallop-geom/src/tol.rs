@@ -760,14 +760,34 @@ pub mod rough {
     /// length times the stepover.
     pub const WALK_RESTART_SHARE: f64 = 0.25;
 
-    /// Adaptive clearing: the shortest step, as a share of the usual one, in
-    /// places too narrow for it (halved until a step stays in the region).
-    pub const WALK_SHORTEST: f64 = 0.125;
-
     /// Adaptive clearing: the radius (mm) of the fillets of the region's
     /// convex corners on the last pass along its rings: a sliver at most
     /// 0.42 x this thick stays in a right-angled corner.
     pub const RING_FILLET: f64 = 0.1;
+
+    /// Adaptive clearing: the sharpest turn of a ring (rad, 100 degrees)
+    /// that gets a fillet; sharper corners keep their tip.
+    pub const RING_FILLET_TURN: f64 = 1.745;
+
+    /// Adaptive clearing: the first arc of a corner's clearing, as a share
+    /// of the tool radius (its radius).
+    pub const CORNER_START_SHARE: f64 = 2.0;
+
+    /// Adaptive clearing: most arcs in one corner.
+    pub const CORNER_ARCS: usize = 16;
+
+    /// Adaptive clearing: a corner's next arc is at least this share smaller
+    /// than the last (else its clearing stops there).
+    pub const CORNER_MIN_SHRINK: f64 = 0.05;
+
+    /// Adaptive clearing: most entries into one region (parts the walk from
+    /// the first could not reach).
+    pub const MAX_ENTRIES: usize = 1000;
+
+    /// Adaptive clearing: the last stretch of a link to a pass's start may
+    /// engage up to this share of the target, by the grid's all-round
+    /// reading.
+    pub const LINK_APPROACH: f64 = 1.0;
 
     /// Adaptive clearing: the chords of the region's walls in the walk's wall
     /// test (mm): a wall bending into the region is met this much early.

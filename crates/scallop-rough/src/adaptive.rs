@@ -74,6 +74,13 @@ struct Planner<'a> {
     probes: Vec<P2>,
 }
 
+/// The walk's steps so far, its passes and its remaining steps.
+struct Walk {
+    steps: Vec<Step>,
+    passes: usize,
+    budget: usize,
+}
+
 /// One step of a walk: where the tool goes, its heading (rad) and engagement (rad).
 #[derive(Clone, Copy)]
 struct Stride {
@@ -136,11 +143,114 @@ pub fn plan_adaptive(region: &Region, options: &ClearOptions) -> Result<Vec<Step
     if !planner.edges.contains(s) {
         return Ok(rings_only(region, options));
     }
-    planner.bore(s, r0);
-    let (mut steps, end) = planner.walk_all(s)?;
+    planner.bore(s, r0, 0);
+    let mut walk = Walk { steps: Vec::new(), passes: 0, budget: tol::MAX_WALK_STEPS };
+    let mut end = planner.walk_all(s, &mut walk)?;
+    // Parts of the region the walk could not reach (joined to the rest by a
+    // neck narrower than its steps, or a tooth gap it could not turn into):
+    // a new entry at the deepest centre far from every cut, each.
+    let far = r + 2.0 * h;
+    for _ in 0..tol::MAX_ENTRIES {
+        let Some(k) = (0..planner.grid.len())
+            .filter(|&k| planner.inside[k] && depth[k] < 0.5 * BIG && planner.swept[k] > far)
+            .max_by(|&a, &b| depth[a].total_cmp(&depth[b]).then(b.cmp(&a)))
+        else {
+            break;
+        };
+        let e = planner.grid.centre(k);
+        if !planner.edges.contains(e) {
+            planner.swept[k] = 0.0;
+            continue;
+        }
+        let r0 = if rh > 0.0 && region.offset(rh).contains(e) { rh } else { 0.0 };
+        walk.steps.push(Step::Link { tool_down: false, via: Vec::new(), cleared: false, to: None });
+        #[allow(clippy::cast_possible_truncation, reason = "passes are bounded by MAX_PASSES")]
+        planner.bore(e, r0, walk.passes as u32);
+        let before = walk.steps.len();
+        end = planner.walk_all(e, &mut walk)?;
+        if walk.steps.len() == before {
+            // Nothing cut from there: the entry alone, a plunge or a helix.
+            walk.steps.pop();
+            planner.swept[k] = 0.0;
+        }
+    }
+    let mut steps = walk.steps;
     let mut rest = planner.finish(region, end);
     steps.append(&mut rest);
     Ok(steps)
+}
+
+/// A convex corner of a region's ring between two lines: its point, the
+/// unit directions in and out (the region on the left), the turn (rad) and
+/// the radius of the largest arc tangent to both within half of each line.
+struct Corner {
+    at: P2,
+    u: P2,
+    turn: f64,
+    largest: f64,
+}
+
+/// The corners of the closed ring `c` that [`fillet_corners`] rounds.
+fn corners(c: &Contour) -> Vec<Corner> {
+    let v = c.vertices();
+    let n = v.len();
+    if !c.is_closed() || n < 3 {
+        return Vec::new();
+    }
+    let mut out = Vec::new();
+    for i in 0..n {
+        let (a, b, d) = (&v[(i + n - 1) % n], &v[i], &v[(i + 1) % n]);
+        let (l1, l2) = ((b.x - a.x).hypot(b.y - a.y), (d.x - b.x).hypot(d.y - b.y));
+        if !(a.bulge == 0.0 && b.bulge == 0.0 && l1 > 0.0 && l2 > 0.0) {
+            continue;
+        }
+        let (u, w) = ([(b.x - a.x) / l1, (b.y - a.y) / l1], [(d.x - b.x) / l2, (d.y - b.y) / l2]);
+        let turn = (u[0] * w[1] - u[1] * w[0]).atan2(u[0] * w[0] + u[1] * w[1]);
+        let largest = 0.5 * l1.min(l2) / (0.5 * turn).tan();
+        if turn > 0.0 && turn <= tol::RING_FILLET_TURN && largest >= tol::RING_FILLET {
+            out.push(Corner { at: [b.x, b.y], u, turn, largest });
+        }
+    }
+    out
+}
+
+/// The closed ring `c` (the region on its left) with each left turn between
+/// two lines of at most [`tol::RING_FILLET_TURN`] replaced by an arc of
+/// radius [`tol::RING_FILLET`] tangent to both, where the lines are long
+/// enough to hold it; `c` itself when nothing changes or the result is not
+/// a valid contour.
+fn fillet_corners(c: &Contour) -> Contour {
+    let v = c.vertices();
+    let n = v.len();
+    if !c.is_closed() || n < 3 {
+        return c.clone();
+    }
+    let rho = tol::RING_FILLET;
+    let mut out = Vec::with_capacity(2 * n);
+    let mut changed = false;
+    for i in 0..n {
+        let (a, b, d) = (&v[(i + n - 1) % n], &v[i], &v[(i + 1) % n]);
+        let (l1, l2) = ((b.x - a.x).hypot(b.y - a.y), (d.x - b.x).hypot(d.y - b.y));
+        let lines = a.bulge == 0.0 && b.bulge == 0.0 && l1 > 0.0 && l2 > 0.0;
+        if lines {
+            let (u, w) = ([(b.x - a.x) / l1, (b.y - a.y) / l1], [(d.x - b.x) / l2, (d.y - b.y) / l2]);
+            let turn = (u[0] * w[1] - u[1] * w[0]).atan2(u[0] * w[0] + u[1] * w[1]);
+            let t = rho * (0.5 * turn).tan();
+            if turn > 0.0 && turn <= tol::RING_FILLET_TURN && t <= 0.5 * l1 && t <= 0.5 * l2 {
+                let p1 = scallop_contour::Vertex { x: b.x - t * u[0], y: b.y - t * u[1], bulge: (0.25 * turn).tan() };
+                let p2 = scallop_contour::Vertex { x: b.x + t * w[0], y: b.y + t * w[1], bulge: 0.0 };
+                out.push(p1);
+                out.push(p2);
+                changed = true;
+                continue;
+            }
+        }
+        out.push(*b);
+    }
+    if !changed {
+        return c.clone();
+    }
+    Contour::new(&out, true).unwrap_or_else(|_| c.clone())
 }
 
 /// `n` unit directions evenly over the front half about +x (from -90 to
@@ -185,7 +295,7 @@ fn orient(c: &Contour, direction: Direction) -> Contour {
 impl Planner<'_> {
     /// The helix's bore about `s` (tool centre circle of radius `r0`), or a
     /// plunge at `s`; its centres are where the first pass may start.
-    fn bore(&mut self, s: P2, r0: f64) {
+    fn bore(&mut self, s: P2, r0: f64, pass: u32) {
         let w = self.options.tool_radius + 2.0 * self.grid.h;
         #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a small positive count")]
         let n = ((std::f64::consts::TAU * r0 / self.grid.h).ceil() as usize).max(1);
@@ -197,11 +307,11 @@ impl Planner<'_> {
         for i in 0..n {
             self.grid.stamp_segment(&mut self.swept, on(i), on(i + 1), w, None);
             if self.edges.contains(on(i)) {
-                self.starts.push((on(i), true, 0));
+                self.starts.push((on(i), true, pass));
             }
         }
         self.grid.stamp_segment(&mut self.swept, s, s, w, None);
-        self.starts.push((s, true, 0));
+        self.starts.push((s, true, pass));
     }
 
     /// Whether the point `q` is material: within R of the region (inside the
@@ -268,21 +378,9 @@ impl Planner<'_> {
     }
 
     /// The next step from `p` after a step along `heading` (see
-    /// [`Planner::next_by`]): a full step, or in a place too narrow for it
-    /// (no turn stays in the region), shorter ones, down to
-    /// [`tol::WALK_SHORTEST`] of it.
+    /// [`Planner::next_by`]).
     fn next(&self, p: P2, heading: f64) -> Option<Stride> {
-        let mut len = tol::WALK_STEP_SHARE * self.options.tool_radius;
-        let shortest = len * tol::WALK_SHORTEST;
-        loop {
-            if let Some(s) = self.next_by(p, heading, len) {
-                return Some(s);
-            }
-            len *= 0.5;
-            if len < shortest {
-                return None;
-            }
-        }
+        self.next_by(p, heading, tol::WALK_STEP_SHARE * self.options.tool_radius)
     }
 
     /// The next step from `p` after a step along `heading`: the turn whose
@@ -439,21 +537,24 @@ impl Planner<'_> {
     }
 
     /// Every pass from the bore about `s` until no earlier centre has
-    /// material next to it: the steps and their links, and where the tool ends.
-    fn walk_all(&mut self, s: P2) -> Result<(Vec<Step>, P2), RoughError> {
-        let mut steps: Vec<Step> = Vec::new();
+    /// material next to it, its steps and links appended to `walk`: where
+    /// the tool ends.
+    fn walk_all(&mut self, s: P2, walk: &mut Walk) -> Result<P2, RoughError> {
         let mut pos = s;
-        let mut budget = tol::MAX_WALK_STEPS;
-        let mut passes = 0usize;
+        let mut fresh = true;
         let spacing = tol::WALK_START_SPACING * self.options.tool_radius;
         let step = tol::WALK_STEP_SHARE * self.options.tool_radius;
         while let Some((i, first)) = self.next_start() {
             let start = self.starts[i].0;
-            passes += 1;
+            walk.passes += 1;
+            let passes = walk.passes;
             if passes > tol::MAX_PASSES {
                 return Err(RoughError::TooMuchWork { what: "adaptive passes", limit: tol::MAX_PASSES });
             }
-            let (run, area) = self.pass(start, first, &mut budget)?;
+            // The link there first: it runs on the field as the tool finds it
+            // (the pass would clear what the link's approach meets).
+            let link = (!fresh).then(|| self.link_step(pos, start));
+            let (run, area) = self.pass(start, first, &mut walk.budget)?;
             // A start serves once: a pass from it that could not go on (the
             // engagement would rise over the target along a wall) would
             // only be tried again; its neighbours serve instead.
@@ -481,21 +582,21 @@ impl Planner<'_> {
                     last = p;
                 }
             }
-            if steps.is_empty() && dist(start, s) > 0.0 {
+            if fresh && dist(start, s) > 0.0 {
                 // From the helix's end (its centre) to the pass: inside the bore.
                 let mut first = vec![s];
                 first.extend_from_slice(&run);
-                self.emit_runs(&mut steps, vec![first]);
+                self.emit_runs(&mut walk.steps, vec![first]);
             } else {
-                if !steps.is_empty() || dist(start, s) > 0.0 {
-                    let link = self.link_step(pos, start);
-                    steps.push(link);
+                if let Some(link) = link {
+                    walk.steps.push(link);
                 }
-                self.emit_runs(&mut steps, vec![run.clone()]);
+                self.emit_runs(&mut walk.steps, vec![run.clone()]);
             }
+            fresh = false;
             pos = *run.last().unwrap_or(&pos);
         }
-        Ok((steps, pos))
+        Ok(pos)
     }
 
     /// The start of the next pass: the head of a run of earlier centres
@@ -535,18 +636,114 @@ impl Planner<'_> {
         None
     }
 
+    /// The largest engagement (rad) along the polyline `run` (the tool at
+    /// its first point), measured at every point on the field as the run
+    /// leaves it, the run stamped (old values to `undo`).
+    fn sweep_run(&mut self, run: &[P2], undo: &mut Vec<(usize, f64)>) -> f64 {
+        let w = self.options.tool_radius + 2.0 * self.grid.h;
+        let mut phi = 0.0f64;
+        for pair in run.windows(2) {
+            let heading = (pair[1][1] - pair[0][1]).atan2(pair[1][0] - pair[0][0]);
+            phi = phi.max(self.front(pair[1], heading));
+            self.grid.stamp_segment(&mut self.swept, pair[0], pair[1], w, Some(undo));
+        }
+        phi
+    }
+
+    fn revert(&mut self, undo: &mut Vec<(usize, f64)>) {
+        while let Some((k, v)) = undo.pop() {
+            self.swept[k] = v;
+        }
+    }
+
+    /// Clears what the passes left in a convex corner of the region before
+    /// its rings are cut: arcs tangent to both walls, from the largest that
+    /// fits down to [`tol::RING_FILLET`], each the smallest whose engagement
+    /// stays within the accepted bound (bisection on the radius), in the
+    /// cutting direction, joined by links (docs/roughing.md, "Corners").
+    fn clear_corner(&mut self, corner: &Corner, pos: &mut P2, steps: &mut Vec<Step>) {
+        let mut rho = corner.largest.min(tol::CORNER_START_SHARE * self.options.tool_radius);
+        let smallest = tol::RING_FILLET;
+        let mut undo = Vec::new();
+        for _ in 0..tol::CORNER_ARCS {
+            if rho <= smallest * (1.0 + 1e-9) {
+                break;
+            }
+            let mut fits = |me: &mut Self, r: f64| {
+                let run = me.corner_arc(corner, r);
+                let ok = me.sweep_run(&run, &mut undo) <= me.accept;
+                me.revert(&mut undo);
+                ok
+            };
+            if !fits(self, rho) {
+                return;
+            }
+            let next = if fits(self, smallest) {
+                smallest
+            } else {
+                let (mut bad, mut good) = (smallest, rho);
+                for _ in 0..tol::WALK_BISECTIONS {
+                    let mid = 0.5 * (bad + good);
+                    if fits(self, mid) {
+                        good = mid;
+                    } else {
+                        bad = mid;
+                    }
+                }
+                good
+            };
+            if next >= rho * (1.0 - tol::CORNER_MIN_SHRINK) {
+                return;
+            }
+            rho = next;
+            let run = self.corner_arc(corner, rho);
+            let Some(&start) = run.first() else { return };
+            let link = self.link_step(*pos, start);
+            steps.push(link);
+            *pos = *run.last().unwrap_or(&start);
+            self.emit_runs(steps, vec![run]);
+        }
+    }
+
+    /// The arc of radius `r` tangent to both walls of `corner`, as points
+    /// in the cutting direction.
+    fn corner_arc(&self, c: &Corner, r: f64) -> Vec<P2> {
+        let t = r * (0.5 * c.turn).tan();
+        let p1 = [c.at[0] - t * c.u[0], c.at[1] - t * c.u[1]];
+        let centre = [p1[0] - r * c.u[1], p1[1] + r * c.u[0]];
+        let a0 = (p1[1] - centre[1]).atan2(p1[0] - centre[0]);
+        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a small positive count")]
+        let n = ((r * c.turn / (0.5 * self.grid.h)).ceil() as usize).max(2);
+        let mut run: Vec<P2> = (0..=n)
+            .map(|i| {
+                #[allow(clippy::cast_precision_loss, reason = "a small count")]
+                let a = a0 + c.turn * i as f64 / n as f64;
+                [centre[0] + r * a.cos(), centre[1] + r * a.sin()]
+            })
+            .collect();
+        if self.options.direction == Direction::Conventional {
+            run.reverse();
+        }
+        run
+    }
+
     /// The region's rings from `pos`, nearest first, with their links.
     fn finish(&mut self, region: &Region, mut pos: P2) -> Vec<Step> {
-        // The region's convex corners rounded by [`tol::RING_FILLET`] (an
-        // opening): a tool centre reaching a sharp corner meets the quarter
-        // of its periphery facing the corner in material however close the
-        // passes came (docs/roughing.md, "Corners"); rounded, the corner
-        // keeps a sliver at most 0.42 x the radius thick. When the opening
-        // loses a ring (a part thinner than the fillet), the rings as they are.
-        let opened = region.offset(tol::RING_FILLET).offset(-tol::RING_FILLET);
-        let source = if opened.rings().len() == region.rings().len() { &opened } else { region };
-        let mut rings: Vec<Contour> = source.rings().iter().map(|c| orient(c, self.options.direction)).collect();
+        // The region's convex corners between two lines, up to a right
+        // angle and a little more, rounded by [`tol::RING_FILLET`]: a tool
+        // centre reaching a sharp corner meets the quarter of its periphery
+        // facing the corner in material however close the passes came
+        // (docs/roughing.md, "Corners"); rounded, the corner keeps a sliver
+        // at most 0.42 x the radius thick. Sharper corners (a gear's tooth
+        // gap) keep their tip: rounded, they would leave their bottom uncut.
+        let rounded: Vec<Contour> = region.rings().iter().map(fillet_corners).collect();
+        let mut rings: Vec<Contour> = rounded.iter().map(|c| orient(c, self.options.direction)).collect();
         let mut steps = Vec::new();
+        for ring in region.rings() {
+            for corner in corners(ring) {
+                self.clear_corner(&corner, &mut pos, &mut steps);
+            }
+        }
         while !rings.is_empty() {
             let started: Vec<Contour> = rings.iter().map(|c| c.starting_near(pos)).collect();
             let d = |c: &Contour| c.start().map_or(f64::INFINITY, |p| dist(p, pos));
@@ -583,4 +780,23 @@ fn flat_arcs(c: &Contour) -> Result<Contour, scallop_contour::ContourError> {
 /// The points as lines and arcs within [`tol::ARC_FIT`], far arcs made lines.
 fn fit(points: &[P2]) -> Option<Contour> {
     Contour::from_points(points, false, tol::ARC_FIT).and_then(|c| flat_arcs(&c)).ok()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn right_angled_corners_get_fillets_and_sharp_ones_keep_their_tips() {
+        let square = Contour::polygon(&[[0.0, 0.0], [4.0, 0.0], [4.0, 4.0], [0.0, 4.0]], true).unwrap();
+        let f = fillet_corners(&square);
+        assert_eq!(f.vertices().len(), 8);
+        let rho = tol::RING_FILLET;
+        let want = 16.0 - (4.0 - std::f64::consts::PI) * rho * rho;
+        assert!((f.signed_area() - want).abs() < 1e-9, "{} vs {want}", f.signed_area());
+        // A spike of 20 degrees keeps its tip.
+        let spike = Contour::polygon(&[[0.0, 0.0], [10.0, 1.76], [0.0, 3.53]], true).unwrap();
+        let g = fillet_corners(&spike);
+        assert!(g.vertices().iter().any(|v| (v.x - 10.0).abs() < 1e-12 && (v.y - 1.76).abs() < 1e-12));
+    }
 }

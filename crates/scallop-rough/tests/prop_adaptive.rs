@@ -236,8 +236,10 @@ fn a_hash_is_cleared_with_its_pieces_joined_tool_down() {
     check_cleared(&report);
     assert!(report.slot_length <= 0.0, "slot {:.2} mm", report.slot_length);
     check_links(&plan, &report);
-    // A join is a retract only where no cleared path is found (at most 2 %).
-    assert!(50 * plan.retracts <= plan.links, "{} retracts, {} links", plan.retracts, plan.links);
+    // A join is a retract only where no cleared path is found (at most 3 %:
+    // the links between corners, along walls whose slivers the rings cut
+    // last, docs/roughing.md "Adaptive clearing", step 8).
+    assert!(33 * plan.retracts <= plan.links, "{} retracts, {} links", plan.retracts, plan.links);
 }
 
 proptest! {
@@ -247,11 +249,14 @@ proptest! {
     fn combs_are_cleared_with_links_that_cut_nothing(
         w in proptest::collection::vec(2.0 * R + 0.5..4.0 * R, 2..4)
     ) {
-        // Fingers a little wider than the tool: fronts split into one piece per finger.
+        // Fingers a little wider than the tool: a finger the walk cannot
+        // turn into gets an entry of its own (a retract), and the links
+        // between the corners at its end may be retracts (docs/roughing.md,
+        // "Adaptive clearing", step 8): at most three a finger.
         let (pocket, plan) = plan(&comb(&w));
         let report = judge(&pocket, &plan);
         check_cleared(&report);
         check_links(&plan, &report);
-        prop_assert!(plan.retracts <= 1, "{} retracts, {} links", plan.retracts, plan.links);
+        prop_assert!(plan.retracts <= 3 * w.len() + 1, "{} retracts, {} links", plan.retracts, plan.links);
     }
 }

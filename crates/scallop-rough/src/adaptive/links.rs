@@ -7,8 +7,8 @@
 //! nothing (no probe of the periphery in material, checked on the grid's
 //! swept field as it is when the link runs), shortened by straight
 //! segments that cut nothing either, the last [`APPROACH_SHARE`] R to the
-//! start allowed to engage up to the accepted bound (a closed front is
-//! entered at a new point). It is a retract only when no such path exists
+//! start allowed to engage up to the target (a pass starts next to
+//! material). It is a retract only when no such path exists
 //! within [`DETOUR`] times the straight distance plus [`DETOUR_EXTRA`] R.
 
 use std::cmp::Reverse;
@@ -19,6 +19,7 @@ use scallop_contour::P2;
 use super::{Planner, dist};
 use crate::grid::BIG;
 use crate::offset::Step;
+use crate::tol;
 use crate::tol::{APPROACH_SHARE, DETOUR, DETOUR_EXTRA, LATTICE, LINK_PROBES, LINK_SLACK, MAX_EXPAND, MAX_GOALS};
 
 /// A lattice node's state in the cache of [`Planner::node_clear`].
@@ -55,7 +56,7 @@ impl Planner<'_> {
             #[allow(clippy::cast_precision_loss, reason = "a small count")]
             let f = i as f64 / n as f64;
             let p = [a[0] + f * (b[0] - a[0]), a[1] + f * (b[1] - a[1])];
-            self.clear_at(p) || (dist(p, target) <= near && self.engagement(p) <= self.accept)
+            self.clear_at(p) || (dist(p, target) <= near && self.engagement(p) <= tol::LINK_APPROACH * self.target)
         })
     }
 
