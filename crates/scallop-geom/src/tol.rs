@@ -727,47 +727,87 @@ pub mod rough {
     /// Adaptive clearing: points probed on the tool's periphery.
     pub const ENGAGE_PROBES: usize = 180;
 
-    /// Adaptive clearing: the next pass tries at most this times the last
-    /// pass's step (never more than the stepover).
-    pub const STEP_GROW: f64 = 1.3;
+    /// Adaptive clearing: the walking tool's step, as a share of the tool
+    /// radius (R / 8: 0.375 mm for a 6 mm tool).
+    pub const WALK_STEP_SHARE: f64 = 0.125;
 
-    /// Adaptive clearing: the smallest step between passes, as a share of the
-    /// grid's cell side (a pass that still exceeds the bound there is kept).
-    pub const STEP_MIN_SHARE: f64 = 0.25;
+    /// Adaptive clearing: the sharpest turn of one step towards the
+    /// material (rad, 30 degrees).
+    pub const WALK_TURN: f64 = 0.524;
 
-    /// Adaptive clearing: trials of one pass's step before the smallest is kept.
-    pub const STEP_TRIALS: usize = 12;
+    /// Adaptive clearing: the sharpest turn of one step away from the
+    /// material (rad, 150 degrees).
+    pub const WALK_TURN_HARD: f64 = 2.618;
+
+    /// Adaptive clearing: the turn by which a step that would leave the
+    /// region is turned further away before bisection (rad, 5 degrees).
+    pub const WALK_WALL_TURN: f64 = 0.0873;
+
+    /// Adaptive clearing: bisections of a step's turn.
+    pub const WALK_BISECTIONS: usize = 8;
+
+    /// Adaptive clearing: headings tried all round at a pass's start.
+    pub const WALK_START_HEADINGS: usize = 72;
+
+    /// Adaptive clearing: a step whose engagement is under this share of the
+    /// target cuts air.
+    pub const WALK_AIR: f64 = 0.1;
+
+    /// Adaptive clearing: a pass ends after this much air (share of R).
+    pub const WALK_AIR_SHARE: f64 = 1.0;
+
+    /// Adaptive clearing: a pass's centres kept as starts of later passes,
+    /// this far apart (share of R).
+    pub const WALK_START_SPACING: f64 = 0.25;
+
+    /// Adaptive clearing: a pass of more steps than this may start again
+    /// where it started (it made progress there) ...
+    pub const WALK_RESTART_STEPS: usize = 4;
+
+    /// Adaptive clearing: ... and when it cleared at least this share of its
+    /// length times the stepover.
+    pub const WALK_RESTART_SHARE: f64 = 0.25;
+
+    /// Adaptive clearing: the radius (mm) of the fillets of the region's
+    /// convex corners on the last pass along its rings: a sliver at most
+    /// 0.42 x this thick stays in a right-angled corner.
+    pub const RING_FILLET: f64 = 0.1;
+
+    /// Adaptive clearing: the sharpest turn of a ring (rad, 100 degrees)
+    /// that gets a fillet; sharper corners keep their tip.
+    pub const RING_FILLET_TURN: f64 = 1.745;
+
+    /// Adaptive clearing: the first arc of a corner's clearing, as a share
+    /// of the tool radius (its radius).
+    pub const CORNER_START_SHARE: f64 = 2.0;
+
+    /// Adaptive clearing: most arcs in one corner.
+    pub const CORNER_ARCS: usize = 16;
+
+    /// Adaptive clearing: a corner's next arc is at least this share smaller
+    /// than the last (else its clearing stops there).
+    pub const CORNER_MIN_SHRINK: f64 = 0.05;
+
+    /// Adaptive clearing: most entries into one region (parts the walk from
+    /// the first could not reach).
+    pub const MAX_ENTRIES: usize = 1000;
+
+    /// Adaptive clearing: the last stretch of a link to a pass's start may
+    /// engage up to this share of the target, by the grid's all-round
+    /// reading.
+    pub const LINK_APPROACH: f64 = 1.0;
+
+    /// Adaptive clearing: the chords of the region's walls in the walk's wall
+    /// test (mm): a wall bending into the region is met this much early.
+    pub const WALK_CHORD: f64 = 5e-5;
+
+    /// Adaptive clearing: most steps of one region's walk.
+    pub const MAX_WALK_STEPS: usize = 20_000_000;
 
     /// Adaptive clearing: the passes (grid iso-lines) are replaced by arcs and
     /// lines within this (mm): fewer, smoother moves; the tool may go this much
     /// deeper into the material or towards a wall.
     pub const ARC_FIT: f64 = 0.01;
-
-    /// Adaptive clearing: a smaller step that lowers a pass's largest
-    /// engagement by less than this (rad, 2 degrees) is not worth it: the
-    /// geometry, not the step, sets the engagement there, and the larger step
-    /// is kept.
-    pub const STEP_STALL: f64 = 0.035;
-
-    /// Adaptive clearing: the front's speed on a wall of the region, as a share
-    /// of its speed inside (a front slowed near the walls meets them nearly
-    /// parallel, with passes closer there: a front meeting a straight wall at an
-    /// angle theta engages the tool going along the wall by up to theta more
-    /// than the target, docs/roughing.md).
-    pub const WALL_SPEED: f64 = 0.3;
-
-    /// Adaptive clearing: the band along the walls where the front slows down,
-    /// as a share of the tool radius.
-    pub const WALL_BAND: f64 = 1.0;
-
-    /// Adaptive clearing: the walls' chords (mm) onto which passes along a wall
-    /// are moved (see `walls.rs`); a chord of a wall bending into the region
-    /// lies this much outside it.
-    pub const WALL_CHORD: f64 = 1e-5;
-
-    /// Adaptive clearing: most wall vertices put back between two wall points
-    /// of a pass (the chords of a wall's arc between two cells).
-    pub const WALL_CORNERS: usize = 256;
 
     /// Adaptive clearing: a fitted arc of a larger radius (mm) becomes a line
     /// (it deviates from its chord by at most chord^2 / 8000 mm: 1 um for a

@@ -1,90 +1,49 @@
-//! Adaptive (engagement-controlled) clearing of one tool-centre region.
+//! Adaptive (engagement-controlled) clearing of one tool-centre region by a
+//! walking tool.
 //!
 //! The tool enters at the region's deepest point (largest inscribed circle,
 //! found by fast marching from the walls) by the emitter's helix, which
-//! bores a disc. The cleared tool-centre set then grows as a front: the set
-//! `F(t)` of points whose distance from the entry measured inside the region
-//! is at most `t` (fast marching from the bore). Each pass is the part of the
-//! boundary of `F(t + a)` not cut before: arcs inside the region and the
-//! newly reached pieces of its walls, run with `F` on the left (climb with a
-//! clockwise spindle: the material on the tool's right). Every point of
-//! `F(t + a)` lies within `a` of `F(t)`, whose boundary was swept, so the
-//! material within R of `F(t)` is cut and a pass meets at most a band about
-//! `a` wide.
+//! bores a disc. From there the path is made one step at a time, as the
+//! adaptive-clearing literature does (for instance Stori and Wright 2000,
+//! "Constant engagement tool path generation for convex geometries", J.
+//! Manuf. Systems 19(3): the direction of each step chosen so that the
+//! engagement stays at its target): a grid keeps the distance from every
+//! point to the tool centres swept so far (the cut material is where it is
+//! at most R), and each step of [`tol::WALK_STEP_SHARE`] R goes in the
+//! direction whose engagement (the arc of the front half of the periphery in
+//! material, the half the tool moves into) is the target `arccos(1 - ae /
+//! R)`, found by bisection on the turn from the last heading: turning
+//! towards the material (right when climbing with an M3 spindle) raises it,
+//! turning away lowers it. A step that would leave the region turns further
+//! away from the material until it stays in (exactly, against the region's
+//! chords): the tool slides along a wall with no more than the target
+//! engagement.
 //!
-//! The front is slowed near the walls (fast marching with a speed of
-//! [`tol::WALL_SPEED`] on a wall, rising to 1 at [`tol::WALL_BAND`] R from
-//! it): it bends to meet a wall nearly parallel, with passes closer together
-//! there. A pass's points on a wall are moved onto the wall itself and the
-//! wall's vertices between them put back (`walls.rs`), so a pass along a wall
-//! follows it exactly and reaches into its corners.
+//! A pass ends when it has cut nothing for [`tol::WALK_AIR_SHARE`] R (it is
+//! cut back to its last cutting step) or when no step stays in the region.
+//! The next pass starts at a tool centre of an earlier pass (or of the bore)
+//! next to material, nearest the tool first, heading where the engagement is
+//! at the target with the material on the cutting side; the way there is a
+//! tool-down link through cleared area, a retract only when none is found
+//! (`links.rs`). The region is done when no earlier centre has material
+//! within reach. Last, the region's own rings are cut (the contour at the
+//! allowance, exact and with arcs), linked the same way.
 //!
-//! The step `a` is chosen per pass from the engagement itself: a grid keeps
-//! the distance from every point to the tool centres swept so far (the
-//! cleared material is where it is at most R), the candidate pass is swept
-//! on it and its engagement (the arc of the periphery in material, probed
-//! all round) measured every cell side; a pass over
-//! [`tol::ENGAGE_ACCEPT`] times the target `arccos(1 - ae / R)` is undone and
-//! tried with a smaller step scaled by the ratio of `1 - cos` of the angles
-//! (the straight-cut relation), a pass under it lets the next one grow by at
-//! most [`tol::STEP_GROW`] up to the stepover. Tight curves (the first rings
-//! about the bore, fronts wrapping round islands and inner corners, narrow
-//! channels) get small steps, straight fronts the stepover. This is the
-//! engagement control of the adaptive-clearing literature (for instance
-//! Elber, Cohen and Drake 2005, "MATHSM: medial axis transform toward high
-//! speed machining of pockets", CAD 37(2): a bounded engagement from the
-//! medial axis outwards), done by measurement instead of a closed form.
-//!
-//! A closed front (not touching a wall) is entered by a spiral turn from
-//! the current point; a pass that starts on a wall starts where the wall
-//! was reached before (cleared). Once every pass is planned, the cuts are
-//! put in an order that clears a branch before moving on, and joined by
-//! tool-down links through cleared area, retracts only when none is found
-//! (`links.rs`). Last, the region's own rings are cut (the contour at the
-//! allowance, exact and with arcs): the grid's iso-lines stay within a cell
-//! side of the walls.
+//! Each pass is cut where it was planned, in the order it was planned, on
+//! the field as it was then: the engagement measured while planning is the
+//! engagement of the program (docs/roughing.md, "Adaptive clearing").
+
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
 
 use scallop_contour::{Contour, P2, Region};
 
-use crate::grid::{BIG, Grid, IsoPoint, iso_lines};
+use crate::grid::{BIG, Grid};
 use crate::offset::Step;
-use crate::walls::Walls;
 use crate::{ClearOptions, Direction, RoughError, tol};
 
 mod links;
-use links::Planned;
-
-/// One piece of a front's boundary to cut.
-enum Piece {
-    /// An open run from a point cut before to another, and how many of its
-    /// first points lie on a wall (the tool goes along the wall into the
-    /// corner the front makes with it: see [`Planner::sweep`]).
-    Open(Vec<P2>, usize),
-    /// A closed front, every point new.
-    Ring(Vec<P2>),
-}
-
-/// What one pass starts from.
-#[derive(Clone, Copy)]
-struct Level<'g> {
-    /// The distance field of the front.
-    g: &'g [f64],
-    /// The step from the last front (mm).
-    a: f64,
-    /// Where the tool is.
-    pos: P2,
-    /// The ring the last pass's spiral turn left open.
-    pending: Option<&'g Vec<P2>>,
-}
-
-/// A pass planned: its largest engagement (rad), cuts, end, and the ring
-/// its spiral turn leaves open.
-struct Cut {
-    phi: f64,
-    items: Vec<Planned>,
-    end: P2,
-    open: Option<Vec<P2>>,
-}
+use crate::walls::Edges;
 
 /// The state of the planner of one region.
 struct Planner<'a> {
@@ -95,25 +54,48 @@ struct Planner<'a> {
     swept: Vec<f64>,
     /// The region grown a hair: links must stay in it.
     holder: Region,
-    /// The region's walls, onto which the passes' wall points are moved.
-    walls: Walls,
+    /// The region's boundary as chords, for the walk's exact wall test.
+    edges: Edges,
     options: &'a ClearOptions,
     /// The largest accepted engagement (rad).
     accept: f64,
+    /// The target engagement (rad).
+    target: f64,
     /// Cells whose centre lies in the region.
     inside: Vec<bool>,
     /// The link search's cache per cell (`links.rs`).
     lattice: Vec<u32>,
     /// Chains cut so far (the cache's clock).
     epoch: u32,
+    /// Tool centres of earlier passes, where a pass may start: the point,
+    /// whether material may still lie next to it, and its pass (0: the bore).
+    starts: Vec<(P2, bool, u32)>,
+    /// Unit directions of the front half's probes about the heading +x.
+    probes: Vec<P2>,
+}
+
+/// The walk's steps so far, its passes and its remaining steps.
+struct Walk {
+    steps: Vec<Step>,
+    passes: usize,
+    budget: usize,
+}
+
+/// One step of a walk: where the tool goes, its heading (rad) and engagement (rad).
+#[derive(Clone, Copy)]
+struct Stride {
+    to: P2,
+    heading: f64,
+    phi: f64,
 }
 
 /// The adaptive clearing of `region` (one connected tool-centre region):
-/// open and closed cuts and links (see the module documentation). The first
-/// cut starts at the entry point, where the emitter's helix bores.
+/// passes, links and the region's rings (see the module documentation). The
+/// first pass starts at the entry point, where the emitter's helix bores.
 ///
 /// # Errors
-/// [`RoughError::TooMuchWork`] beyond [`tol::MAX_PASSES`] passes.
+/// [`RoughError::TooMuchWork`] beyond [`tol::MAX_PASSES`] passes or
+/// [`tol::MAX_WALK_STEPS`] steps.
 pub fn plan_adaptive(region: &Region, options: &ClearOptions) -> Result<Vec<Step>, RoughError> {
     let r = options.tool_radius;
     let Some((lo, hi)) = region.bounds() else { return Ok(Vec::new()) };
@@ -131,7 +113,7 @@ pub fn plan_adaptive(region: &Region, options: &ClearOptions) -> Result<Vec<Step
         .filter(|&k| inside[k] && [k - 1, k + 1, k - grid.nx, k + grid.nx].iter().any(|&n| !inside[n]))
         .map(|k| (k, 0.5 * h))
         .collect();
-    let depth = grid.march(&inside, &walls, None);
+    let depth = grid.march(&inside, &walls);
     let Some(seed) = (0..grid.len())
         .filter(|&k| depth[k] < 0.5 * BIG)
         .max_by(|&a, &b| depth[a].total_cmp(&depth[b]).then(b.cmp(&a)))
@@ -141,48 +123,154 @@ pub fn plan_adaptive(region: &Region, options: &ClearOptions) -> Result<Vec<Step
     let s = grid.centre(seed);
     let rh = tol::HELIX_RADIUS_SHARE * r;
     let r0 = if rh > 0.0 && region.offset(rh).contains(s) { rh } else { 0.0 };
+    let target = (1.0 - (options.stepover / r).min(1.0)).acos();
+    let chord = options.chord_tolerance.clamp(1e-5, tol::WALK_CHORD);
     let mut planner = Planner {
         swept: vec![BIG; grid.len()],
         reach,
         holder: region.offset(-tol::LINK_GROW),
-        walls: Walls::new(region, 2.0 * h),
+        edges: Edges::new(region, chord, 8.0 * h),
         options,
-        accept: tol::ENGAGE_ACCEPT * (1.0 - (options.stepover / r).min(1.0)).acos(),
+        accept: tol::ENGAGE_ACCEPT * target,
+        target,
         lattice: vec![0; grid.len()],
         epoch: 1,
-        inside: inside.clone(),
+        inside,
         grid,
+        starts: Vec::new(),
+        probes: front_probes(tol::ENGAGE_PROBES / 2),
     };
-    planner.bore(s, r0);
-    let bored = planner.swept.clone();
-    let near = r0 + 2.0 * h;
-    let sources: Vec<(usize, f64)> = (0..planner.grid.len())
-        .map(|k| (k, dist(planner.grid.centre(k), s)))
-        .filter(|&(k, d)| d <= near && inside[k])
-        .collect();
-    // The front slows down near the walls: it meets them nearly parallel,
-    // with passes closer together there (see the module documentation).
-    let slow: Vec<f64> = depth.iter().map(|&d| 1.0 / wall_speed(d, r)).collect();
-    let g = planner.grid.march(&inside, &sources, Some(&slow));
-    let cuts = planner.fronts(&g, s, r0)?;
-    // The cuts again in their own order (`links.rs`), from the bore.
-    planner.swept = bored;
-    let (mut steps, pos) = planner.schedule(cuts, s);
-    let mut rest = planner.finish(region, pos);
+    if !planner.edges.contains(s) {
+        return Ok(rings_only(region, options));
+    }
+    planner.bore(s, r0, 0);
+    let mut walk = Walk { steps: Vec::new(), passes: 0, budget: tol::MAX_WALK_STEPS };
+    let mut end = planner.walk_all(s, &mut walk)?;
+    // Parts of the region the walk could not reach (joined to the rest by a
+    // neck narrower than its steps, or a tooth gap it could not turn into):
+    // a new entry at the deepest centre far from every cut, each.
+    let far = r + 2.0 * h;
+    for _ in 0..tol::MAX_ENTRIES {
+        let Some(k) = (0..planner.grid.len())
+            .filter(|&k| planner.inside[k] && depth[k] < 0.5 * BIG && planner.swept[k] > far)
+            .max_by(|&a, &b| depth[a].total_cmp(&depth[b]).then(b.cmp(&a)))
+        else {
+            break;
+        };
+        let e = planner.grid.centre(k);
+        if !planner.edges.contains(e) {
+            planner.swept[k] = 0.0;
+            continue;
+        }
+        let r0 = if rh > 0.0 && region.offset(rh).contains(e) { rh } else { 0.0 };
+        walk.steps.push(Step::Link { tool_down: false, via: Vec::new(), cleared: false, to: None });
+        #[allow(clippy::cast_possible_truncation, reason = "passes are bounded by MAX_PASSES")]
+        planner.bore(e, r0, walk.passes as u32);
+        let before = walk.steps.len();
+        end = planner.walk_all(e, &mut walk)?;
+        if walk.steps.len() == before {
+            // Nothing cut from there: the entry alone, a plunge or a helix.
+            walk.steps.pop();
+            planner.swept[k] = 0.0;
+        }
+    }
+    let mut steps = walk.steps;
+    let mut rest = planner.finish(region, end);
     steps.append(&mut rest);
     Ok(steps)
 }
 
-/// The front's speed at `depth` mm from the region's walls (tool radius
-/// `r`): [`tol::WALL_SPEED`] on the wall, rising linearly to 1 at
-/// [`tol::WALL_BAND`] x `r` from it.
-fn wall_speed(depth: f64, r: f64) -> f64 {
-    let f = (depth / (tol::WALL_BAND * r)).clamp(0.0, 1.0);
-    tol::WALL_SPEED + (1.0 - tol::WALL_SPEED) * f
+/// A convex corner of a region's ring between two lines: its point, the
+/// unit directions in and out (the region on the left), the turn (rad) and
+/// the radius of the largest arc tangent to both within half of each line.
+struct Corner {
+    at: P2,
+    u: P2,
+    turn: f64,
+    largest: f64,
+}
+
+/// The corners of the closed ring `c` that [`fillet_corners`] rounds.
+fn corners(c: &Contour) -> Vec<Corner> {
+    let v = c.vertices();
+    let n = v.len();
+    if !c.is_closed() || n < 3 {
+        return Vec::new();
+    }
+    let mut out = Vec::new();
+    for i in 0..n {
+        let (a, b, d) = (&v[(i + n - 1) % n], &v[i], &v[(i + 1) % n]);
+        let (l1, l2) = ((b.x - a.x).hypot(b.y - a.y), (d.x - b.x).hypot(d.y - b.y));
+        if !(a.bulge == 0.0 && b.bulge == 0.0 && l1 > 0.0 && l2 > 0.0) {
+            continue;
+        }
+        let (u, w) = ([(b.x - a.x) / l1, (b.y - a.y) / l1], [(d.x - b.x) / l2, (d.y - b.y) / l2]);
+        let turn = (u[0] * w[1] - u[1] * w[0]).atan2(u[0] * w[0] + u[1] * w[1]);
+        let largest = 0.5 * l1.min(l2) / (0.5 * turn).tan();
+        if turn > 0.0 && turn <= tol::RING_FILLET_TURN && largest >= tol::RING_FILLET {
+            out.push(Corner { at: [b.x, b.y], u, turn, largest });
+        }
+    }
+    out
+}
+
+/// The closed ring `c` (the region on its left) with each left turn between
+/// two lines of at most [`tol::RING_FILLET_TURN`] replaced by an arc of
+/// radius [`tol::RING_FILLET`] tangent to both, where the lines are long
+/// enough to hold it; `c` itself when nothing changes or the result is not
+/// a valid contour.
+fn fillet_corners(c: &Contour) -> Contour {
+    let v = c.vertices();
+    let n = v.len();
+    if !c.is_closed() || n < 3 {
+        return c.clone();
+    }
+    let rho = tol::RING_FILLET;
+    let mut out = Vec::with_capacity(2 * n);
+    let mut changed = false;
+    for i in 0..n {
+        let (a, b, d) = (&v[(i + n - 1) % n], &v[i], &v[(i + 1) % n]);
+        let (l1, l2) = ((b.x - a.x).hypot(b.y - a.y), (d.x - b.x).hypot(d.y - b.y));
+        let lines = a.bulge == 0.0 && b.bulge == 0.0 && l1 > 0.0 && l2 > 0.0;
+        if lines {
+            let (u, w) = ([(b.x - a.x) / l1, (b.y - a.y) / l1], [(d.x - b.x) / l2, (d.y - b.y) / l2]);
+            let turn = (u[0] * w[1] - u[1] * w[0]).atan2(u[0] * w[0] + u[1] * w[1]);
+            let t = rho * (0.5 * turn).tan();
+            if turn > 0.0 && turn <= tol::RING_FILLET_TURN && t <= 0.5 * l1 && t <= 0.5 * l2 {
+                let p1 = scallop_contour::Vertex { x: b.x - t * u[0], y: b.y - t * u[1], bulge: (0.25 * turn).tan() };
+                let p2 = scallop_contour::Vertex { x: b.x + t * w[0], y: b.y + t * w[1], bulge: 0.0 };
+                out.push(p1);
+                out.push(p2);
+                changed = true;
+                continue;
+            }
+        }
+        out.push(*b);
+    }
+    if !changed {
+        return c.clone();
+    }
+    Contour::new(&out, true).unwrap_or_else(|_| c.clone())
+}
+
+/// `n` unit directions evenly over the front half about +x (from -90 to
+/// +90 degrees, at the middles of `n` equal arcs).
+fn front_probes(n: usize) -> Vec<P2> {
+    (0..n)
+        .map(|i| {
+            #[allow(clippy::cast_precision_loss, reason = "a small count")]
+            let a = -std::f64::consts::FRAC_PI_2 + std::f64::consts::PI * (i as f64 + 0.5) / n as f64;
+            [a.cos(), a.sin()]
+        })
+        .collect()
 }
 
 fn dist(a: P2, b: P2) -> f64 {
     (a[0] - b[0]).hypot(a[1] - b[1])
+}
+
+fn ahead(p: P2, heading: f64, len: f64) -> P2 {
+    [p[0] + len * heading.cos(), p[1] + len * heading.sin()]
 }
 
 /// Only the region's rings, when no grid cell lies inside it.
@@ -206,8 +294,8 @@ fn orient(c: &Contour, direction: Direction) -> Contour {
 
 impl Planner<'_> {
     /// The helix's bore about `s` (tool centre circle of radius `r0`), or a
-    /// plunge at `s`.
-    fn bore(&mut self, s: P2, r0: f64) {
+    /// plunge at `s`; its centres are where the first pass may start.
+    fn bore(&mut self, s: P2, r0: f64, pass: u32) {
         let w = self.options.tool_radius + 2.0 * self.grid.h;
         #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a small positive count")]
         let n = ((std::f64::consts::TAU * r0 / self.grid.h).ceil() as usize).max(1);
@@ -218,13 +306,23 @@ impl Planner<'_> {
         };
         for i in 0..n {
             self.grid.stamp_segment(&mut self.swept, on(i), on(i + 1), w, None);
+            if self.edges.contains(on(i)) {
+                self.starts.push((on(i), true, pass));
+            }
         }
         self.grid.stamp_segment(&mut self.swept, s, s, w, None);
+        self.starts.push((s, true, pass));
+    }
+
+    /// Whether the point `q` is material: within R of the region (inside the
+    /// pocket) and farther than R from every swept centre.
+    fn material(&self, q: P2) -> bool {
+        let r = self.options.tool_radius;
+        self.grid.sample(&self.swept, q) > r && self.grid.sample(&self.reach, q) < r
     }
 
     /// The engagement (rad) of the tool centred at `p`: the share of its
-    /// periphery in material (inside the reach of the region, farther than R
-    /// from every swept centre).
+    /// periphery in material, all round.
     fn engagement(&self, p: P2) -> f64 {
         let r = self.options.tool_radius;
         let n = tol::ENGAGE_PROBES;
@@ -232,8 +330,7 @@ impl Planner<'_> {
         for i in 0..n {
             #[allow(clippy::cast_precision_loss, reason = "a small count")]
             let a = std::f64::consts::TAU * i as f64 / n as f64;
-            let q = [p[0] + r * a.cos(), p[1] + r * a.sin()];
-            if self.grid.sample(&self.reach, q) < r && self.grid.sample(&self.swept, q) > r {
+            if self.material([p[0] + r * a.cos(), p[1] + r * a.sin()]) {
                 count += 1;
             }
         }
@@ -242,190 +339,411 @@ impl Planner<'_> {
         phi
     }
 
-    /// Sweeps the polyline `run` (the tool at its first point), a sample
-    /// every cell side: the largest engagement met after its first `skip`
-    /// points and within R of the last of them; the swept field's old values
-    /// go to `undo`. A run's first points on a wall go along the wall into
-    /// the corner between the wall and the last front, whose angle, not the
-    /// step, sets the engagement there: they are not counted
-    /// (docs/roughing.md).
-    fn sweep(&mut self, run: &[P2], skip: usize, undo: &mut Vec<(usize, f64)>) -> f64 {
+    /// The engagement (rad) of the tool centred at `p` moving along
+    /// `heading`: the arc of the front half of its periphery in material (the
+    /// back half lies in what the tool has just cut).
+    fn front(&self, p: P2, heading: f64) -> f64 {
+        let r = self.options.tool_radius;
+        let n = self.probes.len();
+        let (s, c) = heading.sin_cos();
+        let mut count = 0usize;
+        for &[u, v] in &self.probes {
+            // The probe's direction (u, v) about the heading, rotated onto it.
+            let q = [p[0] + r * (u * c - v * s), p[1] + r * (u * s + v * c)];
+            if self.material(q) {
+                count += 1;
+            }
+        }
+        #[allow(clippy::cast_precision_loss, reason = "small counts")]
+        let phi = std::f64::consts::PI * count as f64 / n as f64;
+        phi
+    }
+
+    /// The sign of a turn away from the material: left (counter-clockwise)
+    /// when climbing, the material on the tool's right.
+    fn away(&self) -> f64 {
+        match self.options.direction {
+            Direction::Climb => 1.0,
+            Direction::Conventional => -1.0,
+        }
+    }
+
+    fn stride(&self, p: P2, heading: f64) -> Stride {
+        self.stride_by(p, heading, tol::WALK_STEP_SHARE * self.options.tool_radius)
+    }
+
+    fn stride_by(&self, p: P2, heading: f64, len: f64) -> Stride {
+        let to = ahead(p, heading, len);
+        Stride { to, heading, phi: self.front(to, heading) }
+    }
+
+    /// The next step from `p` after a step along `heading` (see
+    /// [`Planner::next_by`]).
+    fn next(&self, p: P2, heading: f64) -> Option<Stride> {
+        self.next_by(p, heading, tol::WALK_STEP_SHARE * self.options.tool_radius)
+    }
+
+    /// The next step from `p` after a step along `heading`: the turn whose
+    /// engagement is the target (bisection between the sharpest turn towards
+    /// the material and the sharpest away), then, when that step leaves the
+    /// region, the least further turn away that stays in it with the
+    /// engagement within the accepted bound. `None` when there is none.
+    fn next_by(&self, p: P2, heading: f64, len: f64) -> Option<Stride> {
+        let away = self.away();
+        let at = |d: f64| self.stride_by(p, heading + away * d, len);
+        let (toward, back) = (-tol::WALK_TURN, tol::WALK_TURN_HARD);
+        let mut best = at(toward);
+        if best.phi > self.target {
+            let hard = at(back);
+            if hard.phi > self.accept {
+                // Over the bound whichever way: the pass ends here.
+                return None;
+            }
+            if hard.phi > self.target {
+                best = hard;
+            } else {
+                let (mut lo, mut hi) = (toward, back);
+                best = hard;
+                for _ in 0..tol::WALK_BISECTIONS {
+                    let mid = 0.5 * (lo + hi);
+                    let m = at(mid);
+                    if m.phi > self.target {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                        best = m;
+                    }
+                }
+            }
+        }
+        if self.edges.contains_segment(p, best.to) {
+            return Some(best);
+        }
+        // Turn further away until the step stays in: the first turn that
+        // does, then bisection back towards the wall.
+        let d0 = (best.heading - heading) * away;
+        let mut prev = d0;
+        let mut d = d0;
+        loop {
+            d += tol::WALK_WALL_TURN;
+            if d > tol::WALK_TURN_HARD + 1e-12 {
+                return None;
+            }
+            let s = at(d);
+            if self.edges.contains_segment(p, s.to) {
+                let (mut lo, mut hi, mut ok) = (prev, d, s);
+                for _ in 0..tol::WALK_BISECTIONS {
+                    let mid = 0.5 * (lo + hi);
+                    let m = at(mid);
+                    if self.edges.contains_segment(p, m.to) {
+                        hi = mid;
+                        ok = m;
+                    } else {
+                        lo = mid;
+                    }
+                }
+                if ok.phi <= self.accept {
+                    return Some(ok);
+                }
+                // Along the wall the engagement is over the bound: further
+                // away, the first step in the region under it, if any.
+                let mut e = hi;
+                while e <= tol::WALK_TURN_HARD {
+                    e += tol::WALK_WALL_TURN;
+                    let m = at(e);
+                    if m.phi <= self.accept && self.edges.contains_segment(p, m.to) {
+                        return Some(m);
+                    }
+                }
+                return None;
+            }
+            prev = d;
+        }
+    }
+
+    /// The first step of a pass starting at `p`: from the heading of the
+    /// largest engagement all round, turned away from the material until the
+    /// engagement is the target (and further at a wall), as along a pass.
+    /// `None` when no step from `p` meets material (or none that stays in
+    /// the region does).
+    fn start_heading(&self, p: P2) -> Option<Stride> {
+        let n = tol::WALK_START_HEADINGS;
+        #[allow(clippy::cast_precision_loss, reason = "a small count")]
+        let heading = |i: usize| std::f64::consts::TAU * i as f64 / n as f64;
+        let (mut best, mut phi) = (0.0, -1.0);
+        for i in 0..n {
+            let s = self.stride(p, heading(i));
+            if s.phi > phi {
+                (best, phi) = (heading(i), s.phi);
+            }
+        }
+        if phi < tol::WALK_AIR * self.target {
+            return None;
+        }
+        // From the heading into the material, the turn away to the target
+        // and, at a wall, further away, as along a pass.
+        self.next(p, best).filter(|s| s.phi >= tol::WALK_AIR * self.target)
+    }
+
+    /// A pass from `p` along `heading`: its points (the first is `p`), cut
+    /// back to its last step that cut, and the area it cleared (mm^2, on the
+    /// grid's cells); the swept field holds it.
+    fn pass(&mut self, p: P2, first: Stride, budget: &mut usize) -> Result<(Vec<P2>, f64), RoughError> {
+        let w = self.options.tool_radius + 2.0 * self.grid.h;
+        let air_len = tol::WALK_AIR_SHARE * self.options.tool_radius;
+        let step = tol::WALK_STEP_SHARE * self.options.tool_radius;
+        let mut run = vec![p];
+        let mut undo: Vec<(usize, f64)> = Vec::new();
+        // Per point of `run`: the undo log's length before its move.
+        let mut marks = vec![0usize];
+        let mut last_cut = 0usize;
+        let mut at = p;
+        let mut next = Some(first);
+        while let Some(s) = next {
+            if *budget == 0 {
+                return Err(RoughError::TooMuchWork { what: "adaptive steps", limit: tol::MAX_WALK_STEPS });
+            }
+            *budget -= 1;
+            marks.push(undo.len());
+            self.grid.stamp_segment(&mut self.swept, at, s.to, w, Some(&mut undo));
+            run.push(s.to);
+            if s.phi >= tol::WALK_AIR * self.target {
+                last_cut = run.len() - 1;
+            }
+            #[allow(clippy::cast_precision_loss, reason = "a step count")]
+            let idle = (run.len() - 1 - last_cut) as f64 * step;
+            if idle > air_len {
+                break;
+            }
+            at = s.to;
+            next = self.next(at, s.heading);
+        }
+        // Back to the last step that cut: the air after it is not cut.
+        let keep = last_cut + 1;
+        if keep < run.len() {
+            let mark = marks[keep];
+            while undo.len() > mark {
+                if let Some((k, v)) = undo.pop() {
+                    self.swept[k] = v;
+                }
+            }
+            run.truncate(keep);
+        }
+        let r = self.options.tool_radius;
+        let cleared = undo.iter().filter(|&&(k, old)| old > r && self.swept[k] <= r && self.reach[k] < r).count();
+        #[allow(clippy::cast_precision_loss, reason = "a cell count")]
+        let area = cleared as f64 * self.grid.h * self.grid.h;
+        Ok((run, area))
+    }
+
+    /// Every pass from the bore about `s` until no earlier centre has
+    /// material next to it, its steps and links appended to `walk`: where
+    /// the tool ends.
+    fn walk_all(&mut self, s: P2, walk: &mut Walk) -> Result<P2, RoughError> {
+        let mut pos = s;
+        let mut fresh = true;
+        let spacing = tol::WALK_START_SPACING * self.options.tool_radius;
+        let step = tol::WALK_STEP_SHARE * self.options.tool_radius;
+        while let Some((i, first)) = self.next_start() {
+            let start = self.starts[i].0;
+            walk.passes += 1;
+            let passes = walk.passes;
+            if passes > tol::MAX_PASSES {
+                return Err(RoughError::TooMuchWork { what: "adaptive passes", limit: tol::MAX_PASSES });
+            }
+            // The link there first: it runs on the field as the tool finds it
+            // (the pass would clear what the link's approach meets).
+            let link = (!fresh).then(|| self.link_step(pos, start));
+            let (run, area) = self.pass(start, first, &mut walk.budget)?;
+            // A start serves once: a pass from it that could not go on (the
+            // engagement would rise over the target along a wall) would
+            // only be tried again; its neighbours serve instead.
+            self.starts[i].1 = false;
+            if run.len() < 2 {
+                continue;
+            }
+            // The pass's own start heads its run of starts: the next pass
+            // peels the new frontier from the same upstream end (from a
+            // point further along, the frontier would creep towards the
+            // pass's end, leaving a growing wedge at its start). Only after
+            // progress: a pass that cleared little (slivers in a corner the
+            // tool cannot quite reach) would be made again and again.
+            #[allow(clippy::cast_precision_loss, reason = "a step count")]
+            let progress = area >= tol::WALK_RESTART_SHARE * (run.len() - 1) as f64 * step * self.options.stepover;
+            #[allow(clippy::cast_possible_truncation, reason = "passes are bounded by MAX_PASSES")]
+            if run.len() > tol::WALK_RESTART_STEPS && progress {
+                self.starts.push((start, true, passes as u32));
+            }
+            let mut last = start;
+            for &p in &run[1..] {
+                if dist(p, last) >= spacing {
+                    #[allow(clippy::cast_possible_truncation, reason = "passes are bounded by MAX_PASSES")]
+                    self.starts.push((p, true, passes as u32));
+                    last = p;
+                }
+            }
+            if fresh && dist(start, s) > 0.0 {
+                // From the helix's end (its centre) to the pass: inside the bore.
+                let mut first = vec![s];
+                first.extend_from_slice(&run);
+                self.emit_runs(&mut walk.steps, vec![first]);
+            } else {
+                if let Some(link) = link {
+                    walk.steps.push(link);
+                }
+                self.emit_runs(&mut walk.steps, vec![run.clone()]);
+            }
+            fresh = false;
+            pos = *run.last().unwrap_or(&pos);
+        }
+        Ok(pos)
+    }
+
+    /// The start of the next pass: the head of a run of earlier centres
+    /// next to material (the one before it in its pass has none), on the
+    /// latest pass that has one, and its heading. A pass from a head goes
+    /// along the whole run, the material on the same side, so the frontier
+    /// that the last pass made is peeled from its upstream end, and a branch
+    /// is cleared before the tool moves on. Centres found with no material
+    /// are dropped for good (material only goes away), which makes the next
+    /// one a head.
+    fn next_start(&mut self) -> Option<(usize, Stride)> {
+        let gap = 2.0 * tol::WALK_START_SPACING * self.options.tool_radius;
+        let n = self.starts.len();
+        let head = |starts: &[(P2, bool, u32)], i: usize| {
+            starts[i].1
+                && (i == 0
+                    || !starts[i - 1].1
+                    || starts[i - 1].2 != starts[i].2
+                    || dist(starts[i - 1].0, starts[i].0) > gap)
+        };
+        let key = |starts: &[(P2, bool, u32)], i: usize| (starts[i].2, Reverse(i));
+        let mut heap: BinaryHeap<(u32, Reverse<usize>)> =
+            (0..n).filter(|&i| head(&self.starts, i)).map(|i| key(&self.starts, i)).collect();
+        while let Some((_, Reverse(i))) = heap.pop() {
+            if !self.starts[i].1 {
+                continue;
+            }
+            let p = self.starts[i].0;
+            if let Some(h) = self.start_heading(p) {
+                return Some((i, h));
+            }
+            self.starts[i].1 = false;
+            if i + 1 < n && head(&self.starts, i + 1) {
+                heap.push(key(&self.starts, i + 1));
+            }
+        }
+        None
+    }
+
+    /// The largest engagement (rad) along the polyline `run` (the tool at
+    /// its first point), measured at every point on the field as the run
+    /// leaves it, the run stamped (old values to `undo`).
+    fn sweep_run(&mut self, run: &[P2], undo: &mut Vec<(usize, f64)>) -> f64 {
         let w = self.options.tool_radius + 2.0 * self.grid.h;
         let mut phi = 0.0f64;
-        let Some(&first) = run.first() else { return phi };
-        if skip == 0 {
-            phi = phi.max(self.engagement(first));
-        }
-        self.grid.stamp_segment(&mut self.swept, first, first, w, Some(undo));
-        for (k, pair) in run.windows(2).enumerate() {
-            let (a, b) = (pair[0], pair[1]);
-            let corner = run[skip.saturating_sub(1).min(run.len() - 1)];
-            #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a small positive count")]
-            let n = ((dist(a, b) / self.grid.h).ceil() as usize).max(1);
-            let mut prev = a;
-            for i in 1..=n {
-                #[allow(clippy::cast_precision_loss, reason = "a small count")]
-                let f = i as f64 / n as f64;
-                let p = [a[0] + f * (b[0] - a[0]), a[1] + f * (b[1] - a[1])];
-                let counted = skip == 0 || (k >= skip && dist(p, corner) > self.options.tool_radius);
-                let e = if counted { self.engagement(p) } else { 0.0 };
-                phi = phi.max(e);
-                self.grid.stamp_segment(&mut self.swept, prev, p, w, Some(undo));
-                prev = p;
-            }
+        for pair in run.windows(2) {
+            let heading = (pair[1][1] - pair[0][1]).atan2(pair[1][0] - pair[0][0]);
+            phi = phi.max(self.front(pair[1], heading));
+            self.grid.stamp_segment(&mut self.swept, pair[0], pair[1], w, Some(undo));
         }
         phi
     }
 
-    fn revert(&mut self, undo: &mut Vec<(usize, f64)>, mark: usize) {
-        while undo.len() > mark {
-            if let Some((k, v)) = undo.pop() {
-                self.swept[k] = v;
-            }
+    fn revert(&mut self, undo: &mut Vec<(usize, f64)>) {
+        while let Some((k, v)) = undo.pop() {
+            self.swept[k] = v;
         }
     }
 
-    /// The passes of the growing front from the bore of radius `r0` about `s`
-    /// until the front has reached every point of the distance field `g`.
-    fn fronts(&mut self, g: &[f64], s: P2, r0: f64) -> Result<Vec<Planned>, RoughError> {
-        let gmax = g.iter().copied().filter(|&v| v < 0.5 * BIG).fold(0.0f64, f64::max);
-        let ae = self.options.stepover;
-        let target = self.accept / tol::ENGAGE_ACCEPT;
-        let a_min = tol::STEP_MIN_SHARE * self.grid.h;
-        let (mut t, mut a, mut pos) = (r0, ae, s);
-        let mut steps: Vec<Planned> = Vec::new();
+    /// Clears what the passes left in a convex corner of the region before
+    /// its rings are cut: arcs tangent to both walls, from the largest that
+    /// fits down to [`tol::RING_FILLET`], each the smallest whose engagement
+    /// stays within the accepted bound (bisection on the radius), in the
+    /// cutting direction, joined by links (docs/roughing.md, "Corners").
+    fn clear_corner(&mut self, corner: &Corner, pos: &mut P2, steps: &mut Vec<Step>) {
+        let mut rho = corner.largest.min(tol::CORNER_START_SHARE * self.options.tool_radius);
+        let smallest = tol::RING_FILLET;
         let mut undo = Vec::new();
-        let mut passes = 0usize;
-        let mut pending: Option<Vec<P2>> = None;
-        while t < gmax {
-            passes += 1;
-            if passes > tol::MAX_PASSES {
-                return Err(RoughError::TooMuchWork { what: "adaptive passes", limit: tol::MAX_PASSES });
+        for _ in 0..tol::CORNER_ARCS {
+            if rho <= smallest * (1.0 + 1e-9) {
+                break;
             }
-            let mut trial = 0;
-            let mut last: Option<(f64, f64)> = None;
-            let mut force = false;
-            loop {
-                trial += 1;
-                let level = t + a;
-                let loops = iso_lines(&self.grid, g, level, t).iter().map(|lp| self.walls.snap(lp)).collect();
-                let pieces = pieces(loops, self.options.direction, 2.0 * self.options.tool_radius);
-                undo.clear();
-                let from = Level { g, a, pos, pending: pending.as_ref() };
-                let Cut { phi, items, end, open } = self.cut_level(pieces, from, &mut undo);
-                let ratio = (1.0 - target.cos()) / (1.0 - phi.cos()).max(1e-12);
-                if phi <= self.accept || a <= a_min || trial >= tol::STEP_TRIALS || force {
-                    steps.extend(items);
-                    pending = open;
-                    pos = end;
-                    t = level;
-                    a = (a * ratio.clamp(1.0, tol::STEP_GROW)).min(ae);
-                    break;
-                }
-                self.revert(&mut undo, 0);
-                // A smaller step that did not lower the engagement: the
-                // geometry sets it (a front meeting a wall at a small
-                // angle); the larger step is kept.
-                if let Some((a_last, _)) = last.filter(|l| phi > l.1 - tol::STEP_STALL) {
-                    a = a_last;
-                    force = true;
-                    continue;
-                }
-                last = Some((a, phi));
-                a = (a * 0.9 * ratio).min(0.9 * a).max(a_min);
+            let mut fits = |me: &mut Self, r: f64| {
+                let run = me.corner_arc(corner, r);
+                let ok = me.sweep_run(&run, &mut undo) <= me.accept;
+                me.revert(&mut undo);
+                ok
+            };
+            if !fits(self, rho) {
+                return;
             }
-        }
-        if let Some(ring) = pending {
-            self.stamp(&ring);
-            steps.push((true, ring));
-        }
-        Ok(steps)
-    }
-
-    /// Cuts the pieces of one pass nearest first from `pos`: the largest
-    /// engagement of the cuts, the cuts, where the tool ends, and the ring
-    /// left open by a spiral turn (see [`Planner::spiral`]). `pending` is the
-    /// ring the last pass left open: it is closed first unless this pass is
-    /// one closed front again.
-    fn cut_level(&mut self, mut pieces: Vec<Piece>, level: Level<'_>, undo: &mut Vec<(usize, f64)>) -> Cut {
-        let r = self.options.tool_radius;
-        let mut pos = level.pos;
-        let mut phi = 0.0f64;
-        let mut items = Vec::new();
-        let mut open = None;
-        let single_ring = pieces.len() == 1 && matches!(pieces[0], Piece::Ring(_));
-        if let Some(ring) = level.pending.filter(|_| !single_ring) {
-            phi = phi.max(self.sweep(ring, 0, undo));
-            pos = *ring.last().unwrap_or(&pos);
-            items.push((true, ring.clone()));
-        }
-        while !pieces.is_empty() {
-            let near = |p: &Piece| match p {
-                Piece::Open(v, _) => (dist(v[0], pos), 0),
-                Piece::Ring(v) => nearest_vertex(v, pos),
+            let next = if fits(self, smallest) {
+                smallest
+            } else {
+                let (mut bad, mut good) = (smallest, rho);
+                for _ in 0..tol::WALK_BISECTIONS {
+                    let mid = 0.5 * (bad + good);
+                    if fits(self, mid) {
+                        good = mid;
+                    } else {
+                        bad = mid;
+                    }
+                }
+                good
             };
-            let i = (0..pieces.len()).min_by(|&x, &y| near(&pieces[x]).0.total_cmp(&near(&pieces[y]).0)).unwrap_or(0);
-            let (d, j0) = near(&pieces[i]);
-            let mut skip = 0;
-            // Links are planned later (`links.rs`) and cut nothing but
-            // their approach, which no cut of this plan relies on.
-            let (glued, run) = match pieces.remove(i) {
-                Piece::Open(v, lead) => {
-                    skip = lead;
-                    (false, v)
-                }
-                Piece::Ring(v) if d <= r && single_ring && self.spiral_fits(&v, j0, pos, level) => {
-                    let (run, closing) = self.spiral(&v, j0, pos, level);
-                    open = Some(closing);
-                    (true, run)
-                }
-                Piece::Ring(v) => {
-                    let run: Vec<P2> = v[j0..].iter().chain(v[..=j0].iter()).copied().collect();
-                    (false, run)
-                }
-            };
-            phi = phi.max(self.sweep(&run, skip, undo));
-            pos = *run.last().unwrap_or(&pos);
-            items.push((glued, run));
+            if next >= rho * (1.0 - tol::CORNER_MIN_SHRINK) {
+                return;
+            }
+            rho = next;
+            let run = self.corner_arc(corner, rho);
+            let Some(&start) = run.first() else { return };
+            let link = self.link_step(*pos, start);
+            steps.push(link);
+            *pos = *run.last().unwrap_or(&start);
+            self.emit_runs(steps, vec![run]);
         }
-        Cut { phi, items, end: pos, open }
     }
 
-    /// Whether the spiral's first move, from `pos`, stays in the region.
-    fn spiral_fits(&self, v: &[P2], j: usize, pos: P2, level: Level<'_>) -> bool {
-        let (run, _) = self.spiral(v, j, pos, level);
-        run.get(1).is_some_and(|&p| self.holder.contains_segment(pos, p, self.options.chord_tolerance))
-    }
-
-    /// One turn of a spiral from the last front (level `t`) to the ring `v`
-    /// (level `t + a`), from its vertex `j` nearest `pos` round to it: each
-    /// point of the ring moved back along the distance field's gradient by
-    /// the share of `a` still to climb there. The second polyline is the
-    /// ring from `j` round to it, which the spiral leaves open behind it.
-    fn spiral(&self, v: &[P2], j: usize, pos: P2, level: Level<'_>) -> (Vec<P2>, Vec<P2>) {
-        let ring: Vec<P2> = v[j..].iter().chain(v[..=j].iter()).copied().collect();
-        let mut len = vec![0.0];
-        for w in ring.windows(2) {
-            len.push(len[len.len() - 1] + dist(w[0], w[1]));
+    /// The arc of radius `r` tangent to both walls of `corner`, as points
+    /// in the cutting direction.
+    fn corner_arc(&self, c: &Corner, r: f64) -> Vec<P2> {
+        let t = r * (0.5 * c.turn).tan();
+        let p1 = [c.at[0] - t * c.u[0], c.at[1] - t * c.u[1]];
+        let centre = [p1[0] - r * c.u[1], p1[1] + r * c.u[0]];
+        let a0 = (p1[1] - centre[1]).atan2(p1[0] - centre[0]);
+        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a small positive count")]
+        let n = ((r * c.turn / (0.5 * self.grid.h)).ceil() as usize).max(2);
+        let mut run: Vec<P2> = (0..=n)
+            .map(|i| {
+                #[allow(clippy::cast_precision_loss, reason = "a small count")]
+                let a = a0 + c.turn * i as f64 / n as f64;
+                [centre[0] + r * a.cos(), centre[1] + r * a.sin()]
+            })
+            .collect();
+        if self.options.direction == Direction::Conventional {
+            run.reverse();
         }
-        let total = len[len.len() - 1].max(f64::MIN_POSITIVE);
-        let h = self.grid.h;
-        let mut run = vec![pos];
-        for (q, l) in ring.iter().zip(&len) {
-            let gx = self.grid.sample(level.g, [q[0] + h, q[1]]) - self.grid.sample(level.g, [q[0] - h, q[1]]);
-            let gy = self.grid.sample(level.g, [q[0], q[1] + h]) - self.grid.sample(level.g, [q[0], q[1] - h]);
-            let norm = gx.hypot(gy);
-            let back = (1.0 - l / total) * level.a;
-            let p = if norm > 0.0 && norm < h * 8.0 { [q[0] - back * gx / norm, q[1] - back * gy / norm] } else { *q };
-            run.push(p);
-        }
-        (run, ring)
+        run
     }
 
     /// The region's rings from `pos`, nearest first, with their links.
     fn finish(&mut self, region: &Region, mut pos: P2) -> Vec<Step> {
-        let mut rings: Vec<Contour> = region.rings().iter().map(|c| orient(c, self.options.direction)).collect();
+        // The region's convex corners between two lines, up to a right
+        // angle and a little more, rounded by [`tol::RING_FILLET`]: a tool
+        // centre reaching a sharp corner meets the quarter of its periphery
+        // facing the corner in material however close the passes came
+        // (docs/roughing.md, "Corners"); rounded, the corner keeps a sliver
+        // at most 0.42 x the radius thick. Sharper corners (a gear's tooth
+        // gap) keep their tip: rounded, they would leave their bottom uncut.
+        let rounded: Vec<Contour> = region.rings().iter().map(fillet_corners).collect();
+        let mut rings: Vec<Contour> = rounded.iter().map(|c| orient(c, self.options.direction)).collect();
         let mut steps = Vec::new();
+        for ring in region.rings() {
+            for corner in corners(ring) {
+                self.clear_corner(&corner, &mut pos, &mut steps);
+            }
+        }
         while !rings.is_empty() {
             let started: Vec<Contour> = rings.iter().map(|c| c.starting_near(pos)).collect();
             let d = |c: &Contour| c.start().map_or(f64::INFINITY, |p| dist(p, pos));
@@ -444,87 +762,6 @@ impl Planner<'_> {
         steps
     }
 }
-
-/// The vertex of `v` nearest `p`: (distance, index).
-fn nearest_vertex(v: &[P2], p: P2) -> (f64, usize) {
-    v.iter().enumerate().map(|(k, q)| (dist(*q, p), k)).fold((f64::INFINITY, 0), |b, x| if x.0 < b.0 { x } else { b })
-}
-
-/// The new parts of the iso-lines: closed rings where every point is new,
-/// else runs of new points with the old point before and after each.
-fn pieces(loops: Vec<Vec<IsoPoint>>, direction: Direction, gap: f64) -> Vec<Piece> {
-    let mut out = Vec::new();
-    for lp in loops {
-        let n = lp.len();
-        // A stretch of old points shorter than `gap` joins the runs beside it.
-        let mut keep: Vec<bool> = lp.iter().map(|p| p.1).collect();
-        let Some(first_old) = lp.iter().position(|p| !p.1) else {
-            let mut v: Vec<P2> = lp.iter().map(|p| p.0).collect();
-            if direction == Direction::Conventional {
-                v.reverse();
-            }
-            out.push(Piece::Ring(v));
-            continue;
-        };
-        let Some(start) = (0..n).map(|i| (first_old + i) % n).find(|&i| lp[i].1 && !lp[(i + n - 1) % n].1) else {
-            continue;
-        };
-        let mut i = 0;
-        while i < n {
-            let k = (start + i) % n;
-            if lp[k].1 {
-                i += 1;
-                continue;
-            }
-            let (mut len, mut m) = (0.0, i);
-            while m < n && !lp[(start + m) % n].1 {
-                len += dist(lp[(start + m) % n].0, lp[(start + m + 1) % n].0);
-                m += 1;
-            }
-            if len < gap && m < n {
-                for q in i..m {
-                    keep[(start + q) % n] = true;
-                }
-            }
-            i = m;
-        }
-        let Some(old) = (0..n).find(|&i| !keep[i]) else {
-            let mut v: Vec<P2> = lp.iter().map(|p| p.0).collect();
-            if direction == Direction::Conventional {
-                v.reverse();
-            }
-            out.push(Piece::Ring(v));
-            continue;
-        };
-        let mut run: Vec<P2> = Vec::new();
-        let mut walls: Vec<bool> = Vec::new();
-        for i in 1..=n {
-            let p = lp[(old + i) % n].0;
-            let prev = lp[(old + i - 1) % n].0;
-            if keep[(old + i) % n] {
-                if run.is_empty() {
-                    run.push(prev);
-                    walls.push(lp[(old + i - 1) % n].2);
-                }
-                run.push(p);
-                walls.push(lp[(old + i) % n].2);
-            } else if !run.is_empty() {
-                run.push(p);
-                walls.push(lp[(old + i) % n].2);
-                let mut v = std::mem::take(&mut run);
-                let mut w = std::mem::take(&mut walls);
-                if direction == Direction::Conventional {
-                    v.reverse();
-                    w.reverse();
-                }
-                let lead = w.iter().take_while(|&&x| x).count();
-                out.push(Piece::Open(v, lead));
-            }
-        }
-    }
-    out
-}
-
 /// `c` with its arcs of radius over [`tol::MAX_ARC_RADIUS`] made lines (the
 /// fit of nearly collinear points along a wall: a G-code reader refuses their
 /// far centres).
@@ -543,4 +780,23 @@ fn flat_arcs(c: &Contour) -> Result<Contour, scallop_contour::ContourError> {
 /// The points as lines and arcs within [`tol::ARC_FIT`], far arcs made lines.
 fn fit(points: &[P2]) -> Option<Contour> {
     Contour::from_points(points, false, tol::ARC_FIT).and_then(|c| flat_arcs(&c)).ok()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn right_angled_corners_get_fillets_and_sharp_ones_keep_their_tips() {
+        let square = Contour::polygon(&[[0.0, 0.0], [4.0, 0.0], [4.0, 4.0], [0.0, 4.0]], true).unwrap();
+        let f = fillet_corners(&square);
+        assert_eq!(f.vertices().len(), 8);
+        let rho = tol::RING_FILLET;
+        let want = 16.0 - (4.0 - std::f64::consts::PI) * rho * rho;
+        assert!((f.signed_area() - want).abs() < 1e-9, "{} vs {want}", f.signed_area());
+        // A spike of 20 degrees keeps its tip.
+        let spike = Contour::polygon(&[[0.0, 0.0], [10.0, 1.76], [0.0, 3.53]], true).unwrap();
+        let g = fillet_corners(&spike);
+        assert!(g.vertices().iter().any(|v| (v.x - 10.0).abs() < 1e-12 && (v.y - 1.76).abs() < 1e-12));
+    }
 }

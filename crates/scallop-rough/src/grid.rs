@@ -3,14 +3,13 @@
 //! (minimum of distances to stamped points and segments, read by bilinear
 //! interpolation), the first-order fast marching method for distances
 //! measured inside the region (Sethian 1996, "A fast marching level set
-//! method for monotonically advancing fronts", PNAS 93(4), equation 3), and
-//! oriented iso-lines (marching squares, Lorensen and Cline 1987, in 2D).
+//! method for monotonically advancing fronts", PNAS 93(4), equation 3).
 //!
 //! Samples sit at the cells' centres; `BIG` stands for "far" (unreached,
 //! outside the stamping radius) and keeps the arithmetic finite.
 
 use std::cmp::Reverse;
-use std::collections::{BinaryHeap, HashMap};
+use std::collections::BinaryHeap;
 
 use scallop_contour::{P2, Region};
 
@@ -82,10 +81,12 @@ impl Grid {
         if !inside {
             return BIG;
         }
-        let (fu, fv) = (u.floor(), v.floor());
+        // Non-negative: truncation is the floor.
         #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "checked above")]
-        let k = fv as usize * self.nx + fu as usize;
-        let (a, b) = (u - fu, v - fv);
+        let (iu, iv) = (u as usize, v as usize);
+        let k = iv * self.nx + iu;
+        #[allow(clippy::cast_precision_loss, reason = "grid indices")]
+        let (a, b) = (u - iu as f64, v - iv as f64);
         let (f00, f10, f01, f11) = (f[k], f[k + 1], f[k + self.nx], f[k + self.nx + 1]);
         (f00 * (1.0 - a) + f10 * a) * (1.0 - b) + (f01 * (1.0 - a) + f11 * a) * b
     }
@@ -140,22 +141,24 @@ impl Grid {
                 let k = j * self.nx + i;
                 let c = self.centre(k);
                 let t = if l2 > 0.0 { (((c[0] - a[0]) * dx + (c[1] - a[1]) * dy) / l2).clamp(0.0, 1.0) } else { 0.0 };
-                let d = (c[0] - a[0] - t * dx).hypot(c[1] - a[1] - t * dy);
-                if d <= r && d < f[k] {
-                    if let Some(u) = undo.as_deref_mut() {
-                        u.push((k, f[k]));
+                let (ex, ey) = (c[0] - a[0] - t * dx, c[1] - a[1] - t * dy);
+                let d2 = ex * ex + ey * ey;
+                if d2 <= r * r && d2 < f[k] * f[k] {
+                    let d = d2.sqrt();
+                    if d < f[k] {
+                        if let Some(u) = undo.as_deref_mut() {
+                            u.push((k, f[k]));
+                        }
+                        f[k] = d;
                     }
-                    f[k] = d;
                 }
             }
         }
     }
 
     /// Distances from the sources `seeds` (cell, value) through the cells
-    /// where `open` holds, by fast marching ([`BIG`] where not reached); with
-    /// `slowness`, arrival times of a front whose speed at a cell is the
-    /// inverse of its slowness (mm per unit of time).
-    pub fn march(&self, open: &[bool], seeds: &[(usize, f64)], slowness: Option<&[f64]>) -> Vec<f64> {
+    /// where `open` holds, by fast marching ([`BIG`] where not reached).
+    pub fn march(&self, open: &[bool], seeds: &[(usize, f64)]) -> Vec<f64> {
         let mut t = vec![BIG; self.len()];
         let mut known = vec![false; self.len()];
         let mut heap = BinaryHeap::new();
@@ -178,7 +181,6 @@ impl Grid {
                 let a = t[n - 1].min(t[n + 1]);
                 let b = t[n - self.nx].min(t[n + self.nx]);
                 let (a, b) = if a <= b { (a, b) } else { (b, a) };
-                let h = slowness.map_or(h, |w| h * w[n]);
                 let v = if b - a >= h { a + h } else { 0.5 * (a + b + (2.0 * h * h - (b - a) * (b - a)).sqrt()) };
                 if v < t[n] {
                     t[n] = v;
@@ -200,84 +202,4 @@ impl Grid {
         ];
         cand.into_iter().flatten()
     }
-}
-
-/// A point of an iso-line, whether it is new: beyond the level `prev` (a
-/// point on a wall whose inner sample is at or below `prev` was on the
-/// iso-line of `prev` already), and whether it lies on a wall.
-pub(crate) type IsoPoint = (P2, bool, bool);
-
-/// The closed iso-lines `f = level` with `{f <= level}` on their left
-/// (counter-clockwise around it); values at or above `BIG / 2` are walls.
-pub(crate) fn iso_lines(grid: &Grid, f: &[f64], level: f64, prev: f64) -> Vec<Vec<IsoPoint>> {
-    let nx = grid.nx;
-    let inside = |k: usize| f[k] <= level;
-    let h_edge = |i: usize, j: usize| 2 * (j * nx + i);
-    let v_edge = |i: usize, j: usize| 2 * (j * nx + i) + 1;
-    let mut next: HashMap<usize, usize> = HashMap::new();
-    let mut order: Vec<usize> = Vec::new();
-    let mut point: HashMap<usize, IsoPoint> = HashMap::new();
-    let crossing = |e: usize, a: usize, b: usize, point: &mut HashMap<usize, IsoPoint>| {
-        point.entry(e).or_insert_with(|| {
-            let (ka, kb) = if inside(a) { (a, b) } else { (b, a) };
-            let (pa, pb) = (grid.centre(ka), grid.centre(kb));
-            let wall = f[kb] >= 0.5 * BIG;
-            let s = if wall { 0.0 } else { ((level - f[ka]) / (f[kb] - f[ka])).clamp(0.0, 1.0) };
-            let p = [pa[0] + s * (pb[0] - pa[0]), pa[1] + s * (pb[1] - pa[1])];
-            (p, !wall || f[ka] > prev, wall)
-        });
-    };
-    for j in 0..grid.ny - 1 {
-        for i in 0..nx - 1 {
-            let c = [j * nx + i, j * nx + i + 1, (j + 1) * nx + i + 1, (j + 1) * nx + i];
-            let ins = c.map(inside);
-            if ins.iter().all(|&x| x) || ins.iter().all(|&x| !x) {
-                continue;
-            }
-            // The square's edges counter-clockwise, with their corners in that order.
-            let edges =
-                [(h_edge(i, j), 0, 1), (v_edge(i + 1, j), 1, 2), (h_edge(i, j + 1), 2, 3), (v_edge(i, j), 3, 0)];
-            let mut xs: Vec<(usize, bool)> = Vec::with_capacity(4);
-            for &(e, p, q) in &edges {
-                if ins[p] != ins[q] {
-                    crossing(e, c[p], c[q], &mut point);
-                    xs.push((e, ins[p]));
-                }
-            }
-            let centre_in = c.iter().map(|&k| f[k].min(BIG)).sum::<f64>() * 0.25 <= level;
-            let n = xs.len();
-            for a in 0..n {
-                if !xs[a].1 {
-                    continue;
-                }
-                // Exit `a` joins the next entry counter-clockwise (centre
-                // inside, or only two crossings), else the previous one.
-                let b = if centre_in || n == 2 { (a + 1) % n } else { (a + n - 1) % n };
-                next.insert(xs[a].0, xs[b].0);
-                order.push(xs[a].0);
-            }
-        }
-    }
-    let mut done: HashMap<usize, ()> = HashMap::new();
-    let mut loops = Vec::new();
-    for &start in &order {
-        if done.contains_key(&start) {
-            continue;
-        }
-        let mut ring = Vec::new();
-        let mut e = start;
-        while done.insert(e, ()).is_none() {
-            if let Some(p) = point.get(&e) {
-                ring.push(*p);
-            }
-            match next.get(&e) {
-                Some(&n) => e = n,
-                None => break,
-            }
-        }
-        if ring.len() >= 2 {
-            loops.push(ring);
-        }
-    }
-    loops
 }

@@ -1,101 +1,144 @@
-//! The walls of a tool-centre region for adaptive clearing: the grid's
-//! iso-lines meet a wall at the cell centres next to it (up to a cell side
-//! inside, in steps); their wall points are moved onto the wall itself, and
-//! the wall's corners between two of them are put back, so a pass that runs
-//! along a wall follows it exactly and reaches into its corners (material
-//! left there would be cut by the region's contour at the end, at an
-//! engagement the corner sets, not the step).
-
-use std::collections::HashMap;
+//! The walls of a tool-centre region as chords in buckets, for the exact
+//! tests of adaptive clearing's short steps: whether a point lies in the
+//! region (crossings of a ray, even-odd) and whether a step leaves it (a
+//! proper crossing of a wall, or an end outside).
 
 use scallop_contour::{P2, Region};
 
-use crate::grid::IsoPoint;
-use crate::tol;
-
-/// The region's rings as chords, bucketed for nearest-point queries.
-pub(crate) struct Walls {
-    rings: Vec<Vec<P2>>,
-    /// How far a wall point may be moved (mm).
-    reach: f64,
-    /// Bucket (i, j) of side `side` to the (ring, segment) pairs near it.
-    buckets: HashMap<(i64, i64), Vec<(usize, usize)>>,
+/// The chords of a region's rings, bucketed by squares.
+pub(crate) struct Edges {
+    segs: Vec<(P2, P2)>,
+    x0: f64,
+    y0: f64,
     side: f64,
+    nx: usize,
+    ny: usize,
+    buckets: Vec<Vec<u32>>,
 }
 
-/// The nearest wall point: ring, segment, the point.
-type Foot = (usize, usize, P2);
+fn dist2(a: P2, b: P2) -> f64 {
+    (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)
+}
 
-impl Walls {
-    /// The walls of `region`, chords within [`tol::WALL_CHORD`], found from
-    /// up to `reach` mm away.
-    pub fn new(region: &Region, reach: f64) -> Walls {
-        let rings: Vec<Vec<P2>> = region.rings().iter().map(|c| c.to_points(tol::WALL_CHORD)).collect();
-        let side = reach.max(1e-6);
-        let mut buckets: HashMap<(i64, i64), Vec<(usize, usize)>> = HashMap::new();
-        for (r, ring) in rings.iter().enumerate() {
-            for s in 0..ring.len() {
-                let (a, b) = (ring[s], ring[(s + 1) % ring.len()]);
-                let (i0, j0) = Self::key([a[0].min(b[0]) - side, a[1].min(b[1]) - side], side);
-                let (i1, j1) = Self::key([a[0].max(b[0]) + side, a[1].max(b[1]) + side], side);
+/// The sign of the turn a, b, c (positive: counter-clockwise).
+fn orient(a: P2, b: P2, c: P2) -> f64 {
+    (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+}
+
+impl Edges {
+    /// The rings of `region` as chords within `chord` (mm), in buckets of
+    /// side `side` (mm).
+    pub fn new(region: &Region, chord: f64, side: f64) -> Edges {
+        let mut segs = Vec::new();
+        for ring in region.rings() {
+            let pts = ring.to_points(chord);
+            for (k, a) in pts.iter().enumerate() {
+                let b = pts[(k + 1) % pts.len()];
+                if dist2(*a, b) > 0.0 {
+                    segs.push((*a, b));
+                }
+            }
+        }
+        let (lo, hi) = region.bounds().unwrap_or(([0.0, 0.0], [0.0, 0.0]));
+        let side = side.max(1e-6);
+        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "bounded positive counts")]
+        let (nx, ny) = (((hi[0] - lo[0]) / side).ceil() as usize + 3, ((hi[1] - lo[1]) / side).ceil() as usize + 3);
+        let mut edges =
+            Edges { segs: Vec::new(), x0: lo[0] - side, y0: lo[1] - side, side, nx, ny, buckets: Vec::new() };
+        edges.buckets = vec![Vec::new(); nx * ny];
+        for (k, &(a, b)) in segs.iter().enumerate() {
+            let (i0, j0) = edges.cell([a[0].min(b[0]), a[1].min(b[1])]);
+            let (i1, j1) = edges.cell([a[0].max(b[0]), a[1].max(b[1])]);
+            for j in j0..=j1 {
                 for i in i0..=i1 {
-                    for j in j0..=j1 {
-                        buckets.entry((i, j)).or_default().push((r, s));
+                    #[allow(clippy::cast_possible_truncation, reason = "segment counts are far below 2^32")]
+                    edges.buckets[j * nx + i].push(k as u32);
+                }
+            }
+        }
+        edges.segs = segs;
+        edges
+    }
+
+    /// The bucket of `p`, clamped to the grid.
+    fn cell(&self, p: P2) -> (usize, usize) {
+        #[allow(
+            clippy::cast_possible_truncation,
+            clippy::cast_sign_loss,
+            clippy::cast_precision_loss,
+            reason = "clamped"
+        )]
+        let c = |v: f64, n: usize| v.floor().clamp(0.0, (n - 1) as f64) as usize;
+        (c((p[0] - self.x0) / self.side, self.nx), c((p[1] - self.y0) / self.side, self.ny))
+    }
+
+    /// Whether `p` lies in the region: the walls crossed by the ray from `p`
+    /// towards +x, each counted in the bucket that holds the crossing.
+    pub fn contains(&self, p: P2) -> bool {
+        let (i0, j) = self.cell(p);
+        let mut odd = false;
+        for i in i0..self.nx {
+            #[allow(clippy::cast_precision_loss, reason = "grid indices")]
+            let (bx0, bx1) = (self.x0 + i as f64 * self.side, self.x0 + (i + 1) as f64 * self.side);
+            for &k in &self.buckets[j * self.nx + i] {
+                let (a, b) = self.segs[k as usize];
+                if (a[1] > p[1]) == (b[1] > p[1]) {
+                    continue;
+                }
+                let x = a[0] + (p[1] - a[1]) * (b[0] - a[0]) / (b[1] - a[1]);
+                let last = i + 1 == self.nx;
+                if x > p[0] && (x >= bx0 || i == i0) && (x < bx1 || last) {
+                    odd = !odd;
+                }
+            }
+        }
+        odd
+    }
+
+    /// Whether the step from `a` (in the region) to `b` stays in it: `b`
+    /// inside and no wall crossed on the way (touching a wall is inside).
+    pub fn contains_segment(&self, a: P2, b: P2) -> bool {
+        if !self.contains(b) {
+            return false;
+        }
+        let (i0, j0) = self.cell([a[0].min(b[0]), a[1].min(b[1])]);
+        let (i1, j1) = self.cell([a[0].max(b[0]), a[1].max(b[1])]);
+        for j in j0..=j1 {
+            for i in i0..=i1 {
+                for &k in &self.buckets[j * self.nx + i] {
+                    let (p, q) = self.segs[k as usize];
+                    let (o1, o2) = (orient(p, q, a), orient(p, q, b));
+                    let (o3, o4) = (orient(a, b, p), orient(a, b, q));
+                    if o1 * o2 < 0.0 && o3 * o4 < 0.0 {
+                        return false;
                     }
                 }
             }
         }
-        Walls { rings, reach, buckets, side }
+        true
     }
+}
 
-    fn key(p: P2, side: f64) -> (i64, i64) {
-        #[allow(clippy::cast_possible_truncation, reason = "bucket indices of finite coordinates")]
-        let k = ((p[0] / side).floor() as i64, (p[1] / side).floor() as i64);
-        k
-    }
+#[cfg(test)]
+mod tests {
+    use super::*;
 
-    /// The wall point nearest `p` within the reach, if any.
-    fn foot(&self, p: P2) -> Option<Foot> {
-        let mut best: Option<(f64, Foot)> = None;
-        for &(r, s) in self.buckets.get(&Self::key(p, self.side))? {
-            let ring = &self.rings[r];
-            let (a, b) = (ring[s], ring[(s + 1) % ring.len()]);
-            let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-            let l2 = dx * dx + dy * dy;
-            let t = if l2 > 0.0 { (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2).clamp(0.0, 1.0) } else { 0.0 };
-            let q = [a[0] + t * dx, a[1] + t * dy];
-            let d = (p[0] - q[0]).hypot(p[1] - q[1]);
-            if best.is_none_or(|x| d < x.0) {
-                best = Some((d, (r, s, q)));
-            }
+    #[test]
+    fn points_and_steps_against_a_square_with_a_hole() {
+        let outer = vec![[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [0.0, 10.0]];
+        let hole = vec![[4.0, 4.0], [4.0, 6.0], [6.0, 6.0], [6.0, 4.0]];
+        let region = Region::from_polygons(&[outer, hole], false);
+        let e = Edges::new(&region, 1e-3, 0.7);
+        for (p, want) in [([1.0, 1.0], true), ([5.0, 5.0], false), ([11.0, 5.0], false), ([3.9, 5.0], true)] {
+            assert_eq!(e.contains(p), want, "{p:?}");
+            assert_eq!(region.contains(p), want, "{p:?}");
         }
-        best.filter(|x| x.0 <= self.reach).map(|x| x.1)
-    }
-
-    /// The loop with its wall points on the wall and the wall's vertices
-    /// between two consecutive wall points on nearby segments of one ring.
-    pub fn snap(&self, lp: &[IsoPoint]) -> Vec<IsoPoint> {
-        let mut out: Vec<IsoPoint> = Vec::with_capacity(lp.len());
-        let mut last: Option<Foot> = None;
-        for p in lp {
-            let foot = if p.2 { self.foot(p.0) } else { None };
-            let Some((r, s, q)) = foot else {
-                out.push(*p);
-                last = None;
-                continue;
-            };
-            if let Some((_, s0, _)) = last.filter(|l| l.0 == r) {
-                let n = self.rings[r].len();
-                let (fwd, back) = ((s + n - s0) % n, (s0 + n - s) % n);
-                if fwd > 0 && fwd <= back && fwd <= tol::WALL_CORNERS {
-                    out.extend((1..=fwd).map(|k| (self.rings[r][(s0 + k) % n], p.1, true)));
-                } else if back > 0 && back < fwd && back <= tol::WALL_CORNERS {
-                    out.extend((0..back).map(|k| (self.rings[r][(s0 + n - k) % n], p.1, true)));
-                }
-            }
-            out.push((q, p.1, true));
-            last = Some((r, s, q));
-        }
-        out
+        assert!(e.contains_segment([1.0, 1.0], [3.0, 3.0]));
+        assert!(!e.contains_segment([3.0, 5.0], [4.5, 5.0]));
+        // Across the hole's corner and out again: both ends in the region.
+        assert!(!e.contains_segment([3.5, 4.8], [4.8, 3.5]));
+        // Touching the corner only: in.
+        assert!(e.contains_segment([3.5, 4.5], [4.5, 3.5]));
+        assert!(!e.contains_segment([9.0, 9.0], [10.5, 9.0]));
     }
 }

@@ -4,8 +4,9 @@
 //! no reachable material is left, and the plan is the same on one and two
 //! threads. The simulator follows arc moves along chords within 1 um, as
 //! `scallop engagement` reads G2/G3. The engagement bound (1.1 x the
-//! stepover's angle outside the entry) holds on discs, not yet at the sharp
-//! corners of straight walls (docs/roughing.md, "Adaptive clearing").
+//! stepover's angle outside the entry) holds on discs and on 99 % of the
+//! path elsewhere, not yet at the sharp corners of straight walls
+//! (docs/roughing.md, "Adaptive clearing").
 #![allow(clippy::unwrap_used, reason = "tests: a panic is the failure report")]
 
 use proptest::prelude::*;
@@ -101,11 +102,13 @@ fn discs_stay_within_the_bound_and_no_pocket_has_a_slot() {
     // The bound (1.1 x the stepover's angle) holds on a disc; the straight-
     // walled pockets (rectangle, with an island, L) exceed it at their sharp
     // corners, which this pattern does not handle yet (issue 16,
-    // docs/roughing.md "Adaptive clearing"), so only their slots are judged.
+    // docs/roughing.md "Adaptive clearing"), so their slots and their 99th
+    // percentile are judged.
     let bound = 1.1 * engagement_angle(AE, R);
     for kind in 0..4 {
         let r = judge_shape(&shape(16.0, 12.0, kind));
         assert!(r.slot_length <= 0.0, "shape {kind}: slot {:.2} mm", r.slot_length);
+        assert!(r.p99 <= bound, "shape {kind}: p99 {:.1} deg, bound {:.1} deg", r.p99.to_degrees(), bound.to_degrees());
         if kind == 3 {
             assert!(
                 r.max <= bound,
@@ -233,8 +236,10 @@ fn a_hash_is_cleared_with_its_pieces_joined_tool_down() {
     check_cleared(&report);
     assert!(report.slot_length <= 0.0, "slot {:.2} mm", report.slot_length);
     check_links(&plan, &report);
-    // A join is a retract only where no cleared path is found (at most 2 %).
-    assert!(50 * plan.retracts <= plan.links, "{} retracts, {} links", plan.retracts, plan.links);
+    // A join is a retract only where no cleared path is found (at most 3 %:
+    // the links between corners, along walls whose slivers the rings cut
+    // last, docs/roughing.md "Adaptive clearing", step 8).
+    assert!(33 * plan.retracts <= plan.links, "{} retracts, {} links", plan.retracts, plan.links);
 }
 
 proptest! {
@@ -244,11 +249,14 @@ proptest! {
     fn combs_are_cleared_with_links_that_cut_nothing(
         w in proptest::collection::vec(2.0 * R + 0.5..4.0 * R, 2..4)
     ) {
-        // Fingers a little wider than the tool: fronts split into one piece per finger.
+        // Fingers a little wider than the tool: a finger the walk cannot
+        // turn into gets an entry of its own (a retract), and the links
+        // between the corners at its end may be retracts (docs/roughing.md,
+        // "Adaptive clearing", step 8): at most three a finger.
         let (pocket, plan) = plan(&comb(&w));
         let report = judge(&pocket, &plan);
         check_cleared(&report);
         check_links(&plan, &report);
-        prop_assert!(plan.retracts <= 1, "{} retracts, {} links", plan.retracts, plan.links);
+        prop_assert!(plan.retracts <= 3 * w.len() + 1, "{} retracts, {} links", plan.retracts, plan.links);
     }
 }

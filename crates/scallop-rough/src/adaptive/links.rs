@@ -1,16 +1,5 @@
-//! The order of an adaptive plan's cuts and the tool-down links between
-//! them (docs/roughing.md, "Adaptive clearing", "Order and links").
-//!
-//! The fronts give the cuts level by level over the whole region: in a
-//! branching region (a "#", fingers) every pass visits every branch. The
-//! cuts are grouped into chains (a cut that starts where the one before it
-//! ended, a spiral's turns, belongs to the same chain) and a chain depends
-//! on every earlier chain whose tool centres come within 2 R of its own
-//! (their sweeps overlap): cut after its dependencies, a chain meets no
-//! more material than when it was planned (material only goes away), so
-//! its measured engagement still bounds it. Chains are then cut nearest
-//! first among those whose dependencies are cut: a branch is cleared before
-//! the tool moves on.
+//! The tool-down links of an adaptive plan between its passes
+//! (docs/roughing.md, "Adaptive clearing").
 //!
 //! A link from the end of a chain to the start of the next stays at the
 //! cutting depth through cleared area: a shortest path on a lattice of the
@@ -18,8 +7,8 @@
 //! nothing (no probe of the periphery in material, checked on the grid's
 //! swept field as it is when the link runs), shortened by straight
 //! segments that cut nothing either, the last [`APPROACH_SHARE`] R to the
-//! start allowed to engage up to the accepted bound (a closed front is
-//! entered at a new point). It is a retract only when no such path exists
+//! start allowed to engage up to the target (a pass starts next to
+//! material). It is a retract only when no such path exists
 //! within [`DETOUR`] times the straight distance plus [`DETOUR_EXTRA`] R.
 
 use std::cmp::Reverse;
@@ -30,11 +19,8 @@ use scallop_contour::P2;
 use super::{Planner, dist};
 use crate::grid::BIG;
 use crate::offset::Step;
+use crate::tol;
 use crate::tol::{APPROACH_SHARE, DETOUR, DETOUR_EXTRA, LATTICE, LINK_PROBES, LINK_SLACK, MAX_EXPAND, MAX_GOALS};
-
-/// One cut as planned: whether it starts where the cut before it ended
-/// (glued, no link), and its tool-centre points.
-pub(super) type Planned = (bool, Vec<P2>);
 
 /// A lattice node's state in the cache of [`Planner::node_clear`].
 const CLEAR: u32 = u32::MAX;
@@ -70,7 +56,7 @@ impl Planner<'_> {
             #[allow(clippy::cast_precision_loss, reason = "a small count")]
             let f = i as f64 / n as f64;
             let p = [a[0] + f * (b[0] - a[0]), a[1] + f * (b[1] - a[1])];
-            self.clear_at(p) || (dist(p, target) <= near && self.engagement(p) <= self.accept)
+            self.clear_at(p) || (dist(p, target) <= near && self.engagement(p) <= tol::LINK_APPROACH * self.target)
         })
     }
 
@@ -255,60 +241,12 @@ impl Planner<'_> {
         self.epoch = self.epoch.wrapping_add(1).min(CLEAR - 1);
     }
 
-    /// The planned cuts in the order of the module documentation, with
-    /// their links, from the entry `s` (the swept field is back to the
-    /// bore's): the steps, and where the tool ends.
-    pub(super) fn schedule(&mut self, cuts: Vec<Planned>, s: P2) -> (Vec<Step>, P2) {
-        let chains = chains(cuts);
-        let r = self.options.tool_radius;
-        let spacing = 0.25 * r;
-        let reach = 2.0 * r + spacing + 2.0 * self.grid.h;
-        let deps = dependencies(&chains, spacing, reach);
-        let mut waiting: Vec<usize> = deps.iter().map(Vec::len).collect();
-        let mut after: Vec<Vec<usize>> = vec![Vec::new(); chains.len()];
-        for (j, d) in deps.iter().enumerate() {
-            for &i in d {
-                after[i].push(j);
-            }
-        }
-        let mut ready: Vec<usize> = (0..chains.len()).filter(|&j| waiting[j] == 0).collect();
-        let mut steps: Vec<Step> = Vec::new();
-        let mut pos = s;
-        while !ready.is_empty() {
-            let start = |j: usize| chains[j][0].first().copied().unwrap_or(pos);
-            let i = (0..ready.len())
-                .min_by(|&a, &b| {
-                    dist(start(ready[a]), pos).total_cmp(&dist(start(ready[b]), pos)).then(ready[a].cmp(&ready[b]))
-                })
-                .unwrap_or(0);
-            let j = ready.swap_remove(i);
-            let mut runs = chains[j].clone();
-            if steps.is_empty() {
-                if runs[0].first().is_some_and(|p| dist(*p, s) > 0.0) {
-                    runs[0].insert(0, s);
-                }
-            } else if let Some(&to) = runs[0].first() {
-                let step = self.link_step(pos, to);
-                steps.push(step);
-            }
-            pos = runs.last().and_then(|v| v.last()).copied().unwrap_or(pos);
-            self.emit_runs(&mut steps, runs);
-            for &n in &after[j] {
-                waiting[n] -= 1;
-                if waiting[n] == 0 {
-                    ready.push(n);
-                }
-            }
-        }
-        (steps, pos)
-    }
-
-    /// Appends the runs of a chain as cuts, stamped (the link before the
-    /// first is the caller's; each run starts where the one before ended).
+    /// Appends the runs as cuts, stamped (the link before the first is the
+    /// caller's; each run starts where the one before ended).
     /// A move of a run that leaves the region (a chord of the grid across a
     /// wall's bend) is not cut: the tool goes on from the move's end by a
     /// link.
-    fn emit_runs(&mut self, steps: &mut Vec<Step>, runs: Vec<Vec<P2>>) {
+    pub(super) fn emit_runs(&mut self, steps: &mut Vec<Step>, runs: Vec<Vec<P2>>) {
         let chord = self.options.chord_tolerance;
         for mut run in runs {
             run.dedup_by(|a, b| dist(*a, *b) <= super::tol::LINK_GROW * 0.1);
@@ -347,76 +285,4 @@ impl Planner<'_> {
             None => Step::Link { tool_down: false, via: Vec::new(), cleared: self.clear_at(to), to: Some(to) },
         }
     }
-}
-
-/// The planned cuts grouped into chains: a glued cut joins the chain before it.
-fn chains(cuts: Vec<Planned>) -> Vec<Vec<Vec<P2>>> {
-    let mut out: Vec<Vec<Vec<P2>>> = Vec::new();
-    for (glued, run) in cuts {
-        if run.is_empty() {
-            continue;
-        }
-        match out.last_mut() {
-            Some(c) if glued => c.push(run),
-            _ => out.push(vec![run]),
-        }
-    }
-    out
-}
-
-/// For each chain, the earlier chains that have a point within `reach` of
-/// one of its points, the chains' polylines sampled every `spacing` or less.
-fn dependencies(chains: &[Vec<Vec<P2>>], spacing: f64, reach: f64) -> Vec<Vec<usize>> {
-    let side = reach.max(1e-9);
-    let key = |p: P2| {
-        #[allow(clippy::cast_possible_truncation, reason = "bucket indices of finite coordinates")]
-        let k = ((p[0] / side).floor() as i64, (p[1] / side).floor() as i64);
-        k
-    };
-    let mut buckets: HashMap<(i64, i64), Vec<(usize, P2)>> = HashMap::new();
-    let mut mark = vec![usize::MAX; chains.len()];
-    let mut out = Vec::with_capacity(chains.len());
-    for (j, chain) in chains.iter().enumerate() {
-        let pts = samples(chain, spacing);
-        let mut deps = Vec::new();
-        for &p in &pts {
-            let (bi, bj) = key(p);
-            for dj in -1..=1 {
-                for di in -1..=1 {
-                    let Some(list) = buckets.get(&(bi + di, bj + dj)) else { continue };
-                    for &(i, q) in list {
-                        if mark[i] != j && dist(p, q) < reach {
-                            mark[i] = j;
-                            deps.push(i);
-                        }
-                    }
-                }
-            }
-        }
-        for &p in &pts {
-            buckets.entry(key(p)).or_default().push((j, p));
-        }
-        out.push(deps);
-    }
-    out
-}
-
-/// The points of the runs of a chain, with points added so that consecutive
-/// ones are at most `spacing` apart.
-fn samples(chain: &[Vec<P2>], spacing: f64) -> Vec<P2> {
-    let mut out = Vec::new();
-    for run in chain {
-        let Some(&first) = run.first() else { continue };
-        out.push(first);
-        for w in run.windows(2) {
-            #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a small positive count")]
-            let n = ((dist(w[0], w[1]) / spacing).ceil() as usize).max(1);
-            for i in 1..=n {
-                #[allow(clippy::cast_precision_loss, reason = "a small count")]
-                let f = i as f64 / n as f64;
-                out.push([w[0][0] + f * (w[1][0] - w[0][0]), w[0][1] + f * (w[1][1] - w[0][1])]);
-            }
-        }
-    }
-    out
 }
