@@ -640,6 +640,15 @@ pub mod rough {
     /// one stepover (see `offset.rs`).
     pub const LINK_MARGIN_SHARE: f64 = 0.05;
 
+    /// Share of a region's area an erosion by the stepover may lose beyond
+    /// the bound `P ae + pi ae^2 h` before the offset is taken as failed
+    /// (`offset.rs`): room for the kernel's arcs and joins.
+    pub const OFFSET_AREA_SLACK: f64 = 1e-3;
+
+    /// Relative change of the offset distance when an erosion is computed
+    /// again after a failed offset (`offset.rs`).
+    pub const OFFSET_RETRY: f64 = 1e-4;
+
     /// A facet whose unit normal has `z` above this is horizontal (a floor that
     /// gets a level of its own): within 0.08 degrees of level.
     pub const FLAT_NORMAL_Z: f64 = 1.0 - 1e-6;

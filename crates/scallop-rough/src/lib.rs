@@ -51,6 +51,12 @@ pub enum RoughError {
     /// The waterline kernel refused.
     #[error("waterline of the part: {0}")]
     Waterline(#[from] scallop_waterline::WaterlineError),
+    /// The offset kernel lost part of a region at every attempt.
+    #[error("the offset of a roughing region by {distance} mm failed; give a slightly different stepover")]
+    Offset {
+        /// The offset distance from the region's contour (mm).
+        distance: f64,
+    },
     /// More work than the planner's bounds allow.
     #[error("more than {limit} {what}; give a larger stepover or stepdown")]
     TooMuchWork {
