@@ -229,43 +229,9 @@ pub(crate) fn left_above_allowance(
 /// The connected places (4-neighbours) of cells with `rest > 0`, largest
 /// first, at most [`LEFT_PLACES`].
 fn places(rest: &[f64], zmap: &scallop_sim::ZMap) -> Vec<crate::RestPlaceReport> {
-    let nx = zmap.nx();
-    let (cx, cy) = zmap.cell_size();
-    let mut seen = vec![false; rest.len()];
-    let mut out = Vec::new();
-    let mut stack = Vec::new();
-    for start in 0..rest.len() {
-        if seen[start] || rest[start] <= 0.0 {
-            continue;
-        }
-        seen[start] = true;
-        stack.push(start);
-        let (mut cells, mut deepest) = (0usize, (0.0, start));
-        while let Some(k) = stack.pop() {
-            cells += 1;
-            if rest[k] > deepest.0 {
-                deepest = (rest[k], k);
-            }
-            let (i, j) = (k % nx, k / nx);
-            let neighbours = [
-                (i > 0).then(|| k - 1),
-                (i + 1 < nx).then_some(k + 1),
-                (j > 0).then(|| k - nx),
-                (k + nx < rest.len()).then_some(k + nx),
-            ];
-            for n in neighbours.into_iter().flatten() {
-                if !seen[n] && rest[n] > 0.0 {
-                    seen[n] = true;
-                    stack.push(n);
-                }
-            }
-        }
-        #[allow(clippy::cast_precision_loss, reason = "cell counts")]
-        let area_mm2 = cells as f64 * cx * cy;
-        let c = zmap.cell_center(deepest.1 % nx, deepest.1 / nx);
-        out.push(crate::RestPlaceReport { at: [c.x, c.y], area_mm2, depth_mm: deepest.0 });
-    }
-    out.sort_by(|a, b| b.area_mm2.total_cmp(&a.area_mm2).then(b.depth_mm.total_cmp(&a.depth_mm)));
-    out.truncate(LEFT_PLACES);
-    out
+    scallop_sim::rest_places(rest, zmap)
+        .into_iter()
+        .take(LEFT_PLACES)
+        .map(|p| crate::RestPlaceReport { at: [p.at.x, p.at.y], area_mm2: p.area, depth_mm: p.depth })
+        .collect()
 }

@@ -101,7 +101,7 @@ pub use engagement::{
 };
 pub use envelope::swept_floor;
 pub use error::SimError;
-pub use rest::{OverCell, RestPlace, RestSplit, split_rest};
+pub use rest::{OverCell, RestPlace, RestSplit, rest_places, split_rest};
 pub use verify::{GougeCell, PartField, Verification, VerifyOptions, part_heights, verify, verify_in};
 pub use view::StockView;
 pub use zmap::{Collision, CutReport, MAX_CELLS, MoveId, RapidHit, ToolPart, ZMap};

@@ -144,7 +144,7 @@ pub fn split_rest(
         b.thickness.total_cmp(&a.thickness).then(a.at.x.total_cmp(&b.at.x)).then(a.at.y.total_cmp(&b.at.y))
     });
     machined_over.truncate(crate::tol::OVER_REPORTED);
-    let places = places(&rest, zmap);
+    let places = rest_places(&rest, zmap);
     let area = cx * cy;
     #[allow(clippy::cast_precision_loss, reason = "cell counts")]
     let unreachable_area = rest.iter().filter(|&&r| r > 0.0).count() as f64 * area;
@@ -224,8 +224,11 @@ impl<'a> Reach<'a> {
     }
 }
 
-/// The connected places (4-neighbours) of cells with `rest > 0`, largest first.
-fn places(rest: &[f64], zmap: &ZMap) -> Vec<RestPlace> {
+/// The connected places (4-neighbours) of the cells of `zmap` with `rest > 0`
+/// (one value per cell, row-major), largest first, at most
+/// [`crate::tol::WORST_REPORTED`].
+#[must_use]
+pub fn rest_places(rest: &[f64], zmap: &ZMap) -> Vec<RestPlace> {
     let (nx, ny) = (zmap.nx(), zmap.ny());
     let (cx, cy) = zmap.cell_size();
     let mut seen = vec![false; rest.len()];
