@@ -20,29 +20,13 @@ use proptest::prelude::*;
 use scallop_cutter::{Cutter, CutterShape};
 use scallop_engine::{FinishJob, Job, JobOutput, Operation, Part, StockShape, run_job};
 use scallop_geom::{Aabb3, Point3};
-use scallop_mesh::TriMesh;
 use scallop_rough::{Direction, Pattern, RoughSettings};
+
+mod common;
+use common::boxes_mesh;
 
 /// An axis-aligned box: (min, max) corners.
 type Boxed = ([f64; 3], [f64; 3]);
-
-/// Closed boxes as one mesh: each box's 12 triangles from its 8 corners
-/// (corner bit i: x, y, z high).
-fn boxes_mesh(boxes: &[Boxed]) -> TriMesh {
-    const FACES: [[usize; 4]; 6] = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
-    let mut soup = Vec::new();
-    for &(lo, hi) in boxes {
-        let corner = |i: usize| {
-            let pick = |k: usize| if i >> k & 1 == 1 { hi[k] } else { lo[k] };
-            Point3::new(pick(0), pick(1), pick(2))
-        };
-        for f in FACES {
-            soup.push([corner(f[0]), corner(f[1]), corner(f[2])]);
-            soup.push([corner(f[0]), corner(f[2]), corner(f[3])]);
-        }
-    }
-    TriMesh::from_soup(&soup).unwrap().0
-}
 
 /// A U of walls `t` thick and `h` high around a channel `w` wide, open at
 /// +y, on a plate at z = 0 that spans the stock: two inside corners of 90
