@@ -158,19 +158,8 @@ fn remaining_impeller(
             *all.entry(k).or_insert(0.0) += v;
         }
     }
-    let left: f64 = all.values().sum();
-    println!("volume to remove {total:.0} mm3, left {left:.0} mm3, V_r {:.2} %", 100.0 * left / total);
-    let pct = |v: f64| 100.0 * v / total;
-    let by = |f: &dyn Fn(&(String, i64, i64)) -> String, title: &str| {
-        let mut m: BTreeMap<String, f64> = BTreeMap::new();
-        for (k, v) in &all {
-            *m.entry(f(k)).or_insert(0.0) += v;
-        }
-        println!("\n{title}:");
-        for (k, v) in m {
-            println!("  {k:<50} {v:>8.0} mm3  {:>6.2} %", pct(v));
-        }
-    };
+    print_left(&all, total);
+    let by = |f: &dyn Fn(&(String, i64, i64)) -> String, title: &str| print_by(&all, total, f, title, 50);
     by(&|k| k.0.clone(), "by class");
     by(&|k| format!("{:>2}: {:>2}-{:>2} mm from the hub", k.1, 4 * k.1, 4 * k.1 + 4), "by distance to the hub");
     by(&|k| format!("{:>2}: r {:>2}-{:>2} mm", k.2, 25 + 5 * k.2, 30 + 5 * k.2), "by tenth of the channel (radius)");
@@ -185,6 +174,25 @@ fn remaining_impeller(
 }
 
 /// The class of a remaining sample.
+/// Prints the volume to remove, the volume left in `all` and V_r.
+fn print_left<K>(all: &BTreeMap<K, f64>, total: f64) {
+    let left: f64 = all.values().sum();
+    println!("volume to remove {total:.0} mm3, left {left:.0} mm3, V_r {:.2} %", 100.0 * left / total);
+}
+
+/// Prints the volume left in `all` grouped by the label `f` gives each key,
+/// under `title`, labels `width` wide.
+fn print_by<K>(all: &BTreeMap<K, f64>, total: f64, f: &dyn Fn(&K) -> String, title: &str, width: usize) {
+    let mut m: BTreeMap<String, f64> = BTreeMap::new();
+    for (k, v) in all {
+        *m.entry(f(k)).or_insert(0.0) += v;
+    }
+    println!("\n{title}:");
+    for (k, v) in m {
+        println!("  {k:<width$} {v:>8.0} mm3  {:>6.2} %", 100.0 * v / total);
+    }
+}
+
 fn class(d_b: f64, d_f: f64) -> &'static str {
     let near = ALLOWANCE + 1e-3;
     if d_b <= near || d_f <= near {
@@ -339,19 +347,8 @@ fn remaining(
             *all.entry(k).or_insert(0.0) += v;
         }
     }
-    let left: f64 = all.values().sum();
-    println!("volume to remove {total:.0} mm3, left {left:.0} mm3, V_r {:.2} %", 100.0 * left / total);
-    let pct = |v: f64| 100.0 * v / total;
-    let by = |f: &dyn Fn(&(String, String, i64)) -> String, title: &str| {
-        let mut m: BTreeMap<String, f64> = BTreeMap::new();
-        for (k, v) in &all {
-            *m.entry(f(k)).or_insert(0.0) += v;
-        }
-        println!("\n{title}:");
-        for (k, v) in m {
-            println!("  {k:<45} {v:>8.0} mm3  {:>6.2} %", pct(v));
-        }
-    };
+    print_left(&all, total);
+    let by = |f: &dyn Fn(&(String, String, i64)) -> String, title: &str| print_by(&all, total, f, title, 45);
     by(&|k| k.0.clone(), "by class");
     by(&|k| k.1.clone(), "by side (nearest flank point; bottom when the flanks are 3 mm farther)");
     by(&|k| format!("{:>2}: {:>2}-{:>2} mm above the bottom", k.2, 4 * k.2, 4 * k.2 + 4), "by height band");
