@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Issue 15 "done when": every mesh of ../shared/models/ocl and ../shared/models/mech finished
 # with the default strategy (steep-and-shallow on meshes), with a ball and a bull-nose cutter
-# sized for the part, at sh 0.01 mm and 0.05 mm. Writes one job file per case into OUT and a
-# table (markdown) of part, cutter, sh, exit code, passes, levels, predicted time, planning
+# sized for the part, at sh 0.01 mm and 0.05 mm. Runs the job files of examples/jobs/finish
+# (one per case), writes each run's output into OUT, and a table (markdown) of part, cutter, sh, exit code, passes, levels, predicted time, planning
 # time, simulated scallop, unreachable area.
 # Usage: bench/validation/finish_models.sh [OUT] [--reduced]   (reduced: sphere_on_plate and cone_on_side)
 # Env: SCALLOP (binary, default target/release/scallop, built when missing), TIMEOUT (s, 600),
@@ -20,50 +20,26 @@ if [ ! -d "$MODELS" ]; then
 fi
 [ -x "$SCALLOP" ] || cargo build --release -q -p scallop-cli
 mkdir -p "$OUT"
-MODELS_ABS="$(cd "$MODELS" && pwd)"
-# part | units | ball D | bull D | bull r | flute length
-CASES="ocl/30sphere.stl mm 6 10 2 70
-ocl/carpet1.stl mm 10 12 2 30
-ocl/cone_on_side.stl mm 3 4 1 30
-ocl/demo.stl mm 1 2 0.5 10
-ocl/failedinpycam.stl mm 4 6 1 15
-ocl/mount_rush.stl mm 3 6 1 40
-ocl/pycam-textbox.stl mm 2 4 0.5 20
-ocl/sphere.stl mm 10 16 4 110
-ocl/sphere2.stl mm 3 4 1 35
-ocl/sphere_cutout.stl mm 6 10 2 75
-ocl/sphere_on_plate.stl mm 6 10 2 45
-mech/angle_block.STL in 6 10 2 45
-mech/idler_riser.STL in 6 10 2 30
-mech/octagonal_pocket.stl m 10 16 3 30"
+# The jobs are examples/jobs/finish/<part>-<ball|bull>-<sh>.toml (the cutter sizes a
+# machinist would pick for each part are in them); their part paths are relative to the
+# job file, so they are run from where they are.
+JOBS=examples/jobs/finish
+CASES="$(ls "$JOBS" | sed -n 's/-\(ball\|bull\)-0\.0[15]\.toml$//p' | sort -u)"
 if [ "$REDUCED" = "--reduced" ]; then
-    CASES="$(printf '%s\n' "$CASES" | grep -E 'sphere_on_plate|cone_on_side')"
+    CASES="$(printf '%s\n' "$CASES" | grep -E '^(sphere_on_plate|cone_on_side)$')"
 fi
 if [ -n "${PARTS:-}" ]; then
-    CASES="$(printf '%s\n' "$CASES" | grep -E "/($(printf '%s' "$PARTS" | tr ',' '|'))\.")"
+    CASES="$(printf '%s\n' "$CASES" | grep -E "^($(printf '%s' "$PARTS" | tr ',' '|'))$")"
 fi
 TABLE="$OUT/table.md"
 echo "| part | cutter | sh mm | exit | passes | levels | predicted time | planning s | simulated scallop mm | unreachable mm2 |" > "$TABLE"
 echo "|---|---|---|---|---|---|---|---|---|---|" >> "$TABLE"
-while read -r part units ball bull corner flute; do
+while read -r base; do
     for sh in 0.01 0.05; do
         for tool in ball bull; do
-            name="$(basename "$part" | sed 's/\.[^.]*$//')-$tool-$sh"
-            job="$OUT/$name.toml"
-            {
-                echo "[part]"
-                echo "file = \"$MODELS_ABS/$part\""
-                echo "units = \"$units\""
-                echo "[cutter]"
-                if [ "$tool" = ball ]; then
-                    echo "shape = \"ball\""; echo "diameter = $ball"
-                else
-                    echo "shape = \"bull\""; echo "diameter = $bull"; echo "corner_radius = $corner"
-                fi
-                echo "flute_length = $flute"
-                echo "[finishing]"
-                echo "scallop_height = $sh"
-            } > "$job"
+            name="$base-$tool-$sh"
+            job="$JOBS/$name.toml"
+            part="$(sed -n 's|^file = "\.\./\.\./\.\./\.\./shared/models/\(.*\)"$|\1|p' "$job")"
             start=$(python3 -c "import time; print(time.time())")
             set +e
             timeout "$TIMEOUT" "$SCALLOP" run "$job" -o "$OUT/$name" --json > "$OUT/$name.json" 2> "$OUT/$name.err"

@@ -1650,6 +1650,28 @@ mod tests {
         }
     }
 
+    /// The finishing jobs of the real meshes (issue 15's table): one per part,
+    /// cutter shape and scallop height, each naming a mesh of the shared models
+    /// beside the repository, both scallop heights of the table and its cutter.
+    #[test]
+    fn the_real_mesh_finishing_examples_parse() {
+        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/jobs/finish");
+        let mut count = 0;
+        for entry in std::fs::read_dir(dir).unwrap() {
+            let path = entry.unwrap().path();
+            let name = path.file_stem().unwrap().to_string_lossy().into_owned();
+            let job = parse_job(&std::fs::read_to_string(&path).unwrap()).unwrap();
+            let file = job.part.file.as_deref().unwrap();
+            let (part, rest) = name.rsplit_once('-').and_then(|(a, sh)| Some((a.rsplit_once('-')?, sh))).unwrap();
+            assert!(file.starts_with("../../../../shared/models/"), "{name}: {file}");
+            assert!(std::path::Path::new(file).file_stem().unwrap().to_string_lossy() == part.0, "{name}: {file}");
+            assert_eq!(job.finishing.scallop_height, rest.parse::<f64>().unwrap(), "{name}");
+            assert_eq!(job.cutter.shape, if part.1 == "ball" { ShapeWord::Ball } else { ShapeWord::Bull }, "{name}");
+            count += 1;
+        }
+        assert_eq!(count, 56, "14 meshes x ball, bull-nose x sh 0.01, 0.05");
+    }
+
     #[test]
     fn bad_jobs_name_the_key() {
         let cases = [
