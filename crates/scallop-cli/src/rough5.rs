@@ -527,6 +527,32 @@ fn baseline(
     Ok((as_plan, setups))
 }
 
+/// The program's spec 10.1 figures as two summary lines, each after
+/// `indent`: what is left and cut outside the volume, then the machine time
+/// and the removal rate (`scallop rough5` and a job's rough5 operation).
+pub(crate) fn metric_lines(s: &mut String, m: &Rough5Metrics, indent: &str) {
+    let _ = writeln!(
+        s,
+        "{indent}V_r {:.2} % ({:.0} of {:.0} mm3), gouge {:.3} mm3 (deepest {:.3} mm), out of material (L_HM) {:.1} %",
+        m.remaining_percent,
+        m.remaining_volume_mm3,
+        m.volume_to_remove_mm3,
+        m.gouge_volume_mm3,
+        m.gouge_depth_mm,
+        m.out_of_material_percent
+    );
+    let _ = writeln!(
+        s,
+        "{indent}time {} on the machine (feed {}, rapid {}), removal rate {:.1} mm3/s ({:.3} %/s), path {:.1} dm",
+        crate::output::hms(m.machining_time_s),
+        crate::output::hms(m.feed_time_s),
+        crate::output::hms(m.rapid_time_s),
+        m.removal_rate_mm3_s,
+        m.removal_rate_percent_s,
+        m.path_length_dm
+    );
+}
+
 fn summary_text(r: &Report, output: &Path) -> String {
     let m = &r.metrics;
     let mut s = format!(
@@ -553,26 +579,7 @@ fn summary_text(r: &Report, output: &Path) -> String {
             u.passes
         );
     }
-    let _ = writeln!(
-        s,
-        "  V_r {:.2} % ({:.0} of {:.0} mm3), gouge {:.3} mm3 (deepest {:.3} mm), L_HM {:.1} %",
-        m.remaining_percent,
-        m.remaining_volume_mm3,
-        m.volume_to_remove_mm3,
-        m.gouge_volume_mm3,
-        m.gouge_depth_mm,
-        m.out_of_material_percent
-    );
-    let _ = writeln!(
-        s,
-        "  time {} (feed {}, rapid {}), removal rate {:.1} mm3/s ({:.3} %/s), path {:.1} dm",
-        crate::output::hms(m.machining_time_s),
-        crate::output::hms(m.feed_time_s),
-        crate::output::hms(m.rapid_time_s),
-        m.removal_rate_mm3_s,
-        m.removal_rate_percent_s,
-        m.path_length_dm
-    );
+    metric_lines(&mut s, m, "  ");
     let corrected: usize = r.passes.iter().map(|p| p.corrected).sum();
     let dropped: usize = r.passes.iter().map(|p| p.dropped).sum();
     let _ =

@@ -16,7 +16,7 @@ use scallop_rough5::{CuttingData, OrientSettings, ProofSettings, Rough5Settings,
 use serde::Serialize;
 
 use crate::guides::{PartArg, test_part};
-use crate::output::{hms, print_json, print_text, progress_bar, with_written};
+use crate::output::{print_json, print_text, progress_bar, with_written};
 use crate::outset::OutputSet;
 use crate::{CliResult, Failure};
 
@@ -247,26 +247,7 @@ fn summary(r: &JobReport, out: &Rough5Output, folder: &Path) -> String {
         "{}: 1 operation on the {} ({}, {})\n  1. {}: rough5 ({} tilt), {} levels, {} passes, {} CL points, {} blocks\n",
         r.command, r.part, r.machine, r.dialect, op.name, op.tilt, op.levels, op.passes, op.cl_points, op.blocks
     );
-    let _ = writeln!(
-        s,
-        "     V_r {:.2} % ({:.0} of {:.0} mm3), gouge {:.3} mm3 (deepest {:.3} mm), out of material {:.1} %",
-        m.remaining_percent,
-        m.remaining_volume_mm3,
-        m.volume_to_remove_mm3,
-        m.gouge_volume_mm3,
-        m.gouge_depth_mm,
-        m.out_of_material_percent
-    );
-    let _ = writeln!(
-        s,
-        "     time {} on the machine (feed {}, rapid {}), removal rate {:.1} mm3/s ({:.3} %/s), path {:.1} dm",
-        hms(m.machining_time_s),
-        hms(m.feed_time_s),
-        hms(m.rapid_time_s),
-        m.removal_rate_mm3_s,
-        m.removal_rate_percent_s,
-        m.path_length_dm
-    );
+    crate::rough5::metric_lines(&mut s, m, "     ");
     let _ = writeln!(
         s,
         "     replayed within {:.4} mm; {} retracts, {} ramps, {} CL points dropped at flanks",
