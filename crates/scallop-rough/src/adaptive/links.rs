@@ -34,7 +34,7 @@ impl Planner<'_> {
             #[allow(clippy::cast_precision_loss, reason = "a small count")]
             let a = std::f64::consts::TAU * i as f64 / LINK_PROBES as f64;
             let q = [p[0] + r * a.cos(), p[1] + r * a.sin()];
-            if self.grid.sample(&self.reach, q) < r && self.grid.sample(&self.swept, q) > r + LINK_SLACK {
+            if self.grid.sample(&self.reach, q) < r - self.strip && self.grid.sample(&self.swept, q) > r + LINK_SLACK {
                 return false;
             }
         }
@@ -241,7 +241,7 @@ impl Planner<'_> {
         self.epoch = self.epoch.wrapping_add(1).min(CLEAR - 1);
     }
 
-    /// Appends the runs as cuts, stamped (the link before the first is the
+    /// Appends the runs as cuts (lines), stamped (the link before the first is the
     /// caller's; each run starts where the one before ended).
     /// A move of a run that leaves the region (a chord of the grid across a
     /// wall's bend) is not cut: the tool goes on from the move's end by a
@@ -258,7 +258,7 @@ impl Planner<'_> {
                 }
                 if k - from >= 2 {
                     self.stamp(&run[from..k]);
-                    if let Some(c) = super::fit(&run[from..k]) {
+                    if let Some(c) = super::lines(&run[from..k]) {
                         steps.push(Step::Cut(c));
                     }
                 }
