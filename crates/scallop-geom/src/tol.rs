@@ -832,6 +832,18 @@ pub mod rough {
     /// itself counts them.
     pub const WALK_WALL_STRIP_SHARE: f64 = WALK_FIT_SHARE;
 
+    /// Adaptive clearing: a tool-down link leaves a pass's end and meets the
+    /// next pass's start along arcs of these radii (shares of the tool
+    /// radius, the largest that cuts nothing first), turning away from the
+    /// material, joined by a common tangent or the link search (a Dubins
+    /// path, Dubins 1957, Amer. J. Math. 79(3)): the tool reverses without
+    /// stopping, where a jerk-limited controller stops at each reversal.
+    pub const LINK_TURN_SHARES: [f64; 3] = [0.5, 0.3, 0.15];
+
+    /// Adaptive clearing: the chords of a link's arcs deviate this much from
+    /// them (mm): 6 degrees between chords at a radius of 0.45 mm.
+    pub const LINK_TURN_SAGITTA: f64 = 0.002;
+
     // Tool-down links of the adaptive pattern (`adaptive/links.rs`).
 
     /// Lattice of the link search: every this-many grid cells (R / 8 for the

@@ -574,6 +574,8 @@ impl Planner<'_> {
     /// the tool ends.
     fn walk_all(&mut self, s: P2, walk: &mut Walk) -> Result<P2, RoughError> {
         let mut pos = s;
+        // The heading of the last pass's last move.
+        let mut out: Option<f64> = None;
         let mut fresh = true;
         let spacing = tol::WALK_START_SPACING * self.options.tool_radius;
         let step = tol::WALK_STEP_SHARE * self.options.tool_radius;
@@ -586,7 +588,7 @@ impl Planner<'_> {
             }
             // The link there first: it runs on the field as the tool finds it
             // (the pass would clear what the link's approach meets).
-            let link = (!fresh).then(|| self.link_step(pos, start));
+            let link = (!fresh).then(|| self.turning_link(pos, out, start, first.heading));
             let (run, area, walked) = self.pass(start, first, &mut walk.budget)?;
             let steps = walked.len() - 1;
             // A start serves once: a pass from it that could not go on (the
@@ -631,6 +633,9 @@ impl Planner<'_> {
             }
             fresh = false;
             pos = *run.last().unwrap_or(&pos);
+            if let [.., a, b] = run[..] {
+                out = Some((b[1] - a[1]).atan2(b[0] - a[0]));
+            }
         }
         Ok(pos)
     }
