@@ -276,28 +276,36 @@ impl Planner<'_> {
     /// from the material at both ends, tangent to the passes, of the largest
     /// radius of [`tol::LINK_TURN_SHARES`] whose arcs pass
     /// [`Planner::turn_ok`] and whose middle (the common tangent, else a
-    /// path of [`Planner::link_path`]) is found; else
-    /// [`Planner::link_step`].
+    /// path of [`Planner::link_path`]) is found; else the same with an arc
+    /// at one end only; else [`Planner::link_step`].
     pub(super) fn turning_link(&mut self, from: P2, out: Option<f64>, to: P2, into: f64) -> Step {
         if let Some(h) = out {
-            for share in tol::LINK_TURN_SHARES {
-                let rho = share * self.options.tool_radius;
-                let Some((first, last)) = turns(self.away(), from, h, to, into, rho) else { continue };
-                let ok = |me: &Self, arc: &[P2]| arc.windows(2).all(|w| me.turn_ok(w[0], w[1]));
-                if !ok(self, &first) || !ok(self, &last) {
-                    continue;
+            // Both ends turning first; else one of them (a wall right
+            // behind a start or ahead of an end leaves no room for its arc).
+            for both in [true, false] {
+                for share in tol::LINK_TURN_SHARES {
+                    let rho = share * self.options.tool_radius;
+                    let Some((first, last)) = turns(self.away(), from, h, to, into, rho) else { continue };
+                    let ok = |me: &Self, arc: &[P2]| arc.windows(2).all(|w| me.turn_ok(w[0], w[1]));
+                    let (ok1, ok2) = (ok(self, &first), ok(self, &last));
+                    let usable = if both { ok1 && ok2 } else { ok1 || ok2 };
+                    if !usable {
+                        continue;
+                    }
+                    let first = if ok1 { first } else { vec![from] };
+                    let last = if ok2 { last } else { vec![to] };
+                    let (t1, t2) = (first[first.len() - 1], last[0]);
+                    let Some(middle) = self.link_path(t1, t2) else { continue };
+                    let mut via: Vec<P2> = first[1..].to_vec();
+                    via.extend_from_slice(&middle);
+                    via.extend_from_slice(&last[..last.len() - 1]);
+                    via.dedup_by(|a, b| dist(*a, *b) <= 1e-6);
+                    let mut line = vec![from];
+                    line.extend_from_slice(&via);
+                    line.push(to);
+                    self.stamp(&line);
+                    return Step::Link { tool_down: true, via, cleared: true, to: Some(to) };
                 }
-                let (t1, t2) = (first[first.len() - 1], last[0]);
-                let Some(middle) = self.link_path(t1, t2) else { continue };
-                let mut via: Vec<P2> = first[1..].to_vec();
-                via.extend_from_slice(&middle);
-                via.extend_from_slice(&last[..last.len() - 1]);
-                via.dedup_by(|a, b| dist(*a, *b) <= 1e-6);
-                let mut line = vec![from];
-                line.extend_from_slice(&via);
-                line.push(to);
-                self.stamp(&line);
-                return Step::Link { tool_down: true, via, cleared: true, to: Some(to) };
             }
         }
         self.link_step(from, to)
