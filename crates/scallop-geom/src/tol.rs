@@ -813,15 +813,36 @@ pub mod rough {
     /// Adaptive clearing: most steps of one region's walk.
     pub const MAX_WALK_STEPS: usize = 20_000_000;
 
-    /// Adaptive clearing: the passes (grid iso-lines) are replaced by arcs and
-    /// lines within this (mm): fewer, smoother moves; the tool may go this much
-    /// deeper into the material or towards a wall.
-    pub const ARC_FIT: f64 = 0.01;
+    /// Adaptive clearing: a walked pass (and a corner's arc) is emitted as the
+    /// fewest lines within this share of the tool radius of its steps, each
+    /// inside the region (Douglas-Peucker): 0.02 mm for a 6 mm tool. The steps
+    /// of R / 8 turn a little at each; as lines of a millimetre or more the
+    /// pass runs nearer the feed under a jerk-limited controller, where short
+    /// moves or arcs cut into short chords hold it far below the feed after
+    /// every slow-down (docs/benchmarks.md, "Adaptive clearing: where the
+    /// cycle time goes"). Moving a pass by `f R` changes its engagement by at
+    /// most `f / sin(phi)`: 0.5 degree at 0.2 D.
+    pub const WALK_FIT_SHARE: f64 = 1.0 / 150.0;
 
-    /// Adaptive clearing: a fitted arc of a larger radius (mm) becomes a line
-    /// (it deviates from its chord by at most chord^2 / 8000 mm: 1 um for a
-    /// 2.8 mm chord).
-    pub const MAX_ARC_RADIUS: f64 = 1000.0;
+    /// Adaptive clearing: the strip along the walls, as a share of the tool
+    /// radius, whose material tells no cutting from air in the walk (a pass
+    /// ends, a start is dropped, with only that left) and that links may
+    /// cross: the lines of [`WALK_FIT_SHARE`] leave slivers that thin where
+    /// the tool slides along a wall, which the rings cut. The engagement
+    /// itself counts them.
+    pub const WALK_WALL_STRIP_SHARE: f64 = WALK_FIT_SHARE;
+
+    /// Adaptive clearing: a tool-down link leaves a pass's end and meets the
+    /// next pass's start along arcs of these radii (shares of the tool
+    /// radius, the largest that cuts nothing first), turning away from the
+    /// material, joined by a common tangent or the link search (a Dubins
+    /// path, Dubins 1957, Amer. J. Math. 79(3)): the tool reverses without
+    /// stopping, where a jerk-limited controller stops at each reversal.
+    pub const LINK_TURN_SHARES: [f64; 3] = [0.5, 0.3, 0.15];
+
+    /// Adaptive clearing: the chords of a link's arcs deviate this much from
+    /// them (mm): 6 degrees between chords at a radius of 0.45 mm.
+    pub const LINK_TURN_SAGITTA: f64 = 0.002;
 
     // Tool-down links of the adaptive pattern (`adaptive/links.rs`).
 

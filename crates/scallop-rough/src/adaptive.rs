@@ -72,6 +72,12 @@ struct Planner<'a> {
     starts: Vec<(P2, bool, u32)>,
     /// Unit directions of the front half's probes about the heading +x.
     probes: Vec<P2>,
+    /// The tolerance of the lines a pass is emitted as (mm,
+    /// [`tol::WALK_FIT_SHARE`]).
+    fit: f64,
+    /// The strip along the walls left to the rings (mm,
+    /// [`tol::WALK_WALL_STRIP_SHARE`]).
+    strip: f64,
 }
 
 /// The walk's steps so far, its passes and its remaining steps.
@@ -87,6 +93,9 @@ struct Stride {
     to: P2,
     heading: f64,
     phi: f64,
+    /// The engagement (rad) leaving out the strip along the walls that the
+    /// rings cut ([`tol::WALK_WALL_STRIP_SHARE`]): what tells cutting from air.
+    core: f64,
 }
 
 /// The adaptive clearing of `region` (one connected tool-centre region):
@@ -139,6 +148,8 @@ pub fn plan_adaptive(region: &Region, options: &ClearOptions) -> Result<Vec<Step
         grid,
         starts: Vec::new(),
         probes: front_probes(tol::ENGAGE_PROBES / 2),
+        fit: tol::WALK_FIT_SHARE * r,
+        strip: tol::WALK_WALL_STRIP_SHARE * r,
     };
     if !planner.edges.contains(s) {
         return Ok(rings_only(region, options));
@@ -341,22 +352,30 @@ impl Planner<'_> {
 
     /// The engagement (rad) of the tool centred at `p` moving along
     /// `heading`: the arc of the front half of its periphery in material (the
-    /// back half lies in what the tool has just cut).
-    fn front(&self, p: P2, heading: f64) -> f64 {
+    /// back half lies in what the tool has just cut); and that arc without
+    /// the strip along the walls ([`Stride::core`]).
+    fn front(&self, p: P2, heading: f64) -> (f64, f64) {
         let r = self.options.tool_radius;
         let n = self.probes.len();
         let (s, c) = heading.sin_cos();
-        let mut count = 0usize;
+        let strip = r - self.strip;
+        let (mut count, mut core) = (0usize, 0usize);
         for &[u, v] in &self.probes {
             // The probe's direction (u, v) about the heading, rotated onto it.
             let q = [p[0] + r * (u * c - v * s), p[1] + r * (u * s + v * c)];
-            if self.material(q) {
-                count += 1;
+            if self.grid.sample(&self.swept, q) > r {
+                let reach = self.grid.sample(&self.reach, q);
+                if reach < r {
+                    count += 1;
+                    if reach < strip {
+                        core += 1;
+                    }
+                }
             }
         }
         #[allow(clippy::cast_precision_loss, reason = "small counts")]
-        let phi = std::f64::consts::PI * count as f64 / n as f64;
-        phi
+        let share = |k: usize| std::f64::consts::PI * k as f64 / n as f64;
+        (share(count), share(core))
     }
 
     /// The sign of a turn away from the material: left (counter-clockwise)
@@ -374,7 +393,8 @@ impl Planner<'_> {
 
     fn stride_by(&self, p: P2, heading: f64, len: f64) -> Stride {
         let to = ahead(p, heading, len);
-        Stride { to, heading, phi: self.front(to, heading) }
+        let (phi, core) = self.front(to, heading);
+        Stride { to, heading, phi, core }
     }
 
     /// The next step from `p` after a step along `heading` (see
@@ -473,8 +493,8 @@ impl Planner<'_> {
         let (mut best, mut phi) = (0.0, -1.0);
         for i in 0..n {
             let s = self.stride(p, heading(i));
-            if s.phi > phi {
-                (best, phi) = (heading(i), s.phi);
+            if s.core > phi {
+                (best, phi) = (heading(i), s.core);
             }
         }
         if phi < tol::WALK_AIR * self.target {
@@ -482,13 +502,14 @@ impl Planner<'_> {
         }
         // From the heading into the material, the turn away to the target
         // and, at a wall, further away, as along a pass.
-        self.next(p, best).filter(|s| s.phi >= tol::WALK_AIR * self.target)
+        self.next(p, best).filter(|s| s.core >= tol::WALK_AIR * self.target)
     }
 
     /// A pass from `p` along `heading`: its points (the first is `p`), cut
-    /// back to its last step that cut, and the area it cleared (mm^2, on the
-    /// grid's cells); the swept field holds it.
-    fn pass(&mut self, p: P2, first: Stride, budget: &mut usize) -> Result<(Vec<P2>, f64), RoughError> {
+    /// back to its last step that cut, as lines ([`simplify`]), and
+    /// the area it cleared (mm^2, on the grid's cells) and its steps' points;
+    /// the swept field holds the lines.
+    fn pass(&mut self, p: P2, first: Stride, budget: &mut usize) -> Result<(Vec<P2>, f64, Vec<P2>), RoughError> {
         let w = self.options.tool_radius + 2.0 * self.grid.h;
         let air_len = tol::WALK_AIR_SHARE * self.options.tool_radius;
         let step = tol::WALK_STEP_SHARE * self.options.tool_radius;
@@ -507,7 +528,7 @@ impl Planner<'_> {
             marks.push(undo.len());
             self.grid.stamp_segment(&mut self.swept, at, s.to, w, Some(&mut undo));
             run.push(s.to);
-            if s.phi >= tol::WALK_AIR * self.target {
+            if s.core >= tol::WALK_AIR * self.target {
                 last_cut = run.len() - 1;
             }
             #[allow(clippy::cast_precision_loss, reason = "a step count")]
@@ -529,11 +550,23 @@ impl Planner<'_> {
             }
             run.truncate(keep);
         }
+        // The pass as it is emitted: the fewest lines within `fit` of its
+        // steps, in the region; the swept field then holds those lines, not
+        // the steps, so that later passes are planned on what the program
+        // cuts.
+        let lines = simplify(&self.edges, &run, self.fit);
+        while let Some((k, v)) = undo.pop() {
+            self.swept[k] = v;
+        }
+        for pair in lines.windows(2) {
+            self.grid.stamp_segment(&mut self.swept, pair[0], pair[1], w, Some(&mut undo));
+        }
         let r = self.options.tool_radius;
-        let cleared = undo.iter().filter(|&&(k, old)| old > r && self.swept[k] <= r && self.reach[k] < r).count();
+        let cleared =
+            undo.iter().filter(|&&(k, old)| old > r && self.swept[k] <= r && self.reach[k] < r - self.strip).count();
         #[allow(clippy::cast_precision_loss, reason = "a cell count")]
         let area = cleared as f64 * self.grid.h * self.grid.h;
-        Ok((run, area))
+        Ok((lines, area, run))
     }
 
     /// Every pass from the bore about `s` until no earlier centre has
@@ -541,6 +574,8 @@ impl Planner<'_> {
     /// the tool ends.
     fn walk_all(&mut self, s: P2, walk: &mut Walk) -> Result<P2, RoughError> {
         let mut pos = s;
+        // The heading of the last pass's last move.
+        let mut out: Option<f64> = None;
         let mut fresh = true;
         let spacing = tol::WALK_START_SPACING * self.options.tool_radius;
         let step = tol::WALK_STEP_SHARE * self.options.tool_radius;
@@ -553,8 +588,9 @@ impl Planner<'_> {
             }
             // The link there first: it runs on the field as the tool finds it
             // (the pass would clear what the link's approach meets).
-            let link = (!fresh).then(|| self.link_step(pos, start));
-            let (run, area) = self.pass(start, first, &mut walk.budget)?;
+            let link = (!fresh).then(|| self.turning_link(pos, out, start, first.heading));
+            let (run, area, walked) = self.pass(start, first, &mut walk.budget)?;
+            let steps = walked.len() - 1;
             // A start serves once: a pass from it that could not go on (the
             // engagement would rise over the target along a wall) would
             // only be tried again; its neighbours serve instead.
@@ -569,13 +605,15 @@ impl Planner<'_> {
             // progress: a pass that cleared little (slivers in a corner the
             // tool cannot quite reach) would be made again and again.
             #[allow(clippy::cast_precision_loss, reason = "a step count")]
-            let progress = area >= tol::WALK_RESTART_SHARE * (run.len() - 1) as f64 * step * self.options.stepover;
+            let progress = area >= tol::WALK_RESTART_SHARE * steps as f64 * step * self.options.stepover;
             #[allow(clippy::cast_possible_truncation, reason = "passes are bounded by MAX_PASSES")]
-            if run.len() > tol::WALK_RESTART_STEPS && progress {
+            if steps >= tol::WALK_RESTART_STEPS && progress {
                 self.starts.push((start, true, passes as u32));
             }
+            // The steps' points, every `spacing` or more: within `fit` of
+            // the lines the tool cuts.
             let mut last = start;
-            for &p in &run[1..] {
+            for &p in &walked[1..] {
                 if dist(p, last) >= spacing {
                     #[allow(clippy::cast_possible_truncation, reason = "passes are bounded by MAX_PASSES")]
                     self.starts.push((p, true, passes as u32));
@@ -595,6 +633,9 @@ impl Planner<'_> {
             }
             fresh = false;
             pos = *run.last().unwrap_or(&pos);
+            if let [.., a, b] = run[..] {
+                out = Some((b[1] - a[1]).atan2(b[0] - a[0]));
+            }
         }
         Ok(pos)
     }
@@ -642,10 +683,21 @@ impl Planner<'_> {
     fn sweep_run(&mut self, run: &[P2], undo: &mut Vec<(usize, f64)>) -> f64 {
         let w = self.options.tool_radius + 2.0 * self.grid.h;
         let mut phi = 0.0f64;
+        let step = 0.5 * self.grid.h;
         for pair in run.windows(2) {
             let heading = (pair[1][1] - pair[0][1]).atan2(pair[1][0] - pair[0][0]);
-            phi = phi.max(self.front(pair[1], heading));
-            self.grid.stamp_segment(&mut self.swept, pair[0], pair[1], w, Some(undo));
+            // Every half cell along the move, the move cut up to there.
+            #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a small positive count")]
+            let n = ((dist(pair[0], pair[1]) / step).ceil() as usize).max(1);
+            let mut from = pair[0];
+            for i in 1..=n {
+                #[allow(clippy::cast_precision_loss, reason = "a small count")]
+                let f = i as f64 / n as f64;
+                let q = [pair[0][0] + f * (pair[1][0] - pair[0][0]), pair[0][1] + f * (pair[1][1] - pair[0][1])];
+                phi = phi.max(self.front(q, heading).0);
+                self.grid.stamp_segment(&mut self.swept, from, q, w, Some(undo));
+                from = q;
+            }
         }
         phi
     }
@@ -705,15 +757,18 @@ impl Planner<'_> {
         }
     }
 
-    /// The arc of radius `r` tangent to both walls of `corner`, as points
-    /// in the cutting direction.
+    /// The arc of radius `r` tangent to both walls of `corner`, as the
+    /// points of its chords in the cutting direction.
     fn corner_arc(&self, c: &Corner, r: f64) -> Vec<P2> {
         let t = r * (0.5 * c.turn).tan();
         let p1 = [c.at[0] - t * c.u[0], c.at[1] - t * c.u[1]];
         let centre = [p1[0] - r * c.u[1], p1[1] + r * c.u[0]];
         let a0 = (p1[1] - centre[1]).atan2(p1[0] - centre[0]);
         #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a small positive count")]
-        let n = ((r * c.turn / (0.5 * self.grid.h)).ceil() as usize).max(2);
+        // Chords within `fit` of the arc (inside it: towards its centre,
+        // away from the corner's material).
+        let sweep = 2.0 * (1.0 - (self.fit / r).min(1.0)).acos();
+        let n = ((c.turn / sweep.max(1e-3)).ceil() as usize).max(1);
         let mut run: Vec<P2> = (0..=n)
             .map(|i| {
                 #[allow(clippy::cast_precision_loss, reason = "a small count")]
@@ -762,24 +817,50 @@ impl Planner<'_> {
         steps
     }
 }
-/// `c` with its arcs of radius over [`tol::MAX_ARC_RADIUS`] made lines (the
-/// fit of nearly collinear points along a wall: a G-code reader refuses their
-/// far centres).
-fn flat_arcs(c: &Contour) -> Result<Contour, scallop_contour::ContourError> {
-    let mut v = c.vertices();
-    for k in 0..v.len().saturating_sub(1) {
-        let chord = (v[k + 1].x - v[k].x).hypot(v[k + 1].y - v[k].y);
-        let b = v[k].bulge.abs();
-        if b > 0.0 && chord * (1.0 + b * b) / (4.0 * b) > tol::MAX_ARC_RADIUS {
-            v[k].bulge = 0.0;
-        }
-    }
-    Contour::new(&v, false)
+/// The distance from `p` to the segment `a`-`b`.
+fn segment_distance(p: P2, a: P2, b: P2) -> f64 {
+    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+    let l2 = dx * dx + dy * dy;
+    let t = if l2 > 0.0 { (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2).clamp(0.0, 1.0) } else { 0.0 };
+    dist(p, [a[0] + t * dx, a[1] + t * dy])
 }
 
-/// The points as lines and arcs within [`tol::ARC_FIT`], far arcs made lines.
-fn fit(points: &[P2]) -> Option<Contour> {
-    Contour::from_points(points, false, tol::ARC_FIT).and_then(|c| flat_arcs(&c)).ok()
+/// The points as lines.
+fn lines(points: &[P2]) -> Option<Contour> {
+    Contour::polygon(points, false).ok()
+}
+
+/// The fewest of the points of `run` (its ends kept) whose lines stay
+/// within `tolerance` of it and in the region (Douglas and Peucker
+/// 1973, "Algorithms for the reduction of the number of points required
+/// to represent a digitized line", Cartographica 10(2); a line that
+/// leaves the region is split like one too far from the points).
+fn simplify(edges: &Edges, run: &[P2], tolerance: f64) -> Vec<P2> {
+    let n = run.len();
+    if n <= 2 {
+        return run.to_vec();
+    }
+    let mut keep = vec![false; n];
+    (keep[0], keep[n - 1]) = (true, true);
+    let mut stack = vec![(0, n - 1)];
+    while let Some((i, j)) = stack.pop() {
+        if j <= i + 1 {
+            continue;
+        }
+        let (mut worst, mut at) = (-1.0, (i + j) / 2);
+        for k in i + 1..j {
+            let d = segment_distance(run[k], run[i], run[j]);
+            if d > worst {
+                (worst, at) = (d, k);
+            }
+        }
+        if worst > tolerance || !edges.contains_segment(run[i], run[j]) {
+            keep[at] = true;
+            stack.push((i, at));
+            stack.push((at, j));
+        }
+    }
+    run.iter().zip(&keep).filter(|&(_, &k)| k).map(|(p, _)| *p).collect()
 }
 
 #[cfg(test)]
@@ -798,5 +879,65 @@ mod tests {
         let spike = Contour::polygon(&[[0.0, 0.0], [10.0, 1.76], [0.0, 3.53]], true).unwrap();
         let g = fillet_corners(&spike);
         assert!(g.vertices().iter().any(|v| (v.x - 10.0).abs() < 1e-12 && (v.y - 1.76).abs() < 1e-12));
+    }
+
+    #[test]
+    fn a_walk_becomes_few_lines_near_it_and_inside_the_region() {
+        // A square with a round hole; walks of steps of 0.375 that turn a
+        // little at each, some sliding round the hole (the region's wall
+        // bends into them there: the chords of the hole leave the region).
+        let outer = vec![[0.0, 0.0], [40.0, 0.0], [40.0, 40.0], [0.0, 40.0]];
+        let hole: Vec<P2> = (0..64)
+            .map(|k| {
+                let a = -std::f64::consts::TAU * f64::from(k) / 64.0;
+                [20.0 + 5.0 * a.cos(), 20.0 + 5.0 * a.sin()]
+            })
+            .collect();
+        let region = Region::from_polygons(&[outer, hole], false);
+        let edges = Edges::new(&region, 1e-4, 1.0);
+        let tolerance = 0.02;
+        for case in 0..24u32 {
+            let f = f64::from(case);
+            let (mut p, mut heading) = ([2.0 + 0.5 * f, 2.0 + 0.3 * f], 0.1 * f);
+            let mut run = vec![p];
+            for k in 0..300u32 {
+                let turn = 0.02 * (0.05 * f64::from(k) + f).sin();
+                let next = [p[0] + 0.375 * (heading + turn).cos(), p[1] + 0.375 * (heading + turn).sin()];
+                if !edges.contains_segment(p, next) {
+                    // Round the hole (or turn back at the square's wall).
+                    heading += 0.3;
+                    continue;
+                }
+                heading += turn;
+                p = next;
+                run.push(p);
+            }
+            if case == 0 {
+                // Sliding round the hole, 0.01 mm off its wall: chords of the hole's
+                // circle within the tolerance would cut into it.
+                let r = 5.0 + 1e-2;
+                run = (0..=40)
+                    .map(|k| {
+                        let a = 0.075 * f64::from(k);
+                        [20.0 + r * a.cos(), 20.0 + r * a.sin()]
+                    })
+                    .collect();
+            }
+            let lines = simplify(&edges, &run, tolerance);
+            assert_eq!((lines.first(), lines.last()), (run.first(), run.last()));
+            assert!(
+                case == 0 || lines.len() * 3 < run.len(),
+                "case {case}: {} lines of {} points",
+                lines.len(),
+                run.len()
+            );
+            for q in &run {
+                let d = lines.windows(2).map(|w| segment_distance(*q, w[0], w[1])).fold(f64::INFINITY, f64::min);
+                assert!(d <= tolerance + 1e-12, "case {case}: a step {d} mm from the lines");
+            }
+            for w in lines.windows(2) {
+                assert!(edges.contains_segment(w[0], w[1]), "case {case}: a line leaves the region");
+            }
+        }
     }
 }

@@ -34,7 +34,7 @@ impl Planner<'_> {
             #[allow(clippy::cast_precision_loss, reason = "a small count")]
             let a = std::f64::consts::TAU * i as f64 / LINK_PROBES as f64;
             let q = [p[0] + r * a.cos(), p[1] + r * a.sin()];
-            if self.grid.sample(&self.reach, q) < r && self.grid.sample(&self.swept, q) > r + LINK_SLACK {
+            if self.grid.sample(&self.reach, q) < r - self.strip && self.grid.sample(&self.swept, q) > r + LINK_SLACK {
                 return false;
             }
         }
@@ -241,7 +241,7 @@ impl Planner<'_> {
         self.epoch = self.epoch.wrapping_add(1).min(CLEAR - 1);
     }
 
-    /// Appends the runs as cuts, stamped (the link before the first is the
+    /// Appends the runs as cuts (lines), stamped (the link before the first is the
     /// caller's; each run starts where the one before ended).
     /// A move of a run that leaves the region (a chord of the grid across a
     /// wall's bend) is not cut: the tool goes on from the move's end by a
@@ -258,7 +258,7 @@ impl Planner<'_> {
                 }
                 if k - from >= 2 {
                     self.stamp(&run[from..k]);
-                    if let Some(c) = super::fit(&run[from..k]) {
+                    if let Some(c) = super::lines(&run[from..k]) {
                         steps.push(Step::Cut(c));
                     }
                 }
@@ -269,6 +269,65 @@ impl Planner<'_> {
                 from = k;
             }
         }
+    }
+
+    /// The link from the end `from` of a pass whose last move heads `out`
+    /// to the start `to` of one that leaves along `into`: arcs turning away
+    /// from the material at both ends, tangent to the passes, of the largest
+    /// radius of [`tol::LINK_TURN_SHARES`] whose arcs pass
+    /// [`Planner::turn_ok`] and whose middle (the common tangent, else a
+    /// path of [`Planner::link_path`]) is found; else the same with an arc
+    /// at one end only; else [`Planner::link_step`].
+    pub(super) fn turning_link(&mut self, from: P2, out: Option<f64>, to: P2, into: f64) -> Step {
+        if let Some(h) = out {
+            // Both ends turning first; else one of them (a wall right
+            // behind a start or ahead of an end leaves no room for its arc).
+            for both in [true, false] {
+                for share in tol::LINK_TURN_SHARES {
+                    let rho = share * self.options.tool_radius;
+                    let Some((first, last)) = turns(self.away(), from, h, to, into, rho) else { continue };
+                    let ok = |me: &Self, arc: &[P2]| arc.windows(2).all(|w| me.turn_ok(w[0], w[1]));
+                    let (ok1, ok2) = (ok(self, &first), ok(self, &last));
+                    let usable = if both { ok1 && ok2 } else { ok1 || ok2 };
+                    if !usable {
+                        continue;
+                    }
+                    let first = if ok1 { first } else { vec![from] };
+                    let last = if ok2 { last } else { vec![to] };
+                    let (t1, t2) = (first[first.len() - 1], last[0]);
+                    let Some(middle) = self.link_path(t1, t2) else { continue };
+                    let mut via: Vec<P2> = first[1..].to_vec();
+                    via.extend_from_slice(&middle);
+                    via.extend_from_slice(&last[..last.len() - 1]);
+                    via.dedup_by(|a, b| dist(*a, *b) <= 1e-6);
+                    let mut line = vec![from];
+                    line.extend_from_slice(&via);
+                    line.push(to);
+                    self.stamp(&line);
+                    return Step::Link { tool_down: true, via, cleared: true, to: Some(to) };
+                }
+            }
+        }
+        self.link_step(from, to)
+    }
+
+    /// Whether the chord `a` to `b` of a link's arc may be cut: in the
+    /// region, and every sample cuts nothing or engages no more than a pass
+    /// (the arcs lie within a tool radius of a pass's end or start, where
+    /// material may be next to the tool; measured all round).
+    fn turn_ok(&self, a: P2, b: P2) -> bool {
+        if !self.holder.contains_segment(a, b, self.options.chord_tolerance) {
+            return false;
+        }
+        let step = 0.5 * self.grid.h;
+        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a small positive count")]
+        let n = ((dist(a, b) / step).ceil() as usize).max(1);
+        (1..=n).all(|i| {
+            #[allow(clippy::cast_precision_loss, reason = "a small count")]
+            let f = i as f64 / n as f64;
+            let p = [a[0] + f * (b[0] - a[0]), a[1] + f * (b[1] - a[1])];
+            self.clear_at(p) || self.engagement(p) <= tol::LINK_APPROACH * self.target
+        })
     }
 
     /// The link from `from` to `to` as a step; a tool-down link's path is
@@ -284,5 +343,90 @@ impl Planner<'_> {
             }
             None => Step::Link { tool_down: false, via: Vec::new(), cleared: self.clear_at(to), to: Some(to) },
         }
+    }
+}
+
+/// The arcs of radius `rho` of [`Planner::turning_link`], as chords
+/// within [`tol::LINK_TURN_SAGITTA`]: from `p` (heading `h`) round to the
+/// common tangent, and from it round to `s` (heading `h0`); both turn
+/// away from the material (`side`: 1 left, -1 right). `None` when the circles coincide or an arc
+/// would turn more than 1.25 half turns.
+fn turns(side: f64, p: P2, h: f64, s: P2, h0: f64, rho: f64) -> Option<(Vec<P2>, Vec<P2>)> {
+    let centre = |q: P2, a: f64| [q[0] - rho * side * a.sin(), q[1] + rho * side * a.cos()];
+    let (c1, c2) = (centre(p, h), centre(s, h0));
+    let d = dist(c1, c2);
+    if d <= 1e-9 {
+        return None;
+    }
+    let u = [(c2[0] - c1[0]) / d, (c2[1] - c1[1]) / d];
+    // The tangent's points: on the side of each centre opposite the turn.
+    let off = [u[1] * side * rho, -u[0] * side * rho];
+    let (t1, t2) = ([c1[0] + off[0], c1[1] + off[1]], [c2[0] + off[0], c2[1] + off[1]]);
+    let angle = |c: P2, q: P2| (q[1] - c[1]).atan2(q[0] - c[0]);
+    let sweep = |a0: f64, a1: f64| (side * (a1 - a0)).rem_euclid(std::f64::consts::TAU);
+    let (a0, a1) = (angle(c1, p), angle(c1, t1));
+    let (b0, b1) = (angle(c2, t2), angle(c2, s));
+    let (s1, s2) = (sweep(a0, a1), sweep(b0, b1));
+    let most = 1.25 * std::f64::consts::PI;
+    if s1 > most || s2 > most {
+        return None;
+    }
+    let dtheta = 2.0 * (1.0 - (tol::LINK_TURN_SAGITTA / rho).min(1.0)).acos();
+    let arc = |c: P2, a: f64, sw: f64, end: P2, begin: P2| {
+        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a small positive count")]
+        let n = (sw / dtheta.max(1e-3)).ceil() as usize;
+        let mut pts = vec![begin];
+        for i in 1..n {
+            #[allow(clippy::cast_precision_loss, reason = "a small count")]
+            let t = a + side * sw * i as f64 / n as f64;
+            pts.push([c[0] + rho * t.cos(), c[1] + rho * t.sin()]);
+        }
+        pts.push(end);
+        pts
+    };
+    Some((arc(c1, a0, s1, t1, p), arc(c2, b0, s2, s, t2)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn link_turns_are_tangent_to_both_passes_and_turn_one_way() {
+        let rho = 1.5;
+        let dtheta = 2.0 * (1.0 - tol::LINK_TURN_SAGITTA / rho).acos();
+        let heading = |a: P2, b: P2| (b[1] - a[1]).atan2(b[0] - a[0]);
+        let near =
+            |a: f64, b: f64| (a - b + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
+        let mut tried = 0;
+        for k in 0..200u32 {
+            let f = f64::from(k);
+            let side = if k % 2 == 0 { 1.0 } else { -1.0 };
+            let (p, h) = ([0.0, 0.0], 0.37 * f);
+            let (s, h0) = ([10.0 * (0.1 * f).cos(), 7.0 * (0.23 * f).sin()], 1.3 * f);
+            let Some((first, last)) = turns(side, p, h, s, h0, rho) else { continue };
+            tried += 1;
+            assert_eq!((first[0], last[last.len() - 1]), (p, s));
+            // Leaves the pass's end along it, meets the start along it.
+            assert!(near(heading(first[0], first[1]), h).abs() <= dtheta, "case {k}: out");
+            assert!(near(heading(last[last.len() - 2], last[last.len() - 1]), h0).abs() <= dtheta, "case {k}: in");
+            // The tangent between the arcs continues both.
+            let (t1, t2) = (first[first.len() - 1], last[0]);
+            let t = heading(t1, t2);
+            if first.len() > 1 && dist(first[first.len() - 2], t1) > 1e-9 {
+                assert!(near(heading(first[first.len() - 2], t1), t).abs() <= dtheta, "case {k}: tangent out");
+            }
+            if last.len() > 1 && dist(t2, last[1]) > 1e-9 {
+                assert!(near(heading(t2, last[1]), t).abs() <= dtheta, "case {k}: tangent in");
+            }
+            // Every chord turns to `side` from the one before.
+            for arc in [&first, &last] {
+                for w in arc.windows(3) {
+                    let (a, b) = ([w[1][0] - w[0][0], w[1][1] - w[0][1]], [w[2][0] - w[1][0], w[2][1] - w[1][1]]);
+                    assert!(side * (a[0] * b[1] - a[1] * b[0]) >= -1e-12, "case {k}: turns the other way");
+                }
+            }
+        }
+        assert!(tried >= 40, "{tried} cases turned");
     }
 }
