@@ -127,7 +127,11 @@ impl Local<'_> {
             if !(h_at > 0.0 && h_end <= 0.0) {
                 return None;
             }
-            let (tin, tout) = self.bracket_with(&|p| self.triangle_height(slot, p), at, h_at, outside, h_end);
+            // The triangle's height jumps where its part above the cutter's
+            // profile leaves the cutter's reach: start from there.
+            let guess = self.drop.rim_exit(slot, self.probe.z, at, outside);
+            let height = |p| self.triangle_height(slot, p);
+            let (tin, tout) = self.bracket_with(&height, at, h_at, outside, h_end, guess);
             let (h, next) = self.height_slot(tout);
             if h <= 0.0 {
                 return (tin != tout).then_some((tin, tout));
@@ -143,10 +147,16 @@ impl Local<'_> {
     /// As [`Local::bisect_heights`] without a contact triangle, returning both
     /// ends of the final bracket (inside, outside).
     fn bracket(&self, inside: Point2, h_in: f64, outside: Point2, h_out: f64) -> (Point2, Point2) {
-        self.bracket_with(&|p| self.height(p), inside, h_in, outside, h_out)
+        self.bracket_with(&|p| self.height(p), inside, h_in, outside, h_out, None)
     }
 
     /// The bracket of [`Local::bracket`] on the height function `height`.
+    /// `guess` (a parameter from `inside` to `outside`, as
+    /// [`BoxDrop::rim_exit`](scallop_cutter::BoxDrop::rim_exit)) replaces the
+    /// first secant guess: probed half a tolerance either side, as a secant
+    /// guess, a right one closes the bracket at once, even where the height
+    /// jumps (where secant steps find nothing and only bisection shrinks the
+    /// bracket); a wrong one moves one end, as a poor secant step does.
     fn bracket_with(
         &self,
         height: &dyn Fn(Point2) -> f64,
@@ -154,6 +164,7 @@ impl Local<'_> {
         mut h_in: f64,
         mut outside: Point2,
         mut h_out: f64,
+        mut guess: Option<f64>,
     ) -> (Point2, Point2) {
         let mut bisections = 0;
         loop {
@@ -162,10 +173,11 @@ impl Local<'_> {
                 return (inside, outside);
             }
             let secant = h_in - h_out;
-            let use_secant = bisections == 0 && secant.is_finite() && secant > 0.0;
+            let first = guess.take().filter(|t| (0.0..=1.0).contains(t));
+            let use_secant = first.is_some() || (bisections == 0 && secant.is_finite() && secant > 0.0);
             let (a, b) = (inside, outside);
             let steps: [Option<f64>; 2] = if use_secant {
-                let t = (h_in / secant).clamp(0.0, 1.0);
+                let t = first.unwrap_or(h_in / secant).clamp(0.0, 1.0);
                 let half = SECANT_PROBE * self.probe.tolerance / width;
                 [Some((t - half).max(0.0)), Some((t + half).min(1.0))]
             } else {

@@ -19,6 +19,7 @@
 mod clear;
 mod edge;
 mod facet;
+mod reach;
 mod vertex;
 
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -365,6 +366,22 @@ impl<'a> BoxDrop<'a> {
         let ix = self.index;
         drop_triangle_profile(&self.profile, ix.corners(slot), ix.normal(slot), ix.original_index(slot), &mut best);
         best
+    }
+}
+
+impl BoxDrop<'_> {
+    /// A guess of where, going from `a` to `b`, the triangle in `slot` stops
+    /// lifting the cutter with its tip at `z` above z, as a parameter in
+    /// [0, 1]: the last point of the segment whose cutter axis is within R
+    /// (in XY) of the triangle's part above `z + h(R)`, which the cutter's
+    /// cylindrical body holds. There the triangle's height jumps from above z
+    /// to its floor unless a lower part of it holds the cutter further on;
+    /// `None` if that part is empty or out of reach. A guess only: the caller
+    /// classifies the points near it by [`BoxDrop::drop_one`].
+    #[must_use]
+    pub fn rim_exit(&self, slot: usize, z: f64, a: Point2, b: Point2) -> Option<f64> {
+        let radius = self.profile.radius;
+        reach::rim_exit(self.index.corners(slot), radius, z + self.profile.height(radius), a, b)
     }
 }
 
