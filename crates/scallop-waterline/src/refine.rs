@@ -239,16 +239,23 @@ impl Local<'_> {
     /// inside probe. The outcome is the same as with full evaluations.
     fn contour_near(&self, mid: Point2, normal: Vec2, accept: f64, reach: f64) -> Near {
         let mut first: Option<(f64, Option<usize>)> = None;
-        if let Some(seed) = self.seed.get()
-            && self.triangle_height(seed, mid) > 0.0
-        {
-            let (h, slot) = self.height_slot(mid - normal * accept);
-            if h <= 0.0 {
-                return Near::Within; // inside at the midpoint, outside within `accept`
+        let mut at_mid: Option<(f64, Option<usize>)> = None;
+        if let Some(seed) = self.seed.get() {
+            let h_seed = self.triangle_height(seed, mid);
+            if h_seed > 0.0 {
+                let (h, slot) = self.height_slot(mid - normal * accept);
+                if h <= 0.0 {
+                    return Near::Within; // inside at the midpoint, outside within `accept`
+                }
+                first = Some((h, slot));
+                // The seed lifts the cutter at the midpoint: it stands for the
+                // contact triangle there (any triangle lifting the cutter at an
+                // inside point serves the gap checks and the walk), and its
+                // height, at most the full one, for the secant guess.
+                at_mid = Some((h_seed, Some(seed)));
             }
-            first = Some((h, slot));
         }
-        let (h_mid, slot_mid) = self.height_slot(mid);
+        let (h_mid, slot_mid) = at_mid.unwrap_or_else(|| self.height_slot(mid));
         let mid_in = h_mid > 0.0;
         if !mid_in && slot_mid.is_some_and(|s| self.triangle_height(s, mid + normal * accept) > 0.0) {
             return Near::Within; // outside at the midpoint, inside within `accept`
