@@ -261,6 +261,15 @@ impl Local<'_> {
             return Near::Within; // outside at the midpoint, inside within `accept`
         }
         let towards = if mid_in { -normal } else { normal };
+        // From an inside midpoint, the first crossing along the line is the end
+        // of the walk over the triangles that lift the cutter from the midpoint
+        // on (the probes below find the same one, with more full evaluations).
+        if mid_in
+            && let Some(slot) = slot_mid
+            && let Some((_, out)) = self.walk_bracket(mid, slot, mid + towards * reach)
+        {
+            return if (out - mid).norm() <= accept { Near::Within } else { Near::Found(out) };
+        }
         let (mut last, mut h_last, mut r_last, mut slot_last) = (mid, h_mid, 0.0, slot_mid);
         let mut r = accept;
         loop {
