@@ -214,7 +214,11 @@ impl Local<'_> {
 
     /// Where the contour crosses the line through `mid` along `normal` (unit,
     /// pointing inside): [`Near::Within`] if it does within `accept` of `mid`
-    /// (one probe); otherwise probes at growing distances up to `reach` and
+    /// (one probe); otherwise, from an inside midpoint, the end of the walk of
+    /// [`Local::walk_bracket`] from `mid` to `reach` (the first crossing along
+    /// the line: every point before it is lifted by one of the walked
+    /// triangles); else (an outside midpoint, or a walk that gives up) probes
+    /// at growing distances up to `reach` and
     /// refines the first change of side found between two probes;
     /// [`Near::Missing`] if none. Each next distance is the secant estimate of
     /// the contour from the last two probes, a little beyond (where the height
@@ -236,7 +240,10 @@ impl Local<'_> {
     /// triangles, so one triangle lifting the cutter above z proves inside):
     /// the last contact triangle at `mid` before the full evaluation at the
     /// first outside probe; the midpoint's contact triangle at the first
-    /// inside probe. The outcome is the same as with full evaluations.
+    /// inside probe. Where that last contact triangle lifts the cutter at
+    /// `mid`, it also stands for the midpoint's contact triangle (no full
+    /// evaluation at `mid`). The crossing found is the same as with full
+    /// evaluations, up to the crossing tolerance.
     fn contour_near(&self, mid: Point2, normal: Vec2, accept: f64, reach: f64) -> Near {
         let mut first: Option<(f64, Option<usize>)> = None;
         let mut at_mid: Option<(f64, Option<usize>)> = None;

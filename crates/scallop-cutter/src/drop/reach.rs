@@ -38,7 +38,7 @@ pub(super) fn rim_exit(corners: &[Point3; 3], radius: f64, top: f64, a: Point2, 
     }
     let d = b - a;
     let dd = d.x * d.x + d.y * d.y;
-    if n == 0 || !(dd > 0.0) {
+    if n == 0 || dd.is_nan() || dd <= 0.0 {
         return None;
     }
     let r2 = radius * radius;
@@ -61,7 +61,7 @@ pub(super) fn rim_exit(corners: &[Point3; 3], radius: f64, top: f64, a: Point2, 
         // clipped in t (Liang and Barsky).
         let e = v - u;
         let ee = e.x * e.x + e.y * e.y;
-        if n == 1 || !(ee > 0.0) {
+        if n == 1 || ee.is_nan() || ee <= 0.0 {
             continue;
         }
         let le = ee.sqrt();
@@ -84,4 +84,89 @@ pub(super) fn rim_exit(corners: &[Point3; 3], radius: f64, top: f64, a: Point2, 
         }
     }
     best.filter(|&t| t >= 0.0).map(|t| t.min(1.0))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::CutterShape;
+    use crate::drop::{ClPoint, drop_triangle};
+    use crate::shape::{Cutter, Profile};
+    use scallop_geom::rng::SplitMix64;
+
+    /// XY distance from `p` to the part of the triangle above `top`, by dense
+    /// sampling of the triangle (independent of the clipping above): never
+    /// below the true distance.
+    fn sampled_distance(t: &[Point3; 3], top: f64, p: Point2) -> f64 {
+        let n = 200;
+        let mut best = f64::INFINITY;
+        for i in 0..=n {
+            for j in 0..=n - i {
+                let (s, u) = (f64::from(i) / f64::from(n), f64::from(j) / f64::from(n));
+                let q = t[0] + (t[1] - t[0]) * s + (t[2] - t[0]) * u;
+                if q.z > top {
+                    best = best.min(((q.x - p.x).powi(2) + (q.y - p.y).powi(2)).sqrt());
+                }
+            }
+        }
+        best
+    }
+
+    /// The guess is the segment's last point within R of the triangle's part
+    /// above the profile's top: just before it the cutter's body holds that
+    /// part (the triangle lifts the cutter above z), just after it nothing of
+    /// that part is within R; `None` only where no point of the segment is.
+    #[test]
+    fn the_rim_exit_is_the_last_point_within_reach_of_the_part_above_the_profile() {
+        let mut rng = SplitMix64::new(20_261_206);
+        let shapes = [
+            CutterShape::Ball { radius: 1.0 },
+            CutterShape::Cone { radius: 1.0, half_angle: 0.6 },
+            CutterShape::Flat { radius: 1.0 },
+            CutterShape::Bull { radius: 1.0, corner: 0.3 },
+        ];
+        let (mut lifted, mut none) = (0, 0);
+        for k in 0..3000 {
+            let shape = shapes[k % shapes.len()];
+            let profile = Profile::new(&shape);
+            let cutter = Cutter::new(shape, 20.0).expect("cutter");
+            let mut q = || Point3::new(rng.uniform(-2.0, 2.0), rng.uniform(-2.0, 2.0), rng.uniform(-1.0, 3.0));
+            let t = [q(), q(), q()];
+            let (a, far) = (Point2::new(t[0].x + 0.3, t[0].y - 0.2), q());
+            let b = Point2::new(far.x * 2.0, far.y * 2.0);
+            let z = 0.0;
+            let top = z + profile.height(1.0);
+            let d = b - a;
+            let at = |s: f64| a + d * s;
+            if let Some(s) = rim_exit(&t, 1.0, top, a, b) {
+                assert!((0.0..=1.0).contains(&s), "{s}");
+                let eps = 1e-3 / d.norm();
+                if s - eps > 0.0 {
+                    // Within R of the part above the profile's top: the cutter is lifted.
+                    let before = at(s - eps);
+                    let gap = sampled_distance(&t, top, before);
+                    assert!(gap < 1.0 + 0.05, "{t:?} {a:?} {b:?}: {gap} from the part at {s}");
+                    let n = (t[1] - t[0]).cross(&(t[2] - t[0]));
+                    if n.norm() > 1e-6 && gap < 1.0 - 0.05 {
+                        let n = if n.z < 0.0 { -n / n.norm() } else { n / n.norm() };
+                        let mut cl = ClPoint::floor(before, z - 10.0);
+                        drop_triangle(&cutter, &t, &n, 0, &mut cl);
+                        assert!(cl.tip.z > z, "{shape:?} {t:?}: not lifted before the exit {s}");
+                        lifted += 1;
+                    }
+                }
+                if s + eps < 1.0 {
+                    let gap = sampled_distance(&t, top, at(s + eps));
+                    assert!(gap > 1.0, "{t:?} {a:?} {b:?}: {gap} from the part after the exit {s}");
+                }
+            } else {
+                none += 1;
+                for i in 0..=50 {
+                    let gap = sampled_distance(&t, top, at(f64::from(i) / 50.0));
+                    assert!(gap > 1.0 - 0.05, "{t:?} {a:?} {b:?}: None, but {gap} from the part");
+                }
+            }
+        }
+        assert!(lifted > 300 && none > 100, "both cases are exercised ({lifted}, {none})");
+    }
 }
