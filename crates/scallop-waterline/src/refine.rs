@@ -78,6 +78,11 @@ impl Local<'_> {
         self.drop.drop_one(slot, p, probe.z - probe.step).tip.z - probe.z
     }
 
+    /// `triangle_height(slot, p) > 0`, with the search pruned at z.
+    fn lifts(&self, slot: usize, p: Point2) -> bool {
+        self.drop.lifts(slot, p, self.probe.z)
+    }
+
     /// Shrinks the bracket from `inside` (height `h_in > 0`) to `outside`
     /// (height `h_out <= 0`) to the tolerance and returns its outside end.
     ///
@@ -120,9 +125,21 @@ impl Local<'_> {
     /// that does not advance (rounding): the caller brackets on the full
     /// drop-cutter instead.
     fn walk_bracket(&self, inside: Point2, slot: usize, outside: Point2) -> Option<(Point2, Point2)> {
-        let (mut at, mut slot) = (inside, slot);
+        self.walk_bracket_from(inside, slot, None, outside)
+    }
+
+    /// [`Local::walk_bracket`] with the height `h_inside` of the triangle in
+    /// `slot` at `inside`, when known.
+    fn walk_bracket_from(
+        &self,
+        inside: Point2,
+        slot: usize,
+        h_inside: Option<f64>,
+        outside: Point2,
+    ) -> Option<(Point2, Point2)> {
+        let (mut at, mut slot, mut known) = (inside, slot, h_inside);
         for _ in 0..MAX_WALK_STEPS {
-            let h_at = self.triangle_height(slot, at);
+            let h_at = known.take().unwrap_or_else(|| self.triangle_height(slot, at));
             let h_end = self.triangle_height(slot, outside);
             if !(h_at > 0.0 && h_end <= 0.0) {
                 return None;
@@ -264,7 +281,7 @@ impl Local<'_> {
         }
         let (h_mid, slot_mid) = at_mid.unwrap_or_else(|| self.height_slot(mid));
         let mid_in = h_mid > 0.0;
-        if !mid_in && slot_mid.is_some_and(|s| self.triangle_height(s, mid + normal * accept) > 0.0) {
+        if !mid_in && slot_mid.is_some_and(|s| self.lifts(s, mid + normal * accept)) {
             return Near::Within; // outside at the midpoint, inside within `accept`
         }
         let towards = if mid_in { -normal } else { normal };
@@ -273,7 +290,7 @@ impl Local<'_> {
         // on (the probes below find the same one, with more full evaluations).
         if mid_in
             && let Some(slot) = slot_mid
-            && let Some((_, out)) = self.walk_bracket(mid, slot, mid + towards * reach)
+            && let Some((_, out)) = self.walk_bracket_from(mid, slot, at_mid.map(|(h, _)| h), mid + towards * reach)
         {
             return if (out - mid).norm() <= accept { Near::Within } else { Near::Found(out) };
         }
@@ -331,7 +348,7 @@ impl Local<'_> {
         let mut out = Vec::new();
         let (mut at, mut slot) = (a, slot_a);
         for _ in 0..MAX_COVER_STEPS {
-            if self.triangle_height(slot, b) > 0.0 {
+            if self.lifts(slot, b) {
                 break; // this triangle covers the rest of the segment
             }
             let end = self.triangle_end(slot, at, b);
@@ -370,9 +387,7 @@ impl Local<'_> {
         h_b: f64,
         slot_b: Option<usize>,
     ) -> Option<Point2> {
-        if slot_a.is_some_and(|s| self.triangle_height(s, b) > 0.0)
-            || slot_b.is_some_and(|s| self.triangle_height(s, a) > 0.0)
-        {
+        if slot_a.is_some_and(|s| self.lifts(s, b)) || slot_b.is_some_and(|s| self.lifts(s, a)) {
             return None;
         }
         // An inside point always has a contact triangle (the floor is below z).
@@ -390,7 +405,7 @@ impl Local<'_> {
             if mid == inside || mid == outside {
                 break;
             }
-            if self.triangle_height(slot, mid) > 0.0 {
+            if self.lifts(slot, mid) {
                 inside = mid;
             } else {
                 outside = mid;

@@ -370,6 +370,19 @@ impl<'a> BoxDrop<'a> {
 }
 
 impl BoxDrop<'_> {
+    /// Whether the one triangle in `slot` lifts the cutter at `xy` above `z`:
+    /// the answer of `drop_one(slot, xy, floor).tip.z > z` for any floor below
+    /// z (every contact is computed as there), found with the search pruned
+    /// at z instead of at the floor (the bounds that skip a corner, an edge or
+    /// the whole triangle keep the prune slack).
+    #[must_use]
+    pub fn lifts(&self, slot: usize, xy: Point2, z: f64) -> bool {
+        let mut best = ClPoint::floor(xy, z);
+        let ix = self.index;
+        drop_triangle_profile(&self.profile, ix.corners(slot), ix.normal(slot), ix.original_index(slot), &mut best);
+        best.tip.z > z
+    }
+
     /// A guess of where, going from `a` to `b`, the triangle in `slot` stops
     /// lifting the cutter with its tip at `z` above z, as a parameter in
     /// [0, 1]: the last point of the segment whose cutter axis is within R
