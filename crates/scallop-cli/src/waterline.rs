@@ -76,6 +76,11 @@ struct WaterlineReport {
     grid_seconds: f64,
     contour_seconds: f64,
     seconds: f64,
+    /// CPU time of the process (all threads) spent on the waterline computation: the
+    /// part's preparation (mesh copy and XY index build), the drop-cutter grid and every
+    /// level's loops; the mesh file's parse, the output writing and the process start are
+    /// outside it. `None` where the process CPU clock is not read (not Linux).
+    kernel_cpu_seconds: Option<f64>,
     output: String,
 }
 
@@ -105,6 +110,20 @@ fn parse_levels(specs: &[String]) -> CliResult<Vec<f64>> {
     Ok(levels)
 }
 
+/// The CPU time used so far by this process, all threads (s): `clock_gettime` with
+/// `CLOCK_PROCESS_CPUTIME_ID` (POSIX), on Linux only.
+#[cfg(target_os = "linux")]
+fn process_cpu_seconds() -> Option<f64> {
+    let t = rustix::time::clock_gettime(rustix::time::ClockId::ProcessCPUTime);
+    #[allow(clippy::cast_precision_loss)] // seconds of CPU time: far below 2^52
+    Some(t.tv_sec as f64 + t.tv_nsec as f64 * 1e-9)
+}
+
+#[cfg(not(target_os = "linux"))]
+fn process_cpu_seconds() -> Option<f64> {
+    None
+}
+
 fn reject(what: &str, e: &WaterlineError) -> Failure {
     Failure::rejected(format!("{what}: {e}"))
 }
@@ -117,6 +136,7 @@ pub fn run(args: &WaterlineArgs) -> CliResult<()> {
         return Err(Failure::rejected("--threads 0: give at least 1"));
     }
     let loaded = load(&args.mesh, args.units)?;
+    let cpu_start = process_cpu_seconds();
     let prepared = prepare_part(&loaded.part, &Tolerances { path: tol::CHORD_TOLERANCE, gouge: 0.0 })
         .map_err(|e| Failure::rejected(format!("{}: {e}", args.mesh)))?;
     let bounds = prepared.mesh.bounds();
@@ -168,6 +188,7 @@ pub fn run(args: &WaterlineArgs) -> CliResult<()> {
     }
     bar.finish_and_clear();
     let seconds = start.elapsed().as_secs_f64();
+    let kernel_cpu_seconds = cpu_start.zip(process_cpu_seconds()).map(|(a, b)| b - a);
 
     let json_out = args.output.extension().is_some_and(|e| e.eq_ignore_ascii_case("json"));
     write_atomic(&args.output, |w| {
@@ -211,6 +232,7 @@ pub fn run(args: &WaterlineArgs) -> CliResult<()> {
         grid_seconds,
         contour_seconds: seconds - grid_seconds,
         seconds,
+        kernel_cpu_seconds,
         output: args.output.display().to_string(),
     };
     print_report(&report, args.json, |r| {

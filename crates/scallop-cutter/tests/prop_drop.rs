@@ -133,6 +133,26 @@ proptest! {
         }
     }
 
+    /// `BoxDrop::lifts` (the search pruned at z) answers as one triangle's
+    /// height does (`drop_one` from a floor below z), also at z equal to that
+    /// height and one rounding unit either side of it.
+    #[test]
+    fn lifts_answers_as_the_triangles_height(soup in soup_strategy(30), shape in shape_strategy(),
+                                             pts in prop::collection::vec((-2.0f64..12.0, -2.0f64..12.0, 0usize..30,
+                                                                           -1.0f64..4.0), 1..40)) {
+        let Some((_, index)) = build(&soup) else { return Ok(()) };
+        let c = cutter(shape);
+        let local = BoxDrop::new(&c, &index, Point2::new(0.0, 0.0), Point2::new(10.0, 10.0));
+        for (x, y, slot, z) in pts {
+            let (xy, slot) = (Point2::new(x, y), slot % index.len());
+            let h = local.drop_one(slot, xy, FLOOR).tip.z;
+            for z in [z, h, h.next_down(), h.next_up(), h - 1e-9, h + 1e-9] {
+                let lifted = local.drop_one(slot, xy, FLOOR.min(z - 1.0)).tip.z > z;
+                prop_assert_eq!(local.lifts(slot, xy, z), lifted, "slot {} at {:?}, z {} (height {})", slot, xy, z, h);
+            }
+        }
+    }
+
     /// A wandering path (small steps with occasional jumps, so blocks of many
     /// points and blocks of one) gives the brute-force heights bit for bit.
     #[test]

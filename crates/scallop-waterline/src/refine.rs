@@ -78,6 +78,11 @@ impl Local<'_> {
         self.drop.drop_one(slot, p, probe.z - probe.step).tip.z - probe.z
     }
 
+    /// `triangle_height(slot, p) > 0`, with the search pruned at z.
+    fn lifts(&self, slot: usize, p: Point2) -> bool {
+        self.drop.lifts(slot, p, self.probe.z)
+    }
+
     /// Shrinks the bracket from `inside` (height `h_in > 0`) to `outside`
     /// (height `h_out <= 0`) to the tolerance and returns its outside end.
     ///
@@ -120,14 +125,30 @@ impl Local<'_> {
     /// that does not advance (rounding): the caller brackets on the full
     /// drop-cutter instead.
     fn walk_bracket(&self, inside: Point2, slot: usize, outside: Point2) -> Option<(Point2, Point2)> {
-        let (mut at, mut slot) = (inside, slot);
+        self.walk_bracket_from(inside, slot, None, outside)
+    }
+
+    /// [`Local::walk_bracket`] with the height `h_inside` of the triangle in
+    /// `slot` at `inside`, when known.
+    fn walk_bracket_from(
+        &self,
+        inside: Point2,
+        slot: usize,
+        h_inside: Option<f64>,
+        outside: Point2,
+    ) -> Option<(Point2, Point2)> {
+        let (mut at, mut slot, mut known) = (inside, slot, h_inside);
         for _ in 0..MAX_WALK_STEPS {
-            let h_at = self.triangle_height(slot, at);
+            let h_at = known.take().unwrap_or_else(|| self.triangle_height(slot, at));
             let h_end = self.triangle_height(slot, outside);
             if !(h_at > 0.0 && h_end <= 0.0) {
                 return None;
             }
-            let (tin, tout) = self.bracket_with(&|p| self.triangle_height(slot, p), at, h_at, outside, h_end);
+            // The triangle's height jumps where its part above the cutter's
+            // profile leaves the cutter's reach: start from there.
+            let guess = self.drop.rim_exit(slot, self.probe.z, at, outside);
+            let height = |p| self.triangle_height(slot, p);
+            let (tin, tout) = self.bracket_with(&height, at, h_at, outside, h_end, guess);
             let (h, next) = self.height_slot(tout);
             if h <= 0.0 {
                 return (tin != tout).then_some((tin, tout));
@@ -143,10 +164,16 @@ impl Local<'_> {
     /// As [`Local::bisect_heights`] without a contact triangle, returning both
     /// ends of the final bracket (inside, outside).
     fn bracket(&self, inside: Point2, h_in: f64, outside: Point2, h_out: f64) -> (Point2, Point2) {
-        self.bracket_with(&|p| self.height(p), inside, h_in, outside, h_out)
+        self.bracket_with(&|p| self.height(p), inside, h_in, outside, h_out, None)
     }
 
     /// The bracket of [`Local::bracket`] on the height function `height`.
+    /// `guess` (a parameter from `inside` to `outside`, as
+    /// [`BoxDrop::rim_exit`](scallop_cutter::BoxDrop::rim_exit)) replaces the
+    /// first secant guess: probed half a tolerance either side, as a secant
+    /// guess, a right one closes the bracket at once, even where the height
+    /// jumps (where secant steps find nothing and only bisection shrinks the
+    /// bracket); a wrong one moves one end, as a poor secant step does.
     fn bracket_with(
         &self,
         height: &dyn Fn(Point2) -> f64,
@@ -154,6 +181,7 @@ impl Local<'_> {
         mut h_in: f64,
         mut outside: Point2,
         mut h_out: f64,
+        mut guess: Option<f64>,
     ) -> (Point2, Point2) {
         let mut bisections = 0;
         loop {
@@ -162,10 +190,11 @@ impl Local<'_> {
                 return (inside, outside);
             }
             let secant = h_in - h_out;
-            let use_secant = bisections == 0 && secant.is_finite() && secant > 0.0;
+            let first = guess.take().filter(|t| (0.0..=1.0).contains(t));
+            let use_secant = first.is_some() || (bisections == 0 && secant.is_finite() && secant > 0.0);
             let (a, b) = (inside, outside);
             let steps: [Option<f64>; 2] = if use_secant {
-                let t = (h_in / secant).clamp(0.0, 1.0);
+                let t = first.unwrap_or(h_in / secant).clamp(0.0, 1.0);
                 let half = SECANT_PROBE * self.probe.tolerance / width;
                 [Some((t - half).max(0.0)), Some((t + half).min(1.0))]
             } else {
@@ -202,7 +231,11 @@ impl Local<'_> {
 
     /// Where the contour crosses the line through `mid` along `normal` (unit,
     /// pointing inside): [`Near::Within`] if it does within `accept` of `mid`
-    /// (one probe); otherwise probes at growing distances up to `reach` and
+    /// (one probe); otherwise, from an inside midpoint, the end of the walk of
+    /// [`Local::walk_bracket`] from `mid` to `reach` (the first crossing along
+    /// the line: every point before it is lifted by one of the walked
+    /// triangles); else (an outside midpoint, or a walk that gives up) probes
+    /// at growing distances up to `reach` and
     /// refines the first change of side found between two probes;
     /// [`Near::Missing`] if none. Each next distance is the secant estimate of
     /// the contour from the last two probes, a little beyond (where the height
@@ -224,24 +257,43 @@ impl Local<'_> {
     /// triangles, so one triangle lifting the cutter above z proves inside):
     /// the last contact triangle at `mid` before the full evaluation at the
     /// first outside probe; the midpoint's contact triangle at the first
-    /// inside probe. The outcome is the same as with full evaluations.
+    /// inside probe. Where that last contact triangle lifts the cutter at
+    /// `mid`, it also stands for the midpoint's contact triangle (no full
+    /// evaluation at `mid`). The crossing found is the same as with full
+    /// evaluations, up to the crossing tolerance.
     fn contour_near(&self, mid: Point2, normal: Vec2, accept: f64, reach: f64) -> Near {
         let mut first: Option<(f64, Option<usize>)> = None;
-        if let Some(seed) = self.seed.get()
-            && self.triangle_height(seed, mid) > 0.0
-        {
-            let (h, slot) = self.height_slot(mid - normal * accept);
-            if h <= 0.0 {
-                return Near::Within; // inside at the midpoint, outside within `accept`
+        let mut at_mid: Option<(f64, Option<usize>)> = None;
+        if let Some(seed) = self.seed.get() {
+            let h_seed = self.triangle_height(seed, mid);
+            if h_seed > 0.0 {
+                let (h, slot) = self.height_slot(mid - normal * accept);
+                if h <= 0.0 {
+                    return Near::Within; // inside at the midpoint, outside within `accept`
+                }
+                first = Some((h, slot));
+                // The seed lifts the cutter at the midpoint: it stands for the
+                // contact triangle there (any triangle lifting the cutter at an
+                // inside point serves the gap checks and the walk), and its
+                // height, at most the full one, for the secant guess.
+                at_mid = Some((h_seed, Some(seed)));
             }
-            first = Some((h, slot));
         }
-        let (h_mid, slot_mid) = self.height_slot(mid);
+        let (h_mid, slot_mid) = at_mid.unwrap_or_else(|| self.height_slot(mid));
         let mid_in = h_mid > 0.0;
-        if !mid_in && slot_mid.is_some_and(|s| self.triangle_height(s, mid + normal * accept) > 0.0) {
+        if !mid_in && slot_mid.is_some_and(|s| self.lifts(s, mid + normal * accept)) {
             return Near::Within; // outside at the midpoint, inside within `accept`
         }
         let towards = if mid_in { -normal } else { normal };
+        // From an inside midpoint, the first crossing along the line is the end
+        // of the walk over the triangles that lift the cutter from the midpoint
+        // on (the probes below find the same one, with more full evaluations).
+        if mid_in
+            && let Some(slot) = slot_mid
+            && let Some((_, out)) = self.walk_bracket_from(mid, slot, at_mid.map(|(h, _)| h), mid + towards * reach)
+        {
+            return if (out - mid).norm() <= accept { Near::Within } else { Near::Found(out) };
+        }
         let (mut last, mut h_last, mut r_last, mut slot_last) = (mid, h_mid, 0.0, slot_mid);
         let mut r = accept;
         loop {
@@ -296,7 +348,7 @@ impl Local<'_> {
         let mut out = Vec::new();
         let (mut at, mut slot) = (a, slot_a);
         for _ in 0..MAX_COVER_STEPS {
-            if self.triangle_height(slot, b) > 0.0 {
+            if self.lifts(slot, b) {
                 break; // this triangle covers the rest of the segment
             }
             let end = self.triangle_end(slot, at, b);
@@ -335,9 +387,7 @@ impl Local<'_> {
         h_b: f64,
         slot_b: Option<usize>,
     ) -> Option<Point2> {
-        if slot_a.is_some_and(|s| self.triangle_height(s, b) > 0.0)
-            || slot_b.is_some_and(|s| self.triangle_height(s, a) > 0.0)
-        {
+        if slot_a.is_some_and(|s| self.lifts(s, b)) || slot_b.is_some_and(|s| self.lifts(s, a)) {
             return None;
         }
         // An inside point always has a contact triangle (the floor is below z).
@@ -355,7 +405,7 @@ impl Local<'_> {
             if mid == inside || mid == outside {
                 break;
             }
-            if self.triangle_height(slot, mid) > 0.0 {
+            if self.lifts(slot, mid) {
                 inside = mid;
             } else {
                 outside = mid;

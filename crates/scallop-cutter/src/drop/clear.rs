@@ -23,17 +23,36 @@ use scallop_geom::{Point3, tol};
 /// (see the module's documentation). False on NaN.
 #[inline]
 pub(super) fn ball_clear_of(corners: &[Point3; 3], radius: f64, cx: f64, cy: f64, tip: f64) -> bool {
+    ball_clearance(corners, radius, cx, cy, tip).is_some()
+}
+
+/// [`ball_clear_of`] with a margin: `Some(g)` when the ball is clear, where
+/// every centre `O'` within `g` (3D) of this one, `O = (cx, cy, tip + R)`,
+/// with the triangle still at or below its height, passes the same test (the
+/// distance to the triangle is 1-Lipschitz in the centre: `|O' T| >= |O T| -
+/// |O' O|`, and `g` leaves room for the slack of `O'`, whose distance to the
+/// first corner is at most `|a O| + |O T|`); `g` is 0 when there is no such
+/// room. `None` when not clear.
+#[inline]
+pub(super) fn ball_clearance(corners: &[Point3; 3], radius: f64, cx: f64, cy: f64, tip: f64) -> Option<f64> {
     let oz = tip + radius;
     let [a, b, c] = corners;
     let top = a.z.max(b.z).max(c.z);
     if top > oz || top.is_nan() || oz.is_nan() {
-        return false; // a point above the centre's height may be in the cylinder
+        return None; // a point above the centre's height may be in the cylinder
     }
     let o = [cx, cy, oz];
-    let Some(d2) = distance2(o, [a.x, a.y, a.z], [b.x, b.y, b.z], [c.x, c.y, c.z]) else { return false };
+    let d2 = distance2(o, [a.x, a.y, a.z], [b.x, b.y, b.z], [c.x, c.y, c.z])?;
     let (ax, ay, az) = (a.x - cx, a.y - cy, a.z - oz);
     let r2 = radius * radius;
-    d2 > r2 + tol::REL_PRUNE_SLACK * (r2 + ax * ax + ay * ay + az * az)
+    let a2 = ax * ax + ay * ay + az * az;
+    let limit = r2 + tol::REL_PRUNE_SLACK * (r2 + a2);
+    if d2.partial_cmp(&limit) != Some(std::cmp::Ordering::Greater) {
+        return None; // within reach, or NaN
+    }
+    let d = d2.sqrt();
+    let far = a2.sqrt() + d;
+    Some((d - (r2 + tol::REL_PRUNE_SLACK * (r2 + far * far)).sqrt()).max(0.0))
 }
 
 fn sub(p: [f64; 3], q: [f64; 3]) -> [f64; 3] {
@@ -135,6 +154,45 @@ mod tests {
             }
         }
         assert!(cleared > 10_000, "the test clears triangles ({cleared})");
+    }
+
+    /// Every centre within the margin of [`ball_clearance`] (the triangle still
+    /// at or below it) passes the test too, and the triangle does not raise
+    /// the ball there: random triangles, centres, and moves in every direction
+    /// up to just under the margin.
+    #[test]
+    fn a_centre_within_the_clearance_is_clear() {
+        let profile = Profile::new(&CutterShape::Ball { radius: 1.0 });
+        let mut rng = SplitMix64::new(20_261_207);
+        let mut moved = 0;
+        for _ in 0..20_000 {
+            let mut q = || Point3::new(rng.uniform(-1.5, 1.5), rng.uniform(-1.5, 1.5), rng.uniform(-1.0, 1.0));
+            let t = [q(), q(), q()];
+            let n = (t[1] - t[0]).cross(&(t[2] - t[0]));
+            if n.norm() == 0.0 {
+                continue;
+            }
+            let n: Vec3 = if n.z < 0.0 { -n / n.norm() } else { n / n.norm() };
+            let c = Point2::new(rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0));
+            let mut own = ClPoint::floor(c, -100.0);
+            drop_features(&profile, &t, &n, 0, ALL_FEATURES, &mut own);
+            let tip = own.tip.z + rng.uniform(-0.2, 0.5);
+            let Some(g) = ball_clearance(&t, 1.0, c.x, c.y, tip) else { continue };
+            for u in [0.3, 0.9, 0.999, 1.0 - 1e-9] {
+                let (theta, phi) = (rng.uniform(0.0, 6.3), rng.uniform(-1.5, 1.5));
+                let d = [phi.cos() * theta.cos(), phi.cos() * theta.sin(), phi.sin()].map(|v| v * u * g);
+                let (c2, tip2) = (Point2::new(c.x + d[0], c.y + d[1]), tip + d[2]);
+                if t.iter().any(|p| p.z > tip2 + 1.0) {
+                    continue; // above the centre: the cylinder, not the ball
+                }
+                moved += 1;
+                assert!(ball_clear_of(&t, 1.0, c2.x, c2.y, tip2), "{t:?}: {c2:?} at {tip2}, {} of the margin {g}", u);
+                let mut there = ClPoint::floor(c2, -100.0);
+                drop_features(&profile, &t, &n, 0, ALL_FEATURES, &mut there);
+                assert!(there.tip.z <= tip2, "{t:?}: contact {} above {tip2}", there.tip.z);
+            }
+        }
+        assert!(moved > 10_000, "the test moves clear centres ({moved})");
     }
 
     /// The region test against dense sampling of the triangle: never above

@@ -19,8 +19,10 @@
 mod clear;
 mod edge;
 mod facet;
+mod reach;
 mod vertex;
 
+use std::cell::Cell;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use rayon::prelude::*;
@@ -231,7 +233,8 @@ pub fn drop_grid(
             let (x0, x1) = (xs[start].min(xs[end - 1]), xs[start].max(xs[end - 1]));
             scratch.fill(index, &profile, [x0, y], [x1, y]);
             for (slot_out, &x) in row[start..end].iter_mut().zip(&xs[start..end]) {
-                let (cl, slot) = drop_candidates(&profile, index, &scratch.sorted, Point2::new(x, y), floor, seed);
+                let (cl, slot) =
+                    drop_candidates(&profile, index, &scratch.sorted, Point2::new(x, y), floor, seed, None);
                 seed = slot;
                 *slot_out = cl;
             }
@@ -287,7 +290,7 @@ pub fn drop_path(cutter: &Cutter, index: &MeshIndex, points: &[Point2], floor: f
             scratch.fill(index, &profile, lo, hi);
             let mut seed = None;
             for (slot_out, &xy) in chunk.iter_mut().zip(&points[start..end]) {
-                let (cl, slot) = drop_candidates(&profile, index, &scratch.sorted, xy, floor, seed);
+                let (cl, slot) = drop_candidates(&profile, index, &scratch.sorted, xy, floor, seed, None);
                 seed = slot;
                 *slot_out = cl;
             }
@@ -316,6 +319,9 @@ pub struct BoxDrop<'a> {
     lo: Point2,
     hi: Point2,
     candidates: Vec<Candidate>,
+    /// Per candidate, the ball's last clear centre and its margin squared
+    /// (see [`drop_candidates`]); a negative margin matches nothing.
+    clear: Vec<Cell<[f64; 4]>>,
 }
 
 impl<'a> BoxDrop<'a> {
@@ -338,7 +344,8 @@ impl<'a> BoxDrop<'a> {
         let profile = Profile::new(cutter.shape());
         let mut scratch = BlockScratch::default();
         scratch.fill(index, &profile, [lo.x, lo.y], [hi.x, hi.y]);
-        BoxDrop { profile, index, lo, hi, candidates: scratch.sorted }
+        let clear = vec![Cell::new([0.0, 0.0, 0.0, -1.0]); scratch.sorted.len()];
+        BoxDrop { profile, index, lo, hi, candidates: scratch.sorted, clear }
     }
 
     /// Drop-cutter at `xy` with the tip floored at `floor`, first trying the
@@ -348,7 +355,7 @@ impl<'a> BoxDrop<'a> {
     pub fn drop(&self, xy: Point2, floor: f64, seed: Option<usize>) -> (ClPoint, Option<usize>) {
         let inside = xy.x >= self.lo.x && xy.x <= self.hi.x && xy.y >= self.lo.y && xy.y <= self.hi.y;
         if inside {
-            drop_candidates(&self.profile, self.index, &self.candidates, xy, floor, seed)
+            drop_candidates(&self.profile, self.index, &self.candidates, xy, floor, seed, Some(&self.clear))
         } else {
             let mut best = ClPoint::floor(xy, floor);
             let mut best_slot = None;
@@ -365,6 +372,35 @@ impl<'a> BoxDrop<'a> {
         let ix = self.index;
         drop_triangle_profile(&self.profile, ix.corners(slot), ix.normal(slot), ix.original_index(slot), &mut best);
         best
+    }
+}
+
+impl BoxDrop<'_> {
+    /// Whether the one triangle in `slot` lifts the cutter at `xy` above `z`:
+    /// the answer of `drop_one(slot, xy, floor).tip.z > z` for any floor below
+    /// z (every contact is computed as there), found with the search pruned
+    /// at z instead of at the floor (the bounds that skip a corner, an edge or
+    /// the whole triangle keep the prune slack).
+    #[must_use]
+    pub fn lifts(&self, slot: usize, xy: Point2, z: f64) -> bool {
+        let mut best = ClPoint::floor(xy, z);
+        let ix = self.index;
+        drop_triangle_profile(&self.profile, ix.corners(slot), ix.normal(slot), ix.original_index(slot), &mut best);
+        best.tip.z > z
+    }
+
+    /// A guess of where, going from `a` to `b`, the triangle in `slot` stops
+    /// lifting the cutter with its tip at `z` above z, as a parameter in
+    /// [0, 1]: the last point of the segment whose cutter axis is within R
+    /// (in XY) of the triangle's part above `z + h(R)`, which the cutter's
+    /// cylindrical body holds. There the triangle's height jumps from above z
+    /// to its floor unless a lower part of it holds the cutter further on;
+    /// `None` if that part is empty or out of reach. A guess only: the caller
+    /// classifies the points near it by [`BoxDrop::drop_one`].
+    #[must_use]
+    pub fn rim_exit(&self, slot: usize, z: f64, a: Point2, b: Point2) -> Option<f64> {
+        let radius = self.profile.radius;
+        reach::rim_exit(self.index.corners(slot), radius, z + self.profile.height(radius), a, b)
     }
 }
 
@@ -435,7 +471,12 @@ struct Candidate {
 }
 
 /// Drop-cutter at `xy` over `candidates` sorted by decreasing bound `ub`,
-/// which must hold every triangle within the cutter's reach of `xy`.
+/// which must hold every triangle within the cutter's reach of `xy`. With
+/// `clear_cache` (one entry per candidate, for the ball), a candidate whose
+/// last clearance test found the ball clear by a margin g (the centre, g^2)
+/// is skipped while the ball's centre stays within g of that centre and at
+/// or above the triangle's top ([`clear::ball_clearance`]): the same skip as
+/// the test, without its closest-point computation.
 fn drop_candidates(
     profile: &Profile,
     index: &MeshIndex,
@@ -443,6 +484,7 @@ fn drop_candidates(
     xy: Point2,
     floor: f64,
     seed: Option<usize>,
+    clear_cache: Option<&[Cell<[f64; 4]>]>,
 ) -> (ClPoint, Option<usize>) {
     let mut best = ClPoint::floor(xy, floor);
     let mut best_slot = None;
@@ -455,7 +497,7 @@ fn drop_candidates(
     let slack = index.slack();
     let r2 = profile.radius * profile.radius;
     let ball = matches!(profile.shape, crate::CutterShape::Ball { .. });
-    for c in candidates {
+    for (i, c) in candidates.iter().enumerate() {
         if c.ub + slack <= best.tip.z {
             break; // sorted: nothing after this can rise above the best
         }
@@ -469,8 +511,22 @@ fn drop_candidates(
         if d2 > r2 || c.zmax - profile.height_sq(d2) + slack <= best.tip.z {
             continue;
         }
-        if ball && clear::ball_clear_of(index.corners(c.slot), profile.radius, xy.x, xy.y, best.tip.z) {
-            continue; // the ball at the best height is clear of the whole triangle
+        if ball {
+            // The ball at the best height is clear of the whole triangle: skip it.
+            if let Some(cache) = clear_cache {
+                let oz = best.tip.z + profile.radius;
+                let [x, y, z, g2] = cache[i].get();
+                let (dx, dy, dz) = (xy.x - x, xy.y - y, oz - z);
+                if c.zmax <= oz && dx * dx + dy * dy + dz * dz < g2 {
+                    continue; // within the margin of an earlier clear centre
+                }
+                if let Some(g) = clear::ball_clearance(index.corners(c.slot), profile.radius, xy.x, xy.y, best.tip.z) {
+                    cache[i].set([xy.x, xy.y, oz, g * g]);
+                    continue;
+                }
+            } else if clear::ball_clear_of(index.corners(c.slot), profile.radius, xy.x, xy.y, best.tip.z) {
+                continue;
+            }
         }
         let before = best.tip.z;
         let (slot, features) = (c.slot, index.owned_features(c.slot));
