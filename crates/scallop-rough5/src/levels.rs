@@ -262,7 +262,17 @@ pub fn level_passes_with(
     mode: TiltMode,
     options: &LevelOptions,
 ) -> Result<Vec<LevelPasses>, Rough5Error> {
-    let set = build_guides(bottom, flanks, guides)?;
+    // An open pocket's levels are the offsets of its bottom extended across
+    // its open edge, as the bottom level is: the offsets of the bottom alone
+    // end on the virtual flank ruled by its normals there, which leans away
+    // from a steep open end (52 deg at the impeller's inlet), so the wedge
+    // between the crossable end and that flank was on no level.
+    let extended = if options.open_bottom {
+        scallop_guides::extended_bottom(bottom, flanks, guides.tool_radius + guides.flank_allowance, guides.voxel)
+    } else {
+        None
+    };
+    let set = build_guides(extended.as_ref().unwrap_or(bottom), flanks, guides)?;
     let mut own = vec![bottom_level((bottom, flanks), &set, guides, options)?];
     for l in set.levels {
         own.push(Own { distance: l.distance, support: l.support, loops: l.limit.loops, offsets: l.offsets });
