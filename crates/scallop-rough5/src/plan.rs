@@ -575,7 +575,7 @@ fn blank_beyond(blank: &TriMesh, bottom: &TriMesh) -> Option<TriMesh> {
             // Facing up: the envelope over the rest of the part (a shank
             // beside the blank's outer wall is in the air beyond it).
             let n = (t[1] - t[0]).cross(&(t[2] - t[0]));
-            if !(n.z > BEYOND_FACING * n.norm()) {
+            if n.z <= BEYOND_FACING * n.norm() || n.norm() == 0.0 {
                 return false;
             }
             let c = Point3::from((t[0].coords + t[1].coords + t[2].coords) / 3.0);
