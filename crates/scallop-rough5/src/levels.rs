@@ -71,7 +71,8 @@ pub struct LevelOptions {
     /// Where the bottom's limit curves are open chains (an open pocket),
     /// extend the bottom across its open edge and close them by the virtual
     /// flanks there, so that the bottom is cut too
-    /// ([`scallop_guides::bottom_level`]).
+    /// ([`scallop_guides::bottom_level`]); the offset levels are then the
+    /// offsets of that extended bottom, so they reach a steep open end.
     pub open_bottom: bool,
 }
 
