@@ -278,9 +278,22 @@ pub fn level_passes_with(
     for l in set.levels {
         own.push(Own { distance: l.distance, support: l.support, loops: l.limit.loops, offsets: l.offsets });
     }
+    // The bottom level's tilt curves stay those of the first level of the
+    // bottom alone: over the strip the extended level's curves turn the
+    // bottom's axes into the blades.
+    let first_plain = match (&extended, mode) {
+        (Some(_), TiltMode::Guides) => build_guides(bottom, flanks, guides)?.levels.into_iter().next().map(|l| Own {
+            distance: l.distance,
+            support: l.support,
+            loops: l.limit.loops,
+            offsets: l.offsets,
+        }),
+        _ => None,
+    };
+    let above_of = |j: usize| if j == 0 { first_plain.as_ref().or(own.get(1)) } else { own.get(j + 1) };
     let mut out = Vec::with_capacity(own.len());
     for j in 0..own.len() {
-        let paired = match (mode, own.get(j + 1)) {
+        let paired = match (mode, above_of(j)) {
             (TiltMode::Zero, _) => Err("zero-tilt variant".to_string()),
             (TiltMode::Guides, None) => Err("top level: no level above".to_string()),
             (TiltMode::Guides, Some(above)) => match (own[j].level(), above.level()) {
@@ -291,7 +304,7 @@ pub fn level_passes_with(
         let mut paired_by_rank = None;
         let (passes, untilted, outer) = match paired {
             Ok(p) => (p.path.into_iter().zip(p.tilt.into_iter().map(Some)).collect(), None, 1),
-            Err(why) => match own.get(j + 1) {
+            Err(why) => match above_of(j) {
                 Some(above) if options.pair_by_rank && mode == TiltMode::Guides => {
                     paired_by_rank = Some(why);
                     (by_rank(&own[j].passes(), &above.passes()), None, own[j].loops.len())
