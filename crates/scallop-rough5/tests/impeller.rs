@@ -3,7 +3,8 @@
 //! bottom extended across its open edge, so the levels over the steep hub
 //! reach the inlet section; the shank and holder keep their radius from the
 //! top of the blank beyond the pocket (the neighbouring channels stay full in
-//! the proof), and the whole program is proven from the channel's blank.
+//! the proof), the hub level keeps the tilt curves of the first level of the
+//! hub alone, and the whole program is proven from the channel's blank.
 #![allow(clippy::unwrap_used, reason = "tests: a panic is the failure report")]
 
 use proptest::prelude::*;
@@ -56,6 +57,33 @@ fn the_impeller_levels_reach_its_inlet() {
         checked += 1;
     }
     assert!(checked >= 3, "{checked} levels between 8 and 20 mm");
+}
+
+/// The hub level's tilt curves are those of the first level of the hub
+/// alone, which starts beyond the inlet section (r 25 mm) and ends within a
+/// millimetre of the outlet (r 75 mm): the extended level's curves run over
+/// the strips beyond both (r 19.5 to 80.5 mm), where they turned the hub
+/// level's axes into the blades.
+#[test]
+fn the_impeller_hub_level_leans_towards_the_first_level_of_the_hub() {
+    let part = impeller_channel(&ImpellerParams::default()).unwrap();
+    let bottom = part.faces(&[FaceTag::Bottom]).unwrap();
+    let flanks = part.faces(&[FaceTag::Flank]).unwrap();
+    let depth = part.stock.max.z - bottom.bounds().min.z;
+    let levels = level_passes_with(&bottom, &flanks, &guides(depth), TiltMode::Guides, &ALL).unwrap();
+    let hub = &levels[0];
+    assert_eq!(hub.distance, 0.0);
+    let tilts: Vec<f64> = hub
+        .passes
+        .iter()
+        .filter_map(|(_, t)| t.as_ref())
+        .flat_map(|t| t.line.points.iter())
+        .map(|p| p.x.hypot(p.y))
+        .collect();
+    assert!(!tilts.is_empty(), "the hub level has no tilt curve");
+    let inner = tilts.iter().copied().fold(f64::INFINITY, f64::min);
+    let outer = tilts.iter().copied().fold(0.0, f64::max);
+    assert!(inner > 25.0 && outer < 76.0, "the hub level's tilt curves span r {inner:.2} to {outer:.2} mm");
 }
 
 /// A square plane at z = 0 facing up, 1000 mm wide.
