@@ -292,11 +292,11 @@ pub fn level_passes_with(
     };
     let above_of = |j: usize| if j == 0 { first_plain.as_ref().or(own.get(1)) } else { own.get(j + 1) };
     let mut out = Vec::with_capacity(own.len());
-    for j in 0..own.len() {
+    for (j, level) in own.iter().enumerate() {
         let paired = match (mode, above_of(j)) {
             (TiltMode::Zero, _) => Err("zero-tilt variant".to_string()),
             (TiltMode::Guides, None) => Err("top level: no level above".to_string()),
-            (TiltMode::Guides, Some(above)) => match (own[j].level(), above.level()) {
+            (TiltMode::Guides, Some(above)) => match (level.level(), above.level()) {
                 (Some(a), Some(b)) => pair_levels(&a, &b, guides.radial_step).map_err(|e| e.to_string()),
                 _ => Err("a level without one closed limit loop".to_string()),
             },
@@ -307,14 +307,14 @@ pub fn level_passes_with(
             Err(why) => match above_of(j) {
                 Some(above) if options.pair_by_rank && mode == TiltMode::Guides => {
                     paired_by_rank = Some(why);
-                    (by_rank(&own[j].passes(), &above.passes()), None, own[j].loops.len())
+                    (by_rank(&level.passes(), &above.passes()), None, level.loops.len())
                 }
-                _ => (own[j].passes(), Some(why), own[j].loops.len()),
+                _ => (level.passes(), Some(why), level.loops.len()),
             },
         };
         out.push(LevelPasses {
-            distance: own[j].distance,
-            support: own[j].support.clone(),
+            distance: level.distance,
+            support: level.support.clone(),
             passes,
             untilted,
             outer,
