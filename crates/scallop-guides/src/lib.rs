@@ -45,6 +45,7 @@ mod limit;
 mod morph;
 mod offset;
 mod open;
+pub use open::extended_bottom;
 mod support;
 pub use scallop_geom::tol::guides as tol;
 mod vectorial;

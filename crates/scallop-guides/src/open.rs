@@ -127,7 +127,7 @@ impl OpenBottom {
 /// has no open edge or the strip does not make a valid mesh. Its facets are
 /// split in four until their edges are at most `edge` long (at most
 /// [`MAX_SPLITS`] times): the curves on it are extracted facet by facet.
-pub(crate) fn extended_bottom(bottom: &TriMesh, flanks: &TriMesh, width: f64, edge: f64) -> Option<TriMesh> {
+pub fn extended_bottom(bottom: &TriMesh, flanks: &TriMesh, width: f64, edge: f64) -> Option<TriMesh> {
     let open = OpenBottom::new(bottom, flanks);
     if open.edges.is_empty() {
         return None;

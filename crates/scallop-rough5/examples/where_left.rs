@@ -93,7 +93,18 @@ fn remaining_impeller(
     let mut dexels = DexelStock::from_solid(part.stock, 0.5, &blank).unwrap();
     let moves = ToolMove::from_toolpath(path);
     let options = DexelOptions { axis_tolerance: 0.05, check_collisions: true };
-    dexels.cut_with_progress(tool, &moves, &options, &|_, _| {}).unwrap().check().unwrap();
+    let report = dexels.cut_with_progress(tool, &moves, &options, &|_, _| {}).unwrap();
+    // An unsafe program is still measured: its collisions are listed first.
+    if report.check().is_err() {
+        println!(
+            "NOT SAFE: {} rapid hits, {} shank or holder collisions",
+            report.rapid_hits.len(),
+            report.collisions.len()
+        );
+        for c in report.collisions.iter().take(5) {
+            println!("  {:?} {:?} at ({:.2}, {:.2}) depth {:.3}", c.id, c.part, c.at.x, c.at.y, c.depth);
+        }
+    }
     let volume = DexelPart::new(&part.mesh);
     let face = |t| MeshQuery::new(&part.faces(&[t]).unwrap());
     let (qb, qf, qt) = (face(FaceTag::Bottom), face(FaceTag::Flank), face(FaceTag::Top));

@@ -25,6 +25,9 @@ pub struct BodyCheck {
     /// Highest z of the flanks: samples whose ball is above it are skipped.
     top: f64,
     delta: f64,
+    /// A mesh the shank and holder (not the flutes) must clear too, and its
+    /// highest z ([`BodyCheck::with_stock`]).
+    upper: Option<(MeshQuery, f64)>,
 }
 
 impl BodyCheck {
@@ -46,7 +49,42 @@ impl BodyCheck {
             pieces.push((h, h + s.length, s.bottom_radius.max(s.top_radius)));
             h += s.length;
         }
-        BodyCheck { query: MeshQuery::new(flanks), pieces, top: flanks.bounds().max.z, delta: tol::BODY_STEP }
+        BodyCheck {
+            query: MeshQuery::new(flanks),
+            pieces,
+            top: flanks.bounds().max.z,
+            delta: tol::BODY_STEP,
+            upper: None,
+        }
+    }
+
+    /// This check with the shank and holder also kept their radius from
+    /// `stock` (the surface of stock the flutes never cut: a blank beyond
+    /// the pocket, where the neighbouring channels of an impeller stay full).
+    #[must_use]
+    pub fn with_stock(mut self, stock: &TriMesh) -> BodyCheck {
+        let top = stock.bounds().max.z;
+        self.upper = Some((MeshQuery::new(stock), top));
+        self
+    }
+
+    /// The flank or stock point closest to the sample `p` of piece `piece`
+    /// within `within`, when `p`'s ball of that radius reaches below their
+    /// tops; `Err(())` when it is above both.
+    fn nearest(&self, piece: usize, p: &Point3, within: f64) -> Result<Option<scallop_mesh::ClosestPoint>, ()> {
+        let flank = (p.z - within <= self.top).then(|| self.query.closest_within(p, within)).flatten();
+        let stock = match &self.upper {
+            Some((q, top)) if piece > 0 && p.z - within <= *top => q.closest_within(p, within),
+            _ => None,
+        };
+        let above = p.z - within > self.top && self.upper.as_ref().is_none_or(|u| piece == 0 || p.z - within > u.1);
+        if above {
+            return Err(());
+        }
+        Ok(match (flank, stock) {
+            (Some(a), Some(b)) => Some(if b.distance < a.distance { b } else { a }),
+            (a, b) => a.or(b),
+        })
     }
 
     /// The deepest intrusion of the tool with its tip at `tip` and unit axis
@@ -60,19 +98,19 @@ impl BodyCheck {
     #[must_use]
     pub fn intrusion(&self, tip: &Point3, axis: &Vec3) -> Option<(f64, Vec3)> {
         let mut worst: Option<(f64, Vec3)> = None;
-        for &(h0, h1, rho) in &self.pieces {
+        for (piece, &(h0, h1, rho)) in self.pieces.iter().enumerate() {
             let n = ((h1 - h0) / self.delta).ceil().max(1.0) as usize;
             let need = rho + 0.5 * self.delta;
             for k in 0..=n {
                 let h = h0 + (h1 - h0) * (k as f64 / n as f64);
                 let p = tip + axis * h;
-                if p.z - need > self.top {
+                let Ok(found) = self.nearest(piece, &p, need) else {
                     if axis.z > 0.0 {
                         break;
                     }
                     continue;
-                }
-                let Some(c) = self.query.closest_within(&p, need) else { continue };
+                };
+                let Some(c) = found else { continue };
                 let deficit = need - c.distance;
                 if worst.is_none_or(|w| deficit > w.0) {
                     // A sample on the flank has no direction: zero.
@@ -89,20 +127,16 @@ impl BodyCheck {
     /// closer to the flanks than its radius (plus the clearance on the flutes).
     #[must_use]
     pub fn collides(&self, tip: &Point3, axis: &Vec3) -> bool {
-        for &(h0, h1, rho) in &self.pieces {
+        for (piece, &(h0, h1, rho)) in self.pieces.iter().enumerate() {
             let n = ((h1 - h0) / self.delta).ceil().max(1.0) as usize;
             let need = rho + 0.5 * self.delta;
             for k in 0..=n {
                 let h = h0 + (h1 - h0) * (k as f64 / n as f64);
                 let p = tip + axis * h;
-                if p.z - need > self.top {
-                    if axis.z > 0.0 {
-                        break;
-                    }
-                    continue;
-                }
-                if self.query.closest_within(&p, need).is_some() {
-                    return true;
+                match self.nearest(piece, &p, need) {
+                    Err(()) if axis.z > 0.0 => break,
+                    Ok(Some(_)) => return true,
+                    _ => {}
                 }
             }
         }

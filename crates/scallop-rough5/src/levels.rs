@@ -71,7 +71,8 @@ pub struct LevelOptions {
     /// Where the bottom's limit curves are open chains (an open pocket),
     /// extend the bottom across its open edge and close them by the virtual
     /// flanks there, so that the bottom is cut too
-    /// ([`scallop_guides::bottom_level`]).
+    /// ([`scallop_guides::bottom_level`]); the offset levels are then the
+    /// offsets of that extended bottom, so they reach a steep open end.
     pub open_bottom: bool,
 }
 
@@ -262,17 +263,40 @@ pub fn level_passes_with(
     mode: TiltMode,
     options: &LevelOptions,
 ) -> Result<Vec<LevelPasses>, Rough5Error> {
-    let set = build_guides(bottom, flanks, guides)?;
+    // An open pocket's levels are the offsets of its bottom extended across
+    // its open edge, as the bottom level is: the offsets of the bottom alone
+    // end on the virtual flank ruled by its normals there, which leans away
+    // from a steep open end (52 deg at the impeller's inlet), so the wedge
+    // between the crossable end and that flank was on no level.
+    let extended = if options.open_bottom {
+        scallop_guides::extended_bottom(bottom, flanks, guides.tool_radius + guides.flank_allowance, guides.voxel)
+    } else {
+        None
+    };
+    let set = build_guides(extended.as_ref().unwrap_or(bottom), flanks, guides)?;
     let mut own = vec![bottom_level((bottom, flanks), &set, guides, options)?];
     for l in set.levels {
         own.push(Own { distance: l.distance, support: l.support, loops: l.limit.loops, offsets: l.offsets });
     }
+    // The bottom level's tilt curves stay those of the first level of the
+    // bottom alone: over the strip the extended level's curves turn the
+    // bottom's axes into the blades.
+    let first_plain = match (&extended, mode) {
+        (Some(_), TiltMode::Guides) => build_guides(bottom, flanks, guides)?.levels.into_iter().next().map(|l| Own {
+            distance: l.distance,
+            support: l.support,
+            loops: l.limit.loops,
+            offsets: l.offsets,
+        }),
+        _ => None,
+    };
+    let above_of = |j: usize| if j == 0 { first_plain.as_ref().or(own.get(1)) } else { own.get(j + 1) };
     let mut out = Vec::with_capacity(own.len());
-    for j in 0..own.len() {
-        let paired = match (mode, own.get(j + 1)) {
+    for (j, level) in own.iter().enumerate() {
+        let paired = match (mode, above_of(j)) {
             (TiltMode::Zero, _) => Err("zero-tilt variant".to_string()),
             (TiltMode::Guides, None) => Err("top level: no level above".to_string()),
-            (TiltMode::Guides, Some(above)) => match (own[j].level(), above.level()) {
+            (TiltMode::Guides, Some(above)) => match (level.level(), above.level()) {
                 (Some(a), Some(b)) => pair_levels(&a, &b, guides.radial_step).map_err(|e| e.to_string()),
                 _ => Err("a level without one closed limit loop".to_string()),
             },
@@ -280,17 +304,17 @@ pub fn level_passes_with(
         let mut paired_by_rank = None;
         let (passes, untilted, outer) = match paired {
             Ok(p) => (p.path.into_iter().zip(p.tilt.into_iter().map(Some)).collect(), None, 1),
-            Err(why) => match own.get(j + 1) {
+            Err(why) => match above_of(j) {
                 Some(above) if options.pair_by_rank && mode == TiltMode::Guides => {
                     paired_by_rank = Some(why);
-                    (by_rank(&own[j].passes(), &above.passes()), None, own[j].loops.len())
+                    (by_rank(&level.passes(), &above.passes()), None, level.loops.len())
                 }
-                _ => (own[j].passes(), Some(why), own[j].loops.len()),
+                _ => (level.passes(), Some(why), level.loops.len()),
             },
         };
         out.push(LevelPasses {
-            distance: own[j].distance,
-            support: own[j].support.clone(),
+            distance: level.distance,
+            support: level.support.clone(),
             passes,
             untilted,
             outer,

@@ -225,7 +225,11 @@ pub fn plan_rough5_in(
                       are not handled yet";
         return Err(Rough5Error::NoPass { reason: reason.into() });
     }
-    let body = BodyCheck::new(flanks, cutter, 0.0);
+    // The shank and holder clear the blank beyond the pocket too.
+    let body = match blank.and_then(|b| blank_beyond(b, bottom)) {
+        Some(beyond) => BodyCheck::new(flanks, cutter, 0.0).with_stock(&beyond),
+        None => BodyCheck::new(flanks, cutter, 0.0),
+    };
     let mut out = Emitter::new(stock.max.z, stock.max.z + settings.clearance + cutter.radius(), settings);
     out.flat = Emitter::flat_radius(cutter);
     let mut reports = Vec::new();
@@ -550,6 +554,38 @@ fn translated(placer: &Placer, body: &BodyCheck, pairs: Vec<SyncPoint>) -> Vec<S
             SyncPoint { path: s.path + best, ..s }
         })
         .collect()
+}
+
+/// The least upward component of the unit normal of a blank facet kept by
+/// [`blank_beyond`].
+const BEYOND_FACING: f64 = 0.1;
+
+/// The facets of `blank` that face up and are not over `bottom` (their
+/// centroid's vertical misses it): the top of the stock beyond the pocket,
+/// which no pass cuts (an impeller channel's neighbours stay full up to the
+/// blank's envelope in the proof). `None` when there is no such facet.
+fn blank_beyond(blank: &TriMesh, bottom: &TriMesh) -> Option<TriMesh> {
+    let query = scallop_mesh::MeshQuery::new(bottom);
+    let top = blank.bounds().max.z.max(bottom.bounds().max.z) + 1.0;
+    let soup: Vec<[Point3; 3]> = blank
+        .triangles()
+        .iter()
+        .map(|t| t.map(|v| blank.vertices()[v as usize]))
+        .filter(|t| {
+            // Facing up: the envelope over the rest of the part (a shank
+            // beside the blank's outer wall is in the air beyond it).
+            let n = (t[1] - t[0]).cross(&(t[2] - t[0]));
+            if n.z <= BEYOND_FACING * n.norm() || n.norm() == 0.0 {
+                return false;
+            }
+            let c = Point3::from((t[0].coords + t[1].coords + t[2].coords) / 3.0);
+            query.ray_cast(&Point3::new(c.x, c.y, top), &-Vec3::z()).is_none()
+        })
+        .collect();
+    if soup.is_empty() {
+        return None;
+    }
+    TriMesh::from_soup(&soup).ok().map(|(m, _)| m)
 }
 
 /// How far above the blank (mm) a tool's lowest point must be, everywhere
