@@ -126,6 +126,22 @@ mod tests {
     use scallop_geom::rng::SplitMix64;
     use scallop_geom::{Point2, Vec3};
 
+    /// A random triangle and its upward normal (`None` when degenerate), a centre
+    /// near it, and the ball's own contact with the triangle there.
+    fn random_case(profile: &Profile, rng: &mut SplitMix64) -> Option<([Point3; 3], Vec3, Point2, ClPoint)> {
+        let mut q = || Point3::new(rng.uniform(-1.5, 1.5), rng.uniform(-1.5, 1.5), rng.uniform(-1.0, 1.0));
+        let t = [q(), q(), q()];
+        let n = (t[1] - t[0]).cross(&(t[2] - t[0]));
+        if n.norm() == 0.0 {
+            return None;
+        }
+        let n: Vec3 = if n.z < 0.0 { -n / n.norm() } else { n / n.norm() };
+        let c = Point2::new(rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0));
+        let mut own = ClPoint::floor(c, -100.0);
+        drop_features(profile, &t, &n, 0, ALL_FEATURES, &mut own);
+        Some((t, n, c, own))
+    }
+
     /// A triangle the ball is clear of at a tip height never gives a contact
     /// above that height: random triangles and points, tips just below, at and
     /// above the triangle's own contact.
@@ -135,16 +151,7 @@ mod tests {
         let mut rng = SplitMix64::new(20_261_206);
         let mut cleared = 0;
         for _ in 0..20_000 {
-            let mut q = || Point3::new(rng.uniform(-1.5, 1.5), rng.uniform(-1.5, 1.5), rng.uniform(-1.0, 1.0));
-            let t = [q(), q(), q()];
-            let n = (t[1] - t[0]).cross(&(t[2] - t[0]));
-            if n.norm() == 0.0 {
-                continue;
-            }
-            let n: Vec3 = if n.z < 0.0 { -n / n.norm() } else { n / n.norm() };
-            let c = Point2::new(rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0));
-            let mut own = ClPoint::floor(c, -100.0);
-            drop_features(&profile, &t, &n, 0, ALL_FEATURES, &mut own);
+            let Some((t, _, c, own)) = random_case(&profile, &mut rng) else { continue };
             for offset in [-0.3, -1e-6, -1e-12, 0.0, 1e-12, 1e-6, 0.2, 1.5] {
                 let tip = own.tip.z + offset;
                 if ball_clear_of(&t, 1.0, c.x, c.y, tip) {
@@ -166,16 +173,7 @@ mod tests {
         let mut rng = SplitMix64::new(20_261_207);
         let mut moved = 0;
         for _ in 0..20_000 {
-            let mut q = || Point3::new(rng.uniform(-1.5, 1.5), rng.uniform(-1.5, 1.5), rng.uniform(-1.0, 1.0));
-            let t = [q(), q(), q()];
-            let n = (t[1] - t[0]).cross(&(t[2] - t[0]));
-            if n.norm() == 0.0 {
-                continue;
-            }
-            let n: Vec3 = if n.z < 0.0 { -n / n.norm() } else { n / n.norm() };
-            let c = Point2::new(rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0));
-            let mut own = ClPoint::floor(c, -100.0);
-            drop_features(&profile, &t, &n, 0, ALL_FEATURES, &mut own);
+            let Some((t, n, c, own)) = random_case(&profile, &mut rng) else { continue };
             let tip = own.tip.z + rng.uniform(-0.2, 0.5);
             let Some(g) = ball_clearance(&t, 1.0, c.x, c.y, tip) else { continue };
             for u in [0.3, 0.9, 0.999, 1.0 - 1e-9] {
