@@ -45,19 +45,8 @@ impl Planner<'_> {
     /// `target`: in the region, and every sample cuts nothing, or, within
     /// [`APPROACH_SHARE`] R of `target`, engages no more than a pass.
     fn link_ok(&self, a: P2, b: P2, target: P2) -> bool {
-        if !self.holder.contains_segment(a, b, self.options.chord_tolerance) {
-            return false;
-        }
         let near = APPROACH_SHARE * self.options.tool_radius;
-        let step = 0.5 * self.grid.h;
-        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a small positive count")]
-        let n = ((dist(a, b) / step).ceil() as usize).max(1);
-        (1..=n).all(|i| {
-            #[allow(clippy::cast_precision_loss, reason = "a small count")]
-            let f = i as f64 / n as f64;
-            let p = [a[0] + f * (b[0] - a[0]), a[1] + f * (b[1] - a[1])];
-            self.clear_at(p) || (dist(p, target) <= near && self.engagement(p) <= tol::LINK_APPROACH * self.target)
-        })
+        self.segment_ok(a, b, |p| dist(p, target) <= near && self.engagement(p) <= tol::LINK_APPROACH * self.target)
     }
 
     /// Whether lattice cell `k` is a centre that cuts nothing, cached: a
@@ -311,11 +300,10 @@ impl Planner<'_> {
         self.link_step(from, to)
     }
 
-    /// Whether the chord `a` to `b` of a link's arc may be cut: in the
-    /// region, and every sample cuts nothing or engages no more than a pass
-    /// (the arcs lie within a tool radius of a pass's end or start, where
-    /// material may be next to the tool; measured all round).
-    fn turn_ok(&self, a: P2, b: P2) -> bool {
+    /// Whether the straight move from `a` to `b` stays in the region and each
+    /// of its samples (half a grid cell apart, `b` included, `a` not) cuts
+    /// nothing or passes `engaged_ok`.
+    fn segment_ok(&self, a: P2, b: P2, engaged_ok: impl Fn(P2) -> bool) -> bool {
         if !self.holder.contains_segment(a, b, self.options.chord_tolerance) {
             return false;
         }
@@ -326,8 +314,16 @@ impl Planner<'_> {
             #[allow(clippy::cast_precision_loss, reason = "a small count")]
             let f = i as f64 / n as f64;
             let p = [a[0] + f * (b[0] - a[0]), a[1] + f * (b[1] - a[1])];
-            self.clear_at(p) || self.engagement(p) <= tol::LINK_APPROACH * self.target
+            self.clear_at(p) || engaged_ok(p)
         })
+    }
+
+    /// Whether the chord `a` to `b` of a link's arc may be cut: in the
+    /// region, and every sample cuts nothing or engages no more than a pass
+    /// (the arcs lie within a tool radius of a pass's end or start, where
+    /// material may be next to the tool; measured all round).
+    fn turn_ok(&self, a: P2, b: P2) -> bool {
+        self.segment_ok(a, b, |p| self.engagement(p) <= tol::LINK_APPROACH * self.target)
     }
 
     /// The link from `from` to `to` as a step; a tool-down link's path is
