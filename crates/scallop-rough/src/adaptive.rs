@@ -72,6 +72,12 @@ struct Planner<'a> {
     starts: Vec<(P2, bool, u32)>,
     /// Unit directions of the front half's probes about the heading +x.
     probes: Vec<P2>,
+    /// Unit directions of [`tol::ENGAGE_PROBES`] probes all round, from +x
+    /// ([`Planner::engagement`]).
+    round: Vec<P2>,
+    /// Unit directions of [`tol::LINK_PROBES`] probes all round, from +x
+    /// ([`Planner::clear_at`]).
+    link_round: Vec<P2>,
     /// The tolerance of the lines a pass is emitted as (mm,
     /// [`tol::WALK_FIT_SHARE`]).
     fit: f64,
@@ -148,6 +154,8 @@ pub fn plan_adaptive(region: &Region, options: &ClearOptions) -> Result<Vec<Step
         grid,
         starts: Vec::new(),
         probes: front_probes(tol::ENGAGE_PROBES / 2),
+        round: round_probes(tol::ENGAGE_PROBES),
+        link_round: round_probes(tol::LINK_PROBES),
         fit: tol::WALK_FIT_SHARE * r,
         strip: tol::WALK_WALL_STRIP_SHARE * r,
     };
@@ -276,6 +284,17 @@ fn front_probes(n: usize) -> Vec<P2> {
         .collect()
 }
 
+/// `n` unit directions evenly all round from +x (the `i`th at `TAU i / n`).
+fn round_probes(n: usize) -> Vec<P2> {
+    (0..n)
+        .map(|i| {
+            #[allow(clippy::cast_precision_loss, reason = "a small count")]
+            let a = std::f64::consts::TAU * i as f64 / n as f64;
+            [a.cos(), a.sin()]
+        })
+        .collect()
+}
+
 fn dist(a: P2, b: P2) -> f64 {
     (a[0] - b[0]).hypot(a[1] - b[1])
 }
@@ -306,6 +325,7 @@ fn orient(c: &Contour, direction: Direction) -> Contour {
 impl Planner<'_> {
     /// The helix's bore about `s` (tool centre circle of radius `r0`), or a
     /// plunge at `s`; its centres are where the first pass may start.
+    #[inline(never)]
     fn bore(&mut self, s: P2, r0: f64, pass: u32) {
         let w = self.options.tool_radius + 2.0 * self.grid.h;
         #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a small positive count")]
@@ -334,14 +354,13 @@ impl Planner<'_> {
 
     /// The engagement (rad) of the tool centred at `p`: the share of its
     /// periphery in material, all round.
+    #[inline(never)]
     fn engagement(&self, p: P2) -> f64 {
         let r = self.options.tool_radius;
-        let n = tol::ENGAGE_PROBES;
+        let n = self.round.len();
         let mut count = 0usize;
-        for i in 0..n {
-            #[allow(clippy::cast_precision_loss, reason = "a small count")]
-            let a = std::f64::consts::TAU * i as f64 / n as f64;
-            if self.material([p[0] + r * a.cos(), p[1] + r * a.sin()]) {
+        for &[c, s] in &self.round {
+            if self.material([p[0] + r * c, p[1] + r * s]) {
                 count += 1;
             }
         }
@@ -354,6 +373,7 @@ impl Planner<'_> {
     /// `heading`: the arc of the front half of its periphery in material (the
     /// back half lies in what the tool has just cut); and that arc without
     /// the strip along the walls ([`Stride::core`]).
+    #[inline(never)]
     fn front(&self, p: P2, heading: f64) -> (f64, f64) {
         let r = self.options.tool_radius;
         let n = self.probes.len();
@@ -408,6 +428,7 @@ impl Planner<'_> {
     /// the material and the sharpest away), then, when that step leaves the
     /// region, the least further turn away that stays in it with the
     /// engagement within the accepted bound. `None` when there is none.
+    #[inline(never)]
     fn next_by(&self, p: P2, heading: f64, len: f64) -> Option<Stride> {
         let away = self.away();
         let at = |d: f64| self.stride_by(p, heading + away * d, len);
@@ -486,7 +507,22 @@ impl Planner<'_> {
     /// engagement is the target (and further at a wall), as along a pass.
     /// `None` when no step from `p` meets material (or none that stays in
     /// the region does).
+    #[inline(never)]
     fn start_heading(&self, p: P2) -> Option<Stride> {
+        // No material within reach of any probe of any heading's stride
+        // (the probes lie R beyond a step of `len` from `p`): no heading
+        // meets material, decided on the squares about that ring.
+        let (r, h) = (self.options.tool_radius, self.grid.h);
+        let len = tol::WALK_STEP_SHARE * r;
+        let (inner, outer) = (r - len - h, r + len + h);
+        let ring = |m: P2| {
+            let d = dist(m, p);
+            d >= inner && d <= outer
+        };
+        let bounds = ([p[0] - outer, p[1] - outer], [p[0] + outer, p[1] + outer]);
+        if self.grid.quiet(&self.swept, &self.reach, bounds, ring, r, r) {
+            return None;
+        }
         let n = tol::WALK_START_HEADINGS;
         #[allow(clippy::cast_precision_loss, reason = "a small count")]
         let heading = |i: usize| std::f64::consts::TAU * i as f64 / n as f64;
@@ -509,6 +545,7 @@ impl Planner<'_> {
     /// back to its last step that cut, as lines ([`simplify`]), and
     /// the area it cleared (mm^2, on the grid's cells) and its steps' points;
     /// the swept field holds the lines.
+    #[inline(never)]
     fn pass(&mut self, p: P2, first: Stride, budget: &mut usize) -> Result<(Vec<P2>, f64, Vec<P2>), RoughError> {
         let w = self.options.tool_radius + 2.0 * self.grid.h;
         let air_len = tol::WALK_AIR_SHARE * self.options.tool_radius;
@@ -572,6 +609,7 @@ impl Planner<'_> {
     /// Every pass from the bore about `s` until no earlier centre has
     /// material next to it, its steps and links appended to `walk`: where
     /// the tool ends.
+    #[inline(never)]
     fn walk_all(&mut self, s: P2, walk: &mut Walk) -> Result<P2, RoughError> {
         let mut pos = s;
         // The heading of the last pass's last move.
@@ -648,6 +686,7 @@ impl Planner<'_> {
     /// is cleared before the tool moves on. Centres found with no material
     /// are dropped for good (material only goes away), which makes the next
     /// one a head.
+    #[inline(never)]
     fn next_start(&mut self) -> Option<(usize, Stride)> {
         let gap = 2.0 * tol::WALK_START_SPACING * self.options.tool_radius;
         let n = self.starts.len();
@@ -680,6 +719,7 @@ impl Planner<'_> {
     /// The largest engagement (rad) along the polyline `run` (the tool at
     /// its first point), measured at every point on the field as the run
     /// leaves it, the run stamped (old values to `undo`).
+    #[inline(never)]
     fn sweep_run(&mut self, run: &[P2], undo: &mut Vec<(usize, f64)>) -> f64 {
         let w = self.options.tool_radius + 2.0 * self.grid.h;
         let mut phi = 0.0f64;
@@ -713,6 +753,7 @@ impl Planner<'_> {
     /// fits down to [`tol::RING_FILLET`], each the smallest whose engagement
     /// stays within the accepted bound (bisection on the radius), in the
     /// cutting direction, joined by links (docs/roughing.md, "Corners").
+    #[inline(never)]
     fn clear_corner(&mut self, corner: &Corner, pos: &mut P2, steps: &mut Vec<Step>) {
         let mut rho = corner.largest.min(tol::CORNER_START_SHARE * self.options.tool_radius);
         let smallest = tol::RING_FILLET;
@@ -783,6 +824,7 @@ impl Planner<'_> {
     }
 
     /// The region's rings from `pos`, nearest first, with their links.
+    #[inline(never)]
     fn finish(&mut self, region: &Region, mut pos: P2) -> Vec<Step> {
         // The region's convex corners between two lines, up to a right
         // angle and a little more, rounded by [`tol::RING_FILLET`]: a tool

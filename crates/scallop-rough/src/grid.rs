@@ -18,6 +18,10 @@ use crate::{RoughError, tol};
 /// A value beyond every distance of a grid (mm).
 pub(crate) const BIG: f64 = 1e12;
 
+/// The margin (mm) of [`Grid::quiet`]'s comparisons, far above the rounding
+/// of a bilinear sample of values of a few millimetres (about 1e-15 mm).
+const QUIET_MARGIN: f64 = 1e-9;
+
 /// The grid: `nx * ny` cells of side `h` from `(x0, y0)` (the lower-left corner).
 #[derive(Debug, Clone)]
 pub(crate) struct Grid {
@@ -89,6 +93,56 @@ impl Grid {
         let (a, b) = (u - iu as f64, v - iv as f64);
         let (f00, f10, f01, f11) = (f[k], f[k + 1], f[k + self.nx], f[k + self.nx + 1]);
         (f00 * (1.0 - a) + f10 * a) * (1.0 - b) + (f01 * (1.0 - a) + f11 * a) * b
+    }
+
+    /// Whether no sample of the fields in the box `lo..hi` can be "material"
+    /// (`swept > swept_max` and `reach < reach_min`): every square between
+    /// four centres that meets the box and passes `relevant` (given its
+    /// middle) has all four `swept` values at most `swept_max` less
+    /// [`QUIET_MARGIN`], or all four `reach` values at least `reach_min` plus
+    /// it. [`Grid::sample`] is a convex combination of a square's four
+    /// values, so it lies within their range up to rounding, far below the
+    /// margin; samples off the grid are [`BIG`] in both fields. Exact: `true`
+    /// only when every sample in the box would say "not material".
+    pub fn quiet(
+        &self,
+        swept: &[f64],
+        reach: &[f64],
+        (lo, hi): (P2, P2),
+        relevant: impl Fn(P2) -> bool,
+        swept_max: f64,
+        reach_min: f64,
+    ) -> bool {
+        let (smax, rmin) = (swept_max - QUIET_MARGIN, reach_min + QUIET_MARGIN);
+        // Squares (iu, iv) hold the samples with floor(u) = iu, u = (x - x0) / h - 0.5.
+        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, clippy::cast_precision_loss)]
+        let span = |a: f64, b: f64, o: f64, n: usize| {
+            let last = (n - 2) as f64;
+            let i0 = ((a - o) / self.h - 0.5).floor().max(0.0);
+            let i1 = ((b - o) / self.h - 0.5).floor().min(last);
+            (i0 <= i1).then(|| (i0 as usize, i1 as usize))
+        };
+        let (Some((i0, i1)), Some((j0, j1))) = (span(lo[0], hi[0], self.x0, self.nx), span(lo[1], hi[1], self.y0, self.ny))
+        else {
+            return true;
+        };
+        let nx = self.nx;
+        for j in j0..=j1 {
+            for i in i0..=i1 {
+                let k = j * nx + i;
+                let (a, b, c, d) = (k, k + 1, k + nx, k + nx + 1);
+                let low = swept[a] <= smax && swept[b] <= smax && swept[c] <= smax && swept[d] <= smax;
+                if low || (reach[a] >= rmin && reach[b] >= rmin && reach[c] >= rmin && reach[d] >= rmin) {
+                    continue;
+                }
+                #[allow(clippy::cast_precision_loss, reason = "grid indices")]
+                let mid = [self.x0 + (i as f64 + 1.0) * self.h, self.y0 + (j as f64 + 1.0) * self.h];
+                if relevant(mid) {
+                    return false;
+                }
+            }
+        }
+        true
     }
 
     /// Cells whose centre lies inside `region` (non-zero winding of its

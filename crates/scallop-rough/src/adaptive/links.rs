@@ -20,7 +20,7 @@ use super::{Planner, dist};
 use crate::grid::BIG;
 use crate::offset::Step;
 use crate::tol;
-use crate::tol::{APPROACH_SHARE, DETOUR, DETOUR_EXTRA, LATTICE, LINK_PROBES, LINK_SLACK, MAX_EXPAND, MAX_GOALS};
+use crate::tol::{APPROACH_SHARE, DETOUR, DETOUR_EXTRA, LATTICE, LINK_SLACK, MAX_EXPAND, MAX_GOALS};
 
 /// A lattice node's state in the cache of [`Planner::node_clear`].
 const CLEAR: u32 = u32::MAX;
@@ -28,13 +28,13 @@ const CLEAR: u32 = u32::MAX;
 impl Planner<'_> {
     /// Whether the tool centred at `p` cuts nothing: inside the region's
     /// grid and no probe of its periphery in material.
+    #[inline(never)]
     pub(super) fn clear_at(&self, p: P2) -> bool {
         let r = self.options.tool_radius;
-        for i in 0..LINK_PROBES {
-            #[allow(clippy::cast_precision_loss, reason = "a small count")]
-            let a = std::f64::consts::TAU * i as f64 / LINK_PROBES as f64;
-            let q = [p[0] + r * a.cos(), p[1] + r * a.sin()];
-            if self.grid.sample(&self.reach, q) < r - self.strip && self.grid.sample(&self.swept, q) > r + LINK_SLACK {
+        // The swept field first: in cleared area it settles the probe alone.
+        for &[c, s] in &self.link_round {
+            let q = [p[0] + r * c, p[1] + r * s];
+            if self.grid.sample(&self.swept, q) > r + LINK_SLACK && self.grid.sample(&self.reach, q) < r - self.strip {
                 return false;
             }
         }
@@ -44,6 +44,7 @@ impl Planner<'_> {
     /// Whether the straight move `a` to `b` may be part of a link towards
     /// `target`: in the region, and every sample cuts nothing, or, within
     /// [`APPROACH_SHARE`] R of `target`, engages no more than a pass.
+    #[inline(never)]
     fn link_ok(&self, a: P2, b: P2, target: P2) -> bool {
         let near = APPROACH_SHARE * self.options.tool_radius;
         self.segment_ok(a, b, |p| dist(p, target) <= near && self.engagement(p) <= tol::LINK_APPROACH * self.target)
@@ -52,6 +53,7 @@ impl Planner<'_> {
     /// Whether lattice cell `k` is a centre that cuts nothing, cached: a
     /// clear centre stays clear (material only goes away), a blocked one is
     /// checked again once a chain has been cut since.
+    #[inline(never)]
     fn node_clear(&mut self, k: usize) -> bool {
         match self.lattice[k] {
             CLEAR => true,
@@ -83,6 +85,7 @@ impl Planner<'_> {
     /// A tool-down link from `from` (where the tool is, its disc cleared) to
     /// `to`: the points between them, or `None` when the link must be a
     /// retract (see the module documentation).
+    #[inline(never)]
     pub(super) fn link_path(&mut self, from: P2, to: P2) -> Option<Vec<P2>> {
         if dist(from, to) <= 1e-9 {
             return Some(Vec::new());
@@ -186,6 +189,7 @@ impl Planner<'_> {
     /// The lattice path `nodes` (from the tool's position to `to`) as few
     /// straight moves that each pass [`Planner::link_ok`]: the points
     /// between the ends, or `None` when a lattice move itself fails.
+    #[inline(never)]
     fn shorten(&self, nodes: &[P2], to: P2) -> Option<Vec<P2>> {
         let last = nodes.len() - 1;
         let mut out = Vec::new();
@@ -219,6 +223,7 @@ impl Planner<'_> {
     }
 
     /// Stamps the polyline `run` on the swept field (no engagement measured).
+    #[inline(never)]
     pub(super) fn stamp(&mut self, run: &[P2]) {
         let w = self.options.tool_radius + 2.0 * self.grid.h;
         if let Some(&p) = run.first() {
@@ -235,6 +240,7 @@ impl Planner<'_> {
     /// A move of a run that leaves the region (a chord of the grid across a
     /// wall's bend) is not cut: the tool goes on from the move's end by a
     /// link.
+    #[inline(never)]
     pub(super) fn emit_runs(&mut self, steps: &mut Vec<Step>, runs: Vec<Vec<P2>>) {
         let chord = self.options.chord_tolerance;
         for mut run in runs {
@@ -267,6 +273,7 @@ impl Planner<'_> {
     /// [`Planner::turn_ok`] and whose middle (the common tangent, else a
     /// path of [`Planner::link_path`]) is found; else the same with an arc
     /// at one end only; else [`Planner::link_step`].
+    #[inline(never)]
     pub(super) fn turning_link(&mut self, from: P2, out: Option<f64>, to: P2, into: f64) -> Step {
         if let Some(h) = out {
             // Both ends turning first; else one of them (a wall right
@@ -303,31 +310,42 @@ impl Planner<'_> {
     /// Whether the straight move from `a` to `b` stays in the region and each
     /// of its samples (half a grid cell apart, `b` included, `a` not) cuts
     /// nothing or passes `engaged_ok`.
+    #[inline(never)]
     fn segment_ok(&self, a: P2, b: P2, engaged_ok: impl Fn(P2) -> bool) -> bool {
-        if !self.holder.contains_segment(a, b, self.options.chord_tolerance) {
-            return false;
-        }
+        // The samples first (the region test is the dearer one); both are
+        // pure, so the order does not change the answer.
         let step = 0.5 * self.grid.h;
-        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a small positive count")]
-        let n = ((dist(a, b) / step).ceil() as usize).max(1);
-        (1..=n).all(|i| {
-            #[allow(clippy::cast_precision_loss, reason = "a small count")]
-            let f = i as f64 / n as f64;
-            let p = [a[0] + f * (b[0] - a[0]), a[1] + f * (b[1] - a[1])];
-            self.clear_at(p) || engaged_ok(p)
-        })
+        let r = self.options.tool_radius;
+        // Every probe of every sample lies within R of the move: when the
+        // squares about it hold no material, every sample is clear.
+        let reach = r + self.grid.h;
+        let bounds = ([a[0].min(b[0]) - reach, a[1].min(b[1]) - reach], [a[0].max(b[0]) + reach, a[1].max(b[1]) + reach]);
+        let near = |m: P2| super::segment_distance(m, a, b) <= reach;
+        let clear = self.grid.quiet(&self.swept, &self.reach, bounds, near, r + LINK_SLACK, r - self.strip) || {
+            #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a small positive count")]
+            let n = ((dist(a, b) / step).ceil() as usize).max(1);
+            (1..=n).all(|i| {
+                #[allow(clippy::cast_precision_loss, reason = "a small count")]
+                let f = i as f64 / n as f64;
+                let p = [a[0] + f * (b[0] - a[0]), a[1] + f * (b[1] - a[1])];
+                self.clear_at(p) || engaged_ok(p)
+            })
+        };
+        clear && self.holder.contains_segment(a, b, self.options.chord_tolerance)
     }
 
     /// Whether the chord `a` to `b` of a link's arc may be cut: in the
     /// region, and every sample cuts nothing or engages no more than a pass
     /// (the arcs lie within a tool radius of a pass's end or start, where
     /// material may be next to the tool; measured all round).
+    #[inline(never)]
     fn turn_ok(&self, a: P2, b: P2) -> bool {
         self.segment_ok(a, b, |p| self.engagement(p) <= tol::LINK_APPROACH * self.target)
     }
 
     /// The link from `from` to `to` as a step; a tool-down link's path is
     /// stamped.
+    #[inline(never)]
     pub(super) fn link_step(&mut self, from: P2, to: P2) -> Step {
         match self.link_path(from, to) {
             Some(via) => {
