@@ -54,6 +54,9 @@ struct Planner<'a> {
     swept: Vec<f64>,
     /// The region grown a hair: links must stay in it.
     holder: Region,
+    /// The holder's rings as the chords its segment test clips by, for
+    /// that test's quick accept ([`Planner::in_holder`]).
+    fence: Edges,
     /// The region's boundary as chords, for the walk's exact wall test.
     edges: Edges,
     options: &'a ClearOptions,
@@ -140,10 +143,13 @@ pub fn plan_adaptive(region: &Region, options: &ClearOptions) -> Result<Vec<Step
     let r0 = if rh > 0.0 && region.offset(rh).contains(s) { rh } else { 0.0 };
     let target = (1.0 - (options.stepover / r).min(1.0)).acos();
     let chord = options.chord_tolerance.clamp(1e-5, tol::WALK_CHORD);
+    let holder = region.offset(-tol::LINK_GROW);
+    let fence = Edges::new(&holder, options.chord_tolerance, 8.0 * h);
     let mut planner = Planner {
         swept: vec![BIG; grid.len()],
         reach,
-        holder: region.offset(-tol::LINK_GROW),
+        holder,
+        fence,
         edges: Edges::new(region, chord, 8.0 * h),
         options,
         accept: tol::ENGAGE_ACCEPT * target,
@@ -343,6 +349,18 @@ impl Planner<'_> {
         }
         self.grid.stamp_segment(&mut self.swept, s, s, w, None);
         self.starts.push((s, true, pass));
+    }
+
+    /// Whether the segment `a`-`b` stays in the holder (as
+    /// `Region::contains_segment` at the chord tolerance): at once when `a`
+    /// lies inside the holder's chords and the segment keeps farther than
+    /// twice the tolerance (and a micrometre) from every chord (then the
+    /// exact rings, within the tolerance of the chords, hold it too, and
+    /// clipping by the chords leaves nothing outside); else by that test.
+    fn in_holder(&self, a: P2, b: P2) -> bool {
+        let chord = self.options.chord_tolerance;
+        let margin = 2.0 * chord + 1e-3;
+        (self.fence.contains(a) && self.fence.clear_of(a, b, margin)) || self.holder.contains_segment(a, b, chord)
     }
 
     /// Whether the point `q` is material: within R of the region (inside the

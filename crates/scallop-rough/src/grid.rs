@@ -191,9 +191,21 @@ impl Grid {
         let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
         let l2 = dx * dx + dy * dy;
         for j in j0..=j1 {
-            for i in i0..=i1 {
+            #[allow(clippy::cast_precision_loss, reason = "grid indices")]
+            let y = self.y0 + (j as f64 + 0.5) * self.h;
+            // The row's cells within `r` of the segment's box (a superset
+            // of those within `r` of the segment), one cell more each side.
+            let gap = if y < lo[1] { lo[1] - y } else if y > hi[1] { y - hi[1] } else { 0.0 };
+            if gap > r {
+                continue;
+            }
+            let half = (r * r - gap * gap).sqrt();
+            let (ri0, ri1, _, _) = self.range([lo[0] - half, y], [hi[0] + half, y], self.h);
+            for i in ri0.max(i0)..=ri1.min(i1) {
                 let k = j * self.nx + i;
-                let c = self.centre(k);
+                // As `centre(k)`.
+                #[allow(clippy::cast_precision_loss, reason = "grid indices")]
+                let c = [self.x0 + (i as f64 + 0.5) * self.h, y];
                 let t = if l2 > 0.0 { (((c[0] - a[0]) * dx + (c[1] - a[1]) * dy) / l2).clamp(0.0, 1.0) } else { 0.0 };
                 let (ex, ey) = (c[0] - a[0] - t * dx, c[1] - a[1] - t * dy);
                 let d2 = ex * ex + ey * ey;

@@ -119,6 +119,41 @@ impl Edges {
     }
 }
 
+impl Edges {
+    /// Whether every chord is farther than `margin` from the segment `a`-`b`.
+    pub fn clear_of(&self, a: P2, b: P2, margin: f64) -> bool {
+        let (i0, j0) = self.cell([a[0].min(b[0]) - margin, a[1].min(b[1]) - margin]);
+        let (i1, j1) = self.cell([a[0].max(b[0]) + margin, a[1].max(b[1]) + margin]);
+        let m2 = margin * margin;
+        for j in j0..=j1 {
+            for i in i0..=i1 {
+                for &k in &self.buckets[j * self.nx + i] {
+                    let (p, q) = self.segs[k as usize];
+                    let (o1, o2) = (orient(p, q, a), orient(p, q, b));
+                    let (o3, o4) = (orient(a, b, p), orient(a, b, q));
+                    if (o1 * o2 <= 0.0 && o3 * o4 <= 0.0)
+                        || seg_dist2(a, p, q) <= m2
+                        || seg_dist2(b, p, q) <= m2
+                        || seg_dist2(p, a, b) <= m2
+                        || seg_dist2(q, a, b) <= m2
+                    {
+                        return false;
+                    }
+                }
+            }
+        }
+        true
+    }
+}
+
+/// The squared distance from `p` to the segment `a`-`b`.
+fn seg_dist2(p: P2, a: P2, b: P2) -> f64 {
+    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+    let l2 = dx * dx + dy * dy;
+    let t = if l2 > 0.0 { (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2).clamp(0.0, 1.0) } else { 0.0 };
+    dist2(p, [a[0] + t * dx, a[1] + t * dy])
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -136,7 +136,7 @@ impl Planner<'_> {
             let c = self.grid.centre(k);
             let g = best.get(&k).map_or(BIG, |b| b.0);
             // An end across a wall does not count as a try.
-            if dist(c, to) <= near.max(2.0 * step) && self.holder.contains_segment(c, to, self.options.chord_tolerance)
+            if dist(c, to) <= near.max(2.0 * step) && self.in_holder(c, to)
             {
                 goals += 1;
                 if self.link_ok(c, to, to) {
@@ -242,12 +242,11 @@ impl Planner<'_> {
     /// link.
     #[inline(never)]
     pub(super) fn emit_runs(&mut self, steps: &mut Vec<Step>, runs: Vec<Vec<P2>>) {
-        let chord = self.options.chord_tolerance;
         for mut run in runs {
             run.dedup_by(|a, b| dist(*a, *b) <= super::tol::LINK_GROW * 0.1);
             let mut from = 0;
             for k in 1..=run.len() {
-                let split = k < run.len() && !self.holder.contains_segment(run[k - 1], run[k], chord);
+                let split = k < run.len() && !self.in_holder(run[k - 1], run[k]);
                 if !split && k < run.len() {
                     continue;
                 }
@@ -331,7 +330,7 @@ impl Planner<'_> {
                 self.clear_at(p) || engaged_ok(p)
             })
         };
-        clear && self.holder.contains_segment(a, b, self.options.chord_tolerance)
+        clear && self.in_holder(a, b)
     }
 
     /// Whether the chord `a` to `b` of a link's arc may be cut: in the
