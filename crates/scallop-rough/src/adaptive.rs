@@ -393,10 +393,18 @@ impl Planner<'_> {
     /// the strip along the walls ([`Stride::core`]).
     #[inline(never)]
     fn front(&self, p: P2, heading: f64) -> (f64, f64) {
+        self.front_within(p, heading, f64::INFINITY).unwrap_or((0.0, 0.0))
+    }
+
+    /// [`Planner::front`], or `None` as soon as the engagement is found over
+    /// `limit` (the probes on the material's side come first when climbing).
+    fn front_within(&self, p: P2, heading: f64, limit: f64) -> Option<(f64, f64)> {
         let r = self.options.tool_radius;
         let n = self.probes.len();
         let (s, c) = heading.sin_cos();
         let strip = r - self.strip;
+        #[allow(clippy::cast_precision_loss, reason = "small counts")]
+        let share = |k: usize| std::f64::consts::PI * k as f64 / n as f64;
         let (mut count, mut core) = (0usize, 0usize);
         for &[u, v] in &self.probes {
             // The probe's direction (u, v) about the heading, rotated onto it.
@@ -405,15 +413,16 @@ impl Planner<'_> {
                 let reach = self.grid.sample(&self.reach, q);
                 if reach < r {
                     count += 1;
+                    if share(count) > limit {
+                        return None;
+                    }
                     if reach < strip {
                         core += 1;
                     }
                 }
             }
         }
-        #[allow(clippy::cast_precision_loss, reason = "small counts")]
-        let share = |k: usize| std::f64::consts::PI * k as f64 / n as f64;
-        (share(count), share(core))
+        Some((share(count), share(core)))
     }
 
     /// The sign of a turn away from the material: left (counter-clockwise)
@@ -435,6 +444,13 @@ impl Planner<'_> {
         Stride { to, heading, phi, core }
     }
 
+    /// [`Planner::stride_by`], or `None` when its engagement is over `limit`.
+    fn stride_within(&self, p: P2, heading: f64, len: f64, limit: f64) -> Option<Stride> {
+        let to = ahead(p, heading, len);
+        let (phi, core) = self.front_within(to, heading, limit)?;
+        Some(Stride { to, heading, phi, core })
+    }
+
     /// The next step from `p` after a step along `heading` (see
     /// [`Planner::next_by`]).
     fn next(&self, p: P2, heading: f64) -> Option<Stride> {
@@ -449,32 +465,36 @@ impl Planner<'_> {
     #[inline(never)]
     fn next_by(&self, p: P2, heading: f64, len: f64) -> Option<Stride> {
         let away = self.away();
-        let at = |d: f64| self.stride_by(p, heading + away * d, len);
+        // The step turned by `d`: its end alone, or its stride unless its
+        // engagement is over `limit` (`None`, found early: where only that
+        // comparison matters).
+        let end = |d: f64| ahead(p, heading + away * d, len);
+        let within = |d: f64, limit: f64| self.stride_within(p, heading + away * d, len, limit);
         let (toward, back) = (-tol::WALK_TURN, tol::WALK_TURN_HARD);
-        let mut best = at(toward);
-        if best.phi > self.target {
-            let hard = at(back);
-            if hard.phi > self.accept {
+        let best = match within(toward, self.target) {
+            Some(s) => s,
+            None => {
                 // Over the bound whichever way: the pass ends here.
-                return None;
-            }
-            if hard.phi > self.target {
-                best = hard;
-            } else {
-                let (mut lo, mut hi) = (toward, back);
-                best = hard;
-                for _ in 0..tol::WALK_BISECTIONS {
-                    let mid = 0.5 * (lo + hi);
-                    let m = at(mid);
-                    if m.phi > self.target {
-                        lo = mid;
-                    } else {
-                        hi = mid;
-                        best = m;
+                let hard = within(back, self.accept)?;
+                if hard.phi > self.target {
+                    hard
+                } else {
+                    let (mut lo, mut hi) = (toward, back);
+                    let mut best = hard;
+                    for _ in 0..tol::WALK_BISECTIONS {
+                        let mid = 0.5 * (lo + hi);
+                        match within(mid, self.target) {
+                            None => lo = mid,
+                            Some(m) => {
+                                hi = mid;
+                                best = m;
+                            }
+                        }
                     }
+                    best
                 }
             }
-        }
+        };
         if self.edges.contains_segment(p, best.to) {
             return Some(best);
         }
@@ -488,20 +508,17 @@ impl Planner<'_> {
             if d > tol::WALK_TURN_HARD + 1e-12 {
                 return None;
             }
-            let s = at(d);
-            if self.edges.contains_segment(p, s.to) {
-                let (mut lo, mut hi, mut ok) = (prev, d, s);
+            if self.edges.contains_segment(p, end(d)) {
+                let (mut lo, mut hi) = (prev, d);
                 for _ in 0..tol::WALK_BISECTIONS {
                     let mid = 0.5 * (lo + hi);
-                    let m = at(mid);
-                    if self.edges.contains_segment(p, m.to) {
+                    if self.edges.contains_segment(p, end(mid)) {
                         hi = mid;
-                        ok = m;
                     } else {
                         lo = mid;
                     }
                 }
-                if ok.phi <= self.accept {
+                if let Some(ok) = within(hi, self.accept) {
                     return Some(ok);
                 }
                 // Along the wall the engagement is over the bound: further
@@ -509,9 +526,10 @@ impl Planner<'_> {
                 let mut e = hi;
                 while e <= tol::WALK_TURN_HARD {
                     e += tol::WALK_WALL_TURN;
-                    let m = at(e);
-                    if m.phi <= self.accept && self.edges.contains_segment(p, m.to) {
-                        return Some(m);
+                    if self.edges.contains_segment(p, end(e)) {
+                        if let Some(m) = within(e, self.accept) {
+                            return Some(m);
+                        }
                     }
                 }
                 return None;
