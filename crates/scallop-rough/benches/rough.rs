@@ -3,14 +3,20 @@
 //! OpenCAMLib's `mount_rush` test part): a 6 mm flat end mill, 2 mm stepdown,
 //! 20 % stepover, a stock 5 mm around. The figure with the real part is in
 //! docs/benchmarks.md (`scallop run` on a job file).
+//!
+//! And the adaptive planner alone on a pocket of bench/freecad (the 100 x 60
+//! mm rectangle with a round island of 24 mm, as `scallop pocket` gets it:
+//! the tool-centre region of a 6 mm tool, 20 % stepover, chord tolerance
+//! 0.001 mm); its figures beside FreeCAD's are in docs/benchmarks.md.
 
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use scallop_contour::{Contour, Region};
 use scallop_cutter::{Cutter, CutterShape};
 use scallop_geom::{Aabb3, Point3};
 use scallop_mesh::{MeshIndex, TriMesh};
-use scallop_rough::{Direction, Motion, Pattern, RoughSettings, plan_rough};
+use scallop_rough::{ClearOptions, Direction, Motion, Pattern, RoughSettings, plan_adaptive, plan_rough};
 
 fn terrain() -> TriMesh {
     let (nx, ny, w, d) = (120, 60, 90.0, 50.0);
@@ -56,5 +62,36 @@ fn bench(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench);
+/// bench/freecad/pockets.py's `rectangle_island` as the tool-centre region of a 6 mm tool.
+fn rectangle_island() -> Region {
+    let outer = Contour::polygon(&[[0.0, 0.0], [100.0, 0.0], [100.0, 60.0], [0.0, 60.0]], true).expect("outer");
+    let island: Vec<[f64; 2]> = (0..128)
+        .rev()
+        .map(|k| {
+            let a = std::f64::consts::TAU * f64::from(k) / 128.0;
+            [50.0 + 12.0 * a.cos(), 30.0 + 12.0 * a.sin()]
+        })
+        .collect();
+    let hole = Contour::polygon(&island, true).expect("island");
+    Region::with_holes(outer, vec![hole]).expect("pocket").offset(3.0)
+}
+
+fn adaptive(c: &mut Criterion) {
+    let region = rectangle_island();
+    let options = ClearOptions {
+        tool_radius: 3.0,
+        stepover: 1.2,
+        direction: Direction::Climb,
+        chord_tolerance: 1e-3,
+        pattern: Pattern::Adaptive,
+    };
+    let mut group = c.benchmark_group("adaptive_pocket");
+    group.sample_size(10);
+    group.bench_function("rectangle_island_d6_stepover20", |bench| {
+        bench.iter(|| plan_adaptive(black_box(&region), &options).expect("plan"));
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench, adaptive);
 criterion_main!(benches);

@@ -122,7 +122,8 @@ impl Grid {
             let i1 = ((b - o) / self.h - 0.5).floor().min(last);
             (i0 <= i1).then(|| (i0 as usize, i1 as usize))
         };
-        let (Some((i0, i1)), Some((j0, j1))) = (span(lo[0], hi[0], self.x0, self.nx), span(lo[1], hi[1], self.y0, self.ny))
+        let (Some((i0, i1)), Some((j0, j1))) =
+            (span(lo[0], hi[0], self.x0, self.nx), span(lo[1], hi[1], self.y0, self.ny))
         else {
             return true;
         };
@@ -195,7 +196,13 @@ impl Grid {
             let y = self.y0 + (j as f64 + 0.5) * self.h;
             // The row's cells within `r` of the segment's box (a superset
             // of those within `r` of the segment), one cell more each side.
-            let gap = if y < lo[1] { lo[1] - y } else if y > hi[1] { y - hi[1] } else { 0.0 };
+            let gap = if y < lo[1] {
+                lo[1] - y
+            } else if y > hi[1] {
+                y - hi[1]
+            } else {
+                0.0
+            };
             if gap > r {
                 continue;
             }
@@ -267,5 +274,64 @@ impl Grid {
             (j + 2 < self.ny).then(|| k + self.nx),
         ];
         cand.into_iter().flatten()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        /// [`Grid::quiet`] says "no material" only where no sample in the box
+        /// finds any: fields as the adaptive planner's (a distance from swept
+        /// centres, [`BIG`] beyond the stamping radius, here just past the
+        /// threshold; a distance from the region), their thresholds crossed
+        /// inside the box.
+        #[test]
+        fn quiet_boxes_hold_no_material_sample(
+            s in (0.0..4.0f64, 0.0..4.0f64), w in (0.0..4.0f64, 0.0..4.0f64),
+            centre in (0.0..4.0f64, 0.0..4.0f64), half in 0.05..1.5f64, t in 0.6..1.4f64, cut in 0.0..0.15f64,
+        ) {
+            let g = Grid::new([0.0, 0.0], [4.0, 4.0], 0.5, 0.13).expect("grid");
+            let swept: Vec<f64> = (0..g.len())
+                .map(|k| {
+                    let c = g.centre(k);
+                    let d = (c[0] - s.0).hypot(c[1] - s.1);
+                    if d <= t + cut { d } else { BIG }
+                })
+                .collect();
+            let reach: Vec<f64> = (0..g.len()).map(|k| (g.centre(k)[0] - w.0).abs() + 0.3 * (g.centre(k)[1] - w.1)).collect();
+            let (lo, hi) = ([centre.0 - half, centre.1 - half], [centre.0 + half, centre.1 + half]);
+            if g.quiet(&swept, &reach, (lo, hi), |_| true, t, t) {
+                for i in 0..=40u32 {
+                    for j in 0..=40u32 {
+                        let q = [lo[0] + (hi[0] - lo[0]) * f64::from(i) / 40.0, lo[1] + (hi[1] - lo[1]) * f64::from(j) / 40.0];
+                        let material = g.sample(&swept, q) > t && g.sample(&reach, q) < t;
+                        prop_assert!(!material, "material at {q:?}");
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn quiet_says_yes_in_cleared_area_and_no_next_to_material() {
+        let g = Grid::new([0.0, 0.0], [4.0, 4.0], 0.5, 0.13).expect("grid");
+        // Cleared (swept within 0.5) left of x = 2, material right of it.
+        let swept: Vec<f64> = (0..g.len()).map(|k| if g.centre(k)[0] < 2.0 { 0.5 } else { BIG }).collect();
+        let reach = vec![0.0; g.len()];
+        assert!(g.quiet(&swept, &reach, ([0.5, 0.5], [1.5, 3.5]), |_| true, 1.0, 1.0));
+        assert!(!g.quiet(&swept, &reach, ([1.5, 0.5], [2.5, 3.5]), |_| true, 1.0, 1.0));
+        // The same box, the squares across x = 2 left out as irrelevant.
+        assert!(g.quiet(&swept, &reach, ([1.5, 0.5], [2.5, 3.5]), |m| m[0] < 1.8, 1.0, 1.0));
+        // Cleared left of x = 2, outside the region right of it: every
+        // centre is either swept or out of reach, but samples between the
+        // two find material (swept far, reach near): not quiet.
+        let reach: Vec<f64> = (0..g.len()).map(|k| if g.centre(k)[0] < 2.0 { 0.0 } else { 2.0 }).collect();
+        let boxed = ([1.5, 0.5], [2.5, 3.5]);
+        assert!(!g.quiet(&swept, &reach, boxed, |_| true, 1.0, 1.0));
+        let between = (0..=100).map(|i| [1.9 + 0.002 * f64::from(i), 2.0]);
+        assert!(between.into_iter().any(|q| g.sample(&swept, q) > 1.0 && g.sample(&reach, q) < 1.0));
     }
 }

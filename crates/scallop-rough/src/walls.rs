@@ -157,6 +157,44 @@ fn seg_dist2(p: P2, a: P2, b: P2) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use proptest::prelude::*;
+
+    /// A 20 x 20 square with a square hole, grown by 1 mm (arcs at the
+    /// outer corners), as the adaptive planner's holder.
+    fn grown() -> Region {
+        let outer = vec![[0.0, 0.0], [20.0, 0.0], [20.0, 20.0], [0.0, 20.0]];
+        let hole = vec![[8.0, 8.0], [8.0, 12.0], [12.0, 12.0], [12.0, 8.0]];
+        Region::from_polygons(&[outer, hole], false).offset(-1.0)
+    }
+
+    proptest! {
+        /// The quick accept of the adaptive planner's holder test
+        /// (`Planner::in_holder`): a start inside the chords and a segment
+        /// farther than twice the tolerance from them is inside by the
+        /// clipping test too.
+        #[test]
+        fn clear_of_the_chords_is_inside(a in (-3.0..23.0f64, -3.0..23.0f64), b in (-3.0..23.0f64, -3.0..23.0f64)) {
+            let region = grown();
+            let tolerance = 1e-3;
+            let e = Edges::new(&region, tolerance, 0.7);
+            let (a, b) = ([a.0, a.1], [b.0, b.1]);
+            if e.contains(a) && e.clear_of(a, b, 2.0 * tolerance + 1e-3) {
+                prop_assert!(region.contains_segment(a, b, tolerance));
+            }
+        }
+    }
+
+    #[test]
+    fn clear_of_sees_walls_and_arcs() {
+        let region = grown();
+        let e = Edges::new(&region, 1e-3, 0.7);
+        assert!(e.clear_of([2.0, 2.0], [6.0, 3.0], 0.01));
+        // Across the hole, close to an outer corner's arc, close to a wall.
+        assert!(!e.clear_of([2.0, 10.0], [18.0, 10.0], 0.01));
+        assert!(e.clear_of([20.0, 20.0], [20.6, 20.6], 0.01));
+        assert!(!e.clear_of([20.0, 20.0], [20.703, 20.703], 0.01));
+        assert!(!e.clear_of([2.0, -0.995], [6.0, -0.995], 0.01));
+    }
 
     #[test]
     fn points_and_steps_against_a_square_with_a_hole() {

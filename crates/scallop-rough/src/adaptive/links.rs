@@ -136,8 +136,7 @@ impl Planner<'_> {
             let c = self.grid.centre(k);
             let g = best.get(&k).map_or(BIG, |b| b.0);
             // An end across a wall does not count as a try.
-            if dist(c, to) <= near.max(2.0 * step) && self.in_holder(c, to)
-            {
+            if dist(c, to) <= near.max(2.0 * step) && self.in_holder(c, to) {
                 goals += 1;
                 if self.link_ok(c, to, to) {
                     let mut nodes = vec![c];
@@ -318,7 +317,8 @@ impl Planner<'_> {
         // Every probe of every sample lies within R of the move: when the
         // squares about it hold no material, every sample is clear.
         let reach = r + self.grid.h;
-        let bounds = ([a[0].min(b[0]) - reach, a[1].min(b[1]) - reach], [a[0].max(b[0]) + reach, a[1].max(b[1]) + reach]);
+        let bounds =
+            ([a[0].min(b[0]) - reach, a[1].min(b[1]) - reach], [a[0].max(b[0]) + reach, a[1].max(b[1]) + reach]);
         let near = |m: P2| super::segment_distance(m, a, b) <= reach;
         let clear = self.grid.quiet(&self.swept, &self.reach, bounds, near, r + LINK_SLACK, r - self.strip) || {
             #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a small positive count")]
