@@ -406,11 +406,14 @@ impl Planner<'_> {
         #[allow(clippy::cast_precision_loss, reason = "small counts")]
         let share = |k: usize| std::f64::consts::PI * k as f64 / n as f64;
         let (mut count, mut core) = (0usize, 0usize);
+        let nx = self.grid.nx;
         for &[u, v] in &self.probes {
             // The probe's direction (u, v) about the heading, rotated onto it.
             let q = [p[0] + r * (u * c - v * s), p[1] + r * (u * s + v * c)];
-            if self.grid.sample(&self.swept, q) > r {
-                let reach = self.grid.sample(&self.reach, q);
+            // Off the grid both fields are far: no material.
+            let Some(at) = self.grid.locate(q) else { continue };
+            if Grid::interpolate(&self.swept, nx, at) > r {
+                let reach = Grid::interpolate(&self.reach, nx, at);
                 if reach < r {
                     count += 1;
                     if share(count) > limit {

@@ -78,20 +78,32 @@ impl Grid {
     /// The field `f` at `p`, bilinear between the four nearest centres
     /// ([`BIG`] off the grid).
     pub fn sample(&self, f: &[f64], p: P2) -> f64 {
+        self.locate(p).map_or(BIG, |at| Self::interpolate(f, self.nx, at))
+    }
+
+    /// Where [`Grid::sample`] reads at `p`: the lower-left centre of the
+    /// four and the weights along x and y; `None` off the grid (where a
+    /// sample is [`BIG`]). One location serves every field.
+    pub fn locate(&self, p: P2) -> Option<(usize, f64, f64)> {
         let u = (p[0] - self.x0) / self.h - 0.5;
         let v = (p[1] - self.y0) / self.h - 0.5;
         #[allow(clippy::cast_precision_loss, reason = "grid sizes")]
         let inside = u >= 0.0 && v >= 0.0 && u < (self.nx - 1) as f64 && v < (self.ny - 1) as f64;
         if !inside {
-            return BIG;
+            return None;
         }
         // Non-negative: truncation is the floor.
         #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "checked above")]
         let (iu, iv) = (u as usize, v as usize);
-        let k = iv * self.nx + iu;
         #[allow(clippy::cast_precision_loss, reason = "grid indices")]
-        let (a, b) = (u - iu as f64, v - iv as f64);
-        let (f00, f10, f01, f11) = (f[k], f[k + 1], f[k + self.nx], f[k + self.nx + 1]);
+        let at = (iv * self.nx + iu, u - iu as f64, v - iv as f64);
+        Some(at)
+    }
+
+    /// The field `f` (rows of `nx`) at a location of [`Grid::locate`].
+    #[inline]
+    pub fn interpolate(f: &[f64], nx: usize, (k, a, b): (usize, f64, f64)) -> f64 {
+        let (f00, f10, f01, f11) = (f[k], f[k + 1], f[k + nx], f[k + nx + 1]);
         (f00 * (1.0 - a) + f10 * a) * (1.0 - b) + (f01 * (1.0 - a) + f11 * a) * b
     }
 
@@ -213,7 +225,17 @@ impl Grid {
                 // As `centre(k)`.
                 #[allow(clippy::cast_precision_loss, reason = "grid indices")]
                 let c = [self.x0 + (i as f64 + 0.5) * self.h, y];
-                let t = if l2 > 0.0 { (((c[0] - a[0]) * dx + (c[1] - a[1]) * dy) / l2).clamp(0.0, 1.0) } else { 0.0 };
+                // As `(num / l2).clamp(0.0, 1.0)`, the division only where it
+                // does not clamp (most cells of a short segment's capsule lie
+                // beyond its ends).
+                let num = (c[0] - a[0]) * dx + (c[1] - a[1]) * dy;
+                let t = if !(l2 > 0.0) || num <= 0.0 {
+                    0.0
+                } else if num >= l2 {
+                    1.0
+                } else {
+                    (num / l2).clamp(0.0, 1.0)
+                };
                 let (ex, ey) = (c[0] - a[0] - t * dx, c[1] - a[1] - t * dy);
                 let d2 = ex * ex + ey * ey;
                 if d2 <= r * r && d2 < f[k] * f[k] {

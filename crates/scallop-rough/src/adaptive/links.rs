@@ -17,7 +17,7 @@ use std::collections::{BinaryHeap, HashMap};
 use scallop_contour::P2;
 
 use super::{Planner, dist};
-use crate::grid::BIG;
+use crate::grid::{BIG, Grid};
 use crate::offset::Step;
 use crate::tol;
 use crate::tol::{APPROACH_SHARE, DETOUR, DETOUR_EXTRA, LATTICE, LINK_SLACK, MAX_EXPAND, MAX_GOALS};
@@ -32,9 +32,14 @@ impl Planner<'_> {
     pub(super) fn clear_at(&self, p: P2) -> bool {
         let r = self.options.tool_radius;
         // The swept field first: in cleared area it settles the probe alone.
+        let nx = self.grid.nx;
         for &[c, s] in &self.link_round {
             let q = [p[0] + r * c, p[1] + r * s];
-            if self.grid.sample(&self.swept, q) > r + LINK_SLACK && self.grid.sample(&self.reach, q) < r - self.strip {
+            // Off the grid both fields are far: no material.
+            let Some(at) = self.grid.locate(q) else { continue };
+            if Grid::interpolate(&self.swept, nx, at) > r + LINK_SLACK
+                && Grid::interpolate(&self.reach, nx, at) < r - self.strip
+            {
                 return false;
             }
         }
