@@ -22,6 +22,10 @@ pub(crate) const BIG: f64 = 1e12;
 /// of a bilinear sample of values of a few millimetres (about 1e-15 mm).
 const QUIET_MARGIN: f64 = 1e-9;
 
+/// The largest field values (mm) [`Grid::quiet`] compares by their
+/// difference (rounding about 1e-13 mm).
+const QUIET_VALUES: f64 = 1e3;
+
 /// The grid: `nx * ny` cells of side `h` from `(x0, y0)` (the lower-left corner).
 #[derive(Debug, Clone)]
 pub(crate) struct Grid {
@@ -112,7 +116,8 @@ impl Grid {
     /// four centres that meets the box and passes `relevant` (given its
     /// middle) has all four `swept` values at most `swept_max` less
     /// [`QUIET_MARGIN`], or all four `reach` values at least `reach_min` plus
-    /// it. [`Grid::sample`] is a convex combination of a square's four
+    /// it, or all four `swept - reach` at most `swept_max - reach_min` less
+    /// it (along a wall the passes slid on). [`Grid::sample`] is a convex combination of a square's four
     /// values, so it lies within their range up to rounding, far below the
     /// margin; samples off the grid are [`BIG`] in both fields. Exact: `true`
     /// only when every sample in the box would say "not material".
@@ -126,6 +131,7 @@ impl Grid {
         reach_min: f64,
     ) -> bool {
         let (smax, rmin) = (swept_max - QUIET_MARGIN, reach_min + QUIET_MARGIN);
+        let gap = swept_max - reach_min - QUIET_MARGIN;
         // Squares (iu, iv) hold the samples with floor(u) = iu, u = (x - x0) / h - 0.5.
         #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, clippy::cast_precision_loss)]
         let span = |a: f64, b: f64, o: f64, n: usize| {
@@ -146,6 +152,15 @@ impl Grid {
                 let (a, b, c, d) = (k, k + 1, k + nx, k + nx + 1);
                 let low = swept[a] <= smax && swept[b] <= smax && swept[c] <= smax && swept[d] <= smax;
                 if low || (reach[a] >= rmin && reach[b] >= rmin && reach[c] >= rmin && reach[d] >= rmin) {
+                    continue;
+                }
+                // Or `swept - reach` at most `swept_max - reach_min` (less
+                // the margin) at all four: bilinear too, so everywhere in the
+                // square, where `swept > swept_max` then means `reach >
+                // reach_min` (values below `QUIET_VALUES` only, so that the
+                // rounding stays far below the margin).
+                let close = |n: usize| swept[n] < QUIET_VALUES && reach[n] < QUIET_VALUES && swept[n] - reach[n] <= gap;
+                if close(a) && close(b) && close(c) && close(d) {
                     continue;
                 }
                 #[allow(clippy::cast_precision_loss, reason = "grid indices")]
@@ -355,5 +370,19 @@ mod tests {
         assert!(!g.quiet(&swept, &reach, boxed, |_| true, 1.0, 1.0));
         let between = (0..=100).map(|i| [1.9 + 0.002 * f64::from(i), 2.0]);
         assert!(between.into_iter().any(|q| g.sample(&swept, q) > 1.0 && g.sample(&reach, q) < 1.0));
+        // Along a wall the passes slid on: swept a little over reach. Within
+        // the thresholds' gap, quiet; beyond it, samples find material.
+        let reach: Vec<f64> = (0..g.len()).map(|k| g.centre(k)[0]).collect();
+        let along = ([0.5, 0.5], [1.5, 3.5]);
+        let material = |swept: &[f64]| {
+            (0..=200).any(|i| {
+                g.sample(swept, [0.5 + 0.005 * f64::from(i), 2.0]) > 1.005
+                    && g.sample(&reach, [0.5 + 0.005 * f64::from(i), 2.0]) < 0.98
+            })
+        };
+        let slid: Vec<f64> = reach.iter().map(|x| x + 0.01).collect();
+        assert!(g.quiet(&slid, &reach, along, |_| true, 1.005, 0.98) && !material(&slid));
+        let left: Vec<f64> = reach.iter().map(|x| x + 0.05).collect();
+        assert!(!g.quiet(&left, &reach, along, |_| true, 1.005, 0.98) && material(&left));
     }
 }
