@@ -331,7 +331,6 @@ fn orient(c: &Contour, direction: Direction) -> Contour {
 impl Planner<'_> {
     /// The helix's bore about `s` (tool centre circle of radius `r0`), or a
     /// plunge at `s`; its centres are where the first pass may start.
-    #[inline(never)]
     fn bore(&mut self, s: P2, r0: f64, pass: u32) {
         let w = self.options.tool_radius + 2.0 * self.grid.h;
         #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a small positive count")]
@@ -372,7 +371,6 @@ impl Planner<'_> {
 
     /// The engagement (rad) of the tool centred at `p`: the share of its
     /// periphery in material, all round.
-    #[inline(never)]
     fn engagement(&self, p: P2) -> f64 {
         let r = self.options.tool_radius;
         let n = self.round.len();
@@ -391,7 +389,6 @@ impl Planner<'_> {
     /// `heading`: the arc of the front half of its periphery in material (the
     /// back half lies in what the tool has just cut); and that arc without
     /// the strip along the walls ([`Stride::core`]).
-    #[inline(never)]
     fn front(&self, p: P2, heading: f64) -> (f64, f64) {
         self.front_within(p, heading, f64::INFINITY).unwrap_or((0.0, 0.0))
     }
@@ -465,7 +462,6 @@ impl Planner<'_> {
     /// the material and the sharpest away), then, when that step leaves the
     /// region, the least further turn away that stays in it with the
     /// engagement within the accepted bound. `None` when there is none.
-    #[inline(never)]
     fn next_by(&self, p: P2, heading: f64, len: f64) -> Option<Stride> {
         let away = self.away();
         // The step turned by `d`: its end alone, or its stride unless its
@@ -546,7 +542,6 @@ impl Planner<'_> {
     /// engagement is the target (and further at a wall), as along a pass.
     /// `None` when no step from `p` meets material (or none that stays in
     /// the region does).
-    #[inline(never)]
     fn start_heading(&self, p: P2) -> Option<Stride> {
         // No material within reach of any probe of any heading's stride
         // (the probes lie R beyond a step of `len` from `p`): no heading
@@ -584,7 +579,6 @@ impl Planner<'_> {
     /// back to its last step that cut, as lines ([`simplify`]), and
     /// the area it cleared (mm^2, on the grid's cells) and its steps' points;
     /// the swept field holds the lines.
-    #[inline(never)]
     fn pass(&mut self, p: P2, first: Stride, budget: &mut usize) -> Result<(Vec<P2>, f64, Vec<P2>), RoughError> {
         let w = self.options.tool_radius + 2.0 * self.grid.h;
         let air_len = tol::WALK_AIR_SHARE * self.options.tool_radius;
@@ -648,7 +642,6 @@ impl Planner<'_> {
     /// Every pass from the bore about `s` until no earlier centre has
     /// material next to it, its steps and links appended to `walk`: where
     /// the tool ends.
-    #[inline(never)]
     fn walk_all(&mut self, s: P2, walk: &mut Walk) -> Result<P2, RoughError> {
         let mut pos = s;
         // The heading of the last pass's last move.
@@ -725,7 +718,6 @@ impl Planner<'_> {
     /// is cleared before the tool moves on. Centres found with no material
     /// are dropped for good (material only goes away), which makes the next
     /// one a head.
-    #[inline(never)]
     fn next_start(&mut self) -> Option<(usize, Stride)> {
         let gap = 2.0 * tol::WALK_START_SPACING * self.options.tool_radius;
         let n = self.starts.len();
@@ -758,7 +750,6 @@ impl Planner<'_> {
     /// The largest engagement (rad) along the polyline `run` (the tool at
     /// its first point), measured at every point on the field as the run
     /// leaves it, the run stamped (old values to `undo`).
-    #[inline(never)]
     fn sweep_run(&mut self, run: &[P2], undo: &mut Vec<(usize, f64)>) -> f64 {
         let w = self.options.tool_radius + 2.0 * self.grid.h;
         let mut phi = 0.0f64;
@@ -792,7 +783,6 @@ impl Planner<'_> {
     /// fits down to [`tol::RING_FILLET`], each the smallest whose engagement
     /// stays within the accepted bound (bisection on the radius), in the
     /// cutting direction, joined by links (docs/roughing.md, "Corners").
-    #[inline(never)]
     fn clear_corner(&mut self, corner: &Corner, pos: &mut P2, steps: &mut Vec<Step>) {
         let mut rho = corner.largest.min(tol::CORNER_START_SHARE * self.options.tool_radius);
         let smallest = tol::RING_FILLET;
@@ -863,7 +853,6 @@ impl Planner<'_> {
     }
 
     /// The region's rings from `pos`, nearest first, with their links.
-    #[inline(never)]
     fn finish(&mut self, region: &Region, mut pos: P2) -> Vec<Step> {
         // The region's convex corners between two lines, up to a right
         // angle and a little more, rounded by [`tol::RING_FILLET`]: a tool

@@ -32,7 +32,6 @@ const CHUNK: usize = 16;
 impl Planner<'_> {
     /// Whether the tool centred at `p` cuts nothing: inside the region's
     /// grid and no probe of its periphery in material.
-    #[inline(never)]
     pub(super) fn clear_at(&self, p: P2) -> bool {
         let r = self.options.tool_radius;
         // The swept field first: in cleared area it settles the probe alone.
@@ -53,7 +52,6 @@ impl Planner<'_> {
     /// Whether the straight move `a` to `b` may be part of a link towards
     /// `target`: in the region, and every sample cuts nothing, or, within
     /// [`APPROACH_SHARE`] R of `target`, engages no more than a pass.
-    #[inline(never)]
     fn link_ok(&self, a: P2, b: P2, target: P2) -> bool {
         let near = APPROACH_SHARE * self.options.tool_radius;
         self.segment_ok(a, b, |p| dist(p, target) <= near && self.engagement(p) <= tol::LINK_APPROACH * self.target)
@@ -62,7 +60,6 @@ impl Planner<'_> {
     /// Whether lattice cell `k` is a centre that cuts nothing, cached: a
     /// clear centre stays clear (material only goes away), a blocked one is
     /// checked again once a chain has been cut since.
-    #[inline(never)]
     fn node_clear(&mut self, k: usize) -> bool {
         match self.lattice[k] {
             CLEAR => true,
@@ -94,7 +91,6 @@ impl Planner<'_> {
     /// A tool-down link from `from` (where the tool is, its disc cleared) to
     /// `to`: the points between them, or `None` when the link must be a
     /// retract (see the module documentation).
-    #[inline(never)]
     pub(super) fn link_path(&mut self, from: P2, to: P2) -> Option<Vec<P2>> {
         if dist(from, to) <= 1e-9 {
             return Some(Vec::new());
@@ -197,7 +193,6 @@ impl Planner<'_> {
     /// The lattice path `nodes` (from the tool's position to `to`) as few
     /// straight moves that each pass [`Planner::link_ok`]: the points
     /// between the ends, or `None` when a lattice move itself fails.
-    #[inline(never)]
     fn shorten(&self, nodes: &[P2], to: P2) -> Option<Vec<P2>> {
         let last = nodes.len() - 1;
         let mut out = Vec::new();
@@ -231,7 +226,6 @@ impl Planner<'_> {
     }
 
     /// Stamps the polyline `run` on the swept field (no engagement measured).
-    #[inline(never)]
     pub(super) fn stamp(&mut self, run: &[P2]) {
         let w = self.options.tool_radius + 2.0 * self.grid.h;
         if let Some(&p) = run.first() {
@@ -248,7 +242,6 @@ impl Planner<'_> {
     /// A move of a run that leaves the region (a chord of the grid across a
     /// wall's bend) is not cut: the tool goes on from the move's end by a
     /// link.
-    #[inline(never)]
     pub(super) fn emit_runs(&mut self, steps: &mut Vec<Step>, runs: Vec<Vec<P2>>) {
         for mut run in runs {
             run.dedup_by(|a, b| dist(*a, *b) <= super::tol::LINK_GROW * 0.1);
@@ -280,7 +273,6 @@ impl Planner<'_> {
     /// [`Planner::turn_ok`] and whose middle (the common tangent, else a
     /// path of [`Planner::link_path`]) is found; else the same with an arc
     /// at one end only; else [`Planner::link_step`].
-    #[inline(never)]
     pub(super) fn turning_link(&mut self, from: P2, out: Option<f64>, to: P2, into: f64) -> Step {
         if let Some(h) = out {
             // Both ends turning first; else one of them (a wall right
@@ -317,7 +309,6 @@ impl Planner<'_> {
     /// Whether the straight move from `a` to `b` stays in the region and each
     /// of its samples (half a grid cell apart, `b` included, `a` not) cuts
     /// nothing or passes `engaged_ok`.
-    #[inline(never)]
     fn segment_ok(&self, a: P2, b: P2, engaged_ok: impl Fn(P2) -> bool) -> bool {
         // The samples first (the region test is the dearer one); both are
         // pure, so the order does not change the answer.
@@ -358,14 +349,12 @@ impl Planner<'_> {
     /// region, and every sample cuts nothing or engages no more than a pass
     /// (the arcs lie within a tool radius of a pass's end or start, where
     /// material may be next to the tool; measured all round).
-    #[inline(never)]
     fn turn_ok(&self, a: P2, b: P2) -> bool {
         self.segment_ok(a, b, |p| self.engagement(p) <= tol::LINK_APPROACH * self.target)
     }
 
     /// The link from `from` to `to` as a step; a tool-down link's path is
     /// stamped.
-    #[inline(never)]
     pub(super) fn link_step(&mut self, from: P2, to: P2) -> Step {
         match self.link_path(from, to) {
             Some(via) => {
