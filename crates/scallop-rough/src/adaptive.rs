@@ -525,10 +525,10 @@ impl Planner<'_> {
                 let mut e = hi;
                 while e <= tol::WALK_TURN_HARD {
                     e += tol::WALK_WALL_TURN;
-                    if self.edges.contains_segment(p, end(e)) {
-                        if let Some(m) = within(e, self.accept) {
-                            return Some(m);
-                        }
+                    if self.edges.contains_segment(p, end(e))
+                        && let Some(m) = within(e, self.accept)
+                    {
+                        return Some(m);
                     }
                 }
                 return None;

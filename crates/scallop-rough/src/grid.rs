@@ -138,7 +138,7 @@ impl Grid {
             let last = (n - 2) as f64;
             let i0 = ((a - o) / self.h - 0.5).floor().max(0.0);
             let i1 = ((b - o) / self.h - 0.5).floor().min(last);
-            (i0 <= i1).then(|| (i0 as usize, i1 as usize))
+            (i0 <= i1).then_some((i0 as usize, i1 as usize))
         };
         let (Some((i0, i1)), Some((j0, j1))) =
             (span(lo[0], hi[0], self.x0, self.nx), span(lo[1], hi[1], self.y0, self.ny))
@@ -244,13 +244,8 @@ impl Grid {
                 // does not clamp (most cells of a short segment's capsule lie
                 // beyond its ends).
                 let num = (c[0] - a[0]) * dx + (c[1] - a[1]) * dy;
-                let t = if !(l2 > 0.0) || num <= 0.0 {
-                    0.0
-                } else if num >= l2 {
-                    1.0
-                } else {
-                    (num / l2).clamp(0.0, 1.0)
-                };
+                let t =
+                    if l2 > 0.0 && num > 0.0 { if num >= l2 { 1.0 } else { (num / l2).clamp(0.0, 1.0) } } else { 0.0 };
                 let (ex, ey) = (c[0] - a[0] - t * dx, c[1] - a[1] - t * dy);
                 let d2 = ex * ex + ey * ey;
                 if d2 <= r * r && d2 < f[k] * f[k] {
