@@ -70,6 +70,9 @@ struct Planner<'a> {
     lattice: Vec<u32>,
     /// Chains cut so far (the cache's clock).
     epoch: u32,
+    /// The moves the last pass left stamped on the swept field, until its
+    /// lines are emitted (`links.rs`, `emit_runs`).
+    stamped: Vec<(P2, P2)>,
     /// Tool centres of earlier passes, where a pass may start: the point,
     /// whether material may still lie next to it, and its pass (0: the bore).
     starts: Vec<(P2, bool, u32)>,
@@ -155,6 +158,7 @@ pub fn plan_adaptive(region: &Region, options: &ClearOptions) -> Result<Vec<Step
         accept: tol::ENGAGE_ACCEPT * target,
         target,
         lattice: vec![0; grid.len()],
+        stamped: Vec::new(),
         epoch: 1,
         inside,
         grid,
@@ -631,6 +635,7 @@ impl Planner<'_> {
         for pair in lines.windows(2) {
             self.grid.stamp_segment(&mut self.swept, pair[0], pair[1], w, Some(&mut undo));
         }
+        self.stamped = lines.windows(2).map(|m| (m[0], m[1])).collect();
         let r = self.options.tool_radius;
         let cleared =
             undo.iter().filter(|&&(k, old)| old > r && self.swept[k] <= r && self.reach[k] < r - self.strip).count();

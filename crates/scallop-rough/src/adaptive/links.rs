@@ -232,7 +232,11 @@ impl Planner<'_> {
             self.grid.stamp_segment(&mut self.swept, p, p, w, None);
         }
         for pair in run.windows(2) {
-            self.grid.stamp_segment(&mut self.swept, pair[0], pair[1], w, None);
+            // A move the last pass stamped already (the same ends, the same
+            // width, the field only lowered since) would change nothing.
+            if !self.stamped.contains(&(pair[0], pair[1])) {
+                self.grid.stamp_segment(&mut self.swept, pair[0], pair[1], w, None);
+            }
         }
         self.epoch = self.epoch.wrapping_add(1).min(CLEAR - 1);
     }
@@ -264,6 +268,7 @@ impl Planner<'_> {
                 from = k;
             }
         }
+        self.stamped.clear();
     }
 
     /// The link from the end `from` of a pass whose last move heads `out`
