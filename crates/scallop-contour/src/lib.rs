@@ -19,6 +19,7 @@ use i_overlay::float::single::SingleFloatOverlay;
 use i_overlay::string::clip::ClipRule;
 
 mod fit;
+mod fold;
 pub mod tol;
 
 /// A point of the plane (mm).
@@ -275,6 +276,35 @@ impl Contour {
         self.pline.parallel_offset(d).into_iter().map(Contour::from_pline).collect()
     }
 
+    /// The closed contour without its redundant folds: stretches that run
+    /// along a line, turn back along it (within `width`, mm) and run forward
+    /// over it again; the contour kept passes within `width` of every point
+    /// removed (`docs/roughing.md`, "Offset rings without folds"). An open
+    /// contour is returned as it is.
+    ///
+    /// ```
+    /// use scallop_contour::Contour;
+    /// // The bottom edge runs 0 -> 4, back to 1 and forward to 4 again.
+    /// let c = Contour::polygon(&[[0., 0.], [4., 0.], [1., 0.], [4., 0.], [4., 4.], [0., 4.]], true).unwrap();
+    /// assert_eq!(c.without_folds(1e-3).len(), 4);
+    /// ```
+    #[must_use]
+    pub fn without_folds(&self, width: f64) -> Contour {
+        if !self.is_closed() {
+            return self.clone();
+        }
+        let v = self.vertices();
+        let kept = fold::unfold(&v, width);
+        if kept.len() == v.len() {
+            return self.clone();
+        }
+        let mut pline = Polyline::new_closed();
+        for x in kept {
+            pline.add(x.x, x.y, x.bulge);
+        }
+        Contour { pline }
+    }
+
     /// The first point.
     #[must_use]
     pub fn start(&self) -> Option<P2> {
@@ -411,7 +441,7 @@ impl Region {
             .ccw_plines
             .into_iter()
             .chain(out.cw_plines)
-            .map(|p| Contour::from_pline(p.polyline))
+            .map(|p| Contour::from_pline(p.polyline).without_folds(tol::FOLD_WIDTH))
             .filter(|c| c.signed_area().abs() > tol::MIN_AREA)
             .collect();
         Region { rings }

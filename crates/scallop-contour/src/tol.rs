@@ -8,6 +8,12 @@ pub const POS_EQUAL: f64 = 1e-5;
 /// invalid, and slice ends closer than this are joined (mm).
 pub const OFFSET_DIST: f64 = 1e-4;
 
+/// A ring that turns back along the line it came on, within this distance
+/// of it, over ground it runs again after the turn, is a fold of the offset
+/// kernel: the stretch is removed (mm; `Contour::without_folds`). Far below
+/// any chord tolerance of a pass, far above the kernel's rounding.
+pub const FOLD_WIDTH: f64 = 1e-3;
+
 /// Rings with less area than this are dropped (mm^2): slivers that offsets
 /// and booleans leave at tangencies.
 pub const MIN_AREA: f64 = 1e-6;

@@ -9,7 +9,12 @@ use scallop_contour::{Contour, Region, Vertex};
 use scallop_rough::{ClearOptions, Direction, Pattern, Step, plan_offset};
 
 fn fitting_level() -> Region {
-    let vertices: Vec<Vertex> = include_str!("data/fitting_level_22.txt")
+    level(include_str!("data/fitting_level_22.txt"))
+}
+
+/// A region of one ring from its text: `x y bulge` per line, `#` comments.
+fn level(text: &str) -> Region {
+    let vertices: Vec<Vertex> = text
         .lines()
         .filter(|l| !l.starts_with('#'))
         .map(|l| {
@@ -26,14 +31,47 @@ fn fitting_level() -> Region {
 #[test]
 fn the_fitting_level_is_covered_by_its_passes() {
     let region = fitting_level();
-    let options = ClearOptions {
-        tool_radius: 5.0,
-        stepover: 4.5,
-        direction: Direction::Climb,
-        chord_tolerance: 0.005,
-        pattern: Pattern::Offset,
-    };
-    let steps = plan_offset(&region, &options).unwrap();
+    let steps = plan_offset(&region, &OPTIONS).unwrap();
+    assert_covered(&region, &steps, &OPTIONS);
+}
+
+/// The fitting's 3-axis tool, stepover and tolerance.
+const OPTIONS: ClearOptions = ClearOptions {
+    tool_radius: 5.0,
+    stepover: 4.5,
+    direction: Direction::Climb,
+    chord_tolerance: 0.005,
+    pattern: Pattern::Offset,
+};
+
+/// Another level of the fitting, whose erosions the offset kernel returned
+/// with folds (a ring running A -> D, D -> A and A -> D again): the passes
+/// turn back nowhere, and the region is still covered.
+#[test]
+fn the_fitting_passes_do_not_run_back_over_themselves() {
+    let region = level(include_str!("data/fitting_level_folds.txt"));
+    let steps = plan_offset(&region, &OPTIONS).unwrap();
+    let mut turns = Vec::new();
+    for s in &steps {
+        let Step::Cut(c) = s else { continue };
+        let p = c.to_points(OPTIONS.chord_tolerance);
+        let n = p.len();
+        for i in 0..n {
+            let (a, b, d) = (p[(i + n - 1) % n], p[i], p[(i + 1) % n]);
+            let (u, w) = ([b[0] - a[0], b[1] - a[1]], [d[0] - b[0], d[1] - b[1]]);
+            let cos = (u[0] * w[0] + u[1] * w[1]) / (u[0].hypot(u[1]) * w[0].hypot(w[1]));
+            if cos < -0.999 {
+                turns.push(b);
+            }
+        }
+    }
+    assert!(turns.is_empty(), "the passes turn back at {turns:?}");
+    assert_covered(&region, &steps, &OPTIONS);
+}
+
+/// Every point of `region` on a 1 mm grid lies within the stepover of a pass
+/// (plus 0.1 mm for the grid).
+fn assert_covered(region: &Region, steps: &[Step], options: &ClearOptions) {
     let points: Vec<[f64; 2]> = steps
         .iter()
         .filter_map(|s| match s {
