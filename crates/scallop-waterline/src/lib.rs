@@ -64,6 +64,7 @@
 //!   not depend on the number of threads (parallel work uses indexed collects).
 //! - Never performs I/O; never prints.
 
+mod arms;
 mod cell;
 mod contour;
 mod refine;
@@ -508,6 +509,7 @@ impl<'a> WaterlineGrid<'a> {
         let chains = contour::trace(self, &probe);
         let mut loops = refine::refine_loops(&probe, &chains, self.options.chord_tolerance, z);
         loops.extend(self.islands(z));
+        arms::mend(self, &probe, self.options.chord_tolerance, &mut loops);
         Ok(loops)
     }
 
