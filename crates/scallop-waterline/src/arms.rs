@@ -55,8 +55,8 @@ const MAX_PASSES: usize = 4;
 
 /// The loops of `grid` at the probe's height, mended: each witness outside
 /// every loop is recovered as the module docs say.
-pub(crate) fn mend(grid: &WaterlineGrid<'_>, probe: &Probe<'_>, chord_tolerance: f64, loops: &mut [Loop]) {
-    let witnesses = witnesses(probe.cutter.shape(), probe.index, probe.z, chord_tolerance, probe.tolerance);
+pub(crate) fn mend(grid: &WaterlineGrid<'_>, probe: &Probe<'_>, chord_tolerance: f64, loops: &mut Vec<Loop>) {
+    let witnesses = witnesses(probe.cutter.shape(), probe.index, probe.z, chord_tolerance, probe.tolerance, grid.step);
     if witnesses.is_empty() || loops.is_empty() {
         return;
     }
@@ -107,8 +107,12 @@ fn witnesses(
     z: f64,
     chord_tolerance: f64,
     crossing: f64,
+    step: f64,
 ) -> Vec<Witness> {
     let margin = tol::ARM_MARGIN * chord_tolerance;
+    // Above this height a point's disk holds a grid sample (radius 0.71 step).
+    let band = BAND_RADIUS * step;
+    let band_top = z + if band < shape.radius() { shape.height_at(band) } else { shape.profile_height() };
     // The height where the cutter's radius reaches the margin (strictly above z).
     let h0 = if margin < shape.radius() { shape.height_at(margin) } else { shape.profile_height() }.max(crossing);
     let clip = z + h0;
@@ -125,14 +129,32 @@ fn witnesses(
                 out.push(Witness { at: Point2::new(v.x, v.y), downhill: None });
             }
             let w = corners[(k + 1) % 3];
-            if owned & (1 << (3 + k)) != 0 && (v.z > clip) != (w.z > clip) {
-                let (lo, hi) = if v.z < w.z { (v, w) } else { (w, v) };
-                let t = (clip - lo.z) / (hi.z - lo.z);
-                let at = Point2::new(lo.x + t * (hi.x - lo.x), lo.y + t * (hi.y - lo.y));
-                let d = Vec2::new(lo.x - hi.x, lo.y - hi.y);
-                let len = d.norm();
-                out.push(Witness { at, downhill: (len > 0.0).then(|| d / len) });
+            if owned & (1 << (3 + k)) == 0 {
+                continue;
             }
+            let (lo, hi) = if v.z < w.z { (v, w) } else { (w, v) };
+            let d = Vec2::new(lo.x - hi.x, lo.y - hi.y);
+            let len = d.norm();
+            let downhill = (len > 0.0 && lo.z < hi.z).then(|| d / len);
+            let at = |t: f64| Point2::new(lo.x + t * (hi.x - lo.x), lo.y + t * (hi.y - lo.y));
+            if lo.z <= clip && hi.z > clip {
+                out.push(Witness { at: at((clip - lo.z) / (hi.z - lo.z)), downhill });
+            }
+            // The part of the edge in the band [clip, band_top], one witness per half step.
+            if hi.z < clip || lo.z > band_top || !(len > 0.0) {
+                continue;
+            }
+            let dz = hi.z - lo.z;
+            let (t0, t1) =
+                if dz > 0.0 { (((clip - lo.z) / dz).max(0.0), ((band_top - lo.z) / dz).min(1.0)) } else { (0.0, 1.0) };
+            let count = ((t1 - t0) * len / (WITNESS_SPACING * step)).floor();
+            #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+            // at most the edge's length in half steps
+            let count = if count > 0.0 { count as usize } else { 0 };
+            #[allow(clippy::cast_precision_loss)]
+            out.extend(
+                (1..=count).map(|q| Witness { at: at(t0 + (t1 - t0) * q as f64 / (count + 1) as f64), downhill }),
+            );
         }
     }
     out
@@ -188,12 +210,15 @@ impl Bands {
 
 /// Recovers the arm holding the witness `w` (inside the contour, outside every
 /// loop) into the loop of its nearest chord; `false` if refused (module docs).
-fn splice(probe: &Probe<'_>, step: f64, chord_tolerance: f64, loops: &mut [Loop], witness: Witness) -> bool {
+fn splice(probe: &Probe<'_>, step: f64, chord_tolerance: f64, loops: &mut Vec<Loop>, witness: Witness) -> bool {
     let w = witness.at;
     // The chord across the arm's base: for a point of an edge, the first
     // chord met going back up the edge (the edge is inside all the way);
     // else the nearest chord.
-    let Some((l, i, c)) = witness.downhill.and_then(|u| chord_behind(loops, w, u)).or_else(|| nearest_chord(loops, w))
+    let Some((l, i, c)) = witness
+        .downhill
+        .and_then(|u| first_chord(loops, w, -u, f64::INFINITY, None))
+        .or_else(|| nearest_chord(loops, w))
     else {
         return false;
     };
@@ -229,7 +254,15 @@ fn splice(probe: &Probe<'_>, step: f64, chord_tolerance: f64, loops: &mut [Loop]
     }
     // From the inside witness along u (the normal given points the other way).
     let Near::Found(tip) = local.contour_near(w, -u, probe.tolerance, reach) else { return false };
-    let sides = sides(&local, [c, w, tip], probe.tolerance, chord_tolerance, reach);
+    // The arm may run into a piece of itself that the grid saw and traced
+    // as a loop of its own: the two loops are joined by a bridge.
+    if let Some((k, j, c1)) = first_chord(loops, w, u, (tip - w).norm(), Some(l)) {
+        return bridge(&local, probe.tolerance, chord_tolerance, reach, loops, (l, i), (k, j), [c, w, c1]);
+    }
+    let (right, left) = sides(&local, [c, w, tip], true, probe.tolerance, chord_tolerance, reach);
+    let mut sides = right;
+    sides.push(tip);
+    sides.extend(left.into_iter().rev());
     // The chords across the arm's base: the nearest one, and its neighbours
     // while the new path crosses them (the arm's base may span several).
     let points = &loops[l].points;
@@ -297,19 +330,30 @@ fn splice(probe: &Probe<'_>, step: f64, chord_tolerance: f64, loops: &mut [Loop]
 /// between them are refined as every chord is: a chord refined from outside
 /// the arm (its normal probes grow from the midpoint) might jump across it,
 /// so the sides are found from inside first and the chords left are short.
-fn sides(local: &Local<'_>, spine: [Point2; 3], tolerance: f64, chord_tolerance: f64, reach: f64) -> Vec<Point2> {
+fn sides(
+    local: &Local<'_>,
+    spine: [Point2; 3],
+    to_tip: bool,
+    tolerance: f64,
+    chord_tolerance: f64,
+    reach: f64,
+) -> (Vec<Point2>, Vec<Point2>) {
     let legs = [spine[1] - spine[0], spine[2] - spine[1]];
     let (l0, l1) = (legs[0].norm(), legs[1].norm());
     let total = l0 + l1;
     if !(l1 > 0.0) {
-        return vec![spine[2]];
+        return (Vec::new(), Vec::new());
     }
     #[allow(clippy::cast_precision_loss)]
     let mut at: Vec<f64> = (1..SIDE_PROBES).map(|k| total * k as f64 / SIDE_PROBES as f64).collect();
+    #[allow(clippy::cast_precision_loss)]
     let mut s = total / SIDE_PROBES as f64;
     while at.len() < MAX_SIDE_PROBES && s > BASE_MARGIN * chord_tolerance {
         s *= 0.5;
         at.push(s);
+        if !to_tip {
+            at.push(total - s); // the far end is a base too
+        }
     }
     at.sort_unstable_by(f64::total_cmp);
     let (mut right, mut left) = (Vec::new(), Vec::new());
@@ -328,10 +372,16 @@ fn sides(local: &Local<'_>, spine: [Point2; 3], tolerance: f64, chord_tolerance:
             left.push(q);
         }
     }
-    right.push(spine[2]);
-    right.extend(left.into_iter().rev());
-    right
+    (right, left)
 }
+
+/// Radius, in grid steps, of a witness's disk above which it holds a grid
+/// sample (half the cell's diagonal is 0.71 steps): below it, an edge is
+/// also checked between its ends.
+const BAND_RADIUS: f64 = 0.75;
+
+/// Spacing, in grid steps, of the witnesses along an edge within the band.
+const WITNESS_SPACING: f64 = 0.5;
 
 /// Points evenly spread along an arm's spine probed for its sides.
 const SIDE_PROBES: usize = 8;
@@ -381,30 +431,94 @@ fn crossing(loops: &[Loop], replaced: &dyn Fn(usize, usize) -> bool, path: &[Poi
     if self_crossing { Crossing::Path } else { Crossing::None }
 }
 
-/// The first chord of `loops` met from `p` going against `u`: (loop, chord
-/// index, the point met).
-fn chord_behind(loops: &[Loop], p: Point2, u: Vec2) -> Option<(usize, usize, Point2)> {
+/// The first chord of `loops` (but loop `skip`) met from `p` going along the
+/// unit vector `dir`, within `limit`: (loop, chord index, the point met).
+fn first_chord(
+    loops: &[Loop],
+    p: Point2,
+    dir: Vec2,
+    limit: f64,
+    skip: Option<usize>,
+) -> Option<(usize, usize, Point2)> {
     let mut best: Option<(f64, usize, usize, Point2)> = None;
-    let back = -u;
     for (l, lp) in loops.iter().enumerate() {
+        if skip == Some(l) {
+            continue;
+        }
         let n = lp.points.len();
         for i in 0..n {
             let (a, b) = (lp.points[i], lp.points[(i + 1) % n]);
-            // p + t back = a + s (b - a), t > 0, 0 <= s <= 1.
+            // p + t dir = a + s (b - a), 0 < t <= limit, 0 <= s <= 1.
             let e = b - a;
-            let den = back.x * e.y - back.y * e.x;
+            let den = dir.x * e.y - dir.y * e.x;
             if den == 0.0 {
                 continue;
             }
             let ap = a - p;
             let t = (ap.x * e.y - ap.y * e.x) / den;
-            let s = (ap.x * back.y - ap.y * back.x) / den;
-            if t > 0.0 && (0.0..=1.0).contains(&s) && best.is_none_or(|(bt, ..)| t < bt) {
-                best = Some((t, l, i, p + back * t));
+            let s = (ap.x * dir.y - ap.y * dir.x) / den;
+            if t > 0.0 && t <= limit && (0.0..=1.0).contains(&s) && best.is_none_or(|(bt, ..)| t < bt) {
+                best = Some((t, l, i, p + dir * t));
             }
         }
     }
     best.map(|(_, l, i, c)| (l, i, c))
+}
+
+/// Joins loop `k` into loop `l` by the arm whose spine runs from `c` (on
+/// chord `i` of loop `l`) through the witness to `c1` (on chord `j` of loop
+/// `k`, which the spine enters): out along the arm's right side to loop `k`,
+/// around loop `k`, back along the left side. Orientation: the spine enters
+/// loop `k` across its chord `a1 -> b1` (inside on its left), so `b1` lies on
+/// the right of the spine, and the merged loop keeps both loops' sense.
+/// `false` (nothing changed) if the new path would cross a loop.
+#[allow(clippy::too_many_arguments)]
+fn bridge(
+    local: &Local<'_>,
+    tolerance: f64,
+    chord_tolerance: f64,
+    reach: f64,
+    loops: &mut Vec<Loop>,
+    (l, i): (usize, usize),
+    (k, j): (usize, usize),
+    spine: [Point2; 3],
+) -> bool {
+    let (n, m) = (loops[l].points.len(), loops[k].points.len());
+    let (a, b) = (loops[l].points[i], loops[l].points[(i + 1) % n]);
+    let (a1, b1) = (loops[k].points[j], loops[k].points[(j + 1) % m]);
+    let (right, left) = sides(local, spine, false, tolerance, chord_tolerance, reach);
+    let mut new = Vec::new();
+    let mut from = a;
+    for &p in right.iter().chain([&b1]) {
+        refine_chord(local, from, p, chord_tolerance, 0, &mut new);
+        new.push(p);
+        from = p;
+    }
+    // Around loop k from b1 (pushed) to a1.
+    new.extend((2..=m).map(|s| loops[k].points[(j + s) % m]));
+    from = a1;
+    for &p in left.iter().rev().chain([&b]) {
+        refine_chord(local, from, p, chord_tolerance, 0, &mut new);
+        if p != b {
+            new.push(p);
+        }
+        from = p;
+    }
+    let mut path = Vec::with_capacity(new.len() + 2);
+    path.push(a);
+    path.extend_from_slice(&new);
+    path.push(b);
+    if !matches!(crossing(loops, &|q, r| (q, r) == (l, i) || q == k, &path), Crossing::None) {
+        return false;
+    }
+    let points = &loops[l].points;
+    let mut merged = Vec::with_capacity(n + new.len());
+    merged.extend_from_slice(&points[..=i]);
+    merged.extend_from_slice(&new);
+    merged.extend_from_slice(&points[i + 1..]);
+    loops[l].points = merged;
+    loops.remove(k);
+    true
 }
 
 /// The chord of `loops` nearest to `p`: (loop, chord index, nearest point).
