@@ -259,7 +259,12 @@ fn splice(probe: &Probe<'_>, step: f64, chord_tolerance: f64, loops: &mut Vec<Lo
     if let Some((k, j, c1)) = first_chord(loops, w, u, (tip - w).norm(), Some(l)) {
         return bridge(&local, probe.tolerance, chord_tolerance, reach, loops, (l, i), (k, j), [c, w, c1]);
     }
-    let (right, left) = sides(&local, [c, w, tip], true, probe.tolerance, chord_tolerance, reach);
+    let (mut right, mut left) = sides(&local, [c, w, tip], true, probe.tolerance, chord_tolerance, reach);
+    // Only the sides beyond the chord (on its right) and outside the loop
+    // (near the base a side point may lie behind the chord).
+    let beyond = |p: &Point2| orient2d(&a, &b, p) < 0.0 && loops[l].winding_number(*p) == 0;
+    right.retain(beyond);
+    left.retain(beyond);
     let mut sides = right;
     sides.push(tip);
     sides.extend(left.into_iter().rev());
@@ -486,7 +491,18 @@ fn bridge(
     let (n, m) = (loops[l].points.len(), loops[k].points.len());
     let (a, b) = (loops[l].points[i], loops[l].points[(i + 1) % n]);
     let (a1, b1) = (loops[k].points[j], loops[k].points[(j + 1) % m]);
-    let (right, left) = sides(local, spine, false, tolerance, chord_tolerance, reach);
+    let (mut right, mut left) = sides(local, spine, false, tolerance, chord_tolerance, reach);
+    // Only the sides in the gap between the two loops: beyond both chords
+    // crossed (on their right) and outside both loops (near either base a
+    // side point may lie behind a chord, or on a loop).
+    let apart = |p: &Point2| {
+        orient2d(&a, &b, p) < 0.0
+            && orient2d(&a1, &b1, p) < 0.0
+            && loops[l].winding_number(*p) == 0
+            && loops[k].winding_number(*p) == 0
+    };
+    right.retain(apart);
+    left.retain(apart);
     let mut new = Vec::new();
     let mut from = a;
     for &p in right.iter().chain([&b1]) {
