@@ -13,34 +13,57 @@
 //! - every mesh vertex above z whose margin `r(v.z - z)` is that large;
 //! - every point where a mesh edge crosses the height `z + h0`, `h0` the
 //!   height where the cutter's radius reaches that margin (for a flat end, a
-//!   crossing tolerance above z).
-//!
-//! The second kind finds the arm of a ridge that runs down through z between
-//! its vertices (the arm's tip is where the ridge meets z; the vertices may all
-//! lie inside the traced loops), which a vertex-only check does not.
+//!   crossing tolerance above z): the tip of a ridge's arm, where the ridge
+//!   runs down through z between its vertices (the vertices may all lie
+//!   inside the traced loops), which a vertex-only check misses;
+//! - points every half grid step along the part of each edge between `z + h0`
+//!   and the height where the margin reaches 0.75 steps ([`BAND_RADIUS`]; a
+//!   higher point's disk holds a grid sample): the neck of an arm whose base
+//!   and far end the grid saw, but not its middle.
 //!
 //! A witness outside every loop (exact winding numbers, all loops of the level
-//! summed) is recovered where it is, and only there: the nearest chord of the
-//! loops (a -> b) cuts across the arm's base; if the segment from the chord's
-//! nearest point c to the witness is inside throughout (c inside and no gap,
-//! [`Local::gaps`]), the arm joins the region of that chord, and the contour is
-//! found beyond the witness along the direction c -> witness (the tip). The
-//! chord is replaced by a -> tip -> b, both new chords refined as every chord
-//! is ([`refine_chord`]): the inside of the arm is on the left of a -> tip and
-//! of tip -> b (the arm lies on the right of a -> b, outside the old loop), so
-//! the loop keeps its orientation and stays closed. The splice is kept only if
-//! no new chord crosses a chord of any loop (loops never cross).
+//! summed, the chords binned in bands one grid step high) is recovered where
+//! it is, and only there. The *spine* of its arm runs from the chord of the
+//! loops that cuts across the arm's base (for an edge witness the first chord
+//! met going up the edge, which is inside all the way; for a vertex the
+//! nearest chord) through the witness to the *tip*, the first crossing of the
+//! contour going on down the edge (or away from the chord), found from inside
+//! by [`Local::contour_near`]. The witness is joined to the chord if the walk
+//! from it to the chord stays inside to within a chord tolerance of it.
+//! The arm's sides are found from inside: from points along the spine (8
+//! evenly spread, more at halving distances towards the base), the nearest
+//! crossing to the right and to the left of the spine (a chord refined from
+//! outside a thin arm may probe across it; from inside, the probe finds the
+//! nearest crossing however thin the arm); side points behind the crossed
+//! chord or inside the loop are dropped. The chord `a -> b` is replaced by
+//! `a`, the right side out to the tip, the left side back, `b`, every new
+//! chord refined as any chord is ([`refine_chord`]). The arm lies on the right
+//! of `a -> b` (outside the old loop) and its inside on the left of the new
+//! path, so the loop keeps its orientation and stays closed. Where the new
+//! path crosses a neighbouring chord of the same loop (the arm's base spans
+//! several chords) or itself (the loop had traced part of the arm and turned
+//! back), the run of replaced chords grows (up to [`MAX_RUN`]); a crossing
+//! with another loop refuses the splice (loops never cross).
 //!
-//! What the check guarantees: after it, every witness is inside the loops,
-//! except one whose recovery was refused (not joined to its nearest chord by a
-//! straight inside segment, no contour within reach, or a splice that would
-//! cross a loop), and then the loops are those of the trace. What it does not:
-//! an arm that holds no witness (an arm made by a face point alone, all of
-//! whose edge crossings at `z + h0` and vertices lie inside the loops; an arm
-//! whose witnesses lie within the margin of a chord); an island that reaches
-//! past the 3 x 3 block `islands()` samples (its witnesses are found but are
-//! not joined to a chord, so it is not recovered); a sliver of outside within
-//! an arm.
+//! Where the spine, on its way to the tip, enters another loop (the grid saw
+//! a far piece of the arm and traced it alone), the two loops are joined by a
+//! *bridge*: out along the right side to that loop's chord, around that loop,
+//! back along the left side; the spine enters it across a chord `a1 -> b1`
+//! with its inside on the left, so `b1` is on the spine's right and both
+//! loops keep their sense. A bridge that would cross a loop is refused.
+//!
+//! What the check guarantees: after it, every witness lies inside the loops,
+//! except one whose recovery was refused (not joined to the chord, no contour
+//! within reach, or a splice or bridge that would cross a loop), and then the
+//! loops are those of the trace. What it does not: an arm that holds no
+//! witness (one made by a face point alone, whose edges and vertices lie
+//! inside the loops; one whose witnesses lie within the margin of a chord); an
+//! island that reaches past the 3 x 3 block `islands()` samples (its witnesses
+//! are not joined to a chord); a piece of an arm traced as its own loop that
+//! overlaps the main loop without any witness outside both (the two loops
+//! then cross); a sliver of outside within an arm. The cost is one pass over
+//! the mesh and one winding number per witness per level, and the recovery
+//! only where a witness is outside.
 
 use rayon::prelude::*;
 use scallop_cutter::CutterShape;
@@ -141,7 +164,7 @@ fn witnesses(
                 out.push(Witness { at: at((clip - lo.z) / (hi.z - lo.z)), downhill });
             }
             // The part of the edge in the band [clip, band_top], one witness per half step.
-            if hi.z < clip || lo.z > band_top || !(len > 0.0) {
+            if hi.z < clip || lo.z > band_top || len.is_nan() || len <= 0.0 {
                 continue;
             }
             let dz = hi.z - lo.z;
@@ -226,7 +249,7 @@ fn splice(probe: &Probe<'_>, step: f64, chord_tolerance: f64, loops: &mut Vec<Lo
     let (a, b) = (loops[l].points[i], loops[l].points[(i + 1) % n]);
     let d = w - c;
     let dist = d.norm();
-    if !(dist > 0.0) {
+    if dist.is_nan() || dist <= 0.0 {
         return false;
     }
     // Towards the tip: down the witness's edge, else away from the chord.
@@ -238,7 +261,8 @@ fn splice(probe: &Probe<'_>, step: f64, chord_tolerance: f64, loops: &mut Vec<Lo
     let (lo, hi) = bounds([a, b, w, tip_far]);
     let local: Local<'_> =
         probe.local(Point2::new(lo.x - margin, lo.y - margin), Point2::new(hi.x + margin, hi.y + margin));
-    if !(local.height_slot(w).0 > 0.0) {
+    let h_w = local.height_slot(w).0;
+    if h_w.is_nan() || h_w <= 0.0 {
         return false;
     }
     // Joined to the chord: inside from the witness to c, or to within a chord
@@ -324,17 +348,15 @@ fn splice(probe: &Probe<'_>, step: f64, chord_tolerance: f64, loops: &mut Vec<Lo
     }
 }
 
-/// The arm's outline around its spine (`c` on the chord, the witness, the
-/// tip; inside up to the tip): the contour found from points along the
-/// spine, probed from each to its right and to its left (from an inside point
-/// the probe finds the nearest crossing, however thin the arm), in loop
-/// order: out along the right side, the tip, back along the left side. The
-/// points are [`SIDE_PROBES`] - 1 evenly spread, and more at halving
-/// distances from `c` down to [`BASE_MARGIN`] chord tolerances from it, so
-/// that the first side points lie close to the arm's base. The chords
-/// between them are refined as every chord is: a chord refined from outside
-/// the arm (its normal probes grow from the midpoint) might jump across it,
-/// so the sides are found from inside first and the chords left are short.
+/// The sides of an arm around its spine (`c` on the crossed chord, the
+/// witness, the far end: the tip if `to_tip`, else the point where the spine
+/// enters another loop), inside but at its ends: the contour found from
+/// points along the spine, probed from each to its right and to its left
+/// (from an inside point the probe finds the nearest crossing, however thin
+/// the arm), as (right, left), each in order along the spine. The points are
+/// [`SIDE_PROBES`] - 1 evenly spread, and more at halving distances from `c`
+/// (and from the far end when it is not a tip) down to [`BASE_MARGIN`] chord
+/// tolerances, so that the first side points lie close to the arm's base.
 fn sides(
     local: &Local<'_>,
     spine: [Point2; 3],
@@ -346,7 +368,7 @@ fn sides(
     let legs = [spine[1] - spine[0], spine[2] - spine[1]];
     let (l0, l1) = (legs[0].norm(), legs[1].norm());
     let total = l0 + l1;
-    if !(l1 > 0.0) {
+    if l1.is_nan() || l1 <= 0.0 {
         return (Vec::new(), Vec::new());
     }
     #[allow(clippy::cast_precision_loss)]

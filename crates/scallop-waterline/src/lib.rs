@@ -27,7 +27,12 @@
 //! 4. chords are split where the contour, probed by bisection along the
 //!    chord's normal at its midpoint, lies farther than
 //!    [`WaterlineOptions::chord_tolerance`] from it (adaptive, as OpenCAMLib's
-//!    adaptive waterline refines its fibres).
+//!    adaptive waterline refines its fibres);
+//! 5. islands that no sample sees are sampled again finer around the mesh
+//!    vertex they hold; then every mesh point inside the contour with a margin
+//!    (vertices, and points of edges just above z) is checked to lie inside
+//!    the loops, and a thin arm of inside that crosses a grid edge between two
+//!    outside samples, found that way, is spliced into its loop (`arms.rs`).
 //!
 //! Loops are oriented with the inside (where the cutter at z would cut into
 //! the part) on their left: an outer boundary runs counter-clockwise, a
@@ -520,8 +525,9 @@ impl<'a> WaterlineGrid<'a> {
     /// one. A square 3 cells wide centred on the vertex is sampled again
     /// [`tol::ISLAND_REFINE`] times finer, the vertex itself a sample (inside,
     /// so an island of any size is seen), and contoured; the loops found there
-    /// (whose finer border is outside) are added, each once. An island that reaches past its block, or a thin
-    /// arm of a larger region, is not looked for (the sampling limit).
+    /// (whose finer border is outside) are added, each once. An island that
+    /// reaches past its block is not looked for (the sampling limit); a thin
+    /// arm of a larger region is looked for after this (`arms.rs`).
     fn islands(&self, z: f64) -> Vec<Loop> {
         let (nx, ny) = (self.nx, self.ny);
         let outside = |i: usize, j: usize| self.heights[j * nx + i] <= z;
