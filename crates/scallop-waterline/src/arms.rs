@@ -83,13 +83,15 @@ pub(crate) fn mend(grid: &WaterlineGrid<'_>, probe: &Probe<'_>, chord_tolerance:
     if witnesses.is_empty() || loops.is_empty() {
         return;
     }
-    let mut refused: Vec<Point2> = Vec::new();
+    // Witnesses whose recovery was refused, by their coordinates' bits, sorted.
+    let mut refused: Vec<(u64, u64)> = Vec::new();
+    let key = |p: Point2| (p.x.to_bits(), p.y.to_bits());
     for _ in 0..MAX_PASSES {
         let bands = Bands::new(loops, grid.origin.y, grid.step, grid.ny);
         let missed: Vec<Witness> = witnesses
             .par_iter()
             .with_min_len(256)
-            .filter(|w| bands.winding(w.at) == 0 && !refused.contains(&w.at))
+            .filter(|w| bands.winding(w.at) == 0 && refused.binary_search(&key(w.at)).is_err())
             .copied()
             .collect();
         if missed.is_empty() {
@@ -104,7 +106,9 @@ pub(crate) fn mend(grid: &WaterlineGrid<'_>, probe: &Probe<'_>, chord_tolerance:
             if splice(probe, grid.step, chord_tolerance, loops, w) {
                 spliced = true;
             } else {
-                refused.push(w.at);
+                if let Err(at) = refused.binary_search(&key(w.at)) {
+                    refused.insert(at, key(w.at));
+                }
             }
         }
         if !spliced {

@@ -498,7 +498,8 @@ impl<'a> WaterlineGrid<'a> {
     }
 
     /// The loops at tip height `z`, in a deterministic order (by their first
-    /// grid crossing), each starting at its first grid crossing.
+    /// grid crossing), each starting at its first grid crossing (or, where an
+    /// arm was spliced in across it, at a later point of the loop).
     ///
     /// # Errors
     /// [`WaterlineError::NonFiniteZ`], [`WaterlineError::ZOutsidePart`].
