@@ -236,7 +236,8 @@ impl Bands {
 }
 
 /// Recovers the arm holding the witness `w` (inside the contour, outside every
-/// loop) into the loop of its nearest chord; `false` if refused (module docs).
+/// loop) into the loop of the chord across its base; `false` if refused
+/// (module docs).
 fn splice(probe: &Probe<'_>, step: f64, chord_tolerance: f64, loops: &mut Vec<Loop>, witness: Witness) -> bool {
     let w = witness.at;
     // The chord across the arm's base: for a point of an edge, the first
