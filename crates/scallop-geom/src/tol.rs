@@ -1495,6 +1495,13 @@ pub mod waterline {
     /// island of the contour (see `docs/waterline.md`).
     pub const ISLAND_REFINE: f64 = 16.0;
 
+    /// Margin, in chord tolerances, of the mesh points checked to lie inside a
+    /// level's loops after tracing (`arms.rs`): a point of the mesh above z is
+    /// inside the contour with a margin of the cutter's radius at its height
+    /// above z; the loops stay within about a chord tolerance of the contour, so
+    /// such a point outside them marks a missed arm of inside.
+    pub const ARM_MARGIN: f64 = 8.0;
+
     /// Most halvings of an ambiguous grid cell (two or more exits) when its
     /// crossings are linked by subdivision: features of the contour down to
     /// `step / 2^6` are followed through the cell; below, the inside is joined

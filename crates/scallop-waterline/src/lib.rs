@@ -27,7 +27,12 @@
 //! 4. chords are split where the contour, probed by bisection along the
 //!    chord's normal at its midpoint, lies farther than
 //!    [`WaterlineOptions::chord_tolerance`] from it (adaptive, as OpenCAMLib's
-//!    adaptive waterline refines its fibres).
+//!    adaptive waterline refines its fibres);
+//! 5. islands that no sample sees are sampled again finer around the mesh
+//!    vertex they hold; then every mesh point inside the contour with a margin
+//!    (vertices, and points of edges just above z) is checked to lie inside
+//!    the loops, and a thin arm of inside that crosses a grid edge between two
+//!    outside samples, found that way, is spliced into its loop (`arms.rs`).
 //!
 //! Loops are oriented with the inside (where the cutter at z would cut into
 //! the part) on their left: an outer boundary runs counter-clockwise, a
@@ -64,6 +69,7 @@
 //!   not depend on the number of threads (parallel work uses indexed collects).
 //! - Never performs I/O; never prints.
 
+mod arms;
 mod cell;
 mod contour;
 mod refine;
@@ -492,7 +498,8 @@ impl<'a> WaterlineGrid<'a> {
     }
 
     /// The loops at tip height `z`, in a deterministic order (by their first
-    /// grid crossing), each starting at its first grid crossing.
+    /// grid crossing), each starting at its first grid crossing (or, where an
+    /// arm was spliced in across it, at a later point of the loop).
     ///
     /// # Errors
     /// [`WaterlineError::NonFiniteZ`], [`WaterlineError::ZOutsidePart`].
@@ -508,6 +515,7 @@ impl<'a> WaterlineGrid<'a> {
         let chains = contour::trace(self, &probe);
         let mut loops = refine::refine_loops(&probe, &chains, self.options.chord_tolerance, z);
         loops.extend(self.islands(z));
+        arms::mend(self, &probe, self.options.chord_tolerance, &mut loops);
         Ok(loops)
     }
 
@@ -518,8 +526,9 @@ impl<'a> WaterlineGrid<'a> {
     /// one. A square 3 cells wide centred on the vertex is sampled again
     /// [`tol::ISLAND_REFINE`] times finer, the vertex itself a sample (inside,
     /// so an island of any size is seen), and contoured; the loops found there
-    /// (whose finer border is outside) are added, each once. An island that reaches past its block, or a thin
-    /// arm of a larger region, is not looked for (the sampling limit).
+    /// (whose finer border is outside) are added, each once. An island that
+    /// reaches past its block is not looked for (the sampling limit); a thin
+    /// arm of a larger region is looked for after this (`arms.rs`).
     fn islands(&self, z: f64) -> Vec<Loop> {
         let (nx, ny) = (self.nx, self.ny);
         let outside = |i: usize, j: usize| self.heights[j * nx + i] <= z;

@@ -261,7 +261,7 @@ impl Local<'_> {
     /// `mid`, it also stands for the midpoint's contact triangle (no full
     /// evaluation at `mid`). The crossing found is the same as with full
     /// evaluations, up to the crossing tolerance.
-    fn contour_near(&self, mid: Point2, normal: Vec2, accept: f64, reach: f64) -> Near {
+    pub(crate) fn contour_near(&self, mid: Point2, normal: Vec2, accept: f64, reach: f64) -> Near {
         let mut first: Option<(f64, Option<usize>)> = None;
         let mut at_mid: Option<(f64, Option<usize>)> = None;
         if let Some(seed) = self.seed.get() {
@@ -428,7 +428,7 @@ const BISECTIONS_AFTER_SECANT: u32 = 2;
 const MAX_COVER_STEPS: usize = 256;
 
 /// What [`Local::contour_near`] found.
-enum Near {
+pub(crate) enum Near {
     /// The contour is within the accepted distance.
     Within,
     /// The contour point found (farther).
@@ -438,7 +438,7 @@ enum Near {
 }
 
 /// Margin of a chord's candidate box, in reaches (chord length or grid step).
-const CHORD_MARGIN: f64 = 1.5;
+pub(crate) const CHORD_MARGIN: f64 = 1.5;
 
 /// Least growth of the probe distance from one probe to the next.
 const PROBE_GROWTH: f64 = 2.0;
@@ -458,7 +458,14 @@ const SECANT_PROBE: f64 = 0.45;
 /// Points strictly between `a` and `b` that bring every chord within
 /// `chord_tolerance` of the contour at its midpoint (as far as the probe
 /// along the chord's normal finds the contour), in order from `a` to `b`.
-fn refine_chord(local: &Local<'_>, a: Point2, b: Point2, chord_tolerance: f64, depth: u32, out: &mut Vec<Point2>) {
+pub(crate) fn refine_chord(
+    local: &Local<'_>,
+    a: Point2,
+    b: Point2,
+    chord_tolerance: f64,
+    depth: u32,
+    out: &mut Vec<Point2>,
+) {
     let probe = local.probe;
     let d = b - a;
     let length = d.norm();
