@@ -16,6 +16,10 @@
 //! decision taken on the exact drop-cutter, never on an interpolated height:
 //! 1. `d` is sampled on a grid padded by the cutter radius (in parallel), so
 //!    every border sample is outside and every loop closes inside the grid;
+//!    the grid is cut into blocks, each bounded below and above (everywhere in
+//!    it, not only at its samples) by drop-cutters of a smaller and a larger
+//!    cutter at its centre, and a level samples only the blocks whose bounds
+//!    straddle z (and their neighbours): no contour passes through the others;
 //! 2. each grid edge whose ends are on different sides holds one crossing,
 //!    found by bisection on the exact drop-cutter to
 //!    [`WaterlineOptions::crossing_tolerance`]; the point kept is the outside
