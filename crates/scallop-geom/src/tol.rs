@@ -1496,17 +1496,17 @@ pub mod waterline {
     pub const ISLAND_REFINE: f64 = 16.0;
 
     /// Side of a block of the drop-cutter grid, in cutter radii (rounded to
-    /// whole samples, within [`BLOCK_SAMPLES_MIN`, `BLOCK_SAMPLES_MAX`]): each
+    /// a power of two of samples, within [`BLOCK_SAMPLES_MIN`, `BLOCK_SAMPLES_MAX`]): each
     /// block is bounded by drop-cutters at its centre of cutters about half a
     /// side smaller and larger, and sampled only at the levels whose contour
     /// may pass through it (see `docs/waterline.md`).
     pub const BLOCK_SPAN_PER_RADIUS: f64 = 0.8;
 
     /// Fewest samples per side of a block (below, the two bounds per block
-    /// would cost as much as the samples they spare).
+    /// would cost as much as the samples they spare); a power of two.
     pub const BLOCK_SAMPLES_MIN: usize = 4;
 
-    /// Most samples per side of a block.
+    /// Most samples per side of a block; a power of two.
     pub const BLOCK_SAMPLES_MAX: usize = 16;
 
     /// Rounding margin of the block bounds, relative to the model's largest

@@ -304,6 +304,8 @@ pub struct WaterlineGrid<'a> {
     slot_of: Arc<[u32]>,
     /// Samples per block side.
     block: usize,
+    /// `block` is `1 << shift`.
+    shift: u32,
     /// Blocks along X and Y.
     bx: usize,
     by: usize,
@@ -346,10 +348,12 @@ enum Side {
     Mixed,
 }
 
-/// One level: its height and the side of every block.
+/// One level: its height, the side of every block and of every sample.
 pub(crate) struct Level {
     pub(crate) z: f64,
     sides: Vec<Side>,
+    /// Per sample, row-major: the cutter at z cuts into the part there.
+    inside: Vec<bool>,
 }
 
 impl<'a> WaterlineGrid<'a> {
@@ -459,11 +463,15 @@ impl<'a> WaterlineGrid<'a> {
             slot_of.into()
         });
         // A block spans about BLOCK_SPAN_PER_RADIUS cutter radii (its bounds
-        // are drop-cutters of cutters that much smaller and larger).
+        // are drop-cutters of cutters that much smaller and larger), a power of
+        // two of samples (a sample's block by shifts).
         #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)] // clamped to a small range
-        let block = (tol::BLOCK_SPAN_PER_RADIUS * cutter.radius() / step)
+        let shift = (tol::BLOCK_SPAN_PER_RADIUS * cutter.radius() / step)
+            .log2()
             .round()
-            .clamp(tol::BLOCK_SAMPLES_MIN as f64, tol::BLOCK_SAMPLES_MAX as f64) as usize;
+            .clamp(tol::BLOCK_SAMPLES_MIN.ilog2().into(), tol::BLOCK_SAMPLES_MAX.ilog2().into())
+            as u32;
+        let block = 1usize << shift;
         let (bx, by) = (nx.div_ceil(block), ny.div_ceil(block));
         WaterlineGrid {
             cutter,
@@ -476,6 +484,7 @@ impl<'a> WaterlineGrid<'a> {
             floor,
             slot_of,
             block,
+            shift,
             bx,
             by,
             bounds: vec![[f64::NEG_INFINITY, f64::INFINITY]; bx * by],
@@ -562,7 +571,26 @@ impl<'a> WaterlineGrid<'a> {
         mixed.par_iter().with_min_len(4).for_each(|&b| {
             self.block_cover(b);
         });
-        Level { z, sides }
+        let (nx, shift) = (self.nx, self.shift);
+        let mut inside = vec![false; nx * self.ny];
+        inside.par_chunks_mut(nx).enumerate().for_each(|(j, row)| {
+            let bj = j >> shift;
+            for (bi, run) in row.chunks_mut(self.block).enumerate() {
+                let b = bj * bx + bi;
+                match sides[b] {
+                    Side::In => run.fill(true),
+                    Side::Out => {}
+                    Side::Mixed => {
+                        let s = self.block_samples(b);
+                        let heights = &s.heights[(j & (self.block - 1)) * s.width..][..s.width];
+                        for (v, &h) in run.iter_mut().zip(heights) {
+                            *v = h > z;
+                        }
+                    }
+                }
+            }
+        });
+        Level { z, sides, inside }
     }
 
     /// The samples of block `b`, sampled on first use.
@@ -596,12 +624,25 @@ impl<'a> WaterlineGrid<'a> {
         self.covers[b].get_or_init(|| {
             let ([i0, i1], [j0, j1]) = self.block_range(b);
             let (nx, ny) = (self.nx, self.ny);
+            let own = self.block_samples(b);
+            let slot = |i: usize, j: usize| {
+                if i < i1 && j < j1 { own.slots[(j - j0) * own.width + (i - i0)] } else { self.sample(i, j).1 }
+            };
             (j0..j1)
                 .flat_map(|j| (i0..i1).map(move |i| (i, j)))
                 .map(|(i, j)| {
+                    let here = slot(i, j);
                     [
-                        if i + 1 < nx { self.cover_of([i, j], [i + 1, j]) } else { f64::NEG_INFINITY },
-                        if j + 1 < ny { self.cover_of([i, j], [i, j + 1]) } else { f64::NEG_INFINITY },
+                        if i + 1 < nx {
+                            self.cover_of([i, j], here, [i + 1, j], slot(i + 1, j))
+                        } else {
+                            f64::NEG_INFINITY
+                        },
+                        if j + 1 < ny {
+                            self.cover_of([i, j], here, [i, j + 1], slot(i, j + 1))
+                        } else {
+                            f64::NEG_INFINITY
+                        },
                     ]
                 })
                 .collect()
@@ -616,10 +657,11 @@ impl<'a> WaterlineGrid<'a> {
 
     /// The block holding sample (i, j) and the sample's number in it.
     fn locate(&self, i: usize, j: usize) -> (usize, usize) {
-        let (bi, bj) = (i / self.block, j / self.block);
+        let (bi, bj) = (i >> self.shift, j >> self.shift);
         let b = bj * self.bx + bi;
-        let width = (self.block).min(self.nx - bi * self.block);
-        (b, (j - bj * self.block) * width + (i - bi * self.block))
+        let mask = self.block - 1;
+        let width = self.block.min(self.nx - (bi << self.shift));
+        (b, (j & mask) * width + (i & mask))
     }
 
     /// Drop-cutter height and contact slot at sample (i, j) (sampled on first use).
@@ -632,12 +674,7 @@ impl<'a> WaterlineGrid<'a> {
 
     /// Whether the cutter at the level's height cuts into the part at sample (i, j).
     pub(crate) fn inside(&self, level: &Level, i: usize, j: usize) -> bool {
-        let (b, _) = self.locate(i, j);
-        match level.sides[b] {
-            Side::In => true,
-            Side::Out => false,
-            Side::Mixed => self.sample(i, j).0 > level.z,
-        }
+        level.inside[j * self.nx + i]
     }
 
     /// The blocks of `level` where its contour may pass, in increasing order.
@@ -673,8 +710,8 @@ impl<'a> WaterlineGrid<'a> {
     /// are convex), so a triangle above z at both ends is above z along the
     /// whole edge. Where neither is, a gap may hide between the samples: the
     /// edge is walked at that level (`refine::Local::gaps`).
-    fn cover_of(&self, a: [usize; 2], b: [usize; 2]) -> f64 {
-        let (sa, sb) = (self.sample(a[0], a[1]).1, self.sample(b[0], b[1]).1);
+    /// `sa` and `sb` are the contact slots of the samples.
+    fn cover_of(&self, a: [usize; 2], sa: u32, b: [usize; 2], sb: u32) -> f64 {
         if sa == u32::MAX || sb == u32::MAX {
             return f64::NEG_INFINITY; // an end on the floor is never inside
         }
