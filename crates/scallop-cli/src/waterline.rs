@@ -73,6 +73,8 @@ struct WaterlineReport {
     levels: Vec<LevelReport>,
     loops: usize,
     points: usize,
+    /// Building the grid: its blocks' bounds (each block is sampled by the
+    /// first level that needs it, in that level's seconds).
     grid_seconds: f64,
     contour_seconds: f64,
     seconds: f64,

@@ -30,6 +30,7 @@ mod shape;
 pub use scallop_geom::tol::cutter as tol;
 
 pub use drop::{
-    BoxDrop, ClPoint, Contact, drop_cutter, drop_cutter_brute_force, drop_grid, drop_path, drop_points, drop_triangle,
+    BoxDrop, ClPoint, Contact, drop_cutter, drop_cutter_brute_force, drop_grid, drop_patch, drop_path, drop_points,
+    drop_triangle,
 };
 pub use shape::{Cutter, CutterError, CutterShape, HolderSegment};

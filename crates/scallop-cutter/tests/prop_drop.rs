@@ -7,8 +7,8 @@
 
 use proptest::prelude::*;
 use scallop_cutter::{
-    BoxDrop, ClPoint, Contact, Cutter, CutterShape, drop_cutter, drop_cutter_brute_force, drop_grid, drop_path,
-    drop_triangle,
+    BoxDrop, ClPoint, Contact, Cutter, CutterShape, drop_cutter, drop_cutter_brute_force, drop_grid, drop_patch,
+    drop_path, drop_triangle,
 };
 use scallop_geom::{Point2, Point3, Vec3, assert_near};
 use scallop_mesh::{MeshIndex, TriMesh};
@@ -102,6 +102,26 @@ proptest! {
         for (k, cl) in grid.iter().enumerate() {
             let xy = Point2::new(xs[k % xs.len()], ys[k / xs.len()]);
             let slow = drop_cutter_brute_force(&c, &index, xy, FLOOR);
+            prop_assert_eq!(cl.tip.z.to_bits(), slow.tip.z.to_bits(), "at {:?}: {:?} vs {:?}", xy, cl, slow);
+        }
+    }
+
+    /// A patch (one candidate list for all its rows, walked back and forth)
+    /// gives the brute-force heights bit for bit.
+    #[test]
+    fn patch_equals_brute_force(soup in soup_strategy(80), shape in shape_strategy(),
+                                x0 in -3.0f64..10.0, step in 0.02f64..0.8, y0 in -3.0f64..10.0,
+                                n in (1usize..10, 1usize..10)) {
+        let Some((_, index)) = build(&soup) else { return Ok(()) };
+        let c = cutter(shape);
+        let xs: Vec<f64> = (0..n.0).map(|i| x0 + step * i as f64).collect();
+        let ys: Vec<f64> = (0..n.1).map(|j| y0 + step * j as f64).collect();
+        let patch = drop_patch(&c, &index, &xs, &ys, FLOOR);
+        prop_assert_eq!(patch.len(), xs.len() * ys.len());
+        for (k, cl) in patch.iter().enumerate() {
+            let xy = Point2::new(xs[k % xs.len()], ys[k / xs.len()]);
+            let slow = drop_cutter_brute_force(&c, &index, xy, FLOOR);
+            prop_assert_eq!((cl.tip.x, cl.tip.y), (xy.x, xy.y));
             prop_assert_eq!(cl.tip.z.to_bits(), slow.tip.z.to_bits(), "at {:?}: {:?} vs {:?}", xy, cl, slow);
         }
     }

@@ -1502,6 +1502,25 @@ pub mod waterline {
     /// such a point outside them marks a missed arm of inside.
     pub const ARM_MARGIN: f64 = 8.0;
 
+    /// Side of a block of the drop-cutter grid, in cutter radii (rounded to
+    /// a power of two of samples, within [`BLOCK_SAMPLES_MIN`, `BLOCK_SAMPLES_MAX`]): each
+    /// block is bounded by drop-cutters at its centre of cutters about half a
+    /// side smaller and larger, and sampled only at the levels whose contour
+    /// may pass through it (see `docs/waterline.md`).
+    pub const BLOCK_SPAN_PER_RADIUS: f64 = 0.8;
+
+    /// Fewest samples per side of a block (below, the two bounds per block
+    /// would cost as much as the samples they spare); a power of two.
+    pub const BLOCK_SAMPLES_MIN: usize = 4;
+
+    /// Most samples per side of a block; a power of two.
+    pub const BLOCK_SAMPLES_MAX: usize = 16;
+
+    /// Rounding margin of the block bounds, relative to the model's largest
+    /// |coordinate|: a block is taken as all inside or all outside only when
+    /// the level is farther than this from its bounds.
+    pub const REL_BLOCK_MARGIN: f64 = 1e-9;
+
     /// Most halvings of an ambiguous grid cell (two or more exits) when its
     /// crossings are linked by subdivision: features of the contour down to
     /// `step / 2^6` are followed through the cell; below, the inside is joined

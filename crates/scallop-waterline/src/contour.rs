@@ -27,9 +27,9 @@
 use rayon::prelude::*;
 use scallop_geom::Point2;
 
-use crate::WaterlineGrid;
 use crate::cell::{Cell, Resolver, simple_links};
 use crate::refine::Probe;
+use crate::{Level, WaterlineGrid};
 
 /// The crossings of one grid edge, in increasing x (horizontal) or y
 /// (vertical).
@@ -85,31 +85,37 @@ impl Numbering {
 /// The crossings of every edge that holds some, in increasing edge number:
 /// one per edge with ends on different sides, two per gap on an edge with
 /// both ends inside that no triangle certifies.
-fn edge_crossings(grid: &WaterlineGrid<'_>, probe: &Probe<'_>, inside: &[bool]) -> Vec<EdgeCrossings> {
+fn edge_crossings(grid: &WaterlineGrid<'_>, level: &Level, probe: &Probe<'_>) -> Vec<EdgeCrossings> {
     let (nx, ny) = (grid.nx, grid.ny);
-    let z = probe.z;
     let num = Numbering { nx, ny };
-    // (edge, first end inside, crossing edge (else a gap candidate)).
+    // (edge, first end inside, crossing edge (else a gap candidate)). Every
+    // edge from a sample lies in its block's square: only the blocks where the
+    // contour may pass hold crossings or gaps.
     let mut todo: Vec<(usize, bool, bool)> = Vec::new();
-    let mut look = |id: usize, ka: usize, kb: usize, dir: usize| {
-        let (a, b) = (inside[ka], inside[kb]);
-        if a != b {
-            todo.push((id, a, true));
-        } else if a && grid.cover[ka][dir] <= z {
-            todo.push((id, true, false));
-        }
-    };
-    for j in 0..ny {
-        for i in 0..nx - 1 {
-            look(num.h(i, j), j * nx + i, j * nx + i + 1, 0);
+    for b in grid.mixed_blocks(level) {
+        let ([i0, i1], [j0, j1]) = grid.block_range(b);
+        for j in j0..j1 {
+            for i in i0..i1 {
+                let a = grid.inside(level, i, j);
+                for (dir, [ib, jb]) in [(0, [i + 1, j]), (1, [i, j + 1])] {
+                    if ib >= nx || jb >= ny {
+                        continue;
+                    }
+                    let id = if dir == 0 { num.h(i, j) } else { num.v(i, j) };
+                    if a != grid.inside(level, ib, jb) {
+                        todo.push((id, a, true));
+                    } else if a && grid.cover(level, [i, j], dir) <= level.z {
+                        todo.push((id, true, false));
+                    }
+                }
+            }
         }
     }
-    for j in 0..ny - 1 {
-        for i in 0..nx {
-            look(num.v(i, j), j * nx + i, (j + 1) * nx + i, 1);
-        }
-    }
-    let floored = |k: usize| (grid.heights[k] - z).max(-grid.step);
+    todo.sort_unstable_by_key(|t| t.0);
+    let z = probe.z;
+    let height = |k: usize| grid.sample(k % nx, k / nx).0;
+    let slot_at = |k: usize| grid.sample(k % nx, k / nx).1;
+    let floored = |k: usize| (height(k) - z).max(-grid.step);
     let found: Vec<Vec<Point2>> = todo
         .par_iter()
         .with_min_len(16)
@@ -119,10 +125,10 @@ fn edge_crossings(grid: &WaterlineGrid<'_>, probe: &Probe<'_>, inside: &[bool]) 
             let (a, b) = (grid.point(ia, ja), grid.point(ib, jb));
             let local = probe.local(Point2::new(a.x.min(b.x), a.y.min(b.y)), Point2::new(a.x.max(b.x), a.y.max(b.y)));
             if !crossing {
-                return local.gaps(a, grid.slots[ka] as usize, b, floored(kb));
+                return local.gaps(a, slot_at(ka) as usize, b, floored(kb));
             }
             // Floored as `Probe::height` floors them, so the secant sees one function.
-            let slot = |k: usize| (grid.slots[k] != u32::MAX).then_some(grid.slots[k] as usize);
+            let slot = |k: usize| (slot_at(k) != u32::MAX).then_some(slot_at(k) as usize);
             let p = if first_inside {
                 local.bisect_heights(a, floored(ka), slot(ka), b, floored(kb))
             } else {
@@ -145,11 +151,9 @@ fn edge_crossings(grid: &WaterlineGrid<'_>, probe: &Probe<'_>, inside: &[bool]) 
 /// The chains of crossing points of `grid` at the probe's height, each
 /// starting at its smallest crossing (edge number, then along the edge),
 /// listed in that order.
-pub(crate) fn trace(grid: &WaterlineGrid<'_>, probe: &Probe<'_>) -> Vec<Vec<Point2>> {
+pub(crate) fn trace(grid: &WaterlineGrid<'_>, level: &Level, probe: &Probe<'_>) -> Vec<Vec<Point2>> {
     let (nx, ny) = (grid.nx, grid.ny);
-    let z = probe.z;
-    let inside: Vec<bool> = grid.heights.par_iter().map(|&h| h > z).collect();
-    let edges = edge_crossings(grid, probe, &inside);
+    let edges = edge_crossings(grid, level, probe);
     let Some(last) = edges.last() else { return Vec::new() };
     let total = last.offset + last.points.len();
     let num = Numbering { nx, ny };
@@ -171,7 +175,7 @@ pub(crate) fn trace(grid: &WaterlineGrid<'_>, probe: &Probe<'_>) -> Vec<Vec<Poin
                 sides[side].extend((0..n).map(|s| e.offset + if forward { s } else { n - 1 - s }));
             }
             let corners = [grid.point(i, j), grid.point(i + 1, j), grid.point(i + 1, j + 1), grid.point(i, j + 1)];
-            let at = |[a, b]: [usize; 2]| inside[b * nx + a];
+            let at = |[a, b]: [usize; 2]| grid.inside(level, a, b);
             let cell =
                 Cell { corners, inside: [at([i, j]), at([i + 1, j]), at([i + 1, j + 1]), at([i, j + 1])], sides };
             if let Some(links) = simple_links(&cell) {

@@ -245,6 +245,36 @@ pub fn drop_grid(
     out
 }
 
+/// Drop-cutter on the small grid `xs` x `ys` (row-major, x fastest), on the
+/// calling thread, with one candidate list for the whole patch (as a block of
+/// [`drop_grid`] shares one for a run of a row): for patches a few samples
+/// wide, where a list per row would cost more than the drops. Rows are walked
+/// back and forth, each point seeded with its predecessor's contact. The
+/// heights equal [`drop_cutter`]'s at every point, bit for bit; where two
+/// triangles give the same height, the contact reported may differ.
+#[must_use]
+pub fn drop_patch(cutter: &Cutter, index: &MeshIndex, xs: &[f64], ys: &[f64], floor: f64) -> Vec<ClPoint> {
+    let mut out: Vec<ClPoint> = vec![ClPoint::floor(Point2::origin(), floor); xs.len() * ys.len()];
+    let (Some(&x0), Some(&x1), Some(&y0), Some(&y1)) = (xs.first(), xs.last(), ys.first(), ys.last()) else {
+        return out;
+    };
+    let profile = Profile::new(cutter.shape());
+    let mut scratch = BlockScratch::default();
+    scratch.fill(index, &profile, [x0.min(x1), y0.min(y1)], [x0.max(x1), y0.max(y1)]);
+    let mut seed = None;
+    for (j, &y) in ys.iter().enumerate() {
+        let row = &mut out[j * xs.len()..(j + 1) * xs.len()];
+        for k in 0..xs.len() {
+            let i = if j % 2 == 0 { k } else { xs.len() - 1 - k };
+            let (cl, slot) =
+                drop_candidates(&profile, index, &scratch.sorted, Point2::new(xs[i], y), floor, seed, None);
+            seed = slot;
+            row[i] = cl;
+        }
+    }
+    out
+}
+
 /// Drop-cutter at a sequence of nearby points (a path sampled densely), in
 /// parallel over blocks of consecutive points; the output is in input order.
 ///
