@@ -308,18 +308,8 @@ fn splice(probe: &Probe<'_>, step: f64, chord_tolerance: f64, loops: &mut Vec<Lo
         let (s, e) = ((i + n - back) % n, (i + 1 + ahead) % n);
         let (a, b) = (points[s], points[e]);
         let mut new = Vec::new();
-        let mut from = a;
-        for &p in sides.iter().chain([&b]) {
-            refine_chord(&local, from, p, chord_tolerance, 0, &mut new);
-            if p != b {
-                new.push(p);
-            }
-            from = p;
-        }
-        let mut path = Vec::with_capacity(new.len() + 2);
-        path.push(a);
-        path.extend_from_slice(&new);
-        path.push(b);
+        refine_through(&local, a, &sides, b, chord_tolerance, &mut new);
+        let path = framed(a, &new, b);
         let run = back + ahead; // chords s..s + run (mod n) are replaced
         match crossing(loops, &|k, j| k == l && (j + n - s) % n <= run, &path) {
             Crossing::None => {
@@ -531,26 +521,13 @@ fn bridge(
     right.retain(apart);
     left.retain(apart);
     let mut new = Vec::new();
-    let mut from = a;
-    for &p in right.iter().chain([&b1]) {
-        refine_chord(local, from, p, chord_tolerance, 0, &mut new);
-        new.push(p);
-        from = p;
-    }
+    refine_through(local, a, &right, b1, chord_tolerance, &mut new);
+    new.push(b1);
     // Around loop k from b1 (pushed) to a1.
     new.extend((2..=m).map(|s| loops[k].points[(j + s) % m]));
-    from = a1;
-    for &p in left.iter().rev().chain([&b]) {
-        refine_chord(local, from, p, chord_tolerance, 0, &mut new);
-        if p != b {
-            new.push(p);
-        }
-        from = p;
-    }
-    let mut path = Vec::with_capacity(new.len() + 2);
-    path.push(a);
-    path.extend_from_slice(&new);
-    path.push(b);
+    let left: Vec<Point2> = left.iter().rev().copied().collect();
+    refine_through(local, a1, &left, b, chord_tolerance, &mut new);
+    let path = framed(a, &new, b);
     if !matches!(crossing(loops, &|q, r| (q, r) == (l, i) || q == k, &path), Crossing::None) {
         return false;
     }
@@ -565,6 +542,35 @@ fn bridge(
 }
 
 /// The chord of `loops` nearest to `p`: (loop, chord index, nearest point).
+/// Appends to `new` the chords from `from` through `through` to `to`, each
+/// refined to the chord tolerance, with the points of `through` (not `to`).
+fn refine_through(
+    local: &Local<'_>,
+    from: Point2,
+    through: &[Point2],
+    to: Point2,
+    chord_tolerance: f64,
+    new: &mut Vec<Point2>,
+) {
+    let mut from = from;
+    for &p in through.iter().chain([&to]) {
+        refine_chord(local, from, p, chord_tolerance, 0, new);
+        if p != to {
+            new.push(p);
+        }
+        from = p;
+    }
+}
+
+/// The path `a`, `inner`..., `b`.
+fn framed(a: Point2, inner: &[Point2], b: Point2) -> Vec<Point2> {
+    let mut path = Vec::with_capacity(inner.len() + 2);
+    path.push(a);
+    path.extend_from_slice(inner);
+    path.push(b);
+    path
+}
+
 fn nearest_chord(loops: &[Loop], p: Point2) -> Option<(usize, usize, Point2)> {
     let mut best: Option<(f64, usize, usize, Point2)> = None;
     for (l, lp) in loops.iter().enumerate() {
