@@ -98,51 +98,38 @@ impl Edges {
     /// Whether the step from `a` (in the region) to `b` stays in it: `b`
     /// inside and no wall crossed on the way (touching a wall is inside).
     pub fn contains_segment(&self, a: P2, b: P2) -> bool {
-        if !self.contains(b) {
-            return false;
-        }
-        let (i0, j0) = self.cell([a[0].min(b[0]), a[1].min(b[1])]);
-        let (i1, j1) = self.cell([a[0].max(b[0]), a[1].max(b[1])]);
-        for j in j0..=j1 {
-            for i in i0..=i1 {
-                for &k in &self.buckets[j * self.nx + i] {
-                    let (p, q) = self.segs[k as usize];
-                    let (o1, o2) = (orient(p, q, a), orient(p, q, b));
-                    let (o3, o4) = (orient(a, b, p), orient(a, b, q));
-                    if o1 * o2 < 0.0 && o3 * o4 < 0.0 {
-                        return false;
-                    }
-                }
-            }
-        }
-        true
+        self.contains(b)
+            && !self.walls_near(a, b, 0.0).any(|(p, q)| {
+                let (o1, o2) = (orient(p, q, a), orient(p, q, b));
+                let (o3, o4) = (orient(a, b, p), orient(a, b, q));
+                o1 * o2 < 0.0 && o3 * o4 < 0.0
+            })
+    }
+
+    /// The walls in the buckets that hold the box of `a`-`b` grown by `margin`
+    /// (a wall in several buckets comes once per bucket).
+    fn walls_near(&self, a: P2, b: P2, margin: f64) -> impl Iterator<Item = (P2, P2)> + '_ {
+        let (i0, j0) = self.cell([a[0].min(b[0]) - margin, a[1].min(b[1]) - margin]);
+        let (i1, j1) = self.cell([a[0].max(b[0]) + margin, a[1].max(b[1]) + margin]);
+        (j0..=j1)
+            .flat_map(move |j| (i0..=i1).map(move |i| j * self.nx + i))
+            .flat_map(move |c| self.buckets[c].iter().map(move |&k| self.segs[k as usize]))
     }
 }
 
 impl Edges {
     /// Whether every chord is farther than `margin` from the segment `a`-`b`.
     pub fn clear_of(&self, a: P2, b: P2, margin: f64) -> bool {
-        let (i0, j0) = self.cell([a[0].min(b[0]) - margin, a[1].min(b[1]) - margin]);
-        let (i1, j1) = self.cell([a[0].max(b[0]) + margin, a[1].max(b[1]) + margin]);
         let m2 = margin * margin;
-        for j in j0..=j1 {
-            for i in i0..=i1 {
-                for &k in &self.buckets[j * self.nx + i] {
-                    let (p, q) = self.segs[k as usize];
-                    let (o1, o2) = (orient(p, q, a), orient(p, q, b));
-                    let (o3, o4) = (orient(a, b, p), orient(a, b, q));
-                    if (o1 * o2 <= 0.0 && o3 * o4 <= 0.0)
-                        || seg_dist2(a, p, q) <= m2
-                        || seg_dist2(b, p, q) <= m2
-                        || seg_dist2(p, a, b) <= m2
-                        || seg_dist2(q, a, b) <= m2
-                    {
-                        return false;
-                    }
-                }
-            }
-        }
-        true
+        !self.walls_near(a, b, margin).any(|(p, q)| {
+            let (o1, o2) = (orient(p, q, a), orient(p, q, b));
+            let (o3, o4) = (orient(a, b, p), orient(a, b, q));
+            (o1 * o2 <= 0.0 && o3 * o4 <= 0.0)
+                || seg_dist2(a, p, q) <= m2
+                || seg_dist2(b, p, q) <= m2
+                || seg_dist2(p, a, b) <= m2
+                || seg_dist2(q, a, b) <= m2
+        })
     }
 }
 
