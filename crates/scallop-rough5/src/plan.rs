@@ -82,6 +82,19 @@ pub struct Rough5Settings {
     /// kept; at most [`TRANSLATION_MAX`]) before it is dropped, its
     /// neighbours following by [`TRANSLATION_SLOPE`] per mm along the pass.
     pub translate: bool,
+    /// Whether each run's CL tips are smoothed across the run (by at most
+    /// [`tol::SMOOTH_MAX`], the axes kept): a tip is moved only where its
+    /// tool stays clear of the flanks and the stock and its flutes beyond
+    /// the flank allowance from the flanks, and on the bottom level it stays
+    /// on the level ([`smooth_run`]).
+    pub smooth: bool,
+    /// Whether a run is entered from the level above where its tool stands
+    /// (its guide point's tool placed on the level above along the same
+    /// axis, plus the clearance), not from the highest point of the level
+    /// above: on a level that falls 50 mm along an impeller's channel the
+    /// ramp from the highest point circled 300 mm in the air
+    /// ([`local_entry`]).
+    pub local_entry: bool,
 }
 
 /// Largest axis translation of a colliding pair (mm).
@@ -111,6 +124,8 @@ pub struct PassReport {
     /// Pairs whose axis the collision correction turned to clear the flanks
     /// (kept, unless an angular-step insertion next to them collides).
     pub corrected: usize,
+    /// CL tips moved by the smoothing ([`Rough5Settings::smooth`]).
+    pub smoothed: usize,
     /// Runs the pass was split into.
     pub runs: usize,
     /// Pitch angle theta_t (Eq. 3.7) over the pass: min, max, mean (rad).
@@ -230,12 +245,16 @@ pub fn plan_rough5_in(
         Some(beyond) => BodyCheck::new(flanks, cutter, 0.0).with_stock(&beyond),
         None => BodyCheck::new(flanks, cutter, 0.0),
     };
+    // The flutes keep the flank allowance where the smoothing moves a tip.
+    let keep = BodyCheck::new(flanks, cutter, settings.guides.flank_allowance);
     let mut out = Emitter::new(stock.max.z, stock.max.z + settings.clearance + cutter.radius(), settings);
     out.flat = Emitter::flat_radius(cutter);
     let mut reports = Vec::new();
     // The first level is entered from above the stock: the box's top, or the blank's.
     let stock_top = blank.map_or(stock.max.z, |b| b.bounds().max.z.min(stock.max.z));
     let mut entry_z = stock_top + settings.clearance;
+    // The level cut before this one, for the local entries.
+    let mut above: Option<Placer> = None;
     for (done, j) in (0..levels.len()).rev().enumerate() {
         let level = &levels[j];
         let allowance = if j == 0 { settings.bottom_allowance } else { 0.0 };
@@ -253,13 +272,20 @@ pub fn plan_rough5_in(
             if settings.translate {
                 pairs = translated(&placer, &body, pairs);
             }
-            let (runs, mut report) = place_pass_in(&placer, &body, air.as_ref(), &pairs);
+            let (mut runs, mut report) = place_pass_in(&placer, &body, air.as_ref(), &pairs);
+            if settings.smooth {
+                for run in &mut runs {
+                    report.smoothed += smooth_run(run, (&placer, &body, &keep), j == 0);
+                }
+            }
             report.corrected = corrected;
             report.level = j;
             report.pass = m;
             for run in &runs {
                 top = run.iter().fold(top, |t, c| t.max(c.place.tip.z));
-                out.cut_run(run, entry_z, first, (&placer, &body));
+                let local = above.as_ref().filter(|_| settings.local_entry).and_then(|a| local_entry(a, &run[0]));
+                let entry = local.map_or(entry_z, |z| (z + settings.clearance * run[0].place.axis.z).min(entry_z));
+                out.cut_run(run, entry, first, (&placer, &body));
                 first = false;
             }
             reports.push(report);
@@ -267,6 +293,7 @@ pub fn plan_rough5_in(
         if top.is_finite() {
             entry_z = top + settings.clearance;
         }
+        above = Some(placer);
         progress(done + 1, levels.len());
     }
     if out.path.moves().is_empty() {
@@ -619,6 +646,89 @@ impl Air {
     }
 }
 
+/// The height where the tool of `c` (its axis kept) meets the level cut
+/// before (`above`, placed along the axis through `c`'s guide point): the
+/// material over it is gone where that level's passes ran. `None` where that
+/// tool misses the level above or is not above `c`'s.
+fn local_entry(above: &Placer, c: &Cl) -> Option<f64> {
+    let p = above.place(&c.sync.path, &c.place.axis)?;
+    let rise = (p.tip - c.place.tip).dot(&c.place.axis);
+    (rise > 0.0).then(|| c.place.tip.z + rise * c.place.axis.z)
+}
+
+/// Smooths the tips of `run` across the run, the axes kept, and returns how
+/// many tips moved. Each of [`tol::SMOOTH_ROUNDS`] rounds moves every tip
+/// (not the ends of an open run) half way towards the chord of its two
+/// neighbours, across that chord (the spacing kept), and never more than
+/// [`tol::SMOOTH_MAX`] from where it was placed. On the bottom level
+/// (`bottom`: the allowance is on the part) the moved tip is dropped along
+/// its axis on the level again (only its move across the axis is kept). A
+/// moved tip is kept only where it is still within [`tol::SMOOTH_MAX`] of the
+/// placed one, its tool is clear of the flanks and the stock (`body`), and
+/// its flutes stay beyond the flank allowance from the flanks both where it
+/// was placed and where it moved (`keep`, the check grown by the allowance:
+/// the passes along the flanks are not moved); else the tip stays where it
+/// was placed. Above the bottom the levels are offsets of it by a_p and
+/// more: a tip up to [`tol::SMOOTH_MAX`] under its level leaves a little less
+/// for the level below.
+fn smooth_run(run: &mut [Cl], (placer, body, keep): (&Placer, &BodyCheck, &BodyCheck), bottom: bool) -> usize {
+    let n = run.len();
+    let closed = n > 3 && (run[0].place.tip - run[n - 1].place.tip).norm() < 1e-9;
+    // The distinct tips: a closed run repeats its first at the end.
+    let m = if closed { n - 1 } else { n };
+    if m < 3 {
+        return 0;
+    }
+    let placed: Vec<Point3> = run[..m].iter().map(|c| c.place.tip).collect();
+    let mut tips = placed.clone();
+    for _ in 0..tol::SMOOTH_ROUNDS {
+        tips = (0..m)
+            .map(|i| {
+                if !closed && (i == 0 || i == m - 1) {
+                    return tips[i];
+                }
+                let (a, b) = (tips[(i + m - 1) % m], tips[(i + 1) % m]);
+                let chord = b - a;
+                let len = chord.norm();
+                if len < 1e-9 {
+                    return tips[i];
+                }
+                let t = chord / len;
+                let to_mid = (a + chord * 0.5) - tips[i];
+                let moved = tips[i] + (to_mid - t * to_mid.dot(&t)) * 0.5;
+                let off = moved - placed[i];
+                if off.norm() > tol::SMOOTH_MAX { placed[i] + off * (tol::SMOOTH_MAX / off.norm()) } else { moved }
+            })
+            .collect();
+    }
+    let kept: Vec<Option<Point3>> = (0..m)
+        .into_par_iter()
+        .map(|i| {
+            let axis = run[i].place.axis;
+            // On the bottom the moved tip is dropped on the level again.
+            let tip = if bottom { placer.place(&tips[i], &axis)?.tip } else { tips[i] };
+            let off = (tip - placed[i]).norm();
+            if off < 1e-9 || off > tol::SMOOTH_MAX || body.collides(&tip, &axis) {
+                return None;
+            }
+            // Within the flank allowance of a flank the tip stays: a limit
+            // pass keeps its distance to the flank.
+            (!keep.collides(&placed[i], &axis) && !keep.collides(&tip, &axis)).then_some(tip)
+        })
+        .collect();
+    let mut moved = 0;
+    for (i, tip) in kept.into_iter().enumerate() {
+        if let Some(tip) = tip {
+            run[i].place.tip = tip;
+            moved += 1;
+        }
+    }
+    if closed {
+        run[n - 1] = run[0];
+    }
+    moved
+}
+
 /// The placed and checked CL points of the pairs of one pass, split into
 /// runs where pairs were dropped.
 fn place_pass(placer: &Placer, body: &BodyCheck, pairs: &[SyncPoint]) -> (Vec<Vec<Cl>>, PassReport) {
@@ -673,6 +783,7 @@ fn place_pass_in(
         dropped: placed.len() - kept.len() - in_air,
         air: in_air,
         corrected: 0,
+        smoothed: 0,
         runs: runs.len(),
         pitch,
         max_tilt,
