@@ -54,8 +54,6 @@ pub enum RefineArg {
     OpenBottom,
     /// CL points whose tool lies above the part's blank (the impeller's turned blank) left out as air.
     AirTrim,
-    /// Each run's CL tips smoothed across the run by at most 0.05 mm where the tool stays clear (the voxels' kinks).
-    Smoothing,
     /// Each run entered from the level above where its tool stands, not from that level's highest point.
     LocalEntry,
     /// All of them: the program of 28 Nov 2026.
@@ -173,7 +171,6 @@ struct PassJson {
     points: usize,
     dropped: usize,
     corrected: usize,
-    smoothed: usize,
     runs: usize,
     pitch_deg: [f64; 3],
     max_tilt_deg: f64,
@@ -281,7 +278,6 @@ fn settings(args: &Rough5Args, part: &TestPart) -> CliResult<Rough5Settings> {
         },
         vertical_inside: on(RefineArg::VerticalInside),
         translate: on(RefineArg::Translation),
-        smooth: on(RefineArg::Smoothing),
         local_entry: on(RefineArg::LocalEntry),
         ..base
     })
@@ -451,7 +447,6 @@ fn report(
                 points: p.points,
                 dropped: p.dropped,
                 corrected: p.corrected,
-                smoothed: p.smoothed,
                 runs: p.runs,
                 pitch_deg: p.pitch.map(deg),
                 max_tilt_deg: deg(p.max_tilt),

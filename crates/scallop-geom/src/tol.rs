@@ -913,18 +913,6 @@ pub mod rough5 {
     /// absurd settings.
     pub const MAX_PASS_POINTS: usize = 1_000_000;
 
-    /// Largest distance the smoothing of a run moves a CL tip
-    /// (`scallop_rough5::Rough5Settings::smooth`, mm): the level fields'
-    /// 1 mm voxels leave kinks of 5 to 15 degrees every other CL point
-    /// (0.04 mm off the chord at a 1 mm step), which the machine's junction
-    /// limits slow to a quarter of the feed; within the proof's sweep
-    /// tolerance (0.05 mm).
-    pub const SMOOTH_MAX: f64 = 0.05;
-
-    /// Rounds of the smoothing of a run (each moves a tip half way to the
-    /// chord of its neighbours, across the chord).
-    pub const SMOOTH_ROUNDS: usize = 4;
-
     /// Relative finite-difference step of the SQP gradients (times 1 + |x_i|,
     /// the polynomial coefficients being of order 1).
     pub const SQP_FD_STEP: f64 = 1e-6;

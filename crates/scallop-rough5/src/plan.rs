@@ -82,12 +82,6 @@ pub struct Rough5Settings {
     /// kept; at most [`TRANSLATION_MAX`]) before it is dropped, its
     /// neighbours following by [`TRANSLATION_SLOPE`] per mm along the pass.
     pub translate: bool,
-    /// Whether each run's CL tips are smoothed across the run (by at most
-    /// [`tol::SMOOTH_MAX`], the axes kept): a tip is moved only where its
-    /// tool stays clear of the flanks and the stock and its flutes beyond
-    /// the flank allowance from the flanks, and on the bottom level it stays
-    /// on the level ([`smooth_run`]).
-    pub smooth: bool,
     /// Whether a run is entered from the level above where its tool stands
     /// (its guide point's tool placed on the level above along the same
     /// axis, plus the clearance), not from the highest point of the level
@@ -124,8 +118,6 @@ pub struct PassReport {
     /// Pairs whose axis the collision correction turned to clear the flanks
     /// (kept, unless an angular-step insertion next to them collides).
     pub corrected: usize,
-    /// CL tips moved by the smoothing ([`Rough5Settings::smooth`]).
-    pub smoothed: usize,
     /// Runs the pass was split into.
     pub runs: usize,
     /// Pitch angle theta_t (Eq. 3.7) over the pass: min, max, mean (rad).
@@ -233,7 +225,7 @@ pub fn plan_rough5_in(
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<Rough5Plan, Rough5Error> {
     check(settings)?;
-    let air = blank.map(|b| Air { blank: DexelPart::new(b), radius: cutter.radius() });
+    let air = blank.map(|b| Air { blank: DexelPart::new(b), radius: cutter.radius(), flutes: cutter.flute_length() });
     let levels = level_passes_with(bottom, flanks, &settings.guides, settings.tilt, &settings.levels)?;
     if levels.iter().all(|l| l.passes.is_empty()) {
         let reason = "no level has a closed limit curve: open pockets (limit curves ending on the level's boundary) \
@@ -245,10 +237,9 @@ pub fn plan_rough5_in(
         Some(beyond) => BodyCheck::new(flanks, cutter, 0.0).with_stock(&beyond),
         None => BodyCheck::new(flanks, cutter, 0.0),
     };
-    // The flutes keep the flank allowance where the smoothing moves a tip.
-    let keep = BodyCheck::new(flanks, cutter, settings.guides.flank_allowance);
     let mut out = Emitter::new(stock.max.z, stock.max.z + settings.clearance + cutter.radius(), settings);
     out.flat = Emitter::flat_radius(cutter);
+    out.air = air;
     let mut reports = Vec::new();
     // The first level is entered from above the stock: the box's top, or the blank's.
     let stock_top = blank.map_or(stock.max.z, |b| b.bounds().max.z.min(stock.max.z));
@@ -272,12 +263,7 @@ pub fn plan_rough5_in(
             if settings.translate {
                 pairs = translated(&placer, &body, pairs);
             }
-            let (mut runs, mut report) = place_pass_in(&placer, &body, air.as_ref(), &pairs);
-            if settings.smooth {
-                for run in &mut runs {
-                    report.smoothed += smooth_run(run, (&placer, &body, &keep), j == 0);
-                }
-            }
+            let (runs, mut report) = place_pass_in(&placer, &body, out.air.as_ref(), &pairs);
             report.corrected = corrected;
             report.level = j;
             report.pass = m;
@@ -619,10 +605,18 @@ fn blank_beyond(blank: &TriMesh, bottom: &TriMesh) -> Option<TriMesh> {
 /// within its radius, for its CL point to be left out as air.
 pub const AIR_MARGIN: f64 = 1.0;
 
+/// Steps (mm) of the search along the axis for where the tool is above the
+/// blank (the rapid approaches and retracts of [`plan_rough5_in`]), and up
+/// its flutes.
+const AIR_STEP: f64 = 1.0;
+
 /// The blank a program cuts in, for [`plan_rough5_in`].
 struct Air {
     blank: DexelPart,
     radius: f64,
+    /// The flute length: the part of the tool a rapid must keep out of the
+    /// stock.
+    flutes: f64,
 }
 
 impl Air {
@@ -637,12 +631,37 @@ impl Air {
     /// (the blank is a smooth envelope); its lowest point is taken `R sin
     /// tilt` under the tip.
     fn holds(&self, p: &Placement) -> bool {
-        let low = p.tip.z - self.radius * p.axis.angle(&Vec3::z()).sin() - AIR_MARGIN;
+        self.holds_at(&p.tip, &p.axis)
+    }
+
+    /// [`Air::holds`] for the tool's cross-section at `c` on the axis `axis`.
+    fn holds_at(&self, c: &Point3, axis: &Vec3) -> bool {
+        let low = c.z - self.radius * axis.angle(&Vec3::z()).sin() - AIR_MARGIN;
         let ring = (0..8).flat_map(|k| {
             let a = std::f64::consts::FRAC_PI_4 * f64::from(k);
-            [1.0, 0.5].map(|f| (p.tip.x + f * self.radius * a.cos(), p.tip.y + f * self.radius * a.sin()))
+            [1.0, 0.5].map(|f| (c.x + f * self.radius * a.cos(), c.y + f * self.radius * a.sin()))
         });
-        std::iter::once((p.tip.x, p.tip.y)).chain(ring).all(|(x, y)| self.top(x, y) < low)
+        std::iter::once((c.x, c.y)).chain(ring).all(|(x, y)| self.top(x, y) < low)
+    }
+
+    /// Whether the flutes of the tool with its tip at `tip` along `axis` lie
+    /// above the blank ([`Air::holds_at`] every [`AIR_STEP`] mm up the
+    /// flutes): the blank holds the in-process stock, so a rapid there meets
+    /// no stock.
+    fn clears(&self, tip: &Point3, axis: &Vec3) -> bool {
+        let n = (self.flutes / AIR_STEP).ceil().max(1.0) as usize;
+        (0..=n).all(|k| self.holds_at(&(tip + axis * (self.flutes * k as f64 / n as f64)), axis))
+    }
+
+    /// The lowest height `h` along `axis` over `tip`, from `from` down to
+    /// `to`, such that the tool is above the blank ([`Air::clears`]) at
+    /// every [`AIR_STEP`] from `from` down to `h`; `from` when it is not.
+    fn clear_down_to(&self, tip: &Point3, axis: &Vec3, from: f64, to: f64) -> f64 {
+        let mut h = from;
+        while h - AIR_STEP >= to && self.clears(&(tip + axis * (h - AIR_STEP)), axis) {
+            h -= AIR_STEP;
+        }
+        h
     }
 }
 
@@ -654,79 +673,6 @@ fn local_entry(above: &Placer, c: &Cl) -> Option<f64> {
     let p = above.place(&c.sync.path, &c.place.axis)?;
     let rise = (p.tip - c.place.tip).dot(&c.place.axis);
     (rise > 0.0).then(|| c.place.tip.z + rise * c.place.axis.z)
-}
-
-/// Smooths the tips of `run` across the run, the axes kept, and returns how
-/// many tips moved. Each of [`tol::SMOOTH_ROUNDS`] rounds moves every tip
-/// (not the ends of an open run) half way towards the chord of its two
-/// neighbours, across that chord (the spacing kept), and never more than
-/// [`tol::SMOOTH_MAX`] from where it was placed. On the bottom level
-/// (`bottom`: the allowance is on the part) the moved tip is dropped along
-/// its axis on the level again (only its move across the axis is kept). A
-/// moved tip is kept only where it is still within [`tol::SMOOTH_MAX`] of the
-/// placed one, its tool is clear of the flanks and the stock (`body`), and
-/// its flutes stay beyond the flank allowance from the flanks both where it
-/// was placed and where it moved (`keep`, the check grown by the allowance:
-/// the passes along the flanks are not moved); else the tip stays where it
-/// was placed. Above the bottom the levels are offsets of it by a_p and
-/// more: a tip up to [`tol::SMOOTH_MAX`] under its level leaves a little less
-/// for the level below.
-fn smooth_run(run: &mut [Cl], (placer, body, keep): (&Placer, &BodyCheck, &BodyCheck), bottom: bool) -> usize {
-    let n = run.len();
-    let closed = n > 3 && (run[0].place.tip - run[n - 1].place.tip).norm() < 1e-9;
-    // The distinct tips: a closed run repeats its first at the end.
-    let m = if closed { n - 1 } else { n };
-    if m < 3 {
-        return 0;
-    }
-    let placed: Vec<Point3> = run[..m].iter().map(|c| c.place.tip).collect();
-    let mut tips = placed.clone();
-    for _ in 0..tol::SMOOTH_ROUNDS {
-        tips = (0..m)
-            .map(|i| {
-                if !closed && (i == 0 || i == m - 1) {
-                    return tips[i];
-                }
-                let (a, b) = (tips[(i + m - 1) % m], tips[(i + 1) % m]);
-                let chord = b - a;
-                let len = chord.norm();
-                if len < 1e-9 {
-                    return tips[i];
-                }
-                let t = chord / len;
-                let to_mid = (a + chord * 0.5) - tips[i];
-                let moved = tips[i] + (to_mid - t * to_mid.dot(&t)) * 0.5;
-                let off = moved - placed[i];
-                if off.norm() > tol::SMOOTH_MAX { placed[i] + off * (tol::SMOOTH_MAX / off.norm()) } else { moved }
-            })
-            .collect();
-    }
-    let kept: Vec<Option<Point3>> = (0..m)
-        .into_par_iter()
-        .map(|i| {
-            let axis = run[i].place.axis;
-            // On the bottom the moved tip is dropped on the level again.
-            let tip = if bottom { placer.place(&tips[i], &axis)?.tip } else { tips[i] };
-            let off = (tip - placed[i]).norm();
-            if off < 1e-9 || off > tol::SMOOTH_MAX || body.collides(&tip, &axis) {
-                return None;
-            }
-            // Within the flank allowance of a flank the tip stays: a limit
-            // pass keeps its distance to the flank.
-            (!keep.collides(&placed[i], &axis) && !keep.collides(&tip, &axis)).then_some(tip)
-        })
-        .collect();
-    let mut moved = 0;
-    for (i, tip) in kept.into_iter().enumerate() {
-        if let Some(tip) = tip {
-            run[i].place.tip = tip;
-            moved += 1;
-        }
-    }
-    if closed {
-        run[n - 1] = run[0];
-    }
-    moved
 }
 
 /// The placed and checked CL points of the pairs of one pass, split into
@@ -783,7 +729,6 @@ fn place_pass_in(
         dropped: placed.len() - kept.len() - in_air,
         air: in_air,
         corrected: 0,
-        smoothed: 0,
         runs: runs.len(),
         pitch,
         max_tilt,
@@ -825,6 +770,10 @@ struct Emitter {
     /// The azimuth of the last tilted axis written: where a table-table
     /// machine holds its C table while the axis is on the pole.
     held: Option<f64>,
+    /// The blank, when the program cuts in one: the approaches and retracts
+    /// go at the rapid rate down to and up from where the tool's flutes are
+    /// above it.
+    air: Option<Air>,
 }
 
 impl Emitter {
@@ -840,6 +789,7 @@ impl Emitter {
             links: 0,
             ramps: 0,
             held: None,
+            air: None,
         }
     }
 
@@ -909,7 +859,12 @@ impl Emitter {
     /// stock top (material the levels above could not reach may be left
     /// over the tool), then retracts to the safe height.
     fn retract(&mut self, a: &Placement) {
-        let out = Emitter::above_at(&a.tip, &a.axis, self.stock_top);
+        let mut out = Emitter::above_at(&a.tip, &a.axis, self.stock_top);
+        if let Some(air) = &self.air {
+            // At the feed only until the flutes are above the blank.
+            let h = air.clear_down_to(&a.tip, &a.axis, (out - a.tip).dot(&a.axis), 0.0);
+            out = a.tip + a.axis * h;
+        }
         self.push(MoveKind::Link, out, a.axis);
         let up = self.above(&a.tip, &a.axis);
         self.push(MoveKind::Retract, up, a.axis);
@@ -986,7 +941,16 @@ impl Emitter {
         let s = run[0].place;
         let lift = if s.axis.z > 0.0 { ((entry_z - s.tip.z) / s.axis.z).max(0.0) } else { 0.0 };
         let start = s.tip + s.axis * lift;
-        self.push(MoveKind::Rapid, self.above(&start, &s.axis), s.axis);
+        let over = self.above(&start, &s.axis);
+        self.push(MoveKind::Rapid, over, s.axis);
+        if let Some(air) = &self.air {
+            // At the rapid rate down to where the flutes reach the blank.
+            let h = air.clear_down_to(&s.tip, &s.axis, (over - s.tip).dot(&s.axis), lift);
+            let down = s.tip + s.axis * h;
+            if (down - over).norm() > 1e-9 {
+                self.push(MoveKind::Rapid, down, s.axis);
+            }
+        }
         self.push(MoveKind::Plunge, start, s.axis);
         let closed = run.len() > 2 && (s.tip - run[run.len() - 1].place.tip).norm() < 1e-9;
         if lift <= 0.0 {

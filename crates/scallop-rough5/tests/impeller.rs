@@ -153,7 +153,6 @@ fn the_impeller_program_is_proven_from_its_blank() {
         levels: ALL,
         vertical_inside: true,
         translate: true,
-        smooth: true,
         local_entry: true,
     };
     let blank = part.blank.as_ref();

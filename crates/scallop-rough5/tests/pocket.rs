@@ -40,7 +40,6 @@ fn settings(tilt: TiltMode, depth: f64) -> Rough5Settings {
         levels: LevelOptions::default(),
         vertical_inside: false,
         translate: false,
-        smooth: false,
         local_entry: false,
     }
 }

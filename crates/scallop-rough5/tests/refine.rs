@@ -96,7 +96,6 @@ fn settings(depth: f64, refined: bool) -> Rough5Settings {
         levels: LevelOptions { centre_offsets: refined, pair_by_rank: refined, open_bottom: refined },
         vertical_inside: refined,
         translate: refined,
-        smooth: refined,
         local_entry: refined,
     }
 }
