@@ -608,7 +608,7 @@ pub const AIR_MARGIN: f64 = 1.0;
 /// Steps (mm) of the search along the axis for where the tool is above the
 /// blank (the rapid approaches and retracts of [`plan_rough5_in`]), and up
 /// its flutes.
-const AIR_STEP: f64 = 1.0;
+pub const AIR_STEP: f64 = 1.0;
 
 /// The blank a program cuts in, for [`plan_rough5_in`].
 struct Air {
