@@ -25,7 +25,13 @@
 //! near a flank, near the bottom, the interior), by the side of its nearest
 //! flank point and by its height above the bottom. The time is the UCP 710's
 //! time model block by block (the `scallop rough5` model), summed by move kind,
-//! by tilt and by the length of the feed run the move belongs to.
+//! by tilt and by the length of the feed run the move belongs to, and run by
+//! run between two rapids (time, time at the feed, length, heights, largest
+//! tilt, azimuth travel). On the impeller it also gives the moves at the feed
+//! that remove nothing (the out-of-material share), by kind and tilt.
+//! `WHERE_LEFT_MOVES=FILE` writes every move's time, length, tip, tilt and
+//! azimuth as CSV, `WHERE_LEFT_REMOVED=FILE` (impeller) the volume each move
+//! removes.
 
 #![allow(clippy::unwrap_used, clippy::print_stdout, clippy::cast_precision_loss, reason = "an analysis example")]
 
