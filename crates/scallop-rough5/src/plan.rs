@@ -85,9 +85,9 @@ pub struct Rough5Settings {
     /// Whether a run is entered from the level above where its tool stands
     /// (its guide point's tool placed on the level above along the same
     /// axis, plus the clearance), not from the highest point of the level
-    /// above: on a level that falls 50 mm along an impeller's channel the
-    /// ramp from the highest point circled 300 mm in the air
-    /// ([`local_entry`]).
+    /// above, when that is lower ([`local_entry`]): on a level that falls
+    /// along an impeller's channel the ramp from the highest point circles
+    /// down through the air (docs/rough5.md, "The impeller, sixth session").
     pub local_entry: bool,
 }
 
@@ -857,7 +857,8 @@ impl Emitter {
 
     /// Leaves the material along the axis at the cutting feed up to the
     /// stock top (material the levels above could not reach may be left
-    /// over the tool), then retracts to the safe height.
+    /// over the tool), or in a blank until the flutes are above it, then
+    /// retracts to the safe height.
     fn retract(&mut self, a: &Placement) {
         let mut out = Emitter::above_at(&a.tip, &a.axis, self.stock_top);
         if let Some(air) = &self.air {
@@ -865,7 +866,10 @@ impl Emitter {
             let h = air.clear_down_to(&a.tip, &a.axis, (out - a.tip).dot(&a.axis), 0.0);
             out = a.tip + a.axis * h;
         }
-        self.push(MoveKind::Link, out, a.axis);
+        // (In a blank a tool already above it goes up at the rapid rate.)
+        if self.air.is_none() || (out - a.tip).norm() > 0.0 {
+            self.push(MoveKind::Link, out, a.axis);
+        }
         let up = self.above(&a.tip, &a.axis);
         self.push(MoveKind::Retract, up, a.axis);
     }
@@ -931,7 +935,8 @@ impl Emitter {
     }
 
     /// Retracts along the axis, goes over at the safe height, plunges along
-    /// the new axis to above the level and ramps down along a closed run.
+    /// the new axis to above the level (in a blank, at the rapid rate down
+    /// to where the flutes reach it first) and ramps down along a closed run.
     /// Returns the index of the run where the tool reached the level.
     fn enter(&mut self, run: &[Cl], entry_z: f64) -> usize {
         if let Some(a) = self.last {
@@ -947,11 +952,14 @@ impl Emitter {
             // At the rapid rate down to where the flutes reach the blank.
             let h = air.clear_down_to(&s.tip, &s.axis, (over - s.tip).dot(&s.axis), lift);
             let down = s.tip + s.axis * h;
-            if (down - over).norm() > 1e-9 {
+            if (down - over).norm() > 0.0 {
                 self.push(MoveKind::Rapid, down, s.axis);
             }
         }
-        self.push(MoveKind::Plunge, start, s.axis);
+        // (In a blank the rapid may have reached the start.)
+        if self.air.is_none() || self.current().is_none_or(|(at, _)| (at - start).norm() > 0.0) {
+            self.push(MoveKind::Plunge, start, s.axis);
+        }
         let closed = run.len() > 2 && (s.tip - run[run.len() - 1].place.tip).norm() < 1e-9;
         if lift <= 0.0 {
             return 0;

@@ -16,8 +16,8 @@ use scallop_guides::GuideSettings;
 use scallop_mesh::TriMesh;
 use scallop_parts::{FaceTag, PocketParams, closed_pocket};
 use scallop_rough5::{
-    AIR_MARGIN, AIR_STEP, BodyCheck, LevelOptions, ProofSettings, Rough5Settings, TiltMode, level_passes_with, plan_rough5,
-    plan_rough5_in, prove, prove_from_blank,
+    AIR_MARGIN, AIR_STEP, BodyCheck, LevelOptions, ProofSettings, Rough5Settings, TiltMode, level_passes_with,
+    plan_rough5, plan_rough5_in, prove, prove_from_blank,
 };
 use scallop_toolpath::MoveKind;
 
