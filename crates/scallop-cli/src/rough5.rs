@@ -54,6 +54,8 @@ pub enum RefineArg {
     OpenBottom,
     /// CL points whose tool lies above the part's blank (the impeller's turned blank) left out as air.
     AirTrim,
+    /// Each run entered from the level above where its tool stands, not from that level's highest point.
+    LocalEntry,
     /// All of them: the program of 28 Nov 2026.
     All,
 }
@@ -276,6 +278,7 @@ fn settings(args: &Rough5Args, part: &TestPart) -> CliResult<Rough5Settings> {
         },
         vertical_inside: on(RefineArg::VerticalInside),
         translate: on(RefineArg::Translation),
+        local_entry: on(RefineArg::LocalEntry),
         ..base
     })
 }

@@ -315,6 +315,7 @@ pub fn rough5_settings(
         levels: LevelOptions { centre_offsets: true, pair_by_rank: true, open_bottom: true },
         vertical_inside: true,
         translate: true,
+        local_entry: true,
     })
 }
 

@@ -25,7 +25,13 @@
 //! near a flank, near the bottom, the interior), by the side of its nearest
 //! flank point and by its height above the bottom. The time is the UCP 710's
 //! time model block by block (the `scallop rough5` model), summed by move kind,
-//! by tilt and by the length of the feed run the move belongs to.
+//! by tilt and by the length of the feed run the move belongs to, and run by
+//! run between two rapids (time, time at the feed, length, heights, largest
+//! tilt, azimuth travel). On the impeller it also gives the moves at the feed
+//! that remove nothing (the out-of-material share), by kind and tilt.
+//! `WHERE_LEFT_MOVES=FILE` writes every move's time, length, tip, tilt and
+//! azimuth as CSV, `WHERE_LEFT_REMOVED=FILE` (impeller) the volume each move
+//! removes.
 
 #![allow(clippy::unwrap_used, clippy::print_stdout, clippy::cast_precision_loss, reason = "an analysis example")]
 
@@ -105,6 +111,7 @@ fn remaining_impeller(
             println!("  {:?} {:?} at ({:.2}, {:.2}) depth {:.3}", c.id, c.part, c.at.x, c.at.y, c.depth);
         }
     }
+    air_by_kind(path, &report.removed_by_move);
     let volume = DexelPart::new(&part.mesh);
     let face = |t| MeshQuery::new(&part.faces(&[t]).unwrap());
     let (qb, qf, qt) = (face(FaceTag::Bottom), face(FaceTag::Flank), face(FaceTag::Top));
@@ -186,6 +193,36 @@ fn remaining_impeller(
 
 /// The class of a remaining sample.
 /// Prints the volume to remove, the volume left in `all` and V_r.
+/// The moves at the feed that remove nothing (the out-of-material share
+/// L_HM), by kind and tilt: length in the air over all.
+fn air_by_kind(path: &scallop_toolpath::Toolpath, removed: &[f64]) {
+    let moves = path.moves();
+    let mut by: BTreeMap<String, [f64; 2]> = BTreeMap::new();
+    for (i, m) in moves.iter().enumerate().skip(1) {
+        if matches!(m.kind, MoveKind::Rapid | MoveKind::Retract) {
+            continue;
+        }
+        let tilted = path.axis(i).angle(&Vec3::z()).to_degrees() > 0.1;
+        let key = format!("{:?} | {}", m.kind, if tilted { "tilted" } else { "axis Z" });
+        let len = (m.to - moves[i - 1].to).norm();
+        let e = by.entry(key).or_insert([0.0; 2]);
+        e[1] += len;
+        if removed.get(i).is_none_or(|&v| v <= 0.0) {
+            e[0] += len;
+        }
+    }
+    if let Ok(out) = std::env::var("WHERE_LEFT_REMOVED") {
+        let csv: String = removed.iter().enumerate().map(|(i, v)| format!("{i},{v:.4}\n")).collect();
+        std::fs::write(out, format!("i,removed\n{csv}")).unwrap();
+    }
+    let (air, all) = by.values().fold((0.0, 0.0), |a, v| (a.0 + v[0], a.1 + v[1]));
+    println!("moves at the feed in the air: {air:.0} of {all:.0} mm ({:.1} %)", 100.0 * air / all.max(1e-9));
+    for (k, v) in &by {
+        println!("  {k:<30} {:>7.0} of {:>7.0} mm in the air", v[0], v[1]);
+    }
+    println!();
+}
+
 fn print_left<K>(all: &BTreeMap<K, f64>, total: f64) {
     let left: f64 = all.values().sum();
     println!("volume to remove {total:.0} mm3, left {left:.0} mm3, V_r {:.2} %", 100.0 * left / total);
@@ -455,6 +492,72 @@ fn timing(path: &scallop_toolpath::Toolpath) {
         };
         let key = format!("{kind} | {}", if tilted { "tilted" } else { "axis Z" });
         by.entry(key).or_insert([0.0; 3])[1] += (m.to - moves[i - 1].to).norm();
+    }
+    // Every run of feeds with its neighbouring plunges and links (between two
+    // rapids or retracts): its time, length, time at the feed, heights and tilt.
+    let mut run_time = vec![[0.0; 2]; moves.len()];
+    for ((b, t), floor) in blocks.iter().zip(&time).zip(&at_feed) {
+        run_time[b.3][0] += t;
+        run_time[b.3][1] += floor;
+    }
+    let mut spans: Vec<(usize, usize, [f64; 7])> = Vec::new();
+    let mut i = 1;
+    while i < moves.len() {
+        if matches!(moves[i].kind, MoveKind::Rapid | MoveKind::Retract) {
+            i += 1;
+            continue;
+        }
+        let s = i;
+        // time, at feed, length, z min, z max, max tilt, azimuth travel (deg)
+        let mut v = [0.0, 0.0, 0.0, f64::INFINITY, f64::NEG_INFINITY, 0.0, 0.0];
+        while i < moves.len() && !matches!(moves[i].kind, MoveKind::Rapid | MoveKind::Retract) {
+            let axis = path.axis(i);
+            let before = path.axis(i - 1);
+            v[0] += run_time[i][0];
+            v[1] += run_time[i][1];
+            v[2] += (moves[i].to - moves[i - 1].to).norm();
+            v[3] = v[3].min(moves[i].to.z);
+            v[4] = v[4].max(moves[i].to.z);
+            v[5] = f64::max(v[5], axis.angle(&Vec3::z()).to_degrees());
+            if axis.angle(&Vec3::z()) > 1e-3 && before.angle(&Vec3::z()) > 1e-3 {
+                let d = (axis.y.atan2(axis.x) - before.y.atan2(before.x)).to_degrees().rem_euclid(360.0);
+                v[6] += d.min(360.0 - d);
+            }
+            i += 1;
+        }
+        spans.push((s, i, v));
+    }
+    if let Ok(out) = std::env::var("WHERE_LEFT_MOVES") {
+        let mut csv = String::from("i,kind,time,at_feed,length,x,y,z,tilt,azimuth\n");
+        for (i, m) in moves.iter().enumerate().skip(1) {
+            let a = path.axis(i);
+            csv += &format!(
+                "{i},{:?},{:.5},{:.5},{:.4},{:.3},{:.3},{:.3},{:.3},{:.3}\n",
+                m.kind,
+                run_time[i][0],
+                run_time[i][1],
+                (m.to - moves[i - 1].to).norm(),
+                m.to.x,
+                m.to.y,
+                m.to.z,
+                a.angle(&Vec3::z()).to_degrees(),
+                a.y.atan2(a.x).to_degrees()
+            );
+        }
+        std::fs::write(out, csv).unwrap();
+    }
+    println!("\nruns between rapids (feeds, links, plunges), by time:");
+    println!(
+        "  {:>6} {:>6} {:>8} {:>8} {:>8} {:>11} {:>8} {:>9}",
+        "from", "to", "time (s)", "at feed", "length", "z", "tilt", "azimuth"
+    );
+    let mut by_time: Vec<_> = spans.iter().collect();
+    by_time.sort_by(|a, b| b.2[0].total_cmp(&a.2[0]));
+    for (s, e, v) in by_time {
+        println!(
+            "  {s:>6} {e:>6} {:>8.1} {:>8.1} {:>5.0} mm {:>5.1}-{:<5.1} {:>6.1} deg {:>5.0} deg",
+            v[0], v[1], v[2], v[3], v[4], v[5], v[6]
+        );
     }
     let total: f64 = time.iter().sum();
     println!("\nmachine time {total:.1} s (UCP 710 model)");

@@ -82,6 +82,13 @@ pub struct Rough5Settings {
     /// kept; at most [`TRANSLATION_MAX`]) before it is dropped, its
     /// neighbours following by [`TRANSLATION_SLOPE`] per mm along the pass.
     pub translate: bool,
+    /// Whether a run is entered from the level above where its tool stands
+    /// (its guide point's tool placed on the level above along the same
+    /// axis, plus the clearance), not from the highest point of the level
+    /// above, when that is lower ([`local_entry`]): on a level that falls
+    /// along an impeller's channel the ramp from the highest point circles
+    /// down through the air (docs/rough5.md, "The impeller, sixth session").
+    pub local_entry: bool,
 }
 
 /// Largest axis translation of a colliding pair (mm).
@@ -218,7 +225,7 @@ pub fn plan_rough5_in(
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<Rough5Plan, Rough5Error> {
     check(settings)?;
-    let air = blank.map(|b| Air { blank: DexelPart::new(b), radius: cutter.radius() });
+    let air = blank.map(|b| Air { blank: DexelPart::new(b), radius: cutter.radius(), flutes: cutter.flute_length() });
     let levels = level_passes_with(bottom, flanks, &settings.guides, settings.tilt, &settings.levels)?;
     if levels.iter().all(|l| l.passes.is_empty()) {
         let reason = "no level has a closed limit curve: open pockets (limit curves ending on the level's boundary) \
@@ -232,10 +239,13 @@ pub fn plan_rough5_in(
     };
     let mut out = Emitter::new(stock.max.z, stock.max.z + settings.clearance + cutter.radius(), settings);
     out.flat = Emitter::flat_radius(cutter);
+    out.air = air;
     let mut reports = Vec::new();
     // The first level is entered from above the stock: the box's top, or the blank's.
     let stock_top = blank.map_or(stock.max.z, |b| b.bounds().max.z.min(stock.max.z));
     let mut entry_z = stock_top + settings.clearance;
+    // The level cut before this one, for the local entries.
+    let mut above: Option<Placer> = None;
     for (done, j) in (0..levels.len()).rev().enumerate() {
         let level = &levels[j];
         let allowance = if j == 0 { settings.bottom_allowance } else { 0.0 };
@@ -253,13 +263,15 @@ pub fn plan_rough5_in(
             if settings.translate {
                 pairs = translated(&placer, &body, pairs);
             }
-            let (runs, mut report) = place_pass_in(&placer, &body, air.as_ref(), &pairs);
+            let (runs, mut report) = place_pass_in(&placer, &body, out.air.as_ref(), &pairs);
             report.corrected = corrected;
             report.level = j;
             report.pass = m;
             for run in &runs {
                 top = run.iter().fold(top, |t, c| t.max(c.place.tip.z));
-                out.cut_run(run, entry_z, first, (&placer, &body));
+                let local = above.as_ref().filter(|_| settings.local_entry).and_then(|a| local_entry(a, &run[0]));
+                let entry = local.map_or(entry_z, |z| (z + settings.clearance * run[0].place.axis.z).min(entry_z));
+                out.cut_run(run, entry, first, (&placer, &body));
                 first = false;
             }
             reports.push(report);
@@ -267,6 +279,7 @@ pub fn plan_rough5_in(
         if top.is_finite() {
             entry_z = top + settings.clearance;
         }
+        above = Some(placer);
         progress(done + 1, levels.len());
     }
     if out.path.moves().is_empty() {
@@ -592,10 +605,18 @@ fn blank_beyond(blank: &TriMesh, bottom: &TriMesh) -> Option<TriMesh> {
 /// within its radius, for its CL point to be left out as air.
 pub const AIR_MARGIN: f64 = 1.0;
 
+/// Steps (mm) of the search along the axis for where the tool is above the
+/// blank (the rapid approaches and retracts of [`plan_rough5_in`]), and up
+/// its flutes.
+pub const AIR_STEP: f64 = 1.0;
+
 /// The blank a program cuts in, for [`plan_rough5_in`].
 struct Air {
     blank: DexelPart,
     radius: f64,
+    /// The flute length: the part of the tool a rapid must keep out of the
+    /// stock.
+    flutes: f64,
 }
 
 impl Air {
@@ -610,13 +631,48 @@ impl Air {
     /// (the blank is a smooth envelope); its lowest point is taken `R sin
     /// tilt` under the tip.
     fn holds(&self, p: &Placement) -> bool {
-        let low = p.tip.z - self.radius * p.axis.angle(&Vec3::z()).sin() - AIR_MARGIN;
+        self.holds_at(&p.tip, &p.axis)
+    }
+
+    /// [`Air::holds`] for the tool's cross-section at `c` on the axis `axis`.
+    fn holds_at(&self, c: &Point3, axis: &Vec3) -> bool {
+        let low = c.z - self.radius * axis.angle(&Vec3::z()).sin() - AIR_MARGIN;
         let ring = (0..8).flat_map(|k| {
             let a = std::f64::consts::FRAC_PI_4 * f64::from(k);
-            [1.0, 0.5].map(|f| (p.tip.x + f * self.radius * a.cos(), p.tip.y + f * self.radius * a.sin()))
+            [1.0, 0.5].map(|f| (c.x + f * self.radius * a.cos(), c.y + f * self.radius * a.sin()))
         });
-        std::iter::once((p.tip.x, p.tip.y)).chain(ring).all(|(x, y)| self.top(x, y) < low)
+        std::iter::once((c.x, c.y)).chain(ring).all(|(x, y)| self.top(x, y) < low)
     }
+
+    /// Whether the flutes of the tool with its tip at `tip` along `axis` lie
+    /// above the blank ([`Air::holds_at`] every [`AIR_STEP`] mm up the
+    /// flutes): the blank holds the in-process stock, so a rapid there meets
+    /// no stock.
+    fn clears(&self, tip: &Point3, axis: &Vec3) -> bool {
+        let n = (self.flutes / AIR_STEP).ceil().max(1.0) as usize;
+        (0..=n).all(|k| self.holds_at(&(tip + axis * (self.flutes * k as f64 / n as f64)), axis))
+    }
+
+    /// The lowest height `h` along `axis` over `tip`, from `from` down to
+    /// `to`, such that the tool is above the blank ([`Air::clears`]) at
+    /// every [`AIR_STEP`] from `from` down to `h`; `from` when it is not.
+    fn clear_down_to(&self, tip: &Point3, axis: &Vec3, from: f64, to: f64) -> f64 {
+        let mut h = from;
+        while h - AIR_STEP >= to && self.clears(&(tip + axis * (h - AIR_STEP)), axis) {
+            h -= AIR_STEP;
+        }
+        h
+    }
+}
+
+/// The height where the tool of `c` (its axis kept) meets the level cut
+/// before (`above`, placed along the axis through `c`'s guide point): the
+/// material over it is gone where that level's passes ran. `None` where that
+/// tool misses the level above or is not above `c`'s.
+fn local_entry(above: &Placer, c: &Cl) -> Option<f64> {
+    let p = above.place(&c.sync.path, &c.place.axis)?;
+    let rise = (p.tip - c.place.tip).dot(&c.place.axis);
+    (rise > 0.0).then(|| c.place.tip.z + rise * c.place.axis.z)
 }
 
 /// The placed and checked CL points of the pairs of one pass, split into
@@ -714,6 +770,10 @@ struct Emitter {
     /// The azimuth of the last tilted axis written: where a table-table
     /// machine holds its C table while the axis is on the pole.
     held: Option<f64>,
+    /// The blank, when the program cuts in one: the approaches and retracts
+    /// go at the rapid rate down to and up from where the tool's flutes are
+    /// above it.
+    air: Option<Air>,
 }
 
 impl Emitter {
@@ -729,6 +789,7 @@ impl Emitter {
             links: 0,
             ramps: 0,
             held: None,
+            air: None,
         }
     }
 
@@ -796,10 +857,19 @@ impl Emitter {
 
     /// Leaves the material along the axis at the cutting feed up to the
     /// stock top (material the levels above could not reach may be left
-    /// over the tool), then retracts to the safe height.
+    /// over the tool), or in a blank until the flutes are above it, then
+    /// retracts to the safe height.
     fn retract(&mut self, a: &Placement) {
-        let out = Emitter::above_at(&a.tip, &a.axis, self.stock_top);
-        self.push(MoveKind::Link, out, a.axis);
+        let mut out = Emitter::above_at(&a.tip, &a.axis, self.stock_top);
+        if let Some(air) = &self.air {
+            // At the feed only until the flutes are above the blank.
+            let h = air.clear_down_to(&a.tip, &a.axis, (out - a.tip).dot(&a.axis), 0.0);
+            out = a.tip + a.axis * h;
+        }
+        // (In a blank a tool already above it goes up at the rapid rate.)
+        if self.air.is_none() || (out - a.tip).norm() > 0.0 {
+            self.push(MoveKind::Link, out, a.axis);
+        }
         let up = self.above(&a.tip, &a.axis);
         self.push(MoveKind::Retract, up, a.axis);
     }
@@ -865,7 +935,8 @@ impl Emitter {
     }
 
     /// Retracts along the axis, goes over at the safe height, plunges along
-    /// the new axis to above the level and ramps down along a closed run.
+    /// the new axis to above the level (in a blank, at the rapid rate down
+    /// to where the flutes reach it first) and ramps down along a closed run.
     /// Returns the index of the run where the tool reached the level.
     fn enter(&mut self, run: &[Cl], entry_z: f64) -> usize {
         if let Some(a) = self.last {
@@ -875,8 +946,20 @@ impl Emitter {
         let s = run[0].place;
         let lift = if s.axis.z > 0.0 { ((entry_z - s.tip.z) / s.axis.z).max(0.0) } else { 0.0 };
         let start = s.tip + s.axis * lift;
-        self.push(MoveKind::Rapid, self.above(&start, &s.axis), s.axis);
-        self.push(MoveKind::Plunge, start, s.axis);
+        let over = self.above(&start, &s.axis);
+        self.push(MoveKind::Rapid, over, s.axis);
+        if let Some(air) = &self.air {
+            // At the rapid rate down to where the flutes reach the blank.
+            let h = air.clear_down_to(&s.tip, &s.axis, (over - s.tip).dot(&s.axis), lift);
+            let down = s.tip + s.axis * h;
+            if (down - over).norm() > 0.0 {
+                self.push(MoveKind::Rapid, down, s.axis);
+            }
+        }
+        // (In a blank the rapid may have reached the start.)
+        if self.air.is_none() || self.current().is_none_or(|(at, _)| (at - start).norm() > 0.0) {
+            self.push(MoveKind::Plunge, start, s.axis);
+        }
         let closed = run.len() > 2 && (s.tip - run[run.len() - 1].place.tip).norm() < 1e-9;
         if lift <= 0.0 {
             return 0;

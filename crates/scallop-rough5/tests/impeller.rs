@@ -153,6 +153,7 @@ fn the_impeller_program_is_proven_from_its_blank() {
         levels: ALL,
         vertical_inside: true,
         translate: true,
+        local_entry: true,
     };
     let blank = part.blank.as_ref();
     let plan = plan_rough5_in(&bottom, &flanks, (&part.stock, blank), &tool(), &settings, &|_, _| {}).unwrap();

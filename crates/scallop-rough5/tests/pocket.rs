@@ -40,6 +40,7 @@ fn settings(tilt: TiltMode, depth: f64) -> Rough5Settings {
         levels: LevelOptions::default(),
         vertical_inside: false,
         translate: false,
+        local_entry: false,
     }
 }
 

@@ -16,8 +16,8 @@ use scallop_guides::GuideSettings;
 use scallop_mesh::TriMesh;
 use scallop_parts::{FaceTag, PocketParams, closed_pocket};
 use scallop_rough5::{
-    AIR_MARGIN, BodyCheck, LevelOptions, ProofSettings, Rough5Settings, TiltMode, level_passes_with, plan_rough5,
-    plan_rough5_in, prove, prove_from_blank,
+    AIR_MARGIN, AIR_STEP, BodyCheck, LevelOptions, ProofSettings, Rough5Settings, TiltMode, level_passes_with,
+    plan_rough5, plan_rough5_in, prove, prove_from_blank,
 };
 use scallop_toolpath::MoveKind;
 
@@ -96,6 +96,7 @@ fn settings(depth: f64, refined: bool) -> Rough5Settings {
         levels: LevelOptions { centre_offsets: refined, pair_by_rank: refined, open_bottom: refined },
         vertical_inside: refined,
         translate: refined,
+        local_entry: refined,
     }
 }
 
@@ -235,4 +236,103 @@ fn a_low_blank_trims_the_levels_above_it() {
         prove_from_blank(&trimmed.toolpath, &tool, &part.stock, Some(&blank), &part.mesh, &proof_settings, &|_, _| {})
             .unwrap();
     assert!(proof.gouge_depth <= proof_settings.resolution, "{proof:?}");
+}
+
+/// In a blank 8 mm under the stock top, the tool goes at the rapid rate
+/// down to where its flutes come within [`AIR_MARGIN`] of the blank, and
+/// back up from there: every approach at the feed (a plunge after a rapid)
+/// and every exit at the feed (a link before a retract) ends or starts
+/// within one [`AIR_STEP`] of that height (its lowest point `R sin tilt`
+/// under the tip), where the program without the blank's rapids plunges
+/// from the safe height, 14 mm over the blank. The program is proven from
+/// the blank: no rapid meets its stock.
+#[test]
+fn the_tool_goes_rapid_over_the_blank() {
+    let part = small_pocket();
+    let bottom = part.faces(&[FaceTag::Bottom]).unwrap();
+    let flanks = part.faces(&[FaceTag::Flank]).unwrap();
+    let depth = part.stock.max.z - bottom.bounds().min.z;
+    let (tool, s) = (tool(), settings(depth, true));
+    let top = part.stock.max.z - 8.0;
+    let blank = box_mesh(part.stock.min, Point3::new(part.stock.max.x, part.stock.max.y, top));
+    let plan = plan_rough5_in(&bottom, &flanks, (&part.stock, Some(&blank)), &tool, &s, &|_, _| {}).unwrap();
+    let path = &plan.toolpath;
+    let moves = path.moves();
+    // The height of the tool's lowest point over the blank's top.
+    let over = |i: usize| {
+        let tilt = path.axis(i).angle(&Vec3::z());
+        moves[i].to.z - tool.radius() * tilt.sin() - top
+    };
+    let reach = AIR_MARGIN + AIR_STEP + 1e-6;
+    let mut checked = 0;
+    for i in 1..moves.len() {
+        let approach = moves[i].kind == MoveKind::Plunge && moves[i - 1].kind == MoveKind::Rapid;
+        let exit = moves[i].kind == MoveKind::Link && moves.get(i + 1).is_some_and(|m| m.kind == MoveKind::Retract);
+        if approach {
+            // The plunge starts where the rapid ended.
+            assert!(over(i - 1) <= reach, "move {i}: the plunge starts {} mm over the blank", over(i - 1));
+            checked += 1;
+        }
+        if exit {
+            assert!(over(i) <= reach, "move {i}: the exit at the feed ends {} mm over the blank", over(i));
+            checked += 1;
+        }
+    }
+    assert!(checked > 0);
+    let proof_settings = ProofSettings { resolution: 0.5, axis_tolerance: 0.05 };
+    prove_from_blank(path, &tool, &part.stock, Some(&blank), &part.mesh, &proof_settings, &|_, _| {}).unwrap();
+}
+
+/// On a bottom sloping by 0.2 along x (11.3 degrees), with vertical walls
+/// and the axis +Z, the levels are planes a_p / cos(slope) apart along +Z,
+/// and the tool tips of a level lie at one height over the bottom. A run is
+/// entered from the level above where it starts: every entry plunge ends at
+/// most that spacing plus the clearance (and half a voxel of the levels'
+/// fields) over the lowest tip of the level it enters, not at the clearance
+/// over the level above's highest tip, 8.8 mm higher at the bottom's low
+/// side. The program is proven.
+#[test]
+fn a_run_is_entered_from_the_level_above_where_it_starts() {
+    let part = closed_pocket(&PocketParams {
+        stock: [60.0, 60.0, 24.0],
+        bottom_z: 8.0,
+        wall: 8.0,
+        corner_radius: 6.0,
+        walls: [0.0; 4],
+        tilt: 0.2,
+        dome: 0.0,
+        ..Default::default()
+    })
+    .unwrap();
+    let bottom = part.faces(&[FaceTag::Bottom]).unwrap();
+    let flanks = part.faces(&[FaceTag::Flank]).unwrap();
+    let depth = part.stock.max.z - bottom.bounds().min.z;
+    let (tool, s) = (tool(), Rough5Settings { tilt: TiltMode::Zero, ..settings(depth, true) });
+    let plan = plan_rough5(&bottom, &flanks, &part.stock, &tool, &s, &|_, _| {}).unwrap();
+    let moves = plan.toolpath.moves();
+    // Height over the bottom plane z = 8 + 0.2 (x - 30).
+    let over = |p: &Point3| p.z - (8.0 + 0.2 * (p.x - 30.0));
+    let spacing = s.guides.axial_step / 0.2f64.atan().cos();
+    let mut entries = 0;
+    for i in 1..moves.len() {
+        if !(moves[i].kind == MoveKind::Plunge && moves[i - 1].kind == MoveKind::Rapid) {
+            continue;
+        }
+        // The level entered: the feeds up to the next rapid.
+        let level = moves[i + 1..]
+            .iter()
+            .take_while(|m| !matches!(m.kind, MoveKind::Rapid | MoveKind::Retract))
+            .filter(|m| m.kind == MoveKind::Feed)
+            .map(|m| over(&m.to))
+            .fold(f64::INFINITY, f64::min);
+        // The first level is entered from above the stock.
+        if entries > 0 {
+            let lift = over(&moves[i].to) - level;
+            assert!(lift <= spacing + s.clearance + 0.5 * s.guides.voxel, "move {i}: entered {lift} mm over its level");
+        }
+        entries += 1;
+    }
+    assert!(entries > 2, "{entries} entries");
+    let proof_settings = ProofSettings { resolution: 0.5, axis_tolerance: 0.05 };
+    prove(&plan.toolpath, &tool, &part.stock, &part.mesh, &proof_settings, &|_, _| {}).unwrap();
 }
