@@ -249,11 +249,14 @@ pub fn plan_adaptive_in(
         #[allow(clippy::cast_possible_truncation, reason = "passes are bounded by MAX_PASSES")]
         planner.bore(e, r0, walk.passes as u32);
         let before = walk.steps.len();
-        end = planner.walk_all(Some(e), &mut walk)?;
+        let reached = planner.walk_all(Some(e), &mut walk)?;
         if walk.steps.len() == before {
-            // Nothing cut from there: the entry alone, a plunge or a helix.
+            // Nothing cut from there: the entry alone, a plunge or a helix;
+            // the tool is still where the last walk left it.
             walk.steps.pop();
             planner.swept[k] = 0.0;
+        } else {
+            end = reached;
         }
     }
     let mut steps = walk.steps;

@@ -356,6 +356,14 @@ fn adaptive_levels_are_entered_from_the_open_sides() {
         }
     }
     assert!(air <= 0.03 * feed, "{air:.1} of {feed:.1} mm of feed in the air around the stock");
+    // Every tool-down link stays in the tool-centre region of its level.
+    for k in 1..moves.len() {
+        let (a, b) = (moves[k - 1].to, moves[k].to);
+        if moves[k].kind == MoveKind::Link && (a.z - b.z).abs() < 1e-12 {
+            let level = plan.levels.iter().find(|l| (l.z - b.z).abs() < 1e-9).unwrap();
+            assert!(level.region.offset(-1e-3).contains_segment([a.x, a.y], [b.x, b.y], 1e-3), "link {a:?} -> {b:?} leaves its level");
+        }
+    }
     // Every region point inside the stock is within R of the cutting samples of its level.
     let pts = samples(&plan.toolpath, 0.1);
     for level in &plan.levels {
