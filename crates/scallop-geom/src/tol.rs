@@ -840,6 +840,22 @@ pub mod rough {
     /// stopping, where a jerk-limited controller stops at each reversal.
     pub const LINK_TURN_SHARES: [f64; 3] = [0.5, 0.3, 0.15];
 
+    /// Adaptive clearing: the first arc of a link from a pass's end leaves
+    /// along the pass's last heading, else turned further away from the
+    /// material by the least of these (rad: 10, 20, 30, 45, 60, 90 degrees)
+    /// whose arc fits: a pass that ends against a wall turns there instead
+    /// of reversing (docs/benchmarks.md, "Adaptive clearing: cycle time and
+    /// links, sixth session").
+    pub const LINK_END_TURNS: [f64; 7] = [0.0, 0.175, 0.349, 0.524, 0.785, 1.047, 1.571];
+
+    /// Adaptive clearing: a step's engagement is measured at these points
+    /// along it (shares of its length from its start), and a line that
+    /// replaces several steps at the same points along it: right after a
+    /// turn towards the material, or halfway along a step, the front half
+    /// can lie along the thin edge of what earlier cuts left where it does
+    /// not at the step's end.
+    pub const WALK_STEP_SAMPLES: [f64; 5] = [0.0, 0.25, 0.5, 0.75, 1.0];
+
     /// Adaptive clearing: the chords of a link's arcs deviate this much from
     /// them (mm): 6 degrees between chords at a radius of 0.45 mm.
     pub const LINK_TURN_SAGITTA: f64 = 0.002;

@@ -73,6 +73,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut by_turn = vec![[0.0f64; 3]; bins.len() - 1]; // count, excess cutting, excess link
     let mut slow = [0.0f64; 2];
     let mut prev_dir: Option<scallop_geom::Vec3> = None;
+    // SCALLOP_MOVES=FILE: one line per move (index, kind, x, y, length, entry, exit, peak, duration).
+    let mut dump = std::env::var("SCALLOP_MOVES").ok().map(|_| String::from("k,kind,x,y,len,entry,exit,peak,t,phi\n"));
     for k in 1..moves.len() {
         let v = moves[k].to - moves[k - 1].to;
         let len = v.norm();
@@ -85,6 +87,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         };
         let rate = if kind == 3 { 10_000.0 / 60.0 } else { feed / 60.0 };
         let t = profile[k].duration;
+        if let Some(d) = dump.as_mut() {
+            let f = &profile[k];
+            d.push_str(&format!(
+                "{k},{kind},{:.4},{:.4},{len:.4},{:.2},{:.2},{:.2},{t:.5},{:.1}\n",
+                moves[k].to.x,
+                moves[k].to.y,
+                f.entry,
+                f.exit,
+                f.peak,
+                report.move_phi.get(k).copied().unwrap_or(0.0).to_degrees()
+            ));
+        }
         sums[kind][0] += len;
         sums[kind][1] += len / rate;
         sums[kind][2] += t;
@@ -103,6 +117,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
             prev_dir = Some(dir);
         }
+    }
+    if let (Ok(file), Some(d)) = (std::env::var("SCALLOP_MOVES"), dump) {
+        std::fs::write(file, d)?;
     }
     let total: f64 = sums.iter().map(|s| s[2]).sum();
     println!("{}: total {total:.1} s (model), {} moves", args[2], moves.len());

@@ -512,11 +512,17 @@ impl Planner<'_> {
         Stride { to, heading, phi, core }
     }
 
-    /// [`Planner::stride_by`], or `None` when its engagement is over `limit`.
-    fn stride_within(&self, p: P2, heading: f64, len: f64, limit: f64) -> Option<Stride> {
-        let to = ahead(p, heading, len);
-        let (phi, core) = self.front_within(to, heading, limit)?;
-        Some(Stride { to, heading, phi, core })
+    /// The step from `p` along `heading` of length `len`, its engagement
+    /// the largest at the points `along` it (shares of `len`), or `None`
+    /// when one is over `limit`.
+    fn stride_within(&self, p: P2, heading: f64, len: f64, limit: f64, along: &[f64]) -> Option<Stride> {
+        let (mut phi, mut core) = (0.0f64, 0.0f64);
+        for &f in along {
+            let (a, b) = self.front_within(ahead(p, heading, f * len), heading, limit)?;
+            phi = phi.max(a);
+            core = core.max(b);
+        }
+        Some(Stride { to: ahead(p, heading, len), heading, phi, core })
     }
 
     /// The next step from `p` after a step along `heading` (see
@@ -525,18 +531,29 @@ impl Planner<'_> {
         self.next_by(p, heading, tol::WALK_STEP_SHARE * self.options.tool_radius)
     }
 
-    /// The next step from `p` after a step along `heading`: the turn whose
+    /// The next step from `p` after a step along `heading`: the turn of
+    /// [`Planner::turn_by`], its engagement measured at the points
+    /// [`tol::WALK_STEP_SAMPLES`] along it. Right after a turn towards the material,
+    /// or halfway along a step, the front half can lie along the thin edge
+    /// of what earlier cuts left where it does not at the step's end
+    /// (docs/roughing.md, "Adaptive clearing", step 3).
+    fn next_by(&self, p: P2, heading: f64, len: f64) -> Option<Stride> {
+        self.turn_by(p, heading, len, &tol::WALK_STEP_SAMPLES)
+    }
+
+    /// The step from `p` after a step along `heading`, its engagement
+    /// measured at the points `along` it: the turn whose
     /// engagement is the target (bisection between the sharpest turn towards
     /// the material and the sharpest away), then, when that step leaves the
     /// region, the least further turn away that stays in it with the
     /// engagement within the accepted bound. `None` when there is none.
-    fn next_by(&self, p: P2, heading: f64, len: f64) -> Option<Stride> {
+    fn turn_by(&self, p: P2, heading: f64, len: f64, along: &[f64]) -> Option<Stride> {
         let away = self.away();
         // The step turned by `d`: its end alone, or its stride unless its
         // engagement is over `limit` (`None`, found early: where only that
         // comparison matters).
         let end = |d: f64| ahead(p, heading + away * d, len);
-        let within = |d: f64, limit: f64| self.stride_within(p, heading + away * d, len, limit);
+        let within = |d: f64, limit: f64| self.stride_within(p, heading + away * d, len, limit, along);
         let (toward, back) = (-tol::WALK_TURN, tol::WALK_TURN_HARD);
         let best = match within(toward, self.target) {
             Some(s) => s,
@@ -725,12 +742,29 @@ impl Planner<'_> {
         // steps, in the region; the swept field then holds those lines, not
         // the steps, so that later passes are planned on what the program
         // cuts.
-        let lines = simplify(&self.edges, &run, self.fit);
+        let kept = simplify(&self.edges, &run, self.fit);
         while let Some((k, v)) = undo.pop() {
             self.swept[k] = v;
         }
-        for pair in lines.windows(2) {
-            self.grid.stamp_segment(&mut self.swept, pair[0], pair[1], w, Some(&mut undo));
+        // A line that replaces several steps heads a little off each of
+        // them, and the front half it cuts turns with it: where its
+        // engagement (at the points `WALK_STEP_SAMPLES` along it, on the
+        // field the lines before it leave) is over the accepted bound, the
+        // steps are cut instead.
+        let mut lines = vec![run[0]];
+        for pair in kept.windows(2) {
+            let (i, j) = (pair[0], pair[1]);
+            let merged = j > i + 1 && {
+                let (a, b) = (run[i], run[j]);
+                let heading = (b[1] - a[1]).atan2(b[0] - a[0]);
+                self.stride_within(a, heading, dist(a, b), self.accept, &tol::WALK_STEP_SAMPLES).is_some()
+            };
+            let span: &[P2] = if merged || j == i + 1 { &run[j..=j] } else { &run[i + 1..=j] };
+            for &q in span {
+                let from = lines[lines.len() - 1];
+                self.grid.stamp_segment(&mut self.swept, from, q, w, Some(&mut undo));
+                lines.push(q);
+            }
         }
         self.stamped = lines.windows(2).map(|m| (m[0], m[1])).collect();
         let r = self.options.tool_radius;
@@ -1048,10 +1082,10 @@ fn lines(points: &[P2]) -> Option<Contour> {
 /// 1973, "Algorithms for the reduction of the number of points required
 /// to represent a digitized line", Cartographica 10(2); a line that
 /// leaves the region is split like one too far from the points).
-fn simplify(edges: &Edges, run: &[P2], tolerance: f64) -> Vec<P2> {
+fn simplify(edges: &Edges, run: &[P2], tolerance: f64) -> Vec<usize> {
     let n = run.len();
     if n <= 2 {
-        return run.to_vec();
+        return (0..n).collect();
     }
     let mut keep = vec![false; n];
     (keep[0], keep[n - 1]) = (true, true);
@@ -1073,7 +1107,7 @@ fn simplify(edges: &Edges, run: &[P2], tolerance: f64) -> Vec<P2> {
             stack.push((at, j));
         }
     }
-    run.iter().zip(&keep).filter(|&(_, &k)| k).map(|(p, _)| *p).collect()
+    (0..n).filter(|&k| keep[k]).collect()
 }
 
 #[cfg(test)]
@@ -1136,7 +1170,7 @@ mod tests {
                     })
                     .collect();
             }
-            let lines = simplify(&edges, &run, tolerance);
+            let lines: Vec<P2> = simplify(&edges, &run, tolerance).into_iter().map(|k| run[k]).collect();
             assert_eq!((lines.first(), lines.last()), (run.first(), run.last()));
             assert!(
                 case == 0 || lines.len() * 3 < run.len(),

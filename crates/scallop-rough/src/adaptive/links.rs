@@ -281,31 +281,39 @@ impl Planner<'_> {
     /// at one end only; else [`Planner::link_step`].
     pub(super) fn turning_link(&mut self, from: P2, out: Option<f64>, to: P2, into: f64) -> Step {
         if let Some(h) = out {
-            // Both ends turning first; else one of them (a wall right
-            // behind a start or ahead of an end leaves no room for its arc).
-            for both in [true, false] {
-                for share in tol::LINK_TURN_SHARES {
-                    let rho = share * self.options.tool_radius;
-                    let Some((first, last)) = turns(self.away(), from, h, to, into, rho) else { continue };
-                    let ok = |me: &Self, arc: &[P2]| arc.windows(2).all(|w| me.turn_ok(w[0], w[1]));
-                    let (ok1, ok2) = (ok(self, &first), ok(self, &last));
-                    let usable = if both { ok1 && ok2 } else { ok1 || ok2 };
-                    if !usable {
-                        continue;
+            // Both ends turning first; else the end's arc alone, else the
+            // start's (a wall right behind a start or ahead of an end leaves
+            // no room for its arc). The end's arc leaves along the pass's
+            // last heading, else turned further away from the material by
+            // the least of [`tol::LINK_END_TURNS`] that fits: a pass that
+            // ends against a wall turns a little there instead of reversing.
+            let away = self.away();
+            for (need_end, need_start) in [(true, true), (true, false), (false, true)] {
+                let rotations: &[f64] = if need_end { &tol::LINK_END_TURNS } else { &tol::LINK_END_TURNS[..1] };
+                for &rot in rotations {
+                    for share in tol::LINK_TURN_SHARES {
+                        let rho = share * self.options.tool_radius;
+                        let Some((first, last)) = turns(away, from, h + away * rot, to, into, rho) else { continue };
+                        let ok = |me: &Self, arc: &[P2]| arc.windows(2).all(|w| me.turn_ok(w[0], w[1]));
+                        let ok1 = need_end && ok(self, &first);
+                        let ok2 = need_start && ok(self, &last);
+                        if ok1 != need_end || ok2 != need_start {
+                            continue;
+                        }
+                        let first = if ok1 { first } else { vec![from] };
+                        let last = if ok2 { last } else { vec![to] };
+                        let (t1, t2) = (first[first.len() - 1], last[0]);
+                        let Some(middle) = self.link_path(t1, t2) else { continue };
+                        let mut via: Vec<P2> = first[1..].to_vec();
+                        via.extend_from_slice(&middle);
+                        via.extend_from_slice(&last[..last.len() - 1]);
+                        via.dedup_by(|a, b| dist(*a, *b) <= 1e-6);
+                        let mut line = vec![from];
+                        line.extend_from_slice(&via);
+                        line.push(to);
+                        self.stamp(&line);
+                        return Step::Link { tool_down: true, via, cleared: true, to: Some(to) };
                     }
-                    let first = if ok1 { first } else { vec![from] };
-                    let last = if ok2 { last } else { vec![to] };
-                    let (t1, t2) = (first[first.len() - 1], last[0]);
-                    let Some(middle) = self.link_path(t1, t2) else { continue };
-                    let mut via: Vec<P2> = first[1..].to_vec();
-                    via.extend_from_slice(&middle);
-                    via.extend_from_slice(&last[..last.len() - 1]);
-                    via.dedup_by(|a, b| dist(*a, *b) <= 1e-6);
-                    let mut line = vec![from];
-                    line.extend_from_slice(&via);
-                    line.push(to);
-                    self.stamp(&line);
-                    return Step::Link { tool_down: true, via, cleared: true, to: Some(to) };
                 }
             }
         }
