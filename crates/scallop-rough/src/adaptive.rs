@@ -90,6 +90,10 @@ struct Planner<'a> {
     /// The strip along the walls left to the rings (mm,
     /// [`tol::WALK_WALL_STRIP_SHARE`]).
     strip: f64,
+    /// Signed distance to the boundary of the level's material (negative in
+    /// it), when known ([`plan_adaptive_in`]): a probe where it is positive
+    /// is in air.
+    open: Option<Vec<f64>>,
 }
 
 /// The walk's steps so far, its passes and its remaining steps.
@@ -118,16 +122,47 @@ struct Stride {
 /// [`RoughError::TooMuchWork`] beyond [`tol::MAX_PASSES`] passes or
 /// [`tol::MAX_WALK_STEPS`] steps.
 pub fn plan_adaptive(region: &Region, options: &ClearOptions) -> Result<Vec<Step>, RoughError> {
+    plan_adaptive_in(region, None, options)
+}
+
+/// As [`plan_adaptive`], knowing where the material is: `material` is the
+/// part of the plane that holds material at the level (the stock's section,
+/// or the in-process stock's cells above the level); `None`, material
+/// everywhere within R of the region (a closed pocket). Outside `material`
+/// the tool cuts air: the walk counts no engagement there, a pass may start
+/// from a tool centre clear of the material (entered by a straight plunge,
+/// no helix: the stock's open sides of a level), and a ring of the region
+/// that never comes within R of the material is not cut.
+///
+/// # Errors
+/// As [`plan_adaptive`].
+pub fn plan_adaptive_in(
+    region: &Region,
+    material: Option<&Region>,
+    options: &ClearOptions,
+) -> Result<Vec<Step>, RoughError> {
     let r = options.tool_radius;
     let Some((lo, hi)) = region.bounds() else { return Ok(Vec::new()) };
     let grid = Grid::new(lo, hi, r + 4.0 * r * tol::GRID_SHARE, r * tol::GRID_SHARE)?;
     let h = grid.h;
-    let inside = grid.fill(region, (0.25 * h).min(options.chord_tolerance.max(1e-4)));
+    let fill_tolerance = (0.25 * h).min(options.chord_tolerance.max(1e-4));
+    let inside = grid.fill(region, fill_tolerance);
     let mut reach: Vec<f64> = inside.iter().map(|&i| if i { 0.0 } else { BIG }).collect();
     for ring in region.rings() {
         let pts = ring.to_points(0.25 * h);
         for (k, a) in pts.iter().enumerate() {
             grid.stamp_segment(&mut reach, *a, pts[(k + 1) % pts.len()], r + 2.0 * h, None);
+        }
+    }
+    // Signed distance of each cell centre to the material's boundary: a
+    // cell outside it is no material (its `reach` raised past R by that
+    // much), and the probes read the field itself (`Planner::open_at`).
+    let outside = material.map(|m| signed_distance(&grid, m, 2.0 * r + 4.0 * h, fill_tolerance));
+    if let Some(out) = &outside {
+        for (v, d) in reach.iter_mut().zip(out) {
+            if *d > 0.0 {
+                *v = v.max(r + d);
+            }
         }
     }
     let walls: Vec<(usize, f64)> = (0..grid.len())
@@ -168,13 +203,30 @@ pub fn plan_adaptive(region: &Region, options: &ClearOptions) -> Result<Vec<Step
         link_round: round_probes(tol::LINK_PROBES),
         fit: tol::WALK_FIT_SHARE * r,
         strip: tol::WALK_WALL_STRIP_SHARE * r,
+        open: outside,
     };
     if !planner.edges.contains(s) {
         return Ok(rings_only(region, options));
     }
-    planner.bore(s, r0, 0);
+    // Tool centres of the region just clear of the material (a band a cell
+    // wide, R to R + h outside it, which one step of the walk brings into
+    // it): starts from the air, entered by a straight plunge. The deepest
+    // point is bored only when there are none.
+    let air_starts: Vec<P2> = planner.open.as_ref().map_or_else(Vec::new, |out| {
+        (0..planner.grid.len())
+            .filter(|&k| planner.inside[k] && out[k] >= r && out[k] < r + h)
+            .map(|k| planner.grid.centre(k))
+            .filter(|&p| planner.edges.contains(p))
+            .collect()
+    });
     let mut walk = Walk { steps: Vec::new(), passes: 0, budget: tol::MAX_WALK_STEPS };
-    let mut end = planner.walk_all(s, &mut walk)?;
+    let mut end = if air_starts.is_empty() {
+        planner.bore(s, r0, 0);
+        planner.walk_all(Some(s), &mut walk)?
+    } else {
+        planner.starts.extend(air_starts.iter().map(|&p| (p, true, 0)));
+        planner.walk_all(None, &mut walk)?
+    };
     // Parts of the region the walk could not reach (joined to the rest by a
     // neck narrower than its steps, or a tooth gap it could not turn into):
     // a new entry at the deepest centre far from every cut, each.
@@ -182,6 +234,7 @@ pub fn plan_adaptive(region: &Region, options: &ClearOptions) -> Result<Vec<Step
     for _ in 0..tol::MAX_ENTRIES {
         let Some(k) = (0..planner.grid.len())
             .filter(|&k| planner.inside[k] && depth[k] < 0.5 * BIG && planner.swept[k] > far)
+            .filter(|&k| planner.open.as_ref().is_none_or(|out| out[k] < r))
             .max_by(|&a, &b| depth[a].total_cmp(&depth[b]).then(b.cmp(&a)))
         else {
             break;
@@ -196,11 +249,14 @@ pub fn plan_adaptive(region: &Region, options: &ClearOptions) -> Result<Vec<Step
         #[allow(clippy::cast_possible_truncation, reason = "passes are bounded by MAX_PASSES")]
         planner.bore(e, r0, walk.passes as u32);
         let before = walk.steps.len();
-        end = planner.walk_all(e, &mut walk)?;
+        let reached = planner.walk_all(Some(e), &mut walk)?;
         if walk.steps.len() == before {
-            // Nothing cut from there: the entry alone, a plunge or a helix.
+            // Nothing cut from there: the entry alone, a plunge or a helix;
+            // the tool is still where the last walk left it.
             walk.steps.pop();
             planner.swept[k] = 0.0;
+        } else {
+            end = reached;
         }
     }
     let mut steps = walk.steps;
@@ -370,7 +426,15 @@ impl Planner<'_> {
     /// pocket) and farther than R from every swept centre.
     fn material(&self, q: P2) -> bool {
         let r = self.options.tool_radius;
-        self.grid.sample(&self.swept, q) > r && self.grid.sample(&self.reach, q) < r
+        self.grid.sample(&self.swept, q) > r
+            && self.grid.sample(&self.reach, q) < r
+            && !self.grid.locate(q).is_some_and(|at| self.open_at(at))
+    }
+
+    /// Whether the grid point `at` lies outside the level's material (in
+    /// air), when that is known.
+    fn open_at(&self, at: (usize, f64, f64)) -> bool {
+        self.open.as_ref().is_some_and(|f| Grid::interpolate(f, self.grid.nx, at) > 0.0)
     }
 
     /// The engagement (rad) of the tool centred at `p`: the share of its
@@ -415,7 +479,7 @@ impl Planner<'_> {
             let Some(at) = self.grid.locate(q) else { continue };
             if Grid::interpolate(&self.swept, nx, at) > r {
                 let reach = Grid::interpolate(&self.reach, nx, at);
-                if reach < r {
+                if reach < r && !self.open_at(at) {
                     count += 1;
                     if share(count) > limit {
                         return None;
@@ -564,18 +628,7 @@ impl Planner<'_> {
     /// `None` when no step from `p` meets material (or none that stays in
     /// the region does).
     fn start_heading(&self, p: P2) -> Option<Stride> {
-        // No material within reach of any probe of any heading's stride
-        // (the probes lie R beyond a step of `len` from `p`): no heading
-        // meets material, decided on the squares about that ring.
-        let (r, h) = (self.options.tool_radius, self.grid.h);
-        let len = tol::WALK_STEP_SHARE * r;
-        let (inner, outer) = (r - len - h, r + len + h);
-        let ring = |m: P2| {
-            let d = dist(m, p);
-            d >= inner && d <= outer
-        };
-        let bounds = ([p[0] - outer, p[1] - outer], [p[0] + outer, p[1] + outer]);
-        if self.grid.quiet(&self.swept, &self.reach, bounds, ring, r, r) {
+        if self.nothing_near(p) {
             return None;
         }
         let n = tol::WALK_START_HEADINGS;
@@ -594,6 +647,50 @@ impl Planner<'_> {
         // From the heading into the material, the turn away to the target
         // and, at a wall, further away, as along a pass.
         self.next(p, best).filter(|s| s.core >= tol::WALK_AIR * self.target)
+    }
+
+    /// Whether no material lies within reach of any probe of any heading's
+    /// stride from `p` (the probes lie R beyond a step of `len` from `p`):
+    /// then no heading meets material, decided on the squares about that
+    /// ring.
+    fn nothing_near(&self, p: P2) -> bool {
+        let (r, h) = (self.options.tool_radius, self.grid.h);
+        let len = tol::WALK_STEP_SHARE * r;
+        let (inner, outer) = (r - len - h, r + len + h);
+        let ring = |m: P2| {
+            let d = dist(m, p);
+            d >= inner && d <= outer
+        };
+        let bounds = ([p[0] - outer, p[1] - outer], [p[0] + outer, p[1] + outer]);
+        self.grid.quiet(&self.swept, &self.reach, bounds, ring, r, r)
+    }
+
+    /// The direction (rad) from `p` towards the level's material when the
+    /// tool centred at `p` is clear of it (an air start, R or more outside
+    /// it): against the gradient of the signed distance. `None` elsewhere.
+    fn air_inward(&self, p: P2) -> Option<f64> {
+        let out = self.open.as_ref()?;
+        let r = self.options.tool_radius;
+        if self.grid.sample(out, p) < r - tol::LINK_SLACK {
+            return None;
+        }
+        let e = 0.5 * self.grid.h;
+        let f = |q: P2| self.grid.sample(out, q);
+        let (gx, gy) = (f([p[0] + e, p[1]]) - f([p[0] - e, p[1]]), f([p[0], p[1] + e]) - f([p[0], p[1] - e]));
+        (gx.hypot(gy) > 0.0 && gx.is_finite() && gy.is_finite()).then(|| (-gy).atan2(-gx))
+    }
+
+    /// The first step of a pass from the air start `p`: along the material's
+    /// edge with the material on the side the walk turns towards (right when
+    /// climbing), turned towards it until the engagement is the target (as
+    /// along a pass): a lead-in that meets the material gradually. The
+    /// material lies `inward` ([`Planner::air_inward`]).
+    fn air_heading(&self, p: P2, inward: f64) -> Option<Stride> {
+        if self.nothing_near(p) {
+            return None;
+        }
+        let along = inward + self.away() * std::f64::consts::FRAC_PI_2;
+        self.next(p, along)
     }
 
     /// A pass from `p` along `heading`: its points (the first is `p`), cut
@@ -681,7 +778,12 @@ impl Planner<'_> {
     /// Every pass from the bore about `s` until no earlier centre has
     /// material next to it, its steps and links appended to `walk`: where
     /// the tool ends.
-    fn walk_all(&mut self, s: P2, walk: &mut Walk) -> Result<P2, RoughError> {
+    /// The passes from the bore at `s`, or, with `None`, from the starts
+    /// already listed (tool centres in air: the first pass is entered by a
+    /// straight plunge at its start).
+    fn walk_all(&mut self, s: Option<P2>, walk: &mut Walk) -> Result<P2, RoughError> {
+        let air = s.is_none();
+        let s = s.or_else(|| self.starts.first().map(|t| t.0)).unwrap_or([0.0, 0.0]);
         let mut pos = s;
         // The heading of the last pass's last move.
         let mut out: Option<f64> = None;
@@ -729,7 +831,11 @@ impl Planner<'_> {
                     last = p;
                 }
             }
-            if fresh && dist(start, s) > 0.0 {
+            if fresh && air {
+                // A tool centre in air: plunged straight, no helix.
+                walk.steps.push(Step::Link { tool_down: false, via: Vec::new(), cleared: true, to: None });
+                self.emit_runs(&mut walk.steps, vec![run.clone()]);
+            } else if fresh && dist(start, s) > 0.0 {
                 // From the helix's end (its centre) to the pass: inside the bore.
                 let mut first = vec![s];
                 first.extend_from_slice(&run);
@@ -775,7 +881,14 @@ impl Planner<'_> {
                 continue;
             }
             let p = self.starts[i].0;
-            if let Some(h) = self.start_heading(p) {
+            // An air start's first pass leads in along the material's edge;
+            // a start listed again after a pass heads into its frontier.
+            let inward = if self.starts[i].2 == 0 { self.air_inward(p) } else { None };
+            let heading = match inward {
+                Some(inward) => self.air_heading(p, inward),
+                None => self.start_heading(p),
+            };
+            if let Some(h) = heading {
                 return Some((i, h));
             }
             self.starts[i].1 = false;
@@ -892,6 +1005,8 @@ impl Planner<'_> {
     }
 
     /// The region's rings from `pos`, nearest first, with their links.
+    /// A ring (or a corner) where the tool never comes within R of the
+    /// material is left out ([`plan_adaptive_in`]).
     fn finish(&mut self, region: &Region, mut pos: P2) -> Vec<Step> {
         // The region's convex corners between two lines, up to a right
         // angle and a little more, rounded by [`tol::RING_FILLET`]: a tool
@@ -901,12 +1016,15 @@ impl Planner<'_> {
         // at most 0.42 x the radius thick. Sharper corners (a gear's tooth
         // gap) keep their tip: rounded, they would leave their bottom uncut.
         let rounded: Vec<Contour> = region.rings().iter().map(fillet_corners).collect();
-        let mut rings: Vec<Contour> = rounded.iter().map(|c| orient(c, self.options.direction)).collect();
+        let r = self.options.tool_radius;
+        let away = |p: P2| self.open.as_ref().is_some_and(|out| self.grid.sample(out, p) >= r);
+        let in_air = |c: &Contour| self.open.is_some() && c.to_points(0.25 * self.grid.h).iter().all(|&p| away(p));
+        let mut rings: Vec<Contour> =
+            rounded.iter().filter(|c| !in_air(c)).map(|c| orient(c, self.options.direction)).collect();
         let mut steps = Vec::new();
-        for ring in region.rings() {
-            for corner in corners(ring) {
-                self.clear_corner(&corner, &mut pos, &mut steps);
-            }
+        let corners: Vec<Corner> = region.rings().iter().flat_map(corners).filter(|c| !away(c.at)).collect();
+        for corner in &corners {
+            self.clear_corner(corner, &mut pos, &mut steps);
         }
         while !rings.is_empty() {
             let started: Vec<Contour> = rings.iter().map(|c| c.starting_near(pos)).collect();
@@ -926,6 +1044,26 @@ impl Planner<'_> {
         steps
     }
 }
+/// Each cell centre's signed distance to the boundary of `material`
+/// (negative in it), exact up to `cap` from its rings (chords within
+/// `tolerance`), -[`BIG`] or [`BIG`] beyond.
+fn signed_distance(grid: &Grid, material: &Region, cap: f64, tolerance: f64) -> Vec<f64> {
+    let inside = grid.fill(material, tolerance);
+    let mut d = vec![BIG; grid.len()];
+    for ring in material.rings() {
+        let pts = ring.to_points(tolerance);
+        for (k, a) in pts.iter().enumerate() {
+            grid.stamp_segment(&mut d, *a, pts[(k + 1) % pts.len()], cap, None);
+        }
+    }
+    for (v, &i) in d.iter_mut().zip(&inside) {
+        if i {
+            *v = -*v;
+        }
+    }
+    d
+}
+
 /// The distance from `p` to the segment `a`-`b`.
 fn segment_distance(p: P2, a: P2, b: P2) -> f64 {
     let (dx, dy) = (b[0] - a[0], b[1] - a[1]);

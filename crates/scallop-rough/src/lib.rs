@@ -27,7 +27,7 @@ mod offset;
 pub use scallop_geom::tol::rough as tol;
 mod walls;
 
-pub use adaptive::plan_adaptive;
+pub use adaptive::{plan_adaptive, plan_adaptive_in};
 pub use material::{MaterialMap, limit_to_material};
 pub use offset::{Step, plan_offset};
 
@@ -93,9 +93,24 @@ pub enum Pattern {
 /// # Errors
 /// [`RoughError::TooMuchWork`] beyond the planners' bounds.
 pub fn plan_region(region: &Region, options: &ClearOptions) -> Result<Vec<Step>, RoughError> {
+    plan_region_in(region, None, options)
+}
+
+/// As [`plan_region`], the material of the level being `material` (the
+/// adaptive pattern's [`plan_adaptive_in`]: no engagement counted, passes
+/// started and rings left out where the tool cuts air; the offset pattern
+/// does not use it).
+///
+/// # Errors
+/// As [`plan_region`].
+pub fn plan_region_in(
+    region: &Region,
+    material: Option<&Region>,
+    options: &ClearOptions,
+) -> Result<Vec<Step>, RoughError> {
     match options.pattern {
         Pattern::Offset => plan_offset(region, options),
-        Pattern::Adaptive => plan_adaptive(region, options),
+        Pattern::Adaptive => plan_adaptive_in(region, material, options),
     }
 }
 
@@ -363,7 +378,18 @@ pub fn plan_levels(
         chord_tolerance: tolerance,
         pattern: settings.pattern,
     };
-    let mut nodes = build_tree(&levels, &options)?;
+    // Where each level holds material: the stock's section, and of it the
+    // in-process stock's cells above the level when given.
+    let (lo, hi) = ([stock.min.x, stock.min.y], [stock.max.x, stock.max.y]);
+    let section = Region::from_polygons(&[vec![lo, [hi[0], lo[1]], hi, [lo[0], hi[1]]]], false);
+    let materials: Vec<Region> = levels
+        .par_iter()
+        .map(|l| match material {
+            Some(m) => m.above(l.z + tol::MIN_CHIP).intersection(&section, tolerance),
+            None => section.clone(),
+        })
+        .collect();
+    let mut nodes = build_tree(&levels, &materials, &options)?;
     if let Some(m) = material {
         // A node with no parent is entered from the material's top over its
         // region grown by the tool radius (not the box's top).
@@ -392,7 +418,7 @@ pub fn plan_levels(
 }
 
 /// The nodes of all levels with their parents and plans (planned in parallel).
-fn build_tree(levels: &[Level], options: &ClearOptions) -> Result<Vec<Node>, RoughError> {
+fn build_tree(levels: &[Level], materials: &[Region], options: &ClearOptions) -> Result<Vec<Node>, RoughError> {
     let mut shells: Vec<(usize, Region)> = Vec::new();
     for (k, level) in levels.iter().enumerate() {
         shells.extend(level.region.components().into_iter().map(|c| (k, c)));
@@ -400,7 +426,7 @@ fn build_tree(levels: &[Level], options: &ClearOptions) -> Result<Vec<Node>, Rou
     let first_of_level: Vec<usize> =
         (0..=levels.len()).map(|k| shells.iter().position(|s| s.0 >= k).unwrap_or(shells.len())).collect();
     let planned: Result<Vec<Vec<Step>>, RoughError> =
-        shells.par_iter().map(|(_, region)| plan_region(region, options)).collect();
+        shells.par_iter().map(|(k, region)| plan_region_in(region, Some(&materials[*k]), options)).collect();
     let planned = planned?;
     // Parents are found among the previous level's nodes by containment.
     let mut out: Vec<Node> = Vec::with_capacity(shells.len());
@@ -524,7 +550,7 @@ impl Emitter {
                 Step::Cut(c) => {
                     let Some(s) = c.start() else { continue };
                     if first {
-                        self.enter(nodes, k, s);
+                        self.enter(nodes, k, s, false);
                         first = false;
                     }
                     self.cut(c, node.z);
@@ -532,7 +558,12 @@ impl Emitter {
                 Step::Link { tool_down, via, cleared, to } => {
                     let next = to.or_else(|| next_start(&node.steps, step));
                     if let Some(s) = next {
-                        if *tool_down {
+                        if first {
+                            // The node's entry: a straight plunge where the
+                            // tool cuts nothing there (`cleared`).
+                            self.enter(nodes, k, s, *cleared);
+                            first = false;
+                        } else if *tool_down {
                             for p in via {
                                 self.path.push(Move::new(MoveKind::Link, Point3::new(p[0], p[1], node.z)));
                             }
@@ -553,12 +584,12 @@ impl Emitter {
     /// level both lie in, across it when the straight move stays in its
     /// region, else over the clearance height; then down through the cleared
     /// levels above `k` and a plunge.
-    fn enter(&mut self, nodes: &[Node], k: usize, s: P2) {
+    fn enter(&mut self, nodes: &[Node], k: usize, s: P2, straight: bool) {
         let node = &nodes[k];
         let above = self.cleared_top(nodes, k, s);
         let (Some(here), Some(last)) = (self.at(), self.last) else {
             self.path.push(Move::new(MoveKind::Rapid, Point3::new(s[0], s[1], self.clearance)));
-            self.plunge(s, above, node.z, &node.region);
+            self.plunge(s, above, node.z, &node.region, straight);
             return;
         };
         let ancestors = chain(nodes, k);
@@ -581,13 +612,13 @@ impl Emitter {
                 }
                 self.path.push(Move::new(MoveKind::Link, Point3::new(s[0], s[1], zc)));
                 self.links += 1;
-                self.plunge(s, above.min(zc), node.z, &node.region);
+                self.plunge(s, above.min(zc), node.z, &node.region, straight);
             }
             None => {
                 self.retracts += 1;
                 self.path.push(Move::new(MoveKind::Retract, Point3::new(here.x, here.y, self.clearance)));
                 self.path.push(Move::new(MoveKind::Rapid, Point3::new(s[0], s[1], self.clearance)));
-                self.plunge(s, above, node.z, &node.region);
+                self.plunge(s, above, node.z, &node.region, straight);
             }
         }
     }
@@ -614,13 +645,13 @@ impl Emitter {
     /// circle fits in `region` (the tool centre's circle of
     /// [`tol::HELIX_RADIUS_SHARE`] R, descending at [`tol::HELIX_SLOPE`], one
     /// full turn at `z`, counter-clockwise: climb in the bore), else a
-    /// straight plunge.
-    fn plunge(&mut self, s: P2, above: f64, z: f64, region: &Region) {
+    /// straight plunge (always when `straight`: the tool cuts nothing at `s`).
+    fn plunge(&mut self, s: P2, above: f64, z: f64, region: &Region, straight: bool) {
         let current = self.at().map_or(self.clearance, |p| p.z);
         let approach = above + tol::APPROACH;
         let rh = self.helix_radius;
         let depth = above - z;
-        let fits = rh > 0.0 && depth > 0.0 && region.offset(rh).contains(s);
+        let fits = !straight && rh > 0.0 && depth > 0.0 && region.offset(rh).contains(s);
         let start = if fits { [s[0] + rh, s[1]] } else { s };
         if current > approach {
             self.path.push(Move::new(MoveKind::Rapid, Point3::new(start[0], start[1], approach)));
@@ -662,7 +693,7 @@ impl Emitter {
             self.path.push(Move::new(MoveKind::Rapid, Point3::new(s[0], s[1], above + tol::APPROACH)));
             self.path.push(Move::new(MoveKind::Plunge, Point3::new(s[0], s[1], z)));
         } else {
-            self.plunge(s, above, z, region);
+            self.plunge(s, above, z, region, false);
         }
     }
 

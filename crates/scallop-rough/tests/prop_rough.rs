@@ -306,3 +306,77 @@ proptest! {
         prop_assert!(kept > 0, "no centre kept");
     }
 }
+
+/// Adaptive clearing of a box on a plate in a larger stock: every level's
+/// region runs R past the stock's sides, which are open (air). The levels
+/// are entered from there by straight plunges (no helix), the feed moves
+/// keep out of the air beyond the stock (no ring around it, no pass along
+/// it), every tool centre of the regions inside the stock is reached by the
+/// tool (no reachable stock left), and the plan is the same on one and two
+/// threads.
+#[test]
+fn adaptive_levels_are_entered_from_the_open_sides() {
+    let mesh = stepped_part(-6.0, 6.0, -5.0, 5.0, 6.0, 2.0);
+    let index = MeshIndex::build(&mesh);
+    let r = 3.0;
+    let cutter = Cutter::new(CutterShape::Flat { radius: r }, 40.0).unwrap();
+    let stock = Aabb3 { min: Point3::new(-16.0, -14.0, 0.0), max: Point3::new(16.0, 14.0, 10.0) };
+    let motion = Motion { clearance_z: 20.0, feed: 1000.0 };
+    let set = RoughSettings { pattern: Pattern::Adaptive, ..settings(2.0, 0.3, 0.1) };
+    let run = |threads| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| plan_rough(&index, &cutter, &stock, &set, &motion, 1e-3).unwrap())
+    };
+    let (plan, again) = (run(1), run(2));
+    assert_eq!(plan.toolpath, again.toolpath);
+    assert!(plan.passes > 0);
+    assert_eq!(plan.helices, 0, "a level with an open side is entered from the air");
+    // Distance of a tool centre outside the stock's section (0 inside).
+    let outside = |x: f64, y: f64| {
+        let dx = (stock.min.x - x).max(x - stock.max.x).max(0.0);
+        let dy = (stock.min.y - y).max(y - stock.max.y).max(0.0);
+        dx.hypot(dy)
+    };
+    let moves = plan.toolpath.moves();
+    let (mut feed, mut air) = (0.0, 0.0);
+    for k in 1..moves.len() {
+        if moves[k].kind != MoveKind::Feed || moves[k].to.z >= stock.max.z {
+            continue;
+        }
+        let (a, b) = (moves[k - 1].to, moves[k].to);
+        let n = 20;
+        for i in 0..n {
+            let t = (f64::from(i) + 0.5) / f64::from(n);
+            let len = (b - a).norm() / f64::from(n);
+            feed += len;
+            // The tool cuts nothing beyond R outside the stock.
+            if outside(a.x + t * (b.x - a.x), a.y + t * (b.y - a.y)) >= r - 0.05 {
+                air += len;
+            }
+        }
+    }
+    assert!(air <= 0.03 * feed, "{air:.1} of {feed:.1} mm of feed in the air around the stock");
+    // Every tool-down link stays in the tool-centre region of its level.
+    for k in 1..moves.len() {
+        let (a, b) = (moves[k - 1].to, moves[k].to);
+        if moves[k].kind == MoveKind::Link && (a.z - b.z).abs() < 1e-12 {
+            let level = plan.levels.iter().find(|l| (l.z - b.z).abs() < 1e-9).unwrap();
+            assert!(level.region.offset(-1e-3).contains_segment([a.x, a.y], [b.x, b.y], 1e-3), "link {a:?} -> {b:?} leaves its level");
+        }
+    }
+    // Every region point inside the stock is within R of the cutting samples of its level.
+    let pts = samples(&plan.toolpath, 0.1);
+    for level in &plan.levels {
+        let inner = level.region.offset(-0.05);
+        let at: Vec<&Point3> = pts.iter().filter(|q| (q.z - level.z).abs() < 1e-9).collect();
+        for i in 0..64 {
+            for j in 0..56 {
+                let p = [stock.min.x + 0.5 * (f64::from(i) + 0.5), stock.min.y + 0.5 * (f64::from(j) + 0.5)];
+                if inner.contains(p) {
+                    let covered = at.iter().any(|q| (q.x - p[0]).hypot(q.y - p[1]) <= r);
+                    assert!(covered, "{p:?} at z {} left uncut", level.z);
+                }
+            }
+        }
+    }
+}

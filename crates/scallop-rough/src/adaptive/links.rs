@@ -42,6 +42,7 @@ impl Planner<'_> {
             let Some(at) = self.grid.locate(q) else { continue };
             if Grid::interpolate(&self.swept, nx, at) > r + LINK_SLACK
                 && Grid::interpolate(&self.reach, nx, at) < r - self.strip
+                && !self.open_at(at)
             {
                 return false;
             }
