@@ -361,7 +361,10 @@ fn adaptive_levels_are_entered_from_the_open_sides() {
         let (a, b) = (moves[k - 1].to, moves[k].to);
         if moves[k].kind == MoveKind::Link && (a.z - b.z).abs() < 1e-12 {
             let level = plan.levels.iter().find(|l| (l.z - b.z).abs() < 1e-9).unwrap();
-            assert!(level.region.offset(-1e-3).contains_segment([a.x, a.y], [b.x, b.y], 1e-3), "link {a:?} -> {b:?} leaves its level");
+            assert!(
+                level.region.offset(-1e-3).contains_segment([a.x, a.y], [b.x, b.y], 1e-3),
+                "link {a:?} -> {b:?} leaves its level"
+            );
         }
     }
     // Every region point inside the stock is within R of the cutting samples of its level.

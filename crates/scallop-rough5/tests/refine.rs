@@ -205,13 +205,19 @@ fn box_mesh(lo: Point3, hi: Point3) -> TriMesh {
     TriMesh::from_soup(&soup).unwrap().0
 }
 
-/// In a blank 8 mm under the stock top, the CL points whose tool lies above
-/// the blank are left out: no cutting move runs higher than the blank's top
-/// plus the tool radius, the margin and the entry clearance, where the plan
-/// in the whole box has such moves; the program is shorter and proven from
-/// the blank. The plan in no blank is the plan in the box.
-#[test]
-fn a_low_blank_trims_the_levels_above_it() {
+/// The small pocket, its bottom and flanks, the tool, refined settings and a
+/// blank 8 mm under the stock top (`top`, its height).
+struct LowBlank {
+    part: scallop_parts::TestPart,
+    bottom: TriMesh,
+    flanks: TriMesh,
+    tool: Cutter,
+    s: Rough5Settings,
+    top: f64,
+    blank: TriMesh,
+}
+
+fn low_blank() -> LowBlank {
     let part = small_pocket();
     let bottom = part.faces(&[FaceTag::Bottom]).unwrap();
     let flanks = part.faces(&[FaceTag::Flank]).unwrap();
@@ -219,6 +225,17 @@ fn a_low_blank_trims_the_levels_above_it() {
     let (tool, s) = (tool(), settings(depth, true));
     let top = part.stock.max.z - 8.0;
     let blank = box_mesh(part.stock.min, Point3::new(part.stock.max.x, part.stock.max.y, top));
+    LowBlank { part, bottom, flanks, tool, s, top, blank }
+}
+
+/// In a blank 8 mm under the stock top, the CL points whose tool lies above
+/// the blank are left out: no cutting move runs higher than the blank's top
+/// plus the tool radius, the margin and the entry clearance, where the plan
+/// in the whole box has such moves; the program is shorter and proven from
+/// the blank. The plan in no blank is the plan in the box.
+#[test]
+fn a_low_blank_trims_the_levels_above_it() {
+    let LowBlank { part, bottom, flanks, tool, s, top, blank } = low_blank();
     let boxed = plan_rough5(&bottom, &flanks, &part.stock, &tool, &s, &|_, _| {}).unwrap();
     let none = plan_rough5_in(&bottom, &flanks, (&part.stock, None), &tool, &s, &|_, _| {}).unwrap();
     assert_eq!(none.toolpath, boxed.toolpath);
@@ -248,13 +265,7 @@ fn a_low_blank_trims_the_levels_above_it() {
 /// the blank: no rapid meets its stock.
 #[test]
 fn the_tool_goes_rapid_over_the_blank() {
-    let part = small_pocket();
-    let bottom = part.faces(&[FaceTag::Bottom]).unwrap();
-    let flanks = part.faces(&[FaceTag::Flank]).unwrap();
-    let depth = part.stock.max.z - bottom.bounds().min.z;
-    let (tool, s) = (tool(), settings(depth, true));
-    let top = part.stock.max.z - 8.0;
-    let blank = box_mesh(part.stock.min, Point3::new(part.stock.max.x, part.stock.max.y, top));
+    let LowBlank { part, bottom, flanks, tool, s, top, blank } = low_blank();
     let plan = plan_rough5_in(&bottom, &flanks, (&part.stock, Some(&blank)), &tool, &s, &|_, _| {}).unwrap();
     let path = &plan.toolpath;
     let moves = path.moves();
