@@ -715,6 +715,15 @@ pub mod rough {
     /// as cleared (see `material.rs`).
     pub const MIN_CHIP: f64 = 0.05;
 
+    /// Offset clearing: a ring along which the tool centre stays farther than
+    /// R less this from the level's material cuts nothing worth a pass (mm)
+    /// and is left out (the ring around the stock's sides).
+    pub const AIR_RING_CHIP: f64 = 0.01;
+
+    /// Offset clearing: rings are tested against the material at samples
+    /// this far apart (mm).
+    pub const AIR_RING_STEP: f64 = 0.05;
+
     /// Most cells of an in-process stock map (bounds the memory of the outline
     /// tracing on absurd inputs).
     pub const MAX_MATERIAL_CELLS: usize = 64_000_000;

@@ -29,7 +29,7 @@ mod walls;
 
 pub use adaptive::{plan_adaptive, plan_adaptive_in};
 pub use material::{MaterialMap, limit_to_material};
-pub use offset::{Step, plan_offset};
+pub use offset::{Step, plan_offset, plan_offset_in};
 
 /// Why a roughing plan could not be made; each variant names the setting and the fix.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -98,8 +98,8 @@ pub fn plan_region(region: &Region, options: &ClearOptions) -> Result<Vec<Step>,
 
 /// As [`plan_region`], the material of the level being `material` (the
 /// adaptive pattern's [`plan_adaptive_in`]: no engagement counted, passes
-/// started and rings left out where the tool cuts air; the offset pattern
-/// does not use it).
+/// started and rings left out where the tool cuts air; the offset pattern's
+/// [`plan_offset_in`]: rings left out where the tool cuts air).
 ///
 /// # Errors
 /// As [`plan_region`].
@@ -109,7 +109,7 @@ pub fn plan_region_in(
     options: &ClearOptions,
 ) -> Result<Vec<Step>, RoughError> {
     match options.pattern {
-        Pattern::Offset => plan_offset(region, options),
+        Pattern::Offset => plan_offset_in(region, material, options),
         Pattern::Adaptive => plan_adaptive_in(region, material, options),
     }
 }

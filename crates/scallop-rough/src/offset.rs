@@ -51,6 +51,23 @@ pub enum Step {
 /// # Errors
 /// [`RoughError::TooMuchWork`] beyond [`tol::MAX_PASSES`] levels.
 pub fn plan_offset(region: &Region, options: &ClearOptions) -> Result<Vec<Step>, RoughError> {
+    plan_offset_in(region, None, options)
+}
+
+/// As [`plan_offset`], the material of the level being `material`: a ring
+/// along which the tool never comes within R of it (less than
+/// [`tol::AIR_RING_CHIP`] deep) cuts nothing and is left out. The ring of a
+/// level's region around the stock's sides (the section grown by R) is one.
+/// Leaving rings out keeps the links safe: the area the module documentation
+/// counts as cleared by a ring left out holds no material.
+///
+/// # Errors
+/// As [`plan_offset`].
+pub fn plan_offset_in(
+    region: &Region,
+    material: Option<&Region>,
+    options: &ClearOptions,
+) -> Result<Vec<Step>, RoughError> {
     let ae = options.stepover;
     let mut levels = vec![region.clone()];
     loop {
@@ -69,10 +86,12 @@ pub fn plan_offset(region: &Region, options: &ClearOptions) -> Result<Vec<Step>,
     // The passes of level 0 lie on the region's contour: grown a hair, the
     // region holds them.
     let holder = region.offset(-tol::LINK_GROW);
+    let reach = material.map(|m| Reach::new(m, options.tool_radius, options.chord_tolerance));
     let mut steps = Vec::new();
     let mut pos: Option<P2> = None;
     for k in (0..levels.len()).rev() {
-        let mut rings: Vec<&Contour> = levels[k].rings().iter().collect();
+        let mut rings: Vec<&Contour> =
+            levels[k].rings().iter().filter(|c| reach.as_ref().is_none_or(|m| m.touches(c))).collect();
         while !rings.is_empty() {
             let (i, ring) = nearest(&rings, pos, options.direction);
             rings.swap_remove(i);
@@ -89,6 +108,52 @@ pub fn plan_offset(region: &Region, options: &ClearOptions) -> Result<Vec<Step>,
         }
     }
     Ok(steps)
+}
+
+/// Where a tool centre meets material: the material grown by R less
+/// [`tol::AIR_RING_CHIP`].
+struct Reach {
+    grown: Region,
+    bounds: Option<(P2, P2)>,
+    /// Arcs are sampled as chords within this (mm).
+    chord: f64,
+}
+
+impl Reach {
+    fn new(material: &Region, radius: f64, chord: f64) -> Reach {
+        let grown = material.offset(-(radius - tol::AIR_RING_CHIP).max(0.0));
+        let bounds = grown.bounds();
+        Reach { grown, bounds, chord }
+    }
+
+    /// Some point of `ring`, sampled every [`tol::AIR_RING_STEP`], lies in
+    /// the grown material. Between two samples a straight stretch dips at
+    /// most `s^2 / 8 rho` into a boundary of curvature radius rho (the
+    /// material's corners grown by about R): under a micrometre at the step.
+    fn touches(&self, ring: &Contour) -> bool {
+        let Some((lo, hi)) = self.bounds else { return false };
+        let points = ring.to_points(self.chord);
+        let inside = |p: P2| p[0] >= lo[0] && p[0] <= hi[0] && p[1] >= lo[1] && p[1] <= hi[1] && self.grown.contains(p);
+        let mut prev: Option<P2> = points.last().copied().filter(|_| ring.is_closed());
+        for &p in &points {
+            if let Some(q) = prev {
+                let d = (p[0] - q[0]).hypot(p[1] - q[1]);
+                #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a short ring's samples")]
+                let n = (d / tol::AIR_RING_STEP).ceil().max(1.0) as usize;
+                #[allow(clippy::cast_precision_loss, reason = "small counts")]
+                if (1..=n).any(|i| {
+                    let f = i as f64 / n as f64;
+                    inside([q[0] + f * (p[0] - q[0]), q[1] + f * (p[1] - q[1])])
+                }) {
+                    return true;
+                }
+            } else if inside(p) {
+                return true;
+            }
+            prev = Some(p);
+        }
+        false
+    }
 }
 
 /// The last of `levels` (the erosions of `region` by 0, ae, 2 ae, ...)

@@ -10,8 +10,8 @@ use scallop_cutter::{Cutter, CutterShape, drop_cutter};
 use scallop_geom::{Aabb3, Point2, Point3};
 use scallop_mesh::{MeshIndex, TriMesh};
 use scallop_rough::{
-    ClearOptions, Direction, MaterialMap, Motion, Pattern, RoughSettings, Step, grown_cutter, plan_offset, plan_rough,
-    plan_rough_from, pocket_toolpath,
+    ClearOptions, Direction, MaterialMap, Motion, Pattern, RoughPlan, RoughSettings, Step, grown_cutter, plan_offset,
+    plan_rough, plan_rough_from, pocket_toolpath,
 };
 use scallop_toolpath::{MoveKind, Toolpath};
 
@@ -331,6 +331,39 @@ fn adaptive_levels_are_entered_from_the_open_sides() {
     assert_eq!(plan.toolpath, again.toolpath);
     assert!(plan.passes > 0);
     assert_eq!(plan.helices, 0, "a level with an open side is entered from the air");
+    assert_open_sides_kept(&plan, &stock, r);
+}
+
+/// The offset pattern, told each level's material (the stock's section),
+/// leaves out the ring of the region around the stock's sides (the section
+/// grown by R), along which the tool cuts nothing: at most 3 % of the feed
+/// in the air around the stock, every tool centre inside the stock still
+/// reached, links inside their levels, and the same plan on one and two
+/// threads.
+#[test]
+fn offset_levels_cut_no_ring_around_the_stock() {
+    let mesh = stepped_part(-6.0, 6.0, -5.0, 5.0, 6.0, 2.0);
+    let index = MeshIndex::build(&mesh);
+    let r = 3.0;
+    let cutter = Cutter::new(CutterShape::Flat { radius: r }, 40.0).unwrap();
+    let stock = Aabb3 { min: Point3::new(-16.0, -14.0, 0.0), max: Point3::new(16.0, 14.0, 10.0) };
+    let motion = Motion { clearance_z: 20.0, feed: 1000.0 };
+    let set = RoughSettings { pattern: Pattern::Offset, ..settings(2.0, 0.3, 0.1) };
+    let run = |threads| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| plan_rough(&index, &cutter, &stock, &set, &motion, 1e-3).unwrap())
+    };
+    let (plan, again) = (run(1), run(2));
+    assert_eq!(plan.toolpath, again.toolpath);
+    assert!(plan.passes > 0);
+    assert_open_sides_kept(&plan, &stock, r);
+}
+
+/// Checks of a plan of levels on a part in a box of stock: at most 3 % of
+/// the feed beyond R - 0.05 mm outside the stock's section, every tool-down
+/// link inside its level's region, every region point inside the stock
+/// within R of the cutting samples of its level.
+fn assert_open_sides_kept(plan: &RoughPlan, stock: &Aabb3, r: f64) {
     // Distance of a tool centre outside the stock's section (0 inside).
     let outside = |x: f64, y: f64| {
         let dx = (stock.min.x - x).max(x - stock.max.x).max(0.0);
@@ -372,10 +405,11 @@ fn adaptive_levels_are_entered_from_the_open_sides() {
     for level in &plan.levels {
         let inner = level.region.offset(-0.05);
         let at: Vec<&Point3> = pts.iter().filter(|q| (q.z - level.z).abs() < 1e-9).collect();
-        for i in 0..64 {
-            for j in 0..56 {
+        let (ni, nj) = ((stock.max.x - stock.min.x) / 0.5, (stock.max.y - stock.min.y) / 0.5);
+        for i in 0..ni.ceil() as i32 {
+            for j in 0..nj.ceil() as i32 {
                 let p = [stock.min.x + 0.5 * (f64::from(i) + 0.5), stock.min.y + 0.5 * (f64::from(j) + 0.5)];
-                if inner.contains(p) {
+                if p[0] < stock.max.x && p[1] < stock.max.y && inner.contains(p) {
                     let covered = at.iter().any(|q| (q.x - p[0]).hypot(q.y - p[1]) <= r);
                     assert!(covered, "{p:?} at z {} left uncut", level.z);
                 }
