@@ -313,6 +313,19 @@ impl Contour {
             [v.x, v.y]
         })
     }
+
+    /// Where a pass along the contour ends: the first point of a closed
+    /// contour, the last vertex of an open one.
+    #[must_use]
+    pub fn end(&self) -> Option<P2> {
+        if self.is_closed() {
+            return self.start();
+        }
+        (!self.is_empty()).then(|| {
+            let v = self.pline.at(self.pline.vertex_count() - 1);
+            [v.x, v.y]
+        })
+    }
 }
 
 /// A filled area of the plane: rings with the area on their left (outer

@@ -721,8 +721,14 @@ pub mod rough {
     pub const AIR_RING_CHIP: f64 = 0.01;
 
     /// Offset clearing: rings are tested against the material at samples
-    /// this far apart (mm).
+    /// at least this far apart (mm; farther for larger tools, see
+    /// `scallop-rough`'s `offset.rs`).
     pub const AIR_RING_STEP: f64 = 0.05;
+
+    /// Offset clearing: a ring is cut into the stretches that reach the
+    /// material where the air between two of them is longer than this share
+    /// of the tool radius; a shorter gap is cut through.
+    pub const AIR_RUN_GAP_SHARE: f64 = 2.0;
 
     /// Most cells of an in-process stock map (bounds the memory of the outline
     /// tracing on absurd inputs).

@@ -28,7 +28,7 @@ pub use scallop_geom::tol::rough as tol;
 mod walls;
 
 pub use adaptive::{plan_adaptive, plan_adaptive_in};
-pub use material::{MaterialMap, limit_to_material};
+pub use material::{MaterialMap, limit_to_material, removable_material};
 pub use offset::{Step, plan_offset, plan_offset_in};
 
 /// Why a roughing plan could not be made; each variant names the setting and the fix.
@@ -93,23 +93,26 @@ pub enum Pattern {
 /// # Errors
 /// [`RoughError::TooMuchWork`] beyond the planners' bounds.
 pub fn plan_region(region: &Region, options: &ClearOptions) -> Result<Vec<Step>, RoughError> {
-    plan_region_in(region, None, options)
+    plan_region_in(region, None, None, options)
 }
 
 /// As [`plan_region`], the material of the level being `material` (the
 /// adaptive pattern's [`plan_adaptive_in`]: no engagement counted, passes
 /// started and rings left out where the tool cuts air; the offset pattern's
-/// [`plan_offset_in`]: rings left out where the tool cuts air).
+/// [`plan_offset_in`]: rings left out where the tool cuts air, and links
+/// through that air inside `room`, where the tool centre may go at the
+/// level beyond `region`).
 ///
 /// # Errors
 /// As [`plan_region`].
 pub fn plan_region_in(
     region: &Region,
     material: Option<&Region>,
+    room: Option<&Region>,
     options: &ClearOptions,
 ) -> Result<Vec<Step>, RoughError> {
     match options.pattern {
-        Pattern::Offset => plan_offset_in(region, material, options),
+        Pattern::Offset => plan_offset_in(region, material, room, options),
         Pattern::Adaptive => plan_adaptive_in(region, material, options),
     }
 }
@@ -354,7 +357,7 @@ pub fn plan_rough_from(
 /// # Errors
 /// As [`plan_rough`].
 pub fn plan_levels(
-    mut levels: Vec<Level>,
+    levels: Vec<Level>,
     cutter: &Cutter,
     stock: &Aabb3,
     material: Option<&MaterialMap>,
@@ -363,33 +366,45 @@ pub fn plan_levels(
     tolerance: f64,
 ) -> Result<RoughPlan, RoughError> {
     settings.validate()?;
-    if let Some(m) = material {
-        let r = cutter.radius();
-        levels = levels
+    // Where each level holds material: the stock's section, and with an
+    // in-process stock the material the tool would remove at the level
+    // (its region then cut down to the centres that reach it). The level's
+    // whole region stays the room for links through air.
+    let (lo, hi) = ([stock.min.x, stock.min.y], [stock.max.x, stock.max.y]);
+    let section = Region::from_polygons(&[vec![lo, [hi[0], lo[1]], hi, [lo[0], hi[1]]]], false);
+    let r = cutter.radius();
+    let spaces: Vec<(Level, Region, Option<Region>)> = match material {
+        Some(m) => levels
             .into_par_iter()
-            .map(|l| Level { region: limit_to_material(&l.region, m, l.z, r, tolerance), z: l.z })
-            .filter(|l| !l.region.is_empty())
-            .collect();
+            .map(|l| {
+                let removable = removable_material(&l.region, m, l.z, r, tolerance);
+                let region = if removable.is_empty() {
+                    Region::empty()
+                } else {
+                    l.region.intersection(&removable.offset(-r), tolerance)
+                };
+                (Level { region, z: l.z }, removable.intersection(&section, tolerance), Some(l.region))
+            })
+            .filter(|(l, _, _)| !l.region.is_empty())
+            .collect(),
+        None => levels.into_iter().map(|l| (l, section.clone(), None)).collect(),
+    };
+    let mut levels = Vec::with_capacity(spaces.len());
+    let mut materials = Vec::with_capacity(spaces.len());
+    let mut rooms = Vec::with_capacity(spaces.len());
+    for (l, m, room) in spaces {
+        levels.push(l);
+        materials.push(m);
+        rooms.push(room);
     }
     let options = ClearOptions {
-        tool_radius: cutter.radius(),
-        stepover: settings.stepover * 2.0 * cutter.radius(),
+        tool_radius: r,
+        stepover: settings.stepover * 2.0 * r,
         direction: settings.direction,
         chord_tolerance: tolerance,
         pattern: settings.pattern,
     };
-    // Where each level holds material: the stock's section, and of it the
-    // in-process stock's cells above the level when given.
-    let (lo, hi) = ([stock.min.x, stock.min.y], [stock.max.x, stock.max.y]);
-    let section = Region::from_polygons(&[vec![lo, [hi[0], lo[1]], hi, [lo[0], hi[1]]]], false);
-    let materials: Vec<Region> = levels
-        .par_iter()
-        .map(|l| match material {
-            Some(m) => m.above(l.z + tol::MIN_CHIP).intersection(&section, tolerance),
-            None => section.clone(),
-        })
-        .collect();
-    let mut nodes = build_tree(&levels, &materials, &options)?;
+    let mut nodes = build_tree(&levels, &materials, &rooms, &options)?;
     if let Some(m) = material {
         // A node with no parent is entered from the material's top over its
         // region grown by the tool radius (not the box's top).
@@ -418,15 +433,22 @@ pub fn plan_levels(
 }
 
 /// The nodes of all levels with their parents and plans (planned in parallel).
-fn build_tree(levels: &[Level], materials: &[Region], options: &ClearOptions) -> Result<Vec<Node>, RoughError> {
+fn build_tree(
+    levels: &[Level],
+    materials: &[Region],
+    rooms: &[Option<Region>],
+    options: &ClearOptions,
+) -> Result<Vec<Node>, RoughError> {
     let mut shells: Vec<(usize, Region)> = Vec::new();
     for (k, level) in levels.iter().enumerate() {
         shells.extend(level.region.components().into_iter().map(|c| (k, c)));
     }
     let first_of_level: Vec<usize> =
         (0..=levels.len()).map(|k| shells.iter().position(|s| s.0 >= k).unwrap_or(shells.len())).collect();
-    let planned: Result<Vec<Vec<Step>>, RoughError> =
-        shells.par_iter().map(|(k, region)| plan_region_in(region, Some(&materials[*k]), options)).collect();
+    let planned: Result<Vec<Vec<Step>>, RoughError> = shells
+        .par_iter()
+        .map(|(k, region)| plan_region_in(region, Some(&materials[*k]), rooms[*k].as_ref(), options))
+        .collect();
     let planned = planned?;
     // Parents are found among the previous level's nodes by containment.
     let mut out: Vec<Node> = Vec::with_capacity(shells.len());

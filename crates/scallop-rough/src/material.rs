@@ -174,13 +174,25 @@ impl MaterialMap {
 
 /// `region`, a level's tool-centre region at tool-tip height `z`, cut down
 /// to the centres from which a tool of radius `r` reaches material it would
-/// remove: the material above `z` (by [`tol::MIN_CHIP`]) within
-/// `r - margin` of the region, where the margin (a cell's diagonal plus the
-/// minimum chip) keeps the cells that only hold the allowance out; then
-/// every centre of the region within `r` of that material. Empty when the
-/// level holds nothing to remove. Booleans with chords within `tolerance`.
+/// remove ([`removable_material`]): every centre of the region within `r` of
+/// that material. Empty when the level holds nothing to remove. Booleans
+/// with chords within `tolerance`.
 #[must_use]
 pub fn limit_to_material(region: &Region, material: &MaterialMap, z: f64, r: f64, tolerance: f64) -> Region {
+    let removable = removable_material(region, material, z, r, tolerance);
+    if removable.is_empty() {
+        return Region::empty();
+    }
+    region.intersection(&removable.offset(-r), tolerance)
+}
+
+/// The material a tool of radius `r` at the centres of `region` (a level's
+/// tool-centre region at tool-tip height `z`) would remove: the material
+/// above `z` (by [`tol::MIN_CHIP`]) within `r - margin` of the region, where
+/// the margin (a cell's diagonal plus the minimum chip) keeps the cells that
+/// only hold the allowance out. Booleans with chords within `tolerance`.
+#[must_use]
+pub fn removable_material(region: &Region, material: &MaterialMap, z: f64, r: f64, tolerance: f64) -> Region {
     let [cx, cy] = material.cell_size();
     let margin = cx.hypot(cy) + tol::MIN_CHIP;
     let above = material.above(z + tol::MIN_CHIP);
@@ -188,11 +200,7 @@ pub fn limit_to_material(region: &Region, material: &MaterialMap, z: f64, r: f64
         return Region::empty();
     }
     let reach = region.offset(-(r - margin).max(0.0));
-    let removable = above.intersection(&reach, tolerance);
-    if removable.is_empty() {
-        return Region::empty();
-    }
-    region.intersection(&removable.offset(-r), tolerance)
+    above.intersection(&reach, tolerance)
 }
 
 #[cfg(test)]

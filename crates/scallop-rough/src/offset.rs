@@ -51,7 +51,7 @@ pub enum Step {
 /// # Errors
 /// [`RoughError::TooMuchWork`] beyond [`tol::MAX_PASSES`] levels.
 pub fn plan_offset(region: &Region, options: &ClearOptions) -> Result<Vec<Step>, RoughError> {
-    plan_offset_in(region, None, options)
+    plan_offset_in(region, None, None, options)
 }
 
 /// As [`plan_offset`], the material of the level being `material`: a ring
@@ -59,13 +59,18 @@ pub fn plan_offset(region: &Region, options: &ClearOptions) -> Result<Vec<Step>,
 /// [`tol::AIR_RING_CHIP`] deep) cuts nothing and is left out. The ring of a
 /// level's region around the stock's sides (the section grown by R) is one.
 /// Leaving rings out keeps the links safe: the area the module documentation
-/// counts as cleared by a ring left out holds no material.
+/// counts as cleared by a ring left out holds no material. A ring that meets
+/// the material along part of its length is cut along those stretches
+/// only. Tool-down links may also cross the air (the centres of `room`, else
+/// of `region`, farther than R from the material): the tool cuts nothing
+/// there.
 ///
 /// # Errors
 /// As [`plan_offset`].
 pub fn plan_offset_in(
     region: &Region,
     material: Option<&Region>,
+    room: Option<&Region>,
     options: &ClearOptions,
 ) -> Result<Vec<Step>, RoughError> {
     let ae = options.stepover;
@@ -86,28 +91,76 @@ pub fn plan_offset_in(
     // The passes of level 0 lie on the region's contour: grown a hair, the
     // region holds them.
     let holder = region.offset(-tol::LINK_GROW);
-    let reach = material.map(|m| Reach::new(m, options.tool_radius, options.chord_tolerance));
+    let tol_c = options.chord_tolerance;
+    let reach = material.map(|m| Reach::new(m, options.tool_radius, tol_c));
+    // Where the tool cuts nothing (beyond R of the material): a tool-down
+    // link may cross it as well as the cleared bands.
+    let room = room.map_or_else(|| holder.clone(), |r| r.offset(-tol::LINK_GROW).union(&holder, tol_c));
+    let air = reach.as_ref().map(|m| room.difference(&m.grown, tol_c));
     let mut steps = Vec::new();
     let mut pos: Option<P2> = None;
+    let r = options.tool_radius;
     for k in (0..levels.len()).rev() {
-        let mut rings: Vec<&Contour> =
-            levels[k].rings().iter().filter(|c| reach.as_ref().is_none_or(|m| m.touches(c))).collect();
-        while !rings.is_empty() {
-            let (i, ring) = nearest(&rings, pos, options.direction);
-            rings.swap_remove(i);
-            let Some(start) = ring.start() else { continue };
-            if let Some(p) = pos {
-                let down = bands[k].as_ref().is_some_and(|band| {
-                    band.contains_segment(p, start, options.chord_tolerance)
-                        && holder.contains_segment(p, start, options.chord_tolerance)
-                });
-                steps.push(Step::Link { tool_down: down, via: Vec::new(), cleared: false, to: None });
+        // The material left when the rings of the deeper levels are cut:
+        // they swept every point within R of `levels[k + 1]` (the module
+        // documentation; a sliver under the chip at that reach's edge is
+        // counted as swept).
+        let left = match (material, levels.get(k + 1)) {
+            (Some(m), Some(inner)) => {
+                Some(Reach::new(&m.difference(&inner.offset(-(r + tol::AIR_RING_CHIP)), tol_c), r, tol_c))
             }
-            pos = Some(start);
-            steps.push(Step::Cut(ring));
+            (Some(_), None) => None,
+            (None, _) => None,
+        };
+        let left = left.as_ref().or(reach.as_ref());
+        let mut pieces: Vec<Piece> = Vec::new();
+        for ring in levels[k].rings() {
+            let ring = orient(ring, options.direction);
+            match left {
+                None => pieces.push(Piece { contour: ring, closed: true, from_air: false }),
+                Some(m) => pieces.extend(m.pieces(&ring, r)),
+            }
+        }
+        // A band may reach past the region: it is kept inside.
+        let band = bands[k].as_ref().map(|b| b.intersection(&holder, tol_c));
+        let safe = match (band, &air) {
+            (Some(band), Some(air)) => Some(band.union(air, tol_c)),
+            (Some(band), None) => Some(band),
+            (None, Some(air)) => Some(air.clone()),
+            (None, None) => None,
+        };
+        while !pieces.is_empty() {
+            let (i, cut) = nearest(&pieces, pos);
+            let piece = pieces.swap_remove(i);
+            let Some(start) = cut.start() else { continue };
+            match pos {
+                Some(p) => {
+                    let down = safe.as_ref().is_some_and(|safe| safe.contains_segment(p, start, tol_c));
+                    steps.push(Step::Link { tool_down: down, via: Vec::new(), cleared: piece.from_air, to: None });
+                }
+                None if piece.from_air => {
+                    // The first cut starts where the tool cuts nothing: a
+                    // straight plunge there, no helix.
+                    steps.push(Step::Link { tool_down: false, via: Vec::new(), cleared: true, to: None });
+                }
+                None => {}
+            }
+            pos = cut.end().or(Some(start));
+            steps.push(Step::Cut(cut));
         }
     }
     Ok(steps)
+}
+
+/// A ring to cut, or the stretch of one that reaches the material.
+struct Piece {
+    /// Oriented for the milling direction.
+    contour: Contour,
+    /// A closed ring, which may be started anywhere; else an open stretch,
+    /// cut from its first point.
+    closed: bool,
+    /// The open stretch starts where the tool cuts nothing.
+    from_air: bool,
 }
 
 /// Where a tool centre meets material: the material grown by R less
@@ -117,42 +170,110 @@ struct Reach {
     bounds: Option<(P2, P2)>,
     /// Arcs are sampled as chords within this (mm).
     chord: f64,
+    /// Samples along a ring at most this far apart (mm).
+    step: f64,
 }
 
 impl Reach {
+    /// Between two samples `s` apart a straight stretch dips at most
+    /// `s^2 / 8 rho` into a boundary of curvature radius rho (the material's
+    /// corners grown by R less the chip): the samples lie close enough for
+    /// half the chip.
     fn new(material: &Region, radius: f64, chord: f64) -> Reach {
-        let grown = material.offset(-(radius - tol::AIR_RING_CHIP).max(0.0));
+        let rho = (radius - tol::AIR_RING_CHIP).max(0.0);
+        let grown = material.offset(-rho);
         let bounds = grown.bounds();
-        Reach { grown, bounds, chord }
+        let step = (4.0 * rho * tol::AIR_RING_CHIP).sqrt().clamp(tol::AIR_RING_STEP, radius.max(tol::AIR_RING_STEP));
+        Reach { grown, bounds, chord, step }
     }
 
-    /// Some point of `ring`, sampled every [`tol::AIR_RING_STEP`], lies in
-    /// the grown material. Between two samples a straight stretch dips at
-    /// most `s^2 / 8 rho` into a boundary of curvature radius rho (the
-    /// material's corners grown by about R): under a micrometre at the step.
-    fn touches(&self, ring: &Contour) -> bool {
-        let Some((lo, hi)) = self.bounds else { return false };
-        let points = ring.to_points(self.chord);
-        let inside = |p: P2| p[0] >= lo[0] && p[0] <= hi[0] && p[1] >= lo[1] && p[1] <= hi[1] && self.grown.contains(p);
-        let mut prev: Option<P2> = points.last().copied().filter(|_| ring.is_closed());
-        for &p in &points {
-            if let Some(q) = prev {
-                let d = (p[0] - q[0]).hypot(p[1] - q[1]);
-                #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a short ring's samples")]
-                let n = (d / tol::AIR_RING_STEP).ceil().max(1.0) as usize;
+    fn inside(&self, p: P2) -> bool {
+        self.bounds.is_some_and(|(lo, hi)| {
+            p[0] >= lo[0] && p[0] <= hi[0] && p[1] >= lo[1] && p[1] <= hi[1] && self.grown.contains(p)
+        })
+    }
+
+    /// The stretches of the closed `ring` to cut: the whole ring when the
+    /// tool meets material all along it, none when nowhere, else the open
+    /// stretches that reach it, each one sample longer at both ends, joined
+    /// across gaps of air shorter than [`tol::AIR_RUN_GAP_SHARE`] R (cutting
+    /// through such a gap costs less than a link).
+    fn pieces(&self, ring: &Contour, radius: f64) -> Vec<Piece> {
+        let mut samples: Vec<P2> = Vec::new();
+        let vertices = ring.to_points(self.chord);
+        for (i, &p) in vertices.iter().enumerate() {
+            let q = vertices[(i + 1) % vertices.len()];
+            let d = (q[0] - p[0]).hypot(q[1] - p[1]);
+            #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a ring's samples")]
+            let n = (d / self.step).ceil().max(1.0) as usize;
+            for j in 0..n {
                 #[allow(clippy::cast_precision_loss, reason = "small counts")]
-                if (1..=n).any(|i| {
-                    let f = i as f64 / n as f64;
-                    inside([q[0] + f * (p[0] - q[0]), q[1] + f * (p[1] - q[1])])
-                }) {
-                    return true;
-                }
-            } else if inside(p) {
-                return true;
+                let f = j as f64 / n as f64;
+                samples.push([p[0] + f * (q[0] - p[0]), p[1] + f * (q[1] - p[1])]);
             }
-            prev = Some(p);
         }
-        false
+        let n = samples.len();
+        let touch: Vec<bool> = samples.iter().map(|&p| self.inside(p)).collect();
+        let Some(first_air) = touch.iter().position(|t| !t) else {
+            return vec![Piece { contour: ring.clone(), closed: true, from_air: false }];
+        };
+        if !touch.iter().any(|&t| t) {
+            return Vec::new();
+        }
+        // From an air sample round the ring: the stretches that touch, with
+        // the gaps of air between them.
+        let gap = tol::AIR_RUN_GAP_SHARE * radius;
+        let at = |i: usize| samples[(first_air + i) % n];
+        let hit = |i: usize| touch[(first_air + i) % n];
+        let mut runs: Vec<(usize, usize)> = Vec::new();
+        let mut i = 0;
+        while i < n {
+            if !hit(i) {
+                i += 1;
+                continue;
+            }
+            let a = i;
+            while i < n && hit(i) {
+                i += 1;
+            }
+            runs.push((a, i - 1));
+        }
+        // Join runs across short gaps (the last one to the first across the
+        // ring's start, when the ring closes through air shorter than the gap).
+        let length = |a: usize, b: usize| -> f64 {
+            (a..b)
+                .map(|j| {
+                    let (p, q) = (at(j), at(j + 1));
+                    (q[0] - p[0]).hypot(q[1] - p[1])
+                })
+                .sum()
+        };
+        let mut joined: Vec<(usize, usize)> = Vec::new();
+        for run in runs {
+            match joined.last_mut() {
+                Some(last) if length(last.1, run.0) < gap => last.1 = run.1,
+                _ => joined.push(run),
+            }
+        }
+        if joined.len() > 1 {
+            let (first, last) = (joined[0], joined[joined.len() - 1]);
+            if length(last.1, first.0 + n) < gap {
+                joined[0] = (last.0, first.1 + n);
+                joined.pop();
+            }
+        }
+        if joined.len() == 1 && length(joined[0].1, joined[0].0 + n) < gap {
+            return vec![Piece { contour: ring.clone(), closed: true, from_air: false }];
+        }
+        joined
+            .into_iter()
+            .filter_map(|(a, b)| {
+                // One sample into the air at each end.
+                let points: Vec<P2> = (a.saturating_sub(1)..=b + 1).map(at).collect();
+                let contour = Contour::polygon(&points, false).ok()?;
+                Some(Piece { contour, closed: false, from_air: !hit(a.saturating_sub(1)) })
+            })
+            .collect()
     }
 }
 
@@ -186,24 +307,29 @@ fn erode(region: &Region, levels: &[Region], ae: f64) -> Result<Region, RoughErr
         .ok_or(RoughError::Offset { distance: depth })
 }
 
-/// The ring nearest `pos`, oriented for `direction` and started at its point
-/// nearest `pos`. Climb milling with a clockwise spindle keeps the uncut
-/// material on the tool's right: inside-out, that is the region's own
-/// orientation (the material lies outside each ring's filled side).
-fn nearest(rings: &[&Contour], pos: Option<P2>, direction: Direction) -> (usize, Contour) {
-    let orient = |c: &Contour| match direction {
+/// `c` oriented for `direction`. Climb milling with a clockwise spindle
+/// keeps the uncut material on the tool's right: inside-out, that is the
+/// region's own orientation (the material lies outside each ring's filled
+/// side).
+fn orient(c: &Contour, direction: Direction) -> Contour {
+    match direction {
         Direction::Climb => c.clone(),
         Direction::Conventional => c.reversed(),
-    };
-    let Some(p) = pos else { return (0, orient(rings[0])) };
+    }
+}
+
+/// The piece whose start is nearest `pos` (a closed ring started at its
+/// point nearest `pos`; an open stretch at its first point).
+fn nearest(pieces: &[Piece], pos: Option<P2>) -> (usize, Contour) {
+    let Some(p) = pos else { return (0, pieces[0].contour.clone()) };
     let mut best: Option<(f64, usize, Contour)> = None;
-    for (i, r) in rings.iter().enumerate() {
-        let c = orient(r).starting_near(p);
+    for (i, piece) in pieces.iter().enumerate() {
+        let c = if piece.closed { piece.contour.starting_near(p) } else { piece.contour.clone() };
         let s = c.start().unwrap_or(p);
         let d = (s[0] - p[0]).hypot(s[1] - p[1]);
         if best.as_ref().is_none_or(|b| d < b.0) {
             best = Some((d, i, c));
         }
     }
-    best.map_or_else(|| (0, orient(rings[0])), |(_, i, c)| (i, c))
+    best.map_or_else(|| (0, pieces[0].contour.clone()), |(_, i, c)| (i, c))
 }
