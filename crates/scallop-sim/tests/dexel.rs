@@ -368,7 +368,9 @@ fn five_axis_sub_steps_stay_within_the_bound() {
     let path = [mv(MoveKind::Plunge, p0, a0), mv(MoveKind::Feed, p1, a1)];
     let run = |tol: f64| {
         let mut d = DexelStock::new(stock, 0.25).unwrap();
-        let rep = d.cut(&cutter, &path, &DexelOptions { axis_tolerance: tol, check_collisions: false }).unwrap();
+        let rep = d
+            .cut(&cutter, &path, &DexelOptions { axis_tolerance: tol, check_collisions: false, max_stick_out: None })
+            .unwrap();
         (d, rep)
     };
     let tol = 0.02;
