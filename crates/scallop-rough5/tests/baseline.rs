@@ -221,3 +221,26 @@ fn three_plus_two_starts_from_the_blank() {
     assert!(proof.gouge_depth <= proof_settings.resolution, "{proof:?}");
     assert!(proof.remaining_percent < 100.0 && proof.removed_volume > 0.0, "{proof:?}");
 }
+
+/// The rest setups keep the shank and the holder off the in-process stock
+/// (docs/rough5.md, "Baselines"): with 27 mm of flutes, 28 mm out of a holder
+/// R 20, a setup leaning 15 deg puts the holder's rim under the block's top
+/// next to the undercut flanks, which the setup's levels (the flutes against
+/// the pocket's faces) do not see. The 3+2 program is planned and proven,
+/// its shank and holder clear of the stock along every move.
+#[test]
+fn rest_setups_keep_the_holder_off_the_stock() {
+    let part = closed_pocket(&PocketParams::default()).unwrap();
+    let f = faces(&part);
+    let tool = Cutter::new(CutterShape::Bull { radius: 5.0, corner: 1.5 }, 27.0)
+        .unwrap()
+        .with_shank(5.0, 1.0)
+        .unwrap()
+        .with_holder(vec![HolderSegment { length: 100.0, bottom_radius: 20.0, top_radius: 20.0 }])
+        .unwrap();
+    let plan = plan_three_plus_two(&pocket(&part, &f), &tool, &settings()).unwrap();
+    assert!(plan.setups.len() >= 2 && plan.setups[1..].iter().all(|s| s.passes > 0), "{:?}", plan.setups);
+    let proof_settings = ProofSettings { resolution: 1.0, axis_tolerance: 0.05 };
+    let proof = prove(&plan.toolpath, &tool, &part.stock, &part.mesh, &proof_settings, &|_, _| {}).unwrap();
+    assert!(proof.min_stick_out <= 28.0, "{proof:?}");
+}
