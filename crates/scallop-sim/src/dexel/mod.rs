@@ -700,16 +700,21 @@ impl DexelStock {
         let tick = || progress(done.fetch_add(1, Ordering::Relaxed) + 1, bands);
         let removal = FamilyCut::removal(&flutes, &guards, &steps, &boxes, &unions);
         let search = search.as_ref().map(|(s, _)| *s);
-        // The longest stick-out any band needs: (length, exceeded, limit as (step, place)).
-        let mut need: Option<(f64, bool, Option<(u32, Point3)>)> = None;
+        // The longest stick-out any band needs.
+        let mut need: Option<StickSearch> = None;
         for axis in 0..3 {
             let columns = if axis == 2 { Some((columns.as_slice(), flutes_top)) } else { None };
             let outputs = self.cut_family(axis, &FamilyCut { columns, search, ..removal }, &tick);
             for out in outputs {
                 if let Some(band) = out.stick_out {
                     // The longest; between equal lengths the earliest step (a fixed order).
-                    let step = |n: &(f64, bool, Option<(u32, Point3)>)| n.2.map_or(u32::MAX, |l| l.0);
-                    if need.is_none_or(|n| band.0 > n.0 || (band.0 == n.0 && step(&band) < step(&n))) {
+                    let step = |n: &StickSearch| n.limit.map_or(u32::MAX, |l| l.0);
+                    let longer = |n: &StickSearch| match band.length.total_cmp(&n.length) {
+                        std::cmp::Ordering::Greater => true,
+                        std::cmp::Ordering::Equal => step(&band) < step(n),
+                        std::cmp::Ordering::Less => false,
+                    };
+                    if need.as_ref().is_none_or(longer) {
                         need = Some(band);
                     }
                 }
@@ -739,8 +744,12 @@ impl DexelStock {
             .collect();
         let collisions = collision_list(operation, &collided);
         let min_stick_out = search.map(|s| {
-            let (length, exceeded, limit) = need.unwrap_or((s.cutter.flute_length(), false, None));
-            StickOut { length, limit: limit.map(|(k, at)| (steps[k as usize].id(), at)), exceeded }
+            let n = need.unwrap_or(StickSearch { length: s.cutter.flute_length(), exceeded: false, limit: None });
+            StickOut {
+                length: n.length,
+                limit: n.limit.map(|(k, at)| (steps[k as usize].id(), at)),
+                exceeded: n.exceeded,
+            }
         });
         let removed_volume = removed_by_move.iter().sum();
         let sweeps = steps.len();
@@ -1023,9 +1032,8 @@ struct BandOutput {
     removed: Vec<(u32, f64, f64, Point3)>,
     /// (step, part, depth, place).
     collisions: Vec<(u32, ToolPart, f64, Point3)>,
-    /// The band's smallest collision-free stick-out (length, whether even the
-    /// largest searched collides, the step and place that set it).
-    stick_out: Option<(f64, bool, Option<(u32, Point3)>)>,
+    /// The band's smallest collision-free stick-out.
+    stick_out: Option<StickSearch>,
 }
 
 /// The geometry of one family of rays.
@@ -1149,7 +1157,7 @@ impl Family {
                 }
             }
         }
-        out.stick_out = need.map(|(s, _)| (s.length, s.exceeded, s.limit));
+        out.stick_out = need.map(|(s, _)| s);
         out
     }
 
@@ -1171,7 +1179,9 @@ impl Family {
     }
 }
 
-/// A band's stick-out search so far.
+/// A band's stick-out search so far: the length, whether even the largest
+/// searched meets the stock, the step and place that set it.
+#[derive(Clone, Copy)]
 struct StickSearch {
     length: f64,
     exceeded: bool,
