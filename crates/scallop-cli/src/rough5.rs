@@ -484,8 +484,14 @@ fn baseline(
     let faces = |tags: &[FaceTag]| part.faces(tags).map_err(|e| e.to_string());
     let (surface, opening) = (faces(&[FaceTag::Bottom, FaceTag::Flank])?, faces(&[FaceTag::Top])?);
     let flanks = faces(&[FaceTag::Flank])?;
-    let pocket =
-        Pocket { surface: &surface, opening: &opening, flanks: &flanks, volume: &part.mesh, stock: part.stock };
+    let pocket = Pocket {
+        surface: &surface,
+        opening: &opening,
+        flanks: &flanks,
+        volume: &part.mesh,
+        stock: part.stock,
+        blank: part.blank.as_ref(),
+    };
     let s = BaselineSettings {
         stepdown: settings.guides.axial_step,
         stepover: settings.guides.radial_step,
@@ -554,6 +560,14 @@ pub(crate) fn metric_lines(s: &mut String, m: &Rough5Metrics, indent: &str) {
         m.removal_rate_percent_s,
         m.path_length_dm
     );
+    let _ = match (m.min_stick_out_move, m.min_stick_out_at_mm) {
+        (Some(k), Some([x, y, z])) => writeln!(
+            s,
+            "{indent}minimum collision-free stick-out {:.2} mm (move {k}, stock at ({x:.3}, {y:.3}, {z:.3}))",
+            m.min_stick_out_mm
+        ),
+        _ => writeln!(s, "{indent}minimum collision-free stick-out {:.2} mm (the flutes alone)", m.min_stick_out_mm),
+    };
 }
 
 fn summary_text(r: &Report, output: &Path) -> String {

@@ -27,6 +27,11 @@ fn rough5_writes_a_proven_program_and_its_metrics() {
     let t = num("machining_time_s");
     assert!((num("removal_rate_mm3_s") * t - num("removed_volume_mm3")).abs() <= 1e-6 * num("removed_volume_mm3"));
     assert!((num("removal_rate_percent_s") * t - (100.0 - num("remaining_percent"))).abs() < 1e-9);
+    // The minimum stick-out lies between the flutes (30 mm) and the tool's 41 mm; a move sets it
+    // unless the flutes alone suffice.
+    let stick = num("min_stick_out_mm");
+    assert!((30.0..=41.0).contains(&stick), "{stick}");
+    assert_eq!(m["min_stick_out_move"].is_null(), stick <= 30.0, "{m}");
     let nc = std::fs::read_to_string(dir.join("program.nc")).expect("program");
     assert!(nc.contains("TRAORI"));
     assert!(report["post_error"].is_null());

@@ -203,6 +203,15 @@ pub struct Rough5Metrics {
     pub removal_rate_mm3_s: f64,
     /// Removal rate in % of the volume to remove per second.
     pub removal_rate_percent_s: f64,
+    /// The minimum collision-free stick-out (mm; spec 10.1, L_outil): the
+    /// shortest length out of the holder at which the proof's shank and
+    /// holder check passes (`scallop_rough5::Proof::min_stick_out`).
+    pub min_stick_out_mm: f64,
+    /// The move (index in the program) that asks for it; `None` when the
+    /// flutes alone suffice.
+    pub min_stick_out_move: Option<usize>,
+    /// Where its shank or holder meets the stock when a little shorter (mm).
+    pub min_stick_out_at_mm: Option<[f64; 3]>,
     /// The finished faces' deviation from the allowance and crest heights
     /// (measured by [`run_rough5`]; empty otherwise).
     #[serde(skip_serializing_if = "Vec::is_empty")]
@@ -258,6 +267,9 @@ pub fn rough5_metrics(plan: &Rough5Plan, proof: &Proof, posted: Option<&Posted>)
         estimated_time_at_feed_s: plan.estimated_time,
         removal_rate_mm3_s: proof.removal_rate(t),
         removal_rate_percent_s: if t > 0.0 { (100.0 - proof.remaining_percent) / t } else { 0.0 },
+        min_stick_out_mm: proof.min_stick_out,
+        min_stick_out_move: proof.min_stick_out_at.map(|a| a.0),
+        min_stick_out_at_mm: proof.min_stick_out_at.map(|a| a.1),
         faces: proof
             .faces
             .iter()

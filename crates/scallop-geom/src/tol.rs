@@ -1081,6 +1081,11 @@ pub mod sim {
     /// material (the floor a pass at the same level left, up to the z-map's
     /// rounding) is not engagement.
     pub const ENGAGEMENT_FLOOR: f64 = 0.01;
+
+    /// The smallest collision-free stick-out of a tri-dexel cut
+    /// (`scallop_sim::DexelOptions::max_stick_out`) is bisected to within this
+    /// (mm) above the length where the shank or the holder first meets stock.
+    pub const STICK_OUT_TOL: f64 = 0.01;
 }
 
 pub mod strategy {

@@ -98,7 +98,7 @@ fn remaining_impeller(
     let blank = DexelPart::new(part.blank.as_ref().unwrap());
     let mut dexels = DexelStock::from_solid(part.stock, 0.5, &blank).unwrap();
     let moves = ToolMove::from_toolpath(path);
-    let options = DexelOptions { axis_tolerance: 0.05, check_collisions: true };
+    let options = DexelOptions { axis_tolerance: 0.05, check_collisions: true, max_stick_out: None };
     let report = dexels.cut_with_progress(tool, &moves, &options, &|_, _| {}).unwrap();
     // An unsafe program is still measured: its collisions are listed first.
     if report.check().is_err() {
@@ -311,7 +311,7 @@ fn remaining(
 ) {
     let mut dexels = DexelStock::new(part.stock, 0.5).unwrap();
     let moves = ToolMove::from_toolpath(path);
-    let options = DexelOptions { axis_tolerance: 0.05, check_collisions: true };
+    let options = DexelOptions { axis_tolerance: 0.05, check_collisions: true, max_stick_out: None };
     let report = dexels.cut_with_progress(tool, &moves, &options, &|_, _| {}).unwrap();
     report.check().unwrap();
     let volume = DexelPart::new(&part.mesh);

@@ -46,6 +46,10 @@ pub struct Pocket<'a> {
     pub volume: &'a TriMesh,
     /// The stock block.
     pub stock: Aabb3,
+    /// The blank inside the stock box when the stock is not the whole box (a
+    /// turned blank: closed, outward normals), as the proof takes it
+    /// ([`crate::prove_from_blank`]); `None`: the whole box.
+    pub blank: Option<&'a TriMesh>,
 }
 
 /// Settings of the baselines (mm, rad, mm/min).
@@ -208,13 +212,43 @@ fn rough_settings(settings: &BaselineSettings, cutter: &Cutter) -> RoughSettings
     }
 }
 
+/// `region` (tool centres at tip height `z` in a setup's frame) less the
+/// centres where the shank or the holder would stand in the stock seen along
+/// the setup's axis (`stock`: the highest material of each cell): within the
+/// shank's radius of stock above the flutes (`z` + flute length), or within
+/// the holder's largest radius of stock above the holder's bottom (`z` +
+/// stick-out), each grown by a cell's diagonal (the stock's samples lie
+/// anywhere in their cell). The shank and holder reach up from there, so a
+/// cell whose material rises above those heights is met wherever it lies
+/// under them.
+fn clear_of_stock(region: &Region, stock: &MaterialMap, z: f64, cutter: &Cutter, tolerance: f64) -> Region {
+    let [cx, cy] = stock.cell_size();
+    let grow = cx.hypot(cy);
+    let flutes = cutter.flute_length();
+    let stick_out = flutes + cutter.shank_length();
+    let holder = cutter.holder().iter().map(|s| s.bottom_radius.max(s.top_radius)).fold(0.0, f64::max);
+    let mut out = region.clone();
+    for (from, radius) in [(flutes, cutter.shank_radius()), (stick_out, holder)] {
+        if radius <= 0.0 || out.is_empty() {
+            continue;
+        }
+        let above = stock.above(z + from);
+        if !above.is_empty() {
+            out = out.difference(&above.offset(-(radius + grow)), tolerance);
+        }
+    }
+    out
+}
+
 /// The passes of one setup in its own frame, from the in-process stock
-/// `material` when given (rest roughing).
+/// `material` when given (rest roughing: `material.0` inside the volume to
+/// remove, what the setup cuts; `material.1` all of it, what its shank and
+/// holder must stay off, [`clear_of_stock`]).
 fn plan_setup(
     pocket: &Pocket,
     cutter: &Cutter,
     frame: &Frame,
-    material: Option<&MaterialMap>,
+    material: Option<(&MaterialMap, &MaterialMap)>,
     settings: &BaselineSettings,
 ) -> Result<(Toolpath, SetupReport), Rough5Error> {
     let surface = rotated(pocket.surface, frame)?;
@@ -227,11 +261,19 @@ fn plan_setup(
     let opening = opening_region(pocket.opening, frame, cutter.radius() + settings.flank_allowance);
     let levels: Vec<Level> = levels
         .into_par_iter()
-        .map(|l| Level { region: l.region.intersection(&opening, chord), z: l.z })
+        .map(|l| {
+            let region = l.region.intersection(&opening, chord);
+            let region = match material {
+                Some((_, all)) if !region.is_empty() => clear_of_stock(&region, all, l.z, cutter, chord),
+                _ => region,
+            };
+            Level { region, z: l.z }
+        })
         .filter(|l| !l.region.is_empty())
         .collect();
     let motion = Motion { clearance_z: stock.max.z + settings.clearance + cutter.radius(), feed: settings.feed };
-    let plan = plan_levels(levels, cutter, &stock, material, &rough, &motion, chord).map_err(rough_error)?;
+    let plan =
+        plan_levels(levels, cutter, &stock, material.map(|m| m.0), &rough, &motion, chord).map_err(rough_error)?;
     let report = SetupReport {
         axis: frame.u,
         undercut_area: 0.0,
@@ -346,13 +388,13 @@ fn common(a: &[[f64; 2]], b: &[[f64; 2]]) -> Vec<[f64; 2]> {
     out
 }
 
-/// The material of `dexels` inside the volume to remove (`part`), seen along
-/// the frame's axis: the highest sample of each cell of a grid over the
-/// stock's box in the frame (the Z rays' material sampled every half ray
-/// spacing).
+/// The material of `dexels` inside the volume to remove (`part`; all of it
+/// for `None`), seen along the frame's axis: the highest sample of each cell
+/// of a grid over the stock's box in the frame (the Z rays' material sampled
+/// every half ray spacing).
 fn material_map(
     dexels: &DexelStock,
-    part: &DexelPart,
+    part: Option<&DexelPart>,
     frame: &Frame,
     stock: &Aabb3,
 ) -> Result<MaterialMap, Rough5Error> {
@@ -367,8 +409,15 @@ fn material_map(
             let mut out = Vec::new();
             for iu in 0..nu {
                 let o = dexels.ray_origin(2, iu, iv);
-                let pocket: Vec<[f64; 2]> =
-                    part.intervals(&o, 2).iter().map(|s| [s.0.max(lo), s.1.min(hi)]).filter(|s| s[1] > s[0]).collect();
+                let pocket: Vec<[f64; 2]> = match part {
+                    Some(part) => part
+                        .intervals(&o, 2)
+                        .iter()
+                        .map(|s| [s.0.max(lo), s.1.min(hi)])
+                        .filter(|s| s[1] > s[0])
+                        .collect(),
+                    None => vec![[lo, hi]],
+                };
                 for [a, b] in common(&dexels.intervals(2, iu, iv), &pocket) {
                     #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "short positive span")]
                     let n = ((b - a) / sample).ceil().max(1.0) as usize;
@@ -403,7 +452,7 @@ fn cut(
     settings: &BaselineSettings,
 ) -> Result<(), Rough5Error> {
     let sim = |e: scallop_sim::SimError| Rough5Error::Simulation(e.to_string());
-    let options = DexelOptions { axis_tolerance: settings.axis_tolerance, check_collisions: true };
+    let options = DexelOptions { axis_tolerance: settings.axis_tolerance, check_collisions: true, max_stick_out: None };
     let report = dexels.cut(cutter, &ToolMove::from_toolpath(path), &options).map_err(sim)?;
     report.check().map_err(sim)
 }
@@ -423,13 +472,22 @@ pub fn plan_three_plus_two(
 ) -> Result<BaselinePlan, Rough5Error> {
     let mut plan = plan_zlevel(pocket, cutter, settings)?;
     let sim = |e: scallop_sim::SimError| Rough5Error::Simulation(e.to_string());
-    let mut dexels = DexelStock::new(pocket.stock, settings.resolution).map_err(sim)?;
+    // The in-process stock starts as the proof's does: the blank, not its box
+    // (the box's material around a turned blank is not there to collide with).
+    let blank = pocket.blank.map(DexelPart::new);
+    let mut dexels = match &blank {
+        Some(b) => DexelStock::from_solid(pocket.stock, settings.resolution, b),
+        None => DexelStock::new(pocket.stock, settings.resolution),
+    }
+    .map_err(sim)?;
     cut(&mut dexels, cutter, &plan.toolpath, settings)?;
     let part = DexelPart::new(pocket.volume);
     for (axis, area) in setup_axes(pocket.flanks, settings.max_tilt) {
         let frame = Frame::new(axis);
-        let material = material_map(&dexels, &part, &frame, &rotated_box(&pocket.stock, &frame))?;
-        let (local, mut report) = plan_setup(pocket, cutter, &frame, Some(&material), settings)?;
+        let bounds = rotated_box(&pocket.stock, &frame);
+        let material = material_map(&dexels, Some(&part), &frame, &bounds)?;
+        let all = material_map(&dexels, None, &frame, &bounds)?;
+        let (local, mut report) = plan_setup(pocket, cutter, &frame, Some((&material, &all)), settings)?;
         if local.moves().is_empty() {
             continue;
         }

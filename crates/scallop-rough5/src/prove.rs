@@ -8,7 +8,11 @@
 //! - the stock removed outside it (a gouge of the finished part, beyond the
 //!   rounding of the rays), its volume and its longest piece along a ray;
 //! - the removal rate (removed volume over the time given);
-//! - L_HM: the share of the cutting path length that removed nothing.
+//! - L_HM: the share of the cutting path length that removed nothing;
+//! - the minimum collision-free stick-out (L_outil): the shortest length of
+//!   the tool out of its holder at which neither the shank nor the holder
+//!   meets the in-process stock along the whole program, found during the
+//!   same cut ([`scallop_sim::StickOut`]).
 
 use rayon::prelude::*;
 use scallop_cutter::Cutter;
@@ -46,6 +50,16 @@ pub struct Proof {
     pub sweeps: usize,
     /// Rays per family of the stock.
     pub rays: [usize; 3],
+    /// The minimum collision-free stick-out (mm; spec 10.1, L_outil): the
+    /// shortest length out of the holder, the tool otherwise the same, at
+    /// which the proof's shank and holder check passes, within
+    /// [`scallop_sim::tol::STICK_OUT_TOL`] (the flute length when nothing
+    /// above the flutes meets the stock).
+    pub min_stick_out: f64,
+    /// The move (index in the program) that asks for it, and the middle of
+    /// the stock piece its shank or holder meets when a little shorter;
+    /// `None` when the flutes alone suffice.
+    pub min_stick_out_at: Option<(usize, [f64; 3])>,
     /// The metrics of the finished faces asked for ([`prove_with_faces`]).
     pub faces: Vec<FaceMetrics>,
 }
@@ -170,7 +184,12 @@ pub fn prove_with_faces(
     }
     .map_err(sim)?;
     let moves = ToolMove::from_toolpath(path);
-    let options = DexelOptions { axis_tolerance: settings.axis_tolerance, check_collisions: true };
+    // The search up to the tool's own stick-out: the proof passes only if that one is free.
+    let options = DexelOptions {
+        axis_tolerance: settings.axis_tolerance,
+        check_collisions: true,
+        max_stick_out: Some(cutter.flute_length() + cutter.shank_length()),
+    };
     let report = dexels.cut_with_progress(cutter, &moves, &options, progress).map_err(sim)?;
     report.check().map_err(sim)?;
     let part = DexelPart::new(volume);
@@ -235,6 +254,11 @@ pub fn prove_with_faces(
         air_percent: if cutting > 0.0 { 100.0 * air / cutting } else { 0.0 },
         sweeps: report.sweeps,
         rays: [dexels.grid(0).0 * dexels.grid(0).1, dexels.grid(1).0 * dexels.grid(1).1, nu * nv],
+        min_stick_out: report.min_stick_out.map_or(cutter.flute_length(), |s| s.length),
+        min_stick_out_at: report
+            .min_stick_out
+            .and_then(|s| s.limit)
+            .map(|(id, at)| (id.index as usize, [at.x, at.y, at.z])),
         faces: faces.iter().map(|f| face_metrics(&dexels, &part, f, settings.resolution)).collect(),
     })
 }

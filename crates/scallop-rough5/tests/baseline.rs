@@ -53,7 +53,14 @@ fn faces(part: &TestPart) -> Faces {
 }
 
 fn pocket<'a>(part: &'a TestPart, f: &'a Faces) -> Pocket<'a> {
-    Pocket { surface: &f.surface, opening: &f.opening, flanks: &f.flanks, volume: &part.mesh, stock: part.stock }
+    Pocket {
+        surface: &f.surface,
+        opening: &f.opening,
+        flanks: &f.flanks,
+        volume: &part.mesh,
+        stock: part.stock,
+        blank: part.blank.as_ref(),
+    }
 }
 
 /// Every move stays above the stock's floor, every setup's axis is fixed
@@ -156,4 +163,84 @@ fn setups_lean_away_from_the_undercuts_only() {
         let capped = setup_axes(&flanks, deg(2.0));
         assert!((capped[0].0.angle(&Vec3::z()) - deg(2.0)).abs() < 1e-9);
     }
+}
+
+/// A closed box mesh (outward normals).
+fn box_mesh(b: &scallop_geom::Aabb3) -> scallop_mesh::TriMesh {
+    let (lo, hi) = (b.min, b.max);
+    let v: Vec<scallop_geom::Point3> = (0..8)
+        .map(|k| {
+            scallop_geom::Point3::new(
+                if k & 1 == 0 { lo.x } else { hi.x },
+                if k & 2 == 0 { lo.y } else { hi.y },
+                if k & 4 == 0 { lo.z } else { hi.z },
+            )
+        })
+        .collect();
+    let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+    let t: Vec<[usize; 3]> = quads.iter().flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]]).collect();
+    scallop_mesh::TriMesh::from_indexed(&v, &t).unwrap().0
+}
+
+/// The 3+2 program on a blank smaller than its stock box (the impeller's
+/// turned blank; docs/rough5.md, "Baselines"): the rest setups are planned on
+/// the in-process stock of the blank, as the proof cuts it. Here the blank is
+/// the pocket's block and the box reaches 20 mm above it: a holder 41 mm
+/// above a tip on the bottom near a flank stands in the box's material over
+/// the block's top, which is not there. Planned on the box, the z-level
+/// program "collides"; on the blank it is planned and proven.
+#[test]
+fn three_plus_two_starts_from_the_blank() {
+    let mut part = closed_pocket(&PocketParams::default()).unwrap();
+    let block = part.stock;
+    part.stock.max.z += 20.0;
+    let blank = box_mesh(&block);
+    let f = faces(&part);
+    let (tool, s) = (tool(), settings());
+    // The cause, on the box: the z-level program's holder meets material that
+    // the blank does not have.
+    let boxed = plan_three_plus_two(&pocket(&part, &f), &tool, &s);
+    assert!(
+        matches!(&boxed, Err(scallop_rough5::Rough5Error::Simulation(e)) if e.contains("into the stock")),
+        "{boxed:?}"
+    );
+    part.blank = Some(blank);
+    let plan = plan_three_plus_two(&pocket(&part, &f), &tool, &s).unwrap();
+    assert!(plan.setups.len() >= 2, "{:?}", plan.setups);
+    let proof_settings = ProofSettings { resolution: 1.0, axis_tolerance: 0.05 };
+    let proof = scallop_rough5::prove_from_blank(
+        &plan.toolpath,
+        &tool,
+        &part.stock,
+        part.blank.as_ref(),
+        &part.mesh,
+        &proof_settings,
+        &|_, _| {},
+    )
+    .unwrap();
+    assert!(proof.gouge_depth <= proof_settings.resolution, "{proof:?}");
+    assert!(proof.remaining_percent < 100.0 && proof.removed_volume > 0.0, "{proof:?}");
+}
+
+/// The rest setups keep the shank and the holder off the in-process stock
+/// (docs/rough5.md, "Baselines"): with 27 mm of flutes, 28 mm out of a holder
+/// R 20, a setup leaning 15 deg puts the holder's rim under the block's top
+/// next to the undercut flanks, which the setup's levels (the flutes against
+/// the pocket's faces) do not see. The 3+2 program is planned and proven,
+/// its shank and holder clear of the stock along every move.
+#[test]
+fn rest_setups_keep_the_holder_off_the_stock() {
+    let part = closed_pocket(&PocketParams::default()).unwrap();
+    let f = faces(&part);
+    let tool = Cutter::new(CutterShape::Bull { radius: 5.0, corner: 1.5 }, 27.0)
+        .unwrap()
+        .with_shank(5.0, 1.0)
+        .unwrap()
+        .with_holder(vec![HolderSegment { length: 100.0, bottom_radius: 20.0, top_radius: 20.0 }])
+        .unwrap();
+    let plan = plan_three_plus_two(&pocket(&part, &f), &tool, &settings()).unwrap();
+    assert!(plan.setups.len() >= 2 && plan.setups[1..].iter().all(|s| s.passes > 0), "{:?}", plan.setups);
+    let proof_settings = ProofSettings { resolution: 1.0, axis_tolerance: 0.05 };
+    let proof = prove(&plan.toolpath, &tool, &part.stock, &part.mesh, &proof_settings, &|_, _| {}).unwrap();
+    assert!(proof.min_stick_out <= 28.0, "{proof:?}");
 }

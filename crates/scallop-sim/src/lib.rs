@@ -94,7 +94,7 @@ use scallop_toolpath::Toolpath;
 
 pub use dexel::{
     DexelCollision, DexelGouge, DexelOptions, DexelPart, DexelReport, DexelStock, DexelVerification, MAX_RAYS,
-    MAX_SUBSTEPS, ToolMove, verify_dexel,
+    MAX_SUBSTEPS, StickOut, ToolMove, verify_dexel,
 };
 pub use engagement::{
     EngagementOptions, EngagementReport, Pocket, engagement_angle, pocket_engagement, stock_engagement,

@@ -368,7 +368,9 @@ fn five_axis_sub_steps_stay_within_the_bound() {
     let path = [mv(MoveKind::Plunge, p0, a0), mv(MoveKind::Feed, p1, a1)];
     let run = |tol: f64| {
         let mut d = DexelStock::new(stock, 0.25).unwrap();
-        let rep = d.cut(&cutter, &path, &DexelOptions { axis_tolerance: tol, check_collisions: false }).unwrap();
+        let rep = d
+            .cut(&cutter, &path, &DexelOptions { axis_tolerance: tol, check_collisions: false, max_stick_out: None })
+            .unwrap();
         (d, rep)
     };
     let tol = 0.02;
@@ -726,4 +728,105 @@ fn a_blank_is_the_starting_stock() {
     // An open surface is no blank.
     let open = TriMesh::from_soup(&soup[..soup.len() - 1]).unwrap().0;
     assert!(matches!(DexelStock::from_solid(stock, 0.25, &DexelPart::new(&open)), Err(SimError::OpenBlank)));
+}
+
+/// A bull nose R 3 r 1 with 10 mm of flutes, a shank R 3 out to `stick_out`
+/// and a holder R 8 x 40 above it.
+fn held(stick_out: f64) -> Cutter {
+    Cutter::new(CutterShape::Bull { radius: 3.0, corner: 1.0 }, 10.0)
+        .unwrap()
+        .with_shank(3.0, stick_out - 10.0)
+        .unwrap()
+        .with_holder(vec![HolderSegment { length: 40.0, bottom_radius: 8.0, top_radius: 8.0 }])
+        .unwrap()
+}
+
+/// Whether the cut of `path` on a fresh stock with the tool at `stick_out`
+/// finds no shank or holder collision (a re-proof at that length).
+fn free_at(stock: &Aabb3, path: &[ToolMove], stick_out: f64) -> bool {
+    let mut d = DexelStock::new(*stock, 0.5).unwrap();
+    let options = DexelOptions { axis_tolerance: 0.02, ..DexelOptions::default() };
+    d.cut(&held(stick_out), path, &options).unwrap().collisions.is_empty()
+}
+
+/// The smallest collision-free stick-out found in one cut
+/// ([`DexelOptions::max_stick_out`]) is the one a bisection of re-proofs at
+/// fixed lengths finds: a vertical plunge 15 mm into the block (the holder,
+/// wider than the hole, must stay above the block's top: 15 mm), and random
+/// programs of tilted 5-axis moves along the block's top, where the tilted
+/// holder's rim reaches down into it.
+#[test]
+fn stick_out_search_agrees_with_reproofs() {
+    let stock = Aabb3 { min: p(0.0, 0.0, 0.0), max: p(40.0, 40.0, 20.0) };
+    let search = |path: &[ToolMove], max: f64| {
+        let mut d = DexelStock::new(stock, 0.5).unwrap();
+        let options = DexelOptions { axis_tolerance: 0.02, max_stick_out: Some(max), ..DexelOptions::default() };
+        let report = d.cut(&held(max), path, &options).unwrap();
+        (report.min_stick_out.unwrap(), report.collisions.is_empty())
+    };
+    // The plunge: the flutes reach 10 mm up from the tip at z 5, the holder
+    // must start above z 20.
+    let plunge =
+        [mv(MoveKind::Rapid, p(20.0, 20.0, 30.0), Vec3::z()), mv(MoveKind::Feed, p(20.0, 20.0, 5.0), Vec3::z())];
+    let (found, free) = search(&plunge, 30.0);
+    assert!(free && !found.exceeded, "{found:?}");
+    assert!(found.length >= 15.0 && found.length <= 15.0 + scallop_sim::tol::STICK_OUT_TOL, "{found:?}");
+    assert_eq!(found.limit.unwrap().0.index, 1);
+    // Shallow cuts: the flutes alone.
+    let shallow =
+        [mv(MoveKind::Rapid, p(20.0, 20.0, 30.0), Vec3::z()), mv(MoveKind::Feed, p(20.0, 20.0, 14.0), Vec3::z())];
+    let (found, _) = search(&shallow, 30.0);
+    assert_eq!((found.length, found.limit), (10.0, None));
+    // Random tilted programs.
+    let mut seed = 0x2545_f491_4f6c_dd1d_u64;
+    let mut unit = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut compared = 0;
+    for case in 0..8 {
+        let mut path = vec![mv(MoveKind::Rapid, p(20.0, 20.0, 40.0), Vec3::z())];
+        // Tips at least 13 mm up and tilts of at most 0.5 rad: the flutes'
+        // top (and the shank) stay above the block, the holder's rim (R 8)
+        // dips into it for stick-outs up to about 12.3 mm.
+        for _ in 0..4 {
+            let tip = p(8.0 + 24.0 * unit(), 8.0 + 24.0 * unit(), 13.0 + 2.0 * unit());
+            let axis = tilted(0.3 + 0.2 * unit(), std::f64::consts::TAU * unit());
+            path.push(mv(MoveKind::Feed, tip, axis));
+        }
+        let max = 34.0;
+        let (found, free) = search(&path, max);
+        if case == 0 {
+            // The same on one thread (the bands of rays are fixed).
+            let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
+            assert_eq!(one.install(|| search(&path, max)), (found, free));
+        }
+        // The search ends at the largest length exactly when the cut collides there.
+        assert_eq!(found.exceeded, !free, "case {case}: {found:?}");
+        assert_eq!(free, free_at(&stock, &path, max), "case {case}");
+        if found.exceeded {
+            continue;
+        }
+        // A bisection of re-proofs between the flute length and the largest length.
+        let (mut short, mut long) = (10.0 + 1e-3, max);
+        if free_at(&stock, &path, short) {
+            assert!(found.length <= short, "case {case}: {found:?}");
+            continue;
+        }
+        while long - short > 1e-3 {
+            let mid = 0.5 * (short + long);
+            if free_at(&stock, &path, mid) { long = mid } else { short = mid }
+        }
+        let tol = scallop_sim::tol::STICK_OUT_TOL;
+        assert!(found.length >= short - 1e-9 && found.length <= long + tol, "case {case}: {found:?} [{short}, {long}]");
+        // Just shorter collides, the length found does not.
+        assert!(
+            !free_at(&stock, &path, found.length - tol - 1e-3) && free_at(&stock, &path, found.length),
+            "case {case}"
+        );
+        compared += 1;
+    }
+    assert!(compared >= 5, "{compared}");
 }

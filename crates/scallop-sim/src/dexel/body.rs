@@ -338,6 +338,33 @@ impl Body {
         Some(Body::new(vec![Piece::Frustum { h0, h1: h0 + seg.length, r0: seg.bottom_radius, k }]))
     }
 
+    /// The shank and each holder segment of `cutter` held at stick-out
+    /// `stick_out` instead of its own (the holder's bottom that far from the
+    /// tip; the shank from the flutes' top up to it, none at the flute length).
+    pub(crate) fn guards_at(cutter: &Cutter, stick_out: f64) -> Vec<Body> {
+        let h0 = cutter.flute_length();
+        let mut out = Vec::with_capacity(1 + cutter.holder().len());
+        if stick_out > h0 {
+            out.push(Body::new(vec![Piece::Frustum { h0, h1: stick_out, r0: cutter.shank_radius(), k: 0.0 }]));
+        }
+        let mut from = stick_out.max(h0);
+        for seg in cutter.holder() {
+            let k = (seg.top_radius - seg.bottom_radius) / seg.length;
+            out.push(Body::new(vec![Piece::Frustum { h0: from, h1: from + seg.length, r0: seg.bottom_radius, k }]));
+            from += seg.length;
+        }
+        out
+    }
+
+    /// A cylinder round the axis from the flutes' top to `top` (mm from the
+    /// tip), as wide as the widest of the shank and the holder: it holds them
+    /// at every stick-out up to `top` less the holder's length.
+    pub(crate) fn guard_envelope(cutter: &Cutter, top: f64) -> Body {
+        let h0 = cutter.flute_length();
+        let r = cutter.holder().iter().map(|s| s.bottom_radius.max(s.top_radius)).fold(cutter.shank_radius(), f64::max);
+        Body::new(vec![Piece::Frustum { h0, h1: top.max(h0), r0: r, k: 0.0 }])
+    }
+
     /// Largest distance from the tip to the body (mm).
     pub(crate) fn reach(&self) -> f64 {
         self.reach

@@ -86,13 +86,44 @@ pub struct DexelOptions {
     pub axis_tolerance: f64,
     /// Check the shank and the holder against the in-process stock.
     pub check_collisions: bool,
+    /// Search the smallest stick-out (the tool's length out of the holder)
+    /// up to this length (mm) at which neither the shank nor the holder meets
+    /// the in-process stock along the whole cut, the tool otherwise the same
+    /// ([`DexelReport::min_stick_out`]); `None`: no search.
+    pub max_stick_out: Option<f64>,
 }
 
 impl Default for DexelOptions {
-    /// 0.01 mm for 5-axis moves; collisions checked.
+    /// 0.01 mm for 5-axis moves; collisions checked; no stick-out search.
     fn default() -> Self {
-        DexelOptions { axis_tolerance: 0.01, check_collisions: true }
+        DexelOptions { axis_tolerance: 0.01, check_collisions: true, max_stick_out: None }
     }
+}
+
+/// The smallest collision-free stick-out of a cut
+/// ([`DexelOptions::max_stick_out`]).
+///
+/// The in-process stock at each fixed-axis sweep depends on the flutes only,
+/// so one cut serves every stick-out: each sweep's shank and holder, held at
+/// the smallest length found so far, are checked on the rays against the
+/// stock left by the sweeps before it (as the collision check is, the same
+/// epsilon); where they meet it the length is bisected up, for that sweep
+/// and ray, to within [`crate::tol::STICK_OUT_TOL`]. The result is the
+/// smallest length at which the collision check of the same cut would find
+/// nothing, provided a longer stick-out never collides where a shorter one
+/// did not: true when no segment of the holder is narrower than the shank or
+/// than a segment below it, and no stock stands above the holder's top;
+/// otherwise a length found by the same bisection.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StickOut {
+    /// The length (mm): the flute length when nothing above the flutes meets
+    /// the stock; the largest length searched when even that one collides.
+    pub length: f64,
+    /// The move that asks for it and the middle of the stock piece the shank
+    /// or holder meets just below it; `None` when the flutes alone suffice.
+    pub limit: Option<(MoveId, Point3)>,
+    /// Whether even the largest length searched meets the stock.
+    pub exceeded: bool,
 }
 
 /// A move that drove the shank or holder into the in-process stock.
@@ -144,6 +175,8 @@ pub struct DexelReport {
     pub rapid_hits: Vec<RapidHit>,
     /// Shank and holder collisions with the in-process stock, in program order (errors).
     pub collisions: Vec<DexelCollision>,
+    /// The smallest collision-free stick-out ([`DexelOptions::max_stick_out`]).
+    pub min_stick_out: Option<StickOut>,
 }
 
 impl DexelReport {
@@ -619,18 +652,29 @@ impl DexelStock {
         if u32::try_from(moves.len()).is_err() {
             return Err(SimError::TooManyMoves { moves: moves.len() });
         }
+        if let Some(max) = options.max_stick_out
+            && !max.is_finite()
+        {
+            return Err(SimError::BadTolerance { what: "largest stick-out searched", value: max });
+        }
         let operation = self.operations;
         let next = operation.checked_add(1).ok_or(SimError::TooManyMoves { moves: moves.len() })?;
         let flutes = Body::flutes(cutter);
         let guards = if options.check_collisions { guards(cutter) } else { Vec::new() };
         let steps = self.steps(operation, &flutes, moves, options)?;
         self.operations = next;
-        // Boxes of each step: flutes, then each guard.
+        let search = options.max_stick_out.map(|max| {
+            let max = max.max(cutter.flute_length());
+            let holder: f64 = cutter.holder().iter().map(|s| s.length).sum();
+            (Search { cutter, max }, Body::guard_envelope(cutter, max + holder))
+        });
+        // Boxes of each step: flutes, then each guard, then the stick-out search's envelope.
         let boxes: Vec<Vec<(Point3, Point3)>> = steps
             .iter()
             .map(|s| {
                 let mut b = vec![(s.lo, s.hi)];
                 b.extend(guards.iter().map(|(g, _)| swept_box(g, &s.sweep, self.eps)));
+                b.extend(search.iter().map(|(_, e)| swept_box(e, &s.sweep, self.eps)));
                 b
             })
             .collect();
@@ -655,10 +699,25 @@ impl DexelStock {
         let done = AtomicUsize::new(0);
         let tick = || progress(done.fetch_add(1, Ordering::Relaxed) + 1, bands);
         let removal = FamilyCut::removal(&flutes, &guards, &steps, &boxes, &unions);
+        let search = search.as_ref().map(|(s, _)| *s);
+        // The longest stick-out any band needs.
+        let mut need: Option<StickSearch> = None;
         for axis in 0..3 {
             let columns = if axis == 2 { Some((columns.as_slice(), flutes_top)) } else { None };
-            let outputs = self.cut_family(axis, &FamilyCut { columns, ..removal }, &tick);
+            let outputs = self.cut_family(axis, &FamilyCut { columns, search, ..removal }, &tick);
             for out in outputs {
+                if let Some(band) = out.stick_out {
+                    // The longest; between equal lengths the earliest step (a fixed order).
+                    let step = |n: &StickSearch| n.limit.map_or(u32::MAX, |l| l.0);
+                    let longer = |n: &StickSearch| match band.length.total_cmp(&n.length) {
+                        std::cmp::Ordering::Greater => true,
+                        std::cmp::Ordering::Equal => step(&band) < step(n),
+                        std::cmp::Ordering::Less => false,
+                    };
+                    if need.as_ref().is_none_or(longer) {
+                        need = Some(band);
+                    }
+                }
                 for (k, volume, longest, at) in out.removed {
                     let step = &steps[k as usize];
                     let m = step.index as usize;
@@ -684,6 +743,14 @@ impl DexelStock {
             .filter_map(|(k, r)| r.map(|(depth, at)| RapidHit { id: id(k), at: Point2::new(at.x, at.y), depth }))
             .collect();
         let collisions = collision_list(operation, &collided);
+        let min_stick_out = search.map(|s| {
+            let n = need.unwrap_or(StickSearch { length: s.cutter.flute_length(), exceeded: false, limit: None });
+            StickOut {
+                length: n.length,
+                limit: n.limit.map(|(k, at)| (steps[k as usize].id(), at)),
+                exceeded: n.exceeded,
+            }
+        });
         let removed_volume = removed_by_move.iter().sum();
         let sweeps = steps.len();
         self.bodies.push(flutes);
@@ -697,6 +764,7 @@ impl DexelStock {
             sweeps,
             rapid_hits,
             collisions,
+            min_stick_out,
         })
     }
 
@@ -907,11 +975,20 @@ fn collision_list(operation: u32, collided: &[Vec<(ToolPart, f64, Point3)>]) -> 
 /// axis is +Z, and the flute length.
 type Columns<'a> = (&'a [Option<SweptMove>], f64);
 
+/// The stick-out search of a cut ([`DexelOptions::max_stick_out`]): the
+/// tool and the largest length searched (at least the flute length).
+#[derive(Clone, Copy)]
+struct Search<'a> {
+    cutter: &'a Cutter,
+    max: f64,
+}
+
 /// What one family's bands apply, step by step: the flutes and the guarded
 /// parts of the tool (shank, holder), the fixed-axis steps with their boxes
-/// (flutes first, then one per guard) and the union of those boxes;
-/// `remove == false` only checks the guards; `columns`: the Z rays of vertical
-/// steps in closed form, with the flutes' top.
+/// (flutes first, then one per guard, then the search's envelope) and the
+/// union of those boxes; `remove == false` only checks the guards; `columns`:
+/// the Z rays of vertical steps in closed form, with the flutes' top;
+/// `search`: the stick-out search.
 #[derive(Clone, Copy)]
 struct FamilyCut<'a> {
     flutes: &'a Body,
@@ -921,6 +998,7 @@ struct FamilyCut<'a> {
     unions: &'a [(Point3, Point3)],
     remove: bool,
     columns: Option<Columns<'a>>,
+    search: Option<Search<'a>>,
 }
 
 impl<'a> FamilyCut<'a> {
@@ -932,7 +1010,7 @@ impl<'a> FamilyCut<'a> {
         boxes: &'a [Vec<(Point3, Point3)>],
         unions: &'a [(Point3, Point3)],
     ) -> FamilyCut<'a> {
-        FamilyCut { flutes, guards, steps, boxes, unions, remove: true, columns: None }
+        FamilyCut { flutes, guards, steps, boxes, unions, remove: true, columns: None, search: None }
     }
 }
 
@@ -954,6 +1032,8 @@ struct BandOutput {
     removed: Vec<(u32, f64, f64, Point3)>,
     /// (step, part, depth, place).
     collisions: Vec<(u32, ToolPart, f64, Point3)>,
+    /// The band's smallest collision-free stick-out.
+    stick_out: Option<StickSearch>,
 }
 
 /// The geometry of one family of rays.
@@ -987,10 +1067,15 @@ impl Family {
     }
 
     fn cut_band(&self, band: usize, rays: &mut [Ray], ids: &[u32], cut: &FamilyCut<'_>) -> BandOutput {
-        let FamilyCut { flutes, guards, steps, boxes, unions, remove, columns } = *cut;
+        let FamilyCut { flutes, guards, steps, boxes, unions, remove, columns, search } = *cut;
         let row0 = band * BAND_ROWS;
         let rows = rays.len() / self.nu;
         let mut out = BandOutput::default();
+        // The stick-out search: the length so far and its shank and holder.
+        let mut need = search.map(|s| {
+            let length = s.cutter.flute_length();
+            (StickSearch { length, exceeded: false, limit: None }, Body::guards_at(s.cutter, length))
+        });
         let mut d = Vec3::zeros();
         d[self.axis] = 1.0;
         let (lo, hi) = (self.lo, self.hi);
@@ -1047,6 +1132,20 @@ impl Family {
                             }
                         }
                     }
+                    if let (Some(s), Some((state, bodies))) = (search, need.as_mut())
+                        && !state.exceeded
+                    {
+                        let b = &bx[guards.len() + 1];
+                        if inside(b)
+                            && let Some(range) = ray.material_range(b.0[self.axis], b.1[self.axis], lo, hi)
+                        {
+                            let meets = |bodies: &[Body]| self.meets(ray, step, bodies, &o, range);
+                            if let Some(at) = meets(bodies) {
+                                state.raise(s, k, at, &meets);
+                                *bodies = Body::guards_at(s.cutter, state.length);
+                            }
+                        }
+                    }
                 }
             }
             if removed > 0.0 {
@@ -1058,7 +1157,57 @@ impl Family {
                 }
             }
         }
+        out.stick_out = need.map(|(s, _)| s);
         out
+    }
+
+    /// The middle of the stock piece of `ray` (material within `range` along
+    /// it, through `o`) inside one of `bodies` swept by `step`, if any piece is
+    /// longer than the stock's epsilon (as the collision check counts).
+    fn meets(&self, ray: &Ray, step: &Step, bodies: &[Body], o: &Point3, range: (f64, f64)) -> Option<Point3> {
+        let mut d = Vec3::zeros();
+        d[self.axis] = 1.0;
+        bodies.iter().find_map(|body| {
+            let (a, b) = step.sweep.interval_within(body, o, &d, range.0, range.1)?;
+            let (depth, mid) = ray.overlap(a, b, self.lo, self.hi);
+            (depth > self.eps).then(|| {
+                let mut p = *o;
+                p[self.axis] = mid;
+                p
+            })
+        })
+    }
+}
+
+/// A band's stick-out search so far: the length, whether even the largest
+/// searched meets the stock, the step and place that set it.
+#[derive(Clone, Copy)]
+struct StickSearch {
+    length: f64,
+    exceeded: bool,
+    limit: Option<(u32, Point3)>,
+}
+
+impl StickSearch {
+    /// Step `k` meets the stock at `at` with the shank and holder at
+    /// `self.length`: the length goes up to the smallest, within
+    /// [`crate::tol::STICK_OUT_TOL`], at which `meets` finds nothing (a
+    /// bisection), or to the largest searched when that one meets it too.
+    fn raise(&mut self, search: Search<'_>, k: u32, at: Point3, meets: &dyn Fn(&[Body]) -> Option<Point3>) {
+        let at_length = |l: f64| meets(&Body::guards_at(search.cutter, l));
+        if let Some(p) = at_length(search.max) {
+            *self = StickSearch { length: search.max, exceeded: true, limit: Some((k, p)) };
+            return;
+        }
+        let (mut short, mut long, mut place) = (self.length, search.max, at);
+        while long - short > crate::tol::STICK_OUT_TOL {
+            let mid = 0.5 * (short + long);
+            match at_length(mid) {
+                Some(p) => (short, place) = (mid, p),
+                None => long = mid,
+            }
+        }
+        *self = StickSearch { length: long, exceeded: false, limit: Some((k, place)) };
     }
 }
 
