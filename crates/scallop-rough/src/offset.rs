@@ -92,6 +92,19 @@ pub fn plan_offset_in(
     // region holds them.
     let holder = region.offset(-tol::LINK_GROW);
     let tol_c = options.chord_tolerance;
+    // The level's material and room as far as this region's tool reaches
+    // (a level's many regions share them): its bounds grown by 2 R hold
+    // every point within R of a centre and every straight link between two.
+    let clip = region.bounds().map(|(lo, hi)| {
+        let g = 2.0 * options.tool_radius + tol::LINK_GROW;
+        let (lo, hi) = ([lo[0] - g, lo[1] - g], [hi[0] + g, hi[1] + g]);
+        Region::from_polygons(&[vec![lo, [hi[0], lo[1]], hi, [lo[0], hi[1]]]], false)
+    });
+    let clipped = |m: &Region| clip.as_ref().map_or_else(|| m.clone(), |c| m.intersection(c, tol_c));
+    let material = material.map(clipped);
+    let material = material.as_ref();
+    let room = room.map(clipped);
+    let room = room.as_ref();
     let reach = material.map(|m| Reach::new(m, options.tool_radius, tol_c));
     // Where the tool cuts nothing (beyond R of the material): a tool-down
     // link may cross it as well as the cleared bands.
