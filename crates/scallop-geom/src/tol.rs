@@ -725,6 +725,11 @@ pub mod rough {
     /// `scallop-rough`'s `offset.rs`).
     pub const AIR_RING_STEP: f64 = 0.05;
 
+    /// Offset clearing: a ring's point lies on the open side of its level
+    /// (its nearest boundary is air, not a wall) when it is deeper than its
+    /// level's depth plus this share of ae in the region with its air.
+    pub const OPEN_SIDE_SHARE: f64 = 0.25;
+
     /// Offset clearing: a ring is cut into the stretches that reach the
     /// material where the air between two of them is longer than this share
     /// of the tool radius; a shorter gap is cut through.

@@ -387,7 +387,19 @@ pub fn plan_levels(
             })
             .filter(|(l, _, _)| !l.region.is_empty())
             .collect(),
-        None => levels.into_iter().map(|l| (l, section.clone(), None)).collect(),
+        None => {
+            // Beyond the stock's section grown by R the tool meets neither
+            // stock nor part: room for links and the open sides.
+            let rect = section.offset(-r);
+            let outer = section.offset(-3.0 * r);
+            levels
+                .into_par_iter()
+                .map(|l| {
+                    let room = outer.difference(&rect.difference(&l.region, tolerance), tolerance);
+                    (l, section.clone(), Some(room))
+                })
+                .collect()
+        }
     };
     let mut levels = Vec::with_capacity(spaces.len());
     let mut materials = Vec::with_capacity(spaces.len());

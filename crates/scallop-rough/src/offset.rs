@@ -110,10 +110,15 @@ pub fn plan_offset_in(
     // link may cross it as well as the cleared bands.
     let room = room.map_or_else(|| holder.clone(), |r| r.offset(-tol::LINK_GROW).union(&holder, tol_c));
     let air = reach.as_ref().map(|m| room.difference(&m.grown, tol_c));
-    let mut steps = Vec::new();
-    let mut pos: Option<P2> = None;
     let r = options.tool_radius;
-    for k in (0..levels.len()).rev() {
+    // The region with the air around it: where a ring's nearest boundary is
+    // open (air), not a wall, its points lie deeper in this than their
+    // level's depth.
+    let open_region = air.as_ref().map(|air| region.union(air, tol_c));
+    let mut open_pieces: Vec<Vec<Piece>> = Vec::with_capacity(levels.len());
+    let mut wall_pieces: Vec<Vec<Piece>> = Vec::with_capacity(levels.len());
+    let mut strips: Vec<Option<Region>> = Vec::with_capacity(levels.len());
+    for k in 0..levels.len() {
         // The material left when the rings of the deeper levels are cut:
         // they swept every point within R of `levels[k + 1]` (the module
         // documentation; a sliver under the chip at that reach's edge is
@@ -126,15 +131,112 @@ pub fn plan_offset_in(
             (None, _) => None,
         };
         let left = left.as_ref().or(reach.as_ref());
-        let mut pieces: Vec<Piece> = Vec::new();
+        #[allow(clippy::cast_precision_loss, reason = "a small level count")]
+        let depth = ae * k as f64 + tol::OPEN_SIDE_SHARE * ae;
+        let deep = open_region.as_ref().map(|e| e.offset(depth));
+        let step = reach.as_ref().map_or(tol::AIR_RING_STEP, |m| m.step);
+        let (mut open, mut wall) = (Vec::new(), Vec::new());
         for ring in levels[k].rings() {
             let ring = orient(ring, options.direction);
-            match left {
-                None => pieces.push(Piece { contour: ring, closed: true, from_air: false }),
-                Some(m) => pieces.extend(m.pieces(&ring, r)),
+            // A ring whose every point lies nearer the air than a wall is cut
+            // from the air inwards: it meets the material as it is. Another
+            // is cut inside-out: it meets what the deeper rings left.
+            let is_open = deep.as_ref().is_some_and(|deep| all_inside(&ring, deep, step, tol_c));
+            let by = if is_open { reach.as_ref() } else { left };
+            let pieces = match by {
+                None => vec![Piece { contour: ring, closed: true, from_air: false, to_air: false }],
+                Some(m) => m.pieces(&ring, r),
+            };
+            if is_open {
+                open.extend(pieces.into_iter().map(Piece::reversed));
+            } else {
+                wall.extend(pieces);
             }
         }
-        // A band may reach past the region: it is kept inside.
+        // Links of the open side: through the air, or along the band a
+        // stepover wide inside the level's ring on the open side (swept by
+        // it: a link there engages no more than a pass).
+        let strip = deep.as_ref().map(|deep| {
+            let inner = levels[k].offset(ae * (1.0 + tol::LINK_MARGIN_SHARE));
+            let ring_held = levels[k].offset(-tol::LINK_GROW);
+            ring_held.difference(&inner, tol_c).intersection(&deep.offset(-tol::OPEN_SIDE_SHARE * ae), tol_c)
+        });
+        strips.push(strip);
+        open_pieces.push(open);
+        wall_pieces.push(wall);
+    }
+    let mut steps = Vec::new();
+    let mut pos: Option<P2> = None;
+    // Outside-in from the air first (each pass then has its uncut material
+    // on the inner side only, ae wide: no slot), then inside-out to the walls.
+    // The open side, outside-in: a piece is cut once the pieces a stepover
+    // outside it (its parents) are, the nearest such piece first, so a
+    // corner is cleared level after level before the tool moves on.
+    let mut open: Vec<(usize, Piece, Vec<P2>)> = Vec::new();
+    for (k, pieces) in open_pieces.into_iter().enumerate() {
+        for piece in pieces {
+            let points = piece.contour.to_points(tol_c);
+            open.push((k, piece, points));
+        }
+    }
+    let near = |q: P2, points: &[P2]| {
+        points.windows(2).any(|w| segment_distance(q, w[0], w[1]) <= ae * (1.0 + 2.0 * tol::LINK_MARGIN_SHARE))
+    };
+    let parents: Vec<Vec<usize>> = open
+        .iter()
+        .map(|(k, _, points)| {
+            let probes: Vec<P2> =
+                [0, points.len() / 4, points.len() / 2, 3 * points.len() / 4, points.len().saturating_sub(1)]
+                    .iter()
+                    .filter_map(|&i| points.get(i).copied())
+                    .collect();
+            (0..open.len()).filter(|&j| open[j].0 + 1 == *k && probes.iter().any(|&q| near(q, &open[j].2))).collect()
+        })
+        .collect();
+    let mut done = vec![false; open.len()];
+    let mut last: Option<usize> = None;
+    loop {
+        let ready: Vec<usize> = (0..open.len()).filter(|&i| !done[i] && parents[i].iter().all(|&j| done[j])).collect();
+        if ready.is_empty() {
+            break;
+        }
+        let candidates: Vec<Piece> = ready.iter().map(|&i| open[i].1.clone()).collect();
+        let (c, cut) = nearest(&candidates, pos);
+        let i = ready[c];
+        done[i] = true;
+        let (k, piece) = (open[i].0, &open[i].1);
+        let Some(start) = cut.start() else { continue };
+        // Cleared for links: the air, and the band inside the level of the
+        // piece just cut when this one is its child (a stepover inside it).
+        let child = last.is_some_and(|l| parents[i].contains(&l));
+        let lead = strips.get(k.wrapping_sub(1)).cloned().flatten();
+        match pos {
+            Some(p) => {
+                let length = (start[0] - p[0]).hypot(start[1] - p[1]);
+                let short = length <= ae && holder.contains_segment(p, start, tol_c);
+                let in_air = air.as_ref().is_some_and(|air| air.contains_segment(p, start, tol_c));
+                let along = child
+                    && length <= 4.0 * r
+                    && lead.as_ref().is_some_and(|band| {
+                        band.union(&holder.intersection(band, tol_c), tol_c).contains_segment(p, start, tol_c)
+                    });
+                if short || in_air || along {
+                    steps.push(Step::Link { tool_down: true, via: Vec::new(), cleared: false, to: None });
+                } else {
+                    push_entry(&mut steps, start, piece.from_air, air.as_ref(), lead.as_ref(), &holder, ae, tol_c);
+                }
+            }
+            None => push_entry(&mut steps, start, piece.from_air, air.as_ref(), lead.as_ref(), &holder, ae, tol_c),
+        }
+        last = Some(i);
+        pos = cut.end().or(Some(start));
+        steps.push(Step::Cut(cut));
+    }
+    // The walls, inside-out.
+    for k in (0..levels.len()).rev() {
+        let mut pieces = std::mem::take(&mut wall_pieces[k]);
+        // A band may reach past the region: it is kept inside. It holds
+        // when every deeper ring is cut (the open side's are).
         let band = bands[k].as_ref().map(|b| b.intersection(&holder, tol_c));
         let safe = match (band, &air) {
             (Some(band), Some(air)) => Some(band.union(air, tol_c)),
@@ -148,7 +250,11 @@ pub fn plan_offset_in(
             let Some(start) = cut.start() else { continue };
             match pos {
                 Some(p) => {
-                    let down = safe.as_ref().is_some_and(|safe| safe.contains_segment(p, start, tol_c));
+                    // A link no longer than ae from where the tool cut
+                    // engages no more than a pass does.
+                    let short =
+                        (start[0] - p[0]).hypot(start[1] - p[1]) <= ae && holder.contains_segment(p, start, tol_c);
+                    let down = short || safe.as_ref().is_some_and(|safe| safe.contains_segment(p, start, tol_c));
                     steps.push(Step::Link { tool_down: down, via: Vec::new(), cleared: piece.from_air, to: None });
                 }
                 None if piece.from_air => {
@@ -165,7 +271,82 @@ pub fn plan_offset_in(
     Ok(steps)
 }
 
+/// The entry of an open side's piece from above at `start`: a straight
+/// plunge where the tool cuts nothing there (`from_air`), else a plunge in
+/// the air or the cleared band `lead` beside it and a move in (a retract
+/// with a helix when there is neither).
+#[allow(clippy::too_many_arguments, reason = "the entry's context")]
+fn push_entry(
+    steps: &mut Vec<Step>,
+    start: P2,
+    from_air: bool,
+    air: Option<&Region>,
+    lead: Option<&Region>,
+    holder: &Region,
+    ae: f64,
+    tol_c: f64,
+) {
+    if from_air {
+        steps.push(Step::Link { tool_down: false, via: Vec::new(), cleared: true, to: None });
+        return;
+    }
+    let clear = match (air, lead) {
+        (Some(a), Some(l)) => Some(a.union(l, tol_c)),
+        (Some(a), None) => Some(a.clone()),
+        (None, Some(l)) => Some(l.clone()),
+        (None, None) => None,
+    };
+    match clear.as_ref().and_then(|c| lead_in(start, c, holder, ae, tol_c)) {
+        Some(a) => {
+            steps.push(Step::Link { tool_down: false, via: Vec::new(), cleared: true, to: Some(a) });
+            steps.push(Step::Link { tool_down: true, via: Vec::new(), cleared: false, to: None });
+        }
+        None => steps.push(Step::Link { tool_down: false, via: Vec::new(), cleared: false, to: None }),
+    }
+}
+
+/// Distance from `q` to the segment `a b`.
+fn segment_distance(q: P2, a: P2, b: P2) -> f64 {
+    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+    let l2 = dx * dx + dy * dy;
+    let t = if l2 > 0.0 { (((q[0] - a[0]) * dx + (q[1] - a[1]) * dy) / l2).clamp(0.0, 1.0) } else { 0.0 };
+    (q[0] - a[0] - t * dx).hypot(q[1] - a[1] - t * dy)
+}
+
+/// A point of `air` within a few stepovers of `s` from which a straight
+/// move to `s` stays in the air or the region (`holder`): the nearest of 16
+/// directions at 1 to 4 ae.
+fn lead_in(s: P2, air: &Region, holder: &Region, ae: f64, tol_c: f64) -> Option<P2> {
+    (1..=4).find_map(|m| {
+        (0..16).find_map(|i| {
+            let a = std::f64::consts::PI * f64::from(i) / 8.0;
+            let d = ae * f64::from(m);
+            let q = [s[0] + d * a.cos(), s[1] + d * a.sin()];
+            let inside = |r: &Region| r.contains_segment(q, s, tol_c);
+            (air.contains(q) && (inside(air) || inside(holder) || inside(&air.union(holder, tol_c)))).then_some(q)
+        })
+    })
+}
+
+/// Every point of the closed `ring`, sampled every `step` (arcs as chords
+/// within `chord`), lies in `deep`.
+fn all_inside(ring: &Contour, deep: &Region, step: f64, chord: f64) -> bool {
+    let vertices = ring.to_points(chord);
+    (0..vertices.len()).all(|i| {
+        let (p, q) = (vertices[i], vertices[(i + 1) % vertices.len()]);
+        let d = (q[0] - p[0]).hypot(q[1] - p[1]);
+        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a ring's samples")]
+        let n = (d / step).ceil().max(1.0) as usize;
+        (0..n).all(|j| {
+            #[allow(clippy::cast_precision_loss, reason = "small counts")]
+            let f = j as f64 / n as f64;
+            deep.contains([p[0] + f * (q[0] - p[0]), p[1] + f * (q[1] - p[1])])
+        })
+    })
+}
+
 /// A ring to cut, or the stretch of one that reaches the material.
+#[derive(Clone)]
 struct Piece {
     /// Oriented for the milling direction.
     contour: Contour,
@@ -174,6 +355,15 @@ struct Piece {
     closed: bool,
     /// The open stretch starts where the tool cuts nothing.
     from_air: bool,
+    /// The open stretch ends where the tool cuts nothing.
+    to_air: bool,
+}
+
+impl Piece {
+    /// The piece run the other way.
+    fn reversed(self) -> Piece {
+        Piece { contour: self.contour.reversed(), closed: self.closed, from_air: self.to_air, to_air: self.from_air }
+    }
 }
 
 /// Where a tool centre meets material: the material grown by R less
@@ -228,7 +418,7 @@ impl Reach {
         let n = samples.len();
         let touch: Vec<bool> = samples.iter().map(|&p| self.inside(p)).collect();
         let Some(first_air) = touch.iter().position(|t| !t) else {
-            return vec![Piece { contour: ring.clone(), closed: true, from_air: false }];
+            return vec![Piece { contour: ring.clone(), closed: true, from_air: false, to_air: false }];
         };
         if !touch.iter().any(|&t| t) {
             return Vec::new();
@@ -276,7 +466,7 @@ impl Reach {
             }
         }
         if joined.len() == 1 && length(joined[0].1, joined[0].0 + n) < gap {
-            return vec![Piece { contour: ring.clone(), closed: true, from_air: false }];
+            return vec![Piece { contour: ring.clone(), closed: true, from_air: false, to_air: false }];
         }
         joined
             .into_iter()
@@ -284,7 +474,7 @@ impl Reach {
                 // One sample into the air at each end.
                 let points: Vec<P2> = (a.saturating_sub(1)..=b + 1).map(at).collect();
                 let contour = Contour::polygon(&points, false).ok()?;
-                Some(Piece { contour, closed: false, from_air: !hit(a.saturating_sub(1)) })
+                Some(Piece { contour, closed: false, from_air: !hit(a.saturating_sub(1)), to_air: !hit(b + 1) })
             })
             .collect()
     }

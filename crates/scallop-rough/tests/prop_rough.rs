@@ -13,6 +13,7 @@ use scallop_rough::{
     ClearOptions, Direction, MaterialMap, Motion, Pattern, RoughPlan, RoughSettings, Step, grown_cutter, plan_offset,
     plan_rough, plan_rough_from, pocket_toolpath,
 };
+use scallop_sim::{EngagementOptions, ZMap, engagement_angle, stock_engagement};
 use scallop_toolpath::{MoveKind, Toolpath};
 
 /// A box `[x0, x1] x [y0, y1] x [0, h]` on a plate `[-p, p]^2` at z = 0 and a
@@ -339,7 +340,8 @@ fn adaptive_levels_are_entered_from_the_open_sides() {
 /// grown by R), along which the tool cuts nothing: at most 3 % of the feed
 /// in the air around the stock, every tool centre inside the stock still
 /// reached, links inside their levels, and the same plan on one and two
-/// threads.
+/// threads; its rings nearer the open sides than the part are cut from the
+/// air inwards, so no pass is a slot.
 #[test]
 fn offset_levels_cut_no_ring_around_the_stock() {
     let mesh = stepped_part(-6.0, 6.0, -5.0, 5.0, 6.0, 2.0);
@@ -357,6 +359,12 @@ fn offset_levels_cut_no_ring_around_the_stock() {
     assert_eq!(plan.toolpath, again.toolpath);
     assert!(plan.passes > 0);
     assert_open_sides_kept(&plan, &stock, r);
+    // Every level has open sides: cut from them inwards, no pass is a slot
+    // (the simulator's reading on the stock box; the part is never cut).
+    let map = ZMap::new(stock, 0.1).unwrap();
+    let target = engagement_angle(set.stepover * 2.0 * r, r);
+    let report = stock_engagement(&map, &cutter, &plan.toolpath, target, &EngagementOptions::default()).unwrap();
+    assert!(report.slot_length < 1e-9, "{:.1} mm of slot", report.slot_length);
 }
 
 /// Checks of a plan of levels on a part in a box of stock: at most 3 % of
