@@ -129,7 +129,15 @@ impl RoughModel {
                 limited = self.limit_to_material(region, z, r);
                 &limited
             };
-            let (count, cells) = offset_passes(&self.grid, region, ae / cell);
+            // The planner leaves out the passes (and the stretches of them)
+            // that never come within R of the material (docs/roughing.md,
+            // "Air"): the passes are counted on the cells that do.
+            // (From the whole box, `z` is the region's key, not a level: the
+            // material is the box.)
+            let material: Vec<bool> =
+                self.tops.iter().map(|&t| if self.whole { t.is_finite() } else { t > z + rtol::MIN_CHIP }).collect();
+            let reach = within(&self.grid, &material, (r / cell - 1.0).max(0.0));
+            let (count, cells) = offset_passes(&self.grid, region, &reach, ae / cell);
             // The offsets sweep the region grown by the tool radius down to z.
             let swept = if later { within(&self.grid, region, r / cell) } else { Vec::new() };
             (count > 0).then_some((count, cells, swept))
@@ -193,8 +201,9 @@ impl RoughModel {
 }
 
 /// The passes of the offset pattern in `region` at a stepover of `step`
-/// cells (module docs) and the region's cells, counted in the region's box.
-fn offset_passes(grid: &Grid, region: &[bool], step: f64) -> (usize, usize) {
+/// cells (module docs), on the cells of `reach` only, and the region's
+/// cells, counted in the region's box.
+fn offset_passes(grid: &Grid, region: &[bool], reach: &[bool], step: f64) -> (usize, usize) {
     let Some((i0, j0, i1, j1)) = grid.bounds(region) else { return (0, 0) };
     // The box with a frame of one empty cell.
     let sub = Grid { nx: i1 - i0 + 3, ny: j1 - j0 + 3 };
@@ -204,19 +213,57 @@ fn offset_passes(grid: &Grid, region: &[bool], step: f64) -> (usize, usize) {
             !sub.frame(k) && region[(j + j0 - 1) * grid.nx + i + i0 - 1]
         })
         .collect();
+    let at = |k: usize| (k / sub.nx + j0 - 1) * grid.nx + k % sub.nx + i0 - 1;
     let inward = distances(&sub, &inside.iter().map(|c| !c).collect::<Vec<bool>>());
     let mut passes = 0;
     let mut k = 0.0;
     loop {
         let offset: Vec<bool> = (0..sub.len()).map(|i| inside[i] && inward[i] - 0.5 >= k * step).collect();
-        let loops = sub.loops(&offset);
-        if loops == 0 {
+        if sub.loops(&offset) == 0 {
             break;
         }
-        passes += loops;
+        // The offset's boundary cells within reach: each connected stretch
+        // is a pass (a whole ring, or the stretch of one that reaches).
+        let edge = |i: usize| {
+            let (x, y) = (i % sub.nx, i / sub.nx);
+            [(x + 1, y), (x - 1, y), (x, y + 1), (x, y - 1)].iter().any(|&(a, b)| !offset[b * sub.nx + a])
+        };
+        let reached: Vec<bool> =
+            (0..sub.len()).map(|i| offset[i] && !sub.frame(i) && edge(i) && reach[at(i)]).collect();
+        passes += components(&sub, &reached);
         k += 1.0;
     }
     (passes, inside.iter().filter(|&&c| c).count())
+}
+
+/// The connected pieces of the cells `set` of `grid` (8-neighbours; the
+/// frame holds none).
+fn components(grid: &Grid, set: &[bool]) -> usize {
+    let mut seen = vec![false; grid.len()];
+    let mut count = 0;
+    let mut stack = Vec::new();
+    for k in 0..grid.len() {
+        if !set[k] || seen[k] {
+            continue;
+        }
+        count += 1;
+        seen[k] = true;
+        stack.push(k);
+        while let Some(c) = stack.pop() {
+            let (x, y) = (c % grid.nx, c / grid.nx);
+            for (dx, dy) in [(-1, -1), (0, -1), (1, -1), (-1, 0), (1, 0), (-1, 1), (0, 1), (1, 1)] {
+                let (a, b) = (x.wrapping_add_signed(dx), y.wrapping_add_signed(dy));
+                if a < grid.nx && b < grid.ny {
+                    let n = b * grid.nx + a;
+                    if set[n] && !seen[n] {
+                        seen[n] = true;
+                        stack.push(n);
+                    }
+                }
+            }
+        }
+    }
+    count
 }
 
 /// A grid of `nx * ny` cells, x fastest, whose outer ring is the frame (outside).

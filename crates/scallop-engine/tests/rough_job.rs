@@ -156,8 +156,9 @@ fn rest_roughing_machines_only_what_the_larger_tool_left() {
 /// stock it received: its target from the stepover (0.2 D: 53.13 degrees),
 /// one figure per move of its toolpath (rapids and retracts cut nothing),
 /// the offset pattern's passes at the target (the median within the
-/// stock's reading, docs/simulation.md) and its slots where the offsets
-/// start at 180 (a finishing operation reports none: `finishing_after_roughing`).
+/// stock's reading, docs/simulation.md), and no slot: the levels are open on
+/// the stock's sides and cut from the air inwards (docs/roughing.md, "Open
+/// sides"; a finishing operation reports none: `finishing_after_roughing`).
 #[test]
 fn a_roughing_operation_reports_its_simulated_engagement() {
     let out = run_job(&rough_job(0.3)).unwrap();
@@ -172,6 +173,6 @@ fn a_roughing_operation_reports_its_simulated_engagement() {
     }
     assert!(e.p50_deg <= e.p95_deg && e.p95_deg <= e.max_deg && e.max_deg <= 180.0, "{e:?}");
     assert!((e.p50_deg - e.target_deg).abs() < 6.0, "{e:?}");
-    assert!(e.slot_length_mm > 0.0 && e.cutting_length_mm > e.slot_length_mm, "{e:?}");
+    assert!(e.cutting_length_mm > 0.0 && e.slot_length_mm == 0.0, "{e:?}");
     assert!(e.entries > 0 && e.entries == e.retracts, "{e:?}");
 }
