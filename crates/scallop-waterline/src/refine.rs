@@ -87,6 +87,22 @@ impl Local<'_> {
         self.drop.drop_one(slot, p, probe.z - probe.step).tip.z - probe.z
     }
 
+    /// [`Local::triangle_height`] and the corners and edges of the triangle
+    /// that hold its contact ([`BoxDrop::contact_features`]).
+    fn triangle_contact(&self, slot: usize, p: Point2) -> (f64, u8) {
+        let probe = self.probe;
+        let cl = self.drop.drop_one(slot, p, probe.z - probe.step);
+        (cl.tip.z - probe.z, self.drop.contact_features(slot, &cl.contact))
+    }
+
+    /// [`Local::triangle_height`] on the facet and the corners and edges in
+    /// `features` only: at most the triangle's height, so a point where it is
+    /// > 0 is inside as well (and the triangle lifts the cutter there).
+    fn feature_height(&self, slot: usize, features: u8, p: Point2) -> f64 {
+        let probe = self.probe;
+        self.drop.drop_one_features(slot, features, p, probe.z - probe.step).tip.z - probe.z
+    }
+
     /// `triangle_height(slot, p) > 0`, with the search pruned at z.
     fn lifts(&self, slot: usize, p: Point2) -> bool {
         self.drop.lifts(slot, p, self.probe.z)
@@ -273,9 +289,11 @@ impl Local<'_> {
     pub(crate) fn contour_near(&self, mid: Point2, normal: Vec2, accept: f64, reach: f64) -> Near {
         let mut first: Option<(f64, Option<usize>)> = None;
         let mut at_mid: Option<(f64, Option<usize>)> = None;
+        let mut features = ALL_FEATURES;
         if let Some(seed) = self.seed.get() {
-            let h_seed = self.triangle_height(seed, mid);
+            let (h_seed, held) = self.triangle_contact(seed, mid);
             if h_seed > 0.0 {
+                features = held;
                 // Where the last Newton start's slope puts the contour within
                 // `accept`, the full evaluation that accepts the chord comes
                 // first (elsewhere the seed's own height there decides, below).
@@ -297,7 +315,10 @@ impl Local<'_> {
         let mid_in = h_mid > 0.0;
         let towards = if mid_in { -normal } else { normal };
         if let Some(slot) = slot_mid {
-            match self.newton_near(mid, towards, mid_in, (h_mid, slot), accept, reach, &mut first) {
+            // The features of the seed's contact where the seed stands for the
+            // contact triangle, else the whole triangle.
+            let features = if at_mid.is_some() { features } else { ALL_FEATURES };
+            match self.newton_near(mid, towards, mid_in, (h_mid, slot, features), accept, reach, &mut first) {
                 Start::Settled(near) => return near,
                 Start::Open => {}
             }
@@ -370,13 +391,16 @@ impl Local<'_> {
         mid: Point2,
         towards: Vec2,
         mid_in: bool,
-        (h_mid, slot): (f64, usize),
+        (h_mid, slot, features): (f64, usize, u8),
         accept: f64,
         reach: f64,
         first: &mut Option<(f64, Option<usize>)>,
     ) -> Start {
+        // The triangle's height on the features that hold its contact at the
+        // midpoint: smooth where the contour follows one feature.
+        let height = |p: Point2| self.feature_height(slot, features, p);
         let near = mid + towards * accept;
-        let h_near = self.triangle_height(slot, near);
+        let h_near = height(near);
         // The triangle's height falls (from inside) or rises (from outside) towards the contour.
         let fall = h_mid - h_near;
         self.slope.set(fall.abs() / accept);
@@ -401,7 +425,6 @@ impl Local<'_> {
         let at = |r: f64| mid + towards * r;
         let settle =
             |out: Point2| Start::Settled(if (out - mid).norm() <= accept { Near::Within } else { Near::Found(out) });
-        let height = |p: Point2| self.triangle_height(slot, p);
         if mid_in {
             if !(root.is_finite() && root + half <= reach) {
                 return Start::Open;
@@ -546,6 +569,9 @@ impl Local<'_> {
 /// Most triangles [`Local::walk_bracket`] steps through before the plain
 /// bracket takes over.
 const MAX_WALK_STEPS: usize = 8;
+
+/// Every corner and edge of a triangle (bits as `MeshIndex::owned_features`).
+const ALL_FEATURES: u8 = 0b11_1111;
 
 /// Most secant steps of the Newton start from an outside midpoint
 /// ([`Local::newton_near`]) before the general search takes over.
