@@ -286,6 +286,11 @@ impl Local<'_> {
     /// `mid`, it also stands for the midpoint's contact triangle (no full
     /// evaluation at `mid`). The crossing found is the same as with full
     /// evaluations, up to the crossing tolerance.
+    ///
+    /// Before the probes, [`Local::newton_near`] tries the secant root of
+    /// that triangle's own height along the line (docs/waterline.md, step 6,
+    /// "Newton start"): one full evaluation where it lands within the
+    /// crossing tolerance, as it does along most of a loop.
     pub(crate) fn contour_near(&self, mid: Point2, normal: Vec2, accept: f64, reach: f64) -> Near {
         let mut first: Option<(f64, Option<usize>)> = None;
         let mut at_mid: Option<(f64, Option<usize>)> = None;
@@ -682,7 +687,7 @@ fn chord_groups(chords: &[(Point2, Point2)], step: f64) -> Vec<(usize, usize)> {
 const CHORDS_PER_GROUP: usize = 16;
 
 /// Largest extent of a group of chords, in grid steps.
-const GROUP_SPAN: f64 = 2.0;
+const GROUP_SPAN: f64 = 8.0;
 
 /// Closed loops from the grid chains, every chord refined (in parallel over
 /// chords; the result does not depend on the number of threads).

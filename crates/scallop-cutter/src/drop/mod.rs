@@ -431,17 +431,24 @@ impl BoxDrop<'_> {
         match contact {
             Contact::Vertex { point, .. } => corners.iter().position(|c| c == point).map_or(ALL_FEATURES, |k| 1 << k),
             Contact::Edge { point, .. } => {
-                // The edge whose line passes nearest the contact point (in XY;
-                // the point was computed on it).
+                // The edge nearest the contact point in space (the point was
+                // computed on it; in XY alone the edges of a vertical facet
+                // overlap).
                 let distance = |k: usize| {
                     let (a, b) = (&corners[k], &corners[(k + 1) % 3]);
-                    let (ex, ey) = (b.x - a.x, b.y - a.y);
-                    let len2 = ex * ex + ey * ey;
-                    let cross = (point.x - a.x) * ey - (point.y - a.y) * ex;
-                    if len2 > 0.0 { cross.abs() / len2.sqrt() } else { f64::INFINITY }
+                    let (e, w) = (*b - *a, *point - *a);
+                    let len2 = e.dot(&e);
+                    let t = if len2 > 0.0 { (w.dot(&e) / len2).clamp(0.0, 1.0) } else { 0.0 };
+                    (w - e * t).norm()
                 };
-                let k = (0..3).min_by(|&i, &j| distance(i).total_cmp(&distance(j))).unwrap_or(0);
-                (1 << (3 + k)) | (1 << k) | (1 << ((k + 1) % 3))
+                // Every edge as near, up to rounding (a contact at a corner lies
+                // on two edges, which may differ in the last bit there).
+                let d = [distance(0), distance(1), distance(2)];
+                let near =
+                    d.iter().copied().fold(f64::INFINITY, f64::min) + tol::REL_ROUNDING * (point.coords.norm() + 1.0);
+                (0..3)
+                    .filter(|&k| d[k] <= near)
+                    .fold(0, |bits, k| bits | (1 << (3 + k)) | (1 << k) | (1 << ((k + 1) % 3)))
             }
             Contact::Facet { .. } | Contact::Floor => ALL_FEATURES,
         }
