@@ -476,7 +476,7 @@ impl Local<'_> {
                 }
                 let r = root + half;
                 let rise = h_hi - h_last;
-                if !(rise > 0.0) {
+                if rise.is_nan() || rise <= 0.0 {
                     return Start::Open;
                 }
                 root = r - h_hi * (r - r_last) / rise;
