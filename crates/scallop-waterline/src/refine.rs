@@ -40,6 +40,7 @@ impl<'a> Probe<'a> {
             drop: BoxDrop::new(self.cutter, self.index, lo, hi),
             seed: Cell::new(None),
             slope: Cell::new(f64::NAN),
+            seed_features: Cell::new(ALL_FEATURES),
         }
     }
 }
@@ -59,6 +60,9 @@ pub(crate) struct Local<'a> {
     /// Newton start of [`Local::contour_near`]: predicts whether the contour
     /// lies within the accepted distance of the next midpoint (`NaN`: unknown).
     slope: Cell<f64>,
+    /// The corners and edges of the seed that held its contact at the last
+    /// evaluation ([`BoxDrop::contact_features`]).
+    seed_features: Cell<u8>,
 }
 
 impl Local<'_> {
@@ -72,8 +76,9 @@ impl Local<'_> {
     pub(crate) fn height_slot(&self, p: Point2) -> (f64, Option<usize>) {
         let probe = self.probe;
         let (cl, slot) = self.drop.drop(p, probe.z - probe.step, self.seed.get());
-        if slot.is_some() {
+        if let Some(s) = slot {
             self.seed.set(slot);
+            self.seed_features.set(self.drop.contact_features(s, &cl.contact));
         }
         (cl.tip.z - probe.z, slot)
     }
@@ -87,11 +92,11 @@ impl Local<'_> {
         self.drop.drop_one(slot, p, probe.z - probe.step).tip.z - probe.z
     }
 
-    /// [`Local::triangle_height`] and the corners and edges of the triangle
+    /// [`Local::feature_height`] and the corners and edges of the triangle
     /// that hold its contact ([`BoxDrop::contact_features`]).
-    fn triangle_contact(&self, slot: usize, p: Point2) -> (f64, u8) {
+    fn triangle_contact(&self, slot: usize, features: u8, p: Point2) -> (f64, u8) {
         let probe = self.probe;
-        let cl = self.drop.drop_one(slot, p, probe.z - probe.step);
+        let cl = self.drop.drop_one_features(slot, features, p, probe.z - probe.step);
         (cl.tip.z - probe.z, self.drop.contact_features(slot, &cl.contact))
     }
 
@@ -296,7 +301,13 @@ impl Local<'_> {
         let mut at_mid: Option<(f64, Option<usize>)> = None;
         let mut features = ALL_FEATURES;
         if let Some(seed) = self.seed.get() {
-            let (h_seed, held) = self.triangle_contact(seed, mid);
+            // The seed's last contact features first (the contact moves little
+            // from one midpoint to the next), the whole triangle if they do not lift.
+            let last = self.seed_features.get();
+            let (mut h_seed, mut held) = self.triangle_contact(seed, last, mid);
+            if h_seed <= 0.0 && last != ALL_FEATURES {
+                (h_seed, held) = self.triangle_contact(seed, ALL_FEATURES, mid);
+            }
             if h_seed > 0.0 {
                 features = held;
                 // Where the last Newton start's slope puts the contour within
