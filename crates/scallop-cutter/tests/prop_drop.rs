@@ -153,6 +153,33 @@ proptest! {
         }
     }
 
+    /// `BoxDrop::drop_one_features` never exceeds the whole triangle's height
+    /// (`drop_one`) whatever the features kept, and equals it, bit for bit,
+    /// on the features of `contact_features` of `drop_one`'s contact (the
+    /// contact's corner, or its edge and that edge's corners: those of both
+    /// edges where the contact is a corner reached from an edge).
+    #[test]
+    fn features_of_the_contact_give_the_triangles_height(soup in soup_strategy(30), shape in shape_strategy(),
+                                                         pts in prop::collection::vec((-2.0f64..12.0, -2.0f64..12.0,
+                                                                                       0usize..30, 0u8..64), 1..40)) {
+        let Some((_, index)) = build(&soup) else { return Ok(()) };
+        let c = cutter(shape);
+        let local = BoxDrop::new(&c, &index, Point2::new(0.0, 0.0), Point2::new(10.0, 10.0));
+        for (x, y, slot, mask) in pts {
+            let (xy, slot) = (Point2::new(x, y), slot % index.len());
+            let whole = local.drop_one(slot, xy, FLOOR);
+            let some = local.drop_one_features(slot, mask, xy, FLOOR);
+            prop_assert!(some.tip.z <= whole.tip.z, "slot {} at {:?}, mask {:b}: {:?} above {:?}", slot, xy, mask, some, whole);
+            let held = local.contact_features(slot, &whole.contact);
+            let kept = local.drop_one_features(slot, held, xy, FLOOR);
+            prop_assert_eq!(kept.tip.z.to_bits(), whole.tip.z.to_bits(), "slot {} at {:?}, {:?}, features {:b}",
+                            slot, xy, whole.contact, held);
+            if let Contact::Vertex { .. } = whole.contact {
+                prop_assert_eq!(held.count_ones(), 1, "a corner: {:b}", held);
+            }
+        }
+    }
+
     /// `BoxDrop::lifts` (the search pruned at z) answers as one triangle's
     /// height does (`drop_one` from a floor below z), also at z equal to that
     /// height and one rounding unit either side of it.

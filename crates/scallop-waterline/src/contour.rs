@@ -92,8 +92,12 @@ fn edge_crossings(grid: &WaterlineGrid<'_>, level: &Level, probe: &Probe<'_>) ->
     // edge from a sample lies in its block's square: only the blocks where the
     // contour may pass hold crossings or gaps.
     let mut todo: Vec<(usize, bool, bool)> = Vec::new();
+    // Runs [start, end) of `todo` from one block, with the block's square:
+    // one candidate list serves the block's edges (the heights are the same).
+    let mut runs: Vec<(usize, usize, Point2, Point2)> = Vec::new();
     for b in grid.mixed_blocks(level) {
         let ([i0, i1], [j0, j1]) = grid.block_range(b);
+        let start = todo.len();
         for j in j0..j1 {
             for i in i0..i1 {
                 let a = grid.inside(level, i, j);
@@ -110,39 +114,48 @@ fn edge_crossings(grid: &WaterlineGrid<'_>, level: &Level, probe: &Probe<'_>) ->
                 }
             }
         }
+        if todo.len() > start {
+            let (lo, hi) = (grid.point(i0, j0), grid.point(i1.min(nx - 1), j1.min(ny - 1)));
+            runs.push((start, todo.len(), lo, hi));
+        }
     }
-    todo.sort_unstable_by_key(|t| t.0);
     let z = probe.z;
     let height = |k: usize| grid.sample(k % nx, k / nx).0;
     let slot_at = |k: usize| grid.sample(k % nx, k / nx).1;
     let floored = |k: usize| (height(k) - z).max(-grid.step);
-    let found: Vec<Vec<Point2>> = todo
+    let mut found: Vec<(usize, Vec<Point2>)> = runs
         .par_iter()
-        .with_min_len(16)
-        .map(|&(id, first_inside, crossing)| {
-            let ([ia, ja], [ib, jb]) = num.ends(id);
-            let (ka, kb) = (ja * nx + ia, jb * nx + ib);
-            let (a, b) = (grid.point(ia, ja), grid.point(ib, jb));
-            let local = probe.local(Point2::new(a.x.min(b.x), a.y.min(b.y)), Point2::new(a.x.max(b.x), a.y.max(b.y)));
-            if !crossing {
-                return local.gaps(a, slot_at(ka) as usize, b, floored(kb));
-            }
-            // Floored as `Probe::height` floors them, so the secant sees one function.
-            let slot = |k: usize| (slot_at(k) != u32::MAX).then_some(slot_at(k) as usize);
-            let p = if first_inside {
-                local.bisect_heights(a, floored(ka), slot(ka), b, floored(kb))
-            } else {
-                local.bisect_heights(b, floored(kb), slot(kb), a, floored(ka))
-            };
-            vec![p]
+        .flat_map_iter(|&(start, end, lo, hi)| {
+            let local = probe.local(lo, hi);
+            todo[start..end]
+                .iter()
+                .map(|&(id, first_inside, crossing)| {
+                    let ([ia, ja], [ib, jb]) = num.ends(id);
+                    let (ka, kb) = (ja * nx + ia, jb * nx + ib);
+                    let (a, b) = (grid.point(ia, ja), grid.point(ib, jb));
+                    if !crossing {
+                        return (id, local.gaps(a, slot_at(ka) as usize, b, floored(kb)));
+                    }
+                    // Floored as `Probe::height` floors them, so the secant sees one function.
+                    let slot = |k: usize| (slot_at(k) != u32::MAX).then_some(slot_at(k) as usize);
+                    let p = if first_inside {
+                        local.bisect_heights(a, floored(ka), slot(ka), b, floored(kb))
+                    } else {
+                        local.bisect_heights(b, floored(kb), slot(kb), a, floored(ka))
+                    };
+                    (id, vec![p])
+                })
+                .collect::<Vec<_>>()
         })
         .collect();
+    found.sort_unstable_by_key(|f| f.0);
     let mut offset = 0;
     let mut out = Vec::new();
-    for (&(id, _, _), points) in todo.iter().zip(found) {
+    for (id, points) in found {
         if !points.is_empty() {
-            out.push(EdgeCrossings { id, offset, points: points.clone() });
-            offset += points.len();
+            let n = points.len();
+            out.push(EdgeCrossings { id, offset, points });
+            offset += n;
         }
     }
     out

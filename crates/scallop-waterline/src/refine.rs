@@ -35,7 +35,13 @@ impl<'a> Probe<'a> {
     /// the box ([`BoxDrop`]), so that each evaluation scans a short list
     /// instead of searching the index.
     pub(crate) fn local(&'a self, lo: Point2, hi: Point2) -> Local<'a> {
-        Local { probe: self, drop: BoxDrop::new(self.cutter, self.index, lo, hi), seed: Cell::new(None) }
+        Local {
+            probe: self,
+            drop: BoxDrop::new(self.cutter, self.index, lo, hi),
+            seed: Cell::new(None),
+            slope: Cell::new(f64::NAN),
+            seed_features: Cell::new(ALL_FEATURES),
+        }
     }
 }
 
@@ -50,6 +56,13 @@ pub(crate) struct Local<'a> {
     /// The contact triangle of the last evaluation: tried first at the next
     /// (a valid lower bound that prunes the scan early; the height is the same).
     seed: Cell<Option<usize>>,
+    /// The slope (height per unit length, along the probe line) of the last
+    /// Newton start of [`Local::contour_near`]: predicts whether the contour
+    /// lies within the accepted distance of the next midpoint (`NaN`: unknown).
+    slope: Cell<f64>,
+    /// The corners and edges of the seed that held its contact at the last
+    /// evaluation ([`BoxDrop::contact_features`]).
+    seed_features: Cell<u8>,
 }
 
 impl Local<'_> {
@@ -63,8 +76,9 @@ impl Local<'_> {
     pub(crate) fn height_slot(&self, p: Point2) -> (f64, Option<usize>) {
         let probe = self.probe;
         let (cl, slot) = self.drop.drop(p, probe.z - probe.step, self.seed.get());
-        if slot.is_some() {
+        if let Some(s) = slot {
             self.seed.set(slot);
+            self.seed_features.set(self.drop.contact_features(s, &cl.contact));
         }
         (cl.tip.z - probe.z, slot)
     }
@@ -76,6 +90,22 @@ impl Local<'_> {
     fn triangle_height(&self, slot: usize, p: Point2) -> f64 {
         let probe = self.probe;
         self.drop.drop_one(slot, p, probe.z - probe.step).tip.z - probe.z
+    }
+
+    /// [`Local::feature_height`] and the corners and edges of the triangle
+    /// that hold its contact ([`BoxDrop::contact_features`]).
+    fn triangle_contact(&self, slot: usize, features: u8, p: Point2) -> (f64, u8) {
+        let probe = self.probe;
+        let cl = self.drop.drop_one_features(slot, features, p, probe.z - probe.step);
+        (cl.tip.z - probe.z, self.drop.contact_features(slot, &cl.contact))
+    }
+
+    /// [`Local::triangle_height`] on the facet and the corners and edges in
+    /// `features` only: at most the triangle's height, so a point where it is
+    /// > 0 is inside as well (and the triangle lifts the cutter there).
+    fn feature_height(&self, slot: usize, features: u8, p: Point2) -> f64 {
+        let probe = self.probe;
+        self.drop.drop_one_features(slot, features, p, probe.z - probe.step).tip.z - probe.z
     }
 
     /// `triangle_height(slot, p) > 0`, with the search pruned at z.
@@ -261,17 +291,35 @@ impl Local<'_> {
     /// `mid`, it also stands for the midpoint's contact triangle (no full
     /// evaluation at `mid`). The crossing found is the same as with full
     /// evaluations, up to the crossing tolerance.
+    ///
+    /// Before the probes, [`Local::newton_near`] tries the secant root of
+    /// that triangle's own height along the line (docs/waterline.md, step 6,
+    /// "Newton start"): one full evaluation where it lands within the
+    /// crossing tolerance, as it does along most of a loop.
     pub(crate) fn contour_near(&self, mid: Point2, normal: Vec2, accept: f64, reach: f64) -> Near {
         let mut first: Option<(f64, Option<usize>)> = None;
         let mut at_mid: Option<(f64, Option<usize>)> = None;
+        let mut features = ALL_FEATURES;
         if let Some(seed) = self.seed.get() {
-            let h_seed = self.triangle_height(seed, mid);
+            // The seed's last contact features first (the contact moves little
+            // from one midpoint to the next), the whole triangle if they do not lift.
+            let last = self.seed_features.get();
+            let (mut h_seed, mut held) = self.triangle_contact(seed, last, mid);
+            if h_seed <= 0.0 && last != ALL_FEATURES {
+                (h_seed, held) = self.triangle_contact(seed, ALL_FEATURES, mid);
+            }
             if h_seed > 0.0 {
-                let (h, slot) = self.height_slot(mid - normal * accept);
-                if h <= 0.0 {
-                    return Near::Within; // inside at the midpoint, outside within `accept`
+                features = held;
+                // Where the last Newton start's slope puts the contour within
+                // `accept`, the full evaluation that accepts the chord comes
+                // first (elsewhere the seed's own height there decides, below).
+                if h_seed <= self.slope.get() * accept {
+                    let (h, slot) = self.height_slot(mid - normal * accept);
+                    if h <= 0.0 {
+                        return Near::Within; // inside at the midpoint, outside within `accept`
+                    }
+                    first = Some((h, slot));
                 }
-                first = Some((h, slot));
                 // The seed lifts the cutter at the midpoint: it stands for the
                 // contact triangle there (any triangle lifting the cutter at an
                 // inside point serves the gap checks and the walk), and its
@@ -281,10 +329,16 @@ impl Local<'_> {
         }
         let (h_mid, slot_mid) = at_mid.unwrap_or_else(|| self.height_slot(mid));
         let mid_in = h_mid > 0.0;
-        if !mid_in && slot_mid.is_some_and(|s| self.lifts(s, mid + normal * accept)) {
-            return Near::Within; // outside at the midpoint, inside within `accept`
-        }
         let towards = if mid_in { -normal } else { normal };
+        if let Some(slot) = slot_mid {
+            // The features of the seed's contact where the seed stands for the
+            // contact triangle, else the whole triangle.
+            let features = if at_mid.is_some() { features } else { ALL_FEATURES };
+            match self.newton_near(mid, towards, mid_in, (h_mid, slot, features), accept, reach, &mut first) {
+                Start::Settled(near) => return near,
+                Start::Open => {}
+            }
+        }
         // From an inside midpoint, the first crossing along the line is the end
         // of the walk over the triangles that lift the cutter from the midpoint
         // on (the probes below find the same one, with more full evaluations).
@@ -330,6 +384,119 @@ impl Local<'_> {
 }
 
 impl Local<'_> {
+    /// The Newton start of [`Local::contour_near`] on the triangle in `slot`
+    /// (lifting the cutter at `mid` if `mid_in`, else the contact triangle
+    /// there, below z; `h_mid` the height at `mid`): that triangle's own height
+    /// at `accept` along `towards` (one triangle evaluation) either settles
+    /// the accepted distance or, with the height at `mid`, gives the secant
+    /// root r of the triangle's height along the line (where the contour
+    /// follows one triangle, as along most of a loop, its first Newton step:
+    /// within the crossing tolerance of the contour once the chord's midpoint
+    /// deviation is small). Two points half a crossing tolerance either side
+    /// of r close the bracket: the one on the midpoint's side classified by
+    /// the triangle (from an inside midpoint, the triangle lifting the cutter
+    /// at both ends of the stretch proves it inside throughout, convexity as
+    /// in [`Local::triangle_height`]), the other by the exact drop-cutter. The
+    /// same crossing as the probes of [`Local::contour_near`] find, up to the
+    /// crossing tolerance, with one exact evaluation instead of several.
+    /// [`Start::Open`] where the guess misses (the caller's general search
+    /// follows); `first` records the exact evaluation at `accept`, if made.
+    #[allow(clippy::too_many_arguments)]
+    fn newton_near(
+        &self,
+        mid: Point2,
+        towards: Vec2,
+        mid_in: bool,
+        (h_mid, slot, features): (f64, usize, u8),
+        accept: f64,
+        reach: f64,
+        first: &mut Option<(f64, Option<usize>)>,
+    ) -> Start {
+        // The triangle's height on the features that hold its contact at the
+        // midpoint: smooth where the contour follows one feature.
+        let height = |p: Point2| self.feature_height(slot, features, p);
+        let near = mid + towards * accept;
+        let h_near = height(near);
+        // The triangle's height falls (from inside) or rises (from outside) towards the contour.
+        let fall = h_mid - h_near;
+        self.slope.set(fall.abs() / accept);
+        if mid_in && h_near <= 0.0 {
+            if first.is_none() {
+                let (h, next) = self.height_slot(near);
+                if h <= 0.0 {
+                    return Start::Settled(Near::Within); // inside at the midpoint, outside within `accept`
+                }
+                *first = Some((h, next));
+            }
+            return Start::Open; // another triangle lifts the cutter within `accept`
+        }
+        if !mid_in && h_near > 0.0 {
+            return Start::Settled(Near::Within); // outside at the midpoint, inside within `accept`
+        }
+        if !(if mid_in { fall > 0.0 } else { fall < 0.0 }) {
+            return Start::Open;
+        }
+        let mut root = accept + h_near * accept / fall;
+        let half = SECANT_PROBE * self.probe.tolerance;
+        let at = |r: f64| mid + towards * r;
+        let settle =
+            |out: Point2| Start::Settled(if (out - mid).norm() <= accept { Near::Within } else { Near::Found(out) });
+        if mid_in {
+            if !(root.is_finite() && root + half <= reach) {
+                return Start::Open;
+            }
+            let (lo, hi) = (at(root - half), at(root + half));
+            let h_lo = height(lo);
+            // The triangle's crossing: just past `lo`, or (the guess went past
+            // it, as where the height is concave) between `near` and `lo`.
+            let (inner, outer) = if h_lo > 0.0 {
+                (lo, hi)
+            } else {
+                // Where the triangle leaves the cutter's reach its height jumps:
+                // the guess of [`Local::walk_bracket_from`] first.
+                let guess = self.drop.rim_exit(slot, self.probe.z, near, lo);
+                self.bracket_with(&height, near, h_near, lo, h_lo, guess)
+            };
+            let (h, next) = self.height_slot(outer);
+            if h <= 0.0 {
+                return if inner == outer { Start::Open } else { settle(outer) };
+            }
+            // Inside at `outer` too: the walk goes on from there.
+            match next.and_then(|next| self.walk_bracket_from(outer, next, None, at(reach))) {
+                Some((_, out)) => settle(out),
+                None => Start::Open,
+            }
+        } else {
+            // Secant steps on the triangle's height until it lifts the cutter
+            // past the guess (from below where the height is concave).
+            let (mut r_last, mut h_last) = (accept, h_near);
+            for _ in 0..MAX_NEWTON_STEPS {
+                if !(root.is_finite() && root > r_last && root + half <= reach) {
+                    return Start::Open;
+                }
+                let h_hi = height(at(root + half));
+                if h_hi > 0.0 {
+                    let lo = at(root - half);
+                    let (h, slot_lo) = self.height_slot(lo);
+                    if h <= 0.0 {
+                        return settle(lo);
+                    }
+                    // Another triangle lifts the cutter nearer: the first change
+                    // of side between the midpoint and `lo`.
+                    return settle(self.bisect_heights(lo, h, slot_lo, mid, h_mid));
+                }
+                let r = root + half;
+                let rise = h_hi - h_last;
+                if rise.is_nan() || rise <= 0.0 {
+                    return Start::Open;
+                }
+                root = r - h_hi * (r - r_last) / rise;
+                (r_last, h_last) = (r, h_hi);
+            }
+            Start::Open
+        }
+    }
+
     /// The contour crossings on the segment from `a` to `b`, both inside (the
     /// cutter at z cuts there), in order from `a`: the ends of the gaps
     /// (outside intervals) between them, each an outside point within the
@@ -419,6 +586,13 @@ impl Local<'_> {
 /// bracket takes over.
 const MAX_WALK_STEPS: usize = 8;
 
+/// Every corner and edge of a triangle (bits as `MeshIndex::owned_features`).
+const ALL_FEATURES: u8 = 0b11_1111;
+
+/// Most secant steps of the Newton start from an outside midpoint
+/// ([`Local::newton_near`]) before the general search takes over.
+const MAX_NEWTON_STEPS: usize = 4;
+
 /// Bisection steps after a secant step that failed to halve the bracket,
 /// before the secant is tried again.
 const BISECTIONS_AFTER_SECANT: u32 = 2;
@@ -426,6 +600,14 @@ const BISECTIONS_AFTER_SECANT: u32 = 2;
 /// Most triangles a cover walk along one grid edge steps through before it
 /// gives up (the walk usually takes one to three).
 const MAX_COVER_STEPS: usize = 256;
+
+/// The outcome of [`Local::newton_near`].
+enum Start {
+    /// The answer of [`Local::contour_near`].
+    Settled(Near),
+    /// No answer: the general search follows.
+    Open,
+}
 
 /// What [`Local::contour_near`] found.
 pub(crate) enum Near {
@@ -516,7 +698,7 @@ fn chord_groups(chords: &[(Point2, Point2)], step: f64) -> Vec<(usize, usize)> {
 const CHORDS_PER_GROUP: usize = 16;
 
 /// Largest extent of a group of chords, in grid steps.
-const GROUP_SPAN: f64 = 2.0;
+const GROUP_SPAN: f64 = 8.0;
 
 /// Closed loops from the grid chains, every chord refined (in parallel over
 /// chords; the result does not depend on the number of threads).

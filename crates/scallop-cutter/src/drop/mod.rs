@@ -406,6 +406,54 @@ impl<'a> BoxDrop<'a> {
 }
 
 impl BoxDrop<'_> {
+    /// The drop-cutter on the one triangle in `slot` at `xy` restricted to
+    /// its facet and the corners and edges in `features` (bits as
+    /// [`MeshIndex::owned_features`]), floored at `floor`: at most
+    /// [`BoxDrop::drop_one`]'s height (a maximum over fewer contacts), and
+    /// equal to it where the features hold `drop_one`'s contact. Cheaper where
+    /// few edges are kept (an edge contact costs most).
+    #[must_use]
+    pub fn drop_one_features(&self, slot: usize, features: u8, xy: Point2, floor: f64) -> ClPoint {
+        let mut best = ClPoint::floor(xy, floor);
+        let ix = self.index;
+        drop_features(&self.profile, ix.corners(slot), ix.normal(slot), ix.original_index(slot), features, &mut best);
+        best
+    }
+
+    /// The corners and edges (bits as [`MeshIndex::owned_features`]) of the
+    /// triangle in `slot` that hold `contact`, a contact of that triangle: a
+    /// corner's bit; an edge's bit and its two corners' bits; every bit for a
+    /// facet contact (the contact moves onto an edge where the facet's ends),
+    /// or for a contact of another triangle or the floor.
+    #[must_use]
+    pub fn contact_features(&self, slot: usize, contact: &Contact) -> u8 {
+        let corners = self.index.corners(slot);
+        match contact {
+            Contact::Vertex { point, .. } => corners.iter().position(|c| c == point).map_or(ALL_FEATURES, |k| 1 << k),
+            Contact::Edge { point, .. } => {
+                // The edge nearest the contact point in space (the point was
+                // computed on it; in XY alone the edges of a vertical facet
+                // overlap).
+                let distance = |k: usize| {
+                    let (a, b) = (&corners[k], &corners[(k + 1) % 3]);
+                    let (e, w) = (*b - *a, *point - *a);
+                    let len2 = e.dot(&e);
+                    let t = if len2 > 0.0 { (w.dot(&e) / len2).clamp(0.0, 1.0) } else { 0.0 };
+                    (w - e * t).norm()
+                };
+                // Every edge as near, up to rounding (a contact at a corner lies
+                // on two edges, which may differ in the last bit there).
+                let d = [distance(0), distance(1), distance(2)];
+                let near =
+                    d.iter().copied().fold(f64::INFINITY, f64::min) + tol::REL_ROUNDING * (point.coords.norm() + 1.0);
+                (0..3)
+                    .filter(|&k| d[k] <= near)
+                    .fold(0, |bits, k| bits | (1 << (3 + k)) | (1 << k) | (1 << ((k + 1) % 3)))
+            }
+            Contact::Facet { .. } | Contact::Floor => ALL_FEATURES,
+        }
+    }
+
     /// Whether the one triangle in `slot` lifts the cutter at `xy` above `z`:
     /// the answer of `drop_one(slot, xy, floor).tip.z > z` for any floor below
     /// z (every contact is computed as there), found with the search pruned
