@@ -317,20 +317,8 @@ proptest! {
 /// threads.
 #[test]
 fn adaptive_levels_are_entered_from_the_open_sides() {
-    let mesh = stepped_part(-6.0, 6.0, -5.0, 5.0, 6.0, 2.0);
-    let index = MeshIndex::build(&mesh);
-    let r = 3.0;
-    let cutter = Cutter::new(CutterShape::Flat { radius: r }, 40.0).unwrap();
-    let stock = Aabb3 { min: Point3::new(-16.0, -14.0, 0.0), max: Point3::new(16.0, 14.0, 10.0) };
-    let motion = Motion { clearance_z: 20.0, feed: 1000.0 };
-    let set = RoughSettings { pattern: Pattern::Adaptive, ..settings(2.0, 0.3, 0.1) };
-    let run = |threads| {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-        pool.install(|| plan_rough(&index, &cutter, &stock, &set, &motion, 1e-3).unwrap())
-    };
-    let (plan, again) = (run(1), run(2));
-    assert_eq!(plan.toolpath, again.toolpath);
-    assert!(plan.passes > 0);
+    let (plan, stock, cutter, _) = open_sides_plan(Pattern::Adaptive);
+    let r = cutter.radius();
     assert_eq!(plan.helices, 0, "a level with an open side is entered from the air");
     assert_open_sides_kept(&plan, &stock, r);
 }
@@ -344,20 +332,8 @@ fn adaptive_levels_are_entered_from_the_open_sides() {
 /// air inwards, so no pass is a slot.
 #[test]
 fn offset_levels_cut_no_ring_around_the_stock() {
-    let mesh = stepped_part(-6.0, 6.0, -5.0, 5.0, 6.0, 2.0);
-    let index = MeshIndex::build(&mesh);
-    let r = 3.0;
-    let cutter = Cutter::new(CutterShape::Flat { radius: r }, 40.0).unwrap();
-    let stock = Aabb3 { min: Point3::new(-16.0, -14.0, 0.0), max: Point3::new(16.0, 14.0, 10.0) };
-    let motion = Motion { clearance_z: 20.0, feed: 1000.0 };
-    let set = RoughSettings { pattern: Pattern::Offset, ..settings(2.0, 0.3, 0.1) };
-    let run = |threads| {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-        pool.install(|| plan_rough(&index, &cutter, &stock, &set, &motion, 1e-3).unwrap())
-    };
-    let (plan, again) = (run(1), run(2));
-    assert_eq!(plan.toolpath, again.toolpath);
-    assert!(plan.passes > 0);
+    let (plan, stock, cutter, set) = open_sides_plan(Pattern::Offset);
+    let r = cutter.radius();
     assert_open_sides_kept(&plan, &stock, r);
     // Every level has open sides: cut from them inwards, no pass is a slot
     // (the simulator's reading on the stock box; the part is never cut).
@@ -365,6 +341,26 @@ fn offset_levels_cut_no_ring_around_the_stock() {
     let target = engagement_angle(set.stepover * 2.0 * r, r);
     let report = stock_engagement(&map, &cutter, &plan.toolpath, target, &EngagementOptions::default()).unwrap();
     assert!(report.slot_length < 1e-9, "{:.1} mm of slot", report.slot_length);
+}
+
+/// A box on a plate in a larger stock (every level's region runs R past the
+/// stock's open sides) planned by `pattern` with a 6 mm flat end mill, 2 mm
+/// levels, 0.3 D: the same plan on one and two threads, with passes.
+fn open_sides_plan(pattern: Pattern) -> (RoughPlan, Aabb3, Cutter, RoughSettings) {
+    let mesh = stepped_part(-6.0, 6.0, -5.0, 5.0, 6.0, 2.0);
+    let index = MeshIndex::build(&mesh);
+    let cutter = Cutter::new(CutterShape::Flat { radius: 3.0 }, 40.0).unwrap();
+    let stock = Aabb3 { min: Point3::new(-16.0, -14.0, 0.0), max: Point3::new(16.0, 14.0, 10.0) };
+    let motion = Motion { clearance_z: 20.0, feed: 1000.0 };
+    let set = RoughSettings { pattern, ..settings(2.0, 0.3, 0.1) };
+    let run = |threads| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| plan_rough(&index, &cutter, &stock, &set, &motion, 1e-3).unwrap())
+    };
+    let (plan, again) = (run(1), run(2));
+    assert_eq!(plan.toolpath, again.toolpath);
+    assert!(plan.passes > 0);
+    (plan, stock, cutter, set)
 }
 
 /// Checks of a plan of levels on a part in a box of stock: at most 3 % of
