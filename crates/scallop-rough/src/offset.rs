@@ -119,29 +119,35 @@ pub fn plan_offset_in(
     let mut wall_pieces: Vec<Vec<Piece>> = Vec::with_capacity(levels.len());
     let mut strips: Vec<Option<Region>> = Vec::with_capacity(levels.len());
     for k in 0..levels.len() {
+        #[allow(clippy::cast_precision_loss, reason = "a small level count")]
+        let depth = ae * k as f64 + tol::OPEN_SIDE_SHARE * ae;
+        let deep_test = open_region.as_ref().map(|e| Banded::new(&e.offset(depth), tol_c));
+        let step = reach.as_ref().map_or(tol::AIR_RING_STEP, |m| m.step);
+        // A ring whose every point lies nearer the air than a wall is cut
+        // from the air inwards: it meets the material as it is. Another is
+        // cut inside-out: it meets what the deeper rings left.
+        let rings: Vec<(Contour, bool)> = levels[k]
+            .rings()
+            .iter()
+            .map(|ring| {
+                let ring = orient(ring, options.direction);
+                let is_open = deep_test.as_ref().is_some_and(|deep| all_inside(&ring, deep, step, tol_c));
+                (ring, is_open)
+            })
+            .collect();
         // The material left when the rings of the deeper levels are cut:
         // they swept every point within R of `levels[k + 1]` (the module
         // documentation; a sliver under the chip at that reach's edge is
-        // counted as swept).
+        // counted as swept). Computed for the rings cut inside-out only.
         let left = match (material, levels.get(k + 1)) {
-            (Some(m), Some(inner)) => {
+            (Some(m), Some(inner)) if rings.iter().any(|(_, o)| !o) => {
                 Some(Reach::new(&m.difference(&inner.offset(-(r + tol::AIR_RING_CHIP)), tol_c), r, tol_c))
             }
-            (Some(_), None) => None,
-            (None, _) => None,
+            _ => None,
         };
         let left = left.as_ref().or(reach.as_ref());
-        #[allow(clippy::cast_precision_loss, reason = "a small level count")]
-        let depth = ae * k as f64 + tol::OPEN_SIDE_SHARE * ae;
-        let deep = open_region.as_ref().map(|e| e.offset(depth));
-        let step = reach.as_ref().map_or(tol::AIR_RING_STEP, |m| m.step);
         let (mut open, mut wall) = (Vec::new(), Vec::new());
-        for ring in levels[k].rings() {
-            let ring = orient(ring, options.direction);
-            // A ring whose every point lies nearer the air than a wall is cut
-            // from the air inwards: it meets the material as it is. Another
-            // is cut inside-out: it meets what the deeper rings left.
-            let is_open = deep.as_ref().is_some_and(|deep| all_inside(&ring, deep, step, tol_c));
+        for (ring, is_open) in rings {
             let by = if is_open { reach.as_ref() } else { left };
             let pieces = match by {
                 None => vec![Piece { contour: ring, closed: true, from_air: false, to_air: false }],
@@ -155,11 +161,13 @@ pub fn plan_offset_in(
         }
         // Links of the open side: through the air, or along the band a
         // stepover wide inside the level's ring on the open side (swept by
-        // it: a link there engages no more than a pass).
-        let strip = deep.as_ref().map(|deep| {
+        // it: a link there engages no more than a pass). Computed for the
+        // levels with such rings only.
+        let strip = open_region.as_ref().filter(|_| !open.is_empty()).map(|e| {
+            #[allow(clippy::cast_precision_loss, reason = "a small level count")]
+            let open_side = e.offset(ae * k as f64);
             let inner = levels[k].offset(ae * (1.0 + tol::LINK_MARGIN_SHARE));
-            let ring_held = levels[k].offset(-tol::LINK_GROW);
-            ring_held.difference(&inner, tol_c).intersection(&deep.offset(-tol::OPEN_SIDE_SHARE * ae), tol_c)
+            levels[k].offset(-tol::LINK_GROW).difference(&inner, tol_c).intersection(&open_side, tol_c)
         });
         strips.push(strip);
         open_pieces.push(open);
@@ -328,9 +336,71 @@ fn lead_in(s: P2, air: &Region, holder: &Region, ae: f64, tol_c: f64) -> Option<
     })
 }
 
+/// Point tests against a region whose rings are cut into horizontal bands:
+/// the winding number of a point sums the edges of its band that cross its
+/// height to its right (arcs as chords within the given tolerance).
+struct Banded {
+    /// Per band: the edges `(a, b)` that meet its height range.
+    bands: Vec<Vec<(P2, P2)>>,
+    y0: f64,
+    dy: f64,
+}
+
+impl Banded {
+    fn new(region: &Region, chord: f64) -> Banded {
+        let rings: Vec<Vec<P2>> = region.rings().iter().map(|r| r.to_points(chord)).collect();
+        let edges: Vec<(P2, P2)> = rings
+            .iter()
+            .flat_map(|r| (0..r.len()).map(move |i| (r[i], r[(i + 1) % r.len()])))
+            .filter(|(a, b)| a[1] != b[1])
+            .collect();
+        let (y0, y1) = edges.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), (a, b)| {
+            (lo.min(a[1]).min(b[1]), hi.max(a[1]).max(b[1]))
+        });
+        #[allow(clippy::cast_precision_loss, reason = "an edge count")]
+        let count = ((edges.len() as f64).sqrt().ceil()).clamp(1.0, 4096.0);
+        let dy = if y1 > y0 { (y1 - y0) / count } else { 1.0 };
+        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "at most 4096 bands")]
+        let mut bands = vec![Vec::new(); count as usize];
+        let last = bands.len() - 1;
+        let band = |y: f64| -> usize {
+            #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "clamped to the bands")]
+            let k = ((y - y0) / dy).floor().max(0.0) as usize;
+            k.min(last)
+        };
+        for &(a, b) in &edges {
+            for k in band(a[1].min(b[1]))..=band(a[1].max(b[1])) {
+                bands[k].push((a, b));
+            }
+        }
+        Banded { bands, y0, dy }
+    }
+
+    /// `p` is inside (winding number above 0), as `Region::contains`.
+    fn contains(&self, p: P2) -> bool {
+        if !(p[1] >= self.y0) {
+            return false;
+        }
+        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a band index")]
+        let k = ((p[1] - self.y0) / self.dy).floor() as usize;
+        let Some(edges) = self.bands.get(k) else { return false };
+        let mut winding = 0i32;
+        for &(a, b) in edges {
+            let up = a[1] <= p[1] && b[1] > p[1];
+            let down = b[1] <= p[1] && a[1] > p[1];
+            if up || down {
+                let x = a[0] + (p[1] - a[1]) / (b[1] - a[1]) * (b[0] - a[0]);
+                if x > p[0] {
+                    winding += if up { 1 } else { -1 };
+                }
+            }
+        }
+        winding > 0
+    }
+}
 /// Every point of the closed `ring`, sampled every `step` (arcs as chords
 /// within `chord`), lies in `deep`.
-fn all_inside(ring: &Contour, deep: &Region, step: f64, chord: f64) -> bool {
+fn all_inside(ring: &Contour, deep: &Banded, step: f64, chord: f64) -> bool {
     let vertices = ring.to_points(chord);
     (0..vertices.len()).all(|i| {
         let (p, q) = (vertices[i], vertices[(i + 1) % vertices.len()]);
@@ -370,6 +440,8 @@ impl Piece {
 /// [`tol::AIR_RING_CHIP`].
 struct Reach {
     grown: Region,
+    /// `grown` for point tests.
+    tester: Banded,
     bounds: Option<(P2, P2)>,
     /// Arcs are sampled as chords within this (mm).
     chord: f64,
@@ -387,12 +459,13 @@ impl Reach {
         let grown = material.offset(-rho);
         let bounds = grown.bounds();
         let step = (4.0 * rho * tol::AIR_RING_CHIP).sqrt().clamp(tol::AIR_RING_STEP, radius.max(tol::AIR_RING_STEP));
-        Reach { grown, bounds, chord, step }
+        let tester = Banded::new(&grown, chord);
+        Reach { grown, tester, bounds, chord, step }
     }
 
     fn inside(&self, p: P2) -> bool {
         self.bounds.is_some_and(|(lo, hi)| {
-            p[0] >= lo[0] && p[0] <= hi[0] && p[1] >= lo[1] && p[1] <= hi[1] && self.grown.contains(p)
+            p[0] >= lo[0] && p[0] <= hi[0] && p[1] >= lo[1] && p[1] <= hi[1] && self.tester.contains(p)
         })
     }
 
