@@ -8,7 +8,7 @@ use clap::Args;
 use scallop_analysis::MachineLimits;
 use scallop_geom::Point2;
 use scallop_io::cl::read_cl;
-use scallop_io::gcode::{GcodeOptions, read_gcode};
+use scallop_io::gcode::{GcodeOptions, read_gcode, read_gcode_arcs};
 use scallop_sim::{EngagementOptions, EngagementReport, Pocket, engagement_angle, pocket_engagement};
 use scallop_strategy::{Boundary, FinishingParams, Pattern, lookahead_time};
 use scallop_toolpath::{MoveKind, Toolpath};
@@ -116,21 +116,27 @@ fn read_pocket(path: &Path) -> CliResult<Pocket> {
     Pocket::new(rings).map_err(|e| Failure::rejected(format!("{name}: {e}")))
 }
 
-fn read_program(path: &Path) -> CliResult<Toolpath> {
+/// The program's moves with its arcs as chords (for the engagement), and
+/// with its XY arcs kept (for the cycle time: an arc is one move along its
+/// circle, not hundreds of chords).
+fn read_program(path: &Path) -> CliResult<(Toolpath, Toolpath)> {
     let text = read_text(path, "the program")?;
     let name = path.display();
     let csv = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("csv"));
     let read = if csv {
-        read_cl(&text, 1000.0).map_err(|e| e.to_string())
+        read_cl(&text, 1000.0).map(|p| (p.clone(), p)).map_err(|e| e.to_string())
     } else {
-        read_gcode(&text, &GcodeOptions::default()).map_err(|e| e.to_string())
+        read_gcode(&text, &GcodeOptions::default())
+            .and_then(|chords| Ok((chords, read_gcode_arcs(&text, &GcodeOptions::default())?)))
+            .map_err(|e| e.to_string())
     };
     read.map_err(|e| Failure::rejected(format!("{name}: {e}")))
 }
 
 /// Cycle time of the look-ahead jerk-limited model (scallop-strategy's model
-/// (b)) at one feed for every cutting move, and the plain length / feed.
-fn cycle_times(path: &Toolpath, args: &EngagementArgs) -> CliResult<(f64, f64)> {
+/// (b)) at one feed for every cutting move on `arcs` (the program with its
+/// XY arcs kept), and the plain length / feed on `path` (its arcs as chords).
+fn cycle_times(path: &Toolpath, arcs: &Toolpath, args: &EngagementArgs) -> CliResult<(f64, f64)> {
     let machine = MachineLimits { feed: args.feed / 60.0, ..MachineLimits::default() };
     let params = FinishingParams {
         direction: 0.0,
@@ -154,7 +160,7 @@ fn cycle_times(path: &Toolpath, args: &EngagementArgs) -> CliResult<(f64, f64)> 
             (w[1].to - w[0].to).norm() / rate * 60.0
         })
         .sum();
-    Ok((plain, lookahead_time(path, &params).total()))
+    Ok((plain, lookahead_time(arcs, &params).total()))
 }
 
 fn figures(args: &EngagementArgs, r: &EngagementReport, times: (f64, f64), path: &Toolpath, seconds: f64) -> Figures {
@@ -239,7 +245,7 @@ pub fn run(args: &EngagementArgs) -> CliResult<()> {
         return Err(Failure::rejected(format!("--stepover {}: give a fraction of D in (0, 1]", args.stepover)));
     }
     let pocket = read_pocket(&args.pocket)?;
-    let path = read_program(&args.program)?;
+    let (path, arcs) = read_program(&args.program)?;
     let radius = args.tool_diameter / 2.0;
     let options = EngagementOptions {
         resolution: args.resolution,
@@ -251,7 +257,7 @@ pub fn run(args: &EngagementArgs) -> CliResult<()> {
     let target = engagement_angle(args.stepover * args.tool_diameter, radius);
     let report = pocket_engagement(&pocket, radius, &path, target, &options)
         .map_err(|e| Failure::rejected(format!("{}: {e}", args.program.display())))?;
-    let times = cycle_times(&path, args)?;
+    let times = cycle_times(&path, &arcs, args)?;
     let f = figures(args, &report, times, &path, start.elapsed().as_secs_f64());
     if args.json { print_json(&f) } else { print_text(&text(&f)) }
 }

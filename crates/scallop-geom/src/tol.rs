@@ -664,6 +664,11 @@ pub mod rough {
     /// sample would tie).
     pub const FLAT_LIFT: f64 = 1e-5;
 
+    /// The offset pattern's rings are refitted as lines and arcs within this
+    /// share of the chord tolerance (the region booleans' tolerance, the job's
+    /// path tolerance): the level regions' boundaries are dense polygons.
+    pub const RING_ARC_FIT_SHARE: f64 = 0.25;
+
     /// Rapids down into cleared area stop this far above the cleared level; a
     /// plunge at the plunge feed does the rest.
     pub const APPROACH: f64 = 1.0;

@@ -131,7 +131,7 @@ pub fn plan_offset_in(
             .rings()
             .iter()
             .map(|ring| {
-                let ring = orient(ring, options.direction);
+                let ring = refit(&orient(ring, options.direction), true, tol_c);
                 let is_open = deep_test.as_ref().is_some_and(|deep| all_inside(&ring, deep, step, tol_c));
                 (ring, is_open)
             })
@@ -559,7 +559,7 @@ impl Reach {
             .filter_map(|(a, b)| {
                 // One sample into the air at each end.
                 let points: Vec<P2> = (a.saturating_sub(1)..=b + 1).map(at).collect();
-                let contour = Contour::polygon(&points, false).ok()?;
+                let contour = Contour::from_points(&points, false, tol::RING_ARC_FIT_SHARE * self.chord).ok()?;
                 Some(Piece { contour, closed: false, from_air: !hit(a.saturating_sub(1)), to_air: !hit(b + 1) })
             })
             .collect()
@@ -605,6 +605,17 @@ fn orient(c: &Contour, direction: Direction) -> Contour {
         Direction::Climb => c.clone(),
         Direction::Conventional => c.reversed(),
     }
+}
+
+/// `c` as the fewest lines and arcs within [`tol::RING_ARC_FIT_SHARE`] of
+/// the chord tolerance `chord` (its arcs read as chords within a tenth of
+/// that first): the offsets of a level's region keep its boundary's dense
+/// polygon, whose short moves a jerk-limited controller cannot run at the
+/// feed (docs/roughing.md, "Offset clearing"). `c` itself when no fit is
+/// found.
+fn refit(c: &Contour, closed: bool, chord: f64) -> Contour {
+    let fit = tol::RING_ARC_FIT_SHARE * chord;
+    Contour::from_points(&c.to_points(0.1 * fit), closed, fit).unwrap_or_else(|_| c.clone())
 }
 
 /// The piece whose start is nearest `pos` (a closed ring started at its

@@ -285,3 +285,58 @@ fn an_arc_around_an_inner_corner_is_followed_not_its_chord() {
         other => panic!("the chord should gouge the corner: {other:?}"),
     }
 }
+
+/// A slot along the x axis from outside a stock box to (2.7, 0) at depth,
+/// then a circle of radius 2.7 about the origin (tighter than the 3 mm
+/// radius tool, as a helical entry's) as four quarter arcs, or (`arcs`
+/// false) the same arcs as the chords the engagement follows them by.
+fn tight_circle(arcs: bool) -> Toolpath {
+    let rho = 2.7;
+    let at = |a: f64| Point3::new(rho * a.cos(), rho * a.sin(), -1.0);
+    let mut path = Toolpath::new(1000.0);
+    path.push(Move::new(MoveKind::Rapid, Point3::new(25.0, 0.0, 5.0)));
+    path.push(Move::new(MoveKind::Plunge, Point3::new(25.0, 0.0, -1.0)));
+    path.push(Move::new(MoveKind::Feed, at(0.0)));
+    for q in 1..=4 {
+        let (from, to) =
+            (at(std::f64::consts::FRAC_PI_2 * f64::from(q - 1)), at(std::f64::consts::FRAC_PI_2 * f64::from(q)));
+        let arc = scallop_toolpath::ArcXY { center: Point2::origin(), sweep: std::f64::consts::FRAC_PI_2 };
+        if arcs {
+            path.push_arc(Move::new(MoveKind::Feed, to), arc);
+        } else {
+            for p in arc.chords(&from, &to, scallop_geom::tol::sim::ENGAGEMENT_ARC_SAGITTA) {
+                path.push(Move::new(MoveKind::Feed, p));
+            }
+        }
+    }
+    path.push(Move::new(MoveKind::Retract, Point3::new(rho, 0.0, 5.0)));
+    path
+}
+
+/// On the in-process stock an arc move reads as the same path written as
+/// the chords the measure follows it by, even where it turns tighter than
+/// the tool: there the earlier part of the arc sweeps the front half of the
+/// tool's periphery at its later points, and probing the stock as it was
+/// before the arc began would count material the arc had already removed.
+#[test]
+fn an_arc_reads_as_its_chords_on_the_stock() {
+    use scallop_cutter::{Cutter, CutterShape};
+    use scallop_geom::Aabb3;
+    use scallop_sim::{ZMap, stock_engagement};
+    let stock =
+        ZMap::new(Aabb3 { min: Point3::new(-20.0, -20.0, -5.0), max: Point3::new(20.0, 20.0, 0.0) }, 0.05).unwrap();
+    let flat = Cutter::new(CutterShape::Flat { radius: 3.0 }, 20.0).unwrap();
+    let target = engagement_angle(1.2, 3.0);
+    let read = |path: &Toolpath| stock_engagement(&stock, &flat, path, target, &EngagementOptions::default()).unwrap();
+    let (arcs, chords) = (read(&tight_circle(true)), read(&tight_circle(false)));
+    for (what, a, c) in [("p50", arcs.p50, chords.p50), ("p95", arcs.p95, chords.p95), ("max", arcs.max, chords.max)] {
+        assert!(
+            (a - c).abs() <= 1e-9,
+            "{what}: {:.2} deg as arcs, {:.2} deg as chords",
+            a.to_degrees(),
+            c.to_degrees()
+        );
+    }
+    assert!((arcs.slot_length - chords.slot_length).abs() <= 1e-9, "{} / {}", arcs.slot_length, chords.slot_length);
+    assert!(arcs.cutting_length > 0.0 && arcs.max > 0.0);
+}

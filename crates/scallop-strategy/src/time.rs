@@ -15,6 +15,12 @@
 //! taken at full speed (the model of the thesis: a pass is a portion without
 //! sharp angles).
 //!
+//! An XY arc move ([`Toolpath::arc`], a helix when z changes along it) is
+//! one segment of its own length, met at its junctions along its end
+//! tangents; in model (b) its speed is also capped by its curvature: the
+//! centripetal acceleration `v^2 / rho <= A` and its rate `v^3 / rho^2 <= J`.
+//! Every other move is a line between its ends.
+//!
 //! # (b) Look-ahead model
 //! Every move is a segment with a speed limit; junction speeds are bounded by
 //! - 0 at the start, the end and wherever the class changes;
@@ -96,18 +102,55 @@ fn limits(params: &FinishingParams, class: Class) -> MachineLimits {
 struct Segment {
     class: Class,
     length: f64,
-    dir: Vec3,
+    /// Direction at the start and at the end (equal on a line).
+    dir_in: Vec3,
+    dir_out: Vec3,
+    /// Highest speed the segment's curvature allows (an arc), mm/s.
+    cap: f64,
 }
 
-fn segments(path: &Toolpath) -> Vec<Segment> {
-    path.moves()
-        .windows(2)
-        .filter_map(|w| {
-            let v = w[1].to - w[0].to;
-            let length = v.norm();
-            (length > tol::ZERO_LENGTH).then(|| Segment { class: class(w[1].kind), length, dir: v / length })
-        })
-        .collect()
+/// Move `k` of `path` (from move `k - 1`'s end) as a segment: a line, or an
+/// XY arc with a linear z (a helix) whose length, end tangents and speed cap
+/// are the arc's: the centripetal acceleration `v^2 / rho` within `A` and
+/// its jerk `v^3 / rho^2` within `J` (the trochoid's limits, docs/machine.md).
+fn segment(path: &Toolpath, k: usize, params: &FinishingParams) -> Option<Segment> {
+    let moves = path.moves();
+    let (from, to) = (moves[k - 1].to, moves[k].to);
+    let chord = to - from;
+    let line = |length: f64| {
+        let dir = chord / length;
+        Segment { class: class(moves[k].kind), length, dir_in: dir, dir_out: dir, cap: f64::INFINITY }
+    };
+    if let Some(arc) = path.arc(k) {
+        let r0 = scallop_geom::Vec2::new(from.x - arc.center.x, from.y - arc.center.y);
+        let r1 = scallop_geom::Vec2::new(to.x - arc.center.x, to.y - arc.center.y);
+        let rho = r0.norm();
+        let xy = rho * arc.sweep.abs();
+        if rho > tol::ZERO_LENGTH && xy > tol::ZERO_LENGTH {
+            let dz = to.z - from.z;
+            let length = xy.hypot(dz);
+            let turn = arc.sweep.signum();
+            let tangent = |r: scallop_geom::Vec2| {
+                let t = scallop_geom::Vec2::new(-r.y, r.x) * (turn / r.norm().max(tol::ZERO_LENGTH));
+                Vec3::new(t.x * xy, t.y * xy, dz) / length
+            };
+            let m = &params.machine;
+            let cap = (m.acceleration * rho).sqrt().min((m.jerk * rho * rho).cbrt());
+            return Some(Segment {
+                class: class(moves[k].kind),
+                length,
+                dir_in: tangent(r0),
+                dir_out: tangent(r1),
+                cap,
+            });
+        }
+    }
+    let length = chord.norm();
+    (length > tol::ZERO_LENGTH).then(|| line(length))
+}
+
+fn segments(path: &Toolpath, params: &FinishingParams) -> Vec<(usize, Segment)> {
+    (1..path.moves().len()).filter_map(|k| segment(path, k, params).map(|s| (k, s))).collect()
 }
 
 /// Model (a): stop-to-stop jerk-limited time of every chain between sharp
@@ -132,14 +175,16 @@ pub fn stop_to_stop_time(path: &Toolpath, params: &FinishingParams) -> ClassTime
     let cos_sharp = params.sharp_corner.cos();
     let mut times = ClassTimes::default();
     let mut chain: Option<(Class, f64, Vec3)> = None;
-    for s in segments(path) {
+    for (_, s) in segments(path, params) {
         chain = match chain {
-            Some((c, len, dir)) if c == s.class && dir.dot(&s.dir) >= cos_sharp => Some((c, len + s.length, s.dir)),
+            Some((c, len, dir)) if c == s.class && dir.dot(&s.dir_in) >= cos_sharp => {
+                Some((c, len + s.length, s.dir_out))
+            }
             Some((c, len, _)) => {
                 times.add(c, limits(params, c).segment_time(len));
-                Some((s.class, s.length, s.dir))
+                Some((s.class, s.length, s.dir_out))
             }
-            None => Some((s.class, s.length, s.dir)),
+            None => Some((s.class, s.length, s.dir_out)),
         };
     }
     if let Some((c, len, _)) = chain {
@@ -256,20 +301,18 @@ pub fn lookahead_profile(path: &Toolpath, params: &FinishingParams) -> Vec<MoveF
     let moves = path.moves();
     let mut out = vec![MoveFeed::default(); moves.len()];
     // (move index, segment) for the moves with a length.
-    let segs: Vec<(usize, Segment)> = moves
-        .windows(2)
-        .enumerate()
-        .filter_map(|(k, w)| {
-            let v = w[1].to - w[0].to;
-            let length = v.norm();
-            (length > tol::ZERO_LENGTH).then(|| (k + 1, Segment { class: class(w[1].kind), length, dir: v / length }))
-        })
-        .collect();
+    let segs = segments(path, params);
     let n = segs.len();
     if n == 0 {
         return out;
     }
-    let lims: Vec<MachineLimits> = segs.iter().map(|(_, s)| limits(params, s.class)).collect();
+    let lims: Vec<MachineLimits> = segs
+        .iter()
+        .map(|(_, s)| {
+            let l = limits(params, s.class);
+            MachineLimits { feed: l.feed.min(s.cap), ..l }
+        })
+        .collect();
     let a_max = params.machine.acceleration;
     let mut v = vec![0.0f64; n + 1];
     for i in 1..n {
@@ -277,7 +320,7 @@ pub fn lookahead_profile(path: &Toolpath, params: &FinishingParams) -> Vec<MoveF
         if p.class != q.class {
             continue;
         }
-        let cos_phi = p.dir.dot(&q.dir).clamp(-1.0, 1.0);
+        let cos_phi = p.dir_out.dot(&q.dir_in).clamp(-1.0, 1.0);
         let cos_half = (0.5 * (1.0 + cos_phi)).sqrt(); // cos(phi / 2)
         let cap = lims[i - 1].feed.min(lims[i].feed);
         v[i] = if 1.0 - cos_half <= 0.0 {
@@ -302,6 +345,70 @@ pub fn lookahead_profile(path: &Toolpath, params: &FinishingParams) -> Vec<MoveF
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::{Boundary, Pattern};
+    use scallop_geom::{Point2, Point3};
+    use scallop_toolpath::{ArcXY, Move};
+
+    fn params() -> FinishingParams {
+        FinishingParams {
+            direction: 0.0,
+            pattern: Pattern::Zigzag,
+            scallop_height: 0.01,
+            boundary: Boundary::ContactInside,
+            max_step: 0.5,
+            clearance: 5.0,
+            machine: MachineLimits::default(),
+            plunge_feed: 20.0,
+            rapid_rate: 500.0,
+            sharp_corner: 0.5,
+            blend_tolerance: 0.01,
+        }
+    }
+
+    /// A circle of radius `rho` about the origin from (rho, 0): `quarters`
+    /// quarter arcs, or (`arcs` false) `chords` equal chords per quarter.
+    fn circle(rho: f64, arcs: bool, chords: usize) -> Toolpath {
+        let mut path = Toolpath::new(5000.0);
+        path.push(Move::new(MoveKind::Feed, Point3::new(rho, 0.0, 0.0)));
+        let at = |a: f64| Point3::new(rho * a.cos(), rho * a.sin(), 0.0);
+        for q in 1..=4 {
+            let a = std::f64::consts::FRAC_PI_2 * f64::from(q);
+            if arcs {
+                let arc = ArcXY { center: Point2::origin(), sweep: std::f64::consts::FRAC_PI_2 };
+                path.push_arc(Move::new(MoveKind::Feed, at(a)), arc);
+            } else {
+                for c in 1..=chords {
+                    #[allow(clippy::cast_precision_loss, reason = "a small count")]
+                    let t = a - std::f64::consts::FRAC_PI_2 * (1.0 - c as f64 / chords as f64);
+                    path.push(Move::new(MoveKind::Feed, at(t)));
+                }
+            }
+        }
+        path
+    }
+
+    /// Analytic: four quarter arcs of a circle whose curvature allows the
+    /// feed take the time of one straight move of the circle's length (the
+    /// tangents agree at every junction, the speed changes fit in the first
+    /// and last quarters); the same circle as short chords takes longer; on a
+    /// circle too tight for the feed the tool runs at `sqrt(A rho)` at most.
+    #[test]
+    fn arcs_are_timed_by_their_length_tangents_and_curvature() {
+        let p = params();
+        let rho = 10.0;
+        let length = std::f64::consts::TAU * rho;
+        let arcs = lookahead_time(&circle(rho, true, 0), &p).cutting;
+        let line = p.machine.segment_time(length);
+        assert!((arcs - line).abs() <= 1e-9 * line, "{arcs} s for four arcs, {line} s for a line");
+        let chords = lookahead_time(&circle(rho, false, 80), &p).cutting;
+        assert!(chords > arcs * 1.05, "{chords} s for chords against {arcs} s");
+        assert!((stop_to_stop_time(&circle(rho, true, 0), &p).cutting - line).abs() <= 1e-9 * line);
+        let tight = 0.5;
+        let cap = (p.machine.acceleration * tight).sqrt();
+        assert!(cap < p.machine.feed);
+        let t = lookahead_time(&circle(tight, true, 0), &p).cutting;
+        assert!(t >= std::f64::consts::TAU * tight / cap, "{t} s on a circle of {tight} mm");
+    }
 
     /// With zero entry and exit speeds the look-ahead segment time equals the
     /// spec's stop-to-stop S-curve in all four cases.

@@ -85,6 +85,11 @@ pub fn stock_engagement(
         });
     }
     let rho = radius - inset;
+    // Its arcs as chord moves: a straight move's front half lies beyond R
+    // of every earlier position of it (exact to probe before the move is
+    // cut), an arc's does not where it turns.
+    let (chorded, origin) = chord_moves(path);
+    let path = &chorded;
     let track = track(path, radius, options);
     let mut zmap = stock.clone();
     let moves = path.moves();
@@ -123,7 +128,38 @@ pub fn stock_engagement(
     let mut report = summarise(path, &track, &phi, target, options);
     report.max_penetration = 0.0;
     debug_assert_eq!(report.move_phi.len(), moves.len());
+    // Figures per move of the program as given.
+    let mut move_phi = vec![0.0f64; origin.last().map_or(0, |&k| k + 1)];
+    for (&k, &p) in origin.iter().zip(&report.move_phi) {
+        move_phi[k] = move_phi[k].max(p);
+    }
+    report.move_phi = move_phi;
+    report.max_at = report.max_at.map(|(at, k)| (at, origin[k]));
     Ok(report)
+}
+
+/// `path` with each XY arc move replaced by its chords within
+/// [`crate::tol::ENGAGEMENT_ARC_SAGITTA`] (moves of the same kind), and for
+/// each move of the result the index of the move of `path` it comes from.
+fn chord_moves(path: &Toolpath) -> (Toolpath, Vec<usize>) {
+    let moves = path.moves();
+    let mut out = Toolpath::new(1000.0);
+    let mut origin = Vec::with_capacity(moves.len());
+    for (i, m) in moves.iter().enumerate() {
+        match (i.checked_sub(1).map(|j| moves[j].to), path.arc(i)) {
+            (Some(from), Some(arc)) => {
+                for p in arc.chords(&from, &m.to, crate::tol::ENGAGEMENT_ARC_SAGITTA) {
+                    out.push(scallop_toolpath::Move::new(m.kind, p));
+                    origin.push(i);
+                }
+            }
+            _ => {
+                out.push(*m);
+                origin.push(i);
+            }
+        }
+    }
+    (out, origin)
 }
 
 /// The moves `from..to` of `path` (arcs kept) as a toolpath that starts with a
