@@ -1006,6 +1006,18 @@ pub mod rough5 {
     /// "Limit passes: the tilt where it pays").
     pub const LIMIT_STEP_ALLOWANCES: f64 = 1.0;
 
+    /// A stretch of vertical pairs of a guide-curve pass is thinned to pairs
+    /// at most this many steps (`--step`) apart
+    /// (`scallop_rough5::thin_vertical`): 20 mm blocks at the default 1 mm
+    /// step, the guide points between them checked within the chord below.
+    pub const THIN_SPAN_STEPS: f64 = 20.0;
+
+    /// A vertical pair is dropped only if every guide point it stands for lies
+    /// within this many flank allowances of the segment that replaces them
+    /// (0.05 mm at a 0.5 mm allowance: a tenth of the material the finishing
+    /// tool is given, the proof's own sweep tolerance).
+    pub const THIN_CHORD_ALLOWANCES: f64 = 0.1;
+
     /// A flank triangle whose outward normal (out of the volume to remove)
     /// rises above the horizontal by more than this sine (1 degree) is an
     /// undercut: the 3+2 baseline looks for setups that reach under it

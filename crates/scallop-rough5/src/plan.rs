@@ -543,38 +543,49 @@ fn vertical_where_clear(
             SyncPoint { axis, ..*s }
         })
         .collect();
-    thin_vertical(limit_angular_step(&out, settings.max_angle_step, settings.max_azimuth_step), settings.step)
+    let span = tol::THIN_SPAN_STEPS * settings.step;
+    let chord = tol::THIN_CHORD_ALLOWANCES * settings.guides.flank_allowance;
+    thin_vertical(limit_angular_step(&out, settings.max_angle_step, settings.max_azimuth_step), span, chord)
 }
 
 /// `pairs` without the pairs inside a stretch of vertical axes that their
 /// neighbours make redundant: one is dropped when it, the pairs on either
-/// side and the last pair kept all have the axis +Z and the next pair's
-/// guide point is within `step` of the last kept one's. The synchronisation
-/// steps the path curve by the fraction of the longer of the path and tilt
-/// curves and the angular-step limit inserts pairs where the guide-curve
-/// axis turns, so a pass made vertical keeps pairs a tenth of the step
-/// apart; on the machine those blocks of a few hundredths of a millimetre
-/// slow the feed as much as the rotary axes did (docs/rough5.md, "Limit
-/// passes: the tilt where it pays"). The vertical stretch is then stepped as
-/// the zero-tilt variant steps its passes; the first and last pairs stay.
+/// side and the last pair kept all have the axis +Z, the next pair's guide
+/// point is within `span` of the last kept one's, and every pair from the
+/// last kept one to it lies within `chord` of the segment between the two.
+/// The synchronisation steps the path curve by the fraction of the longer of
+/// the path and tilt curves and the angular-step limit inserts pairs where
+/// the guide-curve axis turns, so a pass made vertical keeps pairs a tenth of
+/// the step apart, along curves traced on the levels' voxel fields; on the
+/// machine those short, kinked blocks slow the feed as much as the rotary
+/// axes did (docs/rough5.md, "Limit passes: the tilt where it pays"). Every
+/// tilted pair, its neighbours and the first and last pairs stay.
 #[must_use]
-pub fn thin_vertical(pairs: Vec<SyncPoint>, step: f64) -> Vec<SyncPoint> {
+pub fn thin_vertical(pairs: Vec<SyncPoint>, span: f64, chord: f64) -> Vec<SyncPoint> {
     let n = pairs.len();
     if n < 3 {
         return pairs;
     }
     let vertical = |s: &SyncPoint| s.axis.angle(&Vec3::z()) <= tol::ANGLE_EPS;
+    let off = |p: &Point3, a: &Point3, b: &Point3| {
+        let ab = b - a;
+        let t = if ab.norm_squared() > 0.0 { ((p - a).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0) } else { 0.0 };
+        (p - (a + ab * t)).norm()
+    };
     let mut out: Vec<SyncPoint> = Vec::with_capacity(n);
     out.push(pairs[0]);
+    let mut last_at = 0;
     for i in 1..n - 1 {
-        let last = out[out.len() - 1];
+        let last = pairs[last_at];
         let redundant = vertical(&last)
             && vertical(&pairs[i - 1])
             && vertical(&pairs[i])
             && vertical(&pairs[i + 1])
-            && (pairs[i + 1].path - last.path).norm() <= step;
+            && (pairs[i + 1].path - last.path).norm() <= span
+            && (last_at + 1..=i).all(|k| off(&pairs[k].path, &last.path, &pairs[i + 1].path) <= chord);
         if !redundant {
             out.push(pairs[i]);
+            last_at = i;
         }
     }
     out.push(pairs[n - 1]);

@@ -4,7 +4,7 @@
 //! drafts leave steps thinner than the flank allowance the program is cut
 //! with the axis +Z and proven, where steeper drafts keep the tilted limit
 //! passes; and a vertical stretch of a pass keeps no pair that its
-//! neighbours make redundant.
+//! neighbours make redundant within a span and a chord.
 #![allow(clippy::unwrap_used, reason = "tests: a panic is the failure report")]
 
 use proptest::prelude::*;
@@ -109,8 +109,8 @@ fn a_draft_under_the_allowance_is_cut_vertical_and_a_steep_one_tilted() {
     assert!(tilt > 9.0, "the 12 deg pocket's limit passes lean {tilt:.2} deg only");
 }
 
-fn pair(x: f64, axis: Vec3) -> SyncPoint {
-    SyncPoint { path: Point3::new(x, 0.0, 0.0), tilt: None, normal: Vec3::z(), tangent: Vec3::x(), axis }
+fn pair(x: f64, y: f64, axis: Vec3) -> SyncPoint {
+    SyncPoint { path: Point3::new(x, y, 0.0), tilt: None, normal: Vec3::z(), tangent: Vec3::x(), axis }
 }
 
 proptest! {
@@ -136,27 +136,31 @@ proptest! {
         prop_assert!((limit_step(&bare, rise) - rise * alpha.tan()).abs() < 1e-9);
     }
 
-    /// Along a straight pass with pairs 0.01 to 0.8 mm apart, some tilted:
-    /// the thinned pairs are a subsequence with the first and last pairs,
-    /// every tilted pair and its neighbours; two kept pairs are no farther
-    /// apart than the step unless they were neighbours; and in a vertical
-    /// stretch two pairs kept two apart are more than the step apart, so a
-    /// vertical stretch of length L keeps at most 2 L / step + 3 pairs.
+    /// Along a pass with pairs 0.01 to 0.8 mm apart, wavering across by up
+    /// to `waver`, some tilted: the thinned pairs are a subsequence with the
+    /// first and last pairs, every tilted pair and its neighbours; two kept
+    /// pairs are no farther apart than the span unless they were neighbours;
+    /// every dropped pair lies within the chord of the segment between the
+    /// kept pairs on either side; and on a straight vertical pass two pairs
+    /// kept two apart are more than the span apart, so a straight vertical
+    /// pass of length L keeps at most 2 L / span + 3 pairs.
     #[test]
     fn a_vertical_stretch_keeps_no_redundant_pair(
         gaps in prop::collection::vec(0.01f64..0.8, 3..300),
         tilted in prop::collection::vec(prop::bool::weighted(0.05), 300),
+        across in prop::collection::vec(-1.0f64..1.0, 300),
+        waver in prop::sample::select(vec![0.0, 0.03, 0.3]),
     ) {
-        let step = 1.0;
+        let (span, chord) = (5.0, 0.05);
         let lean = Vec3::new(0.05, 0.0, 1.0).normalize();
         let mut x = 0.0;
-        let mut pairs = vec![pair(0.0, Vec3::z())];
+        let mut pairs = vec![pair(0.0, 0.0, Vec3::z())];
         for (k, g) in gaps.iter().enumerate() {
             x += g;
-            pairs.push(pair(x, if tilted[k] { lean } else { Vec3::z() }));
+            pairs.push(pair(x, waver * across[k], if tilted[k] { lean } else { Vec3::z() }));
         }
         let n = pairs.len();
-        let kept = thin_vertical(pairs.clone(), step);
+        let kept = thin_vertical(pairs.clone(), span, chord);
         // The original index of every kept pair (x grows strictly).
         let idx: Vec<usize> =
             kept.iter().map(|k| pairs.iter().position(|p| p.path == k.path).unwrap()).collect();
@@ -171,17 +175,20 @@ proptest! {
             }
         }
         for w in idx.windows(2) {
-            let d = pairs[w[1]].path.x - pairs[w[0]].path.x;
-            prop_assert!(w[1] == w[0] + 1 || d <= step + 1e-12, "kept pairs {} and {} are {} apart", w[0], w[1], d);
-        }
-        for w in idx.windows(3) {
-            if (w[0]..=w[2]).all(vertical) && w[1] + 1 < n && vertical(w[1] + 1) && w[1] > 0 && vertical(w[1] - 1) {
-                let d = pairs[w[2]].path.x - pairs[w[0]].path.x;
-                prop_assert!(d > step, "kept pairs {} and {} are {} apart, {} between them", w[0], w[2], d, w[1]);
+            let (a, b) = (pairs[w[0]].path, pairs[w[1]].path);
+            prop_assert!(w[1] == w[0] + 1 || (b - a).norm() <= span + 1e-12, "kept {} and {}: {}", w[0], w[1], (b - a).norm());
+            for p in &pairs[w[0] + 1..w[1]] {
+                let ab = b - a;
+                let t = ((p.path - a).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0);
+                prop_assert!((p.path - (a + ab * t)).norm() <= chord + 1e-12, "a dropped pair is off the chord");
             }
         }
-        if (0..n).all(vertical) {
-            prop_assert!(kept.len() as f64 <= 2.0 * x / step + 3.0, "{} pairs kept on {} mm", kept.len(), x);
+        if waver == 0.0 && (0..n).all(vertical) {
+            for w in idx.windows(3) {
+                let d = pairs[w[2]].path.x - pairs[w[0]].path.x;
+                prop_assert!(d > span, "kept pairs {} and {} are {} apart, {} between them", w[0], w[2], d, w[1]);
+            }
+            prop_assert!(kept.len() as f64 <= 2.0 * x / span + 3.0, "{} pairs kept on {} mm", kept.len(), x);
         }
     }
 }
