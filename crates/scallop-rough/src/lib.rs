@@ -431,6 +431,7 @@ pub fn plan_levels(
         }
     }
     let mut out = Emitter::new(motion, stock.max.z, &options);
+    out.material = material;
     let roots: Vec<usize> = (0..nodes.len()).filter(|&k| nodes[k].parent.is_none()).collect();
     visit_all(&nodes, &roots, &mut out);
     out.finish();
@@ -534,8 +535,13 @@ fn distance_to(node: &Node, here: Option<P2>) -> f64 {
 }
 
 /// Writes nodes as moves.
-struct Emitter {
+struct Emitter<'m> {
     path: Toolpath,
+    /// The in-process stock the operation starts from, when known: an entry
+    /// descends at the feed only through the material over its own disc.
+    material: Option<&'m MaterialMap>,
+    /// The tool's radius (mm).
+    tool_radius: f64,
     clearance: f64,
     stock_top: f64,
     /// Chord tolerance of the link checks (mm).
@@ -551,10 +557,12 @@ struct Emitter {
     retracts: usize,
 }
 
-impl Emitter {
-    fn new(motion: &Motion, stock_top: f64, options: &ClearOptions) -> Emitter {
+impl Emitter<'_> {
+    fn new(motion: &Motion, stock_top: f64, options: &ClearOptions) -> Self {
         Emitter {
             path: Toolpath::new(motion.feed),
+            material: None,
+            tool_radius: options.tool_radius,
             clearance: motion.clearance_z,
             stock_top,
             chord: options.chord_tolerance,
@@ -682,8 +690,12 @@ impl Emitter {
     /// straight plunge (always when `straight`: the tool cuts nothing at `s`).
     fn plunge(&mut self, s: P2, above: f64, z: f64, region: &Region, straight: bool) {
         let current = self.at().map_or(self.clearance, |p| p.z);
-        let approach = above + tol::APPROACH;
         let rh = self.helix_radius;
+        let (above, straight) = match self.material_over(s, above, z) {
+            Some(top) => (top, straight),
+            None => (z, true),
+        };
+        let approach = above + tol::APPROACH;
         let depth = above - z;
         let fits = !straight && rh > 0.0 && depth > 0.0 && region.offset(rh).contains(s);
         let start = if fits { [s[0] + rh, s[1]] } else { s };
@@ -716,6 +728,18 @@ impl Emitter {
         self.helices += 1;
     }
 
+    /// How high material may stand over an entry at `s` down to `z`, given
+    /// that nothing stands above `above` there: with the in-process stock
+    /// known, at most its highest top over the box around the disc the tool
+    /// and its helix sweep (a cell's top bounds the stock over the cell).
+    /// `None` when nothing stands more than [`tol::MIN_CHIP`] above `z`.
+    fn material_over(&self, s: P2, above: f64, z: f64) -> Option<f64> {
+        let Some(m) = self.material else { return Some(above) };
+        let reach = self.tool_radius + self.helix_radius;
+        let top = m.top_in([s[0] - reach, s[1] - reach], [s[0] + reach, s[1] + reach])?;
+        (top > z + tol::MIN_CHIP).then_some(above.min(top))
+    }
+
     /// A retract within a level: up to the clearance, over, and down (a
     /// straight plunge when the tool cuts nothing at `s`: `cleared`).
     fn retract_to(&mut self, s: P2, above: f64, z: f64, region: &Region, cleared: bool) {
@@ -724,6 +748,7 @@ impl Emitter {
         self.path.push(Move::new(MoveKind::Retract, Point3::new(here.x, here.y, self.clearance)));
         self.path.push(Move::new(MoveKind::Rapid, Point3::new(s[0], s[1], self.clearance)));
         if cleared {
+            let above = self.material_over(s, above, z).unwrap_or(z);
             self.path.push(Move::new(MoveKind::Rapid, Point3::new(s[0], s[1], above + tol::APPROACH)));
             self.path.push(Move::new(MoveKind::Plunge, Point3::new(s[0], s[1], z)));
         } else {

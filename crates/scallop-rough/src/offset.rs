@@ -113,11 +113,12 @@ pub fn plan_offset_in(
     let r = options.tool_radius;
     // The region with the air around it: where a ring's nearest boundary is
     // open (air), not a wall, its points lie deeper in this than their
-    // level's depth.
-    let open_region = air.as_ref().map(|air| region.union(air, tol_c));
+    // level's depth. Without air every ring lies at its level's depth from
+    // a wall: none is open.
+    let open_region = air.as_ref().filter(|air| !air.is_empty()).map(|air| region.union(air, tol_c));
     let mut open_pieces: Vec<Vec<Piece>> = Vec::with_capacity(levels.len());
     let mut wall_pieces: Vec<Vec<Piece>> = Vec::with_capacity(levels.len());
-    let mut strips: Vec<Option<Region>> = Vec::with_capacity(levels.len());
+    let mut has_open: Vec<bool> = Vec::with_capacity(levels.len());
     for k in 0..levels.len() {
         #[allow(clippy::cast_precision_loss, reason = "a small level count")]
         let depth = ae * k as f64 + tol::OPEN_SIDE_SHARE * ae;
@@ -163,13 +164,7 @@ pub fn plan_offset_in(
         // stepover wide inside the level's ring on the open side (swept by
         // it: a link there engages no more than a pass). Computed for the
         // levels with such rings only.
-        let strip = open_region.as_ref().filter(|_| !open.is_empty()).map(|e| {
-            #[allow(clippy::cast_precision_loss, reason = "a small level count")]
-            let open_side = e.offset(ae * k as f64);
-            let inner = levels[k].offset(ae * (1.0 + tol::LINK_MARGIN_SHARE));
-            levels[k].offset(-tol::LINK_GROW).difference(&inner, tol_c).intersection(&open_side, tol_c)
-        });
-        strips.push(strip);
+        has_open.push(!open.is_empty());
         open_pieces.push(open);
         wall_pieces.push(wall);
     }
@@ -201,6 +196,24 @@ pub fn plan_offset_in(
             (0..open.len()).filter(|&j| open[j].0 + 1 == *k && probes.iter().any(|&q| near(q, &open[j].2))).collect()
         })
         .collect();
+    // Links of the open side: through the air, or along the band a
+    // stepover wide inside the level's ring on the open side (swept by it: a
+    // link there engages no more than a pass). Computed for the levels with
+    // such rings only, when a link first needs it.
+    let strips: Vec<std::cell::OnceCell<Option<Region>>> =
+        (0..levels.len()).map(|_| std::cell::OnceCell::new()).collect();
+    let strip = |k: usize| -> Option<&Region> {
+        let cell = strips.get(k)?;
+        cell.get_or_init(|| {
+            open_region.as_ref().filter(|_| has_open[k]).map(|e| {
+                #[allow(clippy::cast_precision_loss, reason = "a small level count")]
+                let open_side = e.offset(ae * k as f64);
+                let inner = levels[k].offset(ae * (1.0 + tol::LINK_MARGIN_SHARE));
+                levels[k].offset(-tol::LINK_GROW).difference(&inner, tol_c).intersection(&open_side, tol_c)
+            })
+        })
+        .as_ref()
+    };
     let mut done = vec![false; open.len()];
     let mut last: Option<usize> = None;
     loop {
@@ -217,24 +230,21 @@ pub fn plan_offset_in(
         // Cleared for links: the air, and the band inside the level of the
         // piece just cut when this one is its child (a stepover inside it).
         let child = last.is_some_and(|l| parents[i].contains(&l));
-        let lead = strips.get(k.wrapping_sub(1)).cloned().flatten();
+        let lead = || k.checked_sub(1).and_then(strip);
         match pos {
             Some(p) => {
                 let length = (start[0] - p[0]).hypot(start[1] - p[1]);
-                let short = length <= ae && holder.contains_segment(p, start, tol_c);
-                let in_air = air.as_ref().is_some_and(|air| air.contains_segment(p, start, tol_c));
-                let along = child
-                    && length <= 4.0 * r
-                    && lead.as_ref().is_some_and(|band| {
-                        band.union(&holder.intersection(band, tol_c), tol_c).contains_segment(p, start, tol_c)
-                    });
-                if short || in_air || along {
+                let short = || length <= ae && holder.contains_segment(p, start, tol_c);
+                let in_air = || air.as_ref().is_some_and(|air| air.contains_segment(p, start, tol_c));
+                let along =
+                    || child && length <= 4.0 * r && lead().is_some_and(|band| band.contains_segment(p, start, tol_c));
+                if short() || in_air() || along() {
                     steps.push(Step::Link { tool_down: true, via: Vec::new(), cleared: false, to: None });
                 } else {
-                    push_entry(&mut steps, start, piece.from_air, air.as_ref(), lead.as_ref(), &holder, ae, tol_c);
+                    push_entry(&mut steps, start, piece.from_air, air.as_ref(), lead, &holder, ae, tol_c);
                 }
             }
-            None => push_entry(&mut steps, start, piece.from_air, air.as_ref(), lead.as_ref(), &holder, ae, tol_c),
+            None => push_entry(&mut steps, start, piece.from_air, air.as_ref(), lead, &holder, ae, tol_c),
         }
         last = Some(i);
         pos = cut.end().or(Some(start));
@@ -284,12 +294,12 @@ pub fn plan_offset_in(
 /// the air or the cleared band `lead` beside it and a move in (a retract
 /// with a helix when there is neither).
 #[allow(clippy::too_many_arguments, reason = "the entry's context")]
-fn push_entry(
+fn push_entry<'a>(
     steps: &mut Vec<Step>,
     start: P2,
     from_air: bool,
     air: Option<&Region>,
-    lead: Option<&Region>,
+    lead: impl FnOnce() -> Option<&'a Region>,
     holder: &Region,
     ae: f64,
     tol_c: f64,
@@ -298,7 +308,7 @@ fn push_entry(
         steps.push(Step::Link { tool_down: false, via: Vec::new(), cleared: true, to: None });
         return;
     }
-    let clear = match (air, lead) {
+    let clear = match (air, lead()) {
         (Some(a), Some(l)) => Some(a.union(l, tol_c)),
         (Some(a), None) => Some(a.clone()),
         (None, Some(l)) => Some(l.clone()),
@@ -325,13 +335,16 @@ fn segment_distance(q: P2, a: P2, b: P2) -> f64 {
 /// move to `s` stays in the air or the region (`holder`): the nearest of 16
 /// directions at 1 to 4 ae.
 fn lead_in(s: P2, air: &Region, holder: &Region, ae: f64, tol_c: f64) -> Option<P2> {
+    let both = std::cell::OnceCell::new();
     (1..=4).find_map(|m| {
         (0..16).find_map(|i| {
             let a = std::f64::consts::PI * f64::from(i) / 8.0;
             let d = ae * f64::from(m);
             let q = [s[0] + d * a.cos(), s[1] + d * a.sin()];
             let inside = |r: &Region| r.contains_segment(q, s, tol_c);
-            (air.contains(q) && (inside(air) || inside(holder) || inside(&air.union(holder, tol_c)))).then_some(q)
+            (air.contains(q)
+                && (inside(air) || inside(holder) || inside(both.get_or_init(|| air.union(holder, tol_c)))))
+            .then_some(q)
         })
     })
 }

@@ -308,6 +308,69 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(6))]
+
+    /// Rest roughing enters each piece of material it finds where the tool
+    /// last left the material above it: every descent at a feed (a plunge or
+    /// a helix) starts at most the approach height above the highest
+    /// material the earlier operations left within reach of it (the tool and
+    /// its helix, brute force over the blocks), or above the level when there
+    /// is none; no helix turns where nothing is left to cut. The material:
+    /// a tall narrow block and a low wide one, each placed at random.
+    #[test]
+    fn rest_entries_descend_at_the_feed_only_through_material(
+        tx in -12.0..4.0_f64, ty in -10.0..4.0_f64, lx in -12.0..2.0_f64, ly in -10.0..2.0_f64,
+        lw in 4.0..10.0_f64, low in 0.6..2.5_f64,
+    ) {
+        let (w, d, h) = (10.0, 8.0, 4.0);
+        let mesh = stepped_part(-w / 2.0, w / 2.0, -d / 2.0, d / 2.0, h, 1.5);
+        let index = MeshIndex::build(&mesh);
+        let r = 1.5;
+        let cutter = Cutter::new(CutterShape::Flat { radius: r }, 40.0).unwrap();
+        let stock = Aabb3 { min: Point3::new(-w / 2.0 - 8.0, -d / 2.0 - 8.0, 0.0), max: Point3::new(w / 2.0 + 8.0, d / 2.0 + 8.0, h + 4.0) };
+        let blocks = [[tx, ty, tx + 2.0, ty + 2.0, h + 3.0], [lx, ly, lx + lw, ly + lw, low]];
+        let map = material(&stock, &blocks);
+        let set = settings(1.0, 0.3, 0.2);
+        let motion = Motion { clearance_z: h + 10.0, feed: 1000.0 };
+        let rest = plan_rough_from(&index, &cutter, &stock, Some(&map), &set, &motion, 1e-3).unwrap();
+        prop_assert!(rest.passes > 0);
+        // The highest block top whose square meets the box of half-side
+        // `reach` around `p`.
+        let top_near = |p: Point3, reach: f64| {
+            blocks
+                .iter()
+                .filter(|b| p.x + reach >= b[0] && p.x - reach <= b[2] && p.y + reach >= b[1] && p.y - reach <= b[3])
+                .map(|b| b[4])
+                .fold(f64::NEG_INFINITY, f64::max)
+        };
+        let rh = scallop_rough::tol::HELIX_RADIUS_SHARE * r;
+        // A helix point lies rh from its centre; a cell (0.5 mm) decides a top.
+        let reach = r + 2.0 * rh + 0.5;
+        let moves = rest.toolpath.moves();
+        let mut descents = 0;
+        for k in 1..moves.len() {
+            let (a, b) = (moves[k - 1].to, moves[k].to);
+            if !matches!(moves[k].kind, MoveKind::Plunge | MoveKind::Feed) || b.z > a.z - 1e-9 {
+                continue;
+            }
+            descents += 1;
+            // The level this descent ends on: the next move at a constant height.
+            let level = moves[k..].iter().find(|m| m.kind != MoveKind::Plunge && (m.to.z - b.z).abs() < 1e-9).map_or(b.z, |m| m.to.z);
+            let top = top_near(a, reach);
+            prop_assert!(
+                a.z <= top.max(level) + scallop_rough::tol::APPROACH + 1e-9,
+                "move {k}: a descent at the feed from z {:.3} at ({:.2}, {:.2}); material within reach up to {top:.3}",
+                a.z, a.x, a.y
+            );
+            if moves[k].kind == MoveKind::Feed {
+                prop_assert!(top > b.z, "move {k}: a helix at ({:.2}, {:.2}) z {:.3} with nothing to cut", b.x, b.y, b.z);
+            }
+        }
+        prop_assert!(descents > 0);
+    }
+}
+
 /// Adaptive clearing of a box on a plate in a larger stock: every level's
 /// region runs R past the stock's sides, which are open (air). The levels
 /// are entered from there by straight plunges (no helix), the feed moves
