@@ -48,6 +48,8 @@ pub enum RefineArg {
     PairByRank,
     /// Inner passes with the axis +Z wherever the vertical tool clears the flanks.
     VerticalInside,
+    /// Limit passes with the axis +Z where the vertical tool clears the flanks and leaves a step within the allowance.
+    ThinSteps,
     /// Colliding CL points translated away from the flank (thesis Ch. 3 §3, step 3) before they are dropped.
     Translation,
     /// An open pocket's bottom extended across its open edge and cut as a level (its limit closed there).
@@ -277,6 +279,7 @@ fn settings(args: &Rough5Args, part: &TestPart) -> CliResult<Rough5Settings> {
             open_bottom: on(RefineArg::OpenBottom),
         },
         vertical_inside: on(RefineArg::VerticalInside),
+        vertical_thin_steps: on(RefineArg::ThinSteps),
         translate: on(RefineArg::Translation),
         local_entry: on(RefineArg::LocalEntry),
         ..base

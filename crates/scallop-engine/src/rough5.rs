@@ -326,6 +326,7 @@ pub fn rough5_settings(
         correct: false,
         levels: LevelOptions { centre_offsets: true, pair_by_rank: true, open_bottom: true },
         vertical_inside: true,
+        vertical_thin_steps: true,
         translate: true,
         local_entry: true,
     })

@@ -1001,6 +1001,28 @@ pub mod rough5 {
     /// Jousselin 2020 caps its correction loop at 3 (Ch. 3 §3, Fig. 3.34).
     pub const CORRECTION_ROUNDS: usize = 3;
 
+    /// A pair of a limit pass (along the flanks) keeps its guide-curve tilt
+    /// where the vertical tool would leave, between its level and the level
+    /// above, a step thicker than this many flank allowances (the horizontal
+    /// run of the tilted axis over the level's height): a thinner step only
+    /// takes the finishing tool's stock from one to at most two allowances,
+    /// which a roughing program need not spend the rotary axes on
+    /// (`scallop_rough5::Rough5Settings::vertical_thin_steps`; docs/rough5.md,
+    /// "Limit passes: the tilt where it pays").
+    pub const LIMIT_STEP_ALLOWANCES: f64 = 1.0;
+
+    /// A stretch of vertical pairs of a guide-curve pass is thinned to pairs
+    /// at most this many steps (`--step`) apart
+    /// (`scallop_rough5::thin_vertical`): 20 mm blocks at the default 1 mm
+    /// step, the guide points between them checked within the chord below.
+    pub const THIN_SPAN_STEPS: f64 = 20.0;
+
+    /// A vertical pair is dropped only if every guide point it stands for lies
+    /// within this many flank allowances of the segment that replaces them
+    /// (0.05 mm at a 0.5 mm allowance: a tenth of the material the finishing
+    /// tool is given, the proof's own sweep tolerance).
+    pub const THIN_CHORD_ALLOWANCES: f64 = 0.1;
+
     /// A flank triangle whose outward normal (out of the volume to remove)
     /// rises above the horizontal by more than this sine (1 degree) is an
     /// undercut: the 3+2 baseline looks for setups that reach under it

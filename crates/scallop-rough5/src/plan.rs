@@ -77,6 +77,17 @@ pub struct Rough5Settings {
     /// pairs around such a pair lean in by one angular step per pair, in its
     /// azimuth, so the rotary axes stay still on the inner loops.
     pub vertical_inside: bool,
+    /// Whether the pairs of a level's limit passes (its outermost ones, along
+    /// the flanks) are cut with the axis +Z where the vertical tool is placed
+    /// clear of the flanks and the step it leaves between the level and the
+    /// level above ([`limit_step`]) is at most
+    /// [`tol::LIMIT_STEP_ALLOWANCES`] flank allowances: there the tilt
+    /// removes a wedge thinner than the allowance while the C table of a
+    /// table-table machine turns round every corner of the outline for it.
+    /// The other pairs keep their tilt and their neighbours lean in as with
+    /// [`Self::vertical_inside`] (docs/rough5.md, "Limit passes: the tilt
+    /// where it pays").
+    pub vertical_thin_steps: bool,
     /// Whether a pair whose tool still comes closer to a flank than its
     /// radius is translated away from the flank (Ch. 3 §3, step 3, the axis
     /// kept; at most [`TRANSLATION_MAX`]) before it is dropped, its
@@ -258,7 +269,11 @@ pub fn plan_rough5_in(
             let (mut pairs, corrected) = corrected_pairs(&placer, &body, pairs, settings);
             let outer = m + level.outer >= level.passes.len();
             if settings.vertical_inside && !outer && tilt.is_some() {
-                pairs = vertical_where_clear(&placer, &body, &pairs, settings);
+                pairs = vertical_where_clear(&placer, &body, &pairs, settings, &|_| false);
+            } else if settings.vertical_thin_steps && outer && tilt.is_some() {
+                let most = tol::LIMIT_STEP_ALLOWANCES * settings.guides.flank_allowance;
+                let height = settings.guides.axial_step;
+                pairs = vertical_where_clear(&placer, &body, &pairs, settings, &|s| limit_step(s, height) > most);
             }
             if settings.translate {
                 pairs = translated(&placer, &body, pairs);
@@ -462,9 +477,28 @@ fn arc_positions(pairs: &[SyncPoint]) -> (Vec<f64>, f64) {
     (at, lap)
 }
 
+/// The step (mm) that the vertical tool at pair `s` leaves between its level
+/// and the level above, where the tilted tool along the flank leaves none:
+/// the horizontal run of the pair's axis over the height between its guide
+/// points (P_T on the level, P_D on the level above), or over `height` (the
+/// levels' spacing) for a pair without a tilt point. On a flank at a draft
+/// alpha with levels a_p apart it is a_p tan alpha; under an undercut it is
+/// the overhang the vertical tool cannot reach under.
+#[must_use]
+pub fn limit_step(s: &SyncPoint, height: f64) -> f64 {
+    let rise = s.tilt.map_or(height, |d| (d - s.path).z);
+    let rise = if rise > 0.0 { rise } else { height };
+    let u = s.axis;
+    if u.z <= 0.0 {
+        return f64::INFINITY;
+    }
+    rise * u.x.hypot(u.y) / u.z
+}
+
 /// `pairs` with the axis +Z wherever the vertical tool is placed clear of
-/// the flanks ([`Rough5Settings::vertical_inside`]). A pair where it is not
-/// keeps its axis; the pairs around it lean in, in its azimuth, by its tilt
+/// the flanks and `keep` is false for the pair
+/// ([`Rough5Settings::vertical_inside`], [`Rough5Settings::vertical_thin_steps`]).
+/// A pair where it is not keeps its axis; the pairs around it lean in, in its azimuth, by its tilt
 /// less one angular step per `step` mm along the pass (the largest over such
 /// pairs), so the axis turns by at most the angular step between pairs. The
 /// angular step is limited again afterwards.
@@ -473,10 +507,11 @@ fn vertical_where_clear(
     body: &BodyCheck,
     pairs: &[SyncPoint],
     settings: &Rough5Settings,
+    keep: &(dyn Fn(&SyncPoint) -> bool + Sync),
 ) -> Vec<SyncPoint> {
     let blocked: Vec<bool> = pairs
         .par_iter()
-        .map(|s| placer.place(&s.path, &Vec3::z()).is_none_or(|p| body.collides(&p.tip, &p.axis)))
+        .map(|s| keep(s) || placer.place(&s.path, &Vec3::z()).is_none_or(|p| body.collides(&p.tip, &p.axis)))
         .collect();
     let (at, lap) = arc_positions(pairs);
     let per_mm = settings.max_angle_step / settings.step;
@@ -508,7 +543,53 @@ fn vertical_where_clear(
             SyncPoint { axis, ..*s }
         })
         .collect();
-    limit_angular_step(&out, settings.max_angle_step, settings.max_azimuth_step)
+    let span = tol::THIN_SPAN_STEPS * settings.step;
+    let chord = tol::THIN_CHORD_ALLOWANCES * settings.guides.flank_allowance;
+    thin_vertical(limit_angular_step(&out, settings.max_angle_step, settings.max_azimuth_step), span, chord)
+}
+
+/// `pairs` without the pairs inside a stretch of vertical axes that their
+/// neighbours make redundant: one is dropped when it, the pairs on either
+/// side and the last pair kept all have the axis +Z, the next pair's guide
+/// point is within `span` of the last kept one's, and every pair from the
+/// last kept one to it lies within `chord` of the segment between the two.
+/// The synchronisation steps the path curve by the fraction of the longer of
+/// the path and tilt curves and the angular-step limit inserts pairs where
+/// the guide-curve axis turns, so a pass made vertical keeps pairs a tenth of
+/// the step apart, along curves traced on the levels' voxel fields; on the
+/// machine those short, kinked blocks slow the feed as much as the rotary
+/// axes did (docs/rough5.md, "Limit passes: the tilt where it pays"). Every
+/// tilted pair, its neighbours and the first and last pairs stay.
+#[must_use]
+pub fn thin_vertical(pairs: Vec<SyncPoint>, span: f64, chord: f64) -> Vec<SyncPoint> {
+    let n = pairs.len();
+    if n < 3 {
+        return pairs;
+    }
+    let vertical = |s: &SyncPoint| s.axis.angle(&Vec3::z()) <= tol::ANGLE_EPS;
+    let off = |p: &Point3, a: &Point3, b: &Point3| {
+        let ab = b - a;
+        let t = if ab.norm_squared() > 0.0 { ((p - a).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0) } else { 0.0 };
+        (p - (a + ab * t)).norm()
+    };
+    let mut out: Vec<SyncPoint> = Vec::with_capacity(n);
+    out.push(pairs[0]);
+    let mut last_at = 0;
+    for i in 1..n - 1 {
+        let last = pairs[last_at];
+        let redundant = vertical(&last)
+            && vertical(&pairs[i - 1])
+            && vertical(&pairs[i])
+            && vertical(&pairs[i + 1])
+            && (pairs[i + 1].path - last.path).norm() <= span
+            && (last_at + 1..=i).all(|k| off(&pairs[k].path, &last.path, &pairs[i + 1].path) <= chord);
+        if !redundant {
+            out.push(pairs[i]);
+            last_at = i;
+        }
+    }
+    out.push(pairs[n - 1]);
+    out
 }
 
 /// The translation of the guide point of a pair whose tool comes too close

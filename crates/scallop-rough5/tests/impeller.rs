@@ -152,6 +152,7 @@ fn the_impeller_program_is_proven_from_its_blank() {
         correct: false,
         levels: ALL,
         vertical_inside: true,
+        vertical_thin_steps: true,
         translate: true,
         local_entry: true,
     };

@@ -39,6 +39,7 @@ fn settings(tilt: TiltMode, depth: f64) -> Rough5Settings {
         correct: false,
         levels: LevelOptions::default(),
         vertical_inside: false,
+        vertical_thin_steps: false,
         translate: false,
         local_entry: false,
     }

@@ -95,6 +95,7 @@ fn settings(depth: f64, refined: bool) -> Rough5Settings {
         correct: false,
         levels: LevelOptions { centre_offsets: refined, pair_by_rank: refined, open_bottom: refined },
         vertical_inside: refined,
+        vertical_thin_steps: refined,
         translate: refined,
         local_entry: refined,
     }
