@@ -65,6 +65,24 @@ fn min_clearance(shape: &CutterShape, cl: &ClPoint, t: &[Point3; 3]) -> f64 {
     worst
 }
 
+/// The XY distance from `p` to the triangle `t` (0 inside), for the tests.
+fn xy_distance(t: &[Point3; 3], p: Point2) -> f64 {
+    let cross = |a: &Point3, b: &Point3| (b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x);
+    let s = [cross(&t[0], &t[1]), cross(&t[1], &t[2]), cross(&t[2], &t[0])];
+    if s.iter().all(|&v| v >= 0.0) || s.iter().all(|&v| v <= 0.0) {
+        return 0.0;
+    }
+    (0..3)
+        .map(|k| {
+            let (a, b) = (&t[k], &t[(k + 1) % 3]);
+            let (ex, ey, wx, wy) = (b.x - a.x, b.y - a.y, p.x - a.x, p.y - a.y);
+            let len2 = ex * ex + ey * ey;
+            let u = if len2 > 0.0 { ((wx * ex + wy * ey) / len2).clamp(0.0, 1.0) } else { 0.0 };
+            (wx - u * ex).hypot(wy - u * ey)
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
 fn contact_point(c: &Contact) -> Option<(usize, Point3)> {
     match *c {
         Contact::Floor => None,
@@ -123,6 +141,56 @@ proptest! {
             let slow = drop_cutter_brute_force(&c, &index, xy, FLOOR);
             prop_assert_eq!((cl.tip.x, cl.tip.y), (xy.x, xy.y));
             prop_assert_eq!(cl.tip.z.to_bits(), slow.tip.z.to_bits(), "at {:?}: {:?} vs {:?}", xy, cl, slow);
+        }
+    }
+
+    /// Long thin triangles (a fan of slivers, as the flat faces of CAD meshes
+    /// and a cone's side, down to nearly vertical walls), whose XY boxes reach
+    /// far past them: the search
+    /// through the index, a patch and a box's candidate list (which skip a
+    /// triangle by its distance to its edge lines, `MeshIndex::edge_distance`)
+    /// give the brute-force heights bit for bit, and that distance is never
+    /// above the XY distance to the triangle.
+    #[test]
+    fn slivers_give_the_brute_force_heights(shape in shape_strategy(),
+                                            fan in prop::collection::vec((0.0f64..6.3, 0.7f64..9.0, 4.0f64..12.0,
+                                                                          0.0f64..3.0, 0.0f64..3.0), 1..40),
+                                            pts in prop::collection::vec((-4.0f64..14.0, -4.0f64..14.0), 1..30)) {
+        let apex = Point3::new(5.0, 5.0, 1.5);
+        let soup: Vec<[Point3; 3]> = fan
+            .iter()
+            .map(|&(angle, thin, length, z1, z2)| {
+                // Down to walls of 1e-9 mm, whose XY area is at its rounding.
+                let width = 10f64.powf(-thin);
+                let at = |a: f64| Point3::new(5.0 + length * a.cos(), 5.0 + length * a.sin(), 0.0);
+                let (mut b, mut c) = (at(angle), at(angle + width / length));
+                (b.z, c.z) = (z1, z2);
+                [apex, b, c]
+            })
+            .collect();
+        let Some((_, index)) = build(&soup) else { return Ok(()) };
+        let c = cutter(shape);
+        let local = BoxDrop::new(&c, &index, Point2::new(-4.0, -4.0), Point2::new(14.0, 14.0));
+        // A patch is a grid: its xs in order.
+        let mut xs: Vec<f64> = pts.iter().map(|p| p.0).collect();
+        xs.sort_by(f64::total_cmp);
+        let patch = drop_patch(&c, &index, &xs, &[pts[0].1], FLOOR);
+        for (k, &(x, y)) in pts.iter().enumerate() {
+            let xy = Point2::new(x, y);
+            let slow = drop_cutter_brute_force(&c, &index, xy, FLOOR);
+            let fast = drop_cutter(&c, &index, xy, FLOOR);
+            prop_assert_eq!(fast.tip.z.to_bits(), slow.tip.z.to_bits(), "index at {:?}: {:?} vs {:?}", xy, fast, slow);
+            let (cl, _) = local.drop(xy, FLOOR, None);
+            prop_assert_eq!(cl.tip.z.to_bits(), slow.tip.z.to_bits(), "box at {:?}: {:?} vs {:?}", xy, cl, slow);
+            let row = Point2::new(xs[k], pts[0].1);
+            let slow_row = drop_cutter_brute_force(&c, &index, row, FLOOR);
+            prop_assert_eq!(patch[k].tip.z.to_bits(), slow_row.tip.z.to_bits(), "patch at {:?}", row);
+            for slot in 0..index.len() {
+                let t = index.corners(slot);
+                let d = xy_distance(t, xy);
+                prop_assert!(index.edge_distance(slot, xy) <= d + 1e-12, "slot {} at {:?}: {} > {}",
+                             slot, xy, index.edge_distance(slot, xy), d);
+            }
         }
     }
 

@@ -30,6 +30,9 @@ pub struct MeshIndex {
     zmax: Vec<f64>,
     original: Vec<u32>,
     owned: Vec<u8>,
+    /// Per slot, the outward lines of the triangle's XY edges (see
+    /// [`MeshIndex::edge_lines`]).
+    lines: Vec<[[f64; 3]; 3]>,
     bounds: scallop_geom::Aabb3,
     /// Added to every upper bound so that rounding in a contact computation can
     /// never make pruning skip a triangle that would win by a few ulps.
@@ -69,7 +72,8 @@ impl MeshIndex {
         let zmax = corners.iter().map(|t| t[0].z.max(t[1].z).max(t[2].z)).collect();
         let slack = scallop_geom::tol::REL_PRUNE_SLACK * mesh.bounds().max_abs_coord().max(1.0);
         let owned = ownership(mesh, &order);
-        MeshIndex { nodes, corners, normals, zmax, original: order, owned, bounds: mesh.bounds(), slack }
+        let lines = corners.iter().map(edge_lines).collect();
+        MeshIndex { nodes, corners, normals, zmax, original: order, owned, lines, bounds: mesh.bounds(), slack }
     }
 
     /// Number of triangles.
@@ -170,6 +174,38 @@ impl MeshIndex {
         self.slack
     }
 
+    /// The lines of the XY edges of the triangle in `slot`, `[nx, ny, c]` with
+    /// `(nx, ny)` the unit normal pointing away from the triangle, so that
+    /// `nx x + ny y - c` is the signed distance of (x, y) to the edge's line;
+    /// `[0, 0, inf]` (no bound) for a triangle whose XY projection has no area
+    /// (a vertical wall). See [`MeshIndex::edge_distance`].
+    #[must_use]
+    pub fn edge_lines(&self, slot: usize) -> &[[f64; 3]; 3] {
+        &self.lines[slot]
+    }
+
+    /// A lower bound of the XY distance from `p` to the triangle in `slot`,
+    /// up to rounding: the largest signed distance to its edges' lines (a
+    /// triangle lies inside each of its edges' half-planes). Not above 0
+    /// where `p` is inside the triangle's XY projection, `-inf` for a
+    /// triangle without XY area; tighter than its box's distance for a long
+    /// thin triangle. Callers lower it by [`MeshIndex::slack`] before pruning.
+    #[must_use]
+    #[inline]
+    pub fn edge_distance(&self, slot: usize, p: Point2) -> f64 {
+        Self::line_distance(&self.lines[slot], p)
+    }
+
+    /// [`MeshIndex::edge_distance`] on a copy of [`MeshIndex::edge_lines`].
+    #[must_use]
+    #[inline]
+    pub fn line_distance(lines: &[[f64; 3]; 3], p: Point2) -> f64 {
+        let [l0, l1, l2] = lines;
+        (l0[0] * p.x + l0[1] * p.y - l0[2])
+            .max(l1[0] * p.x + l1[1] * p.y - l1[2])
+            .max(l2[0] * p.x + l2[1] * p.y - l2[2])
+    }
+
     /// Branch-and-bound search for the highest cutter location over the disk of
     /// `radius` around `center`. `lift(d2)` must be a lower bound of how far the
     /// cutter's profile rises above its tip at squared horizontal distance
@@ -213,9 +249,19 @@ impl MeshIndex {
                         continue;
                     }
                     let d2 = self.xy_box(slot).distance_squared(&center);
-                    if d2 <= r2 && self.zmax[slot] - lift(d2) + self.slack > *bound {
-                        visit(slot, bound);
+                    if !(d2 <= r2 && self.zmax[slot] - lift(d2) + self.slack > *bound) {
+                        continue;
                     }
+                    // The distance to the triangle's edge lines, lowered by
+                    // the slack (its rounding), where it says more than the box's.
+                    let side = self.edge_distance(slot, center) - self.slack;
+                    if side > 0.0 && side * side > d2 {
+                        let d2 = side * side;
+                        if !(d2 <= r2 && self.zmax[slot] - lift(d2) + self.slack > *bound) {
+                            continue;
+                        }
+                    }
+                    visit(slot, bound);
                 }
             } else {
                 let (left, right) = (id + 1, node.first_or_right);
@@ -299,4 +345,44 @@ fn build_node(
     let r = build_node(nodes, tris, centroid, right, offset + mid);
     nodes[me].first_or_right = to_u32(r);
     me
+}
+
+/// The outward edge lines of [`MeshIndex::edge_lines`]. The orientation
+/// comes from the sign of the XY area, trusted only where the area is far
+/// above its rounding (`SLIVER` times the square of the longest edge, that
+/// edge far above the coordinates' rounding): a flipped sign would turn every
+/// line inwards. A thinner triangle (a vertical wall, a sliver) gets the two
+/// sides of its longest edge's line, each moved out by the third corner's
+/// distance to it: `|n p - c| - h`, a lower bound of the distance to it.
+fn edge_lines(corners: &[Point3; 3]) -> [[f64; 3]; 3] {
+    const NONE: [[f64; 3]; 3] = [[0.0, 0.0, f64::INFINITY]; 3];
+    /// Least XY area (twice it) per squared longest edge for oriented lines.
+    const SLIVER: f64 = 1e-6;
+    let [a, b, c] = corners;
+    let area2 = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+    let len = |k: usize| {
+        let (p, q) = (&corners[k], &corners[(k + 1) % 3]);
+        (q.x - p.x).hypot(q.y - p.y)
+    };
+    let lens = [len(0), len(1), len(2)];
+    let k = (0..3).fold(0, |m, k| if lens[k] > lens[m] { k } else { m });
+    let longest = lens[k];
+    let scale = corners.iter().fold(1.0_f64, |m, p| m.max(p.x.abs()).max(p.y.abs()));
+    if longest.is_nan() || longest <= 1e-6 * scale {
+        return NONE; // every corner at one XY point, or not finite
+    }
+    let unit = |k: usize, sign: f64| {
+        let (p, q) = (&corners[k], &corners[(k + 1) % 3]);
+        let (nx, ny) = (sign * (q.y - p.y) / lens[k], -sign * (q.x - p.x) / lens[k]);
+        [nx, ny, nx * p.x + ny * p.y]
+    };
+    if area2.abs() > SLIVER * longest * longest {
+        // Counter-clockwise in XY, the outside of edge p -> q is on its right.
+        let sign = area2.signum();
+        return [unit(0, sign), unit(1, sign), unit(2, sign)];
+    }
+    let [nx, ny, d] = unit(k, 1.0);
+    let far = &corners[(k + 2) % 3];
+    let h = (nx * far.x + ny * far.y - d).abs();
+    [[nx, ny, d + h], [-nx, -ny, -d + h], NONE[0]]
 }

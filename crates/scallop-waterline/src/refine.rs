@@ -83,6 +83,24 @@ impl Local<'_> {
         (cl.tip.z - probe.z, slot)
     }
 
+    /// The side of `p` as [`Local::height_slot`] gives it, the search pruned
+    /// at z instead of at the floor: where the cutter at z cuts (> 0) the same
+    /// height and contact triangle (every contact above z is computed as
+    /// there), else 0 and `None` (no contact above z), which leaves the seed
+    /// as it was. For the checks that need only the side of an outside point
+    /// (its height only feeds secant guesses when it is inside). Cheaper where
+    /// the contact triangle at the last point does not hold the cutter near z
+    /// here (its height jumps at its rim, as along a wall's top edge).
+    fn side_slot(&self, p: Point2) -> (f64, Option<usize>) {
+        let probe = self.probe;
+        let (cl, slot) = self.drop.drop(p, probe.z, self.seed.get());
+        if let Some(s) = slot {
+            self.seed.set(slot);
+            self.seed_features.set(self.drop.contact_features(s, &cl.contact));
+        }
+        ((cl.tip.z - probe.z).max(0.0), slot)
+    }
+
     /// Tip height of the drop-cutter on the one triangle in `slot` at `p`,
     /// minus z, floored as [`Probe::height`]: the full height is the maximum of
     /// these over all triangles. The set where it is > 0 is convex (the cutter
@@ -179,7 +197,7 @@ impl Local<'_> {
             let guess = self.drop.rim_exit(slot, self.probe.z, at, outside);
             let height = |p| self.triangle_height(slot, p);
             let (tin, tout) = self.bracket_with(&height, at, h_at, outside, h_end, guess);
-            let (h, next) = self.height_slot(tout);
+            let (h, next) = self.side_slot(tout);
             if h <= 0.0 {
                 return (tin != tout).then_some((tin, tout));
             }
@@ -314,7 +332,7 @@ impl Local<'_> {
                 // `accept`, the full evaluation that accepts the chord comes
                 // first (elsewhere the seed's own height there decides, below).
                 if h_seed <= self.slope.get() * accept {
-                    let (h, slot) = self.height_slot(mid - normal * accept);
+                    let (h, slot) = self.side_slot(mid - normal * accept);
                     if h <= 0.0 {
                         return Near::Within; // inside at the midpoint, outside within `accept`
                     }
@@ -422,7 +440,7 @@ impl Local<'_> {
         self.slope.set(fall.abs() / accept);
         if mid_in && h_near <= 0.0 {
             if first.is_none() {
-                let (h, next) = self.height_slot(near);
+                let (h, next) = self.side_slot(near);
                 if h <= 0.0 {
                     return Start::Settled(Near::Within); // inside at the midpoint, outside within `accept`
                 }
@@ -457,7 +475,7 @@ impl Local<'_> {
                 let guess = self.drop.rim_exit(slot, self.probe.z, near, lo);
                 self.bracket_with(&height, near, h_near, lo, h_lo, guess)
             };
-            let (h, next) = self.height_slot(outer);
+            let (h, next) = self.side_slot(outer);
             if h <= 0.0 {
                 return if inner == outer { Start::Open } else { settle(outer) };
             }
@@ -477,7 +495,7 @@ impl Local<'_> {
                 let h_hi = height(at(root + half));
                 if h_hi > 0.0 {
                     let lo = at(root - half);
-                    let (h, slot_lo) = self.height_slot(lo);
+                    let (h, slot_lo) = self.side_slot(lo);
                     if h <= 0.0 {
                         return settle(lo);
                     }
@@ -531,7 +549,7 @@ impl Local<'_> {
             let (inside, outside) = self.bracket(b, h_b, end, h);
             out.push(end);
             out.push(outside);
-            let (h_in, next) = self.height_slot(inside);
+            let (h_in, next) = self.side_slot(inside);
             match next {
                 Some(next) if h_in > 0.0 && inside != at => (at, slot) = (inside, next),
                 _ => break,
@@ -751,6 +769,56 @@ mod tests {
     use scallop_mesh::{MeshIndex, TriMesh};
 
     use super::Probe;
+
+    /// The side-only evaluation (pruned at z) gives the full one's side, and
+    /// where the cutter cuts the same height and contact triangle, bit for
+    /// bit: on a terrain with cliffs, every shape, levels through it, points
+    /// inside the box and out.
+    #[test]
+    fn side_slot_gives_the_side_and_the_inside_heights() {
+        let height = |i: usize, j: usize| {
+            ((i * 7 + j * 13) % 11) as f64 * 0.7 + if (i + j).is_multiple_of(5) { 4.0 } else { 0.0 }
+        };
+        let at = |i: usize, j: usize| Point3::new(i as f64 * 3.0, j as f64 * 3.0, height(i, j));
+        let mut soup = Vec::new();
+        for j in 0..6 {
+            for i in 0..6 {
+                soup.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+                soup.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+            }
+        }
+        let mesh = TriMesh::from_soup(&soup).expect("terrain").0;
+        let index = MeshIndex::build(&mesh);
+        let (mut inside, mut outside) = (0, 0);
+        for shape in [
+            CutterShape::Flat { radius: 1.5 },
+            CutterShape::Ball { radius: 2.0 },
+            CutterShape::Bull { radius: 2.0, corner: 0.5 },
+            CutterShape::Cone { radius: 2.0, half_angle: 0.5 },
+        ] {
+            let cutter = Cutter::new(shape, 30.0).expect("cutter");
+            for z in [0.9, 2.35, 3.3, 5.6] {
+                let probe = Probe { cutter: &cutter, index: &index, z, tolerance: 1e-7, step: 0.5 };
+                for k in 0..400 {
+                    let p = Point2::new(2.0 + (k % 20) as f64 * 0.41, 3.0 + (k / 20) as f64 * 0.33);
+                    let (full, side) = (
+                        probe.local(Point2::new(4.0, 5.0), Point2::new(9.0, 8.0)),
+                        probe.local(Point2::new(4.0, 5.0), Point2::new(9.0, 8.0)),
+                    );
+                    let ((h, slot), (s, side_slot)) = (full.height_slot(p), side.side_slot(p));
+                    assert_eq!(h > 0.0, s > 0.0, "{shape:?} z {z} at {p:?}: {h} vs {s}");
+                    if h > 0.0 {
+                        assert_eq!((h.to_bits(), slot), (s.to_bits(), side_slot), "{shape:?} z {z} at {p:?}");
+                        inside += 1;
+                    } else {
+                        assert_eq!((s, side_slot), (0.0, None), "{shape:?} z {z} at {p:?}");
+                        outside += 1;
+                    }
+                }
+            }
+        }
+        assert!(inside > 500 && outside > 500, "both sides seen ({inside} inside, {outside} outside)");
+    }
 
     /// The candidate list gives the index's heights (up to rounding), inside its box and out.
     #[test]

@@ -512,7 +512,8 @@ impl BlockScratch {
             let dy = (b.min.y - y1).max(0.0).max(y0 - b.max.y);
             let d2 = (dx * dx + dy * dy).min(radius * radius);
             let ub = zmax - profile.height(d2.sqrt());
-            Candidate { ub, zmax, min: [b.min.x, b.min.y], max: [b.max.x, b.max.y], slot }
+            let lines = *index.edge_lines(slot);
+            Candidate { ub, zmax, min: [b.min.x, b.min.y], max: [b.max.x, b.max.y], lines, slot }
         }));
         // Sort small keys, not the candidates: descending bound, then slot.
         self.keys.clear();
@@ -545,7 +546,21 @@ struct Candidate {
     zmax: f64,
     min: [f64; 2],
     max: [f64; 2],
+    /// The triangle's XY edge lines ([`MeshIndex::edge_lines`]).
+    lines: [[f64; 3]; 3],
     slot: usize,
+}
+
+/// Whether the triangle in `slot` cannot hold the tip at `xy` above `best`:
+/// out of reach by its XY box or its edge lines, or its top lifted by the
+/// profile at that distance not above `best` (the bounds of the scan of
+/// [`drop_candidates`], with the same slack).
+fn out_of_reach(profile: &Profile, index: &MeshIndex, slot: usize, xy: Point2, best: f64) -> bool {
+    let slack = index.slack();
+    let d2 = index.xy_box(slot).distance_squared(&xy);
+    let side = (index.edge_distance(slot, xy) - slack).max(0.0);
+    let d2 = d2.max(side * side);
+    d2 > profile.radius * profile.radius || index.zmax(slot) - profile.height_sq(d2) + slack <= best
 }
 
 /// Drop-cutter at `xy` over `candidates` sorted by decreasing bound `ub`,
@@ -566,14 +581,17 @@ fn drop_candidates(
 ) -> (ClPoint, Option<usize>) {
     let mut best = ClPoint::floor(xy, floor);
     let mut best_slot = None;
-    if let Some(slot) = seed {
+    let slack = index.slack();
+    let r2 = profile.radius * profile.radius;
+    // The seed is tested whole unless the bounds of the scan below show it
+    // cannot rise above the floor (a floor at the level, where only the side
+    // is wanted, and the seed out of reach).
+    if let Some(slot) = seed.filter(|&slot| !out_of_reach(profile, index, slot, xy, best.tip.z)) {
         drop_triangle_profile(profile, index.corners(slot), index.normal(slot), index.original_index(slot), &mut best);
         if !matches!(best.contact, Contact::Floor) {
             best_slot = Some(slot);
         }
     }
-    let slack = index.slack();
-    let r2 = profile.radius * profile.radius;
     let ball = matches!(profile.shape, crate::CutterShape::Ball { .. });
     for (i, c) in candidates.iter().enumerate() {
         if c.ub + slack <= best.tip.z {
@@ -587,6 +605,13 @@ fn drop_candidates(
         let d2 = dx * dx + dy * dy;
         // A bound (up to rounding, which the slack covers): skipping cannot change the height.
         if d2 > r2 || c.zmax - profile.height_sq(d2) + slack <= best.tip.z {
+            continue;
+        }
+        // The same bound at the distance to the triangle's edge lines (a long
+        // thin triangle's box reaches far past it), lowered by the slack to
+        // cover its rounding.
+        let side = MeshIndex::line_distance(&c.lines, xy) - slack;
+        if side > 0.0 && (side > profile.radius || c.zmax - profile.height_sq(side * side) + slack <= best.tip.z) {
             continue;
         }
         if ball {
