@@ -776,19 +776,7 @@ mod tests {
     /// inside the box and out.
     #[test]
     fn side_slot_gives_the_side_and_the_inside_heights() {
-        let height = |i: usize, j: usize| {
-            ((i * 7 + j * 13) % 11) as f64 * 0.7 + if (i + j).is_multiple_of(5) { 4.0 } else { 0.0 }
-        };
-        let at = |i: usize, j: usize| Point3::new(i as f64 * 3.0, j as f64 * 3.0, height(i, j));
-        let mut soup = Vec::new();
-        for j in 0..6 {
-            for i in 0..6 {
-                soup.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
-                soup.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
-            }
-        }
-        let mesh = TriMesh::from_soup(&soup).expect("terrain").0;
-        let index = MeshIndex::build(&mesh);
+        let index = cliff_terrain();
         let (mut inside, mut outside) = (0, 0);
         for shape in [
             CutterShape::Flat { radius: 1.5 },
@@ -820,9 +808,9 @@ mod tests {
         assert!(inside > 500 && outside > 500, "both sides seen ({inside} inside, {outside} outside)");
     }
 
-    /// The candidate list gives the index's heights (up to rounding), inside its box and out.
-    #[test]
-    fn local_heights_equal_the_index_heights() {
+    /// A 6 x 6 grid of 3 mm squares whose corner heights step by 0.7 mm
+    /// with 4 mm cliffs on every fifth diagonal, indexed.
+    fn cliff_terrain() -> MeshIndex {
         let height =
             |i: usize, j: usize| ((i * 7 + j * 13) % 11) as f64 * 0.7 + if (i + j) % 5 == 0 { 4.0 } else { 0.0 };
         let at = |i: usize, j: usize| Point3::new(i as f64 * 3.0, j as f64 * 3.0, height(i, j));
@@ -833,8 +821,13 @@ mod tests {
                 soup.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
             }
         }
-        let mesh = TriMesh::from_soup(&soup).expect("terrain").0;
-        let index = MeshIndex::build(&mesh);
+        MeshIndex::build(&TriMesh::from_soup(&soup).expect("terrain").0)
+    }
+
+    /// The candidate list gives the index's heights (up to rounding), inside its box and out.
+    #[test]
+    fn local_heights_equal_the_index_heights() {
+        let index = cliff_terrain();
         for shape in [
             CutterShape::Flat { radius: 1.5 },
             CutterShape::Ball { radius: 2.0 },
