@@ -18,8 +18,12 @@
 //! An XY arc move ([`Toolpath::arc`], a helix when z changes along it) is
 //! one segment of its own length, met at its junctions along its end
 //! tangents; in model (b) its speed is also capped by its curvature: the
-//! centripetal acceleration `v^2 / rho <= A` and its rate `v^3 / rho^2 <= J`.
-//! Every other move is a line between its ends.
+//! centripetal acceleration `v^2 / rho <= A` and its rate `v^3 / rho^2 <= J`,
+//! with `rho` no less than the radius of the blend of a corner of the same
+//! deflection (below): a small arc of a small sweep (a fillet of a tenth of
+//! a millimetre turning a degree) is taken as that corner, and as `rho` goes
+//! to 0 an arc's cap becomes the corner's junction speed. Every other move is
+//! a line between its ends.
 //!
 //! # (b) Look-ahead model
 //! Every move is a segment with a speed limit; junction speeds are bounded by
@@ -134,7 +138,14 @@ fn segment(path: &Toolpath, k: usize, params: &FinishingParams) -> Option<Segmen
                 let t = scallop_geom::Vec2::new(-r.y, r.x) * (turn / r.norm().max(tol::ZERO_LENGTH));
                 Vec3::new(t.x * xy, t.y * xy, dz) / length
             };
+            // The controller may leave the arc by the blend tolerance, as at a
+            // corner: an arc whose sweep a blended corner of the same
+            // deflection would round more gently is taken as that corner.
             let m = &params.machine;
+            let cos_half = (0.5 * arc.sweep.abs().min(std::f64::consts::PI)).cos();
+            let blend =
+                if cos_half < 1.0 { params.blend_tolerance * cos_half / (1.0 - cos_half) } else { f64::INFINITY };
+            let rho = rho.max(blend);
             let cap = (m.acceleration * rho).sqrt().min((m.jerk * rho * rho).cbrt());
             return Some(Segment {
                 class: class(moves[k].kind),
@@ -408,6 +419,20 @@ mod tests {
         assert!(cap < p.machine.feed);
         let t = lookahead_time(&circle(tight, true, 0), &p).cutting;
         assert!(t >= std::f64::consts::TAU * tight / cap, "{t} s on a circle of {tight} mm");
+        // A fillet of 0.1 mm turning 1.4 degrees between two straight moves
+        // is timed as the corner it rounds (blended at full feed), not at
+        // the speed a whole circle of 0.1 mm would allow.
+        let turn = 1.4f64.to_radians();
+        let mut filleted = Toolpath::new(5000.0);
+        filleted.push(Move::new(MoveKind::Feed, Point3::new(-30.0, 0.1, 0.0)));
+        filleted.push(Move::new(MoveKind::Feed, Point3::new(0.0, 0.1, 0.0)));
+        let end = Point3::new(0.1 * turn.sin(), 0.1 * turn.cos(), 0.0);
+        filleted.push_arc(Move::new(MoveKind::Feed, end), ArcXY { center: Point2::origin(), sweep: -turn });
+        filleted
+            .push(Move::new(MoveKind::Feed, end + scallop_geom::Vec3::new(30.0 * turn.cos(), -30.0 * turn.sin(), 0.0)));
+        let corner = lookahead_time(&filleted, &p).cutting;
+        let straight = p.machine.segment_time(60.0);
+        assert!(corner <= straight * 1.001, "{corner} s for a filleted corner, {straight} s straight");
     }
 
     /// With zero entry and exit speeds the look-ahead segment time equals the
