@@ -15,7 +15,7 @@ use scallop_toolpath::{MoveKind, Toolpath};
 use serde::{Deserialize, Serialize};
 
 use crate::input::read_text;
-use crate::output::{print_json, print_text};
+use crate::output::{print_json, print_text, write_atomic};
 use crate::{CliResult, Failure};
 
 /// Arguments of `scallop engagement`.
@@ -55,6 +55,10 @@ pub struct EngagementArgs {
     /// Strip along the walls not counted as reachable (mm).
     #[arg(long, default_value_t = EngagementOptions::default().uncut_margin)]
     uncut_margin: f64,
+    /// Also write each move's largest engagement as CSV (`move,kind,x0,y0,x1,y1,z,phi_deg`),
+    /// for plotting the program coloured by engagement.
+    #[arg(long)]
+    moves: Option<PathBuf>,
     /// Print JSON on stdout.
     #[arg(long)]
     json: bool,
@@ -235,6 +239,19 @@ fn text(f: &Figures) -> String {
     )
 }
 
+/// One CSV row per move after the first: its kind, XY ends, end height and
+/// largest engagement (degrees, 0 where it cuts nothing).
+fn write_moves(w: &mut impl std::io::Write, path: &Toolpath, report: &EngagementReport) -> std::io::Result<()> {
+    writeln!(w, "move,kind,x0,y0,x1,y1,z,phi_deg")?;
+    let moves = path.moves();
+    for (i, pair) in moves.windows(2).enumerate() {
+        let phi = report.move_phi.get(i + 1).copied().unwrap_or(0.0).to_degrees();
+        let (a, b) = (pair[0].to, pair[1].to);
+        writeln!(w, "{},{:?},{},{},{},{},{},{:.2}", i + 1, pair[1].kind, a.x, a.y, b.x, b.y, b.z, phi)?;
+    }
+    Ok(())
+}
+
 /// `scallop engagement`.
 pub fn run(args: &EngagementArgs) -> CliResult<()> {
     let start = std::time::Instant::now();
@@ -259,5 +276,8 @@ pub fn run(args: &EngagementArgs) -> CliResult<()> {
         .map_err(|e| Failure::rejected(format!("{}: {e}", args.program.display())))?;
     let times = cycle_times(&path, &arcs, args)?;
     let f = figures(args, &report, times, &path, start.elapsed().as_secs_f64());
+    if let Some(file) = &args.moves {
+        write_atomic(file, |w| write_moves(w, &path, &report))?;
+    }
     if args.json { print_json(&f) } else { print_text(&text(&f)) }
 }

@@ -20,10 +20,23 @@ fn engagement_reports_a_slot_and_a_side_cut() {
     let out = scallop()
         .current_dir(&dir)
         .args(["engagement", "--pocket", "p.json", "--program", "x.nc", "--tool-diameter", "6"])
-        .args(["--stepover", "0.2", "--json"])
+        .args(["--stepover", "0.2", "--json", "--moves", "moves.csv"])
         .output()
         .expect("run");
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    // Per move: the slot's move reads 180 degrees, the side cut's the target,
+    // the rapids nothing.
+    let csv = std::fs::read_to_string(dir.join("moves.csv")).expect("moves");
+    let rows: Vec<Vec<&str>> = csv.lines().skip(1).map(|l| l.split(',').collect()).collect();
+    let phi_of = |x0: &str, x1: &str| {
+        rows.iter()
+            .find(|r| r[2] == x0 && r[4] == x1 && r[1] == "Feed")
+            .and_then(|r| r[7].parse::<f64>().ok())
+            .unwrap_or(f64::NAN)
+    };
+    assert!((phi_of("10", "90") - 180.0).abs() <= 1.0, "{csv}");
+    assert!((phi_of("10", "84") - 53.13).abs() <= 1.5, "{csv}");
+    assert!(rows.iter().filter(|r| r[1] == "Rapid").all(|r| r[7] == "0.00"), "{csv}");
     let f: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
     let num = |k: &str| f[k].as_f64().unwrap_or(f64::NAN);
     assert!((num("target_deg") - 53.13).abs() < 0.01);
