@@ -12,7 +12,8 @@
 # scallop's side runs when `scallop pocket` exists, else it is skipped with a message;
 # --pattern gives its clearing pattern (default offset: adaptive is experimental, docs/roughing.md); --planner another scallop binary
 # that plans (`scallop pocket`) while --scallop evaluates (`scallop engagement`).
-# Outputs (pockets, G-code, JSON figures) go to the work directory, never to the repository.
+# Outputs (pockets, G-code, JSON figures, each program drawn coloured by engagement as SVG) go to
+# the work directory, never to the repository.
 # Exit status: 0 done, 2 setup or run error.
 set -euo pipefail
 
@@ -40,7 +41,7 @@ while [ $# -gt 0 ]; do
                 --planner) planner=$val ;;
             esac
             shift ;;
-        -h|--help) sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+        -h|--help) sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
         *) echo "run.sh: unknown option $1" >&2; exit 2 ;;
     esac
     shift
@@ -81,9 +82,19 @@ mkdir -p "$workdir"
 rm -rf "${workdir:?}/pockets"
 python3 "$here/pockets.py" "$workdir/pockets" "${reduced[@]}" > "$workdir/pocket-names.txt"
 
+# Each program is also drawn coloured by engagement (OUT.svg beside OUT.json, draw.py) when the
+# evaluating scallop writes per-move engagement (`engagement --moves`).
+moves=()
+if "$scallop" engagement --help 2>/dev/null | grep -- '--moves' > /dev/null; then moves=(1); fi
 evaluate() { # evaluate NAME PROGRAM OUT.json
+    local extra=()
+    [ ${#moves[@]} -gt 0 ] && extra=(--moves "${3%.json}-moves.csv")
     "$scallop" engagement --pocket "$workdir/pockets/$1.json" --program "$2" --tool-diameter 6 --stepover 0.2 \
-        --gouge-tolerance 0.1 --json > "$3" 2> "$3.err" || { echo "{\"error\": $(python3 -c 'import json,sys; print(json.dumps(open(sys.argv[1]).read().strip()))' "$3.err")}" > "$3"; }
+        --gouge-tolerance 0.1 --json "${extra[@]}" > "$3" 2> "$3.err" || { echo "{\"error\": $(python3 -c 'import json,sys; print(json.dumps(open(sys.argv[1]).read().strip()))' "$3.err")}" > "$3"; }
+    if [ ${#moves[@]} -gt 0 ] && [ -s "${3%.json}-moves.csv" ]; then
+        python3 "$here/draw.py" "$workdir/pockets/$1.json" "${3%.json}-moves.csv" "${3%.json}.svg" --title "$1: $(basename "$2")" \
+            || echo "run.sh: could not draw ${3%.json}.svg" >&2
+    fi
 }
 
 while read -r name; do

@@ -422,6 +422,19 @@ impl Region {
         self.rings.iter().map(|r| r.winding_number(p)).sum::<i32>() > 0
     }
 
+    /// The disc of radius `r` about `c` lies in the region: `c` is inside
+    /// and no ring passes nearer than `r` (arcs exact). The same test as
+    /// `self.offset(r).contains(c)` without building the offset.
+    #[must_use]
+    pub fn holds_disc(&self, c: P2, r: f64) -> bool {
+        let q = cavalier_contours::core::math::Vector2::new(c[0], c[1]);
+        self.contains(c)
+            && self
+                .rings
+                .iter()
+                .all(|ring| ring.pline.closest_point(q, tol::POS_EQUAL).is_none_or(|hit| hit.distance >= r))
+    }
+
     /// Bounding box `(min, max)` of the rings' vertices and arcs.
     #[must_use]
     pub fn bounds(&self) -> Option<(P2, P2)> {

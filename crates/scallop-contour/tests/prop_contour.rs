@@ -129,3 +129,37 @@ fn starting_near_splits_a_segment() {
     assert!(p[0].abs() < 1e-9 && (p[1] - 5.0).abs() < 1e-9, "{p:?}");
     assert!((circle.signed_area() - 25.0 * PI).abs() < 1e-9);
 }
+
+proptest! {
+    /// `holds_disc(c, r)` is `offset(r).contains(c)` (a rectangle with a
+    /// round island and a rounded corner: lines, arcs, a hole), away from
+    /// ties: points within 1e-6 mm of the offset boundary are skipped.
+    #[test]
+    fn holds_disc_is_containment_in_the_offset(
+        r in 0.2..6.0_f64,
+        points in proptest::collection::vec((-5.0..65.0_f64, -5.0..45.0_f64), 60),
+    ) {
+        let outer = Contour::new(
+            &[
+                scallop_contour::Vertex { x: 0.0, y: 0.0, bulge: 0.0 },
+                scallop_contour::Vertex { x: 60.0, y: 0.0, bulge: 0.0 },
+                scallop_contour::Vertex { x: 60.0, y: 30.0, bulge: (PI / 8.0).tan() },
+                scallop_contour::Vertex { x: 50.0, y: 40.0, bulge: 0.0 },
+                scallop_contour::Vertex { x: 0.0, y: 40.0, bulge: 0.0 },
+            ],
+            true,
+        )
+        .unwrap();
+        let island = Contour::circle([25.0, 20.0], 6.0).unwrap().reversed();
+        let region = Region::with_holes(outer, vec![island]).unwrap();
+        let eroded = region.offset(r);
+        let (inner, outer_band) = (eroded.offset(1e-6), eroded.offset(-1e-6));
+        for (x, y) in points {
+            let c = [x, y];
+            if inner.contains(c) != outer_band.contains(c) {
+                continue;
+            }
+            prop_assert_eq!(region.holds_disc(c, r), eroded.contains(c), "{:?} r {}", c, r);
+        }
+    }
+}

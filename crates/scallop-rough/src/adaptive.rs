@@ -178,7 +178,7 @@ pub fn plan_adaptive_in(
     };
     let s = grid.centre(seed);
     let rh = tol::HELIX_RADIUS_SHARE * r;
-    let r0 = if rh > 0.0 && region.offset(rh).contains(s) { rh } else { 0.0 };
+    let r0 = if rh > 0.0 && region.holds_disc(s, rh) { rh } else { 0.0 };
     let target = (1.0 - (options.stepover / r).min(1.0)).acos();
     let chord = options.chord_tolerance.clamp(1e-5, tol::WALK_CHORD);
     let holder = region.offset(-tol::LINK_GROW);
@@ -244,7 +244,7 @@ pub fn plan_adaptive_in(
             planner.swept[k] = 0.0;
             continue;
         }
-        let r0 = if rh > 0.0 && region.offset(rh).contains(e) { rh } else { 0.0 };
+        let r0 = if rh > 0.0 && region.holds_disc(e, rh) { rh } else { 0.0 };
         walk.steps.push(Step::Link { tool_down: false, via: Vec::new(), cleared: false, to: None });
         #[allow(clippy::cast_possible_truncation, reason = "passes are bounded by MAX_PASSES")]
         planner.bore(e, r0, walk.passes as u32);

@@ -697,7 +697,7 @@ impl Emitter<'_> {
         };
         let approach = above + tol::APPROACH;
         let depth = above - z;
-        let fits = !straight && rh > 0.0 && depth > 0.0 && region.offset(rh).contains(s);
+        let fits = !straight && rh > 0.0 && depth > 0.0 && region.holds_disc(s, rh);
         let start = if fits { [s[0] + rh, s[1]] } else { s };
         if current > approach {
             self.path.push(Move::new(MoveKind::Rapid, Point3::new(start[0], start[1], approach)));

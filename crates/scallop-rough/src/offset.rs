@@ -86,8 +86,10 @@ pub fn plan_offset_in(
         levels.push(next);
     }
     let grow = 2.0 * ae + tol::LINK_MARGIN_SHARE * ae;
-    let bands: Vec<Option<Region>> =
-        (0..levels.len()).map(|k| levels.get(k + 1).map(|inner| inner.offset(-grow))).collect();
+    // The band of each level, computed when a link first needs it.
+    let bands: Vec<std::cell::OnceCell<Option<Region>>> =
+        (0..levels.len()).map(|_| std::cell::OnceCell::new()).collect();
+    let band_of = |k: usize| bands[k].get_or_init(|| levels.get(k + 1).map(|inner| inner.offset(-grow)));
     // The passes of level 0 lie on the region's contour: grown a hair, the
     // region holds them.
     let holder = region.offset(-tol::LINK_GROW);
@@ -255,12 +257,17 @@ pub fn plan_offset_in(
         let mut pieces = std::mem::take(&mut wall_pieces[k]);
         // A band may reach past the region: it is kept inside. It holds
         // when every deeper ring is cut (the open side's are).
-        let band = bands[k].as_ref().map(|b| b.intersection(&holder, tol_c));
-        let safe = match (band, &air) {
-            (Some(band), Some(air)) => Some(band.union(air, tol_c)),
-            (Some(band), None) => Some(band),
-            (None, Some(air)) => Some(air.clone()),
-            (None, None) => None,
+        let safe = std::cell::OnceCell::new();
+        let safe = || {
+            safe.get_or_init(|| {
+                let band = band_of(k).as_ref().map(|b| b.intersection(&holder, tol_c));
+                match (band, &air) {
+                    (Some(band), Some(air)) => Some(band.union(air, tol_c)),
+                    (Some(band), None) => Some(band),
+                    (None, Some(air)) => Some(air.clone()),
+                    (None, None) => None,
+                }
+            })
         };
         while !pieces.is_empty() {
             let (i, cut) = nearest(&pieces, pos);
@@ -272,7 +279,7 @@ pub fn plan_offset_in(
                     // engages no more than a pass does.
                     let short =
                         (start[0] - p[0]).hypot(start[1] - p[1]) <= ae && holder.contains_segment(p, start, tol_c);
-                    let down = short || safe.as_ref().is_some_and(|safe| safe.contains_segment(p, start, tol_c));
+                    let down = short || safe().as_ref().is_some_and(|safe| safe.contains_segment(p, start, tol_c));
                     steps.push(Step::Link { tool_down: down, via: Vec::new(), cleared: piece.from_air, to: None });
                 }
                 None if piece.from_air => {
