@@ -259,7 +259,30 @@ pub fn plan_adaptive_in(
             end = reached;
         }
     }
-    let mut steps = walk.steps;
+    // The passes as lines and arcs within half the lines' own tolerance of
+    // their vertices (the walk turns through many short lines), each kept
+    // as lines unless its arcs stay in the region (exactly, against the
+    // region's chords, the arcs as chords within `tol::WALK_CHORD`).
+    let arc_fit = 0.5 * tol::WALK_FIT_SHARE * r;
+    let mut steps: Vec<Step> = walk
+        .steps
+        .into_iter()
+        .map(|step| match step {
+            Step::Cut(c) => {
+                let fitted =
+                    Contour::from_points(&c.to_points(0.1 * arc_fit), c.is_closed(), arc_fit).ok().filter(|f| {
+                        let p = f.to_points(tol::WALK_CHORD);
+                        let closing = f.is_closed().then(|| (p[p.len() - 1], p[0]));
+                        p.windows(2)
+                            .map(|w| (w[0], w[1]))
+                            .chain(closing)
+                            .all(|(a, b)| planner.edges.contains_segment(a, b))
+                    });
+                Step::Cut(fitted.unwrap_or(c))
+            }
+            link @ Step::Link { .. } => link,
+        })
+        .collect();
     let mut rest = planner.finish(region, end);
     steps.append(&mut rest);
     Ok(steps)

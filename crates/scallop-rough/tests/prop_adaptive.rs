@@ -394,3 +394,37 @@ fn the_bench_island_and_hash_stay_within_the_bound() {
         );
     }
 }
+
+/// Every pass of the walk, as emitted (lines and arcs), keeps the tool
+/// centre in the region (grown by `tol::LINK_GROW`, the hair links may use):
+/// the arcs refitted over a pass's lines are kept only where they stay in.
+/// On the bench's "#" and rectangle with an island, where passes slide along
+/// straight and round walls.
+#[test]
+fn passes_as_arcs_stay_in_the_region() {
+    let island: Vec<[f64; 2]> = circle(50.0, 30.0, 12.0, 128, true);
+    for rings in [vec![rect(0.0, 0.0, 100.0, 60.0), island], bench_hash()] {
+        let mut it = rings.iter().map(|r| Contour::polygon(r, true).unwrap());
+        let outer = it.next().unwrap();
+        let region = Region::with_holes(outer, it.collect()).unwrap().offset(3.0);
+        let options = ClearOptions {
+            tool_radius: 3.0,
+            stepover: 1.2,
+            direction: Direction::Climb,
+            chord_tolerance: 1e-3,
+            pattern: Pattern::Adaptive,
+        };
+        let grown = region.offset(-scallop_rough::tol::LINK_GROW);
+        let mut arcs = 0usize;
+        for step in scallop_rough::plan_adaptive(&region, &options).unwrap() {
+            if let scallop_rough::Step::Cut(c) = step {
+                arcs += c.vertices().iter().filter(|v| v.bulge != 0.0).count();
+                for p in c.to_points(1e-5) {
+                    assert!(grown.contains(p), "{p:?} outside the region");
+                }
+            }
+        }
+        // The check is not vacuous: the passes are arcs in good part.
+        assert!(arcs > 100, "{arcs} arcs");
+    }
+}
