@@ -261,23 +261,29 @@ proptest! {
     }
 }
 
-/// The plan of the bench's pockets (bench/freecad/pockets.py: tool D 6,
-/// stepover 0.2 D, as `scallop pocket`), judged by the simulator.
-fn bench_plan(rings: &[Vec<[f64; 2]>]) -> (RoughPlan, EngagementReport) {
-    let r = 3.0;
-    let ae = 1.2;
+/// The tool-centre region of one of the bench's pockets (its rings, the
+/// outer first) and the bench's options (tool D 6, stepover 0.2 D).
+fn bench_region(rings: &[Vec<[f64; 2]>]) -> (Region, ClearOptions) {
     let mut it = rings.iter().map(|q| Contour::polygon(q, true).unwrap());
     let outer = it.next().unwrap();
     let wall = Region::with_holes(outer, it.collect()).unwrap();
     let options = ClearOptions {
-        tool_radius: r,
-        stepover: ae,
+        tool_radius: 3.0,
+        stepover: 1.2,
         direction: Direction::Climb,
         chord_tolerance: 1e-3,
         pattern: Pattern::Adaptive,
     };
+    (wall.offset(options.tool_radius), options)
+}
+
+/// The plan of the bench's pockets (bench/freecad/pockets.py: tool D 6,
+/// stepover 0.2 D, as `scallop pocket`), judged by the simulator.
+fn bench_plan(rings: &[Vec<[f64; 2]>]) -> (RoughPlan, EngagementReport) {
+    let (region, options) = bench_region(rings);
+    let (r, ae) = (options.tool_radius, options.stepover);
     let motion = Motion { clearance_z: 5.0, feed: 5000.0 };
-    let plan = pocket_toolpath(&wall.offset(r), &options, -1.0, 0.0, &motion).unwrap();
+    let plan = pocket_toolpath(&region, &options, -1.0, 0.0, &motion).unwrap();
     let pocket =
         Pocket::new(rings.iter().map(|q| q.iter().map(|p| Point2::new(p[0], p[1])).collect()).collect()).unwrap();
     let report =
@@ -404,16 +410,7 @@ fn the_bench_island_and_hash_stay_within_the_bound() {
 fn passes_as_arcs_stay_in_the_region() {
     let island: Vec<[f64; 2]> = circle(50.0, 30.0, 12.0, 128, true);
     for rings in [vec![rect(0.0, 0.0, 100.0, 60.0), island], bench_hash()] {
-        let mut it = rings.iter().map(|r| Contour::polygon(r, true).unwrap());
-        let outer = it.next().unwrap();
-        let region = Region::with_holes(outer, it.collect()).unwrap().offset(3.0);
-        let options = ClearOptions {
-            tool_radius: 3.0,
-            stepover: 1.2,
-            direction: Direction::Climb,
-            chord_tolerance: 1e-3,
-            pattern: Pattern::Adaptive,
-        };
+        let (region, options) = bench_region(&rings);
         let grown = region.offset(-scallop_rough::tol::LINK_GROW);
         let mut arcs = 0usize;
         for step in scallop_rough::plan_adaptive(&region, &options).unwrap() {
