@@ -102,6 +102,56 @@ pub struct Rough5Settings {
     pub local_entry: bool,
 }
 
+impl Rough5Settings {
+    /// The settings of `scallop rough5` (docs/rough5.md) for the levels and
+    /// curves `guides` and a cutting feed (mm/min): guide curves (SPU), CL
+    /// points every 1 mm, angular steps of 2 deg (axis) and 5 deg (azimuth),
+    /// a 0.5 mm bottom allowance, ramps of 5 deg, 1 mm clearance, links on
+    /// the level up to 2 a_e, rapids at 20 m/min, no optimised orientation,
+    /// no collision correction, and every refinement on
+    /// ([`Self::with_refinements`]).
+    #[must_use]
+    pub fn new(guides: GuideSettings, feed: f64) -> Self {
+        Self {
+            tilt: TiltMode::Guides,
+            guides,
+            bottom_allowance: 0.5,
+            step: 1.0,
+            max_angle_step: 2f64.to_radians(),
+            max_azimuth_step: 5f64.to_radians(),
+            ramp_angle: 5f64.to_radians(),
+            clearance: 1.0,
+            link_max: 2.0 * guides.radial_step,
+            feed,
+            rapid_rate: 20_000.0,
+            orientation: None,
+            correct: false,
+            levels: LevelOptions::default(),
+            vertical_inside: false,
+            vertical_thin_steps: false,
+            translate: false,
+            local_entry: false,
+        }
+        .with_refinements(true)
+    }
+
+    /// These settings with every refinement of the guide-curve program (the
+    /// level repairs of [`LevelOptions`], [`Self::vertical_inside`],
+    /// [`Self::vertical_thin_steps`], [`Self::translate`] and
+    /// [`Self::local_entry`]) on or off.
+    #[must_use]
+    pub fn with_refinements(self, on: bool) -> Self {
+        Self {
+            levels: LevelOptions { centre_offsets: on, pair_by_rank: on, open_bottom: on },
+            vertical_inside: on,
+            vertical_thin_steps: on,
+            translate: on,
+            local_entry: on,
+            ..self
+        }
+    }
+}
+
 /// Largest axis translation of a colliding pair (mm).
 pub const TRANSLATION_MAX: f64 = 2.5;
 /// A translated pair's neighbours are moved by its translation less this much
