@@ -610,6 +610,13 @@ fn vertical_where_clear(
     thin_vertical(limit_angular_step(&out, settings.max_angle_step, settings.max_azimuth_step), span, chord)
 }
 
+/// Distance from `p` to the segment `a`-`b`.
+fn off_segment(p: &Point3, a: &Point3, b: &Point3) -> f64 {
+    let ab = b - a;
+    let t = if ab.norm_squared() > 0.0 { ((p - a).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0) } else { 0.0 };
+    (p - (a + ab * t)).norm()
+}
+
 /// `pairs` without the pairs inside a stretch of vertical axes that their
 /// neighbours make redundant: one is dropped when it, the pairs on either
 /// side and the last pair kept all have the axis +Z, the next pair's guide
@@ -629,11 +636,7 @@ pub fn thin_vertical(pairs: Vec<SyncPoint>, span: f64, chord: f64) -> Vec<SyncPo
         return pairs;
     }
     let vertical = |s: &SyncPoint| s.axis.angle(&Vec3::z()) <= tol::ANGLE_EPS;
-    let off = |p: &Point3, a: &Point3, b: &Point3| {
-        let ab = b - a;
-        let t = if ab.norm_squared() > 0.0 { ((p - a).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0) } else { 0.0 };
-        (p - (a + ab * t)).norm()
-    };
+    let off = off_segment;
     let mut out: Vec<SyncPoint> = Vec::with_capacity(n);
     out.push(pairs[0]);
     let mut last_at = 0;
@@ -1386,6 +1389,16 @@ impl Emitter {
                 return false;
             }
             moves.push(p);
+        }
+        // A vertical link within the thinning's chord of its chord is one block.
+        let chord = tol::THIN_CHORD_ALLOWANCES * s.guides.flank_allowance;
+        let straight = s.round_corners
+            && moves.iter().all(|p| p.axis.angle(&Vec3::z()) <= tol::ANGLE_EPS)
+            && moves
+                .last()
+                .is_some_and(|end| moves.iter().all(|p| off_segment(&p.tip, &a.place.tip, &end.tip) <= chord));
+        if straight {
+            moves.drain(..moves.len() - 1);
         }
         for p in turn {
             self.push(MoveKind::Feed, p.tip, p.axis);

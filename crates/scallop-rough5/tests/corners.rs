@@ -5,9 +5,13 @@
 //! sharp rings covered.
 #![allow(clippy::unwrap_used, reason = "tests: a panic is the failure report")]
 
+mod common;
+
 use proptest::prelude::*;
 use scallop_geom::{Point3, Vec3};
-use scallop_rough5::{SyncPoint, round_corners, tol};
+use scallop_parts::{FaceTag, PocketParams, closed_pocket};
+use scallop_rough5::{Rough5Settings, SyncPoint, plan_rough5, round_corners, tol};
+use scallop_toolpath::MoveKind;
 
 /// A closed counter-clockwise ring of vertical pairs through the corners
 /// `c`, each side cut every `step` mm.
@@ -117,4 +121,61 @@ proptest! {
             }
         }
     }
+}
+
+/// On a 60 x 60 x 20 mm pocket with the rounded corners on, a link between
+/// two passes whose tool stays vertical and whose points lie within the
+/// thinning's chord of the straight line is one block (it was written in
+/// pieces of `--step`, the points the link was checked at); without, it is
+/// in pieces, and the program is the same but for those links.
+#[test]
+fn straight_vertical_links_are_one_block() {
+    let part = closed_pocket(&PocketParams {
+        stock: [60.0, 60.0, 20.0],
+        bottom_z: 6.0,
+        wall: 8.0,
+        corner_radius: 6.0,
+        dome: 1.0,
+        ..Default::default()
+    })
+    .unwrap();
+    let bottom = part.faces(&[FaceTag::Bottom]).unwrap();
+    let flanks = part.faces(&[FaceTag::Flank]).unwrap();
+    let depth = part.stock.max.z - bottom.bounds().min.z;
+    let tool = common::torus(20.0, 100.0);
+    let s = common::settings(depth);
+    let chord = tol::THIN_CHORD_ALLOWANCES * s.guides.flank_allowance;
+    let pieces = |on: bool| {
+        let s = Rough5Settings { round_corners: on, ..s };
+        let path = plan_rough5(&bottom, &flanks, &part.stock, &tool, &s, &|_, _| {}).unwrap().toolpath;
+        let moves = path.moves();
+        // Every run of links between two cutting moves: its moves, all vertical and within the chord?
+        let mut runs = Vec::new();
+        let mut i = 1;
+        while i < moves.len() {
+            if moves[i].kind != MoveKind::Link || moves[i - 1].kind != MoveKind::Feed {
+                i += 1;
+                continue;
+            }
+            let start = i - 1;
+            while i < moves.len() && moves[i].kind == MoveKind::Link {
+                i += 1;
+            }
+            if i < moves.len() && moves[i].kind == MoveKind::Feed {
+                let (a, b) = (moves[start].to, moves[i - 1].to);
+                let ab = b - a;
+                let straight = (start..i).all(|k| {
+                    let t = ((moves[k].to - a).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0);
+                    (moves[k].to - (a + ab * t)).norm() <= chord && path.axis(k).angle(&Vec3::z()) <= 1e-12
+                });
+                if straight {
+                    runs.push(i - 1 - start);
+                }
+            }
+        }
+        runs
+    };
+    let (on, off) = (pieces(true), pieces(false));
+    assert!(!on.is_empty() && on.iter().all(|&n| n == 1), "{on:?}");
+    assert!(off.iter().any(|&n| n > 1), "{off:?}");
 }
