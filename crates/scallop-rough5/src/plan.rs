@@ -688,19 +688,20 @@ struct Fillet {
 }
 
 /// `pairs` with the corners of their vertical stretches rounded (docs/rough5.md,
-/// "Corners and blocks"). A corner is a run of pairs that turn, in plan, by more than
-/// [`tol::CORNER_TURN_NOISE`] each to the same side, at most `link` mm apart, one of them by more than the
-/// arc chords' turn ([`tol::FILLET_TURN_SHARE`] of the time model's smooth
-/// junction). It is replaced by the circular fillet tangent to the stretch that comes
-/// to it and the one that leaves it, in chords that turn by at most that much each: a
-/// convex corner (to the left, the side the pass keeps its inside on) of at most
-/// [`tol::CORNER_FILLET_MAX_TURN`] with a radius up to `convex_radius`, every other
-/// corner only where the fillet passes within `chord` of the pairs it replaces (the
-/// polygon of a curve traced on a voxel field refitted as the arc it stands for).
-/// The fillet never reaches past half the way to the next corner, nor past the first
-/// or last pair, and every pair it replaces or stands between is vertical. The
-/// fillet's pairs have the axis +Z, the guide point's height interpolated along the
-/// fillet, and the other fields of the nearest pair replaced.
+/// "Corners and blocks"). A corner is a run of pairs that turn, in plan, by more
+/// than [`tol::CORNER_TURN_NOISE`] each to the same side, at most `link` mm apart,
+/// one of them by more than the arc chords' turn ([`tol::FILLET_TURN_SHARE`] of the
+/// time model's smooth junction). It is replaced by the circular fillet tangent to
+/// the stretch that comes to it and the one that leaves it, in chords that turn by
+/// at most that much each: a convex corner (to the left, the side the pass keeps
+/// its inside on) of at most [`tol::CORNER_FILLET_MAX_TURN`] with a radius up to
+/// `convex_radius`, every other corner only where the fillet passes within `chord`
+/// of the pairs it replaces (the polygon of a curve traced on a voxel field
+/// refitted as the arc it stands for). The fillet never reaches past half the way
+/// to the next corner, nor past the first or last pair, and every pair it replaces
+/// or stands between is vertical. The fillet's pairs have the axis +Z and the
+/// guide point's height interpolated along the fillet; their level normal and tilt
+/// point are those of the nearest pair replaced.
 #[must_use]
 pub fn round_corners(pairs: Vec<SyncPoint>, convex_radius: f64, chord: f64, link: f64) -> Vec<SyncPoint> {
     let n = pairs.len();
