@@ -58,6 +58,8 @@ pub enum RefineArg {
     AirTrim,
     /// Each run entered from the level above where its tool stands, not from that level's highest point.
     LocalEntry,
+    /// Vertical stretches in long blocks and their corners rounded (inner passes' convex corners by 0.8 R).
+    Corners,
     /// All of them: the program of 28 Nov 2026.
     All,
 }
@@ -282,6 +284,7 @@ fn settings(args: &Rough5Args, part: &TestPart) -> CliResult<Rough5Settings> {
         vertical_thin_steps: on(RefineArg::ThinSteps),
         translate: on(RefineArg::Translation),
         local_entry: on(RefineArg::LocalEntry),
+        round_corners: on(RefineArg::Corners),
         ..base
     })
 }

@@ -14,10 +14,7 @@ use scallop_machine::time::{path_time, rapid_time};
 use scallop_machine::{Joints, Kinematics, Machine};
 use scallop_parts::{FaceTag, TestPart};
 use scallop_post::{Dialect, OutputMode, PostParams, check_replay, program_text, replay};
-use scallop_rough5::{
-    LevelOptions, Proof, ProofFace, ProofSettings, Rough5Plan, Rough5Settings, TiltMode, plan_rough5_in,
-    prove_with_faces,
-};
+use scallop_rough5::{Proof, ProofFace, ProofSettings, Rough5Plan, Rough5Settings, plan_rough5_in, prove_with_faces};
 use scallop_toolpath::Toolpath;
 use serde::Serialize;
 
@@ -288,11 +285,10 @@ pub fn rough5_metrics(plan: &Rough5Plan, proof: &Proof, posted: Option<&Posted>)
     }
 }
 
-/// The settings of `scallop rough5` (docs/rough5.md) for a part, a tool
-/// radius, a_p, a_e and a feed (mm/min): guide curves (SPU), voxel 1 mm, CL
-/// points every 1 mm, angular steps of 2 deg (axis) and 5 deg (azimuth), 0.5 mm
-/// allowances, ramps of 5 deg, links on the level up to 2 a_e, every
-/// refinement of "Where the remaining volume was" on, no collision correction.
+/// The settings of `scallop rough5` (docs/rough5.md,
+/// [`Rough5Settings::new`]) for a part, a tool radius, a_p, a_e and a feed
+/// (mm/min): voxel 1 mm, a 0.5 mm flank allowance, the levels down to the
+/// part's bottom.
 ///
 /// # Errors
 /// The part has no bottom faces.
@@ -303,33 +299,15 @@ pub fn rough5_settings(
     feed: f64,
 ) -> Result<Rough5Settings, EngineError> {
     let bottom = part.faces(&[FaceTag::Bottom])?;
-    Ok(Rough5Settings {
-        tilt: TiltMode::Guides,
-        guides: GuideSettings {
-            tool_radius,
-            flank_allowance: 0.5,
-            axial_step: ap,
-            radial_step: ae,
-            voxel: 1.0,
-            depth: part.stock.max.z - bottom.bounds().min.z,
-        },
-        bottom_allowance: 0.5,
-        step: 1.0,
-        max_angle_step: 2f64.to_radians(),
-        max_azimuth_step: 5f64.to_radians(),
-        ramp_angle: 5f64.to_radians(),
-        clearance: 1.0,
-        link_max: 2.0 * ae,
-        feed,
-        rapid_rate: 20_000.0,
-        orientation: None,
-        correct: false,
-        levels: LevelOptions { centre_offsets: true, pair_by_rank: true, open_bottom: true },
-        vertical_inside: true,
-        vertical_thin_steps: true,
-        translate: true,
-        local_entry: true,
-    })
+    let guides = GuideSettings {
+        tool_radius,
+        flank_allowance: 0.5,
+        axial_step: ap,
+        radial_step: ae,
+        voxel: 1.0,
+        depth: part.stock.max.z - bottom.bounds().min.z,
+    };
+    Ok(Rough5Settings::new(guides, feed))
 }
 
 /// A 5-axis roughing operation of a job.

@@ -1023,6 +1023,36 @@ pub mod rough5 {
     /// tool is given, the proof's own sweep tolerance).
     pub const THIN_CHORD_ALLOWANCES: f64 = 0.1;
 
+    /// The fillet radius, in tool radii, of a convex corner of an inner pass
+    /// (a path curve inside a level's limit curves) where the tool is vertical
+    /// (`scallop_rough5::round_corners`; docs/rough5.md, "Corners and
+    /// blocks"): 4 mm for the R 5 torus. With a_e at most the tool radius the
+    /// next pass out covers what the fillet leaves outside the ring.
+    pub const CORNER_FILLET_RADII: f64 = 0.8;
+
+    /// The largest turn (rad, 120 degrees) of an inner pass's convex corner that
+    /// gets a fillet of [`CORNER_FILLET_RADII`]; sharper corners, the limit
+    /// passes' and concave ones are refitted within the thinning's chord only.
+    pub const CORNER_FILLET_MAX_TURN: f64 = 2.094_395_102_393_195_5;
+
+    /// Turns (rad, 1 degree) below this at a pair are part of a straight or
+    /// gently curved stretch, not of a corner.
+    pub const CORNER_TURN_NOISE: f64 = 0.017_453_292_519_943_295;
+
+    /// The pairs of one corner are at most this many steps (`--step`) apart:
+    /// a long block between two turns makes them two corners.
+    pub const CORNER_LINK_STEPS: f64 = 1.5;
+
+    /// A fillet's end within this (mm) of a pair kept beside it is that pair:
+    /// no block of a few micrometres.
+    pub const FILLET_MERGE: f64 = 0.01;
+
+    /// A fillet's arc is written in chords that turn by at most this share of
+    /// the time model's smooth junction (`machine::SMOOTH_JUNCTION`, 10 degrees):
+    /// a sharper junction is timed as a corner the controller blends within
+    /// its tolerance, which on short blocks is near a stop.
+    pub const FILLET_TURN_SHARE: f64 = 0.9;
+
     /// A flank triangle whose outward normal (out of the volume to remove)
     /// rises above the horizontal by more than this sine (1 degree) is an
     /// undercut: the 3+2 baseline looks for setups that reach under it

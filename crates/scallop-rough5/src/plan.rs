@@ -100,6 +100,65 @@ pub struct Rough5Settings {
     /// along an impeller's channel the ramp from the highest point circles
     /// down through the air (docs/rough5.md, "The impeller, sixth session").
     pub local_entry: bool,
+    /// Whether the vertical stretches of every pass are written in long
+    /// blocks ([`thin_vertical`]) and their corners rounded
+    /// ([`round_corners`]): the convex corners of the inner passes by a fillet
+    /// of [`tol::CORNER_FILLET_RADII`] tool radii (when a_e is at most the
+    /// tool radius), the other corners within the thinning's chord
+    /// (docs/rough5.md, "Corners and blocks").
+    pub round_corners: bool,
+}
+
+impl Rough5Settings {
+    /// The settings of `scallop rough5` (docs/rough5.md) for the levels and
+    /// curves `guides` and a cutting feed (mm/min): guide curves (SPU), CL
+    /// points every 1 mm, angular steps of 2 deg (axis) and 5 deg (azimuth),
+    /// a 0.5 mm bottom allowance, ramps of 5 deg, 1 mm clearance, links on
+    /// the level up to 2 a_e, rapids at 20 m/min, no optimised orientation,
+    /// no collision correction, and every refinement on
+    /// ([`Self::with_refinements`]).
+    #[must_use]
+    pub fn new(guides: GuideSettings, feed: f64) -> Self {
+        Self {
+            tilt: TiltMode::Guides,
+            guides,
+            bottom_allowance: 0.5,
+            step: 1.0,
+            max_angle_step: 2f64.to_radians(),
+            max_azimuth_step: 5f64.to_radians(),
+            ramp_angle: 5f64.to_radians(),
+            clearance: 1.0,
+            link_max: 2.0 * guides.radial_step,
+            feed,
+            rapid_rate: 20_000.0,
+            orientation: None,
+            correct: false,
+            levels: LevelOptions::default(),
+            vertical_inside: false,
+            vertical_thin_steps: false,
+            translate: false,
+            local_entry: false,
+            round_corners: false,
+        }
+        .with_refinements(true)
+    }
+
+    /// These settings with every refinement of the guide-curve program (the
+    /// level repairs of [`LevelOptions`], [`Self::vertical_inside`],
+    /// [`Self::vertical_thin_steps`], [`Self::translate`],
+    /// [`Self::local_entry`] and [`Self::round_corners`]) on or off.
+    #[must_use]
+    pub fn with_refinements(self, on: bool) -> Self {
+        Self {
+            levels: LevelOptions { centre_offsets: on, pair_by_rank: on, open_bottom: on },
+            vertical_inside: on,
+            vertical_thin_steps: on,
+            translate: on,
+            local_entry: on,
+            round_corners: on,
+            ..self
+        }
+    }
 }
 
 /// Largest axis translation of a colliding pair (mm).
@@ -277,6 +336,9 @@ pub fn plan_rough5_in(
             }
             if settings.translate {
                 pairs = translated(&placer, &body, pairs);
+            }
+            if settings.round_corners {
+                pairs = rounded(pairs, outer, settings);
             }
             let (runs, mut report) = place_pass_in(&placer, &body, out.air.as_ref(), &pairs);
             report.corrected = corrected;
@@ -548,6 +610,13 @@ fn vertical_where_clear(
     thin_vertical(limit_angular_step(&out, settings.max_angle_step, settings.max_azimuth_step), span, chord)
 }
 
+/// Distance from `p` to the segment `a`-`b`.
+fn off_segment(p: &Point3, a: &Point3, b: &Point3) -> f64 {
+    let ab = b - a;
+    let t = if ab.norm_squared() > 0.0 { ((p - a).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0) } else { 0.0 };
+    (p - (a + ab * t)).norm()
+}
+
 /// `pairs` without the pairs inside a stretch of vertical axes that their
 /// neighbours make redundant: one is dropped when it, the pairs on either
 /// side and the last pair kept all have the axis +Z, the next pair's guide
@@ -567,11 +636,7 @@ pub fn thin_vertical(pairs: Vec<SyncPoint>, span: f64, chord: f64) -> Vec<SyncPo
         return pairs;
     }
     let vertical = |s: &SyncPoint| s.axis.angle(&Vec3::z()) <= tol::ANGLE_EPS;
-    let off = |p: &Point3, a: &Point3, b: &Point3| {
-        let ab = b - a;
-        let t = if ab.norm_squared() > 0.0 { ((p - a).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0) } else { 0.0 };
-        (p - (a + ab * t)).norm()
-    };
+    let off = off_segment;
     let mut out: Vec<SyncPoint> = Vec::with_capacity(n);
     out.push(pairs[0]);
     let mut last_at = 0;
@@ -589,6 +654,213 @@ pub fn thin_vertical(pairs: Vec<SyncPoint>, span: f64, chord: f64) -> Vec<SyncPo
         }
     }
     out.push(pairs[n - 1]);
+    out
+}
+
+/// `pairs` of a pass in long blocks where vertical, their corners rounded
+/// ([`Rough5Settings::round_corners`]); `outer` for a limit pass.
+fn rounded(pairs: Vec<SyncPoint>, outer: bool, settings: &Rough5Settings) -> Vec<SyncPoint> {
+    let g = &settings.guides;
+    let span = tol::THIN_SPAN_STEPS * settings.step;
+    let chord = tol::THIN_CHORD_ALLOWANCES * g.flank_allowance;
+    let radius = if outer || g.radial_step > g.tool_radius { 0.0 } else { tol::CORNER_FILLET_RADII * g.tool_radius };
+    round_corners(thin_vertical(pairs, span, chord), radius, chord, tol::CORNER_LINK_STEPS * settings.step)
+}
+
+/// A corner of a pass found by [`round_corners`]: the pairs `first..=last`
+/// turn it, by `turn` (rad, positive to the left) in all.
+struct Corner {
+    first: usize,
+    last: usize,
+    turn: f64,
+}
+
+/// The fillet that replaces a corner: from `from` to `to` (positions along
+/// the pass, mm), the arc of centre `centre` and radius `radius` from
+/// `start` (a unit vector from the centre) turning by `turn`.
+struct Fillet {
+    from: f64,
+    to: f64,
+    centre: [f64; 2],
+    radius: f64,
+    start: f64,
+    turn: f64,
+}
+
+/// `pairs` with the corners of their vertical stretches rounded (docs/rough5.md,
+/// "Corners and blocks"). A corner is a run of pairs that turn, in plan, by more
+/// than [`tol::CORNER_TURN_NOISE`] each to the same side, at most `link` mm apart,
+/// one of them by more than the arc chords' turn ([`tol::FILLET_TURN_SHARE`] of the
+/// time model's smooth junction). It is replaced by the circular fillet tangent to
+/// the stretch that comes to it and the one that leaves it, in chords that turn by
+/// at most that much each: a convex corner (to the left, the side the pass keeps
+/// its inside on) of at most [`tol::CORNER_FILLET_MAX_TURN`] with a radius up to
+/// `convex_radius`, every other corner only where the fillet passes within `chord`
+/// of the pairs it replaces (the polygon of a curve traced on a voxel field
+/// refitted as the arc it stands for). The fillet never reaches past half the way
+/// to the next corner, nor past the first or last pair, and every pair it replaces
+/// or stands between is vertical. The fillet's pairs have the axis +Z and the
+/// guide point's height interpolated along the fillet; their level normal and tilt
+/// point are those of the nearest pair replaced.
+#[must_use]
+pub fn round_corners(pairs: Vec<SyncPoint>, convex_radius: f64, chord: f64, link: f64) -> Vec<SyncPoint> {
+    let n = pairs.len();
+    if n < 3 {
+        return pairs;
+    }
+    let xy = |i: usize| [pairs[i].path.x, pairs[i].path.y];
+    let sub = |a: [f64; 2], b: [f64; 2]| [a[0] - b[0], a[1] - b[1]];
+    let norm = |v: [f64; 2]| v[0].hypot(v[1]);
+    let turn_of = |a: [f64; 2], b: [f64; 2]| (a[0] * b[1] - a[1] * b[0]).atan2(a[0] * b[0] + a[1] * b[1]);
+    let mut at = vec![0.0; n];
+    for i in 1..n {
+        at[i] = at[i - 1] + norm(sub(xy(i), xy(i - 1)));
+    }
+    let turns: Vec<f64> = (0..n)
+        .map(|i| {
+            if i == 0 || i == n - 1 {
+                return 0.0;
+            }
+            let (a, b) = (sub(xy(i), xy(i - 1)), sub(xy(i + 1), xy(i)));
+            if norm(a) < tol::ANGLE_EPS.sqrt() || norm(b) < tol::ANGLE_EPS.sqrt() { 0.0 } else { turn_of(a, b) }
+        })
+        .collect();
+    let chord_turn = tol::FILLET_TURN_SHARE * scallop_geom::tol::machine::SMOOTH_JUNCTION;
+    let mut corners: Vec<Corner> = Vec::new();
+    let mut i = 1;
+    while i + 1 < n {
+        if turns[i].abs() <= tol::CORNER_TURN_NOISE {
+            i += 1;
+            continue;
+        }
+        let first = i;
+        while i + 2 < n
+            && turns[i + 1].abs() > tol::CORNER_TURN_NOISE
+            && turns[i + 1].signum() == turns[first].signum()
+            && at[i + 1] - at[i] <= link
+        {
+            i += 1;
+        }
+        if (first..=i).any(|k| turns[k].abs() > chord_turn) {
+            corners.push(Corner { first, last: i, turn: turns[first..=i].iter().sum() });
+        }
+        i += 1;
+    }
+    let vertical = |k: usize| pairs[k].axis.angle(&Vec3::z()) <= tol::ANGLE_EPS;
+    let mut fillets: Vec<Fillet> = Vec::new();
+    for (c, corner) in corners.iter().enumerate() {
+        let (s, e, turn) = (corner.first, corner.last, corner.turn);
+        if turn.abs() >= std::f64::consts::PI * 0.95 {
+            continue;
+        }
+        let unit = |v: [f64; 2]| {
+            let l = norm(v);
+            [v[0] / l, v[1] / l]
+        };
+        let (d_in, d_out) = (unit(sub(xy(s), xy(s - 1))), unit(sub(xy(e + 1), xy(e))));
+        // The corner point V: xy(s) + u d_in = xy(e) - w d_out.
+        let det = d_in[0] * d_out[1] - d_in[1] * d_out[0];
+        if det.abs() < tol::ANGLE_EPS.sqrt() {
+            continue;
+        }
+        let r = sub(xy(e), xy(s));
+        let u = (r[0] * d_out[1] - r[1] * d_out[0]) / det;
+        let w = (d_in[0] * r[1] - d_in[1] * r[0]) / det;
+        if u < -chord || w < -chord {
+            continue;
+        }
+        let (u, w) = (u.max(0.0), w.max(0.0));
+        let corner_at = [xy(s)[0] + u * d_in[0], xy(s)[1] + u * d_in[1]];
+        // Room before and after: half the way to the neighbouring corners.
+        let before = if c > 0 { (at[s] - at[corners[c - 1].last]) / 2.0 } else { at[s] * 0.999 };
+        let after =
+            if c + 1 < corners.len() { (at[corners[c + 1].first] - at[e]) / 2.0 } else { (at[n - 1] - at[e]) * 0.999 };
+        let room = (u + before).min(w + after);
+        let half = turn.abs() / 2.0;
+        let need = u.max(w);
+        let convex = convex_radius > 0.0 && turn > 0.0 && turn.abs() <= tol::CORNER_FILLET_MAX_TURN;
+        let fillet_of = |t: f64| {
+            let radius = t / half.tan();
+            let side = turn.signum();
+            let t1 = [corner_at[0] - t * d_in[0], corner_at[1] - t * d_in[1]];
+            let centre = [t1[0] - side * d_in[1] * radius, t1[1] + side * d_in[0] * radius];
+            let start = (t1[1] - centre[1]).atan2(t1[0] - centre[0]);
+            Fillet { from: at[s] - (t - u), to: at[e] + (t - w), centre, radius, start, turn }
+        };
+        let deviation = |f: &Fillet| {
+            (0..n)
+                .filter(|&k| at[k] > f.from && at[k] < f.to)
+                .map(|k| (norm(sub(xy(k), f.centre)) - f.radius).abs())
+                .fold(0.0, f64::max)
+        };
+        // The largest fillet within the room, the radius and the deviation allowed.
+        let mut t = if convex { room.min(convex_radius * half.tan()) } else { room };
+        let mut found = None;
+        while t >= need && t > 0.0 {
+            let f = fillet_of(t);
+            if convex || deviation(&f) <= chord {
+                found = Some(f);
+                break;
+            }
+            t *= 0.8;
+        }
+        let Some(f) = found else { continue };
+        if f.radius <= 0.0 || !f.radius.is_finite() {
+            continue;
+        }
+        // Every pair from the one before the fillet to the one after it is vertical.
+        let lo = at.partition_point(|&a| a <= f.from).saturating_sub(1);
+        let hi = at.partition_point(|&a| a < f.to).min(n - 1);
+        if (lo..=hi).all(vertical) {
+            fillets.push(f);
+        }
+    }
+    if fillets.is_empty() {
+        return pairs;
+    }
+    let mut out = Vec::with_capacity(n + 16 * fillets.len());
+    let mut next = fillets.iter().peekable();
+    let mut k = 0;
+    while k < n {
+        let Some(f) = next.peek() else {
+            out.push(pairs[k]);
+            k += 1;
+            continue;
+        };
+        if at[k] < f.from {
+            out.push(pairs[k]);
+            k += 1;
+            continue;
+        }
+        // The height along the pass at a position: linear between the pairs.
+        let height = |pos: f64| {
+            let j = at.partition_point(|&a| a < pos).clamp(1, n - 1);
+            let span = at[j] - at[j - 1];
+            let w = if span > 0.0 { (pos - at[j - 1]) / span } else { 0.0 };
+            pairs[j - 1].path.z + (pairs[j].path.z - pairs[j - 1].path.z) * w.clamp(0.0, 1.0)
+        };
+        let (z0, z1) = (height(f.from), height(f.to));
+        let chords = (f.turn.abs() / chord_turn).ceil().max(1.0) as usize;
+        let side = f.turn.signum();
+        let (before, after) = (pairs[k.saturating_sub(1)], pairs[at.partition_point(|&a| a <= f.to).min(n - 1)]);
+        for q in 0..=chords {
+            let w = q as f64 / chords as f64;
+            let a = f.start + f.turn * w;
+            let path =
+                Point3::new(f.centre[0] + f.radius * a.cos(), f.centre[1] + f.radius * a.sin(), z0 + (z1 - z0) * w);
+            let tangent = Vec3::new(-side * a.sin(), side * a.cos(), 0.0);
+            let near = if w < 0.5 { before } else { after };
+            // (A fillet starting on a kept pair's guide point does not repeat it.)
+            if q == 0 && out.last().is_some_and(|l: &SyncPoint| (l.path - path).xy().norm() < tol::FILLET_MERGE) {
+                continue;
+            }
+            out.push(SyncPoint { path, tangent, axis: Vec3::z(), ..near });
+        }
+        while k < n && (at[k] <= f.to || (at[k] - f.to < tol::FILLET_MERGE && k + 1 < n)) {
+            k += 1;
+        }
+        next.next();
+    }
     out
 }
 
@@ -1118,6 +1390,16 @@ impl Emitter {
                 return false;
             }
             moves.push(p);
+        }
+        // A vertical link within the thinning's chord of its chord is one block.
+        let chord = tol::THIN_CHORD_ALLOWANCES * s.guides.flank_allowance;
+        let straight = s.round_corners
+            && moves.iter().all(|p| p.axis.angle(&Vec3::z()) <= tol::ANGLE_EPS)
+            && moves
+                .last()
+                .is_some_and(|end| moves.iter().all(|p| off_segment(&p.tip, &a.place.tip, &end.tip) <= chord));
+        if straight {
+            moves.drain(..moves.len() - 1);
         }
         for p in turn {
             self.push(MoveKind::Feed, p.tip, p.axis);

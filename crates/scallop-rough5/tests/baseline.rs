@@ -6,6 +6,8 @@
 //! program removes; the setups are chosen by the undercuts.
 #![allow(clippy::unwrap_used, reason = "tests: a panic is the failure report")]
 
+mod common;
+
 use scallop_cutter::{Cutter, CutterShape, HolderSegment};
 use scallop_geom::Vec3;
 use scallop_parts::{FaceTag, PocketParams, TestPart, closed_pocket};
@@ -30,12 +32,7 @@ fn settings() -> BaselineSettings {
 }
 
 fn tool() -> Cutter {
-    Cutter::new(CutterShape::Bull { radius: 5.0, corner: 1.5 }, 30.0)
-        .unwrap()
-        .with_shank(5.0, 11.0)
-        .unwrap()
-        .with_holder(vec![HolderSegment { length: 100.0, bottom_radius: 13.5, top_radius: 13.5 }])
-        .unwrap()
+    common::torus(30.0, 100.0)
 }
 
 struct Faces {

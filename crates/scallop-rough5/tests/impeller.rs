@@ -7,30 +7,21 @@
 //! hub alone, and the whole program is proven from the channel's blank.
 #![allow(clippy::unwrap_used, reason = "tests: a panic is the failure report")]
 
+mod common;
+
 use proptest::prelude::*;
-use scallop_cutter::{Cutter, CutterShape, HolderSegment};
+use scallop_cutter::Cutter;
 use scallop_geom::{Point3, Vec3};
-use scallop_guides::GuideSettings;
 use scallop_mesh::TriMesh;
 use scallop_parts::{FaceTag, ImpellerParams, impeller_channel};
 use scallop_rough5::{
-    BodyCheck, LevelOptions, ProofSettings, Rough5Settings, TiltMode, level_passes_with, plan_rough5_in,
-    prove_from_blank,
+    BodyCheck, LevelOptions, ProofSettings, TiltMode, level_passes_with, plan_rough5_in, prove_from_blank,
 };
 
 /// The default tool of `scallop rough5`: torus R 5 r 1.5, 30 mm flutes, 41 mm
 /// stick-out, holder 27 x 192 mm.
 fn tool() -> Cutter {
-    Cutter::new(CutterShape::Bull { radius: 5.0, corner: 1.5 }, 30.0)
-        .unwrap()
-        .with_shank(5.0, 11.0)
-        .unwrap()
-        .with_holder(vec![HolderSegment { length: 192.0, bottom_radius: 13.5, top_radius: 13.5 }])
-        .unwrap()
-}
-
-fn guides(depth: f64) -> GuideSettings {
-    GuideSettings { tool_radius: 5.0, flank_allowance: 0.5, axial_step: 4.0, radial_step: 4.5, voxel: 1.0, depth }
+    common::torus(30.0, 192.0)
 }
 
 const ALL: LevelOptions = LevelOptions { centre_offsets: true, pair_by_rank: true, open_bottom: true };
@@ -44,7 +35,7 @@ fn the_impeller_levels_reach_its_inlet() {
     let bottom = part.faces(&[FaceTag::Bottom]).unwrap();
     let flanks = part.faces(&[FaceTag::Flank]).unwrap();
     let depth = part.stock.max.z - bottom.bounds().min.z;
-    let levels = level_passes_with(&bottom, &flanks, &guides(depth), TiltMode::Guides, &ALL).unwrap();
+    let levels = level_passes_with(&bottom, &flanks, &common::guides(depth), TiltMode::Guides, &ALL).unwrap();
     let mut checked = 0;
     for level in levels.iter().filter(|l| (8.0..=20.0).contains(&l.distance)) {
         let inner = level
@@ -70,7 +61,7 @@ fn the_impeller_hub_level_leans_towards_the_first_level_of_the_hub() {
     let bottom = part.faces(&[FaceTag::Bottom]).unwrap();
     let flanks = part.faces(&[FaceTag::Flank]).unwrap();
     let depth = part.stock.max.z - bottom.bounds().min.z;
-    let levels = level_passes_with(&bottom, &flanks, &guides(depth), TiltMode::Guides, &ALL).unwrap();
+    let levels = level_passes_with(&bottom, &flanks, &common::guides(depth), TiltMode::Guides, &ALL).unwrap();
     let hub = &levels[0];
     assert!(hub.distance.abs() < 1e-12, "level 0 at {} mm", hub.distance);
     let tilts: Vec<f64> = hub
@@ -136,26 +127,7 @@ fn the_impeller_program_is_proven_from_its_blank() {
     let bottom = part.faces(&[FaceTag::Bottom]).unwrap();
     let flanks = part.faces(&[FaceTag::Flank]).unwrap();
     let depth = part.stock.max.z - bottom.bounds().min.z;
-    let settings = Rough5Settings {
-        tilt: TiltMode::Guides,
-        guides: guides(depth),
-        bottom_allowance: 0.5,
-        step: 1.0,
-        max_angle_step: 2f64.to_radians(),
-        max_azimuth_step: 5f64.to_radians(),
-        ramp_angle: 5f64.to_radians(),
-        clearance: 1.0,
-        link_max: 9.0,
-        feed: 2400.0,
-        rapid_rate: 20_000.0,
-        orientation: None,
-        correct: false,
-        levels: ALL,
-        vertical_inside: true,
-        vertical_thin_steps: true,
-        translate: true,
-        local_entry: true,
-    };
+    let settings = common::settings(depth);
     let blank = part.blank.as_ref();
     let plan = plan_rough5_in(&bottom, &flanks, (&part.stock, blank), &tool(), &settings, &|_, _| {}).unwrap();
     let proof_settings = ProofSettings { resolution: 0.5, axis_tolerance: 0.05 };

@@ -7,53 +7,16 @@
 //! neighbours make redundant within a span and a chord.
 #![allow(clippy::unwrap_used, reason = "tests: a panic is the failure report")]
 
+mod common;
+
 use proptest::prelude::*;
-use scallop_cutter::{Cutter, CutterShape, HolderSegment};
 use scallop_geom::{Point3, Vec3};
-use scallop_guides::GuideSettings;
 use scallop_parts::{FaceTag, PocketParams, closed_pocket};
-use scallop_rough5::{
-    LevelOptions, ProofSettings, Rough5Settings, SyncPoint, TiltMode, limit_step, plan_rough5, prove, thin_vertical,
-};
+use scallop_rough5::{ProofSettings, Rough5Settings, SyncPoint, limit_step, plan_rough5, prove, thin_vertical};
 use scallop_toolpath::MoveKind;
 
-fn tool() -> Cutter {
-    Cutter::new(CutterShape::Bull { radius: 5.0, corner: 1.5 }, 20.0)
-        .unwrap()
-        .with_shank(5.0, 11.0)
-        .unwrap()
-        .with_holder(vec![HolderSegment { length: 100.0, bottom_radius: 13.5, top_radius: 13.5 }])
-        .unwrap()
-}
-
 fn settings(depth: f64, thin_steps: bool) -> Rough5Settings {
-    Rough5Settings {
-        tilt: TiltMode::Guides,
-        guides: GuideSettings {
-            tool_radius: 5.0,
-            flank_allowance: 0.5,
-            axial_step: 4.0,
-            radial_step: 4.5,
-            voxel: 1.0,
-            depth,
-        },
-        bottom_allowance: 0.5,
-        step: 1.0,
-        max_angle_step: 2f64.to_radians(),
-        max_azimuth_step: 5f64.to_radians(),
-        ramp_angle: 5f64.to_radians(),
-        clearance: 1.0,
-        link_max: 9.0,
-        feed: 2400.0,
-        rapid_rate: 20_000.0,
-        orientation: None,
-        correct: false,
-        levels: LevelOptions { centre_offsets: true, pair_by_rank: true, open_bottom: true },
-        vertical_inside: true,
-        vertical_thin_steps: thin_steps,
-        translate: true,
-        local_entry: true,
-    }
+    Rough5Settings { vertical_thin_steps: thin_steps, ..common::settings(depth) }
 }
 
 /// A 60 x 60 x 20 mm block with a closed pocket whose four walls have the
@@ -79,7 +42,7 @@ fn largest_tilt_and_proof(part: &scallop_parts::TestPart, thin_steps: bool) -> (
     let bottom = part.faces(&[FaceTag::Bottom]).unwrap();
     let flanks = part.faces(&[FaceTag::Flank]).unwrap();
     let depth = part.stock.max.z - bottom.bounds().min.z;
-    let tool = tool();
+    let tool = common::torus(20.0, 100.0);
     let plan = plan_rough5(&bottom, &flanks, &part.stock, &tool, &settings(depth, thin_steps), &|_, _| {}).unwrap();
     let path = &plan.toolpath;
     let tilt = (0..path.moves().len())

@@ -7,41 +7,23 @@
 //! the volume to remove beyond the rays' rounding).
 #![allow(clippy::unwrap_used, reason = "tests: a panic is the failure report")]
 
-use scallop_cutter::{Cutter, CutterShape, HolderSegment};
+mod common;
+
 use scallop_guides::GuideSettings;
 use scallop_parts::{FaceTag, closed_pocket};
-use scallop_rough5::{
-    LevelOptions, OrientSettings, ProofSettings, Rough5Settings, TiltMode, Weights, plan_rough5, prove,
-};
+use scallop_rough5::{OrientSettings, ProofSettings, Rough5Settings, TiltMode, Weights, plan_rough5, prove};
 use scallop_toolpath::MoveKind;
 
+/// The slice without the refinements, coarser: a_p 6 mm, voxel 1.5 mm, CL
+/// points every 2 mm, angular steps of 3 and 10 deg.
 fn settings(tilt: TiltMode, depth: f64) -> Rough5Settings {
     Rough5Settings {
         tilt,
-        guides: GuideSettings {
-            tool_radius: 5.0,
-            flank_allowance: 0.5,
-            axial_step: 6.0,
-            radial_step: 4.5,
-            voxel: 1.5,
-            depth,
-        },
-        bottom_allowance: 0.5,
+        guides: GuideSettings { axial_step: 6.0, voxel: 1.5, ..common::guides(depth) },
         step: 2.0,
         max_angle_step: 3f64.to_radians(),
         max_azimuth_step: 10f64.to_radians(),
-        ramp_angle: 5f64.to_radians(),
-        clearance: 1.0,
-        link_max: 9.0,
-        feed: 2400.0,
-        rapid_rate: 20_000.0,
-        orientation: None,
-        correct: false,
-        levels: LevelOptions::default(),
-        vertical_inside: false,
-        vertical_thin_steps: false,
-        translate: false,
-        local_entry: false,
+        ..common::settings(depth).with_refinements(false)
     }
 }
 
@@ -50,12 +32,7 @@ fn every_variant_proves_itself_on_the_closed_pocket() {
     let part = closed_pocket(&Default::default()).unwrap();
     let bottom = part.faces(&[FaceTag::Bottom]).unwrap();
     let flanks = part.faces(&[FaceTag::Flank]).unwrap();
-    let tool = Cutter::new(CutterShape::Bull { radius: 5.0, corner: 1.5 }, 30.0)
-        .unwrap()
-        .with_shank(5.0, 11.0)
-        .unwrap()
-        .with_holder(vec![HolderSegment { length: 100.0, bottom_radius: 13.5, top_radius: 13.5 }])
-        .unwrap();
+    let tool = common::torus(30.0, 100.0);
     let depth = part.stock.max.z - bottom.bounds().min.z;
     let mut remaining = Vec::new();
     // The optimised orientation: the thesis's mixed weighting (Ch. 3 §2.3, case 2).

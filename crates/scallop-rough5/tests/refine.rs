@@ -9,10 +9,11 @@
 //! island wider than the tool inside the innermost pass.
 #![allow(clippy::unwrap_used, reason = "tests: a panic is the failure report")]
 
+mod common;
+
 use proptest::prelude::*;
-use scallop_cutter::{Cutter, CutterShape, HolderSegment};
+use scallop_cutter::Cutter;
 use scallop_geom::{Point3, Vec3};
-use scallop_guides::GuideSettings;
 use scallop_mesh::TriMesh;
 use scallop_parts::{FaceTag, PocketParams, closed_pocket};
 use scallop_rough5::{
@@ -22,12 +23,7 @@ use scallop_rough5::{
 use scallop_toolpath::MoveKind;
 
 fn tool() -> Cutter {
-    Cutter::new(CutterShape::Bull { radius: 5.0, corner: 1.5 }, 20.0)
-        .unwrap()
-        .with_shank(5.0, 11.0)
-        .unwrap()
-        .with_holder(vec![HolderSegment { length: 100.0, bottom_radius: 13.5, top_radius: 13.5 }])
-        .unwrap()
+    common::torus(20.0, 100.0)
 }
 
 /// The wall through the origin with unit normal `n` (horizontal part along
@@ -72,33 +68,7 @@ proptest! {
 }
 
 fn settings(depth: f64, refined: bool) -> Rough5Settings {
-    Rough5Settings {
-        tilt: TiltMode::Guides,
-        guides: GuideSettings {
-            tool_radius: 5.0,
-            flank_allowance: 0.5,
-            axial_step: 4.0,
-            radial_step: 4.5,
-            voxel: 1.0,
-            depth,
-        },
-        bottom_allowance: 0.5,
-        step: 1.0,
-        max_angle_step: 2f64.to_radians(),
-        max_azimuth_step: 5f64.to_radians(),
-        ramp_angle: 5f64.to_radians(),
-        clearance: 1.0,
-        link_max: 9.0,
-        feed: 2400.0,
-        rapid_rate: 20_000.0,
-        orientation: None,
-        correct: false,
-        levels: LevelOptions { centre_offsets: refined, pair_by_rank: refined, open_bottom: refined },
-        vertical_inside: refined,
-        vertical_thin_steps: refined,
-        translate: refined,
-        local_entry: refined,
-    }
+    common::settings(depth).with_refinements(refined)
 }
 
 /// A 60 x 60 x 20 mm block with the closed pocket's drafts and undercuts.

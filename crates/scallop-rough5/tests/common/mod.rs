@@ -1,0 +1,32 @@
+//! The tool and the settings the rough5 tests share: each test states only
+//! what it changes.
+
+#![allow(dead_code, clippy::unwrap_used, reason = "shared by several test files; a panic is the failure report")]
+
+use scallop_cutter::{Cutter, CutterShape, HolderSegment};
+use scallop_guides::GuideSettings;
+use scallop_rough5::Rough5Settings;
+
+/// The torus R 5 r 1.5 of the thesis's pocket (spec 9) with `flutes` mm of
+/// flutes, a shank R 5 of 11 mm and a cylindrical holder R 13.5 of
+/// `holder` mm.
+pub fn torus(flutes: f64, holder: f64) -> Cutter {
+    Cutter::new(CutterShape::Bull { radius: 5.0, corner: 1.5 }, flutes)
+        .unwrap()
+        .with_shank(5.0, 11.0)
+        .unwrap()
+        .with_holder(vec![HolderSegment { length: holder, bottom_radius: 13.5, top_radius: 13.5 }])
+        .unwrap()
+}
+
+/// The levels and curves of the torus R 5 on a pocket `depth` mm deep:
+/// 0.5 mm flank allowance, a_p 4 mm, a_e 4.5 mm, voxel 1 mm.
+pub fn guides(depth: f64) -> GuideSettings {
+    GuideSettings { tool_radius: 5.0, flank_allowance: 0.5, axial_step: 4.0, radial_step: 4.5, voxel: 1.0, depth }
+}
+
+/// The settings of `scallop rough5` at 2400 mm/min on a pocket `depth` mm
+/// deep ([`Rough5Settings::new`]).
+pub fn settings(depth: f64) -> Rough5Settings {
+    Rough5Settings::new(guides(depth), 2400.0)
+}
