@@ -82,7 +82,7 @@ pub use scallop_geom::tol::waterline as tol;
 use std::sync::{Arc, OnceLock};
 
 use rayon::prelude::*;
-use scallop_cutter::{ClPoint, Contact, Cutter, CutterShape, drop_cutter, drop_patch, drop_triangle};
+use scallop_cutter::{ClPoint, Contact, Cutter, CutterShape, drop_grid, drop_patch, drop_triangle};
 use scallop_geom::{Point2, predicates::orient2d};
 use scallop_mesh::MeshIndex;
 
@@ -514,30 +514,28 @@ impl<'a> WaterlineGrid<'a> {
             return;
         };
         self.margin = tol::REL_BLOCK_MARGIN * scale;
-        let done = std::sync::atomic::AtomicUsize::new(0);
         let (bx, by, ny, floor, index) = (self.bx, self.by, self.ny, self.floor, self.index);
         let first = self.point(0, 0);
-        self.bounds = (0..bx * by)
-            .into_par_iter()
-            .with_min_len(16)
-            .map(|b| {
-                #[allow(clippy::cast_precision_loss)]
-                let c = Point2::new(
-                    first.x + (b % bx) as f64 * 2.0 * half + half,
-                    first.y + (b / bx) as f64 * 2.0 * half + half,
-                );
-                let lower = lows
-                    .iter()
-                    .map(|(l, offset)| drop_cutter(l, index, c, floor).tip.z - offset)
-                    .fold(f64::NEG_INFINITY, f64::max);
-                let upper = drop_cutter(&high, index, c, floor).tip.z + high_offset;
-                if b % bx == bx - 1 {
-                    let rows = (done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1) * block;
-                    progress(rows.min(ny), ny);
-                }
-                [lower, upper]
-            })
-            .collect();
+        // The block centres, a grid: each bounding cutter dropped on it by
+        // `drop_grid` (candidate lists shared along rows; the heights of
+        // `drop_cutter` bit for bit).
+        #[allow(clippy::cast_precision_loss)]
+        let xs: Vec<f64> = (0..bx).map(|i| first.x + i as f64 * 2.0 * half + half).collect();
+        #[allow(clippy::cast_precision_loss)]
+        let ys: Vec<f64> = (0..by).map(|j| first.y + j as f64 * 2.0 * half + half).collect();
+        let mut bounds = vec![[f64::NEG_INFINITY, f64::NEG_INFINITY]; bx * by];
+        for (l, offset) in &lows {
+            let cl = drop_grid(l, index, &xs, &ys, floor, &|_| {});
+            for (b, c) in bounds.iter_mut().zip(&cl) {
+                b[0] = b[0].max(c.tip.z - offset);
+            }
+        }
+        let rows = |done: usize| progress((done * block).min(ny), ny);
+        let cl = drop_grid(&high, index, &xs, &ys, floor, &rows);
+        for (b, c) in bounds.iter_mut().zip(&cl) {
+            b[1] = c.tip.z + high_offset;
+        }
+        self.bounds = bounds;
     }
 
     /// The side of every block at height `z`, with the samples (and the

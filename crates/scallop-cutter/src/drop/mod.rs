@@ -583,11 +583,15 @@ fn drop_candidates(
     let mut best_slot = None;
     let slack = index.slack();
     let r2 = profile.radius * profile.radius;
-    // The seed is tested whole unless the bounds of the scan below show it
+    // The seed is tested first unless the bounds of the scan below show it
     // cannot rise above the floor (a floor at the level, where only the side
-    // is wanted, and the seed out of reach).
+    // is wanted, and the seed out of reach); its own corners and edges only,
+    // as the scan tests every candidate: an edge it shares with a neighbour
+    // that owns it is tested there (unless the neighbour's bound shows it
+    // cannot rise above the best), not twice.
     if let Some(slot) = seed.filter(|&slot| !out_of_reach(profile, index, slot, xy, best.tip.z)) {
-        drop_triangle_profile(profile, index.corners(slot), index.normal(slot), index.original_index(slot), &mut best);
+        let (corners, normal, triangle) = (index.corners(slot), index.normal(slot), index.original_index(slot));
+        drop_features(profile, corners, normal, triangle, index.owned_features(slot), &mut best);
         if !matches!(best.contact, Contact::Floor) {
             best_slot = Some(slot);
         }
@@ -598,7 +602,7 @@ fn drop_candidates(
             break; // sorted: nothing after this can rise above the best
         }
         if seed == Some(c.slot) {
-            continue; // already tested whole, every corner and edge
+            continue; // already tested (its own corners and edges)
         }
         let dx = (c.min[0] - xy.x).max(0.0).max(xy.x - c.max[0]);
         let dy = (c.min[1] - xy.y).max(0.0).max(xy.y - c.max[1]);
