@@ -9,7 +9,7 @@ mod common;
 
 use proptest::prelude::*;
 use scallop_geom::{Point3, Vec3};
-use scallop_parts::{FaceTag, PocketParams, closed_pocket};
+use scallop_parts::{PocketParams, closed_pocket};
 use scallop_rough5::{Rough5Settings, SyncPoint, plan_rough5, round_corners, tol};
 use scallop_toolpath::MoveKind;
 
@@ -130,18 +130,8 @@ proptest! {
 /// in pieces, and the program is the same but for those links.
 #[test]
 fn straight_vertical_links_are_one_block() {
-    let part = closed_pocket(&PocketParams {
-        stock: [60.0, 60.0, 20.0],
-        bottom_z: 6.0,
-        wall: 8.0,
-        corner_radius: 6.0,
-        dome: 1.0,
-        ..Default::default()
-    })
-    .unwrap();
-    let bottom = part.faces(&[FaceTag::Bottom]).unwrap();
-    let flanks = part.faces(&[FaceTag::Flank]).unwrap();
-    let depth = part.stock.max.z - bottom.bounds().min.z;
+    let part = closed_pocket(&PocketParams { dome: 1.0, ..common::small_pocket(20.0, 6.0) }).unwrap();
+    let (bottom, flanks, depth) = common::bottom_flanks(&part);
     let tool = common::torus(20.0, 100.0);
     let s = common::settings(depth);
     let chord = tol::THIN_CHORD_ALLOWANCES * s.guides.flank_allowance;

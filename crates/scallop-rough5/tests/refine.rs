@@ -275,20 +275,10 @@ fn the_tool_goes_rapid_over_the_blank() {
 /// side. The program is proven.
 #[test]
 fn a_run_is_entered_from_the_level_above_where_it_starts() {
-    let part = closed_pocket(&PocketParams {
-        stock: [60.0, 60.0, 24.0],
-        bottom_z: 8.0,
-        wall: 8.0,
-        corner_radius: 6.0,
-        walls: [0.0; 4],
-        tilt: 0.2,
-        dome: 0.0,
-        ..Default::default()
-    })
-    .unwrap();
-    let bottom = part.faces(&[FaceTag::Bottom]).unwrap();
-    let flanks = part.faces(&[FaceTag::Flank]).unwrap();
-    let depth = part.stock.max.z - bottom.bounds().min.z;
+    let part =
+        closed_pocket(&PocketParams { walls: [0.0; 4], tilt: 0.2, dome: 0.0, ..common::small_pocket(24.0, 8.0) })
+            .unwrap();
+    let (bottom, flanks, depth) = common::bottom_flanks(&part);
     let (tool, s) = (tool(), Rough5Settings { tilt: TiltMode::Zero, ..settings(depth, true) });
     let plan = plan_rough5(&bottom, &flanks, &part.stock, &tool, &s, &|_, _| {}).unwrap();
     let moves = plan.toolpath.moves();

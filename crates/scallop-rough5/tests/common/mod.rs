@@ -5,6 +5,8 @@
 
 use scallop_cutter::{Cutter, CutterShape, HolderSegment};
 use scallop_guides::GuideSettings;
+use scallop_mesh::TriMesh;
+use scallop_parts::{FaceTag, PocketParams, TestPart};
 use scallop_rough5::Rough5Settings;
 
 /// The torus R 5 r 1.5 of the thesis's pocket (spec 9) with `flutes` mm of
@@ -29,4 +31,20 @@ pub fn guides(depth: f64) -> GuideSettings {
 /// deep ([`Rough5Settings::new`]).
 pub fn settings(depth: f64) -> Rough5Settings {
     Rough5Settings::new(guides(depth), 2400.0)
+}
+
+/// A test part's bottom and flanks, and its depth: the stock's top over
+/// the bottom's lowest point.
+pub fn bottom_flanks(part: &TestPart) -> (TriMesh, TriMesh, f64) {
+    let bottom = part.faces(&[FaceTag::Bottom]).unwrap();
+    let flanks = part.faces(&[FaceTag::Flank]).unwrap();
+    let depth = part.stock.max.z - bottom.bounds().min.z;
+    (bottom, flanks, depth)
+}
+
+/// A closed pocket in a 60 x 60 mm block `height` mm high, its bottom at
+/// `bottom_z`, walls 8 mm thick, corners of radius 6 mm; the rest as
+/// [`PocketParams::default`].
+pub fn small_pocket(height: f64, bottom_z: f64) -> PocketParams {
+    PocketParams { stock: [60.0, 60.0, height], bottom_z, wall: 8.0, corner_radius: 6.0, ..Default::default() }
 }
