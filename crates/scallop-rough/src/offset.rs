@@ -86,10 +86,6 @@ pub fn plan_offset_in(
         levels.push(next);
     }
     let grow = 2.0 * ae + tol::LINK_MARGIN_SHARE * ae;
-    // The band of each level, computed when a link first needs it.
-    let bands: Vec<std::cell::OnceCell<Option<Region>>> =
-        (0..levels.len()).map(|_| std::cell::OnceCell::new()).collect();
-    let band_of = |k: usize| bands[k].get_or_init(|| levels.get(k + 1).map(|inner| inner.offset(-grow)));
     // The passes of level 0 lie on the region's contour: grown a hair, the
     // region holds them.
     let holder = region.offset(-tol::LINK_GROW);
@@ -257,10 +253,11 @@ pub fn plan_offset_in(
         let mut pieces = std::mem::take(&mut wall_pieces[k]);
         // A band may reach past the region: it is kept inside. It holds
         // when every deeper ring is cut (the open side's are).
+        // Computed when a link that is not short first needs it.
         let safe = std::cell::OnceCell::new();
         let safe = || {
             safe.get_or_init(|| {
-                let band = band_of(k).as_ref().map(|b| b.intersection(&holder, tol_c));
+                let band = levels.get(k + 1).map(|inner| inner.offset(-grow).intersection(&holder, tol_c));
                 match (band, &air) {
                     (Some(band), Some(air)) => Some(band.union(air, tol_c)),
                     (Some(band), None) => Some(band),
