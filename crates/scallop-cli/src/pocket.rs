@@ -24,6 +24,8 @@ use crate::{CliResult, Failure};
 pub enum PatternArg {
     /// Contour-parallel offsets, inside-out, then the wall contour.
     Offset,
+    /// Contour-parallel offsets with loops where a ring would cut a slot.
+    OffsetLoops,
     /// Engagement-controlled clearing: a front grown from the deepest point.
     Adaptive,
 }
@@ -140,6 +142,7 @@ pub fn run(args: &PocketArgs) -> CliResult<()> {
     let direction = if args.conventional { Direction::Conventional } else { Direction::Climb };
     let pattern = match args.pattern {
         PatternArg::Offset => Pattern::Offset,
+        PatternArg::OffsetLoops => Pattern::OffsetLoops,
         PatternArg::Adaptive => Pattern::Adaptive,
     };
     let options = ClearOptions {

@@ -200,6 +200,7 @@ fn rough_settings(r: &scallop_io::job::RoughingSpec) -> scallop_rough::RoughSett
         axial_allowance: r.stock_to_leave_axial.unwrap_or(r.stock_to_leave),
         pattern: match r.pattern {
             scallop_io::job::RoughPatternWord::Offset => scallop_rough::Pattern::Offset,
+            scallop_io::job::RoughPatternWord::OffsetLoops => scallop_rough::Pattern::OffsetLoops,
             scallop_io::job::RoughPatternWord::Adaptive => scallop_rough::Pattern::Adaptive,
         },
         direction: match r.direction {

@@ -826,6 +826,20 @@ pub mod rough {
     /// the first could not reach).
     pub const MAX_ENTRIES: usize = 1000;
 
+    /// Offset clearing's loops where a ring would slot (docs/roughing.md,
+    /// "Offset clearing", "Slots"): samples along a ring at most this share
+    /// of R apart (a loop's place and its look-ahead probe).
+    pub const LOOP_SAMPLE_SHARE: f64 = 0.01;
+
+    /// Most loops in one level (bounds the work on absurd inputs).
+    pub const MAX_LOOPS: usize = 2_000_000;
+
+    /// Bisections of a loop's advance (to 2 R / 2^20).
+    pub const LOOP_BISECTIONS: usize = 20;
+
+    /// Tool positions along one loop where its engagement is measured.
+    pub const LOOP_POSITIONS: usize = 180;
+
     /// Adaptive clearing: the last stretch of a link to a pass's start may
     /// engage up to this share of the target, by the grid's all-round
     /// reading.

@@ -388,7 +388,8 @@ word_enum! {
 word_enum! {
     /// `roughing.pattern`.
     RoughPatternWord { /// Contour-parallel offsets.
-        Offset = "offset", /// Engagement-controlled (adaptive) clearing.
+        Offset = "offset", /// Contour-parallel offsets, looped where a ring would slot.
+        OffsetLoops = "offset-loops", /// Engagement-controlled (adaptive) clearing.
         Adaptive = "adaptive" }
 }
 word_enum! {

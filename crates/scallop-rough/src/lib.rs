@@ -83,6 +83,10 @@ pub enum Pattern {
     /// Contour-parallel offsets at the stepover, inside-out, then the region's contour.
     #[default]
     Offset,
+    /// As `Offset`, with loops (trochoidal milling) where a ring would cut a
+    /// slot: no pass has material on both sides (docs/roughing.md, "Offset
+    /// clearing", "Slots").
+    OffsetLoops,
     /// A front grown from the deepest point with the engagement held at the
     /// stepover's angle, then the region's contour (docs/roughing.md).
     Adaptive,
@@ -112,7 +116,7 @@ pub fn plan_region_in(
     options: &ClearOptions,
 ) -> Result<Vec<Step>, RoughError> {
     match options.pattern {
-        Pattern::Offset => plan_offset_in(region, material, room, options),
+        Pattern::Offset | Pattern::OffsetLoops => plan_offset_in(region, material, room, options),
         Pattern::Adaptive => plan_adaptive_in(region, material, options),
     }
 }

@@ -20,6 +20,8 @@ use scallop_contour::{Contour, P2, Region};
 
 use crate::{ClearOptions, Direction, RoughError, tol};
 
+mod loops;
+
 /// One step of a clearing plan in the plane.
 #[derive(Debug, Clone)]
 pub enum Step {
@@ -248,9 +250,17 @@ pub fn plan_offset_in(
         pos = cut.end().or(Some(start));
         steps.push(Step::Cut(cut));
     }
-    // The walls, inside-out.
+    // The walls, inside-out. Where a ring's inner side meets material the
+    // deeper rings did not sweep (a slot), it is cut with loops.
+    let target = (1.0 - (ae / r).min(2.0)).acos();
+    let climb = matches!(options.direction, Direction::Climb);
+    let with_loops = matches!(options.pattern, crate::Pattern::OffsetLoops);
+    let mut looper = loops::Looper::new(region, None, r, climb, target, tol_c);
     for k in (0..levels.len()).rev() {
         let mut pieces = std::mem::take(&mut wall_pieces[k]);
+        if with_loops && !pieces.is_empty() {
+            looper.set_deeper(levels.get(k + 1));
+        }
         // A band may reach past the region: it is kept inside. It holds
         // when every deeper ring is cut (the open side's are).
         // Computed when a link that is not short first needs it.
@@ -269,6 +279,7 @@ pub fn plan_offset_in(
         while !pieces.is_empty() {
             let (i, cut) = nearest(&pieces, pos);
             let piece = pieces.swap_remove(i);
+            let cut = if with_loops { looper.looped(&cut) } else { cut };
             let Some(start) = cut.start() else { continue };
             match pos {
                 Some(p) => {
@@ -328,7 +339,7 @@ fn push_entry<'a>(
 }
 
 /// Distance from `q` to the segment `a b`.
-fn segment_distance(q: P2, a: P2, b: P2) -> f64 {
+pub(crate) fn segment_distance(q: P2, a: P2, b: P2) -> f64 {
     let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
     let l2 = dx * dx + dy * dy;
     let t = if l2 > 0.0 { (((q[0] - a[0]) * dx + (q[1] - a[1]) * dy) / l2).clamp(0.0, 1.0) } else { 0.0 };
