@@ -834,8 +834,8 @@ pub mod rough {
     /// Most loops in one level (bounds the work on absurd inputs).
     pub const MAX_LOOPS: usize = 2_000_000;
 
-    /// Bisections of a loop's advance (to 2 R / 2^20).
-    pub const LOOP_BISECTIONS: usize = 20;
+    /// Bisections of a loop's advance (to 2 R / 2^16).
+    pub const LOOP_BISECTIONS: usize = 16;
 
     /// Tool positions along one loop where its engagement is measured.
     pub const LOOP_POSITIONS: usize = 180;

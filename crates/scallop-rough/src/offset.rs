@@ -339,7 +339,7 @@ fn push_entry<'a>(
 }
 
 /// Distance from `q` to the segment `a b`.
-pub(crate) fn segment_distance(q: P2, a: P2, b: P2) -> f64 {
+fn segment_distance(q: P2, a: P2, b: P2) -> f64 {
     let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
     let l2 = dx * dx + dy * dy;
     let t = if l2 > 0.0 { (((q[0] - a[0]) * dx + (q[1] - a[1]) * dy) / l2).clamp(0.0, 1.0) } else { 0.0 };

@@ -391,7 +391,7 @@ pub(super) fn advance(r: f64, radius: f64, target: f64) -> f64 {
     let (mut lo, mut hi) = (0.0, 2.0 * radius);
     for _ in 0..tol::LOOP_BISECTIONS {
         let mid = 0.5 * (lo + hi);
-        if loop_engagement(r, mid, radius) <= target {
+        if loop_engagement_until(r, mid, radius, target) <= target {
             lo = mid;
         } else {
             hi = mid;
@@ -404,55 +404,78 @@ pub(super) fn advance(r: f64, radius: f64, target: f64) -> f64 {
 /// loops `p` apart along +x (centres at `(j p, r)`, each a counter-clockwise
 /// circle from and back to `(j p, 0)`, joined along the x axis), the
 /// material all that no earlier move came within `radius` of.
-pub(super) fn loop_engagement(r: f64, p: f64, radius: f64) -> f64 {
+#[cfg(test)]
+fn loop_engagement(r: f64, p: f64, radius: f64) -> f64 {
+    loop_engagement_until(r, p, radius, f64::INFINITY)
+}
+
+/// [`loop_engagement`], returned as soon as it exceeds `stop` (the places
+/// along the loop taken from a third of the way to the apex on, where it
+/// is largest).
+fn loop_engagement_until(r: f64, p: f64, radius: f64, stop: f64) -> f64 {
+    use std::f64::consts::{FRAC_PI_2, PI, TAU};
     let positions = tol::LOOP_POSITIONS;
     let probes = tol::ENGAGE_PROBES / 2;
-    let mut worst = 0.0f64;
+    let r2 = radius * radius;
+    // The probes' directions from the front half's first one.
+    #[allow(clippy::cast_precision_loss, reason = "small counts")]
+    let turns: Vec<(f64, f64)> = (0..probes).map(|k| (PI * (k as f64 + 0.5) / probes as f64).sin_cos()).collect();
     // The three loops before and their joins.
     let swept_before = |x: P2| -> bool {
         (1..=3).any(|j| {
             #[allow(clippy::cast_precision_loss, reason = "small counts")]
             let cx = -(j as f64) * p;
-            let d = (x[0] - cx).hypot(x[1] - r);
-            (d - r).abs() < radius || segment_distance(x, [cx, 0.0], [cx + p, 0.0]) < radius
+            let (dx, dy) = (x[0] - cx, x[1] - r);
+            let d = (dx * dx + dy * dy).sqrt();
+            if (d - r).abs() < radius {
+                return true;
+            }
+            // The join from (cx, 0) to (cx + p, 0).
+            let qx = x[0].clamp(cx, cx + p);
+            let (ex, ey) = (x[0] - qx, x[1]);
+            ex * ex + ey * ey < r2
         })
     };
-    for i in 0..positions {
+    let mut worst = 0.0f64;
+    let first = positions / 9;
+    for n in 0..positions {
+        let i = (first + n) % positions;
         #[allow(clippy::cast_precision_loss, reason = "small counts")]
-        let psi = -std::f64::consts::FRAC_PI_2 + std::f64::consts::TAU * (i as f64 + 0.5) / positions as f64;
-        let t = [r * psi.cos(), r + r * psi.sin()];
-        let heading = psi + std::f64::consts::FRAC_PI_2;
+        let psi = -FRAC_PI_2 + TAU * (i as f64 + 0.5) / positions as f64;
+        let (sp, cp) = psi.sin_cos();
+        let t = [r * cp, r + r * sp];
+        // The front half starts at the heading less a quarter turn: psi.
+        let along = psi + FRAC_PI_2;
         let mut inside = 0usize;
-        for k in 0..probes {
-            #[allow(clippy::cast_precision_loss, reason = "small counts")]
-            let th = heading - std::f64::consts::FRAC_PI_2 + std::f64::consts::PI * (k as f64 + 0.5) / probes as f64;
-            let x = [t[0] + radius * th.cos(), t[1] + radius * th.sin()];
+        for &(sk, ck) in &turns {
+            let (dx, dy) = (cp * ck - sp * sk, sp * ck + cp * sk);
+            let x = [t[0] + radius * dx, t[1] + radius * dy];
             if swept_before(x) {
                 continue;
             }
-            // This loop's own path so far (from -pi/2 to psi).
-            let a = (x[1] - r).atan2(x[0]);
-            let mut rel = a + std::f64::consts::FRAC_PI_2;
-            rel = rel.rem_euclid(std::f64::consts::TAU);
-            let along = psi + std::f64::consts::FRAC_PI_2;
-            // Beyond the arc's angular range the nearest point of it is an
-            // end: its start, or the tool's own place, which is R from
-            // every probe (the tool does not sweep ahead of itself).
-            let d_arc = if rel < along { (x[0].hypot(x[1] - r) - r).abs() } else { x[0].hypot(x[1]) };
-            if d_arc < radius {
-                continue;
+            // This loop's own path so far (from -pi/2 to psi): no nearer
+            // than the circle, so only probes within R of it are looked at.
+            let dc = (x[0] * x[0] + (x[1] - r) * (x[1] - r)).sqrt();
+            if (dc - r).abs() < radius {
+                let rel = ((x[1] - r).atan2(x[0]) + FRAC_PI_2).rem_euclid(TAU);
+                // Beyond the arc's angular range the nearest point of it is
+                // an end: its start, or the tool's own place, which is R from
+                // every probe (the tool does not sweep ahead of itself).
+                let swept = if rel < along { true } else { x[0] * x[0] + x[1] * x[1] < r2 };
+                if swept {
+                    continue;
+                }
             }
             inside += 1;
         }
         #[allow(clippy::cast_precision_loss, reason = "small counts")]
-        let phi = std::f64::consts::PI * inside as f64 / probes as f64;
+        let phi = PI * inside as f64 / probes as f64;
         worst = worst.max(phi);
+        if worst > stop {
+            return worst;
+        }
     }
     worst
-}
-
-fn segment_distance(q: P2, a: P2, b: P2) -> f64 {
-    super::segment_distance(q, a, b)
 }
 
 #[cfg(test)]
