@@ -255,10 +255,10 @@ pub fn plan_offset_in(
     let target = (1.0 - (ae / r).min(2.0)).acos();
     let climb = matches!(options.direction, Direction::Climb);
     let with_loops = matches!(options.pattern, crate::Pattern::OffsetLoops);
-    let mut looper = loops::Looper::new(region, None, r, climb, target, tol_c);
+    let mut looper = with_loops.then(|| loops::Looper::new(region, None, r, climb, target, tol_c));
     for k in (0..levels.len()).rev() {
         let mut pieces = std::mem::take(&mut wall_pieces[k]);
-        if with_loops && !pieces.is_empty() {
+        if let Some(looper) = looper.as_mut().filter(|_| !pieces.is_empty()) {
             looper.set_deeper(levels.get(k + 1));
         }
         // A band may reach past the region: it is kept inside. It holds
@@ -279,7 +279,10 @@ pub fn plan_offset_in(
         while !pieces.is_empty() {
             let (i, cut) = nearest(&pieces, pos);
             let piece = pieces.swap_remove(i);
-            let cut = if with_loops { looper.looped(&cut) } else { cut };
+            let cut = match looper.as_mut() {
+                Some(looper) => looper.looped(&cut),
+                None => cut,
+            };
             let Some(start) = cut.start() else { continue };
             match pos {
                 Some(p) => {
