@@ -29,9 +29,9 @@ use scallop_toolpath::{Move, MoveKind, Toolpath};
 
 use crate::collide::BodyCheck;
 use crate::correct::correct_pairs;
-use crate::rest::{ROOT_REST_MIN_RUN, root_rest_pairs, swept};
 use crate::levels::{LevelOptions, TiltMode, level_passes_with};
 use crate::orient::{OrientSettings, Orientation, optimise_pass, synchronise_with};
+use crate::rest::{ROOT_REST_MIN_RUN, root_rest_pairs, swept};
 use crate::sync::{SyncPoint, axis_steps, interpolate_axis, limit_angular_step, pitch_angle, synchronise};
 use crate::{LevelPasses, Placement, Placer, Rough5Error, tol};
 
@@ -108,7 +108,8 @@ pub struct Rough5Settings {
     /// tool radius), the other corners within the thinning's chord
     /// (docs/rough5.md, "Corners and blocks").
     pub round_corners: bool,
-    /// Whether the bottom level ends with a rest pass along its limit
+    /// Whether the bottom level ends, in the guide-curve variant, with a rest
+    /// pass along its limit
     /// passes, moved towards the flanks and tilted across the pass where the
     /// whole tool keeps the flank allowance and reaches nearer the flank's
     /// root than the limit pass ([`crate::rest::root_rest_pairs`]): under
@@ -118,13 +119,13 @@ pub struct Rough5Settings {
     pub root_rest: bool,
     /// Whether the bottom level's inner passes are cut with the tool axis
     /// along the bottom's normal where the bottom leans by more than
-    /// [`BOTTOM_NORMAL_MIN_TILT`] and that tool is clear of the flanks (the
-    /// other pairs as with [`Self::vertical_inside`]): on a sloped bottom (an
-    /// impeller's hub, a surface of revolution) the vertical torus stands on
-    /// its corner and leaves scallops up to (R - r) tan(slope) high between
-    /// passes a_e apart; along the normal its flat end lies on the bottom
-    /// (docs/rough5.md, "Impeller hub and roots"). A flat bottom is cut as
-    /// before.
+    /// [`bottom_normal_min_slope`] and that tool is clear of the flanks (the
+    /// other pairs as with [`Self::vertical_inside`]), in the guide-curve
+    /// variant: on a sloped bottom (an impeller's hub, a surface of
+    /// revolution) the vertical torus stands on its corner and leaves steps
+    /// about a_e tan(slope) high between passes a_e apart; along the normal
+    /// its flat end lies on the bottom (docs/rough5.md, "Impeller hub and
+    /// roots"). A flat bottom is cut as before.
     pub bottom_normal: bool,
 }
 
@@ -334,7 +335,9 @@ pub fn plan_rough5_in(
     };
     let body = check_with(0.0);
     // The rest pass's tool keeps the flank allowance with its flutes and corner.
-    let rest = settings.root_rest.then(|| (check_with(settings.guides.flank_allowance), MeshQuery::new(flanks)));
+    let guided = settings.tilt == TiltMode::Guides;
+    let rest =
+        (guided && settings.root_rest).then(|| (check_with(settings.guides.flank_allowance), MeshQuery::new(flanks)));
     let mut out = Emitter::new(stock.max.z, stock.max.z + settings.clearance + cutter.radius(), settings);
     out.flat = Emitter::flat_radius(cutter);
     out.air = air;
@@ -361,9 +364,9 @@ pub fn plan_rough5_in(
             if j == 0 && outer && rest.is_some() {
                 limit_pairs.push(pairs.clone());
             }
-            if settings.bottom_normal && j == 0 && !outer {
-                pairs = along_bottom_normal(&placer, &body, pairs);
-                pairs = vertical_where_clear(&placer, &body, &pairs, settings, &on_sloped_normal);
+            if guided && settings.bottom_normal && j == 0 && !outer {
+                pairs = along_bottom_normal(&placer, &body, pairs, bottom_normal_min_slope(settings));
+                pairs = vertical_where_clear(&placer, &body, &pairs, settings, &on_normal);
             } else if settings.vertical_inside && !outer && tilt.is_some() {
                 pairs = vertical_where_clear(&placer, &body, &pairs, settings, &|_| false);
             } else if settings.vertical_thin_steps && outer && tilt.is_some() {
@@ -408,7 +411,14 @@ pub fn plan_rough5_in(
                     pitch: [0.0; 3],
                     max_tilt: 0.0,
                 };
-                for seg in root_rest_pairs(&placer, rest_body, flank_query, (pairs, &cut), tool, settings.guides.flank_allowance) {
+                for seg in root_rest_pairs(
+                    &placer,
+                    rest_body,
+                    flank_query,
+                    (pairs, &cut),
+                    tool,
+                    settings.guides.flank_allowance,
+                ) {
                     let seg = limit_angular_step(&seg, settings.max_angle_step, settings.max_azimuth_step);
                     let (runs, r) = place_pass_in(&placer, rest_body, out.air.as_ref(), &seg);
                     report.dropped += r.dropped;
@@ -417,8 +427,10 @@ pub fn plan_rough5_in(
                     for run in runs.iter().filter(|r| run_length(r) >= ROOT_REST_MIN_RUN) {
                         report.points += run.len();
                         report.runs += 1;
-                        let local = above.as_ref().filter(|_| settings.local_entry).and_then(|a| local_entry(a, &run[0]));
-                        let entry = local.map_or(entry_z, |z| (z + settings.clearance * run[0].place.axis.z).min(entry_z));
+                        let local =
+                            above.as_ref().filter(|_| settings.local_entry).and_then(|a| local_entry(a, &run[0]));
+                        let entry =
+                            local.map_or(entry_z, |z| (z + settings.clearance * run[0].place.axis.z).min(entry_z));
                         out.cut_run(run, entry, false, (&placer, &body));
                         level_cut.push(run.iter().map(|c| c.place).collect());
                     }
@@ -683,26 +695,32 @@ fn vertical_where_clear(
     thin_vertical(limit_angular_step(&out, settings.max_angle_step, settings.max_azimuth_step), span, chord)
 }
 
-/// The least tilt of the bottom's normal (rad, 2 degrees) that
-/// [`Rough5Settings::bottom_normal`] follows: a flat bottom's pairs stay
-/// vertical.
-pub const BOTTOM_NORMAL_MIN_TILT: f64 = 0.034_906_585_039_886_59;
+/// Whether the pair's axis is its bottom normal ([`along_bottom_normal`]).
+fn on_normal(s: &SyncPoint) -> bool {
+    (s.axis - s.normal).norm() < 1e-12 && s.normal.angle(&Vec3::z()) > 0.0
+}
 
-/// Whether the pair's axis is its bottom normal, leaning by more than
-/// [`BOTTOM_NORMAL_MIN_TILT`] ([`along_bottom_normal`]).
-fn on_sloped_normal(s: &SyncPoint) -> bool {
-    (s.axis - s.normal).norm() < 1e-12 && s.normal.angle(&Vec3::z()) > BOTTOM_NORMAL_MIN_TILT
+/// The least slope (rad) of a bottom whose inner passes follow its normal
+/// ([`Rough5Settings::bottom_normal`]): where the vertical torus leaves a
+/// step a_e tan(slope) between passes a_e apart thicker than the bottom
+/// allowance (6.3 degrees at a_e 4.5 mm and 0.5 mm). A gentler slope leaves
+/// the finishing tool at most twice its stock, as a 3-axis program does,
+/// and tilting for it costs machine time (the closed pocket's bottom leans
+/// 3 to 5 degrees in places).
+#[must_use]
+pub fn bottom_normal_min_slope(settings: &Rough5Settings) -> f64 {
+    (settings.bottom_allowance / settings.guides.radial_step).atan()
 }
 
 /// `pairs` of a bottom level's inner pass with the axis along the bottom's
-/// normal where it leans by more than [`BOTTOM_NORMAL_MIN_TILT`] and that
+/// normal where the bottom leans by more than `min_slope` (rad) and that
 /// tool is placed clear of the flanks; the others keep their axis.
-fn along_bottom_normal(placer: &Placer, body: &BodyCheck, pairs: Vec<SyncPoint>) -> Vec<SyncPoint> {
+fn along_bottom_normal(placer: &Placer, body: &BodyCheck, pairs: Vec<SyncPoint>, min_slope: f64) -> Vec<SyncPoint> {
     pairs
         .into_par_iter()
         .map(|s| {
             let n = s.normal;
-            let lean = n.angle(&Vec3::z()) > BOTTOM_NORMAL_MIN_TILT;
+            let lean = n.angle(&Vec3::z()) > min_slope;
             if lean && placer.place(&s.path, &n).is_some_and(|p| !body.collides(&p.tip, &p.axis)) {
                 SyncPoint { axis: n, ..s }
             } else {

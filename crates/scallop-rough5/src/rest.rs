@@ -151,8 +151,9 @@ pub fn root_rest_pairs(
             let mut open: Vec<Point3> = Vec::new();
             'columns: for i in 0..=columns {
                 let x = -ROOT_REST_BACK_MAX + ROOT_REST_CELL * i as f64;
-                let column: Vec<Point3> =
-                    (0..=rows).map(|k| s.path + along * x + s.normal * (ROOT_REST_LOW + ROOT_REST_CELL * k as f64)).collect();
+                let column: Vec<Point3> = (0..=rows)
+                    .map(|k| s.path + along * x + s.normal * (ROOT_REST_LOW + ROOT_REST_CELL * k as f64))
+                    .collect();
                 if column.iter().any(|q| flanks.closest_within(q, allowance).is_some()) {
                     break 'columns;
                 }

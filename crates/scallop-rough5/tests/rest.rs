@@ -7,8 +7,10 @@ mod common;
 use proptest::prelude::*;
 use scallop_geom::{Point3, Vec3};
 use scallop_mesh::{MeshQuery, TriMesh};
+use scallop_parts::{PocketParams, closed_pocket};
 use scallop_rough5::rest::{inside, root_rest_pairs};
-use scallop_rough5::{BodyCheck, Placement, Placer, SyncPoint};
+use scallop_rough5::{BodyCheck, Placement, Placer, ProofSettings, Rough5Settings, SyncPoint, plan_rough5, prove};
+use scallop_toolpath::MoveKind;
 
 const ALLOWANCE: f64 = 0.5;
 const TOOL: (f64, f64, f64) = (5.0, 1.5, 30.0);
@@ -31,7 +33,8 @@ fn floor_and_wall(lean: f64) -> (TriMesh, TriMesh) {
 /// The floor's limit pass: vertical tools along y, as near the wall as the
 /// tool (its flutes' radius plus the allowance) clears it, and those tools.
 fn limit_pass(placer: &Placer, body: &BodyCheck) -> (Vec<SyncPoint>, Vec<Placement>) {
-    let clear = |x: f64| placer.place(&Point3::new(x, 0.0, 0.0), &Vec3::z()).filter(|p| !body.collides(&p.tip, &p.axis));
+    let clear =
+        |x: f64| placer.place(&Point3::new(x, 0.0, 0.0), &Vec3::z()).filter(|p| !body.collides(&p.tip, &p.axis));
     let mut x = 30.0;
     while clear(x - 0.05).is_some() && x > 0.0 {
         x -= 0.05;
@@ -133,4 +136,45 @@ proptest! {
         let runs = root_rest_pairs(&placer, &rest, &query, (&pairs, &cut), TOOL, ALLOWANCE);
         prop_assert!(runs.is_empty(), "{} rest runs", runs.len());
     }
+}
+
+/// A 60 x 60 mm pocket with vertical walls whose bottom slopes along x by
+/// `slope` (rad), 24 mm high, planned by `scallop rough5`'s settings with or
+/// without the bottom's inner passes along its normal (the rest pass left
+/// out), and proven: V_r (%) and the feeds' largest tilt (rad).
+fn sloped_pocket(slope: f64, bottom_normal: bool) -> (f64, f64, Vec<scallop_toolpath::Move>) {
+    let part =
+        closed_pocket(&PocketParams { walls: [0.0; 4], tilt: slope, dome: 0.0, ..common::small_pocket(24.0, 10.0) })
+            .unwrap();
+    let (bottom, flanks, depth) = common::bottom_flanks(&part);
+    let tool = common::torus(30.0, 192.0);
+    let s = Rough5Settings { bottom_normal, root_rest: false, ..common::settings(depth) };
+    let plan = plan_rough5(&bottom, &flanks, &part.stock, &tool, &s, &|_, _| {}).unwrap();
+    let proof_settings = ProofSettings { resolution: 0.5, axis_tolerance: 0.05 };
+    let proof = prove(&plan.toolpath, &tool, &part.stock, &part.mesh, &proof_settings, &|_, _| {}).unwrap();
+    assert!(proof.gouge_depth <= proof_settings.axis_tolerance, "gouge {} mm", proof.gouge_depth);
+    let moves = plan.toolpath.moves().to_vec();
+    let tilt = (0..moves.len())
+        .filter(|&i| moves[i].kind == MoveKind::Feed)
+        .map(|i| plan.toolpath.axis(i).angle(&Vec3::z()))
+        .fold(0.0, f64::max);
+    (proof.remaining_percent, tilt, moves)
+}
+
+/// On a bottom sloping 11 degrees, steeper than the step rule's 6.3 degrees
+/// (a_e 4.5 mm, 0.5 mm allowance), the bottom's inner passes follow its
+/// normal: the program is proven and leaves less than with vertical inner
+/// passes, whose torus stands on its corner. On a bottom sloping 3 degrees
+/// the program is the same move for move.
+#[test]
+fn a_sloped_bottom_is_cut_along_its_normal() {
+    let steep = 0.2;
+    let (along, tilt, _) = sloped_pocket(steep, true);
+    let (vertical, _, _) = sloped_pocket(steep, false);
+    assert!(tilt >= steep.atan() - 1e-6, "the feeds lean {:.2} deg at most", tilt.to_degrees());
+    assert!(along < vertical - 0.2, "V_r {along:.2} % along the normal, {vertical:.2} % with vertical inner passes");
+    let gentle = 0.05;
+    let (_, _, on) = sloped_pocket(gentle, true);
+    let (_, _, off) = sloped_pocket(gentle, false);
+    assert_eq!(on, off, "a 3 deg bottom's program changed");
 }
