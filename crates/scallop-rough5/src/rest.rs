@@ -44,7 +44,7 @@ pub const ROOT_REST_LOW: f64 = 0.75;
 pub const ROOT_REST_HIGH: f64 = 4.0;
 /// A pair is kept where its tool covers at least this much of its
 /// cross-section (mm^2) that no tool of the bottom level covered.
-pub const ROOT_REST_MIN_AREA: f64 = 2.0;
+pub const ROOT_REST_MIN_AREA: f64 = 1.0;
 /// Pairs whose nearest flank point lies along the pass (the cosine of its
 /// direction with the tangent above this) are not moved: a corner or an open
 /// end.
