@@ -60,6 +60,10 @@ pub enum RefineArg {
     LocalEntry,
     /// Vertical stretches in long blocks and their corners rounded (inner passes' convex corners by 0.8 R).
     Corners,
+    /// A rest pass along the bottom's limit passes, moved towards the flanks' roots and tilted across where the tool clears them.
+    RootRest,
+    /// The bottom level's inner passes with the axis along the bottom's normal where it leans (an impeller's hub).
+    BottomNormal,
     /// All of them: the program of 28 Nov 2026.
     All,
 }
@@ -285,6 +289,8 @@ fn settings(args: &Rough5Args, part: &TestPart) -> CliResult<Rough5Settings> {
         translate: on(RefineArg::Translation),
         local_entry: on(RefineArg::LocalEntry),
         round_corners: on(RefineArg::Corners),
+        root_rest: on(RefineArg::RootRest),
+        bottom_normal: on(RefineArg::BottomNormal),
         ..base
     })
 }

@@ -119,7 +119,7 @@ fn remaining_impeller(
     let cell = dexels.cell_size();
     let area = cell[0] * cell[1];
     let (lo, hi) = (part.stock.min.z, part.stock.max.z);
-    type Row = (BTreeMap<(String, i64, i64), f64>, f64, Vec<[f64; 5]>);
+    type Row = (BTreeMap<(String, i64, i64), f64>, f64, Vec<[f64; 6]>);
     let rows: Vec<Row> = (0..nv)
         .into_par_iter()
         .map(|iv| {
@@ -154,7 +154,7 @@ fn remaining_impeller(
                             };
                             let tenth = ((p.x.hypot(p.y) - 25.0) / 5.0).floor().clamp(-1.0, 10.0) as i64;
                             *acc.entry((c.to_string(), (d_b / 4.0).floor() as i64, tenth)).or_insert(0.0) += w;
-                            samples.push([p.x, p.y, p.z, w, d_b]);
+                            samples.push([p.x, p.y, p.z, w, d_b, d_f]);
                         }
                     }
                 }
@@ -164,9 +164,9 @@ fn remaining_impeller(
         .collect();
     let total: f64 = rows.iter().map(|r| r.1).sum();
     if let Some(csv) = csv {
-        let mut text = String::from("x,y,z,mm3,hub_distance\n");
+        let mut text = String::from("x,y,z,mm3,hub_distance,flank_distance\n");
         for r in rows.iter().flat_map(|r| &r.2) {
-            text.push_str(&format!("{},{},{:.3},{:.5},{:.3}\n", r[0], r[1], r[2], r[3], r[4]));
+            text.push_str(&format!("{},{},{:.3},{:.5},{:.3},{:.3}\n", r[0], r[1], r[2], r[3], r[4], r[5]));
         }
         std::fs::write(csv, text).unwrap();
     }

@@ -54,6 +54,7 @@ pub mod place;
 mod plan;
 mod prove;
 mod radius;
+pub mod rest;
 pub mod sqp;
 mod sync;
 pub use scallop_geom::tol::rough5 as tol;
@@ -72,7 +73,8 @@ pub use orient::{
 pub use place::{Feature, Placement, Placer, tool_frame};
 pub use plan::{
     AIR_MARGIN, AIR_STEP, LevelReport, PassReport, Rough5Plan, Rough5Settings, SinglePass, TRANSLATION_MAX,
-    TRANSLATION_SLOPE, limit_step, plan_rough5, plan_rough5_in, plan_single_pass, round_corners, thin_vertical,
+    TRANSLATION_SLOPE, bottom_normal_min_slope, limit_step, plan_rough5, plan_rough5_in, plan_single_pass,
+    round_corners, thin_vertical,
 };
 pub use prove::{Proof, ProofSettings, prove, prove_from_blank, prove_with_faces};
 pub use radius::{apparent_contour_radius, effective_radius, exact_scallop, scallop_height, swept_profile};

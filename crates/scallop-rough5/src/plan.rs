@@ -23,7 +23,7 @@ use rayon::prelude::*;
 use scallop_cutter::Cutter;
 use scallop_geom::{Aabb3, Point3, Vec3};
 use scallop_guides::{Curve, GuideSettings};
-use scallop_mesh::TriMesh;
+use scallop_mesh::{MeshQuery, TriMesh};
 use scallop_sim::DexelPart;
 use scallop_toolpath::{Move, MoveKind, Toolpath};
 
@@ -31,6 +31,7 @@ use crate::collide::BodyCheck;
 use crate::correct::correct_pairs;
 use crate::levels::{LevelOptions, TiltMode, level_passes_with};
 use crate::orient::{OrientSettings, Orientation, optimise_pass, synchronise_with};
+use crate::rest::{ROOT_REST_MIN_RUN, root_rest_pairs, swept};
 use crate::sync::{SyncPoint, axis_steps, interpolate_axis, limit_angular_step, pitch_angle, synchronise};
 use crate::{LevelPasses, Placement, Placer, Rough5Error, tol};
 
@@ -107,6 +108,25 @@ pub struct Rough5Settings {
     /// tool radius), the other corners within the thinning's chord
     /// (docs/rough5.md, "Corners and blocks").
     pub round_corners: bool,
+    /// Whether the bottom level ends, in the guide-curve variant, with a rest
+    /// pass along its limit
+    /// passes, moved towards the flanks and tilted across the pass where the
+    /// whole tool keeps the flank allowance and reaches nearer the flank's
+    /// root than the limit pass ([`crate::rest::root_rest_pairs`]): under
+    /// an overhanging flank (an impeller's blade) the bottom's limit curve
+    /// keeps the vertical tool several millimetres from the root
+    /// (docs/rough5.md, "Impeller hub and roots").
+    pub root_rest: bool,
+    /// Whether the bottom level's inner passes are cut with the tool axis
+    /// along the bottom's normal where the bottom leans by more than
+    /// [`bottom_normal_min_slope`] and that tool is clear of the flanks (the
+    /// other pairs as with [`Self::vertical_inside`]), in the guide-curve
+    /// variant: on a sloped bottom (an impeller's hub, a surface of
+    /// revolution) the vertical torus stands on its corner and leaves steps
+    /// about a_e tan(slope) high between passes a_e apart; along the normal
+    /// its flat end lies on the bottom (docs/rough5.md, "Impeller hub and
+    /// roots"). A flat bottom is cut as before.
+    pub bottom_normal: bool,
 }
 
 impl Rough5Settings {
@@ -139,6 +159,8 @@ impl Rough5Settings {
             translate: false,
             local_entry: false,
             round_corners: false,
+            root_rest: false,
+            bottom_normal: false,
         }
         .with_refinements(true)
     }
@@ -146,7 +168,8 @@ impl Rough5Settings {
     /// These settings with every refinement of the guide-curve program (the
     /// level repairs of [`LevelOptions`], [`Self::vertical_inside`],
     /// [`Self::vertical_thin_steps`], [`Self::translate`],
-    /// [`Self::local_entry`] and [`Self::round_corners`]) on or off.
+    /// [`Self::local_entry`], [`Self::round_corners`], [`Self::root_rest`]
+    /// and [`Self::bottom_normal`]) on or off.
     #[must_use]
     pub fn with_refinements(self, on: bool) -> Self {
         Self {
@@ -156,6 +179,8 @@ impl Rough5Settings {
             translate: on,
             local_entry: on,
             round_corners: on,
+            root_rest: on,
+            bottom_normal: on,
             ..self
         }
     }
@@ -303,10 +328,16 @@ pub fn plan_rough5_in(
         return Err(Rough5Error::NoPass { reason: reason.into() });
     }
     // The shank and holder clear the blank beyond the pocket too.
-    let body = match blank.and_then(|b| blank_beyond(b, bottom)) {
-        Some(beyond) => BodyCheck::new(flanks, cutter, 0.0).with_stock(&beyond),
-        None => BodyCheck::new(flanks, cutter, 0.0),
+    let beyond = blank.and_then(|b| blank_beyond(b, bottom));
+    let check_with = |clearance: f64| match &beyond {
+        Some(beyond) => BodyCheck::new(flanks, cutter, clearance).with_stock(beyond),
+        None => BodyCheck::new(flanks, cutter, clearance),
     };
+    let body = check_with(0.0);
+    // The rest pass's tool keeps the flank allowance with its flutes and corner.
+    let guided = settings.tilt == TiltMode::Guides;
+    let rest =
+        (guided && settings.root_rest).then(|| (check_with(settings.guides.flank_allowance), MeshQuery::new(flanks)));
     let mut out = Emitter::new(stock.max.z, stock.max.z + settings.clearance + cutter.radius(), settings);
     out.flat = Emitter::flat_radius(cutter);
     out.air = air;
@@ -322,12 +353,21 @@ pub fn plan_rough5_in(
         let placer = Placer::new(level.support.mesh(), cutter, allowance)?;
         let mut top = f64::NEG_INFINITY;
         let mut first = true;
+        let mut limit_pairs: Vec<Vec<SyncPoint>> = Vec::new();
+        // The tools that cut this level, for the rest pass.
+        let mut level_cut: Vec<Vec<Placement>> = Vec::new();
         for (m, (path, tilt)) in level.passes.iter().enumerate() {
             let cursor = out.last.map_or_else(|| path.line.points[0], |c| c.sync.path);
             let (pairs, _) = pass_pairs((path, tilt.as_ref()), &cursor, settings)?;
             let (mut pairs, corrected) = corrected_pairs(&placer, &body, pairs, settings);
             let outer = m + level.outer >= level.passes.len();
-            if settings.vertical_inside && !outer && tilt.is_some() {
+            if j == 0 && outer && rest.is_some() {
+                limit_pairs.push(pairs.clone());
+            }
+            if guided && settings.bottom_normal && j == 0 && !outer {
+                pairs = along_bottom_normal(&placer, &body, pairs, bottom_normal_min_slope(settings));
+                pairs = vertical_where_clear(&placer, &body, &pairs, settings, &on_normal);
+            } else if settings.vertical_inside && !outer && tilt.is_some() {
                 pairs = vertical_where_clear(&placer, &body, &pairs, settings, &|_| false);
             } else if settings.vertical_thin_steps && outer && tilt.is_some() {
                 let most = tol::LIMIT_STEP_ALLOWANCES * settings.guides.flank_allowance;
@@ -350,8 +390,53 @@ pub fn plan_rough5_in(
                 let entry = local.map_or(entry_z, |z| (z + settings.clearance * run[0].place.axis.z).min(entry_z));
                 out.cut_run(run, entry, first, (&placer, &body));
                 first = false;
+                if rest.is_some() && j == 0 {
+                    level_cut.push(run.iter().map(|c| c.place).collect());
+                }
             }
             reports.push(report);
+        }
+        if let Some((rest_body, flank_query)) = rest.as_ref().filter(|_| j == 0) {
+            let tool = (cutter.radius(), corner_radius(cutter), cutter.flute_length());
+            for (m, pairs) in limit_pairs.iter().enumerate() {
+                let cut = swept(&level_cut);
+                let mut report = PassReport {
+                    level: 0,
+                    pass: level.passes.len() + m,
+                    points: 0,
+                    dropped: 0,
+                    air: 0,
+                    corrected: 0,
+                    runs: 0,
+                    pitch: [0.0; 3],
+                    max_tilt: 0.0,
+                };
+                for seg in root_rest_pairs(
+                    &placer,
+                    rest_body,
+                    flank_query,
+                    (pairs, &cut),
+                    tool,
+                    settings.guides.flank_allowance,
+                ) {
+                    let seg = limit_angular_step(&seg, settings.max_angle_step, settings.max_azimuth_step);
+                    let (runs, r) = place_pass_in(&placer, rest_body, out.air.as_ref(), &seg);
+                    report.dropped += r.dropped;
+                    report.air += r.air;
+                    report.max_tilt = report.max_tilt.max(r.max_tilt);
+                    for run in runs.iter().filter(|r| run_length(r) >= ROOT_REST_MIN_RUN) {
+                        report.points += run.len();
+                        report.runs += 1;
+                        let local =
+                            above.as_ref().filter(|_| settings.local_entry).and_then(|a| local_entry(a, &run[0]));
+                        let entry =
+                            local.map_or(entry_z, |z| (z + settings.clearance * run[0].place.axis.z).min(entry_z));
+                        out.cut_run(run, entry, false, (&placer, &body));
+                        level_cut.push(run.iter().map(|c| c.place).collect());
+                    }
+                }
+                reports.push(report);
+            }
         }
         if top.is_finite() {
             entry_z = top + settings.clearance;
@@ -608,6 +693,41 @@ fn vertical_where_clear(
     let span = tol::THIN_SPAN_STEPS * settings.step;
     let chord = tol::THIN_CHORD_ALLOWANCES * settings.guides.flank_allowance;
     thin_vertical(limit_angular_step(&out, settings.max_angle_step, settings.max_azimuth_step), span, chord)
+}
+
+/// Whether the pair's axis is its bottom normal ([`along_bottom_normal`]).
+fn on_normal(s: &SyncPoint) -> bool {
+    (s.axis - s.normal).norm() < 1e-12 && s.normal.angle(&Vec3::z()) > 0.0
+}
+
+/// The least slope (rad) of a bottom whose inner passes follow its normal
+/// ([`Rough5Settings::bottom_normal`]): where the vertical torus leaves a
+/// step a_e tan(slope) between passes a_e apart thicker than the bottom
+/// allowance (6.3 degrees at a_e 4.5 mm and 0.5 mm). A gentler slope leaves
+/// the finishing tool at most twice its stock, as a 3-axis program does,
+/// and tilting for it costs machine time (the closed pocket's bottom leans
+/// 3 to 5 degrees in places).
+#[must_use]
+pub fn bottom_normal_min_slope(settings: &Rough5Settings) -> f64 {
+    (settings.bottom_allowance / settings.guides.radial_step).atan()
+}
+
+/// `pairs` of a bottom level's inner pass with the axis along the bottom's
+/// normal where the bottom leans by more than `min_slope` (rad) and that
+/// tool is placed clear of the flanks; the others keep their axis.
+fn along_bottom_normal(placer: &Placer, body: &BodyCheck, pairs: Vec<SyncPoint>, min_slope: f64) -> Vec<SyncPoint> {
+    pairs
+        .into_par_iter()
+        .map(|s| {
+            let n = s.normal;
+            let lean = n.angle(&Vec3::z()) > min_slope;
+            if lean && placer.place(&s.path, &n).is_some_and(|p| !body.collides(&p.tip, &p.axis)) {
+                SyncPoint { axis: n, ..s }
+            } else {
+                s
+            }
+        })
+        .collect()
 }
 
 /// Distance from `p` to the segment `a`-`b`.
@@ -1026,6 +1146,20 @@ fn local_entry(above: &Placer, c: &Cl) -> Option<f64> {
     let p = above.place(&c.sync.path, &c.place.axis)?;
     let rise = (p.tip - c.place.tip).dot(&c.place.axis);
     (rise > 0.0).then(|| c.place.tip.z + rise * c.place.axis.z)
+}
+
+/// The corner radius r of a torus (R of a ball, 0 of a flat tool).
+fn corner_radius(cutter: &Cutter) -> f64 {
+    match *cutter.shape() {
+        scallop_cutter::CutterShape::Bull { corner, .. } => corner,
+        scallop_cutter::CutterShape::Ball { radius } => radius,
+        _ => 0.0,
+    }
+}
+
+/// The length of a run's tip polyline (mm).
+fn run_length(run: &[Cl]) -> f64 {
+    run.windows(2).map(|w| (w[1].place.tip - w[0].place.tip).norm()).sum()
 }
 
 /// The placed and checked CL points of the pairs of one pass, split into
