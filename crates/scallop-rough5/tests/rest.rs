@@ -51,6 +51,17 @@ fn limit_pass(placer: &Placer, body: &BodyCheck) -> (Vec<SyncPoint>, Vec<Placeme
 
 /// Points of the cross-section y = 0 (every 0.25 mm, 0.75 to 4 mm over the
 /// floor) more than the allowance from the wall.
+/// The limit pass of the floor's tool along `wall` (pairs, tools) and the
+/// rest pass's runs after it.
+fn rest_pass(placer: &Placer, wall: &TriMesh, query: &MeshQuery) -> (Vec<SyncPoint>, Vec<Placement>, Vec<Vec<SyncPoint>>) {
+    let cutter = common::torus(30.0, 192.0);
+    let body = BodyCheck::new(wall, &cutter, 0.0);
+    let rest = BodyCheck::new(wall, &cutter, ALLOWANCE);
+    let (pairs, cut) = limit_pass(placer, &body);
+    let runs = root_rest_pairs(placer, &rest, query, (&pairs, &cut), TOOL, ALLOWANCE);
+    (pairs, cut, runs)
+}
+
 fn section(wall: &MeshQuery) -> Vec<Point3> {
     (0..=80)
         .flat_map(|i| (0..=13).map(move |k| Point3::new(0.25 * f64::from(i), 0.0, 0.75 + 0.25 * f64::from(k))))
@@ -99,11 +110,8 @@ proptest! {
         let (floor, wall) = floor_and_wall(lean_deg.to_radians());
         let cutter = common::torus(30.0, 192.0);
         let placer = Placer::new(&floor, &cutter, ALLOWANCE).unwrap();
-        let body = BodyCheck::new(&wall, &cutter, 0.0);
-        let rest = BodyCheck::new(&wall, &cutter, ALLOWANCE);
         let query = MeshQuery::new(&wall);
-        let (pairs, cut) = limit_pass(&placer, &body);
-        let runs = root_rest_pairs(&placer, &rest, &query, (&pairs, &cut), TOOL, ALLOWANCE);
+        let (pairs, cut, runs) = rest_pass(&placer, &wall, &query);
         let kept: Vec<&SyncPoint> = runs.iter().flatten().collect();
         prop_assert!(kept.len() >= pairs.len() - 2, "{} of {} pairs kept", kept.len(), pairs.len());
         let mut middle = None;
@@ -129,11 +137,8 @@ proptest! {
         let (floor, wall) = floor_and_wall(-draft_deg.to_radians());
         let cutter = common::torus(30.0, 192.0);
         let placer = Placer::new(&floor, &cutter, ALLOWANCE).unwrap();
-        let body = BodyCheck::new(&wall, &cutter, 0.0);
-        let rest = BodyCheck::new(&wall, &cutter, ALLOWANCE);
         let query = MeshQuery::new(&wall);
-        let (pairs, cut) = limit_pass(&placer, &body);
-        let runs = root_rest_pairs(&placer, &rest, &query, (&pairs, &cut), TOOL, ALLOWANCE);
+        let (_, _, runs) = rest_pass(&placer, &wall, &query);
         prop_assert!(runs.is_empty(), "{} rest runs", runs.len());
     }
 }
