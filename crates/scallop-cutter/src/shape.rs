@@ -223,6 +223,23 @@ impl Profile {
         }
     }
 
+    /// The profile's slope dh/drho at radial distance `rho`, where it is
+    /// positive and finite (`None` on a flat bottom, for the flat end, and at
+    /// or past the rim of a ball or a bull-nose's corner).
+    #[inline]
+    pub(crate) fn slope(&self, rho: f64) -> Option<f64> {
+        let slope = match self.shape {
+            CutterShape::Flat { .. } => return None,
+            CutterShape::Ball { .. } | CutterShape::Bull { .. } => {
+                let s = rho - self.flat_radius;
+                let r = self.corner;
+                s / (r * r - s * s).sqrt()
+            }
+            CutterShape::Cone { .. } => self.cot,
+        };
+        (slope.is_finite() && slope > 0.0).then_some(slope)
+    }
+
     /// Same as [`CutterShape::height_at`], without trigonometry.
     #[inline(always)]
     pub(crate) fn height(&self, rho: f64) -> f64 {

@@ -286,6 +286,41 @@ proptest! {
         }
     }
 
+    /// `BoxDrop::contact_gradient` is the slope of the triangle's height:
+    /// central differences of `drop_one` along x and y, where the contact
+    /// keeps its kind on both sides and stays off the rim (where the height
+    /// jumps or turns steep), agree with it.
+    #[test]
+    fn contact_gradient_is_the_slope_of_the_triangles_height(soup in soup_strategy(20), shape in shape_strategy(),
+                                                              pts in prop::collection::vec((-2.0f64..12.0,
+                                                                                            -2.0f64..12.0,
+                                                                                            0usize..20), 1..40)) {
+        let Some((_, index)) = build(&soup) else { return Ok(()) };
+        let c = cutter(shape);
+        let local = BoxDrop::new(&c, &index, Point2::new(0.0, 0.0), Point2::new(10.0, 10.0));
+        let kind = |c: &Contact| std::mem::discriminant(c);
+        for (x, y, slot) in pts {
+            let (xy, slot) = (Point2::new(x, y), slot % index.len());
+            let at = local.drop_one(slot, xy, FLOOR);
+            let Some(g) = local.contact_gradient(&at.contact, xy) else { continue };
+            let Some((_, q)) = contact_point(&at.contact) else { continue };
+            if (q.x - x).hypot(q.y - y) > 0.99 * shape.radius() {
+                continue; // steep near a ball's rim: differences are poor there
+            }
+            let step = 1e-6;
+            for (k, e) in [(0, Point2::new(step, 0.0)), (1, Point2::new(0.0, step))] {
+                let (hi, lo) = (local.drop_one(slot, xy + e.coords, FLOOR), local.drop_one(slot, xy - e.coords, FLOOR));
+                if kind(&hi.contact) != kind(&at.contact) || kind(&lo.contact) != kind(&at.contact) {
+                    continue;
+                }
+                let diff = (hi.tip.z - lo.tip.z) / (2.0 * step);
+                prop_assert!((diff - g[k]).abs() <= 1e-3 * (1.0 + g[k].abs()),
+                             "{:?} slot {} at {:?}, {:?}: gradient {:?}, difference {} along {}",
+                             shape, slot, xy, at.contact, g, diff, k);
+            }
+        }
+    }
+
     /// `BoxDrop::lifts` (the search pruned at z) answers as one triangle's
     /// height does (`drop_one` from a floor below z), also at z equal to that
     /// height and one rounding unit either side of it.

@@ -3,7 +3,7 @@
 use std::cell::Cell;
 
 use rayon::prelude::*;
-use scallop_cutter::{BoxDrop, Cutter};
+use scallop_cutter::{BoxDrop, Contact, Cutter};
 use scallop_geom::{Point2, Vec2};
 use scallop_mesh::MeshIndex;
 
@@ -41,6 +41,7 @@ impl<'a> Probe<'a> {
             seed: Cell::new(None),
             slope: Cell::new(f64::NAN),
             seed_features: Cell::new(ALL_FEATURES),
+            contact: Cell::new(Contact::Floor),
         }
     }
 }
@@ -63,6 +64,8 @@ pub(crate) struct Local<'a> {
     /// The corners and edges of the seed that held its contact at the last
     /// evaluation ([`BoxDrop::contact_features`]).
     seed_features: Cell<u8>,
+    /// The contact of the last [`Local::height_slot`] evaluation.
+    contact: Cell<Contact>,
 }
 
 impl Local<'_> {
@@ -80,6 +83,7 @@ impl Local<'_> {
             self.seed.set(slot);
             self.seed_features.set(self.drop.contact_features(s, &cl.contact));
         }
+        self.contact.set(cl.contact);
         (cl.tip.z - probe.z, slot)
     }
 
@@ -111,11 +115,11 @@ impl Local<'_> {
     }
 
     /// [`Local::feature_height`] and the corners and edges of the triangle
-    /// that hold its contact ([`BoxDrop::contact_features`]).
-    fn triangle_contact(&self, slot: usize, features: u8, p: Point2) -> (f64, u8) {
+    /// that hold its contact ([`BoxDrop::contact_features`]), and that contact.
+    fn triangle_contact(&self, slot: usize, features: u8, p: Point2) -> (f64, u8, Contact) {
         let probe = self.probe;
         let cl = self.drop.drop_one_features(slot, features, p, probe.z - probe.step);
-        (cl.tip.z - probe.z, self.drop.contact_features(slot, &cl.contact))
+        (cl.tip.z - probe.z, self.drop.contact_features(slot, &cl.contact), cl.contact)
     }
 
     /// [`Local::triangle_height`] on the facet and the corners and edges in
@@ -318,16 +322,17 @@ impl Local<'_> {
         let mut first: Option<(f64, Option<usize>)> = None;
         let mut at_mid: Option<(f64, Option<usize>)> = None;
         let mut features = ALL_FEATURES;
+        let mut contact = Contact::Floor;
         if let Some(seed) = self.seed.get() {
             // The seed's last contact features first (the contact moves little
             // from one midpoint to the next), the whole triangle if they do not lift.
             let last = self.seed_features.get();
-            let (mut h_seed, mut held) = self.triangle_contact(seed, last, mid);
+            let (mut h_seed, mut held, mut seed_contact) = self.triangle_contact(seed, last, mid);
             if h_seed <= 0.0 && last != ALL_FEATURES {
-                (h_seed, held) = self.triangle_contact(seed, ALL_FEATURES, mid);
+                (h_seed, held, seed_contact) = self.triangle_contact(seed, ALL_FEATURES, mid);
             }
             if h_seed > 0.0 {
-                features = held;
+                (features, contact) = (held, seed_contact);
                 // Where the last Newton start's slope puts the contour within
                 // `accept`, the full evaluation that accepts the chord comes
                 // first (elsewhere the seed's own height there decides, below).
@@ -345,14 +350,25 @@ impl Local<'_> {
                 at_mid = Some((h_seed, Some(seed)));
             }
         }
-        let (h_mid, slot_mid) = at_mid.unwrap_or_else(|| self.height_slot(mid));
+        let (h_mid, slot_mid) = at_mid.unwrap_or_else(|| {
+            let (h, slot) = self.height_slot(mid);
+            contact = self.contact.get();
+            (h, slot)
+        });
         let mid_in = h_mid > 0.0;
         let towards = if mid_in { -normal } else { normal };
         if let Some(slot) = slot_mid {
             // The features of the seed's contact where the seed stands for the
             // contact triangle, else the whole triangle.
             let features = if at_mid.is_some() { features } else { ALL_FEATURES };
-            match self.newton_near(mid, towards, mid_in, (h_mid, slot, features), accept, reach, &mut first) {
+            // The slope of that height along the line, from its contact, and
+            // how far along the line the contact stays within the cutter's
+            // radius (past it the height jumps: no Newton step beyond).
+            let slope = self.drop.contact_gradient(&contact, mid).map(|g| {
+                (g[0] * towards.x + g[1] * towards.y, rim_distance(&contact, mid, towards, self.probe.cutter.radius()))
+            });
+            let start = (h_mid, slot, features, slope);
+            match self.newton_near(mid, towards, mid_in, start, accept, reach, &mut first) {
                 Start::Settled(near) => return near,
                 Start::Open => {}
             }
@@ -425,7 +441,7 @@ impl Local<'_> {
         mid: Point2,
         towards: Vec2,
         mid_in: bool,
-        (h_mid, slot, features): (f64, usize, u8),
+        (h_mid, slot, features, slope): (f64, usize, u8, Option<(f64, f64)>),
         accept: f64,
         reach: f64,
         first: &mut Option<(f64, Option<usize>)>,
@@ -433,28 +449,53 @@ impl Local<'_> {
         // The triangle's height on the features that hold its contact at the
         // midpoint: smooth where the contour follows one feature.
         let height = |p: Point2| self.feature_height(slot, features, p);
-        let near = mid + towards * accept;
-        let h_near = height(near);
-        // The triangle's height falls (from inside) or rises (from outside) towards the contour.
-        let fall = h_mid - h_near;
-        self.slope.set(fall.abs() / accept);
-        if mid_in && h_near <= 0.0 {
-            if first.is_none() {
-                let (h, next) = self.side_slot(near);
-                if h <= 0.0 {
-                    return Start::Settled(Near::Within); // inside at the midpoint, outside within `accept`
+        // Where the contact's slope along the line puts the root well past
+        // `accept`, the Newton step from the midpoint alone: the crossing then
+        // lies beyond `near` (the bracket below checks it), whose height is not
+        // needed. The stretch from the midpoint up to the bracket is then the
+        // one the convexity argument covers.
+        let newton = slope.and_then(|(g, rim)| {
+            let root = -h_mid / g;
+            // From inside, where the contact leaves the cutter's radius before
+            // its height falls to z, the height jumps there (a wall's top edge
+            // held by the rim): the rim is the guess. From outside, only a
+            // root well inside it.
+            let root = if mid_in {
+                root.min(rim)
+            } else if root < RIM_SHARE * rim {
+                root
+            } else {
+                return None;
+            };
+            (root.is_finite() && root > NEWTON_SKIP * accept).then_some((root, g))
+        });
+        let (mut root, near, h_near, r_near) = if let Some((root, g)) = newton {
+            self.slope.set(g.abs());
+            (root, mid, h_mid, 0.0)
+        } else {
+            let near = mid + towards * accept;
+            let h_near = height(near);
+            // The triangle's height falls (from inside) or rises (from outside) towards the contour.
+            let fall = h_mid - h_near;
+            self.slope.set(fall.abs() / accept);
+            if mid_in && h_near <= 0.0 {
+                if first.is_none() {
+                    let (h, next) = self.side_slot(near);
+                    if h <= 0.0 {
+                        return Start::Settled(Near::Within); // inside at the midpoint, outside within `accept`
+                    }
+                    *first = Some((h, next));
                 }
-                *first = Some((h, next));
+                return Start::Open; // another triangle lifts the cutter within `accept`
             }
-            return Start::Open; // another triangle lifts the cutter within `accept`
-        }
-        if !mid_in && h_near > 0.0 {
-            return Start::Settled(Near::Within); // outside at the midpoint, inside within `accept`
-        }
-        if !(if mid_in { fall > 0.0 } else { fall < 0.0 }) {
-            return Start::Open;
-        }
-        let mut root = accept + h_near * accept / fall;
+            if !mid_in && h_near > 0.0 {
+                return Start::Settled(Near::Within); // outside at the midpoint, inside within `accept`
+            }
+            if !(if mid_in { fall > 0.0 } else { fall < 0.0 }) {
+                return Start::Open;
+            }
+            (accept + h_near * accept / fall, near, h_near, accept)
+        };
         let half = SECANT_PROBE * self.probe.tolerance;
         let at = |r: f64| mid + towards * r;
         let settle =
@@ -487,7 +528,7 @@ impl Local<'_> {
         } else {
             // Secant steps on the triangle's height until it lifts the cutter
             // past the guess (from below where the height is concave).
-            let (mut r_last, mut h_last) = (accept, h_near);
+            let (mut r_last, mut h_last) = (r_near, h_near);
             for _ in 0..MAX_NEWTON_STEPS {
                 if !(root.is_finite() && root > r_last && root + half <= reach) {
                     return Start::Open;
@@ -598,6 +639,30 @@ impl Local<'_> {
         }
         outside
     }
+}
+
+/// The Newton start of [`Local::newton_near`] skips the triangle's height at
+/// the accepted distance where the contact's slope puts the root beyond this
+/// many accepted distances.
+const NEWTON_SKIP: f64 = 2.0;
+
+/// From an outside midpoint, the Newton start from the contact's slope is kept
+/// only where its root lies within this share of the rim distance
+/// ([`rim_distance`]).
+const RIM_SHARE: f64 = 0.5;
+
+/// How far from `p` along `u` (unit) the point of `contact` stays within
+/// `radius` of the cutter's axis in XY (0 on the floor, or already past it).
+fn rim_distance(contact: &Contact, p: Point2, u: Vec2, radius: f64) -> f64 {
+    let q = match contact {
+        Contact::Vertex { point, .. } | Contact::Edge { point, .. } | Contact::Facet { point, .. } => point,
+        Contact::Floor => return 0.0,
+    };
+    let (dx, dy) = (p.x - q.x, p.y - q.y);
+    let b = dx * u.x + dy * u.y;
+    let c = dx * dx + dy * dy - radius * radius;
+    let disc = b * b - c;
+    if c >= 0.0 || disc < 0.0 { 0.0 } else { -b + disc.sqrt() }
 }
 
 /// Most triangles [`Local::walk_bracket`] steps through before the plain

@@ -454,6 +454,31 @@ impl BoxDrop<'_> {
         }
     }
 
+    /// The gradient (mm per mm, in XY) at `xy` of the tip height given by a
+    /// contact at `contact`'s point with the cutter at `xy` (of the triangle's
+    /// height, or of the drop-cutter's, where that contact is its only one):
+    /// by the envelope theorem, the derivative of `q.z - h(|q - xy|)` in `xy`
+    /// at the contact point q, `h'(rho) (q - xy) / rho`. `None` on the floor,
+    /// where the contact is on the cutter's axis or the profile's slope is 0 or
+    /// infinite there (a flat bottom, a ball's rim). A guess for root finders:
+    /// the heights themselves come from evaluations.
+    #[must_use]
+    pub fn contact_gradient(&self, contact: &Contact, xy: Point2) -> Option<[f64; 2]> {
+        let q = match contact {
+            Contact::Vertex { point, .. } | Contact::Edge { point, .. } | Contact::Facet { point, .. } => point,
+            Contact::Floor => return None,
+        };
+        let (dx, dy) = (q.x - xy.x, q.y - xy.y);
+        let rho = (dx * dx + dy * dy).sqrt();
+        // On the axis, or on the rim (a cone's, which holds the contact
+        // while the cutter moves: the envelope theorem does not apply there).
+        if !(rho > 0.0 && rho < RIM_FRACTION * self.profile.radius) {
+            return None;
+        }
+        let k = self.profile.slope(rho)? / rho;
+        Some([k * dx, k * dy])
+    }
+
     /// Whether the one triangle in `slot` lifts the cutter at `xy` above `z`:
     /// the answer of `drop_one(slot, xy, floor).tip.z > z` for any floor below
     /// z (every contact is computed as there), found with the search pruned
@@ -481,6 +506,10 @@ impl BoxDrop<'_> {
         reach::rim_exit(self.index.corners(slot), radius, z + self.profile.height(radius), a, b)
     }
 }
+
+/// Contacts this far out of the cutter's radius or farther are on its rim
+/// ([`BoxDrop::contact_gradient`]).
+const RIM_FRACTION: f64 = 1.0 - 1e-9;
 
 /// Reusable buffers of one worker: the candidates of the current block.
 #[derive(Default)]
