@@ -53,7 +53,11 @@ fn limit_pass(placer: &Placer, body: &BodyCheck) -> (Vec<SyncPoint>, Vec<Placeme
 /// floor) more than the allowance from the wall.
 /// The limit pass of the floor's tool along `wall` (pairs, tools) and the
 /// rest pass's runs after it.
-fn rest_pass(placer: &Placer, wall: &TriMesh, query: &MeshQuery) -> (Vec<SyncPoint>, Vec<Placement>, Vec<Vec<SyncPoint>>) {
+fn rest_pass(
+    placer: &Placer,
+    wall: &TriMesh,
+    query: &MeshQuery,
+) -> (Vec<SyncPoint>, Vec<Placement>, Vec<Vec<SyncPoint>>) {
     let cutter = common::torus(30.0, 192.0);
     let body = BodyCheck::new(wall, &cutter, 0.0);
     let rest = BodyCheck::new(wall, &cutter, ALLOWANCE);
