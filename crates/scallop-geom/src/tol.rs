@@ -831,6 +831,14 @@ pub mod rough {
     /// of R apart (a loop's place and its look-ahead probe).
     pub const LOOP_SAMPLE_SHARE: f64 = 0.01;
 
+    /// Adaptive clearing's rings (docs/roughing.md, "Adaptive clearing"):
+    /// a run of loops along less than this share of R is left out (the ring
+    /// slots there). Short runs are the tips of tooth gaps narrowing below
+    /// any loop, where loops of shrinking radius cost seconds each and
+    /// leave the tip's slot; channels the walk could not turn into are
+    /// longer.
+    pub const LOOP_MIN_RUN_SHARE: f64 = 3.0;
+
     /// Most loops in one level (bounds the work on absurd inputs).
     pub const MAX_LOOPS: usize = 2_000_000;
 

@@ -231,20 +231,25 @@ pub fn plan_adaptive_in(
     // neck narrower than its steps, or a tooth gap it could not turn into):
     // a new entry at the deepest centre far from every cut, each.
     let far = r + 2.0 * h;
+    // Entries tried from which nothing could be cut: not tried again. Their
+    // bores stay out of the swept field (nothing was cut there: the region's
+    // rings meet that material, and cut it with loops, `Planner::finish`).
+    let mut tried = vec![false; planner.grid.len()];
     for _ in 0..tol::MAX_ENTRIES {
         let Some(k) = (0..planner.grid.len())
-            .filter(|&k| planner.inside[k] && depth[k] < 0.5 * BIG && planner.swept[k] > far)
+            .filter(|&k| !tried[k] && planner.inside[k] && depth[k] < 0.5 * BIG && planner.swept[k] > far)
             .filter(|&k| planner.open.as_ref().is_none_or(|out| out[k] < r))
             .max_by(|&a, &b| depth[a].total_cmp(&depth[b]).then(b.cmp(&a)))
         else {
             break;
         };
         let e = planner.grid.centre(k);
+        tried[k] = true;
         if !planner.edges.contains(e) {
-            planner.swept[k] = 0.0;
             continue;
         }
         let r0 = if rh > 0.0 && region.holds_disc(e, rh) { rh } else { 0.0 };
+        let saved = (planner.swept.clone(), planner.lattice.clone(), planner.starts.len());
         walk.steps.push(Step::Link { tool_down: false, via: Vec::new(), cleared: false, to: None });
         #[allow(clippy::cast_possible_truncation, reason = "passes are bounded by MAX_PASSES")]
         planner.bore(e, r0, walk.passes as u32);
@@ -254,7 +259,8 @@ pub fn plan_adaptive_in(
             // Nothing cut from there: the entry alone, a plunge or a helix;
             // the tool is still where the last walk left it.
             walk.steps.pop();
-            planner.swept[k] = 0.0;
+            planner.starts.truncate(saved.2);
+            (planner.swept, planner.lattice) = (saved.0, saved.1);
         } else {
             end = reached;
         }
@@ -1055,6 +1061,28 @@ impl Planner<'_> {
             let i = (0..started.len()).min_by(|&x, &y| d(&started[x]).total_cmp(&d(&started[y]))).unwrap_or(0);
             let ring = started[i].clone();
             rings.remove(i);
+            // Where the ring meets material the walk did not reach on its
+            // inner side too (a channel narrower than a pass could turn in,
+            // a tooth gap), it would slot: loops there, as the offset
+            // pattern's (docs/roughing.md, "Slots: loops").
+            let ring = {
+                let chip = tol::AIR_RING_CHIP;
+                let cleared = |y: P2| {
+                    self.grid.sample(&self.swept, y) <= r - chip
+                        || self.grid.locate(y).is_some_and(|at| self.open_at(at))
+                };
+                let climb = matches!(self.options.direction, Direction::Climb);
+                let target = self.target;
+                let mut looper = crate::offset::loops::Looper::after(
+                    region,
+                    &cleared,
+                    r,
+                    climb,
+                    target,
+                    self.options.chord_tolerance,
+                );
+                looper.looped(&ring)
+            };
             let Some(start) = ring.start() else { continue };
             let link = self.link_step(pos, start);
             steps.push(link);

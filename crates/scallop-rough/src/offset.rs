@@ -20,7 +20,7 @@ use scallop_contour::{Contour, P2, Region};
 
 use crate::{ClearOptions, Direction, RoughError, tol};
 
-mod loops;
+pub(crate) mod loops;
 
 /// One step of a clearing plan in the plane.
 #[derive(Debug, Clone)]

@@ -425,3 +425,24 @@ fn passes_as_arcs_stay_in_the_region() {
         assert!(arcs > 100, "{arcs} arcs");
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(3))]
+
+    #[test]
+    fn fingers_the_walk_cannot_turn_into_are_looped_not_slotted(
+        w in proptest::collection::vec(2.0 * R + 0.25 * R..2.0 * R + 0.45 * R, 1..3)
+    ) {
+        // Fingers a few tenths of R wider than the tool (the bench's 7 mm
+        // finger for a 6 mm tool): the walk's steps cannot turn in them, and
+        // the region's ring used to cut each one as a slot from its mouth to
+        // its end; it is cut with loops there now (docs/roughing.md,
+        // "Adaptive clearing", the region's rings).
+        let (pocket, plan) = plan(&comb(&w));
+        let report = judge(&pocket, &plan);
+        check_cleared(&report);
+        // What is left: where the finger's end meets a loop's sliver, as in
+        // the offset pattern's loops (`prop_loops.rs`).
+        prop_assert!(report.slot_length <= 0.25, "slot {:.2} mm at {:?}", report.slot_length, report.max_at);
+    }
+}

@@ -33,9 +33,14 @@ const RADIUS_SHARES: [f64; 16] =
 
 /// The loops of one level's rings: what the deeper rings and the loops
 /// already cut swept.
-pub(super) struct Looper<'a> {
+pub(crate) struct Looper<'a> {
     /// Where a tool centre may go (the loops' circles stay in it).
     region: &'a Region,
+    /// What an earlier clearing swept, when not offset rings (the adaptive
+    /// walk's field): whether the periphery point is cut.
+    cleared: Option<&'a dyn Fn(P2) -> bool>,
+    /// Runs of loops shorter than this along the ring are left out.
+    min_run: f64,
     /// `levels[k + 1]` grown by R less the chip: swept by the deeper rings.
     deeper: Option<Banded>,
     /// The region grown by R less two chips: where the tool can meet stock.
@@ -50,13 +55,13 @@ pub(super) struct Looper<'a> {
     buckets: HashMap<(i64, i64), Vec<usize>>,
     cell: f64,
     /// Loops made (bounded by [`tol::MAX_LOOPS`]).
-    pub(super) count: usize,
+    pub(crate) count: usize,
 }
 
 impl<'a> Looper<'a> {
     /// `deeper`: `levels[k + 1]`, `None` at the deepest level; `target` the
     /// engagement angle (rad) the loops hold.
-    pub(super) fn new(
+    pub(crate) fn new(
         region: &'a Region,
         deeper: Option<&Region>,
         radius: f64,
@@ -68,6 +73,8 @@ impl<'a> Looper<'a> {
         let reach = Banded::new(&region.offset(-(radius - 2.0 * tol::AIR_RING_CHIP)), chord);
         Looper {
             region,
+            cleared: None,
+            min_run: 0.0,
             deeper,
             reach,
             radius,
@@ -78,6 +85,24 @@ impl<'a> Looper<'a> {
             buckets: HashMap::new(),
             cell: 4.0 * radius,
             count: 0,
+        }
+    }
+
+    /// Loops on the rings of a region an earlier clearing left: `cleared`
+    /// tells whether a point of the periphery was cut (docs/roughing.md,
+    /// "Adaptive clearing", the region's rings).
+    pub(crate) fn after(
+        region: &'a Region,
+        cleared: &'a dyn Fn(P2) -> bool,
+        radius: f64,
+        climb: bool,
+        target: f64,
+        chord: f64,
+    ) -> Looper<'a> {
+        Looper {
+            cleared: Some(cleared),
+            min_run: tol::LOOP_MIN_RUN_SHARE * radius,
+            ..Looper::new(region, None, radius, climb, target, chord)
         }
     }
 
@@ -115,6 +140,7 @@ impl<'a> Looper<'a> {
     /// or in a loop's disc (less the chip).
     fn swept(&self, y: P2) -> bool {
         self.deeper.as_ref().is_some_and(|d| d.contains(y))
+            || self.cleared.is_some_and(|f| f(y))
             || self.buckets.get(&self.key(y)).is_some_and(|v| {
                 v.iter().any(|&i| {
                     let (c, reach) = self.discs[i];
@@ -134,7 +160,7 @@ impl<'a> Looper<'a> {
 
     /// `cut` with loops where its inner side meets material the deeper
     /// rings did not sweep; `cut` itself where there is none.
-    pub(super) fn looped(&mut self, cut: &Contour) -> Contour {
+    pub(crate) fn looped(&mut self, cut: &Contour) -> Contour {
         let closed = cut.is_closed();
         let samples = sample(cut, self.chord, self.side, tol::LOOP_SAMPLE_SHARE * self.radius);
         let n = samples.len();
@@ -233,10 +259,37 @@ impl<'a> Looper<'a> {
             most = (r + p).max(0.25 * self.radius);
             i += 1;
         }
+        if self.min_run > 0.0 {
+            loops = self.long_runs(&samples, &loops);
+        }
         if loops.is_empty() {
             return cut.clone();
         }
         self.build(&samples, &loops, closed).unwrap_or_else(|| cut.clone())
+    }
+
+    /// The loops of the runs at least `min_run` long along the ring (a run
+    /// ends where the next loop is farther on than the last one's reach, as
+    /// in [`Looper::looped`]).
+    fn long_runs(&self, samples: &[Sample], loops: &[(usize, f64)]) -> Vec<(usize, f64)> {
+        let mut kept = Vec::new();
+        let mut run: Vec<(usize, f64)> = Vec::new();
+        let mut flush = |run: &mut Vec<(usize, f64)>| {
+            if let (Some(a), Some(b)) = (run.first(), run.last()) {
+                if samples[b.0].cum - samples[a.0].cum >= self.min_run {
+                    kept.extend_from_slice(run);
+                }
+            }
+            run.clear();
+        };
+        for &l in loops {
+            if run.last().is_some_and(|&(i, r)| samples[l.0].cum - samples[i].cum > 2.0 * (r + self.radius)) {
+                flush(&mut run);
+            }
+            run.push(l);
+        }
+        flush(&mut run);
+        kept
     }
 
     /// The contour through the samples with a full circle at each loop,
