@@ -1055,6 +1055,9 @@ impl Planner<'_> {
         for corner in &corners {
             self.clear_corner(corner, &mut pos, &mut steps);
         }
+        let climb = matches!(self.options.direction, Direction::Climb);
+        let mut looper =
+            crate::offset::loops::Looper::after(region, r, climb, self.target, self.options.chord_tolerance);
         while !rings.is_empty() {
             let started: Vec<Contour> = rings.iter().map(|c| c.starting_near(pos)).collect();
             let d = |c: &Contour| c.start().map_or(f64::INFINITY, |p| dist(p, pos));
@@ -1071,17 +1074,7 @@ impl Planner<'_> {
                     self.grid.sample(&self.swept, y) <= r - chip
                         || self.grid.locate(y).is_some_and(|at| self.open_at(at))
                 };
-                let climb = matches!(self.options.direction, Direction::Climb);
-                let target = self.target;
-                let mut looper = crate::offset::loops::Looper::after(
-                    region,
-                    &cleared,
-                    r,
-                    climb,
-                    target,
-                    self.options.chord_tolerance,
-                );
-                looper.looped(&ring)
+                looper.looped_after(&ring, &cleared)
             };
             let Some(start) = ring.start() else { continue };
             let link = self.link_step(pos, start);

@@ -36,9 +36,6 @@ const RADIUS_SHARES: [f64; 16] =
 pub(crate) struct Looper<'a> {
     /// Where a tool centre may go (the loops' circles stay in it).
     region: &'a Region,
-    /// What an earlier clearing swept, when not offset rings (the adaptive
-    /// walk's field): whether the periphery point is cut.
-    cleared: Option<&'a dyn Fn(P2) -> bool>,
     /// Runs of loops shorter than this along the ring are left out.
     min_run: f64,
     /// `levels[k + 1]` grown by R less the chip: swept by the deeper rings.
@@ -73,7 +70,6 @@ impl<'a> Looper<'a> {
         let reach = Banded::new(&region.offset(-(radius - 2.0 * tol::AIR_RING_CHIP)), chord);
         Looper {
             region,
-            cleared: None,
             min_run: 0.0,
             deeper,
             reach,
@@ -88,22 +84,11 @@ impl<'a> Looper<'a> {
         }
     }
 
-    /// Loops on the rings of a region an earlier clearing left: `cleared`
-    /// tells whether a point of the periphery was cut (docs/roughing.md,
-    /// "Adaptive clearing", the region's rings).
-    pub(crate) fn after(
-        region: &'a Region,
-        cleared: &'a dyn Fn(P2) -> bool,
-        radius: f64,
-        climb: bool,
-        target: f64,
-        chord: f64,
-    ) -> Looper<'a> {
-        Looper {
-            cleared: Some(cleared),
-            min_run: tol::LOOP_MIN_RUN_SHARE * radius,
-            ..Looper::new(region, None, radius, climb, target, chord)
-        }
+    /// Loops on the rings of a region an earlier clearing left
+    /// ([`Looper::looped_after`]; docs/roughing.md, "Adaptive clearing", the
+    /// region's rings).
+    pub(crate) fn after(region: &'a Region, radius: f64, climb: bool, target: f64, chord: f64) -> Looper<'a> {
+        Looper { min_run: tol::LOOP_MIN_RUN_SHARE * radius, ..Looper::new(region, None, radius, climb, target, chord) }
     }
 
     fn grown(deeper: Option<&Region>, radius: f64, chord: f64) -> Option<Banded> {
@@ -138,9 +123,9 @@ impl<'a> Looper<'a> {
 
     /// The tool's periphery at `y` is swept: within R of `levels[k + 1]`
     /// or in a loop's disc (less the chip).
-    fn swept(&self, y: P2) -> bool {
+    fn swept(&self, y: P2, cleared: Option<&dyn Fn(P2) -> bool>) -> bool {
         self.deeper.as_ref().is_some_and(|d| d.contains(y))
-            || self.cleared.is_some_and(|f| f(y))
+            || cleared.is_some_and(|f| f(y))
             || self.buckets.get(&self.key(y)).is_some_and(|v| {
                 v.iter().any(|&i| {
                     let (c, reach) = self.discs[i];
@@ -161,6 +146,17 @@ impl<'a> Looper<'a> {
     /// `cut` with loops where its inner side meets material the deeper
     /// rings did not sweep; `cut` itself where there is none.
     pub(crate) fn looped(&mut self, cut: &Contour) -> Contour {
+        self.looped_by(cut, None)
+    }
+
+    /// As [`Looper::looped`], what an earlier clearing swept told by
+    /// `cleared` (whether a point of the periphery is cut: the adaptive
+    /// walk's field) besides the deeper rings and the loops.
+    pub(crate) fn looped_after(&mut self, cut: &Contour, cleared: &dyn Fn(P2) -> bool) -> Contour {
+        self.looped_by(cut, Some(cleared))
+    }
+
+    fn looped_by(&mut self, cut: &Contour, cleared: Option<&dyn Fn(P2) -> bool>) -> Contour {
         let closed = cut.is_closed();
         let samples = sample(cut, self.chord, self.side, tol::LOOP_SAMPLE_SHARE * self.radius);
         let n = samples.len();
@@ -224,10 +220,10 @@ impl<'a> Looper<'a> {
             let ahead_material = |r: f64| {
                 last.is_some() && {
                     let f = front(r);
-                    self.reach.contains(f) && !self.swept(f)
+                    self.reach.contains(f) && !self.swept(f, cleared)
                 }
             };
-            if self.swept(probe_at(r, p)) && !ahead_material(r) {
+            if self.swept(probe_at(r, p), cleared) && !ahead_material(r) {
                 if last.is_some_and(|l| s.cum - l.0 > 2.0 * (l.2 + self.radius)) {
                     // A run ended: the next one starts small again.
                     last = None;
@@ -247,7 +243,7 @@ impl<'a> Looper<'a> {
                 continue;
             };
             let (r, p) = (RADIUS_SHARES[k] * self.radius, self.advance_of(k));
-            if k != guess && self.swept(probe_at(r, p)) && !ahead_material(r) {
+            if k != guess && self.swept(probe_at(r, p), cleared) && !ahead_material(r) {
                 i += 1;
                 continue;
             }
