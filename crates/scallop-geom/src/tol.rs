@@ -839,6 +839,36 @@ pub mod rough {
     /// longer.
     pub const LOOP_MIN_RUN_SHARE: f64 = 3.0;
 
+    /// Offset clearing's transitions from a ring to the next one out
+    /// (docs/roughing.md, "Offset clearing", transitions): the engagement
+    /// they are planned to hold, as a share of the target.
+    pub const TRANSITION_ENGAGEMENT: f64 = 1.05;
+
+    /// Or this share of the target above the ring's own engagement, where
+    /// the ring's curvature takes that over [`TRANSITION_ENGAGEMENT`].
+    pub const TRANSITION_OVER: f64 = 0.02;
+
+    /// The ring's curvature for a transition: its mean along this share of R.
+    pub const TRANSITION_BEND_SHARE: f64 = 4.0;
+
+    /// Most steps of a transition's depth profile (bounds the work).
+    pub const TRANSITION_MAX_STEPS: usize = 100_000;
+
+    /// A transition's angle to the ring stays this share under what the
+    /// engagement allows.
+    pub const TRANSITION_MARGIN: f64 = 0.1;
+
+    /// Points along a transition at most this share of R apart.
+    pub const TRANSITION_STEP_SHARE: f64 = 0.05;
+
+    /// Largest turn (rad) between chords of either ring along a transition
+    /// (15 degrees; a corner or a loop there keeps the straight link).
+    pub const TRANSITION_TURN: f64 = std::f64::consts::PI / 12.0;
+
+    /// A transition's end lies on the next ring within this share of ae
+    /// (else that ring is not the offset of the last one there).
+    pub const TRANSITION_FIT_SHARE: f64 = 0.01;
+
     /// Most loops in one level (bounds the work on absurd inputs).
     pub const MAX_LOOPS: usize = 2_000_000;
 

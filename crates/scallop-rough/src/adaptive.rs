@@ -231,9 +231,10 @@ pub fn plan_adaptive_in(
     // neck narrower than its steps, or a tooth gap it could not turn into):
     // a new entry at the deepest centre far from every cut, each.
     let far = r + 2.0 * h;
-    // Entries tried from which nothing could be cut: not tried again. Their
-    // bores stay out of the swept field (nothing was cut there: the region's
-    // rings meet that material, and cut it with loops, `Planner::finish`).
+    // Entries tried from which nothing could be cut: no entry is tried again
+    // within `far` of one. Their bores stay out of the swept field (nothing
+    // was cut there: the region's rings meet that material, and cut it with
+    // loops, `Planner::finish`).
     let mut tried = vec![false; planner.grid.len()];
     for _ in 0..tol::MAX_ENTRIES {
         let Some(k) = (0..planner.grid.len())
@@ -261,6 +262,21 @@ pub fn plan_adaptive_in(
             walk.steps.pop();
             planner.starts.truncate(saved.2);
             (planner.swept, planner.lattice) = (saved.0, saved.1);
+            let g = &planner.grid;
+            #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "clamped to the grid")]
+            let span = |c: f64, o: f64, n: usize| {
+                let lo = ((c - far - o) / g.h).floor().max(0.0) as usize;
+                let hi = (((c + far - o) / g.h).ceil().max(0.0) as usize).min(n - 1);
+                lo..=hi
+            };
+            for j in span(e[1], g.y0, g.ny) {
+                for i in span(e[0], g.x0, g.nx) {
+                    let m = j * g.nx + i;
+                    if dist(g.centre(m), e) <= far {
+                        tried[m] = true;
+                    }
+                }
+            }
         } else {
             end = reached;
         }

@@ -16,7 +16,7 @@
 //! pass does: such links stay down at the cutting depth; any other is a
 //! retract.
 
-use scallop_contour::{Contour, P2, Region};
+use scallop_contour::{Contour, P2, Region, Vertex};
 
 use crate::{ClearOptions, Direction, RoughError, tol};
 
@@ -256,6 +256,8 @@ pub fn plan_offset_in(
     let climb = matches!(options.direction, Direction::Climb);
     let with_loops = matches!(options.pattern, crate::Pattern::OffsetLoops);
     let mut looper = with_loops.then(|| loops::Looper::new(region, None, r, climb, target, tol_c));
+    // The last wall ring cut, when closed (a transition leaves it).
+    let mut last_ring: Option<Contour> = None;
     for k in (0..levels.len()).rev() {
         let mut pieces = std::mem::take(&mut wall_pieces[k]);
         if let Some(looper) = looper.as_mut().filter(|_| !pieces.is_empty()) {
@@ -283,6 +285,20 @@ pub fn plan_offset_in(
                 Some(looper) => looper.looped(&cut),
                 None => cut,
             };
+            // From the ring just cut into this one, ae out, without a stop:
+            // a transition that leaves the last ring along it and reaches
+            // this one tangentially (docs/roughing.md, "Offset clearing",
+            // transitions).
+            let (cut, ring) = match (&last_ring, pos) {
+                (Some(prev), Some(p)) if cut.is_closed() => {
+                    match transition(prev, &cut, p, ae, r, target, climb, tol_c, &holder) {
+                        Some((way, ring)) => (way, Some(ring)),
+                        None => (cut.clone(), Some(cut)),
+                    }
+                }
+                _ => (cut.clone(), Some(cut).filter(Contour::is_closed)),
+            };
+            last_ring = ring;
             let Some(start) = cut.start() else { continue };
             match pos {
                 Some(p) => {
@@ -305,6 +321,182 @@ pub fn plan_offset_in(
         }
     }
     Ok(steps)
+}
+
+/// The transition from the closed ring `prev`, cut last and starting (and
+/// ending) at `p`, into the closed ring `next` lying `ae` outside it: the
+/// tool goes on along `prev` and moves out, its heading turning away from
+/// the ring by at most a radian per R of path (no corner where it leaves
+/// `prev`) and by no more than the engagement allows, to `next` at `s = L`
+/// (met at the angle the bound allows there, a degree or two), then around
+/// `next` back to that point. The result is the cut from `p`
+/// (the transition's points, then `next` from where it was reached) and
+/// `next` starting there.
+///
+/// The way keeps the engagement within [`tol::TRANSITION_ENGAGEMENT`] x
+/// `target`, or [`tol::TRANSITION_OVER`] x `target` above the ring's own
+/// where its curvature takes that higher: moving out at an angle `beta` to
+/// the band, `d` deep of its `ae`, the front half of the periphery meets the
+/// band over `beta` more than moving along it (`arccos(1 - d / R)` on a
+/// straight band), so `beta` may be at most `phi - engagement(d)` (less
+/// [`tol::TRANSITION_MARGIN`] of it).
+///
+/// `None` (a straight link instead) where either ring turns by more than [`tol::TRANSITION_TURN`]
+/// between chords along the way, where `next` is not `ae` outside `prev`
+/// there (a ring of another branch), or where the way leaves `holder`.
+#[allow(clippy::too_many_arguments, reason = "the rings and the cut's figures")]
+fn transition(
+    prev: &Contour,
+    next: &Contour,
+    p: P2,
+    ae: f64,
+    r: f64,
+    target: f64,
+    climb: bool,
+    tol_c: f64,
+    holder: &Region,
+) -> Option<(Contour, Contour)> {
+    let pts = prev.to_points(tol_c);
+    let side = if climb { 1.0 } else { -1.0 };
+    // The ring's curvature towards its inner side along the way (a ring
+    // turning that way meets more of its band: `engaged`), 0 where it turns
+    // the other way (less: the straight band's figure holds).
+    let bend = {
+        let (mut turn, mut run) = (0.0, 0.0);
+        for w in pts.windows(3) {
+            let (u, v) = ([w[1][0] - w[0][0], w[1][1] - w[0][1]], [w[2][0] - w[1][0], w[2][1] - w[1][1]]);
+            turn += (u[0] * v[1] - u[1] * v[0]).atan2(u[0] * v[0] + u[1] * v[1]);
+            run += u[0].hypot(u[1]);
+            if run > tol::TRANSITION_BEND_SHARE * r {
+                break;
+            }
+        }
+        if run > 0.0 { (side * turn / run).max(0.0) } else { 0.0 }
+    };
+    // The engagement `d` deep into the band moving along it: the arc of the
+    // front half beyond the last ring's swept boundary (a circle of radius
+    // `rho + R` about the ring's centre of curvature, the tool `rho + d`
+    // from it; straight, `arccos(1 - d / R)`).
+    let engaged = |d: f64| -> f64 {
+        let c = if bend > 0.0 {
+            let rho = 1.0 / bend;
+            let t = rho + d;
+            ((rho + r).powi(2) - t * t - r * r) / (2.0 * t * r)
+        } else {
+            1.0 - d / r
+        };
+        c.clamp(-1.0, 1.0).acos()
+    };
+    // The bound: the target's share, or a little above the ring's own
+    // engagement where its curvature takes it higher.
+    let phi = (tol::TRANSITION_ENGAGEMENT * target).max(engaged(ae) + tol::TRANSITION_OVER * target);
+    // The depth along the way: the heading's angle to the ring turns out at
+    // most one radian per R of path and stays within the bound less the
+    // margin (moving out at `beta`, the band meets the front half over
+    // `beta` more than along it).
+    let ds = tol::TRANSITION_STEP_SHARE * r / 4.0;
+    let (mut along, mut d, mut beta) = (0.0f64, 0.0f64, 0.0f64);
+    let mut profile: Vec<(f64, f64)> = vec![(0.0, 0.0)];
+    while d < ae {
+        let bound = (phi - engaged(d)) * (1.0 - tol::TRANSITION_MARGIN);
+        if bound <= 0.0 || profile.len() > tol::TRANSITION_MAX_STEPS {
+            return None;
+        }
+        beta = (beta + ds / r).min(bound);
+        d = (d + ds * beta.sin()).min(ae);
+        along += ds * beta.cos();
+        profile.push((along, d));
+    }
+    let l = along;
+    let depth = |s: f64| -> f64 {
+        let k = profile.partition_point(|q| q.0 < s).clamp(1, profile.len() - 1);
+        let ((s0, d0), (s1, d1)) = (profile[k - 1], profile[k]);
+        if s1 > s0 { d0 + (d1 - d0) * ((s - s0) / (s1 - s0)).clamp(0.0, 1.0) } else { d1 }
+    };
+    if pts.len() < 3 || prev.start().is_none_or(|s| (s[0] - p[0]).hypot(s[1] - p[1]) > tol_c) {
+        return None;
+    }
+    if prev.length() < 4.0 * l || next.length() < 4.0 * l {
+        return None;
+    }
+    let smooth = |q: &[P2], upto: f64| -> bool {
+        let mut run = 0.0;
+        for w in q.windows(3) {
+            let (u, v) = ([w[1][0] - w[0][0], w[1][1] - w[0][1]], [w[2][0] - w[1][0], w[2][1] - w[1][1]]);
+            let turn = (u[0] * v[1] - u[1] * v[0]).atan2(u[0] * v[0] + u[1] * v[1]).abs();
+            if turn > tol::TRANSITION_TURN {
+                return false;
+            }
+            run += u[0].hypot(u[1]);
+            if run > upto {
+                break;
+            }
+        }
+        true
+    };
+    let reach = l + 2.0 * ae;
+    if !smooth(&pts, reach) || !smooth(&next.to_points(tol_c), reach) {
+        return None;
+    }
+    // Points every share of R along `prev`, with their unit tangents.
+    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a small positive count")]
+    let m = ((l / (tol::TRANSITION_STEP_SHARE * r)).ceil() as usize).max(8);
+    let mut out: Vec<P2> = vec![p];
+    let (mut k, mut done) = (0usize, 0.0f64);
+    let next_pts = next.to_points(tol_c);
+    let on_next = |q: P2| -> f64 {
+        next_pts
+            .windows(2)
+            .map(|w| {
+                let (a, b) = (w[0], w[1]);
+                let ab = [b[0] - a[0], b[1] - a[1]];
+                let len2 = ab[0] * ab[0] + ab[1] * ab[1];
+                let t = if len2 > 0.0 {
+                    (((q[0] - a[0]) * ab[0] + (q[1] - a[1]) * ab[1]) / len2).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                (q[0] - a[0] - t * ab[0]).hypot(q[1] - a[1] - t * ab[1])
+            })
+            .fold(f64::INFINITY, f64::min)
+    };
+    for j in 1..=m {
+        #[allow(clippy::cast_precision_loss, reason = "a small count")]
+        let s = l * j as f64 / m as f64;
+        while k + 1 < pts.len() && done + (pts[k + 1][0] - pts[k][0]).hypot(pts[k + 1][1] - pts[k][1]) < s {
+            done += (pts[k + 1][0] - pts[k][0]).hypot(pts[k + 1][1] - pts[k][1]);
+            k += 1;
+        }
+        if k + 1 >= pts.len() {
+            return None;
+        }
+        let (a, b) = (pts[k], pts[k + 1]);
+        let len = (b[0] - a[0]).hypot(b[1] - a[1]);
+        if len <= 0.0 {
+            return None;
+        }
+        let t = [(b[0] - a[0]) / len, (b[1] - a[1]) / len];
+        let f = (s - done) / len;
+        let at = [a[0] + f * (b[0] - a[0]), a[1] + f * (b[1] - a[1])];
+        let n = [side * t[1], -side * t[0]];
+        let d = if j == m { ae } else { depth(s) };
+        let q = [at[0] + d * n[0], at[1] + d * n[1]];
+        if j == m && on_next(q) > tol::TRANSITION_FIT_SHARE * ae + 2.0 * tol_c {
+            // `next` is not `ae` outside `prev` here.
+            return None;
+        }
+        out.push(q);
+    }
+    let ring = next.starting_near(*out.last()?);
+    let start = ring.start()?;
+    *out.last_mut()? = start;
+    if !out.windows(2).all(|w| holder.contains_segment(w[0], w[1], tol_c)) {
+        return None;
+    }
+    let mut v: Vec<Vertex> = out[..out.len() - 1].iter().map(|q| Vertex { x: q[0], y: q[1], bulge: 0.0 }).collect();
+    v.extend(ring.vertices());
+    v.push(Vertex { x: start[0], y: start[1], bulge: 0.0 });
+    Some((Contour::new(&v, false).ok()?, ring))
 }
 
 /// The entry of an open side's piece from above at `start`: a straight
