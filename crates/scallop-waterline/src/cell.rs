@@ -43,18 +43,28 @@ pub(crate) struct Resolver<'a> {
     /// the crossings found on inner half-edges.
     nodes: Vec<Point2>,
     first_new: usize,
+    /// The sides of the cell linked at depth 0 (grid edges) whose midpoint's
+    /// side does not match the parity of the crossings found before it.
+    mismatched: Vec<usize>,
 }
 
 impl<'a> Resolver<'a> {
     /// A resolver on the candidate triangles of `local` (a box holding the
     /// cell) whose new nodes are numbered from `first_new`.
     pub(crate) fn new(local: &'a Local<'a>, first_new: usize) -> Self {
-        Resolver { local, nodes: Vec::new(), first_new }
+        Resolver { local, nodes: Vec::new(), first_new, mismatched: Vec::new() }
     }
 
-    /// The new crossings, numbered from `first_new` in order.
-    pub(crate) fn into_new_nodes(self) -> Vec<Point2> {
-        self.nodes
+    /// The new crossings, numbered from `first_new` in order, and the sides
+    /// (0 to 3) of the cell linked at depth 0 that hold more crossings than
+    /// were found on them: each side's midpoint is classified when the cell
+    /// is split, and where its side does not match the parity of the
+    /// crossings before it (a grid edge with ends on different sides is given
+    /// one crossing, step 2 of docs/waterline.md, but may hold three), the
+    /// cell is decided unsplit; the caller looks for the side's other
+    /// crossings ([`edge_crossings_split`]) and links the cell again.
+    pub(crate) fn into_parts(self) -> (Vec<Point2>, Vec<usize>) {
+        (self.nodes, self.mismatched)
     }
 
     /// The links (exit, entry) of `cell`, possibly through new crossings.
@@ -67,7 +77,7 @@ impl<'a> Resolver<'a> {
         }
         if depth < tol::MAX_SUBDIVISION_DEPTH {
             let mark = self.nodes.len();
-            if let Some(quarters) = self.split(cell, point) {
+            if let Some(quarters) = self.split(cell, point, depth) {
                 let mut links = Vec::new();
                 for q in &quarters {
                     links.extend(self.link(q, point, depth + 1));
@@ -109,8 +119,10 @@ impl<'a> Resolver<'a> {
 
     /// The four quarters of `cell`, with the crossings of its inner half-edges
     /// added as new nodes; `None` if a side's crossings do not match the side
-    /// of its midpoint (a crossing within the tolerance of the midpoint).
-    fn split(&mut self, cell: &Cell, point: &dyn Fn(usize) -> Point2) -> Option<[Cell; 4]> {
+    /// of its midpoint (more crossings on the side than were found, or a
+    /// crossing within the tolerance of the midpoint), those sides recorded
+    /// at `depth` 0.
+    fn split(&mut self, cell: &Cell, point: &dyn Fn(usize) -> Point2, depth: u32) -> Option<[Cell; 4]> {
         let c = cell.corners;
         let mid: [Point2; 4] = std::array::from_fn(|k| midpoint(c[k], c[(k + 1) % 4]));
         let centre = centre(cell);
@@ -118,6 +130,7 @@ impl<'a> Resolver<'a> {
         // Each side's crossings before and after its midpoint.
         let mut halves: [[Vec<usize>; 2]; 4] = Default::default();
         let mut mid_h = [(0.0, None); 4];
+        let mut mismatched = Vec::new();
         for k in 0..4 {
             let (a, b) = (c[k], c[(k + 1) % 4]);
             let d = b - a;
@@ -127,13 +140,19 @@ impl<'a> Resolver<'a> {
             }
             mid_h[k] = self.local.height_slot(mid[k]);
             if (halves[k][0].len() % 2 == 1) != (cell.inside[k] != (mid_h[k].0 > 0.0)) {
-                return None;
+                mismatched.push(k);
             }
+        }
+        if !mismatched.is_empty() {
+            if depth == 0 {
+                self.mismatched = mismatched;
+            }
+            return None;
         }
         // Inner half-edge k, from mid[k] to the centre: its crossings in that order.
         let mut inner: [Vec<usize>; 4] = Default::default();
         for k in 0..4 {
-            let found = self.crossings(mid[k], mid_h[k], centre, hc)?;
+            let found = crossings(self.local, mid[k], mid_h[k], centre, (hc, None))?;
             for p in found {
                 inner[k].push(self.first_new + self.nodes.len());
                 self.nodes.push(p);
@@ -166,18 +185,47 @@ impl<'a> Resolver<'a> {
             },
         ])
     }
+}
 
-    /// The contour crossings of the segment from `a` to `b` (heights and
-    /// contact slots as `Local::height_slot` gives them), in order from `a`.
-    /// `None` if `a` is inside without a contact triangle (outside the box).
-    fn crossings(&self, a: Point2, (ha, slot_a): (f64, Option<usize>), b: Point2, hb: f64) -> Option<Vec<Point2>> {
-        Some(match (ha > 0.0, hb > 0.0) {
-            (true, false) => vec![self.local.bisect_heights(a, ha, slot_a, b, hb)],
-            (false, true) => vec![self.local.bisect_heights(b, hb, None, a, ha)],
-            (true, true) => self.local.gaps(a, slot_a?, b, hb),
-            (false, false) => Vec::new(),
-        })
-    }
+/// The contour crossings of the segment from `a` to `b` (heights and
+/// contact slots as `Local::height_slot` gives them), in order from `a`: one
+/// where the ends are on different sides (the first from the inside end),
+/// the gaps where both are inside (`Local::gaps`), none where both are
+/// outside. `None` if `a` is inside without a contact triangle (outside the box).
+pub(crate) fn crossings(
+    local: &Local<'_>,
+    a: Point2,
+    (ha, slot_a): (f64, Option<usize>),
+    b: Point2,
+    (hb, slot_b): (f64, Option<usize>),
+) -> Option<Vec<Point2>> {
+    Some(match (ha > 0.0, hb > 0.0) {
+        (true, false) => vec![local.bisect_heights(a, ha, slot_a, b, hb)],
+        (false, true) => vec![local.bisect_heights(b, hb, slot_b, a, ha)],
+        (true, true) => local.gaps(a, slot_a?, b, hb),
+        (false, false) => Vec::new(),
+    })
+}
+
+/// The crossings of the grid edge from `a` to `b` found on its two halves
+/// (as [`crossings`]), its midpoint classified on the exact drop-cutter: where
+/// an edge holds three crossings (its ends on different sides, a gap in the
+/// inside stretch or an inside sliver in the outside one), the half whose ends
+/// are both inside is walked for its gaps, and a half whose ends differ is
+/// given its crossing. The midpoint is the one a cell's split classifies, so
+/// the crossings then match it. `None` as [`crossings`].
+pub(crate) fn edge_crossings_split(
+    local: &Local<'_>,
+    a: Point2,
+    at_a: (f64, Option<usize>),
+    b: Point2,
+    at_b: (f64, Option<usize>),
+) -> Option<Vec<Point2>> {
+    let m = midpoint(a, b);
+    let at_m = local.height_slot(m);
+    let mut out = crossings(local, a, at_a, m, at_m)?;
+    out.extend(crossings(local, m, at_m, b, at_b)?);
+    Some(out)
 }
 
 /// The links of a cell with at most one exit (an exit and its entry, which

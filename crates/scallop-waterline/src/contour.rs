@@ -27,21 +27,11 @@
 use rayon::prelude::*;
 use scallop_geom::Point2;
 
-use crate::cell::{Cell, Resolver, simple_links};
+use std::collections::BTreeMap;
+
+use crate::cell::{self, Cell, Resolver, simple_links};
 use crate::refine::Probe;
 use crate::{Level, WaterlineGrid};
-
-/// The crossings of one grid edge, in increasing x (horizontal) or y
-/// (vertical).
-struct EdgeCrossings {
-    id: usize,
-    points: Vec<Point2>,
-    /// Number of the first crossing in the flat list of all crossings.
-    offset: usize,
-}
-
-/// The links (exit, entry) of one cell and the crossings it adds inside.
-type CellLinks = (Vec<(usize, usize)>, Vec<Point2>);
 
 /// Grid edge numbering: horizontal edges first, then vertical ones.
 struct Numbering {
@@ -84,8 +74,9 @@ impl Numbering {
 
 /// The crossings of every edge that holds some, in increasing edge number:
 /// one per edge with ends on different sides, two per gap on an edge with
-/// both ends inside that no triangle certifies.
-fn edge_crossings(grid: &WaterlineGrid<'_>, level: &Level, probe: &Probe<'_>) -> Vec<EdgeCrossings> {
+/// both ends inside that no triangle certifies. Each edge's crossings are in
+/// increasing x (horizontal) or y (vertical).
+fn edge_crossings(grid: &WaterlineGrid<'_>, level: &Level, probe: &Probe<'_>) -> Vec<(usize, Vec<Point2>)> {
     let (nx, ny) = (grid.nx, grid.ny);
     let num = Numbering { nx, ny };
     // (edge, first end inside, crossing edge (else a gap candidate)). Every
@@ -149,70 +140,191 @@ fn edge_crossings(grid: &WaterlineGrid<'_>, level: &Level, probe: &Probe<'_>) ->
         })
         .collect();
     found.sort_unstable_by_key(|f| f.0);
-    let mut offset = 0;
-    let mut out = Vec::new();
-    for (id, points) in found {
-        if !points.is_empty() {
-            let n = points.len();
-            out.push(EdgeCrossings { id, offset, points });
-            offset += n;
-        }
-    }
-    out
+    found.retain(|f| !f.1.is_empty());
+    found
 }
+
+/// A crossing named independently of the numbering: the `s`-th crossing
+/// (along the edge) of grid edge `edge`, or a cell's `k`-th new crossing.
+#[derive(Clone, Copy)]
+enum Node {
+    Grid { edge: usize, s: usize },
+    New(usize),
+}
+
+/// The links of one cell, the crossings it adds inside, and the grid edges
+/// among its sides that hold more crossings than were found on them.
+struct Linked {
+    links: Vec<(Node, Node)>,
+    added: Vec<Point2>,
+    mismatched: Vec<usize>,
+}
+
+/// Rounds of [`trace`] that look for the other crossings of grid edges whose
+/// midpoint disagrees with their crossings, before the cells left are decided
+/// unsplit (a second round is needed only where the crossings found in the
+/// first make a neighbouring cell ambiguous and its split finds another).
+const SIDE_ROUNDS: usize = 3;
 
 /// The chains of crossing points of `grid` at the probe's height, each
 /// starting at its smallest crossing (edge number, then along the edge),
 /// listed in that order.
+///
+/// Cells are linked in rounds: a cell whose split at depth 0 finds a side's
+/// midpoint on the wrong side for the crossings of that grid edge (the edge
+/// holds more crossings than step 2 gave it) names the edge; its crossings are
+/// then found again on its two halves (`cell::edge_crossings_split`), the same
+/// for both cells that share it, and the cells along the edges changed are
+/// linked again.
 pub(crate) fn trace(grid: &WaterlineGrid<'_>, level: &Level, probe: &Probe<'_>) -> Vec<Vec<Point2>> {
     let (nx, ny) = (grid.nx, grid.ny);
-    let edges = edge_crossings(grid, level, probe);
-    let Some(last) = edges.last() else { return Vec::new() };
-    let total = last.offset + last.points.len();
     let num = Numbering { nx, ny };
-    let mut cells: Vec<[usize; 2]> = edges.iter().flat_map(|e| num.cells(e.id)).collect();
-    cells.sort_unstable_by_key(|c| (c[1], c[0]));
-    cells.dedup();
-    let find = |id: usize| edges.binary_search_by_key(&id, |e| e.id).ok().map(|k| &edges[k]);
-    let points: Vec<Point2> = edges.iter().flat_map(|e| e.points.iter().copied()).collect();
-    // Per cell: its links, and the crossings it adds (numbered from `total`).
-    let linked: Vec<CellLinks> = cells
+    let mut edges = edge_crossings(grid, level, probe);
+    if edges.is_empty() {
+        return Vec::new();
+    }
+    let mut todo: Vec<[usize; 2]> = edges.iter().flat_map(|e| num.cells(e.0)).collect();
+    let mut linked: BTreeMap<(usize, usize), Linked> = BTreeMap::new();
+    let mut split_edges: Vec<usize> = Vec::new();
+    for round in 0..SIDE_ROUNDS {
+        todo.sort_unstable_by_key(|c| (c[1], c[0]));
+        todo.dedup();
+        let results = link_cells(grid, level, probe, &num, &edges, &todo);
+        let mut asked: Vec<usize> = results
+            .iter()
+            .flat_map(|r| r.mismatched.iter().copied())
+            .filter(|id| split_edges.binary_search(id).is_err())
+            .collect();
+        asked.sort_unstable();
+        asked.dedup();
+        if round + 1 == SIDE_ROUNDS {
+            asked.clear();
+        }
+        let fixed: Vec<(usize, Vec<Point2>)> = asked
+            .par_iter()
+            .filter_map(|&id| {
+                let ([ia, ja], [ib, jb]) = num.ends(id);
+                let (a, b) = (grid.point(ia, ja), grid.point(ib, jb));
+                let at = |i: usize, j: usize| {
+                    let (h, slot) = grid.sample(i, j);
+                    ((h - probe.z).max(-grid.step), (slot != u32::MAX).then_some(slot as usize))
+                };
+                let local = probe.local(a, b);
+                cell::edge_crossings_split(&local, a, at(ia, ja), b, at(ib, jb)).map(|p| (id, p))
+            })
+            .collect();
+        split_edges.extend(&asked);
+        split_edges.sort_unstable();
+        let mut again: Vec<[usize; 2]> = fixed.iter().flat_map(|f| num.cells(f.0)).collect();
+        again.sort_unstable_by_key(|c| (c[1], c[0]));
+        again.dedup();
+        for (&c, r) in todo.iter().zip(results) {
+            if again.binary_search_by_key(&(c[1], c[0]), |a| (a[1], a[0])).is_err() {
+                linked.insert((c[1], c[0]), r);
+            }
+        }
+        if again.is_empty() {
+            break;
+        }
+        for (id, points) in fixed {
+            match edges.binary_search_by_key(&id, |e| e.0) {
+                Ok(k) => edges[k].1 = points,
+                Err(k) => edges.insert(k, (id, points)),
+            }
+        }
+        edges.retain(|e| !e.1.is_empty());
+        todo = again;
+    }
+    // Number the crossings: the grid edges' in edge order, then each cell's
+    // new ones in cell order (row by row).
+    let mut offsets = Vec::with_capacity(edges.len());
+    let mut points: Vec<Point2> = Vec::new();
+    for e in &edges {
+        offsets.push(points.len());
+        points.extend(&e.1);
+    }
+    let total = points.len();
+    let mut next = vec![usize::MAX; total];
+    for cell in linked.into_values() {
+        let base = points.len();
+        let number = |n: Node| match n {
+            Node::Grid { edge, s } => {
+                // INVARIANT: a cell links only crossings of the edges it was given.
+                let k = edges.binary_search_by_key(&edge, |e| e.0).unwrap_or_default();
+                offsets[k] + s
+            }
+            Node::New(k) => base + k,
+        };
+        next.resize(base + cell.added.len(), usize::MAX);
+        points.extend(cell.added);
+        for (from, to) in cell.links {
+            next[number(from)] = number(to);
+        }
+    }
+    chains(&next, &points)
+}
+
+/// The links of `cells` (in that order) with the crossings of `edges` (sorted
+/// by edge number).
+fn link_cells(
+    grid: &WaterlineGrid<'_>,
+    level: &Level,
+    probe: &Probe<'_>,
+    num: &Numbering,
+    edges: &[(usize, Vec<Point2>)],
+    cells: &[[usize; 2]],
+) -> Vec<Linked> {
+    let mut offsets = Vec::with_capacity(edges.len());
+    let mut points: Vec<Point2> = Vec::new();
+    for e in edges {
+        offsets.push(points.len());
+        points.extend(&e.1);
+    }
+    let total = points.len();
+    cells
         .par_iter()
         .with_min_len(16)
         .map(|&[i, j]| {
             let walk = [(num.h(i, j), true), (num.v(i + 1, j), true), (num.h(i, j + 1), false), (num.v(i, j), false)];
             let mut sides: [Vec<usize>; 4] = Default::default();
+            // The grid crossings met, by flat number: (number, node).
+            let mut names: Vec<(usize, Node)> = Vec::new();
             for (side, &(id, forward)) in walk.iter().enumerate() {
-                let Some(e) = find(id) else { continue };
-                let n = e.points.len();
-                sides[side].extend((0..n).map(|s| e.offset + if forward { s } else { n - 1 - s }));
+                let Ok(k) = edges.binary_search_by_key(&id, |e| e.0) else { continue };
+                let n = edges[k].1.len();
+                for s in 0..n {
+                    let s = if forward { s } else { n - 1 - s };
+                    sides[side].push(offsets[k] + s);
+                    names.push((offsets[k] + s, Node::Grid { edge: id, s }));
+                }
             }
+            let name = |id: usize| {
+                if id >= total {
+                    return Node::New(id - total);
+                }
+                // INVARIANT: every crossing linked lies on one of the cell's sides.
+                names.iter().find(|n| n.0 == id).map_or(Node::New(usize::MAX), |n| n.1)
+            };
             let corners = [grid.point(i, j), grid.point(i + 1, j), grid.point(i + 1, j + 1), grid.point(i, j + 1)];
             let at = |[a, b]: [usize; 2]| grid.inside(level, a, b);
             let cell =
                 Cell { corners, inside: [at([i, j]), at([i + 1, j]), at([i + 1, j + 1]), at([i, j + 1])], sides };
             if let Some(links) = simple_links(&cell) {
-                return (links, Vec::new()); // no index query for a plain cell
+                // No index query for a plain cell.
+                let links = links.into_iter().map(|(a, b)| (name(a), name(b))).collect();
+                return Linked { links, added: Vec::new(), mismatched: Vec::new() };
             }
             let local = probe.local(corners[0], corners[2]);
             let mut resolver = Resolver::new(&local, total);
             let links = resolver.link(&cell, &|id| points[id], 0);
-            (links, resolver.into_new_nodes())
+            let (added, mismatched) = resolver.into_parts();
+            Linked {
+                links: links.into_iter().map(|(a, b)| (name(a), name(b))).collect(),
+                added,
+                mismatched: mismatched.into_iter().map(|k| walk[k].0).collect(),
+            }
         })
-        .collect();
-    let mut points = points;
-    let mut next = vec![usize::MAX; total];
-    for (links, added) in linked {
-        // Renumber the cell's new crossings after those already placed.
-        let shift = points.len() - total;
-        let renumber = |id: usize| if id >= total { id + shift } else { id };
-        next.resize(points.len() + added.len(), usize::MAX);
-        points.extend(added);
-        for (from, to) in links {
-            next[renumber(from)] = renumber(to);
-        }
-    }
-    chains(&next, &points)
+        .collect()
 }
 
 /// Closed chains of the permutation `next`, each from its smallest crossing.
