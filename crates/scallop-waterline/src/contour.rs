@@ -29,7 +29,7 @@ use scallop_geom::Point2;
 
 use std::collections::BTreeMap;
 
-use crate::cell::{self, Cell, Resolver, simple_links};
+use crate::cell::{self, Base, Cell, Resolver, simple_links};
 use crate::refine::Probe;
 use crate::{Level, WaterlineGrid};
 
@@ -152,30 +152,39 @@ enum Node {
     New(usize),
 }
 
-/// The links of one cell, the crossings it adds inside, and the grid edges
-/// among its sides that hold more crossings than were found on them.
+/// The links of one cell, the crossings it adds inside, and the pieces of
+/// grid edges among its sides that hold more crossings than were found on
+/// them (the edge, the piece's ends).
 struct Linked {
     links: Vec<(Node, Node)>,
     added: Vec<Point2>,
-    mismatched: Vec<usize>,
+    asked: Vec<(usize, Point2, Point2)>,
 }
 
-/// Rounds of [`trace`] that look for the other crossings of grid edges whose
-/// midpoint disagrees with their crossings, before the cells left are decided
-/// unsplit (a second round is needed only where the crossings found in the
-/// first make a neighbouring cell ambiguous and its split finds another).
+/// A piece of a grid edge, as a sortable key: the edge and its ends' bits.
+type PieceKey = (usize, [u64; 4]);
+
+fn piece_key(&(id, p, q): &(usize, Point2, Point2)) -> PieceKey {
+    (id, [p.x.to_bits(), p.y.to_bits(), q.x.to_bits(), q.y.to_bits()])
+}
+
+/// Rounds of [`trace`] that look for the other crossings of pieces of grid
+/// edges whose midpoint disagrees with their crossings, before the cells left
+/// are decided unsplit there (a second round is needed only where the
+/// crossings found in the first make a neighbouring cell ambiguous and its
+/// split finds another).
 const SIDE_ROUNDS: usize = 3;
 
 /// The chains of crossing points of `grid` at the probe's height, each
 /// starting at its smallest crossing (edge number, then along the edge),
 /// listed in that order.
 ///
-/// Cells are linked in rounds: a cell whose split at depth 0 finds a side's
-/// midpoint on the wrong side for the crossings of that grid edge (the edge
-/// holds more crossings than step 2 gave it) names the edge; its crossings are
-/// then found again on its two halves (`cell::edge_crossings_split`), the same
-/// for both cells that share it, and the cells along the edges changed are
-/// linked again.
+/// Cells are linked in rounds: a cell whose split finds the midpoint of a
+/// piece of a grid edge on the wrong side for the crossings of that piece (the
+/// edge holds more crossings than step 2 gave it) names the piece; its
+/// crossings are then found again on its two halves (`cell::refine_piece`),
+/// the same for both cells that share the edge, and the cells along the edges
+/// changed are linked again.
 pub(crate) fn trace(grid: &WaterlineGrid<'_>, level: &Level, probe: &Probe<'_>) -> Vec<Vec<Point2>> {
     let (nx, ny) = (grid.nx, grid.ny);
     let num = Numbering { nx, ny };
@@ -185,36 +194,46 @@ pub(crate) fn trace(grid: &WaterlineGrid<'_>, level: &Level, probe: &Probe<'_>) 
     }
     let mut todo: Vec<[usize; 2]> = edges.iter().flat_map(|e| num.cells(e.0)).collect();
     let mut linked: BTreeMap<(usize, usize), Linked> = BTreeMap::new();
-    let mut split_edges: Vec<usize> = Vec::new();
+    let mut applied: Vec<PieceKey> = Vec::new();
     for round in 0..SIDE_ROUNDS {
         todo.sort_unstable_by_key(|c| (c[1], c[0]));
         todo.dedup();
         let results = link_cells(grid, level, probe, &num, &edges, &todo);
-        let mut asked: Vec<usize> = results
+        let mut asked: Vec<(usize, Point2, Point2)> = results
             .iter()
-            .flat_map(|r| r.mismatched.iter().copied())
-            .filter(|id| split_edges.binary_search(id).is_err())
+            .flat_map(|r| r.asked.iter().copied())
+            .filter(|p| applied.binary_search(&piece_key(p)).is_err())
             .collect();
-        asked.sort_unstable();
-        asked.dedup();
+        asked.sort_unstable_by_key(piece_key);
+        asked.dedup_by_key(|p| piece_key(p));
         if round + 1 == SIDE_ROUNDS {
             asked.clear();
         }
-        let fixed: Vec<(usize, Vec<Point2>)> = asked
+        // The pieces by edge, each edge's applied in key order.
+        let mut by_edge: Vec<(usize, Vec<(Point2, Point2)>)> = Vec::new();
+        for &(id, p, q) in &asked {
+            match by_edge.last_mut() {
+                Some(last) if last.0 == id => last.1.push((p, q)),
+                _ => by_edge.push((id, vec![(p, q)])),
+            }
+        }
+        let fixed: Vec<(usize, Vec<Point2>)> = by_edge
             .par_iter()
-            .filter_map(|&id| {
-                let ([ia, ja], [ib, jb]) = num.ends(id);
+            .map(|(id, pieces)| {
+                let ([ia, ja], [ib, jb]) = num.ends(*id);
                 let (a, b) = (grid.point(ia, ja), grid.point(ib, jb));
-                let at = |i: usize, j: usize| {
-                    let (h, slot) = grid.sample(i, j);
-                    ((h - probe.z).max(-grid.step), (slot != u32::MAX).then_some(slot as usize))
-                };
                 let local = probe.local(a, b);
-                cell::edge_crossings_split(&local, a, at(ia, ja), b, at(ib, jb)).map(|p| (id, p))
+                let mut found =
+                    edges.binary_search_by_key(id, |e| e.0).map_or_else(|_| Vec::new(), |k| edges[k].1.clone());
+                for &(p, q) in pieces {
+                    // `None` (an inside point without a contact triangle) leaves the crossings as they were.
+                    let _ = cell::refine_piece(&local, &mut found, a, b, p, q);
+                }
+                (*id, found)
             })
             .collect();
-        split_edges.extend(&asked);
-        split_edges.sort_unstable();
+        applied.extend(asked.iter().map(piece_key));
+        applied.sort_unstable();
         let mut again: Vec<[usize; 2]> = fixed.iter().flat_map(|f| num.cells(f.0)).collect();
         again.sort_unstable_by_key(|c| (c[1], c[0]));
         again.dedup();
@@ -307,21 +326,25 @@ fn link_cells(
             };
             let corners = [grid.point(i, j), grid.point(i + 1, j), grid.point(i + 1, j + 1), grid.point(i, j + 1)];
             let at = |[a, b]: [usize; 2]| grid.inside(level, a, b);
-            let cell =
-                Cell { corners, inside: [at([i, j]), at([i + 1, j]), at([i + 1, j + 1]), at([i, j + 1])], sides };
+            let cell = Cell {
+                corners,
+                inside: [at([i, j]), at([i + 1, j]), at([i + 1, j + 1]), at([i, j + 1])],
+                sides,
+                bases: [Base::Grid(0), Base::Grid(1), Base::Grid(2), Base::Grid(3)],
+            };
             if let Some(links) = simple_links(&cell) {
                 // No index query for a plain cell.
                 let links = links.into_iter().map(|(a, b)| (name(a), name(b))).collect();
-                return Linked { links, added: Vec::new(), mismatched: Vec::new() };
+                return Linked { links, added: Vec::new(), asked: Vec::new() };
             }
             let local = probe.local(corners[0], corners[2]);
             let mut resolver = Resolver::new(&local, total);
-            let links = resolver.link(&cell, &|id| points[id], 0);
-            let (added, mismatched) = resolver.into_parts();
+            let links = resolver.resolve(&cell, &|id| points[id]);
+            let (added, asked) = resolver.into_parts();
             Linked {
                 links: links.into_iter().map(|(a, b)| (name(a), name(b))).collect(),
                 added,
-                mismatched: mismatched.into_iter().map(|k| walk[k].0).collect(),
+                asked: asked.into_iter().map(|(k, p, q)| (walk[k].0, p, q)).collect(),
             }
         })
         .collect()

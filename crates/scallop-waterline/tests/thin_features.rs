@@ -90,6 +90,27 @@ fn slot_separates_the_two_loops(kind: u8, radius: f64, gap: f64, angle: f64, wal
     Ok(())
 }
 
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 32, .. ProptestConfig::default() })]
+
+    /// The slot of `a_slot_barely_wider_than_the_cutter_separates_the_two_loops`
+    /// with a flat cutter, a few micrometres wide and within 4 degrees of a
+    /// grid direction, where its failures were found: the slot's mouth runs
+    /// along a grid edge for several cells, and a grid edge with ends on
+    /// different sides may hold three crossings.
+    #[test]
+    fn a_thin_slot_nearly_along_the_grid_separates_the_two_loops(
+        radius in 0.8..2.5f64,
+        gap in 2e-6..2e-5f64,
+        quarter in 0u8..4,
+        off in -0.07..0.07f64,
+        wall in 0.0..1.0f64,
+    ) {
+        let angle = (f64::from(quarter) * std::f64::consts::FRAC_PI_2 + off).rem_euclid(std::f64::consts::TAU);
+        slot_separates_the_two_loops(0, radius, gap, angle, wall)?;
+    }
+}
+
 /// The inputs of `a_slot_barely_wider_than_the_cutter_separates_the_two_loops`
 /// that failed for random seeds before the fix of docs/waterline.md (step 3,
 /// "A side's midpoint against its crossings"): a flat cutter, a 2 µm slot
@@ -102,6 +123,9 @@ fn a_slot_nearly_along_the_grid_separates_the_two_loops() {
         (2.374435273889911, 1.5975191050731326, 0.4224856279390674),
         (1.6231453952751853, 3.1992017541795468, 0.0),
         (1.7682290773247413, 3.1585699007764974, 0.0),
+        // Found by `a_thin_slot_nearly_along_the_grid_separates_the_two_loops`.
+        (0.8089310291157943, std::f64::consts::PI + 0.016355600673108418, 0.0),
+        (1.1278162019523357, std::f64::consts::FRAC_PI_2 + 0.02937806583184269, 0.3319373871831357),
     ];
     let failed: Vec<String> = cases
         .iter()
