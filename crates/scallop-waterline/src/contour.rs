@@ -144,6 +144,17 @@ fn edge_crossings(grid: &WaterlineGrid<'_>, level: &Level, probe: &Probe<'_>) ->
     found
 }
 
+/// The links (exit, entry) of one cell in the numbering of the round that
+/// linked it, the crossings it adds inside (numbered from the round's grid
+/// crossings' count, cell by cell), and the pieces of grid edges among its
+/// sides that hold more crossings than were found on them (the edge, the
+/// piece's ends).
+struct Linked {
+    links: Vec<(usize, usize)>,
+    added: Vec<Point2>,
+    asked: Vec<(usize, Point2, Point2)>,
+}
+
 /// A crossing named independently of the numbering: the `s`-th crossing
 /// (along the edge) of grid edge `edge`, or a cell's `k`-th new crossing.
 #[derive(Clone, Copy)]
@@ -152,13 +163,33 @@ enum Node {
     New(usize),
 }
 
-/// The links of one cell, the crossings it adds inside, and the pieces of
-/// grid edges among its sides that hold more crossings than were found on
-/// them (the edge, the piece's ends).
-struct Linked {
-    links: Vec<(Node, Node)>,
-    added: Vec<Point2>,
-    asked: Vec<(usize, Point2, Point2)>,
+/// The crossings of the grid edges, numbered: the edges in order, each along
+/// the edge.
+struct Numbered {
+    offsets: Vec<usize>,
+    points: Vec<Point2>,
+}
+
+impl Numbered {
+    fn new(edges: &[(usize, Vec<Point2>)]) -> Self {
+        let mut offsets = Vec::with_capacity(edges.len());
+        let mut points: Vec<Point2> = Vec::new();
+        for e in edges {
+            offsets.push(points.len());
+            points.extend(&e.1);
+        }
+        Numbered { offsets, points }
+    }
+
+    /// The name of crossing `id` (a grid crossing below the count, else a
+    /// cell's new one).
+    fn name(&self, edges: &[(usize, Vec<Point2>)], id: usize) -> Node {
+        if id >= self.points.len() {
+            return Node::New(id - self.points.len());
+        }
+        let k = self.offsets.partition_point(|&o| o <= id) - 1;
+        Node::Grid { edge: edges[k].0, s: id - self.offsets[k] }
+    }
 }
 
 /// A piece of a grid edge, as a sortable key: the edge and its ends' bits.
@@ -184,7 +215,8 @@ const SIDE_ROUNDS: usize = 3;
 /// edge holds more crossings than step 2 gave it) names the piece; its
 /// crossings are then found again on its two halves (`cell::refine_piece`),
 /// the same for both cells that share the edge, and the cells along the edges
-/// changed are linked again.
+/// changed are linked again. Where no cell names a piece (nearly always),
+/// there is one round.
 pub(crate) fn trace(grid: &WaterlineGrid<'_>, level: &Level, probe: &Probe<'_>) -> Vec<Vec<Point2>> {
     let (nx, ny) = (grid.nx, grid.ny);
     let num = Numbering { nx, ny };
@@ -192,23 +224,42 @@ pub(crate) fn trace(grid: &WaterlineGrid<'_>, level: &Level, probe: &Probe<'_>) 
     if edges.is_empty() {
         return Vec::new();
     }
-    let mut todo: Vec<[usize; 2]> = edges.iter().flat_map(|e| num.cells(e.0)).collect();
-    let mut linked: BTreeMap<(usize, usize), Linked> = BTreeMap::new();
+    let mut cells: Vec<[usize; 2]> = edges.iter().flat_map(|e| num.cells(e.0)).collect();
+    cells.sort_unstable_by_key(|c| (c[1], c[0]));
+    cells.dedup();
+    let mut numbered = Numbered::new(&edges);
+    let first = link_cells(grid, level, probe, &num, &edges, &numbered, &cells);
+    if first.iter().all(|r| r.asked.is_empty()) {
+        let Numbered { mut points, .. } = numbered;
+        let total = points.len();
+        let mut next = vec![usize::MAX; total];
+        for cell in first {
+            // Renumber the cell's new crossings after those already placed.
+            let shift = points.len() - total;
+            let renumber = |id: usize| if id >= total { id + shift } else { id };
+            next.resize(points.len() + cell.added.len(), usize::MAX);
+            points.extend(cell.added);
+            for (from, to) in cell.links {
+                next[renumber(from)] = renumber(to);
+            }
+        }
+        return chains(&next, &points);
+    }
+    // Some pieces of grid edges hold more crossings: the links by name, so
+    // that the cells not linked again keep theirs when the numbering changes.
+    type Named = (Vec<(Node, Node)>, Vec<Point2>);
+    let named = |edges: &[(usize, Vec<Point2>)], numbered: &Numbered, r: Linked| -> Named {
+        let links = r.links.iter().map(|&(a, b)| (numbered.name(edges, a), numbered.name(edges, b))).collect();
+        (links, r.added)
+    };
+    let mut asked: Vec<(usize, Point2, Point2)> = first.iter().flat_map(|r| r.asked.iter().copied()).collect();
+    let mut linked: BTreeMap<(usize, usize), Named> =
+        cells.iter().zip(first).map(|(c, r)| ((c[1], c[0]), named(&edges, &numbered, r))).collect();
     let mut applied: Vec<PieceKey> = Vec::new();
-    for round in 0..SIDE_ROUNDS {
-        todo.sort_unstable_by_key(|c| (c[1], c[0]));
-        todo.dedup();
-        let results = link_cells(grid, level, probe, &num, &edges, &todo);
-        let mut asked: Vec<(usize, Point2, Point2)> = results
-            .iter()
-            .flat_map(|r| r.asked.iter().copied())
-            .filter(|p| applied.binary_search(&piece_key(p)).is_err())
-            .collect();
+    for _ in 1..SIDE_ROUNDS {
+        asked.retain(|p| applied.binary_search(&piece_key(p)).is_err());
         asked.sort_unstable_by_key(piece_key);
         asked.dedup_by_key(|p| piece_key(p));
-        if round + 1 == SIDE_ROUNDS {
-            asked.clear();
-        }
         // The pieces by edge, each edge's applied in key order.
         let mut by_edge: Vec<(usize, Vec<(Point2, Point2)>)> = Vec::new();
         for &(id, p, q) in &asked {
@@ -237,11 +288,6 @@ pub(crate) fn trace(grid: &WaterlineGrid<'_>, level: &Level, probe: &Probe<'_>) 
         let mut again: Vec<[usize; 2]> = fixed.iter().flat_map(|f| num.cells(f.0)).collect();
         again.sort_unstable_by_key(|c| (c[1], c[0]));
         again.dedup();
-        for (&c, r) in todo.iter().zip(results) {
-            if again.binary_search_by_key(&(c[1], c[0]), |a| (a[1], a[0])).is_err() {
-                linked.insert((c[1], c[0]), r);
-            }
-        }
         if again.is_empty() {
             break;
         }
@@ -252,19 +298,19 @@ pub(crate) fn trace(grid: &WaterlineGrid<'_>, level: &Level, probe: &Probe<'_>) 
             }
         }
         edges.retain(|e| !e.1.is_empty());
-        todo = again;
+        numbered = Numbered::new(&edges);
+        let results = link_cells(grid, level, probe, &num, &edges, &numbered, &again);
+        asked = results.iter().flat_map(|r| r.asked.iter().copied()).collect();
+        for (c, r) in again.iter().zip(results) {
+            linked.insert((c[1], c[0]), named(&edges, &numbered, r));
+        }
     }
     // Number the crossings: the grid edges' in edge order, then each cell's
     // new ones in cell order (row by row).
-    let mut offsets = Vec::with_capacity(edges.len());
-    let mut points: Vec<Point2> = Vec::new();
-    for e in &edges {
-        offsets.push(points.len());
-        points.extend(&e.1);
-    }
+    let Numbered { offsets, mut points } = Numbered::new(&edges);
     let total = points.len();
     let mut next = vec![usize::MAX; total];
-    for cell in linked.into_values() {
+    for (links, added) in linked.into_values() {
         let base = points.len();
         let number = |n: Node| match n {
             Node::Grid { edge, s } => {
@@ -274,9 +320,9 @@ pub(crate) fn trace(grid: &WaterlineGrid<'_>, level: &Level, probe: &Probe<'_>) 
             }
             Node::New(k) => base + k,
         };
-        next.resize(base + cell.added.len(), usize::MAX);
-        points.extend(cell.added);
-        for (from, to) in cell.links {
+        next.resize(base + added.len(), usize::MAX);
+        points.extend(added);
+        for (from, to) in links {
             next[number(from)] = number(to);
         }
     }
@@ -284,21 +330,17 @@ pub(crate) fn trace(grid: &WaterlineGrid<'_>, level: &Level, probe: &Probe<'_>) 
 }
 
 /// The links of `cells` (in that order) with the crossings of `edges` (sorted
-/// by edge number).
+/// by edge number), numbered as `numbered`.
 fn link_cells(
     grid: &WaterlineGrid<'_>,
     level: &Level,
     probe: &Probe<'_>,
     num: &Numbering,
     edges: &[(usize, Vec<Point2>)],
+    numbered: &Numbered,
     cells: &[[usize; 2]],
 ) -> Vec<Linked> {
-    let mut offsets = Vec::with_capacity(edges.len());
-    let mut points: Vec<Point2> = Vec::new();
-    for e in edges {
-        offsets.push(points.len());
-        points.extend(&e.1);
-    }
+    let points = &numbered.points;
     let total = points.len();
     cells
         .par_iter()
@@ -306,24 +348,11 @@ fn link_cells(
         .map(|&[i, j]| {
             let walk = [(num.h(i, j), true), (num.v(i + 1, j), true), (num.h(i, j + 1), false), (num.v(i, j), false)];
             let mut sides: [Vec<usize>; 4] = Default::default();
-            // The grid crossings met, by flat number: (number, node).
-            let mut names: Vec<(usize, Node)> = Vec::new();
             for (side, &(id, forward)) in walk.iter().enumerate() {
                 let Ok(k) = edges.binary_search_by_key(&id, |e| e.0) else { continue };
-                let n = edges[k].1.len();
-                for s in 0..n {
-                    let s = if forward { s } else { n - 1 - s };
-                    sides[side].push(offsets[k] + s);
-                    names.push((offsets[k] + s, Node::Grid { edge: id, s }));
-                }
+                let (n, offset) = (edges[k].1.len(), numbered.offsets[k]);
+                sides[side].extend((0..n).map(|s| offset + if forward { s } else { n - 1 - s }));
             }
-            let name = |id: usize| {
-                if id >= total {
-                    return Node::New(id - total);
-                }
-                // INVARIANT: every crossing linked lies on one of the cell's sides.
-                names.iter().find(|n| n.0 == id).map_or(Node::New(usize::MAX), |n| n.1)
-            };
             let corners = [grid.point(i, j), grid.point(i + 1, j), grid.point(i + 1, j + 1), grid.point(i, j + 1)];
             let at = |[a, b]: [usize; 2]| grid.inside(level, a, b);
             let cell = Cell {
@@ -334,18 +363,13 @@ fn link_cells(
             };
             if let Some(links) = simple_links(&cell) {
                 // No index query for a plain cell.
-                let links = links.into_iter().map(|(a, b)| (name(a), name(b))).collect();
                 return Linked { links, added: Vec::new(), asked: Vec::new() };
             }
             let local = probe.local(corners[0], corners[2]);
             let mut resolver = Resolver::new(&local, total);
             let links = resolver.resolve(&cell, &|id| points[id]);
             let (added, asked) = resolver.into_parts();
-            Linked {
-                links: links.into_iter().map(|(a, b)| (name(a), name(b))).collect(),
-                added,
-                asked: asked.into_iter().map(|(k, p, q)| (walk[k].0, p, q)).collect(),
-            }
+            Linked { links, added, asked: asked.into_iter().map(|(k, p, q)| (walk[k].0, p, q)).collect() }
         })
         .collect()
 }
