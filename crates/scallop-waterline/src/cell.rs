@@ -21,6 +21,15 @@
 //! line between the gaps' middles is outside; any other cell joins the inside,
 //! the choice that never links across the inside (a sliver of outside finer
 //! than the limit is left uncut rather than gouged).
+//!
+//! A segment with ends on different sides is given one crossing and may hold
+//! three (a gap in its inside stretch, an inside sliver in its outside one).
+//! Where a split finds a side's midpoint on the wrong side for the crossings
+//! before it, the side's piece is named ([`Resolver::resolve`],
+//! [`Resolver::into_parts`]) and its crossings found again on its two halves
+//! ([`refine_piece`]): here for a piece of an inner half-edge, by the caller
+//! (`contour::trace`, for both cells that share it) for a piece of a grid edge;
+//! then the cell is linked again (docs/waterline.md, step 3).
 
 use scallop_geom::Point2;
 
