@@ -27,21 +27,11 @@
 use rayon::prelude::*;
 use scallop_geom::Point2;
 
-use crate::cell::{Cell, Resolver, simple_links};
+use std::collections::BTreeMap;
+
+use crate::cell::{self, Base, Cell, Resolver, simple_links};
 use crate::refine::Probe;
 use crate::{Level, WaterlineGrid};
-
-/// The crossings of one grid edge, in increasing x (horizontal) or y
-/// (vertical).
-struct EdgeCrossings {
-    id: usize,
-    points: Vec<Point2>,
-    /// Number of the first crossing in the flat list of all crossings.
-    offset: usize,
-}
-
-/// The links (exit, entry) of one cell and the crossings it adds inside.
-type CellLinks = (Vec<(usize, usize)>, Vec<Point2>);
 
 /// Grid edge numbering: horizontal edges first, then vertical ones.
 struct Numbering {
@@ -84,8 +74,9 @@ impl Numbering {
 
 /// The crossings of every edge that holds some, in increasing edge number:
 /// one per edge with ends on different sides, two per gap on an edge with
-/// both ends inside that no triangle certifies.
-fn edge_crossings(grid: &WaterlineGrid<'_>, level: &Level, probe: &Probe<'_>) -> Vec<EdgeCrossings> {
+/// both ends inside that no triangle certifies. Each edge's crossings are in
+/// increasing x (horizontal) or y (vertical).
+fn edge_crossings(grid: &WaterlineGrid<'_>, level: &Level, probe: &Probe<'_>) -> Vec<(usize, Vec<Point2>)> {
     let (nx, ny) = (grid.nx, grid.ny);
     let num = Numbering { nx, ny };
     // (edge, first end inside, crossing edge (else a gap candidate)). Every
@@ -149,70 +140,238 @@ fn edge_crossings(grid: &WaterlineGrid<'_>, level: &Level, probe: &Probe<'_>) ->
         })
         .collect();
     found.sort_unstable_by_key(|f| f.0);
-    let mut offset = 0;
-    let mut out = Vec::new();
-    for (id, points) in found {
-        if !points.is_empty() {
-            let n = points.len();
-            out.push(EdgeCrossings { id, offset, points });
-            offset += n;
-        }
-    }
-    out
+    found.retain(|f| !f.1.is_empty());
+    found
 }
+
+/// The links (exit, entry) of one cell in the numbering of the round that
+/// linked it, the crossings it adds inside (numbered from the round's grid
+/// crossings' count, cell by cell), and the pieces of grid edges among its
+/// sides that hold more crossings than were found on them (the edge, the
+/// piece's ends).
+struct Linked {
+    links: Vec<(usize, usize)>,
+    added: Vec<Point2>,
+    asked: Vec<(usize, Point2, Point2)>,
+}
+
+/// A crossing named independently of the numbering: the `s`-th crossing
+/// (along the edge) of grid edge `edge`, or a cell's `k`-th new crossing.
+#[derive(Clone, Copy)]
+enum Node {
+    Grid { edge: usize, s: usize },
+    New(usize),
+}
+
+/// The crossings of the grid edges, numbered: the edges in order, each along
+/// the edge.
+struct Numbered {
+    offsets: Vec<usize>,
+    points: Vec<Point2>,
+}
+
+impl Numbered {
+    fn new(edges: &[(usize, Vec<Point2>)]) -> Self {
+        let mut offsets = Vec::with_capacity(edges.len());
+        let mut points: Vec<Point2> = Vec::new();
+        for e in edges {
+            offsets.push(points.len());
+            points.extend(&e.1);
+        }
+        Numbered { offsets, points }
+    }
+
+    /// The name of crossing `id` (a grid crossing below the count, else a
+    /// cell's new one).
+    fn name(&self, edges: &[(usize, Vec<Point2>)], id: usize) -> Node {
+        if id >= self.points.len() {
+            return Node::New(id - self.points.len());
+        }
+        let k = self.offsets.partition_point(|&o| o <= id) - 1;
+        Node::Grid { edge: edges[k].0, s: id - self.offsets[k] }
+    }
+}
+
+/// A piece of a grid edge, as a sortable key: the edge and its ends' bits.
+type PieceKey = (usize, [u64; 4]);
+
+fn piece_key(&(id, p, q): &(usize, Point2, Point2)) -> PieceKey {
+    (id, [p.x.to_bits(), p.y.to_bits(), q.x.to_bits(), q.y.to_bits()])
+}
+
+/// Rounds of [`trace`] that look for the other crossings of pieces of grid
+/// edges whose midpoint disagrees with their crossings, before the cells left
+/// are decided unsplit there (a second round is needed only where the
+/// crossings found in the first make a neighbouring cell ambiguous and its
+/// split finds another).
+const SIDE_ROUNDS: usize = 3;
 
 /// The chains of crossing points of `grid` at the probe's height, each
 /// starting at its smallest crossing (edge number, then along the edge),
 /// listed in that order.
+///
+/// Cells are linked in rounds: a cell whose split finds the midpoint of a
+/// piece of a grid edge on the wrong side for the crossings of that piece (the
+/// edge holds more crossings than step 2 gave it) names the piece; its
+/// crossings are then found again on its two halves (`cell::refine_piece`),
+/// the same for both cells that share the edge, and the cells along the edges
+/// changed are linked again. Where no cell names a piece (nearly always),
+/// there is one round.
 pub(crate) fn trace(grid: &WaterlineGrid<'_>, level: &Level, probe: &Probe<'_>) -> Vec<Vec<Point2>> {
     let (nx, ny) = (grid.nx, grid.ny);
-    let edges = edge_crossings(grid, level, probe);
-    let Some(last) = edges.last() else { return Vec::new() };
-    let total = last.offset + last.points.len();
     let num = Numbering { nx, ny };
-    let mut cells: Vec<[usize; 2]> = edges.iter().flat_map(|e| num.cells(e.id)).collect();
+    let mut edges = edge_crossings(grid, level, probe);
+    if edges.is_empty() {
+        return Vec::new();
+    }
+    let mut cells: Vec<[usize; 2]> = edges.iter().flat_map(|e| num.cells(e.0)).collect();
     cells.sort_unstable_by_key(|c| (c[1], c[0]));
     cells.dedup();
-    let find = |id: usize| edges.binary_search_by_key(&id, |e| e.id).ok().map(|k| &edges[k]);
-    let points: Vec<Point2> = edges.iter().flat_map(|e| e.points.iter().copied()).collect();
-    // Per cell: its links, and the crossings it adds (numbered from `total`).
-    let linked: Vec<CellLinks> = cells
+    let mut numbered = Numbered::new(&edges);
+    let first = link_cells(grid, level, probe, &num, &edges, &numbered, &cells);
+    if first.iter().all(|r| r.asked.is_empty()) {
+        let Numbered { mut points, .. } = numbered;
+        let total = points.len();
+        let mut next = vec![usize::MAX; total];
+        for cell in first {
+            // Renumber the cell's new crossings after those already placed.
+            let shift = points.len() - total;
+            let renumber = |id: usize| if id >= total { id + shift } else { id };
+            next.resize(points.len() + cell.added.len(), usize::MAX);
+            points.extend(cell.added);
+            for (from, to) in cell.links {
+                next[renumber(from)] = renumber(to);
+            }
+        }
+        return chains(&next, &points);
+    }
+    // Some pieces of grid edges hold more crossings: the links by name, so
+    // that the cells not linked again keep theirs when the numbering changes.
+    type Named = (Vec<(Node, Node)>, Vec<Point2>);
+    let named = |edges: &[(usize, Vec<Point2>)], numbered: &Numbered, r: Linked| -> Named {
+        let links = r.links.iter().map(|&(a, b)| (numbered.name(edges, a), numbered.name(edges, b))).collect();
+        (links, r.added)
+    };
+    let mut asked: Vec<(usize, Point2, Point2)> = first.iter().flat_map(|r| r.asked.iter().copied()).collect();
+    let mut linked: BTreeMap<(usize, usize), Named> =
+        cells.iter().zip(first).map(|(c, r)| ((c[1], c[0]), named(&edges, &numbered, r))).collect();
+    let mut applied: Vec<PieceKey> = Vec::new();
+    for _ in 1..SIDE_ROUNDS {
+        asked.retain(|p| applied.binary_search(&piece_key(p)).is_err());
+        asked.sort_unstable_by_key(piece_key);
+        asked.dedup_by_key(|p| piece_key(p));
+        // The pieces by edge, each edge's applied in key order.
+        let mut by_edge: Vec<(usize, Vec<(Point2, Point2)>)> = Vec::new();
+        for &(id, p, q) in &asked {
+            match by_edge.last_mut() {
+                Some(last) if last.0 == id => last.1.push((p, q)),
+                _ => by_edge.push((id, vec![(p, q)])),
+            }
+        }
+        let fixed: Vec<(usize, Vec<Point2>)> = by_edge
+            .par_iter()
+            .map(|(id, pieces)| {
+                let ([ia, ja], [ib, jb]) = num.ends(*id);
+                let (a, b) = (grid.point(ia, ja), grid.point(ib, jb));
+                let local = probe.local(a, b);
+                let mut found =
+                    edges.binary_search_by_key(id, |e| e.0).map_or_else(|_| Vec::new(), |k| edges[k].1.clone());
+                for &(p, q) in pieces {
+                    // `None` (an inside point without a contact triangle) leaves the crossings as they were.
+                    let _ = cell::refine_piece(&local, &mut found, a, b, p, q);
+                }
+                (*id, found)
+            })
+            .collect();
+        applied.extend(asked.iter().map(piece_key));
+        applied.sort_unstable();
+        let mut again: Vec<[usize; 2]> = fixed.iter().flat_map(|f| num.cells(f.0)).collect();
+        again.sort_unstable_by_key(|c| (c[1], c[0]));
+        again.dedup();
+        if again.is_empty() {
+            break;
+        }
+        for (id, points) in fixed {
+            match edges.binary_search_by_key(&id, |e| e.0) {
+                Ok(k) => edges[k].1 = points,
+                Err(k) => edges.insert(k, (id, points)),
+            }
+        }
+        edges.retain(|e| !e.1.is_empty());
+        numbered = Numbered::new(&edges);
+        let results = link_cells(grid, level, probe, &num, &edges, &numbered, &again);
+        asked = results.iter().flat_map(|r| r.asked.iter().copied()).collect();
+        for (c, r) in again.iter().zip(results) {
+            linked.insert((c[1], c[0]), named(&edges, &numbered, r));
+        }
+    }
+    // Number the crossings: the grid edges' in edge order, then each cell's
+    // new ones in cell order (row by row).
+    let Numbered { offsets, mut points } = Numbered::new(&edges);
+    let total = points.len();
+    let mut next = vec![usize::MAX; total];
+    for (links, added) in linked.into_values() {
+        let base = points.len();
+        let number = |n: Node| match n {
+            Node::Grid { edge, s } => {
+                // INVARIANT: a cell links only crossings of the edges it was given.
+                let k = edges.binary_search_by_key(&edge, |e| e.0).unwrap_or_default();
+                offsets[k] + s
+            }
+            Node::New(k) => base + k,
+        };
+        next.resize(base + added.len(), usize::MAX);
+        points.extend(added);
+        for (from, to) in links {
+            next[number(from)] = number(to);
+        }
+    }
+    chains(&next, &points)
+}
+
+/// The links of `cells` (in that order) with the crossings of `edges` (sorted
+/// by edge number), numbered as `numbered`.
+fn link_cells(
+    grid: &WaterlineGrid<'_>,
+    level: &Level,
+    probe: &Probe<'_>,
+    num: &Numbering,
+    edges: &[(usize, Vec<Point2>)],
+    numbered: &Numbered,
+    cells: &[[usize; 2]],
+) -> Vec<Linked> {
+    let points = &numbered.points;
+    let total = points.len();
+    cells
         .par_iter()
         .with_min_len(16)
         .map(|&[i, j]| {
             let walk = [(num.h(i, j), true), (num.v(i + 1, j), true), (num.h(i, j + 1), false), (num.v(i, j), false)];
             let mut sides: [Vec<usize>; 4] = Default::default();
             for (side, &(id, forward)) in walk.iter().enumerate() {
-                let Some(e) = find(id) else { continue };
-                let n = e.points.len();
-                sides[side].extend((0..n).map(|s| e.offset + if forward { s } else { n - 1 - s }));
+                let Ok(k) = edges.binary_search_by_key(&id, |e| e.0) else { continue };
+                let (n, offset) = (edges[k].1.len(), numbered.offsets[k]);
+                sides[side].extend((0..n).map(|s| offset + if forward { s } else { n - 1 - s }));
             }
             let corners = [grid.point(i, j), grid.point(i + 1, j), grid.point(i + 1, j + 1), grid.point(i, j + 1)];
             let at = |[a, b]: [usize; 2]| grid.inside(level, a, b);
-            let cell =
-                Cell { corners, inside: [at([i, j]), at([i + 1, j]), at([i + 1, j + 1]), at([i, j + 1])], sides };
+            let cell = Cell {
+                corners,
+                inside: [at([i, j]), at([i + 1, j]), at([i + 1, j + 1]), at([i, j + 1])],
+                sides,
+                bases: [Base::Grid(0), Base::Grid(1), Base::Grid(2), Base::Grid(3)],
+            };
             if let Some(links) = simple_links(&cell) {
-                return (links, Vec::new()); // no index query for a plain cell
+                // No index query for a plain cell.
+                return Linked { links, added: Vec::new(), asked: Vec::new() };
             }
             let local = probe.local(corners[0], corners[2]);
             let mut resolver = Resolver::new(&local, total);
-            let links = resolver.link(&cell, &|id| points[id], 0);
-            (links, resolver.into_new_nodes())
+            let links = resolver.resolve(&cell, &|id| points[id]);
+            let (added, asked) = resolver.into_parts();
+            Linked { links, added, asked: asked.into_iter().map(|(k, p, q)| (walk[k].0, p, q)).collect() }
         })
-        .collect();
-    let mut points = points;
-    let mut next = vec![usize::MAX; total];
-    for (links, added) in linked {
-        // Renumber the cell's new crossings after those already placed.
-        let shift = points.len() - total;
-        let renumber = |id: usize| if id >= total { id + shift } else { id };
-        next.resize(points.len() + added.len(), usize::MAX);
-        points.extend(added);
-        for (from, to) in links {
-            next[renumber(from)] = renumber(to);
-        }
-    }
-    chains(&next, &points)
+        .collect()
 }
 
 /// Closed chains of the permutation `next`, each from its smallest crossing.
