@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use clap::{Args, ValueEnum};
-use scallop_cutter::{Cutter, CutterShape, HolderSegment};
+use scallop_cutter::Cutter;
 use scallop_engine::{OnMachine, Posted, Rough5Metrics, TcpWords, post_tcp, rough5_metrics, rough5_settings};
 use scallop_guides::GuideSettings;
 use scallop_machine::Kinematics;
@@ -16,7 +16,8 @@ use scallop_parts::FaceTag;
 use scallop_parts::TestPart;
 use scallop_rough5::{
     BaselinePlan, BaselineSettings, CuttingData, LevelOptions, OrientSettings, Pocket, Proof, ProofSettings,
-    Rough5Plan, Rough5Settings, TiltMode, Weights, plan_rough5_in, plan_three_plus_two, plan_zlevel, prove_from_blank,
+    Rough5Plan, Rough5Settings, TiltMode, TorusTool, Weights, plan_rough5_in, plan_three_plus_two, plan_zlevel,
+    prove_from_blank,
 };
 use scallop_toolpath::Toolpath;
 use serde::Serialize;
@@ -253,12 +254,16 @@ fn cutter(a: &Rough5Args) -> CliResult<Cutter> {
     let bad = |e: scallop_cutter::CutterError| {
         Failure::rejected(format!("the tool: {e} (--tool-radius, --corner, --flutes, --holder)"))
     };
-    let shape = CutterShape::Bull { radius: a.tool_radius, corner: a.corner };
-    let holder = HolderSegment { length: a.holder[1], bottom_radius: a.holder[0] / 2.0, top_radius: a.holder[0] / 2.0 };
-    Cutter::new(shape, a.flutes)
-        .and_then(|c| c.with_shank(a.tool_radius, a.stick_out - a.flutes))
-        .and_then(|c| c.with_holder(vec![holder]))
-        .map_err(bad)
+    TorusTool {
+        radius: a.tool_radius,
+        corner: a.corner,
+        flutes: a.flutes,
+        stick_out: a.stick_out,
+        holder_diameter: a.holder[0],
+        holder_length: a.holder[1],
+    }
+    .cutter()
+    .map_err(bad)
 }
 
 /// The planning settings of the arguments.

@@ -62,7 +62,7 @@ pub use scallop_geom::tol::rough5 as tol;
 pub use baseline::{BaselinePlan, BaselineSettings, Pocket, SetupReport, plan_three_plus_two, plan_zlevel, setup_axes};
 pub use collide::BodyCheck;
 pub use correct::{CorrectionCount, correct_pairs, correct_planar};
-pub use cutting::CuttingData;
+pub use cutting::{CuttingData, TorusTool};
 pub use error::Rough5Error;
 pub use faces::{FaceMetrics, ProofFace, face_metrics};
 pub use levels::{LevelOptions, LevelPasses, TiltMode, level_passes, level_passes_with, refine_facets};
