@@ -362,7 +362,10 @@ pub fn plan_rough5_in(
     // the tilt points of the spatial correction of the levels below.
     let upper_limits: Vec<Vec<scallop_mesh::Polyline3>> = levels
         .iter()
-        .map(|l| l.passes[l.passes.len() - l.outer.min(l.passes.len())..].iter().map(|(c, _)| c.line.clone()).collect())
+        .map(|l| {
+            let outer = &l.passes[l.passes.len() - l.outer.min(l.passes.len())..];
+            if guided && settings.spatial { outer.iter().map(|(c, _)| c.line.clone()).collect() } else { Vec::new() }
+        })
         .collect();
     let mut out = Emitter::new(stock.max.z, stock.max.z + settings.clearance + cutter.radius(), settings);
     out.flat = Emitter::flat_radius(cutter);
