@@ -213,8 +213,9 @@ fn closest_to_ray(line: &Polyline3, o: &Point3, u: &Vec3) -> Option<Point3> {
 /// from the flank. The thesis measures that lean across the feed direction,
 /// to the left of T (away from the flank for a pocket kept on the left);
 /// here it is measured along the flank normal N_f at the deepest intrusion,
-/// made orthogonal to the axis, which holds for either travel direction
-/// (spec's reading of Eq. 3.32). The new axis's pitch angle theta_t is free:
+/// made orthogonal to the axis, which holds for either travel direction (for
+/// the opposite direction Eq. 3.32 would take the minimum). The new axis's
+/// pitch angle theta_t is free:
 /// a candidate ahead of or behind the pair changes it.
 ///
 /// The tool along each candidate axis is placed on the level again and
