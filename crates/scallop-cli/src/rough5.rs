@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use clap::{Args, ValueEnum};
-use scallop_cutter::{Cutter, CutterShape, HolderSegment};
+use scallop_cutter::Cutter;
 use scallop_engine::{OnMachine, Posted, Rough5Metrics, TcpWords, post_tcp, rough5_metrics, rough5_settings};
 use scallop_guides::GuideSettings;
 use scallop_machine::Kinematics;
@@ -16,7 +16,8 @@ use scallop_parts::FaceTag;
 use scallop_parts::TestPart;
 use scallop_rough5::{
     BaselinePlan, BaselineSettings, CuttingData, LevelOptions, OrientSettings, Pocket, Proof, ProofSettings,
-    Rough5Plan, Rough5Settings, TiltMode, Weights, plan_rough5_in, plan_three_plus_two, plan_zlevel, prove_from_blank,
+    Rough5Plan, Rough5Settings, TiltMode, TorusTool, Weights, plan_rough5_in, plan_three_plus_two, plan_zlevel,
+    prove_from_blank,
 };
 use scallop_toolpath::Toolpath;
 use serde::Serialize;
@@ -66,6 +67,15 @@ pub enum RefineArg {
     BottomNormal,
     /// All of them: the program of 28 Nov 2026.
     All,
+}
+
+/// A collision correction of `--correction` (thesis Ch. 3 §3).
+#[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
+pub enum CorrectionArg {
+    /// Step 1: the axis turned in its correction plane, the pitch angle kept (Eq. 3.31).
+    Planar,
+    /// Step 2: on the offset levels, the axis turned through the nearest point of an upper level's limit curve (Eq. 3.32).
+    Spatial,
 }
 
 /// A 3-axis baseline on the same part, tool and cutting data.
@@ -148,12 +158,14 @@ pub struct Rough5Args {
     /// Target pitch angle theta_tobj for `--tilt optimised` (degrees).
     #[arg(long, default_value_t = 10.0, allow_negative_numbers = true)]
     target: f64,
-    /// Turn the axis of a CL point whose tool collides with a flank in its correction plane (the
-    /// pitch kept) before dropping it: the collision correction of Jousselin 2020, Ch. 3 §3, step 1
-    /// (docs/rough5.md). Off by default: on the closed pocket it keeps V_r and costs time, and with
-    /// `--tilt optimised` the post's replay check refuses one block. Never applied with `--tilt zero`.
-    #[arg(long)]
-    correction: bool,
+    /// Collision corrections of Jousselin 2020, Ch. 3 §3 applied before the axis translation (step 3,
+    /// on unless `--without translation`), comma-separated; `--correction` alone is `planar`
+    /// (docs/rough5.md, "Collision correction"). Off by default: on the closed pocket step 1 keeps V_r
+    /// and costs time (and with `--tilt optimised` the post's replay check refuses one block); step 2
+    /// changes V_r by less than 0.05 points on the three parts for about 1 % more machine time.
+    /// Never applied with `--tilt zero`.
+    #[arg(long, value_enum, value_delimiter = ',', num_args = 0..=1, default_missing_value = "planar")]
+    correction: Vec<CorrectionArg>,
     /// Leave out refinements of the 5-axis programs, comma-separated (default: all of them are on).
     #[arg(long, value_enum, value_delimiter = ',')]
     without: Vec<RefineArg>,
@@ -179,6 +191,10 @@ struct PassJson {
     points: usize,
     dropped: usize,
     corrected: usize,
+    /// CL points whose axis the spatial correction (step 2) turned.
+    spatial: usize,
+    /// CL points the axis translation (step 3) moved.
+    translated: usize,
     runs: usize,
     pitch_deg: [f64; 3],
     max_tilt_deg: f64,
@@ -253,12 +269,16 @@ fn cutter(a: &Rough5Args) -> CliResult<Cutter> {
     let bad = |e: scallop_cutter::CutterError| {
         Failure::rejected(format!("the tool: {e} (--tool-radius, --corner, --flutes, --holder)"))
     };
-    let shape = CutterShape::Bull { radius: a.tool_radius, corner: a.corner };
-    let holder = HolderSegment { length: a.holder[1], bottom_radius: a.holder[0] / 2.0, top_radius: a.holder[0] / 2.0 };
-    Cutter::new(shape, a.flutes)
-        .and_then(|c| c.with_shank(a.tool_radius, a.stick_out - a.flutes))
-        .and_then(|c| c.with_holder(vec![holder]))
-        .map_err(bad)
+    TorusTool {
+        radius: a.tool_radius,
+        corner: a.corner,
+        flutes: a.flutes,
+        stick_out: a.stick_out,
+        holder_diameter: a.holder[0],
+        holder_length: a.holder[1],
+    }
+    .cutter()
+    .map_err(bad)
 }
 
 /// The planning settings of the arguments.
@@ -278,7 +298,7 @@ fn settings(args: &Rough5Args, part: &TestPart) -> CliResult<Rough5Settings> {
         max_angle_step: args.max_angle_step.to_radians(),
         max_azimuth_step: args.max_azimuth_step.to_radians(),
         orientation: matches!(args.tilt, TiltArg::Optimised).then(|| orientation(args, weights)),
-        correct: args.correction && !matches!(args.tilt, TiltArg::Zero),
+        correct: args.correction.contains(&CorrectionArg::Planar) && !matches!(args.tilt, TiltArg::Zero),
         levels: LevelOptions {
             centre_offsets: on(RefineArg::CentreOffsets),
             pair_by_rank: on(RefineArg::PairByRank),
@@ -286,6 +306,7 @@ fn settings(args: &Rough5Args, part: &TestPart) -> CliResult<Rough5Settings> {
         },
         vertical_inside: on(RefineArg::VerticalInside),
         vertical_thin_steps: on(RefineArg::ThinSteps),
+        spatial: args.correction.contains(&CorrectionArg::Spatial) && !matches!(args.tilt, TiltArg::Zero),
         translate: on(RefineArg::Translation),
         local_entry: on(RefineArg::LocalEntry),
         round_corners: on(RefineArg::Corners),
@@ -459,6 +480,8 @@ fn report(
                 points: p.points,
                 dropped: p.dropped,
                 corrected: p.corrected,
+                spatial: p.spatial,
+                translated: p.translated,
                 runs: p.runs,
                 pitch_deg: p.pitch.map(deg),
                 max_tilt_deg: deg(p.max_tilt),
@@ -610,9 +633,14 @@ fn summary_text(r: &Report, output: &Path) -> String {
     }
     metric_lines(&mut s, m, "  ");
     let corrected: usize = r.passes.iter().map(|p| p.corrected).sum();
+    let spatial: usize = r.passes.iter().map(|p| p.spatial).sum();
+    let translated: usize = r.passes.iter().map(|p| p.translated).sum();
     let dropped: usize = r.passes.iter().map(|p| p.dropped).sum();
-    let _ =
-        writeln!(s, "  flank collisions: {corrected} CL points turned clear (collision correction), {dropped} dropped");
+    let _ = writeln!(
+        s,
+        "  flank collisions: {corrected} CL points turned in their plane (step 1), {spatial} turned through an upper \
+         limit curve (step 2), {translated} translated (step 3), {dropped} dropped"
+    );
     let _ = writeln!(
         s,
         "  planned in {:.1} s, proven in {:.1} s; written to {}",

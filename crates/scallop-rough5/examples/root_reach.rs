@@ -18,13 +18,14 @@
 //! move across the pass nearest the flank at which the whole tool keeps the
 //! allowance from the blades, then the open cells that tool covers.
 #![allow(clippy::unwrap_used, clippy::print_stdout, clippy::cast_precision_loss, reason = "an analysis example")]
-use scallop_cutter::{Cutter, CutterShape, HolderSegment};
 use scallop_geom::{Point3, Vec3};
 use scallop_guides::GuideSettings;
 use scallop_mesh::MeshQuery;
 use scallop_parts::{FaceTag, ImpellerParams, impeller_channel};
 use scallop_rough5::rest::inside;
-use scallop_rough5::{BodyCheck, Feature, LevelOptions, Placement, Placer, TiltMode, level_passes_with, synchronise};
+use scallop_rough5::{
+    BodyCheck, Feature, LevelOptions, Placement, Placer, TiltMode, TorusTool, level_passes_with, synchronise,
+};
 
 fn main() {
     let cl = std::env::args().nth(1).unwrap();
@@ -37,12 +38,7 @@ fn main() {
         GuideSettings { tool_radius: 5.0, flank_allowance: 0.5, axial_step: 4.0, radial_step: 4.5, voxel: 1.0, depth };
     let all = LevelOptions { centre_offsets: true, pair_by_rank: true, open_bottom: true };
     let levels = level_passes_with(&bottom, &flanks, &g, TiltMode::Guides, &all).unwrap();
-    let cutter = Cutter::new(CutterShape::Bull { radius: 5.0, corner: 1.5 }, 30.0)
-        .unwrap()
-        .with_shank(5.0, 11.0)
-        .unwrap()
-        .with_holder(vec![HolderSegment { length: 192.0, bottom_radius: 13.5, top_radius: 13.5 }])
-        .unwrap();
+    let cutter = TorusTool::THESIS.cutter().unwrap();
     let tool = (5.0, 1.5, 30.0);
     let text = std::fs::read_to_string(cl).unwrap();
     let mut cut = Vec::new();

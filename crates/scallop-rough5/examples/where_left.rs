@@ -38,13 +38,14 @@
 use std::collections::BTreeMap;
 
 use rayon::prelude::*;
-use scallop_cutter::{Cutter, CutterShape, HolderSegment};
+use scallop_cutter::Cutter;
 use scallop_geom::{Point3, Vec3};
 use scallop_machine::program::{Motion, ProgramOptions, records_of, to_program};
 use scallop_machine::time::{path_time, rapid_time};
 use scallop_machine::{Joints, Kinematics, Machine};
 use scallop_mesh::MeshQuery;
 use scallop_parts::{FaceTag, ImpellerParams, closed_pocket, fitting_pocket, impeller_channel};
+use scallop_rough5::TorusTool;
 use scallop_sim::{DexelOptions, DexelPart, DexelStock, ToolMove};
 use scallop_toolpath::MoveKind;
 
@@ -64,12 +65,7 @@ fn main() {
     let file = args.first().expect("give a toolpath.cl of `scallop rough5 --part pocket`");
     let text = std::fs::read_to_string(file).unwrap();
     let path = scallop_io::cl::read_cl(&text, 2400.0).unwrap();
-    let tool = Cutter::new(CutterShape::Bull { radius: 5.0, corner: 1.5 }, 30.0)
-        .unwrap()
-        .with_shank(5.0, 11.0)
-        .unwrap()
-        .with_holder(vec![HolderSegment { length: 192.0, bottom_radius: 13.5, top_radius: 13.5 }])
-        .unwrap();
+    let tool = TorusTool::THESIS.cutter().unwrap();
     if part_name == "impeller" {
         let part = impeller_channel(&ImpellerParams::default()).unwrap();
         remaining_impeller(&path, &tool, &part, args.get(1));

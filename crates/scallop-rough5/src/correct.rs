@@ -19,11 +19,18 @@
 //! checked, so a corrected pair is collision free by the same test as any
 //! other. A pair with no free axis in the plane, or without a tilt point
 //! (a level cut with the axis +Z), is left as it was: the planner drops it,
-//! as before. Steps 2 and 3 of the thesis (upper limit
-//! curves, axis translation) and the rebuilding loop are not implemented.
+//! as before.
+//!
+//! Step 2, the spatial correction by the upper levels' limit curves (Ch. 3
+//! §3, Fig. 3.32, Eq. 3.32), is [`correct_spatial`] and
+//! [`correct_pairs_spatial`]: a colliding pair's axis is turned to pass
+//! through a point of a limit curve of a level above, the pitch angle free.
+//! Step 3, the axis translation, is in the planner
+//! ([`crate::Rough5Settings::translate`]).
 
 use rayon::prelude::*;
-use scallop_geom::Vec3;
+use scallop_geom::{Point3, Vec3};
+use scallop_mesh::Polyline3;
 
 use crate::collide::BodyCheck;
 use crate::place::Placer;
@@ -160,6 +167,157 @@ pub fn correct_pairs(
             _ => *s,
         })
         .collect();
+    (out, count)
+}
+
+/// The point of segment `a`-`b` closest to the ray from `o` along the unit
+/// `u` (parameter t >= 0), and its distance to the ray.
+fn segment_to_ray(a: &Point3, b: &Point3, o: &Point3, u: &Vec3) -> (Point3, f64) {
+    let d = b - a;
+    let r = a - o;
+    let (aa, bb, dd, ee) = (d.dot(&d), d.dot(u), d.dot(&r), u.dot(&r));
+    let denom = aa - bb * bb;
+    let mut s = if aa > 0.0 && denom > 1e-12 * aa { ((bb * ee - dd) / denom).clamp(0.0, 1.0) } else { 0.0 };
+    let mut t = bb * s + ee;
+    if t < 0.0 {
+        t = 0.0;
+        s = if aa > 0.0 { (-dd / aa).clamp(0.0, 1.0) } else { 0.0 };
+    } else if aa > 0.0 {
+        // The segment point closest to the ray point found.
+        s = ((o + u * t - a).dot(&d) / aa).clamp(0.0, 1.0);
+        t = (a + d * s - o).dot(u).max(0.0);
+    }
+    let q = a + d * s;
+    (q, (q - (o + u * t)).norm())
+}
+
+/// The point of `line` closest to the ray from `o` along the unit `u`.
+fn closest_to_ray(line: &Polyline3, o: &Point3, u: &Vec3) -> Option<Point3> {
+    let pts = &line.points;
+    let n = pts.len();
+    if n == 1 {
+        return Some(pts[0]);
+    }
+    let segments = if line.closed { n } else { n.saturating_sub(1) };
+    (0..segments)
+        .map(|i| segment_to_ray(&pts[i], &pts[(i + 1) % n], o, u))
+        .min_by(|x, y| x.1.total_cmp(&y.1))
+        .map(|(q, _)| q)
+}
+
+/// The pair `s`, whose tool collides with the flanks, with its axis through
+/// P_T and a point of one of the limit curves `upper` of the levels above
+/// its tilt curve's (Jousselin 2020, Ch. 3 §3, step 2, Fig. 3.32, Eq. 3.32):
+/// on each curve, the point closest to the current axis is a candidate tilt
+/// point; the candidate chosen is the one that leans the axis furthest away
+/// from the flank. The thesis measures that lean across the feed direction,
+/// to the left of T (away from the flank for a pocket kept on the left);
+/// here it is measured along the flank normal N_f at the deepest intrusion,
+/// made orthogonal to the axis, which holds for either travel direction (for
+/// the opposite direction Eq. 3.32 would take the minimum). The new axis's
+/// pitch angle theta_t is free:
+/// a candidate ahead of or behind the pair changes it.
+///
+/// The tool along each candidate axis is placed on the level again and
+/// checked: the candidate chosen is the one leaning furthest away among
+/// those whose tool clears the flanks, or, when none does, among those that
+/// reduce the deepest intrusion (step 3 then translates it less). Candidates
+/// are above P_T along the level normal and lean at most 60 degrees from +Z
+/// ([`tol::CONE_MIN_Z`]). `None` when the pair does not collide, has no tilt
+/// point (the axis +Z of a level cut untilted, left alone as by
+/// [`correct_planar`]) or no candidate helps.
+#[must_use]
+pub fn correct_spatial(placer: &Placer, body: &BodyCheck, s: &SyncPoint, upper: &[Polyline3]) -> Option<SyncPoint> {
+    s.tilt?;
+    let placed = placer.place(&s.path, &s.axis)?;
+    let (deficit, normal) = body.intrusion(&placed.tip, &placed.axis)?;
+    let across = normal - s.axis * normal.dot(&s.axis);
+    let away = match across.try_normalize(tol::ANGLE_EPS) {
+        Some(a) => a,
+        // The thesis's measure: the left of the feed direction.
+        None => s.axis.cross(&s.tangent).try_normalize(tol::ANGLE_EPS)?,
+    };
+    // (lean away, clears, deficit, axis, tilt point)
+    let mut best: Option<(f64, bool, f64, Vec3, Point3)> = None;
+    for line in upper {
+        let Some(q) = closest_to_ray(line, &s.path, &s.axis) else { continue };
+        let Some(v) = (q - s.path).try_normalize(tol::ANGLE_EPS) else { continue };
+        if v.z <= tol::CONE_MIN_Z || v.dot(&s.normal) <= 0.0 || (v - s.axis).norm() < tol::ANGLE_EPS {
+            continue;
+        }
+        let Some(p) = placer.place(&s.path, &v) else { continue };
+        let found = body.intrusion(&p.tip, &p.axis);
+        let (clears, d) = found.map_or((true, 0.0), |(d, _)| (false, d));
+        if !clears && d >= deficit {
+            continue;
+        }
+        let lean = v.dot(&away);
+        let better = match best {
+            None => true,
+            Some((l, c, _, _, _)) => (clears && !c) || (clears == c && lean > l),
+        };
+        if better {
+            best = Some((lean, clears, d, v, q));
+        }
+    }
+    best.map(|(_, _, _, v, q)| SyncPoint { tilt: Some(q), axis: v, ..*s })
+}
+
+/// The pairs of one pass with every colliding pair corrected by
+/// [`correct_spatial`] against the limit curves `upper` of the levels above,
+/// and the counts. The neighbours of a corrected pair lean towards its new
+/// axis: walking away from it in both directions, a pair more than
+/// `max_step` (rad) from the axis before it is turned towards that axis (by
+/// [`crate::interpolate_axis`]) to within `max_step` of it, until a pair is
+/// within reach (`leaned_in` counts them). Corrected pairs are not turned by
+/// the lean-in. The result does not depend on the thread count.
+#[must_use]
+pub fn correct_pairs_spatial(
+    placer: &Placer,
+    body: &BodyCheck,
+    pairs: &[SyncPoint],
+    upper: &[Polyline3],
+    max_step: f64,
+) -> (Vec<SyncPoint>, CorrectionCount) {
+    let found: Vec<(bool, Option<SyncPoint>)> = pairs
+        .par_iter()
+        .map(|s| {
+            let collides = placer.place(&s.path, &s.axis).is_some_and(|p| body.collides(&p.tip, &p.axis));
+            (collides, if collides { correct_spatial(placer, body, s, upper) } else { None })
+        })
+        .collect();
+    let mut out: Vec<SyncPoint> = pairs.iter().zip(&found).map(|(s, f)| f.1.unwrap_or(*s)).collect();
+    let fixed: Vec<bool> = found.iter().map(|f| f.1.is_some()).collect();
+    let mut leaned = vec![false; pairs.len()];
+    let n = out.len();
+    for forward in [true, false] {
+        let mut from_fixed = false;
+        for i in 0..n {
+            let k = if forward { i } else { n - 1 - i };
+            if fixed[k] {
+                from_fixed = true;
+                continue;
+            }
+            if !from_fixed || out[k].tilt.is_none() {
+                from_fixed = false;
+                continue;
+            }
+            let prev = out[if forward { k - 1 } else { k + 1 }].axis;
+            let angle = prev.angle(&out[k].axis);
+            if angle <= max_step {
+                from_fixed = false;
+                continue;
+            }
+            let axis = crate::sync::interpolate_axis(&prev, &out[k].axis, max_step / angle);
+            out[k] = with_axis(&out[k], axis);
+            leaned[k] = true;
+        }
+    }
+    let count = CorrectionCount {
+        colliding: found.iter().filter(|f| f.0).count(),
+        corrected: fixed.iter().filter(|&&f| f).count(),
+        leaned_in: leaned.iter().filter(|&&l| l).count(),
+    };
     (out, count)
 }
 

@@ -1,7 +1,64 @@
 //! Cutting data of the roughing tool (Jousselin 2020, Ch. 2 §4 and Ch. 3
 //! §2.3: FRAISA recommendations for aluminium in slotting conditions).
 
+use scallop_cutter::{Cutter, CutterError, CutterShape, HolderSegment};
+
 use crate::Rough5Error;
+
+/// A torus end mill in a cylindrical holder: the tool of `scallop rough5`
+/// and of its tests and examples (spec 9 of the thesis's pocket: the FRAISA
+/// torus R 5 r 1.5 in a slender collet chuck 27 mm across and 192 mm long).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TorusTool {
+    /// Torus radius R (mm).
+    pub radius: f64,
+    /// Corner radius r (mm).
+    pub corner: f64,
+    /// Flute length (mm).
+    pub flutes: f64,
+    /// Stick-out from the holder (mm): the flutes, then a shank of radius R.
+    pub stick_out: f64,
+    /// Holder diameter (mm).
+    pub holder_diameter: f64,
+    /// Holder length (mm).
+    pub holder_length: f64,
+}
+
+impl TorusTool {
+    /// The thesis's tool: R 5, r 1.5, 30 mm of flutes (not given in the
+    /// thesis: they keep the shank above the 35 mm block), 41 mm out of a
+    /// holder 27 mm across and 192 mm long.
+    pub const THESIS: TorusTool = TorusTool {
+        radius: 5.0,
+        corner: 1.5,
+        flutes: 30.0,
+        stick_out: 41.0,
+        holder_diameter: 27.0,
+        holder_length: 192.0,
+    };
+
+    /// The cutter: the torus with its flutes, a shank of radius R up to the
+    /// stick-out, and the holder.
+    ///
+    /// ```
+    /// let tool = scallop_rough5::TorusTool::THESIS.cutter().unwrap();
+    /// assert!((tool.radius() - 5.0).abs() < 1e-12);
+    /// ```
+    ///
+    /// # Errors
+    /// The cutter's error when a length is not positive or the stick-out is
+    /// shorter than the flutes.
+    pub fn cutter(&self) -> Result<Cutter, CutterError> {
+        let holder = HolderSegment {
+            length: self.holder_length,
+            bottom_radius: self.holder_diameter / 2.0,
+            top_radius: self.holder_diameter / 2.0,
+        };
+        Cutter::new(CutterShape::Bull { radius: self.radius, corner: self.corner }, self.flutes)?
+            .with_shank(self.radius, self.stick_out - self.flutes)?
+            .with_holder(vec![holder])
+    }
+}
 
 /// Teeth, feed per tooth and spindle speed; the feed follows from them.
 #[derive(Debug, Clone, Copy, PartialEq)]

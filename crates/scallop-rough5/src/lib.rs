@@ -13,7 +13,8 @@
 //!   cases of Ch. 3 §2.3);
 //! - [`correct_planar`]: the collision correction that turns a colliding
 //!   tool axis in its correction plane, the pitch angle kept (Ch. 3 §3,
-//!   Eq. 3.31);
+//!   Eq. 3.31); [`correct_spatial`]: step 2, the axis turned through a
+//!   point of an upper level's limit curve (Eq. 3.32);
 //! - [`plan_zlevel`], [`plan_three_plus_two`]: the 3-axis baselines on the
 //!   same part, tool and cutting data (z-level roughing in one setup, then
 //!   rest roughing in fixed orientations chosen from the undercuts);
@@ -61,8 +62,8 @@ pub use scallop_geom::tol::rough5 as tol;
 
 pub use baseline::{BaselinePlan, BaselineSettings, Pocket, SetupReport, plan_three_plus_two, plan_zlevel, setup_axes};
 pub use collide::BodyCheck;
-pub use correct::{CorrectionCount, correct_pairs, correct_planar};
-pub use cutting::CuttingData;
+pub use correct::{CorrectionCount, correct_pairs, correct_pairs_spatial, correct_planar, correct_spatial};
+pub use cutting::{CuttingData, TorusTool};
 pub use error::Rough5Error;
 pub use faces::{FaceMetrics, ProofFace, face_metrics};
 pub use levels::{LevelOptions, LevelPasses, TiltMode, level_passes, level_passes_with, refine_facets};

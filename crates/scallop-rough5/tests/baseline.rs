@@ -8,11 +8,12 @@
 
 mod common;
 
-use scallop_cutter::{Cutter, CutterShape, HolderSegment};
+use scallop_cutter::Cutter;
 use scallop_geom::Vec3;
 use scallop_parts::{FaceTag, PocketParams, TestPart, closed_pocket};
 use scallop_rough5::{
-    BaselinePlan, BaselineSettings, Pocket, ProofSettings, plan_three_plus_two, plan_zlevel, prove, setup_axes,
+    BaselinePlan, BaselineSettings, Pocket, ProofSettings, TorusTool, plan_three_plus_two, plan_zlevel, prove,
+    setup_axes,
 };
 use scallop_toolpath::MoveKind;
 
@@ -229,12 +230,10 @@ fn three_plus_two_starts_from_the_blank() {
 fn rest_setups_keep_the_holder_off_the_stock() {
     let part = closed_pocket(&PocketParams::default()).unwrap();
     let f = faces(&part);
-    let tool = Cutter::new(CutterShape::Bull { radius: 5.0, corner: 1.5 }, 27.0)
-        .unwrap()
-        .with_shank(5.0, 1.0)
-        .unwrap()
-        .with_holder(vec![HolderSegment { length: 100.0, bottom_radius: 20.0, top_radius: 20.0 }])
-        .unwrap();
+    let tool =
+        TorusTool { flutes: 27.0, stick_out: 28.0, holder_diameter: 40.0, holder_length: 100.0, ..TorusTool::THESIS }
+            .cutter()
+            .unwrap();
     let plan = plan_three_plus_two(&pocket(&part, &f), &tool, &settings()).unwrap();
     assert!(plan.setups.len() >= 2 && plan.setups[1..].iter().all(|s| s.passes > 0), "{:?}", plan.setups);
     let proof_settings = ProofSettings { resolution: 1.0, axis_tolerance: 0.05 };

@@ -37,18 +37,22 @@ fn every_variant_proves_itself_on_the_closed_pocket() {
     let mut remaining = Vec::new();
     // The optimised orientation: the thesis's mixed weighting (Ch. 3 §2.3, case 2).
     let mixed = OrientSettings::new(Weights { bounds: 15.0, fluidity: 1.2, pitch: 1.0 });
-    // And the guide curves with the collision correction (Ch. 3 §3, step 1).
+    // And the guide curves with the collision correction (Ch. 3 §3, step 1),
+    // and with its step 2 (the upper levels' limit curves).
     let variants = [
-        (TiltMode::Zero, None, false),
-        (TiltMode::Guides, None, false),
-        (TiltMode::Guides, Some(mixed), false),
-        (TiltMode::Guides, None, true),
+        (TiltMode::Zero, None, false, false),
+        (TiltMode::Guides, None, false, false),
+        (TiltMode::Guides, Some(mixed), false, false),
+        (TiltMode::Guides, None, true, false),
+        (TiltMode::Guides, None, false, true),
     ];
-    for (tilt, orientation, correct) in variants {
-        let s = Rough5Settings { orientation, correct, ..settings(tilt, depth) };
+    for (tilt, orientation, correct, spatial) in variants {
+        let s = Rough5Settings { orientation, correct, spatial, ..settings(tilt, depth) };
         let plan = plan_rough5(&bottom, &flanks, &part.stock, &tool, &s, &|_, _| {}).unwrap();
         let path = &plan.toolpath;
         assert!(plan.passes.iter().map(|p| p.points).sum::<usize>() > 100);
+        let turned: usize = plan.passes.iter().map(|p| p.spatial).sum();
+        assert_eq!(turned > 0, spatial, "{turned} pairs turned by step 2");
         for (i, m) in path.moves().iter().enumerate().skip(1) {
             if matches!(m.kind, MoveKind::Feed | MoveKind::Link) {
                 let angle = path.axis(i - 1).angle(&path.axis(i));

@@ -3,22 +3,17 @@
 
 #![allow(dead_code, clippy::unwrap_used, reason = "shared by several test files; a panic is the failure report")]
 
-use scallop_cutter::{Cutter, CutterShape, HolderSegment};
+use scallop_cutter::Cutter;
 use scallop_guides::GuideSettings;
 use scallop_mesh::TriMesh;
 use scallop_parts::{FaceTag, PocketParams, TestPart};
-use scallop_rough5::Rough5Settings;
+use scallop_rough5::{Rough5Settings, TorusTool};
 
 /// The torus R 5 r 1.5 of the thesis's pocket (spec 9) with `flutes` mm of
 /// flutes, a shank R 5 of 11 mm and a cylindrical holder R 13.5 of
 /// `holder` mm.
 pub fn torus(flutes: f64, holder: f64) -> Cutter {
-    Cutter::new(CutterShape::Bull { radius: 5.0, corner: 1.5 }, flutes)
-        .unwrap()
-        .with_shank(5.0, 11.0)
-        .unwrap()
-        .with_holder(vec![HolderSegment { length: holder, bottom_radius: 13.5, top_radius: 13.5 }])
-        .unwrap()
+    TorusTool { flutes, stick_out: flutes + 11.0, holder_length: holder, ..TorusTool::THESIS }.cutter().unwrap()
 }
 
 /// The levels and curves of the torus R 5 on a pocket `depth` mm deep:
