@@ -4,6 +4,9 @@
 //! its plane is not corrected.
 #![allow(clippy::unwrap_used, reason = "tests: a panic is the failure report")]
 
+mod common;
+use common::floor;
+
 use proptest::prelude::*;
 use scallop_cutter::{Cutter, CutterShape};
 use scallop_geom::{Point3, Vec3};
@@ -15,16 +18,6 @@ const STEP: f64 = 2.0 * std::f64::consts::PI / 180.0;
 
 fn p(x: f64, y: f64, z: f64) -> Point3 {
     Point3::new(x, y, z)
-}
-
-/// The plane z = 0 over a 200 mm square (the level).
-fn floor() -> TriMesh {
-    let (m, _) = TriMesh::from_soup(&[
-        [p(-100., -100., 0.), p(100., -100., 0.), p(100., 100., 0.)],
-        [p(-100., -100., 0.), p(100., 100., 0.), p(-100., 100., 0.)],
-    ])
-    .unwrap();
-    m
 }
 
 /// Vertical walls `x = c` for each c, 40 mm high, 200 mm long.

@@ -9,6 +9,9 @@
 //! known exactly, independently of the flank mesh and of `BodyCheck`.
 #![allow(clippy::unwrap_used, reason = "tests: a panic is the failure report")]
 
+mod common;
+use common::floor;
+
 use proptest::prelude::*;
 use scallop_cutter::{Cutter, CutterShape};
 use scallop_geom::{Point3, Vec3};
@@ -29,16 +32,6 @@ const AP: f64 = 4.0;
 
 fn p(x: f64, y: f64, z: f64) -> Point3 {
     Point3::new(x, y, z)
-}
-
-/// The plane z = 0 over a 200 mm square (the level of the pass).
-fn floor() -> TriMesh {
-    let (m, _) = TriMesh::from_soup(&[
-        [p(-100., -100., 0.), p(100., -100., 0.), p(100., 100., 0.)],
-        [p(-100., -100., 0.), p(100., 100., 0.), p(-100., 100., 0.)],
-    ])
-    .unwrap();
-    m
 }
 
 /// A quad as two triangles.

@@ -43,3 +43,14 @@ pub fn bottom_flanks(part: &TestPart) -> (TriMesh, TriMesh, f64) {
 pub fn small_pocket(height: f64, bottom_z: f64) -> PocketParams {
     PocketParams { stock: [60.0, 60.0, height], bottom_z, wall: 8.0, corner_radius: 6.0, ..Default::default() }
 }
+
+/// The plane z = 0 over a 200 mm square (the level of a pass).
+pub fn floor() -> TriMesh {
+    let p = scallop_geom::Point3::new;
+    let (m, _) = TriMesh::from_soup(&[
+        [p(-100., -100., 0.), p(100., -100., 0.), p(100., 100., 0.)],
+        [p(-100., -100., 0.), p(100., 100., 0.), p(-100., 100., 0.)],
+    ])
+    .unwrap();
+    m
+}
