@@ -2,7 +2,7 @@
 # Side by side: FreeCAD 0.20.2 Adaptive clearing vs `scallop pocket` (--pattern offset or adaptive),
 # both evaluated by the same independent measure, `scallop engagement`.
 #
-#   bash bench/freecad/run.sh [--reduced] [--workdir DIR] [--scallop BIN] [--planner BIN] [--pattern NAME] [--markdown FILE]
+#   bash bench/freecad/run.sh [--reduced] [--workdir DIR] [--scallop BIN] [--planner BIN] [--pattern NAME] [--both-ways] [--markdown FILE]
 #
 # Pockets (bench/freecad/pockets.py): rectangle 100 x 60, the same with a 24 mm round
 # island, L 100 x 80 with a 60 x 50 notch, disc 80 mm, a 16-tooth gear, a narrow branching
@@ -11,7 +11,8 @@
 # missing and apt has `freecad-python3`, it is installed (about 1.3 GB, 5 minutes).
 # scallop's side runs when `scallop pocket` exists, else it is skipped with a message;
 # --pattern gives its clearing pattern (default offset: adaptive is experimental, docs/roughing.md); --planner another scallop binary
-# that plans (`scallop pocket`) while --scallop evaluates (`scallop engagement`).
+# that plans (`scallop pocket`) while --scallop evaluates (`scallop engagement`); --both-ways
+# plans the adaptive passes both ways (`scallop pocket --both-ways`), FreeCAD's climb only.
 # Outputs (pockets, G-code, JSON figures, each program drawn coloured by engagement as SVG) go to
 # the work directory, never to the repository.
 # Exit status: 0 done, 2 setup or run error.
@@ -26,9 +27,11 @@ reduced=()
 markdown=""
 pattern=offset
 planner=""
+both=()
 while [ $# -gt 0 ]; do
     case "$1" in
         --reduced) reduced=(--reduced) ;;
+        --both-ways) both=(--both-ways) ;;
         --workdir|--scallop|--planner|--markdown|--pattern)
             [ $# -ge 2 ] || { echo "run.sh: $1 needs a value" >&2; exit 2; }
             val=$2
@@ -41,7 +44,7 @@ while [ $# -gt 0 ]; do
                 --planner) planner=$val ;;
             esac
             shift ;;
-        -h|--help) sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+        -h|--help) sed -n '2,18p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
         *) echo "run.sh: unknown option $1" >&2; exit 2 ;;
     esac
     shift
@@ -111,7 +114,7 @@ while read -r name; do
         rm -rf "$out/scallop"
         start=$(date +%s.%N)
         if RAYON_NUM_THREADS=1 "$planner" pocket --region "$workdir/pockets/$name.json" --tool-diameter 6 --stepover 0.2 \
-            --pattern "$pattern" -o "$out/scallop" > "$out/scallop.log" 2>&1; then
+            --pattern "$pattern" "${both[@]}" -o "$out/scallop" > "$out/scallop.log" 2>&1; then
             end=$(date +%s.%N)
             echo "{\"seconds\": $(python3 -c "print($end - $start)")}" > "$out/scallop-timing.json"
             program=$(find "$out/scallop" -maxdepth 1 \( -name '*.nc' -o -name '*.ngc' -o -name '*.gcode' \) | sort | head -1)

@@ -58,8 +58,13 @@ pub struct PocketArgs {
     #[arg(long, default_value_t = 1e-3, allow_hyphen_values = true)]
     tolerance: f64,
     /// Conventional milling instead of climb.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "both_ways")]
     conventional: bool,
+    /// Adaptive pattern: passes both ways, climb and conventional in turn
+    /// where a pass can go back along the frontier the last one left (the
+    /// rings climb).
+    #[arg(long)]
+    both_ways: bool,
     /// Output folder for `program.nc` and `toolpath.csv`.
     #[arg(short, long)]
     output: PathBuf,
@@ -139,7 +144,13 @@ pub fn run(args: &PocketArgs) -> CliResult<()> {
             args.region.display()
         )));
     }
-    let direction = if args.conventional { Direction::Conventional } else { Direction::Climb };
+    let direction = if args.conventional {
+        Direction::Conventional
+    } else if args.both_ways {
+        Direction::Both
+    } else {
+        Direction::Climb
+    };
     let pattern = match args.pattern {
         PatternArg::Offset => Pattern::Offset,
         PatternArg::OffsetLoops => Pattern::OffsetLoops,

@@ -206,6 +206,7 @@ fn rough_settings(r: &scallop_io::job::RoughingSpec) -> scallop_rough::RoughSett
         direction: match r.direction {
             scallop_io::job::MillingWord::Climb => scallop_rough::Direction::Climb,
             scallop_io::job::MillingWord::Conventional => scallop_rough::Direction::Conventional,
+            scallop_io::job::MillingWord::Both => scallop_rough::Direction::Both,
         },
     }
 }

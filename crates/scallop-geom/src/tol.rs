@@ -794,6 +794,16 @@ pub mod rough {
     /// this far apart (share of R).
     pub const WALK_START_SPACING: f64 = 0.25;
 
+    /// Adaptive clearing both ways: a pass's last centre is also a place to
+    /// start (the next pass goes back from there) unless it lies within this
+    /// share of [`WALK_START_SPACING`] of the centre listed before it.
+    pub const WALK_END_START_SHARE: f64 = 0.25;
+
+    /// Adaptive clearing both ways: only a pass at least this long (share of
+    /// R) is followed by one back along its frontier; a shorter one's
+    /// frontier is peeled from its head, as when climbing.
+    pub const WALK_BOTH_WAYS_SHARE: f64 = 2.0;
+
     /// Adaptive clearing: a pass of more steps than this may start again
     /// where it started (it made progress there) ...
     pub const WALK_RESTART_STEPS: usize = 4;

@@ -396,7 +396,8 @@ word_enum! {
     /// `roughing.direction`.
     MillingWord { /// Climb milling.
         Climb = "climb", /// Conventional milling.
-        Conventional = "conventional" }
+        Conventional = "conventional", /// Both ways: adaptive passes climb and conventional in turn.
+        Both = "both" }
 }
 word_enum! {
     /// `finishing.strategy`.

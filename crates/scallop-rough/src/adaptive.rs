@@ -33,10 +33,9 @@
 //! the field as it was then: the engagement measured while planning is the
 //! engagement of the program (docs/roughing.md, "Adaptive clearing").
 
-use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
-use scallop_contour::{Contour, P2, Region};
+use scallop_contour::{Contour, P2, Region, Vertex};
 
 use crate::grid::{BIG, Grid};
 use crate::offset::Step;
@@ -74,8 +73,14 @@ struct Planner<'a> {
     /// lines are emitted (`links.rs`, `emit_runs`).
     stamped: Vec<(P2, P2)>,
     /// Tool centres of earlier passes, where a pass may start: the point,
-    /// whether material may still lie next to it, and its pass (0: the bore).
-    starts: Vec<(P2, bool, u32)>,
+    /// whether material may still lie next to it, its pass (0: the bore),
+    /// that pass's [`Planner::away`] (a bore's or an air start's: that of
+    /// the direction) and whether its run is peeled from its tail (both
+    /// ways, [`Planner::next_start`]).
+    starts: Vec<Start>,
+    /// The sign of a turn away from the material on the pass being planned
+    /// ([`Planner::away`]).
+    hand: f64,
     /// Unit directions of the front half's probes about the heading +x.
     probes: Vec<P2>,
     /// Unit directions of [`tol::ENGAGE_PROBES`] probes all round, from +x
@@ -95,6 +100,9 @@ struct Planner<'a> {
     /// is in air.
     open: Option<Vec<f64>>,
 }
+
+/// A place where a pass may start ([`Planner::starts`]).
+type Start = (P2, bool, u32, f64, bool);
 
 /// The walk's steps so far, its passes and its remaining steps.
 struct Walk {
@@ -198,6 +206,7 @@ pub fn plan_adaptive_in(
         inside,
         grid,
         starts: Vec::new(),
+        hand: if options.direction == Direction::Conventional { -1.0 } else { 1.0 },
         probes: front_probes(tol::ENGAGE_PROBES / 2),
         round: round_probes(tol::ENGAGE_PROBES),
         link_round: round_probes(tol::LINK_PROBES),
@@ -224,7 +233,8 @@ pub fn plan_adaptive_in(
         planner.bore(s, r0, 0);
         planner.walk_all(Some(s), &mut walk)?
     } else {
-        planner.starts.extend(air_starts.iter().map(|&p| (p, true, 0)));
+        let hand = planner.base_hand();
+        planner.starts.extend(air_starts.iter().map(|&p| (p, true, 0, hand, false)));
         planner.walk_all(None, &mut walk)?
     };
     // Parts of the region the walk could not reach (joined to the rest by a
@@ -290,24 +300,57 @@ pub fn plan_adaptive_in(
         .steps
         .into_iter()
         .map(|step| match step {
-            Step::Cut(c) => {
-                let fitted =
-                    Contour::from_points(&c.to_points(0.1 * arc_fit), c.is_closed(), arc_fit).ok().filter(|f| {
-                        let p = f.to_points(tol::WALK_CHORD);
-                        let closing = f.is_closed().then(|| (p[p.len() - 1], p[0]));
-                        p.windows(2)
-                            .map(|w| (w[0], w[1]))
-                            .chain(closing)
-                            .all(|(a, b)| planner.edges.contains_segment(a, b))
-                    });
-                Step::Cut(fitted.unwrap_or(c))
-            }
+            Step::Cut(c) => Step::Cut(fit_in(&planner.edges, &c, arc_fit).unwrap_or(c)),
             link @ Step::Link { .. } => link,
         })
         .collect();
     let mut rest = planner.finish(region, end);
     steps.append(&mut rest);
     Ok(steps)
+}
+
+/// The pass `c` as lines and arcs within `tolerance` of its points every
+/// tenth of `tolerance` ([`Contour::from_points`]), each arc kept only where
+/// it stays in the region (as chords within [`tol::WALK_CHORD`], exactly
+/// against `edges`), else the points it stood for, as lines. `None` when
+/// the fit fails.
+fn fit_in(edges: &Edges, c: &Contour, tolerance: f64) -> Option<Contour> {
+    let points = c.to_points(0.1 * tolerance);
+    let fitted = Contour::from_points(&points, c.is_closed(), tolerance).ok()?.vertices();
+    let n = fitted.len();
+    let mut out = Vec::with_capacity(n);
+    // The fit's vertices are some of `points`, in order: `at` is where the
+    // last one was found.
+    let mut at = 0usize;
+    #[allow(clippy::float_cmp, reason = "the fit's vertices are copies of the points")]
+    let find = |from: usize, v: &Vertex| (from..points.len()).find(|&k| points[k] == [v.x, v.y]);
+    for k in 0..n {
+        let v = fitted[k];
+        let i = find(at, &v)?;
+        at = i;
+        let next = if k + 1 < n {
+            Some(fitted[k + 1])
+        } else if c.is_closed() {
+            Some(fitted[0])
+        } else {
+            None
+        };
+        let Some(w) = next.filter(|_| v.bulge != 0.0) else {
+            out.push(v);
+            continue;
+        };
+        let arc = Contour::new(&[v, Vertex { bulge: 0.0, ..w }], false).ok()?;
+        let chords = arc.to_points(tol::WALK_CHORD);
+        if chords.windows(2).all(|m| edges.contains_segment(m[0], m[1])) {
+            out.push(v);
+            continue;
+        }
+        // The points the arc stood for, as lines.
+        let j = if k + 1 < n { find(i + 1, &w)? } else { points.len() };
+        out.push(Vertex { bulge: 0.0, ..v });
+        out.extend(points[i + 1..j].iter().map(|p| Vertex { x: p[0], y: p[1], bulge: 0.0 }));
+    }
+    Contour::new(&out, c.is_closed()).ok()
 }
 
 /// A convex corner of a region's ring between two lines: its point, the
@@ -427,9 +470,9 @@ fn rings_only(region: &Region, options: &ClearOptions) -> Vec<Step> {
 }
 
 fn orient(c: &Contour, direction: Direction) -> Contour {
-    match direction {
-        Direction::Climb => c.clone(),
+    match direction.rings() {
         Direction::Conventional => c.reversed(),
+        Direction::Climb | Direction::Both => c.clone(),
     }
 }
 
@@ -438,6 +481,7 @@ impl Planner<'_> {
     /// plunge at `s`; its centres are where the first pass may start.
     fn bore(&mut self, s: P2, r0: f64, pass: u32) {
         let w = self.options.tool_radius + 2.0 * self.grid.h;
+        let hand = self.base_hand();
         #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a small positive count")]
         let n = ((std::f64::consts::TAU * r0 / self.grid.h).ceil() as usize).max(1);
         let on = |i: usize| {
@@ -448,11 +492,11 @@ impl Planner<'_> {
         for i in 0..n {
             self.grid.stamp_segment(&mut self.swept, on(i), on(i + 1), w, None);
             if self.edges.contains(on(i)) {
-                self.starts.push((on(i), true, pass));
+                self.starts.push((on(i), true, pass, hand, false));
             }
         }
         self.grid.stamp_segment(&mut self.swept, s, s, w, None);
-        self.starts.push((s, true, pass));
+        self.starts.push((s, true, pass, hand, false));
     }
 
     /// Whether the segment `a`-`b` stays in the holder (as
@@ -538,13 +582,18 @@ impl Planner<'_> {
         Some((share(count), share(core)))
     }
 
-    /// The sign of a turn away from the material: left (counter-clockwise)
-    /// when climbing, the material on the tool's right.
+    /// The sign of a turn away from the material on the pass being planned:
+    /// left (counter-clockwise, 1) when climbing, the material on the tool's
+    /// right; right (-1) when milling conventionally. Both ways, it changes
+    /// from pass to pass ([`Planner::next_start`]).
     fn away(&self) -> f64 {
-        match self.options.direction {
-            Direction::Climb => 1.0,
-            Direction::Conventional => -1.0,
-        }
+        self.hand
+    }
+
+    /// The sign of [`Planner::away`] of the passes that start from a bore or
+    /// from the air.
+    fn base_hand(&self) -> f64 {
+        if self.options.direction == Direction::Conventional { -1.0 } else { 1.0 }
     }
 
     fn stride(&self, p: P2, heading: f64) -> Stride {
@@ -832,6 +881,8 @@ impl Planner<'_> {
         let mut pos = s;
         // The heading of the last pass's last move.
         let mut out: Option<f64> = None;
+        // The last pass's `away`: its end turns that way into the link.
+        let mut last_hand = self.hand;
         let mut fresh = true;
         let spacing = tol::WALK_START_SPACING * self.options.tool_radius;
         let step = tol::WALK_STEP_SHARE * self.options.tool_radius;
@@ -844,8 +895,9 @@ impl Planner<'_> {
             }
             // The link there first: it runs on the field as the tool finds it
             // (the pass would clear what the link's approach meets).
-            let link = (!fresh).then(|| self.turning_link(pos, out, start, first.heading));
+            let link = (!fresh).then(|| self.turning_link(pos, out, (last_hand, self.hand), start, first.heading));
             let (run, area, walked) = self.pass(start, first, &mut walk.budget)?;
+            let hand = self.hand;
             let steps = walked.len() - 1;
             // A start serves once: a pass from it that could not go on (the
             // engagement would rise over the target along a wall) would
@@ -862,19 +914,36 @@ impl Planner<'_> {
             // tool cannot quite reach) would be made again and again.
             #[allow(clippy::cast_precision_loss, reason = "a step count")]
             let progress = area >= tol::WALK_RESTART_SHARE * steps as f64 * step * self.options.stepover;
+            // Both ways, the run a pass leaves is peeled from its tail, back
+            // along it ([`Planner::next_start`]), but that of a pass that
+            // made no progress (from their tails, two such passes could undo
+            // each other's turn for ever) or of a short one (the link back
+            // to its head is short, and the reversal at its end would stop
+            // the tool as often, where a U-turn rarely fits).
+            #[allow(clippy::cast_precision_loss, reason = "a step count")]
+            let long = steps as f64 * step >= tol::WALK_BOTH_WAYS_SHARE * self.options.tool_radius;
+            let tail = self.options.direction == Direction::Both && progress && long;
             #[allow(clippy::cast_possible_truncation, reason = "passes are bounded by MAX_PASSES")]
+            let pass_no = passes as u32;
             if steps >= tol::WALK_RESTART_STEPS && progress {
-                self.starts.push((start, true, passes as u32));
+                self.starts.push((start, true, pass_no, hand, tail));
             }
             // The steps' points, every `spacing` or more: within `fit` of
             // the lines the tool cuts.
             let mut last = start;
             for &p in &walked[1..] {
                 if dist(p, last) >= spacing {
-                    #[allow(clippy::cast_possible_truncation, reason = "passes are bounded by MAX_PASSES")]
-                    self.starts.push((p, true, passes as u32));
+                    self.starts.push((p, true, pass_no, hand, tail));
                     last = p;
                 }
+            }
+            // Peeled from its tail, the next pass starts right where this one
+            // ended.
+            if let Some(&end) = walked.last()
+                && tail
+                && dist(end, last) > tol::WALK_END_START_SHARE * spacing
+            {
+                self.starts.push((end, true, pass_no, hand, tail));
             }
             if fresh && air {
                 // A tool centre in air: plunged straight, no helix.
@@ -892,6 +961,7 @@ impl Planner<'_> {
                 self.emit_runs(&mut walk.steps, vec![run.clone()]);
             }
             fresh = false;
+            last_hand = hand;
             pos = *run.last().unwrap_or(&pos);
             if let [.., a, b] = run[..] {
                 out = Some((b[1] - a[1]).atan2(b[0] - a[0]));
@@ -908,24 +978,38 @@ impl Planner<'_> {
     /// is cleared before the tool moves on. Centres found with no material
     /// are dropped for good (material only goes away), which makes the next
     /// one a head.
+    ///
+    /// Both ways ([`Direction::Both`]), a pass's run is peeled from its tail
+    /// instead (the one after it has none), the other way round: the tool
+    /// goes back along the frontier from where the last pass ended, with the
+    /// material on its other side. A bore's and the air's starts are heads.
+    /// Sets [`Planner::hand`] for the pass.
     fn next_start(&mut self) -> Option<(usize, Stride)> {
         let gap = 2.0 * tol::WALK_START_SPACING * self.options.tool_radius;
+        let both = self.options.direction == Direction::Both;
         let n = self.starts.len();
-        let head = |starts: &[(P2, bool, u32)], i: usize| {
-            starts[i].1
-                && (i == 0
-                    || !starts[i - 1].1
-                    || starts[i - 1].2 != starts[i].2
-                    || dist(starts[i - 1].0, starts[i].0) > gap)
+        let tails = |starts: &[Start], i: usize| both && starts[i].4;
+        let near = |starts: &[Start], i: usize, j: usize| {
+            starts[j].1 && starts[j].2 == starts[i].2 && dist(starts[j].0, starts[i].0) <= gap
         };
-        let key = |starts: &[(P2, bool, u32)], i: usize| (starts[i].2, Reverse(i));
-        let mut heap: BinaryHeap<(u32, Reverse<usize>)> =
-            (0..n).filter(|&i| head(&self.starts, i)).map(|i| key(&self.starts, i)).collect();
-        while let Some((_, Reverse(i))) = heap.pop() {
+        let head = |starts: &[Start], i: usize| starts[i].1 && !tails(starts, i) && (i == 0 || !near(starts, i, i - 1));
+        let tail = |starts: &[Start], i: usize| {
+            starts[i].1 && tails(starts, i) && (i + 1 == starts.len() || !near(starts, i, i + 1))
+        };
+        #[allow(clippy::cast_possible_wrap, reason = "starts are bounded by the walk's steps")]
+        let key = |starts: &[Start], i: usize| {
+            let order = if tails(starts, i) { i as i64 } else { -(i as i64) };
+            (starts[i].2, order, i)
+        };
+        let mut heap: BinaryHeap<(u32, i64, usize)> =
+            (0..n).filter(|&i| head(&self.starts, i) || tail(&self.starts, i)).map(|i| key(&self.starts, i)).collect();
+        while let Some((_, _, i)) = heap.pop() {
             if !self.starts[i].1 {
                 continue;
             }
             let p = self.starts[i].0;
+            let from_tail = tails(&self.starts, i);
+            self.hand = if from_tail { -self.starts[i].3 } else { self.starts[i].3 };
             // An air start's first pass leads in along the material's edge;
             // a start listed again after a pass heads into its frontier.
             let inward = if self.starts[i].2 == 0 { self.air_inward(p) } else { None };
@@ -937,7 +1021,11 @@ impl Planner<'_> {
                 return Some((i, h));
             }
             self.starts[i].1 = false;
-            if i + 1 < n && head(&self.starts, i + 1) {
+            if from_tail {
+                if i > 0 && tail(&self.starts, i - 1) {
+                    heap.push(key(&self.starts, i - 1));
+                }
+            } else if i + 1 < n && head(&self.starts, i + 1) {
                 heap.push(key(&self.starts, i + 1));
             }
         }
@@ -1071,7 +1159,7 @@ impl Planner<'_> {
         for corner in &corners {
             self.clear_corner(corner, &mut pos, &mut steps);
         }
-        let climb = matches!(self.options.direction, Direction::Climb);
+        let climb = matches!(self.options.direction.rings(), Direction::Climb);
         let mut looper =
             crate::offset::loops::Looper::after(region, r, climb, self.target, self.options.chord_tolerance);
         while !rings.is_empty() {

@@ -75,6 +75,25 @@ pub enum Direction {
     Climb,
     /// Conventional (up) milling.
     Conventional,
+    /// Both ways (adaptive pattern): a pass that ends where the next one
+    /// can start back along the frontier it left is followed by one the
+    /// other way, climb and conventional in turn, where climb only would
+    /// link back to the frontier's upstream end (docs/roughing.md,
+    /// "Adaptive clearing", both ways). The offset patterns, the region's
+    /// rings and corners climb.
+    Both,
+}
+
+impl Direction {
+    /// The direction of closed rings and of the offset patterns: climb but
+    /// for [`Direction::Conventional`].
+    #[must_use]
+    pub fn rings(self) -> Self {
+        match self {
+            Self::Conventional => Self::Conventional,
+            Self::Climb | Self::Both => Self::Climb,
+        }
+    }
 }
 
 /// How a region is cleared.

@@ -253,7 +253,7 @@ pub fn plan_offset_in(
     // The walls, inside-out. Where a ring's inner side meets material the
     // deeper rings did not sweep (a slot), it is cut with loops.
     let target = (1.0 - (ae / r).min(2.0)).acos();
-    let climb = matches!(options.direction, Direction::Climb);
+    let climb = matches!(options.direction.rings(), Direction::Climb);
     let with_loops = matches!(options.pattern, crate::Pattern::OffsetLoops);
     let mut looper = with_loops.then(|| loops::Looper::new(region, None, r, climb, target, tol_c));
     // The last wall ring cut, when closed (a transition leaves it).
@@ -811,9 +811,9 @@ fn erode(region: &Region, levels: &[Region], ae: f64) -> Result<Region, RoughErr
 /// region's own orientation (the material lies outside each ring's filled
 /// side).
 fn orient(c: &Contour, direction: Direction) -> Contour {
-    match direction {
-        Direction::Climb => c.clone(),
+    match direction.rings() {
         Direction::Conventional => c.reversed(),
+        Direction::Climb | Direction::Both => c.clone(),
     }
 }
 

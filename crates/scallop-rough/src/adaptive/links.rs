@@ -279,7 +279,19 @@ impl Planner<'_> {
     /// [`Planner::turn_ok`] and whose middle (the common tangent, else a
     /// path of [`Planner::link_path`]) is found; else the same with an arc
     /// at one end only; else [`Planner::link_step`].
-    pub(super) fn turning_link(&mut self, from: P2, out: Option<f64>, to: P2, into: f64) -> Step {
+    /// `away` and `away0` are the signs of [`Planner::away`] on the last
+    /// pass and on the next: each arc turns away from its own pass's
+    /// material. Both ways, where the next pass goes back along the
+    /// frontier, the two differ: the arcs are then joined by their inner
+    /// tangent, else (they overlap) tried both turning the last pass's way.
+    pub(super) fn turning_link(
+        &mut self,
+        from: P2,
+        out: Option<f64>,
+        (away, away0): (f64, f64),
+        to: P2,
+        into: f64,
+    ) -> Step {
         if let Some(h) = out {
             // Both ends turning first; else the end's arc alone, else the
             // start's (a wall right behind a start or ahead of an end leaves
@@ -287,13 +299,20 @@ impl Planner<'_> {
             // last heading, else turned further away from the material by
             // the least of [`tol::LINK_END_TURNS`] that fits: a pass that
             // ends against a wall turns a little there instead of reversing.
-            let away = self.away();
-            for (need_end, need_start) in [(true, true), (true, false), (false, true)] {
+            let same = (away0 > 0.0) == (away > 0.0);
+            let sides: &[f64] = if same { &[away] } else { &[away0, away] };
+            for (need_end, need_start, &side0) in [(true, true), (true, false), (false, true)]
+                .into_iter()
+                .flat_map(|(e, s)| sides.iter().map(move |side0| (e, s, side0)))
+                .filter(|&(e, s, &side0)| (e && s) || (side0 > 0.0) == (away > 0.0))
+            {
                 let rotations: &[f64] = if need_end { &tol::LINK_END_TURNS } else { &tol::LINK_END_TURNS[..1] };
                 for &rot in rotations {
                     for share in tol::LINK_TURN_SHARES {
                         let rho = share * self.options.tool_radius;
-                        let Some((first, last)) = turns(away, from, h + away * rot, to, into, rho) else { continue };
+                        let Some((first, last)) = turns(away, from, h + away * rot, side0, to, into, rho) else {
+                            continue;
+                        };
                         let ok = |me: &Self, arc: &[P2]| arc.windows(2).all(|w| me.turn_ok(w[0], w[1]));
                         let ok1 = need_end && ok(self, &first);
                         let ok2 = need_start && ok(self, &last);
@@ -385,43 +404,58 @@ impl Planner<'_> {
 
 /// The arcs of radius `rho` of [`Planner::turning_link`], as chords
 /// within [`tol::LINK_TURN_SAGITTA`]: from `p` (heading `h`) round to the
-/// common tangent, and from it round to `s` (heading `h0`); both turn
-/// away from the material (`side`: 1 left, -1 right). `None` when the circles coincide or an arc
-/// would turn more than 1.25 half turns.
-fn turns(side: f64, p: P2, h: f64, s: P2, h0: f64, rho: f64) -> Option<(Vec<P2>, Vec<P2>)> {
-    let centre = |q: P2, a: f64| [q[0] - rho * side * a.sin(), q[1] + rho * side * a.cos()];
-    let (c1, c2) = (centre(p, h), centre(s, h0));
+/// common tangent, and from it round to `s` (heading `h0`); the first turns
+/// `side` (1 left, -1 right), the second `side0` (away from the material of
+/// the pass each arc joins): the outer tangent of the two circles when
+/// they turn the same way, the inner one when not. `None` when the circles
+/// coincide, when they turn opposite ways and overlap, or when an arc would
+/// turn more than 1.25 half turns.
+fn turns(side: f64, p: P2, h: f64, side0: f64, s: P2, h0: f64, rho: f64) -> Option<(Vec<P2>, Vec<P2>)> {
+    let centre = |q: P2, a: f64, sd: f64| [q[0] - rho * sd * a.sin(), q[1] + rho * sd * a.cos()];
+    let (c1, c2) = (centre(p, h, side), centre(s, h0, side0));
     let d = dist(c1, c2);
     if d <= 1e-9 {
         return None;
     }
     let u = [(c2[0] - c1[0]) / d, (c2[1] - c1[1]) / d];
-    // The tangent's points: on the side of each centre opposite the turn.
-    let off = [u[1] * side * rho, -u[0] * side * rho];
-    let (t1, t2) = ([c1[0] + off[0], c1[1] + off[1]], [c2[0] + off[0], c2[1] + off[1]]);
+    // The tangent's direction `v`: `u` when both turn the same way, else
+    // (L u + 2 rho side n(u)) / d with L the tangent's length, n the left
+    // normal. Its points lie rho from each centre, opposite each turn.
+    let v = if (side > 0.0) == (side0 > 0.0) {
+        u
+    } else {
+        if d <= 2.0 * rho {
+            return None;
+        }
+        let l = (d * d - 4.0 * rho * rho).sqrt();
+        [(l * u[0] - 2.0 * rho * side * u[1]) / d, (l * u[1] + 2.0 * rho * side * u[0]) / d]
+    };
+    let off = |sd: f64| [v[1] * sd * rho, -v[0] * sd * rho];
+    let (o1, o2) = (off(side), off(side0));
+    let (t1, t2) = ([c1[0] + o1[0], c1[1] + o1[1]], [c2[0] + o2[0], c2[1] + o2[1]]);
     let angle = |c: P2, q: P2| (q[1] - c[1]).atan2(q[0] - c[0]);
-    let sweep = |a0: f64, a1: f64| (side * (a1 - a0)).rem_euclid(std::f64::consts::TAU);
+    let sweep = |sd: f64, a0: f64, a1: f64| (sd * (a1 - a0)).rem_euclid(std::f64::consts::TAU);
     let (a0, a1) = (angle(c1, p), angle(c1, t1));
     let (b0, b1) = (angle(c2, t2), angle(c2, s));
-    let (s1, s2) = (sweep(a0, a1), sweep(b0, b1));
+    let (s1, s2) = (sweep(side, a0, a1), sweep(side0, b0, b1));
     let most = 1.25 * std::f64::consts::PI;
     if s1 > most || s2 > most {
         return None;
     }
     let dtheta = 2.0 * (1.0 - (tol::LINK_TURN_SAGITTA / rho).min(1.0)).acos();
-    let arc = |c: P2, a: f64, sw: f64, end: P2, begin: P2| {
+    let arc = |c: P2, sd: f64, a: f64, sw: f64, end: P2, begin: P2| {
         #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a small positive count")]
         let n = (sw / dtheta.max(1e-3)).ceil() as usize;
         let mut pts = vec![begin];
         for i in 1..n {
             #[allow(clippy::cast_precision_loss, reason = "a small count")]
-            let t = a + side * sw * i as f64 / n as f64;
+            let t = a + sd * sw * i as f64 / n as f64;
             pts.push([c[0] + rho * t.cos(), c[1] + rho * t.sin()]);
         }
         pts.push(end);
         pts
     };
-    Some((arc(c1, a0, s1, t1, p), arc(c2, b0, s2, s, t2)))
+    Some((arc(c1, side, a0, s1, t1, p), arc(c2, side0, b0, s2, s, t2)))
 }
 
 #[cfg(test)]
@@ -441,7 +475,7 @@ mod tests {
             let side = if k % 2 == 0 { 1.0 } else { -1.0 };
             let (p, h) = ([0.0, 0.0], 0.37 * f);
             let (s, h0) = ([10.0 * (0.1 * f).cos(), 7.0 * (0.23 * f).sin()], 1.3 * f);
-            let Some((first, last)) = turns(side, p, h, s, h0, rho) else { continue };
+            let Some((first, last)) = turns(side, p, h, side, s, h0, rho) else { continue };
             tried += 1;
             assert_eq!((first[0], last[last.len() - 1]), (p, s));
             // Leaves the pass's end along it, meets the start along it.
