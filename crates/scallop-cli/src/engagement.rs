@@ -10,7 +10,7 @@ use scallop_geom::Point2;
 use scallop_io::cl::read_cl;
 use scallop_io::gcode::{GcodeOptions, read_gcode, read_gcode_arcs};
 use scallop_sim::{EngagementOptions, EngagementReport, Pocket, engagement_angle, pocket_engagement};
-use scallop_strategy::{Boundary, FinishingParams, Pattern, lookahead_time};
+use scallop_strategy::{Boundary, FinishingParams, Pattern, lookahead_profile, lookahead_time};
 use scallop_toolpath::{MoveKind, Toolpath};
 use serde::{Deserialize, Serialize};
 
@@ -59,6 +59,12 @@ pub struct EngagementArgs {
     /// for plotting the program coloured by engagement.
     #[arg(long)]
     moves: Option<PathBuf>,
+    /// Also write each move of the program as read (its XY arcs kept) with the
+    /// jerk-limited model's time and speeds as CSV
+    /// (`move,kind,x0,y0,x1,y1,z,seconds,entry_mm_s,peak_mm_s,exit_mm_s`): where the
+    /// cycle time goes.
+    #[arg(long)]
+    feeds: Option<PathBuf>,
     /// Print JSON on stdout.
     #[arg(long)]
     json: bool,
@@ -141,6 +147,20 @@ fn read_program(path: &Path) -> CliResult<(Toolpath, Toolpath)> {
 /// (b)) at one feed for every cutting move on `arcs` (the program with its
 /// XY arcs kept), and the plain length / feed on `path` (its arcs as chords).
 fn cycle_times(path: &Toolpath, arcs: &Toolpath, args: &EngagementArgs) -> CliResult<(f64, f64)> {
+    let params = time_params(args)?;
+    let plain: f64 = path
+        .moves()
+        .windows(2)
+        .map(|w| {
+            let rate = if matches!(w[1].kind, MoveKind::Rapid | MoveKind::Retract) { args.rapid } else { args.feed };
+            (w[1].to - w[0].to).norm() / rate * 60.0
+        })
+        .sum();
+    Ok((plain, lookahead_time(arcs, &params).total()))
+}
+
+/// The time model's settings at the command's feed, rapid rate and blend tolerance.
+fn time_params(args: &EngagementArgs) -> CliResult<FinishingParams> {
     let machine = MachineLimits { feed: args.feed / 60.0, ..MachineLimits::default() };
     let params = FinishingParams {
         direction: 0.0,
@@ -156,15 +176,7 @@ fn cycle_times(path: &Toolpath, arcs: &Toolpath, args: &EngagementArgs) -> CliRe
         blend_tolerance: args.blend_tolerance,
     };
     params.validate().map_err(|e| Failure::rejected(format!("--feed, --rapid, --blend-tolerance: {e}")))?;
-    let plain: f64 = path
-        .moves()
-        .windows(2)
-        .map(|w| {
-            let rate = if matches!(w[1].kind, MoveKind::Rapid | MoveKind::Retract) { args.rapid } else { args.feed };
-            (w[1].to - w[0].to).norm() / rate * 60.0
-        })
-        .sum();
-    Ok((plain, lookahead_time(arcs, &params).total()))
+    Ok(params)
 }
 
 fn figures(args: &EngagementArgs, r: &EngagementReport, times: (f64, f64), path: &Toolpath, seconds: f64) -> Figures {
@@ -252,6 +264,35 @@ fn write_moves(w: &mut impl std::io::Write, path: &Toolpath, report: &Engagement
     Ok(())
 }
 
+/// One CSV row per move of `arcs` after the first: its kind, XY ends, end
+/// height, and the look-ahead model's duration and entry, peak and exit
+/// speeds (`scallop_strategy::lookahead_profile`).
+fn write_feeds(w: &mut impl std::io::Write, arcs: &Toolpath, params: &FinishingParams) -> std::io::Result<()> {
+    writeln!(w, "move,kind,x0,y0,x1,y1,z,seconds,entry_mm_s,peak_mm_s,exit_mm_s")?;
+    let moves = arcs.moves();
+    let profile = lookahead_profile(arcs, params);
+    for (i, pair) in moves.windows(2).enumerate() {
+        let f = profile.get(i + 1).copied().unwrap_or_default();
+        let (a, b) = (pair[0].to, pair[1].to);
+        writeln!(
+            w,
+            "{},{:?},{},{},{},{},{},{:.5},{:.2},{:.2},{:.2}",
+            i + 1,
+            pair[1].kind,
+            a.x,
+            a.y,
+            b.x,
+            b.y,
+            b.z,
+            f.duration,
+            f.entry,
+            f.peak,
+            f.exit
+        )?;
+    }
+    Ok(())
+}
+
 /// `scallop engagement`.
 pub fn run(args: &EngagementArgs) -> CliResult<()> {
     let start = std::time::Instant::now();
@@ -278,6 +319,10 @@ pub fn run(args: &EngagementArgs) -> CliResult<()> {
     let f = figures(args, &report, times, &path, start.elapsed().as_secs_f64());
     if let Some(file) = &args.moves {
         write_atomic(file, |w| write_moves(w, &path, &report))?;
+    }
+    if let Some(file) = &args.feeds {
+        let params = time_params(args)?;
+        write_atomic(file, |w| write_feeds(w, &arcs, &params))?;
     }
     if args.json { print_json(&f) } else { print_text(&text(&f)) }
 }

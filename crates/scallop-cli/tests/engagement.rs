@@ -20,7 +20,7 @@ fn engagement_reports_a_slot_and_a_side_cut() {
     let out = scallop()
         .current_dir(&dir)
         .args(["engagement", "--pocket", "p.json", "--program", "x.nc", "--tool-diameter", "6"])
-        .args(["--stepover", "0.2", "--json", "--moves", "moves.csv"])
+        .args(["--stepover", "0.2", "--json", "--moves", "moves.csv", "--feeds", "feeds.csv"])
         .output()
         .expect("run");
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
@@ -45,6 +45,18 @@ fn engagement_reports_a_slot_and_a_side_cut() {
     assert!((num("phi_max_deg") - 180.0).abs() <= 1.0, "{f}");
     assert_eq!((f["entries"].as_u64(), f["retracts"].as_u64()), (Some(2), Some(2)));
     assert!(num("time_jerk_limited_s") >= num("time_length_over_feed_s") && num("time_length_over_feed_s") > 0.0);
+    // Where the time goes: the moves' durations sum to the cycle time, and no
+    // move is faster than the feed (5000 mm/min) but the rapids.
+    let feeds = std::fs::read_to_string(dir.join("feeds.csv")).expect("feeds");
+    let rows: Vec<Vec<&str>> = feeds.lines().skip(1).map(|l| l.split(',').collect()).collect();
+    let total: f64 = rows.iter().map(|r| r[7].parse::<f64>().unwrap_or(f64::NAN)).sum();
+    assert!((total - num("time_jerk_limited_s")).abs() <= 1e-3 * total + 1e-3, "{total} s\n{feeds}");
+    let fastest = rows
+        .iter()
+        .filter(|r| r[1] != "Rapid" && r[1] != "Retract")
+        .map(|r| r[9].parse::<f64>().unwrap_or(f64::NAN))
+        .fold(0.0f64, f64::max);
+    assert!(fastest > 0.0 && fastest <= 5000.0 / 60.0 + 0.01, "{fastest} mm/s\n{feeds}");
     // Into the island (its wall at y = 40; the tool reaches y = 41): a gouge, exit 1.
     std::fs::write(dir.join("g.nc"), program(38.0).replace("X84", "X95")).expect("program");
     let out = scallop()
