@@ -1803,6 +1803,9 @@ mod tests {
         let r = job.operations[0].roughing.as_ref().unwrap();
         assert_eq!((r.stepdown, r.stepover, r.stock_to_leave, r.stock_to_leave_axial), (2.0, 0.2, 0.3, None));
         assert_eq!((r.pattern, r.direction), (RoughPatternWord::Offset, MillingWord::Climb));
+        let both = parse_job(&rough.replace("stock_to_leave = 0.3\n", "stock_to_leave = 0.3\ndirection = \"both\"\n"))
+            .unwrap();
+        assert_eq!(both.operations[0].roughing.as_ref().unwrap().direction, MillingWord::Both);
         // The job's finishing settings are the finishing operation's.
         assert!((job.finishing.scallop_height - 0.01).abs() < 1e-15);
         for (from, to, key) in [
