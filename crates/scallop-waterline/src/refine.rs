@@ -333,10 +333,23 @@ impl Local<'_> {
             }
             if h_seed > 0.0 {
                 (features, contact) = (held, seed_contact);
-                // Where the last Newton start's slope puts the contour within
+                // Where the seed's fall along the line puts the contour within
                 // `accept`, the full evaluation that accepts the chord comes
                 // first (elsewhere the seed's own height there decides, below).
-                if h_seed <= self.slope.get() * accept {
+                // The fall is the slope of the seed's height at the midpoint,
+                // from its contact (a Newton step: where the height is concave
+                // along the line, as around a convex inside, it overestimates
+                // the distance); the last Newton start's slope where the
+                // contact gives none (the cutter's axis or rim).
+                let near = match self.drop.contact_gradient(&seed_contact, mid) {
+                    Some(g) => {
+                        let fall = g[0] * normal.x + g[1] * normal.y;
+                        let rim = rim_distance(&seed_contact, mid, -normal, self.probe.cutter.radius());
+                        h_seed <= fall * accept || rim <= accept
+                    }
+                    None => h_seed <= self.slope.get() * accept,
+                };
+                if near {
                     let (h, slot) = self.side_slot(mid - normal * accept);
                     if h <= 0.0 {
                         return Near::Within; // inside at the midpoint, outside within `accept`
