@@ -59,7 +59,8 @@ pub(crate) struct Local<'a> {
     seed: Cell<Option<usize>>,
     /// The slope (height per unit length, along the probe line) of the last
     /// Newton start of [`Local::contour_near`]: predicts whether the contour
-    /// lies within the accepted distance of the next midpoint (`NaN`: unknown).
+    /// lies within the accepted distance of the next midpoint where the seed's
+    /// contact there gives no slope (`NaN`: unknown).
     slope: Cell<f64>,
     /// The corners and edges of the seed that held its contact at the last
     /// evaluation ([`BoxDrop::contact_features`]).
@@ -341,8 +342,10 @@ impl Local<'_> {
                 // The fall is the slope of the seed's height at the midpoint,
                 // from its contact (a Newton step: where the height is concave
                 // along the line, as around a convex inside, it overestimates
-                // the distance); the last Newton start's slope where the
-                // contact gives none (the cutter's axis or rim).
+                // the distance); where the contact leaves the cutter's radius
+                // first (the seed's height jumps there, as along a wall's top
+                // edge held by the rim), that distance. The last Newton
+                // start's slope where the contact gives none (axis, rim).
                 let near = match gradient.flatten() {
                     Some(g) => {
                         let fall = g[0] * normal.x + g[1] * normal.y;
