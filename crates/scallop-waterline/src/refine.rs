@@ -59,7 +59,8 @@ pub(crate) struct Local<'a> {
     seed: Cell<Option<usize>>,
     /// The slope (height per unit length, along the probe line) of the last
     /// Newton start of [`Local::contour_near`]: predicts whether the contour
-    /// lies within the accepted distance of the next midpoint (`NaN`: unknown).
+    /// lies within the accepted distance of the next midpoint where the seed's
+    /// contact there gives no slope (`NaN`: unknown).
     slope: Cell<f64>,
     /// The corners and edges of the seed that held its contact at the last
     /// evaluation ([`BoxDrop::contact_features`]).
@@ -114,12 +115,11 @@ impl Local<'_> {
         self.drop.drop_one(slot, p, probe.z - probe.step).tip.z - probe.z
     }
 
-    /// [`Local::feature_height`] and the corners and edges of the triangle
-    /// that hold its contact ([`BoxDrop::contact_features`]), and that contact.
-    fn triangle_contact(&self, slot: usize, features: u8, p: Point2) -> (f64, u8, Contact) {
+    /// [`Local::feature_height`] and the contact that gives it.
+    fn triangle_contact(&self, slot: usize, features: u8, p: Point2) -> (f64, Contact) {
         let probe = self.probe;
         let cl = self.drop.drop_one_features(slot, features, p, probe.z - probe.step);
-        (cl.tip.z - probe.z, self.drop.contact_features(slot, &cl.contact), cl.contact)
+        (cl.tip.z - probe.z, cl.contact)
     }
 
     /// [`Local::triangle_height`] on the facet and the corners and edges in
@@ -323,26 +323,46 @@ impl Local<'_> {
         let mut at_mid: Option<(f64, Option<usize>)> = None;
         let mut features = ALL_FEATURES;
         let mut contact = Contact::Floor;
+        // The slope of the seed's height at the midpoint, once computed.
+        let mut gradient: Option<Option<[f64; 2]>> = None;
         if let Some(seed) = self.seed.get() {
             // The seed's last contact features first (the contact moves little
             // from one midpoint to the next), the whole triangle if they do not lift.
             let last = self.seed_features.get();
-            let (mut h_seed, mut held, mut seed_contact) = self.triangle_contact(seed, last, mid);
+            let (mut h_seed, mut seed_contact) = self.triangle_contact(seed, last, mid);
             if h_seed <= 0.0 && last != ALL_FEATURES {
-                (h_seed, held, seed_contact) = self.triangle_contact(seed, ALL_FEATURES, mid);
+                (h_seed, seed_contact) = self.triangle_contact(seed, ALL_FEATURES, mid);
             }
             if h_seed > 0.0 {
-                (features, contact) = (held, seed_contact);
-                // Where the last Newton start's slope puts the contour within
+                contact = seed_contact;
+                gradient = Some(self.drop.contact_gradient(&seed_contact, mid));
+                // Where the seed's fall along the line puts the contour within
                 // `accept`, the full evaluation that accepts the chord comes
                 // first (elsewhere the seed's own height there decides, below).
-                if h_seed <= self.slope.get() * accept {
+                // The fall is the slope of the seed's height at the midpoint,
+                // from its contact (a Newton step: where the height is concave
+                // along the line, as around a convex inside, it overestimates
+                // the distance); where the contact leaves the cutter's radius
+                // first (the seed's height jumps there, as along a wall's top
+                // edge held by the rim), that distance. The last Newton
+                // start's slope where the contact gives none (axis, rim).
+                let near = match gradient.flatten() {
+                    Some(g) => {
+                        let fall = g[0] * normal.x + g[1] * normal.y;
+                        let rim = rim_distance(&seed_contact, mid, -normal, self.probe.cutter.radius());
+                        h_seed <= fall * accept || rim <= accept
+                    }
+                    None => h_seed <= self.slope.get() * accept,
+                };
+                if near {
                     let (h, slot) = self.side_slot(mid - normal * accept);
                     if h <= 0.0 {
                         return Near::Within; // inside at the midpoint, outside within `accept`
                     }
                     first = Some((h, slot));
                 }
+                // The corners and edges that hold the contact, for the heights below.
+                features = self.drop.contact_features(seed, &seed_contact);
                 // The seed lifts the cutter at the midpoint: it stands for the
                 // contact triangle there (any triangle lifting the cutter at an
                 // inside point serves the gap checks and the walk), and its
@@ -364,7 +384,9 @@ impl Local<'_> {
             // The slope of that height along the line, from its contact, and
             // how far along the line the contact stays within the cutter's
             // radius (past it the height jumps: no Newton step beyond).
-            let slope = self.drop.contact_gradient(&contact, mid).map(|g| {
+            let slope =
+                gradient.filter(|_| at_mid.is_some()).unwrap_or_else(|| self.drop.contact_gradient(&contact, mid));
+            let slope = slope.map(|g| {
                 (g[0] * towards.x + g[1] * towards.y, rim_distance(&contact, mid, towards, self.probe.cutter.radius()))
             });
             let start = (h_mid, slot, features, slope);

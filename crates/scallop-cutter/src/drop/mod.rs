@@ -92,6 +92,11 @@ fn drop_triangle_profile(profile: &Profile, corners: &[Point3; 3], normal: &Vec3
 /// All corners and edges: see [`MeshIndex::owned_features`] for the bits.
 const ALL_FEATURES: u8 = 0b11_1111;
 
+/// A feature bit of [`BoxDrop::drop_one_features`] past the corners and
+/// edges: the facet is left out (set by [`BoxDrop::contact_features`] for a
+/// corner or edge contact; the index's owned features never set it).
+const NO_FACET: u8 = 0b100_0000;
+
 /// The contacts of one triangle, its corners and edges restricted to `features`.
 #[inline]
 fn drop_features(
@@ -103,7 +108,7 @@ fn drop_features(
     best: &mut ClPoint,
 ) {
     let c = Point2::new(best.tip.x, best.tip.y);
-    let plane = facet::plane_contact(profile, corners, normal, c);
+    let plane = if features & NO_FACET == 0 { facet::plane_contact(profile, corners, normal, c) } else { None };
     if let Some(plane) = &plane {
         // Nothing on the triangle's plane can hold the tip above the plane contact
         // (the slack keeps this conservative under rounding).
@@ -408,7 +413,9 @@ impl<'a> BoxDrop<'a> {
 impl BoxDrop<'_> {
     /// The drop-cutter on the one triangle in `slot` at `xy` restricted to
     /// its facet and the corners and edges in `features` (bits as
-    /// [`MeshIndex::owned_features`]), floored at `floor`: at most
+    /// [`MeshIndex::owned_features`]; with bit 6 set, as
+    /// [`BoxDrop::contact_features`] sets it for a corner or an edge contact,
+    /// without the facet), floored at `floor`: at most
     /// [`BoxDrop::drop_one`]'s height (a maximum over fewer contacts), and
     /// equal to it where the features hold `drop_one`'s contact. Cheaper where
     /// few edges are kept (an edge contact costs most).
@@ -424,12 +431,18 @@ impl BoxDrop<'_> {
     /// triangle in `slot` that hold `contact`, a contact of that triangle: a
     /// corner's bit; an edge's bit and its two corners' bits; every bit for a
     /// facet contact (the contact moves onto an edge where the facet's ends),
-    /// or for a contact of another triangle or the floor.
+    /// or for a contact of another triangle or the floor. For a corner or an
+    /// edge, bit 6 too: the facet left out (it did not hold the contact, and a
+    /// plane contact costs about as much as a corner and an edge's bounds).
+    /// Either way [`BoxDrop::drop_one_features`] on these features gives the
+    /// triangle's height, bit for bit.
     #[must_use]
     pub fn contact_features(&self, slot: usize, contact: &Contact) -> u8 {
         let corners = self.index.corners(slot);
         match contact {
-            Contact::Vertex { point, .. } => corners.iter().position(|c| c == point).map_or(ALL_FEATURES, |k| 1 << k),
+            Contact::Vertex { point, .. } => {
+                corners.iter().position(|c| c == point).map_or(ALL_FEATURES, |k| (1 << k) | NO_FACET)
+            }
             Contact::Edge { point, .. } => {
                 // The edge nearest the contact point in space (the point was
                 // computed on it; in XY alone the edges of a vertical facet
@@ -448,7 +461,7 @@ impl BoxDrop<'_> {
                     d.iter().copied().fold(f64::INFINITY, f64::min) + tol::REL_ROUNDING * (point.coords.norm() + 1.0);
                 (0..3)
                     .filter(|&k| d[k] <= near)
-                    .fold(0, |bits, k| bits | (1 << (3 + k)) | (1 << k) | (1 << ((k + 1) % 3)))
+                    .fold(NO_FACET, |bits, k| bits | (1 << (3 + k)) | (1 << k) | (1 << ((k + 1) % 3)))
             }
             Contact::Facet { .. } | Contact::Floor => ALL_FEATURES,
         }
