@@ -15,9 +15,9 @@ use scallop_machine::Kinematics;
 use scallop_parts::FaceTag;
 use scallop_parts::TestPart;
 use scallop_rough5::{
-    BaselinePlan, BaselineSettings, CuttingData, LevelOptions, OrientSettings, Pocket, Proof, ProofSettings,
-    Rough5Plan, Rough5Settings, TiltMode, TorusTool, Weights, plan_rough5_in, plan_three_plus_two, plan_zlevel,
-    prove_from_blank,
+    BaselinePlan, BaselineSettings, CuttingData, EntryCount, EntryMode, LevelOptions, OrientSettings, Pocket, Proof,
+    ProofSettings, Rough5Plan, Rough5Settings, TiltMode, TorusTool, Weights, plan_rough5_in, plan_three_plus_two,
+    plan_zlevel, prove_from_blank,
 };
 use scallop_toolpath::Toolpath;
 use serde::Serialize;
@@ -76,6 +76,32 @@ pub enum CorrectionArg {
     Planar,
     /// Step 2: on the offset levels, the axis turned through the nearest point of an upper level's limit curve (Eq. 3.32).
     Spatial,
+}
+
+/// How the runs are entered (`--entry`, docs/rough5.md, "Entries").
+#[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
+pub enum EntryArg {
+    /// A helix where it fits inside a closed pass, else a side entry from outside the stock where a run starts within
+    /// reach of its side, else a ramp along a closed run, else a plunge.
+    Auto,
+    /// A helix where it fits, else a ramp, else a plunge.
+    Helix,
+    /// A ramp along a closed run, else a plunge (the program before 7 Dec 2026).
+    Ramp,
+    /// A side entry where one is found, else a ramp, else a plunge.
+    Side,
+}
+
+impl EntryArg {
+    /// The planner's entry mode.
+    pub(crate) fn mode(self) -> EntryMode {
+        match self {
+            EntryArg::Auto => EntryMode::Auto,
+            EntryArg::Helix => EntryMode::Helix,
+            EntryArg::Ramp => EntryMode::Ramp,
+            EntryArg::Side => EntryMode::Side,
+        }
+    }
 }
 
 /// A 3-axis baseline on the same part, tool and cutting data.
@@ -166,6 +192,11 @@ pub struct Rough5Args {
     /// Never applied with `--tilt zero`.
     #[arg(long, value_enum, value_delimiter = ',', num_args = 0..=1, default_missing_value = "planar")]
     correction: Vec<CorrectionArg>,
+    /// How the runs are entered: `auto` (a helix where it fits inside a closed pass, else from the stock's side
+    /// where a run starts within reach of it, else a ramp along a closed run, else a plunge), `helix`, `ramp`
+    /// or `side` (docs/rough5.md, "Entries").
+    #[arg(long, value_enum, default_value = "auto")]
+    entry: EntryArg,
     /// Leave out refinements of the 5-axis programs, comma-separated (default: all of them are on).
     #[arg(long, value_enum, value_delimiter = ',')]
     without: Vec<RefineArg>,
@@ -222,6 +253,21 @@ struct SetupJson {
     helices: usize,
 }
 
+/// Entries by kind.
+#[derive(Serialize)]
+pub(crate) struct EntriesJson {
+    helix: usize,
+    ramp: usize,
+    side: usize,
+    plunge: usize,
+}
+
+impl EntriesJson {
+    pub(crate) fn of(e: &EntryCount) -> Self {
+        EntriesJson { helix: e.helix, ramp: e.ramp, side: e.side, plunge: e.plunge }
+    }
+}
+
 #[derive(Serialize)]
 struct Report {
     command: &'static str,
@@ -237,6 +283,10 @@ struct Report {
     retracts: usize,
     links: usize,
     ramps: usize,
+    /// Entries by kind: helix, ramp, side, plunge.
+    entries: EntriesJson,
+    /// The pass starts entered by a plunge into material (tool tips, mm).
+    plunged_at: Vec<[f64; 3]>,
     metrics: Rough5Metrics,
     levels: Vec<LevelJson>,
     passes: Vec<PassJson>,
@@ -312,6 +362,7 @@ fn settings(args: &Rough5Args, part: &TestPart) -> CliResult<Rough5Settings> {
         round_corners: on(RefineArg::Corners),
         root_rest: on(RefineArg::RootRest),
         bottom_normal: on(RefineArg::BottomNormal),
+        entry: args.entry.mode(),
         ..base
     })
 }
@@ -460,6 +511,8 @@ fn report(
         retracts: plan.retracts,
         links: plan.links,
         ramps: plan.ramps,
+        entries: EntriesJson::of(&plan.entries),
+        plunged_at: plan.plunged_at.iter().map(|p| [p.x, p.y, p.z]).collect(),
         metrics,
         levels: plan
             .levels
@@ -563,6 +616,8 @@ fn baseline(
         retracts: sum(|u| u.retracts),
         links: sum(|u| u.links),
         ramps: sum(|u| u.helices),
+        entries: EntryCount { helix: sum(|u| u.helices), ..EntryCount::default() },
+        plunged_at: Vec::new(),
         toolpath: plan.toolpath,
         levels: Vec::new(),
         passes: Vec::new(),
@@ -640,6 +695,12 @@ fn summary_text(r: &Report, output: &Path) -> String {
         s,
         "  flank collisions: {corrected} CL points turned in their plane (step 1), {spatial} turned through an upper \
          limit curve (step 2), {translated} translated (step 3), {dropped} dropped"
+    );
+    let e = &r.entries;
+    let _ = writeln!(
+        s,
+        "  entries: {} helices, {} ramps, {} from the side, {} plunges; {} retracts, {} links",
+        e.helix, e.ramp, e.side, e.plunge, r.retracts, r.links
     );
     let _ = writeln!(
         s,
