@@ -1923,5 +1923,20 @@ mod tests {
             let err = parse_job(&job.replace(from, to)).unwrap_err().to_string();
             assert!(err.contains(key), "{to}: {err}");
         }
+        // The collision corrections: none by default, the step-1 switch, or a list of steps.
+        assert_eq!((r.correction.planar(), r.correction.spatial(), r.entry), (false, false, EntryWord::Auto));
+        for (keys, planar, spatial, entry) in [
+            ("correction = true", true, false, EntryWord::Auto),
+            ("correction = false\nentry = \"side\"", false, false, EntryWord::Side),
+            ("correction = [\"spatial\"]\nentry = \"helix\"", false, true, EntryWord::Helix),
+            ("correction = [\"planar\", \"spatial\"]\nentry = \"ramp\"", true, true, EntryWord::Ramp),
+        ] {
+            let parsed = parse_job(&job.replace("ae = 4.5", &format!("ae = 4.5\n{keys}"))).unwrap();
+            let r = parsed.operations[0].rough5.as_ref().unwrap();
+            assert_eq!((r.correction.planar(), r.correction.spatial(), r.entry), (planar, spatial, entry), "{keys}");
+        }
+        for bad in ["correction = [\"sideways\"]", "correction = 1", "entry = \"plunge\""] {
+            assert!(parse_job(&job.replace("ae = 4.5", &format!("ae = 4.5\n{bad}"))).is_err(), "{bad}");
+        }
     }
 }

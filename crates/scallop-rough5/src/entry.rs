@@ -18,6 +18,7 @@ use scallop_geom::{Point3, Vec3};
 
 use crate::collide::BodyCheck;
 use crate::place::{Placer, tool_frame};
+use crate::tol;
 
 /// How the runs of a roughing program are entered from above the level
 /// cut before ([`crate::Rough5Settings::entry`]).
@@ -83,7 +84,9 @@ pub struct HelixSettings {
     pub radius: f64,
     /// Descent angle above the level (rad).
     pub ramp_angle: f64,
-    /// Largest chord between two points of the helix (mm).
+    /// Largest chord between two points of the helix (mm); the chords also
+    /// turn by at most [`tol::FILLET_TURN_SHARE`] of the machine time
+    /// model's smooth junction.
     pub step: f64,
 }
 
@@ -142,7 +145,12 @@ pub fn helix_entry(
     }
     // The angle the circle turns through while the tool descends.
     let descent = lift / h.ramp_angle.tan() / r;
-    let count = ((descent * r / h.step).ceil() as usize).max(16);
+    // Chords of at most the step, turning by at most the fillets' share of
+    // the time model's smooth junction: a sharper junction is timed as a
+    // corner, near a stop on short blocks (the fitting's helices of 1 mm
+    // chords on 3.75 mm circles, 15 deg apart, took 46 s more than its ramps).
+    let turn = tol::FILLET_TURN_SHARE * scallop_geom::tol::machine::SMOOTH_JUNCTION;
+    let count = ((descent * r / h.step).ceil().max((descent / turn).ceil()) as usize).max(16);
     let mut tips = Vec::with_capacity(count + 1);
     for k in 0..=count {
         let phi = -descent * (1.0 - k as f64 / count as f64);

@@ -1664,6 +1664,18 @@ impl Emitter {
                 return 0;
             }
         }
+        // An open run is entered down a ramp along its first points where the
+        // lifted tool clears the flanks: the approach goes to the ramp's top.
+        let ramp = (lift > 0.0 && !closed).then(|| open_ramp(run, lift, self.settings.ramp_angle, body)).flatten();
+        if let Some(ramp) = ramp.filter(|r| r.len() > 1) {
+            let (top, axis) = ramp[0];
+            self.approach(&top, &axis, lift);
+            for (tip, axis) in &ramp[1..] {
+                self.push(MoveKind::Feed, *tip, *axis);
+            }
+            self.entries.ramp += 1;
+            return 0;
+        }
         let start = s.tip + s.axis * lift;
         self.approach(&start, &s.axis, lift);
         if lift <= 0.0 {
@@ -1673,22 +1685,9 @@ impl Emitter {
             self.entries.ramp += 1;
             return self.ramp(run, lift);
         }
-        match open_ramp(run, lift, self.settings.ramp_angle, body) {
-            Some(ramp) if ramp.len() > 1 => {
-                // Over to the ramp's top (in the air over the level), down it.
-                let top = ramp[0];
-                self.push(MoveKind::Feed, top.0, top.1);
-                for (tip, axis) in &ramp[1..] {
-                    self.push(MoveKind::Feed, *tip, *axis);
-                }
-                self.entries.ramp += 1;
-            }
-            _ => {
-                self.push(MoveKind::Plunge, s.tip, s.axis);
-                self.entries.plunge += 1;
-                self.plunged_at.push(s.tip);
-            }
-        }
+        self.push(MoveKind::Plunge, s.tip, s.axis);
+        self.entries.plunge += 1;
+        self.plunged_at.push(s.tip);
         0
     }
 
