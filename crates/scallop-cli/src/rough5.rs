@@ -178,6 +178,11 @@ pub struct Rough5Args {
     /// Weights (beta, phi, tau) of the bounds, fluidity and pitch-target objectives of `--tilt optimised`.
     #[arg(long, num_args = 3, default_values_t = [15.0, 1.2, 1.0])]
     weights: Vec<f64>,
+    /// Per-pass weights: (beta, phi, tau) of the passes that leave the finished faces' stock (the bottom
+    /// level's passes and each level's limit passes), optimised with `--interval` and `--target`; the other
+    /// passes keep `--weights` with `--tilt optimised`, SPU otherwise. Not with `--tilt zero`.
+    #[arg(long, num_args = 3)]
+    limit_weights: Option<Vec<f64>>,
     /// Interval [theta_tmin, theta_tmax] of the pitch angle for `--tilt optimised` (degrees).
     #[arg(long, num_args = 2, default_values_t = [0.0, 30.0], allow_negative_numbers = true)]
     interval: Vec<f64>,
@@ -348,6 +353,11 @@ fn settings(args: &Rough5Args, part: &TestPart) -> CliResult<Rough5Settings> {
         max_angle_step: args.max_angle_step.to_radians(),
         max_azimuth_step: args.max_azimuth_step.to_radians(),
         orientation: matches!(args.tilt, TiltArg::Optimised).then(|| orientation(args, weights)),
+        limit_orientation: args
+            .limit_weights
+            .as_ref()
+            .filter(|_| !matches!(args.tilt, TiltArg::Zero))
+            .map(|w| orientation(args, Weights { bounds: w[0], fluidity: w[1], pitch: w[2] })),
         correct: args.correction.contains(&CorrectionArg::Planar) && !matches!(args.tilt, TiltArg::Zero),
         levels: LevelOptions {
             centre_offsets: on(RefineArg::CentreOffsets),

@@ -6,9 +6,11 @@
 //!   tangent contact with a level mesh (module G; C_C to C_L by Eq. 1.1);
 //! - [`synchronise`], [`pitch_angle`]: SPU synchronisation of a path curve
 //!   with its tilt curve (Eq. 3.10) and the pitch angle theta_t (Eq. 3.7);
-//! - [`plan_rough5`]: levels top-down, passes inside-out, ramp entries along
-//!   the innermost pass, links on the level or at a safe height, a maximum
-//!   angular step; the guide-curve variant and the zero-tilt baseline
+//! - [`plan_rough5`]: levels top-down, passes inside-out, entries
+//!   ([`EntryMode`]: a helix inside a closed pass, [`helix_entry`]; from
+//!   outside the stock at the level's depth, [`side_entry`]; ramps along
+//!   closed and open runs), links on the level or at a safe height, a
+//!   maximum angular step; the guide-curve variant and the zero-tilt baseline
 //!   (module J); [`plan_single_pass`]: one pass alone (the orientation
 //!   cases of Ch. 3 §2.3);
 //! - [`correct_planar`]: the collision correction that turns a colliding

@@ -5,11 +5,12 @@
 //! clockwise spindle); the tool placed along its axis at every synchronised
 //! pair ([`crate::Placer`]), no more than a maximum angular step between
 //! neighbouring orientations; pairs whose tool body would meet a flank
-//! dropped (the pass is split there); the first run of a level entered by a
-//! ramp along its closed pass from just above the level cut before, later
-//! runs linked on the level when the link is short, placed and collision
-//! free, else through a retract along the tool axis to a safe height, a
-//! rapid, and a plunge back along the axis.
+//! dropped (the pass is split there); the first run of a level entered from
+//! just above the level cut before ([`EntryMode`]: a helix inside a closed
+//! run, from outside the stock at the level's depth, a ramp along the run,
+//! a plunge only where none of them is found), later runs linked on the
+//! level when the link is short, placed and collision free, else through a
+//! retract along the tool axis to a safe height, a rapid, and an entry.
 //!
 //! Three refinements of the guide-curve program (docs/rough5.md, "Where the
 //! remaining volume was"), each a setting: the passes inside a level's
@@ -68,6 +69,12 @@ pub struct Rough5Settings {
     /// The optimised orientation of each paired pass (Jousselin 2020, Ch. 3
     /// §2), or `None` for SPU.
     pub orientation: Option<OrientSettings>,
+    /// The optimised orientation of the passes that leave the stock of the
+    /// finished faces: every pass of the bottom level and each level's limit
+    /// passes (its outermost ones, along the flanks); the other passes (the
+    /// bulk) keep [`Self::orientation`]. `None`: one orientation for all
+    /// (the per-pass weights of spec module H; Jousselin 2020, Ch. 3 §2.3).
+    pub limit_orientation: Option<OrientSettings>,
     /// Whether a pair whose tool collides with a flank is first turned in its
     /// correction plane (Ch. 3 §3, step 1, [`crate::correct_planar`]) before
     /// it is dropped.
@@ -172,6 +179,7 @@ impl Rough5Settings {
             feed,
             rapid_rate: 20_000.0,
             orientation: None,
+            limit_orientation: None,
             correct: false,
             levels: LevelOptions::default(),
             vertical_inside: false,
@@ -403,9 +411,15 @@ pub fn plan_rough5_in(
         let mut level_cut: Vec<Vec<Placement>> = Vec::new();
         for (m, (path, tilt)) in level.passes.iter().enumerate() {
             let cursor = out.last.map_or_else(|| path.line.points[0], |c| c.sync.path);
-            let (pairs, _) = pass_pairs((path, tilt.as_ref()), &cursor, settings)?;
-            let (mut pairs, corrected) = corrected_pairs(&placer, &body, pairs, settings);
             let outer = m + level.outer >= level.passes.len();
+            // Per-pass weights: the passes that leave the finished faces' stock
+            // (the bottom level's and each level's limit passes) with their own.
+            let weighted = match settings.limit_orientation {
+                Some(o) if j == 0 || outer => Rough5Settings { orientation: Some(o), ..*settings },
+                _ => *settings,
+            };
+            let (pairs, _) = pass_pairs((path, tilt.as_ref()), &cursor, &weighted)?;
+            let (mut pairs, corrected) = corrected_pairs(&placer, &body, pairs, settings);
             if j == 0 && outer && rest.is_some() {
                 limit_pairs.push(pairs.clone());
             }
@@ -1228,13 +1242,19 @@ impl Air {
     }
 }
 
+/// Most legs of the ramp along an open run ([`open_ramp`]): out and back.
+/// On the impeller, whose open runs are short and whose lifts reach 30 mm,
+/// ramps of any number of legs took 492 s on the UCP 710 where plunges took
+/// 311 s (docs/rough5.md, "Entries").
+pub const OPEN_RAMP_LEGS: usize = 2;
+
 /// The ramp entry of an open run (tool tips and axes, top first, ending at
-/// its first point on the level): the tool goes back and forth along the
-/// run's first points, lifted along their axes by `tan(ramp_angle)` per mm
+/// its first point on the level): the tool goes along the run's first
+/// points and back, lifted along their axes by `tan(ramp_angle)` per mm
 /// travelled before it reaches the start, at most `lift`; the legs turn at
 /// the run's end or where the one leg is long enough. `None` where a lifted
-/// tool comes closer to a flank than `body` allows (a flank over the run)
-/// or the run has no length.
+/// tool comes closer to a flank than `body` allows (a flank over the run),
+/// the run has no length or [`OPEN_RAMP_LEGS`] legs do not reach `lift`.
 fn open_ramp(run: &[Cl], lift: f64, ramp_angle: f64, body: &BodyCheck) -> Option<Vec<(Point3, Vec3)>> {
     let n = run.len();
     let length = run_length(run);
@@ -1245,6 +1265,7 @@ fn open_ramp(run: &[Cl], lift: f64, ramp_angle: f64, body: &BodyCheck) -> Option
     let full = lift / slope;
     // Backwards in time from the start: out along the run and back.
     let (mut out, mut k, mut forward, mut travelled) = (vec![(run[0].place.tip, run[0].place.axis)], 0usize, true, 0.0);
+    let mut legs = 0;
     while travelled * slope < lift {
         let next = if forward { k + 1 } else { k - 1 };
         travelled += (run[next].place.tip - run[k].place.tip).norm();
@@ -1260,9 +1281,10 @@ fn open_ramp(run: &[Cl], lift: f64, ramp_angle: f64, body: &BodyCheck) -> Option
         let turn_at = if forward { k + 1 == n || travelled >= full } else { k == 0 };
         if turn_at {
             forward = !forward;
-        }
-        if out.len() > tol::MAX_PASS_POINTS {
-            return None;
+            legs += 1;
+            if legs >= OPEN_RAMP_LEGS && travelled * slope < lift {
+                return None;
+            }
         }
     }
     out.reverse();
