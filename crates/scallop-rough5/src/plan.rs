@@ -1741,8 +1741,12 @@ impl Emitter {
         }
     }
 
-    /// The helix entry of a closed run ([`helix_entry`]): its own start
-    /// first, then [`HELIX_STARTS`] evenly spaced points of it, each with the
+    /// The helix entry of a closed run ([`helix_entry`]): first where the
+    /// ramp along the run would reach the level (the lap, and the passes
+    /// synchronised from its end, are then those of the ramp's program: a
+    /// helix at the run's own start moved them, and with them the runs the
+    /// next passes split into; docs/rough5.md, "Entries"), then
+    /// at [`HELIX_STARTS`] evenly spaced points from there, each with the
     /// radii of [`HELIX_RADII`] largest first; the run's index where the
     /// helix ends and its tips.
     fn helix(&self, run: &[Cl], entry_z: f64, placer: &Placer, body: &BodyCheck) -> Option<(usize, Vec<Point3>)> {
@@ -1750,8 +1754,9 @@ impl Emitter {
         let tips: Vec<Point3> = run.iter().map(|c| c.place.tip).collect();
         let starts = HELIX_STARTS.min(n);
         let radius = self.radius;
+        let first = self.ramp_end(run, Emitter::lift(&run[0].place, entry_z));
         for j in 0..starts {
-            let start = j * n / starts;
+            let start = (first + j * n / starts) % n;
             let s = &run[start].place;
             let lift = Emitter::lift(s, entry_z);
             for f in HELIX_RADII {
@@ -1795,16 +1800,7 @@ impl Emitter {
     /// where the lift reaches zero.
     fn ramp(&mut self, run: &[Cl], lift: f64) -> usize {
         let n = run.len() - 1;
-        // At most one lap on a loop within the flat of the tool's end round
-        // its centre (the fitting's smallest inner loops, 15 mm long): there
-        // the ramp circled it up to 4 times, the flat covering the loop
-        // whatever the ramp; it is steeper instead.
-        let full = lift / self.settings.ramp_angle.tan();
-        let tips = || run[..n].iter().map(|c| c.place.tip.coords);
-        let centre = tips().sum::<Vec3>() / n as f64;
-        let lap: f64 = (0..n).map(|k| (run[k + 1].place.tip - run[k].place.tip).norm()).sum();
-        let within = tips().all(|p| (p - centre).norm() <= self.flat);
-        let ramp_len = if within && lap > 0.0 { full.min(lap) } else { full };
+        let ramp_len = self.ramp_length(run, lift);
         let (mut s, mut k) = (0.0, 0usize);
         loop {
             let (a, b) = (&run[k % n].place, &run[(k + 1) % n].place);
@@ -1817,6 +1813,37 @@ impl Emitter {
             }
             self.feed_to(b.tip + b.axis * h, b.axis);
         }
+    }
+
+    /// The length (mm) of the ramp along the closed `run` from `lift`: at
+    /// most one lap on a loop within the flat of the tool's end round its
+    /// centre (the fitting's smallest inner loops, 15 mm long): there the
+    /// ramp circled it up to 4 times, the flat covering the loop whatever
+    /// the ramp; it is steeper instead.
+    fn ramp_length(&self, run: &[Cl], lift: f64) -> f64 {
+        let n = run.len() - 1;
+        let full = lift / self.settings.ramp_angle.tan();
+        let tips = || run[..n].iter().map(|c| c.place.tip.coords);
+        let centre = tips().sum::<Vec3>() / n as f64;
+        let lap: f64 = (0..n).map(|k| (run[k + 1].place.tip - run[k].place.tip).norm()).sum();
+        let within = tips().all(|p| (p - centre).norm() <= self.flat);
+        if within && lap > 0.0 { full.min(lap) } else { full }
+    }
+
+    /// The index of the closed `run` where its ramp from `lift` reaches the
+    /// level ([`Emitter::ramp`]).
+    fn ramp_end(&self, run: &[Cl], lift: f64) -> usize {
+        let n = run.len() - 1;
+        let ramp_len = self.ramp_length(run, lift);
+        let (mut s, mut k) = (0.0, 0usize);
+        while k < tol::MAX_PASS_POINTS {
+            s += (run[(k + 1) % n].place.tip - run[k % n].place.tip).norm();
+            k += 1;
+            if s >= ramp_len {
+                break;
+            }
+        }
+        k % n
     }
 
     /// Links `a` to `b` on the level when the link is short, every point of
