@@ -147,8 +147,7 @@ pub fn helix_entry(
     let descent = lift / h.ramp_angle.tan() / r;
     // Chords of at most the step, turning by at most the fillets' share of
     // the time model's smooth junction: a sharper junction is timed as a
-    // corner, near a stop on short blocks (the fitting's helices of 1 mm
-    // chords on 3.75 mm circles, 15 deg apart, took 46 s more than its ramps).
+    // corner, near a stop on short blocks (docs/rough5.md, "Entries").
     let turn = tol::FILLET_TURN_SHARE * scallop_geom::tol::machine::SMOOTH_JUNCTION;
     let count = ((descent * r / h.step).ceil().max((descent / turn).ceil()) as usize).max(16);
     let mut tips = Vec::with_capacity(count + 1);

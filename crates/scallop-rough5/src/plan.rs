@@ -1243,9 +1243,9 @@ impl Air {
 }
 
 /// Most legs of the ramp along an open run ([`open_ramp`]): out and back.
-/// On the impeller, whose open runs are short and whose lifts reach 30 mm,
-/// ramps of any number of legs took 492 s on the UCP 710 where plunges took
-/// 311 s (docs/rough5.md, "Entries").
+/// A ramp back and forth along a short run stops at every turn; on the
+/// impeller's short open runs more legs cost more machine time than they
+/// save over a plunge (docs/rough5.md, "Entries").
 pub const OPEN_RAMP_LEGS: usize = 2;
 
 /// The ramp entry of an open run (tool tips and axes, top first, ending at
