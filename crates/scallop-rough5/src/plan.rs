@@ -1258,7 +1258,7 @@ pub const OPEN_RAMP_LEGS: usize = 2;
 fn open_ramp(run: &[Cl], lift: f64, ramp_angle: f64, body: &BodyCheck) -> Option<Vec<(Point3, Vec3)>> {
     let n = run.len();
     let length = run_length(run);
-    if n < 2 || !(length > 0.0) || !(lift > 0.0) {
+    if n < 2 || length <= 0.0 || lift <= 0.0 || !lift.is_finite() {
         return None;
     }
     let slope = ramp_angle.tan();
