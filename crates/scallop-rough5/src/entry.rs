@@ -115,8 +115,9 @@ pub fn helix_entry(
     h: &HelixSettings,
 ) -> Option<Vec<Point3>> {
     let n = pass.len().checked_sub(1)?;
-    let ok = n >= 3 && start < n && lift > 0.0 && h.radius > 0.0 && h.step > 0.0;
-    if !ok || !(h.ramp_angle > 0.0 && h.ramp_angle < std::f64::consts::FRAC_PI_2) {
+    let angle_ok = h.ramp_angle > 0.0 && h.ramp_angle < std::f64::consts::FRAC_PI_2;
+    let ok = n >= 3 && start < n && lift > 0.0 && h.radius > 0.0 && h.step > 0.0 && angle_ok;
+    if !ok {
         return None;
     }
     let u = axis.normalize();

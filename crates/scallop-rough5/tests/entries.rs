@@ -95,7 +95,7 @@ proptest! {
     #[test]
     fn a_helix_stays_in_its_loop_and_holds_its_ramp_angle(
         a in 16.0..60.0f64, b in 16.0..60.0f64, c in 2.0..7.9f64,
-        tilt in 0.0..0.26f64, azimuth in 0.0..6.28f64,
+        tilt in 0.0..0.26f64, azimuth in 0.0..std::f64::consts::TAU,
         start_at in 0.0..1.0f64, lift in 0.5..9.0f64, which in 0usize..3, ramp_deg in 2.0..10.0f64,
     ) {
         let tool = common::torus(30.0, 100.0);
