@@ -13,7 +13,7 @@ use scallop_rough5::{OrientSettings, Rough5Settings, TiltMode, Weights, level_pa
 /// for the limit passes: the two programs have the same passes, and the
 /// first pass (in cutting order) where they differ is a limit pass or a pass
 /// of the bottom level (the passes before it see the same cursor and the
-/// same orientation).
+/// same orientation), and some pass's pitch angles change.
 #[test]
 fn limit_passes_take_their_own_weights() {
     let part = closed_pocket(&Default::default()).unwrap();
@@ -31,7 +31,9 @@ fn limit_passes_take_their_own_weights() {
     let level = &levels[p.level];
     let limit = p.pass + level.outer >= level.passes.len();
     assert!(p.level == 0 || limit, "pass {} of level {} changed first", p.pass, p.level);
-    // Its pitch angles (min, max, mean) are another pass's.
-    let moved = a.passes[first].pitch.iter().zip(&b.passes[first].pitch).any(|(x, y)| (x - y).abs() > 1e-9);
-    assert!(moved, "{:?} against {:?}", a.passes[first], b.passes[first]);
+    // And the weighting changed some pass's pitch angles (min, max, mean)
+    // by more than rounding (the first may be optimised to SPU itself).
+    let moved =
+        a.passes.iter().zip(&b.passes).any(|(x, y)| x.pitch.iter().zip(&y.pitch).any(|(p, q)| (p - q).abs() > 1e-6));
+    assert!(moved, "no pass's pitch changed");
 }
