@@ -15,9 +15,9 @@ use scallop_machine::Kinematics;
 use scallop_parts::FaceTag;
 use scallop_parts::TestPart;
 use scallop_rough5::{
-    BaselinePlan, BaselineSettings, CuttingData, LevelOptions, OrientSettings, Pocket, Proof, ProofSettings,
-    Rough5Plan, Rough5Settings, TiltMode, TorusTool, Weights, plan_rough5_in, plan_three_plus_two, plan_zlevel,
-    prove_from_blank,
+    BaselinePlan, BaselineSettings, CuttingData, EntryCount, EntryMode, LevelOptions, OrientSettings, Pocket, Proof,
+    ProofSettings, Rough5Plan, Rough5Settings, TiltMode, TorusTool, Weights, plan_rough5_in, plan_three_plus_two,
+    plan_zlevel, prove_from_blank,
 };
 use scallop_toolpath::Toolpath;
 use serde::Serialize;
@@ -76,6 +76,32 @@ pub enum CorrectionArg {
     Planar,
     /// Step 2: on the offset levels, the axis turned through the nearest point of an upper level's limit curve (Eq. 3.32).
     Spatial,
+}
+
+/// How the runs are entered (`--entry`, docs/rough5.md, "Entries").
+#[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
+pub enum EntryArg {
+    /// A helix where it fits inside a closed pass, else a side entry from outside the stock where a run starts within
+    /// reach of its side, else a ramp along a closed run, else a plunge.
+    Auto,
+    /// A helix where it fits, else a ramp, else a plunge.
+    Helix,
+    /// A ramp along a closed run, else a plunge (the program before 7 Dec 2026).
+    Ramp,
+    /// A side entry where one is found, else a ramp, else a plunge.
+    Side,
+}
+
+impl EntryArg {
+    /// The planner's entry mode.
+    pub(crate) fn mode(self) -> EntryMode {
+        match self {
+            EntryArg::Auto => EntryMode::Auto,
+            EntryArg::Helix => EntryMode::Helix,
+            EntryArg::Ramp => EntryMode::Ramp,
+            EntryArg::Side => EntryMode::Side,
+        }
+    }
 }
 
 /// A 3-axis baseline on the same part, tool and cutting data.
@@ -152,6 +178,11 @@ pub struct Rough5Args {
     /// Weights (beta, phi, tau) of the bounds, fluidity and pitch-target objectives of `--tilt optimised`.
     #[arg(long, num_args = 3, default_values_t = [15.0, 1.2, 1.0])]
     weights: Vec<f64>,
+    /// Per-pass weights: (beta, phi, tau) of the passes that leave the finished faces' stock (the bottom
+    /// level's passes and each level's limit passes), optimised with `--interval` and `--target`; the other
+    /// passes keep `--weights` with `--tilt optimised`, SPU otherwise. Not with `--tilt zero`.
+    #[arg(long, num_args = 3)]
+    limit_weights: Option<Vec<f64>>,
     /// Interval [theta_tmin, theta_tmax] of the pitch angle for `--tilt optimised` (degrees).
     #[arg(long, num_args = 2, default_values_t = [0.0, 30.0], allow_negative_numbers = true)]
     interval: Vec<f64>,
@@ -166,6 +197,11 @@ pub struct Rough5Args {
     /// Never applied with `--tilt zero`.
     #[arg(long, value_enum, value_delimiter = ',', num_args = 0..=1, default_missing_value = "planar")]
     correction: Vec<CorrectionArg>,
+    /// How the runs are entered: `auto` (a helix where it fits inside a closed pass, else from the stock's side
+    /// where a run starts within reach of it, else a ramp along a closed run, else a plunge), `helix`, `ramp`
+    /// or `side` (docs/rough5.md, "Entries").
+    #[arg(long, value_enum, default_value = "auto")]
+    entry: EntryArg,
     /// Leave out refinements of the 5-axis programs, comma-separated (default: all of them are on).
     #[arg(long, value_enum, value_delimiter = ',')]
     without: Vec<RefineArg>,
@@ -222,6 +258,21 @@ struct SetupJson {
     helices: usize,
 }
 
+/// Entries by kind.
+#[derive(Serialize)]
+pub(crate) struct EntriesJson {
+    helix: usize,
+    ramp: usize,
+    side: usize,
+    plunge: usize,
+}
+
+impl EntriesJson {
+    pub(crate) fn of(e: &EntryCount) -> Self {
+        EntriesJson { helix: e.helix, ramp: e.ramp, side: e.side, plunge: e.plunge }
+    }
+}
+
 #[derive(Serialize)]
 struct Report {
     command: &'static str,
@@ -237,6 +288,10 @@ struct Report {
     retracts: usize,
     links: usize,
     ramps: usize,
+    /// Entries by kind: helix, ramp, side, plunge.
+    entries: EntriesJson,
+    /// The pass starts entered by a plunge into material (tool tips, mm).
+    plunged_at: Vec<[f64; 3]>,
     metrics: Rough5Metrics,
     levels: Vec<LevelJson>,
     passes: Vec<PassJson>,
@@ -298,6 +353,11 @@ fn settings(args: &Rough5Args, part: &TestPart) -> CliResult<Rough5Settings> {
         max_angle_step: args.max_angle_step.to_radians(),
         max_azimuth_step: args.max_azimuth_step.to_radians(),
         orientation: matches!(args.tilt, TiltArg::Optimised).then(|| orientation(args, weights)),
+        limit_orientation: args
+            .limit_weights
+            .as_ref()
+            .filter(|_| !matches!(args.tilt, TiltArg::Zero))
+            .map(|w| orientation(args, Weights { bounds: w[0], fluidity: w[1], pitch: w[2] })),
         correct: args.correction.contains(&CorrectionArg::Planar) && !matches!(args.tilt, TiltArg::Zero),
         levels: LevelOptions {
             centre_offsets: on(RefineArg::CentreOffsets),
@@ -312,6 +372,7 @@ fn settings(args: &Rough5Args, part: &TestPart) -> CliResult<Rough5Settings> {
         round_corners: on(RefineArg::Corners),
         root_rest: on(RefineArg::RootRest),
         bottom_normal: on(RefineArg::BottomNormal),
+        entry: args.entry.mode(),
         ..base
     })
 }
@@ -460,6 +521,8 @@ fn report(
         retracts: plan.retracts,
         links: plan.links,
         ramps: plan.ramps,
+        entries: EntriesJson::of(&plan.entries),
+        plunged_at: plan.plunged_at.iter().map(|p| [p.x, p.y, p.z]).collect(),
         metrics,
         levels: plan
             .levels
@@ -563,6 +626,8 @@ fn baseline(
         retracts: sum(|u| u.retracts),
         links: sum(|u| u.links),
         ramps: sum(|u| u.helices),
+        entries: EntryCount { helix: sum(|u| u.helices), ..EntryCount::default() },
+        plunged_at: Vec::new(),
         toolpath: plan.toolpath,
         levels: Vec::new(),
         passes: Vec::new(),
@@ -640,6 +705,12 @@ fn summary_text(r: &Report, output: &Path) -> String {
         s,
         "  flank collisions: {corrected} CL points turned in their plane (step 1), {spatial} turned through an upper \
          limit curve (step 2), {translated} translated (step 3), {dropped} dropped"
+    );
+    let e = &r.entries;
+    let _ = writeln!(
+        s,
+        "  entries: {} helices, {} ramps, {} from the side, {} plunges; {} retracts, {} links",
+        e.helix, e.ramp, e.side, e.plunge, r.retracts, r.links
     );
     let _ = writeln!(
         s,

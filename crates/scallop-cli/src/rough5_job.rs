@@ -11,8 +11,8 @@ use std::time::Instant;
 
 use scallop_engine::{Rough5Job, Rough5Metrics, Rough5Output, Rough5Step, TcpWords, rough5_settings, run_rough5};
 use scallop_guides::GuideSettings;
-use scallop_io::job::{JobFile, OperationSpec, Rough5Spec, TestPartWord, TiltWord};
-use scallop_rough5::{CuttingData, OrientSettings, ProofSettings, Rough5Settings, TiltMode, Weights};
+use scallop_io::job::{EntryWord, JobFile, OperationSpec, Rough5Spec, TestPartWord, TiltWord};
+use scallop_rough5::{CuttingData, EntryMode, OrientSettings, ProofSettings, Rough5Settings, TiltMode, Weights};
 use serde::Serialize;
 
 use crate::guides::{PartArg, test_part};
@@ -41,6 +41,8 @@ struct OperationReport<'a> {
     retracts: usize,
     links: usize,
     ramps: usize,
+    /// Entries by kind: helix, ramp, side, plunge.
+    entries: crate::rough5::EntriesJson,
     metrics: &'a Rough5Metrics,
     planning_time_s: f64,
     proof_time_s: f64,
@@ -147,6 +149,7 @@ pub(crate) fn run(spec: &JobFile, job: &Path, name: &str, output: &Path, json: b
             retracts: out.plan.retracts,
             links: out.plan.links,
             ramps: out.plan.ramps,
+            entries: crate::rough5::EntriesJson::of(&out.plan.entries),
             metrics: &out.metrics,
             planning_time_s: plan_seconds,
             proof_time_s: proof_seconds,
@@ -201,7 +204,14 @@ fn settings_of(
         max_angle_step: r.max_angle_step_deg.to_radians(),
         max_azimuth_step: r.max_azimuth_step_deg.to_radians(),
         orientation: (r.tilt == TiltWord::Optimised).then_some(orientation),
-        correct: r.correction && r.tilt != TiltWord::Zero,
+        correct: r.correction.planar() && r.tilt != TiltWord::Zero,
+        spatial: r.correction.spatial() && r.tilt != TiltWord::Zero,
+        entry: match r.entry {
+            EntryWord::Auto => EntryMode::Auto,
+            EntryWord::Helix => EntryMode::Helix,
+            EntryWord::Ramp => EntryMode::Ramp,
+            EntryWord::Side => EntryMode::Side,
+        },
         ..base
     })
 }

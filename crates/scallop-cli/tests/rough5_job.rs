@@ -43,6 +43,10 @@ fn a_rough5_job_plans_proves_and_posts() {
     assert!(t > 0.0 && t >= num("feed_time_s") && num("feed_time_s") >= 0.999 * num("estimated_time_at_feed_s") - 1.0);
     assert!((num("removal_rate_mm3_s") * t - num("removed_volume_mm3")).abs() <= 1e-6 * num("removed_volume_mm3"));
     assert_eq!(report["total_time_s"].as_f64(), Some(t));
+    // Entered by helices where they fit (`entry = "auto"` by default), the ramps counted twice.
+    let entries = &op["entries"];
+    assert!(entries["helix"].as_u64().unwrap_or(0) > 0, "{entries}");
+    assert_eq!(entries["ramp"], op["ramps"], "{op}");
     // Spec 10.1 per face: quartiles in order, crests from the allowance up.
     let faces = m["faces"].as_array().expect("faces");
     assert_eq!(faces.len(), 2, "{m}");

@@ -187,9 +187,52 @@ pub struct Rough5Spec {
     /// Largest deviation of the simulated 5-axis sweeps from the true ones (mm, default 0.05).
     #[serde(default = "default_sim_tolerance")]
     pub sim_tolerance: f64,
-    /// Collision correction of Ch. 3 §3, step 1 (default false; docs/rough5.md).
+    /// Collision corrections of Ch. 3 §3 (docs/rough5.md): `true` for step 1
+    /// (the planar correction), or a list of steps, `["planar", "spatial"]`
+    /// (step 2: an upper level's limit curve); default none.
     #[serde(default)]
-    pub correction: bool,
+    pub correction: CorrectionSpec,
+    /// How the runs are entered: `auto` (default), `helix`, `ramp` or `side`
+    /// (docs/rough5.md, "Entries").
+    #[serde(default = "default_entry")]
+    pub entry: EntryWord,
+}
+
+/// `rough5.correction`: the step-1 switch, or the list of steps.
+#[derive(Debug, Clone, PartialEq, Eq, Deserialize)]
+#[serde(untagged)]
+pub enum CorrectionSpec {
+    /// `true`: step 1 (the planar correction) alone; `false`: none.
+    Switch(bool),
+    /// The steps, e.g. `["planar", "spatial"]`.
+    Steps(Vec<CorrectionWord>),
+}
+
+impl Default for CorrectionSpec {
+    fn default() -> Self {
+        CorrectionSpec::Switch(false)
+    }
+}
+
+impl CorrectionSpec {
+    /// Whether step 1 (the planar correction, Eq. 3.31) is asked for.
+    #[must_use]
+    pub fn planar(&self) -> bool {
+        match self {
+            CorrectionSpec::Switch(on) => *on,
+            CorrectionSpec::Steps(steps) => steps.contains(&CorrectionWord::Planar),
+        }
+    }
+
+    /// Whether step 2 (an upper level's limit curve, Eq. 3.32) is asked for.
+    #[must_use]
+    pub fn spatial(&self) -> bool {
+        matches!(self, CorrectionSpec::Steps(steps) if steps.contains(&CorrectionWord::Spatial))
+    }
+}
+
+fn default_entry() -> EntryWord {
+    EntryWord::Auto
 }
 
 fn default_rough5_allowance() -> f64 {
@@ -378,6 +421,20 @@ word_enum! {
         Zero = "zero", /// From the path curve to the tilt curve on the level above (SPU).
         Guides = "guides", /// Guide curves with the optimised reparameterisation of each pass.
         Optimised = "optimised" }
+}
+word_enum! {
+    /// A step of `rough5.correction`.
+    CorrectionWord { /// Step 1: the axis turned in its correction plane, the pitch kept (Eq. 3.31).
+        Planar = "planar", /// Step 2: on the offset levels, the axis turned through an upper level's limit curve (Eq. 3.32).
+        Spatial = "spatial" }
+}
+word_enum! {
+    /// `rough5.entry`.
+    EntryWord { /// A helix where it fits, else from the stock's side, else a ramp, else a plunge.
+        Auto = "auto", /// A helix where it fits, else a ramp, else a plunge.
+        Helix = "helix", /// A ramp along a closed run, else a plunge.
+        Ramp = "ramp", /// From the stock's side where a run starts within reach of it, else a ramp, else a plunge.
+        Side = "side" }
 }
 word_enum! {
     /// `finishing.pattern`.
@@ -1869,6 +1926,21 @@ mod tests {
         ] {
             let err = parse_job(&job.replace(from, to)).unwrap_err().to_string();
             assert!(err.contains(key), "{to}: {err}");
+        }
+        // The collision corrections: none by default, the step-1 switch, or a list of steps.
+        assert_eq!((r.correction.planar(), r.correction.spatial(), r.entry), (false, false, EntryWord::Auto));
+        for (keys, planar, spatial, entry) in [
+            ("correction = true", true, false, EntryWord::Auto),
+            ("correction = false\nentry = \"side\"", false, false, EntryWord::Side),
+            ("correction = [\"spatial\"]\nentry = \"helix\"", false, true, EntryWord::Helix),
+            ("correction = [\"planar\", \"spatial\"]\nentry = \"ramp\"", true, true, EntryWord::Ramp),
+        ] {
+            let parsed = parse_job(&job.replace("ae = 4.5", &format!("ae = 4.5\n{keys}"))).unwrap();
+            let r = parsed.operations[0].rough5.as_ref().unwrap();
+            assert_eq!((r.correction.planar(), r.correction.spatial(), r.entry), (planar, spatial, entry), "{keys}");
+        }
+        for bad in ["correction = [\"sideways\"]", "correction = 1", "entry = \"plunge\""] {
+            assert!(parse_job(&job.replace("ae = 4.5", &format!("ae = 4.5\n{bad}"))).is_err(), "{bad}");
         }
     }
 }

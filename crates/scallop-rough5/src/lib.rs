@@ -6,9 +6,11 @@
 //!   tangent contact with a level mesh (module G; C_C to C_L by Eq. 1.1);
 //! - [`synchronise`], [`pitch_angle`]: SPU synchronisation of a path curve
 //!   with its tilt curve (Eq. 3.10) and the pitch angle theta_t (Eq. 3.7);
-//! - [`plan_rough5`]: levels top-down, passes inside-out, ramp entries along
-//!   the innermost pass, links on the level or at a safe height, a maximum
-//!   angular step; the guide-curve variant and the zero-tilt baseline
+//! - [`plan_rough5`]: levels top-down, passes inside-out, entries
+//!   ([`EntryMode`]: a helix inside a closed pass, [`helix_entry`]; from
+//!   outside the stock at the level's depth, [`side_entry`]; ramps along
+//!   closed and open runs), links on the level or at a safe height, a
+//!   maximum angular step; the guide-curve variant and the zero-tilt baseline
 //!   (module J); [`plan_single_pass`]: one pass alone (the orientation
 //!   cases of Ch. 3 §2.3);
 //! - [`correct_planar`]: the collision correction that turns a colliding
@@ -47,6 +49,7 @@ mod baseline;
 mod collide;
 mod correct;
 mod cutting;
+mod entry;
 mod error;
 mod faces;
 mod levels;
@@ -64,6 +67,10 @@ pub use baseline::{BaselinePlan, BaselineSettings, Pocket, SetupReport, plan_thr
 pub use collide::BodyCheck;
 pub use correct::{CorrectionCount, correct_pairs, correct_pairs_spatial, correct_planar, correct_spatial};
 pub use cutting::{CuttingData, TorusTool};
+pub use entry::{
+    EntryCount, EntryMode, HELIX_RADII, HELIX_STARTS, HELIX_TANGENCY, HelixSettings, SIDE_DIRECTIONS, SIDE_REACH_RADII,
+    helix_entry, side_entry,
+};
 pub use error::Rough5Error;
 pub use faces::{FaceMetrics, ProofFace, face_metrics};
 pub use levels::{LevelOptions, LevelPasses, TiltMode, level_passes, level_passes_with, refine_facets};
@@ -73,9 +80,9 @@ pub use orient::{
 };
 pub use place::{Feature, Placement, Placer, tool_frame};
 pub use plan::{
-    AIR_MARGIN, AIR_STEP, LevelReport, PassReport, Rough5Plan, Rough5Settings, SinglePass, TRANSLATION_MAX,
-    TRANSLATION_SLOPE, bottom_normal_min_slope, limit_step, plan_rough5, plan_rough5_in, plan_single_pass,
-    round_corners, thin_vertical,
+    AIR_MARGIN, AIR_STEP, LevelReport, PassReport, Rough5Plan, Rough5Settings, SIDE_MARGIN, SinglePass,
+    TRANSLATION_MAX, TRANSLATION_SLOPE, bottom_normal_min_slope, limit_step, plan_rough5, plan_rough5_in,
+    plan_single_pass, round_corners, thin_vertical,
 };
 pub use prove::{Proof, ProofSettings, prove, prove_from_blank, prove_with_faces};
 pub use radius::{apparent_contour_radius, effective_radius, exact_scallop, scallop_height, swept_profile};

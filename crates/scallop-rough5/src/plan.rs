@@ -5,11 +5,12 @@
 //! clockwise spindle); the tool placed along its axis at every synchronised
 //! pair ([`crate::Placer`]), no more than a maximum angular step between
 //! neighbouring orientations; pairs whose tool body would meet a flank
-//! dropped (the pass is split there); the first run of a level entered by a
-//! ramp along its closed pass from just above the level cut before, later
-//! runs linked on the level when the link is short, placed and collision
-//! free, else through a retract along the tool axis to a safe height, a
-//! rapid, and a plunge back along the axis.
+//! dropped (the pass is split there); the first run of a level entered from
+//! just above the level cut before ([`EntryMode`]: a helix inside a closed
+//! run, from outside the stock at the level's depth, a ramp along the run,
+//! a plunge only where none of them is found), later runs linked on the
+//! level when the link is short, placed and collision free, else through a
+//! retract along the tool axis to a safe height, a rapid, and an entry.
 //!
 //! Three refinements of the guide-curve program (docs/rough5.md, "Where the
 //! remaining volume was"), each a setting: the passes inside a level's
@@ -29,6 +30,9 @@ use scallop_toolpath::{Move, MoveKind, Toolpath};
 
 use crate::collide::BodyCheck;
 use crate::correct::{correct_pairs, correct_pairs_spatial};
+use crate::entry::{
+    EntryCount, EntryMode, HELIX_RADII, HELIX_STARTS, HelixSettings, SIDE_REACH_RADII, helix_entry, side_entry,
+};
 use crate::levels::{LevelOptions, TiltMode, level_passes_with};
 use crate::orient::{OrientSettings, Orientation, optimise_pass, synchronise_with};
 use crate::rest::{ROOT_REST_MIN_RUN, root_rest_pairs, swept};
@@ -65,6 +69,12 @@ pub struct Rough5Settings {
     /// The optimised orientation of each paired pass (Jousselin 2020, Ch. 3
     /// §2), or `None` for SPU.
     pub orientation: Option<OrientSettings>,
+    /// The optimised orientation of the passes that leave the stock of the
+    /// finished faces: every pass of the bottom level and each level's limit
+    /// passes (its outermost ones, along the flanks); the other passes (the
+    /// bulk) keep [`Self::orientation`]. `None`: one orientation for all
+    /// (the per-pass weights of spec module H; Jousselin 2020, Ch. 3 §2.3).
+    pub limit_orientation: Option<OrientSettings>,
     /// Whether a pair whose tool collides with a flank is first turned in its
     /// correction plane (Ch. 3 §3, step 1, [`crate::correct_planar`]) before
     /// it is dropped.
@@ -139,6 +149,11 @@ pub struct Rough5Settings {
     /// its flat end lies on the bottom (docs/rough5.md, "Impeller hub and
     /// roots"). A flat bottom is cut as before.
     pub bottom_normal: bool,
+    /// How the runs are entered ([`EntryMode`]; docs/rough5.md, "Entries"):
+    /// a helix inside a closed pass where one fits, a side entry from outside
+    /// the stock where a run starts within reach of its side, a ramp along a
+    /// closed run, else a plunge.
+    pub entry: EntryMode,
 }
 
 impl Rough5Settings {
@@ -164,6 +179,7 @@ impl Rough5Settings {
             feed,
             rapid_rate: 20_000.0,
             orientation: None,
+            limit_orientation: None,
             correct: false,
             levels: LevelOptions::default(),
             vertical_inside: false,
@@ -174,6 +190,7 @@ impl Rough5Settings {
             round_corners: false,
             root_rest: false,
             bottom_normal: false,
+            entry: EntryMode::Auto,
         }
         .with_refinements(true)
     }
@@ -268,8 +285,13 @@ pub struct Rough5Plan {
     pub retracts: usize,
     /// Links kept on the level.
     pub links: usize,
-    /// Ramp entries.
+    /// Ramp entries (`entries.ramp`).
     pub ramps: usize,
+    /// Entries by kind.
+    pub entries: EntryCount,
+    /// The pass starts (tool tips) entered by a plunge into material: where
+    /// neither a helix, a side entry nor a ramp was found.
+    pub plunged_at: Vec<Point3>,
     /// Time at the programmed feeds and the rapid rate (s), without the
     /// machine's dynamics.
     pub estimated_time: f64,
@@ -369,7 +391,9 @@ pub fn plan_rough5_in(
         .collect();
     let mut out = Emitter::new(stock.max.z, stock.max.z + settings.clearance + cutter.radius(), settings);
     out.flat = Emitter::flat_radius(cutter);
+    out.radius = cutter.radius();
     out.air = air;
+    out.sides = Some(Sides { stock: *stock, pieces: body_pieces(cutter) });
     let mut reports = Vec::new();
     // The first level is entered from above the stock: the box's top, or the blank's.
     let stock_top = blank.map_or(stock.max.z, |b| b.bounds().max.z.min(stock.max.z));
@@ -387,9 +411,15 @@ pub fn plan_rough5_in(
         let mut level_cut: Vec<Vec<Placement>> = Vec::new();
         for (m, (path, tilt)) in level.passes.iter().enumerate() {
             let cursor = out.last.map_or_else(|| path.line.points[0], |c| c.sync.path);
-            let (pairs, _) = pass_pairs((path, tilt.as_ref()), &cursor, settings)?;
-            let (mut pairs, corrected) = corrected_pairs(&placer, &body, pairs, settings);
             let outer = m + level.outer >= level.passes.len();
+            // Per-pass weights: the passes that leave the finished faces' stock
+            // (the bottom level's and each level's limit passes) with their own.
+            let weighted = match settings.limit_orientation {
+                Some(o) if j == 0 || outer => Rough5Settings { orientation: Some(o), ..*settings },
+                _ => *settings,
+            };
+            let (pairs, _) = pass_pairs((path, tilt.as_ref()), &cursor, &weighted)?;
+            let (mut pairs, corrected) = corrected_pairs(&placer, &body, pairs, settings);
             if j == 0 && outer && rest.is_some() {
                 limit_pairs.push(pairs.clone());
             }
@@ -503,7 +533,9 @@ pub fn plan_rough5_in(
         passes: reports,
         retracts: out.retracts,
         links: out.links,
-        ramps: out.ramps,
+        ramps: out.entries.ramp,
+        entries: out.entries,
+        plunged_at: out.plunged_at,
         estimated_time,
     })
 }
@@ -1210,6 +1242,116 @@ impl Air {
     }
 }
 
+/// Most legs of the ramp along an open run ([`open_ramp`]): out and back.
+/// A ramp back and forth along a short run stops at every turn; on the
+/// impeller's short open runs more legs cost more machine time than they
+/// save over a plunge (docs/rough5.md, "Entries").
+pub const OPEN_RAMP_LEGS: usize = 2;
+
+/// The ramp entry of an open run (tool tips and axes, top first, ending at
+/// its first point on the level): the tool goes along the run's first
+/// points and back, lifted along their axes by `tan(ramp_angle)` per mm
+/// travelled before it reaches the start, at most `lift`; the legs turn at
+/// the run's end or where the one leg is long enough. `None` where a lifted
+/// tool comes closer to a flank than `body` allows (a flank over the run),
+/// the run has no length or [`OPEN_RAMP_LEGS`] legs do not reach `lift`.
+fn open_ramp(run: &[Cl], lift: f64, ramp_angle: f64, body: &BodyCheck) -> Option<Vec<(Point3, Vec3)>> {
+    let n = run.len();
+    let length = run_length(run);
+    if n < 2 || length <= 0.0 || lift <= 0.0 || !lift.is_finite() {
+        return None;
+    }
+    let slope = ramp_angle.tan();
+    let full = lift / slope;
+    // Backwards in time from the start: out along the run and back.
+    let (mut out, mut k, mut forward, mut travelled) = (vec![(run[0].place.tip, run[0].place.axis)], 0usize, true, 0.0);
+    let mut legs = 0;
+    while travelled * slope < lift {
+        let next = if forward { k + 1 } else { k - 1 };
+        travelled += (run[next].place.tip - run[k].place.tip).norm();
+        k = next;
+        let h = (travelled * slope).min(lift);
+        let p = &run[k].place;
+        let tip = p.tip + p.axis * h;
+        if body.collides(&tip, &p.axis) {
+            return None;
+        }
+        out.push((tip, p.axis));
+        // Turn at the run's end, or where one leg is the whole ramp.
+        let turn_at = if forward { k + 1 == n || travelled >= full } else { k == 0 };
+        if turn_at {
+            forward = !forward;
+            legs += 1;
+            if legs >= OPEN_RAMP_LEGS && travelled * slope < lift {
+                return None;
+            }
+        }
+    }
+    out.reverse();
+    Some(out)
+}
+
+/// How far (mm) beside the stock the tool's body keeps at the start of a
+/// side entry, the margin of [`AIR_MARGIN`] too.
+pub const SIDE_MARGIN: f64 = AIR_MARGIN;
+
+/// The stock a side entry starts beside: its box, or the blank of
+/// [`plan_rough5_in`], and the tool's body as (h0, h1, radius) above its tip
+/// (flutes, shank, holder).
+struct Sides {
+    stock: Aabb3,
+    pieces: Vec<(f64, f64, f64)>,
+}
+
+impl Sides {
+    /// Whether the whole tool with its tip at `tip` along `axis` is at least
+    /// [`SIDE_MARGIN`] clear of the stock, sampled every [`AIR_STEP`] up its
+    /// body: beside the box (its cross-section's widest reach `rho / cos
+    /// tilt`) or above it, or, in `air`, above the blank's top at the axis
+    /// and at 16 points on each of the circles of radius `rho + margin`,
+    /// `rho` and `rho / 2` (beside the blank its top is `-inf`).
+    fn outside(&self, tip: &Point3, axis: &Vec3, air: Option<&Air>) -> bool {
+        let tilt = axis.angle(&Vec3::z());
+        let (sin, cos) = (tilt.sin(), tilt.cos().max(0.1));
+        self.pieces.iter().all(|&(h0, h1, rho)| {
+            let n = ((h1 - h0) / AIR_STEP).ceil().max(1.0) as usize;
+            (0..=n).all(|k| {
+                let c = tip + axis * (h0 + (h1 - h0) * k as f64 / n as f64);
+                let low = c.z - rho * sin - SIDE_MARGIN;
+                match air {
+                    Some(air) => {
+                        let ring = (0..16).flat_map(|j| {
+                            let a = std::f64::consts::TAU * f64::from(j) / 16.0;
+                            [rho + SIDE_MARGIN, rho, 0.5 * rho].map(|f| (c.x + f * a.cos(), c.y + f * a.sin()))
+                        });
+                        std::iter::once((c.x, c.y)).chain(ring).all(|(x, y)| air.top(x, y) < low)
+                    }
+                    None => {
+                        let b = &self.stock;
+                        let dx = (b.min.x - c.x).max(c.x - b.max.x).max(0.0);
+                        let dy = (b.min.y - c.y).max(c.y - b.max.y).max(0.0);
+                        low > b.max.z || dx.hypot(dy) >= rho / cos + SIDE_MARGIN
+                    }
+                }
+            })
+        })
+    }
+}
+
+/// The tool's body as (h0, h1, radius) above its tip: the flutes, the
+/// shank, the holder's segments.
+fn body_pieces(cutter: &Cutter) -> Vec<(f64, f64, f64)> {
+    let flutes = cutter.flute_length();
+    let shank_top = flutes + cutter.shank_length();
+    let mut pieces = vec![(0.0, flutes, cutter.radius()), (flutes, shank_top, cutter.shank_radius())];
+    let mut h = shank_top;
+    for s in cutter.holder() {
+        pieces.push((h, h + s.length, s.bottom_radius.max(s.top_radius)));
+        h += s.length;
+    }
+    pieces
+}
+
 /// The height where the tool of `c` (its axis kept) meets the level cut
 /// before (`above`, placed along the axis through `c`'s guide point): the
 /// material over it is gone where that level's passes ran. `None` where that
@@ -1325,9 +1467,15 @@ struct Emitter {
     settings: Rough5Settings,
     /// The radius of the flat of the tool's end (0: no ramp is shortened).
     flat: f64,
+    /// The tool's radius (0: no helix).
+    radius: f64,
     retracts: usize,
     links: usize,
-    ramps: usize,
+    entries: EntryCount,
+    plunged_at: Vec<Point3>,
+    /// The stock box and the tool's body, for the side entries (none
+    /// without).
+    sides: Option<Sides>,
     /// The azimuth of the last tilted axis written: where a table-table
     /// machine holds its C table while the axis is on the pole.
     held: Option<f64>,
@@ -1346,9 +1494,12 @@ impl Emitter {
             last: None,
             settings: *settings,
             flat: 0.0,
+            radius: 0.0,
             retracts: 0,
             links: 0,
-            ramps: 0,
+            entries: EntryCount::default(),
+            plunged_at: Vec::new(),
+            sides: None,
             held: None,
             air: None,
         }
@@ -1440,7 +1591,7 @@ impl Emitter {
     fn cut_run(&mut self, run: &[Cl], entry_z: f64, first_of_level: bool, (placer, body): (&Placer, &BodyCheck)) {
         let linked = !first_of_level && self.last.is_some_and(|a| self.try_link(&a, &run[0], placer, body));
         // The tool is now at run[start].
-        let start = if linked { 0 } else { self.enter(run, entry_z) };
+        let start = if linked { 0 } else { self.enter(run, entry_z, (placer, body)) };
         let n = run.len();
         let closed = n > 2 && (run[0].place.tip - run[n - 1].place.tip).norm() < 1e-9;
         if closed {
@@ -1495,42 +1646,144 @@ impl Emitter {
             .collect()
     }
 
-    /// Retracts along the axis, goes over at the safe height, plunges along
-    /// the new axis to above the level (in a blank, at the rapid rate down
-    /// to where the flutes reach it first) and ramps down along a closed run.
-    /// Returns the index of the run where the tool reached the level.
-    fn enter(&mut self, run: &[Cl], entry_z: f64) -> usize {
+    /// Retracts along the axis, goes over at the safe height and enters the
+    /// run from `entry_z` ([`EntryMode`]): down a helix inside a closed run
+    /// ([`Emitter::helix`]), from beside the stock ([`Emitter::side`]), down
+    /// a ramp along a closed run, or by a plunge along the axis. In a blank
+    /// the tool goes down at the rapid rate to where its flutes reach the
+    /// blank. Returns the index of the run where the tool reached the level.
+    fn enter(&mut self, run: &[Cl], entry_z: f64, (placer, body): (&Placer, &BodyCheck)) -> usize {
         if let Some(a) = self.last {
             self.retract(&a.place);
             self.retracts += 1;
         }
         let s = run[0].place;
-        let lift = if s.axis.z > 0.0 { ((entry_z - s.tip.z) / s.axis.z).max(0.0) } else { 0.0 };
-        let start = s.tip + s.axis * lift;
-        let over = self.above(&start, &s.axis);
-        self.push(MoveKind::Rapid, over, s.axis);
-        if let Some(air) = &self.air {
-            // At the rapid rate down to where the flutes reach the blank.
-            let h = air.clear_down_to(&s.tip, &s.axis, (over - s.tip).dot(&s.axis), lift);
-            let down = s.tip + s.axis * h;
-            if (down - over).norm() > 0.0 {
-                self.push(MoveKind::Rapid, down, s.axis);
+        let lift = Emitter::lift(&s, entry_z);
+        let closed = run.len() > 2 && (s.tip - run[run.len() - 1].place.tip).norm() < 1e-9;
+        let mode = self.settings.entry;
+        if lift > 0.0 {
+            if closed
+                && matches!(mode, EntryMode::Auto | EntryMode::Helix)
+                && let Some((start, tips)) = self.helix(run, entry_z, placer, body)
+            {
+                let axis = run[start].place.axis;
+                self.approach(&tips[0], &axis, 0.0);
+                for tip in &tips[1..] {
+                    self.push(MoveKind::Feed, *tip, axis);
+                }
+                self.entries.helix += 1;
+                return start;
+            }
+            if matches!(mode, EntryMode::Auto | EntryMode::Side)
+                && let Some(from) = self.side(run, placer, body)
+            {
+                // Down beside the stock at the rapid rate (in the air all the way).
+                let over = self.above(&from, &s.axis);
+                self.push(MoveKind::Rapid, over, s.axis);
+                self.push(MoveKind::Rapid, from, s.axis);
+                self.push(MoveKind::Feed, s.tip, s.axis);
+                self.entries.side += 1;
+                return 0;
             }
         }
-        // (In a blank the rapid may have reached the start.)
-        if self.air.is_none() || self.current().is_none_or(|(at, _)| (at - start).norm() > 0.0) {
-            self.push(MoveKind::Plunge, start, s.axis);
+        // An open run is entered down a ramp along its first points where the
+        // lifted tool clears the flanks: the approach goes to the ramp's top.
+        let ramp = (lift > 0.0 && !closed).then(|| open_ramp(run, lift, self.settings.ramp_angle, body)).flatten();
+        if let Some(ramp) = ramp.filter(|r| r.len() > 1) {
+            let (top, axis) = ramp[0];
+            self.approach(&top, &axis, lift);
+            for (tip, axis) in &ramp[1..] {
+                self.push(MoveKind::Feed, *tip, *axis);
+            }
+            self.entries.ramp += 1;
+            return 0;
         }
-        let closed = run.len() > 2 && (s.tip - run[run.len() - 1].place.tip).norm() < 1e-9;
+        let start = s.tip + s.axis * lift;
+        self.approach(&start, &s.axis, lift);
         if lift <= 0.0 {
             return 0;
         }
-        if !closed {
-            self.push(MoveKind::Plunge, s.tip, s.axis);
-            return 0;
+        if closed {
+            self.entries.ramp += 1;
+            return self.ramp(run, lift);
         }
-        self.ramps += 1;
-        self.ramp(run, lift)
+        self.push(MoveKind::Plunge, s.tip, s.axis);
+        self.entries.plunge += 1;
+        self.plunged_at.push(s.tip);
+        0
+    }
+
+    /// How far (mm) along its axis the tool at `s` is lifted to reach the
+    /// height `entry_z` (zero where it is above it).
+    fn lift(s: &Placement, entry_z: f64) -> f64 {
+        if s.axis.z > 0.0 { ((entry_z - s.tip.z) / s.axis.z).max(0.0) } else { 0.0 }
+    }
+
+    /// A rapid to the safe height over `to` along `axis`, then (in a blank)
+    /// at the rapid rate down to where the flutes reach the blank, but not
+    /// below `to`, then a plunge to `to`. `low` (mm) is how far `to` is above
+    /// the level along the axis: in a blank the rapid stops that far above
+    /// the tool on the level at the most.
+    fn approach(&mut self, to: &Point3, axis: &Vec3, low: f64) {
+        let over = self.above(to, axis);
+        self.push(MoveKind::Rapid, over, *axis);
+        if let Some(air) = &self.air {
+            let level = to - axis * low;
+            let h = air.clear_down_to(&level, axis, (over - level).dot(axis), low);
+            let down = level + axis * h;
+            if (down - over).norm() > 0.0 {
+                self.push(MoveKind::Rapid, down, *axis);
+            }
+        }
+        // (In a blank the rapid may have reached `to`.)
+        if self.air.is_none() || self.current().is_none_or(|(at, _)| (at - to).norm() > 0.0) {
+            self.push(MoveKind::Plunge, *to, *axis);
+        }
+    }
+
+    /// The helix entry of a closed run ([`helix_entry`]): first where the
+    /// ramp along the run would reach the level (the lap, and the passes
+    /// synchronised from its end, are then those of the ramp's program: a
+    /// helix at the run's own start moved them, and with them the runs the
+    /// next passes split into; docs/rough5.md, "Entries"), then
+    /// at [`HELIX_STARTS`] evenly spaced points from there, each with the
+    /// radii of [`HELIX_RADII`] largest first; the run's index where the
+    /// helix ends and its tips.
+    fn helix(&self, run: &[Cl], entry_z: f64, placer: &Placer, body: &BodyCheck) -> Option<(usize, Vec<Point3>)> {
+        let n = run.len() - 1;
+        let tips: Vec<Point3> = run.iter().map(|c| c.place.tip).collect();
+        let starts = HELIX_STARTS.min(n);
+        let radius = self.radius;
+        let first = self.ramp_end(run, Emitter::lift(&run[0].place, entry_z));
+        for j in 0..starts {
+            let start = (first + j * n / starts) % n;
+            let s = &run[start].place;
+            let lift = Emitter::lift(s, entry_z);
+            for f in HELIX_RADII {
+                let h = HelixSettings {
+                    radius: f * radius,
+                    ramp_angle: self.settings.ramp_angle,
+                    step: self.settings.step,
+                };
+                if let Some(helix) = helix_entry(placer, body, (&tips, start), &s.axis, lift, &h) {
+                    return Some((start, helix));
+                }
+            }
+        }
+        None
+    }
+
+    /// The start of a side entry of `run` ([`side_entry`]): within
+    /// [`SIDE_REACH_RADII`] tool radii of its first point, the whole tool
+    /// outside the stock ([`Sides`]); `None` without a stock.
+    fn side(&self, run: &[Cl], placer: &Placer, body: &BodyCheck) -> Option<Point3> {
+        let sides = self.sides.as_ref()?;
+        let s = &run[0].place;
+        let back = run.get(1).map(|c| s.tip - c.place.tip);
+        let reach = SIDE_REACH_RADII * self.radius;
+        let rise = (self.above(&s.tip, &s.axis) - s.tip).dot(&s.axis);
+        let outside = |p: &Point3, u: &Vec3| sides.outside(p, u, self.air.as_ref());
+        side_entry(placer, body, &outside, (&s.tip, &s.axis), back, self.settings.step, reach, rise)
     }
 
     /// The radius of the flat of `cutter`'s end: R for a flat end mill, R - r
@@ -1547,16 +1800,7 @@ impl Emitter {
     /// where the lift reaches zero.
     fn ramp(&mut self, run: &[Cl], lift: f64) -> usize {
         let n = run.len() - 1;
-        // At most one lap on a loop within the flat of the tool's end round
-        // its centre (the fitting's smallest inner loops, 15 mm long): there
-        // the ramp circled it up to 4 times, the flat covering the loop
-        // whatever the ramp; it is steeper instead.
-        let full = lift / self.settings.ramp_angle.tan();
-        let tips = || run[..n].iter().map(|c| c.place.tip.coords);
-        let centre = tips().sum::<Vec3>() / n as f64;
-        let lap: f64 = (0..n).map(|k| (run[k + 1].place.tip - run[k].place.tip).norm()).sum();
-        let within = tips().all(|p| (p - centre).norm() <= self.flat);
-        let ramp_len = if within && lap > 0.0 { full.min(lap) } else { full };
+        let ramp_len = self.ramp_length(run, lift);
         let (mut s, mut k) = (0.0, 0usize);
         loop {
             let (a, b) = (&run[k % n].place, &run[(k + 1) % n].place);
@@ -1569,6 +1813,37 @@ impl Emitter {
             }
             self.feed_to(b.tip + b.axis * h, b.axis);
         }
+    }
+
+    /// The length (mm) of the ramp along the closed `run` from `lift`: at
+    /// most one lap on a loop within the flat of the tool's end round its
+    /// centre (the fitting's smallest inner loops, 15 mm long): there the
+    /// ramp circled it up to 4 times, the flat covering the loop whatever
+    /// the ramp; it is steeper instead.
+    fn ramp_length(&self, run: &[Cl], lift: f64) -> f64 {
+        let n = run.len() - 1;
+        let full = lift / self.settings.ramp_angle.tan();
+        let tips = || run[..n].iter().map(|c| c.place.tip.coords);
+        let centre = tips().sum::<Vec3>() / n as f64;
+        let lap: f64 = (0..n).map(|k| (run[k + 1].place.tip - run[k].place.tip).norm()).sum();
+        let within = tips().all(|p| (p - centre).norm() <= self.flat);
+        if within && lap > 0.0 { full.min(lap) } else { full }
+    }
+
+    /// The index of the closed `run` where its ramp from `lift` reaches the
+    /// level ([`Emitter::ramp`]).
+    fn ramp_end(&self, run: &[Cl], lift: f64) -> usize {
+        let n = run.len() - 1;
+        let ramp_len = self.ramp_length(run, lift);
+        let (mut s, mut k) = (0.0, 0usize);
+        while k < tol::MAX_PASS_POINTS {
+            s += (run[(k + 1) % n].place.tip - run[k % n].place.tip).norm();
+            k += 1;
+            if s >= ramp_len {
+                break;
+            }
+        }
+        k % n
     }
 
     /// Links `a` to `b` on the level when the link is short, every point of
