@@ -1646,6 +1646,16 @@ pub mod waterline {
     /// most this many times).
     pub const MAX_REFINE_DEPTH: u32 = 40;
 
+    /// A chord longer than this many times `sqrt(8 R chord_tolerance)` (the
+    /// longest chord within the chord tolerance of a circle of the cutter's
+    /// radius R) is accepted only if the contour is within the chord
+    /// tolerance at its quarter points too, not only at its midpoint. A
+    /// vertex's contour is a circle of radius at most R, where chords stay
+    /// under that length; a longer chord spans a flatter piece, where a
+    /// feature the midpoint misses (a notch, a bend off the middle) would
+    /// otherwise hide (docs/waterline.md, step 6).
+    pub const LONG_CHORD_SHARE: f64 = 2.0;
+
     /// Smallest tolerance accepted, relative to the model's largest |coordinate|:
     /// below it the bisection would be deciding rounding noise.
     pub const REL_MIN_TOLERANCE: f64 = 1e-13;

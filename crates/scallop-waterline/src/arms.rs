@@ -69,7 +69,7 @@ use rayon::prelude::*;
 use scallop_cutter::CutterShape;
 use scallop_geom::{Point2, Vec2, predicates::orient2d};
 
-use crate::refine::{CHORD_MARGIN, Local, Near, Probe, refine_chord};
+use crate::refine::{CHORD_MARGIN, Local, Near, Probe, long_chord, refine_chord};
 use crate::{Loop, WaterlineGrid, tol};
 
 /// Most passes of check and recovery per level (a splice may move a chord
@@ -553,8 +553,9 @@ fn refine_through(
     new: &mut Vec<Point2>,
 ) {
     let mut from = from;
+    let long = long_chord(local.probe, chord_tolerance);
     for &p in through.iter().chain([&to]) {
-        refine_chord(local, from, p, chord_tolerance, 0, new);
+        refine_chord(local, (from, p), chord_tolerance, long, 0, new);
         if p != to {
             new.push(p);
         }

@@ -52,7 +52,7 @@ impl<'a> Probe<'a> {
 /// the triangle that owns it, maximised over every triangle that can raise the
 /// result); points outside the box fall back to the index.
 pub(crate) struct Local<'a> {
-    probe: &'a Probe<'a>,
+    pub(crate) probe: &'a Probe<'a>,
     drop: BoxDrop<'a>,
     /// The contact triangle of the last evaluation: tried first at the next
     /// (a valid lower bound that prunes the scan early; the height is the same).
@@ -743,13 +743,14 @@ const SECANT_OVERSHOOT: f64 = 1.25;
 const SECANT_PROBE: f64 = 0.45;
 
 /// Points strictly between `a` and `b` that bring every chord within
-/// `chord_tolerance` of the contour at its midpoint (as far as the probe
-/// along the chord's normal finds the contour), in order from `a` to `b`.
+/// `chord_tolerance` of the contour at its midpoint, and a chord longer than
+/// `long` at its quarter points too (as far as the probe along the chord's
+/// normal finds the contour), in order from `a` to `b`.
 pub(crate) fn refine_chord(
     local: &Local<'_>,
-    a: Point2,
-    b: Point2,
+    (a, b): (Point2, Point2),
     chord_tolerance: f64,
+    long: f64,
     depth: u32,
     out: &mut Vec<Point2>,
 ) {
@@ -760,16 +761,35 @@ pub(crate) fn refine_chord(
         return;
     }
     let normal = Vec2::new(-d.y, d.x) / length; // left of a -> b: the inside
-    let mid = Point2::new(0.5 * (a.x + b.x), 0.5 * (a.y + b.y));
+    let at = |t: f64| Point2::new(a.x + t * d.x, a.y + t * d.y);
     // Within a grid cell the contour may bulge up to about a cell away from the
     // chord joining its two crossings (a ridge along the diagonal): reach that far.
-    let Near::Found(on) = local.contour_near(mid, normal, chord_tolerance, length.max(probe.step)) else { return };
+    let reach = length.max(probe.step);
+    let on = match local.contour_near(at(0.5), normal, chord_tolerance, reach) {
+        Near::Found(on) => on,
+        // Within at the midpoint: a long chord is checked at its quarters.
+        Near::Within if length > long => {
+            let quarter = |t: f64| match local.contour_near(at(t), normal, chord_tolerance, reach) {
+                Near::Found(on) => Some(on),
+                Near::Within | Near::Missing => None,
+            };
+            let Some(on) = quarter(0.25).or_else(|| quarter(0.75)) else { return };
+            on
+        }
+        Near::Within | Near::Missing => return,
+    };
     if on == a || on == b {
         return;
     }
-    refine_chord(local, a, on, chord_tolerance, depth + 1, out);
+    refine_chord(local, (a, on), chord_tolerance, long, depth + 1, out);
     out.push(on);
-    refine_chord(local, on, b, chord_tolerance, depth + 1, out);
+    refine_chord(local, (on, b), chord_tolerance, long, depth + 1, out);
+}
+
+/// The length past which [`refine_chord`] checks a chord's quarter points
+/// ([`tol::LONG_CHORD_SHARE`]).
+pub(crate) fn long_chord(probe: &Probe<'_>, chord_tolerance: f64) -> f64 {
+    tol::LONG_CHORD_SHARE * (8.0 * probe.cutter.radius() * chord_tolerance).sqrt()
 }
 
 /// Runs `[start, end)` of consecutive chords that share one candidate list:
@@ -811,6 +831,7 @@ pub(crate) fn refine_loops(probe: &Probe<'_>, chains: &[Vec<Point2>], chord_tole
     let chords: Vec<(Point2, Point2)> =
         chains.iter().flat_map(|c| (0..c.len()).map(move |i| (c[i], c[(i + 1) % c.len()]))).collect();
     let groups = chord_groups(&chords, probe.step);
+    let long = long_chord(probe, chord_tolerance);
     let inserted: Vec<Vec<Point2>> = groups
         .par_iter()
         .map(|&(start, end)| {
@@ -828,7 +849,7 @@ pub(crate) fn refine_loops(probe: &Probe<'_>, chains: &[Vec<Point2>], chord_tole
                 .iter()
                 .map(|&(a, b)| {
                     let mut out = Vec::new();
-                    refine_chord(&local, a, b, chord_tolerance, 0, &mut out);
+                    refine_chord(&local, (a, b), chord_tolerance, long, 0, &mut out);
                     out
                 })
                 .collect::<Vec<_>>()

@@ -7,7 +7,7 @@ use proptest::prelude::*;
 use scallop_cutter::{Contact, Cutter, drop_cutter_brute_force};
 use scallop_geom::{Point2, Point3, Vec3};
 use scallop_mesh::{MeshIndex, TriMesh};
-use scallop_waterline::{Loop, WaterlineGrid, WaterlineOptions};
+use scallop_waterline::{Loop, WaterlineGrid, WaterlineOptions, tol};
 
 /// A terrain of `n` x `n` cells of `cell` mm over heights `h` (row-major, (n+1)^2).
 fn terrain(n: usize, cell: f64, h: &[f64]) -> TriMesh {
@@ -228,6 +228,41 @@ proptest! {
         prop_assert!(checked.is_ok(), "{}", checked.unwrap_err());
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 24, .. ProptestConfig::default() })]
+
+    /// A chord longer than the longest chord of a circle of the cutter's
+    /// radius within the chord tolerance (times `tol::LONG_CHORD_SHARE`) is
+    /// within the chord tolerance of the contour at its quarter points too,
+    /// not only at its midpoint: a cutter moving along it never cuts into the
+    /// part by more than that (where the contour bends off the chord's middle,
+    /// or crosses the chord there, the midpoint alone misses it).
+    #[test]
+    fn long_chords_are_on_the_contact_surface_at_their_quarters(
+        h in heights(),
+        kind in 0u8..3,
+        radius in 0.8..3.0f64,
+        z_frac in 0.05..0.95f64,
+    ) {
+        let mesh = terrain(6, 4.0, &h);
+        let index = MeshIndex::build(&mesh);
+        let cutter = Cutter::new(common::shape_of(kind, radius), 40.0).expect("cutter");
+        let b = mesh.bounds();
+        let z = b.min.z + z_frac * (b.max.z - b.min.z);
+        let options = WaterlineOptions { chord_tolerance: QUARTER_CHORD_TOLERANCE, ..WaterlineOptions::default() };
+        let grid = WaterlineGrid::new(&cutter, &index, &options).expect("grid");
+        let loops = grid.loops(z).expect("level");
+        let long = tol::LONG_CHORD_SHARE * (8.0 * radius * options.chord_tolerance).sqrt();
+        let reach = options.chord_tolerance * (1.0 + 1e-6) + options.crossing_tolerance;
+        let checked = common::check_chord_points(&cutter, &index, &loops, z, (&[0.25, 0.75], long), reach);
+        prop_assert!(checked.is_ok(), "{}", checked.unwrap_err());
+    }
+}
+
+/// The chord tolerance of the quarter-point property: the one the comparison
+/// with OpenCAMLib uses (`bench/ocl/waterline.py`).
+const QUARTER_CHORD_TOLERANCE: f64 = 8e-6;
 
 /// Largest distance from a loop vertex to the contour accepted by the contact
 /// check: the comparison's target against OpenCAMLib (1e-5 mm).

@@ -32,9 +32,8 @@ const RIM_ROUNDING: f64 = 1e-12;
 ///   `off_reach` cuts (the chord stays near the contour: material left, never
 ///   a gouge, so a looser bound).
 ///
-/// Only the midpoint is checked, as the kernel's chord refinement checks it:
-/// elsewhere on a long chord the contour may bulge farther (open item of
-/// `docs/waterline.md`).
+/// Only the midpoint is checked here; [`check_chord_points`] checks the
+/// quarter points of long chords, which the kernel's refinement checks too.
 ///
 /// Returns the first violation found, described.
 pub fn check_on_contact(
@@ -46,49 +45,19 @@ pub fn check_on_contact(
     chord_reach: f64,
     off_reach: f64,
 ) -> Result<(), String> {
-    let b = index.bounds();
-    let floor = b.min.z - 100.0;
-    let slack = HEIGHT_SLACK * (1.0 + b.max.z.abs().max(b.min.z.abs()));
-    // The brute-force height at q, and whether its contact is on the cutter's
-    // rim (where rounding may decide either way).
-    let d = |q: Point2| {
-        let cl = drop_cutter_brute_force(cutter, index, q, floor);
-        let rim = match cl.contact {
-            Contact::Floor => false,
-            Contact::Vertex { point, .. } | Contact::Edge { point, .. } | Contact::Facet { point, .. } => {
-                (point.x - q.x).hypot(point.y - q.y) >= cutter.radius() * (1.0 - RIM_ROUNDING)
-            }
-        };
-        (cl.tip.z, rim)
-    };
-    let cuts_at = |q: Point2| d(q).0 > z;
-    let safe_at = |q: Point2| {
-        let (h, rim) = d(q);
-        h <= z + slack || rim
-    };
-    // Is some point within r of q on the given side? Searched along the hinted
-    // direction in fine steps (a thin channel of the other side is found), then
-    // on a ring of radius r.
-    let side_near = |q: Point2, hint: Vec2, r: f64, want_cut: bool| {
-        let on = |p: Point2| if want_cut { cuts_at(p) } else { safe_at(p) };
-        (1..=LINE_STEPS).any(|k| on(q + hint * (r * f64::from(k) / f64::from(LINE_STEPS))))
-            || (0..RING).any(|a| {
-                let t = std::f64::consts::TAU * f64::from(a) / f64::from(RING);
-                on(Point2::new(q.x + r * t.cos(), q.y + r * t.sin()))
-            })
-    };
+    let o = Oracle::new(cutter, index, z);
     for l in loops {
         let n = l.points.len();
         for i in 0..n {
             let (a, c) = (l.points[i], l.points[(i + 1) % n]);
-            let dv = d(a).0;
-            if !safe_at(a) {
+            let dv = o.height(a).0;
+            if !o.safe_at(a) {
                 return Err(format!("vertex {a:?} cuts into the part: d = {dv}, z = {z}"));
             }
             let chord = c - a;
             let len = chord.norm();
             let left = if len > 0.0 { Vec2::new(-chord.y, chord.x) / len } else { Vec2::new(0.0, 0.0) };
-            if !side_near(a, left, vertex_reach, true) {
+            if !o.side_near(a, left, vertex_reach, true) {
                 return Err(format!(
                     "vertex {a:?} is farther than {vertex_reach} from the contour (d = {dv}, z = {z})"
                 ));
@@ -97,11 +66,11 @@ pub fn check_on_contact(
                 continue;
             }
             let mid = a + chord * 0.5;
-            let dm = d(mid).0;
-            let cuts = !safe_at(mid);
+            let dm = o.height(mid).0;
+            let cuts = !o.safe_at(mid);
             let hint = if cuts { -left } else { left };
             let reach = if cuts { chord_reach } else { off_reach };
-            if !side_near(mid, hint, reach, !cuts) {
+            if !o.side_near(mid, hint, reach, !cuts) {
                 let what = if cuts { "cuts into the part" } else { "is off the contour" };
                 return Err(format!(
                     "midpoint {mid:?} of chord {a:?} -> {c:?} {what} by more than {reach} (d = {dm}, z = {z})"
@@ -110,6 +79,96 @@ pub fn check_on_contact(
         }
     }
     Ok(())
+}
+
+/// Checks, with the brute-force drop-cutter, that at the points `fractions`
+/// along every chord longer than `min_length` a cutter never cuts into the
+/// part by more than `chord_reach` horizontally: where it cuts (`d > z`), a
+/// point within `chord_reach` outwards does not.
+#[allow(dead_code, reason = "not every test crate checks long chords")]
+pub fn check_chord_points(
+    cutter: &Cutter,
+    index: &MeshIndex,
+    loops: &[Loop],
+    z: f64,
+    (fractions, min_length): (&[f64], f64),
+    chord_reach: f64,
+) -> Result<(), String> {
+    let o = Oracle::new(cutter, index, z);
+    for l in loops {
+        let n = l.points.len();
+        for i in 0..n {
+            let (a, c) = (l.points[i], l.points[(i + 1) % n]);
+            let chord = c - a;
+            let len = chord.norm();
+            if len <= min_length {
+                continue;
+            }
+            let left = Vec2::new(-chord.y, chord.x) / len;
+            for &t in fractions {
+                let q = a + chord * t;
+                if !o.safe_at(q) && !o.side_near(q, -left, chord_reach, false) {
+                    return Err(format!(
+                        "point {t} of chord {a:?} -> {c:?} (length {len}) cuts into the part by more than \
+                         {chord_reach} (d = {}, z = {z})",
+                        o.height(q).0
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The brute-force drop-cutter at one level.
+struct Oracle<'a> {
+    cutter: &'a Cutter,
+    index: &'a MeshIndex,
+    z: f64,
+    floor: f64,
+    slack: f64,
+}
+
+impl<'a> Oracle<'a> {
+    fn new(cutter: &'a Cutter, index: &'a MeshIndex, z: f64) -> Oracle<'a> {
+        let b = index.bounds();
+        let slack = HEIGHT_SLACK * (1.0 + b.max.z.abs().max(b.min.z.abs()));
+        Oracle { cutter, index, z, floor: b.min.z - 100.0, slack }
+    }
+
+    /// The brute-force height at q, and whether its contact is on the
+    /// cutter's rim (where rounding may decide either way).
+    fn height(&self, q: Point2) -> (f64, bool) {
+        let cl = drop_cutter_brute_force(self.cutter, self.index, q, self.floor);
+        let rim = match cl.contact {
+            Contact::Floor => false,
+            Contact::Vertex { point, .. } | Contact::Edge { point, .. } | Contact::Facet { point, .. } => {
+                (point.x - q.x).hypot(point.y - q.y) >= self.cutter.radius() * (1.0 - RIM_ROUNDING)
+            }
+        };
+        (cl.tip.z, rim)
+    }
+
+    fn cuts_at(&self, q: Point2) -> bool {
+        self.height(q).0 > self.z
+    }
+
+    fn safe_at(&self, q: Point2) -> bool {
+        let (h, rim) = self.height(q);
+        h <= self.z + self.slack || rim
+    }
+
+    /// Is some point within r of q on the given side? Searched along the
+    /// hinted direction in fine steps (a thin channel of the other side is
+    /// found), then on a ring of radius r.
+    fn side_near(&self, q: Point2, hint: Vec2, r: f64, want_cut: bool) -> bool {
+        let on = |p: Point2| if want_cut { self.cuts_at(p) } else { self.safe_at(p) };
+        (1..=LINE_STEPS).any(|k| on(q + hint * (r * f64::from(k) / f64::from(LINE_STEPS))))
+            || (0..RING).any(|a| {
+                let t = std::f64::consts::TAU * f64::from(a) / f64::from(RING);
+                on(Point2::new(q.x + r * t.cos(), q.y + r * t.sin()))
+            })
+    }
 }
 
 /// The cutter of shape `kind` (flat, ball, bull-nose with corner 0.4 R, cone
