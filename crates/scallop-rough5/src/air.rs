@@ -3,15 +3,17 @@
 //! in-process stock, with a clearance around the tool, are written at a
 //! named air feed instead of the cutting feed.
 //!
-//! The classification is conservative. The program is cut on a tri-dexel
-//! stock (the blank, or the stock box) in chunks of [`AIR_CHUNK`] moves;
-//! before each chunk is cut, the tool grown by the clearance c (every point
+//! The classification is conservative. The program is cut once on a
+//! tri-dexel stock (the blank, or the stock box): the cutting moves that
+//! remove nothing along its Z rays are the candidates. It is cut again, up
+//! to each run of candidates (at most [`AIR_CHUNK`] moves); before such a
+//! run is cut, the tool grown by the clearance c (every point
 //! of the flutes' offset by c: a torus (R, r) becomes (R + c, r + c) with its
 //! tip c lower along the axis, the flutes 2 c longer) is swept along each of
-//! the chunk's moves, each alone, against the stock as it stands before the
-//! chunk ([`DexelStock::probe`], nothing removed): a move whose grown sweep
+//! the run's moves, each alone, against the stock as it stands before the
+//! run ([`DexelStock::probe`], nothing removed): a move whose grown sweep
 //! meets no material of any ray (beyond the rays' epsilon) is air.
-//! The stock before the chunk holds the stock before each of its moves, so a
+//! The stock before the run holds the stock before each of its moves, so a
 //! move classified air meets no stock left by the moves before it, on the
 //! rays, by at least c. A long straight move of one axis (an entry from
 //! beside the stock, a retract leg) is first cut into pieces of at most
@@ -31,8 +33,8 @@ use scallop_toolpath::{Move, MoveKind, Toolpath};
 
 use crate::Rough5Error;
 
-/// Moves per chunk of the classification: each chunk's moves are tested
-/// against the stock as it stood before the chunk (smaller is finer, and
+/// Longest run of candidate moves of the classification tested together
+/// against the stock as it stood before the run (smaller is finer, and
 /// slower).
 pub const AIR_CHUNK: usize = 24;
 
@@ -163,22 +165,32 @@ pub fn air_moves(
     }
     .map_err(sim)?;
     let options = DexelOptions { axis_tolerance: s.axis_tolerance, check_collisions: false, max_stick_out: None };
+    let tools: Vec<ToolMove> = pieces.iter().map(|p| p.tool).collect();
+    // The candidates: cutting pieces that remove nothing along the Z rays when the
+    // whole program is cut (a piece that removes material is no air move).
+    let removed = dexels.clone().cut(cutter, &tools, &options).map_err(sim)?.removed_by_move;
+    let candidate: Vec<bool> = pieces.iter().zip(&removed).map(|(p, r)| p.cutting && *r <= 0.0).collect();
     let mut air = vec![false; pieces.len()];
     let mut start = 1;
     while start < pieces.len() {
-        let end = (start + AIR_CHUNK).min(pieces.len());
-        // Each list starts with the piece before the chunk: the tool placed where it stands.
-        let chunk = &pieces[start - 1..end];
-        if chunk[1..].iter().any(|p| p.cutting) {
-            let probe: Vec<ToolMove> =
-                chunk.iter().map(|p| ToolMove { tip: p.tool.tip - p.tool.axis * s.clearance, ..p.tool }).collect();
-            let depth = dexels.probe(&grown, &probe, &options).map_err(sim)?;
-            for (k, p) in chunk.iter().enumerate().skip(1) {
-                air[start - 1 + k] = p.cutting && depth[k] == 0.0;
+        // Each list starts with the piece before it: the tool placed where it stands.
+        let end = if candidate[start] {
+            // A run of candidates, at most AIR_CHUNK, probed against the stock before it.
+            let mut end = start;
+            while end < pieces.len() && candidate[end] && end - start < AIR_CHUNK {
+                end += 1;
             }
-        }
-        let real: Vec<ToolMove> = chunk.iter().map(|p| p.tool).collect();
-        dexels.cut(cutter, &real, &options).map_err(sim)?;
+            let probe: Vec<ToolMove> =
+                tools[start - 1..end].iter().map(|t| ToolMove { tip: t.tip - t.axis * s.clearance, ..*t }).collect();
+            let depth = dexels.probe(&grown, &probe, &options).map_err(sim)?;
+            for (k, d) in depth.iter().enumerate().skip(1) {
+                air[start - 1 + k] = *d == 0.0;
+            }
+            end
+        } else {
+            (start..pieces.len()).find(|&k| candidate[k]).unwrap_or(pieces.len())
+        };
+        dexels.cut(cutter, &tools[start - 1..end], &options).map_err(sim)?;
         start = end;
     }
     // The program again: consecutive pieces of one move classified alike joined.
