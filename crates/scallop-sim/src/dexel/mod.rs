@@ -886,10 +886,11 @@ impl DexelStock {
     /// let mut dexels = DexelStock::new(stock, 0.25).unwrap();
     /// let flat = Cutter::new(CutterShape::Flat { radius: 2.0 }, 10.0).unwrap();
     /// let mv = |x: f64, z: f64| ToolMove::new(MoveKind::Feed, Point3::new(x, 5.0, z), Vec3::z());
-    /// // Over the stock, then 1 mm into it twice along the same line.
-    /// let depth = dexels.probe(&flat, &[mv(-3.0, 1.0), mv(23.0, 1.0), mv(23.0, -1.0), mv(-3.0, -1.0)], &DexelOptions::default()).unwrap();
-    /// assert_eq!(depth[..2], [0.0, 0.0]);
-    /// assert!(depth[2] > 0.9 && depth[3] > 0.9);
+    /// // Over the stock, down beside it, then 1 mm into it twice along the same line.
+    /// let path = [mv(-3.0, 1.0), mv(23.0, 1.0), mv(23.0, -1.0), mv(-3.0, -1.0), mv(23.0, -1.0)];
+    /// let depth = dexels.probe(&flat, &path, &DexelOptions::default()).unwrap();
+    /// assert_eq!(depth[..3], [0.0, 0.0, 0.0]);
+    /// assert!(depth[3] > 0.9 && depth[4] > 0.9);
     /// assert_eq!(dexels.volume(), 1000.0);
     /// ```
     pub fn probe(&mut self, cutter: &Cutter, moves: &[ToolMove], options: &DexelOptions) -> Result<Vec<f64>, SimError> {
