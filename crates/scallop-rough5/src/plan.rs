@@ -168,7 +168,8 @@ impl Rough5Settings {
     /// points every 1 mm, angular steps of 2 deg (axis) and 5 deg (azimuth),
     /// a 0.5 mm bottom allowance, ramps of 5 deg, 1 mm clearance, links on
     /// the level up to 2 a_e, rapids at 20 m/min, no optimised orientation,
-    /// no collision correction (steps 1 and 2), and every refinement on
+    /// no collision correction (steps 1 and 2), no air moves ([`Self::air`];
+    /// `scallop rough5` and jobs turn them on), and every refinement on
     /// ([`Self::with_refinements`]).
     #[must_use]
     pub fn new(guides: GuideSettings, feed: f64) -> Self {
