@@ -15,9 +15,9 @@ use scallop_machine::Kinematics;
 use scallop_parts::FaceTag;
 use scallop_parts::TestPart;
 use scallop_rough5::{
-    BaselinePlan, BaselineSettings, CuttingData, EntryCount, EntryMode, LevelOptions, OrientSettings, Pocket, Proof,
-    ProofSettings, Rough5Plan, Rough5Settings, TiltMode, TorusTool, Weights, plan_rough5_in, plan_three_plus_two,
-    plan_zlevel, prove_from_blank,
+    AirSettings, BaselinePlan, BaselineSettings, CuttingData, EntryCount, EntryMode, LevelOptions, OrientSettings,
+    Pocket, Proof, ProofSettings, Rough5Plan, Rough5Settings, TiltMode, TorusTool, Weights, plan_rough5_in,
+    plan_three_plus_two, plan_zlevel, prove_from_blank,
 };
 use scallop_toolpath::Toolpath;
 use serde::Serialize;
@@ -65,6 +65,8 @@ pub enum RefineArg {
     RootRest,
     /// The bottom level's inner passes with the axis along the bottom's normal where it leans (an impeller's hub).
     BottomNormal,
+    /// Feeds, links and plunges outside the in-process stock (by `--air-clearance`) written at `--air-feed`.
+    AirMoves,
     /// All of them: the program of 28 Nov 2026.
     All,
 }
@@ -202,6 +204,14 @@ pub struct Rough5Args {
     /// or `side` (docs/rough5.md, "Entries").
     #[arg(long, value_enum, default_value = "auto")]
     entry: EntryArg,
+    /// Feed of the air moves (mm/min): the feeds, links and plunges that lie outside the in-process stock by
+    /// `--air-clearance` are written as G1 at this feed (docs/rough5.md, "Air moves"; `--without air-moves`
+    /// keeps them at the cutting feed). Default: the UCP 710's linear rapid rate, 30 m/min.
+    #[arg(long, default_value_t = 30_000.0)]
+    air_feed: f64,
+    /// Clearance between the tool and the in-process stock for a move to be written at the air feed (mm).
+    #[arg(long, default_value_t = 1.0)]
+    air_clearance: f64,
     /// Leave out refinements of the 5-axis programs, comma-separated (default: all of them are on).
     #[arg(long, value_enum, value_delimiter = ',')]
     without: Vec<RefineArg>,
@@ -373,6 +383,12 @@ fn settings(args: &Rough5Args, part: &TestPart) -> CliResult<Rough5Settings> {
         root_rest: on(RefineArg::RootRest),
         bottom_normal: on(RefineArg::BottomNormal),
         entry: args.entry.mode(),
+        air: on(RefineArg::AirMoves).then_some(AirSettings {
+            feed: args.air_feed,
+            clearance: args.air_clearance,
+            resolution: args.resolution,
+            axis_tolerance: args.sim_tolerance,
+        }),
         ..base
     })
 }
@@ -632,6 +648,7 @@ fn baseline(
         levels: Vec::new(),
         passes: Vec::new(),
         estimated_time: plan.estimated_time,
+        air: None,
     };
     Ok((as_plan, setups))
 }
@@ -642,13 +659,16 @@ fn baseline(
 pub(crate) fn metric_lines(s: &mut String, m: &Rough5Metrics, indent: &str) {
     let _ = writeln!(
         s,
-        "{indent}V_r {:.2} % ({:.0} of {:.0} mm3), gouge {:.3} mm3 (deepest {:.3} mm), out of material (L_HM) {:.1} %",
+        "{indent}V_r {:.2} % ({:.0} of {:.0} mm3), gouge {:.3} mm3 (deepest {:.3} mm), out of material (L_HM) {:.1} % \
+         ({:.1} % in {} moves at the air feed)",
         m.remaining_percent,
         m.remaining_volume_mm3,
         m.volume_to_remove_mm3,
         m.gouge_volume_mm3,
         m.gouge_depth_mm,
-        m.out_of_material_percent
+        m.out_of_material_percent,
+        m.air_feed_percent,
+        m.air_moves
     );
     let _ = writeln!(
         s,

@@ -12,7 +12,9 @@ use std::time::Instant;
 use scallop_engine::{Rough5Job, Rough5Metrics, Rough5Output, Rough5Step, TcpWords, rough5_settings, run_rough5};
 use scallop_guides::GuideSettings;
 use scallop_io::job::{EntryWord, JobFile, OperationSpec, Rough5Spec, TestPartWord, TiltWord};
-use scallop_rough5::{CuttingData, EntryMode, OrientSettings, ProofSettings, Rough5Settings, TiltMode, Weights};
+use scallop_rough5::{
+    AirSettings, CuttingData, EntryMode, OrientSettings, ProofSettings, Rough5Settings, TiltMode, Weights,
+};
 use serde::Serialize;
 
 use crate::guides::{PartArg, test_part};
@@ -204,6 +206,12 @@ fn settings_of(
         max_angle_step: r.max_angle_step_deg.to_radians(),
         max_azimuth_step: r.max_azimuth_step_deg.to_radians(),
         orientation: (r.tilt == TiltWord::Optimised).then_some(orientation),
+        // The per-pass weights of the limit and bottom passes, as `--limit-weights`.
+        limit_orientation: r
+            .limit_weights
+            .as_ref()
+            .filter(|_| r.tilt != TiltWord::Zero)
+            .map(|w| OrientSettings { weights: Weights { bounds: w[0], fluidity: w[1], pitch: w[2] }, ..orientation }),
         correct: r.correction.planar() && r.tilt != TiltWord::Zero,
         spatial: r.correction.spatial() && r.tilt != TiltWord::Zero,
         entry: match r.entry {
@@ -212,6 +220,12 @@ fn settings_of(
             EntryWord::Ramp => EntryMode::Ramp,
             EntryWord::Side => EntryMode::Side,
         },
+        air: r.air_moves.then_some(AirSettings {
+            feed: r.air_feed,
+            clearance: r.air_clearance,
+            resolution: r.resolution,
+            axis_tolerance: r.sim_tolerance,
+        }),
         ..base
     })
 }
@@ -280,4 +294,38 @@ fn summary(r: &JobReport, out: &Rough5Output, folder: &Path) -> String {
         folder.display()
     );
     s
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, reason = "tests: a panic is the failure report")]
+
+    use super::*;
+
+    /// `limit_weights` of a job reaches the planner as the limit passes'
+    /// orientation (the bulk keeps SPU with `tilt = "guides"`), with the
+    /// interval and target of the mixed weighting; the air-move keys reach
+    /// its air settings.
+    #[test]
+    fn job_keys_reach_the_planner_settings() {
+        let job = "[part]\ntest_part = \"pocket\"\n[[operation]]\nkind = \"rough5\"\n\
+            [operation.cutter]\nshape = \"bull\"\ndiameter = 10\ncorner_radius = 1.5\nflute_length = 30\n\
+            [operation.rough5]\nap = 4\nae = 4.5\nlimit_weights = [1, 0, 2]\nair_feed = 20000\nair_clearance = 1.5\n";
+        let spec = scallop_io::job::parse_job(job).unwrap();
+        let r = spec.operations[0].rough5.as_ref().unwrap();
+        let (_, part) = test_part(PartArg::Pocket).unwrap();
+        let s = settings_of(r, &part, 5.0, 2400.0).unwrap();
+        assert_eq!(s.orientation, None);
+        let limit = s.limit_orientation.unwrap();
+        assert_eq!(limit.weights, Weights { bounds: 1.0, fluidity: 0.0, pitch: 2.0 });
+        assert!(
+            (limit.interval[1] - 30f64.to_radians()).abs() < 1e-12 && (limit.target - 10f64.to_radians()).abs() < 1e-12
+        );
+        let air = s.air.unwrap();
+        assert_eq!((air.feed, air.clearance, air.resolution), (20_000.0, 1.5, 0.5));
+        let plain =
+            scallop_io::job::parse_job(&job.replace("limit_weights = [1, 0, 2]\n", "air_moves = false\n")).unwrap();
+        let s = settings_of(plain.operations[0].rough5.as_ref().unwrap(), &part, 5.0, 2400.0).unwrap();
+        assert_eq!((s.limit_orientation, s.air), (None, None));
+    }
 }

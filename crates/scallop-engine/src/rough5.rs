@@ -184,8 +184,15 @@ pub struct Rough5Metrics {
     pub gouge_depth_mm: f64,
     /// Cutting length (dm).
     pub path_length_dm: f64,
-    /// L_HM: % of the cutting length that removed nothing.
+    /// L_HM: % of the cutting length that removed nothing (air moves
+    /// included).
     pub out_of_material_percent: f64,
+    /// % of the cutting length written at the air feed (moves outside the
+    /// in-process stock by a clearance, `scallop_rough5::air_moves`; part of
+    /// L_HM): L_HM at the cutting feed is the difference.
+    pub air_feed_percent: f64,
+    /// Moves written at the air feed.
+    pub air_moves: usize,
     /// Machine time (s); the time at the programmed feeds without a machine program.
     pub machining_time_s: f64,
     /// Time lost to each axis's velocity, acceleration and jerk limits (s).
@@ -257,6 +264,12 @@ pub fn rough5_metrics(plan: &Rough5Plan, proof: &Proof, posted: Option<&Posted>)
         gouge_depth_mm: proof.gouge_depth,
         path_length_dm: proof.cutting_length / 100.0,
         out_of_material_percent: proof.air_percent,
+        air_feed_percent: if proof.cutting_length > 0.0 {
+            100.0 * proof.air_move_length / proof.cutting_length
+        } else {
+            0.0
+        },
+        air_moves: plan.air.map_or(0, |a| a.moves),
         machining_time_s: t,
         axis_time_lost_s: posted.map_or_else(Vec::new, |p| p.axis_time_lost.clone()),
         feed_time_s: feed,

@@ -196,6 +196,33 @@ pub struct Rough5Spec {
     /// (docs/rough5.md, "Entries").
     #[serde(default = "default_entry")]
     pub entry: EntryWord,
+    /// Per-pass weights (spec module H; docs/rough5.md, "Per-pass weights"):
+    /// `[beta, phi, tau]` (bounds, fluidity, pitch) of the optimised
+    /// orientation of the passes that leave the finished faces' stock (the
+    /// bottom level's passes and each level's limit passes), with the
+    /// interval [0, 30] deg and the target 10 deg, as `scallop rough5
+    /// --limit-weights`; three finite numbers >= 0, not with `tilt = "zero"`.
+    pub limit_weights: Option<Vec<f64>>,
+    /// Whether the feeds, links and plunges that lie outside the in-process
+    /// stock by `air_clearance` are written at `air_feed` (docs/rough5.md,
+    /// "Air moves"; default true, as `scallop rough5`).
+    #[serde(default = "default_true")]
+    pub air_moves: bool,
+    /// Feed of the air moves (mm/min, default 30000, above the cutting feed).
+    #[serde(default = "default_air_feed")]
+    pub air_feed: f64,
+    /// Clearance between the tool and the in-process stock for a move to be
+    /// an air move (mm, default 1).
+    #[serde(default = "default_one")]
+    pub air_clearance: f64,
+}
+
+fn default_true() -> bool {
+    true
+}
+
+fn default_air_feed() -> f64 {
+    30_000.0
 }
 
 /// `rough5.correction`: the step-1 switch, or the list of steps.
@@ -1430,6 +1457,8 @@ fn check_rough5(op: &OperationSpec) -> Result<(), JobError> {
         ("rough5.sim_tolerance", r.sim_tolerance),
         ("rough5.feed_per_tooth", r.feed_per_tooth.unwrap_or(1.0)),
         ("rough5.tool_length", r.tool_length.unwrap_or(1.0)),
+        ("rough5.air_feed", r.air_feed),
+        ("rough5.air_clearance", r.air_clearance),
     ] {
         if !(v.is_finite() && v > 0.0) {
             return bad(key, v.to_string(), "must be a finite number > 0");
@@ -1468,6 +1497,26 @@ fn check_rough5(op: &OperationSpec) -> Result<(), JobError> {
     }
     if r.teeth.is_some() != r.feed_per_tooth.is_some() {
         return bad("rough5.teeth", format!("{:?}", r.teeth), "give both teeth and feed_per_tooth, or neither");
+    }
+    if let Some(w) = &r.limit_weights {
+        let key = "rough5.limit_weights";
+        if w.len() != 3 {
+            return bad(key, format!("{w:?}"), "give three weights [beta, phi, tau] (bounds, fluidity, pitch)");
+        }
+        if let Some(x) = w.iter().find(|x| !(x.is_finite() && **x >= 0.0)) {
+            return bad(
+                key,
+                format!("{w:?}"),
+                if x.is_nan() { "a weight is NaN: give finite weights >= 0" } else { "give finite weights >= 0" },
+            );
+        }
+        if r.tilt == TiltWord::Zero {
+            return bad(
+                key,
+                format!("{w:?}"),
+                "per-pass weights orient tilted passes: remove them or use tilt = \"guides\"",
+            );
+        }
     }
     Ok(())
 }
@@ -1942,5 +1991,29 @@ mod tests {
         for bad in ["correction = [\"sideways\"]", "correction = 1", "entry = \"plunge\""] {
             assert!(parse_job(&job.replace("ae = 4.5", &format!("ae = 4.5\n{bad}"))).is_err(), "{bad}");
         }
+        // Per-pass weights: none by default, three finite weights >= 0 on a tilted program.
+        assert_eq!(r.limit_weights, None);
+        let weighted = parse_job(&job.replace("ae = 4.5", "ae = 4.5\nlimit_weights = [15, 1.2, 1]")).unwrap();
+        assert_eq!(weighted.operations[0].rough5.as_ref().unwrap().limit_weights, Some(vec![15.0, 1.2, 1.0]));
+        for (keys, why) in [
+            ("limit_weights = [15, 1.2]", "three weights"),
+            ("limit_weights = [15, 1.2, 1, 0]", "three weights"),
+            ("limit_weights = [15, nan, 1]", "NaN"),
+            ("limit_weights = [15, 1.2, -1]", ">= 0"),
+            ("limit_weights = [15, 1.2, inf]", ">= 0"),
+            ("limit_weights = [1, 1, 1]\ntilt = \"zero\"", "tilt"),
+            ("limit_weights = \"mixed\"", "limit_weights"),
+        ] {
+            let err = parse_job(&job.replace("ae = 4.5", &format!("ae = 4.5\n{keys}"))).unwrap_err().to_string();
+            assert!(err.contains("rough5.limit_weights") || err.contains("limit_weights"), "{keys}: {err}");
+            assert!(err.contains(why), "{keys}: {err}");
+        }
+        // Air moves: on by default at 30 m/min with a 1 mm clearance; a feed must be positive.
+        assert_eq!((r.air_moves, r.air_feed, r.air_clearance), (true, 30_000.0, 1.0));
+        let off = parse_job(&job.replace("ae = 4.5", "ae = 4.5\nair_moves = false\nair_feed = 20000")).unwrap();
+        let o = off.operations[0].rough5.as_ref().unwrap();
+        assert_eq!((o.air_moves, o.air_feed), (false, 20_000.0));
+        let err = parse_job(&job.replace("ae = 4.5", "ae = 4.5\nair_feed = -1")).unwrap_err().to_string();
+        assert!(err.contains("rough5.air_feed"), "{err}");
     }
 }

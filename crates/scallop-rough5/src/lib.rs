@@ -20,6 +20,9 @@
 //! - [`plan_zlevel`], [`plan_three_plus_two`]: the 3-axis baselines on the
 //!   same part, tool and cutting data (z-level roughing in one setup, then
 //!   rest roughing in fixed orientations chosen from the undercuts);
+//! - [`air_moves`]: the cutting moves that lie in the air (outside the
+//!   in-process stock by a clearance) written at an air feed, checked by the
+//!   proof as rapids;
 //! - [`prove`]: the program cut on a tri-dexel stock with shank and holder
 //!   collisions as errors, and the metrics of spec 10.1 (module L);
 //!   [`prove_with_faces`] adds those of the finished faces ([`face_metrics`]:
@@ -45,6 +48,7 @@
 //! - A placed tool never penetrates the level mesh (the maximum over every
 //!   triangle's contacts); results do not depend on the thread count.
 
+mod air;
 mod baseline;
 mod collide;
 mod correct;
@@ -63,6 +67,7 @@ pub mod sqp;
 mod sync;
 pub use scallop_geom::tol::rough5 as tol;
 
+pub use air::{AIR_CHUNK, AIR_SPLIT, AirMoves, AirSettings, air_moves, grown_flutes, is_air_move};
 pub use baseline::{BaselinePlan, BaselineSettings, Pocket, SetupReport, plan_three_plus_two, plan_zlevel, setup_axes};
 pub use collide::BodyCheck;
 pub use correct::{CorrectionCount, correct_pairs, correct_pairs_spatial, correct_planar, correct_spatial};
@@ -80,7 +85,7 @@ pub use orient::{
 };
 pub use place::{Feature, Placement, Placer, tool_frame};
 pub use plan::{
-    AIR_MARGIN, AIR_STEP, LevelReport, PassReport, Rough5Plan, Rough5Settings, SIDE_MARGIN, SinglePass,
+    AIR_MARGIN, AIR_STEP, AirReport, LevelReport, PassReport, Rough5Plan, Rough5Settings, SIDE_MARGIN, SinglePass,
     TRANSLATION_MAX, TRANSLATION_SLOPE, bottom_normal_min_slope, limit_step, plan_rough5, plan_rough5_in,
     plan_single_pass, round_corners, thin_vertical,
 };

@@ -28,6 +28,7 @@ use scallop_mesh::{MeshQuery, TriMesh};
 use scallop_sim::DexelPart;
 use scallop_toolpath::{Move, MoveKind, Toolpath};
 
+use crate::air::AirSettings;
 use crate::collide::BodyCheck;
 use crate::correct::{correct_pairs, correct_pairs_spatial};
 use crate::entry::{
@@ -154,6 +155,11 @@ pub struct Rough5Settings {
     /// the stock where a run starts within reach of its side, a ramp along a
     /// closed run, else a plunge.
     pub entry: EntryMode,
+    /// The air moves ([`crate::air_moves`]; docs/rough5.md, "Air moves"):
+    /// the feeds, links and plunges that lie outside the in-process stock by
+    /// the clearance, written at the air feed; `None` keeps every cutting
+    /// move at its feed.
+    pub air: Option<AirSettings>,
 }
 
 impl Rough5Settings {
@@ -162,7 +168,8 @@ impl Rough5Settings {
     /// points every 1 mm, angular steps of 2 deg (axis) and 5 deg (azimuth),
     /// a 0.5 mm bottom allowance, ramps of 5 deg, 1 mm clearance, links on
     /// the level up to 2 a_e, rapids at 20 m/min, no optimised orientation,
-    /// no collision correction (steps 1 and 2), and every refinement on
+    /// no collision correction (steps 1 and 2), no air moves ([`Self::air`];
+    /// `scallop rough5` and jobs turn them on), and every refinement on
     /// ([`Self::with_refinements`]).
     #[must_use]
     pub fn new(guides: GuideSettings, feed: f64) -> Self {
@@ -191,6 +198,7 @@ impl Rough5Settings {
             root_rest: false,
             bottom_normal: false,
             entry: EntryMode::Auto,
+            air: None,
         }
         .with_refinements(true)
     }
@@ -295,6 +303,23 @@ pub struct Rough5Plan {
     /// Time at the programmed feeds and the rapid rate (s), without the
     /// machine's dynamics.
     pub estimated_time: f64,
+    /// The air moves ([`Rough5Settings::air`]): how many, their length
+    /// (mm) and the moves cut into pieces to find them; `None` without.
+    pub air: Option<AirReport>,
+}
+
+/// The air moves of a [`Rough5Plan`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AirReport {
+    /// Moves written at the air feed.
+    pub moves: usize,
+    /// Their length (mm).
+    pub length: f64,
+    /// Long moves cut into pieces where they enter or leave the air.
+    pub split: usize,
+    /// Time at the programmed feeds and the rapid rate (s) before the air
+    /// moves (every cutting move at its cutting feed).
+    pub estimated_time_before: f64,
 }
 
 /// A CL point and the pair it was placed from.
@@ -517,6 +542,17 @@ pub fn plan_rough5_in(
         return Err(Rough5Error::NoPass { reason: "no pass could be placed clear of the flanks".into() });
     }
     out.finish();
+    let mut air_report = None;
+    if let Some(a) = &settings.air {
+        let found = crate::air_moves(&out.path, cutter, (stock, blank), a)?;
+        air_report = Some(AirReport {
+            moves: found.moves,
+            length: found.length,
+            split: found.split,
+            estimated_time_before: estimate_time(&out.path, settings.rapid_rate),
+        });
+        out.path = found.toolpath;
+    }
     let levels = levels
         .iter()
         .map(|l| LevelReport {
@@ -537,6 +573,7 @@ pub fn plan_rough5_in(
         entries: out.entries,
         plunged_at: out.plunged_at,
         estimated_time,
+        air: air_report,
     })
 }
 

@@ -8,7 +8,10 @@
 //! - the stock removed outside it (a gouge of the finished part, beyond the
 //!   rounding of the rays), its volume and its longest piece along a ray;
 //! - the removal rate (removed volume over the time given);
-//! - L_HM: the share of the cutting path length that removed nothing;
+//! - L_HM: the share of the cutting path length (feeds, links and plunges,
+//!   at the cutting feed or at the air feed of [`crate::air_moves`]) that
+//!   removed nothing, and the share of it written at the air feed (checked as
+//!   rapids, so they removed nothing);
 //! - the minimum collision-free stick-out (L_outil): the shortest length of
 //!   the tool out of its holder at which neither the shank nor the holder
 //!   meets the in-process stock along the whole program, found during the
@@ -42,10 +45,16 @@ pub struct Proof {
     /// Where that piece is: its ray's x, y and the middle height of the
     /// piece of the ray outside the volume to remove that holds it (mm).
     pub gouge_at: Option<[f64; 3]>,
-    /// Total length of the cutting moves (feeds, links, plunges), mm.
+    /// Total length of the cutting moves (feeds, links, plunges), mm, the
+    /// air moves ([`crate::is_air_move`]) included.
     pub cutting_length: f64,
-    /// L_HM: % of the cutting length that removed nothing.
+    /// L_HM: % of the cutting length that removed nothing (the air moves
+    /// included).
     pub air_percent: f64,
+    /// Length of the air moves (feeds, links and plunges programmed faster
+    /// than the cutting feed, [`crate::is_air_move`]), mm; each is checked as
+    /// a rapid (an error if it removes material).
+    pub air_move_length: f64,
     /// Fixed-axis sweeps the simulation cut.
     pub sweeps: usize,
     /// Rays per family of the stock.
@@ -129,7 +138,8 @@ fn complement(a: &[[f64; 2]], lo: f64, hi: f64) -> Vec<[f64; 2]> {
 ///
 /// # Errors
 /// [`Rough5Error::Simulation`] for a refused stock, a rapid into the stock
-/// or a shank or holder collision.
+/// (an air move, [`crate::is_air_move`], that removes material counts as
+/// one) or a shank or holder collision.
 pub fn prove(
     path: &Toolpath,
     cutter: &Cutter,
@@ -183,7 +193,12 @@ pub fn prove_with_faces(
         None => DexelStock::new(*stock, settings.resolution),
     }
     .map_err(sim)?;
-    let moves = ToolMove::from_toolpath(path);
+    // An air move is checked as a rapid: material it removes is an error.
+    let moves: Vec<ToolMove> = ToolMove::from_toolpath(path)
+        .into_iter()
+        .enumerate()
+        .map(|(i, m)| if crate::is_air_move(path, i) { ToolMove { kind: MoveKind::Rapid, ..m } } else { m })
+        .collect();
     // The search up to the tool's own stick-out: the proof passes only if that one is free.
     let options = DexelOptions {
         axis_tolerance: settings.axis_tolerance,
@@ -231,11 +246,14 @@ pub fn prove_with_faces(
         .collect();
     let sum = |k: usize| rows.iter().map(|r| r[k]).sum::<f64>() * area;
     let (to_remove, left) = (sum(0), sum(1));
-    let (mut cutting, mut air) = (0.0, 0.0);
+    let (mut cutting, mut air, mut air_moves) = (0.0, 0.0, 0.0);
     let moves = path.moves();
     for (i, m) in moves.iter().enumerate().skip(1) {
         if matches!(m.kind, MoveKind::Feed | MoveKind::Link | MoveKind::Plunge) {
             let len = (m.to - moves[i - 1].to).norm();
+            if crate::is_air_move(path, i) {
+                air_moves += len;
+            }
             cutting += len;
             if report.removed_by_move[i] <= eps * area {
                 air += len;
@@ -252,6 +270,7 @@ pub fn prove_with_faces(
         gouge_at: rows.iter().filter(|r| r[3] > 0.0).max_by(|a, b| a[3].total_cmp(&b[3])).map(|r| [r[4], r[5], r[6]]),
         cutting_length: cutting,
         air_percent: if cutting > 0.0 { 100.0 * air / cutting } else { 0.0 },
+        air_move_length: air_moves,
         sweeps: report.sweeps,
         rays: [dexels.grid(0).0 * dexels.grid(0).1, dexels.grid(1).0 * dexels.grid(1).1, nu * nv],
         min_stick_out: report.min_stick_out.map_or(cutter.flute_length(), |s| s.length),

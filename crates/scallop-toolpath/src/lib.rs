@@ -175,6 +175,28 @@ impl Toolpath {
         self.push(m);
     }
 
+    /// Appends a move along an XY arc (as [`Toolpath::push_arc`]) with the
+    /// tool axis `axis` (as [`Toolpath::push_with_axis`]).
+    ///
+    /// ```
+    /// use scallop_geom::{Point2, Point3, Vec3};
+    /// use scallop_toolpath::{ArcXY, Move, MoveKind, Toolpath};
+    /// let mut path = Toolpath::new(1000.0);
+    /// path.push(Move::new(MoveKind::Feed, Point3::new(10.0, 0.0, 0.0)));
+    /// let half = ArcXY { center: Point2::new(5.0, 0.0), sweep: std::f64::consts::PI };
+    /// path.push_arc_with_axis(Move::new(MoveKind::Feed, Point3::new(0.0, 0.0, 0.0)), Vec3::x(), half);
+    /// assert_eq!((path.arc(1), path.axis(1)), (Some(half), Vec3::x()));
+    /// ```
+    pub fn push_arc_with_axis(&mut self, m: Move, axis: Vec3, arc: ArcXY) {
+        let n = axis.norm();
+        debug_assert!(n.is_finite() && n > 0.0, "bad tool axis {axis:?}");
+        let unit = axis / n;
+        if self.current_axis() != unit {
+            self.axes.push((self.moves.len(), unit));
+        }
+        self.push_arc(m, arc);
+    }
+
     /// The tool axis of move `index` (unit, part frame).
     #[must_use]
     pub fn axis(&self, index: usize) -> Vec3 {

@@ -866,6 +866,59 @@ impl DexelStock {
         Ok(collision_list(operation, &collided))
     }
 
+    /// Which of `moves` would meet the stock as it stands: for each move,
+    /// the longest piece of material along a ray inside the sweep of the
+    /// flutes of `cutter` (0 when none is longer than the stock's epsilon),
+    /// each move swept alone against the present stock (nothing is removed,
+    /// so a move does not see what the ones before it in `moves` would cut).
+    /// The first move has no known start: the tool placed at its end. Moves
+    /// are split as in [`DexelStock::cut`].
+    ///
+    /// # Errors
+    /// Those of [`DexelStock::cut`].
+    ///
+    /// ```
+    /// use scallop_cutter::{Cutter, CutterShape};
+    /// use scallop_geom::{Aabb3, Point3, Vec3};
+    /// use scallop_sim::{DexelOptions, DexelStock, ToolMove};
+    /// use scallop_toolpath::MoveKind;
+    /// let stock = Aabb3 { min: Point3::new(0.0, 0.0, -5.0), max: Point3::new(20.0, 10.0, 0.0) };
+    /// let mut dexels = DexelStock::new(stock, 0.25).unwrap();
+    /// let flat = Cutter::new(CutterShape::Flat { radius: 2.0 }, 10.0).unwrap();
+    /// let mv = |x: f64, z: f64| ToolMove::new(MoveKind::Feed, Point3::new(x, 5.0, z), Vec3::z());
+    /// // Over the stock, down beside it, then 1 mm into it twice along the same line.
+    /// let path = [mv(-3.0, 1.0), mv(23.0, 1.0), mv(23.0, -1.0), mv(-3.0, -1.0), mv(23.0, -1.0)];
+    /// let depth = dexels.probe(&flat, &path, &DexelOptions::default()).unwrap();
+    /// assert_eq!(depth[..3], [0.0, 0.0, 0.0]);
+    /// assert!(depth[3] > 0.9 && depth[4] > 0.9);
+    /// assert_eq!(dexels.volume(), 1000.0);
+    /// ```
+    pub fn probe(&mut self, cutter: &Cutter, moves: &[ToolMove], options: &DexelOptions) -> Result<Vec<f64>, SimError> {
+        if !(options.axis_tolerance.is_finite() && options.axis_tolerance > 0.0) {
+            return Err(SimError::BadTolerance { what: "axis tolerance", value: options.axis_tolerance });
+        }
+        if u32::try_from(moves.len()).is_err() {
+            return Err(SimError::TooManyMoves { moves: moves.len() });
+        }
+        let flutes = Body::flutes(cutter);
+        // The flutes checked as a guard: material inside them is measured, nothing removed.
+        let guards = vec![(Body::flutes(cutter), ToolPart::Shank)];
+        let steps = self.steps(self.operations, &flutes, moves, options)?;
+        let boxes: Vec<Vec<(Point3, Point3)>> = steps
+            .iter()
+            .map(|s| vec![(Point3::new(1.0, 1.0, 1.0), Point3::origin()), swept_box(&guards[0].0, &s.sweep, self.eps)])
+            .collect();
+        let unions: Vec<(Point3, Point3)> = boxes.iter().map(|b| b[1]).collect();
+        let check = FamilyCut { remove: false, ..FamilyCut::removal(&flutes, &guards, &steps, &boxes, &unions) };
+        let mut collided: Vec<Vec<(ToolPart, f64, Point3)>> = vec![Vec::new(); moves.len()];
+        for axis in 0..3 {
+            for out in self.cut_family(axis, &check, &|| {}) {
+                merge_collisions(&mut collided, &steps, out.collisions);
+            }
+        }
+        Ok(collided.iter().map(|list| list.iter().map(|c| c.1).fold(0.0, f64::max)).collect())
+    }
+
     /// One family: bands of rays in parallel, each applying its steps in
     /// order; `remove == false` only checks the guards (nothing is cut).
     fn cut_family(&mut self, axis: usize, cut: &FamilyCut<'_>, tick: &(dyn Fn() + Sync)) -> Vec<BandOutput> {
