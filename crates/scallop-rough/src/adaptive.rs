@@ -457,52 +457,6 @@ fn dist(a: P2, b: P2) -> f64 {
 /// compared with ([`Planner::stride_within`]).
 type Measure<'a> = &'a dyn Fn(f64, f64) -> Option<Stride>;
 
-/// A bracket of the first lattice point that passes `test`, searched from
-/// `k0` (in `lo + 1..n`) by galloping then bisection: `(lo, hi, best)` with
-/// `hi = lo + 1`, `lo` failing (or the given `lo`, known to fail, not
-/// tested), `hi` passing with `best` its answer, or `hi = n` (not tested)
-/// and `best` `None` when no point below `n` from `k0` up passes.
-fn bracket(lo: usize, k0: usize, n: usize, test: &dyn Fn(usize) -> Option<Stride>) -> (usize, usize, Option<Stride>) {
-    let (mut lo, mut hi, mut best) = (lo, n, None);
-    if k0 <= lo || k0 >= n {
-        // Nothing to gallop from.
-    } else if let Some(m) = test(k0) {
-        (hi, best) = (k0, Some(m));
-        let mut jump = 1;
-        while hi - lo > 1 {
-            let k = hi.saturating_sub(jump).max(lo + 1);
-            match test(k) {
-                None => {
-                    lo = k;
-                    break;
-                }
-                Some(m) => (hi, best) = (k, Some(m)),
-            }
-            jump *= 2;
-        }
-    } else {
-        lo = k0;
-        let mut jump = 1;
-        while hi - lo > 1 {
-            let k = (lo + jump).min(hi - 1);
-            if let Some(m) = test(k) {
-                (hi, best) = (k, Some(m));
-                break;
-            }
-            lo = k;
-            jump *= 2;
-        }
-    }
-    while hi - lo > 1 {
-        let mid = lo + (hi - lo) / 2;
-        match test(mid) {
-            None => lo = mid,
-            Some(m) => (hi, best) = (mid, Some(m)),
-        }
-    }
-    (lo, hi, best)
-}
-
 /// The turn at lattice point `k` of `n` (a power of two) between `lo` and
 /// `hi`, as bisection from `lo` and `hi` reaches it: each midpoint
 /// `0.5 * (lo + hi)` of the bracket holding `k`, so that a search on the
@@ -583,6 +537,18 @@ impl Planner<'_> {
         (self.fence.contains(a) && self.fence.clear_of(a, b, margin)) || self.holder.contains_segment(a, b, chord)
     }
 
+    /// Stamps the move `a`-`b` on the swept field (R and two cells about
+    /// it, old values to `undo`), leaving cells at least
+    /// two cells and [`tol::AIR_RING_CHIP`] inside the cut as they are
+    /// ([`Grid::stamp_segment_over`]): the field is read only against
+    /// thresholds of R less [`tol::AIR_RING_CHIP`] or more, which such a
+    /// cell's squares answer alike either way.
+    fn stamp_swept(&mut self, a: P2, b: P2, undo: Option<&mut Vec<(usize, f64)>>) {
+        let (r, h) = (self.options.tool_radius, self.grid.h);
+        let floor = r - 2.0 * h - tol::AIR_RING_CHIP;
+        self.grid.stamp_segment_over(&mut self.swept, a, b, r + 2.0 * h, floor, undo);
+    }
+
     /// Whether the point `q` is material: within R of the region (inside the
     /// pocket) and farther than R from every swept centre.
     fn material(&self, q: P2) -> bool {
@@ -623,7 +589,9 @@ impl Planner<'_> {
     }
 
     /// [`Planner::front`], or `None` as soon as the engagement is found over
-    /// `limit` (the probes on the material's side come first when climbing).
+    /// `limit` (the probes on the material's side come first: from the
+    /// right when climbing, from the left when not, [`Planner::away`]; the
+    /// counts do not depend on the order).
     fn front_within(&self, p: P2, heading: f64, limit: f64) -> Option<(f64, f64)> {
         let r = self.options.tool_radius;
         let n = self.probes.len();
@@ -633,7 +601,9 @@ impl Planner<'_> {
         let share = |k: usize| std::f64::consts::PI * k as f64 / n as f64;
         let (mut count, mut core) = (0usize, 0usize);
         let nx = self.grid.nx;
-        for &[u, v] in &self.probes {
+        let from_left = self.away() < 0.0;
+        for i in 0..n {
+            let [u, v] = self.probes[if from_left { n - 1 - i } else { i }];
             // The probe's direction (u, v) about the heading, rotated onto it.
             let q = [p[0] + r * (u * c - v * s), p[1] + r * (u * s + v * c)];
             // Off the grid both fields are far: no material.
@@ -693,8 +663,8 @@ impl Planner<'_> {
 
     /// The next step from `p` after a step along `heading` (see
     /// [`Planner::next_by`]).
-    fn next(&self, p: P2, heading: f64, hint: Option<f64>) -> Option<Stride> {
-        self.next_by(p, heading, tol::WALK_STEP_SHARE * self.options.tool_radius, hint)
+    fn next(&self, p: P2, heading: f64) -> Option<Stride> {
+        self.next_by(p, heading, tol::WALK_STEP_SHARE * self.options.tool_radius)
     }
 
     /// The next step from `p` after a step along `heading`: the turn of
@@ -703,80 +673,55 @@ impl Planner<'_> {
     /// or halfway along a step, the front half can lie along the thin edge
     /// of what earlier cuts left where it does not at the step's end
     /// (docs/roughing.md, "Adaptive clearing", step 3).
-    fn next_by(&self, p: P2, heading: f64, len: f64, hint: Option<f64>) -> Option<Stride> {
-        self.turn_by(p, heading, len, &tol::WALK_STEP_SAMPLES, hint)
+    fn next_by(&self, p: P2, heading: f64, len: f64) -> Option<Stride> {
+        self.turn_by(p, heading, len, &tol::WALK_STEP_SAMPLES)
     }
 
     /// The step whose engagement is the target: its turn (rad, away from
     /// the material) between `toward` (the sharpest turn towards the
-    /// material) and `back` (the sharpest away), on the lattice of
-    /// `2^WALK_BISECTIONS` equal parts between them. The sharpest turn
-    /// towards the material when its step keeps within the target (its
-    /// engagement at every point `along` it, `within(d, target)`); else the
-    /// least lattice turn whose step does; else the sharpest turn away when
-    /// that keeps within the accepted bound; else `None`.
+    /// material) and `back` (the sharpest away). That towards the material
+    /// when its step keeps within the target (its engagement at every
+    /// point along it); else, when the sharpest away is over the accepted
+    /// bound, `None`, and when it is over the target, that one; else the
+    /// bisection's turn between them (`tol::WALK_BISECTIONS` halvings, the
+    /// least turn found to keep within the target).
     ///
-    /// The lattice's turns are the bisection's midpoints, bit for bit
-    /// ([`bisection_turn`]). The search gallops from the lattice turn
-    /// nearest `hint` (the last step's turn: along a frontier the turn
-    /// changes little from step to step) down or up by 1, 2, 4, ... turns
-    /// until the test changes, then bisects that bracket ([`bracket`]);
-    /// it tests the step's end alone (`end_within`) and the points along
-    /// it only at the turn found, going on from there with them when that
-    /// turn's step does not keep within the target (a step whose end is
-    /// over the target is over it). Where the tests are monotone in the
-    /// turn (over the target, then within it) this is the answer of
-    /// bisection from `toward` and `back` with every point measured, for
-    /// about 3 reads of the engagement instead of 40 (docs/roughing.md,
-    /// "Adaptive clearing", step 3).
-    fn turn_search(
+    /// Each test measures the step's end first (`end_within`) and the other
+    /// points (`rest`) only when the end keeps within the bound: a step is
+    /// over the bound when any point is, so the answers are those of
+    /// measuring the points in order, found sooner when the step is over
+    /// (docs/roughing.md, "Adaptive clearing", step 3).
+    fn turn_bisect(
         &self,
         (toward, back): (f64, f64),
-        hint: Option<f64>,
-        (within, end_within, rest): (Measure<'_>, Measure<'_>, Measure<'_>),
+        (end_within, rest): (Measure<'_>, Measure<'_>),
     ) -> Option<Stride> {
         let n = 1usize << tol::WALK_BISECTIONS;
         let at = |k: usize| bisection_turn(toward, back, k, n);
-        let quick = |k: usize| end_within(at(k), self.target);
-        // The whole step at `k`, its end's engagement known (`end`): the
-        // other points too (the largest of all, `None` when one is over).
-        let confirm = |k: usize, end: Stride| {
-            rest(at(k), self.target).map(|m| Stride { phi: m.phi.max(end.phi), core: m.core.max(end.core), ..end })
+        // The step turned by `d`, its engagement at every point within
+        // `limit`: the end's, then the others'.
+        let measure = |d: f64, limit: f64| {
+            end_within(d, limit).and_then(|end| {
+                rest(d, limit).map(|m| Stride { phi: m.phi.max(end.phi), core: m.core.max(end.core), ..end })
+            })
         };
-        let full = |k: usize| quick(k).and_then(|end| confirm(k, end));
-        // The sharpest turn towards the material first (near the end of a
-        // frontier it can keep within the target where lesser turns do not).
+        let full = |k: usize| measure(at(k), self.target);
         if let Some(m) = full(0) {
             return Some(m);
         }
-        #[allow(
-            clippy::cast_possible_truncation,
-            clippy::cast_sign_loss,
-            clippy::cast_precision_loss,
-            reason = "clamped to the lattice"
-        )]
-        let k0 = hint
-            .filter(|d| d.is_finite())
-            .map_or(n / 2, |d| ((d - toward) / (back - toward) * n as f64).round().clamp(1.0, (n - 1) as f64) as usize);
-        // The least turn whose step's end keeps within the target, then the
-        // least from there whose whole step does.
-        let (lo, hi, end) = bracket(0, k0, n, &quick);
-        let hi = if let Some(end) = end.filter(|_| hi < n) {
-            if let Some(m) = confirm(hi, end) {
-                return Some(m);
+        let hard = measure(back, self.accept)?;
+        if hard.phi > self.target {
+            return Some(hard);
+        }
+        let (mut lo, mut hi, mut best) = (0, n, hard);
+        while hi - lo > 1 {
+            let mid = lo + (hi - lo) / 2;
+            match full(mid) {
+                None => lo = mid,
+                Some(m) => (hi, best) = (mid, m),
             }
-            let (_, hi, best) = bracket(hi, (hi + 1).min(n - 1), n, &full);
-            if let Some(m) = best.filter(|_| hi < n) {
-                return Some(m);
-            }
-            hi
-        } else {
-            hi.max(lo)
-        };
-        debug_assert_eq!(hi, n);
-        // No turn keeps within the target: the sharpest away, within the
-        // accepted bound, or the pass ends here.
-        within(back, self.accept)
+        }
+        Some(best)
     }
 
     /// The step from `p` after a step along `heading`, its engagement
@@ -785,7 +730,7 @@ impl Planner<'_> {
     /// the material and the sharpest away), then, when that step leaves the
     /// region, the least further turn away that stays in it with the
     /// engagement within the accepted bound. `None` when there is none.
-    fn turn_by(&self, p: P2, heading: f64, len: f64, along: &[f64], hint: Option<f64>) -> Option<Stride> {
+    fn turn_by(&self, p: P2, heading: f64, len: f64, along: &[f64]) -> Option<Stride> {
         let away = self.away();
         // The step turned by `d`: its end alone, or its stride unless its
         // engagement is over `limit` (`None`, found early: where only that
@@ -796,7 +741,7 @@ impl Planner<'_> {
         let last = along.len().saturating_sub(1);
         let end_within = |d: f64, limit: f64| self.stride_within(p, heading + away * d, len, limit, &along[last..]);
         let rest = |d: f64, limit: f64| self.stride_within(p, heading + away * d, len, limit, &along[..last]);
-        let best = self.turn_search((toward, back), hint, (&within, &end_within, &rest))?;
+        let best = self.turn_bisect((toward, back), (&end_within, &rest))?;
         if self.edges.contains_segment(p, best.to) {
             return Some(best);
         }
@@ -864,7 +809,7 @@ impl Planner<'_> {
         }
         // From the heading into the material, the turn away to the target
         // and, at a wall, further away, as along a pass.
-        self.next(p, best, None).filter(|s| s.core >= tol::WALK_AIR * self.target)
+        self.next(p, best).filter(|s| s.core >= tol::WALK_AIR * self.target)
     }
 
     /// Whether no material lies within reach of any probe of any heading's
@@ -908,7 +853,7 @@ impl Planner<'_> {
             return None;
         }
         let along = inward + self.away() * std::f64::consts::FRAC_PI_2;
-        self.next(p, along, None)
+        self.next(p, along)
     }
 
     /// A pass from `p` along `heading`: its points (the first is `p`), cut
@@ -916,7 +861,6 @@ impl Planner<'_> {
     /// the area it cleared (mm^2, on the grid's cells) and its steps' points;
     /// the swept field holds the lines.
     fn pass(&mut self, p: P2, first: Stride, budget: &mut usize) -> Result<(Vec<P2>, f64, Vec<P2>), RoughError> {
-        let w = self.options.tool_radius + 2.0 * self.grid.h;
         let air_len = tol::WALK_AIR_SHARE * self.options.tool_radius;
         let step = tol::WALK_STEP_SHARE * self.options.tool_radius;
         let mut run = vec![p];
@@ -926,16 +870,13 @@ impl Planner<'_> {
         let mut last_cut = 0usize;
         let mut at = p;
         let mut next = Some(first);
-        // The heading of the step before `s`: `s`'s turn from it is where
-        // the search for the next turn starts ([`Planner::turn_search`]).
-        let mut before: Option<f64> = None;
         while let Some(s) = next {
             if *budget == 0 {
                 return Err(RoughError::TooMuchWork { what: "adaptive steps", limit: tol::MAX_WALK_STEPS });
             }
             *budget -= 1;
             marks.push(undo.len());
-            self.grid.stamp_segment(&mut self.swept, at, s.to, w, Some(&mut undo));
+            self.stamp_swept(at, s.to, Some(&mut undo));
             run.push(s.to);
             if s.core >= tol::WALK_AIR * self.target {
                 last_cut = run.len() - 1;
@@ -946,9 +887,7 @@ impl Planner<'_> {
                 break;
             }
             at = s.to;
-            let hint = before.map(|h| (s.heading - h) * self.away());
-            next = self.next(at, s.heading, hint);
-            before = Some(s.heading);
+            next = self.next(at, s.heading);
         }
         // Back to the last step that cut: the air after it is not cut.
         let keep = last_cut + 1;
@@ -985,7 +924,7 @@ impl Planner<'_> {
             let span: &[P2] = if merged || j == i + 1 { &run[j..=j] } else { &run[i + 1..=j] };
             for &q in span {
                 let from = lines[lines.len() - 1];
-                self.grid.stamp_segment(&mut self.swept, from, q, w, Some(&mut undo));
+                self.stamp_swept(from, q, Some(&mut undo));
                 lines.push(q);
             }
         }
@@ -1165,7 +1104,6 @@ impl Planner<'_> {
     /// its first point), measured at every point on the field as the run
     /// leaves it, the run stamped (old values to `undo`).
     fn sweep_run(&mut self, run: &[P2], undo: &mut Vec<(usize, f64)>) -> f64 {
-        let w = self.options.tool_radius + 2.0 * self.grid.h;
         let mut phi = 0.0f64;
         let step = 0.5 * self.grid.h;
         for pair in run.windows(2) {
@@ -1179,7 +1117,7 @@ impl Planner<'_> {
                 let f = i as f64 / n as f64;
                 let q = [pair[0][0] + f * (pair[1][0] - pair[0][0]), pair[0][1] + f * (pair[1][1] - pair[0][1])];
                 phi = phi.max(self.front(q, heading).0);
-                self.grid.stamp_segment(&mut self.swept, from, q, w, Some(undo));
+                self.stamp_swept(from, q, Some(undo));
                 from = q;
             }
         }

@@ -212,7 +212,26 @@ impl Grid {
 
     /// `f = min(f, distance to the segment a-b)` within `r` of it; the old
     /// values go to `undo` when given.
-    pub fn stamp_segment(&self, f: &mut [f64], a: P2, b: P2, r: f64, mut undo: Option<&mut Vec<(usize, f64)>>) {
+    pub fn stamp_segment(&self, f: &mut [f64], a: P2, b: P2, r: f64, undo: Option<&mut Vec<(usize, f64)>>) {
+        self.stamp_segment_over(f, a, b, r, f64::NEG_INFINITY, undo);
+    }
+
+    /// [`Grid::stamp_segment`], leaving alone the cells whose value is at
+    /// most `floor` already (not even measured). Where the field is a
+    /// distance to what was stamped, its values at adjacent centres differ
+    /// by at most the diagonal `sqrt(2) h`, so a square with a cell left at
+    /// or under `floor` has all four values at most `floor + sqrt(2) h`
+    /// before and after: every sample there compares the same with a
+    /// threshold above that, and only such comparisons read the field.
+    pub fn stamp_segment_over(
+        &self,
+        f: &mut [f64],
+        a: P2,
+        b: P2,
+        r: f64,
+        floor: f64,
+        mut undo: Option<&mut Vec<(usize, f64)>>,
+    ) {
         let lo = [a[0].min(b[0]), a[1].min(b[1])];
         let hi = [a[0].max(b[0]), a[1].max(b[1])];
         let (i0, i1, j0, j1) = self.range(lo, hi, r);
@@ -237,6 +256,9 @@ impl Grid {
             let (ri0, ri1, _, _) = self.range([lo[0] - half, y], [hi[0] + half, y], self.h);
             for i in ri0.max(i0)..=ri1.min(i1) {
                 let k = j * self.nx + i;
+                if f[k] <= floor {
+                    continue;
+                }
                 // As `centre(k)`.
                 #[allow(clippy::cast_precision_loss, reason = "grid indices")]
                 let c = [self.x0 + (i as f64 + 0.5) * self.h, y];

@@ -228,15 +228,14 @@ impl Planner<'_> {
 
     /// Stamps the polyline `run` on the swept field (no engagement measured).
     pub(super) fn stamp(&mut self, run: &[P2]) {
-        let w = self.options.tool_radius + 2.0 * self.grid.h;
         if let Some(&p) = run.first() {
-            self.grid.stamp_segment(&mut self.swept, p, p, w, None);
+            self.stamp_swept(p, p, None);
         }
         for pair in run.windows(2) {
             // A move the last pass stamped already (the same ends, the same
             // width, the field only lowered since) would change nothing.
             if !self.stamped.contains(&(pair[0], pair[1])) {
-                self.grid.stamp_segment(&mut self.swept, pair[0], pair[1], w, None);
+                self.stamp_swept(pair[0], pair[1], None);
             }
         }
         self.epoch = self.epoch.wrapping_add(1).min(CLEAR - 1);
