@@ -81,8 +81,11 @@ struct Planner<'a> {
     /// The sign of a turn away from the material on the pass being planned
     /// ([`Planner::away`]).
     hand: f64,
-    /// Unit directions of the front half's probes about the heading +x.
+    /// Unit directions of the front half's probes about the heading +x,
+    /// from the right.
     probes: Vec<P2>,
+    /// The same from the left.
+    probes_left: Vec<P2>,
     /// Unit directions of [`tol::ENGAGE_PROBES`] probes all round, from +x
     /// ([`Planner::engagement`]).
     round: Vec<P2>,
@@ -208,6 +211,7 @@ pub fn plan_adaptive_in(
         starts: Vec::new(),
         hand: if options.direction == Direction::Conventional { -1.0 } else { 1.0 },
         probes: front_probes(tol::ENGAGE_PROBES / 2),
+        probes_left: front_probes(tol::ENGAGE_PROBES / 2).into_iter().rev().collect(),
         round: round_probes(tol::ENGAGE_PROBES),
         link_round: round_probes(tol::LINK_PROBES),
         fit: tol::WALK_FIT_SHARE * r,
@@ -545,7 +549,7 @@ impl Planner<'_> {
     /// cell's squares answer alike either way.
     fn stamp_swept(&mut self, a: P2, b: P2, undo: Option<&mut Vec<(usize, f64)>>) {
         let (r, h) = (self.options.tool_radius, self.grid.h);
-        let floor = r - 2.0 * h - tol::AIR_RING_CHIP;
+        let floor = self.grid.settled(r - tol::AIR_RING_CHIP);
         self.grid.stamp_segment_over(&mut self.swept, a, b, r + 2.0 * h, floor, undo);
     }
 
@@ -601,9 +605,8 @@ impl Planner<'_> {
         let share = |k: usize| std::f64::consts::PI * k as f64 / n as f64;
         let (mut count, mut core) = (0usize, 0usize);
         let nx = self.grid.nx;
-        let from_left = self.away() < 0.0;
-        for i in 0..n {
-            let [u, v] = self.probes[if from_left { n - 1 - i } else { i }];
+        let probes = if self.away() < 0.0 { &self.probes_left } else { &self.probes };
+        for &[u, v] in probes {
             // The probe's direction (u, v) about the heading, rotated onto it.
             let q = [p[0] + r * (u * c - v * s), p[1] + r * (u * s + v * c)];
             // Off the grid both fields are far: no material.
@@ -1328,6 +1331,30 @@ fn simplify(edges: &Edges, run: &[P2], tolerance: f64) -> Vec<usize> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn lattice_turns_are_the_bisections_midpoints_bit_for_bit() {
+        // Bisections between the walk's bounds and others, every sequence
+        // of answers of 8 halvings of a few: each midpoint tried is the
+        // lattice turn of its index, and so are the ends.
+        let n = 1usize << tol::WALK_BISECTIONS;
+        for (lo0, hi0) in [(-tol::WALK_TURN, tol::WALK_TURN_HARD), (-0.3, 0.7), (0.1, 3.0), (-2.0, -1.9)] {
+            assert_eq!(bisection_turn(lo0, hi0, 0, n).to_bits(), lo0.to_bits());
+            assert_eq!(bisection_turn(lo0, hi0, n, n).to_bits(), hi0.to_bits());
+            for answers in 0..n {
+                let (mut lo, mut hi, mut klo, mut khi) = (lo0, hi0, 0usize, n);
+                for bit in 0..tol::WALK_BISECTIONS {
+                    let (mid, kmid) = (0.5 * (lo + hi), (klo + khi) / 2);
+                    assert_eq!(bisection_turn(lo0, hi0, kmid, n).to_bits(), mid.to_bits(), "{lo0} {hi0} {kmid}");
+                    if answers >> bit & 1 == 1 {
+                        (hi, khi) = (mid, kmid);
+                    } else {
+                        (lo, klo) = (mid, kmid);
+                    }
+                }
+            }
+        }
+    }
 
     #[test]
     fn right_angled_corners_get_fillets_and_sharp_ones_keep_their_tips() {

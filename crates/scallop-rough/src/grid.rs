@@ -216,6 +216,13 @@ impl Grid {
         self.stamp_segment_over(f, a, b, r, f64::NEG_INFINITY, undo);
     }
 
+    /// The `floor` of [`Grid::stamp_segment_over`] for a distance field
+    /// read only against thresholds of `lowest` or more: two cells under
+    /// it (more than a cell's diagonal).
+    pub fn settled(&self, lowest: f64) -> f64 {
+        lowest - 2.0 * self.h
+    }
+
     /// [`Grid::stamp_segment`], leaving alone the cells whose value is at
     /// most `floor` already (not even measured). Where the field is a
     /// distance to what was stamped, its values at adjacent centres differ
@@ -363,6 +370,49 @@ mod tests {
                         let q = [lo[0] + (hi[0] - lo[0]) * f64::from(i) / 40.0, lo[1] + (hi[1] - lo[1]) * f64::from(j) / 40.0];
                         let material = g.sample(&swept, q) > t && g.sample(&reach, q) < t;
                         prop_assert!(!material, "material at {q:?}");
+                    }
+                }
+            }
+        }
+    }
+
+    proptest! {
+        /// A walk of short moves stamped with cells at most
+        /// [`Grid::settled`] left alone reads the same as stamped in full
+        /// against every threshold from the lowest up: exact where a cell
+        /// is over the floor, never under the full field, and every
+        /// bilinear sample on the same side of each threshold.
+        #[test]
+        fn stamps_over_the_floor_read_as_full_stamps(
+            start in (1.0..3.0f64, 1.0..3.0f64), turns in proptest::collection::vec(-0.8..0.8f64, 1..60),
+            len in 0.02..0.4f64, r in 0.4..1.2f64, chip in 0.0..0.05f64,
+        ) {
+            let g = Grid::new([0.0, 0.0], [4.0, 4.0], 1.5, 0.07).expect("grid");
+            let w = r + 2.0 * g.h;
+            let lowest = r - chip;
+            let floor = g.settled(lowest);
+            let (mut full, mut over) = (vec![BIG; g.len()], vec![BIG; g.len()]);
+            let (mut p, mut heading) = ([start.0, start.1], 0.0f64);
+            g.stamp_segment(&mut full, p, p, w, None);
+            g.stamp_segment_over(&mut over, p, p, w, floor, None);
+            for t in &turns {
+                heading += t;
+                let q = [p[0] + len * heading.cos(), p[1] + len * heading.sin()];
+                g.stamp_segment(&mut full, p, q, w, None);
+                g.stamp_segment_over(&mut over, p, q, w, floor, None);
+                p = q;
+            }
+            for k in 0..g.len() {
+                prop_assert!(over[k] >= full[k]);
+                prop_assert!(over[k] <= floor || over[k].to_bits() == full[k].to_bits(), "cell {k}: {} vs {}", over[k], full[k]);
+            }
+            let thresholds = [lowest, lowest + 0.5 * g.h, r, r + 0.005, r + 2.0 * g.h];
+            for i in 0..=160u32 {
+                for j in 0..=160u32 {
+                    let q = [0.1 + 3.8 * f64::from(i) / 160.0, 0.1 + 3.8 * f64::from(j) / 160.0];
+                    let (a, b) = (g.sample(&full, q), g.sample(&over, q));
+                    for t in thresholds {
+                        prop_assert_eq!(a > t, b > t, "at {:?}, threshold {}: {} vs {}", q, t, a, b);
                     }
                 }
             }
