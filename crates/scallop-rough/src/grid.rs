@@ -96,11 +96,12 @@ impl Grid {
         if !inside {
             return None;
         }
-        // Non-negative: truncation is the floor.
+        // Non-negative: truncation is the floor. Through 32 bits (a grid's
+        // side is far below 2^32 cells, [`tol::MAX_GRID_CELLS`]): the same
+        // integers, converted both ways in fewer instructions.
         #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "checked above")]
-        let (iu, iv) = (u as usize, v as usize);
-        #[allow(clippy::cast_precision_loss, reason = "grid indices")]
-        let at = (iv * self.nx + iu, u - iu as f64, v - iv as f64);
+        let (iu, iv) = (u as u32, v as u32);
+        let at = (iv as usize * self.nx + iu as usize, u - f64::from(iu), v - f64::from(iv));
         Some(at)
     }
 
