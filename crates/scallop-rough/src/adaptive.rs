@@ -606,6 +606,7 @@ impl Planner<'_> {
         let (mut count, mut core) = (0usize, 0usize);
         let nx = self.grid.nx;
         let probes = if self.away() < 0.0 { &self.probes_left } else { &self.probes };
+        let open = self.open.as_deref();
         for &[u, v] in probes {
             // The probe's direction (u, v) about the heading, rotated onto it.
             let q = [p[0] + r * (u * c - v * s), p[1] + r * (u * s + v * c)];
@@ -613,7 +614,8 @@ impl Planner<'_> {
             let Some(at) = self.grid.locate(q) else { continue };
             if Grid::interpolate(&self.swept, nx, at) > r {
                 let reach = Grid::interpolate(&self.reach, nx, at);
-                if reach < r && !self.open_at(at) {
+                // As `open_at`, inline.
+                if reach < r && !open.is_some_and(|f| Grid::interpolate(f, nx, at) > 0.0) {
                     count += 1;
                     if share(count) > limit {
                         return None;

@@ -36,13 +36,15 @@ impl Planner<'_> {
         let r = self.options.tool_radius;
         // The swept field first: in cleared area it settles the probe alone.
         let nx = self.grid.nx;
+        let open = self.open.as_deref();
         for &[c, s] in &self.link_round {
             let q = [p[0] + r * c, p[1] + r * s];
             // Off the grid both fields are far: no material.
             let Some(at) = self.grid.locate(q) else { continue };
             if Grid::interpolate(&self.swept, nx, at) > r + LINK_SLACK
                 && Grid::interpolate(&self.reach, nx, at) < r - self.strip
-                && !self.open_at(at)
+                // As `open_at`, inline.
+                && !open.is_some_and(|f| Grid::interpolate(f, nx, at) > 0.0)
             {
                 return false;
             }
