@@ -81,8 +81,11 @@ struct Planner<'a> {
     /// The sign of a turn away from the material on the pass being planned
     /// ([`Planner::away`]).
     hand: f64,
-    /// Unit directions of the front half's probes about the heading +x.
+    /// Unit directions of the front half's probes about the heading +x,
+    /// from the right.
     probes: Vec<P2>,
+    /// The same from the left.
+    probes_left: Vec<P2>,
     /// Unit directions of [`tol::ENGAGE_PROBES`] probes all round, from +x
     /// ([`Planner::engagement`]).
     round: Vec<P2>,
@@ -208,6 +211,7 @@ pub fn plan_adaptive_in(
         starts: Vec::new(),
         hand: if options.direction == Direction::Conventional { -1.0 } else { 1.0 },
         probes: front_probes(tol::ENGAGE_PROBES / 2),
+        probes_left: front_probes(tol::ENGAGE_PROBES / 2).into_iter().rev().collect(),
         round: round_probes(tol::ENGAGE_PROBES),
         link_round: round_probes(tol::LINK_PROBES),
         fit: tol::WALK_FIT_SHARE * r,
@@ -453,6 +457,32 @@ fn dist(a: P2, b: P2) -> f64 {
     (a[0] - b[0]).hypot(a[1] - b[1])
 }
 
+/// A measure of a step by its turn and the bound its engagement is
+/// compared with ([`Planner::stride_within`]).
+type Measure<'a> = &'a dyn Fn(f64, f64) -> Option<Stride>;
+
+/// The turn at lattice point `k` of `n` (a power of two) between `lo` and
+/// `hi`, as bisection from `lo` and `hi` reaches it: each midpoint
+/// `0.5 * (lo + hi)` of the bracket holding `k`, so that a search on the
+/// lattice tests the very turns a bisection would.
+fn bisection_turn(lo: f64, hi: f64, k: usize, n: usize) -> f64 {
+    let (mut lo, mut hi, mut klo, mut khi) = (lo, hi, 0usize, n);
+    loop {
+        if k <= klo {
+            return lo;
+        }
+        if k >= khi {
+            return hi;
+        }
+        let (mid, kmid) = (0.5 * (lo + hi), klo + (khi - klo) / 2);
+        if k < kmid {
+            (hi, khi) = (mid, kmid);
+        } else {
+            (lo, klo) = (mid, kmid);
+        }
+    }
+}
+
 fn ahead(p: P2, heading: f64, len: f64) -> P2 {
     [p[0] + len * heading.cos(), p[1] + len * heading.sin()]
 }
@@ -511,6 +541,18 @@ impl Planner<'_> {
         (self.fence.contains(a) && self.fence.clear_of(a, b, margin)) || self.holder.contains_segment(a, b, chord)
     }
 
+    /// Stamps the move `a`-`b` on the swept field (R and two cells about
+    /// it, old values to `undo`), leaving cells at least
+    /// two cells and [`tol::AIR_RING_CHIP`] inside the cut as they are
+    /// ([`Grid::stamp_segment_over`]): the field is read only against
+    /// thresholds of R less [`tol::AIR_RING_CHIP`] or more, which such a
+    /// cell's squares answer alike either way.
+    fn stamp_swept(&mut self, a: P2, b: P2, undo: Option<&mut Vec<(usize, f64)>>) {
+        let (r, h) = (self.options.tool_radius, self.grid.h);
+        let floor = self.grid.settled(r - tol::AIR_RING_CHIP);
+        self.grid.stamp_segment_over(&mut self.swept, a, b, r + 2.0 * h, floor, undo);
+    }
+
     /// Whether the point `q` is material: within R of the region (inside the
     /// pocket) and farther than R from every swept centre.
     fn material(&self, q: P2) -> bool {
@@ -551,7 +593,9 @@ impl Planner<'_> {
     }
 
     /// [`Planner::front`], or `None` as soon as the engagement is found over
-    /// `limit` (the probes on the material's side come first when climbing).
+    /// `limit` (the probes on the material's side come first: from the
+    /// right when climbing, from the left when not, [`Planner::away`]; the
+    /// counts do not depend on the order).
     fn front_within(&self, p: P2, heading: f64, limit: f64) -> Option<(f64, f64)> {
         let r = self.options.tool_radius;
         let n = self.probes.len();
@@ -561,14 +605,17 @@ impl Planner<'_> {
         let share = |k: usize| std::f64::consts::PI * k as f64 / n as f64;
         let (mut count, mut core) = (0usize, 0usize);
         let nx = self.grid.nx;
-        for &[u, v] in &self.probes {
+        let probes = if self.away() < 0.0 { &self.probes_left } else { &self.probes };
+        let open = self.open.as_deref();
+        for &[u, v] in probes {
             // The probe's direction (u, v) about the heading, rotated onto it.
             let q = [p[0] + r * (u * c - v * s), p[1] + r * (u * s + v * c)];
             // Off the grid both fields are far: no material.
             let Some(at) = self.grid.locate(q) else { continue };
             if Grid::interpolate(&self.swept, nx, at) > r {
                 let reach = Grid::interpolate(&self.reach, nx, at);
-                if reach < r && !self.open_at(at) {
+                // As `open_at`, inline.
+                if reach < r && !open.is_some_and(|f| Grid::interpolate(f, nx, at) > 0.0) {
                     count += 1;
                     if share(count) > limit {
                         return None;
@@ -635,6 +682,53 @@ impl Planner<'_> {
         self.turn_by(p, heading, len, &tol::WALK_STEP_SAMPLES)
     }
 
+    /// The step whose engagement is the target: its turn (rad, away from
+    /// the material) between `toward` (the sharpest turn towards the
+    /// material) and `back` (the sharpest away). That towards the material
+    /// when its step keeps within the target (its engagement at every
+    /// point along it); else, when the sharpest away is over the accepted
+    /// bound, `None`, and when it is over the target, that one; else the
+    /// bisection's turn between them (`tol::WALK_BISECTIONS` halvings, the
+    /// least turn found to keep within the target).
+    ///
+    /// Each test measures the step's end first (`end_within`) and the other
+    /// points (`rest`) only when the end keeps within the bound: a step is
+    /// over the bound when any point is, so the answers are those of
+    /// measuring the points in order, found sooner when the step is over
+    /// (docs/roughing.md, "Adaptive clearing", step 3).
+    fn turn_bisect(
+        &self,
+        (toward, back): (f64, f64),
+        (end_within, rest): (Measure<'_>, Measure<'_>),
+    ) -> Option<Stride> {
+        let n = 1usize << tol::WALK_BISECTIONS;
+        let at = |k: usize| bisection_turn(toward, back, k, n);
+        // The step turned by `d`, its engagement at every point within
+        // `limit`: the end's, then the others'.
+        let measure = |d: f64, limit: f64| {
+            end_within(d, limit).and_then(|end| {
+                rest(d, limit).map(|m| Stride { phi: m.phi.max(end.phi), core: m.core.max(end.core), ..end })
+            })
+        };
+        let full = |k: usize| measure(at(k), self.target);
+        if let Some(m) = full(0) {
+            return Some(m);
+        }
+        let hard = measure(back, self.accept)?;
+        if hard.phi > self.target {
+            return Some(hard);
+        }
+        let (mut lo, mut hi, mut best) = (0, n, hard);
+        while hi - lo > 1 {
+            let mid = lo + (hi - lo) / 2;
+            match full(mid) {
+                None => lo = mid,
+                Some(m) => (hi, best) = (mid, m),
+            }
+        }
+        Some(best)
+    }
+
     /// The step from `p` after a step along `heading`, its engagement
     /// measured at the points `along` it: the turn whose
     /// engagement is the target (bisection between the sharpest turn towards
@@ -649,30 +743,10 @@ impl Planner<'_> {
         let end = |d: f64| ahead(p, heading + away * d, len);
         let within = |d: f64, limit: f64| self.stride_within(p, heading + away * d, len, limit, along);
         let (toward, back) = (-tol::WALK_TURN, tol::WALK_TURN_HARD);
-        let best = match within(toward, self.target) {
-            Some(s) => s,
-            None => {
-                // Over the bound whichever way: the pass ends here.
-                let hard = within(back, self.accept)?;
-                if hard.phi > self.target {
-                    hard
-                } else {
-                    let (mut lo, mut hi) = (toward, back);
-                    let mut best = hard;
-                    for _ in 0..tol::WALK_BISECTIONS {
-                        let mid = 0.5 * (lo + hi);
-                        match within(mid, self.target) {
-                            None => lo = mid,
-                            Some(m) => {
-                                hi = mid;
-                                best = m;
-                            }
-                        }
-                    }
-                    best
-                }
-            }
-        };
+        let last = along.len().saturating_sub(1);
+        let end_within = |d: f64, limit: f64| self.stride_within(p, heading + away * d, len, limit, &along[last..]);
+        let rest = |d: f64, limit: f64| self.stride_within(p, heading + away * d, len, limit, &along[..last]);
+        let best = self.turn_bisect((toward, back), (&end_within, &rest))?;
         if self.edges.contains_segment(p, best.to) {
             return Some(best);
         }
@@ -792,7 +866,6 @@ impl Planner<'_> {
     /// the area it cleared (mm^2, on the grid's cells) and its steps' points;
     /// the swept field holds the lines.
     fn pass(&mut self, p: P2, first: Stride, budget: &mut usize) -> Result<(Vec<P2>, f64, Vec<P2>), RoughError> {
-        let w = self.options.tool_radius + 2.0 * self.grid.h;
         let air_len = tol::WALK_AIR_SHARE * self.options.tool_radius;
         let step = tol::WALK_STEP_SHARE * self.options.tool_radius;
         let mut run = vec![p];
@@ -808,7 +881,7 @@ impl Planner<'_> {
             }
             *budget -= 1;
             marks.push(undo.len());
-            self.grid.stamp_segment(&mut self.swept, at, s.to, w, Some(&mut undo));
+            self.stamp_swept(at, s.to, Some(&mut undo));
             run.push(s.to);
             if s.core >= tol::WALK_AIR * self.target {
                 last_cut = run.len() - 1;
@@ -856,7 +929,7 @@ impl Planner<'_> {
             let span: &[P2] = if merged || j == i + 1 { &run[j..=j] } else { &run[i + 1..=j] };
             for &q in span {
                 let from = lines[lines.len() - 1];
-                self.grid.stamp_segment(&mut self.swept, from, q, w, Some(&mut undo));
+                self.stamp_swept(from, q, Some(&mut undo));
                 lines.push(q);
             }
         }
@@ -1036,7 +1109,6 @@ impl Planner<'_> {
     /// its first point), measured at every point on the field as the run
     /// leaves it, the run stamped (old values to `undo`).
     fn sweep_run(&mut self, run: &[P2], undo: &mut Vec<(usize, f64)>) -> f64 {
-        let w = self.options.tool_radius + 2.0 * self.grid.h;
         let mut phi = 0.0f64;
         let step = 0.5 * self.grid.h;
         for pair in run.windows(2) {
@@ -1050,7 +1122,7 @@ impl Planner<'_> {
                 let f = i as f64 / n as f64;
                 let q = [pair[0][0] + f * (pair[1][0] - pair[0][0]), pair[0][1] + f * (pair[1][1] - pair[0][1])];
                 phi = phi.max(self.front(q, heading).0);
-                self.grid.stamp_segment(&mut self.swept, from, q, w, Some(undo));
+                self.stamp_swept(from, q, Some(undo));
                 from = q;
             }
         }
@@ -1261,6 +1333,30 @@ fn simplify(edges: &Edges, run: &[P2], tolerance: f64) -> Vec<usize> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn lattice_turns_are_the_bisections_midpoints_bit_for_bit() {
+        // Bisections between the walk's bounds and others, every sequence
+        // of answers of 8 halvings of a few: each midpoint tried is the
+        // lattice turn of its index, and so are the ends.
+        let n = 1usize << tol::WALK_BISECTIONS;
+        for (lo0, hi0) in [(-tol::WALK_TURN, tol::WALK_TURN_HARD), (-0.3, 0.7), (0.1, 3.0), (-2.0, -1.9)] {
+            assert_eq!(bisection_turn(lo0, hi0, 0, n).to_bits(), lo0.to_bits());
+            assert_eq!(bisection_turn(lo0, hi0, n, n).to_bits(), hi0.to_bits());
+            for answers in 0..n {
+                let (mut lo, mut hi, mut klo, mut khi) = (lo0, hi0, 0usize, n);
+                for bit in 0..tol::WALK_BISECTIONS {
+                    let (mid, kmid) = (0.5 * (lo + hi), (klo + khi) / 2);
+                    assert_eq!(bisection_turn(lo0, hi0, kmid, n).to_bits(), mid.to_bits(), "{lo0} {hi0} {kmid}");
+                    if answers >> bit & 1 == 1 {
+                        (hi, khi) = (mid, kmid);
+                    } else {
+                        (lo, klo) = (mid, kmid);
+                    }
+                }
+            }
+        }
+    }
 
     #[test]
     fn right_angled_corners_get_fillets_and_sharp_ones_keep_their_tips() {

@@ -96,18 +96,21 @@ impl Grid {
         if !inside {
             return None;
         }
-        // Non-negative: truncation is the floor.
+        // Non-negative: truncation is the floor. Through 32 bits (a grid's
+        // side is far below 2^32 cells, [`tol::MAX_GRID_CELLS`]): the same
+        // integers, converted both ways in fewer instructions.
         #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "checked above")]
-        let (iu, iv) = (u as usize, v as usize);
-        #[allow(clippy::cast_precision_loss, reason = "grid indices")]
-        let at = (iv * self.nx + iu, u - iu as f64, v - iv as f64);
+        let (iu, iv) = (u as u32, v as u32);
+        let at = (iv as usize * self.nx + iu as usize, u - f64::from(iu), v - f64::from(iv));
         Some(at)
     }
 
     /// The field `f` (rows of `nx`) at a location of [`Grid::locate`].
     #[inline]
     pub fn interpolate(f: &[f64], nx: usize, (k, a, b): (usize, f64, f64)) -> f64 {
-        let (f00, f10, f01, f11) = (f[k], f[k + 1], f[k + nx], f[k + nx + 1]);
+        // One bounds check for the four (the slice's length is known).
+        let s = &f[k..k + nx + 2];
+        let (f00, f10, f01, f11) = (s[0], s[1], s[nx], s[nx + 1]);
         (f00 * (1.0 - a) + f10 * a) * (1.0 - b) + (f01 * (1.0 - a) + f11 * a) * b
     }
 
@@ -212,7 +215,33 @@ impl Grid {
 
     /// `f = min(f, distance to the segment a-b)` within `r` of it; the old
     /// values go to `undo` when given.
-    pub fn stamp_segment(&self, f: &mut [f64], a: P2, b: P2, r: f64, mut undo: Option<&mut Vec<(usize, f64)>>) {
+    pub fn stamp_segment(&self, f: &mut [f64], a: P2, b: P2, r: f64, undo: Option<&mut Vec<(usize, f64)>>) {
+        self.stamp_segment_over(f, a, b, r, f64::NEG_INFINITY, undo);
+    }
+
+    /// The `floor` of [`Grid::stamp_segment_over`] for a distance field
+    /// read only against thresholds of `lowest` or more: two cells under
+    /// it (more than a cell's diagonal).
+    pub fn settled(&self, lowest: f64) -> f64 {
+        lowest - 2.0 * self.h
+    }
+
+    /// [`Grid::stamp_segment`], leaving alone the cells whose value is at
+    /// most `floor` already (not even measured). Where the field is a
+    /// distance to what was stamped, its values at adjacent centres differ
+    /// by at most the diagonal `sqrt(2) h`, so a square with a cell left at
+    /// or under `floor` has all four values at most `floor + sqrt(2) h`
+    /// before and after: every sample there compares the same with a
+    /// threshold above that, and only such comparisons read the field.
+    pub fn stamp_segment_over(
+        &self,
+        f: &mut [f64],
+        a: P2,
+        b: P2,
+        r: f64,
+        floor: f64,
+        mut undo: Option<&mut Vec<(usize, f64)>>,
+    ) {
         let lo = [a[0].min(b[0]), a[1].min(b[1])];
         let hi = [a[0].max(b[0]), a[1].max(b[1])];
         let (i0, i1, j0, j1) = self.range(lo, hi, r);
@@ -237,6 +266,9 @@ impl Grid {
             let (ri0, ri1, _, _) = self.range([lo[0] - half, y], [hi[0] + half, y], self.h);
             for i in ri0.max(i0)..=ri1.min(i1) {
                 let k = j * self.nx + i;
+                if f[k] <= floor {
+                    continue;
+                }
                 // As `centre(k)`.
                 #[allow(clippy::cast_precision_loss, reason = "grid indices")]
                 let c = [self.x0 + (i as f64 + 0.5) * self.h, y];
@@ -341,6 +373,49 @@ mod tests {
                         let q = [lo[0] + (hi[0] - lo[0]) * f64::from(i) / 40.0, lo[1] + (hi[1] - lo[1]) * f64::from(j) / 40.0];
                         let material = g.sample(&swept, q) > t && g.sample(&reach, q) < t;
                         prop_assert!(!material, "material at {q:?}");
+                    }
+                }
+            }
+        }
+    }
+
+    proptest! {
+        /// A walk of short moves stamped with cells at most
+        /// [`Grid::settled`] left alone reads the same as stamped in full
+        /// against every threshold from the lowest up: exact where a cell
+        /// is over the floor, never under the full field, and every
+        /// bilinear sample on the same side of each threshold.
+        #[test]
+        fn stamps_over_the_floor_read_as_full_stamps(
+            start in (1.0..3.0f64, 1.0..3.0f64), turns in proptest::collection::vec(-0.8..0.8f64, 1..60),
+            len in 0.02..0.4f64, r in 0.4..1.2f64, chip in 0.0..0.05f64,
+        ) {
+            let g = Grid::new([0.0, 0.0], [4.0, 4.0], 1.5, 0.07).expect("grid");
+            let w = r + 2.0 * g.h;
+            let lowest = r - chip;
+            let floor = g.settled(lowest);
+            let (mut full, mut over) = (vec![BIG; g.len()], vec![BIG; g.len()]);
+            let (mut p, mut heading) = ([start.0, start.1], 0.0f64);
+            g.stamp_segment(&mut full, p, p, w, None);
+            g.stamp_segment_over(&mut over, p, p, w, floor, None);
+            for t in &turns {
+                heading += t;
+                let q = [p[0] + len * heading.cos(), p[1] + len * heading.sin()];
+                g.stamp_segment(&mut full, p, q, w, None);
+                g.stamp_segment_over(&mut over, p, q, w, floor, None);
+                p = q;
+            }
+            for k in 0..g.len() {
+                prop_assert!(over[k] >= full[k]);
+                prop_assert!(over[k] <= floor || over[k].to_bits() == full[k].to_bits(), "cell {k}: {} vs {}", over[k], full[k]);
+            }
+            let thresholds = [lowest, lowest + 0.5 * g.h, r, r + 0.005, r + 2.0 * g.h];
+            for i in 0..=160u32 {
+                for j in 0..=160u32 {
+                    let q = [0.1 + 3.8 * f64::from(i) / 160.0, 0.1 + 3.8 * f64::from(j) / 160.0];
+                    let (a, b) = (g.sample(&full, q), g.sample(&over, q));
+                    for t in thresholds {
+                        prop_assert_eq!(a > t, b > t, "at {:?}, threshold {}: {} vs {}", q, t, a, b);
                     }
                 }
             }

@@ -36,13 +36,15 @@ impl Planner<'_> {
         let r = self.options.tool_radius;
         // The swept field first: in cleared area it settles the probe alone.
         let nx = self.grid.nx;
+        let open = self.open.as_deref();
         for &[c, s] in &self.link_round {
             let q = [p[0] + r * c, p[1] + r * s];
             // Off the grid both fields are far: no material.
             let Some(at) = self.grid.locate(q) else { continue };
             if Grid::interpolate(&self.swept, nx, at) > r + LINK_SLACK
                 && Grid::interpolate(&self.reach, nx, at) < r - self.strip
-                && !self.open_at(at)
+                // As `open_at`, inline.
+                && !open.is_some_and(|f| Grid::interpolate(f, nx, at) > 0.0)
             {
                 return false;
             }
@@ -228,15 +230,14 @@ impl Planner<'_> {
 
     /// Stamps the polyline `run` on the swept field (no engagement measured).
     pub(super) fn stamp(&mut self, run: &[P2]) {
-        let w = self.options.tool_radius + 2.0 * self.grid.h;
         if let Some(&p) = run.first() {
-            self.grid.stamp_segment(&mut self.swept, p, p, w, None);
+            self.stamp_swept(p, p, None);
         }
         for pair in run.windows(2) {
             // A move the last pass stamped already (the same ends, the same
             // width, the field only lowered since) would change nothing.
             if !self.stamped.contains(&(pair[0], pair[1])) {
-                self.grid.stamp_segment(&mut self.swept, pair[0], pair[1], w, None);
+                self.stamp_swept(pair[0], pair[1], None);
             }
         }
         self.epoch = self.epoch.wrapping_add(1).min(CLEAR - 1);
