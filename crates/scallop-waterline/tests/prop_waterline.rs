@@ -215,16 +215,10 @@ proptest! {
         radius in 0.8..3.0f64,
         z_frac in 0.05..0.95f64,
     ) {
-        let mesh = terrain(6, 4.0, &h);
-        let index = MeshIndex::build(&mesh);
-        let cutter = Cutter::new(common::shape_of(kind, radius), 40.0).expect("cutter");
-        let b = mesh.bounds();
-        let z = b.min.z + z_frac * (b.max.z - b.min.z);
         let options = WaterlineOptions::default();
-        let grid = WaterlineGrid::new(&cutter, &index, &options).expect("grid");
-        let loops = grid.loops(z).expect("level");
+        let l = level_of(&h, (kind, radius), z_frac, &options);
         let reach = options.chord_tolerance * (1.0 + 1e-6) + options.crossing_tolerance;
-        let checked = common::check_on_contact(&cutter, &index, &loops, z, CONTOUR_REACH, reach, grid.step());
+        let checked = common::check_on_contact(&l.cutter, &l.index, &l.loops, l.z, CONTOUR_REACH, reach, l.step);
         prop_assert!(checked.is_ok(), "{}", checked.unwrap_err());
     }
 }
@@ -245,19 +239,38 @@ proptest! {
         radius in 0.8..3.0f64,
         z_frac in 0.05..0.95f64,
     ) {
-        let mesh = terrain(6, 4.0, &h);
-        let index = MeshIndex::build(&mesh);
-        let cutter = Cutter::new(common::shape_of(kind, radius), 40.0).expect("cutter");
-        let b = mesh.bounds();
-        let z = b.min.z + z_frac * (b.max.z - b.min.z);
         let options = WaterlineOptions { chord_tolerance: QUARTER_CHORD_TOLERANCE, ..WaterlineOptions::default() };
-        let grid = WaterlineGrid::new(&cutter, &index, &options).expect("grid");
-        let loops = grid.loops(z).expect("level");
+        let l = level_of(&h, (kind, radius), z_frac, &options);
         let long = tol::LONG_CHORD_SHARE * (8.0 * radius * options.chord_tolerance).sqrt();
         let reach = options.chord_tolerance * (1.0 + 1e-6) + options.crossing_tolerance;
-        let checked = common::check_chord_points(&cutter, &index, &loops, z, (&[0.25, 0.75], long), reach);
+        let checked = common::check_chord_points(&l.cutter, &l.index, &l.loops, l.z, (&[0.25, 0.75], long), reach);
         prop_assert!(checked.is_ok(), "{}", checked.unwrap_err());
     }
+}
+
+/// One level of a random terrain of heights `h` (as the properties above
+/// draw it): the part's index, the cutter of `shape` (kind, radius), the
+/// height z at `z_frac` of the part's height, the loops there with `options`
+/// and the grid step.
+struct Level {
+    index: MeshIndex,
+    cutter: Cutter,
+    z: f64,
+    loops: Vec<Loop>,
+    step: f64,
+}
+
+fn level_of(h: &[f64], (kind, radius): (u8, f64), z_frac: f64, options: &WaterlineOptions) -> Level {
+    let mesh = terrain(6, 4.0, h);
+    let index = MeshIndex::build(&mesh);
+    let cutter = Cutter::new(common::shape_of(kind, radius), 40.0).expect("cutter");
+    let b = mesh.bounds();
+    let z = b.min.z + z_frac * (b.max.z - b.min.z);
+    let (loops, step) = {
+        let grid = WaterlineGrid::new(&cutter, &index, options).expect("grid");
+        (grid.loops(z).expect("level"), grid.step())
+    };
+    Level { index, cutter, z, loops, step }
 }
 
 /// The chord tolerance of the quarter-point property: the one the comparison

@@ -46,36 +46,30 @@ pub fn check_on_contact(
     off_reach: f64,
 ) -> Result<(), String> {
     let o = Oracle::new(cutter, index, z);
-    for l in loops {
-        let n = l.points.len();
-        for i in 0..n {
-            let (a, c) = (l.points[i], l.points[(i + 1) % n]);
-            let dv = o.height(a).0;
-            if !o.safe_at(a) {
-                return Err(format!("vertex {a:?} cuts into the part: d = {dv}, z = {z}"));
-            }
-            let chord = c - a;
-            let len = chord.norm();
-            let left = if len > 0.0 { Vec2::new(-chord.y, chord.x) / len } else { Vec2::new(0.0, 0.0) };
-            if !o.side_near(a, left, vertex_reach, true) {
-                return Err(format!(
-                    "vertex {a:?} is farther than {vertex_reach} from the contour (d = {dv}, z = {z})"
-                ));
-            }
-            if len == 0.0 {
-                continue;
-            }
-            let mid = a + chord * 0.5;
-            let dm = o.height(mid).0;
-            let cuts = !o.safe_at(mid);
-            let hint = if cuts { -left } else { left };
-            let reach = if cuts { chord_reach } else { off_reach };
-            if !o.side_near(mid, hint, reach, !cuts) {
-                let what = if cuts { "cuts into the part" } else { "is off the contour" };
-                return Err(format!(
-                    "midpoint {mid:?} of chord {a:?} -> {c:?} {what} by more than {reach} (d = {dm}, z = {z})"
-                ));
-            }
+    for (a, c) in chords(loops) {
+        let dv = o.height(a).0;
+        if !o.safe_at(a) {
+            return Err(format!("vertex {a:?} cuts into the part: d = {dv}, z = {z}"));
+        }
+        let chord = c - a;
+        let len = chord.norm();
+        let left = if len > 0.0 { Vec2::new(-chord.y, chord.x) / len } else { Vec2::new(0.0, 0.0) };
+        if !o.side_near(a, left, vertex_reach, true) {
+            return Err(format!("vertex {a:?} is farther than {vertex_reach} from the contour (d = {dv}, z = {z})"));
+        }
+        if len == 0.0 {
+            continue;
+        }
+        let mid = a + chord * 0.5;
+        let dm = o.height(mid).0;
+        let cuts = !o.safe_at(mid);
+        let hint = if cuts { -left } else { left };
+        let reach = if cuts { chord_reach } else { off_reach };
+        if !o.side_near(mid, hint, reach, !cuts) {
+            let what = if cuts { "cuts into the part" } else { "is off the contour" };
+            return Err(format!(
+                "midpoint {mid:?} of chord {a:?} -> {c:?} {what} by more than {reach} (d = {dm}, z = {z})"
+            ));
         }
     }
     Ok(())
@@ -95,29 +89,34 @@ pub fn check_chord_points(
     chord_reach: f64,
 ) -> Result<(), String> {
     let o = Oracle::new(cutter, index, z);
-    for l in loops {
-        let n = l.points.len();
-        for i in 0..n {
-            let (a, c) = (l.points[i], l.points[(i + 1) % n]);
-            let chord = c - a;
-            let len = chord.norm();
-            if len <= min_length {
-                continue;
-            }
-            let left = Vec2::new(-chord.y, chord.x) / len;
-            for &t in fractions {
-                let q = a + chord * t;
-                if !o.safe_at(q) && !o.side_near(q, -left, chord_reach, false) {
-                    return Err(format!(
-                        "point {t} of chord {a:?} -> {c:?} (length {len}) cuts into the part by more than \
+    for (a, c) in chords(loops) {
+        let chord = c - a;
+        let len = chord.norm();
+        if len <= min_length {
+            continue;
+        }
+        let left = Vec2::new(-chord.y, chord.x) / len;
+        for &t in fractions {
+            let q = a + chord * t;
+            if !o.safe_at(q) && !o.side_near(q, -left, chord_reach, false) {
+                return Err(format!(
+                    "point {t} of chord {a:?} -> {c:?} (length {len}) cuts into the part by more than \
                          {chord_reach} (d = {}, z = {z})",
-                        o.height(q).0
-                    ));
-                }
+                    o.height(q).0
+                ));
             }
         }
     }
     Ok(())
+}
+
+/// Every chord of the closed loops: each point and the next, the last
+/// closing on the first.
+fn chords(loops: &[Loop]) -> impl Iterator<Item = (Point2, Point2)> + '_ {
+    loops.iter().flat_map(|l| {
+        let n = l.points.len();
+        (0..n).map(move |i| (l.points[i], l.points[(i + 1) % n]))
+    })
 }
 
 /// The brute-force drop-cutter at one level.
