@@ -8,27 +8,16 @@ use scallop_geom::{Point2, Point3};
 use scallop_mesh::{MeshIndex, TriMesh};
 use scallop_waterline::{Loop, WaterlineError, WaterlineGrid, WaterlineOptions, tol, waterline};
 
+#[allow(dead_code)] // the contact checks of the other tests
+mod common;
+
 fn p(x: f64, y: f64, z: f64) -> Point3 {
     Point3::new(x, y, z)
 }
 
 /// A box [0, a] x [0, b] x [0, h]: its top and four walls.
 fn box_mesh(a: f64, b: f64, h: f64) -> TriMesh {
-    let (t0, t1, t2, t3) = (p(0., 0., h), p(a, 0., h), p(a, b, h), p(0., b, h));
-    let (b0, b1, b2, b3) = (p(0., 0., 0.), p(a, 0., 0.), p(a, b, 0.), p(0., b, 0.));
-    let soup = [
-        [t0, t1, t2],
-        [t0, t2, t3],
-        [b0, b1, t1],
-        [b0, t1, t0],
-        [b1, b2, t2],
-        [b1, t2, t1],
-        [b2, b3, t3],
-        [b2, t3, t2],
-        [b3, b0, t0],
-        [b3, t0, t3],
-    ];
-    TriMesh::from_soup(&soup).expect("valid box").0
+    TriMesh::from_soup(&common::box_soup(0.0, 0.0, a, b, h)).expect("valid box").0
 }
 
 /// Distance in XY from `q` to the rectangle [0, a] x [0, b] (0 inside).

@@ -9,31 +9,6 @@ use scallop_geom::{Point2, Point3};
 use scallop_mesh::{MeshIndex, TriMesh};
 use scallop_waterline::{Loop, WaterlineGrid, WaterlineOptions};
 
-/// The point (x, y, z) rotated by `angle` about the z axis.
-fn rotated(angle: f64, x: f64, y: f64, z: f64) -> Point3 {
-    let (s, c) = angle.sin_cos();
-    Point3::new(c * x - s * y, s * x + c * y, z)
-}
-
-/// The top and four walls of the box [x0, x1] x [0, b] x [0, h], rotated.
-fn box_soup(angle: f64, x0: f64, x1: f64, b: f64, h: f64) -> Vec<[Point3; 3]> {
-    let p = |x, y, z| rotated(angle, x, y, z);
-    let (t0, t1, t2, t3) = (p(x0, 0., h), p(x1, 0., h), p(x1, b, h), p(x0, b, h));
-    let (b0, b1, b2, b3) = (p(x0, 0., 0.), p(x1, 0., 0.), p(x1, b, 0.), p(x0, b, 0.));
-    vec![
-        [t0, t1, t2],
-        [t0, t2, t3],
-        [b0, b1, t1],
-        [b0, t1, t0],
-        [b1, b2, t2],
-        [b1, t2, t1],
-        [b2, b3, t3],
-        [b2, t3, t2],
-        [b3, b0, t0],
-        [b3, t0, t3],
-    ]
-}
-
 fn winding(loops: &[Loop], q: Point2) -> i32 {
     loops.iter().map(|l| l.winding_number(q)).sum()
 }
@@ -67,8 +42,8 @@ proptest! {
 fn slot_separates_the_two_loops(kind: u8, radius: f64, gap: f64, angle: f64, wall: f64) -> Result<(), TestCaseError> {
     let x1 = BOX_LENGTH + wall; // the first box's wall, off the grid lines
     let x2 = x1 + 2.0 * radius + gap;
-    let mut soup = box_soup(angle, 0.0, x1, BOX_LENGTH, BOX_HEIGHT);
-    soup.extend(box_soup(angle, x2, x2 + BOX_LENGTH, BOX_LENGTH, BOX_HEIGHT));
+    let mut soup = common::box_soup(angle, 0.0, x1, BOX_LENGTH, BOX_HEIGHT);
+    soup.extend(common::box_soup(angle, x2, x2 + BOX_LENGTH, BOX_LENGTH, BOX_HEIGHT));
     let mesh = TriMesh::from_soup(&soup).expect("two boxes").0;
     let index = MeshIndex::build(&mesh);
     let cutter = Cutter::new(common::shape_of(kind, radius), 40.0).expect("cutter");
@@ -81,7 +56,7 @@ fn slot_separates_the_two_loops(kind: u8, radius: f64, gap: f64, angle: f64, wal
     let floor = -100.0;
     for k in 0..=16 {
         let y = BOX_LENGTH * (0.05 + 0.9 * f64::from(k) / 16.0);
-        let m = rotated(angle, x1 + radius + 0.5 * gap, y, 0.0);
+        let m = common::rotated(angle, x1 + radius + 0.5 * gap, y, 0.0);
         let q = Point2::new(m.x, m.y);
         let d = drop_cutter_brute_force(&cutter, &index, q, floor).tip.z;
         prop_assert!(d <= z, "the brute force puts the strip's middle {q:?} inside ({d})");
@@ -181,7 +156,7 @@ mod common;
 /// A wedge ridge along x over `[x0, x1]`, its crest at height `top` on the
 /// line y = `y` and its flanks `half` wide at height 0, rotated.
 fn ridge_soup(angle: f64, x0: f64, x1: f64, y: f64, half: f64, top: f64) -> Vec<[Point3; 3]> {
-    let p = |x, yy, z| rotated(angle, x, yy, z);
+    let p = |x, yy, z| common::rotated(angle, x, yy, z);
     let (a0, a1) = (p(x0, y - half, 0.), p(x1, y - half, 0.));
     let (c0, c1) = (p(x0, y, top), p(x1, y, top));
     let (b0, b1) = (p(x0, y + half, 0.), p(x1, y + half, 0.));
@@ -212,8 +187,8 @@ proptest! {
         let x1 = BOX_LENGTH + wall;
         let x2 = x1 + 2.0 * radius + gap;
         let z = 0.5 * BOX_HEIGHT;
-        let mut soup = box_soup(angle, 0.0, x1, BOX_LENGTH, BOX_HEIGHT);
-        soup.extend(box_soup(angle, x2, x2 + BOX_LENGTH, BOX_LENGTH, BOX_HEIGHT));
+        let mut soup = common::box_soup(angle, 0.0, x1, BOX_LENGTH, BOX_HEIGHT);
+        soup.extend(common::box_soup(angle, x2, x2 + BOX_LENGTH, BOX_LENGTH, BOX_HEIGHT));
         soup.extend(ridge_soup(angle, x1 - 1.0, x2 + 1.0, ridge_y, 0.5, z + above));
         let mesh = TriMesh::from_soup(&soup).expect("boxes and ridge").0;
         let index = MeshIndex::build(&mesh);
@@ -273,7 +248,7 @@ fn loops_cross(loops: &[Loop]) -> Option<(Point2, Point2)> {
 /// `z + above` at `x0` down to `z - above` at `x0 + 2 * run`, so it crosses z at
 /// `x0 + run`; its third corner is at height 0 under the first.
 fn fin_soup(angle: f64, x0: f64, run: f64, y0: f64, z: f64, above: f64) -> [Point3; 3] {
-    let p = |x, y, zz| rotated(angle, x, y, zz);
+    let p = |x, y, zz| common::rotated(angle, x, y, zz);
     [p(x0, y0, z + above), p(x0 + 2.0 * run, y0, z - above), p(x0, y0, 0.0)]
 }
 
@@ -288,7 +263,7 @@ fn fin_soup(angle: f64, x0: f64, run: f64, y0: f64, z: f64, above: f64) -> [Poin
 #[test]
 fn a_thin_arm_between_samples_reaches_its_tip() {
     let (z, step) = (1.0, 0.5);
-    let mut soup = box_soup(0.0, 0.0, 10.1, BOX_LENGTH, 5.0);
+    let mut soup = common::box_soup(0.0, 0.0, 10.1, BOX_LENGTH, 5.0);
     soup.push(fin_soup(0.0, 10.9, 1.2, 5.1, z, 0.12));
     let mesh = TriMesh::from_soup(&soup).expect("box and fin").0;
     let index = MeshIndex::build(&mesh);
@@ -335,7 +310,7 @@ proptest! {
     ) {
         let z = 0.5 * BOX_HEIGHT;
         let x1 = BOX_LENGTH + wall;
-        let mut soup = box_soup(angle, 0.0, x1, BOX_LENGTH, BOX_HEIGHT);
+        let mut soup = common::box_soup(angle, 0.0, x1, BOX_LENGTH, BOX_HEIGHT);
         // The fin starts 0.2 mm inside the widened side and crosses z `run - 0.2` mm outside it.
         soup.push(fin_soup(angle, x1 + radius - 0.2, run, y0, z, above));
         let mesh = TriMesh::from_soup(&soup).expect("box and fin").0;

@@ -5,7 +5,7 @@
 //! part exactly where `d > z`.
 
 use scallop_cutter::{Contact, Cutter, CutterShape, drop_cutter_brute_force};
-use scallop_geom::{Point2, Vec2};
+use scallop_geom::{Point2, Point3, Vec2};
 use scallop_mesh::MeshIndex;
 use scallop_waterline::Loop;
 
@@ -179,4 +179,31 @@ pub fn shape_of(kind: u8, radius: f64) -> CutterShape {
         2 => CutterShape::Bull { radius, corner: 0.4 * radius },
         _ => CutterShape::Cone { radius, half_angle: 0.6 },
     }
+}
+
+/// The point (x, y, z) rotated by `angle` about the z axis.
+#[allow(dead_code)] // not every test file builds boxes
+pub fn rotated(angle: f64, x: f64, y: f64, z: f64) -> Point3 {
+    let (s, c) = angle.sin_cos();
+    Point3::new(c * x - s * y, s * x + c * y, z)
+}
+
+/// The top and four walls of the box [x0, x1] x [0, b] x [0, h], rotated.
+#[allow(dead_code)] // not every test file builds boxes
+pub fn box_soup(angle: f64, x0: f64, x1: f64, b: f64, h: f64) -> Vec<[Point3; 3]> {
+    let p = |x, y, z| rotated(angle, x, y, z);
+    let (t0, t1, t2, t3) = (p(x0, 0., h), p(x1, 0., h), p(x1, b, h), p(x0, b, h));
+    let (b0, b1, b2, b3) = (p(x0, 0., 0.), p(x1, 0., 0.), p(x1, b, 0.), p(x0, b, 0.));
+    vec![
+        [t0, t1, t2],
+        [t0, t2, t3],
+        [b0, b1, t1],
+        [b0, t1, t0],
+        [b1, b2, t2],
+        [b1, t2, t1],
+        [b2, b3, t3],
+        [b2, t3, t2],
+        [b3, b0, t0],
+        [b3, t0, t3],
+    ]
 }
