@@ -893,8 +893,8 @@ impl Planner<'_> {
         let mut marks = vec![0usize];
         let mut last_cut = 0usize;
         // Per point of `run` after the first: whether its step slid along a
-        // wall, and its engagement leaving out the wall strip.
-        let mut slid: Vec<(bool, f64)> = Vec::new();
+        // wall.
+        let mut slid: Vec<bool> = Vec::new();
         let mut at = p;
         let mut next = Some(first);
         while let Some(s) = next {
@@ -905,7 +905,7 @@ impl Planner<'_> {
             marks.push(undo.len());
             self.stamp_swept(at, s.to, Some(&mut undo));
             run.push(s.to);
-            slid.push((s.wall, s.core));
+            slid.push(s.wall);
             if s.core >= tol::WALK_AIR * self.target {
                 last_cut = run.len() - 1;
             }
@@ -926,7 +926,7 @@ impl Planner<'_> {
         // where the wall turned it, and the next pass, planned on the field
         // without the step, takes what it would have cut (docs/roughing.md,
         // "Adaptive clearing", narrow channels).
-        if keep > 2 && slid[keep - 2].0 && self.across_narrow(&run[..keep]) {
+        if keep > 2 && slid[keep - 2] && self.across_narrow(&run[..keep]) {
             keep -= 1;
         }
         if keep < run.len() {
