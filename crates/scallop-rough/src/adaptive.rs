@@ -123,6 +123,9 @@ struct Stride {
     /// The engagement (rad) leaving out the strip along the walls that the
     /// rings cut ([`tol::WALK_WALL_STRIP_SHARE`]): what tells cutting from air.
     core: f64,
+    /// Whether the wall turned the step further away from the material than
+    /// the engagement asked ([`Planner::turn_by`]): the tool slides along it.
+    wall: bool,
 }
 
 /// The adaptive clearing of `region` (one connected tool-centre region):
@@ -650,7 +653,7 @@ impl Planner<'_> {
     fn stride_by(&self, p: P2, heading: f64, len: f64) -> Stride {
         let to = ahead(p, heading, len);
         let (phi, core) = self.front(to, heading);
-        Stride { to, heading, phi, core }
+        Stride { to, heading, phi, core, wall: false }
     }
 
     /// The step from `p` along `heading` of length `len`, its engagement
@@ -663,7 +666,7 @@ impl Planner<'_> {
             phi = phi.max(a);
             core = core.max(b);
         }
-        Some(Stride { to: ahead(p, heading, len), heading, phi, core })
+        Some(Stride { to: ahead(p, heading, len), heading, phi, core, wall: false })
     }
 
     /// The next step from `p` after a step along `heading` (see
@@ -771,7 +774,7 @@ impl Planner<'_> {
                     }
                 }
                 if let Some(ok) = within(hi, self.accept) {
-                    return Some(ok);
+                    return Some(Stride { wall: true, ..ok });
                 }
                 // Along the wall the engagement is over the bound: further
                 // away, the first step in the region under it, if any.
@@ -781,7 +784,7 @@ impl Planner<'_> {
                     if self.edges.contains_segment(p, end(e))
                         && let Some(m) = within(e, self.accept)
                     {
-                        return Some(m);
+                        return Some(Stride { wall: true, ..m });
                     }
                 }
                 return None;
@@ -861,6 +864,22 @@ impl Planner<'_> {
         self.next(p, along)
     }
 
+    /// Whether the pass `run` (its steps' points, cut back to the last that
+    /// cut) is short and ends across a narrow channel: shorter than
+    /// [`tol::WALK_BOTH_WAYS_SHARE`] R, and the region narrower than that
+    /// across its last step, both ways from its end (the lines square to the
+    /// step leave the region within that length on both sides).
+    fn across_narrow(&self, run: &[P2]) -> bool {
+        let width = tol::WALK_BOTH_WAYS_SHARE * self.options.tool_radius;
+        let step = tol::WALK_STEP_SHARE * self.options.tool_radius;
+        #[allow(clippy::cast_precision_loss, reason = "a step count")]
+        let short = (run.len() - 1) as f64 * step < width;
+        let [.., a, b] = run[..] else { return false };
+        let heading = (b[1] - a[1]).atan2(b[0] - a[0]);
+        let side = |turn: f64| !self.edges.contains_segment(b, ahead(b, heading + turn, width));
+        short && side(std::f64::consts::FRAC_PI_2) && side(-std::f64::consts::FRAC_PI_2)
+    }
+
     /// A pass from `p` along `heading`: its points (the first is `p`), cut
     /// back to its last step that cut, as lines ([`simplify`]), and
     /// the area it cleared (mm^2, on the grid's cells) and its steps' points;
@@ -873,6 +892,9 @@ impl Planner<'_> {
         // Per point of `run`: the undo log's length before its move.
         let mut marks = vec![0usize];
         let mut last_cut = 0usize;
+        // Per point of `run` after the first: whether its step slid along a
+        // wall.
+        let mut slid: Vec<bool> = Vec::new();
         let mut at = p;
         let mut next = Some(first);
         while let Some(s) = next {
@@ -883,6 +905,7 @@ impl Planner<'_> {
             marks.push(undo.len());
             self.stamp_swept(at, s.to, Some(&mut undo));
             run.push(s.to);
+            slid.push(s.wall);
             if s.core >= tol::WALK_AIR * self.target {
                 last_cut = run.len() - 1;
             }
@@ -895,7 +918,17 @@ impl Planner<'_> {
             next = self.next(at, s.heading);
         }
         // Back to the last step that cut: the air after it is not cut.
-        let keep = last_cut + 1;
+        let mut keep = last_cut + 1;
+        // A short pass across a narrow channel (wall to wall, the channel
+        // narrower than the length that makes a pass long) ends with its last
+        // step slid along the far wall: a tight turn the tool crawls through,
+        // then a reversal or a link back. That step is not cut: the pass ends
+        // where the wall turned it, and the next pass, planned on the field
+        // without the step, takes what it would have cut (docs/roughing.md,
+        // "Adaptive clearing", narrow channels).
+        if keep > 2 && slid[keep - 2] && self.across_narrow(&run[..keep]) {
+            keep -= 1;
+        }
         if keep < run.len() {
             let mark = marks[keep];
             while undo.len() > mark {
