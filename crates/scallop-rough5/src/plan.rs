@@ -306,6 +306,44 @@ pub struct Rough5Plan {
     /// The air moves ([`Rough5Settings::air`]): how many, their length
     /// (mm) and the moves cut into pieces to find them; `None` without.
     pub air: Option<AirReport>,
+    /// What each move of the toolpath is for (empty when unknown).
+    pub roles: Vec<MoveRole>,
+}
+
+/// What a move of a [`Rough5Plan`] is for (its [`MoveKind`] says how it is
+/// written): the machine time is broken down by it (docs/rough5.md, "Where
+/// the machine time goes").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum MoveRole {
+    /// A pass along the level (and its lap).
+    Cut,
+    /// An entry into the level: down a helix, a ramp, from beside the stock,
+    /// or a plunge into material.
+    Entry,
+    /// From the safe height down to where the entry starts.
+    Approach,
+    /// A link between passes on the level.
+    Link,
+    /// Out of the material along the axis, then up to the safe height (a
+    /// retract, and the retract of a departure from the pole).
+    Retract,
+    /// The axis turned about the pole at a small tilt before leaving it.
+    Turn,
+}
+
+impl MoveRole {
+    /// Its name in reports.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            MoveRole::Cut => "cut",
+            MoveRole::Entry => "entry",
+            MoveRole::Approach => "approach",
+            MoveRole::Link => "link",
+            MoveRole::Retract => "retract",
+            MoveRole::Turn => "turn",
+        }
+    }
 }
 
 /// The air moves of a [`Rough5Plan`].
@@ -552,6 +590,7 @@ pub fn plan_rough5_in(
             estimated_time_before: estimate_time(&out.path, settings.rapid_rate),
         });
         out.path = found.toolpath;
+        out.roles = found.from.iter().map(|&i| out.roles[i]).collect();
     }
     let levels = levels
         .iter()
@@ -574,6 +613,7 @@ pub fn plan_rough5_in(
         plunged_at: out.plunged_at,
         estimated_time,
         air: air_report,
+        roles: out.roles,
     })
 }
 
@@ -1520,6 +1560,9 @@ struct Emitter {
     /// go at the rapid rate down to and up from where the tool's flutes are
     /// above it.
     air: Option<Air>,
+    /// The role of the moves pushed now, and of every move pushed.
+    role: MoveRole,
+    roles: Vec<MoveRole>,
 }
 
 impl Emitter {
@@ -1539,6 +1582,8 @@ impl Emitter {
             sides: None,
             held: None,
             air: None,
+            role: MoveRole::Cut,
+            roles: Vec::new(),
         }
     }
 
@@ -1547,6 +1592,12 @@ impl Emitter {
             self.held = Some(a);
         }
         self.path.push_with_axis(Move::new(kind, to), axis);
+        self.roles.push(self.role);
+    }
+
+    /// Sets the role of the moves pushed next; returns the one before.
+    fn set_role(&mut self, role: MoveRole) -> MoveRole {
+        std::mem::replace(&mut self.role, role)
     }
 
     /// Whether a cutting move from the pose `from_axis` to `axis` leaves the
@@ -1581,13 +1632,17 @@ impl Emitter {
     fn feed_to(&mut self, to: Point3, axis: Vec3) {
         match self.current() {
             Some((tip, from_axis)) if self.departs(&from_axis, &axis) => {
+                let role = self.set_role(MoveRole::Retract);
                 let out = Emitter::above_at(&tip, &from_axis, self.stock_top);
                 self.push(MoveKind::Link, out, from_axis);
                 let up = self.above(&tip, &from_axis);
                 self.push(MoveKind::Retract, up, from_axis);
                 self.retracts += 1;
+                self.set_role(MoveRole::Approach);
                 self.push(MoveKind::Rapid, self.above(&to, &axis), axis);
+                self.set_role(MoveRole::Entry);
                 self.push(MoveKind::Plunge, to, axis);
+                self.set_role(role);
             }
             _ => self.push(MoveKind::Feed, to, axis),
         }
@@ -1609,6 +1664,7 @@ impl Emitter {
     /// over the tool), or in a blank until the flutes are above it, then
     /// retracts to the safe height.
     fn retract(&mut self, a: &Placement) {
+        let role = self.set_role(MoveRole::Retract);
         let mut out = Emitter::above_at(&a.tip, &a.axis, self.stock_top);
         if let Some(air) = &self.air {
             // At the feed only until the flutes are above the blank.
@@ -1621,6 +1677,7 @@ impl Emitter {
         }
         let up = self.above(&a.tip, &a.axis);
         self.push(MoveKind::Retract, up, a.axis);
+        self.set_role(role);
     }
 
     /// Cuts `run`: linked from the previous run when possible (never for
@@ -1629,6 +1686,7 @@ impl Emitter {
         let linked = !first_of_level && self.last.is_some_and(|a| self.try_link(&a, &run[0], placer, body));
         // The tool is now at run[start].
         let start = if linked { 0 } else { self.enter(run, entry_z, (placer, body)) };
+        self.set_role(MoveRole::Cut);
         let n = run.len();
         let closed = n > 2 && (run[0].place.tip - run[n - 1].place.tip).norm() < 1e-9;
         if closed {
@@ -1656,9 +1714,11 @@ impl Emitter {
         if self.departs(&a.place.axis, &b.place.axis)
             && let Some(turn) = self.pole_turn(a, &b.place.axis, checks)
         {
+            let role = self.set_role(MoveRole::Turn);
             for p in turn {
                 self.push(MoveKind::Feed, p.tip, p.axis);
             }
+            self.set_role(role);
         }
     }
 
@@ -1704,7 +1764,9 @@ impl Emitter {
                 && let Some((start, tips)) = self.helix(run, entry_z, placer, body)
             {
                 let axis = run[start].place.axis;
+                let tips = &tips[self.above_blank(tips.iter().map(|t| (t, &axis)))..];
                 self.approach(&tips[0], &axis, 0.0);
+                self.set_role(MoveRole::Entry);
                 for tip in &tips[1..] {
                     self.push(MoveKind::Feed, *tip, axis);
                 }
@@ -1716,8 +1778,10 @@ impl Emitter {
             {
                 // Down beside the stock at the rapid rate (in the air all the way).
                 let over = self.above(&from, &s.axis);
+                self.set_role(MoveRole::Approach);
                 self.push(MoveKind::Rapid, over, s.axis);
                 self.push(MoveKind::Rapid, from, s.axis);
+                self.set_role(MoveRole::Entry);
                 self.push(MoveKind::Feed, s.tip, s.axis);
                 self.entries.side += 1;
                 return 0;
@@ -1727,8 +1791,10 @@ impl Emitter {
         // lifted tool clears the flanks: the approach goes to the ramp's top.
         let ramp = (lift > 0.0 && !closed).then(|| open_ramp(run, lift, self.settings.ramp_angle, body)).flatten();
         if let Some(ramp) = ramp.filter(|r| r.len() > 1) {
+            let ramp = &ramp[self.above_blank(ramp.iter().map(|(t, u)| (t, u)))..];
             let (top, axis) = ramp[0];
             self.approach(&top, &axis, lift);
+            self.set_role(MoveRole::Entry);
             for (tip, axis) in &ramp[1..] {
                 self.push(MoveKind::Feed, *tip, *axis);
             }
@@ -1737,6 +1803,7 @@ impl Emitter {
         }
         let start = s.tip + s.axis * lift;
         self.approach(&start, &s.axis, lift);
+        self.set_role(MoveRole::Entry);
         if lift <= 0.0 {
             return 0;
         }
@@ -1748,6 +1815,21 @@ impl Emitter {
         self.entries.plunge += 1;
         self.plunged_at.push(s.tip);
         0
+    }
+
+    /// How many of the first tools of an entry (tips and axes, top first) to
+    /// leave out because the next one's flutes are still above the blank
+    /// ([`Air::clears`]): the approach comes down at the rapid rate to the
+    /// last of them, and the entry starts there. On the impeller the first
+    /// level is entered from the blank's highest point, and a helix where the
+    /// turned blank is low circled down through the air for 28 mm
+    /// (docs/rough5.md, "Where the machine time goes"). At most all but the
+    /// last two (an entry keeps one move); none without a blank.
+    fn above_blank<'a>(&self, tools: impl Iterator<Item = (&'a Point3, &'a Vec3)>) -> usize {
+        let Some(air) = &self.air else { return 0 };
+        let tools: Vec<_> = tools.collect();
+        let clear = tools.iter().take_while(|(t, u)| air.clears(t, u)).count();
+        clear.saturating_sub(1).min(tools.len().saturating_sub(2))
     }
 
     /// How far (mm) along its axis the tool at `s` is lifted to reach the
@@ -1762,6 +1844,7 @@ impl Emitter {
     /// the level along the axis: in a blank the rapid stops that far above
     /// the tool on the level at the most.
     fn approach(&mut self, to: &Point3, axis: &Vec3, low: f64) {
+        self.set_role(MoveRole::Approach);
         let over = self.above(to, axis);
         self.push(MoveKind::Rapid, over, *axis);
         if let Some(air) = &self.air {
@@ -1921,9 +2004,11 @@ impl Emitter {
         if straight {
             moves.drain(..moves.len() - 1);
         }
+        self.set_role(MoveRole::Turn);
         for p in turn {
             self.push(MoveKind::Feed, p.tip, p.axis);
         }
+        self.set_role(MoveRole::Link);
         for p in moves {
             self.push(MoveKind::Link, p.tip, p.axis);
         }
