@@ -69,6 +69,8 @@ pub enum RefineArg {
     BottomNormal,
     /// Feeds, links and plunges outside the in-process stock (by `--air-clearance`) written at `--air-feed`.
     AirMoves,
+    /// The tilted tool axes of each run smoothed where the smoothed tool is placed clear of the flanks.
+    AxisSmoothing,
     /// All of them: the program of 28 Nov 2026.
     All,
 }
@@ -387,6 +389,7 @@ fn settings(args: &Rough5Args, part: &TestPart) -> CliResult<Rough5Settings> {
         spatial: args.correction.contains(&CorrectionArg::Spatial) && !matches!(args.tilt, TiltArg::Zero),
         translate: on(RefineArg::Translation),
         local_entry: on(RefineArg::LocalEntry),
+        smooth_axes: on(RefineArg::AxisSmoothing),
         round_corners: on(RefineArg::Corners),
         root_rest: on(RefineArg::RootRest),
         bottom_normal: on(RefineArg::BottomNormal),

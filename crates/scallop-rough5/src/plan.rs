@@ -124,6 +124,11 @@ pub struct Rough5Settings {
     /// along an impeller's channel the ramp from the highest point circles
     /// down through the air (docs/rough5.md, "The impeller, sixth session").
     pub local_entry: bool,
+    /// Whether the tilted axes of each run are smoothed ([`smooth_axes`]):
+    /// an axis that zigzags by a fraction of a degree makes the C table of a
+    /// table-table machine swing back and forth by degrees at small tilts
+    /// (docs/rough5.md, "Where the machine time goes").
+    pub smooth_axes: bool,
     /// Whether the vertical stretches of every pass are written in long
     /// blocks ([`thin_vertical`]) and their corners rounded
     /// ([`round_corners`]): the convex corners of the inner passes by a fillet
@@ -194,6 +199,7 @@ impl Rough5Settings {
             spatial: false,
             translate: false,
             local_entry: false,
+            smooth_axes: false,
             round_corners: false,
             root_rest: false,
             bottom_normal: false,
@@ -206,7 +212,7 @@ impl Rough5Settings {
     /// These settings with every refinement of the guide-curve program (the
     /// level repairs of [`LevelOptions`], [`Self::vertical_inside`],
     /// [`Self::vertical_thin_steps`], [`Self::translate`],
-    /// [`Self::local_entry`], [`Self::round_corners`], [`Self::root_rest`]
+    /// [`Self::local_entry`], [`Self::smooth_axes`], [`Self::round_corners`], [`Self::root_rest`]
     /// and [`Self::bottom_normal`]) on or off.
     #[must_use]
     pub fn with_refinements(self, on: bool) -> Self {
@@ -216,6 +222,7 @@ impl Rough5Settings {
             vertical_thin_steps: on,
             translate: on,
             local_entry: on,
+            smooth_axes: on,
             round_corners: on,
             root_rest: on,
             bottom_normal: on,
@@ -514,6 +521,12 @@ pub fn plan_rough5_in(
             report.translated = moved;
             report.level = j;
             report.pass = m;
+            let mut runs = runs;
+            if settings.smooth_axes {
+                for run in &mut runs {
+                    smooth_run(&placer, &body, run, settings);
+                }
+            }
             for run in &runs {
                 top = run.iter().fold(top, |t, c| t.max(c.place.tip.z));
                 let local = above.as_ref().filter(|_| settings.local_entry).and_then(|a| local_entry(a, &run[0]));
@@ -1437,6 +1450,96 @@ fn local_entry(above: &Placer, c: &Cl) -> Option<f64> {
     let p = above.place(&c.sync.path, &c.place.axis)?;
     let rise = (p.tip - c.place.tip).dot(&c.place.axis);
     (rise > 0.0).then(|| c.place.tip.z + rise * c.place.axis.z)
+}
+
+/// Axes tilted less than this (rad, 1 deg) from +Z are left as they are by
+/// [`smooth_axes`], and their neighbours too: near the pole the C table's
+/// azimuth is the machine's concern ([`Emitter::departs`]).
+pub const SMOOTH_MIN_TILT: f64 = std::f64::consts::PI / 180.0;
+
+/// Rounds of [`smooth_axes`].
+pub const SMOOTH_ROUNDS: usize = 3;
+
+/// Smooths the tool axes of a run of tools (`axes[k]`, each placed from its
+/// guide point by `place`, which returns `None` for a tool that cannot be
+/// placed or collides): in [`SMOOTH_ROUNDS`] rounds, each interior axis whose
+/// own and neighbours' tilts are at least [`SMOOTH_MIN_TILT`] is replaced by
+/// `(u[k-1] + 2 u[k] + u[k+1])` normalised when its tool is placed and clear
+/// and it stays within one angular step ([`axis_steps`] of `max_angle_step`,
+/// `max_azimuth_step`) of both neighbours. The ends are kept. Returns the new
+/// axes and how many changed.
+///
+/// ```
+/// use scallop_geom::Vec3;
+/// use scallop_rough5::smooth_axes;
+/// let tilt = |deg: f64, az: f64| {
+///     let (t, a) = (deg.to_radians(), az.to_radians());
+///     Vec3::new(t.sin() * a.cos(), t.sin() * a.sin(), t.cos())
+/// };
+/// // An axis at 8 deg whose azimuth zigzags by 4 deg.
+/// let axes: Vec<Vec3> = (0..9).map(|k| tilt(8.0, if k % 2 == 0 { -5.0 } else { -9.0 })).collect();
+/// let (out, changed) = smooth_axes(&axes, (2f64.to_radians(), 5f64.to_radians()), &|_, u| Some(*u));
+/// assert!(changed > 0);
+/// let swing = |a: &[Vec3]| a.windows(2).map(|w| (w[1].y.atan2(w[1].x) - w[0].y.atan2(w[0].x)).abs()).sum::<f64>();
+/// assert!(swing(&out) < 0.5 * swing(&axes));
+/// ```
+#[must_use]
+pub fn smooth_axes(
+    axes: &[Vec3],
+    (max_angle_step, max_azimuth_step): (f64, f64),
+    place: &dyn Fn(usize, &Vec3) -> Option<Vec3>,
+) -> (Vec<Vec3>, usize) {
+    let mut out = axes.to_vec();
+    let n = out.len();
+    let tilted = |u: &Vec3| u.angle(&Vec3::z()) >= SMOOTH_MIN_TILT;
+    let mut changed = vec![false; n];
+    for _ in 0..SMOOTH_ROUNDS {
+        for k in 1..n.saturating_sub(1) {
+            let (a, u, b) = (out[k - 1], out[k], out[k + 1]);
+            if !(tilted(&a) && tilted(&u) && tilted(&b)) {
+                continue;
+            }
+            let v = (a + u * 2.0 + b).normalize();
+            if !tilted(&v) || v.angle(&u) < 1e-9 {
+                continue;
+            }
+            let within = |x: &Vec3| axis_steps(x, &v, max_angle_step, max_azimuth_step) <= 1;
+            if !(within(&a) && within(&b)) {
+                continue;
+            }
+            if let Some(placed) = place(k, &v) {
+                out[k] = placed;
+                changed[k] = true;
+            }
+        }
+    }
+    let count = changed.iter().filter(|c| **c).count();
+    (out, count)
+}
+
+/// [`smooth_axes`] on a placed run: each new axis placed from its pair's
+/// guide point and checked against the flanks.
+fn smooth_run(placer: &Placer, body: &BodyCheck, run: &mut [Cl], settings: &Rough5Settings) {
+    let axes: Vec<Vec3> = run.iter().map(|c| c.place.axis).collect();
+    let placed = std::cell::RefCell::new(vec![None; run.len()]);
+    let place = |k: usize, u: &Vec3| {
+        let p = placer.place(&run[k].sync.path, u)?;
+        if body.collides(&p.tip, &p.axis) {
+            return None;
+        }
+        placed.borrow_mut()[k] = Some(p);
+        Some(p.axis)
+    };
+    let (_, changed) = smooth_axes(&axes, (settings.max_angle_step, settings.max_azimuth_step), &place);
+    if changed == 0 {
+        return;
+    }
+    for (c, p) in run.iter_mut().zip(placed.into_inner()) {
+        if let Some(p) = p {
+            c.place = p;
+            c.sync.axis = p.axis;
+        }
+    }
 }
 
 /// The corner radius r of a torus (R of a ball, 0 of a flat tool).
