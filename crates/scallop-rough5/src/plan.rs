@@ -463,6 +463,7 @@ pub fn plan_rough5_in(
     out.flat = Emitter::flat_radius(cutter);
     out.radius = cutter.radius();
     out.air = air;
+    out.smooth = settings.smooth_axes;
     out.sides = Some(Sides { stock: *stock, pieces: body_pieces(cutter) });
     let mut reports = Vec::new();
     // The first level is entered from above the stock: the box's top, or the blank's.
@@ -521,12 +522,6 @@ pub fn plan_rough5_in(
             report.translated = moved;
             report.level = j;
             report.pass = m;
-            let mut runs = runs;
-            if settings.smooth_axes {
-                for run in &mut runs {
-                    smooth_run(&placer, &body, run, settings);
-                }
-            }
             for run in &runs {
                 top = run.iter().fold(top, |t, c| t.max(c.place.tip.z));
                 let local = above.as_ref().filter(|_| settings.local_entry).and_then(|a| local_entry(a, &run[0]));
@@ -1517,12 +1512,16 @@ pub fn smooth_axes(
     (out, count)
 }
 
-/// [`smooth_axes`] on a placed run: each new axis placed from its pair's
-/// guide point and checked against the flanks.
-fn smooth_run(placer: &Placer, body: &BodyCheck, run: &mut [Cl], settings: &Rough5Settings) {
+/// [`smooth_axes`] on a placed run but its point `keep` (where the tool
+/// reached the level, which a closed run's lap starts and ends at): each new
+/// axis placed from its pair's guide point and checked against the flanks.
+fn smooth_run(placer: &Placer, body: &BodyCheck, run: &mut [Cl], keep: usize, settings: &Rough5Settings) {
     let axes: Vec<Vec3> = run.iter().map(|c| c.place.axis).collect();
     let placed = std::cell::RefCell::new(vec![None; run.len()]);
     let place = |k: usize, u: &Vec3| {
+        if k == keep {
+            return None;
+        }
         let p = placer.place(&run[k].sync.path, u)?;
         if body.collides(&p.tip, &p.axis) {
             return None;
@@ -1663,6 +1662,9 @@ struct Emitter {
     /// go at the rapid rate down to and up from where the tool's flutes are
     /// above it.
     air: Option<Air>,
+    /// Whether the runs' axes are smoothed ([`Rough5Settings::smooth_axes`]
+    /// in [`plan_rough5_in`]; not for a single pass).
+    smooth: bool,
     /// The role of the moves pushed now, and of every move pushed.
     role: MoveRole,
     roles: Vec<MoveRole>,
@@ -1685,6 +1687,7 @@ impl Emitter {
             sides: None,
             held: None,
             air: None,
+            smooth: false,
             role: MoveRole::Cut,
             roles: Vec::new(),
         }
@@ -1790,6 +1793,17 @@ impl Emitter {
         // The tool is now at run[start].
         let start = if linked { 0 } else { self.enter(run, entry_z, (placer, body)) };
         self.set_role(MoveRole::Cut);
+        // The axes smoothed but where the tool stands now (the lap's start and
+        // end, and the tool the next link leaves from).
+        let smoothed;
+        let run = if self.smooth {
+            let mut copy = run.to_vec();
+            smooth_run(placer, body, &mut copy, start, &self.settings);
+            smoothed = copy;
+            &smoothed[..]
+        } else {
+            run
+        };
         let n = run.len();
         let closed = n > 2 && (run[0].place.tip - run[n - 1].place.tip).norm() < 1e-9;
         if closed {
