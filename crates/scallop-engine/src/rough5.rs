@@ -203,7 +203,9 @@ pub struct TimeShare {
     pub dynamics_s: f64,
     /// What the rotary axes' limits cost (s): the time less that with their
     /// limits lifted (a marginal figure: where both groups bind, the two
-    /// costs overlap).
+    /// costs overlap; it can be slightly negative, since lifting a group's
+    /// limits shortens the blocks where only that group moves, and the
+    /// look-ahead then slows down into them).
     pub rotary_axes_s: f64,
     /// What the linear axes' limits cost (s), likewise.
     pub linear_axes_s: f64,
