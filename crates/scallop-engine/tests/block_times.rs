@@ -43,7 +43,11 @@ fn the_blocks_add_up_to_the_program_time_and_name_what_sets_them() {
     }
     // The straight feed with the axis +Z: the feed sets its velocity-limited time.
     let straight: Vec<_> = blocks.iter().filter(|b| b.cl_index == 2 && b.length_mm > 1.0).collect();
-    assert!(straight.len() == 1 && straight[0].bound == "feed" && straight[0].at_velocity_s == straight[0].at_feed_s);
+    assert!(
+        straight.len() == 1
+            && straight[0].bound == "feed"
+            && (straight[0].at_velocity_s - straight[0].at_feed_s).abs() < 1e-12
+    );
     // The turn on the spot (the C table turned on the pole, then the A tilt;
     // the machine layer's blocks of one CL record): the tip does not move, a
     // rotary axis or the orientation feed sets its velocity-limited time; the

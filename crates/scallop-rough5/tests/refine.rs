@@ -278,11 +278,11 @@ fn helices_start_where_the_tool_reaches_the_blank() {
             .fold(f64::INFINITY, f64::min)
     };
     let mut checked = 0;
-    for i in 1..moves.len() {
+    for (i, m) in moves.iter().enumerate().skip(1) {
         // The first move of an entry after its approach, the entry going on.
         let first = plan.roles[i] == MoveRole::Entry
             && plan.roles[i - 1] == MoveRole::Approach
-            && moves[i].kind == MoveKind::Feed
+            && m.kind == MoveKind::Feed
             && plan.roles.get(i + 1) == Some(&MoveRole::Entry);
         if first && over(i - 1) > AIR_MARGIN {
             assert!(
