@@ -9,7 +9,9 @@ use std::time::Instant;
 
 use clap::{Args, ValueEnum};
 use scallop_cutter::Cutter;
-use scallop_engine::{OnMachine, Posted, Rough5Metrics, TcpWords, post_tcp, rough5_metrics, rough5_settings};
+use scallop_engine::{
+    OnMachine, Posted, Rough5Metrics, TcpWords, TimeShare, post_tcp, rough5_metrics, rough5_settings, time_breakdown,
+};
 use scallop_guides::GuideSettings;
 use scallop_machine::Kinematics;
 use scallop_parts::FaceTag;
@@ -67,6 +69,8 @@ pub enum RefineArg {
     BottomNormal,
     /// Feeds, links and plunges outside the in-process stock (by `--air-clearance`) written at `--air-feed`.
     AirMoves,
+    /// The tilted tool axes of each run smoothed where the smoothed tool is placed clear of the flanks.
+    AxisSmoothing,
     /// All of them: the program of 28 Nov 2026.
     All,
 }
@@ -228,6 +232,10 @@ pub struct Rough5Args {
     /// Print the report as JSON on stdout.
     #[arg(long)]
     json: bool,
+    /// Also write `block_times.csv`: every block of the machine program with its time and what sets it
+    /// (the feed, the orientation feed or an axis's velocity; docs/rough5.md, "Where the machine time goes").
+    #[arg(long)]
+    block_times: bool,
 }
 
 #[derive(Serialize)]
@@ -303,6 +311,8 @@ struct Report {
     /// The pass starts entered by a plunge into material (tool tips, mm).
     plunged_at: Vec<[f64; 3]>,
     metrics: Rough5Metrics,
+    /// The machine time by what the moves are for and how they are written, and what sets it.
+    time_breakdown: Vec<TimeShare>,
     levels: Vec<LevelJson>,
     passes: Vec<PassJson>,
     /// The setups of a 3-axis baseline (empty for the 5-axis programs).
@@ -379,6 +389,7 @@ fn settings(args: &Rough5Args, part: &TestPart) -> CliResult<Rough5Settings> {
         spatial: args.correction.contains(&CorrectionArg::Spatial) && !matches!(args.tilt, TiltArg::Zero),
         translate: on(RefineArg::Translation),
         local_entry: on(RefineArg::LocalEntry),
+        smooth_axes: on(RefineArg::AxisSmoothing),
         round_corners: on(RefineArg::Corners),
         root_rest: on(RefineArg::RootRest),
         bottom_normal: on(RefineArg::BottomNormal),
@@ -479,6 +490,9 @@ pub fn run(args: &Rough5Args) -> CliResult<()> {
     let mut out = OutputSet::begin(&args.output, "rough5")?;
     if let Ok(p) = &posted {
         out.write("program.nc", p.text.as_bytes())?;
+        if args.block_times {
+            out.write("block_times.csv", block_csv(&plan, p).as_bytes())?;
+        }
     }
     out.write("toolpath.cl", scallop_io::cl::write_cl(&plan.toolpath).as_bytes())?;
     let json = serde_json::to_string_pretty(&report).map_err(|e| Failure::Io(e.into()))?;
@@ -519,6 +533,8 @@ fn report(
     seconds: [f64; 2],
 ) -> Report {
     let metrics = rough5_metrics(plan, proof, post.as_ref().ok().copied());
+    let breakdown =
+        post.as_ref().map_or_else(|_| Vec::new(), |p| time_breakdown(&p.block_times, &|i| move_label(plan, i)));
     let deg = f64::to_degrees;
     Report {
         command: "rough5",
@@ -540,6 +556,7 @@ fn report(
         entries: EntriesJson::of(&plan.entries),
         plunged_at: plan.plunged_at.iter().map(|p| [p.x, p.y, p.z]).collect(),
         metrics,
+        time_breakdown: breakdown,
         levels: plan
             .levels
             .iter()
@@ -570,6 +587,44 @@ fn report(
         plan_seconds: seconds[0],
         proof_seconds: seconds[1],
     }
+}
+
+/// What move `i` of the plan is for and how it is written: `role kind`, with
+/// `(air)` for a move at the air feed (`cut feed`, `retract link`, `entry
+/// feed (air)`, ...); the kind alone without roles (the baselines).
+fn move_label(plan: &Rough5Plan, i: usize) -> String {
+    let Some(m) = plan.toolpath.moves().get(i) else { return "other".into() };
+    let kind = format!("{:?}", m.kind).to_lowercase();
+    let air = if scallop_rough5::is_air_move(&plan.toolpath, i) { " (air)" } else { "" };
+    match plan.roles.get(i) {
+        Some(r) => format!("{} {kind}{air}", r.name()),
+        None => format!("{kind}{air}"),
+    }
+}
+
+/// `block_times.csv`: one line per block of the machine program.
+fn block_csv(plan: &Rough5Plan, posted: &Posted) -> String {
+    let mut s = String::from(
+        "block,move,label,length_mm,feed_mm_min,time_s,at_feed_s,at_velocity_s,bound,rotary_only_s,linear_only_s\n",
+    );
+    for b in &posted.block_times {
+        let _ = writeln!(
+            s,
+            "{},{},{},{:.4},{:.0},{:.6},{:.6},{:.6},{},{:.6},{:.6}",
+            b.block,
+            b.cl_index,
+            move_label(plan, b.cl_index),
+            b.length_mm,
+            b.feed_mm_min,
+            b.time_s,
+            b.at_feed_s,
+            b.at_velocity_s,
+            b.bound,
+            b.rotary_only_s,
+            b.linear_only_s
+        );
+    }
+    s
 }
 
 /// The largest tilt of the tool axis from +Z the machine allows: the largest
@@ -649,6 +704,7 @@ fn baseline(
         passes: Vec::new(),
         estimated_time: plan.estimated_time,
         air: None,
+        roles: Vec::new(),
     };
     Ok((as_plan, setups))
 }

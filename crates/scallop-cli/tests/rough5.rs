@@ -15,11 +15,20 @@ fn rough5_writes_a_proven_program_and_its_metrics() {
     succeeded(
         scallop()
             .args(["rough5", "--part", "pocket", "--tilt", "zero", "--ap", "6", "--voxel", "1.5", "--step", "2"])
-            .args(["--resolution", "1", "--json", "-o"])
+            .args(["--resolution", "1", "--json", "--block-times", "-o"])
             .arg(&dir),
     );
     let report = read_json(&dir.join("report.json"));
     let m = &report["metrics"];
+    // The machine time by role and kind adds up to the machine time; block_times.csv has every
+    // block but the first (the start).
+    let shares = report["time_breakdown"].as_array().expect("time_breakdown");
+    let summed: f64 = shares.iter().map(|s| s["time_s"].as_f64().unwrap_or(f64::NAN)).sum();
+    let machining = m["machining_time_s"].as_f64().unwrap_or(f64::NAN);
+    assert!((summed - machining).abs() <= 1e-6 * machining, "{summed} against {machining}");
+    assert!(shares.iter().any(|s| s["label"] == "cut feed"), "{shares:?}");
+    let csv = std::fs::read_to_string(dir.join("block_times.csv")).expect("block_times.csv");
+    assert_eq!(csv.lines().count() as u64, report["blocks"].as_u64().unwrap_or(0), "a header and one line per block");
     let num = |k: &str| m[k].as_f64().unwrap_or(f64::NAN);
     assert!(num("remaining_percent") > 0.0 && num("remaining_percent") < 100.0);
     assert!(num("gouge_depth_mm") <= 1.0);

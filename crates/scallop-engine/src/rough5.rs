@@ -73,6 +73,186 @@ pub fn program_time(
     Ok(t)
 }
 
+/// One block of a machine program and what sets its time
+/// ([`block_times`]).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct BlockTime {
+    /// The block's index in the program.
+    pub block: usize,
+    /// The CL record (toolpath move) it comes from.
+    pub cl_index: usize,
+    /// A rapid (axis by axis, stop to stop).
+    pub rapid: bool,
+    /// Tip travel (mm).
+    pub length_mm: f64,
+    /// Programmed feed (mm/min; the rapid's: 0).
+    pub feed_mm_min: f64,
+    /// Its time by the time model (s).
+    pub time_s: f64,
+    /// The tip's travel at the programmed feed (s; a rapid: 0).
+    pub at_feed_s: f64,
+    /// The time at the velocity limits alone (s, at least `at_feed_s`; a
+    /// rapid: its whole time).
+    pub at_velocity_s: f64,
+    /// What sets `at_velocity_s`: `feed`, `orientation` (the tool axis's turn
+    /// at the NC's reference radius) or an axis's name (a rapid: the axis
+    /// whose stop-to-stop profile is the longest).
+    pub bound: String,
+    /// Its time with the linear axes' velocity, acceleration and jerk limits
+    /// lifted, the rotary axes' kept (s; a rapid: its time).
+    pub rotary_only_s: f64,
+    /// Its time with the rotary axes' limits lifted, the linear axes' kept.
+    pub linear_only_s: f64,
+}
+
+/// Every block of `program` with its time and what sets it: the feed runs by
+/// the look-ahead model ([`scallop_machine::time::path_time`]), the rapids
+/// axis by axis, as [`program_time`] adds them up (the times sum to its
+/// total). A feed block's time splits into the tip's travel at the
+/// programmed feed, the rest of its velocity-limited time (the binding
+/// axis's velocity or the orientation feed: [`scallop_machine::time::velocity_bound`]),
+/// and what the acceleration and jerk limits add (`time_s - at_velocity_s`).
+///
+/// # Errors
+/// The time model refuses a run (a feed that is not positive).
+pub fn block_times(
+    kin: &Kinematics,
+    program: &MachineProgram,
+) -> Result<Vec<BlockTime>, scallop_machine::MachineError> {
+    use scallop_machine::AxisKind;
+    use scallop_machine::time::{VelocityBound, path_time_lifting, rapid_bound, velocity_bound};
+    let machine = kin.machine();
+    let name = |i: usize| machine.axes().get(i).map_or_else(|| format!("axis {i}"), |a| a.name.clone());
+    let b = &program.blocks;
+    let mut out = Vec::with_capacity(b.len());
+    let mut k = 1;
+    while k < b.len() {
+        let length = (b[k].pose.tip - b[k - 1].pose.tip).norm();
+        if b[k].motion == Motion::Rapid {
+            let t = rapid_time(machine, &b[k - 1].joints, &b[k].joints);
+            out.push(BlockTime {
+                block: k,
+                cl_index: b[k].cl_index,
+                rapid: true,
+                length_mm: length,
+                feed_mm_min: 0.0,
+                time_s: t,
+                at_feed_s: 0.0,
+                at_velocity_s: t,
+                bound: rapid_bound(machine, &b[k - 1].joints, &b[k].joints).map_or_else(|| "none".into(), name),
+                rotary_only_s: t,
+                linear_only_s: t,
+            });
+            k += 1;
+            continue;
+        }
+        let start = k - 1;
+        while k < b.len() && b[k].motion != Motion::Rapid {
+            k += 1;
+        }
+        let joints: Vec<Joints> = b[start..k].iter().map(|x| x.joints).collect();
+        let feeds: Vec<f64> = b[start + 1..k].iter().map(|x| x.feed).collect();
+        let r = path_time(kin, &joints, &feeds)?;
+        let group = |kind: AxisKind| -> Vec<usize> {
+            machine.axes().iter().enumerate().filter(|(_, a)| a.kind == kind).map(|(i, _)| i).collect()
+        };
+        let rotary_only = path_time_lifting(kin, &joints, &feeds, &group(AxisKind::Linear))?;
+        let linear_only = path_time_lifting(kin, &joints, &feeds, &group(AxisKind::Rotary))?;
+        for (j, profile) in r.blocks.iter().enumerate() {
+            let i = start + 1 + j;
+            let (t_feed, t_vel, bound) = velocity_bound(kin, &b[i - 1].joints, &b[i].joints, b[i].feed);
+            out.push(BlockTime {
+                block: i,
+                cl_index: b[i].cl_index,
+                rapid: false,
+                length_mm: (b[i].pose.tip - b[i - 1].pose.tip).norm(),
+                feed_mm_min: b[i].feed,
+                time_s: profile.time,
+                at_feed_s: t_feed,
+                at_velocity_s: t_vel,
+                bound: match bound {
+                    VelocityBound::Feed => "feed".into(),
+                    VelocityBound::Orientation => "orientation".into(),
+                    VelocityBound::Axis(a) => name(a),
+                },
+                rotary_only_s: rotary_only.blocks[j].time,
+                linear_only_s: linear_only.blocks[j].time,
+            });
+        }
+    }
+    Ok(out)
+}
+
+/// The machine time of the blocks labelled alike ([`time_breakdown`]).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TimeShare {
+    /// The label (for `scallop rough5`: the move's role and kind).
+    pub label: String,
+    /// Blocks.
+    pub blocks: usize,
+    /// Tip travel (mm).
+    pub length_mm: f64,
+    /// Machine time (s).
+    pub time_s: f64,
+    /// The tip's travel at the programmed feeds (s).
+    pub at_feed_s: f64,
+    /// The velocity-limited time beyond the feed, by what sets it (s): an
+    /// axis's name or `orientation`; the rapids' whole time by their slowest axis.
+    pub velocity_s: Vec<(String, f64)>,
+    /// What the acceleration and jerk limits add (s).
+    pub dynamics_s: f64,
+    /// What the rotary axes' limits cost (s): the time less that with their
+    /// limits lifted (a marginal figure: where both groups bind, the two
+    /// costs overlap; it can be slightly negative, since lifting a group's
+    /// limits shortens the blocks where only that group moves, and the
+    /// look-ahead then slows down into them).
+    pub rotary_axes_s: f64,
+    /// What the linear axes' limits cost (s), likewise.
+    pub linear_axes_s: f64,
+}
+
+/// Sums `blocks` by `label(cl_index)`, in the order the labels first occur.
+#[must_use]
+pub fn time_breakdown(blocks: &[BlockTime], label: &dyn Fn(usize) -> String) -> Vec<TimeShare> {
+    let mut shares: Vec<TimeShare> = Vec::new();
+    for b in blocks {
+        let l = label(b.cl_index);
+        let k = match shares.iter().position(|s| s.label == l) {
+            Some(k) => k,
+            None => {
+                shares.push(TimeShare {
+                    label: l,
+                    blocks: 0,
+                    length_mm: 0.0,
+                    time_s: 0.0,
+                    at_feed_s: 0.0,
+                    velocity_s: Vec::new(),
+                    dynamics_s: 0.0,
+                    rotary_axes_s: 0.0,
+                    linear_axes_s: 0.0,
+                });
+                shares.len() - 1
+            }
+        };
+        let s = &mut shares[k];
+        s.blocks += 1;
+        s.length_mm += b.length_mm;
+        s.time_s += b.time_s;
+        s.at_feed_s += b.at_feed_s;
+        s.dynamics_s += b.time_s - b.at_velocity_s;
+        s.rotary_axes_s += b.time_s - b.linear_only_s;
+        s.linear_axes_s += b.time_s - b.rotary_only_s;
+        let extra = b.at_velocity_s - b.at_feed_s;
+        if extra > 0.0 {
+            match s.velocity_s.iter_mut().find(|(n, _)| *n == b.bound) {
+                Some((_, t)) => *t += extra,
+                None => s.velocity_s.push((b.bound.clone(), extra)),
+            }
+        }
+    }
+    shares
+}
+
 /// A toolpath on a 5-axis machine: its CL records, the joint-space program
 /// (joint limits checked, branches and poles handled) and its time.
 #[derive(Debug, Clone)]
@@ -130,6 +310,8 @@ pub struct Posted {
     pub time: ProgramTime,
     /// Time lost to each axis's limits (s), by axis name.
     pub axis_time_lost: Vec<(String, f64)>,
+    /// Every block's time and what sets it ([`block_times`]).
+    pub block_times: Vec<BlockTime>,
 }
 
 /// The toolpath through the machine (joint limits checked) and the dialect in
@@ -158,12 +340,15 @@ pub fn post_tcp(kin: &Kinematics, path: &Toolpath, dialect: &Dialect, words: &Tc
     let trip = check_replay(&replayed, &run.records, kin, dialect, options.tol_pos, options.tol_ang)
         .map_err(|e| output(format!("the program does not replay to the CL path: {e}")))?;
     let axis_time_lost = kin.machine().axes().iter().zip(run.time.lost).map(|(a, t)| (a.name.clone(), t)).collect();
+    let block_times = block_times(kin, &run.program)
+        .map_err(|e| EngineError::Output { what: format!("time model: {e}"), fix: "report it".into() })?;
     Ok(Posted {
         text,
         blocks: run.program.blocks.len(),
         replay_tip_deviation: trip.max_tip_deviation,
         time: run.time,
         axis_time_lost,
+        block_times,
     })
 }
 

@@ -207,22 +207,41 @@ pub struct TimeReport {
 /// [`MachineError::BadInput`] when `feeds` does not have one entry per block or a feed
 /// is not positive.
 pub fn path_time(kin: &Kinematics, joints: &[Joints], feeds: &[f64]) -> Result<TimeReport, MachineError> {
-    let mut report = profile(kin, joints, feeds, None)?;
+    let mut report = profile(kin, joints, feeds, 0)?;
     for i in 0..kin.machine().axes().len().min(5) {
-        let relaxed = profile(kin, joints, feeds, Some(i))?;
+        let relaxed = profile(kin, joints, feeds, 1 << i)?;
         report.axis_time_lost[i] = (report.total - relaxed.total).max(0.0);
     }
     Ok(report)
 }
 
-/// The look-ahead profile of [`path_time`]; `relax` lifts one axis's dynamic limits
-/// (velocity, acceleration, jerk) to measure the time that axis costs.
-fn profile(
+/// The look-ahead profile of [`path_time`] with the velocity, acceleration and jerk
+/// limits of the axes `lifted` (joint order) lifted, every other limit kept: the time
+/// those axes cost together is [`path_time`]'s total less this one's (per block, the
+/// blocks' times). `axis_time_lost` is left at zero.
+///
+/// ```
+/// use scallop_machine::{Kinematics, Machine, Joints, time::{path_time, path_time_lifting}};
+/// let k = Kinematics::new(&Machine::builtin("ucp710").unwrap(), 0.0);
+/// let q = [Joints::new(0.0, 0.0, 50.0, 0.0, 0.0), Joints::new(100.0, 0.0, 50.0, 0.0, 0.0)];
+/// let (all, free) = (path_time(&k, &q, &[2400.0]).unwrap(), path_time_lifting(&k, &q, &[2400.0], &[0]).unwrap());
+/// assert!(free.total < all.total && (free.total - 2.5).abs() < 1e-3);
+/// ```
+///
+/// # Errors
+/// As [`path_time`].
+pub fn path_time_lifting(
     kin: &Kinematics,
     joints: &[Joints],
     feeds: &[f64],
-    relax: Option<usize>,
+    lifted: &[usize],
 ) -> Result<TimeReport, MachineError> {
+    profile(kin, joints, feeds, lifted.iter().filter(|&&i| i < 32).fold(0, |m, &i| m | (1 << i)))
+}
+
+/// The look-ahead profile of [`path_time`]; `relax` (bit `i` for axis `i`) lifts axes' dynamic limits
+/// (velocity, acceleration, jerk) to measure the time that axis costs.
+fn profile(kin: &Kinematics, joints: &[Joints], feeds: &[f64], relax: u32) -> Result<TimeReport, MachineError> {
     let n = joints.len().saturating_sub(1);
     if feeds.len() != n || feeds.iter().any(|f| !(f.is_finite() && *f > 0.0)) {
         return Err(MachineError::BadInput {
@@ -297,12 +316,78 @@ fn profile(
     })
 }
 
+/// What sets a feed block's time at its velocity limits alone (before acceleration and
+/// jerk): the programmed tip feed, the orientation feed (`nc.r_ref` times the tool axis's
+/// turn, at the same feed), or one axis's velocity (joint order).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VelocityBound {
+    /// The tip's programmed feed.
+    Feed,
+    /// The tool axis's turn at `nc.r_ref` from the tip, at the programmed feed.
+    Orientation,
+    /// The velocity limit of axis `i`.
+    Axis(usize),
+}
+
+/// The velocity-limited time of the feed block `qa -> qb` at `feed` (mm/min), as
+/// [`path_time`] takes it (spec 8.1): `(t_feed, t_vel, bound)` with `t_feed` the tip's
+/// length over the feed, `t_vel >= t_feed` the largest of that, the orientation feed's
+/// time and every axis's travel over its velocity limit, and the term that gives it.
+/// [`path_time`]'s block time is at least `t_vel`; what it takes beyond is the
+/// acceleration and jerk limits' (the look-ahead, the junction caps).
+///
+/// ```
+/// use scallop_machine::{Kinematics, Machine, Joints, time::{velocity_bound, VelocityBound}};
+/// let k = Kinematics::new(&Machine::builtin("ucp710").unwrap(), 0.0);
+/// let (a, b) = (Joints::new(0.0, 0.0, 50.0, 0.0, 0.0), Joints::new(10.0, 0.0, 50.0, 0.0, 0.0));
+/// let (t_feed, t_vel, bound) = velocity_bound(&k, &a, &b, 2400.0);
+/// assert!((t_feed - 0.25).abs() < 1e-9 && t_vel == t_feed && bound == VelocityBound::Feed);
+/// ```
+#[must_use]
+pub fn velocity_bound(kin: &Kinematics, qa: &Joints, qb: &Joints, feed: f64) -> (f64, f64, VelocityBound) {
+    let machine = kin.machine();
+    let f = feed / 60.0;
+    let (pa, pb) = (kin.fk(qa), kin.fk(qb));
+    let t_feed = (pb.tip - pa.tip).norm() / f;
+    let dphi = pa.axis.cross(&pb.axis).norm().atan2(pa.axis.dot(&pb.axis));
+    let mut best = (t_feed, VelocityBound::Feed);
+    let t_orient = machine.nc().r_ref * dphi / f;
+    if t_orient > best.0 {
+        best = (t_orient, VelocityBound::Orientation);
+    }
+    for i in 0..machine.axes().len().min(5) {
+        let t = (qb[i] - qa[i]).abs() / dynamics(machine, i, 0).0;
+        if t > best.0 {
+            best = (t, VelocityBound::Axis(i));
+        }
+    }
+    (t_feed, best.0, best.1)
+}
+
+/// The axis whose stop-to-stop profile sets the time of the rapid `qa -> qb`
+/// ([`rapid_time`]); `None` when no axis moves.
+#[must_use]
+pub fn rapid_bound(machine: &crate::Machine, qa: &Joints, qb: &Joints) -> Option<usize> {
+    let mut best: Option<(f64, usize)> = None;
+    for (i, axis) in machine.axes().iter().enumerate() {
+        let d = (qb[i] - qa[i]).abs();
+        if d > 0.0 {
+            let l = Limits { v: axis.dynamics.rapid, a: axis.dynamics.amax, j: axis.dynamics.jmax };
+            let t = stop_to_stop(d, &l, TimeModel::SCurve).0;
+            if best.is_none_or(|(b, _)| t > b) {
+                best = Some((t, i));
+            }
+        }
+    }
+    best.map(|(_, i)| i)
+}
+
 /// Velocity, acceleration and jerk limits of axis `i`, scaled by
-/// [`tol::RELAXED_AXIS_FACTOR`] when `relax` names it (finite, so the S-curve formulas
+/// [`tol::RELAXED_AXIS_FACTOR`] when `relax` has its bit (finite, so the S-curve formulas
 /// never see `inf / inf`).
-fn dynamics(machine: &crate::Machine, i: usize, relax: Option<usize>) -> (f64, f64, f64) {
+fn dynamics(machine: &crate::Machine, i: usize, relax: u32) -> (f64, f64, f64) {
     let d = &machine.axes()[i].dynamics;
-    let f = if relax == Some(i) { tol::RELAXED_AXIS_FACTOR } else { 1.0 };
+    let f = if relax & (1 << i) != 0 { tol::RELAXED_AXIS_FACTOR } else { 1.0 };
     (d.vmax * f, d.amax * f, d.jmax * f)
 }
 
@@ -314,7 +399,7 @@ fn junction_cap(
     s: &[f64],
     feeds: &[f64],
     k: usize,
-    relax: Option<usize>,
+    relax: u32,
 ) -> f64 {
     let machine = kin.machine();
     let feed_cap = feeds[k - 1].min(feeds[k]) / 60.0;

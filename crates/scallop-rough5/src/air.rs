@@ -78,6 +78,8 @@ pub struct AirMoves {
     pub length: f64,
     /// Cutting moves of the input that were cut into pieces.
     pub split: usize,
+    /// For each move of `toolpath`, the input move it is (a piece of).
+    pub from: Vec<usize>,
 }
 
 /// The flutes of `cutter` grown by `c` (a superset of every point within `c`
@@ -197,6 +199,7 @@ pub fn air_moves(
     let mut out = Toolpath::new(path.feed);
     out.plunge_feed = path.plunge_feed;
     let (mut count, mut length) = (0, 0.0);
+    let mut from = Vec::with_capacity(moves.len());
     let mut k = 0;
     while k < pieces.len() {
         let p = pieces[k];
@@ -217,10 +220,11 @@ pub fn air_moves(
             Some(arc) => out.push_arc_with_axis(m, p.tool.axis, arc),
             _ => out.push_with_axis(m, p.tool.axis),
         }
+        from.push(p.from);
         k = last + 1;
     }
     out.set_feed_from(None);
-    Ok(AirMoves { toolpath: out, moves: count, length, split })
+    Ok(AirMoves { toolpath: out, moves: count, length, split, from })
 }
 
 /// Whether move `index` of `path` is an air move: a feed, link or plunge

@@ -85,9 +85,9 @@ pub use orient::{
 };
 pub use place::{Feature, Placement, Placer, tool_frame};
 pub use plan::{
-    AIR_MARGIN, AIR_STEP, AirReport, LevelReport, PassReport, Rough5Plan, Rough5Settings, SIDE_MARGIN, SinglePass,
-    TRANSLATION_MAX, TRANSLATION_SLOPE, bottom_normal_min_slope, limit_step, plan_rough5, plan_rough5_in,
-    plan_single_pass, round_corners, thin_vertical,
+    AIR_MARGIN, AIR_STEP, AirReport, LevelReport, MoveRole, PassReport, Rough5Plan, Rough5Settings, SIDE_MARGIN,
+    SMOOTH_MIN_TILT, SMOOTH_ROUNDS, SinglePass, TRANSLATION_MAX, TRANSLATION_SLOPE, bottom_normal_min_slope,
+    limit_step, plan_rough5, plan_rough5_in, plan_single_pass, round_corners, smooth_axes, thin_vertical,
 };
 pub use prove::{Proof, ProofSettings, prove, prove_from_blank, prove_with_faces};
 pub use radius::{apparent_contour_radius, effective_radius, exact_scallop, scallop_height, swept_profile};

@@ -124,6 +124,11 @@ pub struct Rough5Settings {
     /// along an impeller's channel the ramp from the highest point circles
     /// down through the air (docs/rough5.md, "The impeller, sixth session").
     pub local_entry: bool,
+    /// Whether the tilted axes of each run are smoothed ([`smooth_axes`]):
+    /// an axis that zigzags by a fraction of a degree makes the C table of a
+    /// table-table machine swing back and forth by degrees at small tilts
+    /// (docs/rough5.md, "Where the machine time goes").
+    pub smooth_axes: bool,
     /// Whether the vertical stretches of every pass are written in long
     /// blocks ([`thin_vertical`]) and their corners rounded
     /// ([`round_corners`]): the convex corners of the inner passes by a fillet
@@ -194,6 +199,7 @@ impl Rough5Settings {
             spatial: false,
             translate: false,
             local_entry: false,
+            smooth_axes: false,
             round_corners: false,
             root_rest: false,
             bottom_normal: false,
@@ -206,7 +212,7 @@ impl Rough5Settings {
     /// These settings with every refinement of the guide-curve program (the
     /// level repairs of [`LevelOptions`], [`Self::vertical_inside`],
     /// [`Self::vertical_thin_steps`], [`Self::translate`],
-    /// [`Self::local_entry`], [`Self::round_corners`], [`Self::root_rest`]
+    /// [`Self::local_entry`], [`Self::smooth_axes`], [`Self::round_corners`], [`Self::root_rest`]
     /// and [`Self::bottom_normal`]) on or off.
     #[must_use]
     pub fn with_refinements(self, on: bool) -> Self {
@@ -216,6 +222,7 @@ impl Rough5Settings {
             vertical_thin_steps: on,
             translate: on,
             local_entry: on,
+            smooth_axes: on,
             round_corners: on,
             root_rest: on,
             bottom_normal: on,
@@ -306,6 +313,44 @@ pub struct Rough5Plan {
     /// The air moves ([`Rough5Settings::air`]): how many, their length
     /// (mm) and the moves cut into pieces to find them; `None` without.
     pub air: Option<AirReport>,
+    /// What each move of the toolpath is for (empty when unknown).
+    pub roles: Vec<MoveRole>,
+}
+
+/// What a move of a [`Rough5Plan`] is for (its [`MoveKind`] says how it is
+/// written): the machine time is broken down by it (docs/rough5.md, "Where
+/// the machine time goes").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum MoveRole {
+    /// A pass along the level (and its lap).
+    Cut,
+    /// An entry into the level: down a helix, a ramp, from beside the stock,
+    /// or a plunge into material.
+    Entry,
+    /// From the safe height down to where the entry starts.
+    Approach,
+    /// A link between passes on the level.
+    Link,
+    /// Out of the material along the axis, then up to the safe height (a
+    /// retract, and the retract of a departure from the pole).
+    Retract,
+    /// The axis turned about the pole at a small tilt before leaving it.
+    Turn,
+}
+
+impl MoveRole {
+    /// Its name in reports.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            MoveRole::Cut => "cut",
+            MoveRole::Entry => "entry",
+            MoveRole::Approach => "approach",
+            MoveRole::Link => "link",
+            MoveRole::Retract => "retract",
+            MoveRole::Turn => "turn",
+        }
+    }
 }
 
 /// The air moves of a [`Rough5Plan`].
@@ -418,6 +463,7 @@ pub fn plan_rough5_in(
     out.flat = Emitter::flat_radius(cutter);
     out.radius = cutter.radius();
     out.air = air;
+    out.smooth = settings.smooth_axes;
     out.sides = Some(Sides { stock: *stock, pieces: body_pieces(cutter) });
     let mut reports = Vec::new();
     // The first level is entered from above the stock: the box's top, or the blank's.
@@ -552,6 +598,7 @@ pub fn plan_rough5_in(
             estimated_time_before: estimate_time(&out.path, settings.rapid_rate),
         });
         out.path = found.toolpath;
+        out.roles = found.from.iter().map(|&i| out.roles[i]).collect();
     }
     let levels = levels
         .iter()
@@ -574,6 +621,7 @@ pub fn plan_rough5_in(
         plunged_at: out.plunged_at,
         estimated_time,
         air: air_report,
+        roles: out.roles,
     })
 }
 
@@ -1399,6 +1447,100 @@ fn local_entry(above: &Placer, c: &Cl) -> Option<f64> {
     (rise > 0.0).then(|| c.place.tip.z + rise * c.place.axis.z)
 }
 
+/// Axes tilted less than this (rad, 1 deg) from +Z are left as they are by
+/// [`smooth_axes`], and their neighbours too: near the pole the C table's
+/// azimuth is the machine's concern ([`Emitter::departs`]).
+pub const SMOOTH_MIN_TILT: f64 = std::f64::consts::PI / 180.0;
+
+/// Rounds of [`smooth_axes`].
+pub const SMOOTH_ROUNDS: usize = 3;
+
+/// Smooths the tool axes of a run of tools (`axes[k]`, each placed from its
+/// guide point by `place`, which returns `None` for a tool that cannot be
+/// placed or collides): in [`SMOOTH_ROUNDS`] rounds, each interior axis whose
+/// own and neighbours' tilts are at least [`SMOOTH_MIN_TILT`] is replaced by
+/// `(u[k-1] + 2 u[k] + u[k+1])` normalised when its tool is placed and clear
+/// and it stays within one angular step ([`axis_steps`] of `max_angle_step`,
+/// `max_azimuth_step`) of both neighbours. The ends are kept. Returns the new
+/// axes and how many changed.
+///
+/// ```
+/// use scallop_geom::Vec3;
+/// use scallop_rough5::smooth_axes;
+/// let tilt = |deg: f64, az: f64| {
+///     let (t, a) = (deg.to_radians(), az.to_radians());
+///     Vec3::new(t.sin() * a.cos(), t.sin() * a.sin(), t.cos())
+/// };
+/// // An axis at 8 deg whose azimuth zigzags by 4 deg.
+/// let axes: Vec<Vec3> = (0..9).map(|k| tilt(8.0, if k % 2 == 0 { -5.0 } else { -9.0 })).collect();
+/// let (out, changed) = smooth_axes(&axes, (2f64.to_radians(), 5f64.to_radians()), &|_, u| Some(*u));
+/// assert!(changed > 0);
+/// let swing = |a: &[Vec3]| a.windows(2).map(|w| (w[1].y.atan2(w[1].x) - w[0].y.atan2(w[0].x)).abs()).sum::<f64>();
+/// assert!(swing(&out) < 0.5 * swing(&axes));
+/// ```
+#[must_use]
+pub fn smooth_axes(
+    axes: &[Vec3],
+    (max_angle_step, max_azimuth_step): (f64, f64),
+    place: &dyn Fn(usize, &Vec3) -> Option<Vec3>,
+) -> (Vec<Vec3>, usize) {
+    let mut out = axes.to_vec();
+    let n = out.len();
+    let tilted = |u: &Vec3| u.angle(&Vec3::z()) >= SMOOTH_MIN_TILT;
+    let mut changed = vec![false; n];
+    for _ in 0..SMOOTH_ROUNDS {
+        for k in 1..n.saturating_sub(1) {
+            let (a, u, b) = (out[k - 1], out[k], out[k + 1]);
+            if !(tilted(&a) && tilted(&u) && tilted(&b)) {
+                continue;
+            }
+            let v = (a + u * 2.0 + b).normalize();
+            if !tilted(&v) || v.angle(&u) < 1e-9 {
+                continue;
+            }
+            let within = |x: &Vec3| axis_steps(x, &v, max_angle_step, max_azimuth_step) <= 1;
+            if !(within(&a) && within(&b)) {
+                continue;
+            }
+            if let Some(placed) = place(k, &v) {
+                out[k] = placed;
+                changed[k] = true;
+            }
+        }
+    }
+    let count = changed.iter().filter(|c| **c).count();
+    (out, count)
+}
+
+/// [`smooth_axes`] on a placed run but its point `keep` (where the tool
+/// reached the level, which a closed run's lap starts and ends at): each new
+/// axis placed from its pair's guide point and checked against the flanks.
+fn smooth_run(placer: &Placer, body: &BodyCheck, run: &mut [Cl], keep: usize, settings: &Rough5Settings) {
+    let axes: Vec<Vec3> = run.iter().map(|c| c.place.axis).collect();
+    let placed = std::cell::RefCell::new(vec![None; run.len()]);
+    let place = |k: usize, u: &Vec3| {
+        if k == keep {
+            return None;
+        }
+        let p = placer.place(&run[k].sync.path, u)?;
+        if body.collides(&p.tip, &p.axis) {
+            return None;
+        }
+        placed.borrow_mut()[k] = Some(p);
+        Some(p.axis)
+    };
+    let (_, changed) = smooth_axes(&axes, (settings.max_angle_step, settings.max_azimuth_step), &place);
+    if changed == 0 {
+        return;
+    }
+    for (c, p) in run.iter_mut().zip(placed.into_inner()) {
+        if let Some(p) = p {
+            c.place = p;
+            c.sync.axis = p.axis;
+        }
+    }
+}
+
 /// The corner radius r of a torus (R of a ball, 0 of a flat tool).
 fn corner_radius(cutter: &Cutter) -> f64 {
     match *cutter.shape() {
@@ -1520,6 +1662,12 @@ struct Emitter {
     /// go at the rapid rate down to and up from where the tool's flutes are
     /// above it.
     air: Option<Air>,
+    /// Whether the runs' axes are smoothed ([`Rough5Settings::smooth_axes`]
+    /// in [`plan_rough5_in`]; not for a single pass).
+    smooth: bool,
+    /// The role of the moves pushed now, and of every move pushed.
+    role: MoveRole,
+    roles: Vec<MoveRole>,
 }
 
 impl Emitter {
@@ -1539,6 +1687,9 @@ impl Emitter {
             sides: None,
             held: None,
             air: None,
+            smooth: false,
+            role: MoveRole::Cut,
+            roles: Vec::new(),
         }
     }
 
@@ -1547,6 +1698,12 @@ impl Emitter {
             self.held = Some(a);
         }
         self.path.push_with_axis(Move::new(kind, to), axis);
+        self.roles.push(self.role);
+    }
+
+    /// Sets the role of the moves pushed next; returns the one before.
+    fn set_role(&mut self, role: MoveRole) -> MoveRole {
+        std::mem::replace(&mut self.role, role)
     }
 
     /// Whether a cutting move from the pose `from_axis` to `axis` leaves the
@@ -1581,13 +1738,17 @@ impl Emitter {
     fn feed_to(&mut self, to: Point3, axis: Vec3) {
         match self.current() {
             Some((tip, from_axis)) if self.departs(&from_axis, &axis) => {
+                let role = self.set_role(MoveRole::Retract);
                 let out = Emitter::above_at(&tip, &from_axis, self.stock_top);
                 self.push(MoveKind::Link, out, from_axis);
                 let up = self.above(&tip, &from_axis);
                 self.push(MoveKind::Retract, up, from_axis);
                 self.retracts += 1;
+                self.set_role(MoveRole::Approach);
                 self.push(MoveKind::Rapid, self.above(&to, &axis), axis);
+                self.set_role(MoveRole::Entry);
                 self.push(MoveKind::Plunge, to, axis);
+                self.set_role(role);
             }
             _ => self.push(MoveKind::Feed, to, axis),
         }
@@ -1609,6 +1770,7 @@ impl Emitter {
     /// over the tool), or in a blank until the flutes are above it, then
     /// retracts to the safe height.
     fn retract(&mut self, a: &Placement) {
+        let role = self.set_role(MoveRole::Retract);
         let mut out = Emitter::above_at(&a.tip, &a.axis, self.stock_top);
         if let Some(air) = &self.air {
             // At the feed only until the flutes are above the blank.
@@ -1621,6 +1783,7 @@ impl Emitter {
         }
         let up = self.above(&a.tip, &a.axis);
         self.push(MoveKind::Retract, up, a.axis);
+        self.set_role(role);
     }
 
     /// Cuts `run`: linked from the previous run when possible (never for
@@ -1629,6 +1792,18 @@ impl Emitter {
         let linked = !first_of_level && self.last.is_some_and(|a| self.try_link(&a, &run[0], placer, body));
         // The tool is now at run[start].
         let start = if linked { 0 } else { self.enter(run, entry_z, (placer, body)) };
+        self.set_role(MoveRole::Cut);
+        // The axes smoothed but where the tool stands now (the lap's start and
+        // end, and the tool the next link leaves from).
+        let smoothed;
+        let run = if self.smooth {
+            let mut copy = run.to_vec();
+            smooth_run(placer, body, &mut copy, start, &self.settings);
+            smoothed = copy;
+            &smoothed[..]
+        } else {
+            run
+        };
         let n = run.len();
         let closed = n > 2 && (run[0].place.tip - run[n - 1].place.tip).norm() < 1e-9;
         if closed {
@@ -1656,9 +1831,11 @@ impl Emitter {
         if self.departs(&a.place.axis, &b.place.axis)
             && let Some(turn) = self.pole_turn(a, &b.place.axis, checks)
         {
+            let role = self.set_role(MoveRole::Turn);
             for p in turn {
                 self.push(MoveKind::Feed, p.tip, p.axis);
             }
+            self.set_role(role);
         }
     }
 
@@ -1704,7 +1881,9 @@ impl Emitter {
                 && let Some((start, tips)) = self.helix(run, entry_z, placer, body)
             {
                 let axis = run[start].place.axis;
+                let tips = &tips[self.above_blank(tips.iter().map(|t| (t, &axis)))..];
                 self.approach(&tips[0], &axis, 0.0);
+                self.set_role(MoveRole::Entry);
                 for tip in &tips[1..] {
                     self.push(MoveKind::Feed, *tip, axis);
                 }
@@ -1716,8 +1895,10 @@ impl Emitter {
             {
                 // Down beside the stock at the rapid rate (in the air all the way).
                 let over = self.above(&from, &s.axis);
+                self.set_role(MoveRole::Approach);
                 self.push(MoveKind::Rapid, over, s.axis);
                 self.push(MoveKind::Rapid, from, s.axis);
+                self.set_role(MoveRole::Entry);
                 self.push(MoveKind::Feed, s.tip, s.axis);
                 self.entries.side += 1;
                 return 0;
@@ -1727,8 +1908,10 @@ impl Emitter {
         // lifted tool clears the flanks: the approach goes to the ramp's top.
         let ramp = (lift > 0.0 && !closed).then(|| open_ramp(run, lift, self.settings.ramp_angle, body)).flatten();
         if let Some(ramp) = ramp.filter(|r| r.len() > 1) {
+            let ramp = &ramp[self.above_blank(ramp.iter().map(|(t, u)| (t, u)))..];
             let (top, axis) = ramp[0];
             self.approach(&top, &axis, lift);
+            self.set_role(MoveRole::Entry);
             for (tip, axis) in &ramp[1..] {
                 self.push(MoveKind::Feed, *tip, *axis);
             }
@@ -1737,6 +1920,7 @@ impl Emitter {
         }
         let start = s.tip + s.axis * lift;
         self.approach(&start, &s.axis, lift);
+        self.set_role(MoveRole::Entry);
         if lift <= 0.0 {
             return 0;
         }
@@ -1748,6 +1932,21 @@ impl Emitter {
         self.entries.plunge += 1;
         self.plunged_at.push(s.tip);
         0
+    }
+
+    /// How many of the first tools of an entry (tips and axes, top first) to
+    /// leave out because the next one's flutes are still above the blank
+    /// ([`Air::clears`]): the approach comes down at the rapid rate to the
+    /// last of them, and the entry starts there. On the impeller the first
+    /// level is entered from the blank's highest point, and a helix where the
+    /// turned blank is low circled down through the air for 28 mm
+    /// (docs/rough5.md, "Where the machine time goes"). At most all but the
+    /// last two (an entry keeps one move); none without a blank.
+    fn above_blank<'a>(&self, tools: impl Iterator<Item = (&'a Point3, &'a Vec3)>) -> usize {
+        let Some(air) = &self.air else { return 0 };
+        let tools: Vec<_> = tools.collect();
+        let clear = tools.iter().take_while(|(t, u)| air.clears(t, u)).count();
+        clear.saturating_sub(1).min(tools.len().saturating_sub(2))
     }
 
     /// How far (mm) along its axis the tool at `s` is lifted to reach the
@@ -1762,6 +1961,7 @@ impl Emitter {
     /// the level along the axis: in a blank the rapid stops that far above
     /// the tool on the level at the most.
     fn approach(&mut self, to: &Point3, axis: &Vec3, low: f64) {
+        self.set_role(MoveRole::Approach);
         let over = self.above(to, axis);
         self.push(MoveKind::Rapid, over, *axis);
         if let Some(air) = &self.air {
@@ -1921,9 +2121,11 @@ impl Emitter {
         if straight {
             moves.drain(..moves.len() - 1);
         }
+        self.set_role(MoveRole::Turn);
         for p in turn {
             self.push(MoveKind::Feed, p.tip, p.axis);
         }
+        self.set_role(MoveRole::Link);
         for p in moves {
             self.push(MoveKind::Link, p.tip, p.axis);
         }

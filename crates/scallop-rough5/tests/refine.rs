@@ -17,8 +17,8 @@ use scallop_geom::{Point3, Vec3};
 use scallop_mesh::TriMesh;
 use scallop_parts::{FaceTag, PocketParams, closed_pocket};
 use scallop_rough5::{
-    AIR_MARGIN, AIR_STEP, BodyCheck, LevelOptions, ProofSettings, Rough5Settings, TiltMode, level_passes_with,
-    plan_rough5, plan_rough5_in, prove, prove_from_blank,
+    AIR_MARGIN, AIR_STEP, BodyCheck, LevelOptions, MoveRole, ProofSettings, Rough5Settings, TiltMode,
+    level_passes_with, plan_rough5, plan_rough5_in, prove, prove_from_blank,
 };
 use scallop_toolpath::MoveKind;
 
@@ -224,6 +224,78 @@ fn a_low_blank_trims_the_levels_above_it() {
         prove_from_blank(&trimmed.toolpath, &tool, &part.stock, Some(&blank), &part.mesh, &proof_settings, &|_, _| {})
             .unwrap();
     assert!(proof.gouge_depth <= proof_settings.resolution, "{proof:?}");
+}
+
+/// The block of the small pocket with its top sloping from the stock's top
+/// at x = `lo.x` down by `fall` mm at x = `hi.x` (a plane, so every face of
+/// the hexahedron is flat).
+fn sloped_box(lo: Point3, hi: Point3, fall: f64) -> TriMesh {
+    let p = |i: usize| {
+        let x = [lo.x, hi.x][i & 1];
+        let top = hi.z - fall * (i & 1) as f64;
+        Point3::new(x, [lo.y, hi.y][(i >> 1) & 1], [lo.z, top][i >> 2])
+    };
+    let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+    let soup: Vec<[Point3; 3]> =
+        quads.iter().flat_map(|q| [[p(q[0]), p(q[1]), p(q[2])], [p(q[0]), p(q[2]), p(q[3])]]).collect();
+    TriMesh::from_soup(&soup).unwrap().0
+}
+
+/// In a blank whose top falls by 10 mm across the small pocket, the first
+/// level is entered from the blank's highest point plus the clearance; an
+/// entry down a helix starts where the tool reaches the blank: at the end of
+/// the first move of every helix whose approach ends above the blank, some
+/// section of the flutes (every mm) comes within [`AIR_MARGIN`] of the blank
+/// within the tool's radius (its lowest point `R sin tilt` under the
+/// section), the test of the rapid approaches (without it, the first move of
+/// a helix ended 2.2 mm over the blank). The program proves from the blank.
+#[test]
+fn helices_start_where_the_tool_reaches_the_blank() {
+    let part = small_pocket();
+    let bottom = part.faces(&[FaceTag::Bottom]).unwrap();
+    let flanks = part.faces(&[FaceTag::Flank]).unwrap();
+    let depth = part.stock.max.z - bottom.bounds().min.z;
+    let (tool, s) = (tool(), settings(depth, true));
+    let (lo, hi, fall) = (part.stock.min, part.stock.max, 10.0);
+    let blank = sloped_box(lo, hi, fall);
+    let blank_top = |x: f64| hi.z - fall * ((x - lo.x) / (hi.x - lo.x)).clamp(0.0, 1.0);
+    let plan = plan_rough5_in(&bottom, &flanks, (&part.stock, Some(&blank)), &tool, &s, &|_, _| {}).unwrap();
+    let path = &plan.toolpath;
+    let moves = path.moves();
+    assert_eq!(plan.roles.len(), moves.len());
+    assert!(plan.entries.helix > 0, "{:?}", plan.entries);
+    // How far the tool at move i is above the blank: the least, over the
+    // sections of its flutes every mm, of the section's lowest point over the
+    // blank's highest point within the tool's radius (the top falls with x).
+    let over = |i: usize| {
+        let (tip, u) = (moves[i].to, path.axis(i));
+        let sections = tool.flute_length().ceil() as usize;
+        (0..=sections)
+            .map(|k| {
+                let c = tip + u * (tool.flute_length() * k as f64 / sections as f64);
+                c.z - tool.radius() * u.angle(&Vec3::z()).sin() - blank_top(c.x - tool.radius())
+            })
+            .fold(f64::INFINITY, f64::min)
+    };
+    let mut checked = 0;
+    for (i, m) in moves.iter().enumerate().skip(1) {
+        // The first move of an entry after its approach, the entry going on.
+        let first = plan.roles[i] == MoveRole::Entry
+            && plan.roles[i - 1] == MoveRole::Approach
+            && m.kind == MoveKind::Feed
+            && plan.roles.get(i + 1) == Some(&MoveRole::Entry);
+        if first && over(i - 1) > AIR_MARGIN {
+            assert!(
+                over(i) <= AIR_MARGIN + 1e-9,
+                "move {i}: the entry's first move ends {} mm over the blank",
+                over(i)
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked > 0);
+    let proof_settings = ProofSettings { resolution: 0.5, axis_tolerance: 0.05 };
+    prove_from_blank(path, &tool, &part.stock, Some(&blank), &part.mesh, &proof_settings, &|_, _| {}).unwrap();
 }
 
 /// In a blank 8 mm under the stock top, the tool goes at the rapid rate
