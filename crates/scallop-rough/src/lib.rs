@@ -28,7 +28,7 @@ pub use scallop_geom::tol::rough as tol;
 mod walls;
 
 pub use adaptive::{plan_adaptive, plan_adaptive_in, plan_adaptive_touching};
-pub use material::{MaterialMap, limit_to_material, removable_material};
+pub use material::{MaterialMap, limit_to_material, material_met, removable_material};
 pub use offset::{Step, plan_offset, plan_offset_in};
 
 /// Why a roughing plan could not be made; each variant names the setting and the fix.
@@ -403,17 +403,14 @@ pub fn plan_levels(
         Some(m) => levels
             .into_par_iter()
             .map(|l| {
-                let removable = removable_material(&l.region, m, l.z, r, tolerance);
+                let adaptive = settings.pattern == Pattern::Adaptive;
+                let (removable, met) = material_met(&l.region, m, l.z, r, tolerance, adaptive);
                 let region = if removable.is_empty() {
                     Region::empty()
                 } else {
                     l.region.intersection(&removable.offset(-r), tolerance)
                 };
-                let touched = (settings.pattern == Pattern::Adaptive && !region.is_empty()).then(|| {
-                    m.above(l.z + tol::MIN_CHIP)
-                        .intersection(&l.region.offset(-r), tolerance)
-                        .intersection(&section, tolerance)
-                });
+                let touched = (adaptive && !region.is_empty()).then(|| met.intersection(&section, tolerance));
                 (Level { region, z: l.z }, removable.intersection(&section, tolerance), Some(l.region), touched)
             })
             .filter(|(l, _, _, _)| !l.region.is_empty())
