@@ -1344,10 +1344,27 @@ impl Planner<'_> {
 /// (negative in it), exact up to `cap` from its rings (chords within
 /// `tolerance`), -[`BIG`] or [`BIG`] beyond.
 fn signed_distance(grid: &Grid, material: &Region, cap: f64, tolerance: f64) -> Vec<f64> {
-    let inside = grid.fill(material, tolerance);
+    // Only the rings whose boxes come within `cap` of the grid's: a closed
+    // ring wholly beside the grid crosses each row of cells an even number
+    // of times on one side of them (no winding there) and stamps no distance
+    // under `cap` (a level's material holds the rings of the whole level).
+    #[allow(clippy::cast_precision_loss, reason = "cell counts")]
+    let (lo, hi) = (
+        [grid.x0 - cap, grid.y0 - cap],
+        [grid.x0 + grid.nx as f64 * grid.h + cap, grid.y0 + grid.ny as f64 * grid.h + cap],
+    );
+    let near = |pts: &Vec<P2>| {
+        let (mut a, mut b) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for p in pts {
+            a = [a[0].min(p[0]), a[1].min(p[1])];
+            b = [b[0].max(p[0]), b[1].max(p[1])];
+        }
+        a[0] <= hi[0] && b[0] >= lo[0] && a[1] <= hi[1] && b[1] >= lo[1]
+    };
+    let rings: Vec<Vec<P2>> = material.rings().iter().map(|c| c.to_points(tolerance)).filter(near).collect();
+    let inside = grid.fill_rings(&rings);
     let mut d = vec![BIG; grid.len()];
-    for ring in material.rings() {
-        let pts = ring.to_points(tolerance);
+    for pts in &rings {
         for (k, a) in pts.iter().enumerate() {
             grid.stamp_segment(&mut d, *a, pts[(k + 1) % pts.len()], cap, None);
         }
