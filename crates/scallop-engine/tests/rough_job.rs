@@ -176,3 +176,61 @@ fn a_roughing_operation_reports_its_simulated_engagement() {
     assert!(e.cutting_length_mm > 0.0 && e.slot_length_mm == 0.0, "{e:?}");
     assert!(e.entries > 0 && e.entries == e.retracts, "{e:?}");
 }
+
+/// A wedge on a plate: a slope rising from z = 0 at x = -10 to z = 8 at
+/// x = 0 (38.7 degrees), a flat top to x = 10, 12 mm wide.
+fn wedge_part() -> TriMesh {
+    let p = |x: f64, y: f64, z: f64| Point3::new(x, y, z);
+    let plate = boxes_mesh(&[([-16.0, -12.0, -1.0], [16.0, 12.0, 0.0])]);
+    let mut soup: Vec<[Point3; 3]> = (0..plate.triangles().len()).map(|i| plate.triangle(i)).collect();
+    let (a, b, c, d) = (p(-10.0, -6.0, 0.0), p(10.0, -6.0, 0.0), p(10.0, 6.0, 0.0), p(-10.0, 6.0, 0.0));
+    let (e, f, g, h) = (p(0.0, -6.0, 8.0), p(10.0, -6.0, 8.0), p(10.0, 6.0, 8.0), p(0.0, 6.0, 8.0));
+    for [q0, q1, q2, q3] in [[a, d, c, b], [a, e, h, d], [e, f, g, h], [b, c, g, f]] {
+        soup.push([q0, q1, q2]);
+        soup.push([q0, q2, q3]);
+    }
+    soup.extend([[a, b, f], [a, f, e], [d, h, g], [d, g, c]]);
+    TriMesh::from_soup(&soup).unwrap().0
+}
+
+/// An adaptive roughing operation on the wedge with a flat end mill of
+/// `radius` at `stepdown` (0.25 D, 0.3 mm left).
+fn wedge_operation(name: &str, radius: f64, stepdown: f64) -> Operation {
+    let mut finish = FinishJob::choi_demo();
+    finish.part = Part::Mesh(wedge_part());
+    finish.part_name = "wedge".into();
+    finish.cutter = Cutter::new(CutterShape::Flat { radius }, 30.0).unwrap();
+    finish.sim_resolution = 0.2;
+    let settings = RoughSettings {
+        stepdown,
+        stepover: 0.25,
+        radial_allowance: 0.3,
+        axial_allowance: 0.3,
+        pattern: Pattern::Adaptive,
+        direction: Direction::Climb,
+    };
+    Operation { name: name.into(), finish, rough: Some(settings) }
+}
+
+/// Adaptive rest roughing along a slope: a 6 mm end mill at 2 mm levels
+/// leaves steps on the wedge's slope, which a 3 mm one takes at 0.5 mm
+/// levels, its passes and rings sliding along the wall where the steps
+/// are. The cells along the wall that hold more than the allowance but lie
+/// in the margin `removable_material` leaves out are material the tool
+/// meets: the walk counts them in its engagement (docs/roughing.md,
+/// "Adaptive clearing", rest roughing), and the simulator reads the rest
+/// operation within 1.1 x the target, with nothing over 1.2 x. Without them
+/// the passes along the wall read 82.5 degrees for 60 (25.9 mm over 1.2 x).
+#[test]
+fn adaptive_rest_along_a_slope_holds_the_engagement() {
+    let stock = Aabb3 { min: Point3::new(-20.0, -16.0, -1.0), max: Point3::new(20.0, 16.0, 11.0) };
+    let job = Job {
+        stock: Some(StockShape::Box(stock)),
+        operations: vec![wedge_operation("rough", 3.0, 2.0), wedge_operation("rest", 1.5, 0.5)],
+    };
+    let out = run_job(&job).unwrap();
+    let rest = out.report.operations[1].engagement.as_ref().unwrap();
+    assert!(rest.cutting_length_mm > 100.0, "{rest:?}");
+    assert!(rest.max_deg <= 1.1 * rest.target_deg, "{rest:?}");
+    assert!(rest.over_length_mm < 1e-9 && rest.slot_length_mm < 1e-9, "{rest:?}");
+}

@@ -102,6 +102,12 @@ struct Planner<'a> {
     /// it), when known ([`plan_adaptive_in`]): a probe where it is positive
     /// is in air.
     open: Option<Vec<f64>>,
+    /// Signed distance to the boundary of the material the tool meets at
+    /// the level beyond `open`'s (the material along the walls that the
+    /// level's material leaves out, [`plan_adaptive_touching`]): it counts in
+    /// the engagement ([`Planner::front`]) and nothing else, as the strip
+    /// along the walls does; with `reach` raised past R outside it.
+    touch: Option<(Vec<f64>, Vec<f64>)>,
 }
 
 /// A place where a pass may start ([`Planner::starts`]).
@@ -155,6 +161,28 @@ pub fn plan_adaptive_in(
     material: Option<&Region>,
     options: &ClearOptions,
 ) -> Result<Vec<Step>, RoughError> {
+    plan_adaptive_touching(region, material, None, options)
+}
+
+/// As [`plan_adaptive_in`], `touched` being more material that the tool
+/// meets at the level (a superset of `material`): in rest roughing, the
+/// in-process stock within R of the level's whole region, where `material`
+/// is the part of it the operation is to remove (the cells along the walls
+/// that hold the allowance left out, [`crate::removable_material`]). The
+/// walk counts `touched` in the engagement it holds at the target, and
+/// `material` alone in what keeps a pass going or a start alive, in links
+/// and in what the rings must cut: the tool slides along the walls with the
+/// engagement the simulator measures there (docs/roughing.md, "Adaptive
+/// clearing", "Rest roughing").
+///
+/// # Errors
+/// As [`plan_adaptive`].
+pub fn plan_adaptive_touching(
+    region: &Region,
+    material: Option<&Region>,
+    touched: Option<&Region>,
+    options: &ClearOptions,
+) -> Result<Vec<Step>, RoughError> {
     let r = options.tool_radius;
     let Some((lo, hi)) = region.bounds() else { return Ok(Vec::new()) };
     let grid = Grid::new(lo, hi, r + 4.0 * r * tol::GRID_SHARE, r * tol::GRID_SHARE)?;
@@ -172,6 +200,13 @@ pub fn plan_adaptive_in(
     // cell outside it is no material (its `reach` raised past R by that
     // much), and the probes read the field itself (`Planner::open_at`).
     let outside = material.map(|m| signed_distance(&grid, m, 2.0 * r + 4.0 * h, fill_tolerance));
+    // The same for the material touched beyond it: its own field, and the
+    // distance from the region raised past R outside it.
+    let touch = touched.filter(|_| material.is_some()).map(|t| {
+        let field = signed_distance(&grid, t, 2.0 * r + 4.0 * h, fill_tolerance);
+        let raised = reach.iter().zip(&field).map(|(&v, &d)| if d > 0.0 { v.max(r + d) } else { v }).collect();
+        (field, raised)
+    });
     if let Some(out) = &outside {
         for (v, d) in reach.iter_mut().zip(out) {
             if *d > 0.0 {
@@ -220,6 +255,7 @@ pub fn plan_adaptive_in(
         fit: tol::WALK_FIT_SHARE * r,
         strip: tol::WALK_WALL_STRIP_SHARE * r,
         open: outside,
+        touch,
     };
     if !planner.edges.contains(s) {
         return Ok(rings_only(region, options));
@@ -610,6 +646,7 @@ impl Planner<'_> {
         let nx = self.grid.nx;
         let probes = if self.away() < 0.0 { &self.probes_left } else { &self.probes };
         let open = self.open.as_deref();
+        let touch = self.touch.as_ref();
         for &[u, v] in probes {
             // The probe's direction (u, v) about the heading, rotated onto it.
             let q = [p[0] + r * (u * c - v * s), p[1] + r * (u * s + v * c)];
@@ -617,13 +654,19 @@ impl Planner<'_> {
             let Some(at) = self.grid.locate(q) else { continue };
             if Grid::interpolate(&self.swept, nx, at) > r {
                 let reach = Grid::interpolate(&self.reach, nx, at);
-                // As `open_at`, inline.
-                if reach < r && !open.is_some_and(|f| Grid::interpolate(f, nx, at) > 0.0) {
+                // As `open_at`, inline; the material touched beyond it
+                // counts in the engagement only.
+                let inside = reach < r && !open.is_some_and(|f| Grid::interpolate(f, nx, at) > 0.0);
+                if inside
+                    || touch.is_some_and(|(f, near)| {
+                        Grid::interpolate(near, nx, at) < r && Grid::interpolate(f, nx, at) <= 0.0
+                    })
+                {
                     count += 1;
                     if share(count) > limit {
                         return None;
                     }
-                    if reach < strip {
+                    if inside && reach < strip {
                         core += 1;
                     }
                 }
@@ -1301,10 +1344,27 @@ impl Planner<'_> {
 /// (negative in it), exact up to `cap` from its rings (chords within
 /// `tolerance`), -[`BIG`] or [`BIG`] beyond.
 fn signed_distance(grid: &Grid, material: &Region, cap: f64, tolerance: f64) -> Vec<f64> {
-    let inside = grid.fill(material, tolerance);
+    // Only the rings whose boxes come within `cap` of the grid's: a closed
+    // ring wholly beside the grid crosses each row of cells an even number
+    // of times on one side of them (no winding there) and stamps no distance
+    // under `cap` (a level's material holds the rings of the whole level).
+    #[allow(clippy::cast_precision_loss, reason = "cell counts")]
+    let (lo, hi) = (
+        [grid.x0 - cap, grid.y0 - cap],
+        [grid.x0 + grid.nx as f64 * grid.h + cap, grid.y0 + grid.ny as f64 * grid.h + cap],
+    );
+    let near = |pts: &Vec<P2>| {
+        let (mut a, mut b) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for p in pts {
+            a = [a[0].min(p[0]), a[1].min(p[1])];
+            b = [b[0].max(p[0]), b[1].max(p[1])];
+        }
+        a[0] <= hi[0] && b[0] >= lo[0] && a[1] <= hi[1] && b[1] >= lo[1]
+    };
+    let rings: Vec<Vec<P2>> = material.rings().iter().map(|c| c.to_points(tolerance)).filter(near).collect();
+    let inside = grid.fill_rings(&rings);
     let mut d = vec![BIG; grid.len()];
-    for ring in material.rings() {
-        let pts = ring.to_points(tolerance);
+    for pts in &rings {
         for (k, a) in pts.iter().enumerate() {
             grid.stamp_segment(&mut d, *a, pts[(k + 1) % pts.len()], cap, None);
         }

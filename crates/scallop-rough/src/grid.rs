@@ -180,12 +180,17 @@ impl Grid {
     /// rings as chords within `tolerance`), row by row.
     pub fn fill(&self, region: &Region, tolerance: f64) -> Vec<bool> {
         let rings: Vec<Vec<P2>> = region.rings().iter().map(|c| c.to_points(tolerance)).collect();
+        self.fill_rings(&rings)
+    }
+
+    /// [`Grid::fill`] of closed rings of points.
+    pub fn fill_rings(&self, rings: &[Vec<P2>]) -> Vec<bool> {
         let mut inside = vec![false; self.len()];
         let mut cross: Vec<(f64, i32)> = Vec::new();
         for j in 0..self.ny {
             let y = self.centre(j * self.nx)[1];
             cross.clear();
-            for ring in &rings {
+            for ring in rings {
                 for (k, a) in ring.iter().enumerate() {
                     let b = ring[(k + 1) % ring.len()];
                     if (a[1] <= y) != (b[1] <= y) {

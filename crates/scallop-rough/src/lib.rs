@@ -27,8 +27,8 @@ mod offset;
 pub use scallop_geom::tol::rough as tol;
 mod walls;
 
-pub use adaptive::{plan_adaptive, plan_adaptive_in};
-pub use material::{MaterialMap, limit_to_material, removable_material};
+pub use adaptive::{plan_adaptive, plan_adaptive_in, plan_adaptive_touching};
+pub use material::{MaterialMap, limit_to_material, material_met, removable_material};
 pub use offset::{Step, plan_offset, plan_offset_in};
 
 /// Why a roughing plan could not be made; each variant names the setting and the fix.
@@ -392,23 +392,28 @@ pub fn plan_levels(
     // Where each level holds material: the stock's section, and with an
     // in-process stock the material the tool would remove at the level
     // (its region then cut down to the centres that reach it). The level's
-    // whole region stays the room for links through air.
+    // whole region stays the room for links through air. The adaptive
+    // pattern is also told the material the tool meets there beyond that
+    // (within R of the level's whole region: the cells along the walls that
+    // `removable_material` leaves out), which it counts in the engagement.
     let (lo, hi) = ([stock.min.x, stock.min.y], [stock.max.x, stock.max.y]);
     let section = Region::from_polygons(&[vec![lo, [hi[0], lo[1]], hi, [lo[0], hi[1]]]], false);
     let r = cutter.radius();
-    let spaces: Vec<(Level, Region, Option<Region>)> = match material {
+    let spaces: Vec<(Level, Region, Option<Region>, Option<Region>)> = match material {
         Some(m) => levels
             .into_par_iter()
             .map(|l| {
-                let removable = removable_material(&l.region, m, l.z, r, tolerance);
+                let adaptive = settings.pattern == Pattern::Adaptive;
+                let (removable, met) = material_met(&l.region, m, l.z, r, tolerance, adaptive);
                 let region = if removable.is_empty() {
                     Region::empty()
                 } else {
                     l.region.intersection(&removable.offset(-r), tolerance)
                 };
-                (Level { region, z: l.z }, removable.intersection(&section, tolerance), Some(l.region))
+                let touched = (adaptive && !region.is_empty()).then(|| met.intersection(&section, tolerance));
+                (Level { region, z: l.z }, removable.intersection(&section, tolerance), Some(l.region), touched)
             })
-            .filter(|(l, _, _)| !l.region.is_empty())
+            .filter(|(l, _, _, _)| !l.region.is_empty())
             .collect(),
         None => {
             // Beyond the stock's section grown by R the tool meets neither
@@ -419,7 +424,7 @@ pub fn plan_levels(
                 .into_par_iter()
                 .map(|l| {
                     let room = outer.difference(&rect.difference(&l.region, tolerance), tolerance);
-                    (l, section.clone(), Some(room))
+                    (l, section.clone(), Some(room), None)
                 })
                 .collect()
         }
@@ -427,10 +432,12 @@ pub fn plan_levels(
     let mut levels = Vec::with_capacity(spaces.len());
     let mut materials = Vec::with_capacity(spaces.len());
     let mut rooms = Vec::with_capacity(spaces.len());
-    for (l, m, room) in spaces {
+    let mut touched = Vec::with_capacity(spaces.len());
+    for (l, m, room, t) in spaces {
         levels.push(l);
         materials.push(m);
         rooms.push(room);
+        touched.push(t);
     }
     let options = ClearOptions {
         tool_radius: r,
@@ -439,7 +446,7 @@ pub fn plan_levels(
         chord_tolerance: tolerance,
         pattern: settings.pattern,
     };
-    let mut nodes = build_tree(&levels, &materials, &rooms, &options)?;
+    let mut nodes = build_tree(&levels, &materials, &rooms, &touched, &options)?;
     if let Some(m) = material {
         // A node with no parent is entered from the material's top over its
         // region grown by the tool radius (not the box's top).
@@ -473,6 +480,7 @@ fn build_tree(
     levels: &[Level],
     materials: &[Region],
     rooms: &[Option<Region>],
+    touched: &[Option<Region>],
     options: &ClearOptions,
 ) -> Result<Vec<Node>, RoughError> {
     let mut shells: Vec<(usize, Region)> = Vec::new();
@@ -483,7 +491,10 @@ fn build_tree(
         (0..=levels.len()).map(|k| shells.iter().position(|s| s.0 >= k).unwrap_or(shells.len())).collect();
     let planned: Result<Vec<Vec<Step>>, RoughError> = shells
         .par_iter()
-        .map(|(k, region)| plan_region_in(region, Some(&materials[*k]), rooms[*k].as_ref(), options))
+        .map(|(k, region)| match (&touched[*k], options.pattern) {
+            (Some(t), Pattern::Adaptive) => plan_adaptive_touching(region, Some(&materials[*k]), Some(t), options),
+            _ => plan_region_in(region, Some(&materials[*k]), rooms[*k].as_ref(), options),
+        })
         .collect();
     let planned = planned?;
     // Parents are found among the previous level's nodes by containment.

@@ -193,14 +193,37 @@ pub fn limit_to_material(region: &Region, material: &MaterialMap, z: f64, r: f64
 /// only hold the allowance out. Booleans with chords within `tolerance`.
 #[must_use]
 pub fn removable_material(region: &Region, material: &MaterialMap, z: f64, r: f64, tolerance: f64) -> Region {
+    material_met(region, material, z, r, tolerance, false).0
+}
+
+/// [`removable_material`] and, when `touched`, the material above `z` (by
+/// [`tol::MIN_CHIP`]) within `r` of the region: all that the tool meets at
+/// the level, the cells along the walls that the removable material leaves
+/// out included (empty when not `touched`). Booleans with chords within
+/// `tolerance`.
+#[must_use]
+pub fn material_met(
+    region: &Region,
+    material: &MaterialMap,
+    z: f64,
+    r: f64,
+    tolerance: f64,
+    touched: bool,
+) -> (Region, Region) {
     let [cx, cy] = material.cell_size();
     let margin = cx.hypot(cy) + tol::MIN_CHIP;
     let above = material.above(z + tol::MIN_CHIP);
     if above.is_empty() || region.is_empty() {
-        return Region::empty();
+        return (Region::empty(), Region::empty());
     }
     let reach = region.offset(-(r - margin).max(0.0));
-    above.intersection(&reach, tolerance)
+    let removable = above.intersection(&reach, tolerance);
+    let met = if touched && !removable.is_empty() {
+        above.intersection(&region.offset(-r), tolerance)
+    } else {
+        Region::empty()
+    };
+    (removable, met)
 }
 
 #[cfg(test)]
