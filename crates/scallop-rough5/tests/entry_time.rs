@@ -54,12 +54,12 @@ fn shuttle(leg: f64, legs: usize, drop: f64, step: f64) -> Vec<Point3> {
     for l in 0..legs {
         for k in 0..per {
             let along = k as f64 * leg / per as f64;
-            let x = if l % 2 == 0 { along } else { leg - along };
+            let x = if l.is_multiple_of(2) { along } else { leg - along };
             let done = (l * per + k) as f64 / total;
             out.push(Point3::new(10.0 + x, -15.0, 25.0 - drop * done));
         }
     }
-    let x = if legs % 2 == 0 { 0.0 } else { leg };
+    let x = if legs.is_multiple_of(2) { 0.0 } else { leg };
     out.push(Point3::new(10.0 + x, -15.0, 25.0 - drop));
     out
 }
