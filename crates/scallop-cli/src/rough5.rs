@@ -71,6 +71,9 @@ pub enum RefineArg {
     AirMoves,
     /// The tilted tool axes of each run smoothed where the smoothed tool is placed clear of the flanks.
     AxisSmoothing,
+    /// Closed runs entered by the helix radius, or the ramp along the run, that takes the least time on the
+    /// machine's linear axes' acceleration and jerk (else the largest helix that fits).
+    EntryDynamics,
     /// All of them: the program of 28 Nov 2026.
     All,
 }
@@ -390,6 +393,11 @@ fn settings(args: &Rough5Args, part: &TestPart) -> CliResult<Rough5Settings> {
         translate: on(RefineArg::Translation),
         local_entry: on(RefineArg::LocalEntry),
         smooth_axes: on(RefineArg::AxisSmoothing),
+        entry_dynamics: if on(RefineArg::EntryDynamics) {
+            scallop_engine::path_dynamics(&load_machine(&args.machine, Path::new(""), "--machine")?)
+        } else {
+            None
+        },
         round_corners: on(RefineArg::Corners),
         root_rest: on(RefineArg::RootRest),
         bottom_normal: on(RefineArg::BottomNormal),

@@ -50,8 +50,8 @@ pub use job::{
 };
 pub use rough5::{
     BlockTime, FaceReport, OnMachine, Posted, ProgramTime, Rough5Job, Rough5Metrics, Rough5Output, Rough5Step,
-    TcpWords, TimeShare, block_times, on_machine, post_tcp, program_time, rough5_metrics, rough5_settings, run_rough5,
-    time_breakdown,
+    TcpWords, TimeShare, block_times, on_machine, path_dynamics, post_tcp, program_time, rough5_metrics,
+    rough5_settings, run_rough5, time_breakdown,
 };
 pub use zones::{
     ProgramCandidate, ZONE_MARGIN_PER_RADIUS, ZONE_MARGIN_PER_SPACING, ZONE_MARGIN_ROUNDS, ZoneFigures,

@@ -14,7 +14,9 @@ use scallop_machine::time::{path_time, rapid_time};
 use scallop_machine::{Joints, Kinematics, Machine};
 use scallop_parts::{FaceTag, TestPart};
 use scallop_post::{Dialect, OutputMode, PostParams, check_replay, program_text, replay};
-use scallop_rough5::{Proof, ProofFace, ProofSettings, Rough5Plan, Rough5Settings, plan_rough5_in, prove_with_faces};
+use scallop_rough5::{
+    PathDynamics, Proof, ProofFace, ProofSettings, Rough5Plan, Rough5Settings, plan_rough5_in, prove_with_faces,
+};
 use scallop_toolpath::Toolpath;
 use serde::Serialize;
 
@@ -508,6 +510,28 @@ pub fn rough5_settings(
     Ok(Rough5Settings::new(guides, feed))
 }
 
+/// The tool tip's dynamics along a path with the axis fixed on `machine`
+/// ([`PathDynamics`], for [`Rough5Settings::entry_dynamics`]): the smallest
+/// acceleration and jerk of its linear axes (a helix's circle runs on them
+/// whatever its plane) and the controller's corner tolerance; `None` for a
+/// machine without linear axes.
+///
+/// ```
+/// let m = scallop_machine::Machine::builtin("ucp710").unwrap();
+/// let d = scallop_engine::path_dynamics(&m).unwrap();
+/// assert_eq!((d.acceleration, d.jerk, d.corner_tolerance), (2100.0, 5000.0, 0.1));
+/// ```
+#[must_use]
+pub fn path_dynamics(machine: &Machine) -> Option<PathDynamics> {
+    let linear: Vec<_> =
+        machine.axes().iter().filter(|a| a.kind == scallop_machine::AxisKind::Linear).map(|a| a.dynamics).collect();
+    (!linear.is_empty()).then(|| PathDynamics {
+        acceleration: linear.iter().map(|d| d.amax).fold(f64::INFINITY, f64::min),
+        jerk: linear.iter().map(|d| d.jmax).fold(f64::INFINITY, f64::min),
+        corner_tolerance: machine.nc().corner_tolerance,
+    })
+}
+
 /// A 5-axis roughing operation of a job.
 #[derive(Debug, Clone)]
 pub struct Rough5Job {
@@ -574,16 +598,15 @@ pub struct Rough5Output {
 pub fn run_rough5(job: &Rough5Job, progress: &(dyn Fn(Rough5Step) + Sync)) -> Result<Rough5Output, EngineError> {
     let part = &job.part;
     let (bottom, flanks) = (part.faces(&[FaceTag::Bottom])?, part.faces(&[FaceTag::Flank])?);
-    let plan = plan_rough5_in(
-        &bottom,
-        &flanks,
-        (&part.stock, part.blank.as_ref()),
-        &job.tool,
-        &job.settings,
-        &|done, total| {
+    // The entries are chosen against the machine's dynamics unless the job set them.
+    let settings = Rough5Settings {
+        entry_dynamics: job.settings.entry_dynamics.or_else(|| path_dynamics(&job.machine)),
+        ..job.settings
+    };
+    let plan =
+        plan_rough5_in(&bottom, &flanks, (&part.stock, part.blank.as_ref()), &job.tool, &settings, &|done, total| {
             progress(Rough5Step::Planning { done, total });
-        },
-    )?;
+        })?;
     let corner = job.settings.guides.tool_radius;
     let faces = [
         ProofFace { name: "bottom", mesh: &bottom, others: &flanks, allowance: job.settings.bottom_allowance, corner },

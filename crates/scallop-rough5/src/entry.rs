@@ -260,3 +260,149 @@ pub fn side_entry(
     }
     best.map(|b| b.1)
 }
+
+/// The tool tip's dynamics along a path whose tool axis stays fixed (a
+/// helix, a ramp): the machine's linear axes alone carry it, so the slowest
+/// linear axis's acceleration and jerk bound it, with the controller's corner
+/// tolerance (the machine time model of spec 8, `scallop_machine::time`).
+/// [`crate::Rough5Settings::entry_dynamics`] chooses the entries by it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PathDynamics {
+    /// Acceleration (mm/s²).
+    pub acceleration: f64,
+    /// Jerk (mm/s³).
+    pub jerk: f64,
+    /// The controller's corner tolerance (mm): a junction sharper than the
+    /// smooth junction is blended within it.
+    pub corner_tolerance: f64,
+}
+
+/// Time (s) of a velocity change `dv` with zero acceleration at both ends
+/// (spec 8.2, as `scallop_machine::time::t_acc`).
+fn t_acc(dv: f64, a: f64, j: f64) -> f64 {
+    let dv = dv.abs();
+    if dv <= a * a / j { 2.0 * (dv / j).sqrt() } else { dv / a + a / j }
+}
+
+/// Distance (mm) a velocity change from `va` to `vb` takes (spec 8.2).
+fn change_distance(va: f64, vb: f64, a: f64, j: f64) -> f64 {
+    (va + vb) / 2.0 * t_acc(vb - va, a, j)
+}
+
+/// The velocity `vb >= va` reachable within `s`, at most `v` (bisection).
+fn reach(va: f64, s: f64, (v, a, j): (f64, f64, f64)) -> f64 {
+    if va >= v || change_distance(va, v, a, j) <= s {
+        return v.max(va);
+    }
+    let (mut lo, mut hi) = (va, v);
+    for _ in 0..scallop_geom::tol::machine::TIME_BISECTION_ITERATIONS {
+        let mid = 0.5 * (lo + hi);
+        if change_distance(va, mid, a, j) <= s { lo = mid } else { hi = mid }
+    }
+    lo
+}
+
+/// Time (s) of a chord of length `s` entered at `v0` and left at `v1` (spec
+/// 8.5): cruise at the peak `v` if there is room, else the peak that fits.
+fn chord_time(v0: f64, v1: f64, s: f64, (v, a, j): (f64, f64, f64)) -> f64 {
+    let used = |vp: f64| change_distance(v0, vp, a, j) + change_distance(vp, v1, a, j);
+    let vp = if used(v) <= s {
+        v
+    } else {
+        let (mut lo, mut hi) = (v0.max(v1), v);
+        for _ in 0..scallop_geom::tol::machine::TIME_BISECTION_ITERATIONS {
+            let mid = 0.5 * (lo + hi);
+            if used(mid) <= s { lo = mid } else { hi = mid }
+        }
+        lo
+    };
+    let cruise = if vp > 0.0 { (s - used(vp)).max(0.0) / vp } else { 0.0 };
+    t_acc(vp - v0, a, j) + t_acc(vp - v1, a, j) + cruise
+}
+
+/// An estimate (s) of the time the tool tip takes along the polyline `tips`
+/// at `feed` (mm/min) under `dynamics`, from a stop to a stop, as the
+/// machine time model of spec 8 (`scallop_machine::time::path_time`) takes
+/// a path whose tool axis stays fixed, with every linear axis at the
+/// slowest one's limits: the speed at each junction is capped (spec 8.3)
+/// below the smooth junction ([`scallop_geom::tol::machine::SMOOTH_JUNCTION`])
+/// by the acceleration, `v² |Δe| / s <= a`, and the jerk,
+/// `v³ |Δ²e| / s² <= j` (e the unit direction, s the mean chord: on a circle
+/// of radius ρ, `v <= (j ρ²)^(1/3)`), above it by a blend within the corner
+/// tolerance; a look-ahead then accelerates and decelerates between the caps
+/// within the acceleration and jerk (spec 8.5). At the first and last
+/// junctions the jerk term takes the direction's first difference (the
+/// model takes a one-sided second difference there), so a path is estimated
+/// a little slower at its ends than by the model.
+///
+/// ```
+/// use scallop_geom::Point3;
+/// use scallop_rough5::{PathDynamics, path_time_estimate};
+/// let d = PathDynamics { acceleration: 2100.0, jerk: 5000.0, corner_tolerance: 0.1 };
+/// // Five turns of a circle of radius 1.25 mm in 0.2 mm chords: the jerk
+/// // holds the speed to (5000 x 1.25²)^(1/3) = 19.8 mm/s, under the
+/// // 40 mm/s feed.
+/// let circle = |r: f64, turns: f64| -> Vec<Point3> {
+///     let n = (5.0 * turns * std::f64::consts::TAU * r).ceil() as usize;
+///     (0..=n).map(|k| { let a = turns * std::f64::consts::TAU * k as f64 / n as f64; Point3::new(r * a.cos(), r * a.sin(), 0.0) }).collect()
+/// };
+/// // (Plus the start and the stop: at the first and last junctions the jerk
+/// // term takes the direction's first difference, the turn from a line into
+/// // the circle, about 0.5 s here.)
+/// let t = path_time_estimate(&circle(1.25, 5.0), 2400.0, &d);
+/// let length = 5.0 * std::f64::consts::TAU * 1.25;
+/// assert!(t > length / 19.9 && t < length / 19.9 + 0.6, "{t} s for {length} mm");
+/// // A straight 40 mm from a stop to a stop: the feed, 1 s, plus the jerk-limited
+/// // start and stop, 2 sqrt(40 / 5000) = 0.179 s.
+/// let line = [Point3::new(0.0, 0.0, 0.0), Point3::new(40.0, 0.0, 0.0)];
+/// assert!((path_time_estimate(&line, 2400.0, &d) - 1.179).abs() < 1e-3);
+/// ```
+#[must_use]
+pub fn path_time_estimate(tips: &[Point3], feed: f64, dynamics: &PathDynamics) -> f64 {
+    let f = feed / 60.0;
+    let chords: Vec<(f64, Vec3)> =
+        tips.windows(2).map(|w| w[1] - w[0]).filter(|d| d.norm() > 1e-9).map(|d| (d.norm(), d / d.norm())).collect();
+    let n = chords.len();
+    if n == 0 || f.is_nan() || f <= 0.0 {
+        return 0.0;
+    }
+    let PathDynamics { acceleration: a, jerk: j, corner_tolerance } = *dynamics;
+    let limits = (f, a, j);
+    // v[k]: the speed at the junction before chord k (a stop at 0 and n).
+    let mut v = vec![f; n + 1];
+    (v[0], v[n]) = (0.0, 0.0);
+    for k in 1..n {
+        let (s1, u1) = chords[k - 1];
+        let (s2, u2) = chords[k];
+        let de = u2 - u1;
+        let theta = u1.cross(&u2).norm().atan2(u1.dot(&u2));
+        let mean = 0.5 * (s1 + s2);
+        let cap = if theta <= scallop_geom::tol::machine::SMOOTH_JUNCTION {
+            let d2e = if k >= 2 && k + 1 < n { ((chords[k + 1].1 - u2) - (u1 - chords[k - 2].1)) / 2.0 } else { de };
+            let by_a = if de.norm() > 1e-12 { (a * mean / de.norm()).sqrt() } else { f };
+            let by_j = if d2e.norm() > 1e-12 { (j * mean * mean / d2e.norm()).cbrt() } else { f };
+            by_a.min(by_j)
+        } else {
+            let blend = (4.0 * corner_tolerance / (theta / 2.0).sin()).min(s1 / 2.0).min(s2 / 2.0);
+            let fits = |v: f64| v * t_acc(v * de.norm(), a, j) <= blend;
+            if fits(f) {
+                f
+            } else {
+                let (mut lo, mut hi) = (0.0, f);
+                for _ in 0..scallop_geom::tol::machine::TIME_BISECTION_ITERATIONS {
+                    let mid = 0.5 * (lo + hi);
+                    if fits(mid) { lo = mid } else { hi = mid }
+                }
+                lo
+            }
+        };
+        v[k] = cap.min(f);
+    }
+    for k in (0..n).rev() {
+        v[k] = v[k].min(reach(v[k + 1], chords[k].0, limits));
+    }
+    for k in 0..n {
+        v[k + 1] = v[k + 1].min(reach(v[k], chords[k].0, limits));
+    }
+    (0..n).map(|k| chord_time(v[k], v[k + 1], chords[k].0, limits)).sum()
+}

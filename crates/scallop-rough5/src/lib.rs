@@ -73,8 +73,8 @@ pub use collide::BodyCheck;
 pub use correct::{CorrectionCount, correct_pairs, correct_pairs_spatial, correct_planar, correct_spatial};
 pub use cutting::{CuttingData, TorusTool};
 pub use entry::{
-    EntryCount, EntryMode, HELIX_RADII, HELIX_STARTS, HELIX_TANGENCY, HelixSettings, SIDE_DIRECTIONS, SIDE_REACH_RADII,
-    helix_entry, side_entry,
+    EntryCount, EntryMode, HELIX_RADII, HELIX_STARTS, HELIX_TANGENCY, HelixSettings, PathDynamics, SIDE_DIRECTIONS,
+    SIDE_REACH_RADII, helix_entry, path_time_estimate, side_entry,
 };
 pub use error::Rough5Error;
 pub use faces::{FaceMetrics, ProofFace, face_metrics};
@@ -85,9 +85,10 @@ pub use orient::{
 };
 pub use place::{Feature, Placement, Placer, tool_frame};
 pub use plan::{
-    AIR_MARGIN, AIR_STEP, AirReport, LevelReport, MoveRole, PassReport, Rough5Plan, Rough5Settings, SIDE_MARGIN,
-    SMOOTH_MIN_TILT, SMOOTH_ROUNDS, SinglePass, TRANSLATION_MAX, TRANSLATION_SLOPE, bottom_normal_min_slope,
-    limit_step, plan_rough5, plan_rough5_in, plan_single_pass, round_corners, smooth_axes, thin_vertical,
+    AIR_MARGIN, AIR_STEP, AirReport, LevelReport, MoveRole, PassReport, Rough5Plan, Rough5Settings, SHUTTLE_LEGS,
+    SIDE_MARGIN, SMOOTH_MIN_TILT, SMOOTH_ROUNDS, SinglePass, TRANSLATION_MAX, TRANSLATION_SLOPE,
+    bottom_normal_min_slope, limit_step, plan_rough5, plan_rough5_in, plan_single_pass, round_corners, smooth_axes,
+    thin_vertical,
 };
 pub use prove::{Proof, ProofSettings, prove, prove_from_blank, prove_with_faces};
 pub use radius::{apparent_contour_radius, effective_radius, exact_scallop, scallop_height, swept_profile};

@@ -32,7 +32,8 @@ use crate::air::AirSettings;
 use crate::collide::BodyCheck;
 use crate::correct::{correct_pairs, correct_pairs_spatial};
 use crate::entry::{
-    EntryCount, EntryMode, HELIX_RADII, HELIX_STARTS, HelixSettings, SIDE_REACH_RADII, helix_entry, side_entry,
+    EntryCount, EntryMode, HELIX_RADII, HELIX_STARTS, HelixSettings, PathDynamics, SIDE_REACH_RADII, helix_entry,
+    path_time_estimate, side_entry,
 };
 use crate::levels::{LevelOptions, TiltMode, level_passes_with};
 use crate::orient::{OrientSettings, Orientation, optimise_pass, synchronise_with};
@@ -160,6 +161,14 @@ pub struct Rough5Settings {
     /// the stock where a run starts within reach of its side, a ramp along a
     /// closed run, else a plunge.
     pub entry: EntryMode,
+    /// The machine's dynamics along a path with the axis fixed
+    /// ([`PathDynamics`]): where a closed run can be entered by a helix, the
+    /// helix's radius, or the ramp along the run instead, is the one whose
+    /// path takes the least time under them ([`path_time_estimate`]): a
+    /// helix on a small circle is held to `(j ρ²)^(1/3)` by the linear axes'
+    /// jerk (docs/rough5.md, "Entries against the machine's dynamics").
+    /// `None`: the largest helix that fits, as before.
+    pub entry_dynamics: Option<PathDynamics>,
     /// The air moves ([`crate::air_moves`]; docs/rough5.md, "Air moves"):
     /// the feeds, links and plunges that lie outside the in-process stock by
     /// the clearance, written at the air feed; `None` keeps every cutting
@@ -204,6 +213,7 @@ impl Rough5Settings {
             root_rest: false,
             bottom_normal: false,
             entry: EntryMode::Auto,
+            entry_dynamics: None,
             air: None,
         }
         .with_refinements(true)
@@ -1637,6 +1647,23 @@ fn azimuth(axis: &Vec3) -> Option<f64> {
     (axis.angle(&Vec3::z()) > POLE_TILT).then(|| axis.y.atan2(axis.x))
 }
 
+/// How [`Emitter::enter`] enters a closed run that a helix fits.
+#[derive(Debug, Clone, PartialEq)]
+enum ClosedEntry {
+    /// Down the helix of this index.
+    Helix(usize),
+    /// Down the ramp along the run.
+    Ramp,
+    /// Down a ramp back and forth along the run ([`Emitter::shuttle`]): its
+    /// tools, top first, and the run's index where it reaches the level.
+    Shuttle(Vec<(Point3, Vec3)>, usize),
+}
+
+/// Most legs of a ramp back and forth along a closed run tried against its
+/// helix and the ramp along it, when the entries are chosen against the
+/// machine's dynamics ([`Rough5Settings::entry_dynamics`]).
+pub const SHUTTLE_LEGS: usize = 6;
+
 /// Writes the runs as moves.
 struct Emitter {
     path: Toolpath,
@@ -1876,19 +1903,31 @@ impl Emitter {
         let closed = run.len() > 2 && (s.tip - run[run.len() - 1].place.tip).norm() < 1e-9;
         let mode = self.settings.entry;
         if lift > 0.0 {
-            if closed
-                && matches!(mode, EntryMode::Auto | EntryMode::Helix)
-                && let Some((start, tips)) = self.helix(run, entry_z, placer, body)
-            {
-                let axis = run[start].place.axis;
-                let tips = &tips[self.above_blank(tips.iter().map(|t| (t, &axis)))..];
-                self.approach(&tips[0], &axis, 0.0);
-                self.set_role(MoveRole::Entry);
-                for tip in &tips[1..] {
-                    self.push(MoveKind::Feed, *tip, axis);
+            if closed && matches!(mode, EntryMode::Auto | EntryMode::Helix) {
+                let helices = self.helices(run, entry_z, placer, body);
+                match self.cheapest_closed_entry(run, (entry_z, lift), &helices, body) {
+                    Some(ClosedEntry::Helix(i)) => {
+                        let (start, tips) = &helices[i];
+                        let axis = run[*start].place.axis;
+                        let tips = &tips[self.above_blank(tips.iter().map(|t| (t, &axis)))..];
+                        self.approach(&tips[0], &axis, 0.0);
+                        self.set_role(MoveRole::Entry);
+                        for tip in &tips[1..] {
+                            self.push(MoveKind::Feed, *tip, axis);
+                        }
+                        self.entries.helix += 1;
+                        return *start;
+                    }
+                    Some(ClosedEntry::Ramp) => {
+                        let top = s.tip + s.axis * lift;
+                        self.approach(&top, &s.axis, lift);
+                        self.set_role(MoveRole::Entry);
+                        self.entries.ramp += 1;
+                        return self.ramp(run, lift);
+                    }
+                    Some(ClosedEntry::Shuttle(tools, end)) => return self.shuttle_entry(run, &tools, end, entry_z),
+                    None => {}
                 }
-                self.entries.helix += 1;
-                return start;
             }
             if matches!(mode, EntryMode::Auto | EntryMode::Side)
                 && let Some(from) = self.side(run, placer, body)
@@ -1917,6 +1956,14 @@ impl Emitter {
             }
             self.entries.ramp += 1;
             return 0;
+        }
+        // A closed run: down the ramp along it, or back and forth where that
+        // takes less time on the machine.
+        if closed
+            && lift > 0.0
+            && let (Some(ClosedEntry::Shuttle(tools, end)), _) = self.cheapest_ramp(run, (entry_z, lift), body)
+        {
+            return self.shuttle_entry(run, &tools, end, entry_z);
         }
         let start = s.tip + s.axis * lift;
         self.approach(&start, &s.axis, lift);
@@ -1978,24 +2025,28 @@ impl Emitter {
         }
     }
 
-    /// The helix entry of a closed run ([`helix_entry`]): first where the
+    /// The helix entries of a closed run ([`helix_entry`]): first where the
     /// ramp along the run would reach the level (the lap, and the passes
     /// synchronised from its end, are then those of the ramp's program: a
     /// helix at the run's own start moved them, and with them the runs the
     /// next passes split into; docs/rough5.md, "Entries"), then
     /// at [`HELIX_STARTS`] evenly spaced points from there, each with the
-    /// radii of [`HELIX_RADII`] largest first; the run's index where the
-    /// helix ends and its tips.
-    fn helix(&self, run: &[Cl], entry_z: f64, placer: &Placer, body: &BodyCheck) -> Option<(usize, Vec<Point3>)> {
+    /// radii of [`HELIX_RADII`] largest first; at the first start where one
+    /// fits, the run's index where the helix ends and its tips: the largest
+    /// only, or with [`Rough5Settings::entry_dynamics`] every radius that fits
+    /// there (largest first). Empty where none fits.
+    fn helices(&self, run: &[Cl], entry_z: f64, placer: &Placer, body: &BodyCheck) -> Vec<(usize, Vec<Point3>)> {
         let n = run.len() - 1;
         let tips: Vec<Point3> = run.iter().map(|c| c.place.tip).collect();
         let starts = HELIX_STARTS.min(n);
         let radius = self.radius;
         let first = self.ramp_end(run, Emitter::lift(&run[0].place, entry_z));
+        let all = self.settings.entry_dynamics.is_some();
         for j in 0..starts {
             let start = (first + j * n / starts) % n;
             let s = &run[start].place;
             let lift = Emitter::lift(s, entry_z);
+            let mut found = Vec::new();
             for f in HELIX_RADII {
                 let h = HelixSettings {
                     radius: f * radius,
@@ -2003,11 +2054,154 @@ impl Emitter {
                     step: self.settings.step,
                 };
                 if let Some(helix) = helix_entry(placer, body, (&tips, start), &s.axis, lift, &h) {
-                    return Some((start, helix));
+                    found.push((start, helix));
+                    if !all {
+                        break;
+                    }
+                }
+            }
+            if !found.is_empty() {
+                return found;
+            }
+        }
+        Vec::new()
+    }
+
+    /// How a closed run with the helices `helices` ([`Emitter::helices`]) is
+    /// entered from `entry_z` (the lift at its start `lift`): `None` without a
+    /// helix; the first helix without [`Rough5Settings::entry_dynamics`]; with
+    /// them, of the helices, the ramp along the run and the ramps back and
+    /// forth along it ([`Emitter::shuttle`], 2 to [`SHUTTLE_LEGS`] legs), the
+    /// one whose path takes the least time ([`path_time_estimate`]; a helix
+    /// from where it reaches the blank, [`Emitter::above_blank`]), a helix on
+    /// a tie. The ramps are candidates only at the ramp angle (not on a loop
+    /// within the flat of the tool's end, where [`Emitter::ramp_length`] makes
+    /// the ramp steeper), and every ramp ends where the ramp along the run
+    /// reaches the level, so the lap is the ramp program's.
+    fn cheapest_closed_entry(
+        &self,
+        run: &[Cl],
+        (entry_z, lift): (f64, f64),
+        helices: &[(usize, Vec<Point3>)],
+        body: &BodyCheck,
+    ) -> Option<ClosedEntry> {
+        if helices.is_empty() {
+            return None;
+        }
+        let Some(dynamics) = self.settings.entry_dynamics else { return Some(ClosedEntry::Helix(0)) };
+        let feed = self.settings.feed;
+        let (mut best, mut best_time) = (ClosedEntry::Helix(0), f64::INFINITY);
+        for (i, (start, tips)) in helices.iter().enumerate() {
+            let axis = run[*start].place.axis;
+            let tips = &tips[self.above_blank(tips.iter().map(|t| (t, &axis)))..];
+            let t = path_time_estimate(tips, feed, &dynamics);
+            if t < best_time {
+                (best, best_time) = (ClosedEntry::Helix(i), t);
+            }
+        }
+        match self.cheapest_ramp(run, (entry_z, lift), body) {
+            (Some(ramp), t) if t < best_time => Some(ramp),
+            _ => Some(best),
+        }
+    }
+
+    /// Of the ramp along the closed `run` from `lift` above its start and the
+    /// ramps back and forth along it ([`Emitter::shuttle`], 2 to
+    /// [`SHUTTLE_LEGS`] legs, ending where the ramp along it reaches the
+    /// level), the one whose path takes the least time under
+    /// [`Rough5Settings::entry_dynamics`] ([`path_time_estimate`]) and its
+    /// time; `(None, inf)` without them, or where the ramp along the run is
+    /// steeper than the ramp angle (a loop within the flat of the tool's end,
+    /// [`Emitter::ramp_length`]).
+    fn cheapest_ramp(&self, run: &[Cl], (entry_z, lift): (f64, f64), body: &BodyCheck) -> (Option<ClosedEntry>, f64) {
+        let Some(dynamics) = self.settings.entry_dynamics else { return (None, f64::INFINITY) };
+        let full = lift / self.settings.ramp_angle.tan();
+        if self.ramp_length(run, lift) < full {
+            return (None, f64::INFINITY);
+        }
+        let feed = self.settings.feed;
+        let (ramp, end) = self.ramp_tips(run, lift);
+        let (mut best, mut best_time) = (ClosedEntry::Ramp, path_time_estimate(&ramp, feed, &dynamics));
+        let end_lift = Emitter::lift(&run[end].place, entry_z);
+        for legs in 2..=SHUTTLE_LEGS {
+            if let Some(tools) = self.shuttle(run, (end, end_lift), legs, body) {
+                let from = self.above_blank(tools.iter().map(|(t, u)| (t, u)));
+                let tips: Vec<Point3> = tools[from..].iter().map(|(p, _)| *p).collect();
+                let t = path_time_estimate(&tips, feed, &dynamics);
+                if t < best_time {
+                    (best, best_time) = (ClosedEntry::Shuttle(tools, end), t);
                 }
             }
         }
-        None
+        (Some(best), best_time)
+    }
+
+    /// Enters `run` down the ramp back and forth `tools` (top first, from
+    /// where the tool reaches the blank) ending at the run's point `end`;
+    /// returns `end`.
+    fn shuttle_entry(&mut self, run: &[Cl], tools: &[(Point3, Vec3)], end: usize, entry_z: f64) -> usize {
+        let tools = &tools[self.above_blank(tools.iter().map(|(t, u)| (t, u)))..];
+        let (top, axis) = tools[0];
+        self.approach(&top, &axis, Emitter::lift(&run[end].place, entry_z));
+        self.set_role(MoveRole::Entry);
+        for (tip, axis) in &tools[1..] {
+            self.push(MoveKind::Feed, *tip, *axis);
+        }
+        self.entries.ramp += 1;
+        end
+    }
+
+    /// A ramp back and forth along the closed `run` in `legs` legs of equal
+    /// length, from `lift` above its point `end` down to it (tools, top
+    /// first): the last leg runs along the run's direction into `end`, each
+    /// tool is the run's lifted along its axis by `tan(ramp_angle)` per mm
+    /// travelled before `end`; `None` where a lifted tool comes closer to a
+    /// flank than `body` allows or a leg has no length. As the open runs'
+    /// ramps ([`open_ramp`]): on a long narrow loop whose helix fits only on a
+    /// small circle, straight legs at the feed cost less than the circle at
+    /// the linear axes' jerk (docs/rough5.md, "Entries against the machine's
+    /// dynamics").
+    fn shuttle(
+        &self,
+        run: &[Cl],
+        (end, lift): (usize, f64),
+        legs: usize,
+        body: &BodyCheck,
+    ) -> Option<Vec<(Point3, Vec3)>> {
+        let n = run.len() - 1;
+        let slope = self.settings.ramp_angle.tan();
+        if n < 2 || lift <= 0.0 || !lift.is_finite() || legs == 0 {
+            return None;
+        }
+        let leg = lift / slope / legs as f64;
+        // Backwards in time from `end`: against the run's direction first.
+        let mut out = vec![(run[end].place.tip, run[end].place.axis)];
+        let (mut k, mut backward, mut travelled, mut in_leg) = (end, true, 0.0, 0.0);
+        let mut steps = 0;
+        while travelled * slope < lift {
+            let next = if backward { (k + n - 1) % n } else { (k + 1) % n };
+            let d = (run[next].place.tip - run[k].place.tip).norm();
+            travelled += d;
+            in_leg += d;
+            k = next;
+            let h = (travelled * slope).min(lift);
+            let p = &run[k].place;
+            let tip = p.tip + p.axis * h;
+            if body.collides(&tip, &p.axis) {
+                return None;
+            }
+            out.push((tip, p.axis));
+            if in_leg >= leg {
+                backward = !backward;
+                in_leg = 0.0;
+            }
+            steps += 1;
+            if steps > tol::MAX_PASS_POINTS {
+                return None;
+            }
+        }
+        out.reverse();
+        Some(out)
     }
 
     /// The start of a side entry of `run` ([`side_entry`]): within
@@ -2033,11 +2227,27 @@ impl Emitter {
         }
     }
 
-    /// Ramps down along a closed run from `lift` above it; returns the index
-    /// where the lift reaches zero.
+    /// Ramps down along a closed run from `lift` above it ([`Emitter::ramp_tips`]);
+    /// returns the index where the lift reaches zero.
     fn ramp(&mut self, run: &[Cl], lift: f64) -> usize {
+        let (tips, end) = self.ramp_tips(run, lift);
+        let n = run.len() - 1;
+        for (k, tip) in tips.iter().enumerate().skip(1) {
+            self.feed_to(*tip, run[k % n].place.axis);
+        }
+        end
+    }
+
+    /// The tips of the ramp along the closed `run` from `lift` above its
+    /// start (the top first; the tool at the run's point `k` is lifted along
+    /// its axis by the lift left there, which falls linearly over
+    /// [`Emitter::ramp_length`]) and the run's index where it reaches the
+    /// level.
+    fn ramp_tips(&self, run: &[Cl], lift: f64) -> (Vec<Point3>, usize) {
         let n = run.len() - 1;
         let ramp_len = self.ramp_length(run, lift);
+        let s0 = &run[0].place;
+        let mut tips = vec![s0.tip + s0.axis * lift];
         let (mut s, mut k) = (0.0, 0usize);
         loop {
             let (a, b) = (&run[k % n].place, &run[(k + 1) % n].place);
@@ -2045,10 +2255,10 @@ impl Emitter {
             k += 1;
             let h = lift * (1.0 - s / ramp_len);
             if h <= 0.0 {
-                self.feed_to(b.tip, b.axis);
-                return k % n;
+                tips.push(b.tip);
+                return (tips, k % n);
             }
-            self.feed_to(b.tip + b.axis * h, b.axis);
+            tips.push(b.tip + b.axis * h);
         }
     }
 
