@@ -96,16 +96,17 @@ pub(crate) fn material_of(zmap: &scallop_sim::ZMap) -> Result<Option<MaterialMap
 const LEFT_PLACES: usize = 10;
 
 /// What a roughing operation with `settings` and `cutter` left above its
-/// allowance on the stock `zmap`, over the part `field` (cells with no part
-/// under their centre are not measured).
+/// allowance on the stock `zmap`, over the part `field` and off its outline
+/// (down to the lowest level, [`scallop_rough::level_bottom`]).
 ///
 /// Per cell p: the floor `F(p)` is the part's height grown sideways by the
 /// radial allowance (the highest part cell within `s` plus a cell's diagonal
 /// of p: a wall lies anywhere between two centres, and a wall across the grid
-/// steps by a diagonal) plus the axial allowance; the
+/// steps by a diagonal) plus the axial allowance; off the outline, where no
+/// part lies within that distance, the lowest level `z_b`. The
 /// material left is `h(p) - F(p)` where above [`LeftFigures::limit_mm`].
 /// The lowest the operation's cutter can take the stock at p is
-/// `reach(p) = min over centres c within R of p of CL(c) + a + h_R(|p - c|)`,
+/// `reach(p) = min over centres c within R of p of max(CL(c) + a, z_b) + h_R(|p - c|)`,
 /// with CL the drop-cutter of the cutter grown by the radial allowance (the
 /// tool the planner keeps off the part) and `h_R` the real cutter's profile
 /// (docs/roughing.md): where `reach(p)` stands above `F(p)` plus the limit,
@@ -149,15 +150,16 @@ pub(crate) fn left_above_allowance(
         (ii < nx && jj < ny).then_some(jj * nx + ii)
     };
     let grow = disc(settings.radial_allowance + cx.hypot(cy));
+    // Off the part's outline the levels take the stock down to the lowest
+    // level, and no tool goes below it.
+    let bottom_level = scallop_rough::level_bottom(&prepared.mesh.bounds(), &zmap.stock(), settings);
     let floor: Vec<f64> = (0..nx * ny)
         .into_par_iter()
         .map(|k| {
-            if part[k] == f64::NEG_INFINITY {
-                return f64::NEG_INFINITY;
-            }
             let (i, j) = (k % nx, k / nx);
-            grow.iter().filter_map(|o| at(i, j, o)).map(|n| part[n]).fold(f64::NEG_INFINITY, f64::max)
-                + settings.axial_allowance
+            let grown = grow.iter().filter_map(|o| at(i, j, o)).map(|n| part[n]).fold(f64::NEG_INFINITY, f64::max)
+                + settings.axial_allowance;
+            if part[k] == f64::NEG_INFINITY { grown.max(bottom_level) } else { grown }
         })
         .collect();
     let left: Vec<usize> =
@@ -191,9 +193,10 @@ pub(crate) fn left_above_allowance(
             let (i, j) = (k % nx, k / nx);
             let reach = reach_disc
                 .iter()
-                .filter_map(|o| at(i, j, o).map(|n| cl[n] + shape.height_at(o.2)))
-                .fold(f64::INFINITY, f64::min)
-                + settings.axial_allowance;
+                .filter_map(|o| {
+                    at(i, j, o).map(|n| (cl[n] + settings.axial_allowance).max(bottom_level) + shape.height_at(o.2))
+                })
+                .fold(f64::INFINITY, f64::min);
             reach > floor[k] + limit
         })
         .collect();

@@ -159,6 +159,8 @@ fn rest_roughing_machines_only_what_the_larger_tool_left() {
 /// stock's reading, docs/simulation.md), and no slot: the levels are open on
 /// the stock's sides and cut from the air inwards (docs/roughing.md, "Open
 /// sides"; a finishing operation reports none: `finishing_after_roughing`).
+/// The entries: one after each retract, and one at each descent reached by a
+/// tool-down link.
 #[test]
 fn a_roughing_operation_reports_its_simulated_engagement() {
     let out = run_job(&rough_job(0.3)).unwrap();
@@ -174,7 +176,10 @@ fn a_roughing_operation_reports_its_simulated_engagement() {
     assert!(e.p50_deg <= e.p95_deg && e.p95_deg <= e.max_deg && e.max_deg <= 180.0, "{e:?}");
     assert!((e.p50_deg - e.target_deg).abs() < 6.0, "{e:?}");
     assert!(e.cutting_length_mm > 0.0 && e.slot_length_mm == 0.0, "{e:?}");
-    assert!(e.entries > 0 && e.entries == e.retracts, "{e:?}");
+    // Each retract is followed by an entry; a descent after a tool-down link
+    // (to the next level) is one too.
+    let links = out.report.operations[0].plan.links;
+    assert!(e.entries > 0 && e.entries >= e.retracts && e.entries <= e.retracts + links, "{e:?} {links}");
 }
 
 /// A wedge on a plate: a slope rising from z = 0 at x = -10 to z = 8 at
@@ -233,4 +238,45 @@ fn adaptive_rest_along_a_slope_holds_the_engagement() {
     assert!(rest.cutting_length_mm > 100.0, "{rest:?}");
     assert!(rest.max_deg <= 1.1 * rest.target_deg, "{rest:?}");
     assert!(rest.over_length_mm < 1e-9 && rest.slot_length_mm < 1e-9, "{rest:?}");
+}
+
+/// The L walls standing alone, no plate: the inside corner at `(-6, -6)` is
+/// a corner of the part's outline, with no part under the fillet the
+/// roughing tool leaves in it.
+fn l_alone() -> TriMesh {
+    boxes_mesh(&[([-10.0, -10.0, 0.0], [10.0, -6.0, 8.0]), ([-10.0, -6.0, 0.0], [-6.0, 10.0, 8.0])])
+}
+
+/// The material left off the part's outline is measured down to the lowest
+/// level (docs/roughing.md, "Material left above the allowance"): the
+/// fillet a 6 mm end mill leaves in the outline's inside corner is reported
+/// unreachable, at the corner, about the fillet's volume, and nothing else
+/// off the outline is (the stock beside it is cut to the lowest level); a
+/// 2 mm end mill's rest pass takes most of it and reports what it could not.
+/// Before, cells with no part under their centre were not measured and both
+/// operations read 0 mm^3.
+#[test]
+fn material_left_in_an_inside_corner_of_the_outline_is_reported() {
+    let op = |name: &str, radius: f64| {
+        let mut o = l_operation(name, radius);
+        o.finish.part = Part::Mesh(l_alone());
+        o
+    };
+    let stock = Aabb3 { min: Point3::new(-12.0, -12.0, 0.0), max: Point3::new(12.0, 12.0, 9.0) };
+    let job = Job { stock: Some(StockShape::Box(stock)), operations: vec![op("rough", 3.0), op("rest", 1.0)] };
+    let out = run_job(&job).unwrap();
+    let [big, rest] = [&out.report.operations[0], &out.report.operations[1]];
+    let (l0, l1) = (big.left.as_ref().unwrap(), rest.left.as_ref().unwrap());
+    // The fillet of radius R + a = 3.2 against walls at the allowance, from the
+    // lowest level (0.2) to the walls' top level (8.2): R^2 (1 - pi / 4) x 8.
+    let fillet = 9.0 * (1.0 - std::f64::consts::FRAC_PI_4) * 8.0;
+    assert!(
+        l0.unreachable_volume_mm3 > 0.4 * fillet && l0.unreachable_volume_mm3 < 1.2 * fillet,
+        "{l0:?}, fillet {fillet} mm^3"
+    );
+    assert!(l0.volume_mm3 < l0.unreachable_volume_mm3 + 1.0, "{l0:?}");
+    let at = l0.places[0].at;
+    assert!((at[0] + 6.0).hypot(at[1] + 6.0) < 3.2, "{l0:?}");
+    assert!(l1.unreachable_volume_mm3 < 0.3 * l0.unreachable_volume_mm3, "{l0:?} {l1:?}");
+    assert!(rest.stock.removed_mm3 > 0.5 * l0.unreachable_volume_mm3, "{:?}", rest.stock);
 }

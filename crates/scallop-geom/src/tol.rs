@@ -1206,6 +1206,13 @@ pub mod sim {
     /// rounding) is not engagement.
     pub const ENGAGEMENT_FLOOR: f64 = 0.01;
 
+    /// A move at cutting depth whose end lies more than this (mm) below its
+    /// start descends: it starts an entry (a plunge, ramp or helix reached by a
+    /// tool-down link counts as one reached from a retract). Moves of one level
+    /// share their height exactly; a ramp's smallest descent per move is far
+    /// above this.
+    pub const ENGAGEMENT_DESCENT: f64 = 1e-6;
+
     /// The smallest collision-free stick-out of a tri-dexel cut
     /// (`scallop_sim::DexelOptions::max_stick_out`) is bisected to within this
     /// (mm) above the length where the shank or the holder first meets stock.

@@ -230,14 +230,21 @@ pub struct RoughPlan {
     pub helices: usize,
 }
 
+/// The lowest level's tool-tip height: the part's bottom plus the axial
+/// allowance (and [`tol::FLAT_LIFT`]), not below the stock's bottom. Off the
+/// part's outline the roughing takes the stock down to this height.
+#[must_use]
+pub fn level_bottom(part: &Aabb3, stock: &Aabb3, settings: &RoughSettings) -> f64 {
+    (part.min.z + settings.axial_allowance + tol::FLAT_LIFT).max(stock.min.z)
+}
+
 /// The tool-tip heights of the levels, top down: every `stepdown` below the
 /// stock top down to the part's bottom plus the axial allowance, and each
 /// horizontal facet's height plus the axial allowance.
 #[must_use]
 pub fn level_heights(index: &MeshIndex, stock: &Aabb3, settings: &RoughSettings) -> Vec<f64> {
-    let part = index.bounds();
     let top = stock.max.z;
-    let bottom = (part.min.z + settings.axial_allowance + tol::FLAT_LIFT).max(stock.min.z);
+    let bottom = level_bottom(&index.bounds(), stock, settings);
     let mut zs = Vec::new();
     let mut k = 1.0;
     while top - k * settings.stepdown > bottom + tol::LEVEL_MERGE && zs.len() < tol::MAX_LEVELS {

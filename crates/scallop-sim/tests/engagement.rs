@@ -174,6 +174,26 @@ fn brute_force_move_phi(pocket: &Pocket, radius: f64, path: &Toolpath, opts: &En
             continue;
         }
         let (a, b) = (xy(i - 1), xy(i));
+        let uncut_at = |q: Point2, at: Point2| {
+            let d = |p: Point2, s: Point2, e: Point2| {
+                let t = ((p - s).dot(&(e - s)) / (e - s).norm_squared()).clamp(0.0, 1.0);
+                if (e - s).norm_squared() > 0.0 { (p - (s + (e - s) * t)).norm() } else { (p - s).norm() }
+            };
+            pocket.contains(q) && d(q, a, at) >= radius - 1e-6 && done.iter().all(|&(s, e)| d(q, s, e) > radius + 1e-6)
+        };
+        if a == b && moves[i].to.z < moves[i - 1].to.z {
+            // A vertical plunge: the half circle (of any direction) with most material.
+            let probes: Vec<bool> = (0..2 * half)
+                .map(|j| {
+                    let theta = (j as f64 + 0.5) * step;
+                    uncut_at(a + Vec2::new(theta.cos(), theta.sin()) * radius, a)
+                })
+                .collect();
+            let best = (0..2 * half).map(|j| (0..half).filter(|&k| probes[(j + k) % (2 * half)]).count()).max();
+            out[i] = best.unwrap_or(0) as f64 * step;
+            done.push((a, b));
+            continue;
+        }
         let n = ((b - a).norm() / opts.sample_step).ceil() as usize;
         for k in 1..=n {
             let at = a + (b - a) * (k as f64 / n as f64);
@@ -181,14 +201,7 @@ fn brute_force_move_phi(pocket: &Pocket, radius: f64, path: &Toolpath, opts: &En
             let uncut = (0..half)
                 .filter(|&j| {
                     let theta = heading - std::f64::consts::FRAC_PI_2 + (j as f64 + 0.5) * step;
-                    let q = at + Vec2::new(theta.cos(), theta.sin()) * radius;
-                    let d = |p: Point2, s: Point2, e: Point2| {
-                        let t = ((p - s).dot(&(e - s)) / (e - s).norm_squared()).clamp(0.0, 1.0);
-                        if (e - s).norm_squared() > 0.0 { (p - (s + (e - s) * t)).norm() } else { (p - s).norm() }
-                    };
-                    pocket.contains(q)
-                        && d(q, a, at) >= radius - 1e-6
-                        && done.iter().all(|&(s, e)| d(q, s, e) > radius + 1e-6)
+                    uncut_at(at + Vec2::new(theta.cos(), theta.sin()) * radius, at)
                 })
                 .count();
             out[i] = f64::max(out[i], uncut as f64 * step);

@@ -105,3 +105,29 @@ fn a_stock_coarser_than_the_tool_is_refused() {
     let options = EngagementOptions { sample_step: f64::NAN, ..EngagementOptions::default() };
     assert!(stock_engagement(&stock(), &cutter, &path, 1.0, &options).is_err());
 }
+
+/// A descent at cutting depth is an entry, however the tool came there: a
+/// slot at z = -1, a plunge to z = -2 at its end (a tool-down link to the
+/// next level) and the slot back. The plunge is the second entry, its bottom
+/// reads the material all round it (180 degrees for the fuller half), and the
+/// slot back is reported apart within 2 R of it, outside from there on
+/// (before, the plunge was no entry and read nothing).
+#[test]
+fn a_plunge_at_depth_is_an_entry() {
+    let cutter = Cutter::new(CutterShape::Flat { radius: R }, 20.0).expect("cutter");
+    let mut path = Toolpath::new(1000.0);
+    path.push(Move::new(MoveKind::Rapid, p(10.0, 20.0, 5.0)));
+    path.push(Move::new(MoveKind::Plunge, p(10.0, 20.0, -1.0)));
+    path.push(Move::new(MoveKind::Feed, p(50.0, 20.0, -1.0)));
+    path.push(Move::new(MoveKind::Plunge, p(50.0, 20.0, -2.0)));
+    path.push(Move::new(MoveKind::Feed, p(10.0, 20.0, -2.0)));
+    path.push(Move::new(MoveKind::Retract, p(10.0, 20.0, 5.0)));
+    let options = EngagementOptions::default();
+    let target = engagement_angle(1.2, R);
+    let r = stock_engagement(&stock(), &cutter, &path, target, &options).expect("engagement");
+    assert_eq!((r.entries, r.retracts), (2, 1), "{r:?}");
+    assert!((r.move_phi[3] - std::f64::consts::PI).abs() <= options.angle_bound(), "plunge {}", r.move_phi[3]);
+    assert!((r.entry_max - std::f64::consts::PI).abs() <= options.angle_bound(), "{r:?}");
+    // Both slots outside their entries' 2 R: 40 - 6 mm each.
+    assert!((r.slot_length - 68.0).abs() <= 2.0 * options.sample_step, "{r:?}");
+}

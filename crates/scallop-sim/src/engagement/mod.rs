@@ -36,7 +36,9 @@ use scallop_geom::Point2;
 use scallop_toolpath::{MoveKind, Toolpath};
 
 use crate::SimError;
-use crate::tol::{ENGAGEMENT_ARC_SAGITTA as ARC_SAGITTA, ENGAGEMENT_BLOCK, ENGAGEMENT_CONTACT};
+use crate::tol::{
+    ENGAGEMENT_ARC_SAGITTA as ARC_SAGITTA, ENGAGEMENT_BLOCK, ENGAGEMENT_CONTACT, ENGAGEMENT_DESCENT as DESCENT,
+};
 pub use pocket::Pocket;
 pub(crate) use pocket::segment_distance;
 use raster::Raster;
@@ -259,16 +261,29 @@ fn track(path: &Toolpath, radius: f64, options: &EngagementOptions) -> Track {
             t.retracts += usize::from(before);
             continue;
         }
-        if !before {
+        let (from, to) = (path.moves()[i - 1].to, path.moves()[i].to);
+        // An entry starts where the tool comes to cutting depth from a retract,
+        // or where it starts descending at depth (a plunge, ramp or helix after
+        // a tool-down link from the level above).
+        let descends = |k: usize| path.moves()[k].to.z < path.moves()[k - 1].to.z - DESCENT;
+        let descent_starts = descends(i) && !(i >= 2 && is_cutting(path, i - 1, options.cut_below) && descends(i - 1));
+        if !before || descent_starts {
             t.entries += 1;
             entry_point = Some(xy(i - 1));
         }
         // An arc move (G2/G3) is followed along its chords within
         // `ARC_SAGITTA`, each a segment of the same move.
-        let (from, to) = (path.moves()[i - 1].to, path.moves()[i].to);
         let ends = path.arc(i).map_or_else(|| vec![to], |arc| arc.chords(&from, &to, ARC_SAGITTA));
         let mut a = xy(i - 1);
         let mut za = from.z;
+        if descends(i) && Point2::new(to.x, to.y) == a {
+            // A vertical plunge: one sample of no length at its bottom, so the
+            // material it meets counts in the entries' largest engagement.
+            t.segments.push(Segment { a, b: a, s1: s, index: i });
+            let segment = t.segments.len() - 1;
+            t.samples.push(Sample { at: a, z: to.z, s, segment, weight: 0.0, entry: true });
+            continue;
+        }
         for end in ends {
             let b = Point2::new(end.x, end.y);
             let length = (b - a).norm();
@@ -315,18 +330,38 @@ fn periphery_arc(
     older: &[(Point2, Point2)],
     n: usize,
 ) -> f64 {
-    let heading = (at.y - from.y).atan2(at.x - from.x);
     let step = std::f64::consts::PI / n as f64;
-    let count = (0..n)
-        .filter(|&k| {
-            let theta = heading - std::f64::consts::FRAC_PI_2 + (k as f64 + 0.5) * step;
-            let q = at + scallop_geom::Vec2::new(theta.cos(), theta.sin()) * radius;
-            stock.0.is_uncut(q, stock.1, radius)
-                && segment_distance(q, from, at) >= radius - ENGAGEMENT_CONTACT
-                && older.iter().all(|&(a, b)| segment_distance(q, a, b) > radius + ENGAGEMENT_CONTACT)
-        })
-        .count();
+    let uncut = |theta: f64| {
+        let q = at + scallop_geom::Vec2::new(theta.cos(), theta.sin()) * radius;
+        stock.0.is_uncut(q, stock.1, radius)
+            && segment_distance(q, from, at) >= radius - ENGAGEMENT_CONTACT
+            && older.iter().all(|&(a, b)| segment_distance(q, a, b) > radius + ENGAGEMENT_CONTACT)
+    };
+    if at == from {
+        // A vertical plunge: the half of the periphery with most material.
+        let probes: Vec<bool> = (0..2 * n).map(|k| uncut((k as f64 + 0.5) * step)).collect();
+        return half_window_max(&probes) as f64 * step;
+    }
+    let heading = (at.y - from.y).atan2(at.x - from.x);
+    let count = (0..n).filter(|&k| uncut(heading - std::f64::consts::FRAC_PI_2 + (k as f64 + 0.5) * step)).count();
     count as f64 * step
+}
+
+/// The most `true` probes among `probes.len() / 2` consecutive ones, the
+/// probes being equally spaced round a circle: the half circle with most
+/// material, for a sample with no direction of motion (a vertical plunge).
+pub(crate) fn half_window_max(probes: &[bool]) -> usize {
+    let (total, half) = (probes.len(), probes.len() / 2);
+    if half == 0 {
+        return 0;
+    }
+    let mut count = probes[..half].iter().filter(|&&b| b).count();
+    let mut best = count;
+    for k in 0..total {
+        count = count + usize::from(probes[(k + half) % total]) - usize::from(probes[k]);
+        best = best.max(count);
+    }
+    best
 }
 
 /// The engagement of every sample, in program order (see the module docs).

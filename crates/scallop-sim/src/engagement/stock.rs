@@ -111,13 +111,16 @@ pub fn stock_engagement(
             .par_iter()
             .map(|s| {
                 let from = track.segments[s.segment].a;
-                let heading = (s.at.y - from.y).atan2(s.at.x - from.x);
                 let floor = s.z + lift + ENGAGEMENT_FLOOR;
+                let probe = |theta: f64| material_above(view, s.at + Vec2::new(theta.cos(), theta.sin()) * rho, floor);
+                if from == s.at {
+                    // A vertical plunge: the half of the periphery with most material.
+                    let probes: Vec<bool> = (0..2 * half).map(|j| probe((j as f64 + 0.5) * step)).collect();
+                    return super::half_window_max(&probes) as f64 * step;
+                }
+                let heading = (s.at.y - from.y).atan2(s.at.x - from.x);
                 let count = (0..half)
-                    .filter(|&j| {
-                        let theta = heading - std::f64::consts::FRAC_PI_2 + (j as f64 + 0.5) * step;
-                        material_above(view, s.at + Vec2::new(theta.cos(), theta.sin()) * rho, floor)
-                    })
+                    .filter(|&j| probe(heading - std::f64::consts::FRAC_PI_2 + (j as f64 + 0.5) * step))
                     .count();
                 count as f64 * step
             })
