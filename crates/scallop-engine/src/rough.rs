@@ -103,7 +103,8 @@ const LEFT_PLACES: usize = 10;
 /// radial allowance (the highest part cell within `s` plus a cell's diagonal
 /// of p: a wall lies anywhere between two centres, and a wall across the grid
 /// steps by a diagonal) plus the axial allowance; off the outline, where no
-/// part lies within that distance, the lowest level `z_b`. The
+/// part lies within that distance, the lowest level `z_b` (cells off it
+/// nearer than that are not measured). The
 /// material left is `h(p) - F(p)` where above [`LeftFigures::limit_mm`].
 /// The lowest the operation's cutter can take the stock at p is
 /// `reach(p) = min over centres c within R of p of max(CL(c) + a, z_b) + h_R(|p - c|)`,
@@ -159,7 +160,14 @@ pub(crate) fn left_above_allowance(
             let (i, j) = (k % nx, k / nx);
             let grown = grow.iter().filter_map(|o| at(i, j, o)).map(|n| part[n]).fold(f64::NEG_INFINITY, f64::max)
                 + settings.axial_allowance;
-            if part[k] == f64::NEG_INFINITY { grown.max(bottom_level) } else { grown }
+            match (part[k] == f64::NEG_INFINITY, grown == f64::NEG_INFINITY) {
+                // Off the outline by more than the grown distance: the lowest level.
+                (true, true) => bottom_level,
+                // Off it by less: the wall's allowance, read by the grown part
+                // only on the part's side of the outline.
+                (true, false) => f64::NEG_INFINITY,
+                (false, _) => grown,
+            }
         })
         .collect();
     let left: Vec<usize> =
