@@ -103,8 +103,8 @@ const LEFT_PLACES: usize = 10;
 /// radial allowance (the highest part cell within `s` plus a cell's diagonal
 /// of p: a wall lies anywhere between two centres, and a wall across the grid
 /// steps by a diagonal) plus the axial allowance; off the outline, where no
-/// part lies within that distance, the lowest level `z_b` (cells off it
-/// nearer than that are not measured). The
+/// part cell lies within the allowance plus two diagonals, the lowest level
+/// `z_b` (cells off it nearer than that are not measured). The
 /// material left is `h(p) - F(p)` where above [`LeftFigures::limit_mm`].
 /// The lowest the operation's cutter can take the stock at p is
 /// `reach(p) = min over centres c within R of p of max(CL(c) + a, z_b) + h_R(|p - c|)`,
@@ -152,22 +152,23 @@ pub(crate) fn left_above_allowance(
     };
     let grow = disc(settings.radial_allowance + cx.hypot(cy));
     // Off the part's outline the levels take the stock down to the lowest
-    // level, and no tool goes below it.
+    // level, and no tool goes below it. A cell off it is measured only
+    // beyond the allowance plus two diagonals of the part's cells: one for
+    // where the outline lies between two centres, one for the planner's
+    // region, whose boundary is sampled too (closer, the allowance beside
+    // the outline's edge reads as material left).
     let bottom_level = scallop_rough::level_bottom(&prepared.mesh.bounds(), &zmap.stock(), settings);
+    let off = disc(settings.radial_allowance + 2.0 * cx.hypot(cy));
     let floor: Vec<f64> = (0..nx * ny)
         .into_par_iter()
         .map(|k| {
             let (i, j) = (k % nx, k / nx);
-            let grown = grow.iter().filter_map(|o| at(i, j, o)).map(|n| part[n]).fold(f64::NEG_INFINITY, f64::max)
-                + settings.axial_allowance;
-            match (part[k] == f64::NEG_INFINITY, grown == f64::NEG_INFINITY) {
-                // Off the outline by more than the grown distance: the lowest level.
-                (true, true) => bottom_level,
-                // Off it by less: the wall's allowance, read by the grown part
-                // only on the part's side of the outline.
-                (true, false) => f64::NEG_INFINITY,
-                (false, _) => grown,
+            if part[k] == f64::NEG_INFINITY {
+                let near = off.iter().filter_map(|o| at(i, j, o)).any(|n| part[n] != f64::NEG_INFINITY);
+                return if near { f64::NEG_INFINITY } else { bottom_level };
             }
+            grow.iter().filter_map(|o| at(i, j, o)).map(|n| part[n]).fold(f64::NEG_INFINITY, f64::max)
+                + settings.axial_allowance
         })
         .collect();
     let left: Vec<usize> =

@@ -250,16 +250,19 @@ fn l_alone() -> TriMesh {
 /// The material left off the part's outline is measured down to the lowest
 /// level (docs/roughing.md, "Material left above the allowance"): the
 /// fillet a 6 mm end mill leaves in the outline's inside corner is reported
-/// unreachable, at the corner, about the fillet's volume, and nothing else
+/// unreachable, at the corner, the fillet's volume beyond the band along the
+/// walls that is not measured off the outline, and nothing else
 /// off the outline is (the stock beside it is cut to the lowest level); a
 /// 2 mm end mill's rest pass takes most of it and reports what it could not.
 /// Before, cells with no part under their centre were not measured and both
 /// operations read 0 mm^3.
 #[test]
 fn material_left_in_an_inside_corner_of_the_outline_is_reported() {
+    const CELL: f64 = 0.1;
     let op = |name: &str, radius: f64| {
         let mut o = l_operation(name, radius);
         o.finish.part = Part::Mesh(l_alone());
+        o.finish.sim_resolution = CELL;
         o
     };
     let stock = Aabb3 { min: Point3::new(-12.0, -12.0, 0.0), max: Point3::new(12.0, 12.0, 9.0) };
@@ -267,11 +270,26 @@ fn material_left_in_an_inside_corner_of_the_outline_is_reported() {
     let out = run_job(&job).unwrap();
     let [big, rest] = [&out.report.operations[0], &out.report.operations[1]];
     let (l0, l1) = (big.left.as_ref().unwrap(), rest.left.as_ref().unwrap());
-    // The fillet of radius R + a = 3.2 against walls at the allowance, from the
-    // lowest level (0.2) to the walls' top level (8.2): R^2 (1 - pi / 4) x 8.
-    let fillet = 9.0 * (1.0 - std::f64::consts::FRAC_PI_4) * 8.0;
+    // The fillet the tool's disc (R = 3, its centre kept R + a = 3.2 from both
+    // walls) leaves in the corner, less the band of a + 2 diagonals along the
+    // walls that is not measured off the outline, from the lowest level (0.2)
+    // to the walls' top level (8.2): integrated on a fine grid.
+    let (r, band, n) = (3.0f64, 0.2 + 2.0 * CELL * std::f64::consts::SQRT_2, 800);
+    let h = 3.2 / f64::from(n);
+    let mut area = 0.0;
+    for i in 0..n {
+        for j in 0..n {
+            let (x, y) = ((f64::from(i) + 0.5) * h, (f64::from(j) + 0.5) * h);
+            if x > band && y > band && (x - 3.2).hypot(y - 3.2) > r {
+                area += h * h;
+            }
+        }
+    }
+    let fillet = area * 8.0;
+    // Within the cells along its edges (about 5 mm of edge, cells of 0.1 mm:
+    // 0.5 mm^2 of 1 mm^2 on either side).
     assert!(
-        l0.unreachable_volume_mm3 > 0.4 * fillet && l0.unreachable_volume_mm3 < 1.2 * fillet,
+        l0.unreachable_volume_mm3 > 0.5 * fillet && l0.unreachable_volume_mm3 < 1.5 * fillet,
         "{l0:?}, fillet {fillet} mm^3"
     );
     assert!(l0.volume_mm3 < l0.unreachable_volume_mm3 + 1.0, "{l0:?}");
