@@ -129,6 +129,102 @@ impl Squares {
     }
 }
 
+/// The most centres [`count_along`] reads together.
+pub(super) const MAX_CENTRES: usize = 5;
+
+/// The probes' counts of [`count_along`]: per centre, in the engagement and
+/// in its core.
+pub(super) type Counts = ([usize; MAX_CENTRES], [usize; MAX_CENTRES]);
+
+/// The counts of the probes at `centres[j] + r (u c - v s, u s + v c)` for
+/// each `(u, v)` of `probes` (each probe's direction rotated by the angle
+/// of cosine `c` and sine `s`), as [`probe`] answers each one (the
+/// engagement's and its core's), for every centre (at most
+/// [`MAX_CENTRES`]); `None` as soon as one centre's engagement count is over
+/// `most`. A probe whose positions at all the centres fall in squares with
+/// one answer ([`Squares::get`]; the box of the positions' squares, which
+/// holds them all) takes it for every centre at once; else each position is
+/// read on its own. The centres of a short step lie within a few cells of
+/// each other, so most probes are settled by a few squares.
+#[allow(clippy::too_many_arguments, reason = "the probes' inputs, read in the inner loop")]
+pub(super) fn count_along(
+    grid: &Grid,
+    squares: &Squares,
+    f: &Fields<'_>,
+    centres: &[[f64; 2]],
+    probes: &[[f64; 2]],
+    (r, c, s): (f64, f64, f64),
+    most: usize,
+) -> Option<Counts> {
+    let m = centres.len().min(MAX_CENTRES);
+    let centres = &centres[..m];
+    let (mut count, mut core) = ([0usize; MAX_CENTRES], [0usize; MAX_CENTRES]);
+    let mut q = [[0.0f64; 2]; MAX_CENTRES];
+    for &[u, v] in probes {
+        let o = [r * (u * c - v * s), r * (u * s + v * c)];
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for (j, p) in centres.iter().enumerate() {
+            q[j] = [p[0] + o[0], p[1] + o[1]];
+            lo = [lo[0].min(q[j][0]), lo[1].min(q[j][1])];
+            hi = [hi[0].max(q[j][0]), hi[1].max(q[j][1])];
+        }
+        match span_answer(grid, squares, f, lo, hi) {
+            Some(NOTHING) => continue,
+            Some(a @ (CORE | RIM)) => {
+                for j in 0..m {
+                    count[j] += 1;
+                    core[j] += usize::from(a == CORE);
+                    if count[j] > most {
+                        return None;
+                    }
+                }
+            }
+            _ => {
+                for j in 0..m {
+                    // Off the grid both fields are far: no material.
+                    let Some(at) = grid.locate(q[j]) else { continue };
+                    let (counted, in_core) = match squares.get(at.0, f) {
+                        NOTHING => continue,
+                        CORE => (true, true),
+                        RIM => (true, false),
+                        _ => probe(f, at),
+                    };
+                    if counted {
+                        count[j] += 1;
+                        if count[j] > most {
+                            return None;
+                        }
+                        core[j] += usize::from(in_core);
+                    }
+                }
+            }
+        }
+    }
+    Some((count, core))
+}
+
+/// The one answer of every square holding a sample in the box `lo..hi`
+/// (on the grid), `None` when they differ or the box leaves the grid.
+#[inline]
+fn span_answer(grid: &Grid, squares: &Squares, f: &Fields<'_>, lo: [f64; 2], hi: [f64; 2]) -> Option<u8> {
+    // As `Grid::locate`: the squares of the box's corners bound those of
+    // every point in it (the location only grows with the coordinate).
+    let ((i0, j0), (i1, j1)) = (grid.square_at(lo)?, grid.square_at(hi)?);
+    let nx = grid.nx;
+    let first = squares.get(j0 * nx + i0, f);
+    if first == MIXED {
+        return None;
+    }
+    for j in j0..=j1 {
+        for i in i0..=i1 {
+            if squares.get(j * nx + i, f) != first {
+                return None;
+            }
+        }
+    }
+    Some(first)
+}
+
 /// The answer of square `k` from its four values of each field (see the
 /// module documentation).
 #[inline(never)]
