@@ -769,9 +769,6 @@ impl Planner<'_> {
     /// the largest at the points `along` it (shares of `len`), or `None`
     /// when one is over `limit`.
     fn stride_within(&self, p: P2, heading: f64, len: f64, limit: f64, along: &[f64]) -> Option<Stride> {
-        if along.len() > 1 && along.len() <= squares::MAX_CENTRES {
-            return self.stride_along(p, heading, len, limit, along);
-        }
         let (mut phi, mut core) = (0.0f64, 0.0f64);
         for &f in along {
             let (a, b) = self.front_within(ahead(p, heading, f * len), heading, limit)?;
@@ -779,37 +776,6 @@ impl Planner<'_> {
             core = core.max(b);
         }
         Some(Stride { to: ahead(p, heading, len), heading, phi, core, wall: false })
-    }
-
-    /// [`Planner::stride_within`] of a few points read together, probe by
-    /// probe ([`squares::count_along`]): the same answers (the largest of
-    /// the points' engagements, `None` when one is over `limit`).
-    fn stride_along(&self, p: P2, heading: f64, len: f64, limit: f64, along: &[f64]) -> Option<Stride> {
-        let mut centres = [[0.0f64; 2]; squares::MAX_CENTRES];
-        for (c, &f) in centres.iter_mut().zip(along) {
-            *c = ahead(p, heading, f * len);
-        }
-        let m = along.len();
-        let n = self.probes.len();
-        #[allow(clippy::cast_precision_loss, reason = "small counts")]
-        let share = |k: usize| std::f64::consts::PI * k as f64 / n as f64;
-        let (s, c) = heading.sin_cos();
-        let probes = if self.away() < 0.0 { &self.probes_left } else { &self.probes };
-        let (count, core) = squares::count_along(
-            &self.grid,
-            &self.squares,
-            &self.fields(),
-            &centres[..m],
-            probes,
-            (self.options.tool_radius, c, s),
-            most_within(n, limit),
-        )?;
-        let (mut phi, mut kept) = (0.0f64, 0.0f64);
-        for j in 0..m {
-            phi = phi.max(share(count[j]));
-            kept = kept.max(share(core[j]));
-        }
-        Some(Stride { to: ahead(p, heading, len), heading, phi, core: kept, wall: false })
     }
 
     /// The next step from `p` after a step along `heading` (see

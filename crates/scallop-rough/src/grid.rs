@@ -105,18 +105,6 @@ impl Grid {
         Some(at)
     }
 
-    /// The square (column, row of its lower-left centre) where
-    /// [`Grid::locate`] finds `p`, `None` off the grid as there.
-    #[inline]
-    pub fn square_at(&self, p: P2) -> Option<(usize, usize)> {
-        let u = (p[0] - self.x0) / self.h - 0.5;
-        let v = (p[1] - self.y0) / self.h - 0.5;
-        #[allow(clippy::cast_precision_loss, reason = "grid sizes")]
-        let inside = u >= 0.0 && v >= 0.0 && u < (self.nx - 1) as f64 && v < (self.ny - 1) as f64;
-        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "checked")]
-        inside.then(|| (u as u32 as usize, v as u32 as usize))
-    }
-
     /// The field `f` (rows of `nx`) at a location of [`Grid::locate`].
     #[inline]
     pub fn interpolate(f: &[f64], nx: usize, (k, a, b): (usize, f64, f64)) -> f64 {
