@@ -535,7 +535,7 @@ fn bisection_turn(lo: f64, hi: f64, k: usize, n: usize) -> f64 {
 fn most_within(n: usize, limit: f64) -> usize {
     #[allow(clippy::cast_precision_loss, reason = "small counts")]
     let share = |k: usize| std::f64::consts::PI * k as f64 / n as f64;
-    if n == 0 || !(share(n) > limit) {
+    if n == 0 || share(n) <= limit || limit.is_nan() {
         return n;
     }
     if share(1) > limit {
@@ -1513,6 +1513,25 @@ mod tests {
                         (lo, klo) = (mid, kmid);
                     }
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn most_within_is_the_last_count_whose_share_keeps_within() {
+        // Against the linear scan, at the walk's probe counts, at limits on
+        // and around every share, and at the ends.
+        for n in [1usize, 2, 7, 90, 180] {
+            #[allow(clippy::cast_precision_loss, reason = "small counts")]
+            let share = |k: usize| std::f64::consts::PI * k as f64 / n as f64;
+            let mut limits = vec![-1.0, 0.0, f64::INFINITY, f64::NAN, 10.0, tol::ENGAGE_ACCEPT * 0.927];
+            for k in 0..=n {
+                let v = share(k);
+                limits.extend([v, v.next_up(), v.next_down(), v + 1e-3, v - 1e-3]);
+            }
+            for limit in limits {
+                let want = (0..=n).filter(|&k| share(k) <= limit || limit.is_nan()).max().unwrap_or(0);
+                assert_eq!(most_within(n, limit), want, "n {n}, limit {limit}");
             }
         }
     }
