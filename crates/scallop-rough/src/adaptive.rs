@@ -741,34 +741,6 @@ impl Planner<'_> {
         Some((share(count), share(core)))
     }
 
-    /// The count of the front half's probes of the tool centred at `p`
-    /// moving along `heading` that are in the engagement's core (as
-    /// [`Planner::front`] counts them), when it is over `over` (any count
-    /// with `None`); `None` as soon as the probes left cannot bring it over.
-    fn core_over(&self, p: P2, heading: f64, over: Option<usize>) -> Option<usize> {
-        let r = self.options.tool_radius;
-        let n = self.probes.len();
-        let (s, c) = heading.sin_cos();
-        let probes = if self.away() < 0.0 { &self.probes_left } else { &self.probes };
-        let fields = self.fields();
-        let mut core = 0usize;
-        for (j, &[u, v]) in probes.iter().enumerate() {
-            if over.is_some_and(|o| core + (n - j) <= o) {
-                return None;
-            }
-            // As `front_within`.
-            let q = [p[0] + r * (u * c - v * s), p[1] + r * (u * s + v * c)];
-            let Some(at) = self.grid.locate(q) else { continue };
-            let in_core = match self.squares.get(at.0, &fields) {
-                NOTHING | RIM => continue,
-                CORE => true,
-                _ => squares::probe(&fields, at).1,
-            };
-            core += usize::from(in_core);
-        }
-        over.is_none_or(|o| core > o).then_some(core)
-    }
-
     /// The sign of a turn away from the material on the pass being planned:
     /// left (counter-clockwise, 1) when climbing, the material on the tool's
     /// right; right (-1) when milling conventionally. Both ways, it changes
@@ -781,6 +753,16 @@ impl Planner<'_> {
     /// from the air.
     fn base_hand(&self) -> f64 {
         if self.options.direction == Direction::Conventional { -1.0 } else { 1.0 }
+    }
+
+    fn stride(&self, p: P2, heading: f64) -> Stride {
+        self.stride_by(p, heading, tol::WALK_STEP_SHARE * self.options.tool_radius)
+    }
+
+    fn stride_by(&self, p: P2, heading: f64, len: f64) -> Stride {
+        let to = ahead(p, heading, len);
+        let (phi, core) = self.front(to, heading);
+        Stride { to, heading, phi, core, wall: false }
     }
 
     /// The step from `p` along `heading` of length `len`, its engagement
@@ -932,18 +914,13 @@ impl Planner<'_> {
         let n = tol::WALK_START_HEADINGS;
         #[allow(clippy::cast_precision_loss, reason = "a small count")]
         let heading = |i: usize| std::f64::consts::TAU * i as f64 / n as f64;
-        // The first heading of the largest engagement leaving out the strip
-        // along the walls ([`Stride::core`], as `stride` measures it), its
-        // count of probes.
-        let len = tol::WALK_STEP_SHARE * self.options.tool_radius;
-        let (mut best, mut most) = (0.0, None);
+        let (mut best, mut phi) = (0.0, -1.0);
         for i in 0..n {
-            if let Some(k) = self.core_over(ahead(p, heading(i), len), heading(i), most) {
-                (best, most) = (heading(i), Some(k));
+            let s = self.stride(p, heading(i));
+            if s.core > phi {
+                (best, phi) = (heading(i), s.core);
             }
         }
-        #[allow(clippy::cast_precision_loss, reason = "small counts")]
-        let phi = most.map_or(-1.0, |k| std::f64::consts::PI * k as f64 / self.probes.len() as f64);
         if phi < tol::WALK_AIR * self.target {
             return None;
         }
