@@ -42,7 +42,9 @@ use crate::offset::Step;
 use crate::{ClearOptions, Direction, RoughError, tol};
 
 mod links;
+mod squares;
 use crate::walls::Edges;
+use squares::{CORE, Fields, NOTHING, RIM, Squares};
 
 /// The state of the planner of one region.
 struct Planner<'a> {
@@ -51,6 +53,9 @@ struct Planner<'a> {
     reach: Vec<f64>,
     /// Distance from the tool centres swept so far.
     swept: Vec<f64>,
+    /// What a probe reads in each square of the grid, where it is one
+    /// answer ([`Squares`]): forgotten wherever `swept` changes.
+    squares: Squares,
     /// The region grown a hair: links must stay in it.
     holder: Region,
     /// The holder's rings as the chords its segment test clips by, for
@@ -234,6 +239,7 @@ pub fn plan_adaptive_touching(
     let fence = Edges::new(&holder, options.chord_tolerance, 8.0 * h);
     let mut planner = Planner {
         swept: vec![BIG; grid.len()],
+        squares: Squares::new(grid.len(), grid.nx),
         reach,
         holder,
         fence,
@@ -315,6 +321,7 @@ pub fn plan_adaptive_touching(
             walk.steps.pop();
             planner.starts.truncate(saved.2);
             (planner.swept, planner.lattice) = (saved.0, saved.1);
+            planner.squares.reset();
             let g = &planner.grid;
             #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "clamped to the grid")]
             let span = |c: f64, o: f64, n: usize| {
@@ -522,6 +529,31 @@ fn bisection_turn(lo: f64, hi: f64, k: usize, n: usize) -> f64 {
     }
 }
 
+/// The largest count `k` of `n` probes whose share of a half turn, `PI k
+/// / n` as [`Planner::front_within`] computes it, is at most `limit` (0
+/// when none is; `n` when `limit` is not a number).
+fn most_within(n: usize, limit: f64) -> usize {
+    #[allow(clippy::cast_precision_loss, reason = "small counts")]
+    let share = |k: usize| std::f64::consts::PI * k as f64 / n as f64;
+    if n == 0 || share(n) <= limit || limit.is_nan() {
+        return n;
+    }
+    if share(1) > limit {
+        return 0;
+    }
+    // From the estimate, to the last count within (share(1) is within,
+    // share(n) is not).
+    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, clippy::cast_precision_loss)]
+    let mut k = ((limit / std::f64::consts::PI * n as f64) as usize).clamp(1, n - 1);
+    while share(k) > limit {
+        k -= 1;
+    }
+    while share(k + 1) <= limit {
+        k += 1;
+    }
+    k
+}
+
 fn ahead(p: P2, heading: f64, len: f64) -> P2 {
     [p[0] + len * heading.cos(), p[1] + len * heading.sin()]
 }
@@ -559,12 +591,12 @@ impl Planner<'_> {
             [s[0] + r0 * a.cos(), s[1] + r0 * a.sin()]
         };
         for i in 0..n {
-            self.grid.stamp_segment(&mut self.swept, on(i), on(i + 1), w, None);
+            self.stamp_full(on(i), on(i + 1), w);
             if self.edges.contains(on(i)) {
                 self.starts.push((on(i), true, pass, hand, false));
             }
         }
-        self.grid.stamp_segment(&mut self.swept, s, s, w, None);
+        self.stamp_full(s, s, w);
         self.starts.push((s, true, pass, hand, false));
     }
 
@@ -586,16 +618,56 @@ impl Planner<'_> {
     /// ([`Grid::stamp_segment_over`]): the field is read only against
     /// thresholds of R less [`tol::AIR_RING_CHIP`] or more, which such a
     /// cell's squares answer alike either way.
-    fn stamp_swept(&mut self, a: P2, b: P2, undo: Option<&mut Vec<(usize, f64)>>) {
+    fn stamp_swept(&mut self, a: P2, b: P2, mut undo: Option<&mut Vec<(usize, f64)>>) {
         let (r, h) = (self.options.tool_radius, self.grid.h);
         let floor = self.grid.settled(r - tol::AIR_RING_CHIP);
-        self.grid.stamp_segment_over(&mut self.swept, a, b, r + 2.0 * h, floor, undo);
+        let squares = &self.squares;
+        self.grid.stamp_segment_with(&mut self.swept, a, b, r + 2.0 * h, floor, |k, old| {
+            if let Some(u) = undo.as_deref_mut() {
+                u.push((k, old));
+            }
+            squares.lowered(k, old, r);
+        });
+    }
+
+    /// Stamps the move `a`-`b` on the swept field within `w` of it, every
+    /// cell (the bore's).
+    fn stamp_full(&mut self, a: P2, b: P2, w: f64) {
+        let r = self.options.tool_radius;
+        let squares = &self.squares;
+        self.grid.stamp_segment_with(&mut self.swept, a, b, w, f64::NEG_INFINITY, |k, old| squares.lowered(k, old, r));
+    }
+
+    /// Sets cell `k` of the swept field back to `v` (undoing a stamp).
+    fn restore_swept(&mut self, k: usize, v: f64) {
+        self.swept[k] = v;
+        self.squares.changed(k);
+    }
+
+    /// The fields a probe reads ([`squares::probe`]).
+    fn fields(&self) -> Fields<'_> {
+        let r = self.options.tool_radius;
+        Fields {
+            swept: &self.swept,
+            reach: &self.reach,
+            open: self.open.as_deref(),
+            touch: self.touch.as_ref().map(|(f, near)| (&f[..], &near[..])),
+            nx: self.grid.nx,
+            r,
+            strip: r - self.strip,
+        }
     }
 
     /// Whether the point `q` is material: within R of the region (inside the
     /// pocket) and farther than R from every swept centre.
     fn material(&self, q: P2) -> bool {
         let r = self.options.tool_radius;
+        // The square's answer where it has one (its material is this).
+        match self.grid.locate(q).map(|at| self.squares.get(at.0, &self.fields())) {
+            None | Some(NOTHING) => return false,
+            Some(CORE | RIM) => return true,
+            _ => {}
+        }
         self.grid.sample(&self.swept, q) > r
             && self.grid.sample(&self.reach, q) < r
             && !self.grid.locate(q).is_some_and(|at| self.open_at(at))
@@ -639,37 +711,31 @@ impl Planner<'_> {
         let r = self.options.tool_radius;
         let n = self.probes.len();
         let (s, c) = heading.sin_cos();
-        let strip = r - self.strip;
         #[allow(clippy::cast_precision_loss, reason = "small counts")]
         let share = |k: usize| std::f64::consts::PI * k as f64 / n as f64;
+        // `share(count) > limit` as a count (`share` only grows with it).
+        let most = most_within(n, limit);
         let (mut count, mut core) = (0usize, 0usize);
-        let nx = self.grid.nx;
         let probes = if self.away() < 0.0 { &self.probes_left } else { &self.probes };
-        let open = self.open.as_deref();
-        let touch = self.touch.as_ref();
+        let fields = self.fields();
         for &[u, v] in probes {
             // The probe's direction (u, v) about the heading, rotated onto it.
             let q = [p[0] + r * (u * c - v * s), p[1] + r * (u * s + v * c)];
             // Off the grid both fields are far: no material.
             let Some(at) = self.grid.locate(q) else { continue };
-            if Grid::interpolate(&self.swept, nx, at) > r {
-                let reach = Grid::interpolate(&self.reach, nx, at);
-                // As `open_at`, inline; the material touched beyond it
-                // counts in the engagement only.
-                let inside = reach < r && !open.is_some_and(|f| Grid::interpolate(f, nx, at) > 0.0);
-                if inside
-                    || touch.is_some_and(|(f, near)| {
-                        Grid::interpolate(near, nx, at) < r && Grid::interpolate(f, nx, at) <= 0.0
-                    })
-                {
-                    count += 1;
-                    if share(count) > limit {
-                        return None;
-                    }
-                    if inside && reach < strip {
-                        core += 1;
-                    }
+            // The square's answer where it has one, else the probe's own.
+            let (counted, in_core) = match self.squares.get(at.0, &fields) {
+                NOTHING => continue,
+                CORE => (true, true),
+                RIM => (true, false),
+                _ => squares::probe(&fields, at),
+            };
+            if counted {
+                count += 1;
+                if count > most {
+                    return None;
                 }
+                core += usize::from(in_core);
             }
         }
         Some((share(count), share(core)))
@@ -976,7 +1042,7 @@ impl Planner<'_> {
             let mark = marks[keep];
             while undo.len() > mark {
                 if let Some((k, v)) = undo.pop() {
-                    self.swept[k] = v;
+                    self.restore_swept(k, v);
                 }
             }
             run.truncate(keep);
@@ -987,7 +1053,7 @@ impl Planner<'_> {
         // cuts.
         let kept = simplify(&self.edges, &run, self.fit);
         while let Some((k, v)) = undo.pop() {
-            self.swept[k] = v;
+            self.restore_swept(k, v);
         }
         // A line that replaces several steps heads a little off each of
         // them, and the front half it cuts turns with it: where its
@@ -1207,7 +1273,7 @@ impl Planner<'_> {
 
     fn revert(&mut self, undo: &mut Vec<(usize, f64)>) {
         while let Some((k, v)) = undo.pop() {
-            self.swept[k] = v;
+            self.restore_swept(k, v);
         }
     }
 
@@ -1447,6 +1513,25 @@ mod tests {
                         (lo, klo) = (mid, kmid);
                     }
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn most_within_is_the_last_count_whose_share_keeps_within() {
+        // Against the linear scan, at the walk's probe counts, at limits on
+        // and around every share, and at the ends.
+        for n in [1usize, 2, 7, 90, 180] {
+            #[allow(clippy::cast_precision_loss, reason = "small counts")]
+            let share = |k: usize| std::f64::consts::PI * k as f64 / n as f64;
+            let mut limits = vec![-1.0, 0.0, f64::INFINITY, f64::NAN, 10.0, tol::ENGAGE_ACCEPT * 0.927];
+            for k in 0..=n {
+                let v = share(k);
+                limits.extend([v, v.next_up(), v.next_down(), v + 1e-3, v - 1e-3]);
+            }
+            for limit in limits {
+                let want = (0..=n).filter(|&k| share(k) <= limit || limit.is_nan()).max().unwrap_or(0);
+                assert_eq!(most_within(n, limit), want, "n {n}, limit {limit}");
             }
         }
     }

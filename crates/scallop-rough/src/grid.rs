@@ -247,6 +247,24 @@ impl Grid {
         floor: f64,
         mut undo: Option<&mut Vec<(usize, f64)>>,
     ) {
+        self.stamp_segment_with(f, a, b, r, floor, |k, old| {
+            if let Some(u) = undo.as_deref_mut() {
+                u.push((k, old));
+            }
+        });
+    }
+
+    /// [`Grid::stamp_segment_over`], telling `wrote` each cell it lowers
+    /// and the cell's old value.
+    pub fn stamp_segment_with(
+        &self,
+        f: &mut [f64],
+        a: P2,
+        b: P2,
+        r: f64,
+        floor: f64,
+        mut wrote: impl FnMut(usize, f64),
+    ) {
         let lo = [a[0].min(b[0]), a[1].min(b[1])];
         let hi = [a[0].max(b[0]), a[1].max(b[1])];
         let (i0, i1, j0, j1) = self.range(lo, hi, r);
@@ -288,9 +306,7 @@ impl Grid {
                 if d2 <= r * r && d2 < f[k] * f[k] {
                     let d = d2.sqrt();
                     if d < f[k] {
-                        if let Some(u) = undo.as_deref_mut() {
-                            u.push((k, f[k]));
-                        }
+                        wrote(k, f[k]);
                         f[k] = d;
                     }
                 }

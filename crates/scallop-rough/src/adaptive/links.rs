@@ -16,6 +16,7 @@ use std::collections::{BinaryHeap, HashMap};
 
 use scallop_contour::P2;
 
+use super::squares::{NOTHING, RIM};
 use super::{Planner, dist};
 use crate::grid::{BIG, Grid};
 use crate::offset::Step;
@@ -37,10 +38,16 @@ impl Planner<'_> {
         // The swept field first: in cleared area it settles the probe alone.
         let nx = self.grid.nx;
         let open = self.open.as_deref();
+        let fields = self.fields();
         for &[c, s] in &self.link_round {
             let q = [p[0] + r * c, p[1] + r * s];
             // Off the grid both fields are far: no material.
             let Some(at) = self.grid.locate(q) else { continue };
+            // A square with no material, or all of it in the strip along
+            // the walls, holds no material of the test below.
+            if matches!(self.squares.get(at.0, &fields), NOTHING | RIM) {
+                continue;
+            }
             if Grid::interpolate(&self.swept, nx, at) > r + LINK_SLACK
                 && Grid::interpolate(&self.reach, nx, at) < r - self.strip
                 // As `open_at`, inline.
