@@ -272,13 +272,35 @@ pub fn plan_adaptive_touching(
             .collect()
     });
     let mut walk = Walk { steps: Vec::new(), passes: 0, budget: tol::MAX_WALK_STEPS };
+    // Rest roughing: the stretches of the region's rings that meet material
+    // and hold the engagement first (the slivers and steps the larger tool
+    // left along the walls, in one pass each), the walk after them on what
+    // they leave (docs/roughing.md, "Adaptive rest roughing: the rings
+    // first").
+    let after = if planner.touch.is_some() { planner.rings_first(region, &mut walk.steps) } else { None };
     let mut end = if air_starts.is_empty() {
+        let saved = after.map(|_| (planner.swept.clone(), planner.lattice.clone(), planner.starts.len()));
+        let before = walk.steps.len();
         planner.bore(s, r0, 0);
-        planner.walk_all(Some(s), &mut walk)?
+        let reached = planner.walk_all(Some(s), None, &mut walk)?;
+        match (after, saved) {
+            (Some(p), Some(saved)) if walk.steps.len() == before => {
+                // Nothing cut from the bore: it is not made.
+                planner.starts.truncate(saved.2);
+                (planner.swept, planner.lattice) = (saved.0, saved.1);
+                p
+            }
+            (Some(_), _) => {
+                // The tool leaves the stretches for the bore.
+                walk.steps.insert(before, Step::Link { tool_down: false, via: Vec::new(), cleared: false, to: None });
+                reached
+            }
+            _ => reached,
+        }
     } else {
         let hand = planner.base_hand();
         planner.starts.extend(air_starts.iter().map(|&p| (p, true, 0, hand, false)));
-        planner.walk_all(None, &mut walk)?
+        planner.walk_all(None, after, &mut walk)?
     };
     // Parts of the region the walk could not reach (joined to the rest by a
     // neck narrower than its steps, or a tooth gap it could not turn into):
@@ -308,7 +330,7 @@ pub fn plan_adaptive_touching(
         #[allow(clippy::cast_possible_truncation, reason = "passes are bounded by MAX_PASSES")]
         planner.bore(e, r0, walk.passes as u32);
         let before = walk.steps.len();
-        let reached = planner.walk_all(Some(e), &mut walk)?;
+        let reached = planner.walk_all(Some(e), None, &mut walk)?;
         if walk.steps.len() == before {
             // Nothing cut from there: the entry alone, a plunge or a helix;
             // the tool is still where the last walk left it.
@@ -1024,15 +1046,18 @@ impl Planner<'_> {
     /// The passes from the bore at `s`, or, with `None`, from the starts
     /// already listed (tool centres in air: the first pass is entered by a
     /// straight plunge at its start).
-    fn walk_all(&mut self, s: Option<P2>, walk: &mut Walk) -> Result<P2, RoughError> {
+    /// With `after`, the tool is there already (at the end of the rings'
+    /// stretches cut first, [`Planner::rings_first`]): the first pass is
+    /// linked from it.
+    fn walk_all(&mut self, s: Option<P2>, after: Option<P2>, walk: &mut Walk) -> Result<P2, RoughError> {
         let air = s.is_none();
         let s = s.or_else(|| self.starts.first().map(|t| t.0)).unwrap_or([0.0, 0.0]);
-        let mut pos = s;
+        let mut pos = after.unwrap_or(s);
         // The heading of the last pass's last move.
         let mut out: Option<f64> = None;
         // The last pass's `away`: its end turns that way into the link.
         let mut last_hand = self.hand;
-        let mut fresh = true;
+        let mut fresh = after.is_none();
         let spacing = tol::WALK_START_SPACING * self.options.tool_radius;
         let step = tol::WALK_STEP_SHARE * self.options.tool_radius;
         while let Some((i, first)) = self.next_start() {
@@ -1253,6 +1278,10 @@ impl Planner<'_> {
             rho = next;
             let run = self.corner_arc(corner, rho);
             let Some(&start) = run.first() else { return };
+            // Rest roughing: an arc that meets no material is not cut.
+            if self.touch.is_some() && !run.iter().any(|&p| self.meets(p)) {
+                continue;
+            }
             let link = self.link_step(*pos, start);
             steps.push(link);
             *pos = *run.last().unwrap_or(&start);
@@ -1285,6 +1314,184 @@ impl Planner<'_> {
         run
     }
 
+    /// Whether the tool centred at `p` meets material: a probe all round,
+    /// [`tol::AIR_RING_CHIP`] inside its periphery, in the material to
+    /// remove or in the material touched beyond it (rest roughing: the
+    /// cells along the walls; the offset pattern's test of a ring against
+    /// the air, docs/roughing.md, "Air"), not swept.
+    fn meets(&self, p: P2) -> bool {
+        let r = self.options.tool_radius;
+        let d = r - tol::AIR_RING_CHIP;
+        let nx = self.grid.nx;
+        let touched = |q: P2| {
+            self.touch.as_ref().is_some_and(|(f, near)| {
+                self.grid.locate(q).is_some_and(|at| {
+                    Grid::interpolate(&self.swept, nx, at) > r
+                        && Grid::interpolate(near, nx, at) < r
+                        && Grid::interpolate(f, nx, at) <= 0.0
+                })
+            })
+        };
+        self.link_round.iter().any(|&[c, s]| {
+            let q = [p[0] + d * c, p[1] + d * s];
+            self.material(q) || touched(q)
+        })
+    }
+
+    /// The closed ring `c` (oriented for the milling direction) as points
+    /// on it at most half a cell apart: its chords within
+    /// [`tol::WALK_CHORD`], cut up.
+    fn ring_samples(&self, c: &Contour) -> (Vec<P2>, Vec<bool>) {
+        let step = 0.5 * self.grid.h;
+        let vertices = c.to_points(tol::WALK_CHORD);
+        let n = vertices.len();
+        let mut out = Vec::with_capacity(n);
+        let mut corner = Vec::with_capacity(n);
+        for (i, &p) in vertices.iter().enumerate() {
+            let q = vertices[(i + 1) % n];
+            #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a ring's samples")]
+            let k = (dist(p, q) / step).ceil().max(1.0) as usize;
+            for j in 0..k {
+                #[allow(clippy::cast_precision_loss, reason = "small counts")]
+                let f = j as f64 / k as f64;
+                out.push([p[0] + f * (q[0] - p[0]), p[1] + f * (q[1] - p[1])]);
+                corner.push(j == 0);
+            }
+        }
+        (out, corner)
+    }
+
+    /// The points of `run` (samples of a ring, [`Planner::ring_samples`])
+    /// that are its chords' ends, `corner` telling which, and its first and
+    /// last: the ring's own lines (a line between two samples of a wall
+    /// that is not one of its chords may cross the wall).
+    fn chords_of(run: &[P2], corner: &[bool]) -> Vec<P2> {
+        let n = run.len();
+        (0..n).filter(|&k| k == 0 || k + 1 == n || corner[k]).map(|k| run[k]).collect()
+    }
+
+    /// Rest roughing (the level's material is what a larger tool left): the
+    /// stretches of the region's rings along which the tool meets material
+    /// and the engagement stays within the accepted bound, cut before the
+    /// walk, each one sample into the air at its start, linked as the walk's
+    /// passes are, the first entered from the air. A rest level's material
+    /// is mostly a step or a sliver along the walls, thinner than the
+    /// stepover: one pass along the wall takes it, where the walk peeled it
+    /// in passes a few steps long, each ended by the wall and linked back
+    /// (docs/roughing.md, "Adaptive rest roughing: the rings first"). Where
+    /// a stretch would engage more (thicker material), it stops; it starts
+    /// again only from the air, so the walk meets that material from its
+    /// open side. Stretches run through air shorter than
+    /// [`tol::AIR_RUN_GAP_SHARE`] R. Returns where the tool ends, `None`
+    /// when nothing was cut.
+    fn rings_first(&mut self, region: &Region, steps: &mut Vec<Step>) -> Option<P2> {
+        let r = self.options.tool_radius;
+        let gap = tol::AIR_RUN_GAP_SHARE * r;
+        let cutting = tol::WALK_AIR * self.target;
+        let mut pos: Option<P2> = None;
+        for ring in region.rings() {
+            let ring = orient(&fillet_corners(ring), self.options.direction);
+            let (samples, corner) = self.ring_samples(&ring);
+            let n = samples.len();
+            // From a sample in air (the tool cuts nothing there) round the
+            // ring; none, and the walk has it.
+            let Some(first_air) = (0..n).find(|&i| !self.meets(samples[i])) else { continue };
+            let at = |i: usize| samples[(first_air + i) % n];
+            let is_corner = |i: usize| corner[(first_air + i) % n];
+            let mut corners: Vec<bool> = Vec::new();
+            // The stretch being measured: its points, the moves' old swept
+            // values, the last point that cut, the air since.
+            let mut cur: Vec<P2> = Vec::new();
+            let mut undo: Vec<(usize, f64)> = Vec::new();
+            let mut last_cut = 0usize;
+            let mut idle = 0.0;
+            // Whether the tool cuts nothing at the stretch's start.
+            let mut clear = true;
+            // A stretch may start only after a sample in air.
+            let mut armed = true;
+            for i in 1..=n + 1 {
+                let end = i > n;
+                let (a, b) = (at(i - 1), at(i));
+                let heading = (b[1] - a[1]).atan2(b[0] - a[0]);
+                let (phi, core) = if end { (f64::INFINITY, 0.0) } else { self.front(b, heading) };
+                let over = phi > self.accept;
+                if !cur.is_empty() && (over || idle > gap) {
+                    let piece = std::mem::take(&mut cur);
+                    let flags = std::mem::take(&mut corners);
+                    self.cut_stretch(piece, &flags, &mut undo, last_cut, clear, &mut pos, steps);
+                    armed = !over;
+                }
+                if end {
+                    break;
+                }
+                if over {
+                    armed = false;
+                    continue;
+                }
+                let cuts = core >= cutting || self.meets(b);
+                if cur.is_empty() {
+                    if !cuts {
+                        // Air before a stretch (not stamped): a stretch may
+                        // start from here.
+                        armed = true;
+                        continue;
+                    }
+                    if !armed {
+                        continue;
+                    }
+                    cur.push(a);
+                    corners.push(true);
+                    clear = self.clear_at(a);
+                    (last_cut, idle) = (0, 0.0);
+                }
+                self.stamp_swept(a, b, Some(&mut undo));
+                cur.push(b);
+                corners.push(is_corner(i));
+                if cuts {
+                    (last_cut, idle) = (cur.len() - 1, 0.0);
+                } else {
+                    idle += dist(a, b);
+                }
+            }
+        }
+        pos
+    }
+
+    /// A stretch of [`Planner::rings_first`]: `run` measured with its moves
+    /// stamped (old values in `undo`), `corner` telling which of its points
+    /// are the ring's chords' ends, cut back to one point past `last_cut`;
+    /// when it cut, the link from `pos` (a straight entry when the tool has
+    /// not been down, `clear` telling whether it cuts nothing at the start)
+    /// and the ring's own lines along it.
+    #[allow(clippy::too_many_arguments, reason = "the measuring loop's state")]
+    fn cut_stretch(
+        &mut self,
+        mut run: Vec<P2>,
+        corner: &[bool],
+        undo: &mut Vec<(usize, f64)>,
+        last_cut: usize,
+        clear: bool,
+        pos: &mut Option<P2>,
+        steps: &mut Vec<Step>,
+    ) {
+        run.truncate((last_cut + 2).min(run.len()));
+        self.revert(undo);
+        if last_cut == 0 || run.len() < 2 {
+            return;
+        }
+        let start = run[0];
+        match *pos {
+            None => steps.push(Step::Link { tool_down: false, via: Vec::new(), cleared: clear, to: None }),
+            Some(p) => {
+                let link = self.link_step(p, start);
+                steps.push(link);
+            }
+        }
+        let lines = Self::chords_of(&run, &corner[..run.len()]);
+        *pos = lines.last().copied();
+        self.emit_runs(steps, vec![lines]);
+    }
+
     /// The region's rings from `pos`, nearest first, with their links.
     /// A ring (or a corner) where the tool never comes within R of the
     /// material is left out ([`plan_adaptive_in`]).
@@ -1307,6 +1514,7 @@ impl Planner<'_> {
         for corner in &corners {
             self.clear_corner(corner, &mut pos, &mut steps);
         }
+        let rest = self.touch.is_some();
         let climb = matches!(self.options.direction.rings(), Direction::Climb);
         let mut looper =
             crate::offset::loops::Looper::after(region, r, climb, self.target, self.options.chord_tolerance);
@@ -1316,28 +1524,98 @@ impl Planner<'_> {
             let i = (0..started.len()).min_by(|&x, &y| d(&started[x]).total_cmp(&d(&started[y]))).unwrap_or(0);
             let ring = started[i].clone();
             rings.remove(i);
-            // Where the ring meets material the walk did not reach on its
-            // inner side too (a channel narrower than a pass could turn in,
-            // a tooth gap), it would slot: loops there, as the offset
-            // pattern's (docs/roughing.md, "Slots: loops").
-            let ring = {
-                let chip = tol::AIR_RING_CHIP;
-                let cleared = |y: P2| {
-                    self.grid.sample(&self.swept, y) <= r - chip
-                        || self.grid.locate(y).is_some_and(|at| self.open_at(at))
+            // Rest roughing: only the stretches of the ring along which the
+            // tool still meets material (the rest is air the walk and the
+            // stretches cut first left), as the offset pattern's rings
+            // (docs/roughing.md, "Adaptive rest roughing: the rings first").
+            let pieces = if rest { self.stretches(&ring) } else { vec![ring] };
+            for piece in pieces {
+                // Where the ring meets material the walk did not reach on its
+                // inner side too (a channel narrower than a pass could turn in,
+                // a tooth gap), it would slot: loops there, as the offset
+                // pattern's (docs/roughing.md, "Slots: loops").
+                let piece = {
+                    let chip = tol::AIR_RING_CHIP;
+                    let cleared = |y: P2| {
+                        self.grid.sample(&self.swept, y) <= r - chip
+                            || self.grid.locate(y).is_some_and(|at| self.open_at(at))
+                    };
+                    looper.looped_after(&piece, &cleared)
                 };
-                looper.looped_after(&ring, &cleared)
-            };
-            let Some(start) = ring.start() else { continue };
-            let link = self.link_step(pos, start);
-            steps.push(link);
-            let mut pts = ring.to_points(0.25 * self.grid.h);
-            pts.push(start);
-            self.stamp(&pts);
-            pos = start;
-            steps.push(Step::Cut(ring));
+                let Some(start) = piece.start() else { continue };
+                let link = self.link_step(pos, start);
+                steps.push(link);
+                let mut pts = piece.to_points(0.25 * self.grid.h);
+                if piece.is_closed() {
+                    pts.push(start);
+                }
+                self.stamp(&pts);
+                pos = piece.end().unwrap_or(start);
+                steps.push(Step::Cut(piece));
+            }
         }
         steps
+    }
+
+    /// The stretches of the closed `ring` along which the tool meets
+    /// material ([`Planner::meets`]): the whole ring when it does all along
+    /// or but for gaps shorter than [`tol::AIR_RUN_GAP_SHARE`] R, none when
+    /// nowhere, else open stretches, each one sample into the air at both
+    /// ends, as the fewest lines within the walk's fit in the region, then
+    /// lines and arcs where they stay in it ([`fit_in`]).
+    fn stretches(&self, ring: &Contour) -> Vec<Contour> {
+        let (samples, corner) = self.ring_samples(ring);
+        let n = samples.len();
+        let hit: Vec<bool> = samples.iter().map(|&p| self.meets(p)).collect();
+        let Some(first_air) = hit.iter().position(|h| !h) else { return vec![ring.clone()] };
+        if !hit.iter().any(|&h| h) {
+            return Vec::new();
+        }
+        let gap = tol::AIR_RUN_GAP_SHARE * self.options.tool_radius;
+        let at = |i: usize| samples[(first_air + i) % n];
+        let on = |i: usize| hit[(first_air + i) % n];
+        let mut runs: Vec<(usize, usize)> = Vec::new();
+        let mut i = 0;
+        while i < n {
+            if !on(i) {
+                i += 1;
+                continue;
+            }
+            let a = i;
+            while i < n && on(i) {
+                i += 1;
+            }
+            runs.push((a, i - 1));
+        }
+        let length = |a: usize, b: usize| -> f64 { (a..b).map(|j| dist(at(j), at(j + 1))).sum() };
+        let mut joined: Vec<(usize, usize)> = Vec::new();
+        for run in runs {
+            match joined.last_mut() {
+                Some(last) if length(last.1, run.0) < gap => last.1 = run.1,
+                _ => joined.push(run),
+            }
+        }
+        if joined.len() > 1 {
+            let (first, last) = (joined[0], joined[joined.len() - 1]);
+            if length(last.1, first.0 + n) < gap {
+                joined[0] = (last.0, first.1 + n);
+                joined.pop();
+            }
+        }
+        if joined.len() == 1 && length(joined[0].1, joined[0].0 + n) < gap {
+            return vec![ring.clone()];
+        }
+        let arc_fit = 0.5 * tol::WALK_FIT_SHARE * self.options.tool_radius;
+        joined
+            .into_iter()
+            .filter_map(|(a, b)| {
+                let range = a.saturating_sub(1)..=b + 1;
+                let points: Vec<P2> = range.clone().map(at).collect();
+                let flags: Vec<bool> = range.map(|i| corner[(first_air + i) % n]).collect();
+                let c = lines(&Self::chords_of(&points, &flags))?;
+                Some(fit_in(&self.edges, &c, arc_fit).unwrap_or(c))
+            })
+            .collect()
     }
 }
 /// Each cell centre's signed distance to the boundary of `material`
