@@ -272,35 +272,13 @@ pub fn plan_adaptive_touching(
             .collect()
     });
     let mut walk = Walk { steps: Vec::new(), passes: 0, budget: tol::MAX_WALK_STEPS };
-    // Rest roughing: the stretches of the region's rings that meet material
-    // and hold the engagement first (the slivers and steps the larger tool
-    // left along the walls, in one pass each), the walk after them on what
-    // they leave (docs/roughing.md, "Adaptive rest roughing: the rings
-    // first").
-    let after = if planner.touch.is_some() { planner.rings_first(region, &mut walk.steps) } else { None };
     let mut end = if air_starts.is_empty() {
-        let saved = after.map(|_| (planner.swept.clone(), planner.lattice.clone(), planner.starts.len()));
-        let before = walk.steps.len();
         planner.bore(s, r0, 0);
-        let reached = planner.walk_all(Some(s), None, &mut walk)?;
-        match (after, saved) {
-            (Some(p), Some(saved)) if walk.steps.len() == before => {
-                // Nothing cut from the bore: it is not made.
-                planner.starts.truncate(saved.2);
-                (planner.swept, planner.lattice) = (saved.0, saved.1);
-                p
-            }
-            (Some(_), _) => {
-                // The tool leaves the stretches for the bore.
-                walk.steps.insert(before, Step::Link { tool_down: false, via: Vec::new(), cleared: false, to: None });
-                reached
-            }
-            _ => reached,
-        }
+        planner.walk_all(Some(s), &mut walk)?
     } else {
         let hand = planner.base_hand();
         planner.starts.extend(air_starts.iter().map(|&p| (p, true, 0, hand, false)));
-        planner.walk_all(None, after, &mut walk)?
+        planner.walk_all(None, &mut walk)?
     };
     // Parts of the region the walk could not reach (joined to the rest by a
     // neck narrower than its steps, or a tooth gap it could not turn into):
@@ -330,7 +308,7 @@ pub fn plan_adaptive_touching(
         #[allow(clippy::cast_possible_truncation, reason = "passes are bounded by MAX_PASSES")]
         planner.bore(e, r0, walk.passes as u32);
         let before = walk.steps.len();
-        let reached = planner.walk_all(Some(e), None, &mut walk)?;
+        let reached = planner.walk_all(Some(e), &mut walk)?;
         if walk.steps.len() == before {
             // Nothing cut from there: the entry alone, a plunge or a helix;
             // the tool is still where the last walk left it.
@@ -1046,18 +1024,15 @@ impl Planner<'_> {
     /// The passes from the bore at `s`, or, with `None`, from the starts
     /// already listed (tool centres in air: the first pass is entered by a
     /// straight plunge at its start).
-    /// With `after`, the tool is there already (at the end of the rings'
-    /// stretches cut first, [`Planner::rings_first`]): the first pass is
-    /// linked from it.
-    fn walk_all(&mut self, s: Option<P2>, after: Option<P2>, walk: &mut Walk) -> Result<P2, RoughError> {
+    fn walk_all(&mut self, s: Option<P2>, walk: &mut Walk) -> Result<P2, RoughError> {
         let air = s.is_none();
         let s = s.or_else(|| self.starts.first().map(|t| t.0)).unwrap_or([0.0, 0.0]);
-        let mut pos = after.unwrap_or(s);
+        let mut pos = s;
         // The heading of the last pass's last move.
         let mut out: Option<f64> = None;
         // The last pass's `away`: its end turns that way into the link.
         let mut last_hand = self.hand;
-        let mut fresh = after.is_none();
+        let mut fresh = true;
         let spacing = tol::WALK_START_SPACING * self.options.tool_radius;
         let step = tol::WALK_STEP_SHARE * self.options.tool_radius;
         while let Some((i, first)) = self.next_start() {
@@ -1278,7 +1253,9 @@ impl Planner<'_> {
             rho = next;
             let run = self.corner_arc(corner, rho);
             let Some(&start) = run.first() else { return };
-            // Rest roughing: an arc that meets no material is not cut.
+            // Rest roughing: an arc that meets no material is not cut
+            // (docs/roughing.md, "Adaptive rest roughing: only the stretches
+            // that meet material").
             if self.touch.is_some() && !run.iter().any(|&p| self.meets(p)) {
                 continue;
             }
@@ -1370,128 +1347,6 @@ impl Planner<'_> {
         (0..n).filter(|&k| k == 0 || k + 1 == n || corner[k]).map(|k| run[k]).collect()
     }
 
-    /// Rest roughing (the level's material is what a larger tool left): the
-    /// stretches of the region's rings along which the tool meets material
-    /// and the engagement stays within the accepted bound, cut before the
-    /// walk, each one sample into the air at its start, linked as the walk's
-    /// passes are, the first entered from the air. A rest level's material
-    /// is mostly a step or a sliver along the walls, thinner than the
-    /// stepover: one pass along the wall takes it, where the walk peeled it
-    /// in passes a few steps long, each ended by the wall and linked back
-    /// (docs/roughing.md, "Adaptive rest roughing: the rings first"). Where
-    /// a stretch would engage more (thicker material), it stops; it starts
-    /// again only from the air, so the walk meets that material from its
-    /// open side. Stretches run through air shorter than
-    /// [`tol::AIR_RUN_GAP_SHARE`] R. Returns where the tool ends, `None`
-    /// when nothing was cut.
-    fn rings_first(&mut self, region: &Region, steps: &mut Vec<Step>) -> Option<P2> {
-        let r = self.options.tool_radius;
-        let gap = tol::AIR_RUN_GAP_SHARE * r;
-        let cutting = tol::WALK_AIR * self.target;
-        let mut pos: Option<P2> = None;
-        for ring in region.rings() {
-            let ring = orient(&fillet_corners(ring), self.options.direction);
-            let (samples, corner) = self.ring_samples(&ring);
-            let n = samples.len();
-            // From a sample in air (the tool cuts nothing there) round the
-            // ring; none, and the walk has it.
-            let Some(first_air) = (0..n).find(|&i| !self.meets(samples[i])) else { continue };
-            let at = |i: usize| samples[(first_air + i) % n];
-            let is_corner = |i: usize| corner[(first_air + i) % n];
-            let mut corners: Vec<bool> = Vec::new();
-            // The stretch being measured: its points, the moves' old swept
-            // values, the last point that cut, the air since.
-            let mut cur: Vec<P2> = Vec::new();
-            let mut undo: Vec<(usize, f64)> = Vec::new();
-            let mut last_cut = 0usize;
-            let mut idle = 0.0;
-            // Whether the tool cuts nothing at the stretch's start.
-            let mut clear = true;
-            // A stretch may start only after a sample in air.
-            let mut armed = true;
-            for i in 1..=n + 1 {
-                let end = i > n;
-                let (a, b) = (at(i - 1), at(i));
-                let heading = (b[1] - a[1]).atan2(b[0] - a[0]);
-                let (phi, core) = if end { (f64::INFINITY, 0.0) } else { self.front(b, heading) };
-                let over = phi > self.accept;
-                if !cur.is_empty() && (over || idle > gap) {
-                    let piece = std::mem::take(&mut cur);
-                    let flags = std::mem::take(&mut corners);
-                    self.cut_stretch(piece, &flags, &mut undo, last_cut, clear, &mut pos, steps);
-                    armed = !over;
-                }
-                if end {
-                    break;
-                }
-                if over {
-                    armed = false;
-                    continue;
-                }
-                let cuts = core >= cutting || self.meets(b);
-                if cur.is_empty() {
-                    if !cuts {
-                        // Air before a stretch (not stamped): a stretch may
-                        // start from here.
-                        armed = true;
-                        continue;
-                    }
-                    if !armed {
-                        continue;
-                    }
-                    cur.push(a);
-                    corners.push(true);
-                    clear = self.clear_at(a);
-                    (last_cut, idle) = (0, 0.0);
-                }
-                self.stamp_swept(a, b, Some(&mut undo));
-                cur.push(b);
-                corners.push(is_corner(i));
-                if cuts {
-                    (last_cut, idle) = (cur.len() - 1, 0.0);
-                } else {
-                    idle += dist(a, b);
-                }
-            }
-        }
-        pos
-    }
-
-    /// A stretch of [`Planner::rings_first`]: `run` measured with its moves
-    /// stamped (old values in `undo`), `corner` telling which of its points
-    /// are the ring's chords' ends, cut back to one point past `last_cut`;
-    /// when it cut, the link from `pos` (a straight entry when the tool has
-    /// not been down, `clear` telling whether it cuts nothing at the start)
-    /// and the ring's own lines along it.
-    #[allow(clippy::too_many_arguments, reason = "the measuring loop's state")]
-    fn cut_stretch(
-        &mut self,
-        mut run: Vec<P2>,
-        corner: &[bool],
-        undo: &mut Vec<(usize, f64)>,
-        last_cut: usize,
-        clear: bool,
-        pos: &mut Option<P2>,
-        steps: &mut Vec<Step>,
-    ) {
-        run.truncate((last_cut + 2).min(run.len()));
-        self.revert(undo);
-        if last_cut == 0 || run.len() < 2 {
-            return;
-        }
-        let start = run[0];
-        match *pos {
-            None => steps.push(Step::Link { tool_down: false, via: Vec::new(), cleared: clear, to: None }),
-            Some(p) => {
-                let link = self.link_step(p, start);
-                steps.push(link);
-            }
-        }
-        let lines = Self::chords_of(&run, &corner[..run.len()]);
-        *pos = lines.last().copied();
-        self.emit_runs(steps, vec![lines]);
-    }
-
     /// The region's rings from `pos`, nearest first, with their links.
     /// A ring (or a corner) where the tool never comes within R of the
     /// material is left out ([`plan_adaptive_in`]).
@@ -1525,9 +1380,10 @@ impl Planner<'_> {
             let ring = started[i].clone();
             rings.remove(i);
             // Rest roughing: only the stretches of the ring along which the
-            // tool still meets material (the rest is air the walk and the
-            // stretches cut first left), as the offset pattern's rings
-            // (docs/roughing.md, "Adaptive rest roughing: the rings first").
+            // tool still meets material (the rest is air, or what the walk
+            // cleared), as the offset pattern's rings (docs/roughing.md,
+            // "Adaptive rest roughing: only the stretches that meet
+            // material").
             let pieces = if rest { self.stretches(&ring) } else { vec![ring] };
             for piece in pieces {
                 // Where the ring meets material the walk did not reach on its
@@ -1561,8 +1417,8 @@ impl Planner<'_> {
     /// material ([`Planner::meets`]): the whole ring when it does all along
     /// or but for gaps shorter than [`tol::AIR_RUN_GAP_SHARE`] R, none when
     /// nowhere, else open stretches, each one sample into the air at both
-    /// ends, as the fewest lines within the walk's fit in the region, then
-    /// lines and arcs where they stay in it ([`fit_in`]).
+    /// ends, as the ring's own lines, then lines and arcs where they stay in
+    /// the region ([`fit_in`]).
     fn stretches(&self, ring: &Contour) -> Vec<Contour> {
         let (samples, corner) = self.ring_samples(ring);
         let n = samples.len();
