@@ -1319,6 +1319,12 @@ impl Planner<'_> {
             rho = next;
             let run = self.corner_arc(corner, rho);
             let Some(&start) = run.first() else { return };
+            // Rest roughing: an arc that meets no material is not cut
+            // (docs/roughing.md, "Adaptive rest roughing: only the stretches
+            // that meet material").
+            if self.touch.is_some() && !run.iter().any(|&p| self.meets(p)) {
+                continue;
+            }
             let link = self.link_step(*pos, start);
             steps.push(link);
             *pos = *run.last().unwrap_or(&start);
@@ -1351,6 +1357,62 @@ impl Planner<'_> {
         run
     }
 
+    /// Whether the tool centred at `p` meets material: a probe all round,
+    /// [`tol::AIR_RING_CHIP`] inside its periphery, in the material to
+    /// remove or in the material touched beyond it (rest roughing: the
+    /// cells along the walls; the offset pattern's test of a ring against
+    /// the air, docs/roughing.md, "Air"), not swept.
+    fn meets(&self, p: P2) -> bool {
+        let r = self.options.tool_radius;
+        let d = r - tol::AIR_RING_CHIP;
+        let nx = self.grid.nx;
+        let touched = |q: P2| {
+            self.touch.as_ref().is_some_and(|(f, near)| {
+                self.grid.locate(q).is_some_and(|at| {
+                    Grid::interpolate(&self.swept, nx, at) > r
+                        && Grid::interpolate(near, nx, at) < r
+                        && Grid::interpolate(f, nx, at) <= 0.0
+                })
+            })
+        };
+        self.link_round.iter().any(|&[c, s]| {
+            let q = [p[0] + d * c, p[1] + d * s];
+            self.material(q) || touched(q)
+        })
+    }
+
+    /// The closed ring `c` (oriented for the milling direction) as points
+    /// on it at most half a cell apart: its chords within
+    /// [`tol::WALK_CHORD`], cut up.
+    fn ring_samples(&self, c: &Contour) -> (Vec<P2>, Vec<bool>) {
+        let step = 0.5 * self.grid.h;
+        let vertices = c.to_points(tol::WALK_CHORD);
+        let n = vertices.len();
+        let mut out = Vec::with_capacity(n);
+        let mut corner = Vec::with_capacity(n);
+        for (i, &p) in vertices.iter().enumerate() {
+            let q = vertices[(i + 1) % n];
+            #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a ring's samples")]
+            let k = (dist(p, q) / step).ceil().max(1.0) as usize;
+            for j in 0..k {
+                #[allow(clippy::cast_precision_loss, reason = "small counts")]
+                let f = j as f64 / k as f64;
+                out.push([p[0] + f * (q[0] - p[0]), p[1] + f * (q[1] - p[1])]);
+                corner.push(j == 0);
+            }
+        }
+        (out, corner)
+    }
+
+    /// The points of `run` (samples of a ring, [`Planner::ring_samples`])
+    /// that are its chords' ends, `corner` telling which, and its first and
+    /// last: the ring's own lines (a line between two samples of a wall
+    /// that is not one of its chords may cross the wall).
+    fn chords_of(run: &[P2], corner: &[bool]) -> Vec<P2> {
+        let n = run.len();
+        (0..n).filter(|&k| k == 0 || k + 1 == n || corner[k]).map(|k| run[k]).collect()
+    }
+
     /// The region's rings from `pos`, nearest first, with their links.
     /// A ring (or a corner) where the tool never comes within R of the
     /// material is left out ([`plan_adaptive_in`]).
@@ -1373,6 +1435,7 @@ impl Planner<'_> {
         for corner in &corners {
             self.clear_corner(corner, &mut pos, &mut steps);
         }
+        let rest = self.touch.is_some();
         let climb = matches!(self.options.direction.rings(), Direction::Climb);
         let mut looper =
             crate::offset::loops::Looper::after(region, r, climb, self.target, self.options.chord_tolerance);
@@ -1382,28 +1445,99 @@ impl Planner<'_> {
             let i = (0..started.len()).min_by(|&x, &y| d(&started[x]).total_cmp(&d(&started[y]))).unwrap_or(0);
             let ring = started[i].clone();
             rings.remove(i);
-            // Where the ring meets material the walk did not reach on its
-            // inner side too (a channel narrower than a pass could turn in,
-            // a tooth gap), it would slot: loops there, as the offset
-            // pattern's (docs/roughing.md, "Slots: loops").
-            let ring = {
-                let chip = tol::AIR_RING_CHIP;
-                let cleared = |y: P2| {
-                    self.grid.sample(&self.swept, y) <= r - chip
-                        || self.grid.locate(y).is_some_and(|at| self.open_at(at))
+            // Rest roughing: only the stretches of the ring along which the
+            // tool still meets material (the rest is air, or what the walk
+            // cleared), as the offset pattern's rings (docs/roughing.md,
+            // "Adaptive rest roughing: only the stretches that meet
+            // material").
+            let pieces = if rest { self.stretches(&ring) } else { vec![ring] };
+            for piece in pieces {
+                // Where the ring meets material the walk did not reach on its
+                // inner side too (a channel narrower than a pass could turn in,
+                // a tooth gap), it would slot: loops there, as the offset
+                // pattern's (docs/roughing.md, "Slots: loops").
+                let piece = {
+                    let chip = tol::AIR_RING_CHIP;
+                    let cleared = |y: P2| {
+                        self.grid.sample(&self.swept, y) <= r - chip
+                            || self.grid.locate(y).is_some_and(|at| self.open_at(at))
+                    };
+                    looper.looped_after(&piece, &cleared)
                 };
-                looper.looped_after(&ring, &cleared)
-            };
-            let Some(start) = ring.start() else { continue };
-            let link = self.link_step(pos, start);
-            steps.push(link);
-            let mut pts = ring.to_points(0.25 * self.grid.h);
-            pts.push(start);
-            self.stamp(&pts);
-            pos = start;
-            steps.push(Step::Cut(ring));
+                let Some(start) = piece.start() else { continue };
+                let link = self.link_step(pos, start);
+                steps.push(link);
+                let mut pts = piece.to_points(0.25 * self.grid.h);
+                if piece.is_closed() {
+                    pts.push(start);
+                }
+                self.stamp(&pts);
+                pos = piece.end().unwrap_or(start);
+                steps.push(Step::Cut(piece));
+            }
         }
         steps
+    }
+
+    /// The stretches of the closed `ring` along which the tool meets
+    /// material ([`Planner::meets`]): the whole ring when it does all along
+    /// or but for gaps shorter than [`tol::AIR_RUN_GAP_SHARE`] R, none when
+    /// nowhere, else open stretches, each one sample into the air at both
+    /// ends, as the ring's own lines, then lines and arcs where they stay in
+    /// the region ([`fit_in`]).
+    fn stretches(&self, ring: &Contour) -> Vec<Contour> {
+        let (samples, corner) = self.ring_samples(ring);
+        let n = samples.len();
+        let hit: Vec<bool> = samples.iter().map(|&p| self.meets(p)).collect();
+        let Some(first_air) = hit.iter().position(|h| !h) else { return vec![ring.clone()] };
+        if !hit.iter().any(|&h| h) {
+            return Vec::new();
+        }
+        let gap = tol::AIR_RUN_GAP_SHARE * self.options.tool_radius;
+        let at = |i: usize| samples[(first_air + i) % n];
+        let on = |i: usize| hit[(first_air + i) % n];
+        let mut runs: Vec<(usize, usize)> = Vec::new();
+        let mut i = 0;
+        while i < n {
+            if !on(i) {
+                i += 1;
+                continue;
+            }
+            let a = i;
+            while i < n && on(i) {
+                i += 1;
+            }
+            runs.push((a, i - 1));
+        }
+        let length = |a: usize, b: usize| -> f64 { (a..b).map(|j| dist(at(j), at(j + 1))).sum() };
+        let mut joined: Vec<(usize, usize)> = Vec::new();
+        for run in runs {
+            match joined.last_mut() {
+                Some(last) if length(last.1, run.0) < gap => last.1 = run.1,
+                _ => joined.push(run),
+            }
+        }
+        if joined.len() > 1 {
+            let (first, last) = (joined[0], joined[joined.len() - 1]);
+            if length(last.1, first.0 + n) < gap {
+                joined[0] = (last.0, first.1 + n);
+                joined.pop();
+            }
+        }
+        if joined.len() == 1 && length(joined[0].1, joined[0].0 + n) < gap {
+            return vec![ring.clone()];
+        }
+        let arc_fit = 0.5 * tol::WALK_FIT_SHARE * self.options.tool_radius;
+        joined
+            .into_iter()
+            .filter_map(|(a, b)| {
+                let range = a.saturating_sub(1)..=b + 1;
+                let points: Vec<P2> = range.clone().map(at).collect();
+                let flags: Vec<bool> = range.map(|i| corner[(first_air + i) % n]).collect();
+                let c = lines(&Self::chords_of(&points, &flags))?;
+                Some(fit_in(&self.edges, &c, arc_fit).unwrap_or(c))
+            })
+            .collect()
     }
 }
 /// Each cell centre's signed distance to the boundary of `material`
