@@ -297,6 +297,7 @@ fn material_left_in_an_inside_corner_of_the_outline_is_reported() {
     assert!((at[0] + 6.0).hypot(at[1] + 6.0) < 3.2, "{l0:?}");
     assert!(l1.unreachable_volume_mm3 < 0.3 * l0.unreachable_volume_mm3, "{l0:?} {l1:?}");
     assert!(rest.stock.removed_mm3 > 0.5 * l0.unreachable_volume_mm3, "{:?}", rest.stock);
+}
 
 /// A frustum on a plate: a 20 x 16 mm base at z = 0 rising to a 8 x 4 mm top
 /// at z = 8, its four sides sloping at 53 to 56 degrees.
