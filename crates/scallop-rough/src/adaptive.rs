@@ -1489,44 +1489,13 @@ impl Planner<'_> {
         let (samples, corner) = self.ring_samples(ring);
         let n = samples.len();
         let hit: Vec<bool> = samples.iter().map(|&p| self.meets(p)).collect();
-        let Some(first_air) = hit.iter().position(|h| !h) else { return vec![ring.clone()] };
-        if !hit.iter().any(|&h| h) {
-            return Vec::new();
-        }
         let gap = tol::AIR_RUN_GAP_SHARE * self.options.tool_radius;
+        let (first_air, joined) = match crate::offset::ring_runs(&samples, &hit, gap) {
+            crate::offset::RingRuns::Whole => return vec![ring.clone()],
+            crate::offset::RingRuns::Nowhere => return Vec::new(),
+            crate::offset::RingRuns::Runs { first_air, runs } => (first_air, runs),
+        };
         let at = |i: usize| samples[(first_air + i) % n];
-        let on = |i: usize| hit[(first_air + i) % n];
-        let mut runs: Vec<(usize, usize)> = Vec::new();
-        let mut i = 0;
-        while i < n {
-            if !on(i) {
-                i += 1;
-                continue;
-            }
-            let a = i;
-            while i < n && on(i) {
-                i += 1;
-            }
-            runs.push((a, i - 1));
-        }
-        let length = |a: usize, b: usize| -> f64 { (a..b).map(|j| dist(at(j), at(j + 1))).sum() };
-        let mut joined: Vec<(usize, usize)> = Vec::new();
-        for run in runs {
-            match joined.last_mut() {
-                Some(last) if length(last.1, run.0) < gap => last.1 = run.1,
-                _ => joined.push(run),
-            }
-        }
-        if joined.len() > 1 {
-            let (first, last) = (joined[0], joined[joined.len() - 1]);
-            if length(last.1, first.0 + n) < gap {
-                joined[0] = (last.0, first.1 + n);
-                joined.pop();
-            }
-        }
-        if joined.len() == 1 && length(joined[0].1, joined[0].0 + n) < gap {
-            return vec![ring.clone()];
-        }
         let arc_fit = 0.5 * tol::WALK_FIT_SHARE * self.options.tool_radius;
         joined
             .into_iter()

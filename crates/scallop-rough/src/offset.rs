@@ -713,57 +713,15 @@ impl Reach {
         }
         let n = samples.len();
         let touch: Vec<bool> = samples.iter().map(|&p| self.inside(p)).collect();
-        let Some(first_air) = touch.iter().position(|t| !t) else {
-            return vec![Piece { contour: ring.clone(), closed: true, from_air: false, to_air: false }];
+        let (first_air, joined) = match ring_runs(&samples, &touch, tol::AIR_RUN_GAP_SHARE * radius) {
+            RingRuns::Whole => {
+                return vec![Piece { contour: ring.clone(), closed: true, from_air: false, to_air: false }];
+            }
+            RingRuns::Nowhere => return Vec::new(),
+            RingRuns::Runs { first_air, runs } => (first_air, runs),
         };
-        if !touch.iter().any(|&t| t) {
-            return Vec::new();
-        }
-        // From an air sample round the ring: the stretches that touch, with
-        // the gaps of air between them.
-        let gap = tol::AIR_RUN_GAP_SHARE * radius;
         let at = |i: usize| samples[(first_air + i) % n];
         let hit = |i: usize| touch[(first_air + i) % n];
-        let mut runs: Vec<(usize, usize)> = Vec::new();
-        let mut i = 0;
-        while i < n {
-            if !hit(i) {
-                i += 1;
-                continue;
-            }
-            let a = i;
-            while i < n && hit(i) {
-                i += 1;
-            }
-            runs.push((a, i - 1));
-        }
-        // Join runs across short gaps (the last one to the first across the
-        // ring's start, when the ring closes through air shorter than the gap).
-        let length = |a: usize, b: usize| -> f64 {
-            (a..b)
-                .map(|j| {
-                    let (p, q) = (at(j), at(j + 1));
-                    (q[0] - p[0]).hypot(q[1] - p[1])
-                })
-                .sum()
-        };
-        let mut joined: Vec<(usize, usize)> = Vec::new();
-        for run in runs {
-            match joined.last_mut() {
-                Some(last) if length(last.1, run.0) < gap => last.1 = run.1,
-                _ => joined.push(run),
-            }
-        }
-        if joined.len() > 1 {
-            let (first, last) = (joined[0], joined[joined.len() - 1]);
-            if length(last.1, first.0 + n) < gap {
-                joined[0] = (last.0, first.1 + n);
-                joined.pop();
-            }
-        }
-        if joined.len() == 1 && length(joined[0].1, joined[0].0 + n) < gap {
-            return vec![Piece { contour: ring.clone(), closed: true, from_air: false, to_air: false }];
-        }
         joined
             .into_iter()
             .filter_map(|(a, b)| {
@@ -774,6 +732,73 @@ impl Reach {
             })
             .collect()
     }
+}
+
+/// Where a closed ring's samples `hit` (the tool meets material or the
+/// region there, `samples` their points, equally spaced).
+pub(crate) enum RingRuns {
+    /// All round, or but for gaps of air shorter than the gap: the whole ring.
+    Whole,
+    /// Nowhere: no piece of it.
+    Nowhere,
+    /// Runs `(a, b)` of sample indices counted from the air sample
+    /// `first_air` (`b` may pass the sample count where the last run joins
+    /// the first across the ring's start), joined across gaps shorter than
+    /// the gap.
+    Runs { first_air: usize, runs: Vec<(usize, usize)> },
+}
+
+/// The stretches of a closed ring whose samples `hit`, joined across gaps of
+/// air shorter than `gap` (mm, along the samples).
+pub(crate) fn ring_runs(samples: &[P2], hit: &[bool], gap: f64) -> RingRuns {
+    let n = samples.len();
+    let Some(first_air) = hit.iter().position(|h| !h) else { return RingRuns::Whole };
+    if !hit.iter().any(|&h| h) {
+        return RingRuns::Nowhere;
+    }
+    let at = |i: usize| samples[(first_air + i) % n];
+    let on = |i: usize| hit[(first_air + i) % n];
+    let mut runs: Vec<(usize, usize)> = Vec::new();
+    let mut i = 0;
+    while i < n {
+        if !on(i) {
+            i += 1;
+            continue;
+        }
+        let a = i;
+        while i < n && on(i) {
+            i += 1;
+        }
+        runs.push((a, i - 1));
+    }
+    // Join runs across short gaps (the last one to the first across the
+    // ring's start, when the ring closes through air shorter than the gap).
+    let length = |a: usize, b: usize| -> f64 {
+        (a..b)
+            .map(|j| {
+                let (p, q) = (at(j), at(j + 1));
+                (q[0] - p[0]).hypot(q[1] - p[1])
+            })
+            .sum()
+    };
+    let mut joined: Vec<(usize, usize)> = Vec::new();
+    for run in runs {
+        match joined.last_mut() {
+            Some(last) if length(last.1, run.0) < gap => last.1 = run.1,
+            _ => joined.push(run),
+        }
+    }
+    if joined.len() > 1 {
+        let (first, last) = (joined[0], joined[joined.len() - 1]);
+        if length(last.1, first.0 + n) < gap {
+            joined[0] = (last.0, first.1 + n);
+            joined.pop();
+        }
+    }
+    if joined.len() == 1 && length(joined[0].1, joined[0].0 + n) < gap {
+        return RingRuns::Whole;
+    }
+    RingRuns::Runs { first_air, runs: joined }
 }
 
 /// The last of `levels` (the erosions of `region` by 0, ae, 2 ae, ...)
