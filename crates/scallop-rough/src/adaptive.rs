@@ -58,8 +58,8 @@ struct Planner<'a> {
     squares: Squares,
     /// The region grown a hair: links must stay in it.
     holder: Region,
-    /// The holder's rings as the chords its segment test clips by, for
-    /// that test's quick accept ([`Planner::in_holder`]).
+    /// The holder's rings as chords, for its segment test
+    /// ([`Planner::in_holder`]).
     fence: Edges,
     /// The region's boundary as chords, for the walk's exact wall test.
     edges: Edges,
@@ -605,11 +605,17 @@ impl Planner<'_> {
     /// lies inside the holder's chords and the segment keeps farther than
     /// twice the tolerance (and a micrometre) from every chord (then the
     /// exact rings, within the tolerance of the chords, hold it too, and
-    /// clipping by the chords leaves nothing outside); else by that test.
+    /// clipping by the chords leaves nothing outside); else by that test's
+    /// rule on the chords near the segment ([`Edges::keeps_inside`]).
     fn in_holder(&self, a: P2, b: P2) -> bool {
         let chord = self.options.chord_tolerance;
         let margin = 2.0 * chord + 1e-3;
-        (self.fence.contains(a) && self.fence.clear_of(a, b, margin)) || self.holder.contains_segment(a, b, chord)
+        if self.fence.contains(a) && self.fence.clear_of(a, b, margin) {
+            return true;
+        }
+        self.holder.contains(a)
+            && self.holder.contains(b)
+            && self.fence.keeps_inside(a, b, scallop_contour::tol::LINK_SLACK)
     }
 
     /// Stamps the move `a`-`b` on the swept field (R and two cells about

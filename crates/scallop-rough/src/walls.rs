@@ -118,6 +118,80 @@ impl Edges {
 }
 
 impl Edges {
+    /// Whether the segment `a`-`b` keeps inside the chords but for pieces
+    /// of at most `slack` (mm) each (a wall touched or run along counts as
+    /// inside): the test of `Region::contains_segment` on these chords
+    /// without its ends' test, done on the walls near the segment instead
+    /// of by clipping it by every ring. The segment is cut where it meets a
+    /// wall (a crossing, a touch, the ends of a stretch along one), and each
+    /// piece is classed by its middle.
+    pub fn keeps_inside(&self, a: P2, b: P2, slack: f64) -> bool {
+        let d = [b[0] - a[0], b[1] - a[1]];
+        let l2 = d[0] * d[0] + d[1] * d[1];
+        if l2 <= slack * slack {
+            return true;
+        }
+        let cross = |u: P2, v: P2| u[0] * v[1] - u[1] * v[0];
+        let along = |p: P2| ((p[0] - a[0]) * d[0] + (p[1] - a[1]) * d[1]) / l2;
+        let mut cuts = vec![0.0, 1.0];
+        for (p, q) in self.walls_near(a, b, ON_WALL) {
+            // A wall that touches the segment or runs along it.
+            let near = |x: P2, s: P2, t: P2| seg_dist2(x, s, t) <= ON_WALL * ON_WALL;
+            let (pn, qn) = (near(p, a, b), near(q, a, b));
+            if pn {
+                cuts.push(along(p));
+            }
+            if qn {
+                cuts.push(along(q));
+            }
+            if near(a, p, q) {
+                cuts.push(0.0);
+            }
+            if near(b, p, q) {
+                cuts.push(1.0);
+            }
+            if pn || qn {
+                continue;
+            }
+            let e = [q[0] - p[0], q[1] - p[1]];
+            let den = cross(d, e);
+            if den == 0.0 {
+                continue;
+            }
+            let ap = [p[0] - a[0], p[1] - a[1]];
+            let (t, u) = (cross(ap, e) / den, cross(ap, d) / den);
+            if (0.0..=1.0).contains(&t) && (0.0..=1.0).contains(&u) {
+                cuts.push(t);
+            }
+        }
+        cuts.iter_mut().for_each(|t| *t = t.clamp(0.0, 1.0));
+        cuts.sort_by(f64::total_cmp);
+        cuts.dedup();
+        let length = l2.sqrt();
+        let mut out = 0.0;
+        for w in cuts.windows(2) {
+            let piece = (w[1] - w[0]) * length;
+            let t = 0.5 * (w[0] + w[1]);
+            let m = [a[0] + t * d[0], a[1] + t * d[1]];
+            let on_wall = || self.walls_near(m, m, ON_WALL).any(|(p, q)| seg_dist2(m, p, q) <= ON_WALL * ON_WALL);
+            if self.contains(m) || on_wall() {
+                out = 0.0;
+            } else {
+                out += piece;
+                if out > slack {
+                    return false;
+                }
+            }
+        }
+        true
+    }
+}
+
+/// How near (mm) a point is to a wall to lie on it, for
+/// [`Edges::keeps_inside`]: the rounding of coordinates of 100 mm.
+const ON_WALL: f64 = 1e-9;
+
+impl Edges {
     /// Whether every chord is farther than `margin` from the segment `a`-`b`.
     pub fn clear_of(&self, a: P2, b: P2, margin: f64) -> bool {
         let m2 = margin * margin;
@@ -169,6 +243,69 @@ mod tests {
                 prop_assert!(region.contains_segment(a, b, tolerance));
             }
         }
+    }
+
+    /// A point on one of the chords of `e` (`k` picks the chord, `t` the
+    /// place along it).
+    fn on_chord(e: &Edges, k: usize, t: f64) -> P2 {
+        let (p, q) = e.segs[k % e.segs.len()];
+        [p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])]
+    }
+
+    proptest! {
+        /// The chords' segment test equals the clipping test of
+        /// `Region::contains_segment` (with its ends' test) on segments
+        /// anywhere, from a wall and between two walls, where the segment
+        /// does not hug a wall; a segment along a wall is inside (the
+        /// clipping test, which rounds both to its integer grid, finds a
+        /// sliver of it outside as often as not).
+        #[test]
+        fn keeps_inside_is_the_clipping_test(
+            a in (-3.0..23.0f64, -3.0..23.0f64),
+            b in (-3.0..23.0f64, -3.0..23.0f64),
+            k in 0usize..10_000,
+            j in 0usize..10_000,
+            t in 0.0..1.0f64,
+            u in 0.0..1.0f64,
+            kind in 0usize..4,
+        ) {
+            let region = grown();
+            let tolerance = 1e-3;
+            let e = Edges::new(&region, tolerance, 0.7);
+            let slack = scallop_contour::tol::LINK_SLACK;
+            let (a, b) = match kind {
+                0 => ([a.0, a.1], [b.0, b.1]),
+                1 => (on_chord(&e, k, t), [b.0, b.1]),
+                2 => (on_chord(&e, k, t), on_chord(&e, j, u)),
+                _ => {
+                    prop_assert!(e.keeps_inside(on_chord(&e, k, t), on_chord(&e, k, u), slack));
+                    return Ok(());
+                }
+            };
+            // The clipping test rounds to its integer grid: where the
+            // segment's middle hugs a wall (within 1e-5 mm), it is noise.
+            let m = [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])];
+            prop_assume!(e.segs.iter().all(|&(p, q)| seg_dist2(m, p, q) > 1e-10));
+            let chords = region.contains(a) && region.contains(b) && e.keeps_inside(a, b, slack);
+            prop_assert_eq!(chords, region.contains_segment(a, b, tolerance), "{:?} {:?}", a, b);
+        }
+    }
+
+    #[test]
+    fn keeps_inside_along_and_across_walls() {
+        let outer = vec![[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [0.0, 10.0]];
+        let hole = vec![[4.0, 4.0], [4.0, 6.0], [6.0, 6.0], [6.0, 4.0]];
+        let region = Region::from_polygons(&[outer, hole], false);
+        let e = Edges::new(&region, 1e-3, 0.7);
+        // Along the outer wall, along the hole's side, touching its corner.
+        assert!(e.keeps_inside([0.0, 0.0], [10.0, 0.0], 1e-6));
+        assert!(e.keeps_inside([4.0, 3.0], [4.0, 7.0], 1e-6));
+        assert!(e.keeps_inside([3.5, 4.5], [4.5, 3.5], 1e-6));
+        // Across the hole, out of the square and back, out by a hair.
+        assert!(!e.keeps_inside([3.0, 5.0], [7.0, 5.0], 1e-6));
+        assert!(!e.keeps_inside([9.0, 1.0], [9.0, -1.0], 1e-6));
+        assert!(!e.keeps_inside([9.0, 9.0], [10.0 + 1e-5, 9.5], 1e-6));
+        assert!(e.keeps_inside([9.0, 9.0], [10.0 + 1e-7, 9.5], 1e-6));
     }
 
     #[test]
