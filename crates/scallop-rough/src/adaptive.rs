@@ -37,7 +37,7 @@ use std::collections::BinaryHeap;
 
 use scallop_contour::{Contour, P2, Region, Vertex};
 
-use crate::grid::{BIG, Grid};
+use crate::grid::{BIG, Blocks, Grid};
 use crate::offset::Step;
 use crate::{ClearOptions, Direction, RoughError, tol};
 
@@ -56,6 +56,9 @@ struct Planner<'a> {
     /// What a probe reads in each square of the grid, where it is one
     /// answer ([`Squares`]): forgotten wherever `swept` changes.
     squares: Squares,
+    /// Bounds of the swept field and of `reach` per block of squares, for
+    /// [`Grid::quiet`]: kept as `squares` is.
+    blocks: Blocks,
     /// The region grown a hair: links must stay in it.
     holder: Region,
     /// The holder's rings as chords, for its segment test
@@ -240,6 +243,7 @@ pub fn plan_adaptive_touching(
     let mut planner = Planner {
         swept: vec![BIG; grid.len()],
         squares: Squares::new(grid.len(), grid.nx),
+        blocks: Blocks::new(&grid, &reach),
         reach,
         holder,
         fence,
@@ -322,6 +326,7 @@ pub fn plan_adaptive_touching(
             planner.starts.truncate(saved.2);
             (planner.swept, planner.lattice) = (saved.0, saved.1);
             planner.squares.reset();
+            planner.blocks.reset();
             let g = &planner.grid;
             #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "clamped to the grid")]
             let span = |c: f64, o: f64, n: usize| {
@@ -627,12 +632,13 @@ impl Planner<'_> {
     fn stamp_swept(&mut self, a: P2, b: P2, mut undo: Option<&mut Vec<(usize, f64)>>) {
         let (r, h) = (self.options.tool_radius, self.grid.h);
         let floor = self.grid.settled(r - tol::AIR_RING_CHIP);
-        let squares = &self.squares;
+        let (squares, blocks) = (&self.squares, &self.blocks);
         self.grid.stamp_segment_with(&mut self.swept, a, b, r + 2.0 * h, floor, |k, old| {
             if let Some(u) = undo.as_deref_mut() {
                 u.push((k, old));
             }
             squares.lowered(k, old, r);
+            blocks.lowered(k, old, r - tol::AIR_RING_CHIP);
         });
     }
 
@@ -640,14 +646,18 @@ impl Planner<'_> {
     /// cell (the bore's).
     fn stamp_full(&mut self, a: P2, b: P2, w: f64) {
         let r = self.options.tool_radius;
-        let squares = &self.squares;
-        self.grid.stamp_segment_with(&mut self.swept, a, b, w, f64::NEG_INFINITY, |k, old| squares.lowered(k, old, r));
+        let (squares, blocks) = (&self.squares, &self.blocks);
+        self.grid.stamp_segment_with(&mut self.swept, a, b, w, f64::NEG_INFINITY, |k, old| {
+            squares.lowered(k, old, r);
+            blocks.lowered(k, old, r - tol::AIR_RING_CHIP);
+        });
     }
 
     /// Sets cell `k` of the swept field back to `v` (undoing a stamp).
     fn restore_swept(&mut self, k: usize, v: f64) {
         self.swept[k] = v;
         self.squares.changed(k);
+        self.blocks.changed(k);
     }
 
     /// The fields a probe reads ([`squares::probe`]).
@@ -948,7 +958,7 @@ impl Planner<'_> {
             d >= inner && d <= outer
         };
         let bounds = ([p[0] - outer, p[1] - outer], [p[0] + outer, p[1] + outer]);
-        self.grid.quiet(&self.swept, &self.reach, bounds, ring, r, r)
+        self.grid.quiet(&self.swept, &self.reach, bounds, ring, r, r, Some(&self.blocks))
     }
 
     /// The direction (rad) from `p` towards the level's material when the

@@ -8,6 +8,7 @@
 //! Samples sit at the cells' centres; `BIG` stands for "far" (unreached,
 //! outside the stamping radius) and keeps the arithmetic finite.
 
+use std::cell::Cell;
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
@@ -25,6 +26,101 @@ const QUIET_MARGIN: f64 = 1e-9;
 /// The largest field values (mm) [`Grid::quiet`] compares by their
 /// difference (rounding about 1e-13 mm).
 const QUIET_VALUES: f64 = 1e3;
+
+/// Side (squares) of the blocks of [`Blocks`].
+const BLOCK: usize = 8;
+
+/// Bounds per block of `BLOCK` x `BLOCK` squares (a square is the four
+/// cell centres a bilinear sample reads, named by its lower-left cell) for
+/// [`Grid::quiet`]: the largest swept distance over the block's
+/// cells (every corner of its squares) and the least distance from the
+/// region. The region's field never changes; the swept one goes down as
+/// the tool moves and up when a stamp is undone, so its bound is kept
+/// lazily: a change marks the blocks of the cell stale ([`Blocks::lowered`],
+/// [`Blocks::changed`]), and a stale bound is recomputed when read. A bound
+/// is never below its block's values: a cell that goes down leaves the old
+/// bound above them, an undo marks it stale.
+pub(crate) struct Blocks {
+    nbx: usize,
+    nx: usize,
+    ny: usize,
+    top: Vec<Cell<f64>>,
+    stale: Vec<Cell<bool>>,
+    least_reach: Vec<f64>,
+}
+
+impl Blocks {
+    /// The bounds of a swept field and of `reach` (fields of `grid`), the
+    /// swept field's all stale.
+    pub fn new(grid: &Grid, reach: &[f64]) -> Blocks {
+        let (nbx, nby) = (grid.nx.div_ceil(BLOCK), grid.ny.div_ceil(BLOCK));
+        let mut blocks = Blocks {
+            nbx,
+            nx: grid.nx,
+            ny: grid.ny,
+            top: vec![Cell::new(BIG); nbx * nby],
+            stale: vec![Cell::new(true); nbx * nby],
+            least_reach: vec![0.0; nbx * nby],
+        };
+        for b in 0..nbx * nby {
+            blocks.least_reach[b] = blocks.cells(b).map(|k| reach[k]).fold(f64::INFINITY, f64::min);
+        }
+        blocks
+    }
+
+    /// The cells of block `b`: the corners of its squares.
+    fn cells(&self, b: usize) -> impl Iterator<Item = usize> + '_ {
+        let (bi, bj) = (b % self.nbx, b / self.nbx);
+        let (i0, j0) = (bi * BLOCK, bj * BLOCK);
+        let (i1, j1) = ((i0 + BLOCK).min(self.nx - 1), (j0 + BLOCK).min(self.ny - 1));
+        (j0..=j1).flat_map(move |j| (i0..=i1).map(move |i| j * self.nx + i))
+    }
+
+    /// The largest value of `swept` over block `b`'s cells, recomputed
+    /// when stale.
+    fn top_swept(&self, b: usize, swept: &[f64]) -> f64 {
+        if self.stale[b].get() {
+            self.top[b].set(self.cells(b).map(|k| swept[k]).fold(f64::NEG_INFINITY, f64::max));
+            self.stale[b].set(false);
+        }
+        self.top[b].get()
+    }
+
+    /// Cell `k` went down from `old`: its blocks' bounds may fall, which
+    /// matters only to the comparisons with thresholds under `old`, none
+    /// under `least` (the bound stays above the values either way).
+    #[inline]
+    pub fn lowered(&self, k: usize, old: f64, least: f64) {
+        if old > least {
+            self.changed(k);
+        }
+    }
+
+    /// Cell `k` changed: the blocks it is a cell of are stale (a cell on a
+    /// block's lower or left side is also its neighbour's upper or right).
+    #[inline]
+    pub fn changed(&self, k: usize) {
+        let (i, j) = (k % self.nx, k / self.nx);
+        let (bi, bj) = (i / BLOCK, j / BLOCK);
+        let left = i % BLOCK == 0 && bi > 0;
+        let below = j % BLOCK == 0 && bj > 0;
+        self.stale[bj * self.nbx + bi].set(true);
+        if left {
+            self.stale[bj * self.nbx + bi - 1].set(true);
+        }
+        if below {
+            self.stale[(bj - 1) * self.nbx + bi].set(true);
+            if left {
+                self.stale[(bj - 1) * self.nbx + bi - 1].set(true);
+            }
+        }
+    }
+
+    /// Every bound of the swept field stale (the field replaced).
+    pub fn reset(&self) {
+        self.stale.iter().for_each(|c| c.set(true));
+    }
+}
 
 /// The grid: `nx * ny` cells of side `h` from `(x0, y0)` (the lower-left corner).
 #[derive(Debug, Clone)]
@@ -123,7 +219,11 @@ impl Grid {
     /// it (along a wall the passes slid on). [`Grid::sample`] is a convex combination of a square's four
     /// values, so it lies within their range up to rounding, far below the
     /// margin; samples off the grid are [`BIG`] in both fields. Exact: `true`
-    /// only when every sample in the box would say "not material".
+    /// only when every sample in the box would say "not material". With
+    /// `blocks` (bounds of these `swept` and `reach`), the blocks of squares
+    /// whose bounds settle every square in them are skipped: the same
+    /// answer.
+    #[allow(clippy::too_many_arguments, reason = "the fields, the box, the thresholds and the blocks")]
     pub fn quiet(
         &self,
         swept: &[f64],
@@ -132,6 +232,7 @@ impl Grid {
         relevant: impl Fn(P2) -> bool,
         swept_max: f64,
         reach_min: f64,
+        blocks: Option<&Blocks>,
     ) -> bool {
         let (smax, rmin) = (swept_max - QUIET_MARGIN, reach_min + QUIET_MARGIN);
         let gap = swept_max - reach_min - QUIET_MARGIN;
@@ -149,26 +250,38 @@ impl Grid {
             return true;
         };
         let nx = self.nx;
-        for j in j0..=j1 {
-            for i in i0..=i1 {
-                let k = j * nx + i;
-                let (a, b, c, d) = (k, k + 1, k + nx, k + nx + 1);
-                let low = swept[a] <= smax && swept[b] <= smax && swept[c] <= smax && swept[d] <= smax;
-                if low || (reach[a] >= rmin && reach[b] >= rmin && reach[c] >= rmin && reach[d] >= rmin) {
+        let square = |i: usize, j: usize| {
+            let k = j * nx + i;
+            let (a, b, c, d) = (k, k + 1, k + nx, k + nx + 1);
+            let low = swept[a] <= smax && swept[b] <= smax && swept[c] <= smax && swept[d] <= smax;
+            if low || (reach[a] >= rmin && reach[b] >= rmin && reach[c] >= rmin && reach[d] >= rmin) {
+                return true;
+            }
+            // Or `swept - reach` at most `swept_max - reach_min` (less
+            // the margin) at all four: bilinear too, so everywhere in the
+            // square, where `swept > swept_max` then means `reach >
+            // reach_min` (values below `QUIET_VALUES` only, so that the
+            // rounding stays far below the margin).
+            let close = |n: usize| swept[n] < QUIET_VALUES && reach[n] < QUIET_VALUES && swept[n] - reach[n] <= gap;
+            if close(a) && close(b) && close(c) && close(d) {
+                return true;
+            }
+            #[allow(clippy::cast_precision_loss, reason = "grid indices")]
+            let mid = [self.x0 + (i as f64 + 1.0) * self.h, self.y0 + (j as f64 + 1.0) * self.h];
+            !relevant(mid)
+        };
+        let Some(blocks) = blocks else {
+            return (j0..=j1).all(|j| (i0..=i1).all(|i| square(i, j)));
+        };
+        for bj in j0 / BLOCK..=j1 / BLOCK {
+            for bi in i0 / BLOCK..=i1 / BLOCK {
+                let b = bj * blocks.nbx + bi;
+                if blocks.least_reach[b] >= rmin || blocks.top_swept(b, swept) <= smax {
                     continue;
                 }
-                // Or `swept - reach` at most `swept_max - reach_min` (less
-                // the margin) at all four: bilinear too, so everywhere in the
-                // square, where `swept > swept_max` then means `reach >
-                // reach_min` (values below `QUIET_VALUES` only, so that the
-                // rounding stays far below the margin).
-                let close = |n: usize| swept[n] < QUIET_VALUES && reach[n] < QUIET_VALUES && swept[n] - reach[n] <= gap;
-                if close(a) && close(b) && close(c) && close(d) {
-                    continue;
-                }
-                #[allow(clippy::cast_precision_loss, reason = "grid indices")]
-                let mid = [self.x0 + (i as f64 + 1.0) * self.h, self.y0 + (j as f64 + 1.0) * self.h];
-                if relevant(mid) {
+                let (ja, jb) = (j0.max(bj * BLOCK), j1.min(bj * BLOCK + BLOCK - 1));
+                let (ia, ib) = (i0.max(bi * BLOCK), i1.min(bi * BLOCK + BLOCK - 1));
+                if !(ja..=jb).all(|j| (ia..=ib).all(|i| square(i, j))) {
                     return false;
                 }
             }
@@ -388,7 +501,7 @@ mod tests {
                 .collect();
             let reach: Vec<f64> = (0..g.len()).map(|k| (g.centre(k)[0] - w.0).abs() + 0.3 * (g.centre(k)[1] - w.1)).collect();
             let (lo, hi) = ([centre.0 - half, centre.1 - half], [centre.0 + half, centre.1 + half]);
-            if g.quiet(&swept, &reach, (lo, hi), |_| true, t, t) {
+            if g.quiet(&swept, &reach, (lo, hi), |_| true, t, t, None) {
                 for i in 0..=40u32 {
                     for j in 0..=40u32 {
                         let q = [lo[0] + (hi[0] - lo[0]) * f64::from(i) / 40.0, lo[1] + (hi[1] - lo[1]) * f64::from(j) / 40.0];
@@ -397,6 +510,67 @@ mod tests {
                     }
                 }
             }
+        }
+    }
+
+    proptest! {
+        /// [`Grid::quiet`] with blocks answers as without them on a swept
+        /// field a walk stamps (the blocks told of each lowered cell) and
+        /// partly undoes (told of each restored one), then resets: boxes
+        /// anywhere, thresholds about R, a region field with a wall.
+        #[test]
+        fn blocks_answer_as_the_squares(
+            start in (1.0..5.0f64, 1.0..5.0f64), turns in proptest::collection::vec(-0.8..0.8f64, 1..40),
+            len in 0.05..0.5f64, r in 0.4..1.2f64, undo_from in 0usize..40, wall in 0.5..5.5f64,
+            boxes in proptest::collection::vec((0.0..6.0f64, 0.0..6.0f64, 0.05..2.5f64, -0.01..0.01f64), 12),
+        ) {
+            let g = Grid::new([0.0, 0.0], [6.0, 6.0], 1.0, 0.09).expect("grid");
+            let reach: Vec<f64> = (0..g.len()).map(|k| (g.centre(k)[0] - wall).max(0.0)).collect();
+            let blocks = Blocks::new(&g, &reach);
+            let mut swept = vec![BIG; g.len()];
+            // Boxes anywhere and about the walk's points.
+            let mut around = boxes.clone();
+            let mut q = [start.0, start.1];
+            let mut h0 = 0.0f64;
+            for (n, t) in turns.iter().enumerate() {
+                h0 += t;
+                q = [q[0] + len * h0.cos(), q[1] + len * h0.sin()];
+                if n % 3 == 0 {
+                    around.push((q[0], q[1], 0.3 + 0.1 * (n % 7) as f64, 0.0));
+                }
+            }
+            let check = |swept: &[f64]| -> Result<(), TestCaseError> {
+                for &(x, y, half, dt) in &around {
+                    let bounds = ([x - half, y - half], [x + half, y + half]);
+                    let ring = |m: P2| (m[0] - x).hypot(m[1] - y) >= 0.3 * half;
+                    let want = g.quiet(swept, &reach, bounds, ring, r + dt, r - dt, None);
+                    prop_assert_eq!(g.quiet(swept, &reach, bounds, ring, r + dt, r - dt, Some(&blocks)), want);
+                }
+                Ok(())
+            };
+            check(&swept)?;
+            let (mut p, mut heading) = ([start.0, start.1], 0.0f64);
+            let mut undo = Vec::new();
+            for (n, t) in turns.iter().enumerate() {
+                heading += t;
+                let q = [p[0] + len * heading.cos(), p[1] + len * heading.sin()];
+                g.stamp_segment_with(&mut swept, p, q, r + 2.0 * g.h, f64::NEG_INFINITY, |k, old| {
+                    if n >= undo_from {
+                        undo.push((k, old));
+                    }
+                    blocks.lowered(k, old, r - 0.02);
+                });
+                p = q;
+            }
+            check(&swept)?;
+            for &(k, old) in undo.iter().rev() {
+                swept[k] = old;
+                blocks.changed(k);
+            }
+            check(&swept)?;
+            swept = vec![BIG; g.len()];
+            blocks.reset();
+            check(&swept)?;
         }
     }
 
@@ -449,16 +623,16 @@ mod tests {
         // Cleared (swept within 0.5) left of x = 2, material right of it.
         let swept: Vec<f64> = (0..g.len()).map(|k| if g.centre(k)[0] < 2.0 { 0.5 } else { BIG }).collect();
         let reach = vec![0.0; g.len()];
-        assert!(g.quiet(&swept, &reach, ([0.5, 0.5], [1.5, 3.5]), |_| true, 1.0, 1.0));
-        assert!(!g.quiet(&swept, &reach, ([1.5, 0.5], [2.5, 3.5]), |_| true, 1.0, 1.0));
+        assert!(g.quiet(&swept, &reach, ([0.5, 0.5], [1.5, 3.5]), |_| true, 1.0, 1.0, None));
+        assert!(!g.quiet(&swept, &reach, ([1.5, 0.5], [2.5, 3.5]), |_| true, 1.0, 1.0, None));
         // The same box, the squares across x = 2 left out as irrelevant.
-        assert!(g.quiet(&swept, &reach, ([1.5, 0.5], [2.5, 3.5]), |m| m[0] < 1.8, 1.0, 1.0));
+        assert!(g.quiet(&swept, &reach, ([1.5, 0.5], [2.5, 3.5]), |m| m[0] < 1.8, 1.0, 1.0, None));
         // Cleared left of x = 2, outside the region right of it: every
         // centre is either swept or out of reach, but samples between the
         // two find material (swept far, reach near): not quiet.
         let reach: Vec<f64> = (0..g.len()).map(|k| if g.centre(k)[0] < 2.0 { 0.0 } else { 2.0 }).collect();
         let boxed = ([1.5, 0.5], [2.5, 3.5]);
-        assert!(!g.quiet(&swept, &reach, boxed, |_| true, 1.0, 1.0));
+        assert!(!g.quiet(&swept, &reach, boxed, |_| true, 1.0, 1.0, None));
         let between = (0..=100).map(|i| [1.9 + 0.002 * f64::from(i), 2.0]);
         assert!(between.into_iter().any(|q| g.sample(&swept, q) > 1.0 && g.sample(&reach, q) < 1.0));
         // Along a wall the passes slid on: swept a little over reach. Within
@@ -472,8 +646,8 @@ mod tests {
             })
         };
         let slid: Vec<f64> = reach.iter().map(|x| x + 0.01).collect();
-        assert!(g.quiet(&slid, &reach, along, |_| true, 1.005, 0.98) && !material(&slid));
+        assert!(g.quiet(&slid, &reach, along, |_| true, 1.005, 0.98, None) && !material(&slid));
         let left: Vec<f64> = reach.iter().map(|x| x + 0.05).collect();
-        assert!(!g.quiet(&left, &reach, along, |_| true, 1.005, 0.98) && material(&left));
+        assert!(!g.quiet(&left, &reach, along, |_| true, 1.005, 0.98, None) && material(&left));
     }
 }

@@ -367,7 +367,7 @@ impl Planner<'_> {
             // than R from the move, no nearer than R to both its ends (the
             // squares' middles, a square's half diagonal either way).
             let near = |m: P2| super::segment_distance(m, p, q) <= reach && dist(m, p).max(dist(m, q)) >= inner;
-            self.grid.quiet(&self.swept, &self.reach, bounds, near, r + LINK_SLACK, r - self.strip)
+            self.grid.quiet(&self.swept, &self.reach, bounds, near, r + LINK_SLACK, r - self.strip, Some(&self.blocks))
         };
         let clear = quiet(a, b) || {
             #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss, reason = "a small positive count")]
