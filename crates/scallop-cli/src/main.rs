@@ -54,9 +54,9 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
-    /// Run the built-in demo: Choi surface, ball cutter, zigzag drop-cutter raster, plain G-code.
+    /// Run the built-in demo: the Choi surface finished by a bull-nose at a guaranteed scallop height, proven on a simulated stock (--raster, --rough: the other demos).
     Demo(output::DemoArgs),
-    /// Run a finishing job from a job file (TOML; see docs/job.md): program, report, toolpath.
+    /// Run a job from a job file (TOML; see docs/job.md): its roughing, rest roughing and finishing operations on one stock, simulated; program, report, toolpath.
     Run(run::RunArgs),
     /// Drop a cutter onto a part on an XY grid and write the cutter locations as CSV.
     Drop(drop::DropArgs),
