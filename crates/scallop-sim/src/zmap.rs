@@ -942,8 +942,14 @@ impl Grid {
         let row0 = band * BAND_ROWS;
         let rows = heights.len() / nx;
         let area = self.cell_x * self.cell_y;
+        let mut out = BandOutput::default();
+        if ids.is_empty() {
+            return out;
+        }
         // Upper bounds of each tile's heights; heights only go down, so a stale
-        // bound stays valid. `dirty` tiles get a fresh one when it matters.
+        // bound stays valid. `dirty` tiles get a fresh one when it matters;
+        // every tile starts so (a band of a short program, as the engagement
+        // measure cuts one move at a time, meets few of its tiles).
         let tiles_per_row = nx.div_ceil(TILE);
         let tile_cells = |tile: usize| {
             let (local, t) = (tile / tiles_per_row, tile % tiles_per_row);
@@ -951,9 +957,8 @@ impl Grid {
         };
         let tile_max =
             |heights: &[f64], tile: usize| heights[tile_cells(tile)].iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        let mut tile_top: Vec<f64> = (0..rows * tiles_per_row).map(|t| tile_max(heights, t)).collect();
-        let mut dirty = vec![false; tile_top.len()];
-        let mut out = BandOutput::default();
+        let mut tile_top = vec![f64::INFINITY; rows * tiles_per_row];
+        let mut dirty = vec![true; tile_top.len()];
         for &k in ids {
             let plan = &plans[k as usize];
             let packed = MoveId { operation, index: plan.id }.pack();
