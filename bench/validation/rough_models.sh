@@ -5,7 +5,8 @@
 # tools are those a machinist would pick for the part's size and narrowest features (the table
 # below). The jobs are written into OUT (they read the meshes by absolute path, so they are not
 # committed) and run with `scallop run JOB -o OUT/NAME --json`; a markdown table of each
-# operation's exit, machine time, planning time, engagement (p99 / max outside entries, target),
+# operation's exit, machine time, planning time, engagement (p99 / max outside entries, target;
+# the largest in entries),
 # slot length, links, and the material left (reachable step height, unreachable volume) goes to
 # OUT/table.md and stdout.
 # Usage: bench/validation/rough_models.sh [OUT] [--reduced]   (reduced: sphere_on_plate, demo)
@@ -51,8 +52,8 @@ if [ -n "${PARTS:-}" ]; then
     CASES="$(printf '%s\n' "$CASES" | grep -E "/($(printf '%s' "$PARTS" | tr ',' '|'))\.(stl|STL)\|")"
 fi
 TABLE="$OUT/table.md"
-echo "| part | pattern | operation | exit | machine time s | plan s | p99 / max deg (target) | slot mm | links % | left: reached max mm, unreachable mm3 |" > "$TABLE"
-echo "|---|---|---|---|---|---|---|---|---|---|" >> "$TABLE"
+echo "| part | pattern | operation | exit | machine time s | plan s | p99 / max deg (target) | entries: max deg | slot mm | links % | left: reached max mm, unreachable mm3 |" > "$TABLE"
+echo "|---|---|---|---|---|---|---|---|---|---|---|" >> "$TABLE"
 while IFS='|' read -r file units rough rest stepover allowance flute box; do
     part="$(basename "$file" | sed 's/\.[sS][tT][lL]$//')"
     read -r rd rs <<< "$rough"
@@ -128,16 +129,17 @@ try:
     r = json.load(open(path))
 except Exception:
     msg = open(err).read().strip().replace("|", "/").replace("\n", " ")[:200]
-    print(f"| {part} | {pattern} | | {code} | | | | | | {msg} |")
+    print(f"| {part} | {pattern} | | {code} | | | | | | | {msg} |")
     sys.exit(0)
 for op in r["operations"]:
     e, left, plan = op.get("engagement"), op.get("left"), op["plan"]
     eng = f"{e['p99_deg']:.1f} / {e['max_deg']:.1f} ({e['target_deg']:.1f})" if e else ""
+    entry = f"{e['entry_max_deg']:.1f}" if e else ""
     slot = f"{e['slot_length_mm']:.1f}" if e else ""
     links = f"{100 * e['link_share']:.1f}" if e else ""
     lf = f"{left['reached_max_mm']:.2f}, {left['unreachable_volume_mm3']:.0f}" if left else ""
     print(f"| {part} | {pattern} | {op['name']} | {code} | {plan['total_time_s']:.1f} | "
-          f"{plan.get('planning_time_s', 0):.1f} | {eng} | {slot} | {links} | {lf} |")
+          f"{plan.get('planning_time_s', 0):.1f} | {eng} | {entry} | {slot} | {links} | {lf} |")
 PY
     done
 done <<< "$CASES"
