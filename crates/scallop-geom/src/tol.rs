@@ -758,6 +758,12 @@ pub mod rough {
     /// planner's margin under the 1.1 bound of docs/roughing.md).
     pub const ENGAGE_ACCEPT: f64 = 1.03;
 
+    /// Adaptive rest roughing: links may leave the rest level's region for
+    /// the level's whole tool-centre region (cleared before) up to this
+    /// share of the tool radius from it (docs/roughing.md, "Adaptive rest
+    /// roughing: links through the level's room").
+    pub const REST_LINK_ROOM_SHARE: f64 = 4.0;
+
     /// Adaptive clearing: points probed on the tool's periphery.
     pub const ENGAGE_PROBES: usize = 180;
 

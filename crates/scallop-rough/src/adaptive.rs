@@ -116,6 +116,16 @@ struct Planner<'a> {
     /// the engagement ([`Planner::front`]) and nothing else, as the strip
     /// along the walls does; with `reach` raised past R outside it.
     touch: Option<(Vec<f64>, Vec<f64>)>,
+    /// Where links may run besides the region ([`plan_adaptive_rest`]).
+    room: Option<Room>,
+}
+
+/// The room of the links ([`plan_adaptive_rest`]): its cells, and as the
+/// region's `holder` and `fence` are.
+struct Room {
+    inside: Vec<bool>,
+    holder: Region,
+    fence: Edges,
 }
 
 /// A place where a pass may start ([`Planner::starts`]).
@@ -191,12 +201,48 @@ pub fn plan_adaptive_touching(
     touched: Option<&Region>,
     options: &ClearOptions,
 ) -> Result<Vec<Step>, RoughError> {
+    plan_adaptive_rest(region, material, touched, None, options)
+}
+
+/// As [`plan_adaptive_touching`], `room` being where links may run besides
+/// `region` (a superset of it): in rest roughing, the level's whole
+/// tool-centre region, cleared by the operations before except where
+/// `material` lies. A link between two pieces of the rest level's region
+/// then goes round the material through it, within
+/// [`tol::REST_LINK_ROOM_SHARE`] R of the region, tool down, where it had to
+/// retract (docs/roughing.md, "Adaptive rest roughing: links through the
+/// level's room").
+///
+/// # Errors
+/// As [`plan_adaptive`].
+pub fn plan_adaptive_rest(
+    region: &Region,
+    material: Option<&Region>,
+    touched: Option<&Region>,
+    room: Option<&Region>,
+    options: &ClearOptions,
+) -> Result<Vec<Step>, RoughError> {
     let r = options.tool_radius;
-    let Some((lo, hi)) = region.bounds() else { return Ok(Vec::new()) };
+    let Some((mut lo, mut hi)) = region.bounds() else { return Ok(Vec::new()) };
+    // The room near the region (links go no farther).
+    let room = room.filter(|_| material.is_some()).map(|room| {
+        let m = tol::REST_LINK_ROOM_SHARE * r;
+        (lo, hi) = ([lo[0] - m, lo[1] - m], [hi[0] + m, hi[1] + m]);
+        let rect = Region::from_polygons(&[vec![lo, [hi[0], lo[1]], hi, [lo[0], hi[1]]]], false);
+        room.intersection(&rect, options.chord_tolerance).union(region, options.chord_tolerance)
+    });
     let grid = Grid::new(lo, hi, r + 4.0 * r * tol::GRID_SHARE, r * tol::GRID_SHARE)?;
     let h = grid.h;
     let fill_tolerance = (0.25 * h).min(options.chord_tolerance.max(1e-4));
     let inside = grid.fill(region, fill_tolerance);
+    let room = room.map(|room| {
+        let holder = room.offset(-tol::LINK_GROW);
+        Room {
+            inside: grid.fill(&room, fill_tolerance),
+            fence: Edges::new(&holder, options.chord_tolerance, 8.0 * h),
+            holder,
+        }
+    });
     let mut reach: Vec<f64> = inside.iter().map(|&i| if i { 0.0 } else { BIG }).collect();
     for ring in region.rings() {
         let pts = ring.to_points(0.25 * h);
@@ -266,6 +312,7 @@ pub fn plan_adaptive_touching(
         strip: tol::WALK_WALL_STRIP_SHARE * r,
         open: outside,
         touch,
+        room,
     };
     if !planner.edges.contains(s) {
         return Ok(rings_only(region, options));
@@ -621,6 +668,21 @@ impl Planner<'_> {
         self.holder.contains(a)
             && self.holder.contains(b)
             && self.fence.keeps_inside(a, b, scallop_contour::tol::LINK_SLACK)
+    }
+
+    /// As [`Planner::in_holder`], in the links' room when there is one
+    /// ([`plan_adaptive_rest`]).
+    fn in_room(&self, a: P2, b: P2) -> bool {
+        let Some(room) = &self.room else { return self.in_holder(a, b) };
+        let chord = self.options.chord_tolerance;
+        let margin = 2.0 * chord + 1e-3;
+        (room.fence.contains(a) && room.fence.clear_of(a, b, margin)) || room.holder.contains_segment(a, b, chord)
+    }
+
+    /// Whether a link may pass through cell `k` (in the region, or in the
+    /// links' room when there is one).
+    fn link_cell(&self, k: usize) -> bool {
+        self.room.as_ref().map_or(self.inside[k], |room| room.inside[k])
     }
 
     /// Stamps the move `a`-`b` on the swept field (R and two cells about

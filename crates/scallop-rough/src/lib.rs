@@ -27,7 +27,7 @@ mod offset;
 pub use scallop_geom::tol::rough as tol;
 mod walls;
 
-pub use adaptive::{plan_adaptive, plan_adaptive_in, plan_adaptive_touching};
+pub use adaptive::{plan_adaptive, plan_adaptive_in, plan_adaptive_rest, plan_adaptive_touching};
 pub use material::{MaterialMap, limit_to_material, material_met, removable_material};
 pub use offset::{Step, plan_offset, plan_offset_in};
 
@@ -499,7 +499,9 @@ fn build_tree(
     let planned: Result<Vec<Vec<Step>>, RoughError> = shells
         .par_iter()
         .map(|(k, region)| match (&touched[*k], options.pattern) {
-            (Some(t), Pattern::Adaptive) => plan_adaptive_touching(region, Some(&materials[*k]), Some(t), options),
+            (Some(t), Pattern::Adaptive) => {
+                plan_adaptive_rest(region, Some(&materials[*k]), Some(t), rooms[*k].as_ref(), options)
+            }
             _ => plan_region_in(region, Some(&materials[*k]), rooms[*k].as_ref(), options),
         })
         .collect();

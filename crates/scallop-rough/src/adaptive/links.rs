@@ -75,7 +75,7 @@ impl Planner<'_> {
             CLEAR => true,
             e if e == self.epoch => false,
             _ => {
-                let ok = self.inside[k] && self.clear_at(self.grid.centre(k));
+                let ok = self.link_cell(k) && self.clear_at(self.grid.centre(k));
                 self.lattice[k] = if ok { CLEAR } else { self.epoch };
                 ok
             }
@@ -151,7 +151,7 @@ impl Planner<'_> {
             let c = self.grid.centre(k);
             let g = best.get(&k).map_or(BIG, |b| b.0);
             // An end across a wall does not count as a try.
-            if dist(c, to) <= near.max(2.0 * step) && self.in_holder(c, to) {
+            if dist(c, to) <= near.max(2.0 * step) && self.in_room(c, to) {
                 goals += 1;
                 if self.link_ok(c, to, to) {
                     let mut nodes = vec![c];
@@ -383,7 +383,7 @@ impl Planner<'_> {
                     || (first..=last).all(|i| self.clear_at(at(i)) || engaged_ok(at(i)))
             })
         };
-        clear && self.in_holder(a, b)
+        clear && self.in_room(a, b)
     }
 
     /// Whether the chord `a` to `b` of a link's arc may be cut: in the
