@@ -660,23 +660,26 @@ impl Planner<'_> {
     /// clipping by the chords leaves nothing outside); else by that test's
     /// rule on the chords near the segment ([`Edges::keeps_inside`]).
     fn in_holder(&self, a: P2, b: P2) -> bool {
-        let chord = self.options.chord_tolerance;
-        let margin = 2.0 * chord + 1e-3;
-        if self.fence.contains(a) && self.fence.clear_of(a, b, margin) {
-            return true;
-        }
-        self.holder.contains(a)
-            && self.holder.contains(b)
-            && self.fence.keeps_inside(a, b, scallop_contour::tol::LINK_SLACK)
+        self.holds(&self.holder, &self.fence, a, b)
     }
 
     /// As [`Planner::in_holder`], in the links' room when there is one
     /// ([`plan_adaptive_rest`]).
     fn in_room(&self, a: P2, b: P2) -> bool {
-        let Some(room) = &self.room else { return self.in_holder(a, b) };
-        let chord = self.options.chord_tolerance;
-        let margin = 2.0 * chord + 1e-3;
-        (room.fence.contains(a) && room.fence.clear_of(a, b, margin)) || room.holder.contains_segment(a, b, chord)
+        match &self.room {
+            Some(room) => self.holds(&room.holder, &room.fence, a, b),
+            None => self.in_holder(a, b),
+        }
+    }
+
+    /// The test of [`Planner::in_holder`] against `holder` and its chords
+    /// `fence`.
+    fn holds(&self, holder: &Region, fence: &Edges, a: P2, b: P2) -> bool {
+        let margin = 2.0 * self.options.chord_tolerance + 1e-3;
+        if fence.contains(a) && fence.clear_of(a, b, margin) {
+            return true;
+        }
+        holder.contains(a) && holder.contains(b) && fence.keeps_inside(a, b, scallop_contour::tol::LINK_SLACK)
     }
 
     /// Whether a link may pass through cell `k` (in the region, or in the
