@@ -1144,16 +1144,20 @@ impl Planner<'_> {
             // the tool as often, where a U-turn rarely fits).
             #[allow(clippy::cast_precision_loss, reason = "a step count")]
             let long = steps as f64 * step >= tol::WALK_BOTH_WAYS_SHARE * self.options.tool_radius;
-            // Nor that of a pass that ends in a channel narrower than
-            // [`tol::WALK_NARROW_END_SHARE`] R (a crossing of a narrow bar
-            // that slid along its far wall): the pass back would start with a
-            // reversal there, a stop, where no U-turn fits; the link back to
-            // the run's head turns (docs/roughing.md, "Adaptive clearing",
-            // narrow channels).
+            // Nor that of a crossing (its ends closer than
+            // [`tol::WALK_BOTH_WAYS_SHARE`] R) that ends in a channel
+            // narrower than [`tol::WALK_NARROW_END_SHARE`] R (a crossing of a
+            // narrow bar that slid along its far wall): the pass back would
+            // start with a reversal there, a stop, where no U-turn fits; the
+            // link back to the run's head turns (docs/roughing.md, "Adaptive
+            // clearing", "Both ways"). A pass along a narrow band (a rest
+            // level's) is still followed back.
+            let crossing = walked.len() >= 2
+                && dist(walked[0], walked[walked.len() - 1]) < tol::WALK_BOTH_WAYS_SHARE * self.options.tool_radius;
             let tail = self.options.direction == Direction::Both
                 && progress
                 && long
-                && !self.narrow_at(&walked, tol::WALK_NARROW_END_SHARE * self.options.tool_radius);
+                && !(crossing && self.narrow_at(&walked, tol::WALK_NARROW_END_SHARE * self.options.tool_radius));
             #[allow(clippy::cast_possible_truncation, reason = "passes are bounded by MAX_PASSES")]
             let pass_no = passes as u32;
             if steps >= tol::WALK_RESTART_STEPS && progress {
