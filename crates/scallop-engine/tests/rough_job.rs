@@ -337,8 +337,11 @@ fn adaptive_rest_on_slopes_cuts_no_ring_in_the_air() {
     let e = rest.engagement.as_ref().unwrap();
     // With every ring and corner arc cut whole: 62 % of the length at depth
     // in links, 119.6 s; with the stretches only 37 %, 100.3 s, the same
-    // material left (0.633 mm reached, 45.86 mm3).
-    assert!(e.link_share < 0.45, "{e:?}");
+    // material left (0.633 mm reached, 45.86 mm3). Since the links turn on
+    // the smallest arc that fits (docs/roughing.md, "Adaptive clearing",
+    // step 7): 46 %, 85.9 s, 65 retracts for 81 (links found where there
+    // were retracts).
+    assert!(e.link_share < 0.5, "{e:?}");
     assert!(rest.plan.total_time_s < 110.0, "{:?}", rest.plan);
     assert!(e.max_deg <= 1.1 * e.target_deg && e.slot_length_mm < 1e-9, "{e:?}");
     let left = rest.left.as_ref().unwrap();

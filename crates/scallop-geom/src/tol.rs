@@ -810,6 +810,13 @@ pub mod rough {
     /// frontier is peeled from its head, as when climbing.
     pub const WALK_BOTH_WAYS_SHARE: f64 = 2.0;
 
+    /// Adaptive clearing both ways: a pass that ends where the region across
+    /// its last step is narrower than this (share of R: a bar 4.5 mm wider
+    /// than a 6 mm tool) is not followed by one back along its frontier
+    /// (the reversal there would stop the tool); its frontier is peeled from
+    /// its head.
+    pub const WALK_NARROW_END_SHARE: f64 = 1.5;
+
     /// Adaptive clearing: a pass of more steps than this may start again
     /// where it started (it made progress there) ...
     pub const WALK_RESTART_STEPS: usize = 4;
@@ -927,11 +934,16 @@ pub mod rough {
 
     /// Adaptive clearing: a tool-down link leaves a pass's end and meets the
     /// next pass's start along arcs of these radii (shares of the tool
-    /// radius, the largest that cuts nothing first), turning away from the
+    /// radius, the smallest that cuts nothing first), turning away from the
     /// material, joined by a common tangent or the link search (a Dubins
     /// path, Dubins 1957, Amer. J. Math. 79(3)): the tool reverses without
     /// stopping, where a jerk-limited controller stops at each reversal.
-    pub const LINK_TURN_SHARES: [f64; 3] = [0.5, 0.3, 0.15];
+    /// The smallest first: under a jerk limit J the speed along an arc of
+    /// radius rho is at most `(J rho^2)^(1/3)`, so a half turn takes at
+    /// least `pi rho^(1/3) / J^(1/3)`, less on a smaller arc, which is also
+    /// shorter (docs/benchmarks.md, "Adaptive clearing: small link turns and
+    /// narrow pass ends, seventeenth session").
+    pub const LINK_TURN_SHARES: [f64; 3] = [0.05, 0.15, 0.5];
 
     /// Adaptive clearing: the first arc of a link from a pass's end leaves
     /// along the pass's last heading, else turned further away from the

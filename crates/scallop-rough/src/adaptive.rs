@@ -1064,10 +1064,17 @@ impl Planner<'_> {
         let step = tol::WALK_STEP_SHARE * self.options.tool_radius;
         #[allow(clippy::cast_precision_loss, reason = "a step count")]
         let short = (run.len() - 1) as f64 * step < width;
+        short && self.narrow_at(run, width)
+    }
+
+    /// Whether the region across the last step of `run`, from its end, is
+    /// narrower than `width` (the lines square to the step leave the region
+    /// within `width` on both sides); `false` for a run of one point.
+    fn narrow_at(&self, run: &[P2], width: f64) -> bool {
         let [.., a, b] = run[..] else { return false };
         let heading = (b[1] - a[1]).atan2(b[0] - a[0]);
         let side = |turn: f64| !self.edges.contains_segment(b, ahead(b, heading + turn, width));
-        short && side(std::f64::consts::FRAC_PI_2) && side(-std::f64::consts::FRAC_PI_2)
+        side(std::f64::consts::FRAC_PI_2) && side(-std::f64::consts::FRAC_PI_2)
     }
 
     /// A pass from `p` along `heading`: its points (the first is `p`), cut
@@ -1218,7 +1225,20 @@ impl Planner<'_> {
             // the tool as often, where a U-turn rarely fits).
             #[allow(clippy::cast_precision_loss, reason = "a step count")]
             let long = steps as f64 * step >= tol::WALK_BOTH_WAYS_SHARE * self.options.tool_radius;
-            let tail = self.options.direction == Direction::Both && progress && long;
+            // Nor that of a crossing (its ends closer than
+            // [`tol::WALK_BOTH_WAYS_SHARE`] R) that ends in a channel
+            // narrower than [`tol::WALK_NARROW_END_SHARE`] R (a crossing of a
+            // narrow bar that slid along its far wall): the pass back would
+            // start with a reversal there, a stop, where no U-turn fits; the
+            // link back to the run's head turns (docs/roughing.md, "Adaptive
+            // clearing", "Both ways"). A pass along a narrow band (a rest
+            // level's) is still followed back.
+            let crossing = walked.len() >= 2
+                && dist(walked[0], walked[walked.len() - 1]) < tol::WALK_BOTH_WAYS_SHARE * self.options.tool_radius;
+            let tail = self.options.direction == Direction::Both
+                && progress
+                && long
+                && !(crossing && self.narrow_at(&walked, tol::WALK_NARROW_END_SHARE * self.options.tool_radius));
             #[allow(clippy::cast_possible_truncation, reason = "passes are bounded by MAX_PASSES")]
             let pass_no = passes as u32;
             if steps >= tol::WALK_RESTART_STEPS && progress {

@@ -201,7 +201,12 @@ fn comb(w: &[f64]) -> Vec<Vec<[f64; 2]>> {
 
 /// The moves of kind `Link` (tool down at cutting depth): a move ending
 /// within 2 R of the link's end (the approach to a cut's start, which may
-/// enter a front at a new point) engages no more than the bound, every other
+/// enter a front at a new point) or within R of its start (the arc turning
+/// away from the last pass's end, which may engage as a pass does,
+/// docs/roughing.md "Adaptive clearing", step 7: since the seventeenth
+/// session the smallest arc that fits is tried first, 0.15 mm for this
+/// tool, and it swings the tool's front past the material the pass stopped
+/// beside) engages no more than the bound, every other
 /// cuts nothing by the simulator's reading. "Nothing" is within the simulator's raster: older
 /// cuts and the walls are cells of `resolution`, so a tool centre at R from
 /// an older one or from a wall may read a sliver up to a cell deep (plus the
@@ -219,7 +224,9 @@ fn check_links(plan: &RoughPlan, report: &EngagementReport) {
         let end = moves[i..].iter().find(|n| n.kind != scallop_toolpath::MoveKind::Link).map_or(m.to, |_| {
             moves[i..].iter().take_while(|n| n.kind == scallop_toolpath::MoveKind::Link).last().map_or(m.to, |n| n.to)
         });
-        let approach = (m.to.x - end.x).hypot(m.to.y - end.y) <= 2.0 * R;
+        let start = moves[..i].iter().rev().find(|n| n.kind != scallop_toolpath::MoveKind::Link).map_or(m.to, |n| n.to);
+        let approach =
+            (m.to.x - end.x).hypot(m.to.y - end.y) <= 2.0 * R || (m.to.x - start.x).hypot(m.to.y - start.y) <= R;
         let phi = report.move_phi[i];
         let limit = if approach { bound } else { air };
         assert!(phi <= limit, "link move {i} to {:?}: {:.1} deg", m.to, phi.to_degrees());
